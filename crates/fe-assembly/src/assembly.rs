@@ -1,0 +1,447 @@
+//! Global assembly of the blocks `A` (u-u), `G` (φ-u) and `B` (φ-φ) of DESIGN.md into sparse
+//! patterns built from the mesh graph, and of the right-hand sides of the symmetric system
+//!
+//! ```text
+//! K [u; φ] = [f; -q],   K = [[A, Gᵀ], [G, -B]]
+//! ```
+//!
+//! Parallel assembly is node-owned: the columns of a node are contiguous (dofs are numbered
+//! node by node), so each node's slice of the value array belongs to one task, which sums the
+//! matching columns of the element matrices of the node's cells. No locks, no atomics, no
+//! triplets. Serial assembly is the classic cell loop that scatters whole element matrices; both
+//! give the same matrices (a test checks it).
+
+use crate::kernels::{coupling_column, dielectric_column, elasticity_column, SimplexGeometry};
+use crate::{AssemblyError, Constraint, Dof, DofMap, Material};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use mesh::{CellKind, Mesh};
+use rayon::prelude::*;
+
+/// How to assemble: a visible choice, not a global setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Parallelism {
+    /// One thread: a loop over cells scattering element matrices.
+    Serial,
+    /// Rayon's pool: node-owned columns, one task per chunk of nodes.
+    #[default]
+    Rayon,
+}
+
+/// The mesh with its materials and dofs: everything needed to assemble.
+pub struct Discretization<'m> {
+    /// The mesh.
+    pub mesh: &'m Mesh,
+    /// The materials, indexed by `cell_material`.
+    pub materials: Vec<Material>,
+    /// Material of each cell.
+    pub cell_material: Vec<usize>,
+    /// The dofs.
+    pub dofs: DofMap,
+    /// Geometry of each cell.
+    pub geometry: Vec<SimplexGeometry>,
+    /// Whether each cell's material is electric.
+    pub cell_electric: Vec<bool>,
+}
+
+/// The assembled blocks of the coupled system (free dofs only).
+pub struct Blocks {
+    /// Elasticity, `n_u x n_u`, SPD once enough displacements are prescribed.
+    pub a: SparseColMat<usize, f64>,
+    /// Coupling, `n_phi x n_u`: `G_{ψ,u} = ∫ (e ε(u)) · ∇ψ`.
+    pub g: SparseColMat<usize, f64>,
+    /// Dielectric, `n_phi x n_phi`, SPD once a potential is prescribed.
+    pub b: SparseColMat<usize, f64>,
+}
+
+impl<'m> Discretization<'m> {
+    /// Sets up the discretisation: `materials` pairs a region name with its material; every
+    /// cell must lie in exactly one of these regions. Only P1 simplices are supported.
+    pub fn new(
+        mesh: &'m Mesh,
+        materials: &[(String, Material)],
+        constraints: &[Constraint],
+    ) -> Result<Self, AssemblyError> {
+        if !matches!(mesh.kind, CellKind::Tri3 | CellKind::Tet4) {
+            return Err(AssemblyError::Input(format!(
+                "{} cells are not supported: the kernels are P1 simplices",
+                mesh.kind.name()
+            )));
+        }
+        let n_cells = mesh.n_cells();
+        let mut cell_material = vec![usize::MAX; n_cells];
+        for (mi, (region, m)) in materials.iter().enumerate() {
+            if m.dim != mesh.dim {
+                return Err(AssemblyError::Input(format!(
+                    "material of region `{region}` is {}D, the mesh is {}D",
+                    m.dim, mesh.dim
+                )));
+            }
+            for &c in mesh.region(region)? {
+                if cell_material[c] != usize::MAX {
+                    return Err(AssemblyError::Input(format!(
+                        "cell {c} lies in region `{region}` and in region `{}`: one material per cell",
+                        materials[cell_material[c]].0
+                    )));
+                }
+                cell_material[c] = mi;
+            }
+        }
+        if let Some(c) = cell_material.iter().position(|&m| m == usize::MAX) {
+            return Err(AssemblyError::Input(format!(
+                "cell {c} has no material (regions given: {})",
+                materials
+                    .iter()
+                    .map(|(r, _)| r.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        let k = mesh.kind.n_nodes();
+        let geometry: Vec<SimplexGeometry> = (0..n_cells)
+            .into_par_iter()
+            .map(|c| {
+                let x: Vec<[f64; 3]> = mesh.cells[c * k..(c + 1) * k]
+                    .iter()
+                    .map(|&v| mesh.points[v])
+                    .collect();
+                SimplexGeometry::new(mesh.dim, &x)
+            })
+            .collect();
+        if let Some(c) = geometry.iter().position(|g| !(g.measure > 0.0)) {
+            return Err(AssemblyError::Mesh(mesh::MeshError::BadCell {
+                cell: c,
+                what: "degenerate or inverted",
+                measure_name: "measure",
+                measure: geometry[c].measure,
+                nodes: mesh.cell(c).to_vec(),
+            }));
+        }
+        let cell_electric: Vec<bool> = cell_material
+            .iter()
+            .map(|&m| materials[m].1.electric)
+            .collect();
+        let mut has_phi = vec![false; mesh.n_nodes()];
+        for (c, cell) in mesh.iter_cells().enumerate() {
+            if cell_electric[c] {
+                for &v in cell {
+                    has_phi[v] = true;
+                }
+            }
+        }
+        let dofs = DofMap::new(mesh, &has_phi, constraints)?;
+        Ok(Discretization {
+            mesh,
+            materials: materials.iter().map(|(_, m)| m.clone()).collect(),
+            cell_material,
+            dofs,
+            geometry,
+            cell_electric,
+        })
+    }
+
+    /// The material of cell `c`.
+    pub fn material(&self, c: usize) -> &Material {
+        &self.materials[self.cell_material[c]]
+    }
+
+    /// Assembles `A`, `G` and `B`.
+    pub fn assemble(&self, par: Parallelism) -> Blocks {
+        let mesh = self.mesh;
+        let d = &self.dofs;
+        let graph_all = mesh.node_graph();
+        let graph_el = mesh.node_graph_where(|c| self.cell_electric[c]);
+        let a = Pattern::new(&graph_all, &ColDofs::U(d), &ColDofs::U(d));
+        let g = Pattern::new(&graph_el, &ColDofs::Phi(d), &ColDofs::U(d));
+        let b = Pattern::new(&graph_el, &ColDofs::Phi(d), &ColDofs::Phi(d));
+        let (mut av, mut gv, mut bv) = (a.zeros(), g.zeros(), b.zeros());
+        match par {
+            Parallelism::Rayon => self.assemble_node_owned(&a, &g, &b, &mut av, &mut gv, &mut bv),
+            Parallelism::Serial => self.assemble_cell_loop(&a, &g, &b, &mut av, &mut gv, &mut bv),
+        }
+        Blocks {
+            a: a.into_matrix(av),
+            g: g.into_matrix(gv),
+            b: b.into_matrix(bv),
+        }
+    }
+
+    fn assemble_node_owned(
+        &self,
+        pa: &Pattern,
+        pg: &Pattern,
+        pb: &Pattern,
+        av: &mut [f64],
+        gv: &mut [f64],
+        bv: &mut [f64],
+    ) {
+        let mesh = self.mesh;
+        let dim = mesh.dim;
+        let nl = dim + 1;
+        let (off, node_cells) = mesh.node_cells();
+        let d = &self.dofs;
+        // per node: its slice of each block's values (its columns are contiguous)
+        let n_nodes = mesh.n_nodes();
+        let a_slices = pa.split_by_node(av, n_nodes, |i| u_cols(d, i));
+        let g_slices = pg.split_by_node(gv, n_nodes, |i| u_cols(d, i));
+        let b_slices = pb.split_by_node(bv, n_nodes, |i| phi_cols(d, i));
+        a_slices
+            .into_par_iter()
+            .zip(g_slices)
+            .zip(b_slices)
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(i, ((a_node, g_node), b_node))| {
+                for &c in &node_cells[off[i]..off[i + 1]] {
+                    let cell = mesh.cell(c);
+                    let a_loc = cell.iter().position(|&v| v == i).unwrap_or(0);
+                    let (m, geo) = (self.material(c), &self.geometry[c]);
+                    for k in 0..dim {
+                        if let Dof::Free(col) = d.u[i * dim + k] {
+                            let colv = elasticity_column(m, geo, nl, a_loc, k);
+                            pa.add_column(a_node.0, a_node.1, col, |add| {
+                                for (b, &vb) in cell.iter().enumerate() {
+                                    for l in 0..dim {
+                                        if let Dof::Free(row) = d.u[vb * dim + l] {
+                                            add(row, colv[b][l]);
+                                        }
+                                    }
+                                }
+                            });
+                            if self.cell_electric[c] {
+                                let colg = coupling_column(m, geo, nl, a_loc, k);
+                                pg.add_column(g_node.0, g_node.1, col, |add| {
+                                    for (b, &vb) in cell.iter().enumerate() {
+                                        if let Dof::Free(row) = d.phi[vb] {
+                                            add(row, colg[b]);
+                                        }
+                                    }
+                                });
+                            }
+                        }
+                    }
+                    if self.cell_electric[c] {
+                        if let Dof::Free(col) = d.phi[i] {
+                            let colb = dielectric_column(m, geo, nl, a_loc);
+                            pb.add_column(b_node.0, b_node.1, col, |add| {
+                                for (b, &vb) in cell.iter().enumerate() {
+                                    if let Dof::Free(row) = d.phi[vb] {
+                                        add(row, colb[b]);
+                                    }
+                                }
+                            });
+                        }
+                    }
+                }
+            });
+    }
+
+    fn assemble_cell_loop(
+        &self,
+        pa: &Pattern,
+        pg: &Pattern,
+        pb: &Pattern,
+        av: &mut [f64],
+        gv: &mut [f64],
+        bv: &mut [f64],
+    ) {
+        let mesh = self.mesh;
+        let dim = mesh.dim;
+        let nl = dim + 1;
+        let d = &self.dofs;
+        for (c, cell) in mesh.iter_cells().enumerate() {
+            let (m, geo) = (self.material(c), &self.geometry[c]);
+            for (a, &va) in cell.iter().enumerate() {
+                for k in 0..dim {
+                    let Dof::Free(col) = d.u[va * dim + k] else {
+                        continue;
+                    };
+                    let colv = elasticity_column(m, geo, nl, a, k);
+                    let colg = coupling_column(m, geo, nl, a, k);
+                    for (b, &vb) in cell.iter().enumerate() {
+                        for l in 0..dim {
+                            if let Dof::Free(row) = d.u[vb * dim + l] {
+                                av[pa.position(row, col)] += colv[b][l];
+                            }
+                        }
+                        if self.cell_electric[c] {
+                            if let Dof::Free(row) = d.phi[vb] {
+                                gv[pg.position(row, col)] += colg[b];
+                            }
+                        }
+                    }
+                }
+                if !self.cell_electric[c] {
+                    continue;
+                }
+                let Dof::Free(col) = d.phi[va] else { continue };
+                let colb = dielectric_column(m, geo, nl, a);
+                for (b, &vb) in cell.iter().enumerate() {
+                    if let Dof::Free(row) = d.phi[vb] {
+                        bv[pb.position(row, col)] += colb[b];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The free column dofs of node `i` in the u field: `(first, count)`.
+fn u_cols(d: &DofMap, i: usize) -> (usize, usize) {
+    let mut first = None;
+    let mut count = 0;
+    for k in 0..d.dim {
+        if let Dof::Free(j) = d.u[i * d.dim + k] {
+            first.get_or_insert(j);
+            count += 1;
+        }
+    }
+    (first.unwrap_or(0), count)
+}
+
+fn phi_cols(d: &DofMap, i: usize) -> (usize, usize) {
+    match d.phi[i] {
+        Dof::Free(j) => (j, 1),
+        _ => (0, 0),
+    }
+}
+
+/// Which field's free dofs index the rows or columns of a block.
+enum ColDofs<'a> {
+    U(&'a DofMap),
+    Phi(&'a DofMap),
+}
+
+impl ColDofs<'_> {
+    fn n(&self) -> usize {
+        match self {
+            ColDofs::U(d) => d.n_u,
+            ColDofs::Phi(d) => d.n_phi,
+        }
+    }
+    fn free_of(&self, node: usize, out: &mut Vec<usize>) {
+        match self {
+            ColDofs::U(d) => {
+                for k in 0..d.dim {
+                    if let Dof::Free(j) = d.u[node * d.dim + k] {
+                        out.push(j);
+                    }
+                }
+            }
+            ColDofs::Phi(d) => {
+                if let Dof::Free(j) = d.phi[node] {
+                    out.push(j);
+                }
+            }
+        }
+    }
+}
+
+/// A compressed-column pattern with sorted rows.
+struct Pattern {
+    nrows: usize,
+    ncols: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+}
+
+impl Pattern {
+    /// Rows of column (node i, dof) = the free row dofs of i's neighbours in `graph`.
+    fn new(graph: &(Vec<usize>, Vec<usize>), rows: &ColDofs<'_>, cols: &ColDofs<'_>) -> Pattern {
+        let (off, nbr) = graph;
+        let n_nodes = off.len() - 1;
+        let mut col_ptr = Vec::with_capacity(cols.n() + 1);
+        col_ptr.push(0);
+        let mut row_idx = Vec::new();
+        let (mut rbuf, mut cbuf) = (Vec::new(), Vec::new());
+        for i in 0..n_nodes {
+            cbuf.clear();
+            cols.free_of(i, &mut cbuf);
+            if cbuf.is_empty() {
+                continue;
+            }
+            rbuf.clear();
+            for &m in &nbr[off[i]..off[i + 1]] {
+                rows.free_of(m, &mut rbuf);
+            }
+            for _ in &cbuf {
+                row_idx.extend_from_slice(&rbuf);
+                col_ptr.push(row_idx.len());
+            }
+        }
+        debug_assert_eq!(col_ptr.len(), cols.n() + 1);
+        Pattern {
+            nrows: rows.n(),
+            ncols: cols.n(),
+            col_ptr,
+            row_idx,
+        }
+    }
+
+    fn zeros(&self) -> Vec<f64> {
+        vec![0.0; self.row_idx.len()]
+    }
+
+    /// Index into the values of entry `(row, col)`; the pattern holds it by construction.
+    fn position(&self, row: usize, col: usize) -> usize {
+        let (s, e) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        s + self.row_idx[s..e]
+            .binary_search(&row)
+            .unwrap_or_else(|_| unreachable!("({row}, {col}) not in pattern"))
+    }
+
+    /// Splits `values` into one slice per node, holding that node's columns `cols(i)`.
+    /// Each slice is returned with the value index it starts at.
+    fn split_by_node<'v>(
+        &self,
+        values: &'v mut [f64],
+        n_nodes: usize,
+        cols: impl Fn(usize) -> (usize, usize),
+    ) -> Vec<(usize, &'v mut [f64])> {
+        let mut out = Vec::with_capacity(n_nodes);
+        let mut rest = values;
+        let mut at = 0;
+        for i in 0..n_nodes {
+            let (first, count) = cols(i);
+            let end = if count == 0 {
+                at
+            } else {
+                self.col_ptr[first + count]
+            };
+            let (head, tail) = rest.split_at_mut(end - at);
+            out.push((at, head));
+            rest = tail;
+            at = end;
+        }
+        out
+    }
+
+    /// Adds into column `col` through `add(row, value)`; `slice` starts at value index `base`.
+    fn add_column(
+        &self,
+        base: usize,
+        slice: &mut [f64],
+        col: usize,
+        fill: impl FnOnce(&mut dyn FnMut(usize, f64)),
+    ) {
+        let (s, e) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        let rows = &self.row_idx[s..e];
+        let vals = &mut slice[s - base..e - base];
+        fill(&mut |row, v| {
+            let p = rows
+                .binary_search(&row)
+                .unwrap_or_else(|_| unreachable!("row {row} not in column {col}"));
+            vals[p] += v;
+        });
+    }
+
+    fn into_matrix(self, values: Vec<f64>) -> SparseColMat<usize, f64> {
+        let sym = SymbolicSparseColMat::new_checked(
+            self.nrows,
+            self.ncols,
+            self.col_ptr,
+            None,
+            self.row_idx,
+        );
+        SparseColMat::new(sym, values)
+    }
+}

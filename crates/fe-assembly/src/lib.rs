@@ -1,0 +1,76 @@
+//! P1 finite elements for static electro-elasticity: materials, element kernels, dof maps,
+//! parallel assembly of the blocks `A`, `G`, `B`, loads, and recovery of stress and electric
+//! displacement.
+//!
+//! # Glossary (signs fixed by DESIGN.md)
+//! - `u`: displacement; `φ` (`phi`): electric potential; `E = -∇φ`.
+//! - Law: `σ = C ε(u) + eᵀ ∇φ`, `D = e ε(u) - β ∇φ` (`C`: elasticity, `e`: piezoelectric
+//!   stress constants, `β` (`beta`): permittivity). Voigt order `[xx, yy, xy]` (2D, plane
+//!   strain) or `[xx, yy, zz, yz, xz, xy]` (3D), engineering shear strains.
+//! - Blocks over free dofs: `A = ∫ Bᵀ C B` (u-u), `G_{ψ,u} = ∫ (e ε(u)) · ∇ψ` (φ-u),
+//!   `B = ∫ ∇Nᵀ β ∇N` (φ-φ). The paper's system is `[[A, Gᵀ], [-G, B]] [u; φ] = [f; q]`;
+//!   negating the electric rows gives the symmetric quasi-definite
+//!   `K = [[A, Gᵀ], [G, -B]]` with right-hand side `[f; -q]`, which is what
+//!   [`Discretization::rhs`] returns.
+//! - Loads: body force `f0`, traction `f2 = σ n`, body charge `q0` (the paper's `div D = q0`),
+//!   surface charge `q2 = D · n`.
+//! - Units: those of the scene (scaled scenes: m, GPa, C/m², nF/m, so φ is in GV).
+//!
+//! # Example
+//! ```
+//! use fe_assembly::{Constraint, Crystal, Discretization, Field, Load, Material, Parallelism};
+//! use std::sync::Arc;
+//! let mesh = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 8, 4);
+//! let pzt = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
+//! let mut bcs = vec![];
+//! for side in ["left", "right"] {
+//!     bcs.push(Constraint::constant(side, Field::Displacement(0), 0.0));
+//!     bcs.push(Constraint::constant(side, Field::Displacement(1), 0.0));
+//!     bcs.push(Constraint::constant(side, Field::Potential, 0.0));
+//! }
+//! let disc = Discretization::new(&mesh, &[("body".into(), pzt)], &bcs).unwrap();
+//! let blocks = disc.assemble(Parallelism::Rayon);
+//! let load = Load::Traction { group: "top".into(), value: Arc::new(|_| [0.0, -2.0, 0.0]) };
+//! let (b_u, b_phi) = disc.rhs(&[load]).unwrap();
+//! assert_eq!(blocks.a.nrows(), disc.dofs.n_u);
+//! assert_eq!(blocks.g.nrows(), disc.dofs.n_phi);
+//! // the total vertical load is p times the length of the top face, less what the clamped
+//! // corners take
+//! let total: f64 = b_u.iter().skip(1).step_by(2).sum();
+//! assert!((total - (-2.0 * 2.0 * 7.0 / 8.0)).abs() < 1e-12);
+//! assert!(b_phi.iter().all(|&q| q == 0.0));
+//! ```
+
+mod assembly;
+mod dofs;
+pub mod kernels;
+mod loads;
+mod material;
+mod recovery;
+
+pub use assembly::{Blocks, Discretization, Parallelism};
+pub use dofs::{Constraint, Dof, DofMap, Field};
+pub use loads::{facet_measure, Load};
+pub use material::{Crystal, Material, MaterialError};
+pub use recovery::CellFields;
+
+use std::sync::Arc;
+
+/// A scalar function of position (its argument holds `dim` coordinates).
+pub type ScalarFn = Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>;
+/// A vector function of position (`dim` meaningful components of the result).
+pub type VectorFn = Arc<dyn Fn(&[f64]) -> [f64; 3] + Send + Sync>;
+
+/// What can go wrong while setting up or assembling.
+#[derive(Debug, thiserror::Error)]
+pub enum AssemblyError {
+    /// A mesh problem (a missing group, a bad cell).
+    #[error(transparent)]
+    Mesh(#[from] mesh::MeshError),
+    /// A material problem.
+    #[error(transparent)]
+    Material(#[from] MaterialError),
+    /// Inconsistent input (materials, conditions, loads), with a message naming the item.
+    #[error("{0}")]
+    Input(String),
+}

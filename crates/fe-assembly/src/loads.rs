@@ -1,0 +1,249 @@
+//! Right-hand sides of `K [u; φ] = [f; -q]` (DESIGN.md):
+//!
+//! - `f_v = ∫_Ω f0 · v dx + ∫_Γ2 f2 · v ds`           (body force, traction),
+//! - `q_ψ = ∫_Ω q0 ψ dx - ∫_Γb q2 ψ ds`              (the paper's (3) `div D = q0`, and `D·n = q2`),
+//!
+//! minus the columns of `K` of the prescribed dofs times their values (Dirichlet lifting).
+//! Integrals use rules exact for quadratics (degree 2), enough for O(h²) in L2 with P1.
+
+use crate::kernels::{coupling_column, coupling_row, dielectric_column, elasticity_column};
+use crate::{AssemblyError, Discretization, Dof, ScalarFn, VectorFn};
+
+/// A load on the body or on a boundary group.
+#[derive(Clone)]
+pub enum Load {
+    /// Body force `f0(x)` per unit volume.
+    BodyForce(VectorFn),
+    /// Body charge `q0(x)` in the paper's sign (`div D = q0`).
+    BodyCharge(ScalarFn),
+    /// Traction `f2(x) = σ n` on a boundary group.
+    Traction {
+        /// Boundary group.
+        group: String,
+        /// The traction vector at a point.
+        value: VectorFn,
+    },
+    /// Surface charge `q2(x) = D · n` on a boundary group.
+    SurfaceCharge {
+        /// Boundary group.
+        group: String,
+        /// The charge density at a point.
+        value: ScalarFn,
+    },
+}
+
+impl std::fmt::Debug for Load {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Load::BodyForce(_) => write!(f, "BodyForce"),
+            Load::BodyCharge(_) => write!(f, "BodyCharge"),
+            Load::Traction { group, .. } => write!(f, "Traction on `{group}`"),
+            Load::SurfaceCharge { group, .. } => write!(f, "SurfaceCharge on `{group}`"),
+        }
+    }
+}
+
+/// Barycentric quadrature on a simplex of dimension `dim`, degree 2: `(weights, points)`,
+/// weights summing to 1 (multiply by the measure).
+fn simplex_rule(dim: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
+    match dim {
+        1 => {
+            let s = 0.5 / 3f64.sqrt();
+            (
+                vec![0.5, 0.5],
+                vec![[0.5 - s, 0.5 + s, 0.0, 0.0], [0.5 + s, 0.5 - s, 0.0, 0.0]],
+            )
+        }
+        2 => {
+            let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
+            (
+                vec![1.0 / 3.0; 3],
+                vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]],
+            )
+        }
+        _ => {
+            let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
+            (
+                vec![0.25; 4],
+                vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
+            )
+        }
+    }
+}
+
+/// Measure of a facet (segment length or triangle area).
+pub fn facet_measure(x: &[[f64; 3]]) -> f64 {
+    let d = |q: usize, k: usize| x[q][k] - x[0][k];
+    if x.len() == 2 {
+        (d(1, 0).powi(2) + d(1, 1).powi(2) + d(1, 2).powi(2)).sqrt()
+    } else {
+        let c = [
+            d(1, 1) * d(2, 2) - d(1, 2) * d(2, 1),
+            d(1, 2) * d(2, 0) - d(1, 0) * d(2, 2),
+            d(1, 0) * d(2, 1) - d(1, 1) * d(2, 0),
+        ];
+        0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+    }
+}
+
+impl Discretization<'_> {
+    /// The right-hand sides `(b_u, b_φ)` of `K [u; φ] = [b_u; b_φ]` for the given loads, with
+    /// the prescribed values lifted: `b_u = f - A_ud u_d - Gᵀ_uφd φ_d`,
+    /// `b_φ = -q - G_φud u_d + B_φφd φ_d`.
+    pub fn rhs(&self, loads: &[Load]) -> Result<(Vec<f64>, Vec<f64>), AssemblyError> {
+        let mesh = self.mesh;
+        let dim = mesh.dim;
+        let d = &self.dofs;
+        let mut bu = vec![0.0; d.n_u];
+        let mut bphi = vec![0.0; d.n_phi];
+        let (w_cell, p_cell) = simplex_rule(dim);
+        let (w_facet, p_facet) = simplex_rule(dim - 1);
+        let at = |nodes: &[usize], bary: &[f64; 4]| {
+            let mut x = [0.0; 3];
+            for (q, &v) in nodes.iter().enumerate() {
+                for k in 0..3 {
+                    x[k] += bary[q] * mesh.points[v][k];
+                }
+            }
+            x
+        };
+        let check = |what: &str, v: f64| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(AssemblyError::Input(format!("{what} is not finite ({v})")))
+            }
+        };
+        for load in loads {
+            match load {
+                Load::BodyForce(f) => {
+                    for (c, cell) in mesh.iter_cells().enumerate() {
+                        let vol = self.geometry[c].measure;
+                        for (w, p) in w_cell.iter().zip(&p_cell) {
+                            let fx = f(&at(cell, p)[..dim]);
+                            for (a, &v) in cell.iter().enumerate() {
+                                for k in 0..dim {
+                                    if let Dof::Free(j) = d.u[v * dim + k] {
+                                        bu[j] += check("the body force", fx[k])? * w * vol * p[a];
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                Load::BodyCharge(q0) => {
+                    for (c, cell) in mesh.iter_cells().enumerate() {
+                        if !self.cell_electric[c] {
+                            continue;
+                        }
+                        let vol = self.geometry[c].measure;
+                        for (w, p) in w_cell.iter().zip(&p_cell) {
+                            let qx = check("the body charge", q0(&at(cell, p)[..dim]))?;
+                            for (a, &v) in cell.iter().enumerate() {
+                                if let Dof::Free(j) = d.phi[v] {
+                                    bphi[j] -= qx * w * vol * p[a];
+                                }
+                            }
+                        }
+                    }
+                }
+                Load::Traction { group, value } => {
+                    for f in mesh.boundary(group)?.iter() {
+                        let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
+                        let len = facet_measure(&x);
+                        for (w, p) in w_facet.iter().zip(&p_facet) {
+                            let t = value(&at(f, p)[..dim]);
+                            for (a, &v) in f.iter().enumerate() {
+                                for k in 0..dim {
+                                    if let Dof::Free(j) = d.u[v * dim + k] {
+                                        bu[j] += check("the traction", t[k])? * w * len * p[a];
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                Load::SurfaceCharge { group, value } => {
+                    for f in mesh.boundary(group)?.iter() {
+                        let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
+                        let len = facet_measure(&x);
+                        for (w, p) in w_facet.iter().zip(&p_facet) {
+                            let qx = check("the surface charge", value(&at(f, p)[..dim]))?;
+                            for (a, &v) in f.iter().enumerate() {
+                                if let Dof::Free(j) = d.phi[v] {
+                                    // q has -∫ q2 ψ, and b_φ = -q
+                                    bphi[j] += qx * w * len * p[a];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self.lift(&mut bu, &mut bphi);
+        Ok((bu, bphi))
+    }
+
+    /// Subtracts the columns of `K` of the prescribed dofs times their values.
+    fn lift(&self, bu: &mut [f64], bphi: &mut [f64]) {
+        let mesh = self.mesh;
+        let dim = mesh.dim;
+        let nl = dim + 1;
+        let d = &self.dofs;
+        for (c, cell) in mesh.iter_cells().enumerate() {
+            let fixed_u = cell
+                .iter()
+                .any(|&v| (0..dim).any(|k| matches!(d.u[v * dim + k], Dof::Fixed(x) if x != 0.0)));
+            let fixed_phi = cell
+                .iter()
+                .any(|&v| matches!(d.phi[v], Dof::Fixed(x) if x != 0.0));
+            if !fixed_u && !fixed_phi {
+                continue;
+            }
+            let (m, geo) = (self.material(c), &self.geometry[c]);
+            for (a, &va) in cell.iter().enumerate() {
+                for k in 0..dim {
+                    let Dof::Fixed(val) = d.u[va * dim + k] else {
+                        continue;
+                    };
+                    if val == 0.0 {
+                        continue;
+                    }
+                    let col = elasticity_column(m, geo, nl, a, k);
+                    let colg = coupling_column(m, geo, nl, a, k);
+                    for (b, &vb) in cell.iter().enumerate() {
+                        for l in 0..dim {
+                            if let Dof::Free(j) = d.u[vb * dim + l] {
+                                bu[j] -= col[b][l] * val;
+                            }
+                        }
+                        if self.cell_electric[c] {
+                            if let Dof::Free(j) = d.phi[vb] {
+                                bphi[j] -= colg[b] * val;
+                            }
+                        }
+                    }
+                }
+                if !self.cell_electric[c] {
+                    continue;
+                }
+                let Dof::Fixed(val) = d.phi[va] else { continue };
+                if val == 0.0 {
+                    continue;
+                }
+                let gt = coupling_row(m, geo, nl, a);
+                let bcol = dielectric_column(m, geo, nl, a);
+                for (b, &vb) in cell.iter().enumerate() {
+                    for l in 0..dim {
+                        if let Dof::Free(j) = d.u[vb * dim + l] {
+                            bu[j] -= gt[b][l] * val;
+                        }
+                    }
+                    if let Dof::Free(j) = d.phi[vb] {
+                        bphi[j] += bcol[b] * val;
+                    }
+                }
+            }
+        }
+    }
+}

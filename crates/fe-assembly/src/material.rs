@@ -1,0 +1,456 @@
+//! Electro-elastic materials: 3D crystal constants with a poling direction, rotated into the
+//! global frame and, in 2D, reduced to plane strain.
+//!
+//! Voigt order `[11, 22, 33, 23, 13, 12]` with engineering shear strains, so the Voigt entries
+//! of `C` and `e` are the tensor components themselves (no factors of 2).
+
+use nalgebra::{DMatrix, Matrix3, SMatrix};
+
+/// 3D constants in the crystal frame (poling along the crystal's 3-axis).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Crystal {
+    /// Elasticity, 6x6 Voigt (stress units, e.g. GPa).
+    pub c: [[f64; 6]; 6],
+    /// Piezoelectric stress constants, 3x6 (rows D_1, D_2, D_3), e.g. C/m^2.
+    pub e: [[f64; 6]; 3],
+    /// Permittivity at constant strain, 3x3, e.g. nF/m.
+    pub permittivity: [[f64; 3]; 3],
+}
+
+impl Crystal {
+    /// PZT-5A as tabulated in SCENES.md (GPa, C/m^2, nF/m): c11 = 121, c12 = 75.4,
+    /// c13 = 75.2, c33 = 111, c44 = 21.1, c66 = 22.6; e31 = -5.4, e33 = 15.8, e15 = 12.3;
+    /// eps11 = 8.11, eps33 = 7.35.
+    pub fn pzt5a() -> Self {
+        Self::hexagonal_6mm(
+            [121.0, 75.4, 75.2, 111.0, 21.1, 22.6],
+            [-5.4, 15.8, 12.3],
+            [8.11, 7.35],
+        )
+    }
+
+    /// A crystal of class 6mm (poled ceramics): `c = [c11, c12, c13, c33, c44, c66]`,
+    /// `e = [e31, e33, e15]`, `eps = [eps11, eps33]`. `c66` is taken as given, not as
+    /// `(c11 - c12) / 2`.
+    pub fn hexagonal_6mm(c: [f64; 6], e: [f64; 3], eps: [f64; 2]) -> Self {
+        let [c11, c12, c13, c33, c44, c66] = c;
+        let mut cm = [[0.0; 6]; 6];
+        cm[0][0] = c11;
+        cm[1][1] = c11;
+        cm[2][2] = c33;
+        cm[0][1] = c12;
+        cm[1][0] = c12;
+        cm[0][2] = c13;
+        cm[2][0] = c13;
+        cm[1][2] = c13;
+        cm[2][1] = c13;
+        cm[3][3] = c44;
+        cm[4][4] = c44;
+        cm[5][5] = c66;
+        let [e31, e33, e15] = e;
+        let mut em = [[0.0; 6]; 3];
+        em[2][0] = e31;
+        em[2][1] = e31;
+        em[2][2] = e33;
+        em[0][4] = e15;
+        em[1][3] = e15;
+        let permittivity = [[eps[0], 0.0, 0.0], [0.0, eps[0], 0.0], [0.0, 0.0, eps[1]]];
+        Crystal {
+            c: cm,
+            e: em,
+            permittivity,
+        }
+    }
+
+    /// An isotropic elastic solid (Young's modulus, Poisson's ratio) with no piezoelectricity
+    /// and the given isotropic permittivity (0 for a body with no electric unknowns).
+    pub fn isotropic(young: f64, poisson: f64, permittivity: f64) -> Self {
+        let lambda = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+        let mu = young / (2.0 * (1.0 + poisson));
+        let mut c = [[0.0; 6]; 6];
+        for i in 0..3 {
+            for j in 0..3 {
+                c[i][j] = lambda + if i == j { 2.0 * mu } else { 0.0 };
+            }
+            c[i + 3][i + 3] = mu;
+        }
+        let p = permittivity;
+        Crystal {
+            c,
+            e: [[0.0; 6]; 3],
+            permittivity: [[p, 0.0, 0.0], [0.0, p, 0.0], [0.0, 0.0, p]],
+        }
+    }
+}
+
+/// A material in the global frame of a `dim`-dimensional problem: `c` is `nv x nv`
+/// (`nv = 3` in 2D: `[xx, yy, xy]`; 6 in 3D), `e` is `dim x nv`, `beta` is `dim x dim`,
+/// all row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Spatial dimension.
+    pub dim: usize,
+    /// Elasticity, row-major `nv x nv`.
+    pub c: Vec<f64>,
+    /// Piezoelectric stress constants, row-major `dim x nv`.
+    pub e: Vec<f64>,
+    /// Permittivity, row-major `dim x dim`; all zero for a purely elastic material.
+    pub beta: Vec<f64>,
+    /// Whether the material carries electric unknowns (a non-zero permittivity).
+    pub electric: bool,
+}
+
+/// A material that cannot be used.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum MaterialError {
+    /// A constant is NaN or infinite.
+    #[error("material `{material}`: {what} has a non-finite entry")]
+    NonFinite {
+        /// The material's name.
+        material: String,
+        /// Which constant.
+        what: &'static str,
+    },
+    /// C or the permittivity is not symmetric.
+    #[error("material `{material}`: {what} is not symmetric (entry ({i}, {j}))")]
+    NotSymmetric {
+        /// The material's name.
+        material: String,
+        /// Which constant.
+        what: &'static str,
+        /// Row.
+        i: usize,
+        /// Column.
+        j: usize,
+    },
+    /// C or the permittivity is not positive definite.
+    #[error("material `{material}`: {what} is not positive definite (smallest eigenvalue {min_eig:.4e})")]
+    NotPositiveDefinite {
+        /// The material's name.
+        material: String,
+        /// Which constant.
+        what: &'static str,
+        /// Its smallest eigenvalue.
+        min_eig: f64,
+    },
+    /// The poling direction is zero or not finite.
+    #[error("material `{material}`: the poling direction {dir:?} is not a non-zero vector")]
+    BadPoling {
+        /// The material's name.
+        material: String,
+        /// The direction given.
+        dir: [f64; 3],
+    },
+}
+
+/// Voigt index of the symmetric pair `(i, j)`.
+fn voigt(i: usize, j: usize) -> usize {
+    match (i.min(j), i.max(j)) {
+        (0, 0) => 0,
+        (1, 1) => 1,
+        (2, 2) => 2,
+        (1, 2) => 3,
+        (0, 2) => 4,
+        _ => 5,
+    }
+}
+
+/// The orthonormal crystal frame for a poling direction: column `a` of `q` is crystal axis
+/// `a` in global coordinates; axis 3 is the poling direction, axis 1 the first global axis
+/// not parallel to it (made orthogonal), axis 2 = axis 3 x axis 1.
+fn crystal_frame(poling: [f64; 3]) -> Option<Matrix3<f64>> {
+    let d = nalgebra::Vector3::from(poling);
+    let norm = d.norm();
+    if !norm.is_finite() || norm == 0.0 {
+        return None;
+    }
+    let a3 = d / norm;
+    let a1 = (0..3)
+        .map(|k| {
+            let mut v = nalgebra::Vector3::zeros();
+            v[k] = 1.0;
+            v - a3 * a3[k]
+        })
+        .find(|v| v.norm() > 1e-8)?
+        .normalize();
+    let a2 = a3.cross(&a1);
+    Some(Matrix3::from_columns(&[a1, a2, a3]))
+}
+
+impl Material {
+    /// The crystal rotated so that its 3-axis points along `poling` (global coordinates), then,
+    /// for `dim = 2`, reduced to plane strain in the x-y plane (eps_zz = gamma_xz = gamma_yz = 0,
+    /// E_z = 0: keep the rows and columns `[xx, yy, xy]` and `[x, y]`). Checks that C and the
+    /// permittivity are symmetric and positive definite (the permittivity may be all zero: then
+    /// the material has no electric unknowns and `e` must be zero too).
+    ///
+    /// ```
+    /// use fe_assembly::{Crystal, Material};
+    /// // PZT-5A poled along y in plane strain: SCENES.md's 2D values.
+    /// let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
+    /// assert_eq!(m.c, vec![121.0, 75.2, 0.0, 75.2, 111.0, 0.0, 0.0, 0.0, 21.1]);
+    /// ```
+    pub fn from_crystal(
+        name: &str,
+        crystal: &Crystal,
+        poling: [f64; 3],
+        dim: usize,
+    ) -> Result<Material, MaterialError> {
+        let q = crystal_frame(poling).ok_or_else(|| MaterialError::BadPoling {
+            material: name.into(),
+            dir: poling,
+        })?;
+        let finite = |what, v: &[f64]| {
+            if v.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(MaterialError::NonFinite {
+                    material: name.into(),
+                    what,
+                })
+            }
+        };
+        finite("C", crystal.c.as_flattened())?;
+        finite("e", crystal.e.as_flattened())?;
+        finite("the permittivity", crystal.permittivity.as_flattened())?;
+        // rotate: T'_{ij..} = q_{ia} q_{jb} .. T_{ab..}
+        let mut c3 = [[0.0; 6]; 6];
+        let mut e3 = [[0.0; 6]; 3];
+        let mut b3 = [[0.0; 3]; 3];
+        let r = |i: usize, a: usize| q[(i, a)];
+        for i in 0..3 {
+            for j in i..3 {
+                for k in 0..3 {
+                    for l in k..3 {
+                        let mut s = 0.0;
+                        for a in 0..3 {
+                            for b in 0..3 {
+                                for cc in 0..3 {
+                                    for d in 0..3 {
+                                        let v = crystal.c[voigt(a, b)][voigt(cc, d)];
+                                        if v != 0.0 {
+                                            s += r(i, a) * r(j, b) * r(k, cc) * r(l, d) * v;
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                        c3[voigt(i, j)][voigt(k, l)] = s;
+                    }
+                }
+            }
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                for k in j..3 {
+                    let mut s = 0.0;
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            for cc in 0..3 {
+                                s += r(i, a) * r(j, b) * r(k, cc) * crystal.e[a][voigt(b, cc)];
+                            }
+                        }
+                    }
+                    e3[i][voigt(j, k)] = s;
+                }
+                let mut s = 0.0;
+                for a in 0..3 {
+                    for b in 0..3 {
+                        s += r(i, a) * r(j, b) * crystal.permittivity[a][b];
+                    }
+                }
+                b3[i][j] = s;
+            }
+        }
+        clean(c3.as_flattened_mut());
+        clean(e3.as_flattened_mut());
+        clean(b3.as_flattened_mut());
+        let (rows, fields): (Vec<usize>, Vec<usize>) = match dim {
+            2 => (vec![0, 1, 5], vec![0, 1]),
+            _ => ((0..6).collect(), (0..3).collect()),
+        };
+        let c: Vec<f64> = rows
+            .iter()
+            .flat_map(|&i| rows.iter().map(move |&j| c3[i][j]))
+            .collect();
+        let e: Vec<f64> = fields
+            .iter()
+            .flat_map(|&i| rows.iter().map(move |&j| e3[i][j]))
+            .collect();
+        let beta: Vec<f64> = fields
+            .iter()
+            .flat_map(|&i| fields.iter().map(move |&j| b3[i][j]))
+            .collect();
+        let electric = beta.iter().any(|&x| x != 0.0);
+        let m = Material {
+            dim,
+            c,
+            e,
+            beta,
+            electric,
+        };
+        m.validate(name)?;
+        Ok(m)
+    }
+
+    /// Number of Voigt strain components (3 in 2D, 6 in 3D).
+    pub fn nv(&self) -> usize {
+        if self.dim == 2 {
+            3
+        } else {
+            6
+        }
+    }
+
+    /// A copy with `e` multiplied by `factor` (the `material.coupling_scale` of the scenes).
+    pub fn with_coupling_scale(mut self, factor: f64) -> Self {
+        for x in &mut self.e {
+            *x *= factor;
+        }
+        self
+    }
+
+    /// Checks symmetry and positive definiteness of C and (for an electric material) beta.
+    pub fn validate(&self, name: &str) -> Result<(), MaterialError> {
+        let nv = self.nv();
+        check_spd(name, "C", &self.c, nv)?;
+        if self.electric {
+            check_spd(name, "the permittivity", &self.beta, self.dim)?;
+        } else if self.e.iter().any(|&x| x != 0.0) {
+            return Err(MaterialError::NotPositiveDefinite {
+                material: name.into(),
+                what: "the permittivity (zero, with a non-zero coupling e)",
+                min_eig: 0.0,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Rounds entries that are round-off of zero (below 1e-14 of the largest) to exactly zero.
+fn clean(v: &mut [f64]) {
+    let big = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for x in v {
+        if x.abs() <= 1e-14 * big {
+            *x = 0.0;
+        } else {
+            // snap values that differ from a short decimal by round-off of the rotation
+            let r = (*x * 1e12).round() / 1e12;
+            if (r - *x).abs() <= 4.0 * f64::EPSILON * x.abs() {
+                *x = r;
+            }
+        }
+    }
+}
+
+fn check_spd(name: &str, what: &'static str, m: &[f64], n: usize) -> Result<(), MaterialError> {
+    if m.iter().any(|x| !x.is_finite()) {
+        return Err(MaterialError::NonFinite {
+            material: name.into(),
+            what,
+        });
+    }
+    let scale = m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    for i in 0..n {
+        for j in 0..i {
+            if (m[i * n + j] - m[j * n + i]).abs() > 1e-12 * scale {
+                return Err(MaterialError::NotSymmetric {
+                    material: name.into(),
+                    what,
+                    i,
+                    j,
+                });
+            }
+        }
+    }
+    let dm = DMatrix::from_row_slice(n, n, m);
+    let min_eig = dm.symmetric_eigenvalues().min();
+    if !(min_eig > 1e-12 * scale) {
+        return Err(MaterialError::NotPositiveDefinite {
+            material: name.into(),
+            what,
+            min_eig,
+        });
+    }
+    let _ = SMatrix::<f64, 1, 1>::zeros();
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// SCENES.md section 1: the plane-strain reduction of PZT-5A poled along y.
+    #[test]
+    fn pzt5a_plane_strain_matches_scenes() {
+        let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
+        assert_eq!(
+            m.c,
+            vec![121.0, 75.2, 0.0, 75.2, 111.0, 0.0, 0.0, 0.0, 21.1]
+        );
+        assert_eq!(m.e, vec![0.0, 0.0, 12.3, -5.4, 15.8, 0.0]);
+        assert_eq!(m.beta, vec![8.11, 0.0, 0.0, 7.35]);
+        assert!(m.electric);
+    }
+
+    /// Poled along z in 3D: the crystal frame is the global frame.
+    #[test]
+    fn pzt5a_3d_along_z_is_the_table() {
+        let cr = Crystal::pzt5a();
+        let m = Material::from_crystal("pzt5a", &cr, [0.0, 0.0, 1.0], 3).unwrap();
+        assert_eq!(m.c, cr.c.as_flattened().to_vec());
+        assert_eq!(m.e, cr.e.as_flattened().to_vec());
+        assert_eq!(m.beta, cr.permittivity.as_flattened().to_vec());
+    }
+
+    /// A rotation keeps the energy of a rotated strain: W(R eps R^T) with rotated C equals
+    /// W(eps) with the original C; checked by rotating about an oblique axis.
+    #[test]
+    fn oblique_poling_keeps_invariants() {
+        let cr = Crystal::pzt5a();
+        let m = Material::from_crystal("x", &cr, [1.0, 2.0, 2.0], 3).unwrap();
+        let c = DMatrix::from_row_slice(6, 6, &m.c);
+        let c0 = DMatrix::from_row_slice(6, 6, cr.c.as_flattened());
+        // the trace of the 4th-order tensor's "bulk" contraction C_iijj is rotation invariant
+        let bulk = |c: &DMatrix<f64>| {
+            (0..3)
+                .flat_map(|i| (0..3).map(move |j| (i, j)))
+                .map(|(i, j)| c[(i, j)])
+                .sum::<f64>()
+        };
+        assert!((bulk(&c) - bulk(&c0)).abs() < 1e-9);
+        let b = DMatrix::from_row_slice(3, 3, &m.beta);
+        assert!((b.trace() - (8.11 * 2.0 + 7.35)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_materials_are_named() {
+        let mut cr = Crystal::pzt5a();
+        cr.c[0][0] = -1.0;
+        let e = Material::from_crystal("bad", &cr, [0.0, 1.0, 0.0], 2).unwrap_err();
+        assert!(
+            matches!(e, MaterialError::NotPositiveDefinite { what: "C", .. }),
+            "{e}"
+        );
+        let mut cr = Crystal::pzt5a();
+        cr.permittivity[2][2] = -7.0;
+        let e = Material::from_crystal("bad", &cr, [0.0, 1.0, 0.0], 2).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("permittivity is not positive definite"),
+            "{e}"
+        );
+        let mut cr = Crystal::pzt5a();
+        cr.e[2][2] = f64::NAN;
+        assert!(matches!(
+            Material::from_crystal("bad", &cr, [0.0, 1.0, 0.0], 2),
+            Err(MaterialError::NonFinite { what: "e", .. })
+        ));
+        assert!(matches!(
+            Material::from_crystal("bad", &Crystal::pzt5a(), [0.0; 3], 2),
+            Err(MaterialError::BadPoling { .. })
+        ));
+        let nu_half = Crystal::isotropic(100.0, 0.5, 0.0);
+        assert!(Material::from_crystal("inc", &nu_half, [0.0, 0.0, 1.0], 2).is_err());
+    }
+}

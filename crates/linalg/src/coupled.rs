@@ -1,0 +1,244 @@
+//! The coupled system `K [u; φ] = [b_u; b_φ]`, `K = [[A, Gᵀ], [G, -B]]` (A, B SPD), solved
+//! two ways that must agree to round-off:
+//!
+//! - [`SchurPcg`] (the paper's Algorithm 3): eliminate φ = B⁻¹ (G u - b_φ), solve
+//!   `S u = b_u + Gᵀ B⁻¹ b_φ` with `S = A + Gᵀ B⁻¹ G` by PCG preconditioned by `A`, using
+//!   Cholesky factors of `A` and `B` computed once;
+//! - [`DirectLdlt`]: one sparse `L D Lᵀ` of `K`, one forward/back solve.
+
+use crate::factor::{FactorKind, Ordering, SparseFactor};
+use crate::pcg::{pcg, LinearOperator, PcgParams};
+use crate::sparse::{lower_quasi_definite, mul_add, mul_t_add};
+use crate::LinalgError;
+use faer::sparse::SparseColMat;
+use faer::Par;
+
+/// What one coupled solve reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveInfo {
+    /// PCG iterations (0 for the direct solve).
+    pub pcg_iters: usize,
+}
+
+/// A solver of `K [u; φ] = [b_u; b_φ]` whose factorisations are done at construction.
+pub trait CoupledSolver {
+    /// Solves; `u` and `phi` hold a warm start on entry (used by iterative solvers) and the
+    /// solution on exit.
+    fn solve(
+        &mut self,
+        b_u: &[f64],
+        b_phi: &[f64],
+        u: &mut [f64],
+        phi: &mut [f64],
+    ) -> Result<SolveInfo, LinalgError>;
+    /// Bytes of the factor values held.
+    fn factor_bytes(&self) -> usize;
+}
+
+/// `S = A + Gᵀ B⁻¹ G` as an operator (never formed).
+pub struct SchurOperator<'a> {
+    a: &'a SparseColMat<usize, f64>,
+    g: &'a SparseColMat<usize, f64>,
+    b_factor: &'a mut SparseFactor,
+    tmp: Vec<f64>,
+}
+
+impl<'a> SchurOperator<'a> {
+    /// The operator of the blocks `a` (n_u x n_u, both triangles stored), `g` (n_φ x n_u) and
+    /// the factor of `B`.
+    pub fn new(
+        a: &'a SparseColMat<usize, f64>,
+        g: &'a SparseColMat<usize, f64>,
+        b_factor: &'a mut SparseFactor,
+    ) -> Self {
+        let n_phi = g.nrows();
+        SchurOperator {
+            a,
+            g,
+            b_factor,
+            tmp: vec![0.0; n_phi],
+        }
+    }
+}
+
+impl LinearOperator for SchurOperator<'_> {
+    fn n(&self) -> usize {
+        self.a.nrows()
+    }
+    fn apply(&mut self, out: &mut [f64], x: &[f64]) {
+        out.fill(0.0);
+        mul_add(self.a.as_ref(), x, out, 1.0);
+        if self.tmp.is_empty() {
+            return;
+        }
+        self.tmp.fill(0.0);
+        mul_add(self.g.as_ref(), x, &mut self.tmp, 1.0);
+        self.b_factor.solve_in_place(&mut self.tmp);
+        mul_t_add(self.g.as_ref(), &self.tmp, out, 1.0);
+    }
+}
+
+/// `P⁻¹ = A⁻¹` through a Cholesky factor.
+pub struct FactorPreconditioner<'a>(pub &'a mut SparseFactor);
+
+impl LinearOperator for FactorPreconditioner<'_> {
+    fn n(&self) -> usize {
+        self.0.n()
+    }
+    fn apply(&mut self, out: &mut [f64], x: &[f64]) {
+        out.copy_from_slice(x);
+        self.0.solve_in_place(out);
+    }
+}
+
+/// The paper's strategy: Cholesky of `A` and `B`, PCG on the Schur complement.
+pub struct SchurPcg {
+    a: SparseColMat<usize, f64>,
+    g: SparseColMat<usize, f64>,
+    chol_a: SparseFactor,
+    chol_b: Option<SparseFactor>,
+    /// PCG parameters, changeable between solves.
+    pub params: PcgParams,
+}
+
+impl SchurPcg {
+    /// Factors `A` and `B` (Cholesky, AMD). `B` may be empty (no electric unknowns).
+    pub fn new(
+        a: SparseColMat<usize, f64>,
+        g: SparseColMat<usize, f64>,
+        b: &SparseColMat<usize, f64>,
+        params: PcgParams,
+        par: Par,
+    ) -> Result<Self, LinalgError> {
+        let chol_a = SparseFactor::new(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, par)
+            .map_err(|e| e.context("the elasticity block A"))?;
+        let chol_b = if b.nrows() > 0 {
+            Some(
+                SparseFactor::new(b.as_ref(), FactorKind::Cholesky, &Ordering::Amd, par)
+                    .map_err(|e| e.context("the dielectric block B"))?,
+            )
+        } else {
+            None
+        };
+        Ok(SchurPcg {
+            a,
+            g,
+            chol_a,
+            chol_b,
+            params,
+        })
+    }
+}
+
+impl CoupledSolver for SchurPcg {
+    fn solve(
+        &mut self,
+        b_u: &[f64],
+        b_phi: &[f64],
+        u: &mut [f64],
+        phi: &mut [f64],
+    ) -> Result<SolveInfo, LinalgError> {
+        let Some(chol_b) = self.chol_b.as_mut() else {
+            u.copy_from_slice(b_u);
+            self.chol_a.solve_in_place(u);
+            return Ok(SolveInfo { pcg_iters: 0 });
+        };
+        // rhs of S u = b_u + Gᵀ B⁻¹ b_φ
+        let mut y = b_phi.to_vec();
+        chol_b.solve_in_place(&mut y);
+        let mut rhs = b_u.to_vec();
+        mul_t_add(self.g.as_ref(), &y, &mut rhs, 1.0);
+        let mut op = SchurOperator::new(&self.a, &self.g, chol_b);
+        let mut pre = FactorPreconditioner(&mut self.chol_a);
+        let info = pcg(&mut op, &mut pre, &rhs, u, &self.params)?;
+        // φ = B⁻¹ (G u - b_φ)
+        phi.iter_mut().zip(b_phi).for_each(|(p, b)| *p = -b);
+        mul_add(self.g.as_ref(), u, phi, 1.0);
+        chol_b.solve_in_place(phi);
+        Ok(SolveInfo {
+            pcg_iters: info.n_iters,
+        })
+    }
+    fn factor_bytes(&self) -> usize {
+        self.chol_a.values_bytes() + self.chol_b.as_ref().map_or(0, |f| f.values_bytes())
+    }
+}
+
+/// One `L D Lᵀ` of `K` (lower triangle built from the blocks).
+pub struct DirectLdlt {
+    factor: SparseFactor,
+    n_u: usize,
+    buf: Vec<f64>,
+}
+
+impl DirectLdlt {
+    /// Builds the lower triangle of `K` and factors it; `ordering` may put chosen dofs last
+    /// (indices into `[u; φ]`).
+    pub fn new(
+        a: &SparseColMat<usize, f64>,
+        g: &SparseColMat<usize, f64>,
+        b: &SparseColMat<usize, f64>,
+        ordering: &Ordering,
+        par: Par,
+    ) -> Result<Self, LinalgError> {
+        let k = lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref());
+        let factor = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, ordering, par)
+            .map_err(|e| e.context("the coupled matrix K"))?;
+        Ok(DirectLdlt {
+            factor,
+            n_u: a.nrows(),
+            buf: vec![0.0; k.nrows()],
+        })
+    }
+
+    /// The factor (for its inertia or pivots).
+    pub fn factor(&self) -> &SparseFactor {
+        &self.factor
+    }
+}
+
+impl CoupledSolver for DirectLdlt {
+    fn solve(
+        &mut self,
+        b_u: &[f64],
+        b_phi: &[f64],
+        u: &mut [f64],
+        phi: &mut [f64],
+    ) -> Result<SolveInfo, LinalgError> {
+        let n_u = self.n_u;
+        self.buf[..n_u].copy_from_slice(b_u);
+        self.buf[n_u..].copy_from_slice(b_phi);
+        self.factor.solve_in_place(&mut self.buf);
+        u.copy_from_slice(&self.buf[..n_u]);
+        phi.copy_from_slice(&self.buf[n_u..]);
+        Ok(SolveInfo { pcg_iters: 0 })
+    }
+    fn factor_bytes(&self) -> usize {
+        self.factor.values_bytes()
+    }
+}
+
+/// `‖K x - b‖₂ / ‖b‖₂` from the blocks (`‖K x - b‖₂` when `b = 0`).
+pub fn equilibrium_residual(
+    a: &SparseColMat<usize, f64>,
+    g: &SparseColMat<usize, f64>,
+    b: &SparseColMat<usize, f64>,
+    u: &[f64],
+    phi: &[f64],
+    b_u: &[f64],
+    b_phi: &[f64],
+) -> f64 {
+    let mut ru: Vec<f64> = b_u.iter().map(|x| -x).collect();
+    mul_add(a.as_ref(), u, &mut ru, 1.0);
+    mul_t_add(g.as_ref(), phi, &mut ru, 1.0);
+    let mut rp: Vec<f64> = b_phi.iter().map(|x| -x).collect();
+    mul_add(g.as_ref(), u, &mut rp, 1.0);
+    mul_add(b.as_ref(), phi, &mut rp, -1.0);
+    let num = (crate::pcg::dot(&ru, &ru) + crate::pcg::dot(&rp, &rp)).sqrt();
+    let den = (crate::pcg::dot(b_u, b_u) + crate::pcg::dot(b_phi, b_phi)).sqrt();
+    if den > 0.0 {
+        num / den
+    } else {
+        num
+    }
+}

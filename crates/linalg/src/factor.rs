@@ -1,0 +1,331 @@
+//! Sparse Cholesky (`L Lᵀ`, SPD) and `L D Lᵀ` (quasi-definite) factorisations over faer's
+//! low-level API: the symbolic analysis is done once, the numeric factorisation can be redone
+//! in place when the values change, and solves reuse their workspace (no allocation).
+
+use crate::LinalgError;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::perm::PermRef;
+use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
+    SymbolicCholeskyRaw, SymmetricOrdering,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par, Side};
+
+/// Which factorisation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FactorKind {
+    /// `L Lᵀ`: the matrix must be symmetric positive definite.
+    Cholesky,
+    /// `L D Lᵀ` without pivoting: any symmetric ordering of a quasi-definite matrix works.
+    Ldlt,
+}
+
+/// The fill-reducing ordering.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum Ordering {
+    /// Approximate minimum degree on the whole matrix.
+    #[default]
+    Amd,
+    /// AMD on every index but `last`, which come last in the given order (for example the
+    /// contact dofs, so that the trailing block of the factor is their Schur complement).
+    AmdThenLast(Vec<usize>),
+}
+
+/// A sparse symmetric factorisation with its workspaces. Only the lower triangle of the matrix
+/// is read.
+pub struct SparseFactor {
+    kind: FactorKind,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    factor_mem: MemBuffer,
+    solve_mem: MemBuffer,
+    solve_mem_ncols: usize,
+    par: Par,
+}
+
+impl std::fmt::Debug for SparseFactor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "SparseFactor({:?}, n = {}, len = {})",
+            self.kind,
+            self.n(),
+            self.values.len()
+        )
+    }
+}
+
+impl SparseFactor {
+    /// Analyses and factors `a` (square; the lower triangle is read).
+    ///
+    /// `par` is passed to faer's dense kernels inside the supernodes. On this project's
+    /// 2-core target `Par::Seq` was measured faster (see `docs/performance.md`).
+    pub fn new(
+        a: SparseColMatRef<'_, usize, f64>,
+        kind: FactorKind,
+        ordering: &Ordering,
+        par: Par,
+    ) -> Result<Self, LinalgError> {
+        let n = a.nrows();
+        if n != a.ncols() {
+            return Err(LinalgError::Shape(format!(
+                "a {}x{} matrix is not square",
+                n,
+                a.ncols()
+            )));
+        }
+        if let Some(i) = a.val().iter().position(|x| !x.is_finite()) {
+            return Err(LinalgError::NonFinite {
+                what: format!("matrix entry {i}"),
+            });
+        }
+        let (fwd, inv);
+        let ord = match ordering {
+            Ordering::Amd => SymmetricOrdering::Amd,
+            Ordering::AmdThenLast(last) => {
+                (fwd, inv) = amd_then_last(a, last)?;
+                SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
+            }
+        };
+        let symbolic = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            ord,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+        let factor_req = match kind {
+            FactorKind::Cholesky => {
+                symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())
+            }
+            FactorKind::Ldlt => {
+                symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
+            }
+        };
+        let solve_mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
+        let mut f = SparseFactor {
+            kind,
+            values: vec![0.0; symbolic.len_val()],
+            symbolic,
+            factor_mem: MemBuffer::new(factor_req),
+            solve_mem,
+            solve_mem_ncols: 1,
+            par,
+        };
+        f.refactor(a)?;
+        Ok(f)
+    }
+
+    /// Factors again, in place, a matrix with the same pattern and new values.
+    pub fn refactor(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), LinalgError> {
+        let stack = MemStack::new(&mut self.factor_mem);
+        match self.kind {
+            FactorKind::Cholesky => {
+                self.symbolic
+                    .factorize_numeric_llt(
+                        &mut self.values,
+                        a,
+                        Side::Lower,
+                        LltRegularization::default(),
+                        self.par,
+                        stack,
+                        Default::default(),
+                    )
+                    .map_err(|e| match e {
+                        faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
+                            index,
+                        } => LinalgError::NotPositiveDefinite { pivot: index },
+                    })?;
+            }
+            FactorKind::Ldlt => {
+                self.symbolic
+                    .factorize_numeric_ldlt(
+                        &mut self.values,
+                        a,
+                        Side::Lower,
+                        LdltRegularization::default(),
+                        self.par,
+                        stack,
+                        Default::default(),
+                    )
+                    .map_err(|e| match e {
+                        faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
+                            LinalgError::ZeroPivot { pivot: index }
+                        }
+                    })?;
+            }
+        }
+        if let Some(i) = self.values.iter().position(|x| !x.is_finite()) {
+            return Err(LinalgError::NonFinite {
+                what: format!("factor entry {i} (overflow)"),
+            });
+        }
+        Ok(())
+    }
+
+    /// Dimension.
+    pub fn n(&self) -> usize {
+        self.symbolic.nrows()
+    }
+
+    /// Number of stored factor values (about 10 % more than nnz(L) for a supernodal factor).
+    pub fn factor_len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Bytes held by the factor's values (the symbolic structure and workspaces come on top;
+    /// the driver measures the process's peak memory for the whole picture).
+    pub fn values_bytes(&self) -> usize {
+        8 * self.values.len()
+    }
+
+    /// Solves `M x = rhs` in place (`x` holds the right-hand side on entry).
+    pub fn solve_in_place(&mut self, x: &mut [f64]) {
+        let n = self.n();
+        let mat = MatMut::from_column_major_slice_mut(x, n, 1);
+        self.solve_mat(mat);
+    }
+
+    /// Solves with every column of `rhs` at once (blocks of right-hand sides cost several
+    /// times less per column than one at a time).
+    pub fn solve_many(&mut self, rhs: MatMut<'_, f64>) {
+        self.solve_mat(rhs);
+    }
+
+    fn solve_mat(&mut self, rhs: MatMut<'_, f64>) {
+        let k = rhs.ncols();
+        if k > self.solve_mem_ncols {
+            self.solve_mem =
+                MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(k, self.par));
+            self.solve_mem_ncols = k;
+        }
+        let stack = MemStack::new(&mut self.solve_mem);
+        match self.kind {
+            FactorKind::Cholesky => LltRef::new(&self.symbolic, &self.values)
+                .solve_in_place_with_conj(Conj::No, rhs, self.par, stack),
+            FactorKind::Ldlt => LdltRef::new(&self.symbolic, &self.values)
+                .solve_in_place_with_conj(Conj::No, rhs, self.par, stack),
+        }
+    }
+
+    /// The pivots of the factor (the diagonal of `D` for `L D Lᵀ`, of `L` for `L Lᵀ`), in the
+    /// factor's (permuted) order.
+    pub fn pivots(&self) -> Vec<f64> {
+        let mut d = Vec::with_capacity(self.n());
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let (cp, ri) = (s.col_ptr(), s.row_idx());
+                for j in 0..self.n() {
+                    // the diagonal is stored first in each column
+                    debug_assert_eq!(ri[cp[j]], j);
+                    d.push(self.values[cp[j]]);
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let (begin, end) = (s.supernode_begin(), s.supernode_end());
+                let (cp_row, cp_val) = (s.col_ptr_for_row_idx(), s.col_ptr_for_val());
+                for k in 0..s.n_supernodes() {
+                    let w = end[k] - begin[k];
+                    let rows = w + (cp_row[k + 1] - cp_row[k]);
+                    let block = &self.values[cp_val[k]..cp_val[k + 1]];
+                    for j in 0..w {
+                        d.push(block[j * rows + j]);
+                    }
+                }
+            }
+        }
+        d
+    }
+
+    /// `(positive, negative, zero)` pivot counts of an `L D Lᵀ` factor: by Sylvester's law the
+    /// inertia of the matrix.
+    pub fn inertia(&self) -> (usize, usize, usize) {
+        let p = self.pivots();
+        (
+            p.iter().filter(|&&x| x > 0.0).count(),
+            p.iter().filter(|&&x| x < 0.0).count(),
+            p.iter().filter(|&&x| x == 0.0).count(),
+        )
+    }
+
+    /// The fill-reducing permutation, `fwd[new] = old`.
+    pub fn permutation(&self) -> Vec<usize> {
+        match self.symbolic.perm() {
+            Some(p) => p.arrays().0.to_vec(),
+            None => (0..self.n()).collect(),
+        }
+    }
+}
+
+/// AMD on the indices not in `last`, then `last` in order. Returns `(fwd, inv)`.
+fn amd_then_last(
+    a: SparseColMatRef<'_, usize, f64>,
+    last: &[usize],
+) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
+    let n = a.nrows();
+    let mut is_last = vec![false; n];
+    for &i in last {
+        if i >= n || is_last[i] {
+            return Err(LinalgError::Shape(format!(
+                "ordering: index {i} is out of range or repeated"
+            )));
+        }
+        is_last[i] = true;
+    }
+    // the pattern of the leading block, renumbered, both triangles
+    let mut new_of = vec![usize::MAX; n];
+    let mut old_of = Vec::with_capacity(n - last.len());
+    for i in 0..n {
+        if !is_last[i] {
+            new_of[i] = old_of.len();
+            old_of.push(i);
+        }
+    }
+    let m = old_of.len();
+    let mut cols: Vec<Vec<usize>> = vec![Vec::new(); m];
+    let sym = a.symbolic();
+    for j in 0..n {
+        if is_last[j] {
+            continue;
+        }
+        for &i in sym.row_idx_of_col_raw(j) {
+            if !is_last[i] && i != j {
+                cols[new_of[j]].push(new_of[i]);
+                cols[new_of[i]].push(new_of[j]);
+            }
+        }
+    }
+    let mut col_ptr = Vec::with_capacity(m + 1);
+    col_ptr.push(0);
+    let mut row_idx = Vec::new();
+    for mut c in cols {
+        c.sort_unstable();
+        c.dedup();
+        row_idx.extend_from_slice(&c);
+        col_ptr.push(row_idx.len());
+    }
+    let nnz = row_idx.len();
+    let pattern = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
+    let mut perm = vec![0usize; m];
+    let mut perm_inv = vec![0usize; m];
+    let mut mem = MemBuffer::new(amd::order_scratch::<usize>(m, nnz));
+    amd::order(
+        &mut perm,
+        &mut perm_inv,
+        pattern.as_ref(),
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+    let mut fwd: Vec<usize> = perm.iter().map(|&p| old_of[p]).collect();
+    fwd.extend_from_slice(last);
+    let mut inv = vec![0usize; n];
+    for (new, &old) in fwd.iter().enumerate() {
+        inv[old] = new;
+    }
+    Ok((fwd, inv))
+}

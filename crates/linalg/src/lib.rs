@@ -1,0 +1,112 @@
+//! Sparse linear algebra for piezocontact: factorisations (faer's low-level sparse Cholesky and
+//! `L D Lᵀ`), preconditioned conjugate gradients, the Schur-complement operator, and the two
+//! strategies for the coupled system. It knows no finite elements: it sees matrices.
+//!
+//! # Glossary (signs fixed by DESIGN.md)
+//! - `A` (n_u x n_u, SPD), `G` (n_φ x n_u), `B` (n_φ x n_φ, SPD): the blocks of
+//!   `K = [[A, Gᵀ], [G, -B]]`, symmetric quasi-definite, with exactly `n_φ` negative pivots.
+//! - `S = A + Gᵀ B⁻¹ G`: the Schur complement of `K` onto `u` (SPD), applied by
+//!   [`SchurOperator`], never formed.
+//! - Sparse matrices are faer's `SparseColMat<usize, f64>`; factorisations read only the lower
+//!   triangle.
+//! - Parallelism is an explicit `faer::Par` argument.
+//!
+//! # Example
+//! ```
+//! use faer::sparse::{SparseColMat, Triplet};
+//! use linalg::{pcg, FactorKind, Identity, Ordering, PcgParams, SparseFactor};
+//! // the 1D Laplacian, 5 x 5
+//! let n = 5;
+//! let mut t = vec![];
+//! for i in 0..n {
+//!     t.push(Triplet::new(i, i, 2.0));
+//!     if i + 1 < n {
+//!         t.push(Triplet::new(i, i + 1, -1.0));
+//!         t.push(Triplet::new(i + 1, i, -1.0));
+//!     }
+//! }
+//! let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
+//! let mut f = SparseFactor::new(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, faer::Par::Seq).unwrap();
+//! let mut x = vec![1.0; n];
+//! f.solve_in_place(&mut x);
+//! // x = A⁻¹ 1 = (i + 1)(n - i) / 2
+//! for i in 0..n {
+//!     assert!((x[i] - ((i + 1) * (n - i)) as f64 / 2.0).abs() < 1e-12);
+//! }
+//! ```
+
+mod coupled;
+mod factor;
+mod pcg;
+pub mod sparse;
+
+pub use coupled::{
+    equilibrium_residual, CoupledSolver, DirectLdlt, FactorPreconditioner, SchurOperator, SchurPcg,
+    SolveInfo,
+};
+pub use factor::{FactorKind, Ordering, SparseFactor};
+pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};
+
+/// What can go wrong in the linear algebra.
+#[derive(Debug, Clone, thiserror::Error, PartialEq)]
+pub enum LinalgError {
+    /// A Cholesky factorisation met a non-positive pivot: the matrix is not SPD (for example a
+    /// body that is not held against rigid motions).
+    #[error("the matrix is not positive definite (pivot {pivot})")]
+    NotPositiveDefinite {
+        /// The pivot's index in the factor's order.
+        pivot: usize,
+    },
+    /// An `L D Lᵀ` factorisation met an exactly zero pivot.
+    #[error("zero pivot {pivot} in the L D Lᵀ factorisation")]
+    ZeroPivot {
+        /// The pivot's index in the factor's order.
+        pivot: usize,
+    },
+    /// PCG did not reach its tolerance.
+    #[error("PCG did not converge in {n_iters} iterations (relative residual {rel_residual:.3e})")]
+    NoConvergence {
+        /// Iterations done.
+        n_iters: usize,
+        /// The last relative residual.
+        rel_residual: f64,
+    },
+    /// PCG met a direction of non-positive curvature.
+    #[error("the operator is not positive definite: curvature {curvature:.3e} at PCG iteration {n_iters}")]
+    NotPositiveDefiniteOperator {
+        /// The iteration.
+        n_iters: usize,
+        /// `pᵀ M p` (or `rᵀ P⁻¹ r`).
+        curvature: f64,
+    },
+    /// A NaN or infinity.
+    #[error("non-finite value in {what}")]
+    NonFinite {
+        /// Where.
+        what: String,
+    },
+    /// Sizes that do not fit.
+    #[error("shape mismatch: {0}")]
+    Shape(String),
+    /// The symbolic analysis failed.
+    #[error("symbolic factorisation failed: {0}")]
+    Symbolic(String),
+    /// An error with the name of the matrix it concerns.
+    #[error("{what}: {source}")]
+    In {
+        /// The matrix.
+        what: &'static str,
+        /// The error.
+        source: Box<LinalgError>,
+    },
+}
+
+impl LinalgError {
+    /// Wraps the error with the name of the matrix it concerns.
+    pub fn context(self, what: &'static str) -> Self {
+        LinalgError::In {
+            what,
+            source: Box::new(self),
+        }
+    }
+}

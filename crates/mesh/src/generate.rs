@@ -1,0 +1,297 @@
+//! Structured generators: a rectangle into P1 triangles or Q1 quadrilaterals, a box into P1
+//! tetrahedra (Kuhn split), with named boundary groups and the region `body`.
+
+use crate::{CellKind, FacetGroup, Mesh};
+use std::collections::BTreeMap;
+
+/// The rectangle `[lo, hi]` cut into `nx x ny` squares, each split along its SW-NE diagonal
+/// into the P1 triangles `(n00, n10, n11)` and `(n00, n11, n01)` (SCENES.md, `paper`).
+///
+/// Node `(i, j)` has index `j (nx + 1) + i`. Boundary groups `left`, `right`, `bottom`, `top`
+/// hold segments ordered counter-clockwise around the rectangle; the region `body` holds every
+/// cell. `nx` and `ny` are clamped to at least 1.
+pub fn rectangle_tri(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize) -> Mesh {
+    let (nx, ny) = (nx.max(1), ny.max(1));
+    let mut cells = Vec::with_capacity(6 * nx * ny);
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    for j in 0..ny {
+        for i in 0..nx {
+            let (n00, n10, n11, n01) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            cells.extend_from_slice(&[n00, n10, n11, n00, n11, n01]);
+        }
+    }
+    rectangle(lo, hi, nx, ny, CellKind::Tri3, cells)
+}
+
+/// The rectangle `[lo, hi]` cut into `nx x ny` Q1 quadrilaterals `(n00, n10, n11, n01)`,
+/// with the same nodes, groups and region as [`rectangle_tri`].
+pub fn rectangle_quad(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize) -> Mesh {
+    let (nx, ny) = (nx.max(1), ny.max(1));
+    let mut cells = Vec::with_capacity(4 * nx * ny);
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    for j in 0..ny {
+        for i in 0..nx {
+            cells.extend_from_slice(&[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    rectangle(lo, hi, nx, ny, CellKind::Quad4, cells)
+}
+
+fn rectangle(
+    lo: [f64; 2],
+    hi: [f64; 2],
+    nx: usize,
+    ny: usize,
+    kind: CellKind,
+    cells: Vec<usize>,
+) -> Mesh {
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    let mut points = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            points.push([lerp(lo[0], hi[0], i, nx), lerp(lo[1], hi[1], j, ny), 0.0]);
+        }
+    }
+    let seg = |pairs: Vec<(usize, usize)>| FacetGroup {
+        nodes_per_facet: 2,
+        facets: pairs.into_iter().flat_map(|(a, b)| [a, b]).collect(),
+    };
+    let mut boundaries = BTreeMap::new();
+    boundaries.insert(
+        "bottom".into(),
+        seg((0..nx).map(|i| (id(i, 0), id(i + 1, 0))).collect()),
+    );
+    boundaries.insert(
+        "right".into(),
+        seg((0..ny).map(|j| (id(nx, j), id(nx, j + 1))).collect()),
+    );
+    boundaries.insert(
+        "top".into(),
+        seg((0..nx).rev().map(|i| (id(i + 1, ny), id(i, ny))).collect()),
+    );
+    boundaries.insert(
+        "left".into(),
+        seg((0..ny).rev().map(|j| (id(0, j + 1), id(0, j))).collect()),
+    );
+    let n_cells = cells.len() / kind.n_nodes();
+    let mut regions = BTreeMap::new();
+    regions.insert("body".into(), (0..n_cells).collect());
+    Mesh {
+        dim: 2,
+        kind,
+        points,
+        cells,
+        boundaries,
+        regions,
+    }
+}
+
+/// The box `[lo, hi]` cut into `nx x ny x nz` cubes, each split into the six Kuhn tetrahedra
+/// `(v000, v000 + e_p1, v000 + e_p1 + e_p2, v111)`, one per order `(p1, p2, p3)` of the axes
+/// (SCENES.md, `paper-3d`), stored positively oriented. The split is conforming, and every
+/// face is cut along the diagonal joining its lowest and highest corners (SW-NE).
+///
+/// Node `(i, j, k)` has index `(k (ny + 1) + j)(nx + 1) + i`. Boundary groups: `left`/`right`
+/// (x = lo/hi), `front`/`back` (y = lo/hi), `bottom`/`top` (z = lo/hi), triangles ordered so
+/// that their right-hand normal points out of the box. Region: `body`.
+pub fn box_tet(lo: [f64; 3], hi: [f64; 3], nx: usize, ny: usize, nz: usize) -> Mesh {
+    let n = [nx.max(1), ny.max(1), nz.max(1)];
+    let id = |i: usize, j: usize, k: usize| (k * (n[1] + 1) + j) * (n[0] + 1) + i;
+    let mut points = Vec::with_capacity((n[0] + 1) * (n[1] + 1) * (n[2] + 1));
+    for k in 0..=n[2] {
+        for j in 0..=n[1] {
+            for i in 0..=n[0] {
+                points.push([
+                    lerp(lo[0], hi[0], i, n[0]),
+                    lerp(lo[1], hi[1], j, n[1]),
+                    lerp(lo[2], hi[2], k, n[2]),
+                ]);
+            }
+        }
+    }
+    const ORDERS: [[usize; 3]; 6] = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut cells = Vec::with_capacity(24 * n[0] * n[1] * n[2]);
+    for k in 0..n[2] {
+        for j in 0..n[1] {
+            for i in 0..n[0] {
+                for order in ORDERS {
+                    let mut c = [i, j, k];
+                    let mut tet = [id(i, j, k), 0, 0, id(i + 1, j + 1, k + 1)];
+                    for (slot, &axis) in order[..2].iter().enumerate() {
+                        c[axis] += 1;
+                        tet[slot + 1] = id(c[0], c[1], c[2]);
+                    }
+                    if signed_volume(&points, &tet) < 0.0 {
+                        tet.swap(2, 3);
+                    }
+                    cells.extend_from_slice(&tet);
+                }
+            }
+        }
+    }
+    // Faces: for a face normal to `axis` at layer `at`, with in-plane axes (a, b) in increasing
+    // order, split each square along its lowest-highest diagonal, then orient outwards.
+    let mut boundaries = BTreeMap::new();
+    let names = [("left", "right"), ("front", "back"), ("bottom", "top")];
+    for axis in 0..3 {
+        let (a, b) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        for (side, name) in [(0usize, names[axis].0), (n[axis], names[axis].1)] {
+            let outward = if side == 0 { -1.0 } else { 1.0 };
+            let mut facets = Vec::with_capacity(6 * n[a] * n[b]);
+            for jb in 0..n[b] {
+                for ia in 0..n[a] {
+                    let node = |da: usize, db: usize| {
+                        let mut c = [0usize; 3];
+                        c[axis] = side;
+                        c[a] = ia + da;
+                        c[b] = jb + db;
+                        id(c[0], c[1], c[2])
+                    };
+                    let (n00, n10, n11, n01) = (node(0, 0), node(1, 0), node(1, 1), node(0, 1));
+                    for mut tri in [[n00, n10, n11], [n00, n11, n01]] {
+                        if triangle_normal(&points, &tri)[axis] * outward < 0.0 {
+                            tri.swap(1, 2);
+                        }
+                        facets.extend_from_slice(&tri);
+                    }
+                }
+            }
+            boundaries.insert(
+                name.to_string(),
+                FacetGroup {
+                    nodes_per_facet: 3,
+                    facets,
+                },
+            );
+        }
+    }
+    let n_cells = cells.len() / 4;
+    let mut regions = BTreeMap::new();
+    regions.insert("body".into(), (0..n_cells).collect());
+    Mesh {
+        dim: 3,
+        kind: CellKind::Tet4,
+        points,
+        cells,
+        boundaries,
+        regions,
+    }
+}
+
+/// `lo + (hi - lo) i / n`, exact at both ends.
+fn lerp(lo: f64, hi: f64, i: usize, n: usize) -> f64 {
+    if i == n {
+        hi
+    } else {
+        lo + (hi - lo) * (i as f64 / n as f64)
+    }
+}
+
+pub(crate) fn signed_volume(points: &[[f64; 3]], t: &[usize]) -> f64 {
+    let p0 = points[t[0]];
+    let d = |q: usize, k: usize| points[t[q]][k] - p0[k];
+    let (a, b, c) = (
+        [d(1, 0), d(1, 1), d(1, 2)],
+        [d(2, 0), d(2, 1), d(2, 2)],
+        [d(3, 0), d(3, 1), d(3, 2)],
+    );
+    (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0]))
+        / 6.0
+}
+
+pub(crate) fn triangle_normal(points: &[[f64; 3]], t: &[usize]) -> [f64; 3] {
+    let p0 = points[t[0]];
+    let u = [
+        points[t[1]][0] - p0[0],
+        points[t[1]][1] - p0[1],
+        points[t[1]][2] - p0[2],
+    ];
+    let v = [
+        points[t[2]][0] - p0[0],
+        points[t[2]][1] - p0[1],
+        points[t[2]][2] - p0[2],
+    ];
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rectangle_counts_and_split() {
+        let m = rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2);
+        assert_eq!(m.n_nodes(), 15);
+        assert_eq!(m.n_cells(), 16);
+        // the first square's two triangles, SW-NE
+        assert_eq!(m.cell(0), &[0, 1, 6]);
+        assert_eq!(m.cell(1), &[0, 6, 5]);
+        let r = m.check().unwrap();
+        assert!((r.total_measure - 2.0).abs() < 1e-14);
+        for (name, len) in [("bottom", 4), ("top", 4), ("left", 2), ("right", 2)] {
+            assert_eq!(m.boundary(name).unwrap().n_facets(), len, "{name}");
+        }
+        let q = rectangle_quad([0.0, 0.0], [2.0, 1.0], 4, 2);
+        assert!((q.check().unwrap().total_measure - 2.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn box_is_conforming_and_oriented() {
+        let m = box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2);
+        assert_eq!(m.n_cells(), 6 * 16);
+        let r = m.check().unwrap();
+        assert!((r.total_measure - 2.0).abs() < 1e-13);
+        // conforming: every interior face is shared by exactly two tets, boundary faces by one,
+        // and the boundary faces are exactly the union of the six groups.
+        let mut faces = std::collections::HashMap::new();
+        for c in m.iter_cells() {
+            for skip in 0..4 {
+                let mut f: Vec<usize> = (0..4).filter(|&q| q != skip).map(|q| c[q]).collect();
+                f.sort_unstable();
+                *faces.entry(f).or_insert(0) += 1;
+            }
+        }
+        let boundary: Vec<_> = faces
+            .iter()
+            .filter(|(_, &k)| k == 1)
+            .map(|(f, _)| f.clone())
+            .collect();
+        assert!(faces.values().all(|&k| k == 1 || k == 2));
+        let mut from_groups: Vec<Vec<usize>> = m
+            .boundaries
+            .values()
+            .flat_map(|g| {
+                g.iter().map(|f| {
+                    let mut f = f.to_vec();
+                    f.sort_unstable();
+                    f
+                })
+            })
+            .collect();
+        from_groups.sort();
+        let mut boundary = boundary;
+        boundary.sort();
+        assert_eq!(from_groups, boundary);
+        // bottom faces point down
+        let b = m.boundary("bottom").unwrap();
+        for f in b.iter() {
+            assert!(triangle_normal(&m.points, f)[2] < 0.0);
+        }
+    }
+}

@@ -1,0 +1,307 @@
+//! The Gmsh MSH 4.1 reader (ASCII and binary).
+//!
+//! The body of the file is parsed by `mshio`; `$PhysicalNames`, which `mshio` skips, is read
+//! here. Physical groups of dimension `dim - 1` become boundary groups and those of dimension
+//! `dim` become regions, named by their physical name (or by their tag where unnamed). Every
+//! cell also belongs to the region `body`, unless the file names a group `body` itself.
+//!
+//! Node tags: where the file's tags are dense (`max - min + 1 == count`), `mshio` does not keep
+//! them, and node `k` of the file (in block order) gets tag `min + k`, which is how Gmsh writes
+//! them. Cells of an entity block that are all negatively oriented (a surface whose normal is
+//! `-z`) are turned round; a block with cells of both orientations is left as it is, and
+//! [`Mesh::check`] then reports the inverted cells.
+
+use crate::{CellKind, FacetGroup, Mesh, MeshError};
+use mshio::mshfile::ElementType;
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+/// Reads a Gmsh MSH 4.1 file (ASCII or binary) and checks it with [`Mesh::check`].
+pub fn read_msh(path: impl AsRef<Path>) -> Result<Mesh, MeshError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    read_msh_bytes(&bytes, &path.display().to_string())
+}
+
+/// Reads the bytes of a Gmsh MSH 4.1 file; `name` is used in error messages.
+pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
+    let err = |message: String| MeshError::Gmsh {
+        path: name.to_string(),
+        message,
+    };
+    if !bytes.starts_with(b"$MeshFormat") {
+        return Err(err(
+            "not a Gmsh file: it does not start with `$MeshFormat`".into()
+        ));
+    }
+    let file = mshio::parse_msh_bytes(bytes).map_err(|e| {
+        let text = e.to_string();
+        let first = text.lines().take(6).collect::<Vec<_>>().join("; ");
+        err(format!("does not parse as MSH 4.1: {first}"))
+    })?;
+    let names = physical_names(bytes).map_err(err)?;
+    let data = file.data;
+    let entities = data
+        .entities
+        .ok_or_else(|| err("the file has no `$Entities` section".into()))?;
+    let nodes = data
+        .nodes
+        .ok_or_else(|| err("the file has no `$Nodes` section".into()))?;
+    let elements = data
+        .elements
+        .ok_or_else(|| err("the file has no `$Elements` section".into()))?;
+
+    // physical tags of each entity
+    let mut phys: HashMap<(i32, i32), Vec<i32>> = HashMap::new();
+    for p in &entities.points {
+        phys.insert((0, p.tag), p.physical_tags.clone());
+    }
+    for c in &entities.curves {
+        phys.insert((1, c.tag), c.physical_tags.clone());
+    }
+    for s in &entities.surfaces {
+        phys.insert((2, s.tag), s.physical_tags.clone());
+    }
+    for v in &entities.volumes {
+        phys.insert((3, v.tag), v.physical_tags.clone());
+    }
+
+    // nodes: tag -> index
+    let mut points = Vec::with_capacity(nodes.num_nodes as usize);
+    let mut index_of: HashMap<u64, usize> = HashMap::with_capacity(nodes.num_nodes as usize);
+    let dense = nodes.max_node_tag - nodes.min_node_tag + 1 == nodes.num_nodes;
+    for block in &nodes.node_blocks {
+        let base = points.len();
+        match (&block.node_tags, dense) {
+            (Some(map), _) => {
+                for (&tag, &local) in map {
+                    index_of.insert(tag, base + local);
+                }
+            }
+            (None, true) => {
+                for local in 0..block.nodes.len() {
+                    index_of.insert(nodes.min_node_tag + (base + local) as u64, base + local);
+                }
+            }
+            (None, false) => return Err(err("node block without node tags".into())),
+        }
+        points.extend(block.nodes.iter().map(|n| [n.x, n.y, n.z]));
+    }
+
+    // the mesh dimension: the highest dimension of a supported element present
+    let kind_of = |t: ElementType| match t {
+        ElementType::Tri3 => Some(CellKind::Tri3),
+        ElementType::Qua4 => Some(CellKind::Quad4),
+        ElementType::Tet4 => Some(CellKind::Tet4),
+        _ => None,
+    };
+    let dim = elements
+        .element_blocks
+        .iter()
+        .map(|b| b.entity_dim)
+        .max()
+        .ok_or_else(|| err("the file has no elements".into()))?;
+    if !(2..=3).contains(&dim) {
+        return Err(err(format!(
+            "the highest element dimension is {dim}; a 2D or 3D mesh is needed"
+        )));
+    }
+    let mut kind: Option<CellKind> = None;
+    let mut cells = Vec::new();
+    let mut regions: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    let mut boundaries: BTreeMap<String, FacetGroup> = BTreeMap::new();
+    let group_name = |d: i32, tag: i32| {
+        names
+            .get(&(d, tag))
+            .cloned()
+            .unwrap_or_else(|| tag.to_string())
+    };
+    let node_index = |tag: u64, elem: u64| {
+        index_of.get(&tag).copied().ok_or_else(|| {
+            err(format!(
+                "element {elem} refers to node tag {tag}, which the file does not define"
+            ))
+        })
+    };
+    for block in &elements.element_blocks {
+        let d = block.entity_dim;
+        if d == dim {
+            let k = kind_of(block.element_type).ok_or_else(|| {
+                err(format!(
+                    "element type {:?} is not supported: cells must be 3-node triangles, 4-node \
+                     quadrilaterals or 4-node tetrahedra",
+                    block.element_type
+                ))
+            })?;
+            if k.dim() != dim as usize {
+                return Err(err(format!("{} cells in a {dim}D mesh", k.name())));
+            }
+            match kind {
+                None => kind = Some(k),
+                Some(k0) if k0 != k => {
+                    return Err(err(format!(
+                        "mixed cell kinds ({} and {}): one kind per mesh",
+                        k0.name(),
+                        k.name()
+                    )))
+                }
+                _ => {}
+            }
+            let first = cells.len() / k.n_nodes();
+            for e in &block.elements {
+                if e.nodes.len() != k.n_nodes() {
+                    return Err(err(format!(
+                        "element {} has {} nodes",
+                        e.element_tag,
+                        e.nodes.len()
+                    )));
+                }
+                for &t in &e.nodes {
+                    cells.push(node_index(t, e.element_tag)?);
+                }
+            }
+            let last = cells.len() / k.n_nodes();
+            orient_block(&points, &mut cells, k, first, last);
+            for &p in phys.get(&(d, block.entity_tag)).into_iter().flatten() {
+                regions
+                    .entry(group_name(d, p))
+                    .or_default()
+                    .extend(first..last);
+            }
+        } else if d == dim - 1 {
+            let facet_nodes = if dim == 2 { 2 } else { 3 };
+            let ok = matches!(
+                (dim, block.element_type),
+                (2, ElementType::Lin2) | (3, ElementType::Tri3)
+            );
+            if !ok {
+                return Err(err(format!(
+                    "boundary element type {:?} is not supported in a {dim}D mesh",
+                    block.element_type
+                )));
+            }
+            let mut facets = Vec::with_capacity(block.elements.len() * facet_nodes);
+            for e in &block.elements {
+                for &t in &e.nodes {
+                    facets.push(node_index(t, e.element_tag)?);
+                }
+            }
+            for &p in phys.get(&(d, block.entity_tag)).into_iter().flatten() {
+                let g = boundaries
+                    .entry(group_name(d, p))
+                    .or_insert_with(|| FacetGroup {
+                        nodes_per_facet: facet_nodes,
+                        facets: vec![],
+                    });
+                g.facets.extend_from_slice(&facets);
+            }
+        }
+    }
+    let kind = kind.ok_or_else(|| err(format!("no {dim}D cells")))?;
+    if dim == 2 {
+        let z0 = points.first().map_or(0.0, |p| p[2]);
+        if let Some((i, p)) = points.iter().enumerate().find(|(_, p)| p[2] != z0) {
+            return Err(err(format!(
+                "a 2D mesh must lie in a plane z = const; node {i} has z = {} (node 0: {z0})",
+                p[2]
+            )));
+        }
+        for p in &mut points {
+            p[2] = 0.0;
+        }
+    }
+    let n_cells = cells.len() / kind.n_nodes();
+    for v in regions.values_mut() {
+        v.sort_unstable();
+        v.dedup();
+    }
+    regions
+        .entry("body".into())
+        .or_insert_with(|| (0..n_cells).collect());
+    let mesh = Mesh {
+        dim: dim as usize,
+        kind,
+        points,
+        cells,
+        boundaries,
+        regions,
+    };
+    mesh.check().map_err(|e| err(format!("{e}")))?;
+    Ok(mesh)
+}
+
+/// Turns round every cell of `first..last` when all of them are negatively oriented.
+fn orient_block(
+    points: &[[f64; 3]],
+    cells: &mut [usize],
+    kind: CellKind,
+    first: usize,
+    last: usize,
+) {
+    let k = kind.n_nodes();
+    let sign = |c: &[usize]| -> f64 {
+        match kind {
+            CellKind::Tet4 => crate::generate::signed_volume(points, c),
+            _ => {
+                let (a, b, cc) = (points[c[0]], points[c[1]], points[c[2]]);
+                (b[0] - a[0]) * (cc[1] - a[1]) - (cc[0] - a[0]) * (b[1] - a[1])
+            }
+        }
+    };
+    let block = &mut cells[first * k..last * k];
+    if !block.is_empty() && block.chunks_exact(k).all(|c| sign(c) < 0.0) {
+        for c in block.chunks_exact_mut(k) {
+            match kind {
+                CellKind::Quad4 => c.swap(1, 3),
+                _ => c.swap(1, 2),
+            }
+        }
+    }
+}
+
+/// Reads `$PhysicalNames` (ASCII in both encodings): `(dim, tag) -> name`.
+fn physical_names(bytes: &[u8]) -> Result<HashMap<(i32, i32), String>, String> {
+    let mut out = HashMap::new();
+    let Some(start) = find(bytes, b"$PhysicalNames") else {
+        return Ok(out);
+    };
+    let rest = &bytes[start..];
+    let end =
+        find(rest, b"$EndPhysicalNames").ok_or("`$PhysicalNames` has no `$EndPhysicalNames`")?;
+    let text = std::str::from_utf8(&rest[..end]).map_err(|_| "`$PhysicalNames` is not text")?;
+    let mut lines = text.lines().skip(1).filter(|l| !l.trim().is_empty());
+    let count: usize = lines
+        .next()
+        .and_then(|l| l.trim().parse().ok())
+        .ok_or("`$PhysicalNames` does not start with a count")?;
+    for (i, line) in lines.enumerate() {
+        let mut parts = line.trim().splitn(3, char::is_whitespace);
+        let bad = || format!("`$PhysicalNames` line {}: `{line}`", i + 2);
+        let d: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
+        let tag: i32 = parts
+            .next()
+            .and_then(|s| s.trim().parse().ok())
+            .ok_or_else(bad)?;
+        let name = parts
+            .next()
+            .ok_or_else(bad)?
+            .trim()
+            .trim_matches('"')
+            .to_string();
+        out.insert((d, tag), name);
+    }
+    if out.len() != count {
+        return Err(format!(
+            "`$PhysicalNames` announces {count} names and holds {}",
+            out.len()
+        ));
+    }
+    Ok(out)
+}
+
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).position(|w| w == needle)
+}

@@ -1,0 +1,367 @@
+//! Meshes for piezocontact: nodes, cells, named boundary facet groups and named cell regions.
+//!
+//! # Glossary
+//! - `dim`: the spatial dimension, 2 (plane strain, x-y) or 3.
+//! - node: a point; stored as `[x, y, z]` with `z = 0` in 2D. Indices are `usize`, 0-based.
+//! - cell: a P1 triangle ([`CellKind::Tri3`]), a Q1 quadrilateral ([`CellKind::Quad4`]) or a
+//!   P1 tetrahedron ([`CellKind::Tet4`]); node order is counter-clockwise (2D) or positively
+//!   oriented (3D, `det[p1-p0, p2-p0, p3-p0] > 0`), checked by [`Mesh::check`].
+//! - facet: a boundary entity of dimension `dim - 1` (a segment in 2D, a triangle in 3D).
+//! - boundary group: a named list of facets (`left`, `right`, `bottom`, `top`, and in 3D also
+//!   `front` (y = y0) and `back` (y = y1) for the generators; Gmsh physical groups of dimension
+//!   `dim - 1` for files).
+//! - region: a named list of cells (`body` for the generators; Gmsh physical groups of
+//!   dimension `dim` for files). Materials are attached to regions.
+//!
+//! Lengths carry the unit of the scene; the mesh itself is unit-free.
+//!
+//! # Example
+//! ```
+//! use mesh::{rectangle_tri, CellKind};
+//! let m = rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2);
+//! assert_eq!(m.kind, CellKind::Tri3);
+//! assert_eq!(m.n_nodes(), 5 * 3);
+//! assert_eq!(m.n_cells(), 2 * 4 * 2);
+//! assert_eq!(m.boundary("bottom").unwrap().n_facets(), 4);
+//! m.check().unwrap();
+//! ```
+
+mod generate;
+mod gmsh;
+mod quality;
+
+pub use generate::{box_tet, rectangle_quad, rectangle_tri};
+pub use gmsh::{read_msh, read_msh_bytes};
+pub use quality::QualityReport;
+
+use std::collections::BTreeMap;
+
+/// The kind of every cell of a mesh (meshes hold one kind).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellKind {
+    /// Three-node triangle (P1), 2D.
+    Tri3,
+    /// Four-node quadrilateral (Q1), 2D, counter-clockwise.
+    Quad4,
+    /// Four-node tetrahedron (P1), 3D.
+    Tet4,
+}
+
+impl CellKind {
+    /// Nodes per cell.
+    pub fn n_nodes(self) -> usize {
+        match self {
+            CellKind::Tri3 => 3,
+            CellKind::Quad4 | CellKind::Tet4 => 4,
+        }
+    }
+    /// Spatial dimension of the cell.
+    pub fn dim(self) -> usize {
+        match self {
+            CellKind::Tri3 | CellKind::Quad4 => 2,
+            CellKind::Tet4 => 3,
+        }
+    }
+    /// Nodes per boundary facet of a mesh of this kind.
+    pub fn facet_n_nodes(self) -> usize {
+        match self {
+            CellKind::Tri3 | CellKind::Quad4 => 2,
+            CellKind::Tet4 => 3,
+        }
+    }
+    /// A short name, as in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            CellKind::Tri3 => "triangle (P1)",
+            CellKind::Quad4 => "quadrilateral (Q1)",
+            CellKind::Tet4 => "tetrahedron (P1)",
+        }
+    }
+}
+
+/// A named set of boundary facets, each given by its `facet_n_nodes` node indices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FacetGroup {
+    /// Nodes per facet (2 in 2D, 3 in 3D).
+    pub nodes_per_facet: usize,
+    /// Flat node indices, `nodes_per_facet` per facet.
+    pub facets: Vec<usize>,
+}
+
+impl FacetGroup {
+    /// Number of facets.
+    pub fn n_facets(&self) -> usize {
+        self.facets
+            .len()
+            .checked_div(self.nodes_per_facet)
+            .unwrap_or(0)
+    }
+    /// The node indices of facet `f`.
+    pub fn facet(&self, f: usize) -> &[usize] {
+        &self.facets[f * self.nodes_per_facet..(f + 1) * self.nodes_per_facet]
+    }
+    /// Iterator over the facets.
+    pub fn iter(&self) -> impl Iterator<Item = &[usize]> + '_ {
+        self.facets.chunks_exact(self.nodes_per_facet.max(1))
+    }
+    /// The distinct nodes of the group, sorted.
+    pub fn nodes(&self) -> Vec<usize> {
+        let mut v = self.facets.clone();
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+}
+
+/// A mesh of one cell kind with named boundary groups and regions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Spatial dimension (2 or 3).
+    pub dim: usize,
+    /// The kind of every cell.
+    pub kind: CellKind,
+    /// Node coordinates, `z = 0` in 2D.
+    pub points: Vec<[f64; 3]>,
+    /// Flat cell connectivity, `kind.n_nodes()` per cell.
+    pub cells: Vec<usize>,
+    /// Named boundary facet groups.
+    pub boundaries: BTreeMap<String, FacetGroup>,
+    /// Named cell regions (lists of cell indices, sorted).
+    pub regions: BTreeMap<String, Vec<usize>>,
+}
+
+/// What can go wrong with a mesh: reading it, checking it, or asking it for a group.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum MeshError {
+    /// A boundary group was asked for that the mesh does not have.
+    #[error("boundary group `{name}` is missing (the mesh has: {available})")]
+    MissingBoundary {
+        /// The group asked for.
+        name: String,
+        /// The groups the mesh has, comma-separated.
+        available: String,
+    },
+    /// A region was asked for that the mesh does not have.
+    #[error("region `{name}` is missing (the mesh has: {available})")]
+    MissingRegion {
+        /// The region asked for.
+        name: String,
+        /// The regions the mesh has, comma-separated.
+        available: String,
+    },
+    /// A cell whose signed measure is zero (up to round-off) or has the wrong sign.
+    #[error("cell {cell} is {what} (signed {measure_name} {measure:.3e}, nodes {nodes:?})")]
+    BadCell {
+        /// Cell index.
+        cell: usize,
+        /// `degenerate` or `inverted`.
+        what: &'static str,
+        /// `area` or `volume`.
+        measure_name: &'static str,
+        /// The signed measure.
+        measure: f64,
+        /// The cell's nodes.
+        nodes: Vec<usize>,
+    },
+    /// A node no cell uses.
+    #[error("{count} node(s) belong to no cell, the first is node {first}")]
+    UnusedNodes {
+        /// How many nodes are unused.
+        count: usize,
+        /// The first unused node.
+        first: usize,
+    },
+    /// A cell or facet that names a node that does not exist.
+    #[error("{item} refers to node {node}, but the mesh has {n_nodes} nodes")]
+    NodeOutOfRange {
+        /// What refers to it (e.g. `cell 12`, `facet 3 of group top`).
+        item: String,
+        /// The bad index.
+        node: usize,
+        /// Number of nodes.
+        n_nodes: usize,
+    },
+    /// A coordinate that is NaN or infinite.
+    #[error("node {node} has a non-finite coordinate {coord:?}")]
+    NonFiniteCoordinate {
+        /// Node index.
+        node: usize,
+        /// Its coordinates.
+        coord: [f64; 3],
+    },
+    /// A mesh without cells.
+    #[error("the mesh has no cells")]
+    Empty,
+    /// A file could not be read.
+    #[error("cannot read mesh file {path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The operating system's message.
+        message: String,
+    },
+    /// A Gmsh file that does not parse, or holds what we cannot use.
+    #[error("Gmsh file {path}: {message}")]
+    Gmsh {
+        /// The file (or `<bytes>`).
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl Mesh {
+    /// Number of nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.points.len()
+    }
+    /// Number of cells.
+    pub fn n_cells(&self) -> usize {
+        self.cells.len() / self.kind.n_nodes()
+    }
+    /// The node indices of cell `c`.
+    pub fn cell(&self, c: usize) -> &[usize] {
+        let k = self.kind.n_nodes();
+        &self.cells[c * k..(c + 1) * k]
+    }
+    /// Iterator over the cells' node lists.
+    pub fn iter_cells(&self) -> impl Iterator<Item = &[usize]> + '_ {
+        self.cells.chunks_exact(self.kind.n_nodes())
+    }
+    /// The coordinates of node `i` (first `dim` entries meaningful).
+    pub fn point(&self, i: usize) -> &[f64] {
+        &self.points[i][..self.dim]
+    }
+    /// The boundary group `name`, or a [`MeshError::MissingBoundary`] that lists what exists.
+    pub fn boundary(&self, name: &str) -> Result<&FacetGroup, MeshError> {
+        self.boundaries
+            .get(name)
+            .ok_or_else(|| MeshError::MissingBoundary {
+                name: name.to_string(),
+                available: join_keys(self.boundaries.keys()),
+            })
+    }
+    /// The region `name`, or a [`MeshError::MissingRegion`] that lists what exists.
+    pub fn region(&self, name: &str) -> Result<&[usize], MeshError> {
+        self.regions
+            .get(name)
+            .map(Vec::as_slice)
+            .ok_or_else(|| MeshError::MissingRegion {
+                name: name.to_string(),
+                available: join_keys(self.regions.keys()),
+            })
+    }
+    /// The facets of group `name` all of whose nodes satisfy `keep(x)` (for example the part
+    /// of the top face under an electrode), as a new group.
+    pub fn select_facets(
+        &self,
+        name: &str,
+        keep: impl Fn(&[f64]) -> bool,
+    ) -> Result<FacetGroup, MeshError> {
+        let g = self.boundary(name)?;
+        let mut out = FacetGroup {
+            nodes_per_facet: g.nodes_per_facet,
+            facets: vec![],
+        };
+        for f in g.iter() {
+            if f.iter().all(|&v| keep(self.point(v))) {
+                out.facets.extend_from_slice(f);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Axis-aligned bounding box `(min, max)`.
+    pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.points {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (lo, hi)
+    }
+    /// The largest cell diameter (longest edge), the `h` of convergence studies.
+    pub fn h_max(&self) -> f64 {
+        let mut h: f64 = 0.0;
+        for c in self.iter_cells() {
+            for (a, &i) in c.iter().enumerate() {
+                for &j in &c[a + 1..] {
+                    h = h.max(dist(&self.points[i], &self.points[j]));
+                }
+            }
+        }
+        h
+    }
+    /// The nodes-by-nodes adjacency (sorted, including the diagonal), in compressed form:
+    /// `(offsets, neighbours)`, node `i`'s neighbours at `neighbours[offsets[i]..offsets[i+1]]`.
+    /// Two nodes are neighbours when a cell holds both.
+    pub fn node_graph(&self) -> (Vec<usize>, Vec<usize>) {
+        self.node_graph_where(|_| true)
+    }
+
+    /// Cells of each node, in compressed form `(offsets, cells)` (as [`Mesh::node_graph`]).
+    pub fn node_cells(&self) -> (Vec<usize>, Vec<usize>) {
+        let n = self.n_nodes();
+        let mut count = vec![0usize; n + 1];
+        for &v in &self.cells {
+            count[v + 1] += 1;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut node_cells = vec![0usize; self.cells.len()];
+        for (c, cell) in self.iter_cells().enumerate() {
+            for &v in cell {
+                node_cells[fill[v]] = c;
+                fill[v] += 1;
+            }
+        }
+        (count, node_cells)
+    }
+
+    /// As [`Mesh::node_graph`], counting only the cells `c` with `keep(c)`; a node in no kept
+    /// cell is its own only neighbour.
+    pub fn node_graph_where(&self, keep: impl Fn(usize) -> bool) -> (Vec<usize>, Vec<usize>) {
+        let n = self.n_nodes();
+        let k = self.kind.n_nodes();
+        let (count, node_cells) = self.node_cells();
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0);
+        let mut nbrs = Vec::with_capacity(n * 8);
+        let mut scratch = Vec::with_capacity(64);
+        for i in 0..n {
+            scratch.clear();
+            for &c in node_cells[count[i]..count[i + 1]]
+                .iter()
+                .filter(|&&c| keep(c))
+            {
+                scratch.extend_from_slice(&self.cells[c * k..(c + 1) * k]);
+            }
+            if scratch.is_empty() {
+                scratch.push(i);
+            }
+            scratch.sort_unstable();
+            scratch.dedup();
+            nbrs.extend_from_slice(&scratch);
+            offsets.push(nbrs.len());
+        }
+        (offsets, nbrs)
+    }
+}
+
+fn join_keys<'a>(keys: impl Iterator<Item = &'a String>) -> String {
+    let v: Vec<&str> = keys.map(String::as_str).collect();
+    if v.is_empty() {
+        "none".to_string()
+    } else {
+        v.join(", ")
+    }
+}
+
+fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
