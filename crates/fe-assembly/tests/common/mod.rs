@@ -1,0 +1,105 @@
+//! Helpers shared by the integration tests: solving the assembled system both ways, and full
+//! tensors from Voigt arrays.
+#![allow(dead_code)]
+
+use fe_assembly::{Blocks, Discretization, Load, Parallelism};
+use linalg::{CoupledSolver, DirectLdlt, Ordering, PcgParams, SchurPcg};
+
+/// Solves with the direct L D Lᵀ and with the Schur PCG; returns both `(u, φ)` free vectors.
+pub fn solve_both(
+    disc: &Discretization<'_>,
+    loads: &[Load],
+) -> ((Vec<f64>, Vec<f64>), (Vec<f64>, Vec<f64>), Blocks) {
+    let blocks = disc.assemble(Parallelism::Rayon);
+    let (bu, bphi) = disc.rhs(loads).unwrap();
+    let (nu, np) = (disc.dofs.n_u, disc.dofs.n_phi);
+    let mut direct = DirectLdlt::new(
+        &blocks.a,
+        &blocks.g,
+        &blocks.b,
+        &Ordering::Amd,
+        faer::Par::Seq,
+    )
+    .unwrap();
+    let (mut u1, mut p1) = (vec![0.0; nu], vec![0.0; np]);
+    direct.solve(&bu, &bphi, &mut u1, &mut p1).unwrap();
+    let params = PcgParams {
+        rel_tol: 1e-13,
+        max_iters: 500,
+        ..Default::default()
+    };
+    let mut schur = SchurPcg::new(
+        blocks.a.clone(),
+        blocks.g.clone(),
+        &blocks.b,
+        params,
+        faer::Par::Seq,
+    )
+    .unwrap();
+    let (mut u2, mut p2) = (vec![0.0; nu], vec![0.0; np]);
+    schur.solve(&bu, &bphi, &mut u2, &mut p2).unwrap();
+    ((u1, p1), (u2, p2), blocks)
+}
+
+/// Voigt index of `(i, j)` in dimension `dim`.
+pub fn voigt(dim: usize, i: usize, j: usize) -> usize {
+    let (a, b) = (i.min(j), i.max(j));
+    if dim == 2 {
+        match (a, b) {
+            (0, 0) => 0,
+            (1, 1) => 1,
+            _ => 2,
+        }
+    } else {
+        match (a, b) {
+            (0, 0) => 0,
+            (1, 1) => 1,
+            (2, 2) => 2,
+            (1, 2) => 3,
+            (0, 2) => 4,
+            _ => 5,
+        }
+    }
+}
+
+/// `σ = C ε + eᵀ ∇φ` and `D = e ε - β ∇φ` for a displacement gradient `gu[k][l] = ∂u_k/∂x_l`
+/// and a potential gradient `gp`.
+pub fn stress_and_d(
+    m: &fe_assembly::Material,
+    gu: &[[f64; 3]; 3],
+    gp: &[f64; 3],
+) -> ([[f64; 3]; 3], [f64; 3]) {
+    let dim = m.dim;
+    let nv = m.nv();
+    let mut sigma = [[0.0; 3]; 3];
+    let mut d = [0.0; 3];
+    for i in 0..dim {
+        for j in 0..dim {
+            let mut s = 0.0;
+            for k in 0..dim {
+                for l in 0..dim {
+                    s += m.c[voigt(dim, i, j) * nv + voigt(dim, k, l)] * gu[k][l];
+                }
+                s += m.e[k * nv + voigt(dim, i, j)] * gp[k];
+            }
+            sigma[i][j] = s;
+        }
+        let mut s = 0.0;
+        for k in 0..dim {
+            for l in 0..dim {
+                s += m.e[i * nv + voigt(dim, k, l)] * gu[k][l];
+            }
+            s -= m.beta[i * dim + k] * gp[k];
+        }
+        d[i] = s;
+    }
+    (sigma, d)
+}
+
+/// Largest absolute difference.
+pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}

@@ -1,0 +1,175 @@
+//! Property tests of the linear algebra on random matrices (no finite elements):
+//! - PCG reaches its tolerance on random SPD systems, with and without a preconditioner;
+//! - the Schur operator equals the dense `S = A + Gᵀ B⁻¹ G`;
+//! - the direct `L D Lᵀ` and the Schur PCG give the same solution of `K x = b`;
+//! - an ordering that puts chosen dofs last gives the same solution as AMD, and `K` has
+//!   exactly `n_φ` negative pivots.
+
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Par;
+use linalg::sparse::{mul_add, to_dense};
+use linalg::{
+    pcg, CoupledSolver, DirectLdlt, FactorKind, Identity, LinearOperator, Ordering, PcgParams,
+    SchurOperator, SchurPcg, SparseFactor,
+};
+use nalgebra::DMatrix;
+use proptest::prelude::*;
+
+/// A random sparse SPD matrix: a random sparse M, then Mᵀ M + shift I.
+fn spd(n: usize, vals: &[f64], shift: f64) -> SparseColMat<usize, f64> {
+    let mut m = DMatrix::<f64>::zeros(n, n);
+    for (k, &v) in vals.iter().enumerate() {
+        let (i, j) = ((k * 7) % n, (k * 13 + k / n) % n);
+        m[(i, j)] += v;
+    }
+    let a = m.transpose() * &m + DMatrix::identity(n, n) * shift;
+    dense_to_sparse(&a)
+}
+
+fn dense_to_sparse(a: &DMatrix<f64>) -> SparseColMat<usize, f64> {
+    let mut t = vec![];
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            if a[(i, j)] != 0.0 {
+                t.push(Triplet::new(i, j, a[(i, j)]));
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(a.nrows(), a.ncols(), &t).unwrap()
+}
+
+fn dense(m: &SparseColMat<usize, f64>) -> DMatrix<f64> {
+    let d = to_dense(m.as_ref());
+    DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| d[i][j])
+}
+
+struct Csc<'a>(&'a SparseColMat<usize, f64>);
+impl LinearOperator for Csc<'_> {
+    fn n(&self) -> usize {
+        self.0.nrows()
+    }
+    fn apply(&mut self, out: &mut [f64], x: &[f64]) {
+        out.fill(0.0);
+        mul_add(self.0.as_ref(), x, out, 1.0);
+    }
+}
+
+struct Inv<'a>(&'a mut SparseFactor);
+impl LinearOperator for Inv<'_> {
+    fn n(&self) -> usize {
+        self.0.n()
+    }
+    fn apply(&mut self, out: &mut [f64], x: &[f64]) {
+        out.copy_from_slice(x);
+        self.0.solve_in_place(out);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+    #[test]
+    fn pcg_reaches_its_tolerance(
+        n in 5usize..60,
+        vals in prop::collection::vec(-1.0f64..1.0, 200),
+        b in prop::collection::vec(-1.0f64..1.0, 60),
+        shift in 1e-3f64..1.0,
+    ) {
+        let a = spd(n, &vals, shift);
+        let b = &b[..n];
+        let params = PcgParams { rel_tol: 1e-10, max_iters: 10 * n, ..Default::default() };
+        let mut x = vec![0.0; n];
+        let info = pcg(&mut Csc(&a), &mut Identity(n), b, &mut x, &params).unwrap();
+        // the true residual meets the tolerance (not only the recursive one), up to drift
+        let mut r = vec![0.0; n];
+        mul_add(a.as_ref(), &x, &mut r, 1.0);
+        let res: f64 = r.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>().sqrt();
+        let nb: f64 = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+        prop_assert!(info.rel_residual <= 1e-10);
+        prop_assert!(res <= 1e-8 * nb, "true residual {res}");
+        // preconditioned by the exact inverse: one iteration (two with round-off)
+        let mut f = SparseFactor::new(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, Par::Seq).unwrap();
+        let mut x2 = vec![0.0; n];
+        let info2 = pcg(&mut Csc(&a), &mut Inv(&mut f), b, &mut x2, &params).unwrap();
+        prop_assert!(info2.n_iters <= 2, "{} iterations with the exact preconditioner", info2.n_iters);
+    }
+
+    #[test]
+    fn schur_operator_equals_dense_and_strategies_agree(
+        nu in 4usize..30,
+        np in 2usize..15,
+        va in prop::collection::vec(-1.0f64..1.0, 120),
+        vb in prop::collection::vec(-1.0f64..1.0, 60),
+        vg in prop::collection::vec(-2.0f64..2.0, 80),
+        rhs in prop::collection::vec(-1.0f64..1.0, 45),
+    ) {
+        let a = spd(nu, &va, 0.1);
+        let b = spd(np, &vb, 0.1);
+        let mut gd = DMatrix::<f64>::zeros(np, nu);
+        for (k, &v) in vg.iter().enumerate() {
+            gd[((k * 5) % np, (k * 3 + k / np) % nu)] += v;
+        }
+        let g = dense_to_sparse(&gd);
+        let (ad, bd) = (dense(&a), dense(&b));
+        let s_dense = &ad + gd.transpose() * bd.clone().try_inverse().unwrap() * &gd;
+        let mut fb = SparseFactor::new(b.as_ref(), FactorKind::Cholesky, &Ordering::Amd, Par::Seq).unwrap();
+        let mut op = SchurOperator::new(&a, &g, &mut fb);
+        let scale = s_dense.amax();
+        for j in 0..nu {
+            let mut e = vec![0.0; nu];
+            e[j] = 1.0;
+            let mut col = vec![0.0; nu];
+            op.apply(&mut col, &e);
+            for i in 0..nu {
+                prop_assert!((col[i] - s_dense[(i, j)]).abs() <= 1e-10 * scale);
+            }
+        }
+        // both strategies solve K x = b
+        let (bu, bp) = (&rhs[..nu], &rhs[30..30 + np]);
+        let mut direct = DirectLdlt::new(&a, &g, &b, &Ordering::Amd, Par::Seq).unwrap();
+        prop_assert_eq!(direct.factor().inertia(), (nu, np, 0));
+        let (mut u1, mut p1) = (vec![0.0; nu], vec![0.0; np]);
+        direct.solve(bu, bp, &mut u1, &mut p1).unwrap();
+        let params = PcgParams { rel_tol: 1e-14, max_iters: 200, ..Default::default() };
+        let mut schur = SchurPcg::new(a.clone(), g.clone(), &b, params, Par::Seq).unwrap();
+        let (mut u2, mut p2) = (vec![0.0; nu], vec![0.0; np]);
+        schur.solve(bu, bp, &mut u2, &mut p2).unwrap();
+        let xs: f64 = u1.iter().chain(&p1).fold(0.0, |m, x| m.max(x.abs()));
+        for (x, y) in u1.iter().chain(&p1).zip(u2.iter().chain(&p2)) {
+            prop_assert!((x - y).abs() <= 1e-9 * xs.max(1e-300), "{x} vs {y}");
+        }
+        // the same with the electric dofs and two u dofs ordered last
+        let mut last: Vec<usize> = (nu..nu + np).collect();
+        last.extend([0, nu / 2]);
+        let mut custom = DirectLdlt::new(&a, &g, &b, &Ordering::AmdThenLast(last.clone()), Par::Seq).unwrap();
+        prop_assert_eq!(&custom.factor().permutation()[nu + np - last.len()..], &last[..]);
+        let (mut u3, mut p3) = (vec![0.0; nu], vec![0.0; np]);
+        custom.solve(bu, bp, &mut u3, &mut p3).unwrap();
+        for (x, y) in u1.iter().chain(&p1).zip(u3.iter().chain(&p3)) {
+            prop_assert!((x - y).abs() <= 1e-10 * xs.max(1e-300));
+        }
+    }
+}
+
+#[test]
+fn not_positive_definite_is_a_typed_error() {
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(
+        2,
+        2,
+        &[Triplet::new(0, 0, 1.0), Triplet::new(1, 1, -1.0)],
+    )
+    .unwrap();
+    let e =
+        SparseFactor::new(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, Par::Seq).unwrap_err();
+    assert!(
+        matches!(e, linalg::LinalgError::NotPositiveDefinite { .. }),
+        "{e}"
+    );
+    let nan =
+        SparseColMat::<usize, f64>::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, f64::NAN)])
+            .unwrap();
+    assert!(matches!(
+        SparseFactor::new(nan.as_ref(), FactorKind::Ldlt, &Ordering::Amd, Par::Seq),
+        Err(linalg::LinalgError::NonFinite { .. })
+    ));
+}
