@@ -1,1 +1,83 @@
-fn main() {}
+//! Project automation: `cargo xtask verify` (fmt, clippy, tests, docs) and `cargo xtask bench`
+//! (the linear benchmark on the paper geometry). Kept free of dependencies.
+
+use std::process::{Command, ExitCode};
+
+fn cargo(args: &[&str], env: &[(&str, &str)]) -> bool {
+    eprintln!("$ cargo {}", args.join(" "));
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.status().map(|s| s.success()).unwrap_or(false)
+}
+
+fn verify() -> bool {
+    cargo(&["fmt", "--all", "--", "--check"], &[])
+        && cargo(
+            &[
+                "clippy",
+                "--workspace",
+                "--all-targets",
+                "--",
+                "-D",
+                "warnings",
+            ],
+            &[],
+        )
+        && cargo(&["test", "--workspace"], &[])
+        && cargo(
+            &["doc", "--workspace", "--no-deps"],
+            &[("RUSTDOCFLAGS", "-D warnings")],
+        )
+}
+
+fn bench(sizes: &[String]) -> bool {
+    if !cargo(
+        &[
+            "build",
+            "--release",
+            "-p",
+            "driver",
+            "--example",
+            "bench_linear",
+        ],
+        &[],
+    ) {
+        return false;
+    }
+    println!("n,dofs_u,dofs_phi,assembly_s,ldlt_symbolic_s,ldlt_numeric_s,ldlt_solve_s,schur_cholesky_s,pcg_iters,pcg_solve_s,rel_diff,peak_MiB");
+    for n in sizes {
+        let exe = std::path::Path::new("target/release/examples/bench_linear");
+        match Command::new(exe).arg(n).status() {
+            Ok(s) if s.success() => {}
+            _ => return false,
+        }
+    }
+    true
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let ok = match args.first().map(String::as_str) {
+        Some("verify") => verify(),
+        Some("bench") => {
+            let sizes: Vec<String> = if args.len() > 1 {
+                args[1..].to_vec()
+            } else {
+                ["64", "128", "256", "512"].map(String::from).to_vec()
+            };
+            bench(&sizes)
+        }
+        _ => {
+            eprintln!("usage: cargo xtask verify | cargo xtask bench [n ...]");
+            false
+        }
+    };
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}

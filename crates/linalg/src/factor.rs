@@ -33,6 +33,9 @@ pub enum Ordering {
     /// AMD on every index but `last`, which come last in the given order (for example the
     /// contact dofs, so that the trailing block of the factor is their Schur complement).
     AmdThenLast(Vec<usize>),
+    /// A given permutation, `fwd[new] = old` (for example AMD on the mesh's node graph,
+    /// expanded to each node's dofs).
+    Given(Vec<usize>),
 }
 
 /// A sparse symmetric factorisation with its workspaces. Only the lower triangle of the matrix
@@ -88,6 +91,10 @@ impl SparseFactor {
             Ordering::Amd => SymmetricOrdering::Amd,
             Ordering::AmdThenLast(last) => {
                 (fwd, inv) = amd_then_last(a, last)?;
+                SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
+            }
+            Ordering::Given(given) => {
+                (fwd, inv) = (given.clone(), inverse_permutation(given)?);
                 SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
             }
         };
@@ -259,6 +266,21 @@ impl SparseFactor {
             None => (0..self.n()).collect(),
         }
     }
+}
+
+/// The inverse of a permutation, or an error if `fwd` is not one.
+fn inverse_permutation(fwd: &[usize]) -> Result<Vec<usize>, LinalgError> {
+    let n = fwd.len();
+    let mut inv = vec![usize::MAX; n];
+    for (new, &old) in fwd.iter().enumerate() {
+        if old >= n || inv[old] != usize::MAX {
+            return Err(LinalgError::Shape(format!(
+                "ordering: {old} is out of range or repeated"
+            )));
+        }
+        inv[old] = new;
+    }
+    Ok(inv)
 }
 
 /// AMD on the indices not in `last`, then `last` in order. Returns `(fwd, inv)`.

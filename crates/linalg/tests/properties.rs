@@ -148,6 +148,16 @@ proptest! {
         for (x, y) in u1.iter().chain(&p1).zip(u3.iter().chain(&p3)) {
             prop_assert!((x - y).abs() <= 1e-10 * xs.max(1e-300));
         }
+        // and with a given permutation (reversed)
+        let rev: Vec<usize> = (0..nu + np).rev().collect();
+        let mut given = DirectLdlt::new(&a, &g, &b, &Ordering::Given(rev.clone()), Par::Seq).unwrap();
+        prop_assert_eq!(given.factor().permutation(), rev);
+        prop_assert_eq!(given.factor().inertia(), (nu, np, 0));
+        let (mut u4, mut p4) = (vec![0.0; nu], vec![0.0; np]);
+        given.solve(bu, bp, &mut u4, &mut p4).unwrap();
+        for (x, y) in u1.iter().chain(&p1).zip(u4.iter().chain(&p4)) {
+            prop_assert!((x - y).abs() <= 1e-10 * xs.max(1e-300));
+        }
     }
 }
 

@@ -5,11 +5,11 @@
 use fe_assembly::{Blocks, Discretization, Load, Parallelism};
 use linalg::{CoupledSolver, DirectLdlt, Ordering, PcgParams, SchurPcg};
 
-/// Solves with the direct L D Lᵀ and with the Schur PCG; returns both `(u, φ)` free vectors.
-pub fn solve_both(
-    disc: &Discretization<'_>,
-    loads: &[Load],
-) -> ((Vec<f64>, Vec<f64>), (Vec<f64>, Vec<f64>), Blocks) {
+/// Free `(u, φ)` vectors.
+pub type Solution = (Vec<f64>, Vec<f64>);
+
+/// Solves with the direct L D Lᵀ and with the Schur PCG; returns both solutions.
+pub fn solve_both(disc: &Discretization<'_>, loads: &[Load]) -> (Solution, Solution, Blocks) {
     let blocks = disc.assemble(Parallelism::Rayon);
     let (bu, bphi) = disc.rhs(loads).unwrap();
     let (nu, np) = (disc.dofs.n_u, disc.dofs.n_phi);

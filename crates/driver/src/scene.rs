@@ -1,0 +1,446 @@
+//! Scene files (TOML): what to solve. A scene is read, `--set KEY=VALUE` overrides are applied
+//! to its TOML tree, and the result is deserialised with unknown keys rejected, so a typo names
+//! itself in the error.
+
+use crate::DriverError;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The scenes shipped with the program, by name (their files are in `scenes/`).
+pub const SHIPPED: &[(&str, &str)] = &[
+    ("paper", include_str!("../../../scenes/paper.toml")),
+    ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
+    (
+        "paper-elastic",
+        include_str!("../../../scenes/paper-elastic.toml"),
+    ),
+];
+
+/// A whole scene.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Short name.
+    pub name: String,
+    /// One line: what the scene is.
+    pub description: String,
+    /// The mesh.
+    pub mesh: MeshSpec,
+    /// Materials by region.
+    pub material: Vec<MaterialSpec>,
+    /// Options on all materials.
+    #[serde(default)]
+    pub materials: MaterialOptions,
+    /// Clamped / grounded groups.
+    #[serde(default)]
+    pub dirichlet: Vec<DirichletSpec>,
+    /// The mechanical load.
+    #[serde(default)]
+    pub load: Option<LoadSpec>,
+    /// A voltage electrode.
+    #[serde(default)]
+    pub electrode: Option<ElectrodeSpec>,
+    /// Contact with a rigid foundation.
+    #[serde(default)]
+    pub contact: Option<ContactSpec>,
+    /// Solver choices.
+    #[serde(default)]
+    pub solver: SolverSpec,
+}
+
+/// How the mesh is made.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// `rectangle` (P1 triangles, SW-NE split), `box` (Kuhn tetrahedra) or `gmsh`.
+    pub kind: String,
+    /// Lower corner (rectangle, box).
+    #[serde(default)]
+    pub lo: Vec<f64>,
+    /// Upper corner (rectangle, box).
+    #[serde(default)]
+    pub hi: Vec<f64>,
+    /// Cells along the shortest edge; the other edges get proportionally many.
+    #[serde(default)]
+    pub n: Option<usize>,
+    /// Cells along x, y, z (override `n` per axis).
+    #[serde(default)]
+    pub nx: Option<usize>,
+    /// Cells along y.
+    #[serde(default)]
+    pub ny: Option<usize>,
+    /// Cells along z.
+    #[serde(default)]
+    pub nz: Option<usize>,
+    /// Target cell size (a length): sets `n` from the shortest edge.
+    #[serde(default)]
+    pub h: Option<f64>,
+    /// Gmsh file (for `kind = "gmsh"`), relative to the scene file.
+    #[serde(default)]
+    pub file: Option<String>,
+    /// The coarse size the smoke tests run.
+    #[serde(default)]
+    pub smoke_n: Option<usize>,
+}
+
+/// A material on a region.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// The region (`body` = every cell of a generated mesh).
+    pub region: String,
+    /// `crystal-6mm` (c = [c11, c12, c13, c33, c44, c66], e = [e31, e33, e15],
+    /// permittivity = [eps11, eps33]) or `isotropic` (young, poisson, permittivity).
+    pub model: String,
+    /// Elastic constants (crystal-6mm).
+    #[serde(default)]
+    pub c: Vec<f64>,
+    /// Piezoelectric constants (crystal-6mm).
+    #[serde(default)]
+    pub e: Vec<f64>,
+    /// Permittivity: `[eps11, eps33]` (crystal-6mm) or `[eps]` (isotropic; omitted or 0: no
+    /// electric unknowns).
+    #[serde(default)]
+    pub permittivity: Vec<f64>,
+    /// Poling direction (global coordinates, 3 components).
+    #[serde(default)]
+    pub poling: Vec<f64>,
+    /// Young's modulus (isotropic).
+    #[serde(default)]
+    pub young: Option<f64>,
+    /// Poisson's ratio (isotropic).
+    #[serde(default)]
+    pub poisson: Option<f64>,
+}
+
+/// Options on all materials.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialOptions {
+    /// Multiplies every piezoelectric constant (`material.coupling_scale`).
+    #[serde(default)]
+    pub coupling_scale: Option<f64>,
+}
+
+/// Dirichlet conditions on a boundary group.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DirichletSpec {
+    /// Boundary group.
+    pub group: String,
+    /// Prescribed displacement (all components), if any.
+    #[serde(default)]
+    pub u: Option<Vec<f64>>,
+    /// Prescribed potential, if any.
+    #[serde(default)]
+    pub phi: Option<f64>,
+}
+
+/// A uniform traction `p * direction` on a group.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Boundary group.
+    pub group: String,
+    /// Magnitude (`load.p`).
+    pub p: f64,
+    /// Unit direction.
+    pub direction: Vec<f64>,
+}
+
+/// A voltage on the part of a group inside a box.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ElectrodeSpec {
+    /// Boundary group the electrode lies on.
+    pub group: String,
+    /// Voltage (`electrode.v`).
+    pub v: f64,
+    /// Only facets whose nodes have `x_range[0] <= x <= x_range[1]`.
+    #[serde(default)]
+    pub x_range: Option<Vec<f64>>,
+}
+
+/// Contact with a rigid, non-conductive foundation.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Boundary group in contact.
+    pub group: String,
+    /// `none`, `signorini`, `tresca` or `coulomb`.
+    pub law: String,
+    /// Coulomb coefficient F.
+    #[serde(default)]
+    pub friction: f64,
+    /// Tresca slip bound S.
+    #[serde(default)]
+    pub slip_bound: f64,
+    /// Initial gap g (uniform).
+    #[serde(default)]
+    pub gap: f64,
+    /// Outward normal of the contact face.
+    pub normal: Vec<f64>,
+}
+
+/// Solver choices.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Linear strategy: `direct-ldlt` or `schur-pcg` (for the contact strategies, see
+    /// `piezocontact strategies`).
+    #[serde(default = "default_strategy")]
+    pub strategy: String,
+    /// Tolerance of the contact solve (complementarity residual).
+    #[serde(default = "default_tol")]
+    pub tol: f64,
+    /// `tight` (default) or `paper`.
+    #[serde(default = "default_rule")]
+    pub rule: String,
+    /// PCG relative tolerance for `schur-pcg` (default 1e-12).
+    #[serde(default)]
+    pub pcg_tol: Option<f64>,
+}
+
+fn default_strategy() -> String {
+    "direct-ldlt".into()
+}
+fn default_tol() -> f64 {
+    1e-10
+}
+fn default_rule() -> String {
+    "tight".into()
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        SolverSpec {
+            strategy: default_strategy(),
+            tol: default_tol(),
+            rule: default_rule(),
+            pcg_tol: None,
+        }
+    }
+}
+
+/// Where a scene came from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Source {
+    /// The name or path given.
+    pub label: String,
+    /// The directory relative paths resolve against.
+    pub dir: std::path::PathBuf,
+}
+
+/// Reads a shipped scene by name, or a scene file by path, and applies the overrides.
+pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(Scene, Source), DriverError> {
+    let (text, source) = if let Some((_, text)) = SHIPPED.iter().find(|(n, _)| *n == name_or_path) {
+        (
+            text.to_string(),
+            Source {
+                label: name_or_path.into(),
+                dir: std::env::current_dir().unwrap_or_default(),
+            },
+        )
+    } else if Path::new(name_or_path).exists() {
+        let text = std::fs::read_to_string(name_or_path).map_err(|e| DriverError::Scene {
+            file: name_or_path.into(),
+            message: e.to_string(),
+        })?;
+        let dir = Path::new(name_or_path)
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        (
+            text,
+            Source {
+                label: name_or_path.into(),
+                dir,
+            },
+        )
+    } else {
+        return Err(DriverError::Scene {
+            file: name_or_path.into(),
+            message: format!(
+                "no shipped scene of that name and no such file (shipped: {})",
+                SHIPPED
+                    .iter()
+                    .map(|(n, _)| *n)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        });
+    };
+    let scene = parse(&text, &source.label, overrides)?;
+    Ok((scene, source))
+}
+
+/// Parses scene text and applies `KEY=VALUE` overrides to its TOML tree.
+pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, DriverError> {
+    let err = |message: String| DriverError::Scene {
+        file: label.into(),
+        message,
+    };
+    let mut tree: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| err(e.to_string()))?;
+    for o in overrides {
+        set(&mut tree, o).map_err(|m| err(format!("--set {o}: {m}")))?;
+    }
+    let scene: Scene = toml::Value::Table(tree)
+        .try_into()
+        .map_err(|e: toml::de::Error| err(e.to_string()))?;
+    validate(&scene).map_err(err)?;
+    Ok(scene)
+}
+
+/// Applies one `a.b.c=value` to the tree. The value is read as TOML (number, string, bool,
+/// array), else as a fraction `p/q`, else as a bare string.
+fn set(tree: &mut toml::Table, assignment: &str) -> Result<(), String> {
+    let (key, raw) = assignment.split_once('=').ok_or("expected KEY=VALUE")?;
+    let path: Vec<&str> = key.trim().split('.').collect();
+    if path.iter().any(|p| p.is_empty()) {
+        return Err(format!("`{key}` is not a dotted key"));
+    }
+    let value = parse_value(raw.trim())?;
+    let mut table = tree;
+    for part in &path[..path.len() - 1] {
+        let entry = table
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        table = match entry {
+            toml::Value::Table(t) => t,
+            toml::Value::Array(a) if a.len() == 1 => match &mut a[0] {
+                toml::Value::Table(t) => t,
+                _ => return Err(format!("`{part}` is not a table")),
+            },
+            _ => return Err(format!("`{part}` is not a table")),
+        };
+    }
+    table.insert(path[path.len() - 1].to_string(), value);
+    Ok(())
+}
+
+fn parse_value(raw: &str) -> Result<toml::Value, String> {
+    if let Ok(t) = format!("v = {raw}").parse::<toml::Table>() {
+        if let Some(v) = t.get("v") {
+            return Ok(v.clone());
+        }
+    }
+    if let Some((p, q)) = raw.split_once('/') {
+        if let (Ok(p), Ok(q)) = (p.trim().parse::<f64>(), q.trim().parse::<f64>()) {
+            return Ok(toml::Value::Float(p / q));
+        }
+    }
+    if raw.is_empty() {
+        return Err("empty value".into());
+    }
+    Ok(toml::Value::String(raw.to_string()))
+}
+
+fn validate(s: &Scene) -> Result<(), String> {
+    let finite = |what: &str, v: f64| {
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("{what} = {v} is not a finite number"))
+        }
+    };
+    match s.mesh.kind.as_str() {
+        "rectangle" | "box" => {
+            let d = if s.mesh.kind == "rectangle" { 2 } else { 3 };
+            if s.mesh.lo.len() != d || s.mesh.hi.len() != d {
+                return Err(format!(
+                    "mesh.lo and mesh.hi need {d} coordinates for a {}",
+                    s.mesh.kind
+                ));
+            }
+            for k in 0..d {
+                finite("mesh.lo", s.mesh.lo[k])?;
+                finite("mesh.hi", s.mesh.hi[k])?;
+                if !(s.mesh.hi[k] > s.mesh.lo[k]) {
+                    return Err(format!(
+                        "mesh.hi[{k}] = {} must exceed mesh.lo[{k}] = {}",
+                        s.mesh.hi[k], s.mesh.lo[k]
+                    ));
+                }
+            }
+        }
+        "gmsh" => {
+            if s.mesh.file.is_none() {
+                return Err("mesh.kind = \"gmsh\" needs mesh.file".into());
+            }
+        }
+        k => return Err(format!("mesh.kind `{k}` is unknown (rectangle, box, gmsh)")),
+    }
+    for (key, v) in [
+        ("mesh.n", s.mesh.n),
+        ("mesh.nx", s.mesh.nx),
+        ("mesh.ny", s.mesh.ny),
+        ("mesh.nz", s.mesh.nz),
+    ] {
+        if v == Some(0) {
+            return Err(format!("{key} must be at least 1"));
+        }
+    }
+    if let Some(h) = s.mesh.h {
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(format!("mesh.h = {h} must be a positive length"));
+        }
+    }
+    if s.material.is_empty() {
+        return Err("the scene has no [[material]]".into());
+    }
+    for m in &s.material {
+        for v in
+            m.c.iter()
+                .chain(&m.e)
+                .chain(&m.permittivity)
+                .chain(&m.poling)
+        {
+            finite(
+                &format!("a constant of the material of region `{}`", m.region),
+                *v,
+            )?;
+        }
+    }
+    if let Some(l) = &s.load {
+        finite("load.p", l.p)?;
+    }
+    if let Some(e) = &s.electrode {
+        finite("electrode.v", e.v)?;
+    }
+    if let Some(c) = &s.contact {
+        if !["none", "signorini", "tresca", "coulomb"].contains(&c.law.as_str()) {
+            return Err(format!(
+                "contact.law `{}` is unknown (none, signorini, tresca, coulomb)",
+                c.law
+            ));
+        }
+        finite("contact.friction", c.friction)?;
+        finite("contact.slip_bound", c.slip_bound)?;
+        finite("contact.gap", c.gap)?;
+        if c.friction < 0.0 {
+            return Err(format!(
+                "contact.friction = {} must be non-negative",
+                c.friction
+            ));
+        }
+        if c.slip_bound < 0.0 {
+            return Err(format!(
+                "contact.slip_bound = {} must be non-negative",
+                c.slip_bound
+            ));
+        }
+    }
+    if !["tight", "paper"].contains(&s.solver.rule.as_str()) {
+        return Err(format!(
+            "solver.rule `{}` is unknown (tight, paper)",
+            s.solver.rule
+        ));
+    }
+    finite("solver.tol", s.solver.tol)?;
+    if !(s.solver.tol > 0.0) {
+        return Err(format!("solver.tol = {} must be positive", s.solver.tol));
+    }
+    Ok(())
+}
