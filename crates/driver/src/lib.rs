@@ -17,6 +17,7 @@
 //! ```
 
 pub mod build;
+pub mod contact_setup;
 pub mod output;
 pub mod run;
 pub mod scene;
@@ -47,6 +48,9 @@ pub enum DriverError {
     /// Inconsistent input.
     #[error("{0}")]
     Input(String),
+    /// The contact solve failed (with its last residual).
+    #[error("contact: {0}")]
+    Contact(#[from] contact::ContactError),
     /// Writing the outputs failed.
     #[error("output: {0}")]
     Output(String),

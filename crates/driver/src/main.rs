@@ -52,7 +52,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Strategies => {
-            for (name, desc) in driver::run::LINEAR_STRATEGIES {
+            for (name, desc) in driver::run::STRATEGIES {
                 println!("{name:16} {desc}");
             }
             ExitCode::SUCCESS

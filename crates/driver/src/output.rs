@@ -111,6 +111,56 @@ pub fn vtu(
     Ok(buf)
 }
 
+/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`.
+pub fn contact_csv(points: &contact::ContactPoints, sol: &contact::ContactSolution) -> Vec<u8> {
+    let dim = points.dim;
+    let nt = sol
+        .lambda
+        .tangential
+        .len()
+        .checked_div(points.len())
+        .unwrap_or(0);
+    let mut s = String::new();
+    s.push_str(if dim == 2 {
+        "x,y,gap,u_n,u_t,lambda_n,lambda_t,status\n"
+    } else {
+        "x,y,z,gap,u_n,u_t,u_t2,lambda_n,lambda_t,lambda_t2,status\n"
+    });
+    for i in 0..points.len() {
+        let mut row: Vec<String> = points.position[i][..dim]
+            .iter()
+            .map(|x| format!("{x:.12e}"))
+            .collect();
+        row.push(format!("{:.12e}", points.gap[i]));
+        row.push(format!("{:.12e}", sol.u.normal[i]));
+        for q in 0..dim - 1 {
+            row.push(format!(
+                "{:.12e}",
+                if nt > 0 {
+                    sol.u.tangential[i * nt + q]
+                } else {
+                    0.0
+                }
+            ));
+        }
+        row.push(format!("{:.12e}", sol.lambda.normal[i]));
+        for q in 0..dim - 1 {
+            row.push(format!(
+                "{:.12e}",
+                if nt > 0 {
+                    sol.lambda.tangential[i * nt + q]
+                } else {
+                    0.0
+                }
+            ));
+        }
+        row.push(sol.status[i].name().to_string());
+        s.push_str(&row.join(","));
+        s.push('\n');
+    }
+    s.into_bytes()
+}
+
 /// Where a run writes by default: `out/<scene>/`.
 pub fn default_dir(scene_name: &str) -> PathBuf {
     Path::new("out").join(scene_name)

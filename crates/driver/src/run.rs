@@ -1,9 +1,11 @@
 //! A run, read as the method: make the mesh, set up, assemble, factor, solve, recover, output.
 
 use crate::build;
+use crate::contact_setup::{self, ContactBoundary};
 use crate::output::{self, Outputs};
 use crate::scene::{Scene, Source};
 use crate::DriverError;
+use contact::{ContactSolution, Law, StopRule, UzawaParams};
 use fe_assembly::{Discretization, Parallelism};
 use linalg::{
     equilibrium_residual, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg,
@@ -12,10 +14,11 @@ use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
 
-/// The linear strategies, by name.
-pub const LINEAR_STRATEGIES: &[(&str, &str)] = &[
-    ("direct-ldlt", "one sparse L D Lᵀ of the quasi-definite K, one forward/back solve per step"),
-    ("schur-pcg", "the paper's Algorithm 3: PCG on S = A + Gᵀ B⁻¹ G preconditioned by A (Cholesky of A and B)"),
+/// The solver strategies, by name: how each contact iteration's primal problem is solved.
+pub const STRATEGIES: &[(&str, &str)] = &[
+    ("uzawa-condensed", "default: Uzawa on the contact compliance condensed once from the L D Lᵀ of K by block solves; one final full solve"),
+    ("uzawa-direct", "Uzawa with one full solve per iteration by the L D Lᵀ of K (factored once)"),
+    ("uzawa-schur-pcg", "the paper's: Uzawa with one Schur-complement PCG solve per iteration (Algorithm 3, preconditioned by A)"),
 ];
 
 /// What a run produced (also written as `run.json`).
@@ -55,19 +58,10 @@ pub fn run(
     let mats = build::materials(scene, dim)?;
     let plan = build::plan(scene, dim, &mats);
     progress(&plan.to_string());
-    if !LINEAR_STRATEGIES
-        .iter()
-        .any(|(n, _)| *n == plan.linear_strategy)
-    {
+    if !STRATEGIES.iter().any(|(n, _)| *n == plan.linear_strategy) {
         return Err(DriverError::Input(format!(
             "solver.strategy `{}` is unknown (see `piezocontact strategies`)",
             plan.linear_strategy
-        )));
-    }
-    if plan.contact_law != "none" {
-        return Err(DriverError::Input(format!(
-            "contact.law = {} is not available in this build: run with --set contact.law=none",
-            plan.contact_law
         )));
     }
     let mats = if plan.electric {
@@ -102,32 +96,118 @@ pub fn run(
         },
         ..Default::default()
     };
-    let mut solver: Box<dyn CoupledSolver> = match plan.linear_strategy.as_str() {
-        "schur-pcg" => Box::new(SchurPcg::new(
+    let schur = plan.linear_strategy == "uzawa-schur-pcg";
+    let mut direct = None;
+    let mut pcg_solver = None;
+    if schur {
+        pcg_solver = Some(SchurPcg::new(
             blocks.a.clone(),
             blocks.g.clone(),
             &blocks.b,
             pcg_params,
             par,
-        )?),
-        _ => Box::new(DirectLdlt::new(
+        )?);
+    } else {
+        direct = Some(DirectLdlt::new(
             &blocks.a,
             &blocks.g,
             &blocks.b,
             &Ordering::Amd,
             par,
-        )?),
-    };
+        )?);
+    }
     let t_factor = t.elapsed().as_secs_f64();
+    progress(&format!("factorisation {t_factor:.3} s"));
     let t = Instant::now();
     let (mut u, mut phi) = (vec![0.0; n_u], vec![0.0; n_phi]);
-    let info = solver.solve(&b_u, &b_phi, &mut u, &mut phi)?;
+    let mut contact_result = None;
+    let pcg_total;
+    if plan.contact_law == "none" {
+        let solver: &mut dyn CoupledSolver = match (&mut direct, &mut pcg_solver) {
+            (Some(d), _) => d,
+            (None, Some(p)) => p,
+            _ => unreachable!("one solver is built"),
+        };
+        pcg_total = solver.solve(&b_u, &b_phi, &mut u, &mut phi)?.pcg_iters;
+    } else {
+        let c = scene
+            .contact
+            .as_ref()
+            .expect("a contact law implies a contact section");
+        let cb =
+            contact_setup::boundary(&mesh, &disc.dofs, &c.group, &c.normal, c.gap, c.friction)?;
+        let n_points = cb.points.len();
+        let law = match (plan.contact_law.as_str(), plan.friction) {
+            (_, false) => Law::Frictionless,
+            ("tresca", true) => Law::Tresca(vec![c.slip_bound; n_points]),
+            _ => Law::Coulomb,
+        };
+        let nt = if plan.friction { dim - 1 } else { 0 };
+        let params = UzawaParams {
+            rule: if plan.rule == "paper" {
+                StopRule::Paper
+            } else {
+                StopRule::Tight {
+                    tol: scene.solver.tol,
+                }
+            },
+            report_every: 500,
+            ..Default::default()
+        };
+        let mut report = |p: &contact::Progress| {
+            progress(&format!(
+                "{:>11} {:>6}: residual {:.3e}, stick {}, slip {}, separated {}",
+                p.stage, p.iter, p.residual, p.counts.0, p.counts.1, p.counts.2
+            ))
+        };
+        let sol = match (&mut direct, &mut pcg_solver) {
+            (Some(d), _) if plan.linear_strategy == "uzawa-condensed" => {
+                let mut dense = contact_setup::condense(&cb, d, &b_u, &b_phi, nt)?;
+                let sol = contact::solve(&mut dense, &cb.points, &law, &params, None, &mut report)?;
+                let mut rhs = b_u.clone();
+                cb.add_forces(&sol.lambda, &mut rhs);
+                d.solve(&rhs, &b_phi, &mut u, &mut phi)?;
+                sol
+            }
+            (direct, pcg) => {
+                let solver: &mut dyn CoupledSolver = match (direct, pcg) {
+                    (Some(d), _) => d,
+                    (None, Some(p)) => p,
+                    _ => unreachable!("one solver is built"),
+                };
+                let mut op = contact_setup::FullSolve {
+                    boundary: &cb,
+                    solver,
+                    b_u: &b_u,
+                    b_phi: &b_phi,
+                    nt,
+                    u: vec![0.0; n_u],
+                    phi: vec![0.0; n_phi],
+                };
+                let sol = contact::solve(&mut op, &cb.points, &law, &params, None, &mut report)?;
+                u = op.u;
+                phi = op.phi;
+                sol
+            }
+        };
+        pcg_total = sol.info.inner_iters;
+        contact_result = Some((cb, sol, law));
+    }
     let t_solve = t.elapsed().as_secs_f64();
-    let eq = equilibrium_residual(&blocks.a, &blocks.g, &blocks.b, &u, &phi, &b_u, &b_phi);
+    // equilibrium of the final pair, with the contact forces in the right-hand side
+    let mut b_full = b_u.clone();
+    if let Some((cb, sol, _)) = &contact_result {
+        cb.add_forces(&sol.lambda, &mut b_full);
+    }
+    let eq = equilibrium_residual(&blocks.a, &blocks.g, &blocks.b, &u, &phi, &b_full, &b_phi);
     progress(&format!(
-        "factorisation {:.3} s, solve {:.3} s ({} PCG iterations), equilibrium residual {:.3e}",
-        t_factor, t_solve, info.pcg_iters, eq
+        "solve {t_solve:.3} s ({pcg_total} PCG iterations), equilibrium residual {eq:.3e}"
     ));
+    let factor_bytes = direct
+        .as_ref()
+        .map(|d| d.factor_bytes())
+        .or(pcg_solver.as_ref().map(|p| p.factor_bytes()))
+        .unwrap_or(0);
     let un = disc.dofs.expand_u(&u);
     let pn = disc.dofs.expand_phi(&phi);
     let fields = disc.recover(&un, &pn);
@@ -136,12 +216,29 @@ pub fn run(
         "plan": plan,
         "mesh": { "n_nodes": mesh.n_nodes(), "n_cells": mesh.n_cells(), "h": mesh.h_max(), "cells_per_axis": build::cells_per_axis(scene) },
         "dofs": { "u": n_u, "phi": n_phi },
-        "contact": { "n_points": 0, "n_stick": 0, "n_slip": 0, "n_separated": 0, "normal_force": 0.0, "tangential_force": 0.0 },
-        "iterations": { "fixed_point": 0, "uzawa": 0, "pcg": info.pcg_iters },
-        "residuals": { "equilibrium": eq, "complementarity": 0.0 },
-        "timings_s": { "mesh": t_mesh, "assembly": t_assembly, "factorization": t_factor, "solve": t_solve, "contact": 0.0, "total": t_total.elapsed().as_secs_f64() },
-        "memory": { "peak_bytes": peak_memory_bytes(), "factor_bytes": solver.factor_bytes() },
-        "solver": { "strategy": plan.linear_strategy, "rule": plan.rule, "pcg_rel_tol": pcg_params.rel_tol },
+        "contact": contact_json(contact_result.as_ref()),
+        "iterations": {
+            "fixed_point": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.fixed_point_iters),
+            "uzawa": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.uzawa_iters),
+            "pcg": pcg_total,
+            "primal_solves": contact_result.as_ref().map_or(1, |(_, s, _)| s.info.operator_calls),
+        },
+        "residuals": {
+            "equilibrium": eq,
+            "complementarity": contact_result.as_ref().map_or(0.0, |(_, s, _)| s.info.complementarity),
+            "converged_to_tolerance": plan.rule == "tight",
+        },
+        "timings_s": { "mesh": t_mesh, "assembly": t_assembly, "factorization": t_factor, "contact": if contact_result.is_some() { t_solve } else { 0.0 }, "solve": t_solve, "total": t_total.elapsed().as_secs_f64() },
+        "memory": { "peak_bytes": peak_memory_bytes(), "factor_bytes": factor_bytes },
+        "solver": {
+            "strategy": plan.linear_strategy,
+            "rule": if plan.rule == "paper" { "paper (the loose rules of the paper's Table 1: relative change 1e-3, PCG (r,z) <= 1e-2 (r0,z0); not converged to a tolerance)" } else { "tight" },
+            "tol": scene.solver.tol,
+            "pcg_rel_tol": pcg_params.rel_tol,
+            "step_r": contact_result.as_ref().map(|(_, s, _)| s.info.step),
+            "mu_max": contact_result.as_ref().map(|(_, s, _)| s.info.mu_max),
+            "step_backoffs": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.step_backoffs),
+        },
     });
     if let Some(dir) = out_dir {
         let mut outs = Outputs::new(dir);
@@ -149,7 +246,24 @@ pub fn run(
             "run.json",
             serde_json::to_vec_pretty(&report).map_err(|e| DriverError::Output(e.to_string()))?,
         );
-        outs.add("solution.vtu", output::vtu(&mesh, &un, &pn, &fields, None)?);
+        let status_field = contact_result.as_ref().map(|(cb, sol, _)| {
+            let mut st = vec![0.0; mesh.n_nodes()];
+            for (i, &node) in cb.nodes.iter().enumerate() {
+                st[node] = match sol.status[i] {
+                    contact::Status::Stick => 1.0,
+                    contact::Status::Slip => 2.0,
+                    contact::Status::Separated => 3.0,
+                };
+            }
+            st
+        });
+        outs.add(
+            "solution.vtu",
+            output::vtu(&mesh, &un, &pn, &fields, status_field.as_deref())?,
+        );
+        if let Some((cb, sol, _)) = &contact_result {
+            outs.add("contact.csv", output::contact_csv(&cb.points, sol));
+        }
         outs.commit()?;
         progress(&format!(
             "wrote {} in {}",
@@ -158,4 +272,41 @@ pub fn run(
         ));
     }
     Ok(RunOutcome { report })
+}
+
+fn contact_json(result: Option<&(ContactBoundary, ContactSolution, Law)>) -> serde_json::Value {
+    let Some((cb, sol, _)) = result else {
+        return json!({ "n_points": 0, "n_stick": 0, "n_slip": 0, "n_separated": 0, "normal_force": 0.0, "tangential_force": 0.0 });
+    };
+    let p = &cb.points;
+    let count = |s| sol.status.iter().filter(|&&x| x == s).count();
+    let normal_force: f64 = p
+        .weight
+        .iter()
+        .zip(&sol.lambda.normal)
+        .map(|(w, l)| w * l)
+        .sum();
+    let nt = sol
+        .lambda
+        .tangential
+        .len()
+        .checked_div(p.len())
+        .unwrap_or(0);
+    let mut t = [0.0; 3];
+    for i in 0..p.len() {
+        for q in 0..nt {
+            for k in 0..3 {
+                t[k] += p.weight[i] * sol.lambda.tangential[i * nt + q] * p.tangent[i][q][k];
+            }
+        }
+    }
+    json!({
+        "n_points": p.len(),
+        "n_stick": count(contact::Status::Stick),
+        "n_slip": count(contact::Status::Slip),
+        "n_separated": count(contact::Status::Separated),
+        "normal_force": normal_force,
+        "tangential_force": (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt(),
+        "max_lambda_n": sol.lambda.normal.iter().cloned().fold(0.0f64, f64::max),
+    })
 }

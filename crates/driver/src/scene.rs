@@ -9,11 +9,29 @@ use std::path::Path;
 /// The scenes shipped with the program, by name (their files are in `scenes/`).
 pub const SHIPPED: &[(&str, &str)] = &[
     ("paper", include_str!("../../../scenes/paper.toml")),
-    ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
+    (
+        "paper-slip",
+        include_str!("../../../scenes/paper-slip.toml"),
+    ),
+    (
+        "paper-frictionless",
+        include_str!("../../../scenes/paper-frictionless.toml"),
+    ),
+    (
+        "paper-stick",
+        include_str!("../../../scenes/paper-stick.toml"),
+    ),
+    (
+        "paper-tresca",
+        include_str!("../../../scenes/paper-tresca.toml"),
+    ),
     (
         "paper-elastic",
         include_str!("../../../scenes/paper-elastic.toml"),
     ),
+    ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
+    ("actuator", include_str!("../../../scenes/actuator.toml")),
+    ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),
 ];
 
 /// A whole scene.
@@ -186,8 +204,8 @@ pub struct ContactSpec {
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
-    /// Linear strategy: `direct-ldlt` or `schur-pcg` (for the contact strategies, see
-    /// `piezocontact strategies`).
+    /// Strategy: `uzawa-condensed` (default), `uzawa-direct`, `uzawa-schur-pcg` (the paper's);
+    /// `piezocontact strategies` lists them.
     #[serde(default = "default_strategy")]
     pub strategy: String,
     /// Tolerance of the contact solve (complementarity residual).
@@ -202,7 +220,7 @@ pub struct SolverSpec {
 }
 
 fn default_strategy() -> String {
-    "direct-ldlt".into()
+    "uzawa-condensed".into()
 }
 fn default_tol() -> f64 {
     1e-10

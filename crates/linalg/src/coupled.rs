@@ -195,6 +195,11 @@ impl DirectLdlt {
     pub fn factor(&self) -> &SparseFactor {
         &self.factor
     }
+
+    /// The factor, to solve with many right-hand sides at once (`[u; φ]` layout).
+    pub fn factor_mut(&mut self) -> &mut SparseFactor {
+        &mut self.factor
+    }
 }
 
 impl CoupledSolver for DirectLdlt {

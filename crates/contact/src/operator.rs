@@ -1,0 +1,78 @@
+//! The one interface the solvers see: "given multipliers on the contact points, return the
+//! displacement of those points". Implemented by a full primal solve (the driver) and by the
+//! condensed dense problem below (small tests, and the condensed strategy).
+
+use crate::points::PointValues;
+
+/// The contact problem seen from the multipliers.
+pub trait ContactOperator {
+    /// Number of contact points.
+    fn n_points(&self) -> usize;
+    /// Tangential components per point carried by this operator (0 for frictionless).
+    fn n_tangential(&self) -> usize;
+    /// Given `lambda`, computes the contact displacement `(u_n, u_t)` of the equilibrium with
+    /// the contact forces `-Nᵀ W λ_n - Tᵀ W λ_t`. Returns inner iterations done (e.g. PCG) or a
+    /// message on failure.
+    fn displacement(
+        &mut self,
+        lambda: &PointValues,
+        out: &mut PointValues,
+    ) -> Result<usize, String>;
+}
+
+/// An affine contact problem given densely: `u = u0 - D W λ` with `D` symmetric positive
+/// (semi)definite (the contact compliance, or Delassus operator), in the layout
+/// `[normal (n); tangential (n·nt)]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseContactProblem {
+    /// Contact displacement under the loads alone (λ = 0).
+    pub u0: PointValues,
+    /// Compliance, row-major, `m x m` with `m = n (1 + nt)`.
+    pub compliance: Vec<f64>,
+    /// Weights `w_i`.
+    pub weight: Vec<f64>,
+    /// Tangential components per point.
+    pub nt: usize,
+}
+
+impl DenseContactProblem {
+    /// Size of the dense system.
+    pub fn m(&self) -> usize {
+        self.weight.len() * (1 + self.nt)
+    }
+}
+
+impl ContactOperator for DenseContactProblem {
+    fn n_points(&self) -> usize {
+        self.weight.len()
+    }
+    fn n_tangential(&self) -> usize {
+        self.nt
+    }
+    fn displacement(
+        &mut self,
+        lambda: &PointValues,
+        out: &mut PointValues,
+    ) -> Result<usize, String> {
+        let n = self.weight.len();
+        let m = self.m();
+        // W λ in the flat layout
+        let mut wl = Vec::with_capacity(m);
+        wl.extend(lambda.normal.iter().zip(&self.weight).map(|(l, w)| l * w));
+        for i in 0..n {
+            for k in 0..self.nt {
+                wl.push(lambda.tangential[i * self.nt + k] * self.weight[i]);
+            }
+        }
+        for r in 0..m {
+            let row = &self.compliance[r * m..(r + 1) * m];
+            let dot: f64 = row.iter().zip(&wl).map(|(a, b)| a * b).sum();
+            if r < n {
+                out.normal[r] = self.u0.normal[r] - dot;
+            } else {
+                out.tangential[r - n] = self.u0.tangential[r - n] - dot;
+            }
+        }
+        Ok(0)
+    }
+}

@@ -1,0 +1,152 @@
+//! Contact points and the multiplier / displacement vectors on them.
+
+/// The contact points: geometry, weights, gaps and friction coefficients.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPoints {
+    /// Spatial dimension (2 or 3): each point has 1 normal and `dim - 1` tangential components.
+    pub dim: usize,
+    /// Positions.
+    pub position: Vec<[f64; 3]>,
+    /// Outward unit normals of the body.
+    pub normal: Vec<[f64; 3]>,
+    /// Tangent bases (`dim - 1` unit vectors used).
+    pub tangent: Vec<[[f64; 3]; 2]>,
+    /// Weights (lumped boundary mass).
+    pub weight: Vec<f64>,
+    /// Initial gaps `g` (`u_n ≤ g`).
+    pub gap: Vec<f64>,
+    /// Coulomb coefficients `F`.
+    pub friction: Vec<f64>,
+}
+
+impl ContactPoints {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.weight.len()
+    }
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.weight.is_empty()
+    }
+    /// Tangential components per point.
+    pub fn n_tangential(&self) -> usize {
+        self.dim - 1
+    }
+    /// Checks sizes and values; returns a message naming the first bad item.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.len();
+        if self.position.len() != n
+            || self.normal.len() != n
+            || self.tangent.len() != n
+            || self.gap.len() != n
+            || self.friction.len() != n
+        {
+            return Err("contact points: arrays of different lengths".into());
+        }
+        for i in 0..n {
+            if !(self.weight[i] > 0.0 && self.weight[i].is_finite()) {
+                return Err(format!(
+                    "contact point {i}: weight {} is not positive",
+                    self.weight[i]
+                ));
+            }
+            if !self.gap[i].is_finite() {
+                return Err(format!(
+                    "contact point {i}: gap {} is not finite",
+                    self.gap[i]
+                ));
+            }
+            if !(self.friction[i] >= 0.0 && self.friction[i].is_finite()) {
+                return Err(format!(
+                    "contact point {i}: friction {} must be finite and non-negative",
+                    self.friction[i]
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Values on the contact points: one normal and `dim - 1` tangential components each
+/// (the tangential part is empty for a frictionless problem).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointValues {
+    /// Normal components.
+    pub normal: Vec<f64>,
+    /// Tangential components, `dim - 1` per point (or none).
+    pub tangential: Vec<f64>,
+}
+
+impl PointValues {
+    /// Zeros for `n` points with `nt` tangential components each.
+    pub fn zeros(n: usize, nt: usize) -> Self {
+        PointValues {
+            normal: vec![0.0; n],
+            tangential: vec![0.0; n * nt],
+        }
+    }
+    /// Weighted 2-norm `(Σ w_i |x_i|²)^½` over both parts.
+    pub fn weighted_norm(&self, w: &[f64]) -> f64 {
+        let nt = self
+            .tangential
+            .len()
+            .checked_div(self.normal.len())
+            .unwrap_or(0);
+        let mut s = 0.0;
+        for (i, &wi) in w.iter().enumerate() {
+            s += wi * self.normal[i] * self.normal[i];
+            for k in 0..nt {
+                s += wi * self.tangential[i * nt + k].powi(2);
+            }
+        }
+        s.sqrt()
+    }
+    /// Euclidean 2-norm over both parts.
+    pub fn norm(&self) -> f64 {
+        self.normal
+            .iter()
+            .chain(&self.tangential)
+            .map(|x| x * x)
+            .sum::<f64>()
+            .sqrt()
+    }
+    /// `self - other`.
+    pub fn minus(&self, other: &PointValues) -> PointValues {
+        PointValues {
+            normal: self
+                .normal
+                .iter()
+                .zip(&other.normal)
+                .map(|(a, b)| a - b)
+                .collect(),
+            tangential: self
+                .tangential
+                .iter()
+                .zip(&other.tangential)
+                .map(|(a, b)| a - b)
+                .collect(),
+        }
+    }
+}
+
+/// The state of a contact point in a solution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// In contact, `|λ_t| < S`.
+    Stick,
+    /// In contact, on the friction bound (or frictionless).
+    Slip,
+    /// No contact force.
+    Separated,
+}
+
+impl Status {
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Stick => "stick",
+            Status::Slip => "slip",
+            Status::Separated => "separated",
+        }
+    }
+}

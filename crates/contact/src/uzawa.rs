@@ -1,0 +1,514 @@
+//! Uzawa's algorithm with projections (the paper's Algorithm 2, signs of DESIGN.md), the fixed
+//! point on the slip bound for Coulomb friction (Algorithm 4), the step from the dual
+//! operator's largest eigenvalue, and the scale-free residuals.
+
+use crate::operator::ContactOperator;
+use crate::points::{ContactPoints, PointValues, Status};
+use crate::projection::{project_disc, project_nonnegative};
+use crate::ContactError;
+
+/// The friction law.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Law {
+    /// Signorini contact alone (no tangential multiplier).
+    Frictionless,
+    /// Tresca friction with a given slip bound per point.
+    Tresca(Vec<f64>),
+    /// Coulomb friction `S = F λ_n`, by the fixed point on `S`.
+    Coulomb,
+}
+
+/// When the loops stop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StopRule {
+    /// The complementarity residual (DESIGN.md) at most `tol`; for Coulomb the residual with
+    /// the Coulomb radius `F λ_n`, so that the fixed point stops only at a Coulomb solution.
+    Tight {
+        /// Tolerance.
+        tol: f64,
+    },
+    /// The paper's loose rules, as reproduced by an independent study: Uzawa stops when
+    /// `‖λ^{k+1} - λ^k‖₂ ≤ 1e-3 ‖λ^{k+1}‖₂`, the fixed point when
+    /// `‖S^l - S^{l-1}‖₂ ≤ 1e-3 ‖S^l‖₂`. Never reported as converged to a tolerance.
+    Paper,
+}
+
+/// Parameters of [`solve`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UzawaParams {
+    /// The Uzawa step `r`; `None`: `safety / μ_max` from a power-iteration estimate.
+    pub step: Option<f64>,
+    /// The factor in `r = safety / μ_max` (the paper's study: 1.8; convergence needs < 2).
+    pub safety: f64,
+    /// Power iterations for `μ_max`.
+    pub power_iters: usize,
+    /// Stopping rule.
+    pub rule: StopRule,
+    /// Uzawa iteration limit (per Tresca solve).
+    pub max_iters: usize,
+    /// Fixed-point iteration limit.
+    pub max_fixed_point: usize,
+    /// Report progress every this many Uzawa iterations (0: never).
+    pub report_every: usize,
+}
+
+impl Default for UzawaParams {
+    fn default() -> Self {
+        UzawaParams {
+            step: None,
+            safety: 1.8,
+            power_iters: 30,
+            rule: StopRule::Tight { tol: 1e-10 },
+            max_iters: 200_000,
+            max_fixed_point: 100,
+            report_every: 0,
+        }
+    }
+}
+
+/// What a converged [`solve`] reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UzawaInfo {
+    /// Uzawa iterations, summed over the fixed point.
+    pub uzawa_iters: usize,
+    /// Fixed-point iterations (0 when the law has none).
+    pub fixed_point_iters: usize,
+    /// Inner iterations reported by the operator (PCG), summed.
+    pub inner_iters: usize,
+    /// Calls of the operator (primal solves), including the power iteration.
+    pub operator_calls: usize,
+    /// The step used.
+    pub step: f64,
+    /// The estimate of the dual operator's largest eigenvalue.
+    pub mu_max: f64,
+    /// Complementarity residual of the returned pair (the law's own radius).
+    pub complementarity: f64,
+    /// Whether a stricter step was needed (divergence detected and the step halved).
+    pub step_backoffs: usize,
+}
+
+/// A converged contact solution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactSolution {
+    /// Multipliers `λ_n ≥ 0` (pressure) and `λ_t`.
+    pub lambda: PointValues,
+    /// Displacement at the points for these multipliers.
+    pub u: PointValues,
+    /// Status of each point.
+    pub status: Vec<Status>,
+    /// Counts and residuals.
+    pub info: UzawaInfo,
+}
+
+/// One line of progress.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progress {
+    /// `uzawa` or `fixed-point`.
+    pub stage: &'static str,
+    /// Iteration number within the stage.
+    pub iter: usize,
+    /// The stage's residual (complementarity, or the paper's relative change).
+    pub residual: f64,
+    /// Stick / slip / separated counts.
+    pub counts: (usize, usize, usize),
+}
+
+/// The slip bound of each point for a law and multipliers: Tresca `S`, Coulomb `F λ_n`,
+/// frictionless 0.
+pub fn slip_bound(points: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f64> {
+    match law {
+        Law::Frictionless => vec![0.0; points.len()],
+        Law::Tresca(s) => s.clone(),
+        Law::Coulomb => points
+            .friction
+            .iter()
+            .zip(lambda_n)
+            .map(|(f, l)| f * l)
+            .collect(),
+    }
+}
+
+/// The natural-map residual of DESIGN.md with step `c`:
+/// `‖(λ_n - max(0, λ_n + c (u_n - g)), λ_t - P_S(λ_t + c u_t))‖_W / ‖λ‖_W`
+/// (0 when λ and the residual vanish, the absolute residual when only λ does).
+pub fn complementarity_residual(
+    points: &ContactPoints,
+    radius: &[f64],
+    lambda: &PointValues,
+    u: &PointValues,
+    c: f64,
+) -> f64 {
+    let n = points.len();
+    let nt = lambda.tangential.len().checked_div(n).unwrap_or(0);
+    let mut r = PointValues::zeros(n, nt);
+    let mut buf = [0.0; 2];
+    for i in 0..n {
+        r.normal[i] = lambda.normal[i]
+            - project_nonnegative(lambda.normal[i] + c * (u.normal[i] - points.gap[i]));
+        if nt > 0 {
+            for k in 0..nt {
+                buf[k] = lambda.tangential[i * nt + k] + c * u.tangential[i * nt + k];
+            }
+            project_disc(&mut buf[..nt], radius[i]);
+            for k in 0..nt {
+                r.tangential[i * nt + k] = lambda.tangential[i * nt + k] - buf[k];
+            }
+        }
+    }
+    let num = r.weighted_norm(&points.weight);
+    let den = lambda.weighted_norm(&points.weight);
+    if den > 0.0 {
+        num / den
+    } else {
+        num
+    }
+}
+
+/// Status of each point (DESIGN.md): separated if `λ_n ≤ 1e-9 max λ_n`; otherwise slip if the
+/// radius is 0 or `|λ_t| ≥ (1 - 1e-9) S`; otherwise stick.
+pub fn classify(lambda: &PointValues, radius: &[f64]) -> Vec<Status> {
+    let n = lambda.normal.len();
+    let nt = lambda.tangential.len().checked_div(n).unwrap_or(0);
+    let max_n = lambda.normal.iter().cloned().fold(0.0f64, f64::max);
+    (0..n)
+        .map(|i| {
+            if !(lambda.normal[i] > 1e-9 * max_n) {
+                Status::Separated
+            } else {
+                let t = (0..nt)
+                    .map(|k| lambda.tangential[i * nt + k].powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                if radius[i] <= 0.0 || t >= (1.0 - 1e-9) * radius[i] {
+                    Status::Slip
+                } else {
+                    Status::Stick
+                }
+            }
+        })
+        .collect()
+}
+
+fn counts(status: &[Status]) -> (usize, usize, usize) {
+    let c = |s| status.iter().filter(|&&x| x == s).count();
+    (c(Status::Stick), c(Status::Slip), c(Status::Separated))
+}
+
+struct Counter<'a> {
+    op: &'a mut dyn ContactOperator,
+    calls: usize,
+    inner: usize,
+}
+
+impl Counter<'_> {
+    fn call(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<(), ContactError> {
+        self.calls += 1;
+        self.inner += self
+            .op
+            .displacement(lambda, out)
+            .map_err(ContactError::Operator)?;
+        Ok(())
+    }
+}
+
+/// Largest eigenvalue of the dual operator `λ ↦ u(0) - u(λ)` in the `W` inner product, by
+/// power iteration from `λ = 1` (a Rayleigh quotient, so a lower estimate).
+fn estimate_mu_max(
+    c: &mut Counter<'_>,
+    points: &ContactPoints,
+    nt: usize,
+    iters: usize,
+) -> Result<f64, ContactError> {
+    let n = points.len();
+    let zero = PointValues::zeros(n, nt);
+    let mut u0 = PointValues::zeros(n, nt);
+    c.call(&zero, &mut u0)?;
+    let mut v = PointValues {
+        normal: vec![1.0; n],
+        tangential: vec![1.0; n * nt],
+    };
+    let mut mu = 0.0;
+    let mut out = PointValues::zeros(n, nt);
+    for _ in 0..iters.max(1) {
+        let nv = v.weighted_norm(&points.weight);
+        if !(nv > 0.0) {
+            break;
+        }
+        v.normal
+            .iter_mut()
+            .chain(v.tangential.iter_mut())
+            .for_each(|x| *x /= nv);
+        c.call(&v, &mut out)?;
+        let mv = u0.minus(&out);
+        let w = &points.weight;
+        let mut rq = 0.0;
+        for i in 0..n {
+            rq += w[i] * v.normal[i] * mv.normal[i];
+            for k in 0..nt {
+                rq += w[i] * v.tangential[i * nt + k] * mv.tangential[i * nt + k];
+            }
+        }
+        mu = f64::max(mu, rq);
+        v = mv;
+    }
+    if !(mu > 0.0 && mu.is_finite()) {
+        return Err(ContactError::Operator(format!("the dual operator's largest eigenvalue estimate is {mu}: the contact points are not loaded by their multipliers")));
+    }
+    Ok(mu)
+}
+
+/// Solves the contact problem for `law` through `op`, from `lambda0` (warm start; zeros when
+/// `None`). Reports progress through `progress`.
+pub fn solve(
+    op: &mut dyn ContactOperator,
+    points: &ContactPoints,
+    law: &Law,
+    params: &UzawaParams,
+    lambda0: Option<PointValues>,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ContactSolution, ContactError> {
+    points.validate().map_err(ContactError::Input)?;
+    let n = points.len();
+    let nt = if matches!(law, Law::Frictionless) {
+        0
+    } else {
+        points.n_tangential()
+    };
+    if op.n_points() != n || op.n_tangential() != nt {
+        return Err(ContactError::Input(format!(
+            "operator has {} points with {} tangential components; expected {n} with {nt}",
+            op.n_points(),
+            op.n_tangential()
+        )));
+    }
+    if let Law::Tresca(s) = law {
+        if s.len() != n || s.iter().any(|x| !(*x >= 0.0 && x.is_finite())) {
+            return Err(ContactError::Input(
+                "Tresca slip bounds: one finite non-negative value per point".into(),
+            ));
+        }
+    }
+    let mut c = Counter {
+        op,
+        calls: 0,
+        inner: 0,
+    };
+    let mu_max = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
+    let mut step = params.step.unwrap_or(params.safety / mu_max);
+    if !(step > 0.0 && step.is_finite()) {
+        return Err(ContactError::Input(format!(
+            "Uzawa step {step} must be positive"
+        )));
+    }
+    let canon = 1.0 / mu_max;
+    let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
+    let mut u = PointValues::zeros(n, nt);
+    let mut info = UzawaInfo {
+        uzawa_iters: 0,
+        fixed_point_iters: 0,
+        inner_iters: 0,
+        operator_calls: 0,
+        step,
+        mu_max,
+        complementarity: f64::NAN,
+        step_backoffs: 0,
+    };
+    match law {
+        Law::Frictionless | Law::Tresca(_) => {
+            let radius = slip_bound(points, law, &lambda.normal);
+            let fresh = uzawa(
+                &mut c,
+                points,
+                &radius,
+                params,
+                canon,
+                &mut step,
+                &mut lambda,
+                &mut u,
+                &mut info,
+                progress,
+            )?;
+            if !fresh {
+                c.call(&lambda, &mut u)?;
+            }
+        }
+        Law::Coulomb => {
+            // the paper starts from S = 0; a warm start from λ uses F λ_n
+            let mut s = slip_bound(points, law, &lambda.normal);
+            let mut fresh = false;
+            for l in 1..=params.max_fixed_point {
+                info.fixed_point_iters = l;
+                fresh = uzawa(
+                    &mut c,
+                    points,
+                    &s,
+                    params,
+                    canon,
+                    &mut step,
+                    &mut lambda,
+                    &mut u,
+                    &mut info,
+                    progress,
+                )?;
+                let s_new = slip_bound(points, law, &lambda.normal);
+                let status = classify(&lambda, &s_new);
+                let (done, residual) = match params.rule {
+                    StopRule::Tight { tol } => {
+                        if !fresh {
+                            c.call(&lambda, &mut u)?;
+                            fresh = true;
+                        }
+                        let r = complementarity_residual(points, &s_new, &lambda, &u, canon);
+                        (r <= tol, r)
+                    }
+                    StopRule::Paper => {
+                        let diff: f64 = s_new
+                            .iter()
+                            .zip(&s)
+                            .map(|(a, b)| (a - b).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        let norm: f64 = s_new.iter().map(|a| a * a).sum::<f64>().sqrt();
+                        let rel = if norm > 0.0 { diff / norm } else { diff };
+                        (rel <= 1e-3, rel)
+                    }
+                };
+                progress(&Progress {
+                    stage: "fixed-point",
+                    iter: l,
+                    residual,
+                    counts: counts(&status),
+                });
+                s = s_new;
+                if done {
+                    break;
+                }
+                if l == params.max_fixed_point {
+                    return Err(ContactError::FixedPointNoConvergence {
+                        n_iters: l,
+                        residual,
+                    });
+                }
+            }
+            if !fresh {
+                c.call(&lambda, &mut u)?;
+            }
+        }
+    }
+    let radius = slip_bound(points, law, &lambda.normal);
+    info.complementarity = complementarity_residual(points, &radius, &lambda, &u, canon);
+    info.operator_calls = c.calls;
+    info.inner_iters = c.inner;
+    info.step = step;
+    if let StopRule::Tight { tol } = params.rule {
+        if !(info.complementarity <= tol) {
+            return Err(ContactError::NoConvergence {
+                n_iters: info.uzawa_iters,
+                residual: info.complementarity,
+            });
+        }
+    }
+    let status = classify(&lambda, &radius);
+    Ok(ContactSolution {
+        lambda,
+        u,
+        status,
+        info,
+    })
+}
+
+/// Uzawa iterations for a given radius. Returns whether `u` is the displacement of the final
+/// `lambda` (true under the tight rule; under the paper's rule the last update is not solved).
+#[allow(clippy::too_many_arguments)]
+fn uzawa(
+    c: &mut Counter<'_>,
+    points: &ContactPoints,
+    radius: &[f64],
+    params: &UzawaParams,
+    canon: f64,
+    step: &mut f64,
+    lambda: &mut PointValues,
+    u: &mut PointValues,
+    info: &mut UzawaInfo,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<bool, ContactError> {
+    let n = points.len();
+    let nt = lambda.tangential.len().checked_div(n).unwrap_or(0);
+    let mut best = f64::INFINITY;
+    let mut last = f64::NAN;
+    let mut buf = [0.0; 2];
+    for k in 1..=params.max_iters {
+        c.call(lambda, u)?;
+        let r = complementarity_residual(points, radius, lambda, u, canon);
+        last = r;
+        if !r.is_finite() {
+            return Err(ContactError::Diverged {
+                n_iters: info.uzawa_iters,
+                residual: r,
+                step: *step,
+            });
+        }
+        if let StopRule::Tight { tol } = params.rule {
+            if r <= tol {
+                return Ok(true);
+            }
+        }
+        // divergence: a residual far above the best seen means the step is too large; halve it
+        if r > 1e3 * best && k > 10 {
+            *step *= 0.5;
+            info.step_backoffs += 1;
+            best = r;
+            if info.step_backoffs > 20 {
+                return Err(ContactError::Diverged {
+                    n_iters: info.uzawa_iters,
+                    residual: r,
+                    step: *step,
+                });
+            }
+        }
+        best = best.min(r);
+        info.uzawa_iters += 1;
+        // the projected update
+        let mut diff2 = 0.0;
+        let mut norm2 = 0.0;
+        for i in 0..n {
+            let new = project_nonnegative(lambda.normal[i] + *step * (u.normal[i] - points.gap[i]));
+            diff2 += (new - lambda.normal[i]).powi(2);
+            norm2 += new * new;
+            lambda.normal[i] = new;
+            if nt > 0 {
+                for q in 0..nt {
+                    buf[q] = lambda.tangential[i * nt + q] + *step * u.tangential[i * nt + q];
+                }
+                project_disc(&mut buf[..nt], radius[i]);
+                for q in 0..nt {
+                    diff2 += (buf[q] - lambda.tangential[i * nt + q]).powi(2);
+                    norm2 += buf[q] * buf[q];
+                    lambda.tangential[i * nt + q] = buf[q];
+                }
+            }
+        }
+        if params.report_every > 0 && k % params.report_every == 0 {
+            progress(&Progress {
+                stage: "uzawa",
+                iter: k,
+                residual: r,
+                counts: counts(&classify(lambda, radius)),
+            });
+        }
+        if params.rule == StopRule::Paper {
+            let rel = if norm2 > 0.0 {
+                (diff2 / norm2).sqrt()
+            } else {
+                diff2.sqrt()
+            };
+            if rel <= 1e-3 {
+                return Ok(false);
+            }
+        }
+    }
+    Err(ContactError::NoConvergence {
+        n_iters: info.uzawa_iters,
+        residual: last,
+    })
+}
