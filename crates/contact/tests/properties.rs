@@ -1,0 +1,200 @@
+//! Property tests of the contact crate on small dense problems (no finite elements):
+//! projections, contraction of the friction fixed point, Uzawa against an independent
+//! active-set enumeration and a KKT check, and homogeneity in the load.
+
+use contact::{
+    complementarity_residual, project_disc, project_nonnegative, solve, ContactPoints, DenseContactProblem, Law,
+    PointValues, StopRule, UzawaParams,
+};
+use nalgebra::{DMatrix, DVector};
+use proptest::prelude::*;
+
+fn points(n: usize, dim: usize, w: &[f64], friction: f64) -> ContactPoints {
+    ContactPoints {
+        dim,
+        position: vec![[0.0; 3]; n],
+        normal: vec![[0.0, 0.0, -1.0]; n],
+        tangent: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; n],
+        weight: w[..n].iter().map(|x| 0.5 + x.abs()).collect(),
+        gap: vec![0.0; n],
+        friction: vec![friction; n],
+    }
+}
+
+/// A random SPD compliance of size m: M Mᵀ / m + 0.1 I.
+fn compliance(m: usize, seed: &[f64]) -> Vec<f64> {
+    let a = DMatrix::from_fn(m, m, |i, j| seed[(i * 7 + j * 3) % seed.len()]);
+    let d = &a * a.transpose() / m as f64 + DMatrix::identity(m, m) * 0.1;
+    (0..m).flat_map(|i| (0..m).map(move |j| (i, j))).map(|(i, j)| d[(i, j)]).collect()
+}
+
+fn problem(n: usize, nt: usize, pts: &ContactPoints, seed: &[f64], load: &[f64]) -> DenseContactProblem {
+    let m = n * (1 + nt);
+    DenseContactProblem {
+        u0: PointValues { normal: load[..n].to_vec(), tangential: load[n..n + n * nt].to_vec() },
+        compliance: compliance(m, seed),
+        weight: pts.weight.clone(),
+        nt,
+    }
+}
+
+fn tight(tol: f64) -> UzawaParams {
+    UzawaParams { rule: StopRule::Tight { tol }, ..Default::default() }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn projections_are_projections(x in prop::collection::vec(-5.0f64..5.0, 3), y in prop::collection::vec(-5.0f64..5.0, 3), radius in 0.0f64..3.0, nt in 1usize..=2) {
+        // normal cone
+        let p = project_nonnegative(x[0]);
+        prop_assert!(p >= 0.0);
+        prop_assert_eq!(project_nonnegative(p), p);
+        prop_assert!((project_nonnegative(x[0]) - project_nonnegative(y[0])).abs() <= (x[0] - y[0]).abs());
+        let ys = y[0].abs(); // a point of the set
+        prop_assert!((x[0] - p) * (ys - p) <= 1e-12);
+        // friction disc (interval in 2D)
+        let mut px = x[..nt].to_vec();
+        project_disc(&mut px, radius);
+        let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
+        prop_assert!(norm(&px) <= radius * (1.0 + 1e-12));
+        let mut twice = px.clone();
+        project_disc(&mut twice, radius);
+        for (a, b) in twice.iter().zip(&px) { prop_assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs())); }
+        let mut py = y[..nt].to_vec();
+        project_disc(&mut py, radius);
+        let d: Vec<f64> = px.iter().zip(&py).map(|(a, b)| a - b).collect();
+        let e: Vec<f64> = x[..nt].iter().zip(&y[..nt]).map(|(a, b)| a - b).collect();
+        prop_assert!(norm(&d) <= norm(&e) * (1.0 + 1e-12) + 1e-12);
+        // variational inequality with a point z of the disc
+        let mut z = y[..nt].to_vec();
+        let nz = norm(&z);
+        if nz > radius { z.iter_mut().for_each(|v| *v *= radius / nz); }
+        let vi: f64 = (0..nt).map(|k| (x[k] - px[k]) * (z[k] - px[k])).sum();
+        prop_assert!(vi <= 1e-10, "VI {vi}");
+    }
+
+    /// Tiny frictionless problems: Uzawa's answer equals the one found by enumerating the
+    /// 2^n active sets (the KKT point of a strictly convex QP is unique).
+    #[test]
+    fn uzawa_matches_active_set_enumeration(n in 1usize..=4, seed in prop::collection::vec(-1.0f64..1.0, 40), w in prop::collection::vec(-1.0f64..1.0, 4), load in prop::collection::vec(-1.0f64..1.0, 12)) {
+        let pts = points(n, 2, &w, 0.0);
+        let mut op = problem(n, 0, &pts, &seed, &load);
+        let sol = solve(&mut op, &pts, &Law::Frictionless, &tight(1e-12), None, &mut |_| {}).unwrap();
+        // enumeration: u = u0 - D W λ; on the active set u_n = g (= 0)
+        let d = DMatrix::from_row_slice(n, n, &op.compliance);
+        let mut found = None;
+        for mask in 0u32..(1 << n) {
+            let act: Vec<usize> = (0..n).filter(|i| mask & (1 << i) != 0).collect();
+            let mut lam = vec![0.0; n];
+            if !act.is_empty() {
+                let k = act.len();
+                let a = DMatrix::from_fn(k, k, |r, c| d[(act[r], act[c])] * pts.weight[act[c]]);
+                let b = DVector::from_fn(k, |r, _| op.u0.normal[act[r]]);
+                let x = a.lu().solve(&b).unwrap();
+                for (r, &i) in act.iter().enumerate() { lam[i] = x[r]; }
+            }
+            let u: Vec<f64> = (0..n).map(|i| op.u0.normal[i] - (0..n).map(|j| d[(i, j)] * pts.weight[j] * lam[j]).sum::<f64>()).collect();
+            let ok = lam.iter().all(|&l| l >= -1e-12) && (0..n).all(|i| act.contains(&i) || u[i] <= 1e-12);
+            if ok { found = Some(lam); break; }
+        }
+        let exact = found.expect("some active set satisfies the KKT conditions");
+        let scale = exact.iter().fold(1e-12f64, |m, x| m.max(x.abs()));
+        for i in 0..n {
+            prop_assert!((sol.lambda.normal[i] - exact[i]).abs() <= 1e-8 * scale, "{:?} vs {:?}", sol.lambda.normal, exact);
+        }
+    }
+
+    /// With friction (Tresca and Coulomb, 2D and 3D), the answer satisfies the KKT conditions:
+    /// λ_n ≥ 0, u_n ≤ g, λ_n (u_n - g) = 0, |λ_t| ≤ S, u_t = 0 where |λ_t| < S, and
+    /// u_t = α λ_t with α ≥ 0 where |λ_t| = S.
+    #[test]
+    fn uzawa_answer_satisfies_kkt(n in 1usize..=5, dim in 2usize..=3, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 5), load in prop::collection::vec(-1.0f64..1.0, 15), f in 0.05f64..0.5, coulomb in proptest::bool::ANY) {
+        let nt = dim - 1;
+        let pts = points(n, dim, &w, f);
+        let mut op = problem(n, nt, &pts, &seed, &load);
+        let law = if coulomb { Law::Coulomb } else { Law::Tresca(vec![0.1; n]) };
+        let sol = solve(&mut op, &pts, &law, &tight(1e-11), None, &mut |_| {}).unwrap();
+        let (l, u) = (&sol.lambda, &sol.u);
+        let scale_l = l.norm().max(1e-12);
+        let scale_u = u.norm().max(op.u0.norm()).max(1e-12);
+        for i in 0..n {
+            let s = if coulomb { f * l.normal[i] } else { 0.1 };
+            prop_assert!(l.normal[i] >= 0.0);
+            prop_assert!(u.normal[i] <= 1e-7 * scale_u);
+            prop_assert!((l.normal[i] * u.normal[i]).abs() <= 1e-7 * scale_l * scale_u);
+            let lt: Vec<f64> = (0..nt).map(|k| l.tangential[i * nt + k]).collect();
+            let ut: Vec<f64> = (0..nt).map(|k| u.tangential[i * nt + k]).collect();
+            let nl = lt.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let nu = ut.iter().map(|x| x * x).sum::<f64>().sqrt();
+            prop_assert!(nl <= s * (1.0 + 1e-9) + 1e-12 * scale_l);
+            if nl < s * (1.0 - 1e-6) {
+                prop_assert!(nu <= 1e-7 * scale_u, "stick point moves: {nu}");
+            } else if nu > 1e-7 * scale_u {
+                let dot: f64 = lt.iter().zip(&ut).map(|(a, b)| a * b).sum();
+                prop_assert!(dot >= (1.0 - 1e-5) * nl * nu, "slip not along lambda_t");
+            }
+        }
+    }
+
+    /// The fixed point S -> F λ_n(S) contracts for small F: the ratio of successive differences
+    /// stays below 1.
+    #[test]
+    fn friction_fixed_point_contracts(n in 2usize..=5, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 5), load in prop::collection::vec(0.2f64..1.0, 15), f in 0.05f64..0.3) {
+        let pts = points(n, 2, &w, f);
+        let mut op = problem(n, 1, &pts, &seed, &load);
+        let mut s = vec![0.0; n];
+        let mut diffs = vec![];
+        for _ in 0..4 {
+            let sol = solve(&mut op, &pts, &Law::Tresca(s.clone()), &tight(1e-13), None, &mut |_| {}).unwrap();
+            let s_new: Vec<f64> = sol.lambda.normal.iter().map(|l| f * l).collect();
+            diffs.push(s_new.iter().zip(&s).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt());
+            s = s_new;
+        }
+        for k in 1..diffs.len() {
+            if diffs[k - 1] > 1e-9 * diffs[0] {
+                let ratio = diffs[k] / diffs[k - 1];
+                prop_assert!(ratio < 1.0, "contraction ratio {ratio} at step {k} (F = {f})");
+            }
+        }
+    }
+
+    /// With g = 0 every datum is proportional to the load, so the solution is too.
+    #[test]
+    fn solution_is_homogeneous_in_the_load(n in 1usize..=4, seed in prop::collection::vec(-1.0f64..1.0, 40), w in prop::collection::vec(-1.0f64..1.0, 4), load in prop::collection::vec(-1.0f64..1.0, 12), alpha in 0.1f64..10.0) {
+        let pts = points(n, 2, &w, 0.3);
+        let mut op1 = problem(n, 1, &pts, &seed, &load);
+        let scaled: Vec<f64> = load.iter().map(|x| alpha * x).collect();
+        let mut op2 = problem(n, 1, &pts, &seed, &scaled);
+        let s1 = solve(&mut op1, &pts, &Law::Coulomb, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let s2 = solve(&mut op2, &pts, &Law::Coulomb, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let scale = s1.lambda.norm().max(1e-12);
+        for (a, b) in s1.lambda.normal.iter().chain(&s1.lambda.tangential).zip(s2.lambda.normal.iter().chain(&s2.lambda.tangential)) {
+            prop_assert!((alpha * a - b).abs() <= 1e-7 * alpha * scale);
+        }
+        prop_assert_eq!(s1.status, s2.status);
+    }
+}
+
+#[test]
+fn residual_is_zero_at_a_solution_and_scale_free() {
+    let pts = points(1, 2, &[0.5], 0.0);
+    let lambda = PointValues { normal: vec![2.0], tangential: vec![] };
+    let u = PointValues { normal: vec![0.0], tangential: vec![] };
+    assert_eq!(complementarity_residual(&pts, &[0.0], &lambda, &u, 1.0), 0.0);
+    // penetration of 1 with λ = 2: residual |2 - (2 + c)| / 2 = c / 2
+    let u = PointValues { normal: vec![1.0], tangential: vec![] };
+    assert!((complementarity_residual(&pts, &[0.0], &lambda, &u, 0.5) - 0.25).abs() < 1e-15);
+}
+
+#[test]
+fn non_convergence_is_a_typed_error_with_the_residual() {
+    let pts = points(2, 2, &[0.5, 0.5], 0.3);
+    let mut op = problem(2, 1, &pts, &[0.3, -0.2, 0.5, 0.1], &[1.0, 0.5, 0.2, -0.1]);
+    let params = UzawaParams { max_iters: 2, ..tight(1e-14) };
+    match solve(&mut op, &pts, &Law::Coulomb, &params, None, &mut |_| {}) {
+        Err(contact::ContactError::NoConvergence { residual, .. }) => assert!(residual > 1e-14),
+        other => panic!("{other:?}"),
+    }
+}
