@@ -27,7 +27,11 @@ fn strategies_agree_on_paper_without_contact() {
     );
     let schur = run(
         "paper",
-        &["mesh.n=16", "contact.law=none", "solver.strategy=uzawa-schur-pcg"],
+        &[
+            "mesh.n=16",
+            "contact.law=none",
+            "solver.strategy=uzawa-schur-pcg",
+        ],
     );
     assert!(direct["residuals"]["equilibrium"].as_f64().unwrap() < 1e-12);
     assert!(schur["residuals"]["equilibrium"].as_f64().unwrap() < 1e-10);

@@ -3,8 +3,8 @@
 //! active-set enumeration and a KKT check, and homogeneity in the load.
 
 use contact::{
-    complementarity_residual, project_disc, project_nonnegative, solve, ContactPoints, DenseContactProblem, Law,
-    PointValues, StopRule, UzawaParams,
+    complementarity_residual, project_disc, project_nonnegative, solve, ContactPoints,
+    DenseContactProblem, Law, PointValues, StopRule, UzawaParams,
 };
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -25,13 +25,25 @@ fn points(n: usize, dim: usize, w: &[f64], friction: f64) -> ContactPoints {
 fn compliance(m: usize, seed: &[f64]) -> Vec<f64> {
     let a = DMatrix::from_fn(m, m, |i, j| seed[(i * 7 + j * 3) % seed.len()]);
     let d = &a * a.transpose() / m as f64 + DMatrix::identity(m, m) * 0.1;
-    (0..m).flat_map(|i| (0..m).map(move |j| (i, j))).map(|(i, j)| d[(i, j)]).collect()
+    (0..m)
+        .flat_map(|i| (0..m).map(move |j| (i, j)))
+        .map(|(i, j)| d[(i, j)])
+        .collect()
 }
 
-fn problem(n: usize, nt: usize, pts: &ContactPoints, seed: &[f64], load: &[f64]) -> DenseContactProblem {
+fn problem(
+    n: usize,
+    nt: usize,
+    pts: &ContactPoints,
+    seed: &[f64],
+    load: &[f64],
+) -> DenseContactProblem {
     let m = n * (1 + nt);
     DenseContactProblem {
-        u0: PointValues { normal: load[..n].to_vec(), tangential: load[n..n + n * nt].to_vec() },
+        u0: PointValues {
+            normal: load[..n].to_vec(),
+            tangential: load[n..n + n * nt].to_vec(),
+        },
         compliance: compliance(m, seed),
         weight: pts.weight.clone(),
         nt,
@@ -39,7 +51,10 @@ fn problem(n: usize, nt: usize, pts: &ContactPoints, seed: &[f64], load: &[f64])
 }
 
 fn tight(tol: f64) -> UzawaParams {
-    UzawaParams { rule: StopRule::Tight { tol }, ..Default::default() }
+    UzawaParams {
+        rule: StopRule::Tight { tol },
+        ..Default::default()
+    }
 }
 
 proptest! {
@@ -180,11 +195,23 @@ proptest! {
 #[test]
 fn residual_is_zero_at_a_solution_and_scale_free() {
     let pts = points(1, 2, &[0.5], 0.0);
-    let lambda = PointValues { normal: vec![2.0], tangential: vec![] };
-    let u = PointValues { normal: vec![0.0], tangential: vec![] };
-    assert_eq!(complementarity_residual(&pts, &[0.0], &lambda, &u, 1.0), 0.0);
+    let lambda = PointValues {
+        normal: vec![2.0],
+        tangential: vec![],
+    };
+    let u = PointValues {
+        normal: vec![0.0],
+        tangential: vec![],
+    };
+    assert_eq!(
+        complementarity_residual(&pts, &[0.0], &lambda, &u, 1.0),
+        0.0
+    );
     // penetration of 1 with λ = 2: residual |2 - (2 + c)| / 2 = c / 2
-    let u = PointValues { normal: vec![1.0], tangential: vec![] };
+    let u = PointValues {
+        normal: vec![1.0],
+        tangential: vec![],
+    };
     assert!((complementarity_residual(&pts, &[0.0], &lambda, &u, 0.5) - 0.25).abs() < 1e-15);
 }
 
@@ -192,7 +219,10 @@ fn residual_is_zero_at_a_solution_and_scale_free() {
 fn non_convergence_is_a_typed_error_with_the_residual() {
     let pts = points(2, 2, &[0.5, 0.5], 0.3);
     let mut op = problem(2, 1, &pts, &[0.3, -0.2, 0.5, 0.1], &[1.0, 0.5, 0.2, -0.1]);
-    let params = UzawaParams { max_iters: 2, ..tight(1e-14) };
+    let params = UzawaParams {
+        max_iters: 2,
+        ..tight(1e-14)
+    };
     match solve(&mut op, &pts, &Law::Coulomb, &params, None, &mut |_| {}) {
         Err(contact::ContactError::NoConvergence { residual, .. }) => assert!(residual > 1e-14),
         other => panic!("{other:?}"),

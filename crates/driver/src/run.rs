@@ -21,11 +21,17 @@ pub const STRATEGIES: &[(&str, &str)] = &[
     ("uzawa-schur-pcg", "the paper's: Uzawa with one Schur-complement PCG solve per iteration (Algorithm 3, preconditioned by A)"),
 ];
 
-/// What a run produced (also written as `run.json`).
+/// What a run produced: the `run.json` tree and the solution.
 #[derive(Debug, Clone)]
 pub struct RunOutcome {
     /// The run.json tree.
     pub report: serde_json::Value,
+    /// Nodal displacements.
+    pub u: Vec<[f64; 3]>,
+    /// Nodal potentials.
+    pub phi: Vec<f64>,
+    /// The contact points and their solution, where the plan has contact.
+    pub contact: Option<(contact::ContactPoints, ContactSolution)>,
 }
 
 /// Bytes of peak resident memory of this process (VmHWM), 0 where unknown.
@@ -87,7 +93,10 @@ pub fn run(
     let par = faer::Par::Seq;
     let t = Instant::now();
     let pcg_params = PcgParams {
-        rel_tol: scene.solver.pcg_tol.unwrap_or(1e-12),
+        rel_tol: scene
+            .solver
+            .pcg_tol
+            .unwrap_or(if plan.rule == "paper" { 1e-2 } else { 1e-12 }),
         max_iters: 10_000,
         stop: if plan.rule == "paper" {
             PcgStop::PaperRz
@@ -222,6 +231,7 @@ pub fn run(
             "uzawa": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.uzawa_iters),
             "pcg": pcg_total,
             "primal_solves": contact_result.as_ref().map_or(1, |(_, s, _)| s.info.operator_calls),
+            "pcg_in_step_estimate": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.estimate_inner_iters),
         },
         "residuals": {
             "equilibrium": eq,
@@ -271,7 +281,12 @@ pub fn run(
             dir.display()
         ));
     }
-    Ok(RunOutcome { report })
+    Ok(RunOutcome {
+        report,
+        u: un,
+        phi: pn,
+        contact: contact_result.map(|(cb, sol, _)| (cb.points, sol)),
+    })
 }
 
 fn contact_json(result: Option<&(ContactBoundary, ContactSolution, Law)>) -> serde_json::Value {
