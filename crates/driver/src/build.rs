@@ -200,6 +200,13 @@ pub fn plan(scene: &Scene, dim: usize, materials: &[(String, Material)]) -> Plan
     let mut outputs = vec!["run.json".to_string(), "solution.vtu".to_string()];
     if law != "none" {
         outputs.push("contact.csv".into());
+        outputs.push("multipliers.svg/png".into());
+    }
+    if dim == 2 {
+        outputs.push("deformed.svg/png".into());
+        if (coupling || electric_data) && materials.iter().any(|(_, m)| m.electric) {
+            outputs.push("potential.svg/png".into());
+        }
     }
     Plan {
         dim,

@@ -20,6 +20,7 @@
 pub mod build;
 pub mod contact_setup;
 pub mod output;
+pub mod plots;
 pub mod run;
 pub mod scene;
 

@@ -274,6 +274,18 @@ pub fn run(
         if let Some((cb, sol, _)) = &contact_result {
             outs.add("contact.csv", output::contact_csv(&cb.points, sol));
         }
+        let pics = crate::plots::pictures(
+            &mesh,
+            &un,
+            &pn,
+            contact_result
+                .as_ref()
+                .map(|(cb, sol, _)| (&cb.points, sol)),
+            plan.electric,
+        )?;
+        for (name, bytes) in pics {
+            outs.add(&name, bytes);
+        }
         outs.commit()?;
         progress(&format!(
             "wrote {} in {}",
