@@ -30,6 +30,41 @@ enum Command {
     },
     /// List the shipped scenes.
     Scenes,
+    /// Run a scene along one parameter; writes sweep.csv and sweep.svg/png.
+    Sweep {
+        /// Scene name or file.
+        scene: String,
+        /// The key to vary, e.g. electrode.v.
+        #[arg(long)]
+        param: String,
+        /// First value.
+        #[arg(long, allow_hyphen_values = true)]
+        from: f64,
+        /// Last value.
+        #[arg(long, allow_hyphen_values = true)]
+        to: f64,
+        /// Number of values (at least 2).
+        #[arg(long, default_value_t = 11)]
+        steps: usize,
+        /// Other overrides.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Output directory (default: out/<scene>-sweep/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Reproduce the paper's Table 1 (Uzawa + Schur PCG + fixed point on `paper`).
+    Table1 {
+        /// Sizes n (h = 1/n) under the paper's loose rule.
+        #[arg(long, value_delimiter = ',', default_values_t = [32, 64, 128, 256])]
+        loose: Vec<usize>,
+        /// Sizes under the tight rule (complementarity 1e-10).
+        #[arg(long, value_delimiter = ',', default_values_t = [32, 64, 128])]
+        tight: Vec<usize>,
+        /// Output directory for table1.md (default: out/table1/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// List the solver strategies.
     Strategies,
 }
@@ -50,6 +85,33 @@ fn main() -> ExitCode {
                 println!("{name:16} {desc}");
             }
             ExitCode::SUCCESS
+        }
+        Command::Sweep { scene, param, from, to, steps, set, out } => {
+            let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", scene.trim_end_matches(".toml"))));
+            match driver::studies::sweep(&scene, &set, &param, from, to, steps, Some(&dir), &mut |l| eprintln!("{l}")) {
+                Ok(_) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Table1 { loose, tight, out } => {
+            let dir = out.unwrap_or_else(|| PathBuf::from("out").join("table1"));
+            let result = driver::studies::table1(&loose, &tight, &mut |l| eprintln!("{l}")).and_then(|rows| {
+                let md = driver::studies::table1_markdown(&rows);
+                println!("{md}");
+                let mut o = driver::output::Outputs::new(&dir);
+                o.add("table1.md", md.into_bytes());
+                o.commit()
+            });
+            match result {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
         }
         Command::Strategies => {
             for (name, desc) in driver::run::STRATEGIES {
