@@ -363,6 +363,9 @@ fn potential<DB: DrawingBackend>(
 }
 
 /// The sweep's picture, SVG and PNG.
-pub fn sweep_pictures(param: &str, rows: &[crate::studies::SweepRow]) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
+pub fn sweep_pictures(
+    param: &str,
+    rows: &[crate::studies::SweepRow],
+) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
     both!("sweep", |a| crate::studies::draw_sweep(a, param, rows))
 }

@@ -37,9 +37,20 @@ fn num(v: &serde_json::Value) -> f64 {
 
 /// Runs `scene_name` for `steps` values of `param` from `from` to `to` (inclusive), with the
 /// other overrides `sets`; writes `sweep.csv` and `sweep.svg/png` into `out` when given.
-pub fn sweep(scene_name: &str, sets: &[String], param: &str, from: f64, to: f64, steps: usize, out: Option<&Path>, progress: &mut dyn FnMut(&str)) -> Result<Vec<SweepRow>, DriverError> {
+pub fn sweep(
+    scene_name: &str,
+    sets: &[String],
+    param: &str,
+    from: f64,
+    to: f64,
+    steps: usize,
+    out: Option<&Path>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<SweepRow>, DriverError> {
     if steps < 2 {
-        return Err(DriverError::Input("sweep needs --steps of at least 2".into()));
+        return Err(DriverError::Input(
+            "sweep needs --steps of at least 2".into(),
+        ));
     }
     let mut rows = vec![];
     for k in 0..steps {
@@ -52,7 +63,11 @@ pub fn sweep(scene_name: &str, sets: &[String], param: &str, from: f64, to: f64,
         let c = &r.report["contact"];
         let row = SweepRow {
             value,
-            counts: (c["n_stick"].as_u64().unwrap_or(0), c["n_slip"].as_u64().unwrap_or(0), c["n_separated"].as_u64().unwrap_or(0)),
+            counts: (
+                c["n_stick"].as_u64().unwrap_or(0),
+                c["n_slip"].as_u64().unwrap_or(0),
+                c["n_separated"].as_u64().unwrap_or(0),
+            ),
             normal_force: num(&c["normal_force"]),
             tangential_force: num(&c["tangential_force"]),
             complementarity: num(&r.report["residuals"]["complementarity"]),
@@ -77,7 +92,17 @@ pub fn sweep(scene_name: &str, sets: &[String], param: &str, from: f64, to: f64,
         for r in &rows {
             csv.push_str(&format!(
                 "{:.12e},{},{},{},{:.12e},{:.12e},{:.3e},{:.3e},{},{},{:.4}\n",
-                r.value, r.counts.0, r.counts.1, r.counts.2, r.normal_force, r.tangential_force, r.complementarity, r.equilibrium, r.uzawa, r.fixed_point, r.seconds
+                r.value,
+                r.counts.0,
+                r.counts.1,
+                r.counts.2,
+                r.normal_force,
+                r.tangential_force,
+                r.complementarity,
+                r.equilibrium,
+                r.uzawa,
+                r.fixed_point,
+                r.seconds
             ));
         }
         let mut outs = Outputs::new(dir);
@@ -86,7 +111,10 @@ pub fn sweep(scene_name: &str, sets: &[String], param: &str, from: f64, to: f64,
             outs.add(&name, bytes);
         }
         outs.commit()?;
-        progress(&format!("wrote sweep.csv, sweep.svg, sweep.png in {}", dir.display()));
+        progress(&format!(
+            "wrote sweep.csv, sweep.svg, sweep.png in {}",
+            dir.display()
+        ));
     }
     Ok(rows)
 }
@@ -125,7 +153,11 @@ fn weighted_error(run: &RunOutcome, exact: &RunOutcome) -> f64 {
 /// The paper's Table 1: `paper` with Uzawa + Schur PCG + fixed point under the paper's loose
 /// rule at `loose_sizes`, then under the tight rule (complementarity 1e-10) at `tight_sizes`,
 /// each with the error of λ against the discrete solution.
-pub fn table1(loose_sizes: &[usize], tight_sizes: &[usize], progress: &mut dyn FnMut(&str)) -> Result<Vec<Table1Row>, DriverError> {
+pub fn table1(
+    loose_sizes: &[usize],
+    tight_sizes: &[usize],
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<Table1Row>, DriverError> {
     let mut rows = vec![];
     let mut sizes: Vec<usize> = loose_sizes.iter().chain(tight_sizes).copied().collect();
     sizes.sort_unstable();
@@ -138,7 +170,14 @@ pub fn table1(loose_sizes: &[usize], tight_sizes: &[usize], progress: &mut dyn F
             if !wanted.contains(&n) {
                 continue;
             }
-            let (sc, src) = scene::load("paper", &[mesh.clone(), format!("solver.rule={rule}"), "solver.strategy=uzawa-schur-pcg".into()])?;
+            let (sc, src) = scene::load(
+                "paper",
+                &[
+                    mesh.clone(),
+                    format!("solver.rule={rule}"),
+                    "solver.strategy=uzawa-schur-pcg".into(),
+                ],
+            )?;
             let r = run(&sc, &src, None, &mut |_| {})?;
             let it = &r.report["iterations"];
             let uz = it["uzawa"].as_u64().unwrap_or(0);
@@ -169,21 +208,40 @@ pub fn table1_markdown(rows: &[Table1Row]) -> String {
     for r in rows {
         s.push_str(&format!(
             "| 1/{} | {} | {} | {} | {:.1} | {:.3} | {:.2e} | {:.2e} |\n",
-            r.n, r.rule, r.fixed_point, r.uzawa, r.pcg_per_solve, r.total_seconds, r.lambda_error, r.complementarity
+            r.n,
+            r.rule,
+            r.fixed_point,
+            r.uzawa,
+            r.pcg_per_solve,
+            r.total_seconds,
+            r.lambda_error,
+            r.complementarity
         ));
     }
     s
 }
 
 /// A log-log-free line plot of the sweep: counts and forces against the parameter.
-pub(crate) fn draw_sweep<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, param: &str, rows: &[SweepRow]) -> Result<(), String> {
+pub(crate) fn draw_sweep<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    param: &str,
+    rows: &[SweepRow],
+) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
     let (top, bottom) = area.split_vertically(300);
     let x0 = rows.first().map_or(0.0, |r| r.value);
     let x1 = rows.last().map_or(1.0, |r| r.value);
-    let (lo, hi) = if x1 > x0 { (x0, x1) } else { (x1, x0.max(x1 + 1e-12)) };
-    let nmax = rows.iter().map(|r| r.counts.0 + r.counts.1 + r.counts.2).max().unwrap_or(1) as f64;
+    let (lo, hi) = if x1 > x0 {
+        (x0, x1)
+    } else {
+        (x1, x0.max(x1 + 1e-12))
+    };
+    let nmax = rows
+        .iter()
+        .map(|r| r.counts.0 + r.counts.1 + r.counts.2)
+        .max()
+        .unwrap_or(1) as f64;
     let mut c1 = ChartBuilder::on(&top)
         .caption(format!("Contact states along {param}"), ("sans-serif", 22))
         .margin(10)
@@ -191,19 +249,39 @@ pub(crate) fn draw_sweep<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::co
         .y_label_area_size(50)
         .build_cartesian_2d(lo..hi, 0.0..nmax * 1.05)
         .map_err(e)?;
-    c1.configure_mesh().y_desc("points").label_style(("sans-serif", 13)).draw().map_err(e)?;
+    c1.configure_mesh()
+        .y_desc("points")
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(e)?;
     for (name, color, get) in [
-        ("stick", GREEN, (|r: &SweepRow| r.counts.0) as fn(&SweepRow) -> u64),
+        (
+            "stick",
+            GREEN,
+            (|r: &SweepRow| r.counts.0) as fn(&SweepRow) -> u64,
+        ),
         ("slip", BLUE, |r: &SweepRow| r.counts.1),
         ("separated", RED, |r: &SweepRow| r.counts.2),
     ] {
-        c1.draw_series(LineSeries::new(rows.iter().map(|r| (r.value, get(r) as f64)), color.stroke_width(2)))
-            .map_err(e)?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        c1.draw_series(LineSeries::new(
+            rows.iter().map(|r| (r.value, get(r) as f64)),
+            color.stroke_width(2),
+        ))
+        .map_err(e)?
+        .label(name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
     }
-    c1.configure_series_labels().label_font(("sans-serif", 13)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(e)?;
-    let fmax = rows.iter().map(|r| r.normal_force.max(r.tangential_force)).fold(0.0f64, f64::max).max(1e-300);
+    c1.configure_series_labels()
+        .label_font(("sans-serif", 13))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(e)?;
+    let fmax = rows
+        .iter()
+        .map(|r| r.normal_force.max(r.tangential_force))
+        .fold(0.0f64, f64::max)
+        .max(1e-300);
     let mut c2 = ChartBuilder::on(&bottom)
         .caption("Contact forces", ("sans-serif", 22))
         .margin(10)
@@ -211,9 +289,31 @@ pub(crate) fn draw_sweep<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::co
         .y_label_area_size(50)
         .build_cartesian_2d(lo..hi, 0.0..fmax * 1.05)
         .map_err(e)?;
-    c2.configure_mesh().x_desc(param).y_desc("force").label_style(("sans-serif", 13)).draw().map_err(e)?;
-    c2.draw_series(LineSeries::new(rows.iter().map(|r| (r.value, r.normal_force)), RED.stroke_width(2))).map_err(e)?.label("normal (sum w lambda_n)").legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    c2.draw_series(LineSeries::new(rows.iter().map(|r| (r.value, r.tangential_force)), BLUE.stroke_width(2))).map_err(e)?.label("tangential |sum w lambda_t|").legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
-    c2.configure_series_labels().label_font(("sans-serif", 13)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(e)?;
+    c2.configure_mesh()
+        .x_desc(param)
+        .y_desc("force")
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(e)?;
+    c2.draw_series(LineSeries::new(
+        rows.iter().map(|r| (r.value, r.normal_force)),
+        RED.stroke_width(2),
+    ))
+    .map_err(e)?
+    .label("normal (sum w lambda_n)")
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    c2.draw_series(LineSeries::new(
+        rows.iter().map(|r| (r.value, r.tangential_force)),
+        BLUE.stroke_width(2),
+    ))
+    .map_err(e)?
+    .label("tangential |sum w lambda_t|")
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    c2.configure_series_labels()
+        .label_font(("sans-serif", 13))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(e)?;
     Ok(())
 }

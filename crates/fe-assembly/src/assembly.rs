@@ -191,44 +191,73 @@ impl<'m> Discretization<'m> {
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, ((a_node, g_node), b_node))| {
+                // the free u columns of node i: (component k, column offset q within the node)
+                let mut ucols = [(0usize, 0usize); 3];
+                let mut nq = 0;
+                for k in 0..dim {
+                    if let Dof::Free(_) = d.u[i * dim + k] {
+                        ucols[nq] = (k, nq);
+                        nq += 1;
+                    }
+                }
+                let ucols = &ucols[..nq];
+                let (first_u, _) = u_cols(d, i);
+                let a_rows = if nq > 0 { pa.rows_of(first_u) } else { &[][..] };
+                let g_rows = if nq > 0 { pg.rows_of(first_u) } else { &[][..] };
+                let phi_col = match d.phi[i] {
+                    Dof::Free(j) => Some(j),
+                    _ => None,
+                };
+                let b_rows = phi_col.map_or(&[][..], |j| pb.rows_of(j));
+                let (la, lg) = (a_rows.len(), g_rows.len());
                 for &c in &node_cells[off[i]..off[i + 1]] {
                     let cell = mesh.cell(c);
                     let a_loc = cell.iter().position(|&v| v == i).unwrap_or(0);
                     let (m, geo) = (self.material(c), &self.geometry[c]);
-                    for k in 0..dim {
-                        if let Dof::Free(col) = d.u[i * dim + k] {
-                            let colv = elasticity_column(m, geo, nl, a_loc, k);
-                            pa.add_column(a_node.0, a_node.1, col, |add| {
-                                for (b, &vb) in cell.iter().enumerate() {
-                                    for l in 0..dim {
-                                        if let Dof::Free(row) = d.u[vb * dim + l] {
-                                            add(row, colv[b][l]);
-                                        }
-                                    }
-                                }
-                            });
-                            if self.cell_electric[c] {
-                                let colg = coupling_column(m, geo, nl, a_loc, k);
-                                pg.add_column(g_node.0, g_node.1, col, |add| {
-                                    for (b, &vb) in cell.iter().enumerate() {
-                                        if let Dof::Free(row) = d.phi[vb] {
-                                            add(row, colg[b]);
-                                        }
-                                    }
-                                });
-                            }
+                    let electric = self.cell_electric[c];
+                    let mut colv = [[[0.0; 3]; 4]; 3];
+                    let mut colg = [[0.0; 4]; 3];
+                    for &(k, q) in ucols {
+                        colv[q] = elasticity_column(m, geo, nl, a_loc, k);
+                        if electric {
+                            colg[q] = coupling_column(m, geo, nl, a_loc, k);
                         }
                     }
-                    if self.cell_electric[c] {
-                        if let Dof::Free(col) = d.phi[i] {
-                            let colb = dielectric_column(m, geo, nl, a_loc);
-                            pb.add_column(b_node.0, b_node.1, col, |add| {
-                                for (b, &vb) in cell.iter().enumerate() {
-                                    if let Dof::Free(row) = d.phi[vb] {
-                                        add(row, colb[b]);
+                    let colb = match (electric, phi_col) {
+                        (true, Some(_)) => Some(dielectric_column(m, geo, nl, a_loc)),
+                        _ => None,
+                    };
+                    for (b, &vb) in cell.iter().enumerate() {
+                        // u rows of node vb: contiguous in every column of node i
+                        if nq > 0 {
+                            let (first_row, count) = u_cols(d, vb);
+                            if count > 0 {
+                                let pos = position(a_rows, first_row);
+                                let mut o = 0;
+                                for l in 0..dim {
+                                    if let Dof::Free(_) = d.u[vb * dim + l] {
+                                        for &(_, q) in ucols {
+                                            a_node.1[q * la + pos + o] += colv[q][b][l];
+                                        }
+                                        o += 1;
                                     }
                                 }
-                            });
+                            }
+                        }
+                        if !electric {
+                            continue;
+                        }
+                        if let Dof::Free(row) = d.phi[vb] {
+                            if nq > 0 {
+                                let pos = position(g_rows, row);
+                                for &(_, q) in ucols {
+                                    g_node.1[q * lg + pos] += colg[q][b];
+                                }
+                            }
+                            if let Some(colb) = &colb {
+                                let pos = position(b_rows, row);
+                                b_node.1[pos] += colb[b];
+                            }
                         }
                     }
                 }
@@ -283,6 +312,12 @@ impl<'m> Discretization<'m> {
             }
         }
     }
+}
+
+/// Index of `row` in the sorted `rows` (present by construction of the pattern).
+fn position(rows: &[usize], row: usize) -> usize {
+    rows.binary_search(&row)
+        .unwrap_or_else(|_| unreachable!("row {row} not in the pattern"))
 }
 
 /// The free column dofs of node `i` in the u field: `(first, count)`.
@@ -377,6 +412,11 @@ impl Pattern {
         }
     }
 
+    /// The row indices of column `col`.
+    fn rows_of(&self, col: usize) -> &[usize] {
+        &self.row_idx[self.col_ptr[col]..self.col_ptr[col + 1]]
+    }
+
     fn zeros(&self) -> Vec<f64> {
         vec![0.0; self.row_idx.len()]
     }
@@ -413,25 +453,6 @@ impl Pattern {
             at = end;
         }
         out
-    }
-
-    /// Adds into column `col` through `add(row, value)`; `slice` starts at value index `base`.
-    fn add_column(
-        &self,
-        base: usize,
-        slice: &mut [f64],
-        col: usize,
-        fill: impl FnOnce(&mut dyn FnMut(usize, f64)),
-    ) {
-        let (s, e) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        let rows = &self.row_idx[s..e];
-        let vals = &mut slice[s - base..e - base];
-        fill(&mut |row, v| {
-            let p = rows
-                .binary_search(&row)
-                .unwrap_or_else(|_| unreachable!("row {row} not in column {col}"));
-            vals[p] += v;
-        });
     }
 
     fn into_matrix(self, values: Vec<f64>) -> SparseColMat<usize, f64> {

@@ -164,6 +164,23 @@ impl DofMap {
         })
     }
 
+    /// Expands a node order (`order[new] = old node`) to the free dofs of `K`'s `[u; φ]`
+    /// layout: each node's displacement components, then its potential (index `n_u + j`).
+    pub fn expand_node_order(&self, order: &[usize]) -> Vec<usize> {
+        let mut out = Vec::with_capacity(self.n_u + self.n_phi);
+        for &node in order {
+            for k in 0..self.dim {
+                if let Dof::Free(j) = self.u[node * self.dim + k] {
+                    out.push(j);
+                }
+            }
+            if let Dof::Free(j) = self.phi[node] {
+                out.push(self.n_u + j);
+            }
+        }
+        out
+    }
+
     /// Nodal displacements `[x, y, z]` from the free values (prescribed values filled in).
     pub fn expand_u(&self, u_free: &[f64]) -> Vec<[f64; 3]> {
         self.u

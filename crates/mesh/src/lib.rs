@@ -28,10 +28,12 @@
 
 mod generate;
 mod gmsh;
+mod ordering;
 mod quality;
 
 pub use generate::{box_tet, rectangle_quad, rectangle_tri};
 pub use gmsh::{read_msh, read_msh_bytes};
+pub use ordering::nested_dissection;
 pub use quality::QualityReport;
 
 use std::collections::BTreeMap;
