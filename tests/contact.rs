@@ -119,11 +119,7 @@ fn frictionless_and_tresca_plans_leave_out_what_they_do_not_need() {
     assert_eq!(t.report["plan"]["fixed_point"], false);
     assert_eq!(t.report["iterations"]["fixed_point"], 0);
     let (_, sol) = t.contact.as_ref().unwrap();
-    assert!(sol
-        .lambda
-        .tangential
-        .iter()
-        .all(|l| l.abs() <= 0.05 * (1.0 + 1e-9)));
+    assert!(sol.lambda.tangential.iter().all(|l| l.abs() <= 0.05 * (1.0 + 1e-9)));
     let none = run("paper", &["mesh.n=8", "contact.law=none"]);
     assert!(none.contact.is_none());
     assert_eq!(none.report["iterations"]["uzawa"], 0);
@@ -137,27 +133,16 @@ fn actuator_lifts_off_sticks_and_slips_along_the_voltage() {
     assert_eq!(counts(&zero).2, 0);
     assert_eq!(counts(&zero).1, 0, "all stick at V = 0");
     let up = run("actuator", &["mesh.n=16", "electrode.v=0.1"]);
-    assert!(
-        counts(&up).1 > 0,
-        "a slip zone at V = 0.1: {:?}",
-        counts(&up)
-    );
+    assert!(counts(&up).1 > 0, "a slip zone at V = 0.1: {:?}", counts(&up));
 }
 
 #[test]
 fn paper_rule_is_labelled_and_reproduces_the_table_counts() {
     let r = run(
         "paper",
-        &[
-            "mesh.n=32",
-            "solver.rule=paper",
-            "solver.strategy=uzawa-schur-pcg",
-        ],
+        &["mesh.n=32", "solver.rule=paper", "solver.strategy=uzawa-schur-pcg"],
     );
-    assert!(r.report["solver"]["rule"]
-        .as_str()
-        .unwrap()
-        .starts_with("paper"));
+    assert!(r.report["solver"]["rule"].as_str().unwrap().starts_with("paper"));
     assert_eq!(r.report["residuals"]["converged_to_tolerance"], false);
     let it = &r.report["iterations"];
     eprintln!("paper rule at n = 32: {it}");
@@ -167,17 +152,10 @@ fn paper_rule_is_labelled_and_reproduces_the_table_counts() {
     // 39 with exact inner solves (solver.pcg_tol=1e-12), 43 with the paper's loose PCG
     assert!((39..=45).contains(&uz), "Uzawa iterations: {uz}");
     let pcg_per_solve = it["pcg"].as_f64().unwrap() / (uz as f64 + 1.0);
-    assert!(
-        pcg_per_solve <= 3.0,
-        "PCG iterations per Uzawa solve: {pcg_per_solve}"
-    );
+    assert!(pcg_per_solve <= 3.0, "PCG iterations per Uzawa solve: {pcg_per_solve}");
     let exact = run(
         "paper",
-        &[
-            "mesh.n=32",
-            "solver.rule=paper",
-            "solver.strategy=uzawa-direct",
-        ],
+        &["mesh.n=32", "solver.rule=paper", "solver.strategy=uzawa-direct"],
     );
     assert_eq!(exact.report["iterations"]["uzawa"], 39);
     assert_eq!(exact.report["iterations"]["fixed_point"], 3);
@@ -187,10 +165,7 @@ fn paper_rule_is_labelled_and_reproduces_the_table_counts() {
 fn every_shipped_scene_runs_at_its_smoke_size() {
     for (name, text) in driver::scene::SHIPPED {
         let scene = driver::scene::parse(text, name, &[]).unwrap();
-        let n = scene
-            .mesh
-            .smoke_n
-            .expect("every shipped scene has a smoke size");
+        let n = scene.mesh.smoke_n.expect("every shipped scene has a smoke size");
         let r = run(name, &[&format!("mesh.n={n}")]);
         let eq = r.report["residuals"]["equilibrium"].as_f64().unwrap();
         assert!(eq < 1e-10, "{name}: equilibrium {eq}");

@@ -10,28 +10,18 @@ use linalg::{DirectLdlt, Ordering};
 fn run(scene: &str, sets: &[&str]) -> serde_json::Value {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let (scene, source) = driver::scene::load(scene, &sets).unwrap();
-    driver::run::run(&scene, &source, None, &mut |_| {})
-        .unwrap()
-        .report
+    driver::run::run(&scene, &source, None, &mut |_| {}).unwrap().report
 }
 
 #[test]
 fn strategies_agree_on_paper_without_contact() {
     let direct = run(
         "paper",
-        &[
-            "mesh.n=16",
-            "contact.law=none",
-            "solver.strategy=uzawa-direct",
-        ],
+        &["mesh.n=16", "contact.law=none", "solver.strategy=uzawa-direct"],
     );
     let schur = run(
         "paper",
-        &[
-            "mesh.n=16",
-            "contact.law=none",
-            "solver.strategy=uzawa-schur-pcg",
-        ],
+        &["mesh.n=16", "contact.law=none", "solver.strategy=uzawa-schur-pcg"],
     );
     assert!(direct["residuals"]["equilibrium"].as_f64().unwrap() < 1e-12);
     assert!(schur["residuals"]["equilibrium"].as_f64().unwrap() < 1e-10);
@@ -59,8 +49,7 @@ fn paper_3d_runs() {
 
 #[test]
 fn supernodal_ldlt_has_the_inertia_of_k() {
-    let (scene, source) =
-        driver::scene::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
+    let (scene, source) = driver::scene::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
     let mesh = driver::build::mesh(&scene, &source).unwrap();
     let mats = driver::build::materials(&scene, 2).unwrap();
     let plan = driver::build::plan(&scene, 2, &mats);
@@ -75,11 +64,9 @@ fn supernodal_ldlt_has_the_inertia_of_k() {
 fn outputs_are_written_and_bad_input_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ok");
-    let (scene, source) =
-        driver::scene::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
+    let (scene, source) = driver::scene::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
     driver::run::run(&scene, &source, Some(&out), &mut |_| {}).unwrap();
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(json["scene"]["name"], "paper");
     let vtu = std::fs::read_to_string(out.join("solution.vtu")).unwrap();
     assert!(vtu.starts_with("<VTKFile type=\"UnstructuredGrid\""));
@@ -88,18 +75,11 @@ fn outputs_are_written_and_bad_input_writes_nothing() {
     let bad = dir.path().join("bad");
     let (scene, source) = driver::scene::load(
         "paper",
-        &[
-            "mesh.n=4".into(),
-            "contact.law=none".into(),
-            "load.group=lid".into(),
-        ],
+        &["mesh.n=4".into(), "contact.law=none".into(), "load.group=lid".into()],
     )
     .unwrap();
     let e = driver::run::run(&scene, &source, Some(&bad), &mut |_| {}).unwrap_err();
-    assert!(
-        e.to_string().contains("boundary group `lid` is missing"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("boundary group `lid` is missing"), "{e}");
     assert!(!bad.exists());
     // an unknown key names itself
     let e = driver::scene::load("paper", &["mesh.nn=4".into()]).unwrap_err();

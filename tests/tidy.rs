@@ -5,19 +5,14 @@
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let p = entry.unwrap().path();
         if p.is_dir() {
-            if p.file_name()
-                .is_some_and(|n| n == "target" || n == "fixtures")
-            {
+            if p.file_name().is_some_and(|n| n == "target" || n == "fixtures") {
                 continue;
             }
             rust_files(&p, out);
@@ -53,8 +48,7 @@ fn crate_dependencies_point_one_way() {
     ];
     let ours = ["mesh", "fe-assembly", "linalg", "contact", "driver"];
     for (krate, may) in allowed {
-        let manifest =
-            std::fs::read_to_string(root().join("crates").join(krate).join("Cargo.toml")).unwrap();
+        let manifest = std::fs::read_to_string(root().join("crates").join(krate).join("Cargo.toml")).unwrap();
         let deps = manifest
             .split("[dependencies]")
             .nth(1)
@@ -64,8 +58,7 @@ fn crate_dependencies_point_one_way() {
             .unwrap();
         for other in ours {
             let uses = deps.lines().any(|l| {
-                l.trim_start().starts_with(&format!("{other}."))
-                    || l.trim_start().starts_with(&format!("{other} "))
+                l.trim_start().starts_with(&format!("{other}.")) || l.trim_start().starts_with(&format!("{other} "))
             });
             if uses {
                 assert!(

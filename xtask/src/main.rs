@@ -15,34 +15,14 @@ fn cargo(args: &[&str], env: &[(&str, &str)]) -> bool {
 
 fn verify() -> bool {
     cargo(&["fmt", "--all", "--", "--check"], &[])
-        && cargo(
-            &[
-                "clippy",
-                "--workspace",
-                "--all-targets",
-                "--",
-                "-D",
-                "warnings",
-            ],
-            &[],
-        )
+        && cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])
         && cargo(&["test", "--workspace"], &[])
-        && cargo(
-            &["doc", "--workspace", "--no-deps"],
-            &[("RUSTDOCFLAGS", "-D warnings")],
-        )
+        && cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])
 }
 
 fn bench(sizes: &[String]) -> bool {
     if !cargo(
-        &[
-            "build",
-            "--release",
-            "-p",
-            "driver",
-            "--example",
-            "bench_linear",
-        ],
+        &["build", "--release", "-p", "driver", "--example", "bench_linear"],
         &[],
     ) {
         return false;

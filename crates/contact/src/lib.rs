@@ -42,8 +42,8 @@ pub use operator::{ContactOperator, DenseContactProblem};
 pub use points::{ContactPoints, PointValues, Status};
 pub use projection::{project_disc, project_nonnegative};
 pub use uzawa::{
-    classify, complementarity_residual, slip_bound, solve, ContactSolution, Law, Progress,
-    StopRule, UzawaInfo, UzawaParams,
+    classify, complementarity_residual, slip_bound, solve, ContactSolution, Law, Progress, StopRule, UzawaInfo,
+    UzawaParams,
 };
 
 /// What can go wrong in a contact solve; each variant carries the last residual.

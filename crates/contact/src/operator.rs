@@ -13,11 +13,7 @@ pub trait ContactOperator {
     /// Given `lambda`, computes the contact displacement `(u_n, u_t)` of the equilibrium with
     /// the contact forces `-Nᵀ W λ_n - Tᵀ W λ_t`. Returns inner iterations done (e.g. PCG) or a
     /// message on failure.
-    fn displacement(
-        &mut self,
-        lambda: &PointValues,
-        out: &mut PointValues,
-    ) -> Result<usize, String>;
+    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, String>;
 }
 
 /// An affine contact problem given densely: `u = u0 - D W λ` with `D` symmetric positive
@@ -49,11 +45,7 @@ impl ContactOperator for DenseContactProblem {
     fn n_tangential(&self) -> usize {
         self.nt
     }
-    fn displacement(
-        &mut self,
-        lambda: &PointValues,
-        out: &mut PointValues,
-    ) -> Result<usize, String> {
+    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, String> {
         let n = self.weight.len();
         let m = self.m();
         // W λ in the flat layout

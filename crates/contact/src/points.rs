@@ -45,16 +45,10 @@ impl ContactPoints {
         }
         for i in 0..n {
             if !(self.weight[i] > 0.0 && self.weight[i].is_finite()) {
-                return Err(format!(
-                    "contact point {i}: weight {} is not positive",
-                    self.weight[i]
-                ));
+                return Err(format!("contact point {i}: weight {} is not positive", self.weight[i]));
             }
             if !self.gap[i].is_finite() {
-                return Err(format!(
-                    "contact point {i}: gap {} is not finite",
-                    self.gap[i]
-                ));
+                return Err(format!("contact point {i}: gap {} is not finite", self.gap[i]));
             }
             if !(self.friction[i] >= 0.0 && self.friction[i].is_finite()) {
                 return Err(format!(
@@ -87,11 +81,7 @@ impl PointValues {
     }
     /// Weighted 2-norm `(Σ w_i |x_i|²)^½` over both parts.
     pub fn weighted_norm(&self, w: &[f64]) -> f64 {
-        let nt = self
-            .tangential
-            .len()
-            .checked_div(self.normal.len())
-            .unwrap_or(0);
+        let nt = self.tangential.len().checked_div(self.normal.len()).unwrap_or(0);
         let mut s = 0.0;
         for (i, &wi) in w.iter().enumerate() {
             s += wi * self.normal[i] * self.normal[i];
@@ -113,12 +103,7 @@ impl PointValues {
     /// `self - other`.
     pub fn minus(&self, other: &PointValues) -> PointValues {
         PointValues {
-            normal: self
-                .normal
-                .iter()
-                .zip(&other.normal)
-                .map(|(a, b)| a - b)
-                .collect(),
+            normal: self.normal.iter().zip(&other.normal).map(|(a, b)| a - b).collect(),
             tangential: self
                 .tangential
                 .iter()

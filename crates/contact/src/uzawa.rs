@@ -121,12 +121,7 @@ pub fn slip_bound(points: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f6
     match law {
         Law::Frictionless => vec![0.0; points.len()],
         Law::Tresca(s) => s.clone(),
-        Law::Coulomb => points
-            .friction
-            .iter()
-            .zip(lambda_n)
-            .map(|(f, l)| f * l)
-            .collect(),
+        Law::Coulomb => points.friction.iter().zip(lambda_n).map(|(f, l)| f * l).collect(),
     }
 }
 
@@ -145,8 +140,7 @@ pub fn complementarity_residual(
     let mut r = PointValues::zeros(n, nt);
     let mut buf = [0.0; 2];
     for i in 0..n {
-        r.normal[i] = lambda.normal[i]
-            - project_nonnegative(lambda.normal[i] + c * (u.normal[i] - points.gap[i]));
+        r.normal[i] = lambda.normal[i] - project_nonnegative(lambda.normal[i] + c * (u.normal[i] - points.gap[i]));
         if nt > 0 {
             for k in 0..nt {
                 buf[k] = lambda.tangential[i * nt + k] + c * u.tangential[i * nt + k];
@@ -205,22 +199,14 @@ struct Counter<'a> {
 impl Counter<'_> {
     fn call(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<(), ContactError> {
         self.calls += 1;
-        self.inner += self
-            .op
-            .displacement(lambda, out)
-            .map_err(ContactError::Operator)?;
+        self.inner += self.op.displacement(lambda, out).map_err(ContactError::Operator)?;
         Ok(())
     }
 }
 
 /// Largest eigenvalue of the dual operator `λ ↦ u(0) - u(λ)` in the `W` inner product, by
 /// power iteration from `λ = 1` (a Rayleigh quotient, so a lower estimate).
-fn estimate_mu_max(
-    c: &mut Counter<'_>,
-    points: &ContactPoints,
-    nt: usize,
-    iters: usize,
-) -> Result<f64, ContactError> {
+fn estimate_mu_max(c: &mut Counter<'_>, points: &ContactPoints, nt: usize, iters: usize) -> Result<f64, ContactError> {
     let n = points.len();
     let zero = PointValues::zeros(n, nt);
     let mut u0 = PointValues::zeros(n, nt);
@@ -293,18 +279,12 @@ pub fn solve(
             ));
         }
     }
-    let mut c = Counter {
-        op,
-        calls: 0,
-        inner: 0,
-    };
+    let mut c = Counter { op, calls: 0, inner: 0 };
     let mu_max = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
     let estimate_inner = c.inner;
     let mut step = params.step.unwrap_or(params.safety / mu_max);
     if !(step > 0.0 && step.is_finite()) {
-        return Err(ContactError::Input(format!(
-            "Uzawa step {step} must be positive"
-        )));
+        return Err(ContactError::Input(format!("Uzawa step {step} must be positive")));
     }
     let canon = 1.0 / mu_max;
     let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
@@ -369,12 +349,7 @@ pub fn solve(
                         (r <= tol, r)
                     }
                     StopRule::Paper => {
-                        let diff: f64 = s_new
-                            .iter()
-                            .zip(&s)
-                            .map(|(a, b)| (a - b).powi(2))
-                            .sum::<f64>()
-                            .sqrt();
+                        let diff: f64 = s_new.iter().zip(&s).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
                         let norm: f64 = s_new.iter().map(|a| a * a).sum::<f64>().sqrt();
                         let rel = if norm > 0.0 { diff / norm } else { diff };
                         (rel <= 1e-3, rel)
@@ -391,10 +366,7 @@ pub fn solve(
                     break;
                 }
                 if l == params.max_fixed_point {
-                    return Err(ContactError::FixedPointNoConvergence {
-                        n_iters: l,
-                        residual,
-                    });
+                    return Err(ContactError::FixedPointNoConvergence { n_iters: l, residual });
                 }
             }
             if !fresh {

@@ -3,8 +3,8 @@
 //! active-set enumeration and a KKT check, and homogeneity in the load.
 
 use contact::{
-    complementarity_residual, project_disc, project_nonnegative, solve, ContactPoints,
-    DenseContactProblem, Law, PointValues, StopRule, UzawaParams,
+    complementarity_residual, project_disc, project_nonnegative, solve, ContactPoints, DenseContactProblem, Law,
+    PointValues, StopRule, UzawaParams,
 };
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -31,13 +31,7 @@ fn compliance(m: usize, seed: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-fn problem(
-    n: usize,
-    nt: usize,
-    pts: &ContactPoints,
-    seed: &[f64],
-    load: &[f64],
-) -> DenseContactProblem {
+fn problem(n: usize, nt: usize, pts: &ContactPoints, seed: &[f64], load: &[f64]) -> DenseContactProblem {
     let m = n * (1 + nt);
     DenseContactProblem {
         u0: PointValues {
@@ -203,10 +197,7 @@ fn residual_is_zero_at_a_solution_and_scale_free() {
         normal: vec![0.0],
         tangential: vec![],
     };
-    assert_eq!(
-        complementarity_residual(&pts, &[0.0], &lambda, &u, 1.0),
-        0.0
-    );
+    assert_eq!(complementarity_residual(&pts, &[0.0], &lambda, &u, 1.0), 0.0);
     // penetration of 1 with λ = 2: residual |2 - (2 + c)| / 2 = c / 2
     let u = PointValues {
         normal: vec![1.0],

@@ -19,13 +19,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    let n: usize = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(64);
+    let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(64);
     let (scene, source) =
-        driver::scene::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()])
-            .expect("paper scene");
+        driver::scene::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("paper scene");
     let mesh = driver::build::mesh(&scene, &source).expect("mesh");
     let mats = driver::build::materials(&scene, 2).expect("materials");
     let plan = driver::build::plan(&scene, 2, &mats);
@@ -44,14 +40,9 @@ fn main() {
         t_asm.push(t.elapsed().as_secs_f64());
         dofs = (disc.dofs.n_u, disc.dofs.n_phi);
         // direct: symbolic + numeric, then numeric again alone
-        let k = linalg::sparse::lower_quasi_definite(
-            blocks.a.as_ref(),
-            blocks.g.as_ref(),
-            blocks.b.as_ref(),
-        );
+        let k = linalg::sparse::lower_quasi_definite(blocks.a.as_ref(), blocks.g.as_ref(), blocks.b.as_ref());
         let t = Instant::now();
-        let mut f = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &Ordering::Amd, faer::Par::Seq)
-            .expect("ldlt");
+        let mut f = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &Ordering::Amd, faer::Par::Seq).expect("ldlt");
         let both = t.elapsed().as_secs_f64();
         let t = Instant::now();
         f.refactor(k.as_ref()).expect("refactor");
@@ -69,14 +60,8 @@ fn main() {
             max_iters: 1000,
             ..Default::default()
         };
-        let mut s = SchurPcg::new(
-            blocks.a.clone(),
-            blocks.g.clone(),
-            &blocks.b,
-            params,
-            faer::Par::Seq,
-        )
-        .expect("schur");
+        let mut s =
+            SchurPcg::new(blocks.a.clone(), blocks.g.clone(), &blocks.b, params, faer::Par::Seq).expect("schur");
         t_chol.push(t.elapsed().as_secs_f64());
         let (mut u, mut p) = (vec![0.0; dofs.0], vec![0.0; dofs.1]);
         let t = Instant::now();

@@ -14,13 +14,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    let n: usize = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(128);
+    let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(128);
     let (scene, source) =
-        driver::scene::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()])
-            .expect("scene");
+        driver::scene::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
     let mesh = driver::build::mesh(&scene, &source).expect("mesh");
     let mats = driver::build::materials(&scene, 2).expect("materials");
     let plan = driver::build::plan(&scene, 2, &mats);
@@ -34,16 +30,12 @@ fn main() {
         .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
     let t_nd = t.elapsed().as_secs_f64();
     println!("n = {n}: nested dissection order computed in {t_nd:.3} s");
-    for (name, ord) in [
-        ("amd", Ordering::Amd),
-        ("nested-dissection", Ordering::Given(nd)),
-    ] {
+    for (name, ord) in [("amd", Ordering::Amd), ("nested-dissection", Ordering::Given(nd))] {
         let (mut sym, mut num, mut sol) = (vec![], vec![], vec![]);
         let mut len = 0;
         for _ in 0..3 {
             let t = Instant::now();
-            let mut f = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, faer::Par::Seq)
-                .expect("ldlt");
+            let mut f = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, faer::Par::Seq).expect("ldlt");
             let both = t.elapsed().as_secs_f64();
             let t = Instant::now();
             f.refactor(k.as_ref()).expect("refactor");

@@ -36,16 +36,8 @@ impl std::fmt::Display for Plan {
             self.dim,
             if self.electric { "yes" } else { "left out" },
             self.contact_law,
-            if self.friction {
-                " (tangential multipliers)"
-            } else {
-                ""
-            },
-            if self.fixed_point {
-                " + fixed point on S"
-            } else {
-                ""
-            },
+            if self.friction { " (tangential multipliers)" } else { "" },
+            if self.fixed_point { " + fixed point on S" } else { "" },
             self.linear_strategy,
             self.rule,
             self.outputs.join(", ")
@@ -105,14 +97,10 @@ pub fn mesh(scene: &Scene, source: &Source) -> Result<mesh::Mesh, DriverError> {
             .clone()
             .unwrap_or_else(|| vec![f64::NEG_INFINITY, f64::INFINITY]);
         if range.len() != 2 {
-            return Err(DriverError::Input(
-                "electrode.x_range needs two numbers".into(),
-            ));
+            return Err(DriverError::Input("electrode.x_range needs two numbers".into()));
         }
         let tol = 1e-12 * (1.0 + range[0].abs().max(range[1].abs()));
-        let g = mesh.select_facets(&e.group, |x| {
-            x[0] >= range[0] - tol && x[0] <= range[1] + tol
-        })?;
+        let g = mesh.select_facets(&e.group, |x| x[0] >= range[0] - tol && x[0] <= range[1] + tol)?;
         if g.n_facets() == 0 {
             return Err(DriverError::Input(format!(
                 "the electrode covers no facet of `{}` in x in [{}, {}]",
@@ -129,14 +117,10 @@ fn material(spec: &MaterialSpec, dim: usize, scale: f64) -> Result<Material, Dri
     let crystal = match spec.model.as_str() {
         "crystal-6mm" => {
             if spec.c.len() != 6 || spec.e.len() != 3 || spec.permittivity.len() != 2 {
-                return Err(bad(
-                    "crystal-6mm needs c (6 values), e (3) and permittivity (2)".into(),
-                ));
+                return Err(bad("crystal-6mm needs c (6 values), e (3) and permittivity (2)".into()));
             }
             Crystal::hexagonal_6mm(
-                [
-                    spec.c[0], spec.c[1], spec.c[2], spec.c[3], spec.c[4], spec.c[5],
-                ],
+                [spec.c[0], spec.c[1], spec.c[2], spec.c[3], spec.c[4], spec.c[5]],
                 [spec.e[0], spec.e[1], spec.e[2]],
                 [spec.permittivity[0], spec.permittivity[1]],
             )
@@ -152,11 +136,7 @@ fn material(spec: &MaterialSpec, dim: usize, scale: f64) -> Result<Material, Dri
             }
             Crystal::isotropic(y, nu, spec.permittivity.first().copied().unwrap_or(0.0))
         }
-        other => {
-            return Err(bad(format!(
-                "model `{other}` is unknown (crystal-6mm, isotropic)"
-            )))
-        }
+        other => return Err(bad(format!("model `{other}` is unknown (crystal-6mm, isotropic)"))),
     };
     let poling = match spec.poling.len() {
         0 => [0.0, 0.0, 1.0],
@@ -186,10 +166,7 @@ pub fn plan(scene: &Scene, dim: usize, materials: &[(String, Material)]) -> Plan
     let coupling = materials.iter().any(|(_, m)| m.e.iter().any(|&x| x != 0.0));
     let electric_data = scene.electrode.as_ref().is_some_and(|e| e.v != 0.0);
     let electric = (coupling || electric_data) && materials.iter().any(|(_, m)| m.electric);
-    let law = scene
-        .contact
-        .as_ref()
-        .map_or("none".to_string(), |c| c.law.clone());
+    let law = scene.contact.as_ref().map_or("none".to_string(), |c| c.law.clone());
     let friction_coeff = scene.contact.as_ref().map_or(0.0, |c| c.friction);
     let slip = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound);
     let friction = match law.as_str() {
@@ -252,9 +229,7 @@ pub fn loads(scene: &Scene, dim: usize) -> Result<Vec<Load>, DriverError> {
     let mut out = vec![];
     if let Some(l) = &scene.load {
         if l.direction.len() != dim {
-            return Err(DriverError::Input(format!(
-                "load.direction needs {dim} components"
-            )));
+            return Err(DriverError::Input(format!("load.direction needs {dim} components")));
         }
         let mut t = [0.0; 3];
         for k in 0..dim {

@@ -30,15 +30,11 @@ pub fn boundary(
 ) -> Result<ContactBoundary, DriverError> {
     let dim = mesh.dim;
     if normal.len() != dim {
-        return Err(DriverError::Input(format!(
-            "contact.normal needs {dim} components"
-        )));
+        return Err(DriverError::Input(format!("contact.normal needs {dim} components")));
     }
     let len = normal.iter().map(|x| x * x).sum::<f64>().sqrt();
     if !(len > 0.0) || !len.is_finite() {
-        return Err(DriverError::Input(
-            "contact.normal is not a non-zero vector".into(),
-        ));
+        return Err(DriverError::Input("contact.normal is not a non-zero vector".into()));
     }
     let mut nv = [0.0; 3];
     for k in 0..dim {
@@ -124,10 +120,7 @@ impl ContactBoundary {
     /// Adds the contact forces `-Nᵀ W λ_n - Tᵀ W λ_t` to `b_u`.
     pub fn add_forces(&self, lambda: &PointValues, b_u: &mut [f64]) {
         let p = &self.points;
-        let (dim, nt) = (
-            p.dim,
-            lambda.tangential.len().checked_div(p.len()).unwrap_or(0),
-        );
+        let (dim, nt) = (p.dim, lambda.tangential.len().checked_div(p.len()).unwrap_or(0));
         for i in 0..p.len() {
             for k in 0..dim {
                 let mut f = lambda.normal[i] * p.normal[i][k];
@@ -142,10 +135,7 @@ impl ContactBoundary {
     /// `u_n` and `u_t` of the free displacement vector `u`.
     pub fn extract(&self, u: &[f64], out: &mut PointValues) {
         let p = &self.points;
-        let (dim, nt) = (
-            p.dim,
-            out.tangential.len().checked_div(p.len()).unwrap_or(0),
-        );
+        let (dim, nt) = (p.dim, out.tangential.len().checked_div(p.len()).unwrap_or(0));
         for i in 0..p.len() {
             let ui: Vec<f64> = (0..dim).map(|k| u[self.dofs[i * dim + k]]).collect();
             out.normal[i] = (0..dim).map(|k| ui[k] * p.normal[i][k]).sum();
@@ -182,11 +172,7 @@ impl ContactOperator for FullSolve<'_> {
     fn n_tangential(&self) -> usize {
         self.nt
     }
-    fn displacement(
-        &mut self,
-        lambda: &PointValues,
-        out: &mut PointValues,
-    ) -> Result<usize, String> {
+    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, String> {
         let mut rhs = self.b_u.to_vec();
         self.boundary.add_forces(lambda, &mut rhs);
         let info = self
@@ -248,11 +234,7 @@ pub fn condense(
             let mut out = PointValues::zeros(n, nt);
             boundary.extract(&u, &mut out);
             for r in 0..m {
-                d[r * m + start + c] = if r < n {
-                    out.normal[r]
-                } else {
-                    out.tangential[r - n]
-                };
+                d[r * m + start + c] = if r < n { out.normal[r] } else { out.tangential[r - n] };
             }
         }
         start += width;

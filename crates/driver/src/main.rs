@@ -95,19 +95,10 @@ fn main() -> ExitCode {
             set,
             out,
         } => {
-            let dir = out.unwrap_or_else(|| {
-                PathBuf::from("out").join(format!("{}-sweep", scene.trim_end_matches(".toml")))
-            });
-            match driver::studies::sweep(
-                &scene,
-                &set,
-                &param,
-                from,
-                to,
-                steps,
-                Some(&dir),
-                &mut |l| eprintln!("{l}"),
-            ) {
+            let dir =
+                out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", scene.trim_end_matches(".toml"))));
+            let spec = driver::studies::SweepSpec { param, from, to, steps };
+            match driver::studies::sweep(&scene, &set, &spec, Some(&dir), &mut |l| eprintln!("{l}")) {
                 Ok(_) => ExitCode::SUCCESS,
                 Err(e) => {
                     eprintln!("error: {e}");
@@ -117,14 +108,13 @@ fn main() -> ExitCode {
         }
         Command::Table1 { loose, tight, out } => {
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join("table1"));
-            let result = driver::studies::table1(&loose, &tight, &mut |l| eprintln!("{l}"))
-                .and_then(|rows| {
-                    let md = driver::studies::table1_markdown(&rows);
-                    println!("{md}");
-                    let mut o = driver::output::Outputs::new(&dir);
-                    o.add("table1.md", md.into_bytes());
-                    o.commit()
-                });
+            let result = driver::studies::table1(&loose, &tight, &mut |l| eprintln!("{l}")).and_then(|rows| {
+                let md = driver::studies::table1_markdown(&rows);
+                println!("{md}");
+                let mut o = driver::output::Outputs::new(&dir);
+                o.add("table1.md", md.into_bytes());
+                o.commit()
+            });
             match result {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => {

@@ -5,8 +5,7 @@ use crate::DriverError;
 use fe_assembly::CellFields;
 use std::path::{Path, PathBuf};
 use vtkio::model::{
-    Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, UnstructuredGridPiece, Version,
-    VertexNumbers, Vtk,
+    Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, UnstructuredGridPiece, Version, VertexNumbers, Vtk,
 };
 
 /// Files to write together.
@@ -29,9 +28,7 @@ impl Outputs {
     }
     /// Writes every file under a temporary name, then renames them all.
     pub fn commit(self) -> Result<(), DriverError> {
-        let io = |what: &str, p: &Path, e: std::io::Error| {
-            DriverError::Output(format!("{what} {}: {e}", p.display()))
-        };
+        let io = |what: &str, p: &Path, e: std::io::Error| DriverError::Output(format!("{what} {}: {e}", p.display()));
         std::fs::create_dir_all(&self.dir).map_err(|e| io("cannot create", &self.dir, e))?;
         let pid = std::process::id();
         let mut written: Vec<(PathBuf, PathBuf)> = vec![];
@@ -84,8 +81,7 @@ pub fn vtu(
     let cell = vec![
         Attribute::generic("stress", nv as u32).with_data(fields.stress.clone()),
         Attribute::generic("strain", nv as u32).with_data(fields.strain.clone()),
-        Attribute::generic("electric_displacement", dim as u32)
-            .with_data(fields.electric_displacement.clone()),
+        Attribute::generic("electric_displacement", dim as u32).with_data(fields.electric_displacement.clone()),
         Attribute::generic("electric_field", dim as u32).with_data(fields.electric_field.clone()),
     ];
     let vtk = Vtk {
@@ -96,10 +92,7 @@ pub fn vtu(
         data: DataSet::inline(UnstructuredGridPiece {
             points: points.into(),
             cells: Cells {
-                cell_verts: VertexNumbers::XML {
-                    connectivity,
-                    offsets,
-                },
+                cell_verts: VertexNumbers::XML { connectivity, offsets },
                 types: vec![ct; mesh.n_cells()],
             },
             data: Attributes { point, cell },
@@ -114,12 +107,7 @@ pub fn vtu(
 /// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`.
 pub fn contact_csv(points: &contact::ContactPoints, sol: &contact::ContactSolution) -> Vec<u8> {
     let dim = points.dim;
-    let nt = sol
-        .lambda
-        .tangential
-        .len()
-        .checked_div(points.len())
-        .unwrap_or(0);
+    let nt = sol.lambda.tangential.len().checked_div(points.len()).unwrap_or(0);
     let mut s = String::new();
     s.push_str(if dim == 2 {
         "x,y,gap,u_n,u_t,lambda_n,lambda_t,status\n"
@@ -127,31 +115,20 @@ pub fn contact_csv(points: &contact::ContactPoints, sol: &contact::ContactSoluti
         "x,y,z,gap,u_n,u_t,u_t2,lambda_n,lambda_t,lambda_t2,status\n"
     });
     for i in 0..points.len() {
-        let mut row: Vec<String> = points.position[i][..dim]
-            .iter()
-            .map(|x| format!("{x:.12e}"))
-            .collect();
+        let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| format!("{x:.12e}")).collect();
         row.push(format!("{:.12e}", points.gap[i]));
         row.push(format!("{:.12e}", sol.u.normal[i]));
         for q in 0..dim - 1 {
             row.push(format!(
                 "{:.12e}",
-                if nt > 0 {
-                    sol.u.tangential[i * nt + q]
-                } else {
-                    0.0
-                }
+                if nt > 0 { sol.u.tangential[i * nt + q] } else { 0.0 }
             ));
         }
         row.push(format!("{:.12e}", sol.lambda.normal[i]));
         for q in 0..dim - 1 {
             row.push(format!(
                 "{:.12e}",
-                if nt > 0 {
-                    sol.lambda.tangential[i * nt + q]
-                } else {
-                    0.0
-                }
+                if nt > 0 { sol.lambda.tangential[i * nt + q] } else { 0.0 }
             ));
         }
         row.push(sol.status[i].name().to_string());

@@ -15,11 +15,7 @@ fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // the bytes are a valid TrueType font shipped with the crate
-        let _ = plotters::style::register_font(
-            FONT,
-            FontStyle::Normal,
-            include_bytes!("../assets/DejaVuSans.ttf"),
-        );
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, include_bytes!("../assets/DejaVuSans.ttf"));
     });
 }
 
@@ -27,12 +23,13 @@ fn err(what: &str, e: impl std::fmt::Display) -> DriverError {
     DriverError::Output(format!("picture {what}: {e}"))
 }
 
+/// A drawing on an SVG area.
+type DrawSvg<'a> = &'a dyn Fn(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>;
+/// The same drawing on a bitmap area.
+type DrawPng<'a> = &'a dyn Fn(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>;
+
 /// Draws with `draw` into an SVG string and a PNG image.
-fn render(
-    name: &str,
-    draw: &dyn Fn(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
-    draw_png: &dyn Fn(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
+fn render(name: &str, draw: DrawSvg<'_>, draw_png: DrawPng<'_>) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
     register_font();
     let mut svg = String::new();
     {
@@ -121,15 +118,9 @@ fn deformed<DB: DrawingBackend>(
     // undeformed outline
     for g in mesh.boundaries.values() {
         for f in g.iter() {
-            let pts: Vec<(f64, f64)> = f
-                .iter()
-                .map(|&v| (mesh.points[v][0], mesh.points[v][1]))
-                .collect();
+            let pts: Vec<(f64, f64)> = f.iter().map(|&v| (mesh.points[v][0], mesh.points[v][1])).collect();
             chart
-                .draw_series(std::iter::once(PathElement::new(
-                    pts,
-                    RGBColor(190, 190, 190),
-                )))
+                .draw_series(std::iter::once(PathElement::new(pts, RGBColor(190, 190, 190))))
                 .map_err(e)?;
         }
     }
@@ -138,12 +129,7 @@ fn deformed<DB: DrawingBackend>(
         .draw_series(mesh.iter_cells().step_by(step).map(|c| {
             let mut pts: Vec<(f64, f64)> = c
                 .iter()
-                .map(|&v| {
-                    (
-                        mesh.points[v][0] + scale * u[v][0],
-                        mesh.points[v][1] + scale * u[v][1],
-                    )
-                })
+                .map(|&v| (mesh.points[v][0] + scale * u[v][0], mesh.points[v][1] + scale * u[v][1]))
                 .collect();
             pts.push(pts[0]);
             PathElement::new(pts, BLUE.mix(0.6))
@@ -166,14 +152,9 @@ fn multipliers<DB: DrawingBackend>(
         let ys: Vec<f64> = p.position.iter().map(|x| x[1]).collect();
         let (ymin, ymax) = ys
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
-                (a.min(y), b.max(y))
-            });
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| (a.min(y), b.max(y)));
         let mid = 0.5 * (ymin + ymax);
-        let best = ys
-            .iter()
-            .map(|y| (y - mid).abs())
-            .fold(f64::INFINITY, f64::min);
+        let best = ys.iter().map(|y| (y - mid).abs()).fold(f64::INFINITY, f64::min);
         idx.retain(|&i| ((ys[i] - mid).abs() - best).abs() < 1e-12);
     }
     idx.sort_by(|&a, &b| p.position[a][0].total_cmp(&p.position[b][0]));
@@ -181,22 +162,10 @@ fn multipliers<DB: DrawingBackend>(
     let ln: Vec<f64> = idx.iter().map(|&i| s.lambda.normal[i]).collect();
     let lt: Vec<f64> = idx
         .iter()
-        .map(|&i| {
-            if nt > 0 {
-                s.lambda.tangential[i * nt]
-            } else {
-                0.0
-            }
-        })
+        .map(|&i| if nt > 0 { s.lambda.tangential[i * nt] } else { 0.0 })
         .collect();
-    let sb: Vec<f64> = idx
-        .iter()
-        .map(|&i| p.friction[i] * s.lambda.normal[i])
-        .collect();
-    let (xmin, xmax) = (
-        x.first().copied().unwrap_or(0.0),
-        x.last().copied().unwrap_or(1.0),
-    );
+    let sb: Vec<f64> = idx.iter().map(|&i| p.friction[i] * s.lambda.normal[i]).collect();
+    let (xmin, xmax) = (x.first().copied().unwrap_or(0.0), x.last().copied().unwrap_or(1.0));
     let ymax = ln
         .iter()
         .chain(&sb)
@@ -278,19 +247,13 @@ fn multipliers<DB: DrawingBackend>(
     Ok(())
 }
 
-fn potential<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    mesh: &mesh::Mesh,
-    phi: &[f64],
-) -> Result<(), String> {
+fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, mesh: &mesh::Mesh, phi: &[f64]) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
     let (lo, hi) = mesh.bounding_box();
     let (pmin, pmax) = phi
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     let span = if pmax > pmin { pmax - pmin } else { 1.0 };
     let mut chart = ChartBuilder::on(area)
         .caption(
@@ -321,10 +284,7 @@ fn potential<DB: DrawingBackend>(
     };
     chart
         .draw_series(mesh.iter_cells().map(|c| {
-            let pts: Vec<(f64, f64)> = c
-                .iter()
-                .map(|&v| (mesh.points[v][0], mesh.points[v][1]))
-                .collect();
+            let pts: Vec<(f64, f64)> = c.iter().map(|&v| (mesh.points[v][0], mesh.points[v][1])).collect();
             let mean = c.iter().map(|&v| phi[v]).sum::<f64>() / c.len() as f64;
             Polygon::new(pts, color(mean).filled())
         }))
@@ -353,19 +313,12 @@ fn potential<DB: DrawingBackend>(
         }
     }
     chart
-        .draw_series(
-            segments
-                .into_iter()
-                .map(|s| PathElement::new(s, BLACK.mix(0.7))),
-        )
+        .draw_series(segments.into_iter().map(|s| PathElement::new(s, BLACK.mix(0.7))))
         .map_err(e)?;
     Ok(())
 }
 
 /// The sweep's picture, SVG and PNG.
-pub fn sweep_pictures(
-    param: &str,
-    rows: &[crate::studies::SweepRow],
-) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
+pub fn sweep_pictures(param: &str, rows: &[crate::studies::SweepRow]) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
     both!("sweep", |a| crate::studies::draw_sweep(a, param, rows))
 }

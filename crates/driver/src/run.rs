@@ -7,9 +7,7 @@ use crate::scene::{Scene, Source};
 use crate::DriverError;
 use contact::{ContactSolution, Law, StopRule, UzawaParams};
 use fe_assembly::{Discretization, Parallelism};
-use linalg::{
-    equilibrium_residual, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg,
-};
+use linalg::{equilibrium_residual, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
@@ -39,11 +37,9 @@ pub fn peak_memory_bytes() -> u64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
-            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
-                l.split_whitespace()
-                    .nth(1)
-                    .and_then(|kb| kb.parse::<u64>().ok())
-            })
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1).and_then(|kb| kb.parse::<u64>().ok()))
         })
         .map_or(0, |kb| kb * 1024)
 }
@@ -117,13 +113,7 @@ pub fn run(
             par,
         )?);
     } else {
-        direct = Some(DirectLdlt::new(
-            &blocks.a,
-            &blocks.g,
-            &blocks.b,
-            &Ordering::Amd,
-            par,
-        )?);
+        direct = Some(DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, par)?);
     }
     let t_factor = t.elapsed().as_secs_f64();
     progress(&format!("factorisation {t_factor:.3} s"));
@@ -139,12 +129,8 @@ pub fn run(
         };
         pcg_total = solver.solve(&b_u, &b_phi, &mut u, &mut phi)?.pcg_iters;
     } else {
-        let c = scene
-            .contact
-            .as_ref()
-            .expect("a contact law implies a contact section");
-        let cb =
-            contact_setup::boundary(&mesh, &disc.dofs, &c.group, &c.normal, c.gap, c.friction)?;
+        let c = scene.contact.as_ref().expect("a contact law implies a contact section");
+        let cb = contact_setup::boundary(&mesh, &disc.dofs, &c.group, &c.normal, c.gap, c.friction)?;
         let n_points = cb.points.len();
         let law = match (plan.contact_law.as_str(), plan.friction) {
             (_, false) => Law::Frictionless,
@@ -156,9 +142,7 @@ pub fn run(
             rule: if plan.rule == "paper" {
                 StopRule::Paper
             } else {
-                StopRule::Tight {
-                    tol: scene.solver.tol,
-                }
+                StopRule::Tight { tol: scene.solver.tol }
             },
             report_every: 500,
             ..Default::default()
@@ -278,20 +262,14 @@ pub fn run(
             &mesh,
             &un,
             &pn,
-            contact_result
-                .as_ref()
-                .map(|(cb, sol, _)| (&cb.points, sol)),
+            contact_result.as_ref().map(|(cb, sol, _)| (&cb.points, sol)),
             plan.electric,
         )?;
         for (name, bytes) in pics {
             outs.add(&name, bytes);
         }
         outs.commit()?;
-        progress(&format!(
-            "wrote {} in {}",
-            plan.outputs.join(", "),
-            dir.display()
-        ));
+        progress(&format!("wrote {} in {}", plan.outputs.join(", "), dir.display()));
     }
     Ok(RunOutcome {
         report,
@@ -307,18 +285,8 @@ fn contact_json(result: Option<&(ContactBoundary, ContactSolution, Law)>) -> ser
     };
     let p = &cb.points;
     let count = |s| sol.status.iter().filter(|&&x| x == s).count();
-    let normal_force: f64 = p
-        .weight
-        .iter()
-        .zip(&sol.lambda.normal)
-        .map(|(w, l)| w * l)
-        .sum();
-    let nt = sol
-        .lambda
-        .tangential
-        .len()
-        .checked_div(p.len())
-        .unwrap_or(0);
+    let normal_force: f64 = p.weight.iter().zip(&sol.lambda.normal).map(|(w, l)| w * l).sum();
+    let nt = sol.lambda.tangential.len().checked_div(p.len()).unwrap_or(0);
     let mut t = [0.0; 3];
     for i in 0..p.len() {
         for q in 0..nt {

@@ -9,26 +9,14 @@ use std::path::Path;
 /// The scenes shipped with the program, by name (their files are in `scenes/`).
 pub const SHIPPED: &[(&str, &str)] = &[
     ("paper", include_str!("../../../scenes/paper.toml")),
-    (
-        "paper-slip",
-        include_str!("../../../scenes/paper-slip.toml"),
-    ),
+    ("paper-slip", include_str!("../../../scenes/paper-slip.toml")),
     (
         "paper-frictionless",
         include_str!("../../../scenes/paper-frictionless.toml"),
     ),
-    (
-        "paper-stick",
-        include_str!("../../../scenes/paper-stick.toml"),
-    ),
-    (
-        "paper-tresca",
-        include_str!("../../../scenes/paper-tresca.toml"),
-    ),
-    (
-        "paper-elastic",
-        include_str!("../../../scenes/paper-elastic.toml"),
-    ),
+    ("paper-stick", include_str!("../../../scenes/paper-stick.toml")),
+    ("paper-tresca", include_str!("../../../scenes/paper-tresca.toml")),
+    ("paper-elastic", include_str!("../../../scenes/paper-elastic.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),
     ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),
@@ -280,11 +268,7 @@ pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(Scene, Source),
             file: name_or_path.into(),
             message: format!(
                 "no shipped scene of that name and no such file (shipped: {})",
-                SHIPPED
-                    .iter()
-                    .map(|(n, _)| *n)
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                SHIPPED.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
             ),
         });
     };
@@ -298,9 +282,7 @@ pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, Dri
         file: label.into(),
         message,
     };
-    let mut tree: toml::Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| err(e.to_string()))?;
+    let mut tree: toml::Table = text.parse().map_err(|e: toml::de::Error| err(e.to_string()))?;
     for o in overrides {
         set(&mut tree, o).map_err(|m| err(format!("--set {o}: {m}")))?;
     }
@@ -409,16 +391,8 @@ fn validate(s: &Scene) -> Result<(), String> {
         return Err("the scene has no [[material]]".into());
     }
     for m in &s.material {
-        for v in
-            m.c.iter()
-                .chain(&m.e)
-                .chain(&m.permittivity)
-                .chain(&m.poling)
-        {
-            finite(
-                &format!("a constant of the material of region `{}`", m.region),
-                *v,
-            )?;
+        for v in m.c.iter().chain(&m.e).chain(&m.permittivity).chain(&m.poling) {
+            finite(&format!("a constant of the material of region `{}`", m.region), *v)?;
         }
     }
     if let Some(l) = &s.load {
@@ -438,23 +412,14 @@ fn validate(s: &Scene) -> Result<(), String> {
         finite("contact.slip_bound", c.slip_bound)?;
         finite("contact.gap", c.gap)?;
         if c.friction < 0.0 {
-            return Err(format!(
-                "contact.friction = {} must be non-negative",
-                c.friction
-            ));
+            return Err(format!("contact.friction = {} must be non-negative", c.friction));
         }
         if c.slip_bound < 0.0 {
-            return Err(format!(
-                "contact.slip_bound = {} must be non-negative",
-                c.slip_bound
-            ));
+            return Err(format!("contact.slip_bound = {} must be non-negative", c.slip_bound));
         }
     }
     if !["tight", "paper"].contains(&s.solver.rule.as_str()) {
-        return Err(format!(
-            "solver.rule `{}` is unknown (tight, paper)",
-            s.solver.rule
-        ));
+        return Err(format!("solver.rule `{}` is unknown (tight, paper)", s.solver.rule));
     }
     finite("solver.tol", s.solver.tol)?;
     if !(s.solver.tol > 0.0) {

@@ -35,22 +35,32 @@ fn num(v: &serde_json::Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
 }
 
-/// Runs `scene_name` for `steps` values of `param` from `from` to `to` (inclusive), with the
-/// other overrides `sets`; writes `sweep.csv` and `sweep.svg/png` into `out` when given.
+/// The parameter a sweep varies: `steps` values from `from` to `to`, inclusive.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepSpec {
+    /// The scene key, e.g. `electrode.v`.
+    pub param: String,
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// Number of values (at least 2).
+    pub steps: usize,
+}
+
+/// Runs `scene_name` along `spec`, with the other overrides `sets`; writes `sweep.csv` and
+/// `sweep.svg/png` into `out` when given.
 pub fn sweep(
     scene_name: &str,
     sets: &[String],
-    param: &str,
-    from: f64,
-    to: f64,
-    steps: usize,
+    spec: &SweepSpec,
     out: Option<&Path>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<SweepRow>, DriverError> {
+    let SweepSpec { param, from, to, steps } = spec;
+    let (param, from, to, steps) = (param.as_str(), *from, *to, *steps);
     if steps < 2 {
-        return Err(DriverError::Input(
-            "sweep needs --steps of at least 2".into(),
-        ));
+        return Err(DriverError::Input("sweep needs --steps of at least 2".into()));
     }
     let mut rows = vec![];
     for k in 0..steps {
@@ -111,10 +121,7 @@ pub fn sweep(
             outs.add(&name, bytes);
         }
         outs.commit()?;
-        progress(&format!(
-            "wrote sweep.csv, sweep.svg, sweep.png in {}",
-            dir.display()
-        ));
+        progress(&format!("wrote sweep.csv, sweep.svg, sweep.png in {}", dir.display()));
     }
     Ok(rows)
 }
@@ -208,14 +215,7 @@ pub fn table1_markdown(rows: &[Table1Row]) -> String {
     for r in rows {
         s.push_str(&format!(
             "| 1/{} | {} | {} | {} | {:.1} | {:.3} | {:.2e} | {:.2e} |\n",
-            r.n,
-            r.rule,
-            r.fixed_point,
-            r.uzawa,
-            r.pcg_per_solve,
-            r.total_seconds,
-            r.lambda_error,
-            r.complementarity
+            r.n, r.rule, r.fixed_point, r.uzawa, r.pcg_per_solve, r.total_seconds, r.lambda_error, r.complementarity
         ));
     }
     s
@@ -232,11 +232,7 @@ pub(crate) fn draw_sweep<DB: DrawingBackend>(
     let (top, bottom) = area.split_vertically(300);
     let x0 = rows.first().map_or(0.0, |r| r.value);
     let x1 = rows.last().map_or(1.0, |r| r.value);
-    let (lo, hi) = if x1 > x0 {
-        (x0, x1)
-    } else {
-        (x1, x0.max(x1 + 1e-12))
-    };
+    let (lo, hi) = if x1 > x0 { (x0, x1) } else { (x1, x0.max(x1 + 1e-12)) };
     let nmax = rows
         .iter()
         .map(|r| r.counts.0 + r.counts.1 + r.counts.2)
@@ -255,11 +251,7 @@ pub(crate) fn draw_sweep<DB: DrawingBackend>(
         .draw()
         .map_err(e)?;
     for (name, color, get) in [
-        (
-            "stick",
-            GREEN,
-            (|r: &SweepRow| r.counts.0) as fn(&SweepRow) -> u64,
-        ),
+        ("stick", GREEN, (|r: &SweepRow| r.counts.0) as fn(&SweepRow) -> u64),
         ("slip", BLUE, |r: &SweepRow| r.counts.1),
         ("separated", RED, |r: &SweepRow| r.counts.2),
     ] {

@@ -89,21 +89,14 @@ impl<'m> Discretization<'m> {
         if let Some(c) = cell_material.iter().position(|&m| m == usize::MAX) {
             return Err(AssemblyError::Input(format!(
                 "cell {c} has no material (regions given: {})",
-                materials
-                    .iter()
-                    .map(|(r, _)| r.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                materials.iter().map(|(r, _)| r.as_str()).collect::<Vec<_>>().join(", ")
             )));
         }
         let k = mesh.kind.n_nodes();
         let geometry: Vec<SimplexGeometry> = (0..n_cells)
             .into_par_iter()
             .map(|c| {
-                let x: Vec<[f64; 3]> = mesh.cells[c * k..(c + 1) * k]
-                    .iter()
-                    .map(|&v| mesh.points[v])
-                    .collect();
+                let x: Vec<[f64; 3]> = mesh.cells[c * k..(c + 1) * k].iter().map(|&v| mesh.points[v]).collect();
                 SimplexGeometry::new(mesh.dim, &x)
             })
             .collect();
@@ -116,10 +109,7 @@ impl<'m> Discretization<'m> {
                 nodes: mesh.cell(c).to_vec(),
             }));
         }
-        let cell_electric: Vec<bool> = cell_material
-            .iter()
-            .map(|&m| materials[m].1.electric)
-            .collect();
+        let cell_electric: Vec<bool> = cell_material.iter().map(|&m| materials[m].1.electric).collect();
         let mut has_phi = vec![false; mesh.n_nodes()];
         for (c, cell) in mesh.iter_cells().enumerate() {
             if cell_electric[c] {
@@ -442,11 +432,7 @@ impl Pattern {
         let mut at = 0;
         for i in 0..n_nodes {
             let (first, count) = cols(i);
-            let end = if count == 0 {
-                at
-            } else {
-                self.col_ptr[first + count]
-            };
+            let end = if count == 0 { at } else { self.col_ptr[first + count] };
             let (head, tail) = rest.split_at_mut(end - at);
             out.push((at, head));
             rest = tail;
@@ -456,13 +442,7 @@ impl Pattern {
     }
 
     fn into_matrix(self, values: Vec<f64>) -> SparseColMat<usize, f64> {
-        let sym = SymbolicSparseColMat::new_checked(
-            self.nrows,
-            self.ncols,
-            self.col_ptr,
-            None,
-            self.row_idx,
-        );
+        let sym = SymbolicSparseColMat::new_checked(self.nrows, self.ncols, self.col_ptr, None, self.row_idx);
         SparseColMat::new(sym, values)
     }
 }

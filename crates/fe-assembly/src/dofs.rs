@@ -74,11 +74,7 @@ impl DofMap {
     /// Builds the map: `has_phi[node]` says which nodes carry a potential; `constraints` are
     /// applied in order. A node constrained twice to values that differ by more than 1e-12
     /// (relative) is an error, and so is a condition that reaches no dof.
-    pub fn new(
-        mesh: &Mesh,
-        has_phi: &[bool],
-        constraints: &[Constraint],
-    ) -> Result<DofMap, AssemblyError> {
+    pub fn new(mesh: &Mesh, has_phi: &[bool], constraints: &[Constraint]) -> Result<DofMap, AssemblyError> {
         let (n, dim) = (mesh.n_nodes(), mesh.dim);
         let mut u: Vec<Option<(f64, usize)>> = vec![None; n * dim];
         let mut phi: Vec<Option<(f64, usize)>> = vec![None; n];

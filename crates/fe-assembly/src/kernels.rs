@@ -90,13 +90,7 @@ pub fn strain_columns(dim: usize, grad: &[f64; 3]) -> [[f64; 6]; 3] {
 }
 
 /// Column `(a, k)` of `A_e = ∫ Bᵀ C B`: `out[b][l]` is the entry of row `(b, l)`.
-pub fn elasticity_column(
-    m: &Material,
-    g: &SimplexGeometry,
-    n_local: usize,
-    a: usize,
-    k: usize,
-) -> [[f64; 3]; 4] {
+pub fn elasticity_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize, k: usize) -> [[f64; 3]; 4] {
     let (dim, nv) = (m.dim, m.nv());
     let ba = strain_columns(dim, &g.grads[a])[k];
     let mut cb = [0.0; 6];
@@ -114,13 +108,7 @@ pub fn elasticity_column(
 }
 
 /// Column `(a, k)` of `G_e = ∫ ∇Nᵀ e B` (rows ψ_b): `out[b] = |T| ∇N_b · (e B_a e_k)`.
-pub fn coupling_column(
-    m: &Material,
-    g: &SimplexGeometry,
-    n_local: usize,
-    a: usize,
-    k: usize,
-) -> [f64; 4] {
+pub fn coupling_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize, k: usize) -> [f64; 4] {
     let (dim, nv) = (m.dim, m.nv());
     let ba = strain_columns(dim, &g.grads[a])[k];
     let mut eb = [0.0; 3];
@@ -141,10 +129,7 @@ pub fn coupling_row(m: &Material, g: &SimplexGeometry, n_local: usize, b: usize)
     // eT grad_b (nv), then B_a^T (eT grad_b)
     let mut etg = [0.0; 6];
     for (j, v) in etg.iter_mut().enumerate().take(nv) {
-        *v = (0..dim)
-            .map(|i| m.e[i * nv + j] * g.grads[b][i])
-            .sum::<f64>()
-            * g.measure;
+        *v = (0..dim).map(|i| m.e[i * nv + j] * g.grads[b][i]).sum::<f64>() * g.measure;
     }
     let mut out = [[0.0; 3]; 4];
     for (a, row) in out.iter_mut().enumerate().take(n_local) {
@@ -161,10 +146,7 @@ pub fn dielectric_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: u
     let dim = m.dim;
     let mut bg = [0.0; 3];
     for (i, v) in bg.iter_mut().enumerate().take(dim) {
-        *v = (0..dim)
-            .map(|j| m.beta[i * dim + j] * g.grads[a][j])
-            .sum::<f64>()
-            * g.measure;
+        *v = (0..dim).map(|j| m.beta[i * dim + j] * g.grads[a][j]).sum::<f64>() * g.measure;
     }
     let mut out = [0.0; 4];
     for (b, v) in out.iter_mut().enumerate().take(n_local) {
@@ -205,12 +187,7 @@ mod tests {
 
     #[test]
     fn gradients_sum_to_zero_and_reproduce_linears() {
-        let x = [
-            [0.1, 0.2, 0.0],
-            [1.3, 0.1, 0.2],
-            [0.4, 1.1, -0.1],
-            [0.3, 0.2, 0.9],
-        ];
+        let x = [[0.1, 0.2, 0.0], [1.3, 0.1, 0.2], [0.4, 1.1, -0.1], [0.3, 0.2, 0.9]];
         for dim in [2, 3] {
             let g = SimplexGeometry::new(dim, &x);
             assert!(g.measure > 0.0);

@@ -56,10 +56,7 @@ fn simplex_rule(dim: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
         }
         2 => {
             let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
-            (
-                vec![1.0 / 3.0; 3],
-                vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]],
-            )
+            (vec![1.0 / 3.0; 3], vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]])
         }
         _ => {
             let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
@@ -194,9 +191,7 @@ impl Discretization<'_> {
             let fixed_u = cell
                 .iter()
                 .any(|&v| (0..dim).any(|k| matches!(d.u[v * dim + k], Dof::Fixed(x) if x != 0.0)));
-            let fixed_phi = cell
-                .iter()
-                .any(|&v| matches!(d.phi[v], Dof::Fixed(x) if x != 0.0));
+            let fixed_phi = cell.iter().any(|&v| matches!(d.phi[v], Dof::Fixed(x) if x != 0.0));
             if !fixed_u && !fixed_phi {
                 continue;
             }

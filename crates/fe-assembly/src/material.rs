@@ -22,11 +22,7 @@ impl Crystal {
     /// c13 = 75.2, c33 = 111, c44 = 21.1, c66 = 22.6; e31 = -5.4, e33 = 15.8, e15 = 12.3;
     /// eps11 = 8.11, eps33 = 7.35.
     pub fn pzt5a() -> Self {
-        Self::hexagonal_6mm(
-            [121.0, 75.4, 75.2, 111.0, 21.1, 22.6],
-            [-5.4, 15.8, 12.3],
-            [8.11, 7.35],
-        )
+        Self::hexagonal_6mm([121.0, 75.4, 75.2, 111.0, 21.1, 22.6], [-5.4, 15.8, 12.3], [8.11, 7.35])
     }
 
     /// A crystal of class 6mm (poled ceramics): `c = [c11, c12, c13, c33, c44, c66]`,
@@ -269,10 +265,7 @@ impl Material {
             2 => (vec![0, 1, 5], vec![0, 1]),
             _ => ((0..6).collect(), (0..3).collect()),
         };
-        let c: Vec<f64> = rows
-            .iter()
-            .flat_map(|&i| rows.iter().map(move |&j| c3[i][j]))
-            .collect();
+        let c: Vec<f64> = rows.iter().flat_map(|&i| rows.iter().map(move |&j| c3[i][j])).collect();
         let e: Vec<f64> = fields
             .iter()
             .flat_map(|&i| rows.iter().map(move |&j| e3[i][j]))
@@ -384,10 +377,7 @@ mod tests {
     #[test]
     fn pzt5a_plane_strain_matches_scenes() {
         let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
-        assert_eq!(
-            m.c,
-            vec![121.0, 75.2, 0.0, 75.2, 111.0, 0.0, 0.0, 0.0, 21.1]
-        );
+        assert_eq!(m.c, vec![121.0, 75.2, 0.0, 75.2, 111.0, 0.0, 0.0, 0.0, 21.1]);
         assert_eq!(m.e, vec![0.0, 0.0, 12.3, -5.4, 15.8, 0.0]);
         assert_eq!(m.beta, vec![8.11, 0.0, 0.0, 7.35]);
         assert!(m.electric);
@@ -428,18 +418,11 @@ mod tests {
         let mut cr = Crystal::pzt5a();
         cr.c[0][0] = -1.0;
         let e = Material::from_crystal("bad", &cr, [0.0, 1.0, 0.0], 2).unwrap_err();
-        assert!(
-            matches!(e, MaterialError::NotPositiveDefinite { what: "C", .. }),
-            "{e}"
-        );
+        assert!(matches!(e, MaterialError::NotPositiveDefinite { what: "C", .. }), "{e}");
         let mut cr = Crystal::pzt5a();
         cr.permittivity[2][2] = -7.0;
         let e = Material::from_crystal("bad", &cr, [0.0, 1.0, 0.0], 2).unwrap_err();
-        assert!(
-            e.to_string()
-                .contains("permittivity is not positive definite"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("permittivity is not positive definite"), "{e}");
         let mut cr = Crystal::pzt5a();
         cr.e[2][2] = f64::NAN;
         assert!(matches!(

@@ -27,13 +27,7 @@ type Jet = (f64, [f64; 3], [[f64; 3]; 3]);
 /// `a sin(kx x + px) sin(ky y + py) sin(kz z + pz)` with its derivatives (z factor 1 in 2D).
 fn prod(dim: usize, a: f64, k: [f64; 3], p: [f64; 3], x: &[f64]) -> Jet {
     let s: Vec<f64> = (0..3)
-        .map(|i| {
-            if i < dim {
-                (k[i] * x[i] + p[i]).sin()
-            } else {
-                1.0
-            }
-        })
+        .map(|i| if i < dim { (k[i] * x[i] + p[i]).sin() } else { 1.0 })
         .collect();
     let c: Vec<f64> = (0..3)
         .map(|i| {
@@ -79,13 +73,7 @@ fn u_jet(dim: usize, k: usize, x: &[f64]) -> Jet {
     )
 }
 fn phi_jet(dim: usize, x: &[f64]) -> Jet {
-    prod(
-        dim,
-        1e-2,
-        [PI / 2.0, PI, PI / 2.0],
-        [PI / 2.0, 0.0, PI / 2.0],
-        x,
-    )
+    prod(dim, 1e-2, [PI / 2.0, PI, PI / 2.0], [PI / 2.0, 0.0, PI / 2.0], x)
 }
 
 /// `(L2 error of (u, φ), energy error)` on the mesh of size n.
@@ -95,11 +83,7 @@ fn errors(dim: usize, n: usize) -> (f64, f64) {
     } else {
         mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 2 * n, n, n)
     };
-    let poling = if dim == 2 {
-        [0.0, 1.0, 0.0]
-    } else {
-        [0.0, 0.0, 1.0]
-    };
+    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
     let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap();
     let nv = m.nv();
     let (mf, mq) = (m.clone(), m.clone());
@@ -158,17 +142,11 @@ fn errors(dim: usize, n: usize) -> (f64, f64) {
         });
     }
     let disc = Discretization::new(&mesh, &[("body".into(), m.clone())], &bcs).unwrap();
-    let loads = [
-        Load::BodyForce(Arc::new(f0)),
-        Load::BodyCharge(Arc::new(q0)),
-    ];
+    let loads = [Load::BodyForce(Arc::new(f0)), Load::BodyCharge(Arc::new(q0))];
     let ((u1, p1), (u2, p2), _) = solve_both(&disc, &loads);
     // the two strategies agree to round-off
     let scale = u1.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-    assert!(
-        common::max_diff(&u1, &u2) < 1e-9 * scale,
-        "strategies disagree"
-    );
+    assert!(common::max_diff(&u1, &u2) < 1e-9 * scale, "strategies disagree");
     assert!(common::max_diff(&p1, &p2) < 1e-9 * p1.iter().fold(0.0f64, |a, x| a.max(x.abs())));
     let (un, pn) = (disc.dofs.expand_u(&u1), disc.dofs.expand_phi(&p1));
     // integrate the errors with a degree-2 rule per cell (exact for the P1 error's square up
@@ -209,11 +187,7 @@ fn errors(dim: usize, n: usize) -> (f64, f64) {
             let mut de = [0.0; 6];
             for i in 0..dim {
                 for j in i..dim {
-                    let exact = if i == j {
-                        ju[i].1[i]
-                    } else {
-                        ju[i].1[j] + ju[j].1[i]
-                    };
+                    let exact = if i == j { ju[i].1[i] } else { ju[i].1[j] + ju[j].1[i] };
                     de[voigt(dim, i, j)] = eps_h[voigt(dim, i, j)] - exact;
                 }
             }
@@ -269,10 +243,7 @@ fn check_against_reference(dim: usize, rows: &[(usize, f64, f64)]) {
         }
         let n: usize = f[1].parse().unwrap();
         let (l2, en): (f64, f64) = (f[2].parse().unwrap(), f[3].parse().unwrap());
-        let row = rows
-            .iter()
-            .find(|r| r.0 == n)
-            .expect("level in the reference table");
+        let row = rows.iter().find(|r| r.0 == n).expect("level in the reference table");
         assert!(
             (row.1 / l2 - 1.0).abs() < 0.02,
             "{dim}D n={n}: L2 {} vs reference {l2}",

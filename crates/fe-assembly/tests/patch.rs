@@ -26,9 +26,7 @@ fn jitter(m: &mut mesh::Mesh, amount: f64) {
     let mut seed = 12345u64;
     for p in &mut m.points {
         for k in 0..m.dim {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             let r = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
             let on_boundary = (0..m.dim).any(|q| p[q] == lo[q] || p[q] == hi[q]);
             if !on_boundary {
@@ -46,18 +44,10 @@ fn run_patch(dim: usize) {
     };
     jitter(&mut mesh, if dim == 2 { 0.08 } else { 0.1 });
     mesh.check().unwrap();
-    let poling = if dim == 2 {
-        [0.0, 1.0, 0.0]
-    } else {
-        [0.0, 0.0, 1.0]
-    };
+    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
     let mat = Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap();
     // the exact linear fields
-    let grad_u = [
-        [1e-3, 2e-3, -1e-3],
-        [-0.5e-3, 3e-3, 0.7e-3],
-        [0.2e-3, -0.4e-3, 1.1e-3],
-    ];
+    let grad_u = [[1e-3, 2e-3, -1e-3], [-0.5e-3, 3e-3, 0.7e-3], [0.2e-3, -0.4e-3, 1.1e-3]];
     let grad_phi = [0.02, -0.03, 0.01];
     let u_exact = move |x: &[f64]| {
         let mut u = [0.0; 3];
@@ -83,8 +73,7 @@ fn run_patch(dim: usize) {
         value: Arc::new(phi_exact),
     });
     let mut loads = vec![];
-    let mut normals: Vec<(&str, [f64; 3])> =
-        vec![("right", [1.0, 0.0, 0.0]), ("left", [-1.0, 0.0, 0.0])];
+    let mut normals: Vec<(&str, [f64; 3])> = vec![("right", [1.0, 0.0, 0.0]), ("left", [-1.0, 0.0, 0.0])];
     if dim == 2 {
         normals.push(("top", [0.0, 1.0, 0.0]));
         normals.push(("bottom", [0.0, -1.0, 0.0]));
@@ -113,12 +102,8 @@ fn run_patch(dim: usize) {
     }
     let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
     let ((u1, p1), (u2, p2), _) = solve_both(&disc, &loads);
-    let nodal_u: Vec<[f64; 3]> = (0..mesh.n_nodes())
-        .map(|i| u_exact(mesh.point(i)))
-        .collect();
-    let nodal_p: Vec<f64> = (0..mesh.n_nodes())
-        .map(|i| phi_exact(mesh.point(i)))
-        .collect();
+    let nodal_u: Vec<[f64; 3]> = (0..mesh.n_nodes()).map(|i| u_exact(mesh.point(i))).collect();
+    let nodal_p: Vec<f64> = (0..mesh.n_nodes()).map(|i| phi_exact(mesh.point(i))).collect();
     let ue = disc.dofs.restrict_u(&nodal_u);
     let pe = disc.dofs.restrict_phi(&nodal_p);
     let (su, sp) = (

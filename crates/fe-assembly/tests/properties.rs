@@ -15,9 +15,7 @@ fn crystal(seed: &[f64]) -> Crystal {
     let mut c = [[0.0; 6]; 6];
     for i in 0..6 {
         for j in 0..6 {
-            c[i][j] = (0..6)
-                .map(|k| seed[i * 6 + k] * seed[j * 6 + k])
-                .sum::<f64>();
+            c[i][j] = (0..6).map(|k| seed[i * 6 + k] * seed[j * 6 + k]).sum::<f64>();
         }
         c[i][i] += 0.5;
     }
@@ -30,17 +28,11 @@ fn crystal(seed: &[f64]) -> Crystal {
     let mut p = [[0.0; 3]; 3];
     for i in 0..3 {
         for j in 0..3 {
-            p[i][j] = (0..3)
-                .map(|k| seed[54 + i * 3 + k] * seed[54 + j * 3 + k])
-                .sum::<f64>();
+            p[i][j] = (0..3).map(|k| seed[54 + i * 3 + k] * seed[54 + j * 3 + k]).sum::<f64>();
         }
         p[i][i] += 0.2;
     }
-    Crystal {
-        c,
-        e,
-        permittivity: p,
-    }
+    Crystal { c, e, permittivity: p }
 }
 
 fn perturbed_mesh(dim: usize, n: usize, jitter: &[f64]) -> mesh::Mesh {

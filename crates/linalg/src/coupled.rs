@@ -24,13 +24,7 @@ pub struct SolveInfo {
 pub trait CoupledSolver {
     /// Solves; `u` and `phi` hold a warm start on entry (used by iterative solvers) and the
     /// solution on exit.
-    fn solve(
-        &mut self,
-        b_u: &[f64],
-        b_phi: &[f64],
-        u: &mut [f64],
-        phi: &mut [f64],
-    ) -> Result<SolveInfo, LinalgError>;
+    fn solve(&mut self, b_u: &[f64], b_phi: &[f64], u: &mut [f64], phi: &mut [f64]) -> Result<SolveInfo, LinalgError>;
     /// Bytes of the factor values held.
     fn factor_bytes(&self) -> usize;
 }
@@ -131,13 +125,7 @@ impl SchurPcg {
 }
 
 impl CoupledSolver for SchurPcg {
-    fn solve(
-        &mut self,
-        b_u: &[f64],
-        b_phi: &[f64],
-        u: &mut [f64],
-        phi: &mut [f64],
-    ) -> Result<SolveInfo, LinalgError> {
+    fn solve(&mut self, b_u: &[f64], b_phi: &[f64], u: &mut [f64], phi: &mut [f64]) -> Result<SolveInfo, LinalgError> {
         let Some(chol_b) = self.chol_b.as_mut() else {
             u.copy_from_slice(b_u);
             self.chol_a.solve_in_place(u);
@@ -203,13 +191,7 @@ impl DirectLdlt {
 }
 
 impl CoupledSolver for DirectLdlt {
-    fn solve(
-        &mut self,
-        b_u: &[f64],
-        b_phi: &[f64],
-        u: &mut [f64],
-        phi: &mut [f64],
-    ) -> Result<SolveInfo, LinalgError> {
+    fn solve(&mut self, b_u: &[f64], b_phi: &[f64], u: &mut [f64], phi: &mut [f64]) -> Result<SolveInfo, LinalgError> {
         let n_u = self.n_u;
         self.buf[..n_u].copy_from_slice(b_u);
         self.buf[n_u..].copy_from_slice(b_phi);

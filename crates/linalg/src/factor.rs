@@ -9,8 +9,8 @@ use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
-    SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
@@ -98,20 +98,11 @@ impl SparseFactor {
                 SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
             }
         };
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            ord,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+        let symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, CholeskySymbolicParams::default())
+            .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
         let factor_req = match kind {
-            FactorKind::Cholesky => {
-                symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())
-            }
-            FactorKind::Ldlt => {
-                symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
-            }
+            FactorKind::Cholesky => symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+            FactorKind::Ldlt => symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
         };
         let solve_mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
         let mut f = SparseFactor {
@@ -143,9 +134,9 @@ impl SparseFactor {
                         Default::default(),
                     )
                     .map_err(|e| match e {
-                        faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
-                            index,
-                        } => LinalgError::NotPositiveDefinite { pivot: index },
+                        faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
+                            LinalgError::NotPositiveDefinite { pivot: index }
+                        }
                     })?;
             }
             FactorKind::Ldlt => {
@@ -206,16 +197,17 @@ impl SparseFactor {
     fn solve_mat(&mut self, rhs: MatMut<'_, f64>) {
         let k = rhs.ncols();
         if k > self.solve_mem_ncols {
-            self.solve_mem =
-                MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(k, self.par));
+            self.solve_mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(k, self.par));
             self.solve_mem_ncols = k;
         }
         let stack = MemStack::new(&mut self.solve_mem);
         match self.kind {
-            FactorKind::Cholesky => LltRef::new(&self.symbolic, &self.values)
-                .solve_in_place_with_conj(Conj::No, rhs, self.par, stack),
-            FactorKind::Ldlt => LdltRef::new(&self.symbolic, &self.values)
-                .solve_in_place_with_conj(Conj::No, rhs, self.par, stack),
+            FactorKind::Cholesky => {
+                LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, stack)
+            }
+            FactorKind::Ldlt => {
+                LdltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, stack)
+            }
         }
     }
 
@@ -284,10 +276,7 @@ fn inverse_permutation(fwd: &[usize]) -> Result<Vec<usize>, LinalgError> {
 }
 
 /// AMD on the indices not in `last`, then `last` in order. Returns `(fwd, inv)`.
-fn amd_then_last(
-    a: SparseColMatRef<'_, usize, f64>,
-    last: &[usize],
-) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
+fn amd_then_last(a: SparseColMatRef<'_, usize, f64>, last: &[usize]) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
     let n = a.nrows();
     let mut is_last = vec![false; n];
     for &i in last {

@@ -41,8 +41,7 @@ mod pcg;
 pub mod sparse;
 
 pub use coupled::{
-    equilibrium_residual, CoupledSolver, DirectLdlt, FactorPreconditioner, SchurOperator, SchurPcg,
-    SolveInfo,
+    equilibrium_residual, CoupledSolver, DirectLdlt, FactorPreconditioner, SchurOperator, SchurPcg, SolveInfo,
 };
 pub use factor::{FactorKind, Ordering, SparseFactor};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};

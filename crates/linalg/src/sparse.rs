@@ -50,35 +50,20 @@ pub fn lower_quasi_definite(
     let mut vals = Vec::with_capacity(cap);
     col_ptr.push(0);
     for j in 0..n_u {
-        for (&i, &v) in a
-            .symbolic()
-            .row_idx_of_col_raw(j)
-            .iter()
-            .zip(a.val_of_col(j))
-        {
+        for (&i, &v) in a.symbolic().row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
             if i >= j {
                 rows.push(i);
                 vals.push(v);
             }
         }
-        for (&i, &v) in g
-            .symbolic()
-            .row_idx_of_col_raw(j)
-            .iter()
-            .zip(g.val_of_col(j))
-        {
+        for (&i, &v) in g.symbolic().row_idx_of_col_raw(j).iter().zip(g.val_of_col(j)) {
             rows.push(n_u + i);
             vals.push(v);
         }
         col_ptr.push(rows.len());
     }
     for j in 0..n_phi {
-        for (&i, &v) in b
-            .symbolic()
-            .row_idx_of_col_raw(j)
-            .iter()
-            .zip(b.val_of_col(j))
-        {
+        for (&i, &v) in b.symbolic().row_idx_of_col_raw(j).iter().zip(b.val_of_col(j)) {
             if i >= j {
                 rows.push(n_u + i);
                 vals.push(-v);
@@ -86,22 +71,14 @@ pub fn lower_quasi_definite(
         }
         col_ptr.push(rows.len());
     }
-    SparseColMat::new(
-        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows),
-        vals,
-    )
+    SparseColMat::new(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows), vals)
 }
 
 /// `M` as a dense row-major array (for tests and small problems).
 pub fn to_dense(m: SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
     let mut d = vec![vec![0.0; m.ncols()]; m.nrows()];
     for j in 0..m.ncols() {
-        for (&i, &v) in m
-            .symbolic()
-            .row_idx_of_col_raw(j)
-            .iter()
-            .zip(m.val_of_col(j))
-        {
+        for (&i, &v) in m.symbolic().row_idx_of_col_raw(j).iter().zip(m.val_of_col(j)) {
             d[i][j] += v;
         }
     }

@@ -9,8 +9,8 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::Par;
 use linalg::sparse::{mul_add, to_dense};
 use linalg::{
-    pcg, CoupledSolver, DirectLdlt, FactorKind, Identity, LinearOperator, Ordering, PcgParams,
-    SchurOperator, SchurPcg, SparseFactor,
+    pcg, CoupledSolver, DirectLdlt, FactorKind, Identity, LinearOperator, Ordering, PcgParams, SchurOperator, SchurPcg,
+    SparseFactor,
 };
 use nalgebra::DMatrix;
 use proptest::prelude::*;
@@ -163,21 +163,12 @@ proptest! {
 
 #[test]
 fn not_positive_definite_is_a_typed_error() {
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(
-        2,
-        2,
-        &[Triplet::new(0, 0, 1.0), Triplet::new(1, 1, -1.0)],
-    )
-    .unwrap();
-    let e =
-        SparseFactor::new(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, Par::Seq).unwrap_err();
-    assert!(
-        matches!(e, linalg::LinalgError::NotPositiveDefinite { .. }),
-        "{e}"
-    );
-    let nan =
-        SparseColMat::<usize, f64>::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, f64::NAN)])
+    let a =
+        SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &[Triplet::new(0, 0, 1.0), Triplet::new(1, 1, -1.0)])
             .unwrap();
+    let e = SparseFactor::new(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, Par::Seq).unwrap_err();
+    assert!(matches!(e, linalg::LinalgError::NotPositiveDefinite { .. }), "{e}");
+    let nan = SparseColMat::<usize, f64>::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, f64::NAN)]).unwrap();
     assert!(matches!(
         SparseFactor::new(nan.as_ref(), FactorKind::Ldlt, &Ordering::Amd, Par::Seq),
         Err(linalg::LinalgError::NonFinite { .. })

@@ -37,14 +37,7 @@ pub fn rectangle_quad(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize) -> Mesh 
     rectangle(lo, hi, nx, ny, CellKind::Quad4, cells)
 }
 
-fn rectangle(
-    lo: [f64; 2],
-    hi: [f64; 2],
-    nx: usize,
-    ny: usize,
-    kind: CellKind,
-    cells: Vec<usize>,
-) -> Mesh {
+fn rectangle(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize, kind: CellKind, cells: Vec<usize>) -> Mesh {
     let id = |i: usize, j: usize| j * (nx + 1) + i;
     let mut points = Vec::with_capacity((nx + 1) * (ny + 1));
     for j in 0..=ny {
@@ -109,14 +102,7 @@ pub fn box_tet(lo: [f64; 3], hi: [f64; 3], nx: usize, ny: usize, nz: usize) -> M
             }
         }
     }
-    const ORDERS: [[usize; 3]; 6] = [
-        [0, 1, 2],
-        [0, 2, 1],
-        [1, 0, 2],
-        [1, 2, 0],
-        [2, 0, 1],
-        [2, 1, 0],
-    ];
+    const ORDERS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
     let mut cells = Vec::with_capacity(24 * n[0] * n[1] * n[2]);
     for k in 0..n[2] {
         for j in 0..n[1] {
@@ -206,9 +192,7 @@ pub(crate) fn signed_volume(points: &[[f64; 3]], t: &[usize]) -> f64 {
         [d(2, 0), d(2, 1), d(2, 2)],
         [d(3, 0), d(3, 1), d(3, 2)],
     );
-    (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-        + a[2] * (b[0] * c[1] - b[1] * c[0]))
-        / 6.0
+    (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0
 }
 
 pub(crate) fn triangle_normal(points: &[[f64; 3]], t: &[usize]) -> [f64; 3] {
@@ -267,11 +251,7 @@ mod tests {
                 *faces.entry(f).or_insert(0) += 1;
             }
         }
-        let boundary: Vec<_> = faces
-            .iter()
-            .filter(|(_, &k)| k == 1)
-            .map(|(f, _)| f.clone())
-            .collect();
+        let boundary: Vec<_> = faces.iter().filter(|(_, &k)| k == 1).map(|(f, _)| f.clone()).collect();
         assert!(faces.values().all(|&k| k == 1 || k == 2));
         let mut from_groups: Vec<Vec<usize>> = m
             .boundaries

@@ -33,9 +33,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
         message,
     };
     if !bytes.starts_with(b"$MeshFormat") {
-        return Err(err(
-            "not a Gmsh file: it does not start with `$MeshFormat`".into()
-        ));
+        return Err(err("not a Gmsh file: it does not start with `$MeshFormat`".into()));
     }
     let file = mshio::parse_msh_bytes(bytes).map_err(|e| {
         let text = e.to_string();
@@ -113,12 +111,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
     let mut cells = Vec::new();
     let mut regions: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut boundaries: BTreeMap<String, FacetGroup> = BTreeMap::new();
-    let group_name = |d: i32, tag: i32| {
-        names
-            .get(&(d, tag))
-            .cloned()
-            .unwrap_or_else(|| tag.to_string())
-    };
+    let group_name = |d: i32, tag: i32| names.get(&(d, tag)).cloned().unwrap_or_else(|| tag.to_string());
     let node_index = |tag: u64, elem: u64| {
         index_of.get(&tag).copied().ok_or_else(|| {
             err(format!(
@@ -153,11 +146,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
             let first = cells.len() / k.n_nodes();
             for e in &block.elements {
                 if e.nodes.len() != k.n_nodes() {
-                    return Err(err(format!(
-                        "element {} has {} nodes",
-                        e.element_tag,
-                        e.nodes.len()
-                    )));
+                    return Err(err(format!("element {} has {} nodes", e.element_tag, e.nodes.len())));
                 }
                 for &t in &e.nodes {
                     cells.push(node_index(t, e.element_tag)?);
@@ -166,10 +155,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
             let last = cells.len() / k.n_nodes();
             orient_block(&points, &mut cells, k, first, last);
             for &p in phys.get(&(d, block.entity_tag)).into_iter().flatten() {
-                regions
-                    .entry(group_name(d, p))
-                    .or_default()
-                    .extend(first..last);
+                regions.entry(group_name(d, p)).or_default().extend(first..last);
             }
         } else if d == dim - 1 {
             let facet_nodes = if dim == 2 { 2 } else { 3 };
@@ -190,12 +176,10 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
                 }
             }
             for &p in phys.get(&(d, block.entity_tag)).into_iter().flatten() {
-                let g = boundaries
-                    .entry(group_name(d, p))
-                    .or_insert_with(|| FacetGroup {
-                        nodes_per_facet: facet_nodes,
-                        facets: vec![],
-                    });
+                let g = boundaries.entry(group_name(d, p)).or_insert_with(|| FacetGroup {
+                    nodes_per_facet: facet_nodes,
+                    facets: vec![],
+                });
                 g.facets.extend_from_slice(&facets);
             }
         }
@@ -218,9 +202,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
         v.sort_unstable();
         v.dedup();
     }
-    regions
-        .entry("body".into())
-        .or_insert_with(|| (0..n_cells).collect());
+    regions.entry("body".into()).or_insert_with(|| (0..n_cells).collect());
     let mesh = Mesh {
         dim: dim as usize,
         kind,
@@ -234,13 +216,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
 }
 
 /// Turns round every cell of `first..last` when all of them are negatively oriented.
-fn orient_block(
-    points: &[[f64; 3]],
-    cells: &mut [usize],
-    kind: CellKind,
-    first: usize,
-    last: usize,
-) {
+fn orient_block(points: &[[f64; 3]], cells: &mut [usize], kind: CellKind, first: usize, last: usize) {
     let k = kind.n_nodes();
     let sign = |c: &[usize]| -> f64 {
         match kind {
@@ -269,8 +245,7 @@ fn physical_names(bytes: &[u8]) -> Result<HashMap<(i32, i32), String>, String> {
         return Ok(out);
     };
     let rest = &bytes[start..];
-    let end =
-        find(rest, b"$EndPhysicalNames").ok_or("`$PhysicalNames` has no `$EndPhysicalNames`")?;
+    let end = find(rest, b"$EndPhysicalNames").ok_or("`$PhysicalNames` has no `$EndPhysicalNames`")?;
     let text = std::str::from_utf8(&rest[..end]).map_err(|_| "`$PhysicalNames` is not text")?;
     let mut lines = text.lines().skip(1).filter(|l| !l.trim().is_empty());
     let count: usize = lines
@@ -281,16 +256,8 @@ fn physical_names(bytes: &[u8]) -> Result<HashMap<(i32, i32), String>, String> {
         let mut parts = line.trim().splitn(3, char::is_whitespace);
         let bad = || format!("`$PhysicalNames` line {}: `{line}`", i + 2);
         let d: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
-        let tag: i32 = parts
-            .next()
-            .and_then(|s| s.trim().parse().ok())
-            .ok_or_else(bad)?;
-        let name = parts
-            .next()
-            .ok_or_else(bad)?
-            .trim()
-            .trim_matches('"')
-            .to_string();
+        let tag: i32 = parts.next().and_then(|s| s.trim().parse().ok()).ok_or_else(bad)?;
+        let name = parts.next().ok_or_else(bad)?.trim().trim_matches('"').to_string();
         out.insert((d, tag), name);
     }
     if out.len() != count {

@@ -93,10 +93,7 @@ pub struct FacetGroup {
 impl FacetGroup {
     /// Number of facets.
     pub fn n_facets(&self) -> usize {
-        self.facets
-            .len()
-            .checked_div(self.nodes_per_facet)
-            .unwrap_or(0)
+        self.facets.len().checked_div(self.nodes_per_facet).unwrap_or(0)
     }
     /// The node indices of facet `f`.
     pub fn facet(&self, f: usize) -> &[usize] {
@@ -236,12 +233,10 @@ impl Mesh {
     }
     /// The boundary group `name`, or a [`MeshError::MissingBoundary`] that lists what exists.
     pub fn boundary(&self, name: &str) -> Result<&FacetGroup, MeshError> {
-        self.boundaries
-            .get(name)
-            .ok_or_else(|| MeshError::MissingBoundary {
-                name: name.to_string(),
-                available: join_keys(self.boundaries.keys()),
-            })
+        self.boundaries.get(name).ok_or_else(|| MeshError::MissingBoundary {
+            name: name.to_string(),
+            available: join_keys(self.boundaries.keys()),
+        })
     }
     /// The region `name`, or a [`MeshError::MissingRegion`] that lists what exists.
     pub fn region(&self, name: &str) -> Result<&[usize], MeshError> {
@@ -255,11 +250,7 @@ impl Mesh {
     }
     /// The facets of group `name` all of whose nodes satisfy `keep(x)` (for example the part
     /// of the top face under an electrode), as a new group.
-    pub fn select_facets(
-        &self,
-        name: &str,
-        keep: impl Fn(&[f64]) -> bool,
-    ) -> Result<FacetGroup, MeshError> {
+    pub fn select_facets(&self, name: &str, keep: impl Fn(&[f64]) -> bool) -> Result<FacetGroup, MeshError> {
         let g = self.boundary(name)?;
         let mut out = FacetGroup {
             nodes_per_facet: g.nodes_per_facet,
@@ -337,10 +328,7 @@ impl Mesh {
         let mut scratch = Vec::with_capacity(64);
         for i in 0..n {
             scratch.clear();
-            for &c in node_cells[count[i]..count[i + 1]]
-                .iter()
-                .filter(|&&c| keep(c))
-            {
+            for &c in node_cells[count[i]..count[i + 1]].iter().filter(|&&c| keep(c)) {
                 scratch.extend_from_slice(&self.cells[c * k..(c + 1) * k]);
             }
             if scratch.is_empty() {

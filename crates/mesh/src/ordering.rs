@@ -104,9 +104,7 @@ mod tests {
         // the top separator (ordered last) lies along x = 1 (the median of x), one cell wide,
         // and removing it leaves no edge between x < 1 and x > 1
         let (_, sep) = order.split_at(order.len() - 21);
-        assert!(sep
-            .iter()
-            .all(|&v| (m.points[v][0] - 1.0).abs() <= 0.05 + 1e-12));
+        assert!(sep.iter().all(|&v| (m.points[v][0] - 1.0).abs() <= 0.05 + 1e-12));
         let in_sep = |v: usize| sep.contains(&v);
         let (off, nbr) = &g;
         for v in 0..m.n_nodes() {

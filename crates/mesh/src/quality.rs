@@ -42,11 +42,7 @@ impl Mesh {
             }
         }
         let n_nodes = self.n_nodes();
-        let out_of_range = |item: String, node: usize| MeshError::NodeOutOfRange {
-            item,
-            node,
-            n_nodes,
-        };
+        let out_of_range = |item: String, node: usize| MeshError::NodeOutOfRange { item, node, n_nodes };
         for (c, cell) in self.iter_cells().enumerate() {
             if let Some(&v) = cell.iter().find(|&&v| v >= n_nodes) {
                 return Err(out_of_range(format!("cell {c}"), v));
@@ -55,10 +51,7 @@ impl Mesh {
         for (name, g) in &self.boundaries {
             for (f, facet) in g.iter().enumerate() {
                 if let Some(&v) = facet.iter().find(|&&v| v >= n_nodes) {
-                    return Err(out_of_range(
-                        format!("facet {f} of boundary group `{name}`"),
-                        v,
-                    ));
+                    return Err(out_of_range(format!("facet {f} of boundary group `{name}`"), v));
                 }
             }
         }
@@ -109,8 +102,8 @@ impl Mesh {
             report.h_max = report.h_max.max(lmax);
             report.h_min = report.h_min.min(lmin);
             let reference = match self.kind {
-                CellKind::Tri3 => 0.25, // right isoceles triangle: h^2 / 4 with h the hypotenuse
-                CellKind::Quad4 => 0.5, // square: h^2 / 2 with h the diagonal
+                CellKind::Tri3 => 0.25,       // right isoceles triangle: h^2 / 4 with h the hypotenuse
+                CellKind::Quad4 => 0.5,       // square: h^2 / 2 with h the diagonal
                 CellKind::Tet4 => 1.0 / 27.0, // cube-corner-ish scale, see Kuhn tetrahedra
             };
             report.max_aspect = report.max_aspect.max(reference * scale / measure);
@@ -173,13 +166,7 @@ mod tests {
         let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 2, 2);
         let c0 = m.cell(0).to_vec();
         m.points[c0[2]] = [0.25, 0.0, 0.0]; // collapse onto the bottom edge
-        assert!(matches!(
-            m.check(),
-            Err(MeshError::BadCell {
-                what: "degenerate",
-                ..
-            })
-        ));
+        assert!(matches!(m.check(), Err(MeshError::BadCell { what: "degenerate", .. })));
         let mut t = box_tet([0.0; 3], [1.0; 3], 1, 1, 1);
         t.cells.swap(0, 1);
         assert!(matches!(
@@ -196,16 +183,10 @@ mod tests {
     fn unused_nodes_nan_and_missing_groups() {
         let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1);
         m.points.push([5.0, 5.0, 0.0]);
-        assert_eq!(
-            m.check(),
-            Err(MeshError::UnusedNodes { count: 1, first: 4 })
-        );
+        assert_eq!(m.check(), Err(MeshError::UnusedNodes { count: 1, first: 4 }));
         let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1);
         m.points[2][1] = f64::NAN;
-        assert!(matches!(
-            m.check(),
-            Err(MeshError::NonFiniteCoordinate { node: 2, .. })
-        ));
+        assert!(matches!(m.check(), Err(MeshError::NonFiniteCoordinate { node: 2, .. })));
         let err = m.boundary("contact").unwrap_err();
         assert_eq!(
             err.to_string(),

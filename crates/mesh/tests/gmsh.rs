@@ -100,10 +100,7 @@ fn broken_files_give_typed_errors() {
     assert!(e.to_string().contains("cut.msh"));
     // not a mesh at all
     let e = read_msh_bytes(b"hello", "x.msh").unwrap_err();
-    assert!(
-        e.to_string().contains("does not start with `$MeshFormat`"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("does not start with `$MeshFormat`"), "{e}");
     // a missing file
     let e = read_msh(fixture("nope.msh")).unwrap_err();
     assert!(matches!(e, MeshError::Io { .. }));
@@ -126,10 +123,5 @@ fn corrupt_last_element(text: &str) -> String {
     let line = before[last_line_start..].trim_end();
     let mut parts: Vec<&str> = line.split_whitespace().collect();
     parts[1] = "999999";
-    format!(
-        "{}{}\n{}",
-        &text[..last_line_start],
-        parts.join(" "),
-        &text[end..]
-    )
+    format!("{}{}\n{}", &text[..last_line_start], parts.join(" "), &text[end..])
 }

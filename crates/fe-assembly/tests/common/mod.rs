@@ -13,14 +13,7 @@ pub fn solve_both(disc: &Discretization<'_>, loads: &[Load]) -> (Solution, Solut
     let blocks = disc.assemble(Parallelism::Rayon);
     let (bu, bphi) = disc.rhs(loads).unwrap();
     let (nu, np) = (disc.dofs.n_u, disc.dofs.n_phi);
-    let mut direct = DirectLdlt::new(
-        &blocks.a,
-        &blocks.g,
-        &blocks.b,
-        &Ordering::Amd,
-        faer::Par::Seq,
-    )
-    .unwrap();
+    let mut direct = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq).unwrap();
     let (mut u1, mut p1) = (vec![0.0; nu], vec![0.0; np]);
     direct.solve(&bu, &bphi, &mut u1, &mut p1).unwrap();
     let params = PcgParams {
@@ -28,14 +21,7 @@ pub fn solve_both(disc: &Discretization<'_>, loads: &[Load]) -> (Solution, Solut
         max_iters: 500,
         ..Default::default()
     };
-    let mut schur = SchurPcg::new(
-        blocks.a.clone(),
-        blocks.g.clone(),
-        &blocks.b,
-        params,
-        faer::Par::Seq,
-    )
-    .unwrap();
+    let mut schur = SchurPcg::new(blocks.a.clone(), blocks.g.clone(), &blocks.b, params, faer::Par::Seq).unwrap();
     let (mut u2, mut p2) = (vec![0.0; nu], vec![0.0; np]);
     schur.solve(&bu, &bphi, &mut u2, &mut p2).unwrap();
     ((u1, p1), (u2, p2), blocks)
@@ -64,11 +50,7 @@ pub fn voigt(dim: usize, i: usize, j: usize) -> usize {
 
 /// `σ = C ε + eᵀ ∇φ` and `D = e ε - β ∇φ` for a displacement gradient `gu[k][l] = ∂u_k/∂x_l`
 /// and a potential gradient `gp`.
-pub fn stress_and_d(
-    m: &fe_assembly::Material,
-    gu: &[[f64; 3]; 3],
-    gp: &[f64; 3],
-) -> ([[f64; 3]; 3], [f64; 3]) {
+pub fn stress_and_d(m: &fe_assembly::Material, gu: &[[f64; 3]; 3], gp: &[f64; 3]) -> ([[f64; 3]; 3], [f64; 3]) {
     let dim = m.dim;
     let nv = m.nv();
     let mut sigma = [[0.0; 3]; 3];
@@ -98,8 +80,5 @@ pub fn stress_and_d(
 
 /// Largest absolute difference.
 pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
