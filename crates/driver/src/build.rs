@@ -179,7 +179,7 @@ pub fn plan(scene: &Scene, dim: usize, materials: &[(String, Material)]) -> Plan
         outputs.push("contact.csv".into());
         outputs.push("multipliers.svg/png".into());
     }
-    if dim == 2 {
+    if dim == 2 || scene.mesh.kind == "box" {
         outputs.push("deformed.svg/png".into());
         if (coupling || electric_data) && materials.iter().any(|(_, m)| m.electric) {
             outputs.push("potential.svg/png".into());

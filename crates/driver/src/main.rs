@@ -69,6 +69,44 @@ enum Command {
     Strategies,
 }
 
+/// Lines to stderr, and a progress bar for the contact solve when stderr is a terminal.
+struct Terminal {
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Terminal {
+    fn new() -> Self {
+        Terminal { bar: None }
+    }
+}
+
+impl driver::run::Reporter for Terminal {
+    fn line(&mut self, text: &str) {
+        match &self.bar {
+            Some(bar) if !bar.is_hidden() => bar.println(text),
+            _ => eprintln!("{text}"),
+        }
+        if text.starts_with("solve ") {
+            if let Some(bar) = self.bar.take() {
+                bar.finish_and_clear();
+            }
+        }
+    }
+    fn fraction(&mut self, stage: &str, fraction: f64) {
+        let bar = self.bar.get_or_insert_with(|| {
+            let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{prefix} [{bar:40}] {percent:>3}% of the way to the tolerance, {elapsed}",
+            ) {
+                bar.set_style(style.progress_chars("=> "));
+            }
+            bar.set_prefix(stage.to_string());
+            bar
+        });
+        bar.set_position((fraction * 1000.0) as u64);
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or(Command::Run {
@@ -133,7 +171,7 @@ fn main() -> ExitCode {
             let name = scene.unwrap_or_else(|| "paper".into());
             let result = driver::scene::load(&name, &set).and_then(|(scene, source)| {
                 let dir = out.unwrap_or_else(|| driver::output::default_dir(&scene.name));
-                driver::run::run(&scene, &source, Some(&dir), &mut |line| eprintln!("{line}"))
+                driver::run::run_with_reporter(&scene, &source, Some(&dir), &mut Terminal::new())
             });
             match result {
                 Ok(_) => ExitCode::SUCCESS,

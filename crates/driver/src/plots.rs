@@ -63,6 +63,67 @@ macro_rules! both {
     };
 }
 
+/// What the 2D pictures draw: triangles over nodes with 2D coordinates and in-plane
+/// displacements. For a 2D run, the mesh itself; for a 3D run, the face `front` (y = lo)
+/// seen in the x-z plane.
+struct View {
+    title: &'static str,
+    tris: Vec<[usize; 3]>,
+    xy: Vec<[f64; 2]>,
+    uv: Vec<[f64; 2]>,
+    outline: Vec<[usize; 2]>,
+    labels: (&'static str, &'static str),
+}
+
+impl View {
+    fn new(mesh: &mesh::Mesh, u: &[[f64; 3]]) -> Option<View> {
+        if mesh.dim == 2 {
+            return Some(View {
+                title: "",
+                tris: mesh.iter_cells().map(|c| [c[0], c[1], c[2]]).collect(),
+                xy: mesh.points.iter().map(|p| [p[0], p[1]]).collect(),
+                uv: u.iter().map(|v| [v[0], v[1]]).collect(),
+                outline: mesh
+                    .boundaries
+                    .values()
+                    .flat_map(|g| g.iter().map(|f| [f[0], f[1]]).collect::<Vec<_>>())
+                    .collect(),
+                labels: ("x", "y"),
+            });
+        }
+        let face = mesh.boundaries.get("front")?;
+        let tris: Vec<[usize; 3]> = face.iter().map(|f| [f[0], f[1], f[2]]).collect();
+        let mut edges = std::collections::HashMap::new();
+        for t in &tris {
+            for q in 0..3 {
+                let (a, b) = (t[q].min(t[(q + 1) % 3]), t[q].max(t[(q + 1) % 3]));
+                *edges.entry([a, b]).or_insert(0) += 1;
+            }
+        }
+        Some(View {
+            title: " (face y = lo, seen in x-z)",
+            tris,
+            xy: mesh.points.iter().map(|p| [p[0], p[2]]).collect(),
+            uv: u.iter().map(|v| [v[0], v[2]]).collect(),
+            outline: edges.into_iter().filter(|(_, k)| *k == 1).map(|(e, _)| e).collect(),
+            labels: ("x", "z"),
+        })
+    }
+
+    fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        let used: std::collections::BTreeSet<usize> = self.tris.iter().flatten().copied().collect();
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for &v in &used {
+            for k in 0..2 {
+                lo[k] = lo[k].min(self.xy[v][k]);
+                hi[k] = hi[k].max(self.xy[v][k]);
+            }
+        }
+        (lo, hi)
+    }
+}
+
 /// All pictures of a 2D run (3D runs get the multipliers along the contact face's middle line).
 pub fn pictures(
     mesh: &mesh::Mesh,
@@ -72,10 +133,10 @@ pub fn pictures(
     electric: bool,
 ) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
     let mut out = vec![];
-    if mesh.dim == 2 {
-        out.extend(both!("deformed", |a| deformed(a, mesh, u))?);
+    if let Some(view) = View::new(mesh, u) {
+        out.extend(both!("deformed", |a| deformed(a, &view))?);
         if electric {
-            out.extend(both!("potential", |a| potential(a, mesh, phi))?);
+            out.extend(both!("potential", |a| potential(a, &view, phi))?);
         }
     }
     if let Some((p, s)) = contact {
@@ -84,25 +145,23 @@ pub fn pictures(
     Ok(out)
 }
 
-fn deformed<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    mesh: &mesh::Mesh,
-    u: &[[f64; 3]],
-) -> Result<(), String> {
+fn deformed<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
-    let (lo, hi) = mesh.bounding_box();
+    let (lo, hi) = view.bounds();
     let size = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    let umax = u
+    let umax = view
+        .tris
         .iter()
-        .map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt())
+        .flatten()
+        .map(|&v| (view.uv[v][0].powi(2) + view.uv[v][1].powi(2)).sqrt())
         .fold(0.0f64, f64::max);
     let scale = if umax > 0.0 { 0.1 * size / umax } else { 1.0 };
     let pad = 0.15 * size;
     let mut chart = ChartBuilder::on(area)
         .caption(
-            format!("Deformed configuration (displacement x {scale:.3e})"),
-            (FONT, 24),
+            format!("Deformed configuration{} (displacement x {scale:.3e})", view.title),
+            (FONT, 22),
         )
         .margin(15)
         .x_label_area_size(35)
@@ -112,28 +171,33 @@ fn deformed<DB: DrawingBackend>(
     chart
         .configure_mesh()
         .disable_mesh()
+        .x_desc(view.labels.0)
+        .y_desc(view.labels.1)
         .label_style((FONT, 14))
         .draw()
         .map_err(e)?;
-    // undeformed outline
-    for g in mesh.boundaries.values() {
-        for f in g.iter() {
-            let pts: Vec<(f64, f64)> = f.iter().map(|&v| (mesh.points[v][0], mesh.points[v][1])).collect();
-            chart
-                .draw_series(std::iter::once(PathElement::new(pts, RGBColor(190, 190, 190))))
-                .map_err(e)?;
-        }
-    }
-    let step = (mesh.n_cells() / 20_000).max(1);
     chart
-        .draw_series(mesh.iter_cells().step_by(step).map(|c| {
-            let mut pts: Vec<(f64, f64)> = c
-                .iter()
-                .map(|&v| (mesh.points[v][0] + scale * u[v][0], mesh.points[v][1] + scale * u[v][1]))
-                .collect();
-            pts.push(pts[0]);
-            PathElement::new(pts, BLUE.mix(0.6))
+        .draw_series(view.outline.iter().map(|&[a, b]| {
+            PathElement::new(
+                vec![(view.xy[a][0], view.xy[a][1]), (view.xy[b][0], view.xy[b][1])],
+                RGBColor(190, 190, 190),
+            )
         }))
+        .map_err(e)?;
+    let step = (view.tris.len() / 20_000).max(1);
+    let at = |v: usize| {
+        (
+            view.xy[v][0] + scale * view.uv[v][0],
+            view.xy[v][1] + scale * view.uv[v][1],
+        )
+    };
+    chart
+        .draw_series(
+            view.tris
+                .iter()
+                .step_by(step)
+                .map(|t| PathElement::new(vec![at(t[0]), at(t[1]), at(t[2]), at(t[0])], BLUE.mix(0.6))),
+        )
         .map_err(e)?;
     Ok(())
 }
@@ -247,18 +311,24 @@ fn multipliers<DB: DrawingBackend>(
     Ok(())
 }
 
-fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, mesh: &mesh::Mesh, phi: &[f64]) -> Result<(), String> {
+fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View, phi: &[f64]) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
-    let (lo, hi) = mesh.bounding_box();
-    let (pmin, pmax) = phi
+    let (lo, hi) = view.bounds();
+    let (pmin, pmax) = view
+        .tris
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        .flatten()
+        .map(|&v| phi[v])
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     let span = if pmax > pmin { pmax - pmin } else { 1.0 };
     let mut chart = ChartBuilder::on(area)
         .caption(
-            format!("Electric potential: {pmin:.3e} (blue) to {pmax:.3e} (red), 12 contours"),
-            (FONT, 22),
+            format!(
+                "Electric potential{}: {pmin:.3e} (blue) to {pmax:.3e} (red), 12 contours",
+                view.title
+            ),
+            (FONT, 20),
         )
         .margin(15)
         .x_label_area_size(35)
@@ -268,12 +338,14 @@ fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, mesh: &mesh::Mes
     chart
         .configure_mesh()
         .disable_mesh()
+        .x_desc(view.labels.0)
+        .y_desc(view.labels.1)
         .label_style((FONT, 14))
         .draw()
         .map_err(e)?;
+    // blue -> white -> red
     let color = |v: f64| {
         let t = ((v - pmin) / span).clamp(0.0, 1.0);
-        // blue -> white -> red
         if t < 0.5 {
             let s = t / 0.5;
             RGBColor((255.0 * s) as u8, (255.0 * s) as u8, 255)
@@ -282,28 +354,28 @@ fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, mesh: &mesh::Mes
             RGBColor(255, (255.0 * s) as u8, (255.0 * s) as u8)
         }
     };
+    let xy = |v: usize| (view.xy[v][0], view.xy[v][1]);
     chart
-        .draw_series(mesh.iter_cells().map(|c| {
-            let pts: Vec<(f64, f64)> = c.iter().map(|&v| (mesh.points[v][0], mesh.points[v][1])).collect();
-            let mean = c.iter().map(|&v| phi[v]).sum::<f64>() / c.len() as f64;
-            Polygon::new(pts, color(mean).filled())
+        .draw_series(view.tris.iter().map(|t| {
+            let mean = t.iter().map(|&v| phi[v]).sum::<f64>() / 3.0;
+            Polygon::new(t.iter().map(|&v| xy(v)).collect::<Vec<_>>(), color(mean).filled())
         }))
         .map_err(e)?;
     // isolines by marching triangles
     let levels = 12;
     let mut segments = vec![];
-    for c in mesh.iter_cells() {
+    for t in &view.tris {
         for l in 1..levels {
             let level = pmin + span * l as f64 / levels as f64;
             let mut cut = vec![];
             for q in 0..3 {
-                let (a, b) = (c[q], c[(q + 1) % 3]);
+                let (a, b) = (t[q], t[(q + 1) % 3]);
                 let (fa, fb) = (phi[a] - level, phi[b] - level);
                 if (fa < 0.0) != (fb < 0.0) {
-                    let t = fa / (fa - fb);
+                    let s = fa / (fa - fb);
                     cut.push((
-                        mesh.points[a][0] + t * (mesh.points[b][0] - mesh.points[a][0]),
-                        mesh.points[a][1] + t * (mesh.points[b][1] - mesh.points[a][1]),
+                        view.xy[a][0] + s * (view.xy[b][0] - view.xy[a][0]),
+                        view.xy[a][1] + s * (view.xy[b][1] - view.xy[a][1]),
                     ));
                 }
             }

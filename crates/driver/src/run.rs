@@ -44,6 +44,23 @@ pub fn peak_memory_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
+/// Receives what a run reports: lines, and (for a progress bar) the fraction done of a long
+/// stage.
+pub trait Reporter {
+    /// One line: a stage done, or an outer iteration.
+    fn line(&mut self, text: &str);
+    /// The fraction in `[0, 1]` of the current iterative stage (`stage` names it).
+    fn fraction(&mut self, _stage: &str, _fraction: f64) {}
+}
+
+struct Lines<'a>(&'a mut dyn FnMut(&str));
+
+impl Reporter for Lines<'_> {
+    fn line(&mut self, text: &str) {
+        (self.0)(text)
+    }
+}
+
 /// Runs a scene and writes its outputs into `out_dir` (atomically; nothing on error).
 /// `progress` receives one line per stage or outer iteration.
 pub fn run(
@@ -52,6 +69,16 @@ pub fn run(
     out_dir: Option<&Path>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<RunOutcome, DriverError> {
+    run_with_reporter(scene, source, out_dir, &mut Lines(progress))
+}
+
+/// As [`run`], reporting through a [`Reporter`] (the command line draws a progress bar).
+pub fn run_with_reporter(
+    scene: &Scene,
+    source: &Source,
+    out_dir: Option<&Path>,
+    reporter: &mut dyn Reporter,
+) -> Result<RunOutcome, DriverError> {
     let t_total = Instant::now();
     let t = Instant::now();
     let mesh = build::mesh(scene, source)?;
@@ -59,7 +86,7 @@ pub fn run(
     let dim = mesh.dim;
     let mats = build::materials(scene, dim)?;
     let plan = build::plan(scene, dim, &mats);
-    progress(&plan.to_string());
+    reporter.line(&plan.to_string());
     if !STRATEGIES.iter().any(|(n, _)| *n == plan.linear_strategy) {
         return Err(DriverError::Input(format!(
             "solver.strategy `{}` is unknown (see `piezocontact strategies`)",
@@ -79,7 +106,7 @@ pub fn run(
     let (b_u, b_phi) = disc.rhs(&loads)?;
     let t_assembly = t.elapsed().as_secs_f64();
     let (n_u, n_phi) = (disc.dofs.n_u, disc.dofs.n_phi);
-    progress(&format!(
+    reporter.line(&format!(
         "mesh: {} nodes, {} cells, h = {:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {:.3} s",
         mesh.n_nodes(),
         mesh.n_cells(),
@@ -116,7 +143,7 @@ pub fn run(
         direct = Some(DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, par)?);
     }
     let t_factor = t.elapsed().as_secs_f64();
-    progress(&format!("factorisation {t_factor:.3} s"));
+    reporter.line(&format!("factorisation {t_factor:.3} s"));
     let t = Instant::now();
     let (mut u, mut phi) = (vec![0.0; n_u], vec![0.0; n_phi]);
     let mut contact_result = None;
@@ -144,14 +171,25 @@ pub fn run(
             } else {
                 StopRule::Tight { tol: scene.solver.tol }
             },
-            report_every: 500,
+            report_every: 50,
             ..Default::default()
         };
+        // a line per fixed-point step and per 500 Uzawa steps; the fraction done for a bar,
+        // from the residual's way down (log scale) to the tolerance
+        let tol = scene.solver.tol;
+        let mut first_residual = None;
         let mut report = |p: &contact::Progress| {
-            progress(&format!(
-                "{:>11} {:>6}: residual {:.3e}, stick {}, slip {}, separated {}",
-                p.stage, p.iter, p.residual, p.counts.0, p.counts.1, p.counts.2
-            ))
+            if p.stage == "uzawa" && p.residual > 0.0 {
+                let r0 = *first_residual.get_or_insert(p.residual.max(tol * 10.0));
+                let f = ((r0 / p.residual).ln() / (r0 / tol).ln()).clamp(0.0, 1.0);
+                reporter.fraction("contact", f);
+            }
+            if p.stage != "uzawa" || p.iter % 500 == 0 {
+                reporter.line(&format!(
+                    "{:>11} {:>6}: residual {:.3e}, stick {}, slip {}, separated {}",
+                    p.stage, p.iter, p.residual, p.counts.0, p.counts.1, p.counts.2
+                ))
+            }
         };
         let sol = match (&mut direct, &mut pcg_solver) {
             (Some(d), _) if plan.linear_strategy == "uzawa-condensed" => {
@@ -193,7 +231,7 @@ pub fn run(
         cb.add_forces(&sol.lambda, &mut b_full);
     }
     let eq = equilibrium_residual(&blocks.a, &blocks.g, &blocks.b, &u, &phi, &b_full, &b_phi);
-    progress(&format!(
+    reporter.line(&format!(
         "solve {t_solve:.3} s ({pcg_total} PCG iterations), equilibrium residual {eq:.3e}"
     ));
     let factor_bytes = direct
@@ -269,7 +307,7 @@ pub fn run(
             outs.add(&name, bytes);
         }
         outs.commit()?;
-        progress(&format!("wrote {} in {}", plan.outputs.join(", "), dir.display()));
+        reporter.line(&format!("wrote {} in {}", plan.outputs.join(", "), dir.display()));
     }
     Ok(RunOutcome {
         report,
