@@ -112,7 +112,7 @@ pub fn mesh(scene: &Scene, source: &Source) -> Result<mesh::Mesh, DriverError> {
     Ok(mesh)
 }
 
-fn material(spec: &MaterialSpec, dim: usize, scale: f64) -> Result<Material, DriverError> {
+fn material(spec: &MaterialSpec, dim: usize) -> Result<Material, DriverError> {
     let bad = |m: String| DriverError::Input(format!("material of region `{}`: {m}", spec.region));
     let crystal = match spec.model.as_str() {
         "crystal-6mm" => {
@@ -143,21 +143,19 @@ fn material(spec: &MaterialSpec, dim: usize, scale: f64) -> Result<Material, Dri
         3 => [spec.poling[0], spec.poling[1], spec.poling[2]],
         n => return Err(bad(format!("poling needs 3 components, not {n}"))),
     };
+    let scale = spec.coupling_scale.unwrap_or(1.0);
+    if !scale.is_finite() {
+        return Err(bad(format!("coupling_scale = {scale} is not finite")));
+    }
     Ok(Material::from_crystal(&spec.region, &crystal, poling, dim)?.with_coupling_scale(scale))
 }
 
 /// The materials (global frame), with the electric part removed when the plan leaves it out.
 pub fn materials(scene: &Scene, dim: usize) -> Result<Vec<(String, Material)>, DriverError> {
-    let scale = scene.materials.coupling_scale.unwrap_or(1.0);
-    if !scale.is_finite() {
-        return Err(DriverError::Input(format!(
-            "material.coupling_scale = {scale} is not finite"
-        )));
-    }
     scene
         .material
         .iter()
-        .map(|s| Ok((s.region.clone(), material(s, dim, scale)?)))
+        .map(|s| Ok((s.region.clone(), material(s, dim)?)))
         .collect()
 }
 

@@ -24,7 +24,7 @@ enum Command {
         /// Override a scene key, e.g. --set mesh.n=128 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// Output directory (default: out/<scene>/).
+        /// Output directory (default: out/SCENE/).
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -49,7 +49,7 @@ enum Command {
         /// Other overrides.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// Output directory (default: out/<scene>-sweep/).
+        /// Output directory (default: out/SCENE-sweep/).
         #[arg(long)]
         out: Option<PathBuf>,
     },

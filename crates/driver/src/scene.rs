@@ -34,9 +34,6 @@ pub struct Scene {
     pub mesh: MeshSpec,
     /// Materials by region.
     pub material: Vec<MaterialSpec>,
-    /// Options on all materials.
-    #[serde(default)]
-    pub materials: MaterialOptions,
     /// Clamped / grounded groups.
     #[serde(default)]
     pub dirichlet: Vec<DirichletSpec>,
@@ -117,13 +114,7 @@ pub struct MaterialSpec {
     /// Poisson's ratio (isotropic).
     #[serde(default)]
     pub poisson: Option<f64>,
-}
-
-/// Options on all materials.
-#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialOptions {
-    /// Multiplies every piezoelectric constant (`material.coupling_scale`).
+    /// Multiplies the piezoelectric constants (`material.coupling_scale`; default 1).
     #[serde(default)]
     pub coupling_scale: Option<f64>,
 }
