@@ -30,7 +30,24 @@ fn main() {
         .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
     let t_nd = t.elapsed().as_secs_f64();
     println!("n = {n}: nested dissection order computed in {t_nd:.3} s");
-    for (name, ord) in [("amd", Ordering::Amd), ("nested-dissection", Ordering::Given(nd))] {
+    let bottom = mesh.boundary("bottom").expect("paper has a bottom").nodes();
+    let contact_dofs: Vec<usize> = bottom
+        .iter()
+        .flat_map(|&v| (0..2).map(move |k| (v, k)))
+        .filter_map(|(v, k)| match disc.dofs.u[v * 2 + k] {
+            fe_assembly::Dof::Free(j)
+                if (0..2).all(|q| matches!(disc.dofs.u[v * 2 + q], fe_assembly::Dof::Free(_))) =>
+            {
+                Some(j)
+            }
+            _ => None,
+        })
+        .collect();
+    for (name, ord) in [
+        ("amd", Ordering::Amd),
+        ("nested-dissection", Ordering::Given(nd)),
+        ("amd-contact-last", Ordering::AmdThenLast(contact_dofs)),
+    ] {
         let (mut sym, mut num, mut sol) = (vec![], vec![], vec![]);
         let mut len = 0;
         for _ in 0..3 {

@@ -184,9 +184,109 @@ impl ContactOperator for FullSolve<'_> {
     }
 }
 
-/// The condensed problem `u_c = u0 - D W λ`: `D` from block solves with the factor of `K`,
-/// 64 right-hand sides at a time.
+/// How the compliance of a condensed problem was formed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CondenseRoute {
+    /// Read off the trailing block of the factor (contact dofs ordered last): `D = R S_c⁻¹ Rᵀ`.
+    TrailingBlock,
+    /// Block solves with the factor, 64 right-hand sides at a time.
+    BlockSolves,
+}
+
+/// The condensed problem `u_c = u0 - D W λ` with `D = C K⁻¹ Cᵀ`. When the factor of `K` was
+/// ordered with the contact dofs last, `(K⁻¹)_cc = S_c⁻¹` with `S_c` read off its trailing block
+/// (one dense inverse, no extra sparse solve); otherwise by block solves.
 pub fn condense(
+    boundary: &ContactBoundary,
+    solver: &mut DirectLdlt,
+    b_u: &[f64],
+    b_phi: &[f64],
+    nt: usize,
+) -> Result<(DenseContactProblem, CondenseRoute), DriverError> {
+    if let Some(problem) = condense_from_factor(boundary, solver, b_u, b_phi, nt)? {
+        return Ok((problem, CondenseRoute::TrailingBlock));
+    }
+    Ok((
+        condense_by_solves(boundary, solver, b_u, b_phi, nt)?,
+        CondenseRoute::BlockSolves,
+    ))
+}
+
+/// `u0` (the loads alone) at the contact points.
+fn loads_alone(
+    boundary: &ContactBoundary,
+    solver: &mut DirectLdlt,
+    b_u: &[f64],
+    b_phi: &[f64],
+    nt: usize,
+) -> Result<PointValues, DriverError> {
+    let n = boundary.points.len();
+    let mut u0 = PointValues::zeros(n, nt);
+    let (mut u, mut phi) = (vec![0.0; b_u.len()], vec![0.0; b_phi.len()]);
+    solver.solve(b_u, b_phi, &mut u, &mut phi)?;
+    boundary.extract(&u, &mut u0);
+    Ok(u0)
+}
+
+fn condense_from_factor(
+    boundary: &ContactBoundary,
+    solver: &mut DirectLdlt,
+    b_u: &[f64],
+    b_phi: &[f64],
+    nt: usize,
+) -> Result<Option<DenseContactProblem>, DriverError> {
+    let k = boundary.dofs.len();
+    let fwd = solver.factor().permutation();
+    if fwd[fwd.len() - k..] != boundary.dofs[..] {
+        return Ok(None);
+    }
+    let Some(sc) = solver.factor().trailing_schur_complement(k) else {
+        return Ok(None);
+    };
+    // (K⁻¹)_cc = S_c⁻¹ by a dense Cholesky (S_c is SPD: a principal block of S⁻¹'s inverse)
+    let s = faer::Mat::<f64>::from_fn(k, k, |i, j| sc[i * k + j]);
+    let llt = s
+        .llt(faer::Side::Lower)
+        .map_err(|e| DriverError::Input(format!("the condensed contact matrix is not positive definite: {e:?}")))?;
+    let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);
+    let p = &boundary.points;
+    let (n, dim) = (p.len(), p.dim);
+    let m = n * (1 + nt);
+    // rows of R: the normal, then the tangents, of each point, over its dim dofs
+    let dir = |r: usize| -> (usize, [f64; 3]) {
+        if r < n {
+            (r, p.normal[r])
+        } else {
+            let (i, q) = ((r - n) / nt, (r - n) % nt);
+            (i, p.tangent[i][q])
+        }
+    };
+    let mut d = vec![0.0; m * m];
+    for r in 0..m {
+        let (i, a) = dir(r);
+        for c in 0..=r {
+            let (j, b) = dir(c);
+            let mut v = 0.0;
+            for x in 0..dim {
+                for y in 0..dim {
+                    v += a[x] * inv[(i * dim + x, j * dim + y)] * b[y];
+                }
+            }
+            d[r * m + c] = v;
+            d[c * m + r] = v;
+        }
+    }
+    let u0 = loads_alone(boundary, solver, b_u, b_phi, nt)?;
+    Ok(Some(DenseContactProblem {
+        u0,
+        compliance: d,
+        weight: p.weight.clone(),
+        nt,
+    }))
+}
+
+/// The condensed problem by block solves with the factor of `K`, 64 right-hand sides at a time.
+fn condense_by_solves(
     boundary: &ContactBoundary,
     solver: &mut DirectLdlt,
     b_u: &[f64],
@@ -198,13 +298,7 @@ pub fn condense(
     let m = n * (1 + nt);
     let n_u = b_u.len();
     let n_all = n_u + b_phi.len();
-    // u0: the loads alone
-    let mut u0 = PointValues::zeros(n, nt);
-    {
-        let (mut u, mut phi) = (vec![0.0; n_u], vec![0.0; b_phi.len()]);
-        solver.solve(b_u, b_phi, &mut u, &mut phi)?;
-        boundary.extract(&u, &mut u0);
-    }
+    let u0 = loads_alone(boundary, solver, b_u, b_phi, nt)?;
     // column j of D: the contact displacement under a unit force along direction j
     let mut d = vec![0.0; m * m];
     const BLOCK: usize = 64;

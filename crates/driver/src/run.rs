@@ -128,6 +128,12 @@ pub fn run_with_reporter(
         },
         ..Default::default()
     };
+    let mut contact_boundary = match scene.contact.as_ref() {
+        Some(c) if plan.contact_law != "none" => Some(contact_setup::boundary(
+            &mesh, &disc.dofs, &c.group, &c.normal, c.gap, c.friction,
+        )?),
+        _ => None,
+    };
     let schur = plan.linear_strategy == "uzawa-schur-pcg";
     let mut direct = None;
     let mut pcg_solver = None;
@@ -140,13 +146,21 @@ pub fn run_with_reporter(
             par,
         )?);
     } else {
-        direct = Some(DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, par)?);
+        // the condensed strategy orders the contact dofs last, to read the contact block off
+        // the factor
+        let ordering = match (&contact_boundary, plan.linear_strategy.as_str()) {
+            (Some(cb), "uzawa-condensed") => Ordering::AmdThenLast(cb.dofs.clone()),
+            _ => Ordering::Amd,
+        };
+        direct = Some(DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &ordering, par)?);
     }
     let t_factor = t.elapsed().as_secs_f64();
     reporter.line(&format!("factorisation {t_factor:.3} s"));
     let t = Instant::now();
     let (mut u, mut phi) = (vec![0.0; n_u], vec![0.0; n_phi]);
     let mut contact_result = None;
+    let mut condense_seconds = 0.0;
+    let mut condense_route: Option<String> = None;
     let pcg_total;
     if plan.contact_law == "none" {
         let solver: &mut dyn CoupledSolver = match (&mut direct, &mut pcg_solver) {
@@ -157,7 +171,7 @@ pub fn run_with_reporter(
         pcg_total = solver.solve(&b_u, &b_phi, &mut u, &mut phi)?.pcg_iters;
     } else {
         let c = scene.contact.as_ref().expect("a contact law implies a contact section");
-        let cb = contact_setup::boundary(&mesh, &disc.dofs, &c.group, &c.normal, c.gap, c.friction)?;
+        let cb = contact_boundary.take().expect("built with the plan");
         let n_points = cb.points.len();
         let law = match (plan.contact_law.as_str(), plan.friction) {
             (_, false) => Law::Frictionless,
@@ -174,6 +188,19 @@ pub fn run_with_reporter(
             report_every: 50,
             ..Default::default()
         };
+        // the condensed strategy forms the contact compliance first
+        let mut dense_problem = None;
+        if let (Some(d), "uzawa-condensed") = (&mut direct, plan.linear_strategy.as_str()) {
+            let t_condense = Instant::now();
+            let (dense, route) = contact_setup::condense(&cb, d, &b_u, &b_phi, nt)?;
+            condense_seconds = t_condense.elapsed().as_secs_f64();
+            reporter.line(&format!(
+                "condensed the contact compliance ({m} x {m}, {route:?}) in {condense_seconds:.3} s",
+                m = dense.m()
+            ));
+            condense_route = Some(format!("{route:?}"));
+            dense_problem = Some(dense);
+        }
         // a line per fixed-point step and per 500 Uzawa steps; the fraction done for a bar,
         // from the residual's way down (log scale) to the tolerance
         let tol = scene.solver.tol;
@@ -193,7 +220,7 @@ pub fn run_with_reporter(
         };
         let sol = match (&mut direct, &mut pcg_solver) {
             (Some(d), _) if plan.linear_strategy == "uzawa-condensed" => {
-                let mut dense = contact_setup::condense(&cb, d, &b_u, &b_phi, nt)?;
+                let mut dense = dense_problem.take().expect("condensed before the solve");
                 let sol = contact::solve(&mut dense, &cb.points, &law, &params, None, &mut report)?;
                 let mut rhs = b_u.clone();
                 cb.add_forces(&sol.lambda, &mut rhs);
@@ -260,7 +287,8 @@ pub fn run_with_reporter(
             "complementarity": contact_result.as_ref().map_or(0.0, |(_, s, _)| s.info.complementarity),
             "converged_to_tolerance": plan.rule == "tight",
         },
-        "timings_s": { "mesh": t_mesh, "assembly": t_assembly, "factorization": t_factor, "contact": if contact_result.is_some() { t_solve } else { 0.0 }, "solve": t_solve, "total": t_total.elapsed().as_secs_f64() },
+        "timings_s": { "mesh": t_mesh, "assembly": t_assembly, "factorization": t_factor,
+            "condense": condense_seconds, "contact": if contact_result.is_some() { t_solve } else { 0.0 }, "solve": t_solve, "total": t_total.elapsed().as_secs_f64() },
         "memory": { "peak_bytes": peak_memory_bytes(), "factor_bytes": factor_bytes },
         "solver": {
             "strategy": plan.linear_strategy,
@@ -270,6 +298,7 @@ pub fn run_with_reporter(
             "step_r": contact_result.as_ref().map(|(_, s, _)| s.info.step),
             "mu_max": contact_result.as_ref().map(|(_, s, _)| s.info.mu_max),
             "step_backoffs": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.step_backoffs),
+            "condense_route": condense_route,
         },
     });
     if let Some(dir) = out_dir {

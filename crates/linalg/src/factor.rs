@@ -12,6 +12,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
 };
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -98,7 +99,15 @@ impl SparseFactor {
                 SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
             }
         };
-        let symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, CholeskySymbolicParams::default())
+        // chosen dofs last are there to be read off the last supernode: force supernodal
+        let params = match ordering {
+            Ordering::AmdThenLast(_) => CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+            _ => CholeskySymbolicParams::default(),
+        };
+        let symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
             .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
         let factor_req = match kind {
             FactorKind::Cholesky => symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
@@ -238,6 +247,68 @@ impl SparseFactor {
             }
         }
         d
+    }
+
+    /// The Schur complement onto the last `k` indices of the factor's order, `L_cc D_c L_ccᵀ`,
+    /// read off the trailing corner of an `L D Lᵀ` factor (dense, row-major `k x k`). With an
+    /// ordering that puts chosen dofs last ([`Ordering::AmdThenLast`]) this is exactly the Schur
+    /// complement of the matrix onto those dofs. `None` unless the factor is a supernodal
+    /// `L D Lᵀ` whose last supernode holds all `k` columns.
+    pub fn trailing_schur_complement(&self, k: usize) -> Option<Vec<f64>> {
+        if self.kind != FactorKind::Ldlt || k == 0 || k > self.n() {
+            return None;
+        }
+        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
+            return None;
+        };
+        let last = s.n_supernodes().checked_sub(1)?;
+        let (begin, end) = (s.supernode_begin()[last], s.supernode_end()[last]);
+        if end != self.n() || begin > self.n() - k {
+            return None;
+        }
+        let w = end - begin;
+        let rows = w + (s.col_ptr_for_row_idx()[last + 1] - s.col_ptr_for_row_idx()[last]);
+        let block = &self.values[s.col_ptr_for_val()[last]..s.col_ptr_for_val()[last + 1]];
+        let off = w - k;
+        // S_c = (L_cc D_c) L_ccᵀ by one dense product
+        let d: Vec<f64> = (0..k).map(|j| block[(off + j) * rows + off + j]).collect();
+        let l = faer::Mat::<f64>::from_fn(k, k, |i, j| match i.cmp(&j) {
+            std::cmp::Ordering::Equal => 1.0,
+            std::cmp::Ordering::Greater => block[(off + j) * rows + off + i],
+            std::cmp::Ordering::Less => 0.0,
+        });
+        let mut ld = l.clone();
+        for j in 0..k {
+            for i in j..k {
+                ld[(i, j)] *= d[j];
+            }
+        }
+        let mut prod = faer::Mat::<f64>::zeros(k, k);
+        faer::linalg::matmul::matmul(
+            prod.as_mut(),
+            faer::Accum::Replace,
+            ld.as_ref(),
+            l.transpose(),
+            1.0,
+            self.par,
+        );
+        let mut out = vec![0.0; k * k];
+        for i in 0..k {
+            for j in 0..=i {
+                let v = 0.5 * (prod[(i, j)] + prod[(j, i)]);
+                out[i * k + j] = v;
+                out[j * k + i] = v;
+            }
+        }
+        Some(out)
+    }
+
+    /// Whether the factor is supernodal, with the first column of its last supernode.
+    pub fn last_supernode_begin(&self) -> Option<usize> {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => s.n_supernodes().checked_sub(1).map(|l| s.supernode_begin()[l]),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        }
     }
 
     /// `(positive, negative, zero)` pivot counts of an `L D Lᵀ` factor: by Sylvester's law the

@@ -174,3 +174,64 @@ fn not_positive_definite_is_a_typed_error() {
         Err(linalg::LinalgError::NonFinite { .. })
     ));
 }
+
+/// The trailing corner of an `L D Lᵀ` factor with chosen dofs last is the Schur complement of
+/// `K` onto them: its inverse equals the corresponding block of `K⁻¹` (checked on the 2D
+/// Laplacian-like quasi-definite matrix of a grid, large enough to go supernodal).
+#[test]
+fn trailing_block_is_the_schur_complement() {
+    // K = [[A, Gᵀ], [G, -B]] with A, B grid Laplacians + I and G a shifted identity
+    let m = 40; // grid m x m, so n_u = n_phi = 1600
+    let n = m * m;
+    let lap = |shift: f64| {
+        let mut t = vec![];
+        for i in 0..m {
+            for j in 0..m {
+                let p = i * m + j;
+                t.push(Triplet::new(p, p, 4.0 + shift));
+                if i + 1 < m {
+                    t.push(Triplet::new(p, p + m, -1.0));
+                    t.push(Triplet::new(p + m, p, -1.0));
+                }
+                if j + 1 < m {
+                    t.push(Triplet::new(p, p + 1, -1.0));
+                    t.push(Triplet::new(p + 1, p, -1.0));
+                }
+            }
+        }
+        SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap()
+    };
+    let (a, b) = (lap(0.5), lap(1.0));
+    let g = SparseColMat::<usize, f64>::try_new_from_triplets(
+        n,
+        n,
+        &(0..n).map(|i| Triplet::new(i, i, 0.7)).collect::<Vec<_>>(),
+    )
+    .unwrap();
+    // the "contact" dofs: the u dofs of the grid's first row
+    let last: Vec<usize> = (0..m).collect();
+    let mut f = DirectLdlt::new(&a, &g, &b, &Ordering::AmdThenLast(last.clone()), Par::Seq).unwrap();
+    let begin = f.factor().last_supernode_begin();
+    let sc = f
+        .factor()
+        .trailing_schur_complement(m)
+        .unwrap_or_else(|| panic!("last supernode begins at {begin:?} of {}", 2 * n));
+    // column j of K⁻¹ restricted to the contact dofs, by a solve
+    let sc = DMatrix::from_row_slice(m, m, &sc);
+    let inv = sc.clone().try_inverse().unwrap();
+    for (j, &dj) in last.iter().enumerate() {
+        let (mut u, mut p) = (vec![0.0; n], vec![0.0; n]);
+        let mut e = vec![0.0; n];
+        e[dj] = 1.0;
+        f.solve(&e, &vec![0.0; n], &mut u, &mut p).unwrap();
+        for (i, &di) in last.iter().enumerate() {
+            assert!(
+                (u[di] - inv[(i, j)]).abs() < 1e-12 * inv.amax(),
+                "({i}, {j}): {} vs {}",
+                u[di],
+                inv[(i, j)]
+            );
+        }
+    }
+    let _ = f.factor_mut();
+}
