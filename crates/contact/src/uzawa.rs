@@ -248,6 +248,17 @@ fn estimate_mu_max(c: &mut Counter<'_>, points: &ContactPoints, nt: usize, iters
     Ok(mu)
 }
 
+/// The state of the dual iteration shared by the Uzawa loops of one solve.
+struct Dual<'a, 'b> {
+    c: Counter<'b>,
+    points: &'a ContactPoints,
+    params: &'a UzawaParams,
+    /// The canonical step `1 / μ_max` of the residual.
+    canon: f64,
+    /// Counts so far; `info.step` is the current step.
+    info: UzawaInfo,
+}
+
 /// Solves the contact problem for `law` through `op`, from `lambda0` (warm start; zeros when
 /// `None`). Reports progress through `progress`.
 pub fn solve(
@@ -282,14 +293,14 @@ pub fn solve(
     let mut c = Counter { op, calls: 0, inner: 0 };
     let mu_max = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
     let estimate_inner = c.inner;
-    let mut step = params.step.unwrap_or(params.safety / mu_max);
+    let step = params.step.unwrap_or(params.safety / mu_max);
     if !(step > 0.0 && step.is_finite()) {
         return Err(ContactError::Input(format!("Uzawa step {step} must be positive")));
     }
     let canon = 1.0 / mu_max;
     let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
     let mut u = PointValues::zeros(n, nt);
-    let mut info = UzawaInfo {
+    let info = UzawaInfo {
         uzawa_iters: 0,
         fixed_point_iters: 0,
         inner_iters: 0,
@@ -300,23 +311,19 @@ pub fn solve(
         complementarity: f64::NAN,
         step_backoffs: 0,
     };
+    let mut d = Dual {
+        c,
+        points,
+        params,
+        canon,
+        info,
+    };
     match law {
         Law::Frictionless | Law::Tresca(_) => {
             let radius = slip_bound(points, law, &lambda.normal);
-            let fresh = uzawa(
-                &mut c,
-                points,
-                &radius,
-                params,
-                canon,
-                &mut step,
-                &mut lambda,
-                &mut u,
-                &mut info,
-                progress,
-            )?;
+            let fresh = uzawa(&mut d, &radius, &mut lambda, &mut u, progress)?;
             if !fresh {
-                c.call(&lambda, &mut u)?;
+                d.c.call(&lambda, &mut u)?;
             }
         }
         Law::Coulomb => {
@@ -324,25 +331,14 @@ pub fn solve(
             let mut s = slip_bound(points, law, &lambda.normal);
             let mut fresh = false;
             for l in 1..=params.max_fixed_point {
-                info.fixed_point_iters = l;
-                fresh = uzawa(
-                    &mut c,
-                    points,
-                    &s,
-                    params,
-                    canon,
-                    &mut step,
-                    &mut lambda,
-                    &mut u,
-                    &mut info,
-                    progress,
-                )?;
+                d.info.fixed_point_iters = l;
+                fresh = uzawa(&mut d, &s, &mut lambda, &mut u, progress)?;
                 let s_new = slip_bound(points, law, &lambda.normal);
                 let status = classify(&lambda, &s_new);
                 let (done, residual) = match params.rule {
                     StopRule::Tight { tol } => {
                         if !fresh {
-                            c.call(&lambda, &mut u)?;
+                            d.c.call(&lambda, &mut u)?;
                             fresh = true;
                         }
                         let r = complementarity_residual(points, &s_new, &lambda, &u, canon);
@@ -370,16 +366,16 @@ pub fn solve(
                 }
             }
             if !fresh {
-                c.call(&lambda, &mut u)?;
+                d.c.call(&lambda, &mut u)?;
             }
         }
     }
     let radius = slip_bound(points, law, &lambda.normal);
+    let mut info = d.info;
     info.complementarity = complementarity_residual(points, &radius, &lambda, &u, canon);
-    info.operator_calls = c.calls;
+    info.operator_calls = d.c.calls;
     info.estimate_inner_iters = estimate_inner;
-    info.inner_iters = c.inner - estimate_inner;
-    info.step = step;
+    info.inner_iters = d.c.inner - estimate_inner;
     if let StopRule::Tight { tol } = params.rule {
         if !(info.complementarity <= tol) {
             return Err(ContactError::NoConvergence {
@@ -399,33 +395,28 @@ pub fn solve(
 
 /// Uzawa iterations for a given radius. Returns whether `u` is the displacement of the final
 /// `lambda` (true under the tight rule; under the paper's rule the last update is not solved).
-#[allow(clippy::too_many_arguments)]
 fn uzawa(
-    c: &mut Counter<'_>,
-    points: &ContactPoints,
+    d: &mut Dual<'_, '_>,
     radius: &[f64],
-    params: &UzawaParams,
-    canon: f64,
-    step: &mut f64,
     lambda: &mut PointValues,
     u: &mut PointValues,
-    info: &mut UzawaInfo,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<bool, ContactError> {
+    let (points, params, canon) = (d.points, d.params, d.canon);
     let n = points.len();
     let nt = lambda.tangential.len().checked_div(n).unwrap_or(0);
     let mut best = f64::INFINITY;
     let mut last = f64::NAN;
     let mut buf = [0.0; 2];
     for k in 1..=params.max_iters {
-        c.call(lambda, u)?;
+        d.c.call(lambda, u)?;
         let r = complementarity_residual(points, radius, lambda, u, canon);
         last = r;
         if !r.is_finite() {
             return Err(ContactError::Diverged {
-                n_iters: info.uzawa_iters,
+                n_iters: d.info.uzawa_iters,
                 residual: r,
-                step: *step,
+                step: d.info.step,
             });
         }
         if let StopRule::Tight { tol } = params.rule {
@@ -435,30 +426,30 @@ fn uzawa(
         }
         // divergence: a residual far above the best seen means the step is too large; halve it
         if r > 1e3 * best && k > 10 {
-            *step *= 0.5;
-            info.step_backoffs += 1;
+            d.info.step *= 0.5;
+            d.info.step_backoffs += 1;
             best = r;
-            if info.step_backoffs > 20 {
+            if d.info.step_backoffs > 20 {
                 return Err(ContactError::Diverged {
-                    n_iters: info.uzawa_iters,
+                    n_iters: d.info.uzawa_iters,
                     residual: r,
-                    step: *step,
+                    step: d.info.step,
                 });
             }
         }
         best = best.min(r);
-        info.uzawa_iters += 1;
+        d.info.uzawa_iters += 1;
         // the projected update
         let mut diff2 = 0.0;
         let mut norm2 = 0.0;
         for i in 0..n {
-            let new = project_nonnegative(lambda.normal[i] + *step * (u.normal[i] - points.gap[i]));
+            let new = project_nonnegative(lambda.normal[i] + d.info.step * (u.normal[i] - points.gap[i]));
             diff2 += (new - lambda.normal[i]).powi(2);
             norm2 += new * new;
             lambda.normal[i] = new;
             if nt > 0 {
                 for q in 0..nt {
-                    buf[q] = lambda.tangential[i * nt + q] + *step * u.tangential[i * nt + q];
+                    buf[q] = lambda.tangential[i * nt + q] + d.info.step * u.tangential[i * nt + q];
                 }
                 project_disc(&mut buf[..nt], radius[i]);
                 for q in 0..nt {
@@ -488,7 +479,7 @@ fn uzawa(
         }
     }
     Err(ContactError::NoConvergence {
-        n_iters: info.uzawa_iters,
+        n_iters: d.info.uzawa_iters,
         residual: last,
     })
 }

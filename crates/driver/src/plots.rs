@@ -4,6 +4,7 @@
 
 use crate::DriverError;
 use contact::{ContactPoints, ContactSolution, Status};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::Once;
@@ -145,6 +146,33 @@ pub fn pictures(
     Ok(out)
 }
 
+/// The axes of a picture of a [`View`]: caption, ranges, axis names, no grid.
+fn view_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    labels: (&str, &str),
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FONT, 20))
+        .margin(15)
+        .x_label_area_size(35)
+        .y_label_area_size(45)
+        .build_cartesian_2d(x, y)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style((FONT, 14))
+        .draw()
+        .map_err(e)?;
+    Ok(chart)
+}
+
 fn deformed<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
@@ -158,24 +186,14 @@ fn deformed<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View) -> R
         .fold(0.0f64, f64::max);
     let scale = if umax > 0.0 { 0.1 * size / umax } else { 1.0 };
     let pad = 0.15 * size;
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!("Deformed configuration{} (displacement x {scale:.3e})", view.title),
-            (FONT, 22),
-        )
-        .margin(15)
-        .x_label_area_size(35)
-        .y_label_area_size(45)
-        .build_cartesian_2d(lo[0] - pad..hi[0] + pad, lo[1] - pad..hi[1] + pad)
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(view.labels.0)
-        .y_desc(view.labels.1)
-        .label_style((FONT, 14))
-        .draw()
-        .map_err(e)?;
+    let caption = format!("Deformed configuration{} (displacement x {scale:.3e})", view.title);
+    let mut chart = view_chart(
+        area,
+        caption,
+        lo[0] - pad..hi[0] + pad,
+        lo[1] - pad..hi[1] + pad,
+        view.labels,
+    )?;
     chart
         .draw_series(view.outline.iter().map(|&[a, b]| {
             PathElement::new(
@@ -322,27 +340,11 @@ fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View, phi
         .map(|&v| phi[v])
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     let span = if pmax > pmin { pmax - pmin } else { 1.0 };
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!(
-                "Electric potential{}: {pmin:.3e} (blue) to {pmax:.3e} (red), 12 contours",
-                view.title
-            ),
-            (FONT, 20),
-        )
-        .margin(15)
-        .x_label_area_size(35)
-        .y_label_area_size(45)
-        .build_cartesian_2d(lo[0]..hi[0], lo[1]..hi[1])
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(view.labels.0)
-        .y_desc(view.labels.1)
-        .label_style((FONT, 14))
-        .draw()
-        .map_err(e)?;
+    let caption = format!(
+        "Electric potential{}: {pmin:.3e} (blue) to {pmax:.3e} (red), 12 contours",
+        view.title
+    );
+    let mut chart = view_chart(area, caption, lo[0]..hi[0], lo[1]..hi[1], view.labels)?;
     // blue -> white -> red
     let color = |v: f64| {
         let t = ((v - pmin) / span).clamp(0.0, 1.0);
