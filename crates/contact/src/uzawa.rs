@@ -126,14 +126,21 @@ pub fn slip_bound(points: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f6
 }
 
 /// The natural-map residual of DESIGN.md with step `c`:
-/// `‖(λ_n - max(0, λ_n + c (u_n - g)), λ_t - P_S(λ_t + c u_t))‖_W / ‖λ‖_W`
-/// (0 when λ and the residual vanish, the absolute residual when only λ does).
+/// `‖(λ_n - max(0, λ_n + c (u_n - g)), λ_t - P_S(λ_t + c u_t))‖_W / max(‖λ‖_W, reference)`.
+///
+/// `reference` is the multiplier scale of the problem, `c ‖(u_n(0) - g, u_t(0))‖_W` with `u(0)`
+/// the contact displacement under the loads alone ([`solve`] computes it): without it, a
+/// solution whose multipliers vanish at a grazing point would be approached with `‖r‖` and `‖λ‖`
+/// shrinking together and a relative residual that never falls. Both terms scale like λ, so
+/// the residual is free of units and of the solver's own step. A zero denominator gives the
+/// absolute residual.
 pub fn complementarity_residual(
     points: &ContactPoints,
     radius: &[f64],
     lambda: &PointValues,
     u: &PointValues,
     c: f64,
+    reference: f64,
 ) -> f64 {
     let n = points.len();
     let nt = lambda.tangential.len().checked_div(n).unwrap_or(0);
@@ -152,7 +159,7 @@ pub fn complementarity_residual(
         }
     }
     let num = r.weighted_norm(&points.weight);
-    let den = lambda.weighted_norm(&points.weight);
+    let den = lambda.weighted_norm(&points.weight).max(reference);
     if den > 0.0 {
         num / den
     } else {
@@ -206,14 +213,22 @@ impl Counter<'_> {
 
 /// Largest eigenvalue of the dual operator `λ ↦ u(0) - u(λ)` in the `W` inner product, by
 /// power iteration from `λ = 1` (a Rayleigh quotient, so a lower estimate).
-fn estimate_mu_max(c: &mut Counter<'_>, points: &ContactPoints, nt: usize, iters: usize) -> Result<f64, ContactError> {
+fn estimate_mu_max(
+    c: &mut Counter<'_>,
+    points: &ContactPoints,
+    nt: usize,
+    iters: usize,
+) -> Result<(f64, PointValues), ContactError> {
     let n = points.len();
     let zero = PointValues::zeros(n, nt);
     let mut u0 = PointValues::zeros(n, nt);
     c.call(&zero, &mut u0)?;
+    // a deterministic start with no symmetry (a constant vector can lie along an eigenvector of
+    // a lower eigenvalue, and the Rayleigh quotient then never sees the top one)
+    let start = |i: usize| 1.0 + 0.5 * (1.3 * i as f64 + 0.7).sin();
     let mut v = PointValues {
-        normal: vec![1.0; n],
-        tangential: vec![1.0; n * nt],
+        normal: (0..n).map(start).collect(),
+        tangential: (0..n * nt).map(|i| start(n + i)).collect(),
     };
     let mut mu = 0.0;
     let mut out = PointValues::zeros(n, nt);
@@ -245,8 +260,11 @@ fn estimate_mu_max(c: &mut Counter<'_>, points: &ContactPoints, nt: usize, iters
     if !(mu > 0.0 && mu.is_finite()) {
         return Err(ContactError::Operator(format!("the dual operator's largest eigenvalue estimate is {mu}: the contact points are not loaded by their multipliers")));
     }
-    Ok(mu)
+    Ok((mu, u0))
 }
+
+/// Uzawa iterations without a 1 % gain on the best residual before the step is halved.
+const STALL_WINDOW: usize = 500;
 
 /// The state of the dual iteration shared by the Uzawa loops of one solve.
 struct Dual<'a, 'b> {
@@ -255,6 +273,8 @@ struct Dual<'a, 'b> {
     params: &'a UzawaParams,
     /// The canonical step `1 / μ_max` of the residual.
     canon: f64,
+    /// The multiplier scale of the residual's denominator.
+    reference: f64,
     /// Counts so far; `info.step` is the current step.
     info: UzawaInfo,
 }
@@ -291,13 +311,19 @@ pub fn solve(
         }
     }
     let mut c = Counter { op, calls: 0, inner: 0 };
-    let mu_max = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
+    let (mu_max, u0) = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
     let estimate_inner = c.inner;
     let step = params.step.unwrap_or(params.safety / mu_max);
     if !(step > 0.0 && step.is_finite()) {
         return Err(ContactError::Input(format!("Uzawa step {step} must be positive")));
     }
     let canon = 1.0 / mu_max;
+    // the multiplier scale of the problem: c ‖u(0) - g‖_W
+    let free = PointValues {
+        normal: u0.normal.iter().zip(&points.gap).map(|(u, g)| u - g).collect(),
+        tangential: u0.tangential.clone(),
+    };
+    let reference = canon * free.weighted_norm(&points.weight);
     let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
     let mut u = PointValues::zeros(n, nt);
     let info = UzawaInfo {
@@ -316,6 +342,7 @@ pub fn solve(
         points,
         params,
         canon,
+        reference,
         info,
     };
     match law {
@@ -341,7 +368,7 @@ pub fn solve(
                             d.c.call(&lambda, &mut u)?;
                             fresh = true;
                         }
-                        let r = complementarity_residual(points, &s_new, &lambda, &u, canon);
+                        let r = complementarity_residual(points, &s_new, &lambda, &u, canon, reference);
                         (r <= tol, r)
                     }
                     StopRule::Paper => {
@@ -372,7 +399,7 @@ pub fn solve(
     }
     let radius = slip_bound(points, law, &lambda.normal);
     let mut info = d.info;
-    info.complementarity = complementarity_residual(points, &radius, &lambda, &u, canon);
+    info.complementarity = complementarity_residual(points, &radius, &lambda, &u, canon, reference);
     info.operator_calls = d.c.calls;
     info.estimate_inner_iters = estimate_inner;
     info.inner_iters = d.c.inner - estimate_inner;
@@ -402,15 +429,17 @@ fn uzawa(
     u: &mut PointValues,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<bool, ContactError> {
-    let (points, params, canon) = (d.points, d.params, d.canon);
+    let (points, params, canon, reference) = (d.points, d.params, d.canon, d.reference);
     let n = points.len();
     let nt = lambda.tangential.len().checked_div(n).unwrap_or(0);
     let mut best = f64::INFINITY;
+    let mut window_best = f64::INFINITY;
+    let mut window_start = 0;
     let mut last = f64::NAN;
     let mut buf = [0.0; 2];
     for k in 1..=params.max_iters {
         d.c.call(lambda, u)?;
-        let r = complementarity_residual(points, radius, lambda, u, canon);
+        let r = complementarity_residual(points, radius, lambda, u, canon, reference);
         last = r;
         if !r.is_finite() {
             return Err(ContactError::Diverged {
@@ -429,6 +458,24 @@ fn uzawa(
             d.info.step *= 0.5;
             d.info.step_backoffs += 1;
             best = r;
+            if d.info.step_backoffs > 20 {
+                return Err(ContactError::Diverged {
+                    n_iters: d.info.uzawa_iters,
+                    residual: r,
+                    step: d.info.step,
+                });
+            }
+        }
+        // stagnation: no 1 % gain on the best residual over a window means the step is too
+        // large for the dual operator (an under-estimated μ_max); halve it
+        if r < 0.99 * window_best {
+            window_best = r;
+            window_start = k;
+        } else if k - window_start >= STALL_WINDOW {
+            d.info.step *= 0.5;
+            d.info.step_backoffs += 1;
+            window_best = r;
+            window_start = k;
             if d.info.step_backoffs > 20 {
                 return Err(ContactError::Diverged {
                     n_iters: d.info.uzawa_iters,
