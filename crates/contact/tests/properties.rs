@@ -230,3 +230,143 @@ fn non_convergence_is_a_typed_error_with_the_residual() {
         other => panic!("{other:?}"),
     }
 }
+
+/// Found by the property test (3000 cases): a 2x2 dual operator whose lower eigenvector is
+/// (W-)parallel to a constant vector. A power iteration started there estimated the lower
+/// eigenvalue, the step exceeded 2/μ_max and Uzawa cycled at a residual of 0.65. Both points
+/// are in contact: λ = (D W)⁻¹ u0.
+#[test]
+fn regression_power_iteration_sees_the_top_eigenvalue() {
+    let d = vec![
+        0.6052426855451863,
+        -0.04304387242789706,
+        -0.04304387242789706,
+        0.7235217446426216,
+    ];
+    let w = vec![1.196450878607202, 1.010716700710865];
+    let mut pts = points(2, 2, &[0.0, 0.0], 0.0);
+    pts.weight = w.clone();
+    let u0 = [0.0, 0.856966981224736];
+    let mut op = DenseContactProblem {
+        u0: PointValues {
+            normal: u0.to_vec(),
+            tangential: vec![],
+        },
+        compliance: d.clone(),
+        weight: w.clone(),
+        nt: 0,
+    };
+    let sol = solve(&mut op, &pts, &Law::Frictionless, &tight(1e-12), None, &mut |_| {}).unwrap();
+    let a = DMatrix::from_fn(2, 2, |i, j| d[i * 2 + j] * w[j]);
+    let exact = a.lu().solve(&DVector::from_row_slice(&u0)).unwrap();
+    for i in 0..2 {
+        assert!(
+            (sol.lambda.normal[i] - exact[i]).abs() < 1e-9 * exact.amax(),
+            "{:?} vs {exact}",
+            sol.lambda.normal
+        );
+    }
+    // the top eigenvalue of W^½ D W^½ is 0.7752 (by hand); the step must stay below 2 / 0.7752
+    assert!(
+        sol.info.step < 2.0 / 0.7752,
+        "step {} from mu_max estimate {}",
+        sol.info.step,
+        sol.info.mu_max
+    );
+}
+
+/// Found by the property test: a Coulomb point of small pressure (3.4e-7 against 1.3) on the edge
+/// of its disc slides (u_t along λ_t) although |λ_t| / F λ_n = 1 - 2e-5: the residual resolves λ
+/// to tol ‖λ‖, not to tol F λ_n. The answer meets the KKT conditions at that resolution.
+#[test]
+fn regression_grazing_coulomb_point() {
+    let seed: Vec<f64> = vec![
+        0.008925409187059892,
+        0.13227518050516598,
+        0.8707524604043606,
+        -0.022627715842901807,
+        -0.47149587672179966,
+        -0.7043758036018389,
+        0.4435082149136713,
+        0.29963004667594056,
+        0.5190722930258421,
+        -0.752358219206777,
+        -0.7018195232643204,
+        0.0,
+        -0.9515232386680026,
+        0.8097213651473112,
+        0.0,
+        -0.4811199022853766,
+        0.6299617333308923,
+        0.0,
+        0.660792981027592,
+        0.12090628157906223,
+        0.0,
+        0.5756706978078774,
+        0.5972992928677556,
+        0.0,
+        -0.9837888128453111,
+        -0.2392789739363984,
+        0.0,
+        -0.7847400409699141,
+        0.6794219612350854,
+        0.0,
+        0.15582497231643924,
+        -0.38919804112025363,
+        0.0,
+        -0.9369706721915753,
+        0.7317847233991839,
+        -0.9659484378074485,
+        0.05767879097733943,
+        0.12663952171002513,
+        0.4773599184895834,
+        -0.9073322692477119,
+        0.12385733587629011,
+        -0.7283862997742543,
+        0.13836049798703917,
+        -0.39914763275688453,
+        -0.27372093825661564,
+        0.9707698539301293,
+        0.4208671242242073,
+        0.2824271261005917,
+        -0.5699955674861195,
+        -0.2614376391710398,
+        -0.41756337674461314,
+        -0.8927331667502518,
+        0.1513193852755074,
+        0.23442066852724536,
+        -0.4393588522353138,
+        -0.15047829874485924,
+        -0.9311842421085919,
+        0.9584240544589223,
+        -0.17193582960254855,
+        0.05481265867094484,
+    ];
+    let load = [
+        0.2945922197174039,
+        0.11793010988799946,
+        -0.9829798561918247,
+        -0.05772934162347857,
+        0.4908103017564955,
+        0.3249021202676558,
+        -0.6389783250959045,
+        0.30156146591879235,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ];
+    let f = 0.2439128030433884;
+    let pts = points(4, 3, &[0.0; 4], f);
+    let mut op = problem(4, 2, &pts, &seed, &load);
+    let sol = solve(&mut op, &pts, &Law::Coulomb, &tight(1e-11), None, &mut |_| {}).unwrap();
+    assert!(sol.info.complementarity <= 1e-11);
+    // point 3: in contact with a small pressure, sliding along λ_t
+    let (l, u) = (&sol.lambda, &sol.u);
+    assert!(l.normal[3] > 1e-8 && l.normal[3] < 1e-6);
+    let dot = l.tangential[6] * u.tangential[6] + l.tangential[7] * u.tangential[7];
+    let nl = (l.tangential[6].powi(2) + l.tangential[7].powi(2)).sqrt();
+    let nu = (u.tangential[6].powi(2) + u.tangential[7].powi(2)).sqrt();
+    assert!(dot >= (1.0 - 1e-5) * nl * nu);
+    assert!((nl - f * l.normal[3]).abs() <= 1e-8 * l.norm());
+}
