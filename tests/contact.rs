@@ -177,3 +177,37 @@ fn every_shipped_scene_runs_at_its_smoke_size() {
         }
     }
 }
+
+#[test]
+fn gmsh_mesh_with_two_materials_by_region() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/layered-gmsh.toml");
+    let (scene, source) = driver::scene::load(file, &[]).unwrap();
+    let mesh = driver::build::mesh(&scene, &source).unwrap();
+    let r = driver::run::run(&scene, &source, None, &mut |_| {}).unwrap();
+    // potentials only on the nodes of the PZT layer (y >= 0.8), less the grounded ones
+    let pzt_nodes: std::collections::BTreeSet<usize> = mesh
+        .region("pzt")
+        .unwrap()
+        .iter()
+        .flat_map(|&c| mesh.cell(c).to_vec())
+        .collect();
+    let grounded = pzt_nodes
+        .iter()
+        .filter(|&&v| mesh.points[v][0] == 0.0 || mesh.points[v][0] == 2.0)
+        .count();
+    assert_eq!(
+        r.report["dofs"]["phi"].as_u64().unwrap() as usize,
+        pzt_nodes.len() - grounded
+    );
+    assert!(pzt_nodes.iter().all(|&v| mesh.points[v][1] >= 0.8 - 1e-12));
+    assert!(r.report["residuals"]["complementarity"].as_f64().unwrap() <= 1e-10);
+    assert!(r.report["residuals"]["equilibrium"].as_f64().unwrap() <= 1e-12);
+    // the foundation carries the load: sum of w lambda_n is the applied force less what the
+    // clamped sides take, so it lies between 0 and |p| times the top's length
+    let f = r.report["contact"]["normal_force"].as_f64().unwrap();
+    assert!(f > 0.5 && f < 4.0, "normal force {f}");
+    // potentials vanish in the substrate (no electric unknowns there)
+    let substrate_only: Vec<usize> = (0..mesh.n_nodes()).filter(|v| !pzt_nodes.contains(v)).collect();
+    assert!(substrate_only.iter().all(|&v| r.phi[v] == 0.0));
+    assert!(r.phi.iter().any(|&p| p != 0.0));
+}
