@@ -163,12 +163,9 @@ pub fn run_with_reporter(
     let mut condense_route: Option<String> = None;
     let pcg_total;
     if plan.contact_law == "none" {
-        let solver: &mut dyn CoupledSolver = match (&mut direct, &mut pcg_solver) {
-            (Some(d), _) => d,
-            (None, Some(p)) => p,
-            _ => unreachable!("one solver is built"),
-        };
-        pcg_total = solver.solve(&b_u, &b_phi, &mut u, &mut phi)?.pcg_iters;
+        pcg_total = built(&mut direct, &mut pcg_solver)
+            .solve(&b_u, &b_phi, &mut u, &mut phi)?
+            .pcg_iters;
     } else {
         let c = scene.contact.as_ref().expect("a contact law implies a contact section");
         let cb = contact_boundary.take().expect("built with the plan");
@@ -228,11 +225,7 @@ pub fn run_with_reporter(
                 sol
             }
             (direct, pcg) => {
-                let solver: &mut dyn CoupledSolver = match (direct, pcg) {
-                    (Some(d), _) => d,
-                    (None, Some(p)) => p,
-                    _ => unreachable!("one solver is built"),
-                };
+                let solver = built(direct, pcg);
                 let mut op = contact_setup::FullSolve {
                     boundary: &cb,
                     solver,
@@ -344,6 +337,15 @@ pub fn run_with_reporter(
         phi: pn,
         contact: contact_result.map(|(cb, sol, _)| (cb.points, sol)),
     })
+}
+
+/// The linear solver the plan built: the `L D Lᵀ` of `K` or the Schur PCG.
+fn built<'a>(direct: &'a mut Option<DirectLdlt>, pcg: &'a mut Option<SchurPcg>) -> &'a mut dyn CoupledSolver {
+    match (direct, pcg) {
+        (Some(d), _) => d,
+        (None, Some(p)) => p,
+        (None, None) => unreachable!("the run builds one linear solver before solving"),
+    }
 }
 
 fn contact_json(result: Option<&(ContactBoundary, ContactSolution, Law)>) -> serde_json::Value {
