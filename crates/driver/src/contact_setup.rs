@@ -1,7 +1,8 @@
 //! The contact boundary as the `contact` crate sees it: points with normals, tangents,
 //! lumped weights and gaps, and two implementations of "given multipliers, return the contact
 //! displacement": one full primal solve per call, or the condensed dense compliance
-//! (Delassus operator) computed once by block solves with the `L D Lᵀ` factor.
+//! (Delassus operator) formed once from the `L D Lᵀ` factor of `K`: read off its trailing
+//! supernode when the contact dofs were ordered last, else by block solves.
 
 use crate::DriverError;
 use contact::{ContactOperator, ContactPoints, DenseContactProblem, PointValues};
