@@ -105,6 +105,12 @@ fn si_units_give_the_paper_answer_mapped() {
     assert!(rel_diff(&up, &us, 1e-5) < 1e-9);
     assert!(rel_diff(&paper.phi, &si.phi, 1e4) < 1e-9);
     assert_eq!(counts(&paper), counts(&si));
+    // the same iteration counts: every stopping test is scale-free
+    assert_eq!(paper.report["iterations"]["uzawa"], si.report["iterations"]["uzawa"]);
+    assert_eq!(
+        paper.report["iterations"]["fixed_point"],
+        si.report["iterations"]["fixed_point"]
+    );
 }
 
 #[test]
