@@ -155,6 +155,23 @@ proptest! {
         }
     }
 
+    /// The accelerated projected gradient (FISTA with restart) reaches the KKT point plain
+    /// Uzawa reaches, with Tresca and Coulomb friction in 2D and 3D.
+    #[test]
+    fn accelerated_and_plain_uzawa_agree(n in 1usize..=5, dim in 2usize..=3, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 5), load in prop::collection::vec(-1.0f64..1.0, 15), f in 0.05f64..0.5, coulomb in proptest::bool::ANY) {
+        let nt = dim - 1;
+        let pts = points(n, dim, &w, f);
+        let law = if coulomb { Law::Coulomb } else { Law::Tresca(vec![0.1; n]) };
+        let mut op1 = problem(n, nt, &pts, &seed, &load);
+        let mut op2 = op1.clone();
+        let plain = solve(&mut op1, &pts, &law, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let fast = solve(&mut op2, &pts, &law, &UzawaParams { accelerate: true, ..tight(1e-12) }, None, &mut |_| {}).unwrap();
+        let scale = plain.lambda.norm().max(op1.u0.norm());
+        let d = plain.lambda.minus(&fast.lambda).norm();
+        prop_assert!(d <= 1e-8 * scale.max(1e-12), "difference {d} (scale {scale})");
+        prop_assert!(fast.info.complementarity <= 1e-12);
+    }
+
     /// The fixed point S -> F λ_n(S) contracts for small F: the ratio of successive differences
     /// stays below 1.
     #[test]

@@ -14,7 +14,8 @@ use std::time::Instant;
 
 /// The solver strategies, by name: how each contact iteration's primal problem is solved.
 pub const STRATEGIES: &[(&str, &str)] = &[
-    ("uzawa-condensed", "default: Uzawa on the contact compliance condensed once from the L D Lᵀ of K by block solves; one final full solve"),
+    ("uzawa-condensed", "default: Uzawa on the contact compliance, read once off the L D Lᵀ of K (contact dofs last); one final full solve"),
+    ("apg-condensed", "as uzawa-condensed, with Nesterov-accelerated projected gradient (FISTA, adaptive restart, step 1/mu_max)"),
     ("uzawa-direct", "Uzawa with one full solve per iteration by the L D Lᵀ of K (factored once)"),
     ("uzawa-schur-pcg", "the paper's: Uzawa with one Schur-complement PCG solve per iteration (Algorithm 3, preconditioned by A)"),
 ];
@@ -149,7 +150,7 @@ pub fn run_with_reporter(
         // the condensed strategy orders the contact dofs last, to read the contact block off
         // the factor
         let ordering = match (&contact_boundary, plan.linear_strategy.as_str()) {
-            (Some(cb), "uzawa-condensed") => Ordering::AmdThenLast(cb.dofs.clone()),
+            (Some(cb), "uzawa-condensed" | "apg-condensed") => Ordering::AmdThenLast(cb.dofs.clone()),
             _ => Ordering::Amd,
         };
         direct = Some(DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &ordering, par)?);
@@ -183,11 +184,12 @@ pub fn run_with_reporter(
                 StopRule::Tight { tol: scene.solver.tol }
             },
             report_every: 50,
+            accelerate: plan.linear_strategy == "apg-condensed",
             ..Default::default()
         };
         // the condensed strategy forms the contact compliance first
         let mut dense_problem = None;
-        if let (Some(d), "uzawa-condensed") = (&mut direct, plan.linear_strategy.as_str()) {
+        if let (Some(d), "uzawa-condensed" | "apg-condensed") = (&mut direct, plan.linear_strategy.as_str()) {
             let t_condense = Instant::now();
             let (dense, route) = contact_setup::condense(&cb, d, &b_u, &b_phi, nt)?;
             condense_seconds = t_condense.elapsed().as_secs_f64();
@@ -216,7 +218,7 @@ pub fn run_with_reporter(
             }
         };
         let sol = match (&mut direct, &mut pcg_solver) {
-            (Some(d), _) if plan.linear_strategy == "uzawa-condensed" => {
+            (Some(d), _) if dense_problem.is_some() => {
                 let mut dense = dense_problem.take().expect("condensed before the solve");
                 let sol = contact::solve(&mut dense, &cb.points, &law, &params, None, &mut report)?;
                 let mut rhs = b_u.clone();

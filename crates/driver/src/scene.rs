@@ -183,7 +183,8 @@ pub struct ContactSpec {
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
-    /// Strategy: `uzawa-condensed` (default), `uzawa-direct`, `uzawa-schur-pcg` (the paper's);
+    /// Strategy: `uzawa-condensed` (default), `apg-condensed`, `uzawa-direct`, `uzawa-schur-pcg`
+    /// (the paper's);
     /// `piezocontact strategies` lists them.
     #[serde(default = "default_strategy")]
     pub strategy: String,
