@@ -276,6 +276,9 @@ struct Momentum {
 /// Uzawa iterations without a 1 % gain on the best residual before the step is halved.
 const STALL_WINDOW: usize = 500;
 
+/// Halvings of the step before the iteration is declared divergent.
+const MAX_BACKOFFS: usize = 20;
+
 /// The state of the dual iteration shared by the Uzawa loops of one solve.
 struct Dual<'a, 'b> {
     c: Counter<'b>,
@@ -440,6 +443,22 @@ pub fn solve(
     })
 }
 
+impl Dual<'_, '_> {
+    /// Halves the step; a [`ContactError::Diverged`] after [`MAX_BACKOFFS`] halvings.
+    fn back_off(&mut self, residual: f64) -> Result<(), ContactError> {
+        self.info.step *= 0.5;
+        self.info.step_backoffs += 1;
+        if self.info.step_backoffs > MAX_BACKOFFS {
+            return Err(ContactError::Diverged {
+                n_iters: self.info.uzawa_iters,
+                residual,
+                step: self.info.step,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Uzawa iterations for a given radius. Returns whether `u` is the displacement of the final
 /// `lambda` (true under the tight rule; under the paper's rule the last update is not solved).
 fn uzawa(
@@ -474,36 +493,20 @@ fn uzawa(
                 return Ok(true);
             }
         }
-        // divergence: a residual far above the best seen means the step is too large; halve it
-        if r > 1e3 * best && k > 10 {
-            d.info.step *= 0.5;
-            d.info.step_backoffs += 1;
-            best = r;
-            if d.info.step_backoffs > 20 {
-                return Err(ContactError::Diverged {
-                    n_iters: d.info.uzawa_iters,
-                    residual: r,
-                    step: d.info.step,
-                });
-            }
-        }
-        // stagnation: no 1 % gain on the best residual over a window means the step is too
-        // large for the dual operator (an under-estimated μ_max); halve it
+        // a residual far above the best seen (divergence), or no 1 % gain on the best over a
+        // window (a stall): the step is too large for the dual operator (an under-estimated
+        // μ_max); halve it and start the momentum afresh
+        let diverging = r > 1e3 * best && k > 10;
         if r < 0.99 * window_best {
             window_best = r;
             window_start = k;
-        } else if k - window_start >= STALL_WINDOW {
-            d.info.step *= 0.5;
-            d.info.step_backoffs += 1;
+        }
+        if diverging || k - window_start >= STALL_WINDOW {
+            d.back_off(r)?;
+            best = r;
             window_best = r;
             window_start = k;
-            if d.info.step_backoffs > 20 {
-                return Err(ContactError::Diverged {
-                    n_iters: d.info.uzawa_iters,
-                    residual: r,
-                    step: d.info.step,
-                });
-            }
+            momentum = Momentum { t: 1.0, x_prev: None };
         }
         best = best.min(r);
         d.info.uzawa_iters += 1;
