@@ -50,10 +50,12 @@ fn paper_3d_runs() {
 #[test]
 fn supernodal_ldlt_has_the_inertia_of_k() {
     let (scene, source) = driver::scene::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
-    let mesh = driver::build::mesh(&scene, &source).unwrap();
-    let mats = driver::build::materials(&scene, 2).unwrap();
-    let plan = driver::build::plan(&scene, 2, &mats);
-    let bcs = driver::build::constraints(&scene, &plan).unwrap();
+    let driver::build::Setup {
+        mesh,
+        materials: mats,
+        constraints: bcs,
+        ..
+    } = driver::build::setup(&scene, &source).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).unwrap();
     let b = disc.assemble(Parallelism::Rayon);
     let f = DirectLdlt::new(&b.a, &b.g, &b.b, &Ordering::Amd, faer::Par::Seq).unwrap();

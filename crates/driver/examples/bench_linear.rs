@@ -22,11 +22,13 @@ fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(64);
     let (scene, source) =
         driver::scene::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("paper scene");
-    let mesh = driver::build::mesh(&scene, &source).expect("mesh");
-    let mats = driver::build::materials(&scene, 2).expect("materials");
-    let plan = driver::build::plan(&scene, 2, &mats);
-    let bcs = driver::build::constraints(&scene, &plan).expect("constraints");
-    let loads = driver::build::loads(&scene, 2).expect("loads");
+    let driver::build::Setup {
+        mesh,
+        materials: mats,
+        constraints: bcs,
+        loads,
+        ..
+    } = driver::build::setup(&scene, &source).expect("setup");
     let (mut t_asm, mut t_sym, mut t_num, mut t_solve, mut t_chol, mut t_pcg) =
         (vec![], vec![], vec![], vec![], vec![], vec![]);
     let mut iters = 0;

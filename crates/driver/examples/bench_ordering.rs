@@ -17,10 +17,12 @@ fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(128);
     let (scene, source) =
         driver::scene::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
-    let mesh = driver::build::mesh(&scene, &source).expect("mesh");
-    let mats = driver::build::materials(&scene, 2).expect("materials");
-    let plan = driver::build::plan(&scene, 2, &mats);
-    let bcs = driver::build::constraints(&scene, &plan).expect("bcs");
+    let driver::build::Setup {
+        mesh,
+        materials: mats,
+        constraints: bcs,
+        ..
+    } = driver::build::setup(&scene, &source).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).expect("setup");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());

@@ -241,6 +241,43 @@ pub fn loads(scene: &Scene, dim: usize) -> Result<Vec<Load>, DriverError> {
     Ok(out)
 }
 
+/// Everything a scene sets up before assembly: the mesh, the materials (without their electric
+/// part when the plan has no electric unknowns), the plan, the Dirichlet conditions and the loads.
+pub struct Setup {
+    /// The mesh (with an `electrode` group where the scene has one).
+    pub mesh: mesh::Mesh,
+    /// Materials by region.
+    pub materials: Vec<(String, Material)>,
+    /// What the run computes.
+    pub plan: Plan,
+    /// Dirichlet conditions.
+    pub constraints: Vec<Constraint>,
+    /// Loads.
+    pub loads: Vec<Load>,
+}
+
+/// Makes the [`Setup`] of a scene.
+pub fn setup(scene: &Scene, source: &Source) -> Result<Setup, DriverError> {
+    let mesh = mesh(scene, source)?;
+    let dim = mesh.dim;
+    let materials = materials(scene, dim)?;
+    let plan = plan(scene, dim, &materials);
+    let materials = if plan.electric {
+        materials
+    } else {
+        without_electric(materials)
+    };
+    let constraints = constraints(scene, &plan)?;
+    let loads = loads(scene, dim)?;
+    Ok(Setup {
+        mesh,
+        materials,
+        plan,
+        constraints,
+        loads,
+    })
+}
+
 /// Materials with the electric part removed (for a plan without electric unknowns).
 pub fn without_electric(materials: Vec<(String, Material)>) -> Vec<(String, Material)> {
     materials

@@ -82,11 +82,15 @@ pub fn run_with_reporter(
 ) -> Result<RunOutcome, DriverError> {
     let t_total = Instant::now();
     let t = Instant::now();
-    let mesh = build::mesh(scene, source)?;
-    let t_mesh = t.elapsed().as_secs_f64();
+    let build::Setup {
+        mesh,
+        materials: mats,
+        plan,
+        constraints: bcs,
+        loads,
+    } = build::setup(scene, source)?;
+    let t_setup = t.elapsed().as_secs_f64();
     let dim = mesh.dim;
-    let mats = build::materials(scene, dim)?;
-    let plan = build::plan(scene, dim, &mats);
     reporter.line(&plan.to_string());
     if !STRATEGIES.iter().any(|(n, _)| *n == plan.linear_strategy) {
         return Err(DriverError::Input(format!(
@@ -94,13 +98,6 @@ pub fn run_with_reporter(
             plan.linear_strategy
         )));
     }
-    let mats = if plan.electric {
-        mats
-    } else {
-        build::without_electric(mats)
-    };
-    let bcs = build::constraints(scene, &plan)?;
-    let loads = build::loads(scene, dim)?;
     let t = Instant::now();
     let disc = Discretization::new(&mesh, &mats, &bcs)?;
     let blocks = disc.assemble(Parallelism::Rayon);
@@ -282,7 +279,7 @@ pub fn run_with_reporter(
             "complementarity": contact_result.as_ref().map_or(0.0, |(_, s, _)| s.info.complementarity),
             "converged_to_tolerance": plan.rule == "tight",
         },
-        "timings_s": { "mesh": t_mesh, "assembly": t_assembly, "factorization": t_factor,
+        "timings_s": { "setup": t_setup, "assembly": t_assembly, "factorization": t_factor,
             "condense": condense_seconds, "contact": if contact_result.is_some() { t_solve } else { 0.0 }, "solve": t_solve, "total": t_total.elapsed().as_secs_f64() },
         "memory": { "peak_bytes": peak_memory_bytes(), "factor_bytes": factor_bytes },
         "solver": {
