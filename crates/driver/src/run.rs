@@ -80,6 +80,13 @@ pub fn run_with_reporter(
     out_dir: Option<&Path>,
     reporter: &mut dyn Reporter,
 ) -> Result<RunOutcome, DriverError> {
+    // an unknown strategy is rejected before any mesh is built
+    if !STRATEGIES.iter().any(|(n, _)| *n == scene.solver.strategy) {
+        return Err(DriverError::Input(format!(
+            "solver.strategy `{}` is unknown (see `piezocontact strategies`)",
+            scene.solver.strategy
+        )));
+    }
     let t_total = Instant::now();
     let t = Instant::now();
     let build::Setup {
@@ -92,12 +99,6 @@ pub fn run_with_reporter(
     let t_setup = t.elapsed().as_secs_f64();
     let dim = mesh.dim;
     reporter.line(&plan.to_string());
-    if !STRATEGIES.iter().any(|(n, _)| *n == plan.linear_strategy) {
-        return Err(DriverError::Input(format!(
-            "solver.strategy `{}` is unknown (see `piezocontact strategies`)",
-            plan.linear_strategy
-        )));
-    }
     let t = Instant::now();
     let disc = Discretization::new(&mesh, &mats, &bcs)?;
     let blocks = disc.assemble(Parallelism::Rayon);

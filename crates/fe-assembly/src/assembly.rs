@@ -138,14 +138,15 @@ impl<'m> Discretization<'m> {
     pub fn assemble(&self, par: Parallelism) -> Blocks {
         let mesh = self.mesh;
         let d = &self.dofs;
-        let graph_all = mesh.node_graph();
-        let graph_el = mesh.node_graph_where(|c| self.cell_electric[c]);
+        let node_cells = mesh.node_cells();
+        let graph_all = mesh.node_graph_from(&node_cells, |_| true);
+        let graph_el = mesh.node_graph_from(&node_cells, |c| self.cell_electric[c]);
         let a = Pattern::new(&graph_all, &ColDofs::U(d), &ColDofs::U(d));
         let g = Pattern::new(&graph_el, &ColDofs::Phi(d), &ColDofs::U(d));
         let b = Pattern::new(&graph_el, &ColDofs::Phi(d), &ColDofs::Phi(d));
         let (mut av, mut gv, mut bv) = (a.zeros(), g.zeros(), b.zeros());
         match par {
-            Parallelism::Rayon => self.assemble_node_owned(&a, &g, &b, &mut av, &mut gv, &mut bv),
+            Parallelism::Rayon => self.assemble_node_owned(&node_cells, &a, &g, &b, &mut av, &mut gv, &mut bv),
             Parallelism::Serial => self.assemble_cell_loop(&a, &g, &b, &mut av, &mut gv, &mut bv),
         }
         Blocks {
@@ -155,8 +156,10 @@ impl<'m> Discretization<'m> {
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn assemble_node_owned(
         &self,
+        node_cells: &(Vec<usize>, Vec<usize>),
         pa: &Pattern,
         pg: &Pattern,
         pb: &Pattern,
@@ -167,7 +170,7 @@ impl<'m> Discretization<'m> {
         let mesh = self.mesh;
         let dim = mesh.dim;
         let nl = dim + 1;
-        let (off, node_cells) = mesh.node_cells();
+        let (off, node_cells) = (&node_cells.0, &node_cells.1);
         let d = &self.dofs;
         // per node: its slice of each block's values (its columns are contiguous)
         let n_nodes = mesh.n_nodes();

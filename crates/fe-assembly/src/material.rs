@@ -4,7 +4,7 @@
 //! Voigt order `[11, 22, 33, 23, 13, 12]` with engineering shear strains, so the Voigt entries
 //! of `C` and `e` are the tensor components themselves (no factors of 2).
 
-use nalgebra::{DMatrix, Matrix3, SMatrix};
+use nalgebra::{DMatrix, Matrix3};
 
 /// 3D constants in the crystal frame (poling along the crystal's 3-axis).
 #[derive(Clone, Debug, PartialEq)]
@@ -365,7 +365,6 @@ fn check_spd(name: &str, what: &'static str, m: &[f64], n: usize) -> Result<(), 
             min_eig,
         });
     }
-    let _ = SMatrix::<f64, 1, 1>::zeros();
     Ok(())
 }
 

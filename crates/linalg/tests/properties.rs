@@ -233,5 +233,4 @@ fn trailing_block_is_the_schur_complement() {
             );
         }
     }
-    let _ = f.factor_mut();
 }

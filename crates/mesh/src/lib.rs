@@ -319,9 +319,19 @@ impl Mesh {
     /// As [`Mesh::node_graph`], counting only the cells `c` with `keep(c)`; a node in no kept
     /// cell is its own only neighbour.
     pub fn node_graph_where(&self, keep: impl Fn(usize) -> bool) -> (Vec<usize>, Vec<usize>) {
+        self.node_graph_from(&self.node_cells(), keep)
+    }
+
+    /// As [`Mesh::node_graph_where`], from the cells of each node already computed by
+    /// [`Mesh::node_cells`] (so that several graphs share one pass over the cells).
+    pub fn node_graph_from(
+        &self,
+        node_cells: &(Vec<usize>, Vec<usize>),
+        keep: impl Fn(usize) -> bool,
+    ) -> (Vec<usize>, Vec<usize>) {
         let n = self.n_nodes();
         let k = self.kind.n_nodes();
-        let (count, node_cells) = self.node_cells();
+        let (count, node_cells) = (&node_cells.0, &node_cells.1);
         let mut offsets = Vec::with_capacity(n + 1);
         offsets.push(0);
         let mut nbrs = Vec::with_capacity(n * 8);
