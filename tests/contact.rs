@@ -85,10 +85,16 @@ fn strategies_agree() {
         // 2.4e-8 on paper at n = 16, the dual's conditioning times the residual)
         let a12 = run(scene, &[n, "solver.tol=1e-12", "solver.strategy=uzawa-condensed"]);
         let d = run(scene, &[n, "solver.tol=1e-12", "solver.strategy=apg-condensed"]);
+        let e = run(scene, &[n, "solver.tol=1e-12", "solver.strategy=newton-condensed"]);
         assert!(
             rel_diff(&lambdas(&a12), &lambdas(&d), 1.0) < 1e-8,
             "{scene}: condensed vs accelerated"
         );
+        assert!(
+            rel_diff(&lambdas(&a12), &lambdas(&e), 1.0) < 1e-8,
+            "{scene}: Uzawa vs semismooth Newton"
+        );
+        assert_eq!(e.report["iterations"]["newton_fallback"], false, "{scene}");
         assert!(
             rel_diff(&lambdas(&a), &lambdas(&b), 1.0) < 1e-8,
             "{scene}: condensed vs direct"
@@ -115,6 +121,7 @@ fn si_units_give_the_paper_answer_mapped() {
     assert_eq!(counts(&paper), counts(&si));
     // the same iteration counts: every stopping test is scale-free
     assert_eq!(paper.report["iterations"]["uzawa"], si.report["iterations"]["uzawa"]);
+    assert_eq!(paper.report["iterations"]["newton"], si.report["iterations"]["newton"]);
     assert_eq!(
         paper.report["iterations"]["fixed_point"],
         si.report["iterations"]["fixed_point"]

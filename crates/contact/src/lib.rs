@@ -33,11 +33,13 @@
 //! assert_eq!(sol.status[0], Status::Slip); // frictionless contact: slip
 //! ```
 
+mod newton;
 mod operator;
 mod points;
 mod projection;
 mod uzawa;
 
+pub use newton::{solve_newton, NewtonParams};
 pub use operator::{ContactOperator, DenseContactProblem};
 pub use points::{ContactPoints, PointValues, Status};
 pub use projection::{project_disc, project_nonnegative};
@@ -74,6 +76,16 @@ pub enum ContactError {
         residual: f64,
         /// The last step.
         step: f64,
+    },
+    /// The semismooth Newton iteration stalled (and its fallback was switched off).
+    #[error("semismooth Newton stalled after {n_iters} steps on {reason} (complementarity residual {residual:.3e}); allow the fallback or use the apg-condensed strategy")]
+    NewtonStalled {
+        /// Newton steps done.
+        n_iters: usize,
+        /// Last residual.
+        residual: f64,
+        /// What stopped it.
+        reason: String,
     },
     /// The primal solve failed.
     #[error("primal solve failed: {0}")]

@@ -71,7 +71,7 @@ impl ContactOperator for DenseContactProblem {
 
 /// A dot product with eight independent partial sums, so that it vectorises (a single running
 /// sum is a chain of dependent additions).
-fn dot8(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot8(a: &[f64], b: &[f64]) -> f64 {
     let mut acc = [0.0f64; 8];
     let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
     let (ra, rb) = (ca.remainder(), cb.remainder());

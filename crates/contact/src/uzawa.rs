@@ -73,8 +73,14 @@ impl Default for UzawaParams {
 /// What a converged [`solve`] reports.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UzawaInfo {
-    /// Uzawa iterations, summed over the fixed point.
+    /// Uzawa (first-order) iterations, summed over the fixed point.
     pub uzawa_iters: usize,
+    /// Semismooth Newton steps ([`crate::solve_newton`]; 0 for the first-order methods).
+    pub newton_iters: usize,
+    /// Step halvings in Newton's line search, summed.
+    pub line_search_cuts: usize,
+    /// Whether Newton stalled and the accelerated gradient finished the solve.
+    pub fallback: bool,
     /// Fixed-point iterations (0 when the law has none).
     pub fixed_point_iters: usize,
     /// Inner iterations reported by the operator (PCG) in the Uzawa loops, summed.
@@ -201,13 +207,18 @@ fn counts(status: &[Status]) -> (usize, usize, usize) {
     (c(Status::Stick), c(Status::Slip), c(Status::Separated))
 }
 
-struct Counter<'a> {
+/// The operator with a count of its calls and of the inner iterations they report.
+pub(crate) struct Counter<'a> {
     op: &'a mut dyn ContactOperator,
     calls: usize,
     inner: usize,
 }
 
-impl Counter<'_> {
+impl<'a> Counter<'a> {
+    pub(crate) fn new(op: &'a mut dyn ContactOperator) -> Self {
+        Counter { op, calls: 0, inner: 0 }
+    }
+
     fn call(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<(), ContactError> {
         self.calls += 1;
         self.inner += self.op.displacement(lambda, out).map_err(ContactError::Operator)?;
@@ -217,7 +228,7 @@ impl Counter<'_> {
 
 /// Largest eigenvalue of the dual operator `λ ↦ u(0) - u(λ)` in the `W` inner product, by
 /// power iteration from `λ = 1` (a Rayleigh quotient, so a lower estimate).
-fn estimate_mu_max(
+pub(crate) fn estimate_mu_max(
     c: &mut Counter<'_>,
     points: &ContactPoints,
     nt: usize,
@@ -323,7 +334,7 @@ pub fn solve(
             ));
         }
     }
-    let mut c = Counter { op, calls: 0, inner: 0 };
+    let mut c = Counter::new(op);
     let (mu_max, u0) = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
     let estimate_inner = c.inner;
     if params.accelerate && params.rule == StopRule::Paper {
@@ -351,6 +362,9 @@ pub fn solve(
     let mut u = PointValues::zeros(n, nt);
     let info = UzawaInfo {
         uzawa_iters: 0,
+        newton_iters: 0,
+        line_search_cuts: 0,
+        fallback: false,
         fixed_point_iters: 0,
         inner_iters: 0,
         estimate_inner_iters: 0,

@@ -3,8 +3,8 @@
 //! active-set enumeration and a KKT check, and homogeneity in the load.
 
 use contact::{
-    complementarity_residual, project_disc, project_nonnegative, solve, ContactPoints, DenseContactProblem, Law,
-    PointValues, StopRule, UzawaParams,
+    complementarity_residual, project_disc, project_nonnegative, solve, solve_newton, ContactPoints,
+    DenseContactProblem, Law, NewtonParams, PointValues, StopRule, UzawaParams,
 };
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -170,6 +170,29 @@ proptest! {
         let d = plain.lambda.minus(&fast.lambda).norm();
         prop_assert!(d <= 1e-8 * scale.max(1e-12), "difference {d} (scale {scale})");
         prop_assert!(fast.info.complementarity <= 1e-12);
+    }
+
+    /// Semismooth Newton (without its fallback) reaches the KKT point plain Uzawa reaches:
+    /// frictionless, Tresca and Coulomb (solved directly, no fixed point), in 2D and 3D.
+    #[test]
+    fn newton_and_uzawa_agree(n in 1usize..=6, dim in 2usize..=3, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 6), load in prop::collection::vec(-1.0f64..1.0, 18), f in 0.05f64..0.5, law in 0usize..3) {
+        let pts = points(n, dim, &w, f);
+        let (law, nt) = match law {
+            0 => (Law::Frictionless, 0),
+            1 => (Law::Tresca(vec![0.1; n]), dim - 1),
+            _ => (Law::Coulomb, dim - 1),
+        };
+        let mut op1 = problem(n, nt, &pts, &seed, &load);
+        let mut op2 = op1.clone();
+        let plain = solve(&mut op1, &pts, &law, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let params = NewtonParams { tol: 1e-12, fallback: false, ..Default::default() };
+        let newton = solve_newton(&mut op2, &pts, &law, &params, None, &mut |_| {}).unwrap();
+        let scale = plain.lambda.norm().max(op1.u0.norm());
+        let d = plain.lambda.minus(&newton.lambda).norm();
+        prop_assert!(d <= 1e-8 * scale.max(1e-12), "difference {d} (scale {scale})");
+        prop_assert!(newton.info.complementarity <= 1e-12);
+        prop_assert!(newton.info.newton_iters <= 30, "{} Newton steps", newton.info.newton_iters);
+        prop_assert_eq!(&newton.status, &plain.status);
     }
 
     /// The fixed point S -> F λ_n(S) contracts for small F: the ratio of successive differences

@@ -45,9 +45,16 @@ fn main() {
             _ => None,
         })
         .collect();
+    let mut is_last = vec![false; k.nrows()];
+    for &j in &contact_dofs {
+        is_last[j] = true;
+    }
+    let mut nd_last: Vec<usize> = nd.iter().copied().filter(|&j| !is_last[j]).collect();
+    nd_last.extend_from_slice(&contact_dofs);
     for (name, ord) in [
         ("amd", Ordering::Amd),
         ("nested-dissection", Ordering::Given(nd)),
+        ("nd-contact-last", Ordering::Given(nd_last)),
         ("amd-contact-last", Ordering::AmdThenLast(contact_dofs)),
     ] {
         let (mut sym, mut num, mut sol) = (vec![], vec![], vec![]);

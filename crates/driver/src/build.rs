@@ -188,7 +188,8 @@ pub fn plan(scene: &Scene, dim: usize, materials: &[(String, Material)]) -> Plan
         electric,
         contact_law: law.clone(),
         friction,
-        fixed_point: law == "coulomb" && friction_coeff > 0.0,
+        // semismooth Newton solves Coulomb's law directly
+        fixed_point: law == "coulomb" && friction_coeff > 0.0 && scene.solver.strategy != "newton-condensed",
         linear_strategy: scene.solver.strategy.clone(),
         rule: scene.solver.rule.clone(),
         outputs,

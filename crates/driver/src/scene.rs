@@ -183,8 +183,8 @@ pub struct ContactSpec {
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
-    /// Strategy: `uzawa-condensed` (default), `apg-condensed`, `uzawa-direct`, `uzawa-schur-pcg`
-    /// (the paper's);
+    /// Strategy: `newton-condensed` (default), `apg-condensed`, `uzawa-condensed`,
+    /// `uzawa-direct`, `uzawa-schur-pcg` (the paper's);
     /// `piezocontact strategies` lists them.
     #[serde(default = "default_strategy")]
     pub strategy: String,
@@ -200,7 +200,7 @@ pub struct SolverSpec {
 }
 
 fn default_strategy() -> String {
-    "uzawa-condensed".into()
+    "newton-condensed".into()
 }
 fn default_tol() -> f64 {
     1e-10
@@ -412,6 +412,12 @@ fn validate(s: &Scene) -> Result<(), String> {
     }
     if !["tight", "paper"].contains(&s.solver.rule.as_str()) {
         return Err(format!("solver.rule `{}` is unknown (tight, paper)", s.solver.rule));
+    }
+    if s.solver.rule == "paper" && !s.solver.strategy.starts_with("uzawa") {
+        return Err(format!(
+            "solver.rule `paper` is the paper's rule for Uzawa; strategy `{}` stops on the complementarity residual (use solver.rule=tight, or a uzawa-* strategy)",
+            s.solver.strategy
+        ));
     }
     finite("solver.tol", s.solver.tol)?;
     if !(s.solver.tol > 0.0) {

@@ -37,6 +37,15 @@ pub enum Ordering {
     /// A given permutation, `fwd[new] = old` (for example AMD on the mesh's node graph,
     /// expanded to each node's dofs).
     Given(Vec<usize>),
+    /// A given permutation (`order`, `fwd[new] = old`) with the indices of `last` taken out of
+    /// it and put last, in the given order (for example nested dissection of the mesh with the
+    /// contact dofs last; measured cheaper than [`Ordering::AmdThenLast`] on 2D meshes).
+    GivenThenLast {
+        /// The permutation of all indices.
+        order: Vec<usize>,
+        /// The indices to put last.
+        last: Vec<usize>,
+    },
 }
 
 /// A sparse symmetric factorisation with its workspaces. Only the lower triangle of the matrix
@@ -98,10 +107,18 @@ impl SparseFactor {
                 (fwd, inv) = (given.clone(), inverse_permutation(given)?);
                 SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
             }
+            Ordering::GivenThenLast { order, last } => {
+                let is_last = mark(n, last)?;
+                let mut f: Vec<usize> = order.iter().copied().filter(|&i| i >= n || !is_last[i]).collect();
+                f.extend_from_slice(last);
+                let i = inverse_permutation(&f)?;
+                (fwd, inv) = (f, i);
+                SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
+            }
         };
         // chosen dofs last are there to be read off the last supernode: force supernodal
         let params = match ordering {
-            Ordering::AmdThenLast(_) => CholeskySymbolicParams {
+            Ordering::AmdThenLast(_) | Ordering::GivenThenLast { .. } => CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
                 ..Default::default()
             },
@@ -346,9 +363,8 @@ fn inverse_permutation(fwd: &[usize]) -> Result<Vec<usize>, LinalgError> {
     Ok(inv)
 }
 
-/// AMD on the indices not in `last`, then `last` in order. Returns `(fwd, inv)`.
-fn amd_then_last(a: SparseColMatRef<'_, usize, f64>, last: &[usize]) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
-    let n = a.nrows();
+/// A mask of `last` among `0..n`; an error names an index out of range or repeated.
+fn mark(n: usize, last: &[usize]) -> Result<Vec<bool>, LinalgError> {
     let mut is_last = vec![false; n];
     for &i in last {
         if i >= n || is_last[i] {
@@ -358,6 +374,13 @@ fn amd_then_last(a: SparseColMatRef<'_, usize, f64>, last: &[usize]) -> Result<(
         }
         is_last[i] = true;
     }
+    Ok(is_last)
+}
+
+/// AMD on the indices not in `last`, then `last` in order. Returns `(fwd, inv)`.
+fn amd_then_last(a: SparseColMatRef<'_, usize, f64>, last: &[usize]) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
+    let n = a.nrows();
+    let is_last = mark(n, last)?;
     // the pattern of the leading block, renumbered, both triangles
     let mut new_of = vec![usize::MAX; n];
     let mut old_of = Vec::with_capacity(n - last.len());

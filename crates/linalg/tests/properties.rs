@@ -210,7 +210,26 @@ fn trailing_block_is_the_schur_complement() {
     .unwrap();
     // the "contact" dofs: the u dofs of the grid's first row
     let last: Vec<usize> = (0..m).collect();
-    let mut f = DirectLdlt::new(&a, &g, &b, &Ordering::AmdThenLast(last.clone()), Par::Seq).unwrap();
+    // AMD on the rest, or a given order of all (reversed) with the contact dofs taken out
+    let given = Ordering::GivenThenLast {
+        order: (0..2 * n).rev().collect(),
+        last: last.clone(),
+    };
+    for ordering in [Ordering::AmdThenLast(last.clone()), given] {
+        check_trailing_block(&a, &g, &b, &ordering, &last);
+    }
+}
+
+fn check_trailing_block(
+    a: &SparseColMat<usize, f64>,
+    g: &SparseColMat<usize, f64>,
+    b: &SparseColMat<usize, f64>,
+    ordering: &Ordering,
+    last: &[usize],
+) {
+    let (n, m) = (a.nrows(), last.len());
+    let mut f = DirectLdlt::new(a, g, b, ordering, Par::Seq).unwrap();
+    assert_eq!(&f.factor().permutation()[2 * n - m..], last);
     let begin = f.factor().last_supernode_begin();
     let sc = f
         .factor()
