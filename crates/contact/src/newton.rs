@@ -49,6 +49,8 @@ impl Default for NewtonParams {
 
 /// Armijo's sufficient-decrease constant.
 const ARMIJO: f64 = 1e-4;
+/// Merit values the non-monotone line search compares with.
+const MEMORY: usize = 8;
 /// Step halvings of the line search before the direction is given up.
 const MAX_HALVINGS: usize = 30;
 
@@ -314,6 +316,7 @@ pub fn solve_newton(
     let mut s = flat.state(x0);
     let mut r = residual(&s);
     let mut stalled = None;
+    let mut history = std::collections::VecDeque::with_capacity(MEMORY + 1);
     while !(r <= params.tol) {
         if info.newton_iters >= params.max_iters {
             stalled = Some("the iteration limit");
@@ -323,13 +326,16 @@ pub fn solve_newton(
             stalled = Some("a singular Newton matrix");
             break;
         };
-        // Armijo backtracking on the weighted norm of the equations
+        // non-monotone Armijo backtracking on the weighted norm of the equations, against the
+        // largest of the last MEMORY norms (Grippo, Lampariello and Lucidi): a full step that
+        // changes a point's branch may raise the norm for a step on the way to the solution
+        let reference_norm = history.iter().copied().fold(s.norm, f64::max);
         let mut alpha = 1.0;
         let mut accepted = None;
         for _ in 0..=MAX_HALVINGS {
             let x: Vec<f64> = s.x.iter().zip(&delta).map(|(a, b)| a + alpha * b).collect();
             let trial = flat.state(x);
-            if trial.norm <= (1.0 - ARMIJO * alpha) * s.norm {
+            if trial.norm <= (1.0 - ARMIJO * alpha) * reference_norm {
                 accepted = Some(trial);
                 break;
             }
@@ -340,6 +346,10 @@ pub fn solve_newton(
             stalled = Some("a failed line search");
             break;
         };
+        history.push_back(s.norm);
+        if history.len() > MEMORY {
+            history.pop_front();
+        }
         s = next;
         r = residual(&s);
         info.newton_iters += 1;

@@ -192,7 +192,21 @@ proptest! {
         prop_assert!(d <= 1e-8 * scale.max(1e-12), "difference {d} (scale {scale})");
         prop_assert!(newton.info.complementarity <= 1e-12);
         prop_assert!(newton.info.newton_iters <= 30, "{} Newton steps", newton.info.newton_iters);
-        prop_assert_eq!(&newton.status, &plain.status);
+        // the same status, but at a degenerate point (on the edge of its disc, or touching with
+        // no pressure, to the resolution of the tolerance) where either answer is right
+        let l = &newton.lambda;
+        for i in 0..n {
+            if newton.status[i] != plain.status[i] {
+                let edge = match &law {
+                    Law::Frictionless => f64::INFINITY,
+                    Law::Tresca(s) => s[i],
+                    Law::Coulomb => f * l.normal[i],
+                };
+                let lt = (0..nt).map(|k| l.tangential[i * nt + k].powi(2)).sum::<f64>().sqrt();
+                let degenerate = (lt - edge).abs() <= 1e-7 * scale || l.normal[i] <= 1e-7 * scale;
+                prop_assert!(degenerate, "point {}: {:?} against Uzawa's {:?}", i, newton.status[i], plain.status[i]);
+            }
+        }
     }
 
     /// The fixed point S -> F λ_n(S) contracts for small F: the ratio of successive differences

@@ -15,8 +15,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(128);
+    let name = std::env::args().nth(2).unwrap_or_else(|| "paper".into());
     let (scene, source) =
-        driver::scene::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
+        driver::scene::load(&name, &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
     let driver::build::Setup {
         mesh,
         materials: mats,
@@ -33,12 +34,13 @@ fn main() {
     let t_nd = t.elapsed().as_secs_f64();
     println!("n = {n}: nested dissection order computed in {t_nd:.3} s");
     let bottom = mesh.boundary("bottom").expect("paper has a bottom").nodes();
+    let dim = mesh.dim;
     let contact_dofs: Vec<usize> = bottom
         .iter()
-        .flat_map(|&v| (0..2).map(move |k| (v, k)))
-        .filter_map(|(v, k)| match disc.dofs.u[v * 2 + k] {
+        .flat_map(|&v| (0..dim).map(move |k| (v, k)))
+        .filter_map(|(v, k)| match disc.dofs.u[v * dim + k] {
             fe_assembly::Dof::Free(j)
-                if (0..2).all(|q| matches!(disc.dofs.u[v * 2 + q], fe_assembly::Dof::Free(_))) =>
+                if (0..dim).all(|q| matches!(disc.dofs.u[v * dim + q], fe_assembly::Dof::Free(_))) =>
             {
                 Some(j)
             }
@@ -59,7 +61,7 @@ fn main() {
     ] {
         let (mut sym, mut num, mut sol) = (vec![], vec![], vec![]);
         let mut len = 0;
-        for _ in 0..3 {
+        for _ in 0..std::env::var("REPEATS").ok().and_then(|s| s.parse().ok()).unwrap_or(3) {
             let t = Instant::now();
             let mut f = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, faer::Par::Seq).expect("ldlt");
             let both = t.elapsed().as_secs_f64();

@@ -241,15 +241,11 @@ fn condense_from_factor(
     if fwd[fwd.len() - k..] != boundary.dofs[..] {
         return Ok(None);
     }
-    let Some(sc) = solver.factor().trailing_schur_complement(k) else {
+    // (K⁻¹)_cc = S_c⁻¹ = L_cc⁻ᵀ D_c⁻¹ L_cc⁻¹ straight from the factor's trailing block
+    let Some(flat) = solver.factor().trailing_schur_inverse(k)? else {
         return Ok(None);
     };
-    // (K⁻¹)_cc = S_c⁻¹ by a dense Cholesky (S_c is SPD: a principal block of S⁻¹'s inverse)
-    let s = faer::Mat::<f64>::from_fn(k, k, |i, j| sc[i * k + j]);
-    let llt = s
-        .llt(faer::Side::Lower)
-        .map_err(|e| DriverError::Input(format!("the condensed contact matrix is not positive definite: {e:?}")))?;
-    let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);
+    let inv = |i: usize, j: usize| flat[i * k + j];
     let p = &boundary.points;
     let (n, dim) = (p.len(), p.dim);
     let m = n * (1 + nt);
@@ -270,7 +266,7 @@ fn condense_from_factor(
             let mut v = 0.0;
             for x in 0..dim {
                 for y in 0..dim {
-                    v += a[x] * inv[(i * dim + x, j * dim + y)] * b[y];
+                    v += a[x] * inv(i * dim + x, j * dim + y) * b[y];
                 }
             }
             d[r * m + c] = v;

@@ -146,16 +146,18 @@ pub fn run_with_reporter(
             par,
         )?);
     } else {
-        // the condensed strategies order the contact dofs last, to read the contact block off
-        // the factor, after nested dissection of the rest (measured cheaper than AMD then last)
+        // geometric nested dissection (measured no slower than AMD in 2D and 1.6x faster in
+        // 3D, docs/performance.md); the condensed strategies put the contact dofs last, to read
+        // the contact block off the factor
+        let order = disc
+            .dofs
+            .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
         let ordering = match (&contact_boundary, condensed(&plan.linear_strategy)) {
             (Some(cb), true) => Ordering::GivenThenLast {
-                order: disc
-                    .dofs
-                    .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph())),
+                order,
                 last: cb.dofs.clone(),
             },
-            _ => Ordering::Amd,
+            _ => Ordering::Given(order),
         };
         direct = Some(DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &ordering, par)?);
     }

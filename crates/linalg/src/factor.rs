@@ -272,21 +272,7 @@ impl SparseFactor {
     /// complement of the matrix onto those dofs. `None` unless the factor is a supernodal
     /// `L D Lᵀ` whose last supernode holds all `k` columns.
     pub fn trailing_schur_complement(&self, k: usize) -> Option<Vec<f64>> {
-        if self.kind != FactorKind::Ldlt || k == 0 || k > self.n() {
-            return None;
-        }
-        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
-            return None;
-        };
-        let last = s.n_supernodes().checked_sub(1)?;
-        let (begin, end) = (s.supernode_begin()[last], s.supernode_end()[last]);
-        if end != self.n() || begin > self.n() - k {
-            return None;
-        }
-        let w = end - begin;
-        let rows = w + (s.col_ptr_for_row_idx()[last + 1] - s.col_ptr_for_row_idx()[last]);
-        let block = &self.values[s.col_ptr_for_val()[last]..s.col_ptr_for_val()[last + 1]];
-        let off = w - k;
+        let (block, rows, off) = self.trailing_block(k)?;
         // S_c = (L_cc D_c) L_ccᵀ by one dense product
         let d: Vec<f64> = (0..k).map(|j| block[(off + j) * rows + off + j]).collect();
         let l = faer::Mat::<f64>::from_fn(k, k, |i, j| match i.cmp(&j) {
@@ -318,6 +304,78 @@ impl SparseFactor {
             }
         }
         Some(out)
+    }
+
+    /// The inverse of [`SparseFactor::trailing_schur_complement`], `S_c⁻¹ = L_cc⁻ᵀ D_c⁻¹ L_cc⁻¹`
+    /// (dense, row-major `k x k`): the block of the matrix's inverse on the last `k` indices,
+    /// with no further factorisation (one unit-triangular inverse and one triangular product,
+    /// `2k³/3` flops). `None` under the conditions of `trailing_schur_complement`;
+    /// [`LinalgError::NotPositiveDefinite`] where a pivot of the block is not positive (the
+    /// block of a quasi-definite matrix on its positive-definite dofs has only positive ones).
+    pub fn trailing_schur_inverse(&self, k: usize) -> Result<Option<Vec<f64>>, LinalgError> {
+        let Some((block, rows, off)) = self.trailing_block(k) else {
+            return Ok(None);
+        };
+        let l = faer::MatRef::from_column_major_slice_with_stride(&block[off * rows + off..], k, k, rows);
+        let d: Vec<f64> = (0..k).map(|j| l[(j, j)]).collect();
+        if let Some(j) = d.iter().position(|x| !(*x > 0.0)) {
+            return Err(LinalgError::NotPositiveDefinite {
+                pivot: self.n() - k + j,
+            });
+        }
+        let mut x = faer::Mat::<f64>::zeros(k, k);
+        faer::linalg::triangular_inverse::invert_unit_lower_triangular(x.as_mut(), l, self.par);
+        // the unit diagonal is implied, not necessarily written
+        for j in 0..k {
+            x[(j, j)] = 1.0;
+        }
+        let mut y = x.clone();
+        for j in 0..k {
+            for i in j..k {
+                y[(i, j)] /= d[i];
+            }
+        }
+        let mut prod = faer::Mat::<f64>::zeros(k, k);
+        faer::linalg::matmul::triangular::matmul(
+            prod.as_mut(),
+            faer::linalg::matmul::triangular::BlockStructure::Rectangular,
+            faer::Accum::Replace,
+            x.transpose(),
+            faer::linalg::matmul::triangular::BlockStructure::TriangularUpper,
+            y.as_ref(),
+            faer::linalg::matmul::triangular::BlockStructure::TriangularLower,
+            1.0,
+            self.par,
+        );
+        let mut out = vec![0.0; k * k];
+        for i in 0..k {
+            for j in 0..=i {
+                let v = 0.5 * (prod[(i, j)] + prod[(j, i)]);
+                out[i * k + j] = v;
+                out[j * k + i] = v;
+            }
+        }
+        Ok(Some(out))
+    }
+
+    /// The values of the last supernode, its row count, and the offset of the last `k`
+    /// columns in it, when the factor is a supernodal `L D Lᵀ` whose last supernode holds them.
+    fn trailing_block(&self, k: usize) -> Option<(&[f64], usize, usize)> {
+        if self.kind != FactorKind::Ldlt || k == 0 || k > self.n() {
+            return None;
+        }
+        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
+            return None;
+        };
+        let last = s.n_supernodes().checked_sub(1)?;
+        let (begin, end) = (s.supernode_begin()[last], s.supernode_end()[last]);
+        if end != self.n() || begin > self.n() - k {
+            return None;
+        }
+        let w = end - begin;
+        let rows = w + (s.col_ptr_for_row_idx()[last + 1] - s.col_ptr_for_row_idx()[last]);
+        let block = &self.values[s.col_ptr_for_val()[last]..s.col_ptr_for_val()[last + 1]];
+        Some((block, rows, w - k))
     }
 
     /// Whether the factor is supernodal, with the first column of its last supernode.

@@ -235,9 +235,12 @@ fn check_trailing_block(
         .factor()
         .trailing_schur_complement(m)
         .unwrap_or_else(|| panic!("last supernode begins at {begin:?} of {}", 2 * n));
-    // column j of K⁻¹ restricted to the contact dofs, by a solve
+    // column j of K⁻¹ restricted to the contact dofs, by a solve, against S_c⁻¹ inverted here
+    // and against the inverse read off the factor
     let sc = DMatrix::from_row_slice(m, m, &sc);
     let inv = sc.clone().try_inverse().unwrap();
+    let direct = DMatrix::from_row_slice(m, m, &f.factor().trailing_schur_inverse(m).unwrap().unwrap());
+    assert!((&direct - &inv).amax() < 1e-12 * inv.amax());
     for (j, &dj) in last.iter().enumerate() {
         let (mut u, mut p) = (vec![0.0; n], vec![0.0; n]);
         let mut e = vec![0.0; n];
