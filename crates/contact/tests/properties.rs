@@ -424,3 +424,53 @@ fn regression_grazing_coulomb_point() {
     assert!(dot >= (1.0 - 1e-5) * nl * nu);
     assert!((nl - f * l.normal[3]).abs() <= 1e-8 * l.norm());
 }
+
+/// Where Newton stops short (here: no step allowed), the accelerated gradient finishes the
+/// solve from where it stopped and says so; with the fallback off, the stall is a typed error
+/// naming its cause.
+#[test]
+fn newton_falls_back_on_the_accelerated_gradient() {
+    let seed: Vec<f64> = (0..40).map(|i| ((i * 37 % 17) as f64 / 8.5) - 1.0).collect();
+    let pts = points(4, 3, &[0.3, -0.2, 0.9, 0.1], 0.3);
+    let load = [0.8, 0.5, 0.9, 0.2, 0.3, -0.4, 0.1, 0.6, -0.2, 0.5, 0.4, -0.1];
+    let mut op = problem(4, 2, &pts, &seed, &load);
+    let reference = solve_newton(
+        &mut op.clone(),
+        &pts,
+        &Law::Coulomb,
+        &NewtonParams {
+            tol: 1e-12,
+            ..Default::default()
+        },
+        None,
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(!reference.info.fallback);
+    let none = NewtonParams {
+        tol: 1e-12,
+        max_iters: 0,
+        ..Default::default()
+    };
+    let sol = solve_newton(&mut op, &pts, &Law::Coulomb, &none, None, &mut |_| {}).unwrap();
+    assert!(sol.info.fallback && sol.info.newton_iters == 0 && sol.info.uzawa_iters > 0);
+    assert!(sol.info.complementarity <= 1e-12);
+    let d = sol.lambda.minus(&reference.lambda).norm();
+    assert!(d <= 1e-8 * reference.lambda.norm(), "{d}");
+    let e = solve_newton(
+        &mut op,
+        &pts,
+        &Law::Coulomb,
+        &NewtonParams {
+            fallback: false,
+            ..none
+        },
+        None,
+        &mut |_| {},
+    )
+    .unwrap_err();
+    assert!(
+        matches!(&e, contact::ContactError::NewtonStalled { reason, .. } if reason.contains("iteration limit")),
+        "{e}"
+    );
+}

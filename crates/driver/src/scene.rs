@@ -329,6 +329,11 @@ fn parse_value(raw: &str) -> Result<toml::Value, String> {
     Ok(toml::Value::String(raw.to_string()))
 }
 
+/// The largest structured mesh a scene may ask for, in squares or cubes (2D n = 1024 on
+/// `paper` is 2.1e6; the sparse factor of 5e7 cells would not fit in memory): beyond it, an
+/// error rather than an allocation failure.
+const MAX_CELLS: f64 = 5e7;
+
 fn validate(s: &Scene) -> Result<(), String> {
     let finite = |what: &str, v: f64| {
         if v.is_finite() {
@@ -377,6 +382,14 @@ fn validate(s: &Scene) -> Result<(), String> {
     if let Some(h) = s.mesh.h {
         if !(h > 0.0 && h.is_finite()) {
             return Err(format!("mesh.h = {h} must be a positive length"));
+        }
+    }
+    if s.mesh.kind != "gmsh" {
+        let cells: f64 = crate::build::cells_per_axis(s).iter().map(|&c| c as f64).product();
+        if cells > MAX_CELLS {
+            return Err(format!(
+                "the mesh would have {cells:.3e} cells (squares or cubes); the limit is {MAX_CELLS:.0e}, beyond what one machine factors (use a smaller mesh.n or a larger mesh.h)"
+            ));
         }
     }
     if s.material.is_empty() {
