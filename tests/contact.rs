@@ -232,3 +232,22 @@ fn gmsh_mesh_with_two_materials_by_region() {
     assert!(substrate_only.iter().all(|&v| r.phi[v] == 0.0));
     assert!(r.phi.iter().any(|&p| p != 0.0));
 }
+
+/// Every case of the stability study reads, and at a smoke size converges with the default
+/// strategy to what it must show (the study itself runs the real sizes: `piezocontact
+/// stability`).
+#[test]
+fn stability_cases_hold_at_smoke_size() {
+    for case in driver::stability::cases().iter().filter(|c| !c.fine) {
+        let sets = case.smoke_sets();
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let r = run(case.scene, &sets);
+        if let Err(e) = driver::stability::check(case.expect, &r.report) {
+            panic!("{}: {e}", case.name);
+        }
+        if let Some(p) = &case.paper_sets {
+            let sets: Vec<String> = p.iter().map(|s| s.to_string()).collect();
+            driver::scene::load(case.scene, &sets).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        }
+    }
+}

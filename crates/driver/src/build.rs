@@ -91,6 +91,21 @@ pub fn mesh(scene: &Scene, source: &Source) -> Result<mesh::Mesh, DriverError> {
         }
     };
     mesh.check()?;
+    for r in &m.regions {
+        let cells: Vec<usize> = (0..mesh.n_cells())
+            .filter(|&c| {
+                let cell = mesh.cell(c);
+                (0..r.lo.len()).all(|k| {
+                    let x = cell.iter().map(|&v| mesh.points[v][k]).sum::<f64>() / cell.len() as f64;
+                    x >= r.lo[k] && x <= r.hi[k]
+                })
+            })
+            .collect();
+        if cells.is_empty() {
+            return Err(DriverError::Input(format!("mesh.region `{}` holds no cell", r.name)));
+        }
+        mesh.regions.insert(r.name.clone(), cells);
+    }
     if let Some(e) = &scene.electrode {
         let range = e
             .x_range

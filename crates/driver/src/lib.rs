@@ -23,6 +23,7 @@ pub mod output;
 pub mod plots;
 pub mod run;
 pub mod scene;
+pub mod stability;
 pub mod studies;
 
 /// What can go wrong in a run; each variant names the file or item at fault.

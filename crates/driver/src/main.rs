@@ -8,7 +8,7 @@ use std::process::ExitCode;
 #[command(
     name = "piezocontact",
     version,
-    about = "Frictional contact of piezoelectric bodies (Uzawa, Schur PCG, fixed point)"
+    about = "Frictional contact of piezoelectric bodies (semismooth Newton, Uzawa, Schur PCG, fixed point)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -67,6 +67,16 @@ enum Command {
     },
     /// List the solver strategies.
     Strategies,
+    /// Run the stiff and extreme cases (SCENES.md section 5), each in its own process, and
+    /// write their table to docs/stability.md.
+    Stability {
+        /// Leave out the fine cases (2D n = 512 and 1024, 3D n = 32).
+        #[arg(long)]
+        quick: bool,
+        /// Directory for stability.md.
+        #[arg(long, default_value = "docs")]
+        out: PathBuf,
+    },
 }
 
 /// Lines to stderr, and a progress bar for the contact solve when stderr is a terminal.
@@ -155,6 +165,29 @@ fn main() -> ExitCode {
             });
             match result {
                 Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Stability { quick, out } => {
+            let exe = match std::env::current_exe() {
+                Ok(e) => e,
+                Err(e) => {
+                    eprintln!("error: cannot find this program's path to run the cases: {e}");
+                    return ExitCode::FAILURE;
+                }
+            };
+            match driver::stability::write(&exe, quick, &out, &mut |l| eprintln!("{l}")) {
+                Ok(rows) => {
+                    eprintln!(
+                        "{} runs as expected; wrote {}",
+                        rows.len(),
+                        out.join("stability.md").display()
+                    );
+                    ExitCode::SUCCESS
+                }
                 Err(e) => {
                     eprintln!("error: {e}");
                     ExitCode::FAILURE

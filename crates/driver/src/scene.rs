@@ -20,6 +20,11 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),
     ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),
+    ("layered", include_str!("../../../scenes/layered.toml")),
+    (
+        "near-incompressible",
+        include_str!("../../../scenes/near-incompressible.toml"),
+    ),
 ];
 
 /// A whole scene.
@@ -84,6 +89,21 @@ pub struct MeshSpec {
     /// The coarse size the smoke tests run.
     #[serde(default)]
     pub smoke_n: Option<usize>,
+    /// Named cell regions of a generated mesh, by box (`[[mesh.region]]`).
+    #[serde(default, rename = "region")]
+    pub regions: Vec<RegionSpec>,
+}
+
+/// A named region of a generated mesh: the cells whose centroid lies in the box `[lo, hi]`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSpec {
+    /// The region's name (materials refer to it).
+    pub name: String,
+    /// Lower corner of the box.
+    pub lo: Vec<f64>,
+    /// Upper corner of the box.
+    pub hi: Vec<f64>,
 }
 
 /// A material on a region.
@@ -382,6 +402,25 @@ fn validate(s: &Scene) -> Result<(), String> {
     if let Some(h) = s.mesh.h {
         if !(h > 0.0 && h.is_finite()) {
             return Err(format!("mesh.h = {h} must be a positive length"));
+        }
+    }
+    for r in &s.mesh.regions {
+        let d = s.mesh.lo.len();
+        if s.mesh.kind == "gmsh" {
+            return Err(format!(
+                "mesh.region `{}`: regions by box are for generated meshes (a Gmsh file names its own)",
+                r.name
+            ));
+        }
+        if r.lo.len() != d || r.hi.len() != d {
+            return Err(format!("mesh.region `{}`: lo and hi need {d} coordinates", r.name));
+        }
+        for (a, b) in r.lo.iter().zip(&r.hi) {
+            finite(&format!("a corner of mesh.region `{}`", r.name), *a)?;
+            finite(&format!("a corner of mesh.region `{}`", r.name), *b)?;
+            if !(b >= a) {
+                return Err(format!("mesh.region `{}`: hi must not be below lo", r.name));
+            }
         }
     }
     if s.mesh.kind != "gmsh" {

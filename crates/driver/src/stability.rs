@@ -1,0 +1,479 @@
+//! The stability study (`piezocontact stability`): the stiff and extreme cases of SCENES.md
+//! section 5, each run in its own process (so that its peak memory is its own, and a failure
+//! cannot take the study down), with the default strategy and, on the cases up to n = 128, the
+//! paper's Uzawa + Schur PCG. Every case either converges (the residuals of its `run.json`
+//! meet the tolerance, and what it must show, it shows: all separated for a gap of 1, all
+//! stuck for F = 1e6, ...) or stops with the typed error it printed. The table goes to
+//! `docs/stability.md`.
+
+use crate::output::Outputs;
+use crate::DriverError;
+use serde_json::Value;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::process::Command;
+
+/// What a case must show beyond convergence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Expect {
+    /// Converged, nothing more.
+    Converged,
+    /// Every contact point separated (no contact force).
+    AllSeparated,
+    /// Every contact point in contact and sticking.
+    AllStick,
+    /// Every contact point in contact and sliding (frictionless).
+    AllSlip,
+    /// Some contact, none separated.
+    NoneSeparated,
+}
+
+/// One extreme case: a shipped scene with overrides.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    /// Short name.
+    pub name: &'static str,
+    /// What it stresses.
+    pub why: &'static str,
+    /// Shipped scene.
+    pub scene: &'static str,
+    /// Overrides for the default strategy.
+    pub sets: Vec<&'static str>,
+    /// Overrides for the paper's strategy (a smaller mesh), or `None` where that run is left
+    /// out (the fine cases).
+    pub paper_sets: Option<Vec<&'static str>>,
+    /// What the answer must show.
+    pub expect: Expect,
+    /// A fine case (left out by `--quick`).
+    pub fine: bool,
+}
+
+impl Case {
+    /// The case's overrides with the mesh brought down to a smoke size (for tests): `mesh.n`
+    /// to 16, and an anisotropic `nx` x `ny` mesh to 128 x 1 (the same aspect ratio).
+    pub fn smoke_sets(&self) -> Vec<String> {
+        self.sets
+            .iter()
+            .map(|s| match s.split_once('=') {
+                Some(("mesh.n", _)) => "mesh.n=16".to_string(),
+                Some(("mesh.nx", _)) => "mesh.nx=128".to_string(),
+                Some(("mesh.ny", _)) => "mesh.ny=1".to_string(),
+                _ => s.to_string(),
+            })
+            .collect()
+    }
+}
+
+/// The cases of SCENES.md section 5 (bad input has its own corpus, `tests/bad-input`).
+pub fn cases() -> Vec<Case> {
+    let c = |name, why, scene, sets: Vec<&'static str>, paper: Option<Vec<&'static str>>, expect, fine| Case {
+        name,
+        why,
+        scene,
+        sets,
+        paper_sets: paper,
+        expect,
+        fine,
+    };
+    let small = || Some(vec!["mesh.n=32"]);
+    use Expect::*;
+    vec![
+        c(
+            "coupling x10",
+            "e x 10: the Schur complement drifts from A",
+            "paper-slip",
+            vec!["mesh.n=128", "material.coupling_scale=10"],
+            Some(vec!["mesh.n=32", "material.coupling_scale=10"]),
+            Converged,
+            false,
+        ),
+        c(
+            "coupling x100",
+            "e x 100",
+            "paper-slip",
+            vec!["mesh.n=128", "material.coupling_scale=100"],
+            Some(vec!["mesh.n=32", "material.coupling_scale=100"]),
+            Converged,
+            false,
+        ),
+        c(
+            "nu = 0.4999",
+            "near-incompressible isotropic body, E = 100, e = 0",
+            "near-incompressible",
+            vec!["mesh.n=128"],
+            small(),
+            NoneSeparated,
+            false,
+        ),
+        c(
+            "aspect 64",
+            "1024 x 8 cells on the paper block",
+            "paper",
+            vec!["mesh.nx=1024", "mesh.ny=8"],
+            Some(vec!["mesh.nx=512", "mesh.ny=4"]),
+            NoneSeparated,
+            false,
+        ),
+        c(
+            "F = 0",
+            "frictionless through the Coulomb law",
+            "paper",
+            vec!["mesh.n=128", "contact.friction=0"],
+            Some(vec!["mesh.n=32", "contact.friction=0"]),
+            AllSlip,
+            false,
+        ),
+        c(
+            "F = 1e-3",
+            "almost frictionless",
+            "paper",
+            vec!["mesh.n=128", "contact.friction=1e-3"],
+            Some(vec!["mesh.n=32", "contact.friction=1e-3"]),
+            NoneSeparated,
+            false,
+        ),
+        c(
+            "F = 0.1",
+            "stick and slip zones",
+            "paper",
+            vec!["mesh.n=128", "contact.friction=0.1"],
+            Some(vec!["mesh.n=32", "contact.friction=0.1"]),
+            NoneSeparated,
+            false,
+        ),
+        c(
+            "F = 0.6",
+            "the paper's coefficient",
+            "paper",
+            vec!["mesh.n=128"],
+            small(),
+            AllStick,
+            false,
+        ),
+        c(
+            "F = 10",
+            "large friction",
+            "paper",
+            vec!["mesh.n=128", "contact.friction=10"],
+            Some(vec!["mesh.n=32", "contact.friction=10"]),
+            AllStick,
+            false,
+        ),
+        c(
+            "F = 1e6",
+            "huge friction",
+            "paper",
+            vec!["mesh.n=128", "contact.friction=1e6"],
+            Some(vec!["mesh.n=32", "contact.friction=1e6"]),
+            AllStick,
+            false,
+        ),
+        c(
+            "gap -1e-3",
+            "initial penetration",
+            "paper",
+            vec!["mesh.n=128", "contact.gap=-1e-3"],
+            Some(vec!["mesh.n=32", "contact.gap=-1e-3"]),
+            NoneSeparated,
+            false,
+        ),
+        c(
+            "gap 1",
+            "no contact at all",
+            "paper",
+            vec!["mesh.n=128", "contact.gap=1"],
+            Some(vec!["mesh.n=32", "contact.gap=1"]),
+            AllSeparated,
+            false,
+        ),
+        c(
+            "gap 1e-14",
+            "a gap below round-off of the displacement",
+            "paper",
+            vec!["mesh.n=128", "contact.gap=1e-14"],
+            Some(vec!["mesh.n=32", "contact.gap=1e-14"]),
+            NoneSeparated,
+            false,
+        ),
+        c(
+            "layered",
+            "PZT layer on a substrate 1e4 times softer",
+            "layered",
+            vec!["mesh.n=128"],
+            Some(vec!["mesh.n=40"]),
+            Converged,
+            false,
+        ),
+        c(
+            "SI units",
+            "entries over 19 orders of magnitude",
+            "pzt5a-si",
+            vec!["mesh.n=128"],
+            small(),
+            AllStick,
+            false,
+        ),
+        c(
+            "n = 512",
+            "2D, 1.6 million unknowns",
+            "paper",
+            vec!["mesh.n=512"],
+            None,
+            AllStick,
+            true,
+        ),
+        c(
+            "n = 1024",
+            "2D, 6.3 million unknowns",
+            "paper",
+            vec!["mesh.n=1024"],
+            None,
+            AllStick,
+            true,
+        ),
+        c(
+            "3D n = 32",
+            "3D, 274 thousand unknowns",
+            "paper-3d",
+            vec!["mesh.n=32"],
+            None,
+            Converged,
+            true,
+        ),
+    ]
+}
+
+/// The outcome of one run of a case.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// The case's name.
+    pub case: String,
+    /// Strategy.
+    pub strategy: String,
+    /// Overrides used.
+    pub sets: String,
+    /// Unknowns (u + φ), 0 on failure.
+    pub dofs: u64,
+    /// Iterations, as a short text.
+    pub iterations: String,
+    /// Complementarity residual (NaN on failure).
+    pub complementarity: f64,
+    /// Equilibrium residual.
+    pub equilibrium: f64,
+    /// Run time (s), set-up to solution.
+    pub seconds: f64,
+    /// Peak resident memory of the run (MiB).
+    pub peak_mib: f64,
+    /// `converged, ...` or the error.
+    pub outcome: String,
+    /// Whether the outcome is what the case must give.
+    pub as_expected: bool,
+}
+
+fn num(v: &Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+/// Checks what the case must show, from its `run.json`: `Ok` with the status counts, or what
+/// is wrong.
+pub fn check(expect: Expect, report: &Value) -> Result<String, String> {
+    let c = &report["contact"];
+    let count = |k: &str| c[k].as_u64().unwrap_or(0);
+    let (n, stick, slip, sep) = (
+        count("n_points"),
+        count("n_stick"),
+        count("n_slip"),
+        count("n_separated"),
+    );
+    let counts = format!("stick {stick}, slip {slip}, separated {sep}");
+    let res = &report["residuals"];
+    let (comp, tol) = (num(&res["complementarity"]), num(&report["solver"]["tol"]));
+    if res["converged_to_tolerance"] != Value::Bool(true) || !(comp <= tol) {
+        return Err(format!(
+            "not converged: complementarity {comp:.2e} (tolerance {tol:.0e})"
+        ));
+    }
+    let ok = match expect {
+        Expect::Converged => true,
+        Expect::AllSeparated => sep == n,
+        Expect::AllStick => stick == n,
+        Expect::AllSlip => slip == n,
+        Expect::NoneSeparated => sep == 0 && n > 0,
+    };
+    if ok {
+        Ok(counts)
+    } else {
+        Err(format!("{counts}: expected {expect:?}"))
+    }
+}
+
+fn iterations(report: &Value) -> String {
+    let it = &report["iterations"];
+    let get = |k: &str| it[k].as_u64().unwrap_or(0);
+    let mut parts = vec![];
+    if get("newton") > 0 {
+        parts.push(format!("{} Newton", get("newton")));
+    }
+    if get("uzawa") > 0 {
+        parts.push(format!("{} Uzawa", get("uzawa")));
+    }
+    if get("fixed_point") > 0 {
+        parts.push(format!("{} FP", get("fixed_point")));
+    }
+    if get("pcg") > 0 {
+        parts.push(format!("{} PCG", get("pcg")));
+    }
+    if it["newton_fallback"] == Value::Bool(true) {
+        parts.push("fallback".into());
+    }
+    if parts.is_empty() {
+        "-".into()
+    } else {
+        parts.join(", ")
+    }
+}
+
+/// Runs one case with one strategy through `exe run`, in a scratch directory that is removed.
+fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize) -> Row {
+    let scratch = std::env::temp_dir().join(format!("piezocontact-stability-{}-{index}", std::process::id()));
+    let mut cmd = Command::new(exe);
+    cmd.arg("run").arg(case.scene);
+    for s in sets {
+        cmd.arg("--set").arg(s);
+    }
+    cmd.arg("--set").arg(format!("solver.strategy={strategy}"));
+    cmd.arg("--out").arg(&scratch);
+    let mut row = Row {
+        case: case.name.into(),
+        strategy: strategy.into(),
+        sets: sets.join(" "),
+        dofs: 0,
+        iterations: "-".into(),
+        complementarity: f64::NAN,
+        equilibrium: f64::NAN,
+        seconds: f64::NAN,
+        peak_mib: f64::NAN,
+        outcome: String::new(),
+        as_expected: false,
+    };
+    let started = std::time::Instant::now();
+    let output = cmd.output();
+    let report = std::fs::read(scratch.join("run.json"))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<Value>(&b).ok());
+    let _ = std::fs::remove_dir_all(&scratch);
+    match (output, report) {
+        (Ok(out), Some(r)) if out.status.success() => {
+            row.dofs = r["dofs"]["u"].as_u64().unwrap_or(0) + r["dofs"]["phi"].as_u64().unwrap_or(0);
+            row.iterations = iterations(&r);
+            row.complementarity = num(&r["residuals"]["complementarity"]);
+            row.equilibrium = num(&r["residuals"]["equilibrium"]);
+            row.seconds = num(&r["timings_s"]["total"]);
+            row.peak_mib = num(&r["memory"]["peak_bytes"]) / (1 << 20) as f64;
+            match check(case.expect, &r) {
+                Ok(counts) => {
+                    row.outcome = format!("converged; {counts}");
+                    row.as_expected = true;
+                }
+                Err(e) => row.outcome = format!("UNEXPECTED: {e}"),
+            }
+        }
+        (Ok(out), _) => {
+            row.seconds = started.elapsed().as_secs_f64();
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            let message = stderr
+                .lines()
+                .rev()
+                .find(|l| l.starts_with("error:"))
+                .unwrap_or("no error message")
+                .trim_start_matches("error: ")
+                .to_string();
+            // a typed error is a sound outcome of an extreme case; a crash is not
+            row.as_expected = out.status.code().is_some() && !stderr.contains("panicked");
+            row.outcome = if row.as_expected {
+                format!("stopped with an error: {message}")
+            } else {
+                format!("CRASHED ({}): {message}", out.status)
+            };
+        }
+        (Err(e), _) => row.outcome = format!("CRASHED: could not start {}: {e}", exe.display()),
+    }
+    row
+}
+
+/// Runs the cases (without the fine ones when `quick`), with the default strategy and, where
+/// the case has one, the paper's strategy on its smaller mesh. `exe` is the `piezocontact`
+/// binary.
+pub fn study(exe: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Vec<Row> {
+    let mut rows = vec![];
+    for case in cases().iter().filter(|c| !(quick && c.fine)) {
+        let mut runs = vec![("newton-condensed", case.sets.clone())];
+        if let Some(p) = &case.paper_sets {
+            runs.push(("uzawa-schur-pcg", p.clone()));
+        }
+        for (strategy, sets) in runs {
+            let row = run_case(exe, case, strategy, &sets, rows.len());
+            progress(&format!(
+                "{:14} {:17} {:>9} dofs  {:>26}  {:8.2} s  {:7.0} MiB  {}",
+                row.case, row.strategy, row.dofs, row.iterations, row.seconds, row.peak_mib, row.outcome
+            ));
+            rows.push(row);
+        }
+    }
+    rows
+}
+
+/// The Markdown page of a study.
+pub fn markdown(rows: &[Row], command: &str) -> String {
+    let mut s = String::from("# Stability: stiff and extreme cases\n\n");
+    let _ = writeln!(
+        s,
+        "Written by `{command}` (do not edit by hand). Each case runs in its own process with the default strategy (`newton-condensed`) and, up to n = 128, with the paper's Uzawa + Schur PCG on a smaller mesh; tolerance 1e-10 on the complementarity residual. Time: set-up to solution; memory: the run's peak resident set. An outcome is \"converged\" only where run.json's residuals meet the tolerance and the answer shows what the case must (all separated for a gap of 1, all stuck for large F, ...); a typed error is a sound outcome, a crash or a wrong answer is not.\n"
+    );
+    let cases = cases();
+    s.push_str("| case | what it stresses | strategy | mesh | unknowns | iterations | complementarity | equilibrium | time (s) | peak (MiB) | outcome |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for r in rows {
+        let why = cases.iter().find(|c| c.name == r.case).map_or("", |c| c.why);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | `{}` | {} | {} | {:.1e} | {:.1e} | {:.2} | {:.0} | {} |",
+            r.case,
+            why,
+            r.strategy,
+            r.sets,
+            r.dofs,
+            r.iterations,
+            r.complementarity,
+            r.equilibrium,
+            r.seconds,
+            r.peak_mib,
+            r.outcome
+        );
+    }
+    let bad = rows.iter().filter(|r| !r.as_expected).count();
+    let _ = writeln!(s, "\n{} runs, {} as expected, {bad} not.", rows.len(), rows.len() - bad);
+    s
+}
+
+/// Runs the study and writes `stability.md` into `dir`; an error if any run is not as expected.
+pub fn write(exe: &Path, quick: bool, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Row>, DriverError> {
+    let rows = study(exe, quick, progress);
+    let command = if quick {
+        "piezocontact stability --quick"
+    } else {
+        "piezocontact stability"
+    };
+    let mut out = Outputs::new(dir);
+    out.add("stability.md", markdown(&rows, command).into_bytes());
+    out.commit()?;
+    let bad: Vec<&str> = rows
+        .iter()
+        .filter(|r| !r.as_expected)
+        .map(|r| r.case.as_str())
+        .collect();
+    if bad.is_empty() {
+        Ok(rows)
+    } else {
+        Err(DriverError::Input(format!("cases not as expected: {}", bad.join(", "))))
+    }
+}
