@@ -52,7 +52,7 @@ pub use uzawa::{
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
 pub enum ContactError {
     /// Uzawa did not reach its tolerance.
-    #[error("Uzawa did not converge in {n_iters} iterations (complementarity residual {residual:.3e}); try a looser solver.tol or the condensed strategy")]
+    #[error("Uzawa did not converge in {n_iters} iterations (complementarity residual {residual:.3e}); try solver.strategy=newton-condensed, or a looser solver.tol")]
     NoConvergence {
         /// Iterations done.
         n_iters: usize,
@@ -60,7 +60,7 @@ pub enum ContactError {
         residual: f64,
     },
     /// The fixed point on the slip bound did not converge.
-    #[error("the friction fixed point did not converge in {n_iters} iterations (residual {residual:.3e}); large friction coefficients may need more")]
+    #[error("the friction fixed point did not converge in {n_iters} iterations (residual {residual:.3e}); the fixed point on S may cycle under strong coupling or large F; try solver.strategy=newton-condensed, which solves Coulomb's law directly")]
     FixedPointNoConvergence {
         /// Iterations done.
         n_iters: usize,

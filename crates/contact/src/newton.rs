@@ -306,6 +306,7 @@ pub fn solve_newton(
         mu_max,
         complementarity: f64::NAN,
         step_backoffs: 0,
+        relaxations: 0,
     };
     let residual = |s: &State| {
         let lambda = flat.to_values(&s.x);

@@ -97,6 +97,8 @@ pub struct UzawaInfo {
     pub complementarity: f64,
     /// Whether a stricter step was needed (divergence detected and the step halved).
     pub step_backoffs: usize,
+    /// Halvings of the friction fixed point's relaxation factor (a residual that did not fall).
+    pub relaxations: usize,
 }
 
 /// A converged contact solution.
@@ -301,6 +303,9 @@ struct Dual<'a, 'b> {
     reference: f64,
     /// Counts so far; `info.step` is the current step.
     info: UzawaInfo,
+    /// A tolerance for the Tresca solves tighter than the rule's, once the friction fixed point
+    /// stalls just above its tolerance (inexact inner solves put a floor under its residual).
+    inner_tol: Option<f64>,
 }
 
 /// Solves the contact problem for `law` through `op`, from `lambda0` (warm start; zeros when
@@ -373,6 +378,7 @@ pub fn solve(
         mu_max,
         complementarity: f64::NAN,
         step_backoffs: 0,
+        relaxations: 0,
     };
     let mut d = Dual {
         c,
@@ -381,6 +387,7 @@ pub fn solve(
         canon,
         reference,
         info,
+        inner_tol: None,
     };
     match law {
         Law::Frictionless | Law::Tresca(_) => {
@@ -394,6 +401,12 @@ pub fn solve(
             // the paper starts from S = 0; a warm start from λ uses F λ_n
             let mut s = slip_bound(points, law, &lambda.normal);
             let mut fresh = false;
+            // relaxation of the fixed point, S ← S + ω (F λ_n - S): ω = 1 is the paper's
+            // iteration; under the tight rule ω halves (down to 1/64) whenever the residual
+            // fails to fall, which damps the two-cycles strong coupling can cause (the fixed
+            // points are the same for every ω > 0)
+            let mut omega = 1.0;
+            let mut previous = f64::INFINITY;
             for l in 1..=params.max_fixed_point {
                 d.info.fixed_point_iters = l;
                 fresh = uzawa(&mut d, &s, &mut lambda, &mut u, progress)?;
@@ -421,7 +434,22 @@ pub fn solve(
                     residual,
                     counts: counts(&status),
                 });
-                s = s_new;
+                if let StopRule::Tight { tol } = params.rule {
+                    if residual >= previous && residual > 100.0 * tol && omega > 1.0 / 64.0 {
+                        omega *= 0.5;
+                        d.info.relaxations += 1;
+                    }
+                    // near the tolerance the inner solves' own error shows: solve them tighter
+                    if residual <= 100.0 * tol {
+                        d.inner_tol = Some(d.inner_tol.unwrap_or(tol).min(0.01 * tol).max(1e-15));
+                    }
+                }
+                previous = residual;
+                s = if omega == 1.0 {
+                    s_new
+                } else {
+                    s.iter().zip(&s_new).map(|(a, b)| a + omega * (b - a)).collect()
+                };
                 if done {
                     break;
                 }
@@ -503,7 +531,7 @@ fn uzawa(
             });
         }
         if let StopRule::Tight { tol } = params.rule {
-            if r <= tol {
+            if r <= d.inner_tol.unwrap_or(tol) {
                 return Ok(true);
             }
         }

@@ -313,6 +313,7 @@ pub fn run_with_reporter(
             "step_r": contact_result.as_ref().map(|(_, s, _)| s.info.step),
             "mu_max": contact_result.as_ref().map(|(_, s, _)| s.info.mu_max),
             "step_backoffs": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.step_backoffs),
+            "fixed_point_relaxations": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.relaxations),
             "condense_route": condense_route,
         },
     });
