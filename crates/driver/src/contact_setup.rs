@@ -203,14 +203,61 @@ pub fn condense(
     b_u: &[f64],
     b_phi: &[f64],
     nt: usize,
-) -> Result<(DenseContactProblem, CondenseRoute), DriverError> {
-    if let Some(problem) = condense_from_factor(boundary, solver, b_u, b_phi, nt)? {
-        return Ok((problem, CondenseRoute::TrailingBlock));
+) -> Result<Condensed, DriverError> {
+    if let Some((problem, forward)) = condense_from_factor(boundary, solver, b_u, b_phi, nt)? {
+        return Ok(Condensed {
+            problem,
+            route: CondenseRoute::TrailingBlock,
+            forward: Some(forward),
+        });
     }
-    Ok((
-        condense_by_solves(boundary, solver, b_u, b_phi, nt)?,
-        CondenseRoute::BlockSolves,
-    ))
+    Ok(Condensed {
+        problem: condense_by_solves(boundary, solver, b_u, b_phi, nt)?,
+        route: CondenseRoute::BlockSolves,
+        forward: None,
+    })
+}
+
+/// The condensed problem, how it was formed, and (trailing-block route) the forward half of
+/// the solve with the loads, which the recovery of `u` and `φ` finishes.
+pub struct Condensed {
+    /// `u_c = u0 - D W λ`.
+    pub problem: DenseContactProblem,
+    /// How `D` was formed.
+    pub route: CondenseRoute,
+    /// `L⁻¹ P [b_u; b_φ]`, where the factor has the contact dofs last.
+    pub forward: Option<Vec<f64>>,
+}
+
+/// `u` and `φ` under the loads and the contact forces of `lambda`. With the forward half of the
+/// loads' solve at hand (contact dofs last), the forces change the right-hand side only on the
+/// trailing indices: their forward half is a dense triangular solve, and one backward sweep
+/// finishes, so the whole contact run costs the same sparse work as one solve.
+pub fn recover(
+    boundary: &ContactBoundary,
+    solver: &mut DirectLdlt,
+    condensed: Condensed,
+    lambda: &PointValues,
+    b_u: &[f64],
+    b_phi: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>), DriverError> {
+    let n_u = b_u.len();
+    if let Some(mut y) = condensed.forward {
+        let mut forces = vec![0.0; n_u];
+        boundary.add_forces(lambda, &mut forces);
+        let d: Vec<f64> = boundary.dofs.iter().map(|&j| forces[j]).collect();
+        if solver.factor().forward_update_trailing(&mut y, &d) {
+            if let Some(mut x) = solver.factor().backward(y) {
+                let phi = x.split_off(n_u);
+                return Ok((x, phi));
+            }
+        }
+    }
+    let mut rhs = b_u.to_vec();
+    boundary.add_forces(lambda, &mut rhs);
+    let (mut u, mut phi) = (vec![0.0; n_u], vec![0.0; b_phi.len()]);
+    solver.solve(&rhs, b_phi, &mut u, &mut phi)?;
+    Ok((u, phi))
 }
 
 /// `u0` (the loads alone) at the contact points.
@@ -235,7 +282,7 @@ fn condense_from_factor(
     b_u: &[f64],
     b_phi: &[f64],
     nt: usize,
-) -> Result<Option<DenseContactProblem>, DriverError> {
+) -> Result<Option<(DenseContactProblem, Vec<f64>)>, DriverError> {
     let k = boundary.dofs.len();
     let fwd = solver.factor().permutation();
     if fwd[fwd.len() - k..] != boundary.dofs[..] {
@@ -273,13 +320,29 @@ fn condense_from_factor(
             d[c * m + r] = v;
         }
     }
-    let u0 = loads_alone(boundary, solver, b_u, b_phi, nt)?;
-    Ok(Some(DenseContactProblem {
-        u0,
-        compliance: d,
-        weight: p.weight.clone(),
-        nt,
-    }))
+    // u0 at the contact dofs from the forward half of the loads' solve and the trailing block
+    let loads: Vec<f64> = b_u.iter().chain(b_phi).copied().collect();
+    let Some(forward) = solver.factor().forward(&loads) else {
+        return Ok(None);
+    };
+    let Some(tail) = solver.factor().trailing_backward(&forward, k) else {
+        return Ok(None);
+    };
+    let mut u_dofs = vec![0.0; b_u.len()];
+    for (j, &dof) in boundary.dofs.iter().enumerate() {
+        u_dofs[dof] = tail[j];
+    }
+    let mut u0 = PointValues::zeros(n, nt);
+    boundary.extract(&u_dofs, &mut u0);
+    Ok(Some((
+        DenseContactProblem {
+            u0,
+            compliance: d,
+            weight: p.weight.clone(),
+            nt,
+        },
+        forward,
+    )))
 }
 
 /// The condensed problem by block solves with the factor of `K`, 64 right-hand sides at a time.

@@ -197,14 +197,15 @@ pub fn run_with_reporter(
         let mut dense_problem = None;
         if let (Some(d), true) = (&mut direct, condensed(&plan.linear_strategy)) {
             let t_condense = Instant::now();
-            let (dense, route) = contact_setup::condense(&cb, d, &b_u, &b_phi, nt)?;
+            let condensed = contact_setup::condense(&cb, d, &b_u, &b_phi, nt)?;
             condense_seconds = t_condense.elapsed().as_secs_f64();
             reporter.line(&format!(
                 "condensed the contact compliance ({m} x {m}, {route:?}) in {condense_seconds:.3} s",
-                m = dense.m()
+                m = condensed.problem.m(),
+                route = condensed.route
             ));
-            condense_route = Some(format!("{route:?}"));
-            dense_problem = Some(dense);
+            condense_route = Some(format!("{:?}", condensed.route));
+            dense_problem = Some(condensed);
         }
         // a line per fixed-point step and per 500 Uzawa steps; the fraction done for a bar,
         // from the residual's way down (log scale) to the tolerance
@@ -228,19 +229,18 @@ pub fn run_with_reporter(
         };
         let sol = match (&mut direct, &mut pcg_solver) {
             (Some(d), _) if dense_problem.is_some() => {
-                let mut dense = dense_problem.take().expect("condensed before the solve");
+                let mut condensed = dense_problem.take().expect("condensed before the solve");
+                let dense = &mut condensed.problem;
                 let sol = if plan.linear_strategy == "newton-condensed" {
                     let newton = NewtonParams {
                         tol: scene.solver.tol,
                         ..Default::default()
                     };
-                    contact::solve_newton(&mut dense, &cb.points, &law, &newton, None, &mut report)?
+                    contact::solve_newton(dense, &cb.points, &law, &newton, None, &mut report)?
                 } else {
-                    contact::solve(&mut dense, &cb.points, &law, &params, None, &mut report)?
+                    contact::solve(dense, &cb.points, &law, &params, None, &mut report)?
                 };
-                let mut rhs = b_u.clone();
-                cb.add_forces(&sol.lambda, &mut rhs);
-                d.solve(&rhs, &b_phi, &mut u, &mut phi)?;
+                (u, phi) = contact_setup::recover(&cb, d, condensed, &sol.lambda, &b_u, &b_phi)?;
                 sol
             }
             (direct, pcg) => {

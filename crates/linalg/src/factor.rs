@@ -7,7 +7,9 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
@@ -376,6 +378,121 @@ impl SparseFactor {
         let rows = w + (s.col_ptr_for_row_idx()[last + 1] - s.col_ptr_for_row_idx()[last]);
         let block = &self.values[s.col_ptr_for_val()[last]..s.col_ptr_for_val()[last + 1]];
         Some((block, rows, w - k))
+    }
+
+    /// The forward half of an `L D Lᵀ` solve: `y = L⁻¹ P x` (in the factor's order), for a
+    /// supernodal `L D Lᵀ` (`None` otherwise). With [`SparseFactor::backward`] it is
+    /// [`SparseFactor::solve_in_place`]; split, a right-hand side that differs from a solved one
+    /// only on the trailing indices needs no second forward sweep
+    /// ([`SparseFactor::forward_update_trailing`]).
+    pub fn forward(&self, x: &[f64]) -> Option<Vec<f64>> {
+        let (sym, fwd) = self.supernodal_ldlt()?;
+        let mut y: Vec<f64> = fwd.iter().map(|&old| x[old]).collect();
+        let f = SupernodalLdltRef::new(sym, &self.values);
+        let mut ym = MatMut::from_column_major_slice_mut(&mut y, self.n(), 1);
+        let mut tmp = vec![];
+        for s in 0..sym.n_supernodes() {
+            let node = f.supernode(s);
+            let ls = node.val();
+            let w = ls.ncols();
+            let (top, bot) = ls.split_at_row(w);
+            let mut x_top = ym.rb_mut().subrows_mut(node.start(), w);
+            faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place(top, x_top.rb_mut(), Par::Seq);
+            let pattern = node.pattern();
+            tmp.clear();
+            tmp.resize(pattern.len(), 0.0);
+            let mut t = MatMut::from_column_major_slice_mut(&mut tmp, pattern.len(), 1);
+            faer::linalg::matmul::matmul(t.rb_mut(), faer::Accum::Replace, bot, x_top.rb(), 1.0, Par::Seq);
+            for (k, &i) in pattern.iter().enumerate() {
+                ym[(i, 0)] -= tmp[k];
+            }
+        }
+        Some(y)
+    }
+
+    /// Adds `L_cc⁻¹ d` to the last `d.len()` entries of a forward result `y`: `y` becomes the
+    /// forward half of the right-hand side plus `d` on the last indices of the factor's order
+    /// (`L` is block lower triangular, so such a change reaches no earlier index). `false`
+    /// where the trailing indices are not all in the last supernode.
+    pub fn forward_update_trailing(&self, y: &mut [f64], d: &[f64]) -> bool {
+        let k = d.len();
+        let Some((block, rows, off)) = self.trailing_block(k) else {
+            return false;
+        };
+        let l = faer::MatRef::from_column_major_slice_with_stride(&block[off * rows + off..], k, k, rows);
+        let mut z = d.to_vec();
+        let zm = MatMut::from_column_major_slice_mut(&mut z, k, 1);
+        faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place(l, zm, Par::Seq);
+        let n = self.n();
+        for (yi, zi) in y[n - k..].iter_mut().zip(&z) {
+            *yi += zi;
+        }
+        true
+    }
+
+    /// The last `k` entries of the solution `Pᵀ L⁻ᵀ D⁻¹ y` (in the factor's order), from the
+    /// trailing block alone (`L⁻ᵀ` is block upper triangular): the solution on the trailing
+    /// indices for the price of a dense `k x k` triangular solve. `None` where the last `k`
+    /// indices are not all in the last supernode.
+    pub fn trailing_backward(&self, y: &[f64], k: usize) -> Option<Vec<f64>> {
+        let (block, rows, off) = self.trailing_block(k)?;
+        let l = faer::MatRef::from_column_major_slice_with_stride(&block[off * rows + off..], k, k, rows);
+        let n = self.n();
+        let mut z: Vec<f64> = (0..k).map(|j| y[n - k + j] / l[(j, j)]).collect();
+        let zm = MatMut::from_column_major_slice_mut(&mut z, k, 1);
+        faer::linalg::triangular_solve::solve_unit_upper_triangular_in_place(l.transpose(), zm, Par::Seq);
+        Some(z)
+    }
+
+    /// The backward half of an `L D Lᵀ` solve: `x = Pᵀ L⁻ᵀ D⁻¹ y` from a forward result `y`
+    /// (consumed). `None` unless the factor is a supernodal `L D Lᵀ`.
+    pub fn backward(&self, mut y: Vec<f64>) -> Option<Vec<f64>> {
+        let (sym, fwd) = self.supernodal_ldlt()?;
+        let f = SupernodalLdltRef::new(sym, &self.values);
+        let n = self.n();
+        let mut ym = MatMut::from_column_major_slice_mut(&mut y, n, 1);
+        for s in 0..sym.n_supernodes() {
+            let node = f.supernode(s);
+            let ls = node.val();
+            for j in 0..ls.ncols() {
+                ym[(node.start() + j, 0)] /= ls[(j, j)];
+            }
+        }
+        let mut tmp = vec![];
+        for s in (0..sym.n_supernodes()).rev() {
+            let node = f.supernode(s);
+            let ls = node.val();
+            let w = ls.ncols();
+            let (top, bot) = ls.split_at_row(w);
+            let pattern = node.pattern();
+            tmp.clear();
+            tmp.extend(pattern.iter().map(|&i| ym[(i, 0)]));
+            let t = faer::MatRef::from_column_major_slice(&tmp, pattern.len(), 1);
+            let mut x_top = ym.rb_mut().subrows_mut(node.start(), w);
+            faer::linalg::matmul::matmul(x_top.rb_mut(), faer::Accum::Add, bot.transpose(), t, -1.0, Par::Seq);
+            faer::linalg::triangular_solve::solve_unit_upper_triangular_in_place(top.transpose(), x_top, Par::Seq);
+        }
+        let mut x = vec![0.0; n];
+        for (new, &old) in fwd.iter().enumerate() {
+            x[old] = y[new];
+        }
+        Some(x)
+    }
+
+    /// The supernodal symbolic factor and the permutation, for an `L D Lᵀ`.
+    fn supernodal_ldlt(
+        &self,
+    ) -> Option<(
+        &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>,
+        Vec<usize>,
+    )> {
+        if self.kind != FactorKind::Ldlt {
+            return None;
+        }
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => Some((s, self.permutation())),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        }
     }
 
     /// Whether the factor is supernodal, with the first column of its last supernode.

@@ -230,6 +230,33 @@ fn check_trailing_block(
     let (n, m) = (a.nrows(), last.len());
     let mut f = DirectLdlt::new(a, g, b, ordering, Par::Seq).unwrap();
     assert_eq!(&f.factor().permutation()[2 * n - m..], last);
+    // the split solve: forward then backward is a solve, and a change of the right-hand side
+    // on the trailing indices needs only the trailing block in the forward half
+    let rhs: Vec<f64> = (0..2 * n).map(|i| ((i * 7 % 11) as f64) - 5.0).collect();
+    let d: Vec<f64> = (0..m).map(|j| 0.5 + j as f64).collect();
+    let mut full = rhs.clone();
+    f.factor_mut().solve_in_place(&mut full);
+    let y = f.factor().forward(&rhs).unwrap();
+    let split = f.factor().backward(y.clone()).unwrap();
+    let tail = f.factor().trailing_backward(&y, m).unwrap();
+    for (j, &i) in last.iter().enumerate() {
+        assert!((tail[j] - full[i]).abs() <= 1e-12 * full.iter().fold(0.0f64, |a, x| a.max(x.abs())));
+    }
+    let scale = full.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    assert!(split.iter().zip(&full).all(|(x, y)| (x - y).abs() <= 1e-12 * scale));
+    let mut changed = rhs.clone();
+    for (j, &i) in last.iter().enumerate() {
+        changed[i] += d[j];
+    }
+    f.factor_mut().solve_in_place(&mut changed);
+    let mut y2 = y;
+    assert!(f.factor().forward_update_trailing(&mut y2, &d));
+    let updated = f.factor().backward(y2).unwrap();
+    let scale = changed.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    assert!(updated
+        .iter()
+        .zip(&changed)
+        .all(|(x, y)| (x - y).abs() <= 1e-12 * scale));
     let begin = f.factor().last_supernode_begin();
     let sc = f
         .factor()
