@@ -251,3 +251,51 @@ fn stability_cases_hold_at_smoke_size() {
         }
     }
 }
+
+/// Hertz's problem in plane strain (scene `hertz`).
+///
+/// - Source: K. L. Johnson, Contact Mechanics (1985), section 4.2: a cylinder of radius R on a
+///   half-plane, load P per unit length, `a² = 4 P R / (π E*)`, `p0 = 2 P / (π a)`,
+///   `p(x) = p0 √(1 - x²/a²)`; here the foundation is rigid, so `E* = E / (1 - ν²)`.
+/// - Goal: the contact pressure of the discrete frictionless problem is Hertz's, which checks
+///   the gap, the Signorini multipliers and their weights against a solution we did not write.
+/// - Sketch: the block (-4,4)x(0,4), E = 100, ν = 0.3, the curvature 1/R = 0.1 in the gap
+///   `g = x²/(2R)`, rollers on the sides, the top pushed down 0.03: P (the reaction) is about
+///   1.84, a about 0.461, p0 about 2.54; the block is 9 half-widths wide and deep.
+/// - Expected at n = 48 (h = 1/12, about a/5.5), measured: peak pressure 0.9 % above p0; the
+///   last point in contact is the last node with |x| < a; the nodal pressure profile within
+///   3.8 % of Hertz's in the discrete L2 norm over |x| ≤ 1.5 a (1.9 % at n = 96, 1.5 % at
+///   n = 192: the rest is the block's finite size).
+/// - Tolerances: peak within 3 % (the nodal peak of a P1 field on a semi-ellipse sampled at
+///   h = a/5.5, plus the 0.4 % finite-size error that remains at n = 192); the edge within one
+///   cell, where the discrete contact zone can only end at a node; the profile within 6 %
+///   (its error is largest in the cell that holds the edge, where √(1 - x²/a²) is steepest).
+#[test]
+fn hertz_pressure_is_johnsons() {
+    let r = run("hertz", &["mesh.n=48"]);
+    let (points, sol) = r.contact.as_ref().unwrap();
+    let p = r.report["contact"]["normal_force"].as_f64().unwrap();
+    let e_star = 100.0 / (1.0 - 0.3f64 * 0.3);
+    let a = (4.0 * p * 10.0 / (std::f64::consts::PI * e_star)).sqrt();
+    let p0 = 2.0 * p / (std::f64::consts::PI * a);
+    let h = 8.0 / 96.0;
+    let peak = sol.lambda.normal.iter().cloned().fold(0.0, f64::max);
+    assert!((peak / p0 - 1.0).abs() < 0.03, "peak {peak} against p0 = {p0}");
+    let edge = points
+        .position
+        .iter()
+        .zip(&sol.lambda.normal)
+        .filter(|(_, &l)| l > 0.0)
+        .map(|(x, _)| x[0].abs())
+        .fold(0.0, f64::max);
+    assert!(edge <= a && a < edge + h, "contact ends at {edge}, a = {a}");
+    let (mut err, mut norm) = (0.0, 0.0);
+    for (x, &l) in points.position.iter().zip(&sol.lambda.normal) {
+        if x[0].abs() <= 1.5 * a {
+            let exact = p0 * (1.0 - x[0] * x[0] / (a * a)).max(0.0).sqrt();
+            err += (l - exact).powi(2);
+            norm += exact * exact;
+        }
+    }
+    assert!((err / norm).sqrt() < 0.06, "profile error {}", (err / norm).sqrt());
+}

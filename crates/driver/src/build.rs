@@ -228,6 +228,26 @@ pub fn constraints(scene: &Scene, plan: &Plan) -> Result<Vec<Constraint>, Driver
                 out.push(Constraint::constant(&d.group, Field::Displacement(k), v));
             }
         }
+        // single components (rollers); with `u` as well, a component would be given twice
+        for (k, v) in [d.ux, d.uy, d.uz].into_iter().enumerate() {
+            let Some(v) = v else { continue };
+            if d.u.is_some() || k >= plan.dim {
+                return Err(DriverError::Input(format!(
+                    "dirichlet on `{}`: u{} is given together with u, or beyond the {}D mesh",
+                    d.group,
+                    ["x", "y", "z"][k],
+                    plan.dim
+                )));
+            }
+            if !v.is_finite() {
+                return Err(DriverError::Input(format!(
+                    "dirichlet on `{}`: u{} = {v} is not finite",
+                    d.group,
+                    ["x", "y", "z"][k]
+                )));
+            }
+            out.push(Constraint::constant(&d.group, Field::Displacement(k), v));
+        }
         if let (Some(phi), true) = (d.phi, plan.electric) {
             out.push(Constraint::constant(&d.group, Field::Potential, phi));
         }

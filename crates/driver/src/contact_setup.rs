@@ -4,6 +4,7 @@
 //! (Delassus operator) formed once from the `L D Lᵀ` factor of `K`: read off its trailing
 //! supernode when the contact dofs were ordered last, else by block solves.
 
+use crate::scene::ContactSpec;
 use crate::DriverError;
 use contact::{ContactOperator, ContactPoints, DenseContactProblem, PointValues};
 use fe_assembly::{facet_measure, Dof, DofMap};
@@ -21,15 +22,19 @@ pub struct ContactBoundary {
 
 /// Builds the contact points: the nodes of `group` whose displacement is entirely free
 /// (clamped nodes are left out), weighted by their lumped boundary mass.
-pub fn boundary(
-    mesh: &mesh::Mesh,
-    dofs: &DofMap,
-    group: &str,
-    normal: &[f64],
-    gap: f64,
-    friction: f64,
-) -> Result<ContactBoundary, DriverError> {
+pub fn boundary(mesh: &mesh::Mesh, dofs: &DofMap, spec: &ContactSpec) -> Result<ContactBoundary, DriverError> {
+    let (group, normal, friction) = (spec.group.as_str(), spec.normal.as_slice(), spec.friction);
     let dim = mesh.dim;
+    let center = match &spec.gap_center {
+        None => [0.0; 3],
+        Some(c) if c.len() == dim => [c[0], c[1], c.get(2).copied().unwrap_or(0.0)],
+        Some(c) => {
+            return Err(DriverError::Input(format!(
+                "contact.gap_center needs {dim} components, not {}",
+                c.len()
+            )))
+        }
+    };
     if normal.len() != dim {
         return Err(DriverError::Input(format!("contact.normal needs {dim} components")));
     }
@@ -80,7 +85,14 @@ pub fn boundary(
         out.points.normal.push(nv);
         out.points.tangent.push(tangents);
         out.points.weight.push(weight[node]);
-        out.points.gap.push(gap);
+        // the gap: uniform, plus the parabola of a curved body along the face
+        let x = mesh.points[node];
+        let d = [x[0] - center[0], x[1] - center[1], x[2] - center[2]];
+        let along_n: f64 = (0..3).map(|k| d[k] * nv[k]).sum();
+        let dist2 = (0..3).map(|k| d[k] * d[k]).sum::<f64>() - along_n * along_n;
+        out.points
+            .gap
+            .push(spec.gap + 0.5 * spec.gap_curvature * dist2.max(0.0));
         out.points.friction.push(friction);
     }
     if out.nodes.is_empty() {

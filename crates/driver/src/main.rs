@@ -182,13 +182,9 @@ fn main() -> ExitCode {
                     return ExitCode::FAILURE;
                 }
             };
-            match driver::stability::write(
-                &exe,
-                quick,
-                std::time::Duration::from_secs(limit),
-                &out,
-                &mut |l| eprintln!("{l}"),
-            ) {
+            match driver::stability::write(&exe, quick, std::time::Duration::from_secs(limit), &out, &mut |l| {
+                eprintln!("{l}")
+            }) {
                 Ok(rows) => {
                     eprintln!(
                         "{} runs as expected; wrote {}",

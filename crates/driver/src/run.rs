@@ -129,9 +129,7 @@ pub fn run_with_reporter(
         ..Default::default()
     };
     let mut contact_boundary = match scene.contact.as_ref() {
-        Some(c) if plan.contact_law != "none" => Some(contact_setup::boundary(
-            &mesh, &disc.dofs, &c.group, &c.normal, c.gap, c.friction,
-        )?),
+        Some(c) if plan.contact_law != "none" => Some(contact_setup::boundary(&mesh, &disc.dofs, c)?),
         _ => None,
     };
     let schur = plan.linear_strategy == "uzawa-schur-pcg";
@@ -315,6 +313,7 @@ pub fn run_with_reporter(
             "step_backoffs": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.step_backoffs),
             "fixed_point_relaxations": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.relaxations),
             "condense_route": condense_route,
+            "smallest_pivot_ratio": direct.as_ref().map(|d| d.factor().pivot_ratio()),
         },
     });
     if let Some(dir) = out_dir {

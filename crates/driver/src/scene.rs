@@ -25,6 +25,7 @@ pub const SHIPPED: &[(&str, &str)] = &[
         "near-incompressible",
         include_str!("../../../scenes/near-incompressible.toml"),
     ),
+    ("hertz", include_str!("../../../scenes/hertz.toml")),
 ];
 
 /// A whole scene.
@@ -148,6 +149,15 @@ pub struct DirichletSpec {
     /// Prescribed displacement (all components), if any.
     #[serde(default)]
     pub u: Option<Vec<f64>>,
+    /// Prescribed x component alone (a roller), if any.
+    #[serde(default)]
+    pub ux: Option<f64>,
+    /// Prescribed y component alone, if any.
+    #[serde(default)]
+    pub uy: Option<f64>,
+    /// Prescribed z component alone, if any.
+    #[serde(default)]
+    pub uz: Option<f64>,
     /// Prescribed potential, if any.
     #[serde(default)]
     pub phi: Option<f64>,
@@ -192,9 +202,17 @@ pub struct ContactSpec {
     /// Tresca slip bound S.
     #[serde(default)]
     pub slip_bound: f64,
-    /// Initial gap g (uniform).
+    /// Initial gap g (uniform part).
     #[serde(default)]
     pub gap: f64,
+    /// Curvature `1/R` of a parabolic gap, `g(x) = gap + |x - c|²_t / (2R)` with `|·|_t` the
+    /// distance along the contact face from `gap_center` (a body of radius R on a flat
+    /// foundation, as in Hertz's problem); 0 by default.
+    #[serde(default)]
+    pub gap_curvature: f64,
+    /// The point `c` of the parabolic gap (default: the origin).
+    #[serde(default)]
+    pub gap_center: Option<Vec<f64>>,
     /// Outward normal of the contact face.
     pub normal: Vec<f64>,
 }
@@ -455,6 +473,10 @@ fn validate(s: &Scene) -> Result<(), String> {
         finite("contact.friction", c.friction)?;
         finite("contact.slip_bound", c.slip_bound)?;
         finite("contact.gap", c.gap)?;
+        finite("contact.gap_curvature", c.gap_curvature)?;
+        for v in c.gap_center.iter().flatten() {
+            finite("contact.gap_center", *v)?;
+        }
         if c.friction < 0.0 {
             return Err(format!("contact.friction = {} must be non-negative", c.friction));
         }

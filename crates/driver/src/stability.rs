@@ -411,7 +411,10 @@ fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize
         }
         (Ok(out), _) if out.status.code().is_none() && started.elapsed() >= limit => {
             row.seconds = started.elapsed().as_secs_f64();
-            row.outcome = format!("not finished in the study's time limit of {} s (stopped)", limit.as_secs());
+            row.outcome = format!(
+                "not finished in the study's time limit of {} s (stopped)",
+                limit.as_secs()
+            );
             // slow is not wrong: the paper's method on a hard case is allowed to take long
             row.as_expected = true;
         }

@@ -18,6 +18,10 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
+/// Below this `|pivot| / |diagonal entry|` a factorisation reports the matrix singular to
+/// working precision ([`LinalgError::NearlySingular`]).
+pub const SINGULAR_PIVOT_RATIO: f64 = 1e-13;
+
 /// Which factorisation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FactorKind {
@@ -60,6 +64,8 @@ pub struct SparseFactor {
     solve_mem: MemBuffer,
     solve_mem_ncols: usize,
     par: Par,
+    /// The smallest `|pivot| / |diagonal entry|` of the last numeric factorisation.
+    pivot_ratio: f64,
 }
 
 impl std::fmt::Debug for SparseFactor {
@@ -141,6 +147,7 @@ impl SparseFactor {
             solve_mem,
             solve_mem_ncols: 1,
             par,
+            pivot_ratio: f64::NAN,
         };
         f.refactor(a)?;
         Ok(f)
@@ -190,7 +197,46 @@ impl SparseFactor {
                 what: format!("factor entry {i} (overflow)"),
             });
         }
+        // a pivot that kept fewer than 3 significant digits of its diagonal entry (the rest
+        // cancelled): the matrix is singular to working precision. The ratio is free of the
+        // units (a diagonal scaling of the matrix scales both alike).
+        let (ratio, at) = self.smallest_pivot_ratio(a);
+        self.pivot_ratio = ratio;
+        if ratio < SINGULAR_PIVOT_RATIO {
+            return Err(LinalgError::NearlySingular { index: at, ratio });
+        }
         Ok(())
+    }
+
+    /// The smallest `|pivot| / |diagonal entry|` of the last numeric factorisation: a measure of
+    /// how close to singular the matrix is (1 for a diagonal matrix; below
+    /// [`SINGULAR_PIVOT_RATIO`] the factorisation is refused).
+    pub fn pivot_ratio(&self) -> f64 {
+        self.pivot_ratio
+    }
+
+    /// The smallest `|d_i| / |a_ii|` over the pivots (`l_ii² / a_ii` for `L Lᵀ`), with the
+    /// original index where it occurs.
+    pub fn smallest_pivot_ratio(&self, a: SparseColMatRef<'_, usize, f64>) -> (f64, usize) {
+        let fwd = self.permutation();
+        let pivots = self.pivots();
+        let mut best = (f64::INFINITY, 0);
+        for (new, &old) in fwd.iter().enumerate() {
+            let col = a.symbolic().row_idx_of_col_raw(old);
+            let diag = col
+                .iter()
+                .position(|&r| r == old)
+                .map_or(0.0, |k| a.val_of_col(old)[k].abs());
+            let d = match self.kind {
+                FactorKind::Ldlt => pivots[new].abs(),
+                FactorKind::Cholesky => pivots[new] * pivots[new],
+            };
+            let ratio = if diag > 0.0 { d / diag } else { f64::INFINITY };
+            if ratio < best.0 {
+                best = (ratio, old);
+            }
+        }
+        best
     }
 
     /// Dimension.

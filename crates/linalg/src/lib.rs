@@ -43,7 +43,7 @@ pub mod sparse;
 pub use coupled::{
     equilibrium_residual, CoupledSolver, DirectLdlt, FactorPreconditioner, SchurOperator, SchurPcg, SolveInfo,
 };
-pub use factor::{FactorKind, Ordering, SparseFactor};
+pub use factor::{FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};
 
 /// What can go wrong in the linear algebra.
@@ -61,6 +61,15 @@ pub enum LinalgError {
     ZeroPivot {
         /// The pivot's index in the factor's order.
         pivot: usize,
+    },
+    /// A pivot lost all but a few digits of its diagonal entry to cancellation: the matrix is
+    /// singular to working precision.
+    #[error("the matrix is singular to working precision at unknown {index} (its pivot is {ratio:.1e} of its diagonal entry): is a rigid-body motion, or a floating potential, left free by the Dirichlet conditions? (contact alone does not hold a body here: every solve needs K invertible)")]
+    NearlySingular {
+        /// The unknown (original index) whose pivot cancelled.
+        index: usize,
+        /// `|pivot| / |diagonal entry|`.
+        ratio: f64,
     },
     /// PCG did not reach its tolerance.
     #[error("PCG did not converge in {n_iters} iterations (relative residual {rel_residual:.3e})")]
