@@ -54,6 +54,14 @@ const MEMORY: usize = 8;
 /// Step halvings of the line search before the direction is given up.
 const MAX_HALVINGS: usize = 30;
 
+/// One row of the generalised Jacobian, `J_r = E_r + B_r C` (`C = c D W`), with `E_r` and `B_r`
+/// sparse: `(index, coefficient)` pairs.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct RowForm {
+    e: Vec<(usize, f64)>,
+    b: Vec<(usize, f64)>,
+}
+
 /// The branch of a point's equations at `z`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Branch {
@@ -123,26 +131,18 @@ impl Flat<'_> {
         State { x, u, z, f, norm }
     }
 
-    /// The Newton direction `J δ = -f` at `s`, with `J` a generalised Jacobian of the
-    /// equations; `None` where `J` is singular.
-    fn direction(&self, s: &State) -> Option<Vec<f64>> {
-        let (n, nt, m, c) = (self.n, self.nt, self.m, self.c);
-        let d = &self.p.compliance;
-        // row r of M = I - c D W, the derivative of z
-        let m_row = |r: usize, col: usize| -> f64 {
-            let id = if r == col { 1.0 } else { 0.0 };
-            id - c * d[r * m + col] * self.w[col]
-        };
-        // Jᵀ, column-major: row r of J is column r of Jᵀ, written contiguously
-        let mut jt = Mat::<f64>::zeros(m, m);
+    /// The rows of a generalised Jacobian at `s`, each as `J_r = E_r + B_r C` with
+    /// `C = c D W` (so that `M = I - C` is the derivative of `z`) and `E_r`, `B_r` sparse over
+    /// the point's own components.
+    fn rows(&self, s: &State) -> Vec<RowForm> {
+        let (n, nt) = (self.n, self.nt);
+        let mut rows = vec![RowForm::default(); self.m];
         for i in 0..n {
-            // normal: [z_n]₊ has derivative 1 (contact) or 0 (separated)
+            // normal: [z_n]₊ has derivative 1 (contact: J = C) or 0 (separated: J = I)
             if s.z[i] > 0.0 {
-                for col in 0..m {
-                    jt[(col, i)] = c * d[i * m + col] * self.w[col];
-                }
+                rows[i].b.push((i, 1.0));
             } else {
-                jt[(i, i)] = 1.0;
+                rows[i].e.push((i, 1.0));
             }
             if nt == 0 {
                 continue;
@@ -158,44 +158,54 @@ impl Flat<'_> {
             } else {
                 Branch::Slip
             };
-            match branch {
-                Branch::Stick => {
-                    // λ_t - z_t: derivative c D W
-                    for k in 0..nt {
-                        for col in 0..m {
-                            jt[(col, t + k)] = c * d[(t + k) * m + col] * self.w[col];
-                        }
-                    }
-                }
-                Branch::Separated => {
+            for k in 0..nt {
+                let row = &mut rows[t + k];
+                match branch {
+                    // λ_t - z_t: derivative C
+                    Branch::Stick => row.b.push((t + k, 1.0)),
                     // λ_t - P_0(z_t) = λ_t (a zero radius): the identity
-                    for k in 0..nt {
-                        jt[(t + k, t + k)] = 1.0;
-                    }
-                }
-                Branch::Slip => {
-                    // λ_t - S q/|q|: derivative I - (S/|q|)(I - q̂q̂ᵀ) M_t - q̂ dS
-                    let qh: Vec<f64> = q.iter().map(|v| v / qn).collect();
-                    let ratio = radius / qn;
-                    let coulomb_slope = match self.law {
-                        Law::Coulomb if s.z[i] > 0.0 => self.points.friction[i],
-                        _ => 0.0,
-                    };
-                    for k in 0..nt {
-                        for col in 0..m {
-                            let mut v = if t + k == col { 1.0 } else { 0.0 };
-                            for l in 0..nt {
-                                let proj = if k == l { 1.0 } else { 0.0 } - qh[k] * qh[l];
-                                if proj != 0.0 {
-                                    v -= ratio * proj * m_row(t + l, col);
-                                }
+                    Branch::Separated => row.e.push((t + k, 1.0)),
+                    Branch::Slip => {
+                        // λ_t - S q/|q|: derivative I - (S/|q|)(I - q̂q̂ᵀ) M_t - q̂ dS, with
+                        // dS = F M_n for Coulomb at a contact point
+                        let ratio = radius / qn;
+                        let slope = match self.law {
+                            Law::Coulomb if s.z[i] > 0.0 => self.points.friction[i],
+                            _ => 0.0,
+                        };
+                        row.e.push((t + k, 1.0));
+                        for l in 0..nt {
+                            let proj = if k == l { 1.0 } else { 0.0 } - q[k] * q[l] / (qn * qn);
+                            if proj != 0.0 {
+                                row.e.push((t + l, -ratio * proj));
+                                row.b.push((t + l, ratio * proj));
                             }
-                            if coulomb_slope > 0.0 {
-                                v -= qh[k] * coulomb_slope * m_row(i, col);
-                            }
-                            jt[(col, t + k)] = v;
+                        }
+                        if slope > 0.0 {
+                            row.e.push((i, -q[k] / qn * slope));
+                            row.b.push((i, q[k] / qn * slope));
                         }
                     }
+                }
+            }
+        }
+        rows
+    }
+
+    /// The Newton direction `J δ = -f` by one LU of the whole `m x m` Jacobian; `None` where
+    /// it is singular.
+    fn direction(&self, s: &State, rows: &[RowForm]) -> Option<Vec<f64>> {
+        let (m, c) = (self.m, self.c);
+        let d = &self.p.compliance;
+        // Jᵀ, column-major: row r of J is column r of Jᵀ, written contiguously
+        let mut jt = Mat::<f64>::zeros(m, m);
+        for (r, form) in rows.iter().enumerate() {
+            for &(j, v) in &form.e {
+                jt[(j, r)] += v;
+            }
+            for &(j, v) in &form.b {
+                for col in 0..m {
+                    jt[(col, r)] += v * c * d[j * m + col] * self.w[col];
                 }
             }
         }
@@ -203,6 +213,63 @@ impl Flat<'_> {
         let mut rhs = Mat::<f64>::from_fn(m, 1, |r, _| -s.f[r]);
         lu.solve_transpose_in_place(rhs.as_mut());
         let delta: Vec<f64> = (0..m).map(|r| rhs[(r, 0)]).collect();
+        delta.iter().all(|v| v.is_finite()).then_some(delta)
+    }
+
+    /// The same direction through `y = C δ`: `(E C⁻¹ + B) y = -f`, whose rows are the identity
+    /// at every point in contact and sticking (`E_r = 0`, `B_r = e_r`), so that only the rows of
+    /// sliding and separated points form a dense system (`N x N`, often far smaller than
+    /// `m x m`, and empty when every point sticks); then `δ = C⁻¹ y`. `stiffness` is `D⁻¹`
+    /// (row-major). `None` where the reduced system is singular.
+    fn direction_reduced(&self, s: &State, rows: &[RowForm], stiffness: &[f64]) -> Option<Vec<f64>> {
+        let (m, c) = (self.m, self.c);
+        let identity = |r: usize, form: &RowForm| form.e.is_empty() && form.b == [(r, 1.0)];
+        let mut slot = vec![usize::MAX; m];
+        let others: Vec<usize> = (0..m).filter(|&r| !identity(r, &rows[r])).collect();
+        for (k, &r) in others.iter().enumerate() {
+            slot[r] = k;
+        }
+        // y on the identity rows is -f there
+        let mut y: Vec<f64> = (0..m)
+            .map(|r| if slot[r] == usize::MAX { -s.f[r] } else { 0.0 })
+            .collect();
+        let nn = others.len();
+        if nn > 0 {
+            // rows of M = E C⁻¹ + B on the other rows; C⁻¹ = W⁻¹ D⁻¹ / c
+            let mut mnn = Mat::<f64>::zeros(nn, nn);
+            let mut rhs = Mat::<f64>::zeros(nn, 1);
+            let mut row = vec![0.0; m];
+            for (k, &r) in others.iter().enumerate() {
+                row.iter_mut().for_each(|v| *v = 0.0);
+                for &(j, v) in &rows[r].e {
+                    let scale = v / (c * self.w[j]);
+                    for (x, dj) in row.iter_mut().zip(&stiffness[j * m..(j + 1) * m]) {
+                        *x += scale * dj;
+                    }
+                }
+                for &(j, v) in &rows[r].b {
+                    row[j] += v;
+                }
+                let mut b = -s.f[r];
+                for col in 0..m {
+                    if slot[col] == usize::MAX {
+                        b -= row[col] * y[col];
+                    } else {
+                        mnn[(k, slot[col])] = row[col];
+                    }
+                }
+                rhs[(k, 0)] = b;
+            }
+            let lu = mnn.partial_piv_lu();
+            lu.solve_in_place(rhs.as_mut());
+            for (k, &r) in others.iter().enumerate() {
+                y[r] = rhs[(k, 0)];
+            }
+        }
+        // δ = C⁻¹ y
+        let delta: Vec<f64> = (0..m)
+            .map(|r| crate::operator::dot8(&stiffness[r * m..(r + 1) * m], &y) / (c * self.w[r]))
+            .collect();
         delta.iter().all(|v| v.is_finite()).then_some(delta)
     }
 
@@ -314,6 +381,21 @@ pub fn solve_newton(
         let radius = slip_bound(points, law, &lambda.normal);
         complementarity_residual(points, &radius, &lambda, &u, c, reference)
     };
+    // D⁻¹ once (the compliance is SPD): each Newton step then solves only on the rows of the
+    // sliding and separated points; without it, on the whole Jacobian
+    let stiffness = {
+        let d = Mat::<f64>::from_fn(m, m, |i, j| problem.compliance[i * m + j]);
+        d.llt(faer::Side::Lower).ok().map(|llt| {
+            let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);
+            let mut flat = vec![0.0; m * m];
+            for i in 0..m {
+                for j in 0..m {
+                    flat[i * m + j] = inv[(i, j)];
+                }
+            }
+            flat
+        })
+    };
     let mut s = flat.state(x0);
     let mut r = residual(&s);
     let mut stalled = None;
@@ -323,7 +405,9 @@ pub fn solve_newton(
             stalled = Some("the iteration limit");
             break;
         }
-        let Some(delta) = flat.direction(&s) else {
+        let rows = flat.rows(&s);
+        let reduced = stiffness.as_deref().and_then(|k| flat.direction_reduced(&s, &rows, k));
+        let Some(delta) = reduced.or_else(|| flat.direction(&s, &rows)) else {
             stalled = Some("a singular Newton matrix");
             break;
         };
@@ -410,4 +494,87 @@ pub fn solve_newton(
         u,
         info,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reduced Newton solve (through `y = C δ`, on the sliding and separated rows only)
+    /// gives the direction of the full LU, at states with every branch present.
+    #[test]
+    fn reduced_direction_is_the_full_one() {
+        for (case, law) in [Law::Coulomb, Law::Tresca(vec![0.05; 5]), Law::Frictionless]
+            .into_iter()
+            .enumerate()
+        {
+            for dim in [2, 3] {
+                let n = 5;
+                let nt = if matches!(law, Law::Frictionless) { 0 } else { dim - 1 };
+                let m = n * (1 + nt);
+                let points = ContactPoints {
+                    dim,
+                    position: vec![[0.0; 3]; n],
+                    normal: vec![[0.0, 0.0, -1.0]; n],
+                    tangent: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; n],
+                    weight: (0..n).map(|i| 0.5 + 0.1 * i as f64).collect(),
+                    gap: vec![0.0; n],
+                    friction: vec![0.3; n],
+                };
+                // an SPD compliance: a Gram matrix plus the identity
+                let g = |i: usize, j: usize| ((i * 7 + j * 3 + case) % 5) as f64 * 0.1 - 0.2;
+                let compliance: Vec<f64> = (0..m * m)
+                    .map(|k| {
+                        let (i, j) = (k / m, k % m);
+                        (0..m).map(|l| g(i, l) * g(j, l)).sum::<f64>() + if i == j { 1.0 } else { 0.0 }
+                    })
+                    .collect();
+                let u0: Vec<f64> = (0..m).map(|r| (r as f64 * 1.7).sin()).collect();
+                let problem = DenseContactProblem {
+                    u0: PointValues {
+                        normal: u0[..n].to_vec(),
+                        tangential: u0[n..].to_vec(),
+                    },
+                    compliance: compliance.clone(),
+                    weight: points.weight.clone(),
+                    nt,
+                };
+                let flat = Flat {
+                    p: &problem,
+                    points: &points,
+                    law: &law,
+                    n,
+                    nt,
+                    m,
+                    c: 0.7,
+                    w: (0..m)
+                        .map(|j| points.weight[if j < n { j } else { (j - n) / nt }])
+                        .collect(),
+                    u0,
+                };
+                let inv = Mat::<f64>::from_fn(m, m, |i, j| compliance[i * m + j])
+                    .llt(faer::Side::Lower)
+                    .map(|l| faer::linalg::solvers::DenseSolveCore::inverse(&l))
+                    .unwrap();
+                let stiffness: Vec<f64> = (0..m * m).map(|k| inv[(k / m, k % m)]).collect();
+                let x: Vec<f64> = (0..m).map(|r| 0.8 * (r as f64 * 2.3 + 0.4).cos()).collect();
+                let s = flat.state(x);
+                let rows = flat.rows(&s);
+                // both kinds of rows are present, so the reduction is exercised
+                let reduced_rows = (0..m)
+                    .filter(|&r| !(rows[r].e.is_empty() && rows[r].b == [(r, 1.0)]))
+                    .count();
+                assert!(
+                    reduced_rows > 0 && reduced_rows < m,
+                    "{law:?} {dim}D: {reduced_rows} of {m}"
+                );
+                let full = flat.direction(&s, &rows).unwrap();
+                let reduced = flat.direction_reduced(&s, &rows, &stiffness).unwrap();
+                let scale = full.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                for (a, b) in full.iter().zip(&reduced) {
+                    assert!((a - b).abs() <= 1e-10 * scale, "{law:?} {dim}D: {a} vs {b}");
+                }
+            }
+        }
+    }
 }
