@@ -266,9 +266,16 @@ impl Flat<'_> {
                 y[r] = rhs[(k, 0)];
             }
         }
-        // δ = C⁻¹ y
+        // δ = C⁻¹ y; on a row that is the identity in J (a separated point: E_r = e_r, B_r = 0)
+        // δ_r = -f_r exactly, which sets its multiplier to exactly zero, not to round-off
         let delta: Vec<f64> = (0..m)
-            .map(|r| crate::operator::dot8(&stiffness[r * m..(r + 1) * m], &y) / (c * self.w[r]))
+            .map(|r| {
+                if rows[r].b.is_empty() && rows[r].e == [(r, 1.0)] {
+                    -s.f[r]
+                } else {
+                    crate::operator::dot8(&stiffness[r * m..(r + 1) * m], &y) / (c * self.w[r])
+                }
+            })
             .collect();
         delta.iter().all(|v| v.is_finite()).then_some(delta)
     }
