@@ -474,19 +474,21 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     s.push_str("| case | what it stresses | strategy | mesh | unknowns | iterations | complementarity | equilibrium | time (s) | peak (MiB) | outcome |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         let why = cases.iter().find(|c| c.name == r.case).map_or("", |c| c.why);
+        // a run that stopped has no report: its numbers are left blank, not NaN
+        let num = |v: f64, text: String| if v.is_finite() { text } else { "-".into() };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | `{}` | {} | {} | {:.1e} | {:.1e} | {:.2} | {:.0} | {} |",
+            "| {} | {} | {} | `{}` | {} | {} | {} | {} | {:.2} | {} | {} |",
             r.case,
             why,
             r.strategy,
             r.sets,
-            r.dofs,
+            if r.dofs > 0 { r.dofs.to_string() } else { "-".into() },
             r.iterations,
-            r.complementarity,
-            r.equilibrium,
+            num(r.complementarity, format!("{:.1e}", r.complementarity)),
+            num(r.equilibrium, format!("{:.1e}", r.equilibrium)),
             r.seconds,
-            r.peak_mib,
+            num(r.peak_mib, format!("{:.0}", r.peak_mib)),
             r.outcome
         );
     }
