@@ -16,7 +16,9 @@
 use crate::operator::DenseContactProblem;
 use crate::points::{ContactPoints, PointValues};
 use crate::projection::project_disc;
-use crate::uzawa::{classify, complementarity_residual, estimate_mu_max, slip_bound, Counter};
+use crate::uzawa::{
+    check_input, classify, complementarity_residual, estimate_mu_max, multiplier_scale, slip_bound, Counter,
+};
 use crate::{ContactError, ContactSolution, Law, Progress, StopRule, UzawaInfo, UzawaParams};
 use faer::linalg::solvers::Solve;
 use faer::Mat;
@@ -302,28 +304,16 @@ pub fn solve_newton(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    points.validate().map_err(ContactError::Input)?;
-    let n = points.len();
-    let nt = if matches!(law, Law::Frictionless) {
-        0
+    let nt_given = if problem.compliance.len() == problem.m() * problem.m() {
+        problem.nt
     } else {
-        points.n_tangential()
-    };
-    if problem.weight.len() != n || problem.nt != nt || problem.compliance.len() != problem.m() * problem.m() {
         return Err(ContactError::Input(format!(
-            "condensed problem has {} points with {} tangential components and {} compliance entries; expected {n} points with {nt}",
-            problem.weight.len(),
-            problem.nt,
-            problem.compliance.len()
+            "the compliance has {} entries, not ({})²",
+            problem.compliance.len(),
+            problem.m()
         )));
-    }
-    if let Law::Tresca(s) = law {
-        if s.len() != n || s.iter().any(|x| !(*x >= 0.0 && x.is_finite())) {
-            return Err(ContactError::Input(
-                "Tresca slip bounds: one finite non-negative value per point".into(),
-            ));
-        }
-    }
+    };
+    let (n, nt) = check_input(points, law, problem.weight.len(), nt_given)?;
     if !(params.tol > 0.0) {
         return Err(ContactError::Input(format!(
             "Newton tolerance {} must be positive",
@@ -333,11 +323,7 @@ pub fn solve_newton(
     let (mu_max, reference) = {
         let mut counter = Counter::new(problem);
         let (mu, u0) = estimate_mu_max(&mut counter, points, nt, params.power_iters)?;
-        let free = PointValues {
-            normal: u0.normal.iter().zip(&points.gap).map(|(u, g)| u - g).collect(),
-            tangential: u0.tangential.clone(),
-        };
-        (mu, free.weighted_norm(&points.weight) / mu)
+        (mu, multiplier_scale(points, &u0, 1.0 / mu))
     };
     let c = 1.0 / mu_max;
     let m = n * (1 + nt);

@@ -280,6 +280,46 @@ pub(crate) fn estimate_mu_max(
     Ok((mu, u0))
 }
 
+/// Checks the points, the law's data, and the size of the problem (`n_points` points with
+/// `n_tangential` tangential components each) against them; returns `(n, nt)`.
+pub(crate) fn check_input(
+    points: &ContactPoints,
+    law: &Law,
+    n_points: usize,
+    n_tangential: usize,
+) -> Result<(usize, usize), ContactError> {
+    points.validate().map_err(ContactError::Input)?;
+    let n = points.len();
+    let nt = if matches!(law, Law::Frictionless) {
+        0
+    } else {
+        points.n_tangential()
+    };
+    if n_points != n || n_tangential != nt {
+        return Err(ContactError::Input(format!(
+            "the problem has {n_points} points with {n_tangential} tangential components; expected {n} with {nt}"
+        )));
+    }
+    if let Law::Tresca(s) = law {
+        if s.len() != n || s.iter().any(|x| !(*x >= 0.0 && x.is_finite())) {
+            return Err(ContactError::Input(
+                "Tresca slip bounds: one finite non-negative value per point".into(),
+            ));
+        }
+    }
+    Ok((n, nt))
+}
+
+/// The multiplier scale of the problem, `c ‖u(0) - g‖_W` (the floor of the residual's
+/// denominator, see [`complementarity_residual`]).
+pub(crate) fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64 {
+    let free = PointValues {
+        normal: u0.normal.iter().zip(&points.gap).map(|(u, g)| u - g).collect(),
+        tangential: u0.tangential.clone(),
+    };
+    c * free.weighted_norm(&points.weight)
+}
+
 /// The accelerated iteration's memory: the momentum weight and the previous projected iterate.
 struct Momentum {
     t: f64,
@@ -318,27 +358,7 @@ pub fn solve(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    points.validate().map_err(ContactError::Input)?;
-    let n = points.len();
-    let nt = if matches!(law, Law::Frictionless) {
-        0
-    } else {
-        points.n_tangential()
-    };
-    if op.n_points() != n || op.n_tangential() != nt {
-        return Err(ContactError::Input(format!(
-            "operator has {} points with {} tangential components; expected {n} with {nt}",
-            op.n_points(),
-            op.n_tangential()
-        )));
-    }
-    if let Law::Tresca(s) = law {
-        if s.len() != n || s.iter().any(|x| !(*x >= 0.0 && x.is_finite())) {
-            return Err(ContactError::Input(
-                "Tresca slip bounds: one finite non-negative value per point".into(),
-            ));
-        }
-    }
+    let (n, nt) = check_input(points, law, op.n_points(), op.n_tangential())?;
     let mut c = Counter::new(op);
     let (mu_max, u0) = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
     let estimate_inner = c.inner;
@@ -357,12 +377,7 @@ pub fn solve(
         return Err(ContactError::Input(format!("Uzawa step {step} must be positive")));
     }
     let canon = 1.0 / mu_max;
-    // the multiplier scale of the problem: c ‖u(0) - g‖_W
-    let free = PointValues {
-        normal: u0.normal.iter().zip(&points.gap).map(|(u, g)| u - g).collect(),
-        tangential: u0.tangential.clone(),
-    };
-    let reference = canon * free.weighted_norm(&points.weight);
+    let reference = multiplier_scale(points, &u0, canon);
     let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
     let mut u = PointValues::zeros(n, nt);
     let info = UzawaInfo {

@@ -475,7 +475,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     for r in rows {
         let why = cases.iter().find(|c| c.name == r.case).map_or("", |c| c.why);
         // a run that stopped has no report: its numbers are left blank, not NaN
-        let num = |v: f64, text: String| if v.is_finite() { text } else { "-".into() };
+        let shown = |v: f64, text: String| if v.is_finite() { text } else { "-".into() };
         let _ = writeln!(
             s,
             "| {} | {} | {} | `{}` | {} | {} | {} | {} | {:.2} | {} | {} |",
@@ -485,10 +485,10 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
             r.sets,
             if r.dofs > 0 { r.dofs.to_string() } else { "-".into() },
             r.iterations,
-            num(r.complementarity, format!("{:.1e}", r.complementarity)),
-            num(r.equilibrium, format!("{:.1e}", r.equilibrium)),
+            shown(r.complementarity, format!("{:.1e}", r.complementarity)),
+            shown(r.equilibrium, format!("{:.1e}", r.equilibrium)),
             r.seconds,
-            num(r.peak_mib, format!("{:.0}", r.peak_mib)),
+            shown(r.peak_mib, format!("{:.0}", r.peak_mib)),
             r.outcome
         );
     }
