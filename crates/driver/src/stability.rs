@@ -220,7 +220,7 @@ pub fn cases() -> Vec<Case> {
             "paper",
             vec!["mesh.n=512"],
             None,
-            AllStick,
+            NoneSeparated, // the points next to the clamped corners may slide on fine meshes
             true,
         ),
         c(
@@ -229,7 +229,7 @@ pub fn cases() -> Vec<Case> {
             "paper",
             vec!["mesh.n=1024"],
             None,
-            AllStick,
+            NoneSeparated,
             true,
         ),
         c(
@@ -506,13 +506,13 @@ pub fn write(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<Row>, DriverError> {
     let rows = study(exe, quick, limit, progress);
-    let command = if quick {
-        "piezocontact stability --quick"
-    } else {
-        "piezocontact stability"
-    };
+    let command = format!(
+        "piezocontact stability{} --limit {}",
+        if quick { " --quick" } else { "" },
+        limit.as_secs()
+    );
     let mut out = Outputs::new(dir);
-    out.add("stability.md", markdown(&rows, command).into_bytes());
+    out.add("stability.md", markdown(&rows, &command).into_bytes());
     out.commit()?;
     let bad: Vec<&str> = rows
         .iter()
