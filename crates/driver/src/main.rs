@@ -76,7 +76,8 @@ enum Command {
         /// Directory for stability.md.
         #[arg(long, default_value = "docs")]
         out: PathBuf,
-        /// Time limit per run, in seconds.
+        /// Time limit per run of the paper's strategy, in seconds (the default strategy gets
+        /// 1800 s at least).
         #[arg(long, default_value_t = 600)]
         limit: u64,
     },
