@@ -353,21 +353,7 @@ pub fn solve_newton(
         Some(_) => return Err(ContactError::Input("warm start of the wrong size".into())),
         None => vec![0.0; m],
     };
-    let mut info = UzawaInfo {
-        uzawa_iters: 0,
-        newton_iters: 0,
-        line_search_cuts: 0,
-        fallback: false,
-        fixed_point_iters: 0,
-        inner_iters: 0,
-        estimate_inner_iters: 0,
-        operator_calls: 0,
-        step: c,
-        mu_max,
-        complementarity: f64::NAN,
-        step_backoffs: 0,
-        relaxations: 0,
-    };
+    let mut info = UzawaInfo::new(c, mu_max);
     let residual = |s: &State| {
         let lambda = flat.to_values(&s.x);
         let u = flat.to_values(&s.u);

@@ -101,6 +101,27 @@ pub struct UzawaInfo {
     pub relaxations: usize,
 }
 
+impl UzawaInfo {
+    /// Counts at zero for a solve with this step (or Newton augmentation) and `μ_max`.
+    pub(crate) fn new(step: f64, mu_max: f64) -> Self {
+        UzawaInfo {
+            uzawa_iters: 0,
+            newton_iters: 0,
+            line_search_cuts: 0,
+            fallback: false,
+            fixed_point_iters: 0,
+            inner_iters: 0,
+            estimate_inner_iters: 0,
+            operator_calls: 0,
+            step,
+            mu_max,
+            complementarity: f64::NAN,
+            step_backoffs: 0,
+            relaxations: 0,
+        }
+    }
+}
+
 /// A converged contact solution.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactSolution {
@@ -380,21 +401,7 @@ pub fn solve(
     let reference = multiplier_scale(points, &u0, canon);
     let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
     let mut u = PointValues::zeros(n, nt);
-    let info = UzawaInfo {
-        uzawa_iters: 0,
-        newton_iters: 0,
-        line_search_cuts: 0,
-        fallback: false,
-        fixed_point_iters: 0,
-        inner_iters: 0,
-        estimate_inner_iters: 0,
-        operator_calls: 0,
-        step,
-        mu_max,
-        complementarity: f64::NAN,
-        step_backoffs: 0,
-        relaxations: 0,
-    };
+    let info = UzawaInfo::new(step, mu_max);
     let mut d = Dual {
         c,
         points,

@@ -320,12 +320,12 @@ impl SparseFactor {
     /// complement of the matrix onto those dofs. `None` unless the factor is a supernodal
     /// `L D Lᵀ` whose last supernode holds all `k` columns.
     pub fn trailing_schur_complement(&self, k: usize) -> Option<Vec<f64>> {
-        let (block, rows, off) = self.trailing_block(k)?;
+        let corner = self.trailing_block(k)?;
         // S_c = (L_cc D_c) L_ccᵀ by one dense product
-        let d: Vec<f64> = (0..k).map(|j| block[(off + j) * rows + off + j]).collect();
+        let d: Vec<f64> = (0..k).map(|j| corner[(j, j)]).collect();
         let l = faer::Mat::<f64>::from_fn(k, k, |i, j| match i.cmp(&j) {
             std::cmp::Ordering::Equal => 1.0,
-            std::cmp::Ordering::Greater => block[(off + j) * rows + off + i],
+            std::cmp::Ordering::Greater => corner[(i, j)],
             std::cmp::Ordering::Less => 0.0,
         });
         let mut ld = l.clone();
@@ -343,15 +343,7 @@ impl SparseFactor {
             1.0,
             self.par,
         );
-        let mut out = vec![0.0; k * k];
-        for i in 0..k {
-            for j in 0..=i {
-                let v = 0.5 * (prod[(i, j)] + prod[(j, i)]);
-                out[i * k + j] = v;
-                out[j * k + i] = v;
-            }
-        }
-        Some(out)
+        Some(symmetric_row_major(&prod))
     }
 
     /// The inverse of [`SparseFactor::trailing_schur_complement`], `S_c⁻¹ = L_cc⁻ᵀ D_c⁻¹ L_cc⁻¹`
@@ -361,10 +353,9 @@ impl SparseFactor {
     /// [`LinalgError::NotPositiveDefinite`] where a pivot of the block is not positive (the
     /// block of a quasi-definite matrix on its positive-definite dofs has only positive ones).
     pub fn trailing_schur_inverse(&self, k: usize) -> Result<Option<Vec<f64>>, LinalgError> {
-        let Some((block, rows, off)) = self.trailing_block(k) else {
+        let Some(l) = self.trailing_block(k) else {
             return Ok(None);
         };
-        let l = faer::MatRef::from_column_major_slice_with_stride(&block[off * rows + off..], k, k, rows);
         let d: Vec<f64> = (0..k).map(|j| l[(j, j)]).collect();
         if let Some(j) = d.iter().position(|x| !(*x > 0.0)) {
             return Err(LinalgError::NotPositiveDefinite {
@@ -395,20 +386,13 @@ impl SparseFactor {
             1.0,
             self.par,
         );
-        let mut out = vec![0.0; k * k];
-        for i in 0..k {
-            for j in 0..=i {
-                let v = 0.5 * (prod[(i, j)] + prod[(j, i)]);
-                out[i * k + j] = v;
-                out[j * k + i] = v;
-            }
-        }
-        Ok(Some(out))
+        Ok(Some(symmetric_row_major(&prod)))
     }
 
-    /// The values of the last supernode, its row count, and the offset of the last `k`
-    /// columns in it, when the factor is a supernodal `L D Lᵀ` whose last supernode holds them.
-    fn trailing_block(&self, k: usize) -> Option<(&[f64], usize, usize)> {
+    /// The trailing `k x k` corner of the factor, `D_c` on its diagonal and `L_cc` below it (a
+    /// view into the last supernode), when the factor is a supernodal `L D Lᵀ` whose last
+    /// supernode holds the last `k` columns.
+    fn trailing_block(&self, k: usize) -> Option<faer::MatRef<'_, f64>> {
         if self.kind != FactorKind::Ldlt || k == 0 || k > self.n() {
             return None;
         }
@@ -423,7 +407,13 @@ impl SparseFactor {
         let w = end - begin;
         let rows = w + (s.col_ptr_for_row_idx()[last + 1] - s.col_ptr_for_row_idx()[last]);
         let block = &self.values[s.col_ptr_for_val()[last]..s.col_ptr_for_val()[last + 1]];
-        Some((block, rows, w - k))
+        let off = w - k;
+        Some(faer::MatRef::from_column_major_slice_with_stride(
+            &block[off * rows + off..],
+            k,
+            k,
+            rows,
+        ))
     }
 
     /// The forward half of an `L D Lᵀ` solve: `y = L⁻¹ P x` (in the factor's order), for a
@@ -462,10 +452,9 @@ impl SparseFactor {
     /// where the trailing indices are not all in the last supernode.
     pub fn forward_update_trailing(&self, y: &mut [f64], d: &[f64]) -> bool {
         let k = d.len();
-        let Some((block, rows, off)) = self.trailing_block(k) else {
+        let Some(l) = self.trailing_block(k) else {
             return false;
         };
-        let l = faer::MatRef::from_column_major_slice_with_stride(&block[off * rows + off..], k, k, rows);
         let mut z = d.to_vec();
         let zm = MatMut::from_column_major_slice_mut(&mut z, k, 1);
         faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place(l, zm, Par::Seq);
@@ -481,8 +470,7 @@ impl SparseFactor {
     /// indices for the price of a dense `k x k` triangular solve. `None` where the last `k`
     /// indices are not all in the last supernode.
     pub fn trailing_backward(&self, y: &[f64], k: usize) -> Option<Vec<f64>> {
-        let (block, rows, off) = self.trailing_block(k)?;
-        let l = faer::MatRef::from_column_major_slice_with_stride(&block[off * rows + off..], k, k, rows);
+        let l = self.trailing_block(k)?;
         let n = self.n();
         let mut z: Vec<f64> = (0..k).map(|j| y[n - k + j] / l[(j, j)]).collect();
         let zm = MatMut::from_column_major_slice_mut(&mut z, k, 1);
@@ -582,6 +570,21 @@ fn inverse_permutation(fwd: &[usize]) -> Result<Vec<usize>, LinalgError> {
         inv[old] = new;
     }
     Ok(inv)
+}
+
+/// `(M + Mᵀ)/2` of a square matrix, row-major: a product that is symmetric in exact arithmetic,
+/// with its round-off asymmetry removed.
+fn symmetric_row_major(m: &faer::Mat<f64>) -> Vec<f64> {
+    let k = m.nrows();
+    let mut out = vec![0.0; k * k];
+    for i in 0..k {
+        for j in 0..=i {
+            let v = 0.5 * (m[(i, j)] + m[(j, i)]);
+            out[i * k + j] = v;
+            out[j * k + i] = v;
+        }
+    }
+    out
 }
 
 /// A mask of `last` among `0..n`; an error names an index out of range or repeated.
