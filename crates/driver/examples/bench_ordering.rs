@@ -60,7 +60,7 @@ fn main() {
         ("amd-contact-last", Ordering::AmdThenLast(contact_dofs)),
     ] {
         let (mut sym, mut num, mut sol) = (vec![], vec![], vec![]);
-        let mut len = 0;
+        let (mut len, mut flops) = (0, 0.0);
         for _ in 0..std::env::var("REPEATS").ok().and_then(|s| s.parse().ok()).unwrap_or(3) {
             let t = Instant::now();
             let mut f = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, faer::Par::Seq).expect("ldlt");
@@ -75,11 +75,14 @@ fn main() {
             f.solve_in_place(&mut x);
             sol.push(t.elapsed().as_secs_f64());
             len = f.factor_len();
+            flops = f.factor_flops();
         }
+        let nu = median(num.clone());
         println!(
-            "{name:18} factor entries {len:>10}  symbolic {:.3} s  numeric {:.3} s  solve {:.3} s",
+            "{name:18} factor entries {len:>10}  symbolic {:.3} s  numeric {nu:.3} s ({:.2} GFlop, {:.2} GFlop/s)  solve {:.3} s",
             median(sym),
-            median(num),
+            flops / 1e9,
+            flops / 1e9 / nu,
             median(sol)
         );
     }
