@@ -290,6 +290,9 @@ pub struct Setup {
     pub constraints: Vec<Constraint>,
     /// Loads.
     pub loads: Vec<Load>,
+    /// The exact field solution of a `manufactured` or `affine` scene (its Dirichlet data and
+    /// loads are in `constraints` and `loads`).
+    pub exact: Option<fe_assembly::Exact>,
 }
 
 /// Makes the [`Setup`] of a scene.
@@ -303,14 +306,26 @@ pub fn setup(scene: &Scene, source: &Source) -> Result<Setup, DriverError> {
     } else {
         without_electric(materials)
     };
-    let constraints = constraints(scene, &plan)?;
-    let loads = loads(scene, dim)?;
+    let mut constraints = constraints(scene, &plan)?;
+    let mut loads = loads(scene, dim)?;
+    let exact = crate::exact::field_solution(scene, dim);
+    if let (Some(ex), Some(spec)) = (&exact, &scene.exact) {
+        let groups = crate::exact::groups(spec, scene);
+        let groups: Vec<&str> = groups.iter().map(String::as_str).collect();
+        constraints.extend(
+            ex.constraints(&groups)
+                .into_iter()
+                .filter(|c| plan.electric || !matches!(c.field, Field::Potential)),
+        );
+        loads.extend(ex.loads(&materials[0].1));
+    }
     Ok(Setup {
         mesh,
         materials,
         plan,
         constraints,
         loads,
+        exact,
     })
 }
 

@@ -96,6 +96,7 @@ pub fn run_with_reporter(
         plan,
         constraints: bcs,
         loads,
+        exact,
     } = build::setup(scene, source)?;
     let t_setup = t.elapsed().as_secs_f64();
     let dim = mesh.dim;
@@ -279,12 +280,40 @@ pub fn run_with_reporter(
     let un = disc.dofs.expand_u(&u);
     let pn = disc.dofs.expand_phi(&phi);
     let fields = disc.recover(&un, &pn);
+    let contact_summary = contact_json(contact_result.as_ref());
+    let exact_report = match (&exact, &contact_result, &scene.exact) {
+        (Some(ex), _, Some(spec)) => Some(crate::exact::field_errors(
+            &spec.kind,
+            &disc,
+            &un,
+            &pn,
+            ex,
+            plan.electric,
+        )),
+        (None, Some((cb, sol, _)), Some(_)) => crate::exact::contact_errors(
+            scene,
+            &cb.points,
+            sol,
+            contact_summary["normal_force"].as_f64().unwrap_or(0.0),
+            contact_summary["tangential_force"].as_f64().unwrap_or(0.0),
+        ),
+        _ => None,
+    };
+    if let Some(e) = &exact_report {
+        reporter.line(&format!(
+            "exact ({}): {} = {:.4e}",
+            e["kind"].as_str().unwrap_or(""),
+            e["error_name"].as_str().unwrap_or("error"),
+            e["error"].as_f64().unwrap_or(f64::NAN)
+        ));
+    }
     let report = json!({
         "scene": { "name": scene.name, "source": source.label, "description": scene.description, "settings": scene },
         "plan": plan,
         "mesh": { "n_nodes": mesh.n_nodes(), "n_cells": mesh.n_cells(), "h": mesh.h_max(), "cells_per_axis": build::cells_per_axis(scene) },
         "dofs": { "u": n_u, "phi": n_phi },
-        "contact": contact_json(contact_result.as_ref()),
+        "contact": contact_summary,
+        "exact": exact_report,
         "iterations": {
             "fixed_point": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.fixed_point_iters),
             "uzawa": contact_result.as_ref().map_or(0, |(_, s, _)| s.info.uzawa_iters),

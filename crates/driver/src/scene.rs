@@ -26,6 +26,13 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../../scenes/near-incompressible.toml"),
     ),
     ("hertz", include_str!("../../../scenes/hertz.toml")),
+    (
+        "cattaneo-mindlin",
+        include_str!("../../../scenes/cattaneo-mindlin.toml"),
+    ),
+    ("manufactured", include_str!("../../../scenes/manufactured.toml")),
+    ("manufactured-3d", include_str!("../../../scenes/manufactured-3d.toml")),
+    ("patch", include_str!("../../../scenes/patch.toml")),
 ];
 
 /// A whole scene.
@@ -55,6 +62,43 @@ pub struct Scene {
     /// Solver choices.
     #[serde(default)]
     pub solver: SolverSpec,
+    /// A known solution, for verification: the run reports its error against it.
+    #[serde(default)]
+    pub exact: Option<ExactSpec>,
+}
+
+/// The exact solutions a scene can be checked against (SCENES.md section 6).
+///
+/// - `manufactured`: the smooth coupled solution of [`fe_assembly::Exact::manufactured`]; the
+///   run prescribes it on every boundary group of the generated mesh and adds the body force
+///   and charge that make it exact (one material).
+/// - `affine`: `u = u0 + grad_u x`, `φ = phi0 + grad_phi · x`, prescribed on `groups` (a
+///   patch test: P1 reproduces it to round-off).
+/// - `hertz`: Hertz's frictionless cylinder on a half-plane (Johnson 1985, section 4.2),
+///   from the contact reaction P, the gap's curvature 1/R and the isotropic material.
+/// - `cattaneo-mindlin`: the same with a tangential force Q below F P (Johnson 1985, section
+///   7.1): a central stick zone of half-width `c = a √(1 - Q/(F P))`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ExactSpec {
+    /// `manufactured`, `affine`, `hertz` or `cattaneo-mindlin`.
+    pub kind: String,
+    /// Groups where an `affine` or `manufactured` solution is prescribed (default: every
+    /// side of the generated rectangle or box).
+    #[serde(default)]
+    pub groups: Vec<String>,
+    /// `affine`: the displacement at the origin.
+    #[serde(default)]
+    pub u0: Vec<f64>,
+    /// `affine`: `∂_j u_k`, row `k`, `dim x dim` row-major.
+    #[serde(default)]
+    pub grad_u: Vec<f64>,
+    /// `affine`: the potential at the origin.
+    #[serde(default)]
+    pub phi0: f64,
+    /// `affine`: `∇φ`.
+    #[serde(default)]
+    pub grad_phi: Vec<f64>,
 }
 
 /// How the mesh is made.
@@ -492,6 +536,9 @@ fn validate(s: &Scene) -> Result<(), String> {
             "solver.rule `paper` is the paper's rule for Uzawa; strategy `{}` stops on the complementarity residual (use solver.rule=tight, or a uzawa-* strategy)",
             s.solver.strategy
         ));
+    }
+    if let Some(x) = &s.exact {
+        crate::exact::validate(x, s)?;
     }
     finite("solver.tol", s.solver.tol)?;
     if !(s.solver.tol > 0.0) {

@@ -43,6 +43,7 @@
 
 mod assembly;
 mod dofs;
+pub mod exact;
 pub mod kernels;
 mod loads;
 mod material;
@@ -50,6 +51,7 @@ mod recovery;
 
 pub use assembly::{Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field};
+pub use exact::{ErrorNorms, Exact};
 pub use loads::{facet_measure, Load};
 pub use material::{Crystal, Material, MaterialError};
 pub use recovery::CellFields;

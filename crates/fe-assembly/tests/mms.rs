@@ -16,65 +16,8 @@
 
 mod common;
 
-use common::{solve_both, voigt};
-use fe_assembly::{kernels, Constraint, Crystal, Discretization, Field, Load, Material};
-use std::f64::consts::PI;
-use std::sync::Arc;
-
-/// Value, gradient and Hessian of one scalar field.
-type Jet = (f64, [f64; 3], [[f64; 3]; 3]);
-
-/// `a sin(kx x + px) sin(ky y + py) sin(kz z + pz)` with its derivatives (z factor 1 in 2D).
-fn prod(dim: usize, a: f64, k: [f64; 3], p: [f64; 3], x: &[f64]) -> Jet {
-    let s: Vec<f64> = (0..3)
-        .map(|i| if i < dim { (k[i] * x[i] + p[i]).sin() } else { 1.0 })
-        .collect();
-    let c: Vec<f64> = (0..3)
-        .map(|i| {
-            if i < dim {
-                k[i] * (k[i] * x[i] + p[i]).cos()
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let s2: Vec<f64> = (0..3)
-        .map(|i| if i < dim { -k[i] * k[i] * s[i] } else { 0.0 })
-        .collect();
-    let v = a * s[0] * s[1] * s[2];
-    let mut g = [0.0; 3];
-    let mut h = [[0.0; 3]; 3];
-    for i in 0..dim {
-        let f = |q: usize| if q == i { c[q] } else { s[q] };
-        g[i] = a * f(0) * f(1) * f(2);
-        for j in 0..dim {
-            let ff = |q: usize| {
-                if q == i && q == j {
-                    s2[q]
-                } else if q == i || q == j {
-                    c[q]
-                } else {
-                    s[q]
-                }
-            };
-            h[i][j] = a * ff(0) * ff(1) * ff(2);
-        }
-    }
-    (v, g, h)
-}
-
-fn u_jet(dim: usize, k: usize, x: &[f64]) -> Jet {
-    prod(
-        dim,
-        1e-3,
-        [PI * (k as f64 + 1.0) / 2.0, PI, PI / 2.0],
-        [0.0, 0.0, PI / 2.0],
-        x,
-    )
-}
-fn phi_jet(dim: usize, x: &[f64]) -> Jet {
-    prod(dim, 1e-2, [PI / 2.0, PI, PI / 2.0], [PI / 2.0, 0.0, PI / 2.0], x)
-}
+use common::solve_both;
+use fe_assembly::{Crystal, Discretization, Exact, Material};
 
 /// `(L2 error of (u, φ), energy error)` on the mesh of size n.
 fn errors(dim: usize, n: usize) -> (f64, f64) {
@@ -85,126 +28,22 @@ fn errors(dim: usize, n: usize) -> (f64, f64) {
     };
     let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
     let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap();
-    let nv = m.nv();
-    let (mf, mq) = (m.clone(), m.clone());
-    let f0 = move |x: &[f64]| {
-        // f0_i = -Σ_j ∂_j σ_ij = -Σ_j Σ_kl C_ijkl ∂_jl u_k - Σ_j Σ_k e_kij ∂_jk φ
-        let hu: Vec<Jet> = (0..dim).map(|k| u_jet(dim, k, x)).collect();
-        let hp = phi_jet(dim, x).2;
-        let mut f = [0.0; 3];
-        for i in 0..dim {
-            let mut s = 0.0;
-            for j in 0..dim {
-                for k in 0..dim {
-                    for l in 0..dim {
-                        s += mf.c[voigt(dim, i, j) * nv + voigt(dim, k, l)] * hu[k].2[l][j];
-                    }
-                    s += mf.e[k * nv + voigt(dim, i, j)] * hp[k][j];
-                }
-            }
-            f[i] = -s;
-        }
-        f
-    };
-    let q0 = move |x: &[f64]| {
-        // q0 = div D = Σ_i (Σ_kl e_ikl ∂_il u_k - Σ_k β_ik ∂_ik φ)
-        let hu: Vec<Jet> = (0..dim).map(|k| u_jet(dim, k, x)).collect();
-        let hp = phi_jet(dim, x).2;
-        let mut s = 0.0;
-        for i in 0..dim {
-            for k in 0..dim {
-                for l in 0..dim {
-                    s += mq.e[i * nv + voigt(dim, k, l)] * hu[k].2[l][i];
-                }
-                s -= mq.beta[i * dim + k] * hp[i][k];
-            }
-        }
-        s
-    };
+    let exact = Exact::manufactured(dim);
     let groups: &[&str] = if dim == 2 {
         &["left", "right", "bottom", "top"]
     } else {
         &["left", "right", "bottom", "top", "front", "back"]
     };
-    let mut bcs = vec![];
-    for &g in groups {
-        for k in 0..dim {
-            bcs.push(Constraint {
-                group: g.into(),
-                field: Field::Displacement(k),
-                value: Arc::new(move |x| u_jet(dim, k, x).0),
-            });
-        }
-        bcs.push(Constraint {
-            group: g.into(),
-            field: Field::Potential,
-            value: Arc::new(move |x| phi_jet(dim, x).0),
-        });
-    }
-    let disc = Discretization::new(&mesh, &[("body".into(), m.clone())], &bcs).unwrap();
-    let loads = [Load::BodyForce(Arc::new(f0)), Load::BodyCharge(Arc::new(q0))];
+    let disc = Discretization::new(&mesh, &[("body".into(), m.clone())], &exact.constraints(groups)).unwrap();
+    let loads = exact.loads(&m);
     let ((u1, p1), (u2, p2), _) = solve_both(&disc, &loads);
     // the two strategies agree to round-off
     let scale = u1.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     assert!(common::max_diff(&u1, &u2) < 1e-9 * scale, "strategies disagree");
     assert!(common::max_diff(&p1, &p2) < 1e-9 * p1.iter().fold(0.0f64, |a, x| a.max(x.abs())));
     let (un, pn) = (disc.dofs.expand_u(&u1), disc.dofs.expand_phi(&p1));
-    // integrate the errors with a degree-2 rule per cell (exact for the P1 error's square up
-    // to O(h^3) terms of the smooth part, enough for the rates)
-    let rule: Vec<[f64; 4]> = if dim == 2 {
-        let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
-        vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]]
-    } else {
-        let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
-        vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]]
-    };
-    let (mut l2, mut energy) = (0.0, 0.0);
-    for (c, cell) in mesh.iter_cells().enumerate() {
-        let g = &disc.geometry[c];
-        let w = g.measure / rule.len() as f64;
-        let ul: Vec<[f64; 3]> = cell.iter().map(|&v| un[v]).collect();
-        let pl: Vec<f64> = cell.iter().map(|&v| pn[v]).collect();
-        let eps_h = kernels::cell_strain(dim, g, &ul);
-        let gp_h = kernels::cell_gradient(dim, g, &pl);
-        for bary in &rule {
-            let mut x = [0.0; 3];
-            let (mut uh, mut ph) = ([0.0; 3], 0.0);
-            for (a, &v) in cell.iter().enumerate() {
-                for k in 0..3 {
-                    x[k] += bary[a] * mesh.points[v][k];
-                    uh[k] += bary[a] * un[v][k];
-                }
-                ph += bary[a] * pn[v];
-            }
-            let x = &x[..dim];
-            let ju: Vec<Jet> = (0..dim).map(|k| u_jet(dim, k, x)).collect();
-            let jp = phi_jet(dim, x);
-            for k in 0..dim {
-                l2 += w * (uh[k] - ju[k].0).powi(2);
-            }
-            l2 += w * (ph - jp.0).powi(2);
-            // strain error (Voigt, engineering shear) and its energy
-            let mut de = [0.0; 6];
-            for i in 0..dim {
-                for j in i..dim {
-                    let exact = if i == j { ju[i].1[i] } else { ju[i].1[j] + ju[j].1[i] };
-                    de[voigt(dim, i, j)] = eps_h[voigt(dim, i, j)] - exact;
-                }
-            }
-            for a in 0..nv {
-                for b in 0..nv {
-                    energy += w * de[a] * m.c[a * nv + b] * de[b];
-                }
-            }
-            let dg: Vec<f64> = (0..dim).map(|i| gp_h[i] - jp.1[i]).collect();
-            for a in 0..dim {
-                for b in 0..dim {
-                    energy += w * dg[a] * m.beta[a * dim + b] * dg[b];
-                }
-            }
-        }
-    }
-    (l2.sqrt(), energy.sqrt())
+    let e = disc.error_norms(&un, &pn, &exact);
+    ((e.l2_u.powi(2) + e.l2_phi.powi(2)).sqrt(), e.energy)
 }
 
 fn study(dim: usize, levels: &[usize]) -> Vec<(usize, f64, f64)> {

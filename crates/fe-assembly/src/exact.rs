@@ -1,0 +1,309 @@
+//! Exact solutions for verification: a smooth solution `(u, φ)` given with its first and second
+//! derivatives, the body force and charge that make it solve the coupled equations
+//! (manufactured solutions, Roache 2002), the Dirichlet data it prescribes, and the errors of a
+//! discrete solution against it in the L2 and energy norms.
+//!
+//! The equations (signs of DESIGN.md): `-div σ = f0`, `div D = q0`, with
+//! `σ = C ε(u) + eᵀ ∇φ` and `D = e ε(u) - β ∇φ`. So, in index form,
+//! `f0_i = -Σ_jkl C_ijkl ∂_jl u_k - Σ_jk e_kij ∂_jk φ` and
+//! `q0 = Σ_ikl e_ikl ∂_il u_k - Σ_ik β_ik ∂_ik φ`.
+
+use crate::{kernels, Constraint, Discretization, Field, Load, Material};
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// Value, gradient and Hessian of a scalar field at a point (unused components zero).
+pub type Jet = (f64, [f64; 3], [[f64; 3]; 3]);
+
+/// An exact solution: the jets of the `dim` displacement components and of the potential.
+#[derive(Clone)]
+pub struct Exact {
+    /// Spatial dimension, 2 or 3.
+    pub dim: usize,
+    /// `u(x)[k]` is the jet of `u_k`.
+    pub u: Arc<dyn Fn(&[f64]) -> [Jet; 3] + Send + Sync>,
+    /// The jet of `φ`.
+    pub phi: Arc<dyn Fn(&[f64]) -> Jet + Send + Sync>,
+}
+
+/// `a Π_i sin(k_i x_i + p_i)` over the first `dim` coordinates, with its derivatives.
+pub fn sine_product(dim: usize, a: f64, k: [f64; 3], p: [f64; 3], x: &[f64]) -> Jet {
+    let mut s = [1.0; 3];
+    let mut c = [0.0; 3];
+    for i in 0..dim {
+        s[i] = (k[i] * x[i] + p[i]).sin();
+        c[i] = k[i] * (k[i] * x[i] + p[i]).cos();
+    }
+    let mut g = [0.0; 3];
+    let mut h = [[0.0; 3]; 3];
+    for i in 0..dim {
+        let f = |q: usize| if q == i { c[q] } else { s[q] };
+        g[i] = a * f(0) * f(1) * f(2);
+        for j in 0..dim {
+            let ff = |q: usize| match (q == i, q == j) {
+                (true, true) => -k[q] * k[q] * s[q],
+                (true, false) | (false, true) => c[q],
+                (false, false) => s[q],
+            };
+            h[i][j] = a * ff(0) * ff(1) * ff(2);
+        }
+    }
+    (a * s[0] * s[1] * s[2], g, h)
+}
+
+impl Exact {
+    /// The manufactured solution of the verification study, on `(0,2) x (0,1) [x (0,1)]`:
+    /// `u_k = 1e-3 sin(π x (k+1)/2) sin(π y) [cos(π z/2)]`, `φ = 1e-2 cos(π x/2) sin(π y)
+    /// [cos(π z/2)]` (amplitudes of the paper's scaled units: strains of 1e-3, fields of 1e-2).
+    pub fn manufactured(dim: usize) -> Self {
+        Exact {
+            dim,
+            u: Arc::new(move |x| {
+                let mut out = [(0.0, [0.0; 3], [[0.0; 3]; 3]); 3];
+                for (k, o) in out.iter_mut().enumerate().take(dim) {
+                    *o = sine_product(
+                        dim,
+                        1e-3,
+                        [PI * (k as f64 + 1.0) / 2.0, PI, PI / 2.0],
+                        [0.0, 0.0, PI / 2.0],
+                        x,
+                    );
+                }
+                out
+            }),
+            phi: Arc::new(move |x| sine_product(dim, 1e-2, [PI / 2.0, PI, PI / 2.0], [PI / 2.0, 0.0, PI / 2.0], x)),
+        }
+    }
+
+    /// An affine solution `u = u0 + (∇u) x`, `φ = φ0 + ∇φ · x`: what a patch test reproduces to
+    /// round-off. `grad_u[k][j] = ∂_j u_k`.
+    pub fn affine(dim: usize, u0: [f64; 3], grad_u: [[f64; 3]; 3], phi0: f64, grad_phi: [f64; 3]) -> Self {
+        Exact {
+            dim,
+            u: Arc::new(move |x| {
+                let mut out = [(0.0, [0.0; 3], [[0.0; 3]; 3]); 3];
+                for k in 0..dim {
+                    let v = u0[k] + (0..dim).map(|j| grad_u[k][j] * x[j]).sum::<f64>();
+                    out[k] = (v, grad_u[k], [[0.0; 3]; 3]);
+                }
+                out
+            }),
+            phi: Arc::new(move |x| {
+                let v = phi0 + (0..dim).map(|j| grad_phi[j] * x[j]).sum::<f64>();
+                (v, grad_phi, [[0.0; 3]; 3])
+            }),
+        }
+    }
+
+    /// The body force `f0` and body charge `q0` for which this is the solution with material
+    /// `m` (one material in the whole body).
+    pub fn loads(&self, m: &Material) -> [Load; 2] {
+        let dim = self.dim;
+        let nv = m.nv();
+        let (mf, mq) = (m.clone(), m.clone());
+        let (uf, pf) = (self.u.clone(), self.phi.clone());
+        let (uq, pq) = (self.u.clone(), self.phi.clone());
+        let f0 = move |x: &[f64]| {
+            let (hu, hp) = (uf(x), pf(x).2);
+            let mut f = [0.0; 3];
+            for (i, fi) in f.iter_mut().enumerate().take(dim) {
+                let mut s = 0.0;
+                for j in 0..dim {
+                    for k in 0..dim {
+                        for l in 0..dim {
+                            s += mf.c[voigt(dim, i, j) * nv + voigt(dim, k, l)] * hu[k].2[l][j];
+                        }
+                        s += mf.e[k * nv + voigt(dim, i, j)] * hp[k][j];
+                    }
+                }
+                *fi = -s;
+            }
+            f
+        };
+        let q0 = move |x: &[f64]| {
+            let (hu, hp) = (uq(x), pq(x).2);
+            let mut s = 0.0;
+            for i in 0..dim {
+                for k in 0..dim {
+                    for l in 0..dim {
+                        s += mq.e[i * nv + voigt(dim, k, l)] * hu[k].2[l][i];
+                    }
+                    s -= mq.beta[i * dim + k] * hp[i][k];
+                }
+            }
+            s
+        };
+        [Load::BodyForce(Arc::new(f0)), Load::BodyCharge(Arc::new(q0))]
+    }
+
+    /// Dirichlet data for every displacement component and the potential on each of `groups`.
+    pub fn constraints(&self, groups: &[&str]) -> Vec<Constraint> {
+        let mut out = vec![];
+        for &g in groups {
+            for k in 0..self.dim {
+                let u = self.u.clone();
+                out.push(Constraint {
+                    group: g.into(),
+                    field: Field::Displacement(k),
+                    value: Arc::new(move |x| u(x)[k].0),
+                });
+            }
+            let phi = self.phi.clone();
+            out.push(Constraint {
+                group: g.into(),
+                field: Field::Potential,
+                value: Arc::new(move |x| phi(x).0),
+            });
+        }
+        out
+    }
+}
+
+/// Errors of a discrete solution against an [`Exact`] one, absolute and relative.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorNorms {
+    /// `‖u_h - u‖_L2`.
+    pub l2_u: f64,
+    /// `‖φ_h - φ‖_L2`.
+    pub l2_phi: f64,
+    /// The energy norm of the error, `(∫ ε(e_u):C:ε(e_u) + ∇e_φ·β∇e_φ)^½` (the coupling
+    /// cancels in the paper's form).
+    pub energy: f64,
+    /// `‖u‖_L2`, `‖φ‖_L2` and the energy norm of the exact solution, for relative errors.
+    pub norms: (f64, f64, f64),
+}
+
+impl ErrorNorms {
+    /// `‖u_h - u‖ / ‖u‖` in L2.
+    pub fn rel_l2_u(&self) -> f64 {
+        self.l2_u / self.norms.0
+    }
+    /// `‖φ_h - φ‖ / ‖φ‖` in L2.
+    pub fn rel_l2_phi(&self) -> f64 {
+        self.l2_phi / self.norms.1
+    }
+    /// Relative error in the energy norm.
+    pub fn rel_energy(&self) -> f64 {
+        self.energy / self.norms.2
+    }
+}
+
+/// Voigt index of `(i, j)` (the order of the glossary).
+pub fn voigt(dim: usize, i: usize, j: usize) -> usize {
+    let (a, b) = (i.min(j), i.max(j));
+    match (dim, a, b) {
+        (2, 0, 0) => 0,
+        (2, 1, 1) => 1,
+        (2, _, _) => 2,
+        (_, 0, 0) => 0,
+        (_, 1, 1) => 1,
+        (_, 2, 2) => 2,
+        (_, 1, 2) => 3,
+        (_, 0, 2) => 4,
+        _ => 5,
+    }
+}
+
+impl Discretization<'_> {
+    /// The errors of the nodal solution `(u, φ)` (all nodes, as [`crate::DofMap::expand_u`]
+    /// gives them) against `exact`, by a degree-2 rule on each cell (exact for the square of
+    /// a P1 function; for the smooth part, accurate to `O(h³)` relative, enough for rates).
+    pub fn error_norms(&self, u: &[[f64; 3]], phi: &[f64], exact: &Exact) -> ErrorNorms {
+        let (mesh, dim) = (self.mesh, self.mesh.dim);
+        let rule: Vec<[f64; 4]> = if dim == 2 {
+            let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
+            vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]]
+        } else {
+            let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
+            vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]]
+        };
+        let (mut eu, mut ep, mut en) = (0.0, 0.0, 0.0);
+        let (mut nu, mut np, mut nn) = (0.0, 0.0, 0.0);
+        let energy = |m: &Material, eps: &[f64; 6], grad: &[f64]| {
+            let nv = m.nv();
+            let mut s = 0.0;
+            for a in 0..nv {
+                for b in 0..nv {
+                    s += eps[a] * m.c[a * nv + b] * eps[b];
+                }
+            }
+            for a in 0..dim {
+                for b in 0..dim {
+                    s += grad[a] * m.beta[a * dim + b] * grad[b];
+                }
+            }
+            s
+        };
+        for (c, cell) in mesh.iter_cells().enumerate() {
+            let g = &self.geometry[c];
+            let m = &self.materials[self.cell_material[c]];
+            let w = g.measure / rule.len() as f64;
+            let ul: Vec<[f64; 3]> = cell.iter().map(|&v| u[v]).collect();
+            let pl: Vec<f64> = cell.iter().map(|&v| phi[v]).collect();
+            let eps_h = kernels::cell_strain(dim, g, &ul);
+            let gp_h = kernels::cell_gradient(dim, g, &pl);
+            for bary in &rule {
+                let mut x = [0.0; 3];
+                let (mut uh, mut ph) = ([0.0; 3], 0.0);
+                for (a, &v) in cell.iter().enumerate() {
+                    for k in 0..3 {
+                        x[k] += bary[a] * mesh.points[v][k];
+                        uh[k] += bary[a] * u[v][k];
+                    }
+                    ph += bary[a] * phi[v];
+                }
+                let x = &x[..dim];
+                let (ju, jp) = ((exact.u)(x), (exact.phi)(x));
+                for k in 0..dim {
+                    eu += w * (uh[k] - ju[k].0).powi(2);
+                    nu += w * ju[k].0.powi(2);
+                }
+                ep += w * (ph - jp.0).powi(2);
+                np += w * jp.0.powi(2);
+                // strains in Voigt order with engineering shears
+                let (mut de, mut ex) = ([0.0; 6], [0.0; 6]);
+                for i in 0..dim {
+                    for j in i..dim {
+                        let e = if i == j { ju[i].1[i] } else { ju[i].1[j] + ju[j].1[i] };
+                        ex[voigt(dim, i, j)] = e;
+                        de[voigt(dim, i, j)] = eps_h[voigt(dim, i, j)] - e;
+                    }
+                }
+                let dg: Vec<f64> = (0..dim).map(|i| gp_h[i] - jp.1[i]).collect();
+                en += w * energy(m, &de, &dg);
+                nn += w * energy(m, &ex, &jp.1[..dim]);
+            }
+        }
+        ErrorNorms {
+            l2_u: eu.sqrt(),
+            l2_phi: ep.sqrt(),
+            energy: en.sqrt(),
+            norms: (nu.sqrt(), np.sqrt(), nn.sqrt()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The jets' derivatives against central differences.
+    #[test]
+    fn sine_product_derivatives_match_differences() {
+        let x = [0.3, 0.7, 0.2];
+        let (k, p) = ([1.3, 2.1, 0.7], [0.2, 0.0, 1.1]);
+        let (_, g, h) = sine_product(3, 0.5, k, p, &x);
+        let d = 1e-5;
+        for i in 0..3 {
+            let (mut xp, mut xm) = (x, x);
+            xp[i] += d;
+            xm[i] -= d;
+            let (vp, gp, _) = sine_product(3, 0.5, k, p, &xp);
+            let (vm, gm, _) = sine_product(3, 0.5, k, p, &xm);
+            assert!(((vp - vm) / (2.0 * d) - g[i]).abs() < 1e-8);
+            for j in 0..3 {
+                assert!(((gp[j] - gm[j]) / (2.0 * d) - h[j][i]).abs() < 1e-8);
+            }
+        }
+    }
+}
