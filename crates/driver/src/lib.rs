@@ -19,6 +19,7 @@
 
 pub mod build;
 pub mod contact_setup;
+pub mod convergence;
 pub mod exact;
 pub mod output;
 pub mod plots;

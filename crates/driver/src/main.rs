@@ -67,6 +67,31 @@ enum Command {
     },
     /// List the solver strategies.
     Strategies,
+    /// Error against h and against run time: a scene over mesh sizes, strategies and
+    /// tolerances; writes study.md, study.csv and log-log plots (SVG, PNG).
+    Study {
+        /// Scene name or file (default: paper).
+        scene: Option<String>,
+        /// Mesh sizes mesh.n (default: the scene's n/4, n/2, n).
+        #[arg(long, value_delimiter = ',')]
+        sizes: Vec<usize>,
+        /// Strategies (default: the scene's).
+        #[arg(long, value_delimiter = ',')]
+        strategies: Vec<String>,
+        /// Tolerances (default: 1e-4, 1e-6, 1e-8).
+        #[arg(long, value_delimiter = ',', default_values_t = [1e-4, 1e-6, 1e-8])]
+        tols: Vec<f64>,
+        /// Size of the reference run for a scene without an exact solution (default: 4 x the
+        /// largest size).
+        #[arg(long)]
+        reference: Option<usize>,
+        /// Other overrides.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Output directory (default: out/SCENE-study/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Run the stiff and extreme cases (SCENES.md section 5), each in its own process, and
     /// write their table to docs/stability.md.
     Stability {
@@ -130,13 +155,36 @@ fn main() -> ExitCode {
     });
     match command {
         Command::Scenes => {
+            use std::io::Write;
+            let mut out = std::io::stdout().lock();
             for (name, text) in driver::scene::SHIPPED {
                 let desc = driver::scene::parse(text, name, &[])
                     .map(|s| s.description)
                     .unwrap_or_default();
-                println!("{name:16} {desc}");
+                // a closed pipe (`| head`) ends the listing quietly
+                if writeln!(out, "{name:18} {desc}").is_err() {
+                    break;
+                }
             }
             ExitCode::SUCCESS
+        }
+        Command::Study {
+            scene,
+            sizes,
+            strategies,
+            tols,
+            reference,
+            set,
+            out,
+        } => {
+            let scene = scene.unwrap_or_else(|| "paper".into());
+            match study_command(&scene, sizes, strategies, tols, reference, &set, out) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
         }
         Command::Sweep {
             scene,
@@ -221,4 +269,47 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// `piezocontact study`: defaults from the scene, the study, its files.
+fn study_command(
+    scene: &str,
+    mut sizes: Vec<usize>,
+    mut strategies: Vec<String>,
+    tols: Vec<f64>,
+    reference_n: Option<usize>,
+    set: &[String],
+    out: Option<PathBuf>,
+) -> Result<(), driver::DriverError> {
+    let (base, _) = driver::scene::load(scene, set)?;
+    if sizes.is_empty() {
+        let n = base.mesh.n.unwrap_or(16).max(4);
+        sizes = vec![n / 4, n / 2, n];
+    }
+    if strategies.is_empty() {
+        strategies.push(base.solver.strategy.clone());
+    }
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-study", base.name)));
+    let spec = driver::convergence::StudySpec {
+        sizes,
+        strategies,
+        tols,
+        reference_n,
+    };
+    let study = driver::convergence::study(scene, set, &spec, &mut |l| eprintln!("{l}"))?;
+    let mut outs = driver::output::Outputs::new(&dir);
+    let md = format!(
+        "# Study of `{}`\n\n{}",
+        study.scene,
+        driver::convergence::markdown(&study, "study")
+    );
+    outs.add("study.md", md.clone().into_bytes());
+    outs.add("study.csv", driver::convergence::csv(&study).into_bytes());
+    for (name, bytes) in driver::plots::study_pictures("study", &study)? {
+        outs.add(&name, bytes);
+    }
+    outs.commit()?;
+    println!("{md}");
+    eprintln!("wrote study.md, study.csv and the plots in {}", dir.display());
+    Ok(())
 }

@@ -396,3 +396,164 @@ fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View, phi
 pub fn sweep_pictures(param: &str, rows: &[crate::studies::SweepRow]) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
     both!("sweep", |a| crate::studies::draw_sweep(a, param, rows))
 }
+
+/// One series of a log-log chart: its name and its `(x, y)` points (non-positive values are
+/// drawn at the floor of the axis). A series with an empty name continues the previous one's
+/// colour and legend entry.
+pub type Series = (String, Vec<(f64, f64)>);
+
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// A log-log chart of `series` with markers and lines, titled, with axis labels.
+fn draw_loglog<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    labels: (&str, &str),
+    series: &[Series],
+) -> Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    area.fill(&WHITE).map_err(e)?;
+    let pts = series.iter().flat_map(|(_, p)| p.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+    for &(x, y) in pts.clone() {
+        if x > 0.0 && x.is_finite() {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+        }
+        if y > 0.0 && y.is_finite() {
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if !(x1 > 0.0) {
+        (x0, x1) = (1.0, 10.0);
+    }
+    if !(y1 > 0.0) {
+        (y0, y1) = (1e-16, 1.0);
+    }
+    let (x0, x1) = (x0 / 1.5, x1 * 1.5);
+    // room above the data for the legend
+    let (y0, y1) = (y0.max(1e-17) / 3.0, y1 * 3.0 * (y1 / y0.max(1e-17)).powf(0.6).max(10.0));
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, 22))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style((FONT, 13))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(e)?;
+    let mut k = 0;
+    for (i, (name, p)) in series.iter().enumerate() {
+        if i > 0 && !name.is_empty() {
+            k += 1;
+        }
+        let color = PALETTE[k % PALETTE.len()];
+        let p: Vec<(f64, f64)> = p.iter().map(|&(x, y)| (x, y.max(y0))).collect();
+        let line = chart
+            .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))
+            .map_err(e)?;
+        if !name.is_empty() {
+            line.label(name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+        }
+        chart
+            .draw_series(p.iter().map(|&q| Circle::new(q, 4, color.filled())))
+            .map_err(e)?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(e)?;
+    Ok(())
+}
+
+/// A log-log chart as SVG and PNG, named `name`.
+pub fn loglog(
+    name: &str,
+    title: &str,
+    labels: (&str, &str),
+    series: &[Series],
+) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
+    both!(name, |a| draw_loglog(a, title, labels, series))
+}
+
+/// The three pictures of a convergence study: error against time (a line per strategy and
+/// size, through its tolerances), discretisation error against h, iterations against h (a line
+/// per strategy, at its tightest tolerance). Names start with `prefix`.
+pub fn study_pictures(prefix: &str, s: &crate::convergence::Study) -> Result<Vec<(String, Vec<u8>)>, DriverError> {
+    let mut strategies: Vec<&str> = vec![];
+    for r in &s.rows {
+        if !strategies.contains(&r.strategy.as_str()) {
+            strategies.push(&r.strategy);
+        }
+    }
+    let mut time = vec![];
+    let mut iters = vec![];
+    for st in &strategies {
+        let rows: Vec<_> = s.rows.iter().filter(|r| r.strategy == *st).collect();
+        let mut sizes: Vec<usize> = rows.iter().map(|r| r.n).collect();
+        sizes.dedup();
+        for (i, n) in sizes.iter().enumerate() {
+            let mut p: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.n == *n)
+                .map(|r| (r.seconds, r.error))
+                .collect();
+            p.sort_by(|a, b| a.0.total_cmp(&b.0));
+            // one colour per strategy; a line per size joins its tolerances
+            time.push((if i == 0 { st.to_string() } else { String::new() }, p));
+        }
+        let tightest = rows.iter().map(|r| r.tol).fold(f64::INFINITY, f64::min);
+        iters.push((
+            st.to_string(),
+            rows.iter()
+                .filter(|r| r.tol == tightest)
+                .map(|r| (r.h, r.iterations.max(1) as f64))
+                .collect(),
+        ));
+    }
+    let rates = s.rates();
+    let label = match rates.last() {
+        Some(r) => format!("tight runs (last order {:.2})", r.2),
+        None => "tight runs".to_string(),
+    };
+    let err_h = vec![(label, s.tight.iter().map(|&(_, e, h)| (h, e)).collect())];
+    let mut out = loglog(
+        &format!("{prefix}-error-time"),
+        &format!("{}: error against run time", s.scene),
+        ("wall time of the run (s)", "error"),
+        &time,
+    )?;
+    out.extend(loglog(
+        &format!("{prefix}-error-h"),
+        &format!("{}: discretisation error against h", s.scene),
+        ("h", "error"),
+        &err_h,
+    )?);
+    out.extend(loglog(
+        &format!("{prefix}-iterations-h"),
+        &format!("{}: iterations against h (tightest tolerance)", s.scene),
+        ("h", "iterations"),
+        &iters,
+    )?);
+    Ok(out)
+}

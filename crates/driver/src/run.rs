@@ -26,6 +26,8 @@ pub const STRATEGIES: &[(&str, &str)] = &[
 pub struct RunOutcome {
     /// The run.json tree.
     pub report: serde_json::Value,
+    /// Node coordinates (`z = 0` in 2D).
+    pub nodes: Vec<[f64; 3]>,
     /// Nodal displacements.
     pub u: Vec<[f64; 3]>,
     /// Nodal potentials.
@@ -384,6 +386,7 @@ pub fn run_with_reporter(
     }
     Ok(RunOutcome {
         report,
+        nodes: mesh.points.clone(),
         u: un,
         phi: pn,
         contact: contact_result.map(|(cb, sol, _)| (cb.points, sol)),
