@@ -299,3 +299,100 @@ fn hertz_pressure_is_johnsons() {
     }
     assert!((err / norm).sqrt() < 0.06, "profile error {}", (err / norm).sqrt());
 }
+
+/// Cattaneo-Mindlin in plane strain (scene `cattaneo-mindlin`).
+///
+/// - Source: K. L. Johnson, Contact Mechanics (1985), section 7.1 (Cattaneo 1938, Mindlin
+///   1949): a cylinder pressed by P and pulled by Q < F P on a half-plane, with normal and
+///   tangential loading uncoupled, has a central stick zone of half-width `c = a √(1 - Q/(F P))`,
+///   and `q(x) = F p0 √(1 - x²/a²) - F p0 (c/a) √(1 - x²/c²)` (second term inside the stick
+///   zone only).
+/// - Goal: the Coulomb solution (stick zone, slip with `|λ_t| = F λ_n`, traction profile)
+///   against a solution we did not write.
+/// - Sketch: the `hertz` block with Poisson's ratio 0.475, F = 0.5, its sides free and its top
+///   displaced by (0.02, -0.03): P ≈ 2.35, Q ≈ 0.75, Q/(F P) ≈ 0.64, c/a ≈ 0.60; n = 192
+///   (h = 1/48, about a/23).
+/// - Expected, measured at n = 192: the stick zone [-0.271, 0.250] (half-width 0.260 against
+///   c = 0.290, centred 0.02 a left of the axis); the traction profile within 10.1 % (19.5 %
+///   at n = 96, 6.8 % at n = 384).
+/// - Tolerances: the stick zone's edge moves in steps of h and the uncoupling is not exact:
+///   Dundurs' β = (1 - 2ν)/(2(1 - ν)) = 0.048 against a rigid foundation (Cattaneo needs 0),
+///   and P1 stiffens as ν nears ½. So: half-width within 3 h of c, centre within 0.05 a,
+///   profile within 13 %, and Coulomb's law itself (slip at `F λ_n`) to 1e-8.
+#[test]
+fn cattaneo_mindlin_stick_zone() {
+    let r = run("cattaneo-mindlin", &["mesh.n=192"]);
+    let x = &r.report["exact"];
+    let (a, c, c_h) = (
+        x["a"].as_f64().unwrap(),
+        x["c"].as_f64().unwrap(),
+        x["c_h"].as_f64().unwrap(),
+    );
+    let h = 1.0 / 48.0;
+    let q_over_fp = x["load_q"].as_f64().unwrap() / (0.5 * x["load_p"].as_f64().unwrap());
+    assert!((0.5..0.75).contains(&q_over_fp), "Q/(F P) = {q_over_fp}");
+    assert!(
+        (c_h - c).abs() < 3.0 * h,
+        "stick half-width {c_h} against c = {c} (a = {a})"
+    );
+    assert!(x["stick_offset"].as_f64().unwrap().abs() < 0.05, "{x}");
+    assert!(
+        x["error"].as_f64().unwrap() < 0.13,
+        "traction profile error {}",
+        x["error"]
+    );
+    let (_, sol) = r.contact.as_ref().unwrap();
+    for (i, s) in sol.status.iter().enumerate() {
+        if *s == contact::Status::Slip {
+            let (ln, lt) = (sol.lambda.normal[i], sol.lambda.tangential[i].abs());
+            assert!(
+                (lt - 0.5 * ln).abs() <= 1e-8 * ln.max(1.0),
+                "slip point {i}: |λ_t| {lt}, F λ_n {}",
+                0.5 * ln
+            );
+        }
+    }
+}
+
+/// The convergence study on `paper` against a finer nested mesh.
+///
+/// - Goal: `piezocontact study` measures what it says: the discretisation error falls with h,
+///   Newton's algebraic error is round-off at any tolerance it accepts, Uzawa's falls with its
+///   tolerance, and a reference that does not nest is refused with a typed error.
+/// - Sketch: sizes 4 and 8, reference 32; Newton and Uzawa on the condensed problem at
+///   tolerances 1e-2 and 1e-8.
+#[test]
+fn study_separates_discretisation_and_algebraic_errors() {
+    use driver::convergence::{study, StudySpec};
+    let spec = StudySpec {
+        sizes: vec![4, 8],
+        strategies: vec!["newton-condensed".into(), "uzawa-condensed".into()],
+        tols: vec![1e-2, 1e-8],
+        reference_n: Some(32),
+    };
+    let s = study("paper", &[], &spec, &mut |_| {}).unwrap();
+    assert_eq!(s.rows.len(), 8);
+    assert!(s.tight[1].1 < s.tight[0].1, "{:?}", s.tight);
+    for r in &s.rows {
+        assert!(r.seconds > 0.0 && r.error > 0.0);
+        match (r.strategy.as_str(), r.tol) {
+            ("newton-condensed", _) => assert!(r.algebraic < 1e-10, "{r:?}"),
+            (_, 1e-8) => assert!(r.algebraic < 1e-6, "{r:?}"),
+            _ => assert!(r.algebraic > 1e-6, "{r:?}"),
+        }
+    }
+    let bad = StudySpec {
+        reference_n: Some(12),
+        ..spec.clone()
+    };
+    let e = study("paper", &[], &bad, &mut |_| {}).unwrap_err().to_string();
+    assert!(e.contains("must be a multiple of the largest size 8"), "{e}");
+    // 16 is a multiple of 8 but not of 6: the nodes at x = 1/6 have no match
+    let bad = StudySpec {
+        sizes: vec![6, 8],
+        reference_n: Some(16),
+        ..spec
+    };
+    let e = study("paper", &[], &bad, &mut |_| {}).unwrap_err().to_string();
+    assert!(e.contains("is not a node of the reference mesh"), "{e}");
+}

@@ -1,4 +1,5 @@
-//! Project automation: `cargo xtask verify` (fmt, clippy, tests, docs) and `cargo xtask bench`
+//! Project automation: `cargo xtask verify [--full]` (fmt, clippy, tests, docs, the
+//! verification report in docs/verification.md) and `cargo xtask bench`
 //! (the linear benchmark on the paper geometry). Kept free of dependencies.
 
 use std::process::{Command, ExitCode};
@@ -13,11 +14,19 @@ fn cargo(args: &[&str], env: &[(&str, &str)]) -> bool {
     c.status().map(|s| s.success()).unwrap_or(false)
 }
 
-fn verify() -> bool {
+/// fmt, clippy, the tests (the tidy test among them), rustdoc, then the verification report:
+/// a smoke run of every shipped scene and the convergence studies, written to
+/// docs/verification.md (`full`: to the finest meshes).
+fn verify(full: bool) -> bool {
+    let mut report = vec!["run", "--release", "-p", "driver", "--", "verification"];
+    if full {
+        report.push("--full");
+    }
     cargo(&["fmt", "--all", "--", "--check"], &[])
         && cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])
         && cargo(&["test", "--workspace"], &[])
         && cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])
+        && cargo(&report, &[])
 }
 
 fn bench(sizes: &[String]) -> bool {
@@ -41,7 +50,7 @@ fn bench(sizes: &[String]) -> bool {
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let ok = match args.first().map(String::as_str) {
-        Some("verify") => verify(),
+        Some("verify") => verify(args.iter().any(|a| a == "--full")),
         Some("bench") => {
             let sizes: Vec<String> = if args.len() > 1 {
                 args[1..].to_vec()
@@ -51,7 +60,7 @@ fn main() -> ExitCode {
             bench(&sizes)
         }
         _ => {
-            eprintln!("usage: cargo xtask verify | cargo xtask bench [n ...]");
+            eprintln!("usage: cargo xtask verify [--full] | cargo xtask bench [n ...]");
             false
         }
     };

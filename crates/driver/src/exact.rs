@@ -289,7 +289,7 @@ mod tests {
         assert!((a - 2.0 / PI.sqrt()).abs() < 1e-14);
         assert!((p0 - 1.0 / PI.sqrt()).abs() < 1e-14);
         // ∫ q dx = F P - F P (c/a)² = Q by construction of c
-        let (f, q) = (0.5, 0.3);
+        let (f, q): (f64, f64) = (0.5, 0.3);
         let c = a * (1.0 - q / f).sqrt();
         let n = 200_000;
         let h = 2.0 * a / n as f64;

@@ -27,6 +27,7 @@ pub mod run;
 pub mod scene;
 pub mod stability;
 pub mod studies;
+pub mod verification;
 
 /// What can go wrong in a run; each variant names the file or item at fault.
 #[derive(Debug, thiserror::Error)]

@@ -67,6 +67,16 @@ enum Command {
     },
     /// List the solver strategies.
     Strategies,
+    /// The verification report: a smoke run of every shipped scene and the convergence study
+    /// of each analytic instance and of `paper`, each checked; writes docs/verification.md.
+    Verification {
+        /// Run the studies to their finest meshes.
+        #[arg(long)]
+        full: bool,
+        /// Directory for verification.md (plots go to its img/).
+        #[arg(long, default_value = "docs")]
+        out: PathBuf,
+    },
     /// Error against h and against run time: a scene over mesh sizes, strategies and
     /// tolerances; writes study.md, study.csv and log-log plots (SVG, PNG).
     Study {
@@ -167,6 +177,27 @@ fn main() -> ExitCode {
                 }
             }
             ExitCode::SUCCESS
+        }
+        Command::Verification { full, out } => {
+            match driver::verification::report(full, &out, &mut |l| eprintln!("{l}")) {
+                Ok(failures) if failures.is_empty() => {
+                    eprintln!(
+                        "verification: every check holds; wrote {}",
+                        out.join("verification.md").display()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Ok(failures) => {
+                    for f in &failures {
+                        eprintln!("verification FAILED: {f}");
+                    }
+                    ExitCode::FAILURE
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
         }
         Command::Study {
             scene,

@@ -15,15 +15,20 @@ use std::sync::Arc;
 /// Value, gradient and Hessian of a scalar field at a point (unused components zero).
 pub type Jet = (f64, [f64; 3], [[f64; 3]; 3]);
 
+/// The jets of the displacement components at a point.
+pub type VectorJetFn = Arc<dyn Fn(&[f64]) -> [Jet; 3] + Send + Sync>;
+/// The jet of a scalar field at a point.
+pub type ScalarJetFn = Arc<dyn Fn(&[f64]) -> Jet + Send + Sync>;
+
 /// An exact solution: the jets of the `dim` displacement components and of the potential.
 #[derive(Clone)]
 pub struct Exact {
     /// Spatial dimension, 2 or 3.
     pub dim: usize,
     /// `u(x)[k]` is the jet of `u_k`.
-    pub u: Arc<dyn Fn(&[f64]) -> [Jet; 3] + Send + Sync>,
+    pub u: VectorJetFn,
     /// The jet of `φ`.
-    pub phi: Arc<dyn Fn(&[f64]) -> Jet + Send + Sync>,
+    pub phi: ScalarJetFn,
 }
 
 /// `a Π_i sin(k_i x_i + p_i)` over the first `dim` coordinates, with its derivatives.

@@ -1,0 +1,281 @@
+//! The verification report (`piezocontact verification`, run by `cargo xtask verify`): a smoke
+//! run of every shipped scene, then the convergence study of each analytic instance and of the
+//! paper scene, each checked against what it must show, written to `docs/verification.md` with
+//! its plots, so the page cannot drift from the code.
+
+use crate::convergence::{self, Study, StudySpec};
+use crate::output::Outputs;
+use crate::run::run;
+use crate::scene;
+use crate::DriverError;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+/// One study of the report and the check it must pass.
+pub struct Entry {
+    /// Scene.
+    pub scene: &'static str,
+    /// Sizes (quick, full).
+    pub sizes: (&'static [usize], &'static [usize]),
+    /// Reference size for scenes without an exact solution (quick, full).
+    pub reference: (Option<usize>, Option<usize>),
+    /// Strategies.
+    pub strategies: &'static [&'static str],
+    /// Tolerances.
+    pub tols: &'static [f64],
+    /// What must hold, in words (printed on the page).
+    pub claim: &'static str,
+    /// The check of the claim.
+    pub check: fn(&Study) -> Result<(), String>,
+}
+
+fn last_rate(s: &Study) -> f64 {
+    s.rates().last().map_or(f64::NAN, |r| r.2)
+}
+
+fn finest(s: &Study) -> f64 {
+    s.tight.last().map_or(f64::NAN, |t| t.1)
+}
+
+/// The studies of the report.
+pub const ENTRIES: &[Entry] = &[
+    Entry {
+        scene: "patch",
+        sizes: (&[2, 4, 8], &[2, 4, 8, 16]),
+        reference: (None, None),
+        strategies: &["newton-condensed", "uzawa-schur-pcg"],
+        tols: &[1e-12],
+        claim: "an affine (u, φ) is reproduced to round-off: relative energy error below 1e-11 on every mesh and strategy",
+        check: |s| match s.rows.iter().find(|r| !(r.error < 1e-11)) {
+            Some(r) => Err(format!("n = {}, {}: error {:.3e}", r.n, r.strategy, r.error)),
+            None => Ok(()),
+        },
+    },
+    Entry {
+        scene: "manufactured",
+        sizes: (&[4, 8, 16, 32], &[4, 8, 16, 32, 64, 128]),
+        reference: (None, None),
+        strategies: &["newton-condensed", "uzawa-schur-pcg"],
+        tols: &[1e-6, 1e-10],
+        claim: "P1 converges at order 1 in the energy norm (observed order between 0.95 and 1.2 on the finest pair)",
+        check: |s| {
+            let r = last_rate(s);
+            if (0.95..1.2).contains(&r) {
+                Ok(())
+            } else {
+                Err(format!("energy order {r:.3}"))
+            }
+        },
+    },
+    Entry {
+        scene: "manufactured-3d",
+        sizes: (&[2, 4, 8], &[2, 4, 8, 16]),
+        reference: (None, None),
+        strategies: &["newton-condensed", "uzawa-schur-pcg"],
+        tols: &[1e-6, 1e-10],
+        claim: "order 1 in the energy norm in 3D (between 0.9 and 1.2 on the finest pair)",
+        check: |s| {
+            let r = last_rate(s);
+            if (0.9..1.2).contains(&r) {
+                Ok(())
+            } else {
+                Err(format!("energy order {r:.3}"))
+            }
+        },
+    },
+    Entry {
+        scene: "hertz",
+        sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
+        reference: (None, None),
+        strategies: &["newton-condensed", "apg-condensed"],
+        tols: &[1e-6, 1e-10],
+        claim: "the contact pressure approaches Hertz's: profile error below 3 % on the finest mesh and below half the coarsest's (the block's finite size leaves about 1 %)",
+        check: |s| {
+            let (first, e) = (s.tight.first().map_or(f64::NAN, |t| t.1), finest(s));
+            if e < 0.03 && e < 0.5 * first {
+                Ok(())
+            } else {
+                Err(format!("finest error {e:.3e}, coarsest {first:.3e}"))
+            }
+        },
+    },
+    Entry {
+        scene: "cattaneo-mindlin",
+        sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
+        reference: (None, None),
+        strategies: &["newton-condensed", "apg-condensed"],
+        tols: &[1e-6, 1e-10],
+        claim: "the tangential traction approaches Cattaneo-Mindlin's: error falling with h, below 12 % at n = 192 (β = 0.048 and P1 near-incompressibility remain, see the scene)",
+        check: |s| {
+            let falls = s.tight.windows(2).all(|w| w[1].1 < w[0].1);
+            let at192 = s.tight.iter().find(|t| t.0 == 192).map_or(f64::NAN, |t| t.1);
+            if falls && at192 < 0.12 {
+                Ok(())
+            } else {
+                Err(format!("error at n = 192 {at192:.3e}, falling with h: {falls}"))
+            }
+        },
+    },
+    Entry {
+        scene: "paper",
+        sizes: (&[8, 16, 32], &[16, 32, 64, 128]),
+        reference: (Some(128), Some(512)),
+        strategies: &["newton-condensed", "apg-condensed", "uzawa-condensed", "uzawa-schur-pcg"],
+        tols: &[1e-2, 1e-4, 1e-6, 1e-8],
+        claim: "the multipliers converge under refinement (observed order above 0.8 against the finer mesh), and every strategy reaches the tight run's answer as its tolerance falls",
+        check: |s| {
+            let r = last_rate(s);
+            let tightest = s.rows.iter().map(|r| r.tol).fold(f64::INFINITY, f64::min);
+            let bad = s.rows.iter().find(|r| r.tol == tightest && !(r.algebraic < 1e-5));
+            match (r > 0.8, bad) {
+                (true, None) => Ok(()),
+                (false, _) => Err(format!("order {r:.3}")),
+                (_, Some(b)) => Err(format!("{} at n = {}: algebraic error {:.3e} at tol {:.0e}", b.strategy, b.n, b.algebraic, b.tol)),
+            }
+        },
+    },
+];
+
+/// The smoke run of one shipped scene: `(scene, unknowns, iterations, seconds, outcome)`.
+pub type SmokeRow = (String, u64, String, f64, Result<String, String>);
+
+/// Runs every shipped scene at its smoke size.
+pub fn smoke(progress: &mut dyn FnMut(&str)) -> Vec<SmokeRow> {
+    scene::SHIPPED
+        .iter()
+        .map(|(name, _)| {
+            let t = Instant::now();
+            let result = scene::load(name, &[]).and_then(|(sc, _)| {
+                let n = sc.mesh.smoke_n.unwrap_or(4);
+                let (sc, src) = scene::load(name, &[format!("mesh.n={n}")])?;
+                run(&sc, &src, None, &mut |_| {})
+            });
+            let secs = t.elapsed().as_secs_f64();
+            let row = match result {
+                Ok(r) => {
+                    let it = &r.report["iterations"];
+                    let dofs =
+                        r.report["dofs"]["u"].as_u64().unwrap_or(0) + r.report["dofs"]["phi"].as_u64().unwrap_or(0);
+                    let iters = format!(
+                        "{} Newton, {} Uzawa, {} PCG",
+                        it["newton"].as_u64().unwrap_or(0),
+                        it["uzawa"].as_u64().unwrap_or(0),
+                        it["pcg"].as_u64().unwrap_or(0)
+                    );
+                    let c = &r.report["contact"];
+                    let outcome = if c["n_points"].as_u64().unwrap_or(0) > 0 {
+                        format!(
+                            "ran; stick {}, slip {}, separated {}",
+                            c["n_stick"], c["n_slip"], c["n_separated"]
+                        )
+                    } else {
+                        "ran (no contact)".to_string()
+                    };
+                    (name.to_string(), dofs, iters, secs, Ok(outcome))
+                }
+                Err(e) => (name.to_string(), 0, "-".into(), secs, Err(e.to_string())),
+            };
+            progress(&format!(
+                "smoke {}: {:.2} s, {}",
+                row.0,
+                row.3,
+                row.4.as_ref().map_or_else(|e| format!("FAILED: {e}"), |s| s.clone())
+            ));
+            row
+        })
+        .collect()
+}
+
+/// Runs the report (`full`: to the finest meshes), writes `verification.md` into `docs` and
+/// its plots into `docs/img`; returns the failed checks (empty: all hold).
+pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<String>, DriverError> {
+    let t0 = Instant::now();
+    let mut failures = vec![];
+    let smoke_rows = smoke(progress);
+    for (name, _, _, _, r) in &smoke_rows {
+        if let Err(e) = r {
+            failures.push(format!("smoke run of `{name}`: {e}"));
+        }
+    }
+    let mut md = String::new();
+    let mut pictures = Outputs::new(&docs.join("img"));
+    let mut sections = String::new();
+    let mut summary = vec![];
+    for entry in ENTRIES {
+        let spec = StudySpec {
+            sizes: if full { entry.sizes.1 } else { entry.sizes.0 }.to_vec(),
+            strategies: entry.strategies.iter().map(|s| s.to_string()).collect(),
+            tols: entry.tols.to_vec(),
+            reference_n: if full { entry.reference.1 } else { entry.reference.0 },
+        };
+        let t = Instant::now();
+        let study = convergence::study(entry.scene, &[], &spec, progress)?;
+        let secs = t.elapsed().as_secs_f64();
+        let verdict = (entry.check)(&study);
+        if let Err(e) = &verdict {
+            failures.push(format!("{}: {e}", entry.scene));
+        }
+        let prefix = format!("verification-{}", entry.scene);
+        for (name, bytes) in crate::plots::study_pictures(&prefix, &study)? {
+            pictures.add(&name, bytes);
+        }
+        summary.push((entry.scene, last_rate(&study), finest(&study), secs, verdict.is_ok()));
+        let _ = writeln!(sections, "## `{}`\n", entry.scene);
+        let _ = writeln!(
+            sections,
+            "Claim: {}. **{}**{}.\n",
+            entry.claim,
+            if verdict.is_ok() { "Holds" } else { "FAILS" },
+            verdict.err().map_or(String::new(), |e| format!(" ({e})"))
+        );
+        sections.push_str(&convergence::markdown(&study, &format!("img/{prefix}")));
+        sections.push('\n');
+    }
+    let _ = writeln!(md, "# Verification\n");
+    let _ = writeln!(
+        md,
+        "Written by `piezocontact verification{}` (run by `cargo xtask verify{}`) in {:.0} s; do not edit by hand. \
+         Times are wall times of whole runs on the machine that wrote the page (2 cores, shared).\n",
+        if full { " --full" } else { "" },
+        if full { " --full" } else { "" },
+        t0.elapsed().as_secs_f64()
+    );
+    let _ = writeln!(
+        md,
+        "Every error says what it is measured against. The discretisation error of a size is that of a tight run \
+         (newton-condensed to {:e}); the algebraic error of a run is its difference from that tight run; the error \
+         of a run is its own error against the exact solution or the finer mesh, both parts together.\n",
+        convergence::TIGHT_TOL
+    );
+    let _ = writeln!(md, "## Summary\n\n| scene | finest discretisation error | last observed order | study time (s) | claim |\n|---|---|---|---|---|");
+    for (scene, rate, err, secs, ok) in &summary {
+        let _ = writeln!(
+            md,
+            "| {scene} | {err:.3e} | {rate:.2} | {secs:.1} | {} |",
+            if *ok { "holds" } else { "FAILS" }
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\n## Smoke runs of the shipped scenes (each at its `mesh.smoke_n`)\n"
+    );
+    let _ = writeln!(
+        md,
+        "| scene | unknowns | iterations | time (s) | outcome |\n|---|---|---|---|---|"
+    );
+    for (name, dofs, iters, secs, r) in &smoke_rows {
+        let _ = writeln!(
+            md,
+            "| {name} | {dofs} | {iters} | {secs:.3} | {} |",
+            r.as_ref().map_or_else(|e| format!("FAILED: {e}"), |s| s.clone())
+        );
+    }
+    md.push('\n');
+    md.push_str(&sections);
+    pictures.commit()?;
+    let mut page = Outputs::new(docs);
+    page.add("verification.md", md.into_bytes());
+    page.commit()?;
+    Ok(failures)
+}
