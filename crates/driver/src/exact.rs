@@ -173,8 +173,8 @@ pub fn field_errors(
     })
 }
 
-/// Hertz's half-width and peak pressure for the load `p` per unit length (Johnson 1985, eq.
-/// 4.43): `a² = 4 P R / (π E*)`, `p0 = 2 P / (π a)`, with `E* = E / (1 - ν²)` against a rigid
+/// Hertz's half-width and peak pressure for the load `p` per unit length (Johnson 1985, section
+/// 4.2): `a² = 4 P R / (π E*)`, `p0 = 2 P / (π a)`, with `E* = E / (1 - ν²)` against a rigid
 /// foundation.
 pub fn hertz(p: f64, radius: f64, young: f64, poisson: f64) -> (f64, f64) {
     let e_star = young / (1.0 - poisson * poisson);
@@ -182,7 +182,7 @@ pub fn hertz(p: f64, radius: f64, young: f64, poisson: f64) -> (f64, f64) {
     (a, 2.0 * p / (PI * a))
 }
 
-/// Cattaneo-Mindlin's tangential traction (Johnson 1985, eqs. 7.7-7.8) for the friction
+/// Cattaneo-Mindlin's tangential traction (Johnson 1985, section 7.1) for the friction
 /// coefficient `f`, Hertz's `a` and `p0`, and the stick half-width `c = a √(1 - Q/(F P))`:
 /// `q = F p0 √(1 - x²/a²) - F p0 (c/a) √(1 - x²/c²)` (the second term for `|x| < c` only).
 pub fn cattaneo_traction(x: f64, f: f64, a: f64, p0: f64, c: f64) -> f64 {
