@@ -140,10 +140,24 @@ impl<'m> Discretization<'m> {
         let d = &self.dofs;
         let node_cells = mesh.node_cells();
         let graph_all = mesh.node_graph_from(&node_cells, |_| true);
-        let graph_el = mesh.node_graph_from(&node_cells, |c| self.cell_electric[c]);
-        let a = Pattern::new(&graph_all, &ColDofs::U(d), &ColDofs::U(d));
-        let g = Pattern::new(&graph_el, &ColDofs::Phi(d), &ColDofs::U(d));
-        let b = Pattern::new(&graph_el, &ColDofs::Phi(d), &ColDofs::Phi(d));
+        // the electric cells' graph is the whole graph when every cell is electric
+        let graph_el_owned;
+        let graph_el = if self.cell_electric.iter().all(|&e| e) {
+            &graph_all
+        } else {
+            graph_el_owned = mesh.node_graph_from(&node_cells, |c| self.cell_electric[c]);
+            &graph_el_owned
+        };
+        // the three patterns are independent: build them side by side
+        let (a, (g, b)) = rayon::join(
+            || Pattern::new(&graph_all, &ColDofs::U(d), &ColDofs::U(d)),
+            || {
+                rayon::join(
+                    || Pattern::new(graph_el, &ColDofs::Phi(d), &ColDofs::U(d)),
+                    || Pattern::new(graph_el, &ColDofs::Phi(d), &ColDofs::Phi(d)),
+                )
+            },
+        );
         let (mut av, mut gv, mut bv) = (a.zeros(), g.zeros(), b.zeros());
         match par {
             Parallelism::Rayon => self.assemble_node_owned(&node_cells, &a, &g, &b, &mut av, &mut gv, &mut bv),
