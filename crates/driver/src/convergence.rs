@@ -155,7 +155,9 @@ fn iterations(r: &RunOutcome) -> (u64, &'static str) {
     if get("newton") > 0 {
         (get("newton"), "Newton")
     } else if get("uzawa") > 0 {
-        (get("uzawa"), "Uzawa")
+        // the accelerated gradient counts its steps with Uzawa's
+        let accelerated = r.report["solver"]["strategy"] == "apg-condensed";
+        (get("uzawa"), if accelerated { "APG" } else { "Uzawa" })
     } else if get("pcg") > 0 {
         (get("pcg"), "PCG")
     } else {
