@@ -308,7 +308,7 @@ pub fn setup(scene: &Scene, source: &Source) -> Result<Setup, DriverError> {
     };
     let mut constraints = constraints(scene, &plan)?;
     let mut loads = loads(scene, dim)?;
-    let exact = crate::exact::field_solution(scene, dim);
+    let exact = crate::exact::field_solution(scene, dim)?;
     if let (Some(ex), Some(spec)) = (&exact, &scene.exact) {
         let groups = crate::exact::groups(spec, scene);
         let groups: Vec<&str> = groups.iter().map(String::as_str).collect();

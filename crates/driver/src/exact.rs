@@ -4,6 +4,7 @@
 //! `error` the headline figure the verification study plots.
 
 use crate::scene::{ExactSpec, Scene};
+use crate::DriverError;
 use contact::{ContactPoints, ContactSolution, Status};
 use fe_assembly::{Discretization, Exact};
 use serde_json::{json, Value};
@@ -68,20 +69,15 @@ pub fn validate(x: &ExactSpec, s: &Scene) -> Result<(), String> {
             if s.material.len() != 1 {
                 return Err(format!("exact.kind `{}` needs exactly one [[material]]", x.kind));
             }
-            let Some(dim) = dim_of(s).or(if x.groups.is_empty() { None } else { Some(0) }) else {
+            if dim_of(s).is_none() && x.groups.is_empty() {
                 return Err(format!(
                     "exact.kind `{}` on a Gmsh mesh needs exact.groups (the boundary groups to prescribe it on)",
                     x.kind
                 ));
-            };
-            if x.kind == "affine" && dim > 0 {
-                let ok = |v: &[f64], n: usize| v.is_empty() || v.len() == n;
-                if !ok(&x.u0, dim) || !ok(&x.grad_u, dim * dim) || !ok(&x.grad_phi, dim) {
-                    return Err(format!(
-                        "exact (affine) in {dim}D needs u0 of {dim}, grad_u of {} (row-major) and grad_phi of {dim} values",
-                        dim * dim
-                    ));
-                }
+            }
+            // a Gmsh mesh's dimension is known once it is read: checked again there
+            if let Some(dim) = dim_of(s) {
+                affine_lengths(x, dim)?;
             }
             if let Some(v) = x.u0.iter().chain(&x.grad_u).chain(&x.grad_phi).find(|v| !v.is_finite()) {
                 return Err(format!("exact: the value {v} is not finite"));
@@ -122,16 +118,33 @@ pub fn validate(x: &ExactSpec, s: &Scene) -> Result<(), String> {
     Ok(())
 }
 
-/// The field solution of a `manufactured` or `affine` scene in dimension `dim`.
-pub fn field_solution(s: &Scene, dim: usize) -> Option<Exact> {
-    let x = s.exact.as_ref()?;
+/// Checks the lengths of an `affine` solution's data in dimension `dim` (empty means zero).
+fn affine_lengths(x: &ExactSpec, dim: usize) -> Result<(), String> {
+    let ok = |v: &[f64], n: usize| v.is_empty() || v.len() == n;
+    if x.kind != "affine" || (ok(&x.u0, dim) && ok(&x.grad_u, dim * dim) && ok(&x.grad_phi, dim)) {
+        Ok(())
+    } else {
+        Err(format!(
+            "exact (affine) in {dim}D needs u0 of {dim}, grad_u of {} (row-major) and grad_phi of {dim} values",
+            dim * dim
+        ))
+    }
+}
+
+/// The field solution of a `manufactured` or `affine` scene in dimension `dim` (the mesh's:
+/// a Gmsh mesh's affine data are checked against it here).
+pub fn field_solution(s: &Scene, dim: usize) -> Result<Option<Exact>, DriverError> {
+    let Some(x) = s.exact.as_ref() else {
+        return Ok(None);
+    };
+    affine_lengths(x, dim).map_err(DriverError::Input)?;
     let pad = |v: &[f64], n: usize| -> Vec<f64> {
         let mut out = vec![0.0; n];
         out[..v.len().min(n)].copy_from_slice(&v[..v.len().min(n)]);
         out
     };
     match x.kind.as_str() {
-        "manufactured" => Some(Exact::manufactured(dim)),
+        "manufactured" => Ok(Some(Exact::manufactured(dim))),
         "affine" => {
             let (u0, g, gp) = (pad(&x.u0, 3), pad(&x.grad_u, dim * dim), pad(&x.grad_phi, 3));
             let mut grad_u = [[0.0; 3]; 3];
@@ -140,15 +153,15 @@ pub fn field_solution(s: &Scene, dim: usize) -> Option<Exact> {
                     grad_u[k][j] = g[k * dim + j];
                 }
             }
-            Some(Exact::affine(
+            Ok(Some(Exact::affine(
                 dim,
                 [u0[0], u0[1], u0[2]],
                 grad_u,
                 x.phi0,
                 [gp[0], gp[1], gp[2]],
-            ))
+            )))
         }
-        _ => None,
+        _ => Ok(None),
     }
 }
 
