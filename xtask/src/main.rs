@@ -1,6 +1,9 @@
 //! Project automation: `cargo xtask verify [--full]` (fmt, clippy, tests, docs, the
 //! verification report in docs/verification.md) and `cargo xtask bench`
-//! (the linear benchmark on the paper geometry). Kept free of dependencies.
+//! (the linear benchmark on the paper geometry), `cargo xtask metrics` (lines per crate, the
+//! longest functions). Kept free of dependencies.
+
+mod metrics;
 
 use std::process::{Command, ExitCode};
 
@@ -52,6 +55,11 @@ fn bench(sizes: &[String]) -> bool {
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let ok = match args.first().map(String::as_str) {
+        Some("metrics") => metrics::run(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .parent()
+                .unwrap_or(std::path::Path::new(".")),
+        ),
         Some("verify") => verify(args.iter().any(|a| a == "--full")),
         Some("bench") => {
             let sizes: Vec<String> = if args.len() > 1 {
@@ -62,7 +70,7 @@ fn main() -> ExitCode {
             bench(&sizes)
         }
         _ => {
-            eprintln!("usage: cargo xtask verify [--full] | cargo xtask bench [n ...]");
+            eprintln!("usage: cargo xtask verify [--full] | cargo xtask bench [n ...] | cargo xtask metrics");
             false
         }
     };
