@@ -8,7 +8,7 @@
 //! `f0_i = -Σ_jkl C_ijkl ∂_jl u_k - Σ_jk e_kij ∂_jk φ` and
 //! `q0 = Σ_ikl e_ikl ∂_il u_k - Σ_ik β_ik ∂_ik φ`.
 
-use crate::{kernels, Constraint, Discretization, Field, Load, Material};
+use crate::{kernels, voigt, Constraint, Discretization, Field, Load, Material};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -190,22 +190,6 @@ impl ErrorNorms {
     /// Relative error in the energy norm.
     pub fn rel_energy(&self) -> f64 {
         self.energy / self.norms.2
-    }
-}
-
-/// Voigt index of `(i, j)` (the order of the glossary).
-pub fn voigt(dim: usize, i: usize, j: usize) -> usize {
-    let (a, b) = (i.min(j), i.max(j));
-    match (dim, a, b) {
-        (2, 0, 0) => 0,
-        (2, 1, 1) => 1,
-        (2, _, _) => 2,
-        (_, 0, 0) => 0,
-        (_, 1, 1) => 1,
-        (_, 2, 2) => 2,
-        (_, 1, 2) => 3,
-        (_, 0, 2) => 4,
-        _ => 5,
     }
 }
 

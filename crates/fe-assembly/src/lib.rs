@@ -53,7 +53,7 @@ pub use assembly::{Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field};
 pub use exact::{ErrorNorms, Exact};
 pub use loads::{facet_measure, Load};
-pub use material::{Crystal, Material, MaterialError};
+pub use material::{voigt, Crystal, Material, MaterialError};
 pub use recovery::CellFields;
 
 use std::sync::Arc;

@@ -139,14 +139,18 @@ pub enum MaterialError {
     },
 }
 
-/// Voigt index of the symmetric pair `(i, j)`.
-fn voigt(i: usize, j: usize) -> usize {
-    match (i.min(j), i.max(j)) {
-        (0, 0) => 0,
-        (1, 1) => 1,
-        (2, 2) => 2,
-        (1, 2) => 3,
-        (0, 2) => 4,
+/// Voigt index of the symmetric pair `(i, j)` in dimension `dim`: `[xx, yy, xy]` in 2D,
+/// `[xx, yy, zz, yz, xz, xy]` (= `[11, 22, 33, 23, 13, 12]`) in 3D.
+pub fn voigt(dim: usize, i: usize, j: usize) -> usize {
+    match (dim, i.min(j), i.max(j)) {
+        (2, 0, 0) => 0,
+        (2, 1, 1) => 1,
+        (2, _, _) => 2,
+        (_, 0, 0) => 0,
+        (_, 1, 1) => 1,
+        (_, 2, 2) => 2,
+        (_, 1, 2) => 3,
+        (_, 0, 2) => 4,
         _ => 5,
     }
 }
@@ -223,7 +227,7 @@ impl Material {
                             for b in 0..3 {
                                 for cc in 0..3 {
                                     for d in 0..3 {
-                                        let v = crystal.c[voigt(a, b)][voigt(cc, d)];
+                                        let v = crystal.c[voigt(3, a, b)][voigt(3, cc, d)];
                                         if v != 0.0 {
                                             s += r(i, a) * r(j, b) * r(k, cc) * r(l, d) * v;
                                         }
@@ -231,7 +235,7 @@ impl Material {
                                 }
                             }
                         }
-                        c3[voigt(i, j)][voigt(k, l)] = s;
+                        c3[voigt(3, i, j)][voigt(3, k, l)] = s;
                     }
                 }
             }
@@ -243,11 +247,11 @@ impl Material {
                     for a in 0..3 {
                         for b in 0..3 {
                             for cc in 0..3 {
-                                s += r(i, a) * r(j, b) * r(k, cc) * crystal.e[a][voigt(b, cc)];
+                                s += r(i, a) * r(j, b) * r(k, cc) * crystal.e[a][voigt(3, b, cc)];
                             }
                         }
                     }
-                    e3[i][voigt(j, k)] = s;
+                    e3[i][voigt(3, j, k)] = s;
                 }
                 let mut s = 0.0;
                 for a in 0..3 {
@@ -300,6 +304,15 @@ impl Material {
         for x in &mut self.e {
             *x *= factor;
         }
+        self
+    }
+
+    /// The material without its electric part (no permittivity, no coupling): for a problem
+    /// whose plan has no electric unknowns.
+    pub fn without_electric(mut self) -> Self {
+        self.electric = false;
+        self.beta.iter_mut().for_each(|x| *x = 0.0);
+        self.e.iter_mut().for_each(|x| *x = 0.0);
         self
     }
 

@@ -27,26 +27,7 @@ pub fn solve_both(disc: &Discretization<'_>, loads: &[Load]) -> (Solution, Solut
     ((u1, p1), (u2, p2), blocks)
 }
 
-/// Voigt index of `(i, j)` in dimension `dim`.
-pub fn voigt(dim: usize, i: usize, j: usize) -> usize {
-    let (a, b) = (i.min(j), i.max(j));
-    if dim == 2 {
-        match (a, b) {
-            (0, 0) => 0,
-            (1, 1) => 1,
-            _ => 2,
-        }
-    } else {
-        match (a, b) {
-            (0, 0) => 0,
-            (1, 1) => 1,
-            (2, 2) => 2,
-            (1, 2) => 3,
-            (0, 2) => 4,
-            _ => 5,
-        }
-    }
-}
+pub use fe_assembly::voigt;
 
 /// `σ = C ε + eᵀ ∇φ` and `D = e ε - β ∇φ` for a displacement gradient `gu[k][l] = ∂u_k/∂x_l`
 /// and a potential gradient `gp`.
