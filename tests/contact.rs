@@ -13,31 +13,21 @@
 //! `paper` sticks everywhere; the answer is proportional to p (g = 0); `pzt5a-si` is `paper`
 //! under the change of units of SCENES.md section 4; the strategies agree to 1e-8.
 
-use driver::run::RunOutcome;
+use problem::Solution;
 
-fn run(scene: &str, sets: &[&str]) -> RunOutcome {
+fn run(scene: &str, sets: &[&str]) -> Solution {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let (scene, source) = driver::scene::load(scene, &sets).unwrap();
-    driver::run::run(&scene, &source, None, &mut |_| {}).unwrap()
+    driver::studies::solve(scene, &sets).unwrap()
 }
 
-fn counts(r: &RunOutcome) -> (u64, u64, u64) {
-    let c = &r.report["contact"];
-    (
-        c["n_stick"].as_u64().unwrap(),
-        c["n_slip"].as_u64().unwrap(),
-        c["n_separated"].as_u64().unwrap(),
-    )
+fn counts(r: &Solution) -> (usize, usize, usize) {
+    let c = &r.report.contact;
+    (c.n_stick, c.n_slip, c.n_separated)
 }
 
-fn lambdas(r: &RunOutcome) -> Vec<f64> {
-    let (_, sol) = r.contact.as_ref().unwrap();
-    sol.lambda
-        .normal
-        .iter()
-        .chain(&sol.lambda.tangential)
-        .copied()
-        .collect()
+fn lambdas(r: &Solution) -> Vec<f64> {
+    let lambda = &r.contact.as_ref().unwrap().solution.lambda;
+    lambda.normal.iter().chain(&lambda.tangential).copied().collect()
 }
 
 fn rel_diff(a: &[f64], b: &[f64], scale_b: f64) -> f64 {
@@ -52,10 +42,10 @@ fn rel_diff(a: &[f64], b: &[f64], scale_b: f64) -> f64 {
 #[test]
 fn paper_slip_has_the_slip_zone_of_scenes_md() {
     let r = run("paper-slip", &[]);
-    assert_eq!(r.report["contact"]["n_points"], 127);
+    assert_eq!(r.report.contact.n_points, 127);
     assert_eq!(counts(&r), (58, 69, 0));
-    assert!(r.report["residuals"]["complementarity"].as_f64().unwrap() <= 1e-10);
-    assert!(r.report["residuals"]["equilibrium"].as_f64().unwrap() <= 1e-12);
+    assert!(r.report.residuals.complementarity <= 1e-10);
+    assert!(r.report.residuals.equilibrium <= 1e-12);
 }
 
 #[test]
@@ -94,7 +84,7 @@ fn strategies_agree() {
             rel_diff(&lambdas(&a12), &lambdas(&e), 1.0) < 1e-8,
             "{scene}: Uzawa vs semismooth Newton"
         );
-        assert_eq!(e.report["iterations"]["newton_fallback"], false, "{scene}");
+        assert!(!e.report.iterations.newton_fallback, "{scene}");
         assert!(
             rel_diff(&lambdas(&a), &lambdas(&b), 1.0) < 1e-8,
             "{scene}: condensed vs direct"
@@ -104,7 +94,7 @@ fn strategies_agree() {
             "{scene}: condensed vs schur-pcg"
         );
         assert_eq!(counts(&a), counts(&b), "{scene}");
-        assert!(c.report["iterations"]["pcg"].as_u64().unwrap() > 0);
+        assert!(c.report.iterations.pcg > 0);
     }
 }
 
@@ -120,30 +110,25 @@ fn si_units_give_the_paper_answer_mapped() {
     assert!(rel_diff(&paper.phi, &si.phi, 1e4) < 1e-11);
     assert_eq!(counts(&paper), counts(&si));
     // the same iteration counts: every stopping test is scale-free
-    assert_eq!(paper.report["iterations"]["uzawa"], si.report["iterations"]["uzawa"]);
-    assert_eq!(paper.report["iterations"]["newton"], si.report["iterations"]["newton"]);
-    assert_eq!(
-        paper.report["iterations"]["fixed_point"],
-        si.report["iterations"]["fixed_point"]
-    );
+    assert_eq!(paper.report.iterations, si.report.iterations);
 }
 
 #[test]
 fn frictionless_and_tresca_plans_leave_out_what_they_do_not_need() {
     let f = run("paper-frictionless", &["mesh.n=8"]);
-    assert_eq!(f.report["plan"]["friction"], false);
-    assert_eq!(f.report["iterations"]["fixed_point"], 0);
-    assert!(f.contact.as_ref().unwrap().1.lambda.tangential.is_empty());
+    assert!(!f.report.plan.friction);
+    assert_eq!(f.report.iterations.fixed_point, 0);
+    assert!(f.contact.as_ref().unwrap().solution.lambda.tangential.is_empty());
     let (_, s, _) = counts(&f);
     assert_eq!(s, 15);
     let t = run("paper-tresca", &["mesh.n=16"]);
-    assert_eq!(t.report["plan"]["fixed_point"], false);
-    assert_eq!(t.report["iterations"]["fixed_point"], 0);
-    let (_, sol) = t.contact.as_ref().unwrap();
+    assert!(!t.report.plan.fixed_point);
+    assert_eq!(t.report.iterations.fixed_point, 0);
+    let sol = &t.contact.as_ref().unwrap().solution;
     assert!(sol.lambda.tangential.iter().all(|l| l.abs() <= 0.05 * (1.0 + 1e-9)));
     let none = run("paper", &["mesh.n=8", "contact.law=none"]);
     assert!(none.contact.is_none());
-    assert_eq!(none.report["iterations"]["uzawa"], 0);
+    assert_eq!(none.report.iterations.uzawa, 0);
 }
 
 #[test]
@@ -163,38 +148,35 @@ fn paper_rule_is_labelled_and_reproduces_the_table_counts() {
         "paper",
         &["mesh.n=32", "solver.rule=paper", "solver.strategy=uzawa-schur-pcg"],
     );
-    assert!(r.report["solver"]["rule"].as_str().unwrap().starts_with("paper"));
-    assert_eq!(r.report["residuals"]["converged_to_tolerance"], false);
-    let it = &r.report["iterations"];
-    eprintln!("paper rule at n = 32: {it}");
+    assert!(r.report.solver.rule.starts_with("paper"));
+    assert!(!r.report.residuals.converged_to_tolerance);
+    let it = &r.report.iterations;
+    eprintln!("paper rule at n = 32: {it:?}");
     // the paper's Table 1 at h = 1/32: 3 fixed-point, 39 Uzawa, 2 PCG iterations (per solve)
-    assert_eq!(it["fixed_point"], 3);
-    let uz = it["uzawa"].as_u64().unwrap();
+    assert_eq!(it.fixed_point, 3);
+    let uz = it.uzawa;
     // 39 with exact inner solves (solver.pcg_tol=1e-12), 43 with the paper's loose PCG
     assert!((39..=45).contains(&uz), "Uzawa iterations: {uz}");
-    let pcg_per_solve = it["pcg"].as_f64().unwrap() / (uz as f64 + 1.0);
+    let pcg_per_solve = it.pcg as f64 / (uz as f64 + 1.0);
     assert!(pcg_per_solve <= 3.0, "PCG iterations per Uzawa solve: {pcg_per_solve}");
     let exact = run(
         "paper",
         &["mesh.n=32", "solver.rule=paper", "solver.strategy=uzawa-direct"],
     );
-    assert_eq!(exact.report["iterations"]["uzawa"], 39);
-    assert_eq!(exact.report["iterations"]["fixed_point"], 3);
+    assert_eq!(exact.report.iterations.uzawa, 39);
+    assert_eq!(exact.report.iterations.fixed_point, 3);
 }
 
 #[test]
 fn every_shipped_scene_runs_at_its_smoke_size() {
-    for (name, text) in driver::scene::SHIPPED {
-        let scene = driver::scene::parse(text, name, &[]).unwrap();
+    for (name, text) in driver::scene_file::SHIPPED {
+        let scene = driver::scene_file::parse(text, name, &[]).unwrap();
         let n = scene.mesh.smoke_n.expect("every shipped scene has a smoke size");
         let r = run(name, &[&format!("mesh.n={n}")]);
-        let eq = r.report["residuals"]["equilibrium"].as_f64().unwrap();
+        let eq = r.report.residuals.equilibrium;
         assert!(eq < 1e-10, "{name}: equilibrium {eq}");
         if r.contact.is_some() {
-            assert!(
-                r.report["residuals"]["complementarity"].as_f64().unwrap() <= 1e-10,
-                "{name}"
-            );
+            assert!(r.report.residuals.complementarity <= 1e-10, "{name}");
         }
     }
 }
@@ -202,9 +184,8 @@ fn every_shipped_scene_runs_at_its_smoke_size() {
 #[test]
 fn gmsh_mesh_with_two_materials_by_region() {
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/layered-gmsh.toml");
-    let (scene, source) = driver::scene::load(file, &[]).unwrap();
-    let mesh = driver::build::mesh(&scene, &source).unwrap();
-    let r = driver::run::run(&scene, &source, None, &mut |_| {}).unwrap();
+    let r = driver::studies::solve(file, &[]).unwrap();
+    let mesh = &r.mesh;
     // potentials only on the nodes of the PZT layer (y >= 0.8), less the grounded ones
     let pzt_nodes: std::collections::BTreeSet<usize> = mesh
         .region("pzt")
@@ -216,16 +197,13 @@ fn gmsh_mesh_with_two_materials_by_region() {
         .iter()
         .filter(|&&v| mesh.points[v][0] == 0.0 || mesh.points[v][0] == 2.0)
         .count();
-    assert_eq!(
-        r.report["dofs"]["phi"].as_u64().unwrap() as usize,
-        pzt_nodes.len() - grounded
-    );
+    assert_eq!(r.report.dofs.phi, pzt_nodes.len() - grounded);
     assert!(pzt_nodes.iter().all(|&v| mesh.points[v][1] >= 0.8 - 1e-12));
-    assert!(r.report["residuals"]["complementarity"].as_f64().unwrap() <= 1e-10);
-    assert!(r.report["residuals"]["equilibrium"].as_f64().unwrap() <= 1e-12);
+    assert!(r.report.residuals.complementarity <= 1e-10);
+    assert!(r.report.residuals.equilibrium <= 1e-12);
     // the foundation carries the load: sum of w lambda_n is the applied force less what the
     // clamped sides take, so it lies between 0 and |p| times the top's length
-    let f = r.report["contact"]["normal_force"].as_f64().unwrap();
+    let f = r.report.contact.normal_force;
     assert!(f > 0.5 && f < 4.0, "normal force {f}");
     // potentials vanish in the substrate (no electric unknowns there)
     let substrate_only: Vec<usize> = (0..mesh.n_nodes()).filter(|v| !pzt_nodes.contains(v)).collect();
@@ -238,16 +216,17 @@ fn gmsh_mesh_with_two_materials_by_region() {
 /// stability`).
 #[test]
 fn stability_cases_hold_at_smoke_size() {
-    for case in driver::stability::cases().iter().filter(|c| !c.fine) {
+    use driver::studies::stability;
+    for case in stability::cases().iter().filter(|c| !c.fine) {
         let sets = case.smoke_sets();
         let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
         let r = run(case.scene, &sets);
-        if let Err(e) = driver::stability::check(case.expect, &r.report) {
+        if let Err(e) = stability::check(case.expect, &r.report) {
             panic!("{}: {e}", case.name);
         }
         if let Some(p) = &case.paper_sets {
             let sets: Vec<String> = p.iter().map(|s| s.to_string()).collect();
-            driver::scene::load(case.scene, &sets).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+            driver::scene_file::load(case.scene, &sets).unwrap_or_else(|e| panic!("{}: {e}", case.name));
         }
     }
 }
@@ -273,8 +252,9 @@ fn stability_cases_hold_at_smoke_size() {
 #[test]
 fn hertz_pressure_is_johnsons() {
     let r = run("hertz", &["mesh.n=48"]);
-    let (points, sol) = r.contact.as_ref().unwrap();
-    let p = r.report["contact"]["normal_force"].as_f64().unwrap();
+    let c = r.contact.as_ref().unwrap();
+    let (points, sol) = (&c.points, &c.solution);
+    let p = r.report.contact.normal_force;
     let e_star = 100.0 / (1.0 - 0.3f64 * 0.3);
     let a = (4.0 * p * 10.0 / (std::f64::consts::PI * e_star)).sqrt();
     let p0 = 2.0 * p / (std::f64::consts::PI * a);
@@ -322,26 +302,20 @@ fn hertz_pressure_is_johnsons() {
 #[test]
 fn cattaneo_mindlin_stick_zone() {
     let r = run("cattaneo-mindlin", &["mesh.n=192"]);
-    let x = &r.report["exact"];
-    let (a, c, c_h) = (
-        x["a"].as_f64().unwrap(),
-        x["c"].as_f64().unwrap(),
-        x["c_h"].as_f64().unwrap(),
-    );
+    let Some(problem::exact::ExactReport::Contact(x)) = &r.report.exact else {
+        panic!("no contact errors reported");
+    };
+    let (a, c, c_h) = (x.a, x.c.unwrap(), x.c_h.unwrap());
     let h = 1.0 / 48.0;
-    let q_over_fp = x["load_q"].as_f64().unwrap() / (0.5 * x["load_p"].as_f64().unwrap());
+    let q_over_fp = x.load_q.unwrap() / (0.5 * x.load_p);
     assert!((0.5..0.75).contains(&q_over_fp), "Q/(F P) = {q_over_fp}");
     assert!(
         (c_h - c).abs() < 3.0 * h,
         "stick half-width {c_h} against c = {c} (a = {a})"
     );
-    assert!(x["stick_offset"].as_f64().unwrap().abs() < 0.05, "{x}");
-    assert!(
-        x["error"].as_f64().unwrap() < 0.13,
-        "traction profile error {}",
-        x["error"]
-    );
-    let (_, sol) = r.contact.as_ref().unwrap();
+    assert!(x.stick_offset.unwrap().abs() < 0.05, "{x:?}");
+    assert!(x.error < 0.13, "traction profile error {}", x.error);
+    let sol = &r.contact.as_ref().unwrap().solution;
     for (i, s) in sol.status.iter().enumerate() {
         if *s == contact::Status::Slip {
             let (ln, lt) = (sol.lambda.normal[i], sol.lambda.tangential[i].abs());
@@ -363,10 +337,11 @@ fn cattaneo_mindlin_stick_zone() {
 ///   tolerances 1e-2 and 1e-8.
 #[test]
 fn study_separates_discretisation_and_algebraic_errors() {
-    use driver::convergence::{study, StudySpec};
+    use driver::studies::convergence::{study, StudySpec};
+    use problem::Strategy;
     let spec = StudySpec {
         sizes: vec![4, 8],
-        strategies: vec!["newton-condensed".into(), "uzawa-condensed".into()],
+        strategies: vec![Strategy::NewtonCondensed, Strategy::UzawaCondensed],
         tols: vec![1e-2, 1e-8],
         reference_n: Some(32),
     };
@@ -375,8 +350,8 @@ fn study_separates_discretisation_and_algebraic_errors() {
     assert!(s.tight[1].1 < s.tight[0].1, "{:?}", s.tight);
     for r in &s.rows {
         assert!(r.seconds > 0.0 && r.error > 0.0);
-        match (r.strategy.as_str(), r.tol) {
-            ("newton-condensed", _) => assert!(r.algebraic < 1e-10, "{r:?}"),
+        match (r.strategy, r.tol) {
+            (Strategy::NewtonCondensed, _) => assert!(r.algebraic < 1e-10, "{r:?}"),
             (_, 1e-8) => assert!(r.algebraic < 1e-6, "{r:?}"),
             _ => assert!(r.algebraic > 1e-6, "{r:?}"),
         }

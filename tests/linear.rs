@@ -6,11 +6,11 @@
 
 use fe_assembly::{Discretization, Parallelism};
 use linalg::{DirectLdlt, Ordering};
+use problem::{RunReport, Silent};
 
-fn run(scene: &str, sets: &[&str]) -> serde_json::Value {
+fn run(scene: &str, sets: &[&str]) -> RunReport {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let (scene, source) = driver::scene::load(scene, &sets).unwrap();
-    driver::run::run(&scene, &source, None, &mut |_| {}).unwrap().report
+    driver::studies::solve(scene, &sets).unwrap().report
 }
 
 #[test]
@@ -23,39 +23,39 @@ fn strategies_agree_on_paper_without_contact() {
         "paper",
         &["mesh.n=16", "contact.law=none", "solver.strategy=uzawa-schur-pcg"],
     );
-    assert!(direct["residuals"]["equilibrium"].as_f64().unwrap() < 1e-12);
-    assert!(schur["residuals"]["equilibrium"].as_f64().unwrap() < 1e-10);
-    assert!(schur["iterations"]["pcg"].as_u64().unwrap() > 1);
-    assert_eq!(direct["dofs"], schur["dofs"]);
+    assert!(direct.residuals.equilibrium < 1e-12);
+    assert!(schur.residuals.equilibrium < 1e-10);
+    assert!(schur.iterations.pcg > 1);
+    assert_eq!(direct.dofs, schur.dofs);
     // 2D paper block at n = 16: (33 x 17) nodes, 2 x 31 x 17 free u, 31 x 17 free phi
-    assert_eq!(direct["dofs"]["u"], 2 * 31 * 17);
-    assert_eq!(direct["dofs"]["phi"], 31 * 17);
+    assert_eq!(direct.dofs.u, 2 * 31 * 17);
+    assert_eq!(direct.dofs.phi, 31 * 17);
 }
 
 #[test]
 fn elastic_scene_has_no_electric_unknowns() {
     let r = run("paper-elastic", &["mesh.n=8", "contact.law=none"]);
-    assert_eq!(r["dofs"]["phi"], 0);
-    assert_eq!(r["plan"]["electric"], false);
-    assert!(r["residuals"]["equilibrium"].as_f64().unwrap() < 1e-12);
+    assert_eq!(r.dofs.phi, 0);
+    assert!(!r.plan.electric);
+    assert!(r.residuals.equilibrium < 1e-12);
 }
 
 #[test]
 fn paper_3d_runs() {
     let r = run("paper-3d", &["mesh.n=2", "contact.law=none"]);
-    assert_eq!(r["dofs"]["u"], 3 * 3 * 3 * 3);
-    assert!(r["residuals"]["equilibrium"].as_f64().unwrap() < 1e-12);
+    assert_eq!(r.dofs.u, 3 * 3 * 3 * 3);
+    assert!(r.residuals.equilibrium < 1e-12);
 }
 
 #[test]
 fn supernodal_ldlt_has_the_inertia_of_k() {
-    let (scene, source) = driver::scene::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
-    let driver::build::Setup {
+    let (scene, _) = driver::scene_file::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
+    let problem::setup::Setup {
         mesh,
         materials: mats,
         constraints: bcs,
         ..
-    } = driver::build::setup(&scene, &source).expect("setup");
+    } = problem::setup::setup(&scene, None).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).unwrap();
     let b = disc.assemble(Parallelism::Rayon);
     let f = DirectLdlt::new(&b.a, &b.g, &b.b, &Ordering::Amd, faer::Par::Seq).unwrap();
@@ -66,28 +66,28 @@ fn supernodal_ldlt_has_the_inertia_of_k() {
 fn outputs_are_written_and_bad_input_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ok");
-    let (scene, source) = driver::scene::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
-    driver::run::run(&scene, &source, Some(&out), &mut |_| {}).unwrap();
-    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
-    assert_eq!(json["scene"]["name"], "paper");
+    let (scene, source) = driver::scene_file::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
+    driver::run::run(&scene, &source, &out, &mut Silent).unwrap();
+    let json: RunReport = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(json.scene.name, "paper");
     let vtu = std::fs::read_to_string(out.join("solution.vtu")).unwrap();
     assert!(vtu.starts_with("<VTKFile type=\"UnstructuredGrid\""));
     assert!(vtu.contains("Name=\"phi\"") && vtu.contains("Name=\"stress\""));
     // a missing boundary group: a typed error naming it, and no output directory
     let bad = dir.path().join("bad");
-    let (scene, source) = driver::scene::load(
+    let (scene, source) = driver::scene_file::load(
         "paper",
         &["mesh.n=4".into(), "contact.law=none".into(), "load.group=lid".into()],
     )
     .unwrap();
-    let e = driver::run::run(&scene, &source, Some(&bad), &mut |_| {}).unwrap_err();
+    let e = driver::run::run(&scene, &source, &bad, &mut Silent).err().unwrap();
     assert!(e.to_string().contains("boundary group `lid` is missing"), "{e}");
     assert!(!bad.exists());
     // an unknown key names itself
-    let e = driver::scene::load("paper", &["mesh.nn=4".into()]).unwrap_err();
+    let e = driver::scene_file::load("paper", &["mesh.nn=4".into()]).unwrap_err();
     assert!(e.to_string().contains("unknown field `nn`"), "{e}");
     // a non-positive-definite material
-    let (scene, source) = driver::scene::load(
+    let (scene, source) = driver::scene_file::load(
         "paper",
         &[
             "mesh.n=4".into(),
@@ -96,7 +96,7 @@ fn outputs_are_written_and_bad_input_writes_nothing() {
         ],
     )
     .unwrap();
-    let e = driver::run::run(&scene, &source, None, &mut |_| {}).unwrap_err();
+    let e = driver::run::solve(&scene, &source, &mut Silent).err().unwrap();
     assert!(e.to_string().contains("C is not positive definite"), "{e}");
 }
 
@@ -112,12 +112,12 @@ fn outputs_are_written_and_bad_input_writes_nothing() {
 /// - Tolerance: 1e-11, round-off amplified by the condition number of `K` at n = 8 (about 1e3).
 #[test]
 fn patch_scene_is_reproduced_to_round_off() {
-    for strategy in ["newton-condensed", "uzawa-schur-pcg"] {
-        let r = run(
-            "patch",
-            &[&format!("solver.strategy=\"{strategy}\""), "solver.pcg_tol=1e-14"],
-        );
-        let e = r["exact"]["error"].as_f64().unwrap();
+    for sets in [
+        &["solver.strategy=newton-condensed"][..],
+        &["solver.strategy=uzawa-schur-pcg", "solver.pcg_tol=1e-14"],
+    ] {
+        let strategy = sets[0];
+        let e = run("patch", sets).exact.unwrap().error();
         assert!(e < 1e-11, "{strategy}: energy error {e}");
     }
 }
@@ -138,11 +138,7 @@ fn manufactured_scenes_converge_at_order_one() {
     for (scene, sizes) in [("manufactured", [16, 32]), ("manufactured-3d", [4, 8])] {
         let e: Vec<f64> = sizes
             .iter()
-            .map(|n| {
-                run(scene, &[&format!("mesh.n={n}")])["exact"]["error"]
-                    .as_f64()
-                    .unwrap()
-            })
+            .map(|n| run(scene, &[&format!("mesh.n={n}")]).exact.unwrap().error())
             .collect();
         let order = (e[0] / e[1]).log2();
         assert!((0.9..1.2).contains(&order), "{scene}: errors {e:?}, order {order}");

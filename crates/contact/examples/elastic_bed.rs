@@ -65,10 +65,12 @@ fn main() {
     }
     // the base pushes a parabolic profile into the floor and drags everything by 0.02
     let x: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) * h).collect();
-    let u0 = PointValues {
-        normal: x.iter().map(|x| 0.05 - 0.4 * (x - 0.5).powi(2)).collect(),
-        tangential: vec![0.02; n],
-    };
+    let u0 = PointValues::from_parts(
+        x.iter().map(|x| 0.05 - 0.4 * (x - 0.5).powi(2)).collect(),
+        vec![0.02; n],
+        1,
+    )
+    .expect("one tangential value per point");
     let points = ContactPoints {
         dim: 2,
         position: x.iter().map(|&x| [x, 0.0, 0.0]).collect(),

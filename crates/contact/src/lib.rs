@@ -25,7 +25,7 @@
 //!     tangent: vec![[[1.0, 0.0, 0.0], [0.0; 3]]], weight: vec![1.0], gap: vec![0.0], friction: vec![0.0],
 //! };
 //! let mut op = DenseContactProblem {
-//!     u0: PointValues { normal: vec![1.0], tangential: vec![] },
+//!     u0: PointValues::from_parts(vec![1.0], vec![], 0).unwrap(),
 //!     compliance: vec![1.0], weight: vec![1.0], nt: 0,
 //! };
 //! let sol = solve(&mut op, &points, &Law::Frictionless, &UzawaParams::default(), None, &mut |_| {}).unwrap();
@@ -37,22 +37,43 @@ mod newton;
 mod operator;
 mod points;
 mod projection;
+mod solution;
 mod uzawa;
 
 pub use newton::{solve_newton, NewtonParams};
 pub use operator::{ContactOperator, DenseContactProblem};
 pub use points::{ContactPoints, PointValues, Status};
 pub use projection::{project_disc, project_nonnegative};
-pub use uzawa::{
-    classify, complementarity_residual, slip_bound, solve, ContactSolution, Law, Progress, StopRule, UzawaInfo,
-    UzawaParams,
+pub use solution::{
+    classify, complementarity_residual, slip_bound, ContactInfo, ContactSolution, Law, Progress, Stage,
 };
+pub use uzawa::{solve, StopRule, UzawaParams};
 
-/// What can go wrong in a contact solve; each variant carries the last residual.
-#[derive(Debug, Clone, thiserror::Error, PartialEq)]
+/// A failure of the primal solve behind a [`ContactOperator`], with its cause (for example the
+/// linear solver's own error), which [`std::error::Error::source`] returns.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("{0}")]
+pub struct OperatorError(std::sync::Arc<dyn std::error::Error + Send + Sync>);
+
+impl OperatorError {
+    /// Wraps the error of a primal solve.
+    pub fn new(source: impl std::error::Error + Send + Sync + 'static) -> Self {
+        OperatorError(std::sync::Arc::new(source))
+    }
+
+    /// The error of the primal solve.
+    pub fn cause(&self) -> &(dyn std::error::Error + Send + Sync + 'static) {
+        &*self.0
+    }
+}
+
+/// What can go wrong in a contact solve; each variant of a loop that stopped carries its last
+/// residual. The messages name no solver option: the application that chose the solver knows
+/// what else to try.
+#[derive(Debug, Clone, thiserror::Error)]
 pub enum ContactError {
-    /// Uzawa did not reach its tolerance.
-    #[error("Uzawa did not converge in {n_iters} iterations (complementarity residual {residual:.3e}); try solver.strategy=newton-condensed, or a looser solver.tol")]
+    /// The first-order iteration did not reach its tolerance.
+    #[error("Uzawa did not converge in {n_iters} iterations (complementarity residual {residual:.3e})")]
     NoConvergence {
         /// Iterations done.
         n_iters: usize,
@@ -60,7 +81,7 @@ pub enum ContactError {
         residual: f64,
     },
     /// The fixed point on the slip bound did not converge.
-    #[error("the friction fixed point did not converge in {n_iters} iterations (residual {residual:.3e}); the fixed point on S may cycle under strong coupling or large F; try solver.strategy=newton-condensed, which solves Coulomb's law directly")]
+    #[error("the friction fixed point did not converge in {n_iters} iterations (residual {residual:.3e}); the fixed point on S may cycle under strong coupling or large F")]
     FixedPointNoConvergence {
         /// Iterations done.
         n_iters: usize,
@@ -68,7 +89,7 @@ pub enum ContactError {
         residual: f64,
     },
     /// The iteration diverged even after halving the step.
-    #[error("Uzawa diverged after {n_iters} iterations (residual {residual:.3e}, step {step:.3e}); give a smaller solver step")]
+    #[error("Uzawa diverged after {n_iters} iterations (residual {residual:.3e}, step {step:.3e})")]
     Diverged {
         /// Iterations done.
         n_iters: usize,
@@ -78,7 +99,7 @@ pub enum ContactError {
         step: f64,
     },
     /// The semismooth Newton iteration stalled (and its fallback was switched off).
-    #[error("semismooth Newton stalled after {n_iters} steps on {reason} (complementarity residual {residual:.3e}); allow the fallback or use the apg-condensed strategy")]
+    #[error("semismooth Newton stalled after {n_iters} steps on {reason} (complementarity residual {residual:.3e})")]
     NewtonStalled {
         /// Newton steps done.
         n_iters: usize,
@@ -87,9 +108,16 @@ pub enum ContactError {
         /// What stopped it.
         reason: String,
     },
+    /// The multipliers do not move the contact points: the dual operator's largest eigenvalue
+    /// is not positive and finite.
+    #[error("the dual operator's largest eigenvalue estimate is {mu_max}: the contact points are not loaded by their multipliers")]
+    NotLoaded {
+        /// The estimate.
+        mu_max: f64,
+    },
     /// The primal solve failed.
     #[error("primal solve failed: {0}")]
-    Operator(String),
+    Operator(#[source] OperatorError),
     /// Bad input.
     #[error("contact input: {0}")]
     Input(String),

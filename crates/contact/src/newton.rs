@@ -16,10 +16,10 @@
 use crate::operator::DenseContactProblem;
 use crate::points::{ContactPoints, PointValues};
 use crate::projection::project_disc;
-use crate::uzawa::{
-    check_input, classify, complementarity_residual, estimate_mu_max, multiplier_scale, slip_bound, Counter,
+use crate::solution::{
+    check_input, classify, complementarity_residual, counts, estimate_mu_max, multiplier_scale, slip_bound, Counter,
 };
-use crate::{ContactError, ContactSolution, Law, Progress, StopRule, UzawaInfo, UzawaParams};
+use crate::{ContactError, ContactInfo, ContactSolution, Law, Progress, Stage, StopRule, UzawaParams};
 use faer::linalg::solvers::Solve;
 use faer::Mat;
 
@@ -283,19 +283,21 @@ impl Flat<'_> {
     }
 
     fn to_values(&self, x: &[f64]) -> PointValues {
-        PointValues {
-            normal: x[..self.n].to_vec(),
-            tangential: x[self.n..].to_vec(),
-        }
+        PointValues::from_flat(x, self.n, self.nt)
     }
 }
 
 /// Solves the condensed contact problem `problem` for `law` by the semismooth Newton method of
 /// this module, from `lambda0` (zeros when `None`). Reports one progress line per Newton step.
 ///
-/// The returned [`UzawaInfo`] counts Newton steps in `newton_iters` (and the fallback's
-/// first-order steps, if any, in `uzawa_iters`); `complementarity` is the residual of
+/// The returned [`ContactInfo`] counts Newton steps in `newton_iters` and gives Newton's
+/// constant `c` in `augmentation` (and the fallback's first-order steps, if any, in
+/// `uzawa_iters`, with their step in `step`); `complementarity` is the residual of
 /// [`crate::complementarity_residual`] with the law's radius, at most `params.tol`.
+///
+/// # Errors
+/// [`ContactError::Input`] for inconsistent data, [`ContactError::NewtonStalled`] when Newton
+/// stalls with the fallback switched off, and the fallback's own errors.
 pub fn solve_newton(
     problem: &mut DenseContactProblem,
     points: &ContactPoints,
@@ -353,7 +355,8 @@ pub fn solve_newton(
         Some(_) => return Err(ContactError::Input("warm start of the wrong size".into())),
         None => vec![0.0; m],
     };
-    let mut info = UzawaInfo::new(c, mu_max);
+    let mut info = ContactInfo::new(mu_max);
+    info.augmentation = Some(c);
     let residual = |s: &State| {
         let lambda = flat.to_values(&s.x);
         let u = flat.to_values(&s.u);
@@ -418,17 +421,11 @@ pub fn solve_newton(
         r = residual(&s);
         info.newton_iters += 1;
         let lambda = flat.to_values(&s.x);
-        let status = classify(&lambda, &slip_bound(points, law, &lambda.normal));
-        let count = |st| status.iter().filter(|&&x| x == st).count();
         progress(&Progress {
-            stage: "newton",
+            stage: Stage::Newton,
             iter: info.newton_iters,
             residual: r,
-            counts: (
-                count(crate::Status::Stick),
-                count(crate::Status::Slip),
-                count(crate::Status::Separated),
-            ),
+            counts: counts(&classify(&lambda, &slip_bound(points, law, &lambda.normal))),
         });
         if !r.is_finite() {
             stalled = Some("a non-finite residual");
@@ -460,6 +457,7 @@ pub fn solve_newton(
         let mut sol = crate::solve(problem, points, law, &apg, Some(start), progress)?;
         sol.info.newton_iters = info.newton_iters;
         sol.info.line_search_cuts = info.line_search_cuts;
+        sol.info.augmentation = info.augmentation;
         sol.info.fallback = true;
         return Ok(sol);
     }
@@ -510,10 +508,7 @@ mod tests {
                     .collect();
                 let u0: Vec<f64> = (0..m).map(|r| (r as f64 * 1.7).sin()).collect();
                 let problem = DenseContactProblem {
-                    u0: PointValues {
-                        normal: u0[..n].to_vec(),
-                        tangential: u0[n..].to_vec(),
-                    },
+                    u0: PointValues::from_flat(&u0, n, nt),
                     compliance: compliance.clone(),
                     weight: points.weight.clone(),
                     nt,

@@ -3,6 +3,7 @@
 //! condensed dense problem below (small tests, and the condensed strategy).
 
 use crate::points::PointValues;
+use crate::OperatorError;
 
 /// The contact problem seen from the multipliers.
 pub trait ContactOperator {
@@ -11,9 +12,11 @@ pub trait ContactOperator {
     /// Tangential components per point carried by this operator (0 for frictionless).
     fn n_tangential(&self) -> usize;
     /// Given `lambda`, computes the contact displacement `(u_n, u_t)` of the equilibrium with
-    /// the contact forces `-Nᵀ W λ_n - Tᵀ W λ_t`. Returns inner iterations done (e.g. PCG) or a
-    /// message on failure.
-    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, String>;
+    /// the contact forces `-Nᵀ W λ_n - Tᵀ W λ_t`. Returns inner iterations done (e.g. PCG).
+    ///
+    /// # Errors
+    /// An [`OperatorError`] that carries the primal solver's own error.
+    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError>;
 }
 
 /// An affine contact problem given densely: `u = u0 - D W λ` with `D` symmetric positive
@@ -45,7 +48,7 @@ impl ContactOperator for DenseContactProblem {
     fn n_tangential(&self) -> usize {
         self.nt
     }
-    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, String> {
+    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
         let n = self.weight.len();
         let m = self.m();
         // W λ in the flat layout

@@ -1,5 +1,7 @@
 //! Contact points and the multiplier / displacement vectors on them.
 
+use crate::ContactError;
+
 /// The contact points: geometry, weights, gaps and friction coefficients.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactPoints {
@@ -61,14 +63,17 @@ impl ContactPoints {
     }
 }
 
-/// Values on the contact points: one normal and `dim - 1` tangential components each
-/// (the tangential part is empty for a frictionless problem).
+/// Values on the contact points: one normal and `nt` tangential components each (`nt = 0` for
+/// a frictionless problem, else `dim - 1`), in the layout `[normal (n); tangential (n·nt)]`.
+/// The shape is set when the values are made ([`PointValues::zeros`],
+/// [`PointValues::from_parts`]) and known after (`n_tangential`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PointValues {
-    /// Normal components.
+    /// Normal components, one per point.
     pub normal: Vec<f64>,
-    /// Tangential components, `dim - 1` per point (or none).
+    /// Tangential components, `nt` per point.
     pub tangential: Vec<f64>,
+    nt: usize,
 }
 
 impl PointValues {
@@ -77,20 +82,82 @@ impl PointValues {
         PointValues {
             normal: vec![0.0; n],
             tangential: vec![0.0; n * nt],
+            nt,
         }
     }
+
+    /// Values from their parts, `nt` tangential components per point.
+    ///
+    /// # Errors
+    /// [`ContactError::Input`] where `tangential` does not hold `nt` values per point.
+    pub fn from_parts(normal: Vec<f64>, tangential: Vec<f64>, nt: usize) -> Result<Self, ContactError> {
+        if tangential.len() != normal.len() * nt {
+            return Err(ContactError::Input(format!(
+                "{} tangential values for {} points with {nt} components each",
+                tangential.len(),
+                normal.len()
+            )));
+        }
+        Ok(PointValues { normal, tangential, nt })
+    }
+
+    /// The values of a flat vector in the layout `[normal (n); tangential (n·nt)]`.
+    pub(crate) fn from_flat(x: &[f64], n: usize, nt: usize) -> Self {
+        PointValues {
+            normal: x[..n].to_vec(),
+            tangential: x[n..].to_vec(),
+            nt,
+        }
+    }
+
+    /// Number of points.
+    pub fn n_points(&self) -> usize {
+        self.normal.len()
+    }
+
+    /// Tangential components per point.
+    pub fn n_tangential(&self) -> usize {
+        self.nt
+    }
+
+    /// The tangential components of point `i`.
+    pub fn tangential_of(&self, i: usize) -> &[f64] {
+        &self.tangential[i * self.nt..(i + 1) * self.nt]
+    }
+
+    /// The Euclidean norm of the tangential components of point `i`.
+    pub fn tangential_norm(&self, i: usize) -> f64 {
+        self.tangential_sq(i).sqrt()
+    }
+
+    fn tangential_sq(&self, i: usize) -> f64 {
+        self.tangential_of(i).iter().map(|x| x * x).sum()
+    }
+
     /// Weighted 2-norm `(Σ w_i |x_i|²)^½` over both parts.
     pub fn weighted_norm(&self, w: &[f64]) -> f64 {
-        let nt = self.tangential.len().checked_div(self.normal.len()).unwrap_or(0);
         let mut s = 0.0;
         for (i, &wi) in w.iter().enumerate() {
             s += wi * self.normal[i] * self.normal[i];
-            for k in 0..nt {
-                s += wi * self.tangential[i * nt + k].powi(2);
+            for x in self.tangential_of(i) {
+                s += wi * x * x;
             }
         }
         s.sqrt()
     }
+
+    /// Weighted inner product `Σ w_i (x_i · y_i)` over both parts.
+    pub fn weighted_dot(&self, other: &PointValues, w: &[f64]) -> f64 {
+        let mut s = 0.0;
+        for (i, &wi) in w.iter().enumerate() {
+            s += wi * self.normal[i] * other.normal[i];
+            for (a, b) in self.tangential_of(i).iter().zip(other.tangential_of(i)) {
+                s += wi * a * b;
+            }
+        }
+        s
+    }
+
     /// Euclidean 2-norm over both parts.
     pub fn norm(&self) -> f64 {
         self.normal
@@ -100,6 +167,7 @@ impl PointValues {
             .sum::<f64>()
             .sqrt()
     }
+
     /// `self - other`.
     pub fn minus(&self, other: &PointValues) -> PointValues {
         PointValues {
@@ -110,7 +178,13 @@ impl PointValues {
                 .zip(&other.tangential)
                 .map(|(a, b)| a - b)
                 .collect(),
+            nt: self.nt,
         }
+    }
+
+    /// Whether every value is finite.
+    pub fn is_finite(&self) -> bool {
+        self.normal.iter().chain(&self.tangential).all(|x| x.is_finite())
     }
 }
 

@@ -16,7 +16,7 @@
 //!   cargo run --release -p driver --example bench_contact -- error paper 64
 //!   options: --strategies a,b,c  --repeats R  --tols 1e-2,1e-4  --csv FILE
 
-use driver::run::RunOutcome;
+use problem::Solution;
 use std::fmt::Write as _;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -24,46 +24,24 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn run(scene: &str, sets: &[String]) -> Result<RunOutcome, String> {
-    let (scene, source) = driver::scene::load(scene, sets).map_err(|e| e.to_string())?;
-    driver::run::run(&scene, &source, None, &mut |_| {}).map_err(|e| e.to_string())
+fn run(scene: &str, sets: &[String]) -> Result<Solution, String> {
+    driver::studies::solve(scene, sets).map_err(|e| e.to_string())
 }
 
-fn total(r: &RunOutcome) -> f64 {
-    r.report["timings_s"]["total"].as_f64().unwrap_or(f64::NAN)
-}
-
-fn iterations(r: &RunOutcome) -> String {
-    let it = &r.report["iterations"];
-    let (newton, uzawa, fp) = (
-        it["newton"].as_u64().unwrap_or(0),
-        it["uzawa"].as_u64().unwrap_or(0),
-        it["fixed_point"].as_u64().unwrap_or(0),
-    );
-    match (newton, uzawa) {
-        (0, 0) => "-".into(),
-        (n, 0) => format!("{n} Newton"),
-        (0, u) if fp > 0 => format!("{u} ({fp} FP)"),
-        (0, u) => format!("{u}"),
-        (n, u) => format!("{n} Newton + {u}"),
-    }
+fn total(r: &Solution) -> f64 {
+    r.report.timings_s.total
 }
 
 /// The weighted multipliers `√w λ` in one vector (normal, then tangential).
-fn weighted_lambda(r: &RunOutcome) -> Vec<f64> {
-    let Some((points, sol)) = &r.contact else {
+fn weighted_lambda(r: &Solution) -> Vec<f64> {
+    let Some(c) = &r.contact else {
         return vec![];
     };
-    let nt = sol.lambda.tangential.len().checked_div(points.len()).unwrap_or(0);
-    let mut v: Vec<f64> = sol
-        .lambda
-        .normal
-        .iter()
-        .zip(&points.weight)
-        .map(|(l, w)| l * w.sqrt())
-        .collect();
-    for (j, l) in sol.lambda.tangential.iter().enumerate() {
-        v.push(l * points.weight[j / nt.max(1)].sqrt());
+    let (lambda, w) = (&c.solution.lambda, &c.points.weight);
+    let nt = lambda.n_tangential();
+    let mut v: Vec<f64> = lambda.normal.iter().zip(w).map(|(l, w)| l * w.sqrt()).collect();
+    for (j, l) in lambda.tangential.iter().enumerate() {
+        v.push(l * w[j / nt.max(1)].sqrt());
     }
     v
 }
@@ -130,11 +108,11 @@ fn floor(scene: &str, sizes: &[usize], o: &Options) -> (String, String) {
         let size = format!("mesh.n={n}");
         let mut floors = vec![];
         let mut times: Vec<Vec<f64>> = vec![vec![]; o.strategies.len()];
-        let mut last: Vec<Option<RunOutcome>> = vec![None; o.strategies.len()];
+        let mut last: Vec<Option<Solution>> = (0..o.strategies.len()).map(|_| None).collect();
         let mut dofs = 0;
         for _ in 0..o.repeats {
             let f = run(scene, &[size.clone(), "contact.law=none".into()]).expect("linear floor");
-            dofs = f.report["dofs"]["u"].as_u64().unwrap_or(0) + f.report["dofs"]["phi"].as_u64().unwrap_or(0);
+            dofs = f.report.dofs.total();
             floors.push(total(&f));
             for (k, s) in o.strategies.iter().enumerate() {
                 match run(
@@ -157,9 +135,9 @@ fn floor(scene: &str, sizes: &[usize], o: &Options) -> (String, String) {
                 continue;
             };
             let t = median(times[k].clone());
-            let points = r.report["contact"]["n_points"].as_u64().unwrap_or(0);
-            let res = r.report["residuals"]["complementarity"].as_f64().unwrap_or(f64::NAN);
-            let it = iterations(r);
+            let points = r.report.contact.n_points;
+            let res = r.report.residuals.complementarity;
+            let it = r.report.iterations.summary();
             eprintln!("  {s:18} {it:>16}  {t:8.3} s  ratio {:.2}", t / fl);
             let _ = writeln!(
                 md,
@@ -209,8 +187,8 @@ fn error(scene: &str, n: usize, o: &Options) -> (String, String) {
             let Some(r) = last else { continue };
             let t = median(ts);
             let err = relative_error(&weighted_lambda(&r), &lref);
-            let res = r.report["residuals"]["complementarity"].as_f64().unwrap_or(f64::NAN);
-            let it = iterations(&r);
+            let res = r.report.residuals.complementarity;
+            let it = r.report.iterations.summary();
             eprintln!("  {s:18} tol {tol:7.0e} {it:>16}  {t:8.3} s  error {err:.2e}");
             let _ = writeln!(md, "| {n} | {s} | {tol:.0e} | {it} | {t:.3} | {err:.2e} | {res:.1e} |");
             let _ = writeln!(csv, "{scene},{n},{s},{tol:e},{it},{t},{err},{res}");

@@ -16,14 +16,14 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(128);
     let name = std::env::args().nth(2).unwrap_or_else(|| "paper".into());
-    let (scene, source) =
-        driver::scene::load(&name, &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
-    let driver::build::Setup {
+    let (scene, _) =
+        driver::scene_file::load(&name, &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
+    let problem::setup::Setup {
         mesh,
         materials: mats,
         constraints: bcs,
         ..
-    } = driver::build::setup(&scene, &source).expect("setup");
+    } = problem::setup::setup(&scene, None).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).expect("setup");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());

@@ -1,35 +1,25 @@
-//! The `piezocontact` driver: scene files, the run plan, the solve, and the outputs
-//! (`run.json`, `solution.vtu`). The command-line program is a thin layer over this library.
-//!
-//! # Glossary
-//! - scene: a TOML file (or a shipped scene's name) that says what to solve; `--set KEY=VALUE`
-//!   overrides any of its keys (`mesh.n=128`, `contact.law=none`, `mesh.h=1/128`).
-//! - plan: what the run needs, decided before computing (electric unknowns or not, which
-//!   contact loops, which linear strategy, which outputs); printed and stored in `run.json`.
-//! - Units are those of the scene (the scaled scenes: m, GPa, C/m², nF/m; φ in GV).
+//! The `piezocontact` application over the [`problem`] library: scene files and `--set`
+//! overrides ([`scene_file`]), the run of a scene with its Gmsh mesh read and its outputs
+//! written ([`run`], [`output`]), pictures drawn from plain series ([`plots`]), and the studies
+//! (sweep, Table 1, convergence, verification, stability: [`studies`]). The command-line
+//! program (`src/main.rs`) is one dispatch over these.
 //!
 //! # Example
 //! ```
-//! let (scene, source) = driver::scene::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
-//! let out = driver::run::run(&scene, &source, None, &mut |_| {}).unwrap();
+//! let (scene, source) = driver::scene_file::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
+//! let solution = driver::run::solve(&scene, &source, &mut problem::Silent).unwrap();
 //! // 9 x 5 nodes, the two clamped columns removed: 2 x 7 x 5 free displacements
-//! assert_eq!(out.report["dofs"]["u"], 2 * 7 * 5);
-//! assert!(out.report["residuals"]["equilibrium"].as_f64().unwrap() < 1e-12);
+//! assert_eq!(solution.report.dofs.u, 2 * 7 * 5);
+//! assert!(solution.report.residuals.equilibrium < 1e-12);
 //! ```
 
-pub mod build;
-pub mod contact_setup;
-pub mod convergence;
-pub mod exact;
 pub mod output;
 pub mod plots;
 pub mod run;
-pub mod scene;
-pub mod stability;
+pub mod scene_file;
 pub mod studies;
-pub mod verification;
 
-/// What can go wrong in a run; each variant names the file or item at fault.
+/// What can go wrong in the application; each variant names the file or item at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum DriverError {
     /// A scene that does not read, or holds an invalid value.
@@ -40,25 +30,37 @@ pub enum DriverError {
         /// What is wrong.
         message: String,
     },
-    /// A mesh problem.
+    /// A Gmsh file that cannot be read.
     #[error("mesh: {0}")]
     Mesh(#[from] mesh::MeshError),
-    /// An assembly problem (materials, conditions, groups).
-    #[error("setup: {0}")]
-    Assembly(#[from] fe_assembly::AssemblyError),
-    /// A material problem.
-    #[error("material: {0}")]
-    Material(#[from] fe_assembly::MaterialError),
-    /// A linear-algebra failure.
-    #[error("linear solve: {0}")]
-    Linalg(#[from] linalg::LinalgError),
-    /// Inconsistent input.
+    /// The run failed (the message names the input or step at fault).
+    #[error(transparent)]
+    Problem(#[from] problem::ProblemError),
+    /// A file or directory that cannot be written.
+    #[error("output: {what}: {source}")]
+    Output {
+        /// What was being done, with the path.
+        what: String,
+        /// The error of the file system.
+        source: std::io::Error,
+    },
+    /// A picture or file that cannot be made.
+    #[error("output: {name}: {message}")]
+    Picture {
+        /// The file.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Command-line arguments that do not fit together.
     #[error("{0}")]
-    Input(String),
-    /// The contact solve failed (with its last residual).
-    #[error("contact: {0}")]
-    Contact(#[from] contact::ContactError),
-    /// Writing the outputs failed.
-    #[error("output: {0}")]
-    Output(String),
+    Usage(String),
+    /// Cases of a study that did not end as they must.
+    #[error("{what}: {}", .items.join("; "))]
+    Unexpected {
+        /// What the items are.
+        what: &'static str,
+        /// The cases, each with what went wrong.
+        items: Vec<String>,
+    },
 }

@@ -1,6 +1,10 @@
 //! `piezocontact`: the command line. See `piezocontact --help`.
 
 use clap::{Parser, Subcommand};
+use driver::studies::{convergence, stability, sweep, table1, verification};
+use driver::{output, scene_file, DriverError};
+use problem::{Event, Strategy};
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -21,9 +25,12 @@ enum Command {
     Run {
         /// Scene name or file.
         scene: Option<String>,
-        /// Override a scene key, e.g. --set mesh.n=128 (repeatable).
+        /// Override a scene key, e.g. --set mesh.n=128 (repeatable; `--set ~KEY` removes a key).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Remove a scene key, e.g. --unset contact.friction (repeatable).
+        #[arg(long = "unset", value_name = "KEY")]
+        unset: Vec<String>,
         /// Output directory (default: out/SCENE/).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -87,7 +94,7 @@ enum Command {
         sizes: Vec<usize>,
         /// Strategies (default: the scene's).
         #[arg(long, value_delimiter = ',')]
-        strategies: Vec<String>,
+        strategies: Vec<Strategy>,
         /// Tolerances (default: 1e-4, 1e-6, 1e-8).
         #[arg(long, value_delimiter = ',', default_values_t = [1e-4, 1e-6, 1e-8])]
         tols: Vec<f64>,
@@ -121,39 +128,41 @@ enum Command {
 /// Lines to stderr, and a progress bar for the contact solve when stderr is a terminal.
 struct Terminal {
     bar: Option<indicatif::ProgressBar>,
+    first_residual: Option<f64>,
 }
 
-impl Terminal {
-    fn new() -> Self {
-        Terminal { bar: None }
+impl problem::Reporter for Terminal {
+    fn event(&mut self, event: &Event<'_>) {
+        if let Some(line) = event.line() {
+            match &self.bar {
+                Some(bar) if !bar.is_hidden() => bar.println(line),
+                _ => eprintln!("{line}"),
+            }
+        }
+        if let Event::Contact { progress, .. } = event {
+            let first = *self.first_residual.get_or_insert(progress.residual);
+            if let Some(fraction) = event.contact_fraction(first) {
+                self.bar
+                    .get_or_insert_with(contact_bar)
+                    .set_position((fraction * 1000.0) as u64);
+            }
+        }
+        if let (Event::Solved { .. }, Some(bar)) = (event, self.bar.take()) {
+            bar.finish_and_clear();
+        }
     }
 }
 
-impl driver::run::Reporter for Terminal {
-    fn line(&mut self, text: &str) {
-        match &self.bar {
-            Some(bar) if !bar.is_hidden() => bar.println(text),
-            _ => eprintln!("{text}"),
-        }
-        if text.starts_with("solve ") {
-            if let Some(bar) = self.bar.take() {
-                bar.finish_and_clear();
-            }
-        }
+/// The progress bar of the contact solve: the way down to the tolerance, on a log scale.
+fn contact_bar() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{prefix} [{bar:40}] {percent:>3}% of the way to the tolerance, {elapsed}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
     }
-    fn fraction(&mut self, stage: &str, fraction: f64) {
-        let bar = self.bar.get_or_insert_with(|| {
-            let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
-            if let Ok(style) = indicatif::ProgressStyle::with_template(
-                "{prefix} [{bar:40}] {percent:>3}% of the way to the tolerance, {elapsed}",
-            ) {
-                bar.set_style(style.progress_chars("=> "));
-            }
-            bar.set_prefix(stage.to_string());
-            bar
-        });
-        bar.set_position((fraction * 1000.0) as u64);
-    }
+    bar.set_prefix("contact");
+    bar
 }
 
 fn main() -> ExitCode {
@@ -161,14 +170,46 @@ fn main() -> ExitCode {
     let command = cli.command.unwrap_or(Command::Run {
         scene: None,
         set: vec![],
+        unset: vec![],
         out: None,
     });
+    match dispatch(command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Lines of the studies' progress, to stderr.
+fn say(line: &str) {
+    eprintln!("{line}");
+}
+
+fn dispatch(command: Command) -> Result<(), DriverError> {
     match command {
+        Command::Run { scene, set, unset, out } => {
+            let name = scene.unwrap_or_else(|| "paper".into());
+            let (scene, source) = scene_file::load(&name, &overrides(set, unset))?;
+            let dir = out.unwrap_or_else(|| output::default_dir(&scene.name));
+            let solution = driver::run::run(
+                &scene,
+                &source,
+                &dir,
+                &mut Terminal {
+                    bar: None,
+                    first_residual: None,
+                },
+            )?;
+            let names: Vec<&str> = solution.report.plan.outputs.iter().map(|o| o.name()).collect();
+            say(&format!("wrote {} in {}", names.join(", "), dir.display()));
+            Ok(())
+        }
         Command::Scenes => {
-            use std::io::Write;
             let mut out = std::io::stdout().lock();
-            for (name, text) in driver::scene::SHIPPED {
-                let desc = driver::scene::parse(text, name, &[])
+            for (name, text) in scene_file::SHIPPED {
+                let desc = scene_file::parse(text, name, &[])
                     .map(|s| s.description)
                     .unwrap_or_default();
                 // a closed pipe (`| head`) ends the listing quietly
@@ -176,46 +217,13 @@ fn main() -> ExitCode {
                     break;
                 }
             }
-            ExitCode::SUCCESS
+            Ok(())
         }
-        Command::Verification { full, out } => {
-            match driver::verification::report(full, &out, &mut |l| eprintln!("{l}")) {
-                Ok(failures) if failures.is_empty() => {
-                    eprintln!(
-                        "verification: every check holds; wrote {}",
-                        out.join("verification.md").display()
-                    );
-                    ExitCode::SUCCESS
-                }
-                Ok(failures) => {
-                    for f in &failures {
-                        eprintln!("verification FAILED: {f}");
-                    }
-                    ExitCode::FAILURE
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
+        Command::Strategies => {
+            for s in Strategy::ALL {
+                println!("{:16} {}", s.name(), s.description());
             }
-        }
-        Command::Study {
-            scene,
-            sizes,
-            strategies,
-            tols,
-            reference,
-            set,
-            out,
-        } => {
-            let scene = scene.unwrap_or_else(|| "paper".into());
-            match study_command(&scene, sizes, strategies, tols, reference, &set, out) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
+            Ok(())
         }
         Command::Sweep {
             scene,
@@ -228,119 +236,108 @@ fn main() -> ExitCode {
         } => {
             let dir =
                 out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", scene.trim_end_matches(".toml"))));
-            let spec = driver::studies::SweepSpec { param, from, to, steps };
-            match driver::studies::sweep(&scene, &set, &spec, Some(&dir), &mut |l| eprintln!("{l}")) {
-                Ok(_) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
+            let spec = sweep::SweepSpec { param, from, to, steps };
+            sweep::sweep(&scene, &set, &spec, Some(&dir), &mut say).map(|_| ())
         }
         Command::Table1 { loose, tight, out } => {
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join("table1"));
-            let result = driver::studies::table1(&loose, &tight, &mut |l| eprintln!("{l}")).and_then(|rows| {
-                let md = driver::studies::table1_markdown(&rows);
-                println!("{md}");
-                let mut o = driver::output::Outputs::new(&dir);
-                o.add("table1.md", md.into_bytes());
-                o.commit()
-            });
-            match result {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
+            let md = table1::markdown(&table1::table1(&loose, &tight, &mut say)?);
+            println!("{md}");
+            let mut o = output::Outputs::new(&dir);
+            o.add("table1.md", md.into_bytes());
+            o.commit()
+        }
+        Command::Study {
+            scene,
+            sizes,
+            strategies,
+            tols,
+            reference,
+            set,
+            out,
+        } => study_command(
+            &scene.unwrap_or_else(|| "paper".into()),
+            sizes,
+            strategies,
+            tols,
+            reference,
+            &set,
+            out,
+        ),
+        Command::Verification { full, out } => {
+            let failures = verification::report(full, &out, &mut say)?;
+            if !failures.is_empty() {
+                return Err(DriverError::Unexpected {
+                    what: "verification checks that fail",
+                    items: failures,
+                });
             }
+            say(&format!(
+                "verification: every check holds; wrote {}",
+                out.join("verification.md").display()
+            ));
+            Ok(())
         }
         Command::Stability { quick, out, limit } => {
-            let exe = match std::env::current_exe() {
-                Ok(e) => e,
-                Err(e) => {
-                    eprintln!("error: cannot find this program's path to run the cases: {e}");
-                    return ExitCode::FAILURE;
-                }
-            };
-            match driver::stability::write(&exe, quick, std::time::Duration::from_secs(limit), &out, &mut |l| {
-                eprintln!("{l}")
-            }) {
-                Ok(rows) => {
-                    eprintln!(
-                        "{} runs as expected; wrote {}",
-                        rows.len(),
-                        out.join("stability.md").display()
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
-        }
-        Command::Strategies => {
-            for (name, desc) in driver::run::STRATEGIES {
-                println!("{name:16} {desc}");
-            }
-            ExitCode::SUCCESS
-        }
-        Command::Run { scene, set, out } => {
-            let name = scene.unwrap_or_else(|| "paper".into());
-            let result = driver::scene::load(&name, &set).and_then(|(scene, source)| {
-                let dir = out.unwrap_or_else(|| driver::output::default_dir(&scene.name));
-                driver::run::run_with_reporter(&scene, &source, Some(&dir), &mut Terminal::new())
-            });
-            match result {
-                Ok(_) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
+            let exe = std::env::current_exe().map_err(|e| DriverError::Output {
+                what: "cannot find this program's path to run the cases".into(),
+                source: e,
+            })?;
+            let rows = stability::write(&exe, quick, std::time::Duration::from_secs(limit), &out, &mut say)?;
+            say(&format!(
+                "{} runs as expected; wrote {}",
+                rows.len(),
+                out.join("stability.md").display()
+            ));
+            Ok(())
         }
     }
+}
+
+/// The overrides of `--set KEY=VALUE` and `--unset KEY` (as `~KEY`), in that order.
+fn overrides(set: Vec<String>, unset: Vec<String>) -> Vec<String> {
+    set.into_iter()
+        .chain(unset.into_iter().map(|k| format!("~{k}")))
+        .collect()
 }
 
 /// `piezocontact study`: defaults from the scene, the study, its files.
 fn study_command(
     scene: &str,
     mut sizes: Vec<usize>,
-    mut strategies: Vec<String>,
+    mut strategies: Vec<Strategy>,
     tols: Vec<f64>,
     reference_n: Option<usize>,
     set: &[String],
     out: Option<PathBuf>,
-) -> Result<(), driver::DriverError> {
-    let (base, _) = driver::scene::load(scene, set)?;
+) -> Result<(), DriverError> {
+    let (base, _) = scene_file::load(scene, set)?;
     if sizes.is_empty() {
         let n = base.mesh.n.unwrap_or(16).max(4);
         sizes = vec![n / 4, n / 2, n];
     }
     if strategies.is_empty() {
-        strategies.push(base.solver.strategy.clone());
+        strategies.push(base.solver.strategy);
     }
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-study", base.name)));
-    let spec = driver::convergence::StudySpec {
+    let spec = convergence::StudySpec {
         sizes,
         strategies,
         tols,
         reference_n,
     };
-    let study = driver::convergence::study(scene, set, &spec, &mut |l| eprintln!("{l}"))?;
-    let mut outs = driver::output::Outputs::new(&dir);
+    let study = convergence::study(scene, set, &spec, &mut say)?;
+    let mut outs = output::Outputs::new(&dir);
     let md = format!(
         "# Study of `{}`\n\n{}",
         study.scene,
-        driver::convergence::markdown(&study, "study")
+        convergence::markdown(&study, "study")
     );
     outs.add("study.md", md.clone().into_bytes());
-    outs.add("study.csv", driver::convergence::csv(&study).into_bytes());
-    for (name, bytes) in driver::plots::study_pictures("study", &study)? {
-        outs.add(&name, bytes);
-    }
+    outs.add("study.csv", convergence::csv(&study).into_bytes());
+    outs.extend(convergence::pictures("study", &study)?);
     outs.commit()?;
     println!("{md}");
-    eprintln!("wrote study.md, study.csv and the plots in {}", dir.display());
+    say(&format!("wrote study.md, study.csv and the plots in {}", dir.display()));
     Ok(())
 }

@@ -154,7 +154,7 @@ impl CoupledSolver for SchurPcg {
 
 /// One `L D Lᵀ` of `K` (lower triangle built from the blocks).
 pub struct DirectLdlt {
-    factor: SparseFactor,
+    pub(crate) factor: SparseFactor,
     n_u: usize,
     buf: Vec<f64>,
 }
@@ -179,14 +179,9 @@ impl DirectLdlt {
         })
     }
 
-    /// The factor (for its inertia or pivots).
+    /// The factor (for its inertia, pivots, ordering and size).
     pub fn factor(&self) -> &SparseFactor {
         &self.factor
-    }
-
-    /// The factor, to solve with many right-hand sides at once (`[u; φ]` layout).
-    pub fn factor_mut(&mut self) -> &mut SparseFactor {
-        &mut self.factor
     }
 }
 

@@ -345,45 +345,14 @@ impl SparseFactor {
         d
     }
 
-    /// The Schur complement onto the last `k` indices of the factor's order, `L_cc D_c L_ccᵀ`,
-    /// read off the trailing corner of an `L D Lᵀ` factor (dense, row-major `k x k`). With an
-    /// ordering that puts chosen dofs last ([`Ordering::AmdThenLast`]) this is exactly the Schur
-    /// complement of the matrix onto those dofs. `None` unless the factor is a supernodal
-    /// `L D Lᵀ` whose last supernode holds all `k` columns.
-    pub fn trailing_schur_complement(&self, k: usize) -> Option<Vec<f64>> {
-        let corner = self.trailing_block(k)?;
-        // S_c = (L_cc D_c) L_ccᵀ by one dense product
-        let d: Vec<f64> = (0..k).map(|j| corner[(j, j)]).collect();
-        let l = faer::Mat::<f64>::from_fn(k, k, |i, j| match i.cmp(&j) {
-            std::cmp::Ordering::Equal => 1.0,
-            std::cmp::Ordering::Greater => corner[(i, j)],
-            std::cmp::Ordering::Less => 0.0,
-        });
-        let mut ld = l.clone();
-        for j in 0..k {
-            for i in j..k {
-                ld[(i, j)] *= d[j];
-            }
-        }
-        let mut prod = faer::Mat::<f64>::zeros(k, k);
-        faer::linalg::matmul::matmul(
-            prod.as_mut(),
-            faer::Accum::Replace,
-            ld.as_ref(),
-            l.transpose(),
-            1.0,
-            self.par,
-        );
-        Some(symmetric_row_major(&prod))
-    }
-
-    /// The inverse of [`SparseFactor::trailing_schur_complement`], `S_c⁻¹ = L_cc⁻ᵀ D_c⁻¹ L_cc⁻¹`
-    /// (dense, row-major `k x k`): the block of the matrix's inverse on the last `k` indices,
-    /// with no further factorisation (one unit-triangular inverse and one triangular product,
-    /// `2k³/3` flops). `None` under the conditions of `trailing_schur_complement`;
+    /// The inverse of the Schur complement onto the last `k` indices of the factor's order,
+    /// `S_c⁻¹ = L_cc⁻ᵀ D_c⁻¹ L_cc⁻¹` (dense, row-major `k x k`): the block of the matrix's
+    /// inverse on the last `k` indices, with no further factorisation (one unit-triangular
+    /// inverse and one triangular product, `2k³/3` flops). `None` unless the factor is a
+    /// supernodal `L D Lᵀ` whose last supernode holds all `k` columns;
     /// [`LinalgError::NotPositiveDefinite`] where a pivot of the block is not positive (the
     /// block of a quasi-definite matrix on its positive-definite dofs has only positive ones).
-    pub fn trailing_schur_inverse(&self, k: usize) -> Result<Option<Vec<f64>>, LinalgError> {
+    pub(crate) fn trailing_schur_inverse(&self, k: usize) -> Result<Option<Vec<f64>>, LinalgError> {
         let Some(l) = self.trailing_block(k) else {
             return Ok(None);
         };
@@ -452,7 +421,7 @@ impl SparseFactor {
     /// [`SparseFactor::solve_in_place`]; split, a right-hand side that differs from a solved one
     /// only on the trailing indices needs no second forward sweep
     /// ([`SparseFactor::forward_update_trailing`]).
-    pub fn forward(&self, x: &[f64]) -> Option<Vec<f64>> {
+    pub(crate) fn forward(&self, x: &[f64]) -> Option<Vec<f64>> {
         let (sym, fwd) = self.supernodal_ldlt()?;
         let mut y: Vec<f64> = fwd.iter().map(|&old| x[old]).collect();
         let f = SupernodalLdltRef::new(sym, &self.values);
@@ -481,7 +450,7 @@ impl SparseFactor {
     /// forward half of the right-hand side plus `d` on the last indices of the factor's order
     /// (`L` is block lower triangular, so such a change reaches no earlier index). `false`
     /// where the trailing indices are not all in the last supernode.
-    pub fn forward_update_trailing(&self, y: &mut [f64], d: &[f64]) -> bool {
+    pub(crate) fn forward_update_trailing(&self, y: &mut [f64], d: &[f64]) -> bool {
         let k = d.len();
         let Some(l) = self.trailing_block(k) else {
             return false;
@@ -500,7 +469,7 @@ impl SparseFactor {
     /// trailing block alone (`L⁻ᵀ` is block upper triangular): the solution on the trailing
     /// indices for the price of a dense `k x k` triangular solve. `None` where the last `k`
     /// indices are not all in the last supernode.
-    pub fn trailing_backward(&self, y: &[f64], k: usize) -> Option<Vec<f64>> {
+    pub(crate) fn trailing_backward(&self, y: &[f64], k: usize) -> Option<Vec<f64>> {
         let l = self.trailing_block(k)?;
         let n = self.n();
         let mut z: Vec<f64> = (0..k).map(|j| y[n - k + j] / l[(j, j)]).collect();
@@ -511,7 +480,7 @@ impl SparseFactor {
 
     /// The backward half of an `L D Lᵀ` solve: `x = Pᵀ L⁻ᵀ D⁻¹ y` from a forward result `y`
     /// (consumed). `None` unless the factor is a supernodal `L D Lᵀ`.
-    pub fn backward(&self, mut y: Vec<f64>) -> Option<Vec<f64>> {
+    pub(crate) fn backward(&self, mut y: Vec<f64>) -> Option<Vec<f64>> {
         let (sym, fwd) = self.supernodal_ldlt()?;
         let f = SupernodalLdltRef::new(sym, &self.values);
         let n = self.n();
@@ -560,14 +529,6 @@ impl SparseFactor {
         }
     }
 
-    /// Whether the factor is supernodal, with the first column of its last supernode.
-    pub fn last_supernode_begin(&self) -> Option<usize> {
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => s.n_supernodes().checked_sub(1).map(|l| s.supernode_begin()[l]),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
-        }
-    }
-
     /// `(positive, negative, zero)` pivot counts of an `L D Lᵀ` factor: by Sylvester's law the
     /// inertia of the matrix.
     pub fn inertia(&self) -> (usize, usize, usize) {
@@ -605,7 +566,7 @@ fn inverse_permutation(fwd: &[usize]) -> Result<Vec<usize>, LinalgError> {
 
 /// `(M + Mᵀ)/2` of a square matrix, row-major: a product that is symmetric in exact arithmetic,
 /// with its round-off asymmetry removed.
-fn symmetric_row_major(m: &faer::Mat<f64>) -> Vec<f64> {
+pub(crate) fn symmetric_row_major(m: &faer::Mat<f64>) -> Vec<f64> {
     let k = m.nrows();
     let mut out = vec![0.0; k * k];
     for i in 0..k {

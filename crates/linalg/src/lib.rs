@@ -35,11 +35,13 @@
 //! }
 //! ```
 
+mod condense;
 mod coupled;
 mod factor;
 mod pcg;
 pub mod sparse;
 
+pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{
     equilibrium_residual, CoupledSolver, DirectLdlt, FactorPreconditioner, SchurOperator, SchurPcg, SolveInfo,
 };

@@ -3,14 +3,15 @@
 //! - the Schur operator equals the dense `S = A + Gᵀ B⁻¹ G`;
 //! - the direct `L D Lᵀ` and the Schur PCG give the same solution of `K x = b`;
 //! - an ordering that puts chosen dofs last gives the same solution as AMD, and `K` has
-//!   exactly `n_φ` negative pivots.
+//!   exactly `n_φ` negative pivots;
+//! - the condensation onto chosen dofs is the block of `K⁻¹`, by both of its routes.
 
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Par;
 use linalg::sparse::{mul_add, to_dense};
 use linalg::{
-    pcg, CoupledSolver, DirectLdlt, FactorKind, Identity, LinearOperator, Ordering, PcgParams, SchurOperator, SchurPcg,
-    SparseFactor,
+    pcg, CondenseRoute, CoupledSolver, DirectLdlt, FactorKind, Identity, LinearOperator, Ordering, PcgParams,
+    SchurOperator, SchurPcg, SparseFactor,
 };
 use nalgebra::DMatrix;
 use proptest::prelude::*;
@@ -175,11 +176,13 @@ fn not_positive_definite_is_a_typed_error() {
     ));
 }
 
-/// The trailing corner of an `L D Lᵀ` factor with chosen dofs last is the Schur complement of
-/// `K` onto them: its inverse equals the corresponding block of `K⁻¹` (checked on the 2D
+/// The condensation onto chosen dofs, by both routes (the trailing block of an `L D Lᵀ` with
+/// the dofs last, and block solves): its inverse block equals the block of `K⁻¹` computed by
+/// unit solves, its solution at the dofs the full solve's, and the solve with a change of the
+/// right-hand side at the dofs the full solve of the changed loads (checked on the 2D
 /// Laplacian-like quasi-definite matrix of a grid, large enough to go supernodal).
 #[test]
-fn trailing_block_is_the_schur_complement() {
+fn condensation_is_the_block_of_the_inverse() {
     // K = [[A, Gᵀ], [G, -B]] with A, B grid Laplacians + I and G a shifted identity
     let m = 40; // grid m x m, so n_u = n_phi = 1600
     let n = m * m;
@@ -230,56 +233,66 @@ fn check_trailing_block(
     let (n, m) = (a.nrows(), last.len());
     let mut f = DirectLdlt::new(a, g, b, ordering, Par::Seq).unwrap();
     assert_eq!(&f.factor().permutation()[2 * n - m..], last);
-    // the split solve: forward then backward is a solve, and a change of the right-hand side
-    // on the trailing indices needs only the trailing block in the forward half
+    // the loads, and a change of the right-hand side on the condensed dofs
     let rhs: Vec<f64> = (0..2 * n).map(|i| ((i * 7 % 11) as f64) - 5.0).collect();
+    let (b_u, b_phi) = rhs.split_at(n);
     let d: Vec<f64> = (0..m).map(|j| 0.5 + j as f64).collect();
-    let mut full = rhs.clone();
-    f.factor_mut().solve_in_place(&mut full);
-    let y = f.factor().forward(&rhs).unwrap();
-    let split = f.factor().backward(y.clone()).unwrap();
-    let tail = f.factor().trailing_backward(&y, m).unwrap();
-    for (j, &i) in last.iter().enumerate() {
-        assert!((tail[j] - full[i]).abs() <= 1e-12 * full.iter().fold(0.0f64, |a, x| a.max(x.abs())));
-    }
-    let scale = full.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-    assert!(split.iter().zip(&full).all(|(x, y)| (x - y).abs() <= 1e-12 * scale));
+    let solve = |f: &mut DirectLdlt, rhs: &[f64]| {
+        let (mut u, mut p) = (vec![0.0; n], vec![0.0; n]);
+        f.solve(&rhs[..n], &rhs[n..], &mut u, &mut p).unwrap();
+        u.into_iter().chain(p).collect::<Vec<f64>>()
+    };
+    let full = solve(&mut f, &rhs);
     let mut changed = rhs.clone();
     for (j, &i) in last.iter().enumerate() {
         changed[i] += d[j];
     }
-    f.factor_mut().solve_in_place(&mut changed);
-    let mut y2 = y;
-    assert!(f.factor().forward_update_trailing(&mut y2, &d));
-    let updated = f.factor().backward(y2).unwrap();
-    let scale = changed.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-    assert!(updated
-        .iter()
-        .zip(&changed)
-        .all(|(x, y)| (x - y).abs() <= 1e-12 * scale));
-    let begin = f.factor().last_supernode_begin();
-    let sc = f
-        .factor()
-        .trailing_schur_complement(m)
-        .unwrap_or_else(|| panic!("last supernode begins at {begin:?} of {}", 2 * n));
-    // column j of K⁻¹ restricted to the contact dofs, by a solve, against S_c⁻¹ inverted here
-    // and against the inverse read off the factor
-    let sc = DMatrix::from_row_slice(m, m, &sc);
-    let inv = sc.clone().try_inverse().unwrap();
-    let direct = DMatrix::from_row_slice(m, m, &f.factor().trailing_schur_inverse(m).unwrap().unwrap());
-    assert!((&direct - &inv).amax() < 1e-12 * inv.amax());
+    let full_changed = solve(&mut f, &changed);
+    // column j of K⁻¹ restricted to the condensed dofs, by a solve with a unit load
+    let mut inv = DMatrix::<f64>::zeros(m, m);
     for (j, &dj) in last.iter().enumerate() {
-        let (mut u, mut p) = (vec![0.0; n], vec![0.0; n]);
-        let mut e = vec![0.0; n];
+        let mut e = vec![0.0; 2 * n];
         e[dj] = 1.0;
-        f.solve(&e, &vec![0.0; n], &mut u, &mut p).unwrap();
+        let x = solve(&mut f, &e);
         for (i, &di) in last.iter().enumerate() {
-            assert!(
-                (u[di] - inv[(i, j)]).abs() < 1e-12 * inv.amax(),
-                "({i}, {j}): {} vs {}",
-                u[di],
-                inv[(i, j)]
-            );
+            inv[(i, j)] = x[di];
         }
+    }
+    let scale = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    for route in [CondenseRoute::TrailingBlock, CondenseRoute::BlockSolves] {
+        // the block route, forced by condensing onto the dofs in another order than the factor's
+        let mut dofs = last.to_vec();
+        if route == CondenseRoute::BlockSolves {
+            dofs.reverse();
+        }
+        let condensed = f.condense(b_u, b_phi, &dofs).unwrap();
+        assert_eq!(condensed.loads.route, route);
+        let got = DMatrix::from_row_slice(m, m, &condensed.inverse);
+        for (i, &di) in dofs.iter().enumerate() {
+            let p = last.iter().position(|&x| x == di).unwrap();
+            assert!((condensed.loads.solution[i] - full[di]).abs() <= 1e-12 * scale(&full));
+            for (j, &dj) in dofs.iter().enumerate() {
+                let q = last.iter().position(|&x| x == dj).unwrap();
+                assert!(
+                    (got[(i, j)] - inv[(p, q)]).abs() < 1e-12 * inv.amax(),
+                    "{route:?} ({i}, {j})"
+                );
+            }
+        }
+        // the solve with the update at the condensed dofs is the full solve of the changed loads
+        let d_in_order: Vec<f64> = dofs
+            .iter()
+            .map(|&x| d[last.iter().position(|&y| y == x).unwrap()])
+            .collect();
+        let (u, p) = f.solve_with_update(condensed.loads, b_u, b_phi, &d_in_order).unwrap();
+        let updated: Vec<f64> = u.into_iter().chain(p).collect();
+        let s = scale(&full_changed);
+        assert!(
+            updated
+                .iter()
+                .zip(&full_changed)
+                .all(|(x, y)| (x - y).abs() <= 1e-12 * s),
+            "{route:?}"
+        );
     }
 }

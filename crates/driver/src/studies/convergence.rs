@@ -14,9 +14,10 @@
 //! `1e-12`); the *algebraic* error of a run is its difference from that tight run (same
 //! measure); the *total* error is the run's own error against the reference.
 
-use crate::run::{run, RunOutcome, STRATEGIES};
-use crate::scene;
+use super::solve;
+use crate::plots::{self, Series};
 use crate::DriverError;
+use problem::{ContactLaw, Solution, Strategy};
 use std::collections::HashMap;
 use std::fmt::Write as _;
 
@@ -28,8 +29,8 @@ pub const TIGHT_TOL: f64 = 1e-12;
 pub struct StudySpec {
     /// Mesh sizes (`mesh.n`), coarse to fine.
     pub sizes: Vec<usize>,
-    /// Strategies (names of [`STRATEGIES`]).
-    pub strategies: Vec<String>,
+    /// Strategies.
+    pub strategies: Vec<Strategy>,
     /// Tolerances (`solver.tol`; for a scene without contact, the Schur PCG's tolerance).
     pub tols: Vec<f64>,
     /// The size of the reference run, for a scene without an exact solution (default: four
@@ -45,13 +46,13 @@ pub struct StudyRow {
     /// Largest cell diameter.
     pub h: f64,
     /// Free unknowns, u + φ.
-    pub dofs: u64,
+    pub dofs: usize,
     /// Strategy.
-    pub strategy: String,
+    pub strategy: Strategy,
     /// Tolerance.
     pub tol: f64,
     /// Outer iterations (Newton steps, else Uzawa steps, else PCG iterations).
-    pub iterations: u64,
+    pub iterations: usize,
     /// What `iterations` counts.
     pub iteration_kind: &'static str,
     /// Wall time of the whole run (run.json `timings_s.total`), s.
@@ -96,21 +97,21 @@ struct Snapshot {
 }
 
 impl Snapshot {
-    fn of(r: &RunOutcome) -> Self {
-        let contact = r.contact.as_ref().map(|(p, sol)| {
-            let nt = sol.lambda.tangential.len() / p.len().max(1);
-            let mut v = Vec::with_capacity(p.len() * (1 + nt));
+    fn of(r: &Solution) -> Self {
+        let contact = r.contact.as_ref().map(|c| {
+            let (p, lambda) = (&c.points, &c.solution.lambda);
+            let mut v = Vec::with_capacity(p.len() * (1 + lambda.n_tangential()));
             for i in 0..p.len() {
-                v.push(sol.lambda.normal[i]);
-                v.extend_from_slice(&sol.lambda.tangential[i * nt..(i + 1) * nt]);
+                v.push(lambda.normal[i]);
+                v.extend_from_slice(lambda.tangential_of(i));
             }
             (p.position.clone(), v)
         });
         Snapshot {
-            nodes: r.nodes.clone(),
+            nodes: r.mesh.points.clone(),
             u: r.u.clone(),
             contact,
-            exact: r.report["exact"]["error"].as_f64(),
+            exact: r.report.exact.as_ref().map(|e| e.error()),
         }
     }
 
@@ -127,7 +128,7 @@ impl Snapshot {
         };
         let rw = rvals.len() / rpts.len().max(1);
         if rw != width {
-            return Err(DriverError::Input(
+            return Err(DriverError::Usage(
                 "the reference run has another number of multipliers per point".into(),
             ));
         }
@@ -135,7 +136,7 @@ impl Snapshot {
         let (mut num, mut den) = (0.0, 0.0);
         for (i, x) in pts.iter().enumerate() {
             let j = *index.get(&key(x)).ok_or_else(|| {
-                DriverError::Input(format!(
+                DriverError::Usage(format!(
                     "the point ({:.6}, {:.6}, {:.6}) of the coarse mesh is not a node of the reference mesh (a finer mesh must contain the coarse one: use a multiple of mesh.n)",
                     x[0], x[1], x[2]
                 ))
@@ -149,29 +150,13 @@ impl Snapshot {
     }
 }
 
-fn iterations(r: &RunOutcome) -> (u64, &'static str) {
-    let it = &r.report["iterations"];
-    let get = |k: &str| it[k].as_u64().unwrap_or(0);
-    if get("newton") > 0 {
-        (get("newton"), "Newton")
-    } else if get("uzawa") > 0 {
-        // the accelerated gradient counts its steps with Uzawa's
-        let accelerated = r.report["solver"]["strategy"] == "apg-condensed";
-        (get("uzawa"), if accelerated { "APG" } else { "Uzawa" })
-    } else if get("pcg") > 0 {
-        (get("pcg"), "PCG")
-    } else {
-        (0, "direct")
-    }
-}
-
-fn settings(sets: &[String], n: usize, strategy: &str, tol: f64, has_contact: bool) -> Vec<String> {
+fn settings(sets: &[String], n: usize, strategy: Strategy, tol: f64, has_contact: bool) -> Vec<String> {
     let mut s = sets.to_vec();
     s.push(format!("mesh.n={n}"));
     s.push(format!("solver.strategy=\"{strategy}\""));
     s.push("solver.rule=\"tight\"".into());
     s.push(format!("solver.tol={tol:e}"));
-    if !has_contact || strategy == "uzawa-schur-pcg" {
+    if strategy.runs_pcg() {
         // the PCG's own tolerance: the whole algebraic error without contact
         s.push(format!(
             "solver.pcg_tol={:e}",
@@ -181,61 +166,78 @@ fn settings(sets: &[String], n: usize, strategy: &str, tol: f64, has_contact: bo
     s
 }
 
+/// The reference of a study's errors: the exact solution, or a tight run on a finer mesh.
+enum Reference {
+    /// The scene's exact solution (each run reports its error).
+    Exact,
+    /// A tight run on the finer, nested mesh `n`.
+    Finer(usize, Snapshot),
+}
+
+impl Reference {
+    fn error_of(&self, snap: &Snapshot) -> Result<f64, DriverError> {
+        match self {
+            Reference::Finer(_, r) => snap.difference(r),
+            Reference::Exact => snap
+                .exact
+                .ok_or_else(|| DriverError::Usage("the run reported no exact error".into())),
+        }
+    }
+}
+
+/// Checks a study's specification.
+fn check(spec: &StudySpec) -> Result<(), DriverError> {
+    if spec.sizes.is_empty() || spec.strategies.is_empty() || spec.tols.is_empty() {
+        return Err(DriverError::Usage(
+            "a study needs at least one size, strategy and tolerance".into(),
+        ));
+    }
+    if let Some(t) = spec.tols.iter().find(|t| !(**t > 0.0 && t.is_finite())) {
+        return Err(DriverError::Usage(format!("tolerance {t} must be positive")));
+    }
+    Ok(())
+}
+
 /// Runs the study of `scene_name` (with the overrides `sets`); `progress` gets a line per run.
+///
+/// # Errors
+/// [`DriverError::Usage`] for a specification that does not fit (no size, a tolerance that is
+/// not positive, a reference size that does not nest); a run's error.
 pub fn study(
     scene_name: &str,
     sets: &[String],
     spec: &StudySpec,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Study, DriverError> {
-    if spec.sizes.is_empty() || spec.strategies.is_empty() || spec.tols.is_empty() {
-        return Err(DriverError::Input(
-            "a study needs at least one size, strategy and tolerance".into(),
-        ));
-    }
-    for s in &spec.strategies {
-        if !STRATEGIES.iter().any(|(n, _)| n == s) {
-            return Err(DriverError::Input(format!(
-                "strategy `{s}` is unknown (see `piezocontact strategies`)"
-            )));
-        }
-    }
-    if let Some(t) = spec.tols.iter().find(|t| !(**t > 0.0 && t.is_finite())) {
-        return Err(DriverError::Input(format!("tolerance {t} must be positive")));
-    }
+    check(spec)?;
     let mut sizes = spec.sizes.clone();
     sizes.sort_unstable();
     sizes.dedup();
-    let (base, _) = scene::load(scene_name, sets)?;
-    let has_contact = base.contact.as_ref().is_some_and(|c| c.law != "none");
-    let has_exact = base.exact.is_some();
-    let one = |n: usize, strategy: &str, tol: f64, progress: &mut dyn FnMut(&str)| -> Result<RunOutcome, DriverError> {
-        let (sc, src) = scene::load(scene_name, &settings(sets, n, strategy, tol, has_contact))?;
-        let r = run(&sc, &src, None, &mut |_| {})?;
+    let (base, _) = crate::scene_file::load(scene_name, sets)?;
+    let has_contact = base.contact_law() != ContactLaw::None;
+    let mut one = |n: usize, strategy: Strategy, tol: f64| -> Result<Solution, DriverError> {
+        let r = solve(scene_name, &settings(sets, n, strategy, tol, has_contact))?;
         progress(&format!(
             "study {}: n = {n}, {strategy}, tol {tol:.0e}: {:.3} s",
-            base.name,
-            r.report["timings_s"]["total"].as_f64().unwrap_or(0.0)
+            base.name, r.report.timings_s.total
         ));
         Ok(r)
     };
-    let reference = if has_exact {
-        None
-    } else {
-        let largest = *sizes.last().expect("checked non-empty");
-        let n_ref = spec.reference_n.unwrap_or(4 * largest);
-        if n_ref <= largest || n_ref % largest != 0 {
-            return Err(DriverError::Input(format!(
-                "the reference size {n_ref} must be a multiple of the largest size {largest}, and larger"
-            )));
+    let reference = match &base.exact {
+        Some(_) => Reference::Exact,
+        None => {
+            let largest = *sizes.last().unwrap_or(&1);
+            let n_ref = spec.reference_n.unwrap_or(4 * largest);
+            if n_ref <= largest || n_ref % largest != 0 {
+                return Err(DriverError::Usage(format!(
+                    "the reference size {n_ref} must be a multiple of the largest size {largest}, and larger"
+                )));
+            }
+            Reference::Finer(n_ref, Snapshot::of(&one(n_ref, Strategy::NewtonCondensed, TIGHT_TOL)?))
         }
-        Some((
-            n_ref,
-            Snapshot::of(&one(n_ref, "newton-condensed", TIGHT_TOL, progress)?),
-        ))
     };
     let against = match (&reference, &base.exact) {
-        (Some((n_ref, _)), _) => format!(
+        (Reference::Finer(n_ref, _), _) => format!(
             "a tight run on the finer mesh n = {n_ref}: relative l2 difference of the {} ",
             if has_contact {
                 "contact multipliers at the coarse contact nodes"
@@ -243,54 +245,38 @@ pub fn study(
                 "displacements at the coarse nodes"
             }
         ),
-        (None, Some(x)) => format!(
-            "the exact solution ({}): {}",
-            x.kind,
-            crate::exact::KINDS
-                .iter()
-                .find(|(k, _)| *k == x.kind)
-                .map_or("", |(_, d)| d)
-        ),
-        (None, None) => unreachable!("a scene has an exact solution or gets a reference run"),
-    };
-    let error_of = |snap: &Snapshot| -> Result<f64, DriverError> {
-        match &reference {
-            Some((_, r)) => snap.difference(r),
-            None => snap
-                .exact
-                .ok_or_else(|| DriverError::Input("the run reported no exact error".into())),
-        }
+        (Reference::Exact, Some(x)) => format!("the exact solution ({}): {}", x.kind, x.kind.measures()),
+        (Reference::Exact, None) => String::new(),
     };
     let mut rows = vec![];
     let mut tight = vec![];
     for &n in &sizes {
-        let t_run = one(n, "newton-condensed", TIGHT_TOL, progress)?;
+        let t_run = one(n, Strategy::NewtonCondensed, TIGHT_TOL)?;
         let t_snap = Snapshot::of(&t_run);
-        let disc = error_of(&t_snap)?;
-        let h = t_run.report["mesh"]["h"].as_f64().unwrap_or(f64::NAN);
+        let disc = reference.error_of(&t_snap)?;
+        let h = t_run.report.mesh.h;
         tight.push((n, disc, h));
-        for strategy in &spec.strategies {
+        for &strategy in &spec.strategies {
             // a direct solve without contact has no tolerance: one run stands for all
-            let tols: &[f64] = if !has_contact && strategy != "uzawa-schur-pcg" {
+            let tols = if !has_contact && !strategy.runs_pcg() {
                 &spec.tols[..1]
             } else {
-                &spec.tols
+                &spec.tols[..]
             };
             for &tol in tols {
-                let r = one(n, strategy, tol, progress)?;
+                let r = one(n, strategy, tol)?;
                 let snap = Snapshot::of(&r);
-                let (iterations, iteration_kind) = iterations(&r);
-                let dofs = r.report["dofs"]["u"].as_u64().unwrap_or(0) + r.report["dofs"]["phi"].as_u64().unwrap_or(0);
+                let (iterations, iteration_kind) = r.report.iterations.outer(strategy);
                 rows.push(StudyRow {
                     n,
                     h,
-                    dofs,
-                    strategy: strategy.clone(),
+                    dofs: r.report.dofs.total(),
+                    strategy,
                     tol,
                     iterations,
                     iteration_kind,
-                    seconds: r.report["timings_s"]["total"].as_f64().unwrap_or(f64::NAN),
-                    error: error_of(&snap)?,
+                    seconds: r.report.timings_s.total,
+                    error: reference.error_of(&snap)?,
                     discretisation: disc,
                     algebraic: snap.difference(&t_snap)?,
                 });
@@ -377,6 +363,67 @@ pub fn markdown(s: &Study, img: &str) -> String {
     out
 }
 
+/// The three pictures of a study: error against time (one colour per strategy, a line per
+/// size through its tolerances), discretisation error against h, iterations against h (a line
+/// per strategy, at its tightest tolerance). Names start with `prefix`.
+///
+/// # Errors
+/// [`DriverError::Picture`] where plotters cannot draw.
+pub fn pictures(prefix: &str, s: &Study) -> Result<plots::Files, DriverError> {
+    let mut strategies: Vec<Strategy> = vec![];
+    for r in &s.rows {
+        if !strategies.contains(&r.strategy) {
+            strategies.push(r.strategy);
+        }
+    }
+    let (mut time, mut iters) = (vec![], vec![]);
+    for &st in &strategies {
+        let rows: Vec<&StudyRow> = s.rows.iter().filter(|r| r.strategy == st).collect();
+        let mut sizes: Vec<usize> = rows.iter().map(|r| r.n).collect();
+        sizes.dedup();
+        for (i, n) in sizes.iter().enumerate() {
+            let mut p: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.n == *n)
+                .map(|r| (r.seconds, r.error))
+                .collect();
+            p.sort_by(|a, b| a.0.total_cmp(&b.0));
+            // one colour per strategy; a line per size joins its tolerances
+            time.push(Series::line(if i == 0 { st.name() } else { "" }, p));
+        }
+        let tightest = rows.iter().map(|r| r.tol).fold(f64::INFINITY, f64::min);
+        let at_tightest = rows.iter().filter(|r| r.tol == tightest);
+        iters.push(Series::line(
+            st.name(),
+            at_tightest.map(|r| (r.h, r.iterations.max(1) as f64)).collect(),
+        ));
+    }
+    let label = match s.rates().last() {
+        Some(r) => format!("tight runs (last order {:.2})", r.2),
+        None => "tight runs".to_string(),
+    };
+    let err_h = [Series::line(&label, s.tight.iter().map(|&(_, e, h)| (h, e)).collect())];
+    let mut out = plots::loglog(
+        &format!("{prefix}-error-time"),
+        &format!("{}: error against run time", s.scene),
+        ("wall time of the run (s)", "error"),
+        &time,
+    )?;
+    out.extend(plots::loglog(
+        &format!("{prefix}-error-h"),
+        &format!("{}: discretisation error against h", s.scene),
+        ("h", "error"),
+        &err_h,
+    )?);
+    out.extend(plots::loglog(
+        &format!("{prefix}-iterations-h"),
+        &format!("{}: iterations against h (tightest tolerance)", s.scene),
+        ("h", "iterations"),
+        &iters,
+    )?);
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -397,14 +444,14 @@ mod tests {
     fn a_bad_spec_is_refused() {
         let spec = StudySpec {
             sizes: vec![4],
-            strategies: vec!["nope".into()],
-            tols: vec![1e-6],
+            strategies: vec![Strategy::NewtonCondensed],
+            tols: vec![-1e-6],
             reference_n: None,
         };
         let e = study("paper", &[], &spec, &mut |_| {}).unwrap_err().to_string();
-        assert!(e.contains("strategy `nope` is unknown"), "{e}");
+        assert!(e.contains("tolerance -0.000001 must be positive"), "{e}");
         let spec = StudySpec {
-            strategies: vec!["newton-condensed".into()],
+            tols: vec![1e-6],
             reference_n: Some(6),
             ..spec
         };

@@ -8,7 +8,7 @@
 
 use crate::output::Outputs;
 use crate::DriverError;
-use serde_json::Value;
+use problem::{RunReport, Strategy};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -250,11 +250,11 @@ pub struct Row {
     /// The case's name.
     pub case: String,
     /// Strategy.
-    pub strategy: String,
+    pub strategy: Strategy,
     /// Overrides used.
     pub sets: String,
     /// Unknowns (u + φ), 0 on failure.
-    pub dofs: u64,
+    pub dofs: usize,
     /// Iterations, as a short text.
     pub iterations: String,
     /// Complementarity residual (NaN on failure).
@@ -271,66 +271,28 @@ pub struct Row {
     pub as_expected: bool,
 }
 
-fn num(v: &Value) -> f64 {
-    v.as_f64().unwrap_or(f64::NAN)
-}
-
-/// Checks what the case must show, from its `run.json`: `Ok` with the status counts, or what
-/// is wrong.
-pub fn check(expect: Expect, report: &Value) -> Result<String, String> {
-    let c = &report["contact"];
-    let count = |k: &str| c[k].as_u64().unwrap_or(0);
-    let (n, stick, slip, sep) = (
-        count("n_points"),
-        count("n_stick"),
-        count("n_slip"),
-        count("n_separated"),
-    );
-    let counts = format!("stick {stick}, slip {slip}, separated {sep}");
-    let res = &report["residuals"];
-    let (comp, tol) = (num(&res["complementarity"]), num(&report["solver"]["tol"]));
-    if res["converged_to_tolerance"] != Value::Bool(true) || !(comp <= tol) {
+/// Checks what the case must show, from its report: `Ok` with the status counts, or what is
+/// wrong.
+pub fn check(expect: Expect, report: &RunReport) -> Result<String, String> {
+    let c = &report.contact;
+    let counts = format!("stick {}, slip {}, separated {}", c.n_stick, c.n_slip, c.n_separated);
+    let (comp, tol) = (report.residuals.complementarity, report.solver.tol);
+    if !report.residuals.converged_to_tolerance || !(comp <= tol) {
         return Err(format!(
             "not converged: complementarity {comp:.2e} (tolerance {tol:.0e})"
         ));
     }
     let ok = match expect {
         Expect::Converged => true,
-        Expect::AllSeparated => sep == n,
-        Expect::AllStick => stick == n,
-        Expect::AllSlip => slip == n,
-        Expect::NoneSeparated => sep == 0 && n > 0,
+        Expect::AllSeparated => c.n_separated == c.n_points,
+        Expect::AllStick => c.n_stick == c.n_points,
+        Expect::AllSlip => c.n_slip == c.n_points,
+        Expect::NoneSeparated => c.n_separated == 0 && c.n_points > 0,
     };
     if ok {
         Ok(counts)
     } else {
         Err(format!("{counts}: expected {expect:?}"))
-    }
-}
-
-fn iterations(report: &Value) -> String {
-    let it = &report["iterations"];
-    let get = |k: &str| it[k].as_u64().unwrap_or(0);
-    let mut parts = vec![];
-    if get("newton") > 0 {
-        parts.push(format!("{} Newton", get("newton")));
-    }
-    if get("uzawa") > 0 {
-        parts.push(format!("{} Uzawa", get("uzawa")));
-    }
-    if get("fixed_point") > 0 {
-        parts.push(format!("{} FP", get("fixed_point")));
-    }
-    if get("pcg") > 0 {
-        parts.push(format!("{} PCG", get("pcg")));
-    }
-    if it["newton_fallback"] == Value::Bool(true) {
-        parts.push("fallback".into());
-    }
-    if parts.is_empty() {
-        "-".into()
-    } else {
-        parts.join(", ")
     }
 }
 
@@ -365,7 +327,7 @@ fn run_with_limit(mut cmd: Command, limit: Duration) -> std::io::Result<std::pro
 }
 
 /// Runs one case with one strategy through `exe run`, in a scratch directory that is removed.
-fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize, limit: Duration) -> Row {
+fn run_case(exe: &Path, case: &Case, strategy: Strategy, sets: &[&str], index: usize, limit: Duration) -> Row {
     let scratch = std::env::temp_dir().join(format!("piezocontact-stability-{}-{index}", std::process::id()));
     let mut cmd = Command::new(exe);
     cmd.arg("run").arg(case.scene);
@@ -376,7 +338,7 @@ fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize
     cmd.arg("--out").arg(&scratch);
     let mut row = Row {
         case: case.name.into(),
-        strategy: strategy.into(),
+        strategy,
         sets: sets.join(" "),
         dofs: 0,
         iterations: "-".into(),
@@ -391,16 +353,16 @@ fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize
     let output = run_with_limit(cmd, limit);
     let report = std::fs::read(scratch.join("run.json"))
         .ok()
-        .and_then(|b| serde_json::from_slice::<Value>(&b).ok());
+        .and_then(|b| serde_json::from_slice::<RunReport>(&b).ok());
     let _ = std::fs::remove_dir_all(&scratch);
     match (output, report) {
         (Ok(out), Some(r)) if out.status.success() => {
-            row.dofs = r["dofs"]["u"].as_u64().unwrap_or(0) + r["dofs"]["phi"].as_u64().unwrap_or(0);
-            row.iterations = iterations(&r);
-            row.complementarity = num(&r["residuals"]["complementarity"]);
-            row.equilibrium = num(&r["residuals"]["equilibrium"]);
-            row.seconds = num(&r["timings_s"]["total"]);
-            row.peak_mib = num(&r["memory"]["peak_bytes"]) / (1 << 20) as f64;
+            row.dofs = r.dofs.total();
+            row.iterations = r.iterations.summary();
+            row.complementarity = r.residuals.complementarity;
+            row.equilibrium = r.residuals.equilibrium;
+            row.seconds = r.timings_s.total;
+            row.peak_mib = r.memory.peak_bytes as f64 / (1 << 20) as f64;
             match check(case.expect, &r) {
                 Ok(counts) => {
                     row.outcome = format!("converged; {counts}");
@@ -447,14 +409,14 @@ fn run_case(exe: &Path, case: &Case, strategy: &str, sets: &[&str], index: usize
 pub fn study(exe: &Path, quick: bool, limit: Duration, progress: &mut dyn FnMut(&str)) -> Vec<Row> {
     let mut rows = vec![];
     for case in cases().iter().filter(|c| !(quick && c.fine)) {
-        let mut runs = vec![("newton-condensed", case.sets.clone())];
+        let mut runs = vec![(Strategy::NewtonCondensed, case.sets.clone())];
         if let Some(p) = &case.paper_sets {
-            runs.push(("uzawa-schur-pcg", p.clone()));
+            runs.push((Strategy::UzawaSchurPcg, p.clone()));
         }
         for (strategy, sets) in runs {
             // the limit is for the paper's strategy, which may crawl on a hard case; the default
             // strategy's runs (the fine cases among them) get 30 minutes at least
-            let limit = if strategy == "uzawa-schur-pcg" {
+            let limit = if strategy == Strategy::UzawaSchurPcg {
                 limit
             } else {
                 limit.max(Duration::from_secs(1800))
@@ -529,6 +491,9 @@ pub fn write(
     if bad.is_empty() {
         Ok(rows)
     } else {
-        Err(DriverError::Input(format!("cases not as expected: {}", bad.join(", "))))
+        Err(DriverError::Unexpected {
+            what: "cases not as expected",
+            items: bad.into_iter().map(String::from).collect(),
+        })
     }
 }

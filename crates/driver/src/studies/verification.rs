@@ -3,11 +3,11 @@
 //! paper scene, each checked against what it must show, written to `docs/verification.md` with
 //! its plots, so the page cannot drift from the code.
 
-use crate::convergence::{self, Study, StudySpec};
+use super::convergence::{self, Study, StudySpec};
 use crate::output::Outputs;
-use crate::run::run;
-use crate::scene;
+use crate::scene_file;
 use crate::DriverError;
+use problem::Strategy::{self, ApgCondensed, NewtonCondensed, UzawaCondensed, UzawaSchurPcg};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -21,7 +21,7 @@ pub struct Entry {
     /// Reference size for scenes without an exact solution (quick, full).
     pub reference: (Option<usize>, Option<usize>),
     /// Strategies.
-    pub strategies: &'static [&'static str],
+    pub strategies: &'static [Strategy],
     /// Tolerances.
     pub tols: &'static [f64],
     /// What must hold, in words (printed on the page).
@@ -54,7 +54,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "patch",
         sizes: (&[2, 4, 8], &[2, 4, 8, 16]),
         reference: (None, None),
-        strategies: &["newton-condensed", "uzawa-schur-pcg"],
+        strategies: &[NewtonCondensed, UzawaSchurPcg],
         tols: &[1e-12],
         claim: "an affine (u, φ) is reproduced to round-off: relative energy error below 1e-11 on every mesh and strategy",
         check: |s| match s.rows.iter().find(|r| !(r.error < 1e-11)) {
@@ -66,7 +66,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "manufactured",
         sizes: (&[4, 8, 16, 32], &[4, 8, 16, 32, 64, 128]),
         reference: (None, None),
-        strategies: &["newton-condensed", "uzawa-schur-pcg"],
+        strategies: &[NewtonCondensed, UzawaSchurPcg],
         tols: &[1e-6, 1e-10],
         claim: "P1 converges at order 1 in the energy norm (observed order between 0.95 and 1.2 on the finest pair)",
         check: |s| last_order_within(s, 0.95..1.2),
@@ -75,7 +75,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "manufactured-3d",
         sizes: (&[2, 4, 8], &[2, 4, 8, 16]),
         reference: (None, None),
-        strategies: &["newton-condensed", "uzawa-schur-pcg"],
+        strategies: &[NewtonCondensed, UzawaSchurPcg],
         tols: &[1e-6, 1e-10],
         claim: "order 1 in the energy norm in 3D (between 0.9 and 1.2 on the finest pair)",
         check: |s| last_order_within(s, 0.9..1.2),
@@ -84,7 +84,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "hertz",
         sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
         reference: (None, None),
-        strategies: &["newton-condensed", "apg-condensed"],
+        strategies: &[NewtonCondensed, ApgCondensed],
         tols: &[1e-6, 1e-10],
         claim: "the contact pressure approaches Hertz's: profile error below 3 % on the finest mesh and below half the coarsest's (the block's finite size leaves about 1 %)",
         check: |s| {
@@ -100,7 +100,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "cattaneo-mindlin",
         sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
         reference: (None, None),
-        strategies: &["newton-condensed", "apg-condensed"],
+        strategies: &[NewtonCondensed, ApgCondensed],
         tols: &[1e-6, 1e-10],
         claim: "the tangential traction approaches Cattaneo-Mindlin's: error falling with h, below 12 % at n = 192 (β = 0.048 and P1 near-incompressibility remain, see the scene)",
         check: |s| {
@@ -117,7 +117,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "paper",
         sizes: (&[8, 16, 32, 64], &[16, 32, 64, 128]),
         reference: (Some(256), Some(512)),
-        strategies: &["newton-condensed", "apg-condensed", "uzawa-condensed", "uzawa-schur-pcg"],
+        strategies: &[NewtonCondensed, ApgCondensed, UzawaCondensed, UzawaSchurPcg],
         tols: &[1e-2, 1e-4, 1e-6, 1e-8],
         claim: "the multipliers converge under refinement (observed order above 0.8 against the finer mesh), and every strategy reaches the tight run's answer as its tolerance falls",
         check: |s| {
@@ -134,41 +134,32 @@ pub const ENTRIES: &[Entry] = &[
 ];
 
 /// The smoke run of one shipped scene: `(scene, unknowns, iterations, seconds, outcome)`.
-pub type SmokeRow = (String, u64, String, f64, Result<String, String>);
+pub type SmokeRow = (String, usize, String, f64, Result<String, String>);
 
 /// Runs every shipped scene at its smoke size.
 pub fn smoke(progress: &mut dyn FnMut(&str)) -> Vec<SmokeRow> {
-    scene::SHIPPED
+    scene_file::SHIPPED
         .iter()
         .map(|(name, _)| {
             let t = Instant::now();
-            let result = scene::load(name, &[]).and_then(|(sc, _)| {
+            let result = scene_file::load(name, &[]).and_then(|(sc, _)| {
                 let n = sc.mesh.smoke_n.unwrap_or(4);
-                let (sc, src) = scene::load(name, &[format!("mesh.n={n}")])?;
-                run(&sc, &src, None, &mut |_| {})
+                super::solve(name, &[format!("mesh.n={n}")])
             });
             let secs = t.elapsed().as_secs_f64();
             let row = match result {
                 Ok(r) => {
-                    let it = &r.report["iterations"];
-                    let dofs =
-                        r.report["dofs"]["u"].as_u64().unwrap_or(0) + r.report["dofs"]["phi"].as_u64().unwrap_or(0);
-                    let iters = format!(
-                        "{} Newton, {} Uzawa, {} PCG",
-                        it["newton"].as_u64().unwrap_or(0),
-                        it["uzawa"].as_u64().unwrap_or(0),
-                        it["pcg"].as_u64().unwrap_or(0)
-                    );
-                    let c = &r.report["contact"];
-                    let outcome = if c["n_points"].as_u64().unwrap_or(0) > 0 {
+                    let (c, it) = (&r.report.contact, &r.report.iterations);
+                    let iters = format!("{} Newton, {} Uzawa, {} PCG", it.newton, it.uzawa, it.pcg);
+                    let outcome = if c.n_points > 0 {
                         format!(
                             "ran; stick {}, slip {}, separated {}",
-                            c["n_stick"], c["n_slip"], c["n_separated"]
+                            c.n_stick, c.n_slip, c.n_separated
                         )
                     } else {
                         "ran (no contact)".to_string()
                     };
-                    (name.to_string(), dofs, iters, secs, Ok(outcome))
+                    (name.to_string(), r.report.dofs.total(), iters, secs, Ok(outcome))
                 }
                 Err(e) => (name.to_string(), 0, "-".into(), secs, Err(e.to_string())),
             };
@@ -201,7 +192,7 @@ pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result
     for entry in ENTRIES {
         let spec = StudySpec {
             sizes: if full { entry.sizes.1 } else { entry.sizes.0 }.to_vec(),
-            strategies: entry.strategies.iter().map(|s| s.to_string()).collect(),
+            strategies: entry.strategies.to_vec(),
             tols: entry.tols.to_vec(),
             reference_n: if full { entry.reference.1 } else { entry.reference.0 },
         };
@@ -213,9 +204,7 @@ pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result
             failures.push(format!("{}: {e}", entry.scene));
         }
         let prefix = format!("verification-{}", entry.scene);
-        for (name, bytes) in crate::plots::study_pictures(&prefix, &study)? {
-            pictures.add(&name, bytes);
-        }
+        pictures.extend(convergence::pictures(&prefix, &study)?);
         summary.push((entry.scene, last_rate(&study), finest(&study), secs, verdict.is_ok()));
         let _ = writeln!(sections, "## `{}`\n", entry.scene);
         let _ = writeln!(

@@ -1,0 +1,313 @@
+//! What a contact solve returns and how it is judged, the same for every solver: the law, the
+//! solution with its counts ([`ContactInfo`]), progress lines, the slip bound, the
+//! scale-free complementarity residual and the stick/slip status of DESIGN.md.
+
+use crate::operator::ContactOperator;
+use crate::points::{ContactPoints, PointValues, Status};
+use crate::projection::{project_disc, project_nonnegative};
+use crate::{ContactError, OperatorError};
+
+/// The friction law.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Law {
+    /// Signorini contact alone (no tangential multiplier).
+    Frictionless,
+    /// Tresca friction with a given slip bound per point.
+    Tresca(Vec<f64>),
+    /// Coulomb friction `S = F λ_n`: by the fixed point on `S` ([`crate::solve`]), or directly
+    /// ([`crate::solve_newton`]).
+    Coulomb,
+}
+
+/// What a contact solve reports, whichever solver ran: each field means one thing, and a
+/// count is 0 (a step `None`) where its loop did not run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactInfo {
+    /// First-order steps (Uzawa or the accelerated gradient), summed over the fixed point.
+    pub uzawa_iters: usize,
+    /// Semismooth Newton steps ([`crate::solve_newton`]).
+    pub newton_iters: usize,
+    /// Step halvings in Newton's line search, summed.
+    pub line_search_cuts: usize,
+    /// Whether Newton stalled and the accelerated gradient finished the solve.
+    pub fallback: bool,
+    /// Fixed-point iterations on the slip bound (0 when the solve has none).
+    pub fixed_point_iters: usize,
+    /// Inner iterations reported by the operator (PCG) in the first-order loops, summed.
+    pub inner_iters: usize,
+    /// Inner iterations spent estimating `μ_max` (power iteration).
+    pub estimate_inner_iters: usize,
+    /// Calls of the operator (primal solves), including the power iteration.
+    pub operator_calls: usize,
+    /// The first-order step `r` last used; `None` when no first-order step was taken.
+    pub step: Option<f64>,
+    /// The constant `c` of Newton's natural map (`1/μ_max`); `None` when Newton did not run.
+    pub augmentation: Option<f64>,
+    /// The estimate of the dual operator's largest eigenvalue.
+    pub mu_max: f64,
+    /// Complementarity residual of the returned pair (the law's own radius).
+    pub complementarity: f64,
+    /// Halvings of the first-order step (divergence or a stall detected).
+    pub step_backoffs: usize,
+    /// Halvings of the friction fixed point's relaxation factor (a residual that did not fall).
+    pub relaxations: usize,
+}
+
+impl ContactInfo {
+    /// Counts at zero for a solve with this estimate of `μ_max`.
+    pub(crate) fn new(mu_max: f64) -> Self {
+        ContactInfo {
+            uzawa_iters: 0,
+            newton_iters: 0,
+            line_search_cuts: 0,
+            fallback: false,
+            fixed_point_iters: 0,
+            inner_iters: 0,
+            estimate_inner_iters: 0,
+            operator_calls: 0,
+            step: None,
+            augmentation: None,
+            mu_max,
+            complementarity: f64::NAN,
+            step_backoffs: 0,
+            relaxations: 0,
+        }
+    }
+}
+
+/// A converged contact solution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactSolution {
+    /// Multipliers `λ_n ≥ 0` (pressure) and `λ_t`.
+    pub lambda: PointValues,
+    /// Displacement at the points for these multipliers.
+    pub u: PointValues,
+    /// Status of each point.
+    pub status: Vec<Status>,
+    /// Counts and residuals.
+    pub info: ContactInfo,
+}
+
+impl ContactSolution {
+    /// `(stick, slip, separated)` counts.
+    pub fn counts(&self) -> (usize, usize, usize) {
+        counts(&self.status)
+    }
+}
+
+/// The loop a progress line comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// A first-order step (Uzawa or the accelerated gradient).
+    Uzawa,
+    /// A step of the fixed point on the slip bound.
+    FixedPoint,
+    /// A semismooth Newton step.
+    Newton,
+}
+
+impl Stage {
+    /// Lower-case name (`uzawa`, `fixed-point`, `newton`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Uzawa => "uzawa",
+            Stage::FixedPoint => "fixed-point",
+            Stage::Newton => "newton",
+        }
+    }
+}
+
+/// One line of progress.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progress {
+    /// The loop it comes from.
+    pub stage: Stage,
+    /// Iteration number within the stage.
+    pub iter: usize,
+    /// The stage's residual (complementarity, or the paper's relative change).
+    pub residual: f64,
+    /// Stick / slip / separated counts.
+    pub counts: (usize, usize, usize),
+}
+
+/// The slip bound of each point for a law and multipliers: Tresca `S`, Coulomb `F λ_n`,
+/// frictionless 0.
+pub fn slip_bound(points: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f64> {
+    match law {
+        Law::Frictionless => vec![0.0; points.len()],
+        Law::Tresca(s) => s.clone(),
+        Law::Coulomb => points.friction.iter().zip(lambda_n).map(|(f, l)| f * l).collect(),
+    }
+}
+
+/// The natural-map residual of DESIGN.md with step `c`:
+/// `‖(λ_n - max(0, λ_n + c (u_n - g)), λ_t - P_S(λ_t + c u_t))‖_W / max(‖λ‖_W, reference)`.
+///
+/// `reference` is the multiplier scale of the problem, `c ‖(u_n(0) - g, u_t(0))‖_W` with `u(0)`
+/// the contact displacement under the loads alone ([`crate::solve`] computes it): without it, a
+/// solution whose multipliers vanish at a grazing point would be approached with `‖r‖` and `‖λ‖`
+/// shrinking together and a relative residual that never falls. Both terms scale like λ, so
+/// the residual is free of units and of the solver's own step. A zero denominator gives the
+/// absolute residual.
+pub fn complementarity_residual(
+    points: &ContactPoints,
+    radius: &[f64],
+    lambda: &PointValues,
+    u: &PointValues,
+    c: f64,
+    reference: f64,
+) -> f64 {
+    let n = points.len();
+    let nt = lambda.n_tangential();
+    let mut r = PointValues::zeros(n, nt);
+    let mut buf = [0.0; 2];
+    for i in 0..n {
+        r.normal[i] = lambda.normal[i] - project_nonnegative(lambda.normal[i] + c * (u.normal[i] - points.gap[i]));
+        if nt > 0 {
+            for k in 0..nt {
+                buf[k] = lambda.tangential[i * nt + k] + c * u.tangential[i * nt + k];
+            }
+            project_disc(&mut buf[..nt], radius[i]);
+            for k in 0..nt {
+                r.tangential[i * nt + k] = lambda.tangential[i * nt + k] - buf[k];
+            }
+        }
+    }
+    let num = r.weighted_norm(&points.weight);
+    let den = lambda.weighted_norm(&points.weight).max(reference);
+    if den > 0.0 {
+        num / den
+    } else {
+        num
+    }
+}
+
+/// Status of each point (DESIGN.md): separated if `λ_n ≤ 1e-9 max λ_n`; otherwise slip if the
+/// radius is 0 or `|λ_t| ≥ (1 - 1e-9) S`; otherwise stick.
+pub fn classify(lambda: &PointValues, radius: &[f64]) -> Vec<Status> {
+    let max_n = lambda.normal.iter().cloned().fold(0.0f64, f64::max);
+    (0..lambda.n_points())
+        .map(|i| {
+            if !(lambda.normal[i] > 1e-9 * max_n) {
+                Status::Separated
+            } else if radius[i] <= 0.0 || lambda.tangential_norm(i) >= (1.0 - 1e-9) * radius[i] {
+                Status::Slip
+            } else {
+                Status::Stick
+            }
+        })
+        .collect()
+}
+
+/// `(stick, slip, separated)` counts of a status vector.
+pub(crate) fn counts(status: &[Status]) -> (usize, usize, usize) {
+    let c = |s| status.iter().filter(|&&x| x == s).count();
+    (c(Status::Stick), c(Status::Slip), c(Status::Separated))
+}
+
+/// Checks the points, the law's data, and the size of the problem (`n_points` points with
+/// `n_tangential` tangential components each) against them; returns `(n, nt)`.
+pub(crate) fn check_input(
+    points: &ContactPoints,
+    law: &Law,
+    n_points: usize,
+    n_tangential: usize,
+) -> Result<(usize, usize), ContactError> {
+    points.validate().map_err(ContactError::Input)?;
+    let n = points.len();
+    let nt = if matches!(law, Law::Frictionless) {
+        0
+    } else {
+        points.n_tangential()
+    };
+    if n_points != n || n_tangential != nt {
+        return Err(ContactError::Input(format!(
+            "the problem has {n_points} points with {n_tangential} tangential components; expected {n} with {nt}"
+        )));
+    }
+    if let Law::Tresca(s) = law {
+        if s.len() != n || s.iter().any(|x| !(*x >= 0.0 && x.is_finite())) {
+            return Err(ContactError::Input(
+                "Tresca slip bounds: one finite non-negative value per point".into(),
+            ));
+        }
+    }
+    Ok((n, nt))
+}
+
+/// The multiplier scale of the problem, `c ‖u(0) - g‖_W` (the floor of the residual's
+/// denominator, see [`complementarity_residual`]).
+pub(crate) fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64 {
+    let mut free = u0.clone();
+    for (u, g) in free.normal.iter_mut().zip(&points.gap) {
+        *u -= g;
+    }
+    c * free.weighted_norm(&points.weight)
+}
+
+/// The operator with a count of its calls and of the inner iterations they report.
+pub(crate) struct Counter<'a> {
+    op: &'a mut dyn ContactOperator,
+    pub(crate) calls: usize,
+    pub(crate) inner: usize,
+}
+
+impl<'a> Counter<'a> {
+    pub(crate) fn new(op: &'a mut dyn ContactOperator) -> Self {
+        Counter { op, calls: 0, inner: 0 }
+    }
+
+    pub(crate) fn call(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<(), ContactError> {
+        self.calls += 1;
+        self.inner += self
+            .op
+            .displacement(lambda, out)
+            .map_err(|e: OperatorError| ContactError::Operator(e))?;
+        Ok(())
+    }
+}
+
+/// Largest eigenvalue of the dual operator `λ ↦ u(0) - u(λ)` in the `W` inner product, by
+/// power iteration (a Rayleigh quotient, so a lower estimate); also returns `u(0)`, the
+/// contact displacement under the loads alone.
+pub(crate) fn estimate_mu_max(
+    c: &mut Counter<'_>,
+    points: &ContactPoints,
+    nt: usize,
+    iters: usize,
+) -> Result<(f64, PointValues), ContactError> {
+    let n = points.len();
+    let zero = PointValues::zeros(n, nt);
+    let mut u0 = PointValues::zeros(n, nt);
+    c.call(&zero, &mut u0)?;
+    // a deterministic start with no symmetry (a constant vector can lie along an eigenvector of
+    // a lower eigenvalue, and the Rayleigh quotient then never sees the top one)
+    let start = |i: usize| 1.0 + 0.5 * (1.3 * i as f64 + 0.7).sin();
+    let mut v = PointValues::zeros(n, nt);
+    for (i, x) in v.normal.iter_mut().chain(v.tangential.iter_mut()).enumerate() {
+        *x = start(i);
+    }
+    let mut mu = 0.0;
+    let mut out = PointValues::zeros(n, nt);
+    for _ in 0..iters.max(1) {
+        let nv = v.weighted_norm(&points.weight);
+        if !(nv > 0.0) {
+            break;
+        }
+        v.normal
+            .iter_mut()
+            .chain(v.tangential.iter_mut())
+            .for_each(|x| *x /= nv);
+        c.call(&v, &mut out)?;
+        let mv = u0.minus(&out);
+        mu = f64::max(mu, v.weighted_dot(&mv, &points.weight));
+        v = mv;
+    }
+    // leave the operator's warm start (an iterative primal solver starts from its last
+    // solution) at the loads alone, where the solvers start
+    c.call(&zero, &mut out)?;
+    if !(mu > 0.0 && mu.is_finite()) {
+        return Err(ContactError::NotLoaded { mu_max: mu });
+    }
+    Ok((mu, u0))
+}

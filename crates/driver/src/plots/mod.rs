@@ -1,0 +1,367 @@
+//! Pictures as SVG and PNG, drawn from plain data: charts of named series of points (linear
+//! axes, stacked panels; or log-log), and views of a triangle mesh (deformed, contours of a
+//! nodal field) in [`mesh_view`]. They know no run, study or scene: the caller builds the
+//! series. Text uses the DejaVu Sans font shipped in `assets/` (no system font is needed).
+//!
+//! Extreme values never stop a picture: non-finite points are left out, and an axis whose
+//! data span no finite range gets a unit one.
+
+pub mod mesh_view;
+
+use crate::DriverError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::sync::Once;
+
+pub(crate) const FONT: &str = "sans-serif";
+const SIZE: (u32, u32) = (960, 600);
+
+/// A picture's files: `(name.svg, bytes)` and `(name.png, bytes)`.
+pub type Files = Vec<(String, Vec<u8>)>;
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // the bytes are a valid TrueType font shipped with the crate
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, include_bytes!("../../assets/DejaVuSans.ttf"));
+    });
+}
+
+fn err(what: &str, e: impl std::fmt::Display) -> DriverError {
+    DriverError::Picture {
+        name: what.into(),
+        message: e.to_string(),
+    }
+}
+
+/// A drawing on an SVG area.
+type DrawSvg<'a> = &'a dyn Fn(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>;
+/// The same drawing on a bitmap area.
+type DrawPng<'a> = &'a dyn Fn(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>;
+
+/// Draws with `draw` into an SVG string and a PNG image.
+pub(crate) fn render(name: &str, draw: DrawSvg<'_>, draw_png: DrawPng<'_>) -> Result<Files, DriverError> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let area = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw(&area).map_err(|e| err(name, e))?;
+        area.present().map_err(|e| err(name, e))?;
+    }
+    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let area = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        draw_png(&area).map_err(|e| err(name, e))?;
+        area.present().map_err(|e| err(name, e))?;
+    }
+    let mut png_bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut png_bytes, SIZE.0, SIZE.1);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(|e| err(name, e))?;
+        w.write_image_data(&rgb).map_err(|e| err(name, e))?;
+    }
+    Ok(vec![
+        (format!("{name}.svg"), svg.into_bytes()),
+        (format!("{name}.png"), png_bytes),
+    ])
+}
+
+/// Renders one drawing function, generic over the backend, to both formats.
+macro_rules! both {
+    ($name:expr, $f:expr) => {
+        crate::plots::render($name, &|a| $f(a), &|a| $f(a))
+    };
+}
+pub(crate) use both;
+
+/// Colours of the series, in order.
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(214, 39, 40),
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// How a series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mark {
+    /// A line through the points, in the series' colour.
+    Line,
+    /// A thin grey line (a bound, a reference).
+    Reference,
+    /// Dots at the points, in the colour of the series before it.
+    Dots,
+}
+
+/// One named series of points. A series with an empty name continues the previous one's
+/// colour and legend entry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Its name in the legend.
+    pub name: String,
+    /// Its points.
+    pub points: Vec<(f64, f64)>,
+    /// How it is drawn.
+    pub mark: Mark,
+}
+
+impl Series {
+    /// A line through `points`.
+    pub fn line(name: &str, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            name: name.into(),
+            points,
+            mark: Mark::Line,
+        }
+    }
+}
+
+/// One chart with linear axes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Panel {
+    /// Its caption.
+    pub title: String,
+    /// The axes' names.
+    pub labels: (String, String),
+    /// What it draws.
+    pub series: Vec<Series>,
+}
+
+/// Beyond this magnitude values are clamped, so that no span overflows.
+const LIMIT: f64 = 1e300;
+
+/// The range of the finite `values` (clamped to `±LIMIT`), always holding 0, padded by a tenth
+/// of its span (a range of width `max(1, |v|)` where all values are one `v`).
+fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .map(|v| v.clamp(-LIMIT, LIMIT))
+        .fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+    let span = hi - lo;
+    if !(span > 0.0) {
+        let w = 0.5 * lo.abs().max(1.0);
+        return (lo - w, lo + w);
+    }
+    let pad = 0.1 * span;
+    (if lo < 0.0 { lo - pad } else { lo }, hi + pad)
+}
+
+/// The range of the finite x values (clamped to `±LIMIT`; not padded, not forced to hold 0).
+fn x_range(panels: &[Panel]) -> (f64, f64) {
+    let xs = panels
+        .iter()
+        .flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)))
+        .filter(|x| x.is_finite())
+        .map(|x| x.clamp(-LIMIT, LIMIT));
+    let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+    if lo < hi {
+        (lo, hi)
+    } else if lo.is_finite() {
+        let w = 0.5 * lo.abs().max(1.0);
+        (lo - w, lo + w)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, x: (f64, f64)) -> Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let y = padded_range(panel.series.iter().flat_map(|s| s.points.iter().map(|q| q.1)));
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, (FONT, 22))
+        .margin(12)
+        .x_label_area_size(38)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(panel.labels.0.as_str())
+        .y_desc(panel.labels.1.as_str())
+        .label_style((FONT, 13))
+        .draw()
+        .map_err(e)?;
+    let mut k = 0;
+    for (i, s) in panel.series.iter().enumerate() {
+        if i > 0 && !s.name.is_empty() && s.mark != Mark::Dots {
+            k += 1;
+        }
+        let points: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .map(|&(a, b)| (a.clamp(-LIMIT, LIMIT), b.clamp(-LIMIT, LIMIT)))
+            .collect();
+        let color = PALETTE[k % PALETTE.len()];
+        let drawn = match s.mark {
+            Mark::Line => chart.draw_series(LineSeries::new(points, color.stroke_width(2))),
+            Mark::Reference => chart.draw_series(LineSeries::new(points, BLACK.mix(0.5))),
+            Mark::Dots => chart.draw_series(points.into_iter().map(|q| Circle::new(q, 3, color.filled()))),
+        }
+        .map_err(e)?;
+        if !s.name.is_empty() {
+            let mark = s.mark;
+            drawn
+                .label(s.name.as_str())
+                .legend(move |(x, y)| -> DynElement<'static, DB, (i32, i32)> {
+                    match mark {
+                        Mark::Dots => Circle::new((x + 10, y), 3, color.filled()).into_dyn(),
+                        Mark::Reference => PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.5)).into_dyn(),
+                        Mark::Line => PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)).into_dyn(),
+                    }
+                });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 13))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(e)
+}
+
+fn draw_panels<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panels: &[Panel]) -> Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    area.fill(&WHITE).map_err(e)?;
+    let x = x_range(panels);
+    for (sub, panel) in area.split_evenly((panels.len().max(1), 1)).iter().zip(panels) {
+        draw_panel(sub, panel, x)?;
+    }
+    Ok(())
+}
+
+/// Panels with linear axes stacked in one picture, sharing their x range, as SVG and PNG
+/// named `name`.
+///
+/// # Errors
+/// [`DriverError::Picture`] where plotters cannot draw.
+pub fn panels(name: &str, panels: &[Panel]) -> Result<Files, DriverError> {
+    both!(name, |a| draw_panels(a, panels))
+}
+
+/// A log-log chart of `series` with markers and lines.
+fn draw_loglog<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    labels: (&str, &str),
+    series: &[Series],
+) -> Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    area.fill(&WHITE).map_err(e)?;
+    let positive = |v: f64| v > 0.0 && v <= LIMIT;
+    let pts = series.iter().flat_map(|s| s.points.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+    for &(x, y) in pts {
+        if positive(x) {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+        }
+        if positive(y) {
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if !(x1 > 0.0) {
+        (x0, x1) = (1.0, 10.0);
+    }
+    if !(y1 > 0.0) {
+        (y0, y1) = (1e-16, 1.0);
+    }
+    let (x0, x1) = (x0 / 1.5, x1 * 1.5);
+    // room above the data for the legend
+    let (y0, y1) = (
+        y0.max(1e-17) / 3.0,
+        (y1 * 3.0 * (y1 / y0.max(1e-17)).powf(0.6).max(10.0)).min(1e305),
+    );
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, 22))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style((FONT, 13))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(e)?;
+    let mut k = 0;
+    for (i, s) in series.iter().enumerate() {
+        if i > 0 && !s.name.is_empty() {
+            k += 1;
+        }
+        let color = PALETTE[(k + 1) % PALETTE.len()];
+        let p: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|(x, y)| positive(*x) && !y.is_nan())
+            .map(|&(x, y)| (x, y.clamp(y0, y1)))
+            .collect();
+        let line = chart
+            .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))
+            .map_err(e)?;
+        if !s.name.is_empty() {
+            line.label(s.name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+        }
+        chart
+            .draw_series(p.iter().map(|&q| Circle::new(q, 4, color.filled())))
+            .map_err(e)?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(e)?;
+    Ok(())
+}
+
+/// A log-log chart as SVG and PNG, named `name`. Points with a non-positive or non-finite x
+/// are left out; y is clamped to the axis.
+///
+/// # Errors
+/// [`DriverError::Picture`] where plotters cannot draw.
+pub fn loglog(name: &str, title: &str, labels: (&str, &str), series: &[Series]) -> Result<Files, DriverError> {
+    both!(name, |a| draw_loglog(a, title, labels, series))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Extreme values (infinite, NaN, 1e308) neither hang nor fail a picture.
+    #[test]
+    fn extreme_values_draw() {
+        let wild = vec![(0.0, 1e308), (1.0, f64::INFINITY), (2.0, f64::NAN), (3.0, -1e308)];
+        let panel = Panel {
+            title: "wild".into(),
+            labels: ("x".into(), "y".into()),
+            series: vec![Series::line("a", wild.clone())],
+        };
+        assert_eq!(panels("wild", &[panel]).unwrap().len(), 2);
+        assert_eq!(
+            loglog("wild", "wild", ("x", "y"), &[Series::line("a", wild)])
+                .unwrap()
+                .len(),
+            2
+        );
+        let empty = Panel {
+            title: "empty".into(),
+            labels: ("x".into(), "y".into()),
+            series: vec![],
+        };
+        assert_eq!(panels("empty", &[empty]).unwrap().len(), 2);
+    }
+}

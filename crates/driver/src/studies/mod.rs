@@ -1,0 +1,23 @@
+//! The studies over many runs, each building its own table and series: a scene along one
+//! parameter ([`sweep`]), the paper's Table 1 ([`table1`]), error against h and run time
+//! ([`convergence`]), the verification report ([`verification`]) and the stiff and extreme
+//! cases ([`stability`]).
+
+pub mod convergence;
+pub mod stability;
+pub mod sweep;
+pub mod table1;
+pub mod verification;
+
+use crate::scene_file;
+use crate::DriverError;
+use problem::{Silent, Solution};
+
+/// Solves a shipped scene or scene file with overrides, silently, writing nothing.
+///
+/// # Errors
+/// The scene's or the run's error.
+pub fn solve(scene: &str, sets: &[String]) -> Result<Solution, DriverError> {
+    let (scene, source) = scene_file::load(scene, sets)?;
+    crate::run::solve(&scene, &source, &mut Silent)
+}

@@ -1,0 +1,66 @@
+//! Analytical solutions of contact problems (plane strain, a rigid flat foundation), from
+//! Johnson, *Contact Mechanics* (Cambridge, 1985): Hertz's frictionless cylinder (section 4.2)
+//! and Cattaneo-Mindlin's partial slip under a tangential force (section 7.1).
+
+use std::f64::consts::PI;
+
+/// Hertz's half-width `a` and peak pressure `p0` for the load `p` per unit length on a cylinder
+/// of radius `radius` (Johnson 1985, section 4.2): `a² = 4 P R / (π E*)`, `p0 = 2 P / (π a)`,
+/// with `E* = E / (1 - ν²)` against a rigid foundation.
+pub fn hertz(p: f64, radius: f64, young: f64, poisson: f64) -> (f64, f64) {
+    let e_star = young / (1.0 - poisson * poisson);
+    let a = (4.0 * p * radius / (PI * e_star)).sqrt();
+    (a, 2.0 * p / (PI * a))
+}
+
+/// Hertz's pressure at `x` from the centre: `p0 √(1 - x²/a²)` inside the contact, 0 outside.
+pub fn hertz_pressure(x: f64, a: f64, p0: f64) -> f64 {
+    p0 * (1.0 - x * x / (a * a)).max(0.0).sqrt()
+}
+
+/// The stick half-width of Cattaneo-Mindlin, `c = a √(1 - Q/(F P))` (0 once `Q ≥ F P`).
+pub fn cattaneo_stick_half_width(a: f64, q: f64, f: f64, p: f64) -> f64 {
+    a * (1.0 - (q / (f * p)).min(1.0)).sqrt()
+}
+
+/// Cattaneo-Mindlin's tangential traction (Johnson 1985, section 7.1) for the friction
+/// coefficient `f`, Hertz's `a` and `p0`, and the stick half-width `c`:
+/// `q = F p0 √(1 - x²/a²) - F p0 (c/a) √(1 - x²/c²)` (the second term for `|x| < c` only).
+pub fn cattaneo_traction(x: f64, f: f64, a: f64, p0: f64, c: f64) -> f64 {
+    let slip = f * p0 * (1.0 - x * x / (a * a)).max(0.0).sqrt();
+    let stick = if x.abs() < c {
+        f * p0 * (c / a) * (1.0 - x * x / (c * c)).sqrt()
+    } else {
+        0.0
+    };
+    slip - stick
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Johnson's numbers: P = 1, R = 1, E* = 1 gives a = 2/√π and p0 = 1/√π; the
+    /// Cattaneo traction integrates to Q.
+    #[test]
+    fn hertz_and_cattaneo_formulas() {
+        let (a, p0) = hertz(1.0, 1.0, 1.0, 0.0);
+        assert!((a - 2.0 / PI.sqrt()).abs() < 1e-14);
+        assert!((p0 - 1.0 / PI.sqrt()).abs() < 1e-14);
+        // ∫ q dx = F P - F P (c/a)² = Q by construction of c
+        let (f, q): (f64, f64) = (0.5, 0.3);
+        let c = cattaneo_stick_half_width(a, q, f, 1.0);
+        assert!((c - a * (1.0 - q / f).sqrt()).abs() < 1e-15);
+        let n = 200_000;
+        let h = 2.0 * a / n as f64;
+        let integral: f64 = (0..n)
+            .map(|i| cattaneo_traction(-a + (i as f64 + 0.5) * h, f, a, p0, c) * h)
+            .sum();
+        assert!((integral - q).abs() < 1e-5, "{integral}");
+        // and Hertz's pressure integrates to P
+        let pressure: f64 = (0..n)
+            .map(|i| hertz_pressure(-a + (i as f64 + 0.5) * h, a, p0) * h)
+            .sum();
+        assert!((pressure - 1.0).abs() < 1e-5, "{pressure}");
+    }
+}

@@ -1,0 +1,295 @@
+//! The contact boundary as the `contact` crate sees it: points with normals, tangents, lumped
+//! weights and gaps, and two implementations of "given multipliers, return the contact
+//! displacement": one full primal solve per call ([`FullSolve`]), or the condensed dense
+//! compliance `D = R (K⁻¹)_cc Rᵀ` (Delassus operator), from the condensation of `K` onto the
+//! contact dofs that `linalg` does ([`ContactBoundary::condense`]). The projection `R` of the
+//! contact dofs onto each point's normal and tangents is this module's; the sparse work is
+//! linalg's.
+
+use crate::scene::{ContactSpec, SceneError};
+use crate::ProblemError;
+use contact::{ContactOperator, ContactPoints, DenseContactProblem, OperatorError, PointValues};
+use fe_assembly::{facet_measure, Dof, DofMap};
+use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
+
+/// The contact points of a boundary group and the u dofs of their nodes.
+pub struct ContactBoundary {
+    /// The points.
+    pub points: ContactPoints,
+    /// Mesh node of each point.
+    pub nodes: Vec<usize>,
+    /// Free u dof of each component of each point's node (`dim` per point).
+    pub dofs: Vec<usize>,
+}
+
+/// `t1` = the first axis made orthogonal to `n`; in 3D `t2 = t1 x n` (so that n = -z gives
+/// t1 = x, t2 = y, as SCENES.md fixes).
+fn tangent_basis(dim: usize, n: [f64; 3]) -> [[f64; 3]; 2] {
+    if dim == 2 {
+        return [[-n[1], n[0], 0.0], [0.0; 3]];
+    }
+    let mut t1 = [0.0; 3];
+    for axis in 0..3 {
+        let mut e = [0.0; 3];
+        e[axis] = 1.0;
+        let d = n[axis];
+        let v = [e[0] - d * n[0], e[1] - d * n[1], e[2] - d * n[2]];
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if l > 1e-8 {
+            t1 = [v[0] / l, v[1] / l, v[2] / l];
+            break;
+        }
+    }
+    let t2 = [
+        t1[1] * n[2] - t1[2] * n[1],
+        t1[2] * n[0] - t1[0] * n[2],
+        t1[0] * n[1] - t1[1] * n[0],
+    ];
+    [t1, t2]
+}
+
+/// The unit normal of a validated spec in dimension `dim`.
+fn unit_normal(spec: &ContactSpec, dim: usize) -> Result<[f64; 3], SceneError> {
+    let len = spec.normal.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(len > 0.0) || !len.is_finite() {
+        return Err(SceneError::new(
+            "contact.normal",
+            "contact.normal is not a non-zero vector",
+        ));
+    }
+    let mut nv = [0.0; 3];
+    for k in 0..dim {
+        nv[k] = spec.normal[k] / len;
+    }
+    Ok(nv)
+}
+
+/// Lumped boundary mass of each node on `group`: each facet's measure shared equally among its
+/// nodes.
+fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup) -> Vec<f64> {
+    let mut weight = vec![0.0; mesh.n_nodes()];
+    for f in group.iter() {
+        let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
+        let m = facet_measure(&x) / f.len() as f64;
+        for &v in f {
+            weight[v] += m;
+        }
+    }
+    weight
+}
+
+impl ContactBoundary {
+    /// The contact points of the group of `spec`: its nodes whose displacement is entirely free
+    /// (clamped nodes are left out), weighted by their lumped boundary mass, with the gap
+    /// `gap + |x - c|²_t / (2R)` (uniform, plus the parabola of a curved body along the face).
+    ///
+    /// # Errors
+    /// A missing group, a zero normal, or a group with no free node.
+    pub fn new(mesh: &mesh::Mesh, dofs: &DofMap, spec: &ContactSpec) -> Result<Self, ProblemError> {
+        let dim = mesh.dim;
+        let center = match &spec.gap_center {
+            Some(c) => [c[0], c[1], c.get(2).copied().unwrap_or(0.0)],
+            None => [0.0; 3],
+        };
+        let nv = unit_normal(spec, dim)?;
+        let tangents = tangent_basis(dim, nv);
+        let group = mesh.boundary(&spec.group)?;
+        let weight = lumped_weights(mesh, group);
+        let friction = spec.friction();
+        let mut points = ContactPoints {
+            dim,
+            position: vec![],
+            normal: vec![],
+            tangent: vec![],
+            weight: vec![],
+            gap: vec![],
+            friction: vec![],
+        };
+        let (mut nodes, mut point_dofs) = (vec![], vec![]);
+        for node in group.nodes() {
+            let free: Vec<usize> = (0..dim)
+                .filter_map(|k| match dofs.u[node * dim + k] {
+                    Dof::Free(j) => Some(j),
+                    _ => None,
+                })
+                .collect();
+            if free.len() != dim {
+                continue;
+            }
+            nodes.push(node);
+            point_dofs.extend_from_slice(&free);
+            let x = mesh.points[node];
+            let d = [x[0] - center[0], x[1] - center[1], x[2] - center[2]];
+            let along_n: f64 = (0..3).map(|k| d[k] * nv[k]).sum();
+            let dist2 = (0..3).map(|k| d[k] * d[k]).sum::<f64>() - along_n * along_n;
+            points.position.push(x);
+            points.normal.push(nv);
+            points.tangent.push(tangents);
+            points.weight.push(weight[node]);
+            points.gap.push(spec.gap + 0.5 * spec.gap_curvature * dist2.max(0.0));
+            points.friction.push(friction);
+        }
+        if nodes.is_empty() {
+            return Err(SceneError::new(
+                "contact.group",
+                format!("contact group `{}` has no node with a free displacement", spec.group),
+            )
+            .into());
+        }
+        Ok(ContactBoundary {
+            points,
+            nodes,
+            dofs: point_dofs,
+        })
+    }
+
+    /// The contact forces `-Nᵀ W λ_n - Tᵀ W λ_t` on the contact dofs, in the order of `dofs`.
+    pub fn forces(&self, lambda: &PointValues) -> Vec<f64> {
+        let p = &self.points;
+        let (dim, nt) = (p.dim, lambda.n_tangential());
+        let mut out = vec![0.0; self.dofs.len()];
+        for i in 0..p.len() {
+            for k in 0..dim {
+                let mut f = lambda.normal[i] * p.normal[i][k];
+                for q in 0..nt {
+                    f += lambda.tangential[i * nt + q] * p.tangent[i][q][k];
+                }
+                out[i * dim + k] = -p.weight[i] * f;
+            }
+        }
+        out
+    }
+
+    /// Adds the contact forces of `lambda` to `b_u`.
+    pub fn add_forces(&self, lambda: &PointValues, b_u: &mut [f64]) {
+        for (&j, f) in self.dofs.iter().zip(self.forces(lambda)) {
+            b_u[j] += f;
+        }
+    }
+
+    /// `u_n` and `u_t` of the values `u_c` at the contact dofs (in the order of `dofs`).
+    fn project(&self, u_c: &[f64], out: &mut PointValues) {
+        let p = &self.points;
+        let (dim, nt) = (p.dim, out.n_tangential());
+        for i in 0..p.len() {
+            let ui = &u_c[i * dim..(i + 1) * dim];
+            out.normal[i] = (0..dim).map(|k| ui[k] * p.normal[i][k]).sum();
+            for q in 0..nt {
+                out.tangential[i * nt + q] = (0..dim).map(|k| ui[k] * p.tangent[i][q][k]).sum();
+            }
+        }
+    }
+
+    /// `u_n` and `u_t` of the free displacement vector `u`.
+    pub fn extract(&self, u: &[f64], out: &mut PointValues) {
+        let u_c: Vec<f64> = self.dofs.iter().map(|&j| u[j]).collect();
+        self.project(&u_c, out);
+    }
+
+    /// The contact problem condensed onto the points, `u = u0 - D W λ` with
+    /// `D = R (K⁻¹)_cc Rᵀ` (`R`: each point's normal, then its `nt` tangents), and the loads'
+    /// part of the condensation for [`ContactBoundary::recover`].
+    ///
+    /// # Errors
+    /// The condensation's linear-algebra error.
+    pub fn condense(
+        &self,
+        solver: &mut DirectLdlt,
+        b_u: &[f64],
+        b_phi: &[f64],
+        nt: usize,
+    ) -> Result<(DenseContactProblem, CondensedLoads), ProblemError> {
+        let condensed = solver.condense(b_u, b_phi, &self.dofs)?;
+        let (k, inv) = (self.dofs.len(), condensed.inverse);
+        let p = &self.points;
+        let (n, dim) = (p.len(), p.dim);
+        let m = n * (1 + nt);
+        // rows of R: the normal, then the tangents, of each point, over its dim dofs
+        let dir = |r: usize| -> (usize, [f64; 3]) {
+            if r < n {
+                (r, p.normal[r])
+            } else {
+                let (i, q) = ((r - n) / nt, (r - n) % nt);
+                (i, p.tangent[i][q])
+            }
+        };
+        let mut d = vec![0.0; m * m];
+        for r in 0..m {
+            let (i, a) = dir(r);
+            for c in 0..=r {
+                let (j, b) = dir(c);
+                let mut v = 0.0;
+                for x in 0..dim {
+                    for y in 0..dim {
+                        v += a[x] * inv[(i * dim + x) * k + j * dim + y] * b[y];
+                    }
+                }
+                d[r * m + c] = v;
+                d[c * m + r] = v;
+            }
+        }
+        let mut u0 = PointValues::zeros(n, nt);
+        self.project(&condensed.loads.solution, &mut u0);
+        let problem = DenseContactProblem {
+            u0,
+            compliance: d,
+            weight: p.weight.clone(),
+            nt,
+        };
+        Ok((problem, condensed.loads))
+    }
+
+    /// `u` and `φ` under the loads and the contact forces of `lambda`, finishing the
+    /// condensation's solve (the forces change the right-hand side at the contact dofs only).
+    ///
+    /// # Errors
+    /// The solve's linear-algebra error.
+    pub fn recover(
+        &self,
+        solver: &mut DirectLdlt,
+        loads: CondensedLoads,
+        lambda: &PointValues,
+        b_u: &[f64],
+        b_phi: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), ProblemError> {
+        Ok(solver.solve_with_update(loads, b_u, b_phi, &self.forces(lambda))?)
+    }
+}
+
+/// One full primal solve per call (warm-started: the iterative linear solver starts from the
+/// previous solution).
+pub struct FullSolve<'a> {
+    /// The contact boundary.
+    pub boundary: &'a ContactBoundary,
+    /// The factored linear solver.
+    pub solver: &'a mut dyn CoupledSolver,
+    /// Load right-hand side.
+    pub b_u: &'a [f64],
+    /// Electric right-hand side.
+    pub b_phi: &'a [f64],
+    /// Tangential components carried.
+    pub nt: usize,
+    /// The last displacement.
+    pub u: Vec<f64>,
+    /// The last potential.
+    pub phi: Vec<f64>,
+}
+
+impl ContactOperator for FullSolve<'_> {
+    fn n_points(&self) -> usize {
+        self.boundary.points.len()
+    }
+    fn n_tangential(&self) -> usize {
+        self.nt
+    }
+    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+        let mut rhs = self.b_u.to_vec();
+        self.boundary.add_forces(lambda, &mut rhs);
+        let info = self
+            .solver
+            .solve(&rhs, self.b_phi, &mut self.u, &mut self.phi)
+            .map_err(OperatorError::new)?;
+        self.boundary.extract(&self.u, out);
+        Ok(info.pcg_iters)
+    }
+}

@@ -1,0 +1,265 @@
+//! A scene's known solution (its `[exact]` section; SCENES.md section 6) and the errors a run
+//! reports against it: the fields of a manufactured or affine solution (energy and L2 norms),
+//! and the contact tractions of Hertz and Cattaneo-Mindlin (profile errors, the contact and
+//! stick zones). The formulas of the contact solutions are in [`crate::analytical`].
+
+use crate::analytical::{cattaneo_stick_half_width, cattaneo_traction, hertz, hertz_pressure};
+use crate::scene::{ExactKind, Scene};
+use contact::{ContactPoints, ContactSolution, Status};
+use fe_assembly::{Discretization, Exact};
+use serde::{Deserialize, Serialize};
+
+/// A field solution set up for a run: the exact fields and the groups they are prescribed on.
+pub struct FieldSolution {
+    /// Which kind.
+    pub kind: ExactKind,
+    /// The exact `(u, φ)` with its loads and Dirichlet data.
+    pub exact: Exact,
+    /// The boundary groups it is prescribed on.
+    pub groups: Vec<String>,
+}
+
+impl FieldSolution {
+    /// The field solution of a validated `manufactured` or `affine` scene in dimension `dim`
+    /// (`None` for other scenes).
+    pub fn of(scene: &Scene, dim: usize) -> Option<FieldSolution> {
+        let x = scene.exact.as_ref().filter(|x| x.kind.is_field())?;
+        let pad = |v: &[f64], n: usize| -> Vec<f64> {
+            let mut out = vec![0.0; n];
+            out[..v.len().min(n)].copy_from_slice(&v[..v.len().min(n)]);
+            out
+        };
+        let exact = if x.kind == ExactKind::Manufactured {
+            Exact::manufactured(dim)
+        } else {
+            let (u0, g, gp) = (pad(&x.u0, 3), pad(&x.grad_u, dim * dim), pad(&x.grad_phi, 3));
+            let mut grad_u = [[0.0; 3]; 3];
+            for k in 0..dim {
+                for j in 0..dim {
+                    grad_u[k][j] = g[k * dim + j];
+                }
+            }
+            Exact::affine(
+                dim,
+                [u0[0], u0[1], u0[2]],
+                grad_u,
+                x.phi0.unwrap_or(0.0),
+                [gp[0], gp[1], gp[2]],
+            )
+        };
+        Some(FieldSolution {
+            kind: x.kind,
+            exact,
+            groups: x.groups(&scene.mesh),
+        })
+    }
+
+    /// The errors of the nodal solution `(u, φ)` against it.
+    pub fn errors(&self, disc: &Discretization<'_>, u: &[[f64; 3]], phi: &[f64], electric: bool) -> ExactReport {
+        let e = disc.error_norms(u, phi, &self.exact);
+        ExactReport::Field(FieldErrors {
+            kind: self.kind,
+            error: e.rel_energy(),
+            error_name: if electric {
+                "relative energy-norm error of (u, φ)"
+            } else {
+                "relative energy-norm error of u"
+            }
+            .into(),
+            l2_u: e.l2_u,
+            l2_phi: e.l2_phi,
+            energy: e.energy,
+            rel_l2_u: e.rel_l2_u(),
+            rel_l2_phi: if electric { e.rel_l2_phi() } else { 0.0 },
+            rel_energy: e.rel_energy(),
+        })
+    }
+}
+
+/// The `exact` section of run.json.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum ExactReport {
+    /// Against a field solution.
+    Field(FieldErrors),
+    /// Against Hertz or Cattaneo-Mindlin.
+    Contact(ContactErrors),
+}
+
+impl ExactReport {
+    /// The kind of solution.
+    pub fn kind(&self) -> ExactKind {
+        match self {
+            ExactReport::Field(f) => f.kind,
+            ExactReport::Contact(c) => c.kind,
+        }
+    }
+
+    /// The headline error (what [`ExactKind::measures`] says).
+    pub fn error(&self) -> f64 {
+        match self {
+            ExactReport::Field(f) => f.error,
+            ExactReport::Contact(c) => c.error,
+        }
+    }
+
+    /// What the headline error measures, in words.
+    pub fn error_name(&self) -> &str {
+        match self {
+            ExactReport::Field(f) => &f.error_name,
+            ExactReport::Contact(c) => &c.error_name,
+        }
+    }
+}
+
+/// The errors of a run against a field solution.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct FieldErrors {
+    /// `manufactured` or `affine`.
+    pub kind: ExactKind,
+    /// The relative energy-norm error.
+    pub error: f64,
+    /// What `error` measures.
+    pub error_name: String,
+    /// L2 error of u.
+    pub l2_u: f64,
+    /// L2 error of φ.
+    pub l2_phi: f64,
+    /// Energy-norm error.
+    pub energy: f64,
+    /// Relative L2 error of u.
+    pub rel_l2_u: f64,
+    /// Relative L2 error of φ (0 without electric unknowns).
+    pub rel_l2_phi: f64,
+    /// Relative energy-norm error.
+    pub rel_energy: f64,
+}
+
+/// The errors of a run against Hertz's or Cattaneo-Mindlin's solution.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ContactErrors {
+    /// `hertz` or `cattaneo-mindlin`.
+    pub kind: ExactKind,
+    /// The contact reaction P (per unit length).
+    pub load_p: f64,
+    /// The cylinder's radius R.
+    pub radius: f64,
+    /// Hertz's half-width.
+    pub a: f64,
+    /// Hertz's peak pressure.
+    pub p0: f64,
+    /// The half-width of the computed contact zone.
+    pub a_h: f64,
+    /// The centre of the computed contact zone.
+    pub contact_centre: f64,
+    /// `|a_h - a| / a`.
+    pub a_error: f64,
+    /// `|max λ_n - p0| / p0`.
+    pub peak_error: f64,
+    /// Relative l2 error of the pressure profile over `|x| ≤ 1.5 a`.
+    pub pressure_error: f64,
+    /// The headline error: the pressure profile's (Hertz) or the traction profile's.
+    pub error: f64,
+    /// What `error` measures.
+    pub error_name: String,
+    /// Cattaneo-Mindlin: the tangential reaction Q.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load_q: Option<f64>,
+    /// Cattaneo-Mindlin: the stick half-width `c`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub c: Option<f64>,
+    /// Cattaneo-Mindlin: the half-width of the computed stick zone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub c_h: Option<f64>,
+    /// Cattaneo-Mindlin: `|c_h - c| / a`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub c_error: Option<f64>,
+    /// Cattaneo-Mindlin: the centre of the computed stick zone, in units of `a`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stick_offset: Option<f64>,
+}
+
+/// Relative discrete l2 error of `values` against `exact(x)` over the points with
+/// `|x| ≤ reach`.
+fn profile_error(xs: &[f64], values: &[f64], reach: f64, exact: impl Fn(f64) -> f64) -> f64 {
+    let (mut err, mut norm) = (0.0, 0.0);
+    for (&x, &v) in xs.iter().zip(values) {
+        if x.abs() <= reach {
+            let e = exact(x);
+            err += (v - e).powi(2);
+            norm += e * e;
+        }
+    }
+    (err / norm).sqrt()
+}
+
+/// Half the extent and the centre of the points whose flag is set.
+fn extent(xs: &[f64], flag: impl Fn(usize) -> bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (i, &x) in xs.iter().enumerate() {
+        if flag(i) {
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+    }
+    if lo > hi {
+        (0.0, 0.0)
+    } else {
+        ((hi - lo) / 2.0, (hi + lo) / 2.0)
+    }
+}
+
+/// The `exact` section of a Hertz or Cattaneo-Mindlin scene (validated: one isotropic
+/// material, a curved gap): the reactions `p` (normal) and `q` (tangential), Hertz's `a` and
+/// `p0`, the measured contact and stick zones, and the profile errors. `None` for other scenes.
+pub fn contact_errors(
+    scene: &Scene,
+    points: &ContactPoints,
+    sol: &ContactSolution,
+    p: f64,
+    q: f64,
+) -> Option<ExactReport> {
+    let x = scene.exact.as_ref().filter(|x| !x.kind.is_field())?;
+    let c = scene.contact.as_ref()?;
+    let m = scene.material.first()?;
+    let (young, poisson) = (m.young?, m.poisson?);
+    let radius = 1.0 / c.gap_curvature;
+    let x0 = c.gap_center.as_ref().and_then(|v| v.first().copied()).unwrap_or(0.0);
+    let xs: Vec<f64> = points.position.iter().map(|p| p[0] - x0).collect();
+    let (a, p0) = hertz(p, radius, young, poisson);
+    let (a_h, centre) = extent(&xs, |i| sol.lambda.normal[i] > 0.0);
+    let pressure_error = profile_error(&xs, &sol.lambda.normal, 1.5 * a, |x| hertz_pressure(x, a, p0));
+    let peak = sol.lambda.normal.iter().cloned().fold(0.0, f64::max);
+    let mut out = ContactErrors {
+        kind: x.kind,
+        load_p: p,
+        radius,
+        a,
+        p0,
+        a_h,
+        contact_centre: centre,
+        a_error: (a_h - a).abs() / a,
+        peak_error: (peak - p0).abs() / p0,
+        pressure_error,
+        error: pressure_error,
+        error_name: x.kind.measures().into(),
+        load_q: None,
+        c: None,
+        c_h: None,
+        c_error: None,
+        stick_offset: None,
+    };
+    if x.kind == ExactKind::CattaneoMindlin {
+        let f = c.friction();
+        let cc = cattaneo_stick_half_width(a, q, f, p);
+        let (c_h, stick_centre) = extent(&xs, |i| sol.status[i] == Status::Stick);
+        let t: Vec<f64> = (0..points.len()).map(|i| sol.lambda.tangential_norm(i)).collect();
+        out.error = profile_error(&xs, &t, 1.5 * a, |x| cattaneo_traction(x, f, a, p0, cc));
+        out.load_q = Some(q);
+        out.c = Some(cc);
+        out.c_h = Some(c_h);
+        out.c_error = Some((c_h - cc).abs() / a);
+        out.stick_offset = Some(stick_centre / a);
+    }
+    Some(ExactReport::Contact(out))
+}

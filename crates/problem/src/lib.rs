@@ -1,0 +1,127 @@
+//! The discrete problem of piezocontact and its method, as a library: the typed scene, the
+//! plan of what a run computes, the set-up of the finite-element problem, the contact
+//! boundary, the run as named steps, and a typed report. It ties the four crates below it
+//! together (`mesh`, `fe-assembly`, `linalg`, `contact`); it does no file IO, never prints,
+//! and every choice in it is an enum. The `piezocontact` application (`driver`) reads scene
+//! files, writes outputs and draws pictures on top of it.
+//!
+//! # Glossary (signs fixed by DESIGN.md)
+//! - scene ([`Scene`]): what to solve (mesh, materials, Dirichlet data, load, electrode,
+//!   contact, solver, exact solution); checked by [`Scene::validate`].
+//! - plan ([`Plan`]): what a run computes, decided before computing (electric unknowns or
+//!   not, which contact loops, which strategy, which outputs); the run obeys it.
+//! - `λ_n ≥ 0`: the contact pressure; `λ_t`: the tangential multiplier; `u_n ≤ g`.
+//! - Units are those of the scene (the scaled scenes: m, GPa, C/m², nF/m; φ in GV).
+//!
+//! # Example
+//! A scene built in code (no file): the paper's PZT-5A block, clamped at its sides, pressed
+//! onto a rigid foundation with Coulomb friction; then the multipliers and the displacement
+//! read back.
+//! ```
+//! use problem::{ContactLaw, ContactSpec, DirichletSpec, LoadSpec, MaterialSpec, MeshSpec, Scene, Silent};
+//! let clamped = |group: &str| DirichletSpec {
+//!     group: group.into(),
+//!     u: Some(vec![0.0, 0.0]),
+//!     phi: Some(0.0),
+//!     ..Default::default()
+//! };
+//! let pzt5a = [121.0, 75.4, 75.2, 111.0, 21.1, 22.6]; // GPa
+//! let mut contact = ContactSpec::new("bottom", ContactLaw::Coulomb, &[0.0, -1.0]);
+//! contact.friction = Some(0.6);
+//! let scene = Scene {
+//!     name: "block".into(),
+//!     description: "PZT-5A pressed on a rigid floor".into(),
+//!     mesh: MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 8),
+//!     material: vec![MaterialSpec::crystal_6mm("body", pzt5a, [-5.4, 15.8, 12.3], [8.11, 7.35], [0.0, 1.0, 0.0])],
+//!     dirichlet: vec![clamped("left"), clamped("right")],
+//!     load: Some(LoadSpec { group: "top".into(), p: -2.0, direction: vec![0.0, 1.0] }),
+//!     electrode: None,
+//!     contact: Some(contact),
+//!     solver: Default::default(),
+//!     exact: None,
+//! };
+//! let solution = problem::solve(&scene, None, &mut Silent).unwrap();
+//! let contact = solution.contact.as_ref().unwrap();
+//! // the foundation carries the load: Σ w λ_n = 2 x (length of the top face less the corners)
+//! let lambda_n = &contact.solution.lambda.normal;
+//! let force: f64 = contact.points.weight.iter().zip(lambda_n).map(|(w, l)| w * l).sum();
+//! assert!((force - solution.report.contact.normal_force).abs() < 1e-12);
+//! assert!(lambda_n.iter().all(|&l| l > 0.0)); // pressed everywhere
+//! assert!(solution.report.residuals.complementarity <= 1e-10);
+//! // the body moves down under the load, and not into the floor (u_n = -u_y ≤ gap = 0)
+//! let top_middle = solution.mesh.points.iter().position(|x| x[0] == 1.0 && x[1] == 1.0).unwrap();
+//! assert!(solution.u[top_middle][1] < 0.0);
+//! assert!(contact.nodes.iter().all(|&v| -solution.u[v][1] <= 1e-12));
+//! ```
+
+pub mod analytical;
+pub mod boundary;
+pub mod exact;
+pub mod plan;
+pub mod progress;
+pub mod report;
+pub mod run;
+pub mod scene;
+pub mod setup;
+
+pub use plan::{Output, Plan};
+pub use progress::{Event, Lines, Reporter, Silent};
+pub use report::RunReport;
+pub use run::{solve, ContactResult, Solution};
+pub use scene::{
+    ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec, LoadSpec,
+    MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy,
+};
+
+use contact::ContactError;
+
+/// What can go wrong in a run; each variant names the input or the step at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemError {
+    /// A scene value that cannot be used (named by its key).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A mesh problem (a missing group, a bad cell).
+    #[error("mesh: {0}")]
+    Mesh(#[from] mesh::MeshError),
+    /// An assembly problem (materials, conditions, groups).
+    #[error("setup: {0}")]
+    Assembly(#[from] fe_assembly::AssemblyError),
+    /// A material that cannot be used.
+    #[error("material: {0}")]
+    Material(#[from] fe_assembly::MaterialError),
+    /// A linear-algebra failure.
+    #[error("linear solve: {0}")]
+    Linalg(#[from] linalg::LinalgError),
+    /// The contact solve failed (with its last residual), and what else to try.
+    #[error("contact: {source}{hint}")]
+    Contact {
+        /// The contact solver's error.
+        source: ContactError,
+        /// What to try that the run did not (empty when nothing is known to help).
+        hint: String,
+    },
+}
+
+impl ProblemError {
+    /// A contact error of a run of `strategy`, with a hint that names only what it did not try.
+    pub fn contact(source: ContactError, strategy: Strategy) -> Self {
+        let newton = strategy == Strategy::NewtonCondensed;
+        let hint = match &source {
+            ContactError::NoConvergence { .. } | ContactError::Diverged { .. } if !newton => {
+                "; try solver.strategy=newton-condensed (semismooth Newton), or a looser solver.tol"
+            }
+            ContactError::FixedPointNoConvergence { .. } => {
+                "; try solver.strategy=newton-condensed, which solves Coulomb's law directly (no fixed point on S)"
+            }
+            ContactError::NoConvergence { .. } | ContactError::Diverged { .. } => {
+                "; semismooth Newton stalled and its fallback (the accelerated gradient) did not finish either: a looser solver.tol may be reached, and a smaller contact.friction or material.coupling_scale restores uniqueness of the solution"
+            }
+            _ => "",
+        };
+        ProblemError::Contact {
+            source,
+            hint: hint.into(),
+        }
+    }
+}

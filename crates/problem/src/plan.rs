@@ -1,0 +1,120 @@
+//! The plan: what a run computes, decided from the scene and its materials before anything is
+//! computed. The run reads its decisions from the plan and nowhere else: a part the plan leaves
+//! out is not built (no electric unknowns, no contact boundary, no tangential multipliers, no
+//! output file), and the printed plan is this same value.
+
+use crate::scene::{choice, ContactLaw, ContactSolver, MeshKind, Rule, Scene, Strategy};
+use fe_assembly::Material;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+choice! {
+    /// A file a run writes.
+    pub enum Output ("output") {
+        /// The report.
+        RunJson = "run.json",
+        /// The solution for ParaView.
+        SolutionVtu = "solution.vtu",
+        /// One row per contact point.
+        ContactCsv = "contact.csv",
+        /// The multipliers along the contact boundary (SVG and PNG).
+        Multipliers = "multipliers.svg/png",
+        /// The deformed mesh (SVG and PNG).
+        Deformed = "deformed.svg/png",
+        /// Contours of the potential (SVG and PNG).
+        Potential = "potential.svg/png",
+    }
+}
+
+/// What a run will compute.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Plan {
+    /// Spatial dimension.
+    pub dim: usize,
+    /// Whether electric unknowns exist (some coupling or electric data, on an electric material).
+    pub electric: bool,
+    /// The contact law (`none`: no contact boundary is built).
+    pub contact_law: ContactLaw,
+    /// Whether the tangential multipliers exist (friction).
+    pub friction: bool,
+    /// Whether the fixed point on the slip bound runs (Coulomb friction solved by a first-order
+    /// strategy; Newton solves Coulomb's law directly).
+    pub fixed_point: bool,
+    /// The strategy.
+    pub linear_strategy: Strategy,
+    /// The stopping rule.
+    pub rule: Rule,
+    /// The files the run writes.
+    pub outputs: Vec<Output>,
+}
+
+impl Plan {
+    /// Decides what the run of `scene` needs, on a mesh of dimension `dim` with `materials`.
+    pub fn new(scene: &Scene, dim: usize, materials: &[(String, Material)]) -> Plan {
+        let coupling = materials.iter().any(|(_, m)| m.e.iter().any(|&x| x != 0.0));
+        let electric_data = scene.electrode.as_ref().is_some_and(|e| e.v != 0.0);
+        let electric = (coupling || electric_data) && materials.iter().any(|(_, m)| m.electric);
+        let law = scene.contact_law();
+        let friction = scene.contact.as_ref().is_some_and(|c| match law {
+            ContactLaw::Coulomb => c.friction() > 0.0,
+            ContactLaw::Tresca => c.slip_bound() > 0.0,
+            _ => false,
+        });
+        let strategy = scene.solver.strategy;
+        let mut outputs = vec![Output::RunJson, Output::SolutionVtu];
+        if law != ContactLaw::None {
+            outputs.extend([Output::ContactCsv, Output::Multipliers]);
+        }
+        // the pictures of the mesh are drawn in 2D, and on the face y = lo of a box
+        if dim == 2 || scene.mesh.kind == MeshKind::Box {
+            outputs.push(Output::Deformed);
+            if electric {
+                outputs.push(Output::Potential);
+            }
+        }
+        Plan {
+            dim,
+            electric,
+            contact_law: law,
+            friction,
+            fixed_point: law == ContactLaw::Coulomb
+                && friction
+                && matches!(strategy.contact_solver(), ContactSolver::FirstOrder { .. }),
+            linear_strategy: strategy,
+            rule: scene.solver.rule,
+            outputs,
+        }
+    }
+
+    /// Tangential components per contact point: `dim - 1` with friction, else 0.
+    pub fn n_tangential(&self) -> usize {
+        if self.friction {
+            self.dim - 1
+        } else {
+            0
+        }
+    }
+
+    /// Whether the run writes `output`.
+    pub fn writes(&self, output: Output) -> bool {
+        self.outputs.contains(&output)
+    }
+}
+
+impl fmt::Display for Plan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let outputs: Vec<&str> = self.outputs.iter().map(|o| o.name()).collect();
+        write!(
+            f,
+            "plan: {}D, electric unknowns: {}, contact: {}{}{}, linear: {}, rule: {}, outputs: {}",
+            self.dim,
+            if self.electric { "yes" } else { "left out" },
+            self.contact_law,
+            if self.friction { " (tangential multipliers)" } else { "" },
+            if self.fixed_point { " + fixed point on S" } else { "" },
+            self.linear_strategy,
+            self.rule,
+            outputs.join(", ")
+        )
+    }
+}

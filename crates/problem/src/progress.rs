@@ -1,0 +1,159 @@
+//! What a run tells its caller while it works: one [`Event`] per step done and per outer
+//! iteration of the contact solve, through the [`Reporter`] trait. Each event knows the line it
+//! prints ([`Event::line`]); a terminal may also draw a progress bar from the contact events.
+
+use crate::plan::Plan;
+use linalg::CondenseRoute;
+use std::fmt;
+
+/// A step of a run, done; or an iteration of its contact solve.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Event<'a> {
+    /// The plan is made.
+    Planned(&'a Plan),
+    /// The blocks and loads are assembled.
+    Assembled {
+        /// Mesh nodes.
+        n_nodes: usize,
+        /// Mesh cells.
+        n_cells: usize,
+        /// Largest cell diameter.
+        h: f64,
+        /// Free displacement unknowns.
+        n_u: usize,
+        /// Free potential unknowns.
+        n_phi: usize,
+        /// Wall time (s).
+        seconds: f64,
+    },
+    /// The linear solver is factored.
+    Factored {
+        /// Wall time (s).
+        seconds: f64,
+    },
+    /// The contact compliance is formed.
+    Condensed {
+        /// Its size, `m x m`.
+        m: usize,
+        /// How.
+        route: CondenseRoute,
+        /// Wall time (s).
+        seconds: f64,
+    },
+    /// An outer iteration of the contact solve, with the tolerance it aims at.
+    Contact {
+        /// The solver's progress line.
+        progress: &'a contact::Progress,
+        /// The tolerance of the solve.
+        tol: f64,
+    },
+    /// The solve is done: `u`, `φ` and (with contact) the multipliers.
+    Solved {
+        /// Wall time of the solve (contact included), s.
+        seconds: f64,
+        /// PCG iterations, summed.
+        pcg_iters: usize,
+        /// The equilibrium residual of the final pair.
+        equilibrium: f64,
+    },
+    /// The error against the scene's exact solution.
+    Exact {
+        /// Which solution.
+        kind: crate::scene::ExactKind,
+        /// What the error measures.
+        what: &'a str,
+        /// The error.
+        error: f64,
+    },
+}
+
+impl Event<'_> {
+    /// The line the event prints, `None` for the first-order steps between the 500s (they
+    /// report every 50 steps, for a progress bar).
+    pub fn line(&self) -> Option<String> {
+        match self {
+            Event::Contact { progress: p, .. } if p.stage == contact::Stage::Uzawa && p.iter % 500 != 0 => None,
+            _ => Some(self.to_string()),
+        }
+    }
+
+    /// The fraction of the contact solve done, on a log scale from `first` (the first residual
+    /// seen) down to the tolerance: for a progress bar.
+    pub fn contact_fraction(&self, first: f64) -> Option<f64> {
+        let Event::Contact { progress: p, tol } = self else {
+            return None;
+        };
+        if !(p.residual > 0.0) {
+            return None;
+        }
+        let r0 = first.max(tol * 10.0);
+        Some(((r0 / p.residual).ln() / (r0 / tol).ln()).clamp(0.0, 1.0))
+    }
+}
+
+impl fmt::Display for Event<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Event::Planned(plan) => write!(f, "{plan}"),
+            Event::Assembled {
+                n_nodes,
+                n_cells,
+                h,
+                n_u,
+                n_phi,
+                seconds,
+            } => write!(
+                f,
+                "mesh: {n_nodes} nodes, {n_cells} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
+            ),
+            Event::Factored { seconds } => write!(f, "factorisation {seconds:.3} s"),
+            Event::Condensed { m, route, seconds } => write!(
+                f,
+                "condensed the contact compliance ({m} x {m}, {route:?}) in {seconds:.3} s"
+            ),
+            Event::Contact { progress: p, .. } => write!(
+                f,
+                "{:>11} {:>6}: residual {:.3e}, stick {}, slip {}, separated {}",
+                p.stage.name(),
+                p.iter,
+                p.residual,
+                p.counts.0,
+                p.counts.1,
+                p.counts.2
+            ),
+            Event::Solved {
+                seconds,
+                pcg_iters,
+                equilibrium,
+            } => write!(
+                f,
+                "solve {seconds:.3} s ({pcg_iters} PCG iterations), equilibrium residual {equilibrium:.3e}"
+            ),
+            Event::Exact { kind, what, error } => write!(f, "exact ({kind}): {what} = {error:.4e}"),
+        }
+    }
+}
+
+/// Receives the events of a run.
+pub trait Reporter {
+    /// One event, in the order the run makes them.
+    fn event(&mut self, event: &Event<'_>);
+}
+
+/// A reporter that drops every event.
+pub struct Silent;
+
+impl Reporter for Silent {
+    fn event(&mut self, _: &Event<'_>) {}
+}
+
+/// A reporter that passes each event's line (where it has one) to a closure.
+pub struct Lines<F: FnMut(&str)>(pub F);
+
+impl<F: FnMut(&str)> Reporter for Lines<F> {
+    fn event(&mut self, event: &Event<'_>) {
+        if let Some(line) = event.line() {
+            (self.0)(&line)
+        }
+    }
+}

@@ -1,0 +1,268 @@
+//! The report of a run as a typed value ([`RunReport`]): what `run.json` holds, field for
+//! field (serde writes it; the application writes the file). Its sections are the ones
+//! DESIGN.md lists: the scene, the plan, sizes, contact counts and forces, iterations,
+//! residuals, timings, memory, and the solver's own parameters.
+
+use crate::exact::ExactReport;
+use crate::plan::Plan;
+use crate::scene::{Rule, Scene, Strategy};
+use serde::{Deserialize, Serialize};
+
+/// The report of one run (`run.json`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RunReport {
+    /// The scene as run.
+    pub scene: SceneReport,
+    /// What the run computed.
+    pub plan: Plan,
+    /// Mesh sizes.
+    pub mesh: MeshReport,
+    /// Free unknowns, after Dirichlet elimination.
+    pub dofs: DofsReport,
+    /// The contact boundary's counts and resultant forces (zeros without contact).
+    pub contact: ContactReport,
+    /// The error against the scene's exact solution, where it has one.
+    pub exact: Option<ExactReport>,
+    /// Iteration counts (0 where a loop is not in the plan).
+    pub iterations: Iterations,
+    /// Scale-free residuals of the final state.
+    pub residuals: Residuals,
+    /// Wall times of the steps, s.
+    pub timings_s: Timings,
+    /// Memory.
+    pub memory: Memory,
+    /// The solver's parameters.
+    pub solver: SolverReport,
+}
+
+/// The scene as run.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SceneReport {
+    /// Its name.
+    pub name: String,
+    /// Where it came from: a shipped scene's name or a file's path (set by the application;
+    /// the scene's name otherwise).
+    pub source: String,
+    /// Its description.
+    pub description: String,
+    /// Every setting, overrides applied.
+    pub settings: Scene,
+}
+
+/// Mesh sizes.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct MeshReport {
+    /// Nodes.
+    pub n_nodes: usize,
+    /// Cells.
+    pub n_cells: usize,
+    /// Largest cell diameter.
+    pub h: f64,
+    /// Cells per axis of a generated mesh (empty for a Gmsh mesh).
+    pub cells_per_axis: Vec<usize>,
+}
+
+/// Free unknowns.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct DofsReport {
+    /// Displacement.
+    pub u: usize,
+    /// Potential.
+    pub phi: usize,
+}
+
+impl DofsReport {
+    /// `u + φ`.
+    pub fn total(&self) -> usize {
+        self.u + self.phi
+    }
+}
+
+/// The contact boundary's counts and resultant forces.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct ContactReport {
+    /// Contact points.
+    pub n_points: usize,
+    /// Points in contact and sticking.
+    pub n_stick: usize,
+    /// Points in contact and sliding (all of them, frictionless).
+    pub n_slip: usize,
+    /// Points with no contact force.
+    pub n_separated: usize,
+    /// `Σ w λ_n`.
+    pub normal_force: f64,
+    /// `|Σ w λ_t t|`.
+    pub tangential_force: f64,
+    /// The largest contact pressure (absent without contact).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_lambda_n: Option<f64>,
+}
+
+impl ContactReport {
+    /// The summary of a contact solution on its points.
+    pub fn of(points: &contact::ContactPoints, sol: &contact::ContactSolution) -> Self {
+        let (n_stick, n_slip, n_separated) = sol.counts();
+        let normal_force: f64 = points.weight.iter().zip(&sol.lambda.normal).map(|(w, l)| w * l).sum();
+        let nt = sol.lambda.n_tangential();
+        let mut t = [0.0; 3];
+        for i in 0..points.len() {
+            for q in 0..nt {
+                for k in 0..3 {
+                    t[k] += points.weight[i] * sol.lambda.tangential[i * nt + q] * points.tangent[i][q][k];
+                }
+            }
+        }
+        ContactReport {
+            n_points: points.len(),
+            n_stick,
+            n_slip,
+            n_separated,
+            normal_force,
+            tangential_force: (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt(),
+            max_lambda_n: Some(sol.lambda.normal.iter().cloned().fold(0.0f64, f64::max)),
+        }
+    }
+}
+
+/// Iteration counts.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Iterations {
+    /// Fixed-point steps on the slip bound.
+    pub fixed_point: usize,
+    /// First-order steps (Uzawa, or the accelerated gradient's).
+    pub uzawa: usize,
+    /// Semismooth Newton steps.
+    pub newton: usize,
+    /// Halvings in Newton's line search.
+    pub line_search_cuts: usize,
+    /// Whether Newton stalled and the accelerated gradient finished.
+    pub newton_fallback: bool,
+    /// PCG iterations in the contact loops (or the one linear solve).
+    pub pcg: usize,
+    /// Primal solves (1 without contact).
+    pub primal_solves: usize,
+    /// PCG iterations spent estimating `μ_max`.
+    pub pcg_in_step_estimate: usize,
+}
+
+impl Iterations {
+    /// One line: the counts of the loops that ran (`4 Newton`, `39 Uzawa, 3 FP, 812 PCG`),
+    /// `-` for a direct linear solve.
+    pub fn summary(&self) -> String {
+        let mut parts = vec![];
+        for (count, name) in [
+            (self.newton, "Newton"),
+            (self.uzawa, "Uzawa"),
+            (self.fixed_point, "FP"),
+            (self.pcg, "PCG"),
+        ] {
+            if count > 0 {
+                parts.push(format!("{count} {name}"));
+            }
+        }
+        if self.newton_fallback {
+            parts.push("fallback".into());
+        }
+        if parts.is_empty() {
+            "-".into()
+        } else {
+            parts.join(", ")
+        }
+    }
+
+    /// The outer iteration count of a run of `strategy` and what it counts: Newton steps, else
+    /// first-order steps (APG for the accelerated strategy), else PCG iterations, else
+    /// `direct`.
+    pub fn outer(&self, strategy: Strategy) -> (usize, &'static str) {
+        if self.newton > 0 {
+            (self.newton, "Newton")
+        } else if self.uzawa > 0 {
+            (
+                self.uzawa,
+                if strategy == Strategy::ApgCondensed {
+                    "APG"
+                } else {
+                    "Uzawa"
+                },
+            )
+        } else if self.pcg > 0 {
+            (self.pcg, "PCG")
+        } else {
+            (0, "direct")
+        }
+    }
+}
+
+/// Scale-free residuals of the final state.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Residuals {
+    /// `‖K x - b‖ / ‖b‖` with the contact forces in `b`.
+    pub equilibrium: f64,
+    /// The natural-map residual of DESIGN.md (0 without contact).
+    pub complementarity: f64,
+    /// Whether the run stopped on its tolerance (the tight rule), not on the paper's loose rule.
+    pub converged_to_tolerance: bool,
+}
+
+/// Wall times, s.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Timings {
+    /// The mesh, materials, plan, conditions and loads.
+    pub setup: f64,
+    /// Assembly of the blocks and loads.
+    pub assembly: f64,
+    /// Factorisation.
+    pub factorization: f64,
+    /// Forming the contact compliance (condensed strategies).
+    pub condense: f64,
+    /// The contact solve (0 without contact).
+    pub contact: f64,
+    /// The solve, contact included.
+    pub solve: f64,
+    /// Set-up to solution.
+    pub total: f64,
+}
+
+/// Memory.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Memory {
+    /// Peak resident memory of the process (set by the application; 0 where unknown).
+    pub peak_bytes: u64,
+    /// Bytes of the factors' values.
+    pub factor_bytes: usize,
+}
+
+/// The solver's parameters and what its loops measured.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SolverReport {
+    /// The strategy.
+    pub strategy: Strategy,
+    /// The stopping rule, in words.
+    pub rule: String,
+    /// The contact tolerance asked.
+    pub tol: f64,
+    /// The PCG's relative tolerance.
+    pub pcg_rel_tol: f64,
+    /// The first-order step `r` last used (`null` where no first-order step ran).
+    pub step_r: Option<f64>,
+    /// The constant `c = 1/μ_max` of Newton's natural map (`null` where Newton did not run).
+    pub augmentation_c: Option<f64>,
+    /// The estimate of the dual operator's largest eigenvalue.
+    pub mu_max: Option<f64>,
+    /// Halvings of the first-order step.
+    pub step_backoffs: usize,
+    /// Halvings of the fixed point's relaxation.
+    pub fixed_point_relaxations: usize,
+    /// How the contact compliance was formed (condensed strategies).
+    pub condense_route: Option<String>,
+    /// The smallest `|pivot| / |diagonal entry|` of the `L D Lᵀ` (direct strategies).
+    pub smallest_pivot_ratio: Option<f64>,
+}
+
+/// The stopping rule in words, as the report gives it.
+pub fn rule_in_words(rule: Rule) -> &'static str {
+    match rule {
+        Rule::Paper => "paper (the loose rules of the paper's Table 1: relative change 1e-3, PCG (r,z) <= 1e-2 (r0,z0); not converged to a tolerance)",
+        Rule::Tight => "tight",
+    }
+}

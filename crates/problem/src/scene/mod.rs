@@ -1,0 +1,663 @@
+//! The scene as typed data: what to solve. Every choice (mesh kind, material model, contact
+//! law, strategy, rule, exact solution) is an enum from the moment the scene is read; the
+//! numbers are plain fields. A scene comes from a TOML file through serde (the application
+//! reads the text) or is built in code; either way [`Scene::validate`] checks it before
+//! anything is computed (`validate.rs`), and refuses keys that do not exist or do not apply.
+
+mod validate;
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+pub use validate::SceneError;
+
+/// An enum of named choices: serde reads and writes the names, `name()` gives them, `ALL` lists
+/// the variants, and `FromStr` parses a name (with a message that names the key and lists the
+/// choices; serde reads through it).
+macro_rules! choice {
+    ($(#[$meta:meta])* $vis:vis enum $ty:ident ($what:literal) {
+        $($(#[$vmeta:meta])* $var:ident = $text:literal,)+
+    }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        #[serde(try_from = "String")]
+        $vis enum $ty {
+            $($(#[$vmeta])* #[serde(rename = $text)] $var,)+
+        }
+        impl $ty {
+            /// Every variant, in the order of the documentation.
+            pub const ALL: &'static [$ty] = &[$($ty::$var),+];
+            /// The name in scene files.
+            pub fn name(self) -> &'static str {
+                match self { $($ty::$var => $text),+ }
+            }
+        }
+        impl fmt::Display for $ty {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.pad(self.name())
+            }
+        }
+        impl TryFrom<String> for $ty {
+            type Error = String;
+            fn try_from(s: String) -> Result<Self, String> {
+                s.parse()
+            }
+        }
+        impl std::str::FromStr for $ty {
+            type Err = String;
+            fn from_str(s: &str) -> Result<Self, String> {
+                Self::ALL.iter().copied().find(|v| v.name() == s).ok_or_else(|| {
+                    let names: Vec<&str> = Self::ALL.iter().map(|v| v.name()).collect();
+                    format!("{} `{s}` is unknown ({})", $what, names.join(", "))
+                })
+            }
+        }
+    };
+}
+pub(crate) use choice;
+
+choice! {
+    /// How the mesh is made.
+    pub enum MeshKind ("mesh.kind") {
+        /// P1 triangles on a rectangle (each square split SW-NE).
+        Rectangle = "rectangle",
+        /// P1 tetrahedra on a box (Kuhn's split of each cube).
+        Box = "box",
+        /// A Gmsh file (MSH 4.1), read by the application.
+        Gmsh = "gmsh",
+    }
+}
+
+choice! {
+    /// The constitutive model of a material.
+    pub enum MaterialModel ("material.model") {
+        /// A poled ceramic of class 6mm: `c = [c11, c12, c13, c33, c44, c66]`,
+        /// `e = [e31, e33, e15]`, `permittivity = [eps11, eps33]`, `poling`.
+        Crystal6mm = "crystal-6mm",
+        /// An isotropic elastic solid: `young`, `poisson`, `permittivity = [eps]` (optional).
+        Isotropic = "isotropic",
+    }
+}
+
+choice! {
+    /// The contact law on the contact group.
+    pub enum ContactLaw ("contact.law") {
+        /// No contact: the contact section is switched off (its other keys are kept, unused).
+        None = "none",
+        /// Signorini contact, frictionless.
+        Signorini = "signorini",
+        /// Tresca friction with a given slip bound `slip_bound`.
+        Tresca = "tresca",
+        /// Coulomb friction with coefficient `friction`.
+        Coulomb = "coulomb",
+    }
+}
+
+choice! {
+    /// How the contact problem and its linear systems are solved (`piezocontact strategies`).
+    pub enum Strategy ("solver.strategy") {
+        /// Semismooth Newton on the contact compliance read off the `L D Lᵀ` of `K`.
+        NewtonCondensed = "newton-condensed",
+        /// The accelerated projected gradient on the same compliance.
+        ApgCondensed = "apg-condensed",
+        /// Uzawa on the same compliance.
+        UzawaCondensed = "uzawa-condensed",
+        /// Uzawa with one full solve per iteration by the `L D Lᵀ` of `K`.
+        UzawaDirect = "uzawa-direct",
+        /// The paper's: Uzawa with one Schur-complement PCG solve per iteration.
+        UzawaSchurPcg = "uzawa-schur-pcg",
+    }
+}
+
+choice! {
+    /// When the contact loops stop.
+    pub enum Rule ("solver.rule") {
+        /// The complementarity residual at most `solver.tol`.
+        Tight = "tight",
+        /// The paper's loose rules (Table 1), never reported as converged to a tolerance.
+        Paper = "paper",
+    }
+}
+
+choice! {
+    /// The known solution a scene is checked against.
+    pub enum ExactKind ("exact.kind") {
+        /// The smooth manufactured solution of `fe_assembly::Exact::manufactured`.
+        Manufactured = "manufactured",
+        /// An affine `(u, φ)` (a patch test).
+        Affine = "affine",
+        /// Hertz's frictionless cylinder on a half-plane.
+        Hertz = "hertz",
+        /// Cattaneo-Mindlin's partial slip under a tangential force.
+        CattaneoMindlin = "cattaneo-mindlin",
+    }
+}
+
+/// How a strategy's contact solver works.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactSolver {
+    /// Semismooth Newton (`contact::solve_newton`).
+    Newton,
+    /// Uzawa's first-order iteration (`contact::solve`), accelerated or not.
+    FirstOrder {
+        /// Nesterov's acceleration (the APG strategy).
+        accelerate: bool,
+    },
+}
+
+impl Strategy {
+    /// One line: what the strategy does.
+    pub fn description(self) -> &'static str {
+        match self {
+            Strategy::NewtonCondensed => "default: semismooth Newton (Alart-Curnier, Coulomb solved directly) on the contact compliance, read once off the L D Lᵀ of K (contact dofs last); one final full solve",
+            Strategy::ApgCondensed => "Nesterov-accelerated projected gradient (FISTA, adaptive restart, step 1/mu_max) on the same compliance",
+            Strategy::UzawaCondensed => "Uzawa (r = 1.8/mu_max) on the same compliance",
+            Strategy::UzawaDirect => "Uzawa with one full solve per iteration by the L D Lᵀ of K (factored once)",
+            Strategy::UzawaSchurPcg => "the paper's: Uzawa with one Schur-complement PCG solve per iteration (Algorithm 3, preconditioned by A)",
+        }
+    }
+
+    /// Whether the contact problem is solved on the condensed compliance (one factorisation with
+    /// the contact dofs last).
+    pub fn is_condensed(self) -> bool {
+        matches!(
+            self,
+            Strategy::NewtonCondensed | Strategy::ApgCondensed | Strategy::UzawaCondensed
+        )
+    }
+
+    /// Whether the linear systems are solved by the Schur-complement PCG (Algorithm 3).
+    pub fn runs_pcg(self) -> bool {
+        self == Strategy::UzawaSchurPcg
+    }
+
+    /// Whether the contact iteration is the paper's Uzawa (so the paper's rule applies).
+    pub fn is_uzawa(self) -> bool {
+        matches!(
+            self,
+            Strategy::UzawaCondensed | Strategy::UzawaDirect | Strategy::UzawaSchurPcg
+        )
+    }
+
+    /// The contact solver it runs.
+    pub fn contact_solver(self) -> ContactSolver {
+        match self {
+            Strategy::NewtonCondensed => ContactSolver::Newton,
+            Strategy::ApgCondensed => ContactSolver::FirstOrder { accelerate: true },
+            _ => ContactSolver::FirstOrder { accelerate: false },
+        }
+    }
+}
+
+impl ExactKind {
+    /// What the headline error of this kind measures.
+    pub fn measures(self) -> &'static str {
+        match self {
+            ExactKind::Manufactured => "relative energy-norm error of (u, φ) against the manufactured solution",
+            ExactKind::Affine => "relative energy-norm error against the affine solution (a patch test: round-off)",
+            ExactKind::Hertz => "relative l2 error of the nodal contact pressure against Hertz's, over |x| ≤ 1.5 a",
+            ExactKind::CattaneoMindlin => {
+                "relative l2 error of the nodal tangential traction against Cattaneo-Mindlin's, over |x| ≤ 1.5 a"
+            }
+        }
+    }
+
+    /// Whether it is a field solution without contact (manufactured, affine).
+    pub fn is_field(self) -> bool {
+        matches!(self, ExactKind::Manufactured | ExactKind::Affine)
+    }
+}
+
+/// A whole scene.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Short name.
+    pub name: String,
+    /// One line: what the scene is.
+    pub description: String,
+    /// The mesh.
+    pub mesh: MeshSpec,
+    /// Materials by region.
+    pub material: Vec<MaterialSpec>,
+    /// Clamped / grounded groups.
+    #[serde(default)]
+    pub dirichlet: Vec<DirichletSpec>,
+    /// The mechanical load.
+    #[serde(default)]
+    pub load: Option<LoadSpec>,
+    /// A voltage electrode.
+    #[serde(default)]
+    pub electrode: Option<ElectrodeSpec>,
+    /// Contact with a rigid foundation.
+    #[serde(default)]
+    pub contact: Option<ContactSpec>,
+    /// Solver choices.
+    #[serde(default)]
+    pub solver: SolverSpec,
+    /// A known solution, for verification: the run reports its error against it.
+    #[serde(default)]
+    pub exact: Option<ExactSpec>,
+}
+
+impl Scene {
+    /// The contact law, `none` where the scene has no contact section.
+    pub fn contact_law(&self) -> ContactLaw {
+        self.contact.as_ref().map_or(ContactLaw::None, |c| c.law)
+    }
+
+    /// The contact section when its law is not `none`.
+    pub fn active_contact(&self) -> Option<&ContactSpec> {
+        self.contact.as_ref().filter(|c| c.law != ContactLaw::None)
+    }
+}
+
+/// How the mesh is made. A generated mesh (`rectangle`, `box`) takes `lo`, `hi` and a size
+/// (`n`, `nx`, `ny`, `nz` or `h`) and may name regions by box; a Gmsh mesh takes `file`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// `rectangle`, `box` or `gmsh`.
+    pub kind: MeshKind,
+    /// Lower corner (rectangle, box).
+    #[serde(default)]
+    pub lo: Vec<f64>,
+    /// Upper corner (rectangle, box).
+    #[serde(default)]
+    pub hi: Vec<f64>,
+    /// Cells along the shortest edge; the other edges get proportionally many.
+    #[serde(default)]
+    pub n: Option<usize>,
+    /// Cells along x (overrides `n` on that axis).
+    #[serde(default)]
+    pub nx: Option<usize>,
+    /// Cells along y.
+    #[serde(default)]
+    pub ny: Option<usize>,
+    /// Cells along z (box).
+    #[serde(default)]
+    pub nz: Option<usize>,
+    /// Target cell size (a length): sets `n` from the shortest edge.
+    #[serde(default)]
+    pub h: Option<f64>,
+    /// Gmsh file (for `kind = "gmsh"`), relative to the scene file.
+    #[serde(default)]
+    pub file: Option<String>,
+    /// The coarse size the smoke tests run.
+    #[serde(default)]
+    pub smoke_n: Option<usize>,
+    /// Named cell regions of a generated mesh, by box (`[[mesh.region]]`).
+    #[serde(default, rename = "region")]
+    pub regions: Vec<RegionSpec>,
+}
+
+impl MeshSpec {
+    /// A rectangle `[lo, hi]` of P1 triangles, `n` cells along its shorter edge.
+    pub fn rectangle(lo: [f64; 2], hi: [f64; 2], n: usize) -> Self {
+        Self::generated(MeshKind::Rectangle, lo.to_vec(), hi.to_vec(), n)
+    }
+
+    /// A box `[lo, hi]` of P1 tetrahedra, `n` cells along its shortest edge.
+    pub fn cuboid(lo: [f64; 3], hi: [f64; 3], n: usize) -> Self {
+        Self::generated(MeshKind::Box, lo.to_vec(), hi.to_vec(), n)
+    }
+
+    /// A Gmsh file (MSH 4.1), relative to the scene file.
+    pub fn gmsh(file: &str) -> Self {
+        MeshSpec {
+            file: Some(file.into()),
+            ..Self::generated(MeshKind::Gmsh, vec![], vec![], 0)
+        }
+    }
+
+    fn generated(kind: MeshKind, lo: Vec<f64>, hi: Vec<f64>, n: usize) -> Self {
+        MeshSpec {
+            kind,
+            lo,
+            hi,
+            n: (n > 0).then_some(n),
+            nx: None,
+            ny: None,
+            nz: None,
+            h: None,
+            file: None,
+            smoke_n: None,
+            regions: vec![],
+        }
+    }
+
+    /// The dimension of a generated mesh (`None` for a Gmsh file: known once it is read).
+    pub fn dim(&self) -> Option<usize> {
+        match self.kind {
+            MeshKind::Rectangle => Some(2),
+            MeshKind::Box => Some(3),
+            MeshKind::Gmsh => None,
+        }
+    }
+
+    /// Cells per axis of a generated mesh from `n` (along the shortest edge), `h`, `nx`, `ny`,
+    /// `nz` (8 along the shortest edge when none is given).
+    pub fn cells_per_axis(&self) -> Vec<usize> {
+        let lens: Vec<f64> = self.lo.iter().zip(&self.hi).map(|(a, b)| b - a).collect();
+        let shortest = lens.iter().cloned().fold(f64::INFINITY, f64::min);
+        let n = match (self.h, self.n) {
+            (Some(h), _) => (shortest / h).round().max(1.0) as usize,
+            (None, Some(n)) => n,
+            (None, None) => 8,
+        };
+        let mut out: Vec<usize> = lens
+            .iter()
+            .map(|l| ((l / shortest) * n as f64).round().max(1.0) as usize)
+            .collect();
+        for (k, o) in [self.nx, self.ny, self.nz].iter().enumerate() {
+            if let (Some(v), Some(slot)) = (o, out.get_mut(k)) {
+                *slot = *v;
+            }
+        }
+        out
+    }
+}
+
+/// A named region of a generated mesh: the cells whose centroid lies in the box `[lo, hi]`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSpec {
+    /// The region's name (materials refer to it).
+    pub name: String,
+    /// Lower corner of the box.
+    pub lo: Vec<f64>,
+    /// Upper corner of the box.
+    pub hi: Vec<f64>,
+}
+
+/// A material on a region.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// The region (`body` = every cell of a generated mesh).
+    pub region: String,
+    /// `crystal-6mm` or `isotropic`.
+    pub model: MaterialModel,
+    /// Elastic constants `[c11, c12, c13, c33, c44, c66]` (crystal-6mm).
+    #[serde(default)]
+    pub c: Vec<f64>,
+    /// Piezoelectric constants `[e31, e33, e15]` (crystal-6mm).
+    #[serde(default)]
+    pub e: Vec<f64>,
+    /// Permittivity: `[eps11, eps33]` (crystal-6mm) or `[eps]` (isotropic; omitted or 0: no
+    /// electric unknowns).
+    #[serde(default)]
+    pub permittivity: Vec<f64>,
+    /// Poling direction (global coordinates, 3 components; crystal-6mm).
+    #[serde(default)]
+    pub poling: Vec<f64>,
+    /// Young's modulus (isotropic).
+    #[serde(default)]
+    pub young: Option<f64>,
+    /// Poisson's ratio (isotropic).
+    #[serde(default)]
+    pub poisson: Option<f64>,
+    /// Multiplies the piezoelectric constants (`material.coupling_scale`; crystal-6mm; default 1).
+    #[serde(default)]
+    pub coupling_scale: Option<f64>,
+}
+
+impl MaterialSpec {
+    /// A poled 6mm crystal on `region`: `c = [c11, c12, c13, c33, c44, c66]`,
+    /// `e = [e31, e33, e15]`, `permittivity = [eps11, eps33]`, poled along `poling`.
+    pub fn crystal_6mm(region: &str, c: [f64; 6], e: [f64; 3], permittivity: [f64; 2], poling: [f64; 3]) -> Self {
+        MaterialSpec {
+            c: c.to_vec(),
+            e: e.to_vec(),
+            permittivity: permittivity.to_vec(),
+            poling: poling.to_vec(),
+            ..Self::bare(region, MaterialModel::Crystal6mm)
+        }
+    }
+
+    /// An isotropic elastic solid on `region` (no electric unknowns).
+    pub fn isotropic(region: &str, young: f64, poisson: f64) -> Self {
+        MaterialSpec {
+            young: Some(young),
+            poisson: Some(poisson),
+            ..Self::bare(region, MaterialModel::Isotropic)
+        }
+    }
+
+    fn bare(region: &str, model: MaterialModel) -> Self {
+        MaterialSpec {
+            region: region.into(),
+            model,
+            c: vec![],
+            e: vec![],
+            permittivity: vec![],
+            poling: vec![],
+            young: None,
+            poisson: None,
+            coupling_scale: None,
+        }
+    }
+}
+
+/// Dirichlet conditions on a boundary group: any of a whole displacement `u`, single components
+/// `ux`, `uy`, `uz` (rollers), and the potential `phi`.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DirichletSpec {
+    /// Boundary group.
+    pub group: String,
+    /// Prescribed displacement (all components), if any.
+    #[serde(default)]
+    pub u: Option<Vec<f64>>,
+    /// Prescribed x component alone (a roller), if any.
+    #[serde(default)]
+    pub ux: Option<f64>,
+    /// Prescribed y component alone, if any.
+    #[serde(default)]
+    pub uy: Option<f64>,
+    /// Prescribed z component alone, if any.
+    #[serde(default)]
+    pub uz: Option<f64>,
+    /// Prescribed potential, if any.
+    #[serde(default)]
+    pub phi: Option<f64>,
+}
+
+/// A uniform traction `p * direction` on a group.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Boundary group.
+    pub group: String,
+    /// Magnitude (`load.p`).
+    pub p: f64,
+    /// Unit direction.
+    pub direction: Vec<f64>,
+}
+
+/// A voltage on the part of a group inside a range of x.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ElectrodeSpec {
+    /// Boundary group the electrode lies on.
+    pub group: String,
+    /// Voltage (`electrode.v`).
+    pub v: f64,
+    /// Only facets whose nodes have `x_range[0] <= x <= x_range[1]`.
+    #[serde(default)]
+    pub x_range: Option<Vec<f64>>,
+}
+
+/// Contact with a rigid, non-conductive foundation.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Boundary group in contact.
+    pub group: String,
+    /// `none`, `signorini`, `tresca` or `coulomb`.
+    pub law: ContactLaw,
+    /// Coulomb coefficient F (Coulomb only).
+    #[serde(default, serialize_with = "zero_when_absent")]
+    pub friction: Option<f64>,
+    /// Tresca slip bound S (Tresca only).
+    #[serde(default, serialize_with = "zero_when_absent")]
+    pub slip_bound: Option<f64>,
+    /// Initial gap g (uniform part).
+    #[serde(default)]
+    pub gap: f64,
+    /// Curvature `1/R` of a parabolic gap, `g(x) = gap + |x - c|²_t / (2R)` with `|·|_t` the
+    /// distance along the contact face from `gap_center` (a body of radius R on a flat
+    /// foundation, as in Hertz's problem); 0 by default.
+    #[serde(default)]
+    pub gap_curvature: f64,
+    /// The point `c` of the parabolic gap (default: the origin).
+    #[serde(default)]
+    pub gap_center: Option<Vec<f64>>,
+    /// Outward normal of the contact face.
+    pub normal: Vec<f64>,
+}
+
+impl ContactSpec {
+    /// Contact on `group` with outward normal `normal`, initial gap 0.
+    pub fn new(group: &str, law: ContactLaw, normal: &[f64]) -> Self {
+        ContactSpec {
+            group: group.into(),
+            law,
+            friction: None,
+            slip_bound: None,
+            gap: 0.0,
+            gap_curvature: 0.0,
+            gap_center: None,
+            normal: normal.to_vec(),
+        }
+    }
+
+    /// The Coulomb coefficient F (0 where not given).
+    pub fn friction(&self) -> f64 {
+        self.friction.unwrap_or(0.0)
+    }
+
+    /// The Tresca slip bound S (0 where not given).
+    pub fn slip_bound(&self) -> f64 {
+        self.slip_bound.unwrap_or(0.0)
+    }
+}
+
+/// Solver choices.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// The strategy (default `newton-condensed`).
+    #[serde(default = "default_strategy")]
+    pub strategy: Strategy,
+    /// Tolerance of the contact solve (complementarity residual; default 1e-10).
+    #[serde(default = "default_tol")]
+    pub tol: f64,
+    /// `tight` (default) or `paper`.
+    #[serde(default = "default_rule")]
+    pub rule: Rule,
+    /// PCG relative tolerance (`uzawa-schur-pcg` only; default 1e-12, or the paper's 1e-2 under
+    /// its rule).
+    #[serde(default)]
+    pub pcg_tol: Option<f64>,
+}
+
+fn default_strategy() -> Strategy {
+    Strategy::NewtonCondensed
+}
+fn default_tol() -> f64 {
+    1e-10
+}
+fn default_rule() -> Rule {
+    Rule::Tight
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        SolverSpec {
+            strategy: default_strategy(),
+            tol: default_tol(),
+            rule: default_rule(),
+            pcg_tol: None,
+        }
+    }
+}
+
+/// The exact solution a scene can be checked against (SCENES.md section 6).
+///
+/// - `manufactured`: the smooth coupled solution of `fe_assembly::Exact::manufactured`,
+///   prescribed on `groups` (default: every side of the generated mesh), with the body force
+///   and charge that make it exact (one material).
+/// - `affine`: `u = u0 + grad_u x`, `φ = phi0 + grad_phi · x`, prescribed on `groups` (a
+///   patch test: P1 reproduces it to round-off).
+/// - `hertz`: Hertz's frictionless cylinder on a half-plane (Johnson 1985, section 4.2),
+///   from the contact reaction P, the gap's curvature 1/R and the isotropic material.
+/// - `cattaneo-mindlin`: the same with a tangential force Q below F P (Johnson 1985, section
+///   7.1): a central stick zone of half-width `c = a √(1 - Q/(F P))`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ExactSpec {
+    /// Which solution.
+    pub kind: ExactKind,
+    /// Groups where an `affine` or `manufactured` solution is prescribed (default: every
+    /// side of the generated rectangle or box).
+    #[serde(default)]
+    pub groups: Vec<String>,
+    /// `affine`: the displacement at the origin.
+    #[serde(default)]
+    pub u0: Vec<f64>,
+    /// `affine`: `∂_j u_k`, row `k`, `dim x dim` row-major.
+    #[serde(default)]
+    pub grad_u: Vec<f64>,
+    /// `affine`: the potential at the origin.
+    #[serde(default, serialize_with = "zero_when_absent")]
+    pub phi0: Option<f64>,
+    /// `affine`: `∇φ`.
+    #[serde(default)]
+    pub grad_phi: Vec<f64>,
+}
+
+impl ExactSpec {
+    /// The groups where a field solution is prescribed: the given ones, else every side of
+    /// the generated mesh.
+    pub fn groups(&self, mesh: &MeshSpec) -> Vec<String> {
+        if !self.groups.is_empty() {
+            return self.groups.clone();
+        }
+        let sides: &[&str] = if mesh.dim() == Some(3) {
+            &["left", "right", "bottom", "top", "front", "back"]
+        } else {
+            &["left", "right", "bottom", "top"]
+        };
+        sides.iter().map(|g| g.to_string()).collect()
+    }
+
+    /// Checks the lengths of an `affine` solution's data in dimension `dim` (empty means
+    /// zero); a Gmsh mesh's dimension is known only once it is read, so the set-up calls this
+    /// again.
+    ///
+    /// # Errors
+    /// A [`SceneError`] on `exact` naming the lengths needed.
+    pub fn check_lengths(&self, dim: usize) -> Result<(), SceneError> {
+        let ok = |v: &[f64], n: usize| v.is_empty() || v.len() == n;
+        if self.kind != ExactKind::Affine
+            || (ok(&self.u0, dim) && ok(&self.grad_u, dim * dim) && ok(&self.grad_phi, dim))
+        {
+            Ok(())
+        } else {
+            Err(SceneError::new(
+                "exact",
+                format!(
+                    "exact (affine) in {dim}D needs u0 of {dim}, grad_u of {} (row-major) and grad_phi of {dim} values",
+                    dim * dim
+                ),
+            ))
+        }
+    }
+}
+
+/// Writes an absent optional number as 0, its meaning (the run.json of earlier versions wrote
+/// every number of the scene).
+fn zero_when_absent<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(v.unwrap_or(0.0))
+}

@@ -1,0 +1,483 @@
+//! The checks of a scene, before anything is computed: every number finite and in range, every
+//! list of the length it needs, and no key that does not apply to the chosen kind, model or
+//! law (a key that would be silently ignored is refused, with the reason). Lengths that depend
+//! on the dimension are checked here for generated meshes and again by the set-up once a Gmsh
+//! mesh is read ([`Scene::check_dimension`]).
+
+use super::{
+    ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, Rule, Scene,
+    SolverSpec,
+};
+
+/// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
+/// is wrong with it.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{message}")]
+pub struct SceneError {
+    /// The key at fault, e.g. `contact.friction`.
+    pub key: String,
+    /// What is wrong, naming the key.
+    pub message: String,
+}
+
+impl SceneError {
+    /// An error on `key`.
+    pub fn new(key: &str, message: impl Into<String>) -> Self {
+        SceneError {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// `key` given where it has no effect: `reason` says why.
+    fn not_applicable(key: &str, reason: &str) -> Self {
+        SceneError::new(
+            key,
+            format!("{key} does not apply: {reason} (remove it, or `--set ~{key}` on the command line)"),
+        )
+    }
+}
+
+/// The largest structured mesh a scene may ask for, in squares or cubes (2D n = 1024 on
+/// `paper` is 2.1e6; the sparse factor of 5e7 cells would not fit in memory): beyond it, an
+/// error rather than an allocation failure.
+const MAX_CELLS: f64 = 5e7;
+
+fn finite(key: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(SceneError::new(key, format!("{key} = {v} is not a finite number")))
+    }
+}
+
+fn all_finite(key: &str, values: &[f64]) -> Result<(), SceneError> {
+    values.iter().try_for_each(|&v| finite(key, v))
+}
+
+fn refuse_if(given: bool, key: &str, reason: &str) -> Result<(), SceneError> {
+    if given {
+        Err(SceneError::not_applicable(key, reason))
+    } else {
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// Checks the whole scene.
+    ///
+    /// # Errors
+    /// The first [`SceneError`] found, naming its key.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        validate_mesh(&self.mesh)?;
+        if self.material.is_empty() {
+            return Err(SceneError::new("material", "the scene has no [[material]]"));
+        }
+        for m in &self.material {
+            validate_material(m).map_err(|e| match e.message.starts_with("material `") {
+                true => e,
+                false => SceneError::new(&e.key, format!("material `{}`: {}", m.region, e.message)),
+            })?;
+        }
+        for d in &self.dirichlet {
+            let values =
+                d.u.iter()
+                    .flatten()
+                    .chain(&d.ux)
+                    .chain(&d.uy)
+                    .chain(&d.uz)
+                    .chain(&d.phi);
+            values.clone().try_for_each(|&v| finite("dirichlet", v))?;
+            if values.count() == 0 {
+                return Err(SceneError::new(
+                    "dirichlet",
+                    format!(
+                        "the dirichlet entry on `{}` prescribes nothing (give u, ux, uy, uz or phi)",
+                        d.group
+                    ),
+                ));
+            }
+        }
+        if let Some(l) = &self.load {
+            finite("load.p", l.p)?;
+            all_finite("load.direction", &l.direction)?;
+        }
+        if let Some(e) = &self.electrode {
+            finite("electrode.v", e.v)?;
+            if let Some(r) = &e.x_range {
+                all_finite("electrode.x_range", r)?;
+                if r.len() != 2 || !(r[0] <= r[1]) {
+                    return Err(SceneError::new(
+                        "electrode.x_range",
+                        "electrode.x_range needs two numbers, the first not above the second",
+                    ));
+                }
+            }
+        }
+        if let Some(c) = &self.contact {
+            validate_contact(c)?;
+        }
+        validate_solver(&self.solver)?;
+        if let Some(x) = &self.exact {
+            validate_exact(x, self)?;
+        }
+        if let Some(dim) = self.mesh.dim() {
+            self.check_dimension(dim)?;
+        }
+        Ok(())
+    }
+
+    /// Checks the lengths that depend on the dimension `dim` of the mesh: Dirichlet data, the
+    /// load's direction, the contact normal and the gap's centre, the regions' boxes and the
+    /// affine solution's data.
+    ///
+    /// # Errors
+    /// A [`SceneError`] naming the key and the length it needs.
+    pub fn check_dimension(&self, dim: usize) -> Result<(), SceneError> {
+        let len = |key: &str, v: &[f64], n: usize| {
+            if v.len() == n {
+                Ok(())
+            } else {
+                Err(SceneError::new(
+                    key,
+                    format!("{key} needs {n} components, not {}", v.len()),
+                ))
+            }
+        };
+        for d in &self.dirichlet {
+            if let Some(u) = &d.u {
+                len("dirichlet.u", u, dim).map_err(|e| on_group(e, &d.group))?;
+            }
+            for (k, (v, name)) in [(d.ux, "ux"), (d.uy, "uy"), (d.uz, "uz")].into_iter().enumerate() {
+                if v.is_some() && (d.u.is_some() || k >= dim) {
+                    return Err(SceneError::new(
+                        &format!("dirichlet.{name}"),
+                        format!(
+                            "dirichlet on `{}`: {name} is given together with u, or beyond the {dim}D mesh",
+                            d.group
+                        ),
+                    ));
+                }
+            }
+        }
+        if let Some(l) = &self.load {
+            len("load.direction", &l.direction, dim)?;
+        }
+        if let Some(c) = &self.contact {
+            len("contact.normal", &c.normal, dim)?;
+            if let Some(g) = &c.gap_center {
+                len("contact.gap_center", g, dim)?;
+            }
+        }
+        for r in &self.mesh.regions {
+            if r.lo.len() != dim || r.hi.len() != dim {
+                return Err(SceneError::new(
+                    "mesh.region",
+                    format!("mesh.region `{}`: lo and hi need {dim} coordinates", r.name),
+                ));
+            }
+        }
+        match &self.exact {
+            Some(x) => x.check_lengths(dim),
+            None => Ok(()),
+        }
+    }
+}
+
+fn on_group(e: SceneError, group: &str) -> SceneError {
+    SceneError::new(&e.key, format!("dirichlet on `{group}`: {}", e.message))
+}
+
+fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
+    for (key, v) in [
+        ("mesh.n", m.n),
+        ("mesh.nx", m.nx),
+        ("mesh.ny", m.ny),
+        ("mesh.nz", m.nz),
+        ("mesh.smoke_n", m.smoke_n),
+    ] {
+        if v == Some(0) {
+            return Err(SceneError::new(key, format!("{key} must be at least 1")));
+        }
+    }
+    let Some(d) = m.dim() else {
+        // a Gmsh file fixes the mesh: the generator's keys would be silently ignored
+        let why = "a Gmsh file fixes the mesh (mesh.kind = \"gmsh\")";
+        for (key, given) in [
+            ("mesh.lo", !m.lo.is_empty()),
+            ("mesh.hi", !m.hi.is_empty()),
+            ("mesh.n", m.n.is_some()),
+            ("mesh.nx", m.nx.is_some()),
+            ("mesh.ny", m.ny.is_some()),
+            ("mesh.nz", m.nz.is_some()),
+            ("mesh.h", m.h.is_some()),
+            ("mesh.region", !m.regions.is_empty()),
+        ] {
+            refuse_if(given, key, why)?;
+        }
+        if m.file.is_none() {
+            return Err(SceneError::new("mesh.file", "mesh.kind = \"gmsh\" needs mesh.file"));
+        }
+        return Ok(());
+    };
+    refuse_if(
+        m.file.is_some(),
+        "mesh.file",
+        "the mesh is generated (mesh.kind is not \"gmsh\")",
+    )?;
+    refuse_if(
+        m.kind == MeshKind::Rectangle && m.nz.is_some(),
+        "mesh.nz",
+        "a rectangle has no z axis",
+    )?;
+    if m.lo.len() != d || m.hi.len() != d {
+        return Err(SceneError::new(
+            "mesh.lo",
+            format!("mesh.lo and mesh.hi need {d} coordinates for a {}", m.kind),
+        ));
+    }
+    for k in 0..d {
+        finite("mesh.lo", m.lo[k])?;
+        finite("mesh.hi", m.hi[k])?;
+        if !(m.hi[k] > m.lo[k]) {
+            return Err(SceneError::new(
+                "mesh.hi",
+                format!("mesh.hi[{k}] = {} must exceed mesh.lo[{k}] = {}", m.hi[k], m.lo[k]),
+            ));
+        }
+    }
+    if let Some(h) = m.h {
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(SceneError::new(
+                "mesh.h",
+                format!("mesh.h = {h} must be a positive length"),
+            ));
+        }
+    }
+    for r in &m.regions {
+        let key = format!("a corner of mesh.region `{}`", r.name);
+        all_finite(&key, &r.lo)?;
+        all_finite(&key, &r.hi)?;
+        if r.lo.iter().zip(&r.hi).any(|(a, b)| !(b >= a)) {
+            return Err(SceneError::new(
+                "mesh.region",
+                format!("mesh.region `{}`: hi must not be below lo", r.name),
+            ));
+        }
+    }
+    let cells: f64 = m.cells_per_axis().iter().map(|&c| c as f64).product();
+    if cells > MAX_CELLS {
+        return Err(SceneError::new(
+            "mesh.n",
+            format!(
+                "the mesh would have {cells:.3e} cells (squares or cubes); the limit is {MAX_CELLS:.0e}, beyond what one machine factors (use a smaller mesh.n or a larger mesh.h)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
+    let at = |what: &str| format!("material `{}`: {what}", m.region);
+    let bad = |what: &str| SceneError::new("material", at(what));
+    all_finite(
+        &format!("a constant of the material of region `{}`", m.region),
+        &[
+            &m.c[..],
+            &m.e,
+            &m.permittivity,
+            &m.poling,
+            &m.young.into_iter().collect::<Vec<_>>()[..],
+        ]
+        .concat(),
+    )?;
+    match m.model {
+        MaterialModel::Crystal6mm => {
+            let why = "an isotropic constant, and the model is crystal-6mm";
+            refuse_if(m.young.is_some(), "material.young", why)?;
+            refuse_if(m.poisson.is_some(), "material.poisson", why)?;
+            if m.c.len() != 6 || m.e.len() != 3 || m.permittivity.len() != 2 {
+                return Err(bad("crystal-6mm needs c (6 values), e (3) and permittivity (2)"));
+            }
+            if !m.poling.is_empty() && m.poling.len() != 3 {
+                return Err(bad(&format!("poling needs 3 components, not {}", m.poling.len())));
+            }
+            if let Some(s) = m.coupling_scale {
+                finite("material.coupling_scale", s)?;
+            }
+        }
+        MaterialModel::Isotropic => {
+            let why = "the model is isotropic";
+            refuse_if(!m.c.is_empty(), "material.c", why)?;
+            refuse_if(!m.e.is_empty(), "material.e", why)?;
+            refuse_if(!m.poling.is_empty(), "material.poling", why)?;
+            refuse_if(
+                m.coupling_scale.is_some(),
+                "material.coupling_scale",
+                "an isotropic material has no piezoelectric coupling to scale",
+            )?;
+            let (Some(y), Some(nu)) = (m.young, m.poisson) else {
+                return Err(bad("isotropic needs young and poisson"));
+            };
+            finite("material.poisson", nu)?;
+            if !(y > 0.0 && nu > -1.0 && nu < 0.5) {
+                return Err(bad(&format!(
+                    "young = {y} must be positive and poisson = {nu} in (-1, 0.5): C is not positive definite"
+                )));
+            }
+            if m.permittivity.len() > 1 {
+                return Err(bad("isotropic takes one permittivity value"));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
+    for (key, v) in [
+        ("contact.friction", c.friction()),
+        ("contact.slip_bound", c.slip_bound()),
+        ("contact.gap", c.gap),
+        ("contact.gap_curvature", c.gap_curvature),
+    ] {
+        finite(key, v)?;
+        if v < 0.0 && key != "contact.gap" && key != "contact.gap_curvature" {
+            return Err(SceneError::new(key, format!("{key} = {v} must be non-negative")));
+        }
+    }
+    all_finite("contact.gap_center", c.gap_center.as_deref().unwrap_or_default())?;
+    all_finite("contact.normal", &c.normal)?;
+    match c.law {
+        ContactLaw::Signorini => {
+            let why = "friction, and contact.law = \"signorini\" is frictionless";
+            refuse_if(c.friction.is_some(), "contact.friction", why)?;
+            refuse_if(c.slip_bound.is_some(), "contact.slip_bound", why)?;
+        }
+        ContactLaw::Tresca => refuse_if(
+            c.friction.is_some(),
+            "contact.friction",
+            "Coulomb's coefficient, and contact.law = \"tresca\" takes contact.slip_bound",
+        )?,
+        ContactLaw::Coulomb => refuse_if(
+            c.slip_bound.is_some(),
+            "contact.slip_bound",
+            "Tresca's bound, and contact.law = \"coulomb\" takes contact.friction",
+        )?,
+        // contact switched off: the section is kept as it is, unused (the plan says so)
+        ContactLaw::None => {}
+    }
+    refuse_if(
+        c.gap_center.is_some() && c.gap_curvature == 0.0,
+        "contact.gap_center",
+        "the centre of a curved gap, and contact.gap_curvature is 0",
+    )
+}
+
+fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
+    if s.rule == Rule::Paper && !s.strategy.is_uzawa() {
+        return Err(SceneError::new(
+            "solver.rule",
+            format!(
+                "solver.rule `paper` is the paper's rule for Uzawa; strategy `{}` stops on the complementarity residual (use solver.rule=tight, or a uzawa-* strategy)",
+                s.strategy
+            ),
+        ));
+    }
+    refuse_if(
+        s.pcg_tol.is_some() && !s.strategy.runs_pcg(),
+        "solver.pcg_tol",
+        &format!("strategy `{}` runs no PCG (only uzawa-schur-pcg does)", s.strategy),
+    )?;
+    finite("solver.tol", s.tol)?;
+    if !(s.tol > 0.0) {
+        return Err(SceneError::new(
+            "solver.tol",
+            format!("solver.tol = {} must be positive", s.tol),
+        ));
+    }
+    Ok(())
+}
+
+fn validate_exact(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
+    let law = s.contact_law();
+    let kind = x.kind;
+    if kind.is_field() {
+        if law != ContactLaw::None {
+            return Err(SceneError::new(
+                "exact.kind",
+                format!("exact.kind `{kind}` is a solution without contact; set contact.law = \"none\""),
+            ));
+        }
+        if s.material.len() != 1 {
+            return Err(SceneError::new(
+                "exact.kind",
+                format!("exact.kind `{kind}` needs exactly one [[material]]"),
+            ));
+        }
+        if s.mesh.dim().is_none() && x.groups.is_empty() {
+            return Err(SceneError::new(
+                "exact.groups",
+                format!(
+                    "exact.kind `{kind}` on a Gmsh mesh needs exact.groups (the boundary groups to prescribe it on)"
+                ),
+            ));
+        }
+        all_finite(
+            "exact",
+            &[
+                &x.u0[..],
+                &x.grad_u,
+                &x.grad_phi,
+                &x.phi0.into_iter().collect::<Vec<_>>(),
+            ]
+            .concat(),
+        )?;
+        if kind == ExactKind::Manufactured {
+            let why = "data of an affine solution, and exact.kind is `manufactured`";
+            refuse_if(!x.u0.is_empty(), "exact.u0", why)?;
+            refuse_if(!x.grad_u.is_empty(), "exact.grad_u", why)?;
+            refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
+            refuse_if(!x.grad_phi.is_empty(), "exact.grad_phi", why)?;
+        }
+        return Ok(());
+    }
+    let why = "a field solution's data, and exact.kind is a contact solution";
+    refuse_if(!x.groups.is_empty(), "exact.groups", why)?;
+    refuse_if(
+        !(x.u0.is_empty() && x.grad_u.is_empty() && x.grad_phi.is_empty()),
+        "exact.u0",
+        why,
+    )?;
+    refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
+    if s.mesh.kind != MeshKind::Rectangle {
+        return Err(SceneError::new(
+            "exact.kind",
+            format!("exact.kind `{kind}` is a plane-strain solution: it needs mesh.kind = \"rectangle\""),
+        ));
+    }
+    let Some(c) = s.contact.as_ref().filter(|c| c.gap_curvature > 0.0) else {
+        return Err(SceneError::new(
+            "exact.kind",
+            format!("exact.kind `{kind}` needs contact with a curved gap (contact.gap_curvature > 0)"),
+        ));
+    };
+    if kind == ExactKind::Hertz && law != ContactLaw::Signorini {
+        return Err(SceneError::new(
+            "exact.kind",
+            "exact.kind `hertz` is frictionless: set contact.law = \"signorini\"",
+        ));
+    }
+    if kind == ExactKind::CattaneoMindlin && !(law == ContactLaw::Coulomb && c.friction() > 0.0) {
+        return Err(SceneError::new(
+            "exact.kind",
+            "exact.kind `cattaneo-mindlin` needs contact.law = \"coulomb\" with contact.friction > 0",
+        ));
+    }
+    if s.material.len() != 1 || s.material[0].model != MaterialModel::Isotropic {
+        return Err(SceneError::new(
+            "exact.kind",
+            format!("exact.kind `{kind}` needs one isotropic material (young, poisson)"),
+        ));
+    }
+    Ok(())
+}

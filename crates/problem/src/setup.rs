@@ -1,0 +1,196 @@
+//! From a scene to the finite-element problem: the mesh (generated here, or read by the
+//! application and handed over), the materials, the plan, the Dirichlet conditions and the
+//! loads.
+
+use crate::exact::FieldSolution;
+use crate::plan::Plan;
+use crate::scene::{MaterialModel, MaterialSpec, MeshKind, Scene, SceneError};
+use crate::ProblemError;
+use fe_assembly::{Constraint, Crystal, Field, Load, Material};
+use std::sync::Arc;
+
+/// Everything a scene sets up before assembly.
+pub struct Setup {
+    /// The mesh (with an `electrode` group where the scene has one).
+    pub mesh: mesh::Mesh,
+    /// Materials by region (without their electric part when the plan has no electric
+    /// unknowns).
+    pub materials: Vec<(String, Material)>,
+    /// What the run computes.
+    pub plan: Plan,
+    /// Dirichlet conditions (electric ones only when the plan has electric unknowns).
+    pub constraints: Vec<Constraint>,
+    /// Loads.
+    pub loads: Vec<Load>,
+    /// The exact field solution of a `manufactured` or `affine` scene (its Dirichlet data and
+    /// loads are in `constraints` and `loads`).
+    pub exact: Option<FieldSolution>,
+}
+
+/// Makes the [`Setup`] of a validated scene. `given` is the mesh of a `gmsh` scene, read by
+/// the caller (this crate does no IO); a generated mesh is made here.
+///
+/// # Errors
+/// A [`ProblemError`] naming the scene key, mesh group or material at fault.
+pub fn setup(scene: &Scene, given: Option<mesh::Mesh>) -> Result<Setup, ProblemError> {
+    let mesh = mesh(scene, given)?;
+    let dim = mesh.dim;
+    scene.check_dimension(dim)?;
+    let materials = materials(scene, dim)?;
+    let plan = Plan::new(scene, dim, &materials);
+    let materials = if plan.electric {
+        materials
+    } else {
+        materials.into_iter().map(|(r, m)| (r, m.without_electric())).collect()
+    };
+    let mut constraints = constraints(scene, &plan);
+    let mut loads = loads(scene, dim);
+    let exact = FieldSolution::of(scene, dim);
+    if let Some(ex) = &exact {
+        let groups: Vec<&str> = ex.groups.iter().map(String::as_str).collect();
+        constraints.extend(
+            ex.exact
+                .constraints(&groups)
+                .into_iter()
+                .filter(|c| plan.electric || !matches!(c.field, Field::Potential)),
+        );
+        loads.extend(ex.exact.loads(&materials[0].1));
+    }
+    Ok(Setup {
+        mesh,
+        materials,
+        plan,
+        constraints,
+        loads,
+        exact,
+    })
+}
+
+/// The mesh of the scene, checked, with its regions by box and an `electrode` group where the
+/// scene has one.
+fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<mesh::Mesh, ProblemError> {
+    let m = &scene.mesh;
+    let n = m.cells_per_axis();
+    let mut mesh = match (m.kind, given) {
+        (MeshKind::Rectangle, _) => mesh::rectangle_tri([m.lo[0], m.lo[1]], [m.hi[0], m.hi[1]], n[0], n[1]),
+        (MeshKind::Box, _) => mesh::box_tet(
+            [m.lo[0], m.lo[1], m.lo[2]],
+            [m.hi[0], m.hi[1], m.hi[2]],
+            n[0],
+            n[1],
+            n[2],
+        ),
+        (MeshKind::Gmsh, Some(mesh)) => mesh,
+        (MeshKind::Gmsh, None) => {
+            return Err(ProblemError::Scene(SceneError::new(
+                "mesh.file",
+                "mesh.kind = \"gmsh\": the caller reads the file and hands the mesh over",
+            )))
+        }
+    };
+    mesh.check()?;
+    for r in &m.regions {
+        let cells: Vec<usize> = (0..mesh.n_cells())
+            .filter(|&c| {
+                let cell = mesh.cell(c);
+                (0..r.lo.len()).all(|k| {
+                    let x = cell.iter().map(|&v| mesh.points[v][k]).sum::<f64>() / cell.len() as f64;
+                    x >= r.lo[k] && x <= r.hi[k]
+                })
+            })
+            .collect();
+        if cells.is_empty() {
+            return Err(SceneError::new("mesh.region", format!("mesh.region `{}` holds no cell", r.name)).into());
+        }
+        mesh.regions.insert(r.name.clone(), cells);
+    }
+    if let Some(e) = &scene.electrode {
+        let range = e
+            .x_range
+            .clone()
+            .unwrap_or_else(|| vec![f64::NEG_INFINITY, f64::INFINITY]);
+        let tol = 1e-12 * (1.0 + range[0].abs().max(range[1].abs()));
+        let g = mesh.select_facets(&e.group, |x| x[0] >= range[0] - tol && x[0] <= range[1] + tol)?;
+        if g.n_facets() == 0 {
+            return Err(SceneError::new(
+                "electrode.x_range",
+                format!(
+                    "the electrode covers no facet of `{}` in x in [{}, {}]",
+                    e.group, range[0], range[1]
+                ),
+            )
+            .into());
+        }
+        mesh.boundaries.insert("electrode".into(), g);
+    }
+    Ok(mesh)
+}
+
+/// The material of a validated spec in dimension `dim`, in the global frame.
+fn material(spec: &MaterialSpec, dim: usize) -> Result<Material, ProblemError> {
+    let crystal = match spec.model {
+        MaterialModel::Crystal6mm => {
+            let (c, e, p) = (&spec.c, &spec.e, &spec.permittivity);
+            Crystal::hexagonal_6mm([c[0], c[1], c[2], c[3], c[4], c[5]], [e[0], e[1], e[2]], [p[0], p[1]])
+        }
+        MaterialModel::Isotropic => Crystal::isotropic(
+            spec.young.unwrap_or_default(),
+            spec.poisson.unwrap_or_default(),
+            spec.permittivity.first().copied().unwrap_or(0.0),
+        ),
+    };
+    let poling = match spec.poling[..] {
+        [a, b, c] => [a, b, c],
+        _ => [0.0, 0.0, 1.0],
+    };
+    let scale = spec.coupling_scale.unwrap_or(1.0);
+    Ok(Material::from_crystal(&spec.region, &crystal, poling, dim)?.with_coupling_scale(scale))
+}
+
+/// The materials of the scene by region, in the global frame.
+fn materials(scene: &Scene, dim: usize) -> Result<Vec<(String, Material)>, ProblemError> {
+    scene
+        .material
+        .iter()
+        .map(|s| Ok((s.region.clone(), material(s, dim)?)))
+        .collect()
+}
+
+/// Dirichlet conditions of a validated scene (electric ones only when the plan has electric
+/// unknowns).
+fn constraints(scene: &Scene, plan: &Plan) -> Vec<Constraint> {
+    let mut out = vec![];
+    for d in &scene.dirichlet {
+        for (k, &v) in d.u.iter().flatten().enumerate() {
+            out.push(Constraint::constant(&d.group, Field::Displacement(k), v));
+        }
+        // single components (rollers)
+        for (k, v) in [d.ux, d.uy, d.uz].into_iter().enumerate() {
+            if let Some(v) = v {
+                out.push(Constraint::constant(&d.group, Field::Displacement(k), v));
+            }
+        }
+        if let (Some(phi), true) = (d.phi, plan.electric) {
+            out.push(Constraint::constant(&d.group, Field::Potential, phi));
+        }
+    }
+    if let (Some(e), true) = (&scene.electrode, plan.electric) {
+        out.push(Constraint::constant("electrode", Field::Potential, e.v));
+    }
+    out
+}
+
+/// The loads of a validated scene.
+fn loads(scene: &Scene, dim: usize) -> Vec<Load> {
+    let Some(l) = &scene.load else {
+        return vec![];
+    };
+    let mut t = [0.0; 3];
+    for k in 0..dim {
+        t[k] = l.p * l.direction[k];
+    }
+    vec![Load::Traction {
+        group: l.group.clone(),
+        value: Arc::new(move |_| t),
+    }]
+}
