@@ -217,7 +217,7 @@ fn gmsh_mesh_with_two_materials_by_region() {
 #[test]
 fn stability_cases_hold_at_smoke_size() {
     use driver::studies::stability;
-    for case in stability::cases().iter().filter(|c| !c.fine) {
+    for case in stability::CASES.iter().filter(|c| !c.fine) {
         let sets = case.smoke_sets();
         let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
         let r = run(case.scene, &sets);

@@ -68,6 +68,68 @@ struct Momentum {
     x_prev: Option<PointValues>,
 }
 
+impl Momentum {
+    /// FISTA's extrapolation: `lambda` holds `x_{k+1} = P(y_k + r (u(y_k) - g))`; the momentum
+    /// restarts when the step goes against it (O'Donoghue and Candès' gradient test, in the
+    /// `W` inner product), else `lambda` becomes `x_{k+1} + β (x_{k+1} - x_k)`.
+    fn extrapolate(&mut self, y_old: &PointValues, lambda: &mut PointValues, w: &[f64]) {
+        let x_prev = self.x_prev.get_or_insert_with(|| y_old.clone());
+        let test = y_old.minus(lambda).weighted_dot(&lambda.minus(x_prev), w);
+        let t_next = 0.5 * (1.0 + (1.0 + 4.0 * self.t * self.t).sqrt());
+        let beta = if test > 0.0 {
+            self.t = 1.0;
+            0.0
+        } else {
+            let b = (self.t - 1.0) / t_next;
+            self.t = t_next;
+            b
+        };
+        let x_new = lambda.clone();
+        let parts = [
+            (&mut lambda.normal, &x_new.normal, &x_prev.normal),
+            (&mut lambda.tangential, &x_new.tangential, &x_prev.tangential),
+        ];
+        for (l, xn, xp) in parts {
+            for (l, (xn, xp)) in l.iter_mut().zip(xn.iter().zip(xp)) {
+                *l = xn + beta * (xn - xp);
+            }
+        }
+        *x_prev = x_new;
+    }
+}
+
+/// Uzawa's projected update in place, `λ_n ← max(0, λ_n + r (u_n - g))`,
+/// `λ_t ← P_S(λ_t + r u_t)`; returns `(‖Δλ‖², ‖λ_new‖²)` for the paper's rule.
+fn projected_step(
+    points: &ContactPoints,
+    radius: &[f64],
+    r: f64,
+    lambda: &mut PointValues,
+    u: &PointValues,
+) -> (f64, f64) {
+    let nt = lambda.n_tangential();
+    let (mut diff2, mut norm2) = (0.0, 0.0);
+    let mut buf = [0.0; 2];
+    for i in 0..points.len() {
+        let new = project_nonnegative(lambda.normal[i] + r * (u.normal[i] - points.gap[i]));
+        diff2 += (new - lambda.normal[i]).powi(2);
+        norm2 += new * new;
+        lambda.normal[i] = new;
+        if nt > 0 {
+            for q in 0..nt {
+                buf[q] = lambda.tangential[i * nt + q] + r * u.tangential[i * nt + q];
+            }
+            project_disc(&mut buf[..nt], radius[i]);
+            for q in 0..nt {
+                diff2 += (buf[q] - lambda.tangential[i * nt + q]).powi(2);
+                norm2 += buf[q] * buf[q];
+                lambda.tangential[i * nt + q] = buf[q];
+            }
+        }
+    }
+    (diff2, norm2)
+}
+
 /// Uzawa iterations without a 1 % gain on the best residual before the step is halved.
 const STALL_WINDOW: usize = 500;
 
@@ -280,13 +342,10 @@ fn uzawa(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<bool, ContactError> {
     let (points, params, canon, reference) = (d.points, d.params, d.canon, d.reference);
-    let n = points.len();
-    let nt = lambda.n_tangential();
     let mut best = f64::INFINITY;
     let mut window_best = f64::INFINITY;
     let mut window_start = 0;
     let mut last = f64::NAN;
-    let mut buf = [0.0; 2];
     let mut momentum = Momentum { t: 1.0, x_prev: None };
     for k in 1..=params.max_iters {
         d.c.call(lambda, u)?;
@@ -322,62 +381,9 @@ fn uzawa(
         best = best.min(r);
         d.info.uzawa_iters += 1;
         let y_old = if params.accelerate { Some(lambda.clone()) } else { None };
-        // the projected update
-        let mut diff2 = 0.0;
-        let mut norm2 = 0.0;
-        for i in 0..n {
-            let new = project_nonnegative(lambda.normal[i] + d.step * (u.normal[i] - points.gap[i]));
-            diff2 += (new - lambda.normal[i]).powi(2);
-            norm2 += new * new;
-            lambda.normal[i] = new;
-            if nt > 0 {
-                for q in 0..nt {
-                    buf[q] = lambda.tangential[i * nt + q] + d.step * u.tangential[i * nt + q];
-                }
-                project_disc(&mut buf[..nt], radius[i]);
-                for q in 0..nt {
-                    diff2 += (buf[q] - lambda.tangential[i * nt + q]).powi(2);
-                    norm2 += buf[q] * buf[q];
-                    lambda.tangential[i * nt + q] = buf[q];
-                }
-            }
-        }
+        let (diff2, norm2) = projected_step(points, radius, d.step, lambda, u);
         if let Some(y_old) = y_old {
-            // FISTA: λ holds x_{k+1} = P(y_k + r (u(y_k) - g)); restart the momentum when the
-            // step goes against it (O'Donoghue and Candès' gradient test), then extrapolate
-            let x_prev = momentum.x_prev.get_or_insert_with(|| y_old.clone());
-            let w = &points.weight;
-            let mut test = 0.0;
-            for i in 0..n {
-                test += w[i] * (y_old.normal[i] - lambda.normal[i]) * (lambda.normal[i] - x_prev.normal[i]);
-                for q in 0..nt {
-                    let j = i * nt + q;
-                    test += w[i]
-                        * (y_old.tangential[j] - lambda.tangential[j])
-                        * (lambda.tangential[j] - x_prev.tangential[j]);
-                }
-            }
-            let t_next = 0.5 * (1.0 + (1.0 + 4.0 * momentum.t * momentum.t).sqrt());
-            let beta = if test > 0.0 {
-                momentum.t = 1.0;
-                0.0
-            } else {
-                let b = (momentum.t - 1.0) / t_next;
-                momentum.t = t_next;
-                b
-            };
-            let x_new = lambda.clone();
-            for (l, (xn, xp)) in lambda.normal.iter_mut().zip(x_new.normal.iter().zip(&x_prev.normal)) {
-                *l = xn + beta * (xn - xp);
-            }
-            for (l, (xn, xp)) in lambda
-                .tangential
-                .iter_mut()
-                .zip(x_new.tangential.iter().zip(&x_prev.tangential))
-            {
-                *l = xn + beta * (xn - xp);
-            }
-            *x_prev = x_new;
+            momentum.extrapolate(&y_old, lambda, &points.weight);
         }
         if params.report_every > 0 && k % params.report_every == 0 {
             progress(&Progress {

@@ -189,36 +189,8 @@ fn say(line: &str) {
 
 fn dispatch(command: Command) -> Result<(), DriverError> {
     match command {
-        Command::Run { scene, set, unset, out } => {
-            let name = scene.unwrap_or_else(|| "paper".into());
-            let (scene, source) = scene_file::load(&name, &overrides(set, unset))?;
-            let dir = out.unwrap_or_else(|| output::default_dir(&scene.name));
-            let solution = driver::run::run(
-                &scene,
-                &source,
-                &dir,
-                &mut Terminal {
-                    bar: None,
-                    first_residual: None,
-                },
-            )?;
-            let names: Vec<&str> = solution.report.plan.outputs.iter().map(|o| o.name()).collect();
-            say(&format!("wrote {} in {}", names.join(", "), dir.display()));
-            Ok(())
-        }
-        Command::Scenes => {
-            let mut out = std::io::stdout().lock();
-            for (name, text) in scene_file::SHIPPED {
-                let desc = scene_file::parse(text, name, &[])
-                    .map(|s| s.description)
-                    .unwrap_or_default();
-                // a closed pipe (`| head`) ends the listing quietly
-                if writeln!(out, "{name:18} {desc}").is_err() {
-                    break;
-                }
-            }
-            Ok(())
-        }
+        Command::Run { scene, set, unset, out } => run(scene, overrides(set, unset), out),
+        Command::Scenes => scenes(),
         Command::Strategies => {
             for s in Strategy::ALL {
                 println!("{:16} {}", s.name(), s.description());
@@ -234,16 +206,15 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             set,
             out,
         } => {
-            let dir =
-                out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", scene.trim_end_matches(".toml"))));
+            let stem = scene.trim_end_matches(".toml");
+            let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}-sweep")));
             let spec = sweep::SweepSpec { param, from, to, steps };
             sweep::sweep(&scene, &set, &spec, Some(&dir), &mut say).map(|_| ())
         }
         Command::Table1 { loose, tight, out } => {
-            let dir = out.unwrap_or_else(|| PathBuf::from("out").join("table1"));
             let md = table1::markdown(&table1::table1(&loose, &tight, &mut say)?);
             println!("{md}");
-            let mut o = output::Outputs::new(&dir);
+            let mut o = output::Outputs::new(&out.unwrap_or_else(|| PathBuf::from("out").join("table1")));
             o.add("table1.md", md.into_bytes());
             o.commit()
         }
@@ -255,43 +226,74 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             reference,
             set,
             out,
-        } => study_command(
-            &scene.unwrap_or_else(|| "paper".into()),
-            sizes,
-            strategies,
-            tols,
-            reference,
-            &set,
-            out,
-        ),
-        Command::Verification { full, out } => {
-            let failures = verification::report(full, &out, &mut say)?;
-            if !failures.is_empty() {
-                return Err(DriverError::Unexpected {
-                    what: "verification checks that fail",
-                    items: failures,
-                });
-            }
-            say(&format!(
-                "verification: every check holds; wrote {}",
-                out.join("verification.md").display()
-            ));
-            Ok(())
+        } => {
+            let scene = scene.unwrap_or_else(|| "paper".into());
+            study(&scene, sizes, strategies, tols, reference, &set, out)
         }
-        Command::Stability { quick, out, limit } => {
-            let exe = std::env::current_exe().map_err(|e| DriverError::Output {
-                what: "cannot find this program's path to run the cases".into(),
-                source: e,
-            })?;
-            let rows = stability::write(&exe, quick, std::time::Duration::from_secs(limit), &out, &mut say)?;
-            say(&format!(
-                "{} runs as expected; wrote {}",
-                rows.len(),
-                out.join("stability.md").display()
-            ));
-            Ok(())
+        Command::Verification { full, out } => verification(full, &out),
+        Command::Stability { quick, out, limit } => stability(quick, &out, limit),
+    }
+}
+
+/// `piezocontact run`: the scene solved, its plan's outputs written.
+fn run(scene: Option<String>, overrides: Vec<String>, out: Option<PathBuf>) -> Result<(), DriverError> {
+    let name = scene.unwrap_or_else(|| "paper".into());
+    let (scene, source) = scene_file::load(&name, &overrides)?;
+    let dir = out.unwrap_or_else(|| output::default_dir(&scene.name));
+    let mut terminal = Terminal {
+        bar: None,
+        first_residual: None,
+    };
+    let solution = driver::run::run(&scene, &source, &dir, &mut terminal)?;
+    let names: Vec<&str> = solution.report.plan.outputs.iter().map(|o| o.name()).collect();
+    say(&format!("wrote {} in {}", names.join(", "), dir.display()));
+    Ok(())
+}
+
+/// `piezocontact scenes`: one line per shipped scene.
+fn scenes() -> Result<(), DriverError> {
+    let mut out = std::io::stdout().lock();
+    for (name, text) in scene_file::SHIPPED {
+        let desc = scene_file::parse(text, name, &[])
+            .map(|s| s.description)
+            .unwrap_or_default();
+        // a closed pipe (`| head`) ends the listing quietly
+        if writeln!(out, "{name:18} {desc}").is_err() {
+            break;
         }
     }
+    Ok(())
+}
+
+/// `piezocontact verification`: the report, an error listing the checks that fail.
+fn verification(full: bool, out: &std::path::Path) -> Result<(), DriverError> {
+    let failures = verification::report(full, out, &mut say)?;
+    if !failures.is_empty() {
+        return Err(DriverError::Unexpected {
+            what: "verification checks that fail",
+            items: failures,
+        });
+    }
+    say(&format!(
+        "verification: every check holds; wrote {}",
+        out.join("verification.md").display()
+    ));
+    Ok(())
+}
+
+/// `piezocontact stability`: the cases, each in a child process of this program.
+fn stability(quick: bool, out: &std::path::Path, limit: u64) -> Result<(), DriverError> {
+    let exe = std::env::current_exe().map_err(|e| DriverError::Output {
+        what: "cannot find this program's path to run the cases".into(),
+        source: e,
+    })?;
+    let rows = stability::write(&exe, quick, std::time::Duration::from_secs(limit), out, &mut say)?;
+    say(&format!(
+        "{} runs as expected; wrote {}",
+        rows.len(),
+        out.join("stability.md").display()
+    ));
+    Ok(())
 }
 
 /// The overrides of `--set KEY=VALUE` and `--unset KEY` (as `~KEY`), in that order.
@@ -302,7 +304,7 @@ fn overrides(set: Vec<String>, unset: Vec<String>) -> Vec<String> {
 }
 
 /// `piezocontact study`: defaults from the scene, the study, its files.
-fn study_command(
+fn study(
     scene: &str,
     mut sizes: Vec<usize>,
     mut strategies: Vec<Strategy>,

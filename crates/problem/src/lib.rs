@@ -75,6 +75,11 @@ pub use scene::{
 
 use contact::ContactError;
 
+/// The README's Rust examples, run as doc tests (the library consumer's example among them).
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 /// What can go wrong in a run; each variant names the input or the step at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum ProblemError {

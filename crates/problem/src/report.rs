@@ -146,6 +146,21 @@ pub struct Iterations {
 }
 
 impl Iterations {
+    /// The counts of a contact solve (`None`: a run without contact, one linear solve) with
+    /// `pcg` PCG iterations.
+    pub fn of(info: Option<&contact::ContactInfo>, pcg: usize) -> Self {
+        Iterations {
+            fixed_point: info.map_or(0, |i| i.fixed_point_iters),
+            uzawa: info.map_or(0, |i| i.uzawa_iters),
+            newton: info.map_or(0, |i| i.newton_iters),
+            line_search_cuts: info.map_or(0, |i| i.line_search_cuts),
+            newton_fallback: info.is_some_and(|i| i.fallback),
+            pcg,
+            primal_solves: info.map_or(1, |i| i.operator_calls),
+            pcg_in_step_estimate: info.map_or(0, |i| i.estimate_inner_iters),
+        }
+    }
+
     /// One line: the counts of the loops that ran (`4 Newton`, `39 Uzawa, 3 FP, 812 PCG`),
     /// `-` for a direct linear solve.
     pub fn summary(&self) -> String {
@@ -257,6 +272,26 @@ pub struct SolverReport {
     pub condense_route: Option<String>,
     /// The smallest `|pivot| / |diagonal entry|` of the `L D Lᵀ` (direct strategies).
     pub smallest_pivot_ratio: Option<f64>,
+}
+
+impl SolverReport {
+    /// What a contact solve measured (`None`: a run without contact), with the strategy's
+    /// settings left at their defaults for the caller to fill.
+    pub fn of(info: Option<&contact::ContactInfo>) -> Self {
+        SolverReport {
+            strategy: Strategy::NewtonCondensed,
+            rule: String::new(),
+            tol: 0.0,
+            pcg_rel_tol: 0.0,
+            step_r: info.and_then(|i| i.step),
+            augmentation_c: info.and_then(|i| i.augmentation),
+            mu_max: info.map(|i| i.mu_max),
+            step_backoffs: info.map_or(0, |i| i.step_backoffs),
+            fixed_point_relaxations: info.map_or(0, |i| i.relaxations),
+            condense_route: None,
+            smallest_pivot_ratio: None,
+        }
+    }
 }
 
 /// The stopping rule in words, as the report gives it.

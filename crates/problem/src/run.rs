@@ -13,7 +13,10 @@ use crate::report::{
 use crate::scene::{ContactLaw, ContactSolver, Rule, Scene};
 use crate::setup::{setup, Setup};
 use crate::ProblemError;
-use contact::{ContactPoints, ContactSolution, Law, NewtonParams, StopRule, UzawaParams};
+use contact::{
+    ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, Law, NewtonParams, StopRule,
+    UzawaParams,
+};
 use fe_assembly::{Blocks, CellFields, Discretization, Parallelism};
 use linalg::{equilibrium_residual, CondenseRoute, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
 use std::time::Instant;
@@ -244,14 +247,81 @@ fn solve_linear(solver: &mut LinearSolver, a: &Assembled<'_>) -> Result<Solved, 
     })
 }
 
-/// The contact law of the plan on `n` points: frictionless without tangential multipliers,
-/// Tresca with the scene's bound, else Coulomb.
-fn contact_law(plan: &Plan, scene: &Scene, n: usize) -> Law {
-    let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
-    match (plan.contact_law, plan.friction) {
-        (_, false) => Law::Frictionless,
-        (ContactLaw::Tresca, true) => Law::Tresca(vec![slip_bound; n]),
-        _ => Law::Coulomb,
+/// The contact problem as its solvers see it.
+enum Operator<'a> {
+    /// The condensed compliance (Newton, or a first-order method).
+    Condensed(&'a mut DenseContactProblem),
+    /// One full primal solve per call (first-order methods).
+    FullSolves(&'a mut dyn ContactOperator),
+}
+
+/// How the plan's contact problem is solved: the law on its points, the solver, the tolerance.
+struct ContactSolve<'p> {
+    plan: &'p Plan,
+    law: Law,
+    tol: f64,
+}
+
+impl<'p> ContactSolve<'p> {
+    /// The plan's contact law on `n` points: frictionless without tangential multipliers,
+    /// Tresca with the scene's bound, else Coulomb.
+    fn new(plan: &'p Plan, scene: &Scene, n: usize) -> Self {
+        let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
+        let law = match (plan.contact_law, plan.friction) {
+            (_, false) => Law::Frictionless,
+            (ContactLaw::Tresca, true) => Law::Tresca(vec![slip_bound; n]),
+            _ => Law::Coulomb,
+        };
+        // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
+        debug_assert_eq!(
+            plan.fixed_point,
+            law == Law::Coulomb && matches!(plan.linear_strategy.contact_solver(), ContactSolver::FirstOrder { .. })
+        );
+        ContactSolve {
+            plan,
+            law,
+            tol: scene.solver.tol,
+        }
+    }
+
+    /// Runs the strategy's contact solver on `problem`, reporting each outer iteration.
+    fn run(
+        &self,
+        problem: Operator<'_>,
+        points: &ContactPoints,
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        let tol = self.tol;
+        let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+        let solved = match (self.plan.linear_strategy.contact_solver(), problem) {
+            (ContactSolver::Newton, Operator::Condensed(dense)) => {
+                let params = NewtonParams {
+                    tol,
+                    ..Default::default()
+                };
+                contact::solve_newton(dense, points, &self.law, &params, None, &mut progress)
+            }
+            (ContactSolver::FirstOrder { accelerate }, problem) => {
+                let op: &mut dyn ContactOperator = match problem {
+                    Operator::Condensed(dense) => dense,
+                    Operator::FullSolves(op) => op,
+                };
+                let params = UzawaParams {
+                    rule: match self.plan.rule {
+                        Rule::Paper => StopRule::Paper,
+                        Rule::Tight => StopRule::Tight { tol },
+                    },
+                    report_every: 50,
+                    accelerate,
+                    ..Default::default()
+                };
+                contact::solve(op, points, &self.law, &params, None, &mut progress)
+            }
+            (ContactSolver::Newton, Operator::FullSolves(_)) => Err(ContactError::Input(
+                "semismooth Newton needs the condensed compliance".into(),
+            )),
+        };
+        solved.map_err(|e| ProblemError::contact(e, self.plan.linear_strategy))
     }
 }
 
@@ -266,70 +336,34 @@ fn solve_contact(
     reporter: &mut dyn Reporter,
 ) -> Result<Solved, ProblemError> {
     let t = Instant::now();
-    let law = contact_law(plan, scene, boundary.points.len());
-    let contact_solver = plan.linear_strategy.contact_solver();
-    // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
-    debug_assert_eq!(
-        plan.fixed_point,
-        law == Law::Coulomb && matches!(contact_solver, ContactSolver::FirstOrder { .. })
-    );
-    let tol = scene.solver.tol;
-    let uzawa = |accelerate: bool| UzawaParams {
-        rule: match plan.rule {
-            Rule::Paper => StopRule::Paper,
-            Rule::Tight => StopRule::Tight { tol },
-        },
-        report_every: 50,
-        accelerate,
-        ..Default::default()
-    };
-    let nt = plan.n_tangential();
-    let mut condense = None;
-    let failed = |e| ProblemError::contact(e, plan.linear_strategy);
-    let (sol, u, phi) = match solver {
+    let how = ContactSolve::new(plan, scene, boundary.points.len());
+    let (sol, (u, phi), condense) = match solver {
         LinearSolver::Direct(direct) if plan.linear_strategy.is_condensed() => {
             let t_condense = Instant::now();
-            let (mut problem, loads) = boundary.condense(direct, &a.b_u, &a.b_phi, nt)?;
-            let seconds = t_condense.elapsed().as_secs_f64();
-            condense = Some((loads.route, seconds));
+            let (mut dense, loads) = boundary.condense(direct, &a.b_u, &a.b_phi, plan.n_tangential())?;
+            let condense = (loads.route, t_condense.elapsed().as_secs_f64());
             reporter.event(&Event::Condensed {
-                m: problem.m(),
-                route: loads.route,
-                seconds,
+                m: dense.m(),
+                route: condense.0,
+                seconds: condense.1,
             });
-            let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-            let points = &boundary.points;
-            let sol = match contact_solver {
-                ContactSolver::Newton => {
-                    let params = NewtonParams {
-                        tol,
-                        ..Default::default()
-                    };
-                    contact::solve_newton(&mut problem, points, &law, &params, None, &mut progress)
-                }
-                ContactSolver::FirstOrder { accelerate } => {
-                    contact::solve(&mut problem, points, &law, &uzawa(accelerate), None, &mut progress)
-                }
-            }
-            .map_err(failed)?;
-            drop(problem);
-            let (u, phi) = boundary.recover(direct, loads, &sol.lambda, &a.b_u, &a.b_phi)?;
-            (sol, u, phi)
+            let sol = how.run(Operator::Condensed(&mut dense), &boundary.points, reporter)?;
+            drop(dense);
+            let u_phi = boundary.recover(direct, loads, &sol.lambda, &a.b_u, &a.b_phi)?;
+            (sol, u_phi, Some(condense))
         }
         other => {
-            let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
             let mut op = FullSolve {
                 boundary: &boundary,
                 solver: other.coupled(),
                 b_u: &a.b_u,
                 b_phi: &a.b_phi,
-                nt,
+                nt: plan.n_tangential(),
                 u: vec![0.0; a.disc.dofs.n_u],
                 phi: vec![0.0; a.disc.dofs.n_phi],
             };
-            let sol =
-                contact::solve(&mut op, &boundary.points, &law, &uzawa(false), None, &mut progress).map_err(failed)?;
-            (sol, op.u, op.phi)
+            let sol = how.run(Operator::FullSolves(&mut op), &boundary.points, reporter)?;
+            (sol, (op.u, op.phi), None)
         }
     };
     Ok(Solved {
@@ -436,16 +470,7 @@ fn report(
         },
         contact: r.contact.clone(),
         exact: r.exact.clone(),
-        iterations: Iterations {
-            fixed_point: info.map_or(0, |i| i.fixed_point_iters),
-            uzawa: info.map_or(0, |i| i.uzawa_iters),
-            newton: info.map_or(0, |i| i.newton_iters),
-            line_search_cuts: info.map_or(0, |i| i.line_search_cuts),
-            newton_fallback: info.is_some_and(|i| i.fallback),
-            pcg: s.pcg_iters,
-            primal_solves: info.map_or(1, |i| i.operator_calls),
-            pcg_in_step_estimate: info.map_or(0, |i| i.estimate_inner_iters),
-        },
+        iterations: Iterations::of(info, s.pcg_iters),
         residuals: Residuals {
             equilibrium,
             complementarity: info.map_or(0.0, |i| i.complementarity),
@@ -461,13 +486,9 @@ fn report(
             rule: rule_in_words(plan.rule).into(),
             tol: scene.solver.tol,
             pcg_rel_tol: f.pcg_params.rel_tol,
-            step_r: info.and_then(|i| i.step),
-            augmentation_c: info.and_then(|i| i.augmentation),
-            mu_max: info.map(|i| i.mu_max),
-            step_backoffs: info.map_or(0, |i| i.step_backoffs),
-            fixed_point_relaxations: info.map_or(0, |i| i.relaxations),
             condense_route: s.condense.map(|(route, _)| format!("{route:?}")),
             smallest_pivot_ratio: direct.map(|d| d.factor().pivot_ratio()),
+            ..SolverReport::of(info)
         },
     }
 }

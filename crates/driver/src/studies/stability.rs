@@ -30,7 +30,7 @@ pub enum Expect {
 }
 
 /// One extreme case: a shipped scene with overrides.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Case {
     /// Short name.
     pub name: &'static str,
@@ -39,10 +39,10 @@ pub struct Case {
     /// Shipped scene.
     pub scene: &'static str,
     /// Overrides for the default strategy.
-    pub sets: Vec<&'static str>,
+    pub sets: &'static [&'static str],
     /// Overrides for the paper's strategy (a smaller mesh), or `None` where that run is left
     /// out (the fine cases).
-    pub paper_sets: Option<Vec<&'static str>>,
+    pub paper_sets: Option<&'static [&'static str]>,
     /// What the answer must show.
     pub expect: Expect,
     /// A fine case (left out by `--quick`).
@@ -66,183 +66,170 @@ impl Case {
 }
 
 /// The cases of SCENES.md section 5 (bad input has its own corpus, `tests/bad-input`).
-pub fn cases() -> Vec<Case> {
-    let c = |name, why, scene, sets: Vec<&'static str>, paper: Option<Vec<&'static str>>, expect, fine| Case {
-        name,
-        why,
-        scene,
-        sets,
-        paper_sets: paper,
-        expect,
-        fine,
-    };
-    let small = || Some(vec!["mesh.n=32"]);
-    use Expect::*;
-    vec![
-        c(
-            "coupling x10",
-            "e x 10: the Schur complement drifts from A",
-            "paper-slip",
-            vec!["mesh.n=128", "material.coupling_scale=10"],
-            Some(vec!["mesh.n=32", "material.coupling_scale=10"]),
-            Converged,
-            false,
-        ),
-        c(
-            "coupling x100",
-            "e x 100",
-            "paper-slip",
-            vec!["mesh.n=128", "material.coupling_scale=100"],
-            Some(vec!["mesh.n=32", "material.coupling_scale=100"]),
-            Converged,
-            false,
-        ),
-        c(
-            "nu = 0.4999",
-            "near-incompressible isotropic body, E = 100, e = 0",
-            "near-incompressible",
-            vec!["mesh.n=128"],
-            small(),
-            NoneSeparated,
-            false,
-        ),
-        c(
-            "aspect 64",
-            "1024 x 8 cells on the paper block",
-            "paper",
-            vec!["mesh.nx=1024", "mesh.ny=8"],
-            Some(vec!["mesh.nx=512", "mesh.ny=4"]),
-            NoneSeparated,
-            false,
-        ),
-        c(
-            "F = 0",
-            "frictionless through the Coulomb law",
-            "paper",
-            vec!["mesh.n=128", "contact.friction=0"],
-            Some(vec!["mesh.n=32", "contact.friction=0"]),
-            AllSlip,
-            false,
-        ),
-        c(
-            "F = 1e-3",
-            "almost frictionless",
-            "paper",
-            vec!["mesh.n=128", "contact.friction=1e-3"],
-            Some(vec!["mesh.n=32", "contact.friction=1e-3"]),
-            NoneSeparated,
-            false,
-        ),
-        c(
-            "F = 0.1",
-            "stick and slip zones",
-            "paper",
-            vec!["mesh.n=128", "contact.friction=0.1"],
-            Some(vec!["mesh.n=32", "contact.friction=0.1"]),
-            NoneSeparated,
-            false,
-        ),
-        c(
-            "F = 0.6",
-            "the paper's coefficient",
-            "paper",
-            vec!["mesh.n=128"],
-            small(),
-            AllStick,
-            false,
-        ),
-        c(
-            "F = 10",
-            "large friction",
-            "paper",
-            vec!["mesh.n=128", "contact.friction=10"],
-            Some(vec!["mesh.n=32", "contact.friction=10"]),
-            AllStick,
-            false,
-        ),
-        c(
-            "F = 1e6",
-            "huge friction",
-            "paper",
-            vec!["mesh.n=128", "contact.friction=1e6"],
-            Some(vec!["mesh.n=32", "contact.friction=1e6"]),
-            AllStick,
-            false,
-        ),
-        c(
-            "gap -1e-3",
-            "initial penetration",
-            "paper",
-            vec!["mesh.n=128", "contact.gap=-1e-3"],
-            Some(vec!["mesh.n=32", "contact.gap=-1e-3"]),
-            NoneSeparated,
-            false,
-        ),
-        c(
-            "gap 1",
-            "no contact at all",
-            "paper",
-            vec!["mesh.n=128", "contact.gap=1"],
-            Some(vec!["mesh.n=32", "contact.gap=1"]),
-            AllSeparated,
-            false,
-        ),
-        c(
-            "gap 1e-14",
-            "a gap below round-off of the displacement",
-            "paper",
-            vec!["mesh.n=128", "contact.gap=1e-14"],
-            Some(vec!["mesh.n=32", "contact.gap=1e-14"]),
-            NoneSeparated,
-            false,
-        ),
-        c(
-            "layered",
-            "PZT layer on a substrate 1e4 times softer",
-            "layered",
-            vec!["mesh.n=128"],
-            Some(vec!["mesh.n=40"]),
-            Converged,
-            false,
-        ),
-        c(
-            "SI units",
-            "entries over 19 orders of magnitude",
-            "pzt5a-si",
-            vec!["mesh.n=128"],
-            small(),
-            AllStick,
-            false,
-        ),
-        c(
-            "n = 512",
-            "2D, 1.6 million unknowns",
-            "paper",
-            vec!["mesh.n=512"],
-            None,
-            NoneSeparated, // the points next to the clamped corners may slide on fine meshes
-            true,
-        ),
-        c(
-            "n = 1024",
-            "2D, 6.3 million unknowns",
-            "paper",
-            vec!["mesh.n=1024"],
-            None,
-            NoneSeparated,
-            true,
-        ),
-        c(
-            "3D n = 32",
-            "3D, 274 thousand unknowns",
-            "paper-3d",
-            vec!["mesh.n=32"],
-            None,
-            Converged,
-            true,
-        ),
-    ]
-}
+pub const CASES: &[Case] = &[
+    Case {
+        name: "coupling x10",
+        why: "e x 10: the Schur complement drifts from A",
+        scene: "paper-slip",
+        sets: &["mesh.n=128", "material.coupling_scale=10"],
+        paper_sets: Some(&["mesh.n=32", "material.coupling_scale=10"]),
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "coupling x100",
+        why: "e x 100",
+        scene: "paper-slip",
+        sets: &["mesh.n=128", "material.coupling_scale=100"],
+        paper_sets: Some(&["mesh.n=32", "material.coupling_scale=100"]),
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "nu = 0.4999",
+        why: "near-incompressible isotropic body, E = 100, e = 0",
+        scene: "near-incompressible",
+        sets: &["mesh.n=128"],
+        paper_sets: Some(&["mesh.n=32"]),
+        expect: Expect::NoneSeparated,
+        fine: false,
+    },
+    Case {
+        name: "aspect 64",
+        why: "1024 x 8 cells on the paper block",
+        scene: "paper",
+        sets: &["mesh.nx=1024", "mesh.ny=8"],
+        paper_sets: Some(&["mesh.nx=512", "mesh.ny=4"]),
+        expect: Expect::NoneSeparated,
+        fine: false,
+    },
+    Case {
+        name: "F = 0",
+        why: "frictionless through the Coulomb law",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.friction=0"],
+        paper_sets: Some(&["mesh.n=32", "contact.friction=0"]),
+        expect: Expect::AllSlip,
+        fine: false,
+    },
+    Case {
+        name: "F = 1e-3",
+        why: "almost frictionless",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.friction=1e-3"],
+        paper_sets: Some(&["mesh.n=32", "contact.friction=1e-3"]),
+        expect: Expect::NoneSeparated,
+        fine: false,
+    },
+    Case {
+        name: "F = 0.1",
+        why: "stick and slip zones",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.friction=0.1"],
+        paper_sets: Some(&["mesh.n=32", "contact.friction=0.1"]),
+        expect: Expect::NoneSeparated,
+        fine: false,
+    },
+    Case {
+        name: "F = 0.6",
+        why: "the paper's coefficient",
+        scene: "paper",
+        sets: &["mesh.n=128"],
+        paper_sets: Some(&["mesh.n=32"]),
+        expect: Expect::AllStick,
+        fine: false,
+    },
+    Case {
+        name: "F = 10",
+        why: "large friction",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.friction=10"],
+        paper_sets: Some(&["mesh.n=32", "contact.friction=10"]),
+        expect: Expect::AllStick,
+        fine: false,
+    },
+    Case {
+        name: "F = 1e6",
+        why: "huge friction",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.friction=1e6"],
+        paper_sets: Some(&["mesh.n=32", "contact.friction=1e6"]),
+        expect: Expect::AllStick,
+        fine: false,
+    },
+    Case {
+        name: "gap -1e-3",
+        why: "initial penetration",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.gap=-1e-3"],
+        paper_sets: Some(&["mesh.n=32", "contact.gap=-1e-3"]),
+        expect: Expect::NoneSeparated,
+        fine: false,
+    },
+    Case {
+        name: "gap 1",
+        why: "no contact at all",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.gap=1"],
+        paper_sets: Some(&["mesh.n=32", "contact.gap=1"]),
+        expect: Expect::AllSeparated,
+        fine: false,
+    },
+    Case {
+        name: "gap 1e-14",
+        why: "a gap below round-off of the displacement",
+        scene: "paper",
+        sets: &["mesh.n=128", "contact.gap=1e-14"],
+        paper_sets: Some(&["mesh.n=32", "contact.gap=1e-14"]),
+        expect: Expect::NoneSeparated,
+        fine: false,
+    },
+    Case {
+        name: "layered",
+        why: "PZT layer on a substrate 1e4 times softer",
+        scene: "layered",
+        sets: &["mesh.n=128"],
+        paper_sets: Some(&["mesh.n=40"]),
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "SI units",
+        why: "entries over 19 orders of magnitude",
+        scene: "pzt5a-si",
+        sets: &["mesh.n=128"],
+        paper_sets: Some(&["mesh.n=32"]),
+        expect: Expect::AllStick,
+        fine: false,
+    },
+    Case {
+        name: "n = 512",
+        why: "2D, 1.6 million unknowns",
+        scene: "paper",
+        sets: &["mesh.n=512"],
+        paper_sets: None,
+        expect: Expect::NoneSeparated, // the points next to the clamped corners may slide on fine meshes
+        fine: true,
+    },
+    Case {
+        name: "n = 1024",
+        why: "2D, 6.3 million unknowns",
+        scene: "paper",
+        sets: &["mesh.n=1024"],
+        paper_sets: None,
+        expect: Expect::NoneSeparated,
+        fine: true,
+    },
+    Case {
+        name: "3D n = 32",
+        why: "3D, 274 thousand unknowns",
+        scene: "paper-3d",
+        sets: &["mesh.n=32"],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: true,
+    },
+];
 
 /// The outcome of one run of a case.
 #[derive(Clone, Debug, PartialEq)]
@@ -408,10 +395,10 @@ fn run_case(exe: &Path, case: &Case, strategy: Strategy, sets: &[&str], index: u
 /// binary.
 pub fn study(exe: &Path, quick: bool, limit: Duration, progress: &mut dyn FnMut(&str)) -> Vec<Row> {
     let mut rows = vec![];
-    for case in cases().iter().filter(|c| !(quick && c.fine)) {
-        let mut runs = vec![(Strategy::NewtonCondensed, case.sets.clone())];
-        if let Some(p) = &case.paper_sets {
-            runs.push((Strategy::UzawaSchurPcg, p.clone()));
+    for case in CASES.iter().filter(|c| !(quick && c.fine)) {
+        let mut runs = vec![(Strategy::NewtonCondensed, case.sets)];
+        if let Some(p) = case.paper_sets {
+            runs.push((Strategy::UzawaSchurPcg, p));
         }
         for (strategy, sets) in runs {
             // the limit is for the paper's strategy, which may crawl on a hard case; the default
@@ -421,7 +408,7 @@ pub fn study(exe: &Path, quick: bool, limit: Duration, progress: &mut dyn FnMut(
             } else {
                 limit.max(Duration::from_secs(1800))
             };
-            let row = run_case(exe, case, strategy, &sets, rows.len(), limit);
+            let row = run_case(exe, case, strategy, sets, rows.len(), limit);
             progress(&format!(
                 "{:14} {:17} {:>9} dofs  {:>26}  {:8.2} s  {:7.0} MiB  {}",
                 row.case, row.strategy, row.dofs, row.iterations, row.seconds, row.peak_mib, row.outcome
@@ -439,7 +426,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
         s,
         "Written by `{command}` (do not edit by hand). Each case runs in its own process with the default strategy (`newton-condensed`) and, up to n = 128, with the paper's Uzawa + Schur PCG on a smaller mesh; tolerance 1e-10 on the complementarity residual; a run of the paper's strategy still going at the study's time limit is stopped and reported as such (the default strategy gets 30 minutes at least). Time: set-up to solution; memory: the run's peak resident set. An outcome is \"converged\" only where run.json's residuals meet the tolerance and the answer shows what the case must (all separated for a gap of 1, all stuck for large F, ...); a typed error is a sound outcome, a crash or a wrong answer is not.\n"
     );
-    let cases = cases();
+    let cases = CASES;
     s.push_str("| case | what it stresses | strategy | mesh | unknowns | iterations | complementarity | equilibrium | time (s) | peak (MiB) | outcome |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         let why = cases.iter().find(|c| c.name == r.case).map_or("", |c| c.why);

@@ -174,57 +174,65 @@ pub fn smoke(progress: &mut dyn FnMut(&str)) -> Vec<SmokeRow> {
         .collect()
 }
 
-/// Runs the report (`full`: to the finest meshes), writes `verification.md` into `docs` and
-/// its plots into `docs/img`; returns the failed checks (empty: all hold).
-pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<String>, DriverError> {
-    let t0 = Instant::now();
-    let mut failures = vec![];
-    let smoke_rows = smoke(progress);
-    for (name, _, _, _, r) in &smoke_rows {
-        if let Err(e) = r {
-            failures.push(format!("smoke run of `{name}`: {e}"));
-        }
-    }
+/// One study of the report, done: its section of the page and its summary line.
+struct Done {
+    scene: &'static str,
+    rate: f64,
+    finest: f64,
+    seconds: f64,
+    holds: bool,
+    section: String,
+}
+
+/// Runs the study of `entry` and checks its claim; its pictures go to `pictures`.
+fn run_entry(
+    entry: &Entry,
+    full: bool,
+    pictures: &mut Outputs,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Done, Option<String>), DriverError> {
+    let spec = StudySpec {
+        sizes: if full { entry.sizes.1 } else { entry.sizes.0 }.to_vec(),
+        strategies: entry.strategies.to_vec(),
+        tols: entry.tols.to_vec(),
+        reference_n: if full { entry.reference.1 } else { entry.reference.0 },
+    };
+    let t = Instant::now();
+    let study = convergence::study(entry.scene, &[], &spec, progress)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let verdict = (entry.check)(&study);
+    let prefix = format!("verification-{}", entry.scene);
+    pictures.extend(convergence::pictures(&prefix, &study)?);
+    let mut section = format!("## `{}`\n\n", entry.scene);
+    let _ = writeln!(
+        section,
+        "Claim: {}. **{}**{}.\n",
+        entry.claim,
+        if verdict.is_ok() { "Holds" } else { "FAILS" },
+        verdict.as_ref().err().map_or(String::new(), |e| format!(" ({e})"))
+    );
+    section.push_str(&convergence::markdown(&study, &format!("img/{prefix}")));
+    section.push('\n');
+    let done = Done {
+        scene: entry.scene,
+        rate: last_rate(&study),
+        finest: finest(&study),
+        seconds,
+        holds: verdict.is_ok(),
+        section,
+    };
+    Ok((done, verdict.err().map(|e| format!("{}: {e}", entry.scene))))
+}
+
+/// The page: how it was written, the summary, the smoke runs, then each study's section.
+fn page(full: bool, seconds: f64, studies: &[Done], smoke_rows: &[SmokeRow]) -> String {
+    let flag = if full { " --full" } else { "" };
     let mut md = String::new();
-    let mut pictures = Outputs::new(&docs.join("img"));
-    let mut sections = String::new();
-    let mut summary = vec![];
-    for entry in ENTRIES {
-        let spec = StudySpec {
-            sizes: if full { entry.sizes.1 } else { entry.sizes.0 }.to_vec(),
-            strategies: entry.strategies.to_vec(),
-            tols: entry.tols.to_vec(),
-            reference_n: if full { entry.reference.1 } else { entry.reference.0 },
-        };
-        let t = Instant::now();
-        let study = convergence::study(entry.scene, &[], &spec, progress)?;
-        let secs = t.elapsed().as_secs_f64();
-        let verdict = (entry.check)(&study);
-        if let Err(e) = &verdict {
-            failures.push(format!("{}: {e}", entry.scene));
-        }
-        let prefix = format!("verification-{}", entry.scene);
-        pictures.extend(convergence::pictures(&prefix, &study)?);
-        summary.push((entry.scene, last_rate(&study), finest(&study), secs, verdict.is_ok()));
-        let _ = writeln!(sections, "## `{}`\n", entry.scene);
-        let _ = writeln!(
-            sections,
-            "Claim: {}. **{}**{}.\n",
-            entry.claim,
-            if verdict.is_ok() { "Holds" } else { "FAILS" },
-            verdict.err().map_or(String::new(), |e| format!(" ({e})"))
-        );
-        sections.push_str(&convergence::markdown(&study, &format!("img/{prefix}")));
-        sections.push('\n');
-    }
     let _ = writeln!(md, "# Verification\n");
     let _ = writeln!(
         md,
-        "Written by `piezocontact verification{}` (run by `cargo xtask verify{}`) in {:.0} s; do not edit by hand. \
-         Times are wall times of whole runs on the machine that wrote the page (2 cores, shared).\n",
-        if full { " --full" } else { "" },
-        if full { " --full" } else { "" },
-        t0.elapsed().as_secs_f64()
+        "Written by `piezocontact verification{flag}` (run by `cargo xtask verify{flag}`) in {seconds:.0} s; do not edit by hand. \
+         Times are wall times of whole runs on the machine that wrote the page (2 cores, shared).\n"
     );
     let _ = writeln!(
         md,
@@ -234,11 +242,12 @@ pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result
         convergence::TIGHT_TOL
     );
     let _ = writeln!(md, "## Summary\n\n| scene | finest discretisation error | last observed order | study time (s) | claim |\n|---|---|---|---|---|");
-    for (scene, rate, err, secs, ok) in &summary {
+    for d in studies {
+        let verdict = if d.holds { "holds" } else { "FAILS" };
         let _ = writeln!(
             md,
-            "| {scene} | {err:.3e} | {rate:.2} | {secs:.1} | {} |",
-            if *ok { "holds" } else { "FAILS" }
+            "| {} | {:.3e} | {:.2} | {:.1} | {verdict} |",
+            d.scene, d.finest, d.rate, d.seconds
         );
     }
     let _ = writeln!(
@@ -249,15 +258,37 @@ pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result
         md,
         "| scene | unknowns | iterations | time (s) | outcome |\n|---|---|---|---|---|"
     );
-    for (name, dofs, iters, secs, r) in &smoke_rows {
-        let _ = writeln!(
-            md,
-            "| {name} | {dofs} | {iters} | {secs:.3} | {} |",
-            r.as_ref().map_or_else(|e| format!("FAILED: {e}"), |s| s.clone())
-        );
+    for (name, dofs, iters, secs, r) in smoke_rows {
+        let outcome = r.as_ref().map_or_else(|e| format!("FAILED: {e}"), |s| s.clone());
+        let _ = writeln!(md, "| {name} | {dofs} | {iters} | {secs:.3} | {outcome} |");
     }
     md.push('\n');
-    md.push_str(&sections);
+    for d in studies {
+        md.push_str(&d.section);
+    }
+    md
+}
+
+/// Runs the report (`full`: to the finest meshes), writes `verification.md` into `docs` and
+/// its plots into `docs/img`; returns the failed checks (empty: all hold).
+///
+/// # Errors
+/// A study's error, or the files'.
+pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result<Vec<String>, DriverError> {
+    let t0 = Instant::now();
+    let smoke_rows = smoke(progress);
+    let mut failures: Vec<String> = smoke_rows
+        .iter()
+        .filter_map(|(name, _, _, _, r)| r.as_ref().err().map(|e| format!("smoke run of `{name}`: {e}")))
+        .collect();
+    let mut pictures = Outputs::new(&docs.join("img"));
+    let mut studies = vec![];
+    for entry in ENTRIES {
+        let (done, failure) = run_entry(entry, full, &mut pictures, progress)?;
+        failures.extend(failure);
+        studies.push(done);
+    }
+    let md = page(full, t0.elapsed().as_secs_f64(), &studies, &smoke_rows);
     pictures.commit()?;
     let mut page = Outputs::new(docs);
     page.add("verification.md", md.into_bytes());

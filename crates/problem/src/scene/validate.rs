@@ -74,10 +74,8 @@ impl Scene {
             return Err(SceneError::new("material", "the scene has no [[material]]"));
         }
         for m in &self.material {
-            validate_material(m).map_err(|e| match e.message.starts_with("material `") {
-                true => e,
-                false => SceneError::new(&e.key, format!("material `{}`: {}", m.region, e.message)),
-            })?;
+            validate_material(m)
+                .map_err(|e| SceneError::new(&e.key, format!("material `{}`: {}", m.region, e.message)))?;
         }
         for d in &self.dirichlet {
             let values =
@@ -200,26 +198,35 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
             return Err(SceneError::new(key, format!("{key} must be at least 1")));
         }
     }
-    let Some(d) = m.dim() else {
-        // a Gmsh file fixes the mesh: the generator's keys would be silently ignored
-        let why = "a Gmsh file fixes the mesh (mesh.kind = \"gmsh\")";
-        for (key, given) in [
-            ("mesh.lo", !m.lo.is_empty()),
-            ("mesh.hi", !m.hi.is_empty()),
-            ("mesh.n", m.n.is_some()),
-            ("mesh.nx", m.nx.is_some()),
-            ("mesh.ny", m.ny.is_some()),
-            ("mesh.nz", m.nz.is_some()),
-            ("mesh.h", m.h.is_some()),
-            ("mesh.region", !m.regions.is_empty()),
-        ] {
-            refuse_if(given, key, why)?;
-        }
-        if m.file.is_none() {
-            return Err(SceneError::new("mesh.file", "mesh.kind = \"gmsh\" needs mesh.file"));
-        }
-        return Ok(());
-    };
+    match m.dim() {
+        None => validate_gmsh(m),
+        Some(d) => validate_generated(m, d),
+    }
+}
+
+/// A Gmsh mesh: a file, and none of the generator's keys (they would be silently ignored).
+fn validate_gmsh(m: &MeshSpec) -> Result<(), SceneError> {
+    let why = "a Gmsh file fixes the mesh (mesh.kind = \"gmsh\")";
+    for (key, given) in [
+        ("mesh.lo", !m.lo.is_empty()),
+        ("mesh.hi", !m.hi.is_empty()),
+        ("mesh.n", m.n.is_some()),
+        ("mesh.nx", m.nx.is_some()),
+        ("mesh.ny", m.ny.is_some()),
+        ("mesh.nz", m.nz.is_some()),
+        ("mesh.h", m.h.is_some()),
+        ("mesh.region", !m.regions.is_empty()),
+    ] {
+        refuse_if(given, key, why)?;
+    }
+    if m.file.is_none() {
+        return Err(SceneError::new("mesh.file", "mesh.kind = \"gmsh\" needs mesh.file"));
+    }
+    Ok(())
+}
+
+/// A generated mesh in dimension `d`: its box, size and regions.
+fn validate_generated(m: &MeshSpec, d: usize) -> Result<(), SceneError> {
     refuse_if(
         m.file.is_some(),
         "mesh.file",
@@ -277,20 +284,20 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// A material's constants for its model (the caller names the region in the message).
 fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
-    let at = |what: &str| format!("material `{}`: {what}", m.region);
-    let bad = |what: &str| SceneError::new("material", at(what));
-    all_finite(
-        &format!("a constant of the material of region `{}`", m.region),
-        &[
-            &m.c[..],
-            &m.e,
-            &m.permittivity,
-            &m.poling,
-            &m.young.into_iter().collect::<Vec<_>>()[..],
-        ]
-        .concat(),
-    )?;
+    let bad = |what: &str| SceneError::new("material", what);
+    for (key, values) in [
+        ("material.c", &m.c),
+        ("material.e", &m.e),
+        ("material.permittivity", &m.permittivity),
+        ("material.poling", &m.poling),
+    ] {
+        all_finite(key, values)?;
+    }
+    if let Some(y) = m.young {
+        finite("material.young", y)?;
+    }
     match m.model {
         MaterialModel::Crystal6mm => {
             let why = "an isotropic constant, and the model is crystal-6mm";
@@ -334,14 +341,14 @@ fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
 }
 
 fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
+    finite("contact.gap", c.gap)?;
+    finite("contact.gap_curvature", c.gap_curvature)?;
     for (key, v) in [
         ("contact.friction", c.friction()),
         ("contact.slip_bound", c.slip_bound()),
-        ("contact.gap", c.gap),
-        ("contact.gap_curvature", c.gap_curvature),
     ] {
         finite(key, v)?;
-        if v < 0.0 && key != "contact.gap" && key != "contact.gap_curvature" {
+        if v < 0.0 {
             return Err(SceneError::new(key, format!("{key} = {v} must be non-negative")));
         }
     }
@@ -399,48 +406,58 @@ fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
 }
 
 fn validate_exact(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
-    let law = s.contact_law();
-    let kind = x.kind;
-    if kind.is_field() {
-        if law != ContactLaw::None {
-            return Err(SceneError::new(
-                "exact.kind",
-                format!("exact.kind `{kind}` is a solution without contact; set contact.law = \"none\""),
-            ));
-        }
-        if s.material.len() != 1 {
-            return Err(SceneError::new(
-                "exact.kind",
-                format!("exact.kind `{kind}` needs exactly one [[material]]"),
-            ));
-        }
-        if s.mesh.dim().is_none() && x.groups.is_empty() {
-            return Err(SceneError::new(
-                "exact.groups",
-                format!(
-                    "exact.kind `{kind}` on a Gmsh mesh needs exact.groups (the boundary groups to prescribe it on)"
-                ),
-            ));
-        }
-        all_finite(
-            "exact",
-            &[
-                &x.u0[..],
-                &x.grad_u,
-                &x.grad_phi,
-                &x.phi0.into_iter().collect::<Vec<_>>(),
-            ]
-            .concat(),
-        )?;
-        if kind == ExactKind::Manufactured {
-            let why = "data of an affine solution, and exact.kind is `manufactured`";
-            refuse_if(!x.u0.is_empty(), "exact.u0", why)?;
-            refuse_if(!x.grad_u.is_empty(), "exact.grad_u", why)?;
-            refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
-            refuse_if(!x.grad_phi.is_empty(), "exact.grad_phi", why)?;
-        }
-        return Ok(());
+    if x.kind.is_field() {
+        validate_field_solution(x, s)
+    } else {
+        validate_contact_solution(x, s)
     }
+}
+
+/// A manufactured or affine solution: no contact, one material, its groups and data.
+fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
+    let kind = x.kind;
+    if s.contact_law() != ContactLaw::None {
+        return Err(SceneError::new(
+            "exact.kind",
+            format!("exact.kind `{kind}` is a solution without contact; set contact.law = \"none\""),
+        ));
+    }
+    if s.material.len() != 1 {
+        return Err(SceneError::new(
+            "exact.kind",
+            format!("exact.kind `{kind}` needs exactly one [[material]]"),
+        ));
+    }
+    if s.mesh.dim().is_none() && x.groups.is_empty() {
+        return Err(SceneError::new(
+            "exact.groups",
+            format!("exact.kind `{kind}` on a Gmsh mesh needs exact.groups (the boundary groups to prescribe it on)"),
+        ));
+    }
+    all_finite(
+        "exact",
+        &[
+            &x.u0[..],
+            &x.grad_u,
+            &x.grad_phi,
+            &x.phi0.into_iter().collect::<Vec<_>>(),
+        ]
+        .concat(),
+    )?;
+    if kind == ExactKind::Manufactured {
+        let why = "data of an affine solution, and exact.kind is `manufactured`";
+        refuse_if(!x.u0.is_empty(), "exact.u0", why)?;
+        refuse_if(!x.grad_u.is_empty(), "exact.grad_u", why)?;
+        refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
+        refuse_if(!x.grad_phi.is_empty(), "exact.grad_phi", why)?;
+    }
+    Ok(())
+}
+
+/// Hertz or Cattaneo-Mindlin: a rectangle, a curved gap, the law they solve, one isotropic
+/// material.
+fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
+    let (law, kind) = (s.contact_law(), x.kind);
     let why = "a field solution's data, and exact.kind is a contact solution";
     refuse_if(!x.groups.is_empty(), "exact.groups", why)?;
     refuse_if(
