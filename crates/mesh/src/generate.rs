@@ -76,6 +76,7 @@ fn rectangle(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize, kind: CellKind, c
         cells,
         boundaries,
         regions,
+        reoriented_cells: 0,
     }
 }
 
@@ -172,6 +173,7 @@ pub fn box_tet(lo: [f64; 3], hi: [f64; 3], nx: usize, ny: usize, nz: usize) -> M
         cells,
         boundaries,
         regions,
+        reoriented_cells: 0,
     }
 }
 

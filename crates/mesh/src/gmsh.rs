@@ -5,11 +5,15 @@
 //! `dim` become regions, named by their physical name (or by their tag where unnamed). Every
 //! cell also belongs to the region `body`, unless the file names a group `body` itself.
 //!
-//! Node tags: where the file's tags are dense (`max - min + 1 == count`), `mshio` does not keep
-//! them, and node `k` of the file (in block order) gets tag `min + k`, which is how Gmsh writes
-//! them. Cells of an entity block that are all negatively oriented (a surface whose normal is
-//! `-z`) are turned round; a block with cells of both orientations is left as it is, and
-//! [`Mesh::check`] then reports the inverted cells.
+//! Node tags: MSH 4.1 lets a `$Nodes` block list its tags in any order. Where the tags are dense
+//! (`max - min + 1 == count`) `mshio` does not keep them, so they are read here
+//! ([`node_tags`]), in ASCII and binary, and every node keeps the tag the file gives it.
+//!
+//! Orientation: the cells of a 2D entity block that are all negatively oriented (a surface whose
+//! normal is `-z`, which Gmsh writes when a surface is defined clockwise) are turned round, and
+//! counted in [`Mesh::reoriented_cells`]; a 3D mesh whose tetrahedra are all inverted is refused
+//! (Gmsh writes positive ones: such a file is mirrored or misread). A block with cells of both
+//! orientations is left as it is, and [`Mesh::check`] then reports the inverted cells.
 
 use crate::{CellKind, FacetGroup, Mesh, MeshError};
 use mshio::mshfile::ElementType;
@@ -113,28 +117,21 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
             nodes.num_nodes
         )));
     }
-    let mut points = Vec::with_capacity(held);
+    let tags = node_tags(bytes).map_err(err)?;
+    if tags.len() != held {
+        return Err(err(format!(
+            "the $Nodes blocks hold {held} nodes but {} node tags",
+            tags.len()
+        )));
+    }
     let mut index_of: HashMap<u64, usize> = HashMap::with_capacity(held);
-    let dense = nodes
-        .max_node_tag
-        .checked_sub(nodes.min_node_tag)
-        .and_then(|d| d.checked_add(1))
-        == Some(nodes.num_nodes);
-    for block in &nodes.node_blocks {
-        let base = points.len();
-        match (&block.node_tags, dense) {
-            (Some(map), _) => {
-                for (&tag, &local) in map {
-                    index_of.insert(tag, base + local);
-                }
-            }
-            (None, true) => {
-                for local in 0..block.nodes.len() {
-                    index_of.insert(nodes.min_node_tag.saturating_add((base + local) as u64), base + local);
-                }
-            }
-            (None, false) => return Err(err("node block without node tags".into())),
+    for (k, &tag) in tags.iter().enumerate() {
+        if index_of.insert(tag, k).is_some() {
+            return Err(err(format!("node tag {tag} is defined twice")));
         }
+    }
+    let mut points: Vec<[f64; 3]> = Vec::with_capacity(held);
+    for block in &nodes.node_blocks {
         points.extend(block.nodes.iter().map(|n| [n.x, n.y, n.z]));
     }
 
@@ -158,6 +155,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
     }
     let mut kind: Option<CellKind> = None;
     let mut cells = Vec::new();
+    let mut reoriented = 0;
     let mut regions: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut boundaries: BTreeMap<String, FacetGroup> = BTreeMap::new();
     let group_name = |d: i32, tag: i32| names.get(&(d, tag)).cloned().unwrap_or_else(|| tag.to_string());
@@ -202,7 +200,7 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
                 }
             }
             let last = cells.len() / k.n_nodes();
-            orient_block(&points, &mut cells, k, first, last);
+            reoriented += orient_block(&points, &mut cells, k, first, last);
             for &p in phys.get(&(d, block.entity_tag)).into_iter().flatten() {
                 regions.entry(group_name(d, p)).or_default().extend(first..last);
             }
@@ -247,6 +245,11 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
         }
     }
     let n_cells = cells.len() / kind.n_nodes();
+    if kind == CellKind::Tet4 && reoriented == n_cells {
+        return Err(err(format!(
+            "all {n_cells} tetrahedra are inverted (negative volume): Gmsh writes them positive, so the file is mirrored or its nodes are misnumbered"
+        )));
+    }
     for v in regions.values_mut() {
         v.sort_unstable();
         v.dedup();
@@ -259,13 +262,15 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
         cells,
         boundaries,
         regions,
+        reoriented_cells: reoriented,
     };
     mesh.check().map_err(|e| err(format!("{e}")))?;
     Ok(mesh)
 }
 
-/// Turns round every cell of `first..last` when all of them are negatively oriented.
-fn orient_block(points: &[[f64; 3]], cells: &mut [usize], kind: CellKind, first: usize, last: usize) {
+/// Turns round every cell of `first..last` when all of them are negatively oriented; returns
+/// how many were turned.
+fn orient_block(points: &[[f64; 3]], cells: &mut [usize], kind: CellKind, first: usize, last: usize) -> usize {
     let k = kind.n_nodes();
     let sign = |c: &[usize]| -> f64 {
         match kind {
@@ -277,14 +282,101 @@ fn orient_block(points: &[[f64; 3]], cells: &mut [usize], kind: CellKind, first:
         }
     };
     let block = &mut cells[first * k..last * k];
-    if !block.is_empty() && block.chunks_exact(k).all(|c| sign(c) < 0.0) {
-        for c in block.chunks_exact_mut(k) {
-            match kind {
-                CellKind::Quad4 => c.swap(1, 3),
-                _ => c.swap(1, 2),
-            }
+    if block.is_empty() || !block.chunks_exact(k).all(|c| sign(c) < 0.0) {
+        return 0;
+    }
+    for c in block.chunks_exact_mut(k) {
+        match kind {
+            CellKind::Quad4 => c.swap(1, 3),
+            _ => c.swap(1, 2),
         }
     }
+    last - first
+}
+
+/// The node tags of the `$Nodes` section, in the order of its blocks (ASCII or binary, as the
+/// `$MeshFormat` line says; binary in either byte order, as the one written after it says).
+pub(crate) fn node_tags(bytes: &[u8]) -> Result<Vec<u64>, String> {
+    let binary = bytes.split(|&b| b == b'\n').nth(1).is_some_and(|l| l.split(|&b| b == b' ').nth(1) == Some(b"1"));
+    // the section follows `$EndEntities` (binary data before it could hold any bytes)
+    let from = find(bytes, b"$EndEntities").unwrap_or(0);
+    let start = find(&bytes[from..], b"$Nodes\n").ok_or("no `$Nodes` section")? + from + 7;
+    if binary {
+        // the int 1 written right after the `$MeshFormat` line tells the byte order
+        let after_header = bytes.iter().enumerate().filter(|(_, &b)| b == b'\n').nth(1).map_or(0, |(i, _)| i + 1);
+        let big = bytes.get(after_header..after_header + 4) == Some(&1i32.to_be_bytes()[..]);
+        binary_node_tags(&bytes[start..], !big)
+    } else {
+        let end = find(&bytes[start..], b"$EndNodes").ok_or("`$Nodes` has no `$EndNodes`")? + start;
+        let text = std::str::from_utf8(&bytes[start..end]).map_err(|_| "`$Nodes` is not text")?;
+        ascii_node_tags(text)
+    }
+}
+
+/// The next token of `$Nodes`, named `what` in the error where there is none.
+fn token<'t>(tokens: &mut impl Iterator<Item = &'t str>, what: &str) -> Result<&'t str, String> {
+    tokens.next().ok_or_else(|| format!("`$Nodes`: {what} is missing"))
+}
+
+/// The next token of `$Nodes` as a whole number.
+fn whole<'t>(tokens: &mut impl Iterator<Item = &'t str>, what: &str) -> Result<u64, String> {
+    let t = token(tokens, what)?;
+    t.parse::<u64>().map_err(|_| format!("`$Nodes`: {what} `{t}` is not a whole number"))
+}
+
+fn ascii_node_tags(text: &str) -> Result<Vec<u64>, String> {
+    let mut t = text.split_ascii_whitespace();
+    let blocks = whole(&mut t, "the block count")?;
+    for what in ["the node count", "the smallest tag", "the largest tag"] {
+        whole(&mut t, what)?;
+    }
+    let mut tags = vec![];
+    for _ in 0..blocks {
+        let dim = whole(&mut t, "a block's dimension")?;
+        whole(&mut t, "a block's entity")?;
+        let parametric = whole(&mut t, "a block's parametric flag")?;
+        let n = whole(&mut t, "a block's node count")?;
+        for _ in 0..n {
+            tags.push(whole(&mut t, "a node tag")?);
+        }
+        // the coordinates: x y z, and the parametric ones
+        let per_node = 3 + if parametric == 1 { dim } else { 0 };
+        for _ in 0..n.saturating_mul(per_node) {
+            token(&mut t, "a coordinate")?;
+        }
+    }
+    Ok(tags)
+}
+
+fn binary_node_tags(data: &[u8], little: bool) -> Result<Vec<u64>, String> {
+    let mut at = 0usize;
+    let mut take = |n: usize| -> Result<&[u8], String> {
+        let s = data.get(at..at + n).ok_or("`$Nodes` is cut short")?;
+        at += n;
+        Ok(s)
+    };
+    let word = |b: &[u8]| -> u64 {
+        let a: [u8; 8] = b.try_into().unwrap_or_default();
+        if little { u64::from_le_bytes(a) } else { u64::from_be_bytes(a) }
+    };
+    let int = |b: &[u8]| -> i32 {
+        let a: [u8; 4] = b.try_into().unwrap_or_default();
+        if little { i32::from_le_bytes(a) } else { i32::from_be_bytes(a) }
+    };
+    let blocks = word(take(8)?);
+    take(24)?; // the node count, the smallest and the largest tag
+    let mut tags = vec![];
+    for _ in 0..blocks {
+        let dim = int(take(4)?);
+        take(4)?; // the entity tag
+        let parametric = int(take(4)?);
+        let n = usize::try_from(word(take(8)?)).map_err(|_| "`$Nodes`: a block's node count is too large")?;
+        let tag_bytes = take(n.checked_mul(8).ok_or("`$Nodes`: a block's node count is too large")?)?;
+        tags.extend(tag_bytes.chunks_exact(8).map(word));
+        let per_node = 3 + if parametric == 1 { dim.max(0) as usize } else { 0 };
+        take(n.saturating_mul(per_node).saturating_mul(8))?;
+    }
+    Ok(tags)
 }
 
 /// Reads `$PhysicalNames` (ASCII in both encodings): `(dim, tag) -> name`.

@@ -30,6 +30,7 @@ mod generate;
 mod gmsh;
 mod ordering;
 mod quality;
+mod topology;
 
 pub use generate::{box_tet, rectangle_quad, rectangle_tri};
 pub use gmsh::{read_msh, read_msh_bytes};
@@ -127,6 +128,8 @@ pub struct Mesh {
     pub boundaries: BTreeMap<String, FacetGroup>,
     /// Named cell regions (lists of cell indices, sorted).
     pub regions: BTreeMap<String, Vec<usize>>,
+    /// Cells the reader turned round (a 2D block written clockwise); 0 for a generated mesh.
+    pub reoriented_cells: usize,
 }
 
 /// What can go wrong with a mesh: reading it, checking it, or asking it for a group.
@@ -191,6 +194,34 @@ pub enum MeshError {
     /// A mesh without cells.
     #[error("the mesh has no cells")]
     Empty,
+    /// A facet shared by more than two cells: cells overlap.
+    #[error("facet {facet:?} is shared by {} cells ({cells:?}): the cells overlap", cells.len())]
+    OverlappingCells {
+        /// The facet's nodes.
+        facet: Vec<usize>,
+        /// The cells that hold it.
+        cells: Vec<usize>,
+    },
+    /// Two cells with the same nodes.
+    #[error("cells {first} and {second} have the same nodes")]
+    DuplicateCell {
+        /// The first.
+        first: usize,
+        /// The second.
+        second: usize,
+    },
+    /// A facet of a boundary group that is not one boundary facet of the mesh, listed once.
+    #[error("facet {facet} of boundary group `{group}` (nodes {nodes:?}) {problem}")]
+    BadBoundaryFacet {
+        /// The group.
+        group: String,
+        /// The facet's index in the group.
+        facet: usize,
+        /// Its nodes.
+        nodes: Vec<usize>,
+        /// What is wrong.
+        problem: &'static str,
+    },
     /// A file could not be read.
     #[error("cannot read mesh file {path}: {message}")]
     Io {
@@ -360,6 +391,16 @@ fn join_keys<'a>(keys: impl Iterator<Item = &'a String>) -> String {
     } else {
         v.join(", ")
     }
+}
+
+/// The Euclidean norm of `v`, scaled so that neither tiny nor huge entries underflow or
+/// overflow in the squares.
+pub fn scaled_norm(v: &[f64]) -> f64 {
+    let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return scale;
+    }
+    scale * v.iter().map(|x| (x / scale) * (x / scale)).sum::<f64>().sqrt()
 }
 
 fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {

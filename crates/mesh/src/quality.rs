@@ -1,5 +1,5 @@
 //! Quality checks: finite coordinates, node indices in range, no degenerate or inverted cell,
-//! no unused node.
+//! no unused node, and the topology of `topology.rs`.
 
 use crate::generate::signed_volume;
 use crate::{CellKind, Mesh, MeshError};
@@ -18,6 +18,8 @@ pub struct QualityReport {
     /// The largest ratio of a cell's longest edge to its inscribed size
     /// (`h^dim / measure`, normalised to 1-ish for a right isoceles simplex).
     pub max_aspect: f64,
+    /// Nodes that share their coordinates with another node (a crack, or parts not merged).
+    pub coincident_nodes: usize,
 }
 
 /// A cell whose measure is below this fraction of `h^dim` (its longest edge to the power of
@@ -31,7 +33,8 @@ impl Mesh {
     /// [`MeshError::NonFiniteCoordinate`], [`MeshError::NodeOutOfRange`] (cells, facets,
     /// region entries), [`MeshError::BadCell`] (degenerate: `|measure| <= 1e-12 h^dim`;
     /// inverted: negative measure, or for a quadrilateral a non-positive corner Jacobian),
-    /// [`MeshError::UnusedNodes`].
+    /// [`MeshError::UnusedNodes`], then the topology: [`MeshError::OverlappingCells`],
+    /// [`MeshError::DuplicateCell`], [`MeshError::BadBoundaryFacet`].
     pub fn check(&self) -> Result<QualityReport, MeshError> {
         if self.n_cells() == 0 {
             return Err(MeshError::Empty);
@@ -71,6 +74,7 @@ impl Mesh {
             h_max: 0.0,
             h_min: f64::INFINITY,
             max_aspect: 0.0,
+            coincident_nodes: 0,
         };
         let measure_name = if self.dim == 2 { "area" } else { "volume" };
         for (c, cell) in self.iter_cells().enumerate() {
@@ -117,6 +121,7 @@ impl Mesh {
             let first = used.iter().position(|u| !u).unwrap_or(0);
             return Err(MeshError::UnusedNodes { count, first });
         }
+        report.coincident_nodes = self.check_topology()?;
         Ok(report)
     }
 

@@ -125,3 +125,173 @@ fn corrupt_last_element(text: &str) -> String {
     parts[1] = "999999";
     format!("{}{}\n{}", &text[..last_line_start], parts.join(" "), &text[end..])
 }
+
+/// The file with every node tag `t` replaced by `perm(t)`, in `$Nodes` and `$Elements` (ASCII):
+/// the same mesh, its nodes listed with their tags out of order.
+fn renumber_ascii(text: &str, perm: &dyn Fn(u64) -> u64) -> String {
+    let section = |name: &str| {
+        let a = text.find(&format!("${name}\n")).unwrap() + name.len() + 2;
+        (a, text[a..].find(&format!("$End{name}")).unwrap() + a)
+    };
+    let ((na, nb), (ea, eb)) = (section("Nodes"), section("Elements"));
+    let mut nodes = String::new();
+    let mut lines = text[na..nb].lines();
+    nodes.push_str(lines.next().unwrap());
+    nodes.push('\n');
+    while let Some(header) = lines.next() {
+        let n: usize = header.split_whitespace().nth(3).unwrap().parse().unwrap();
+        nodes.push_str(header);
+        nodes.push('\n');
+        for _ in 0..n {
+            let t: u64 = lines.next().unwrap().trim().parse().unwrap();
+            nodes.push_str(&format!("{}\n", perm(t)));
+        }
+        for _ in 0..n {
+            nodes.push_str(lines.next().unwrap());
+            nodes.push('\n');
+        }
+    }
+    let mut elements = String::new();
+    let mut lines = text[ea..eb].lines();
+    elements.push_str(lines.next().unwrap());
+    elements.push('\n');
+    while let Some(header) = lines.next() {
+        let n: usize = header.split_whitespace().nth(3).unwrap().parse().unwrap();
+        elements.push_str(header);
+        elements.push('\n');
+        for _ in 0..n {
+            let mut parts = lines.next().unwrap().split_whitespace();
+            let tag = parts.next().unwrap().to_string();
+            let nodes: Vec<String> = parts.map(|t| perm(t.parse().unwrap()).to_string()).collect();
+            elements.push_str(&format!("{tag} {}\n", nodes.join(" ")));
+        }
+    }
+    format!("{}{nodes}{}{elements}{}", &text[..na], &text[nb..ea], &text[eb..])
+}
+
+/// The same for a binary file (size_t of 8 bytes, little endian, as Gmsh writes it here).
+fn renumber_binary(bytes: &[u8], perm: &dyn Fn(u64) -> u64) -> Vec<u8> {
+    let find = |from: usize, needle: &[u8]| bytes[from..].windows(needle.len()).position(|w| w == needle).unwrap() + from;
+    let mut out = bytes.to_vec();
+    let word = |b: &[u8], at: usize| u64::from_le_bytes(b[at..at + 8].try_into().unwrap());
+    let int = |b: &[u8], at: usize| i32::from_le_bytes(b[at..at + 4].try_into().unwrap());
+    let mut put = |out: &mut Vec<u8>, at: usize| {
+        let t = word(bytes, at);
+        out[at..at + 8].copy_from_slice(&perm(t).to_le_bytes());
+    };
+    // $Nodes: 4 words, then blocks of (3 ints, 1 word, n tags, 3 n doubles)
+    let mut at = find(find(0, b"$EndEntities"), b"$Nodes\n") + 7;
+    let blocks = word(bytes, at);
+    at += 32;
+    for _ in 0..blocks {
+        let n = word(bytes, at + 12) as usize;
+        at += 20;
+        for k in 0..n {
+            put(&mut out, at + 8 * k);
+        }
+        at += 8 * n + 24 * n;
+    }
+    // $Elements: 4 words, then blocks of (3 ints, 1 word, n x (tag, nodes))
+    let mut at = find(at, b"$Elements\n") + 10;
+    let blocks = word(bytes, at);
+    at += 32;
+    for _ in 0..blocks {
+        let kind = int(bytes, at + 8);
+        let n = word(bytes, at + 12) as usize;
+        at += 20;
+        let per = match kind {
+            15 => 1, // point
+            1 => 2,  // line
+            2 => 3,  // triangle
+            4 => 4,  // tetrahedron
+            other => panic!("element type {other} in the fixture"),
+        };
+        for _ in 0..n {
+            for q in 0..per {
+                put(&mut out, at + 8 * (1 + q));
+            }
+            at += 8 * (1 + per);
+        }
+    }
+    out
+}
+
+/// The cells of a mesh as sets of coordinates (independent of the node numbering), sorted.
+fn geometry(m: &mesh::Mesh) -> (Vec<Vec<[i64; 3]>>, Vec<(String, Vec<Vec<[i64; 3]>>)>) {
+    let key = |v: usize| m.points[v].map(|x| (x * 1e9).round() as i64);
+    let sorted = |items: Vec<Vec<[i64; 3]>>| {
+        let mut items: Vec<Vec<[i64; 3]>> = items
+            .into_iter()
+            .map(|mut c| {
+                c.sort();
+                c
+            })
+            .collect();
+        items.sort();
+        items
+    };
+    let cells = sorted(m.iter_cells().map(|c| c.iter().map(|&v| key(v)).collect()).collect());
+    let groups = m
+        .boundaries
+        .iter()
+        .map(|(name, g)| (name.clone(), sorted(g.iter().map(|f| f.iter().map(|&v| key(v)).collect()).collect())))
+        .collect();
+    (cells, groups)
+}
+
+/// MSH 4.1 lets a `$Nodes` block list its tags in any order: dense tags reversed, or
+/// shuffled, give the same mesh as the file written in order (the reader once gave node `k`
+/// the tag `min + k`: a reversed file became a mirrored body), in ASCII and in binary.
+#[test]
+fn node_tags_in_any_order_give_the_same_mesh() {
+    let text = std::fs::read_to_string(fixture("layered2d.msh")).unwrap();
+    let original = read_msh(fixture("layered2d.msh")).unwrap();
+    let n = original.n_nodes() as u64;
+    let reverse = move |t: u64| n + 1 - t;
+    // a shuffle of 1..=n: t -> 1 + (t * 37) mod n, a permutation since gcd(37, n) = 1
+    assert_ne!(n % 37, 0);
+    let shuffle = move |t: u64| 1 + (t * 37) % n;
+    for (name, perm) in [("reversed", &reverse as &dyn Fn(u64) -> u64), ("shuffled", &shuffle)] {
+        let m = read_msh_bytes(renumber_ascii(&text, perm).as_bytes(), name).unwrap();
+        assert_eq!(geometry(&m), geometry(&original), "{name}");
+        assert_eq!(m.reoriented_cells, original.reoriented_cells, "{name}");
+    }
+    let bytes = std::fs::read(fixture("box3d_bin.msh")).unwrap();
+    let original = read_msh(fixture("box3d_bin.msh")).unwrap();
+    let n = original.n_nodes() as u64;
+    let reverse = move |t: u64| n + 1 - t;
+    let m = read_msh_bytes(&renumber_binary(&bytes, &reverse), "reversed.msh").unwrap();
+    assert_eq!(geometry(&m), geometry(&original));
+}
+
+/// A 3D file whose tetrahedra are all inverted (every node mirrored in z) is refused: Gmsh
+/// writes positive tetrahedra, so such a file is mirrored or misread.
+#[test]
+fn a_wholly_inverted_tet_mesh_is_refused() {
+    let bytes = std::fs::read(fixture("box3d_bin.msh")).unwrap();
+    let m = read_msh_bytes(&bytes, "box.msh").unwrap();
+    assert_eq!(m.reoriented_cells, 0);
+    // swap two nodes of every tetrahedron: all inverted
+    let find = |from: usize, needle: &[u8]| bytes[from..].windows(needle.len()).position(|w| w == needle).unwrap() + from;
+    let mut out = bytes.clone();
+    let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+    let mut at = find(0, b"$Elements\n") + 10;
+    let blocks = word(at);
+    at += 32;
+    for _ in 0..blocks {
+        let kind = i32::from_le_bytes(bytes[at + 8..at + 12].try_into().unwrap());
+        let n = word(at + 12) as usize;
+        at += 20;
+        let per = [0, 2, 3, 0, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1][kind as usize];
+        for _ in 0..n {
+            if kind == 4 {
+                let (a, b) = (at + 8, at + 16);
+                out[a..a + 8].copy_from_slice(&bytes[b..b + 8]);
+                out[b..b + 8].copy_from_slice(&bytes[a..a + 8]);
+            }
+            at += 8 * (1 + per);
+        }
+    }
+    let e = read_msh_bytes(&out, "mirrored.msh").unwrap_err().to_string();
+    assert!(e.contains("tetrahedra are inverted"), "{e}");
+}

@@ -1,0 +1,217 @@
+//! Topology checks and the outward normals of boundary facets.
+//!
+//! A conforming mesh has every facet on one cell (the boundary) or two (the interior); no two
+//! cells with the same nodes; boundary groups made of boundary facets, each listed once (a
+//! facet listed twice, as two physical groups of one name on one curve give, would count its
+//! load or contact twice). Nodes at the same coordinates (a crack, or a mesh glued from parts
+//! that were not merged) are allowed and counted.
+
+use crate::{CellKind, Mesh, MeshError};
+
+/// A facet as its sorted nodes (unused slots `usize::MAX`), so equal facets compare equal.
+type Key = [usize; 4];
+
+fn key(nodes: &[usize]) -> Key {
+    let mut k = [usize::MAX; 4];
+    k[..nodes.len()].copy_from_slice(nodes);
+    k[..nodes.len()].sort_unstable();
+    k
+}
+
+impl CellKind {
+    /// The local nodes of each facet of a cell (edges in 2D, faces of a tetrahedron).
+    pub fn facets(self) -> &'static [&'static [usize]] {
+        match self {
+            CellKind::Tri3 => &[&[0, 1], &[1, 2], &[2, 0]],
+            CellKind::Quad4 => &[&[0, 1], &[1, 2], &[2, 3], &[3, 0]],
+            CellKind::Tet4 => &[&[1, 2, 3], &[0, 2, 3], &[0, 1, 3], &[0, 1, 2]],
+        }
+    }
+}
+
+impl Mesh {
+    /// Every facet of every cell with its cell, sorted by facet.
+    fn cell_facets(&self) -> Vec<(Key, usize)> {
+        let local = self.kind.facets();
+        let mut all = Vec::with_capacity(self.n_cells() * local.len());
+        let mut buf = [0usize; 3];
+        for (c, cell) in self.iter_cells().enumerate() {
+            for f in local {
+                for (q, &l) in f.iter().enumerate() {
+                    buf[q] = cell[l];
+                }
+                all.push((key(&buf[..f.len()]), c));
+            }
+        }
+        all.sort_unstable();
+        all
+    }
+
+    /// Checks the topology: every facet on one or two cells, no two cells with the same
+    /// nodes, every facet of a boundary group a boundary facet listed once. Returns the number
+    /// of nodes that share their coordinates with another node.
+    ///
+    /// # Errors
+    /// [`MeshError::OverlappingCells`], [`MeshError::DuplicateCell`],
+    /// [`MeshError::BadBoundaryFacet`].
+    pub(crate) fn check_topology(&self) -> Result<usize, MeshError> {
+        let facets = self.cell_facets();
+        // runs of one facet: its cells
+        let mut i = 0;
+        while i < facets.len() {
+            let j = i + facets[i..].iter().take_while(|f| f.0 == facets[i].0).count();
+            if j - i > 2 {
+                return Err(MeshError::OverlappingCells {
+                    facet: facets[i].0.iter().copied().filter(|&v| v != usize::MAX).collect(),
+                    cells: facets[i..j].iter().map(|f| f.1).collect(),
+                });
+            }
+            i = j;
+        }
+        let mut cells: Vec<(Key, usize)> = self.iter_cells().enumerate().map(|(c, n)| (key(n), c)).collect();
+        cells.sort_unstable();
+        if let Some(w) = cells.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(MeshError::DuplicateCell {
+                first: w[0].1.min(w[1].1),
+                second: w[0].1.max(w[1].1),
+            });
+        }
+        for (name, group) in &self.boundaries {
+            let mut seen: Vec<(Key, usize)> = group.iter().enumerate().map(|(f, n)| (key(n), f)).collect();
+            seen.sort_unstable();
+            let bad = |facet: usize, problem: &'static str| MeshError::BadBoundaryFacet {
+                group: name.clone(),
+                facet,
+                nodes: group.facet(facet).to_vec(),
+                problem,
+            };
+            if let Some(w) = seen.windows(2).find(|w| w[0].0 == w[1].0) {
+                return Err(bad(w[1].1.max(w[0].1), "is listed twice (two physical groups of one name, or one facet twice): its load or contact would count twice"));
+            }
+            for (k, f) in &seen {
+                let at = facets.partition_point(|x| x.0 < *k);
+                let on = facets[at..].iter().take_while(|x| x.0 == *k).count();
+                match on {
+                    0 => return Err(bad(*f, "is not a facet of any cell")),
+                    1 => {}
+                    _ => return Err(bad(*f, "lies inside the mesh (two cells share it): a boundary group holds boundary facets only")),
+                }
+            }
+        }
+        Ok(self.coincident_nodes())
+    }
+
+    /// Nodes whose coordinates equal those of another node (each such node but the first).
+    fn coincident_nodes(&self) -> usize {
+        let mut order: Vec<[u64; 3]> = self
+            .points
+            .iter()
+            .map(|p| p.map(|x| if x == 0.0 { 0.0f64.to_bits() } else { x.to_bits() }))
+            .collect();
+        order.sort_unstable();
+        order.windows(2).filter(|w| w[0] == w[1]).count()
+    }
+
+    /// The unit outward normal of each facet of boundary group `group`: the facet's normal,
+    /// turned away from the cell that holds it.
+    ///
+    /// # Errors
+    /// [`MeshError::MissingBoundary`]; [`MeshError::BadBoundaryFacet`] for a facet that no cell
+    /// holds.
+    pub fn outward_normals(&self, group: &str) -> Result<Vec<[f64; 3]>, MeshError> {
+        let g = self.boundary(group)?;
+        let (offsets, node_cells) = self.node_cells();
+        let mut out = Vec::with_capacity(g.n_facets());
+        for (f, facet) in g.iter().enumerate() {
+            let owner = node_cells[offsets[facet[0]]..offsets[facet[0] + 1]]
+                .iter()
+                .copied()
+                .find(|&c| facet.iter().all(|v| self.cell(c).contains(v)))
+                .ok_or_else(|| MeshError::BadBoundaryFacet {
+                    group: group.into(),
+                    facet: f,
+                    nodes: facet.to_vec(),
+                    problem: "is not a facet of any cell",
+                })?;
+            let p = |v: usize| self.points[v];
+            let n = if self.dim == 2 {
+                let (a, b) = (p(facet[0]), p(facet[1]));
+                [b[1] - a[1], a[0] - b[0], 0.0]
+            } else {
+                crate::generate::triangle_normal(&self.points, facet)
+            };
+            // a node of the cell off the facet lies inside: the normal points away from it
+            let inside = self.cell(owner).iter().copied().find(|v| !facet.contains(v)).unwrap_or(facet[0]);
+            let a = p(facet[0]);
+            let towards: f64 = (0..3).map(|k| n[k] * (p(inside)[k] - a[k])).sum();
+            let len = crate::scaled_norm(&n);
+            let s = if towards > 0.0 { -1.0 / len } else { 1.0 / len };
+            out.push(n.map(|x| x * s));
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{box_tet, rectangle_tri, MeshError};
+
+    #[test]
+    fn a_conforming_mesh_passes_and_its_normals_point_out() {
+        let m = rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2);
+        assert_eq!(m.check_topology(), Ok(0));
+        for (g, n) in [("bottom", [0.0, -1.0]), ("top", [0.0, 1.0]), ("left", [-1.0, 0.0]), ("right", [1.0, 0.0])] {
+            for v in m.outward_normals(g).unwrap() {
+                assert!((v[0] - n[0]).abs() < 1e-14 && (v[1] - n[1]).abs() < 1e-14, "{g}: {v:?}");
+            }
+        }
+        let b = box_tet([0.0; 3], [1.0, 2.0, 1.0], 2, 2, 2);
+        assert_eq!(b.check_topology(), Ok(0));
+        for v in b.outward_normals("bottom").unwrap() {
+            assert!((v[2] + 1.0).abs() < 1e-14, "{v:?}");
+        }
+    }
+
+    #[test]
+    fn broken_topology_is_named() {
+        // a cell listed twice
+        let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 2, 2);
+        let c0 = m.cell(0).to_vec();
+        m.cells.extend_from_slice(&c0);
+        assert!(matches!(m.check_topology(), Err(MeshError::OverlappingCells { .. })));
+        // a boundary facet listed twice (two physical groups of one name)
+        let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 2, 2);
+        let g = m.boundaries.get_mut("bottom").unwrap();
+        let first = g.facet(0).to_vec();
+        g.facets.extend_from_slice(&first);
+        let e = m.check_topology().unwrap_err().to_string();
+        assert!(e.contains("listed twice"), "{e}");
+        // an interior facet in a group: the diagonal of the first square
+        let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 2, 2);
+        let diag = {
+            let c = m.cell(0);
+            let f = m.cell(1);
+            let shared: Vec<usize> = c.iter().copied().filter(|v| f.contains(v)).collect();
+            shared
+        };
+        m.boundaries.get_mut("top").unwrap().facets.extend_from_slice(&diag);
+        let e = m.check_topology().unwrap_err().to_string();
+        assert!(e.contains("lies inside the mesh"), "{e}");
+        // a crack: the diagonal of a square with its two nodes doubled is counted, not refused
+        let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1);
+        let (c0, c1) = (m.cell(0).to_vec(), m.cell(1).to_vec());
+        let shared: Vec<usize> = c0.iter().copied().filter(|v| c1.contains(v)).collect();
+        for (k, &v) in shared.iter().enumerate() {
+            m.points.push(m.points[v]);
+            let copy = m.points.len() - 1;
+            for slot in &mut m.cells[3..6] {
+                if *slot == v {
+                    *slot = copy;
+                }
+            }
+            assert!(k < 2);
+        }
+        m.boundaries.clear();
+        assert_eq!(m.check_topology(), Ok(2));
+    }
+}
