@@ -155,8 +155,10 @@ fn paper_rule_is_labelled_and_reproduces_the_table_counts() {
     // the paper's Table 1 at h = 1/32: 3 fixed-point, 39 Uzawa, 2 PCG iterations (per solve)
     assert_eq!(it.fixed_point, 3);
     let uz = it.uzawa;
-    // 39 with exact inner solves (solver.pcg_tol=1e-12), 43 with the paper's loose PCG
-    assert!((39..=45).contains(&uz), "Uzawa iterations: {uz}");
+    // 39 with exact inner solves (solver.pcg_tol=1e-12); with the paper's loose PCG the step
+    // r = 1.8/μ_max comes from inexact solves, and the count moves a little: 38 since μ_max is
+    // estimated from the contact forces alone (no cancellation against the loads), 43 before
+    assert!((36..=45).contains(&uz), "Uzawa iterations: {uz}");
     let pcg_per_solve = it.pcg as f64 / (uz as f64 + 1.0);
     assert!(pcg_per_solve <= 3.0, "PCG iterations per Uzawa solve: {pcg_per_solve}");
     let exact = run(

@@ -49,6 +49,22 @@ impl Default for NewtonParams {
     }
 }
 
+/// `(Σ w_j x_j²)^½`; where the sum of squares would overflow or underflow, scaled by the
+/// largest entry first.
+fn weighted_norm(x: &[f64], w: &[f64]) -> f64 {
+    // divided by s: `1/s` overflows for a subnormal s
+    let sum = |s: f64| x.iter().zip(w).map(|(v, w)| w * (v / s) * (v / s)).sum::<f64>();
+    let plain = sum(1.0);
+    if crate::projection::trusted(plain) || x.iter().all(|v| *v == 0.0) {
+        return plain.sqrt();
+    }
+    let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return if x.iter().any(|v| v.is_nan()) { f64::NAN } else { scale };
+    }
+    scale * sum(scale).sqrt()
+}
+
 /// Armijo's sufficient-decrease constant.
 const ARMIJO: f64 = 1e-4;
 /// Merit values the non-monotone line search compares with.
@@ -129,7 +145,7 @@ impl Flat<'_> {
                 }
             }
         }
-        let norm = f.iter().zip(&self.w).map(|(a, w)| w * a * a).sum::<f64>().sqrt();
+        let norm = weighted_norm(&f, &self.w);
         State { x, u, z, f, norm }
     }
 
@@ -151,7 +167,7 @@ impl Flat<'_> {
             }
             let t = n + i * nt;
             let q = &s.z[t..t + nt];
-            let qn = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let qn = crate::projection::norm(q);
             let radius = self.radius(i, &s.z);
             let branch = if !(radius > 0.0) {
                 Branch::Separated
@@ -177,7 +193,7 @@ impl Flat<'_> {
                         };
                         row.e.push((t + k, 1.0));
                         for l in 0..nt {
-                            let proj = if k == l { 1.0 } else { 0.0 } - q[k] * q[l] / (qn * qn);
+                            let proj = if k == l { 1.0 } else { 0.0 } - (q[k] / qn) * (q[l] / qn);
                             if proj != 0.0 {
                                 row.e.push((t + l, -ratio * proj));
                                 row.b.push((t + l, ratio * proj));
@@ -440,8 +456,15 @@ pub fn solve_newton(
                 reason: why.to_string(),
             });
         }
+        let lambda = flat.to_values(&s.x);
+        progress(&Progress {
+            stage: Stage::Fallback,
+            iter: info.newton_iters,
+            residual: r,
+            counts: counts(&classify(&lambda, &slip_bound(points, law, &lambda.normal))),
+        });
         // the first-order method from the multipliers reached, projected onto the sets
-        let mut start = flat.to_values(&s.x);
+        let mut start = lambda;
         start.normal.iter_mut().for_each(|v| *v = v.max(0.0));
         let radius = slip_bound(points, law, &start.normal);
         for i in 0..n {

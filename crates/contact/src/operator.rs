@@ -17,6 +17,26 @@ pub trait ContactOperator {
     /// # Errors
     /// An [`OperatorError`] that carries the primal solver's own error.
     fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError>;
+
+    /// The contact displacement under the contact forces of `lambda` alone, without the loads:
+    /// `-D W λ`, the linear part of [`ContactOperator::displacement`]. The default takes the
+    /// difference of two calls, `u(λ) - u(0)`, which loses the digits of `D W λ` where the loads
+    /// are far larger than `λ`; an operator that can apply the forces alone should.
+    ///
+    /// # Errors
+    /// As [`ContactOperator::displacement`].
+    fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+        let zero = PointValues::zeros(lambda.n_points(), lambda.n_tangential());
+        let mut u0 = zero.clone();
+        let inner = self.displacement(&zero, &mut u0)? + self.displacement(lambda, out)?;
+        for (o, z) in out.normal.iter_mut().zip(&u0.normal) {
+            *o -= z;
+        }
+        for (o, z) in out.tangential.iter_mut().zip(&u0.tangential) {
+            *o -= z;
+        }
+        Ok(inner)
+    }
 }
 
 /// An affine contact problem given densely: `u = u0 - D W λ` with `D` symmetric positive
@@ -49,6 +69,18 @@ impl ContactOperator for DenseContactProblem {
         self.nt
     }
     fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+        self.apply(lambda, out, true);
+        Ok(0)
+    }
+    fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+        self.apply(lambda, out, false);
+        Ok(0)
+    }
+}
+
+impl DenseContactProblem {
+    /// `out = u0 - D W λ` (`with_loads`) or `-D W λ`.
+    fn apply(&self, lambda: &PointValues, out: &mut PointValues, with_loads: bool) {
         let n = self.weight.len();
         let m = self.m();
         // W λ in the flat layout
@@ -62,13 +94,13 @@ impl ContactOperator for DenseContactProblem {
         for r in 0..m {
             let row = &self.compliance[r * m..(r + 1) * m];
             let dot = dot8(row, &wl);
-            if r < n {
-                out.normal[r] = self.u0.normal[r] - dot;
+            let (slot, load) = if r < n {
+                (&mut out.normal[r], self.u0.normal[r])
             } else {
-                out.tangential[r - n] = self.u0.tangential[r - n] - dot;
-            }
+                (&mut out.tangential[r - n], self.u0.tangential[r - n])
+            };
+            *slot = if with_loads { load - dot } else { -dot };
         }
-        Ok(0)
     }
 }
 

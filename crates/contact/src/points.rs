@@ -127,23 +127,39 @@ impl PointValues {
 
     /// The Euclidean norm of the tangential components of point `i`.
     pub fn tangential_norm(&self, i: usize) -> f64 {
-        self.tangential_sq(i).sqrt()
+        crate::projection::norm(self.tangential_of(i))
     }
 
-    fn tangential_sq(&self, i: usize) -> f64 {
-        self.tangential_of(i).iter().map(|x| x * x).sum()
-    }
-
-    /// Weighted 2-norm `(Σ w_i |x_i|²)^½` over both parts.
+    /// Weighted 2-norm `(Σ w_i |x_i|²)^½` over both parts; where the sum of squares would
+    /// overflow or underflow (data near 1e±150 and beyond), scaled by the largest entry first.
     pub fn weighted_norm(&self, w: &[f64]) -> f64 {
-        let mut s = 0.0;
+        let plain = self.weighted_sum_of_squares(w, 1.0);
+        if crate::projection::trusted(plain)
+            || plain == 0.0 && !self.normal.iter().chain(&self.tangential).any(|x| *x != 0.0)
+        {
+            return plain.sqrt();
+        }
+        let scale = self
+            .normal
+            .iter()
+            .chain(&self.tangential)
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        if scale == 0.0 || !scale.is_finite() {
+            return if self.is_finite() { scale } else { f64::NAN };
+        }
+        scale * self.weighted_sum_of_squares(w, scale).sqrt()
+    }
+
+    /// `Σ w_i |x_i / s|²` (a division: `1/s` overflows for a subnormal `s`).
+    fn weighted_sum_of_squares(&self, w: &[f64], s: f64) -> f64 {
+        let mut sum = 0.0;
         for (i, &wi) in w.iter().enumerate() {
-            s += wi * self.normal[i] * self.normal[i];
+            sum += wi * (self.normal[i] / s) * (self.normal[i] / s);
             for x in self.tangential_of(i) {
-                s += wi * x * x;
+                sum += wi * (x / s) * (x / s);
             }
         }
-        s.sqrt()
+        sum
     }
 
     /// Weighted inner product `Σ w_i (x_i · y_i)` over both parts.

@@ -1,5 +1,24 @@
 //! The projections onto the multiplier sets, each written once and used everywhere.
 
+/// The squares' sum of a norm, kept where it can be trusted: far from the ends of the range
+/// of `f64`, where it neither overflowed nor lost its digits to underflow.
+#[inline]
+pub(crate) fn trusted(sum_of_squares: f64) -> bool {
+    sum_of_squares > 1e-290 && sum_of_squares < 1e290
+}
+
+/// The Euclidean norm of a short vector (a point's tangential components), with no overflow
+/// or underflow in the squares, whatever the size of the data.
+#[inline]
+pub fn norm(x: &[f64]) -> f64 {
+    let s: f64 = x.iter().map(|v| v * v).sum();
+    if trusted(s) {
+        s.sqrt()
+    } else {
+        x.iter().fold(0.0, |a, &v| a.hypot(v))
+    }
+}
+
 /// Projection onto the normal cone `{λ_n ≥ 0}`: a clamp at zero. (NaN maps to 0.)
 #[inline]
 pub fn project_nonnegative(x: f64) -> f64 {
@@ -18,7 +37,7 @@ pub fn project_disc(x: &mut [f64], radius: f64) {
         x.iter_mut().for_each(|v| *v = 0.0);
         return;
     }
-    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let norm = norm(x);
     if norm > radius {
         let s = radius / norm;
         x.iter_mut().for_each(|v| *v *= s);

@@ -104,15 +104,18 @@ pub enum Stage {
     FixedPoint,
     /// A semismooth Newton step.
     Newton,
+    /// Newton stalled: the accelerated gradient takes over (one line, then its own steps).
+    Fallback,
 }
 
 impl Stage {
-    /// Lower-case name (`uzawa`, `fixed-point`, `newton`).
+    /// Lower-case name (`uzawa`, `fixed-point`, `newton`, `fallback`).
     pub fn name(self) -> &'static str {
         match self {
             Stage::Uzawa => "uzawa",
             Stage::FixedPoint => "fixed-point",
             Stage::Newton => "newton",
+            Stage::Fallback => "fallback",
         }
     }
 }
@@ -265,11 +268,19 @@ impl<'a> Counter<'a> {
             .map_err(|e: OperatorError| ContactError::Operator(e))?;
         Ok(())
     }
+
+    /// [`ContactOperator::forces_alone`], counted.
+    fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<(), ContactError> {
+        self.calls += 1;
+        self.inner += self.op.forces_alone(lambda, out).map_err(ContactError::Operator)?;
+        Ok(())
+    }
 }
 
-/// Largest eigenvalue of the dual operator `λ ↦ u(0) - u(λ)` in the `W` inner product, by
-/// power iteration (a Rayleigh quotient, so a lower estimate); also returns `u(0)`, the
-/// contact displacement under the loads alone.
+/// Largest eigenvalue of the dual operator `λ ↦ u(0) - u(λ) = D W λ` in the `W` inner product,
+/// by power iteration (a Rayleigh quotient, so a lower estimate), applied through
+/// [`ContactOperator::forces_alone`] (no cancellation against the loads, whatever their size);
+/// also returns `u(0)`, the contact displacement under the loads alone.
 pub(crate) fn estimate_mu_max(
     c: &mut Counter<'_>,
     points: &ContactPoints,
@@ -298,8 +309,12 @@ pub(crate) fn estimate_mu_max(
             .iter_mut()
             .chain(v.tangential.iter_mut())
             .for_each(|x| *x /= nv);
-        c.call(&v, &mut out)?;
-        let mv = u0.minus(&out);
+        c.forces_alone(&v, &mut out)?;
+        let mut mv = out.clone();
+        mv.normal
+            .iter_mut()
+            .chain(mv.tangential.iter_mut())
+            .for_each(|x| *x = -*x);
         mu = f64::max(mu, v.weighted_dot(&mv, &points.weight));
         v = mv;
     }

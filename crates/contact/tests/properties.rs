@@ -459,3 +459,60 @@ fn newton_falls_back_on_the_accelerated_gradient() {
         "{e}"
     );
 }
+
+/// Homogeneity over the whole range of `f64`: with the gap 0, the contact problem with the loads
+/// scaled by `s` has the solution scaled by `s` (the laws are positively homogeneous), so the
+/// solvers must return `s λ(1)` with the same statuses and iteration counts, for `s` from 1e-300
+/// to 1e300. Norms whose squares overflow or underflow (1e±150 and beyond) once made the
+/// projection onto the disc return 0 (a Coulomb problem solved as a frictionless one), and the
+/// power iteration see a zero eigenvalue where the loads dwarfed the unit multipliers.
+#[test]
+fn solutions_scale_with_the_data_over_the_whole_range() {
+    for dim in [2, 3] {
+        let (n, nt) = (6, dim - 1);
+        let seed: Vec<f64> = (0..40).map(|k| ((k * 37 % 17) as f64 - 8.0) / 9.0).collect();
+        let pts = points(n, dim, &seed, 0.4);
+        let load: Vec<f64> = (0..n * (1 + nt))
+            .map(|k| {
+                if k < n {
+                    1.0 + 0.1 * k as f64
+                } else {
+                    0.3 * (k as f64).sin()
+                }
+            })
+            .collect();
+        let reference = {
+            let mut p = problem(n, nt, &pts, &seed, &load);
+            solve_newton(&mut p, &pts, &Law::Coulomb, &NewtonParams::default(), None, &mut |_| {}).unwrap()
+        };
+        for s in [1e-300, 1e-200, 1e-150, 1e-100, 1e100, 1e150, 1e200, 1e300] {
+            let scaled: Vec<f64> = load.iter().map(|x| x * s).collect();
+            let mut p = problem(n, nt, &pts, &seed, &scaled);
+            let newton = solve_newton(&mut p, &pts, &Law::Coulomb, &NewtonParams::default(), None, &mut |_| {})
+                .unwrap_or_else(|e| panic!("{dim}D, s = {s:e}: {e}"));
+            let mut p = problem(n, nt, &pts, &seed, &scaled);
+            let apg = UzawaParams {
+                accelerate: true,
+                ..tight(1e-12)
+            };
+            let first_order = solve(&mut p, &pts, &Law::Coulomb, &apg, None, &mut |_| {})
+                .unwrap_or_else(|e| panic!("{dim}D, s = {s:e}: {e}"));
+            for (what, sol) in [("Newton", &newton), ("APG", &first_order)] {
+                assert_eq!(sol.status, reference.status, "{what} {dim}D, s = {s:e}");
+                let lambda = sol.lambda.normal.iter().chain(&sol.lambda.tangential);
+                let expected = reference.lambda.normal.iter().chain(&reference.lambda.tangential);
+                for (a, b) in lambda.zip(expected) {
+                    assert!(
+                        (a / s - b).abs() <= 1e-8 * reference.lambda.norm(),
+                        "{what} {dim}D, s = {s:e}: {a:e} vs {b}"
+                    );
+                }
+            }
+            assert!(!newton.info.fallback, "{dim}D, s = {s:e}: Newton fell back");
+            assert_eq!(
+                newton.info.newton_iters, reference.info.newton_iters,
+                "{dim}D, s = {s:e}"
+            );
+        }
+    }
+}

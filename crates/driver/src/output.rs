@@ -183,9 +183,11 @@ fn vtu(solution: &Solution) -> Result<Vec<u8>, DriverError> {
     Ok(buf)
 }
 
-/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`.
+/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`;
+/// the displacements are those of the final solution (a frictionless body slides: its `u_t`
+/// is written too), the tangential multipliers 0 where the law carries none.
 fn contact_csv(c: &ContactResult) -> Vec<u8> {
-    let (points, sol) = (&c.points, &c.solution);
+    let (points, sol, u) = (&c.points, &c.solution, &c.displacement);
     let dim = points.dim;
     let nt = sol.lambda.n_tangential();
     let mut s = String::new();
@@ -197,12 +199,9 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
     for i in 0..points.len() {
         let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| format!("{x:.12e}")).collect();
         row.push(format!("{:.12e}", points.gap[i]));
-        row.push(format!("{:.12e}", sol.u.normal[i]));
-        for q in 0..dim - 1 {
-            row.push(format!(
-                "{:.12e}",
-                if nt > 0 { sol.u.tangential[i * nt + q] } else { 0.0 }
-            ));
+        row.push(format!("{:.12e}", u.normal[i]));
+        for &ut in u.tangential_of(i) {
+            row.push(format!("{ut:.12e}"));
         }
         row.push(format!("{:.12e}", sol.lambda.normal[i]));
         for q in 0..dim - 1 {

@@ -200,7 +200,11 @@ impl CoupledSolver for DirectLdlt {
     }
 }
 
-/// `‖K x - b‖₂ / ‖b‖₂` from the blocks (`‖K x - b‖₂` when `b = 0`).
+/// `‖K x - b‖₂ / max(‖b‖₂, scale)` from the blocks (`‖K x - b‖₂` when both are 0). `scale`
+/// is the size of the parts `b` is made of, for a `b` whose parts cancel (loads balanced by
+/// contact forces: `‖b‖` then says nothing of the error's size). The norms are scaled, so the
+/// residual is the same for data of any magnitude.
+#[allow(clippy::too_many_arguments)]
 pub fn equilibrium_residual(
     a: &SparseColMat<usize, f64>,
     g: &SparseColMat<usize, f64>,
@@ -209,6 +213,7 @@ pub fn equilibrium_residual(
     phi: &[f64],
     b_u: &[f64],
     b_phi: &[f64],
+    scale: f64,
 ) -> f64 {
     let mut ru: Vec<f64> = b_u.iter().map(|x| -x).collect();
     mul_add(a.as_ref(), u, &mut ru, 1.0);
@@ -216,8 +221,16 @@ pub fn equilibrium_residual(
     let mut rp: Vec<f64> = b_phi.iter().map(|x| -x).collect();
     mul_add(g.as_ref(), u, &mut rp, 1.0);
     mul_add(b.as_ref(), phi, &mut rp, -1.0);
-    let num = (crate::pcg::dot(&ru, &ru) + crate::pcg::dot(&rp, &rp)).sqrt();
-    let den = (crate::pcg::dot(b_u, b_u) + crate::pcg::dot(b_phi, b_phi)).sqrt();
+    let both = |a: &[f64], b: &[f64]| {
+        let s = crate::pcg::dot(a, a) + crate::pcg::dot(b, b);
+        if s > 1e-290 && s < 1e290 {
+            s.sqrt()
+        } else {
+            crate::pcg::norm(a).hypot(crate::pcg::norm(b))
+        }
+    };
+    let num = both(&ru, &rp);
+    let den = both(b_u, b_phi).max(scale);
     if den > 0.0 {
         num / den
     } else {

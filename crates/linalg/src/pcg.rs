@@ -157,7 +157,18 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// Euclidean norm.
+/// Euclidean norm; where the sum of squares would overflow or underflow (entries near 1e±150
+/// and beyond), scaled by the largest entry first.
 pub fn norm(a: &[f64]) -> f64 {
-    dot(a, a).sqrt()
+    let plain = dot(a, a);
+    if plain > 1e-290 && plain < 1e290 || a.iter().all(|x| *x == 0.0) {
+        return plain.sqrt();
+    }
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        // zero, or a NaN or infinity that the caller must see
+        return if a.iter().any(|x| x.is_nan()) { f64::NAN } else { scale };
+    }
+    // divided by scale: `1/scale` overflows for a subnormal scale
+    scale * a.iter().map(|x| (x / scale) * (x / scale)).sum::<f64>().sqrt()
 }

@@ -297,13 +297,21 @@ fn orient_block(points: &[[f64; 3]], cells: &mut [usize], kind: CellKind, first:
 /// The node tags of the `$Nodes` section, in the order of its blocks (ASCII or binary, as the
 /// `$MeshFormat` line says; binary in either byte order, as the one written after it says).
 pub(crate) fn node_tags(bytes: &[u8]) -> Result<Vec<u64>, String> {
-    let binary = bytes.split(|&b| b == b'\n').nth(1).is_some_and(|l| l.split(|&b| b == b' ').nth(1) == Some(b"1"));
+    let binary = bytes
+        .split(|&b| b == b'\n')
+        .nth(1)
+        .is_some_and(|l| l.split(|&b| b == b' ').nth(1) == Some(b"1"));
     // the section follows `$EndEntities` (binary data before it could hold any bytes)
     let from = find(bytes, b"$EndEntities").unwrap_or(0);
     let start = find(&bytes[from..], b"$Nodes\n").ok_or("no `$Nodes` section")? + from + 7;
     if binary {
         // the int 1 written right after the `$MeshFormat` line tells the byte order
-        let after_header = bytes.iter().enumerate().filter(|(_, &b)| b == b'\n').nth(1).map_or(0, |(i, _)| i + 1);
+        let after_header = bytes
+            .iter()
+            .enumerate()
+            .filter(|(_, &b)| b == b'\n')
+            .nth(1)
+            .map_or(0, |(i, _)| i + 1);
         let big = bytes.get(after_header..after_header + 4) == Some(&1i32.to_be_bytes()[..]);
         binary_node_tags(&bytes[start..], !big)
     } else {
@@ -321,7 +329,8 @@ fn token<'t>(tokens: &mut impl Iterator<Item = &'t str>, what: &str) -> Result<&
 /// The next token of `$Nodes` as a whole number.
 fn whole<'t>(tokens: &mut impl Iterator<Item = &'t str>, what: &str) -> Result<u64, String> {
     let t = token(tokens, what)?;
-    t.parse::<u64>().map_err(|_| format!("`$Nodes`: {what} `{t}` is not a whole number"))
+    t.parse::<u64>()
+        .map_err(|_| format!("`$Nodes`: {what} `{t}` is not a whole number"))
 }
 
 fn ascii_node_tags(text: &str) -> Result<Vec<u64>, String> {
@@ -357,11 +366,19 @@ fn binary_node_tags(data: &[u8], little: bool) -> Result<Vec<u64>, String> {
     };
     let word = |b: &[u8]| -> u64 {
         let a: [u8; 8] = b.try_into().unwrap_or_default();
-        if little { u64::from_le_bytes(a) } else { u64::from_be_bytes(a) }
+        if little {
+            u64::from_le_bytes(a)
+        } else {
+            u64::from_be_bytes(a)
+        }
     };
     let int = |b: &[u8]| -> i32 {
         let a: [u8; 4] = b.try_into().unwrap_or_default();
-        if little { i32::from_le_bytes(a) } else { i32::from_be_bytes(a) }
+        if little {
+            i32::from_le_bytes(a)
+        } else {
+            i32::from_be_bytes(a)
+        }
     };
     let blocks = word(take(8)?);
     take(24)?; // the node count, the smallest and the largest tag

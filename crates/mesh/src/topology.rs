@@ -94,7 +94,12 @@ impl Mesh {
                 match on {
                     0 => return Err(bad(*f, "is not a facet of any cell")),
                     1 => {}
-                    _ => return Err(bad(*f, "lies inside the mesh (two cells share it): a boundary group holds boundary facets only")),
+                    _ => {
+                        return Err(bad(
+                            *f,
+                            "lies inside the mesh (two cells share it): a boundary group holds boundary facets only",
+                        ))
+                    }
                 }
             }
         }
@@ -141,7 +146,12 @@ impl Mesh {
                 crate::generate::triangle_normal(&self.points, facet)
             };
             // a node of the cell off the facet lies inside: the normal points away from it
-            let inside = self.cell(owner).iter().copied().find(|v| !facet.contains(v)).unwrap_or(facet[0]);
+            let inside = self
+                .cell(owner)
+                .iter()
+                .copied()
+                .find(|v| !facet.contains(v))
+                .unwrap_or(facet[0]);
             let a = p(facet[0]);
             let towards: f64 = (0..3).map(|k| n[k] * (p(inside)[k] - a[k])).sum();
             let len = crate::scaled_norm(&n);
@@ -160,7 +170,12 @@ mod tests {
     fn a_conforming_mesh_passes_and_its_normals_point_out() {
         let m = rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2);
         assert_eq!(m.check_topology(), Ok(0));
-        for (g, n) in [("bottom", [0.0, -1.0]), ("top", [0.0, 1.0]), ("left", [-1.0, 0.0]), ("right", [1.0, 0.0])] {
+        for (g, n) in [
+            ("bottom", [0.0, -1.0]),
+            ("top", [0.0, 1.0]),
+            ("left", [-1.0, 0.0]),
+            ("right", [1.0, 0.0]),
+        ] {
             for v in m.outward_normals(g).unwrap() {
                 assert!((v[0] - n[0]).abs() < 1e-14 && (v[1] - n[1]).abs() < 1e-14, "{g}: {v:?}");
             }

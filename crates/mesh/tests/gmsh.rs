@@ -171,11 +171,12 @@ fn renumber_ascii(text: &str, perm: &dyn Fn(u64) -> u64) -> String {
 
 /// The same for a binary file (size_t of 8 bytes, little endian, as Gmsh writes it here).
 fn renumber_binary(bytes: &[u8], perm: &dyn Fn(u64) -> u64) -> Vec<u8> {
-    let find = |from: usize, needle: &[u8]| bytes[from..].windows(needle.len()).position(|w| w == needle).unwrap() + from;
+    let find =
+        |from: usize, needle: &[u8]| bytes[from..].windows(needle.len()).position(|w| w == needle).unwrap() + from;
     let mut out = bytes.to_vec();
     let word = |b: &[u8], at: usize| u64::from_le_bytes(b[at..at + 8].try_into().unwrap());
     let int = |b: &[u8], at: usize| i32::from_le_bytes(b[at..at + 4].try_into().unwrap());
-    let mut put = |out: &mut Vec<u8>, at: usize| {
+    let put = |out: &mut Vec<u8>, at: usize| {
         let t = word(bytes, at);
         out[at..at + 8].copy_from_slice(&perm(t).to_le_bytes());
     };
@@ -216,11 +217,15 @@ fn renumber_binary(bytes: &[u8], perm: &dyn Fn(u64) -> u64) -> Vec<u8> {
     out
 }
 
-/// The cells of a mesh as sets of coordinates (independent of the node numbering), sorted.
-fn geometry(m: &mesh::Mesh) -> (Vec<Vec<[i64; 3]>>, Vec<(String, Vec<Vec<[i64; 3]>>)>) {
+/// Cells or facets, each as its nodes' (rounded) coordinates, sorted.
+type Shapes = Vec<Vec<[i64; 3]>>;
+
+/// The cells of a mesh and of each boundary group as sets of coordinates (independent of the
+/// node numbering).
+fn geometry(m: &mesh::Mesh) -> (Shapes, Vec<(String, Shapes)>) {
     let key = |v: usize| m.points[v].map(|x| (x * 1e9).round() as i64);
-    let sorted = |items: Vec<Vec<[i64; 3]>>| {
-        let mut items: Vec<Vec<[i64; 3]>> = items
+    let sorted = |items: Shapes| {
+        let mut items: Shapes = items
             .into_iter()
             .map(|mut c| {
                 c.sort();
@@ -234,7 +239,12 @@ fn geometry(m: &mesh::Mesh) -> (Vec<Vec<[i64; 3]>>, Vec<(String, Vec<Vec<[i64; 3
     let groups = m
         .boundaries
         .iter()
-        .map(|(name, g)| (name.clone(), sorted(g.iter().map(|f| f.iter().map(|&v| key(v)).collect()).collect())))
+        .map(|(name, g)| {
+            (
+                name.clone(),
+                sorted(g.iter().map(|f| f.iter().map(|&v| key(v)).collect()).collect()),
+            )
+        })
         .collect();
     (cells, groups)
 }
@@ -272,7 +282,8 @@ fn a_wholly_inverted_tet_mesh_is_refused() {
     let m = read_msh_bytes(&bytes, "box.msh").unwrap();
     assert_eq!(m.reoriented_cells, 0);
     // swap two nodes of every tetrahedron: all inverted
-    let find = |from: usize, needle: &[u8]| bytes[from..].windows(needle.len()).position(|w| w == needle).unwrap() + from;
+    let find =
+        |from: usize, needle: &[u8]| bytes[from..].windows(needle.len()).position(|w| w == needle).unwrap() + from;
     let mut out = bytes.clone();
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
     let mut at = find(0, b"$Elements\n") + 10;

@@ -48,9 +48,16 @@ fn tangent_basis(dim: usize, n: [f64; 3]) -> [[f64; 3]; 2] {
     [t1, t2]
 }
 
-/// The unit normal of a validated spec in dimension `dim`.
+/// The largest angle between `contact.normal` and the outward normal of a facet of the
+/// contact group: beyond it the given normal does not describe the face (pointing into the
+/// body, it would let the body pass through the foundation; tangent to it, it would turn the
+/// contact force sideways). 45° lets a mildly curved face keep one normal.
+pub const MAX_NORMAL_ANGLE_DEG: f64 = 45.0;
+
+/// The unit normal of a validated spec in dimension `dim` (scaled, so that tiny or huge
+/// components neither underflow nor overflow).
 fn unit_normal(spec: &ContactSpec, dim: usize) -> Result<[f64; 3], SceneError> {
-    let len = spec.normal.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let len = mesh::scaled_norm(&spec.normal);
     if !(len > 0.0) || !len.is_finite() {
         return Err(SceneError::new(
             "contact.normal",
@@ -62,6 +69,31 @@ fn unit_normal(spec: &ContactSpec, dim: usize) -> Result<[f64; 3], SceneError> {
         nv[k] = spec.normal[k] / len;
     }
     Ok(nv)
+}
+
+/// Checks the unit normal `nv` against the outward normal of every facet of the group.
+fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(), ProblemError> {
+    let g = mesh.boundary(&spec.group)?;
+    for (f, out) in mesh.outward_normals(&spec.group)?.iter().enumerate() {
+        let cos: f64 = (0..3).map(|k| out[k] * nv[k]).sum();
+        let angle = cos.clamp(-1.0, 1.0).acos().to_degrees();
+        if angle > MAX_NORMAL_ANGLE_DEG {
+            let at = mesh.points[g.facet(f)[0]];
+            let shown: Vec<String> = out[..mesh.dim].iter().map(|x| format!("{x:.3}")).collect();
+            return Err(SceneError::new(
+                "contact.normal",
+                format!(
+                    "contact.normal {:?} makes {angle:.0}° with the outward normal [{}] of facet {f} of `{}` (at {:?}); it must point out of the body, within {MAX_NORMAL_ANGLE_DEG}° of every facet's",
+                    spec.normal,
+                    shown.join(", "),
+                    spec.group,
+                    &at[..mesh.dim]
+                ),
+            )
+            .into());
+        }
+    }
+    Ok(())
 }
 
 /// Lumped boundary mass of each node on `group`: each facet's measure shared equally among its
@@ -92,6 +124,7 @@ impl ContactBoundary {
             None => [0.0; 3],
         };
         let nv = unit_normal(spec, dim)?;
+        check_normal(mesh, spec, nv)?;
         let tangents = tangent_basis(dim, nv);
         let group = mesh.boundary(&spec.group)?;
         let weight = lumped_weights(mesh, group);
@@ -290,6 +323,18 @@ impl ContactOperator for FullSolve<'_> {
             .solve(&rhs, self.b_phi, &mut self.u, &mut self.phi)
             .map_err(OperatorError::new)?;
         self.boundary.extract(&self.u, out);
+        Ok(info.pcg_iters)
+    }
+    fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+        let mut rhs = vec![0.0; self.b_u.len()];
+        self.boundary.add_forces(lambda, &mut rhs);
+        let (mut u, mut phi) = (vec![0.0; self.u.len()], vec![0.0; self.phi.len()]);
+        let zero = vec![0.0; self.b_phi.len()];
+        let info = self
+            .solver
+            .solve(&rhs, &zero, &mut u, &mut phi)
+            .map_err(OperatorError::new)?;
+        self.boundary.extract(&u, out);
         Ok(info.pcg_iters)
     }
 }

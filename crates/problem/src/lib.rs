@@ -98,6 +98,15 @@ pub enum ProblemError {
     /// A linear-algebra failure.
     #[error("linear solve: {0}")]
     Linalg(#[from] linalg::LinalgError),
+    /// A result that is not a finite number: the data overflow (or underflow) double
+    /// precision, or the problem is singular.
+    #[error("{what} is not finite: {cause}")]
+    NotFinite {
+        /// The result.
+        what: &'static str,
+        /// The inputs that most likely overflowed, or what else it may be.
+        cause: String,
+    },
     /// The contact solve failed (with its last residual), and what else to try.
     #[error("contact: {source}{hint}")]
     Contact {
@@ -109,6 +118,25 @@ pub enum ProblemError {
 }
 
 impl ProblemError {
+    /// `Ok` when every value is finite, else [`ProblemError::NotFinite`] naming `what` and the
+    /// scene's most extreme numbers.
+    pub fn check_finite(values: &[f64], what: &'static str, scene: &Scene) -> Result<(), ProblemError> {
+        if values.iter().all(|v| v.is_finite()) {
+            return Ok(());
+        }
+        let extreme = scene.extreme_numbers();
+        let cause = if extreme.is_empty() {
+            "no input is extreme (all within 1e-100 to 1e100 in magnitude): the problem may be singular".to_string()
+        } else {
+            let named: Vec<String> = extreme.iter().take(3).map(|(k, v)| format!("{k} = {v:e}")).collect();
+            format!(
+                "the data overflow double precision; the most extreme inputs are {} (bring them nearer 1, e.g. by a change of units)",
+                named.join(", ")
+            )
+        };
+        Err(ProblemError::NotFinite { what, cause })
+    }
+
     /// A contact error of a run of `strategy`, with a hint that names only what it did not try.
     pub fn contact(source: ContactError, strategy: Strategy) -> Self {
         let newton = strategy == Strategy::NewtonCondensed;

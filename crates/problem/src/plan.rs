@@ -52,8 +52,7 @@ impl Plan {
     /// Decides what the run of `scene` needs, on a mesh of dimension `dim` with `materials`.
     pub fn new(scene: &Scene, dim: usize, materials: &[(String, Material)]) -> Plan {
         let coupling = materials.iter().any(|(_, m)| m.e.iter().any(|&x| x != 0.0));
-        let electric_data = scene.electrode.as_ref().is_some_and(|e| e.v != 0.0);
-        let electric = (coupling || electric_data) && materials.iter().any(|(_, m)| m.electric);
+        let electric = (coupling || electric_data(scene)) && materials.iter().any(|(_, m)| m.electric);
         let law = scene.contact_law();
         let friction = scene.contact.as_ref().is_some_and(|c| match law {
             ContactLaw::Coulomb => c.friction() > 0.0,
@@ -99,6 +98,13 @@ impl Plan {
     pub fn writes(&self, output: Output) -> bool {
         self.outputs.contains(&output)
     }
+}
+
+/// Whether the scene prescribes a non-zero potential (an electrode's voltage or a Dirichlet
+/// potential): electric data that needs electric unknowns even without coupling.
+pub fn electric_data(scene: &Scene) -> bool {
+    scene.electrode.as_ref().is_some_and(|e| e.v != 0.0)
+        || scene.dirichlet.iter().any(|d| d.phi.is_some_and(|p| p != 0.0))
 }
 
 impl fmt::Display for Plan {

@@ -11,6 +11,8 @@ use std::fmt;
 pub enum Event<'a> {
     /// The plan is made.
     Planned(&'a Plan),
+    /// The mesh's checks noted something without refusing the mesh.
+    MeshNotes(crate::setup::MeshNotes),
     /// The blocks and loads are assembled.
     Assembled {
         /// Mesh nodes.
@@ -95,6 +97,11 @@ impl fmt::Display for Event<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Event::Planned(plan) => write!(f, "{plan}"),
+            Event::MeshNotes(n) => write!(
+                f,
+                "note: the mesh reader turned {} cells round (a surface written clockwise); {} nodes lie at the coordinates of another node (a crack, or parts not merged)",
+                n.reoriented_cells, n.coincident_nodes
+            ),
             Event::Assembled {
                 n_nodes,
                 n_cells,
@@ -110,6 +117,11 @@ impl fmt::Display for Event<'_> {
             Event::Condensed { m, route, seconds } => write!(
                 f,
                 "condensed the contact compliance ({m} x {m}, {route:?}) in {seconds:.3} s"
+            ),
+            Event::Contact { progress: p, .. } if p.stage == contact::Stage::Fallback => write!(
+                f,
+                "semismooth Newton stalled after {} steps (residual {:.3e}): the accelerated gradient takes over from its multipliers (run.json: iterations.newton_fallback)",
+                p.iter, p.residual
             ),
             Event::Contact { progress: p, .. } => write!(
                 f,

@@ -60,6 +60,12 @@ pub struct MeshReport {
     pub h: f64,
     /// Cells per axis of a generated mesh (empty for a Gmsh mesh).
     pub cells_per_axis: Vec<usize>,
+    /// Cells the Gmsh reader turned round (a surface written clockwise).
+    #[serde(default)]
+    pub reoriented_cells: usize,
+    /// Nodes at the coordinates of another node (a crack, or parts not merged).
+    #[serde(default)]
+    pub coincident_nodes: usize,
 }
 
 /// Free unknowns.
@@ -118,7 +124,7 @@ impl ContactReport {
             n_slip,
             n_separated,
             normal_force,
-            tangential_force: (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt(),
+            tangential_force: linalg::norm(&t),
             max_lambda_n: Some(sol.lambda.normal.iter().cloned().fold(0.0f64, f64::max)),
         }
     }

@@ -11,11 +11,11 @@ use crate::report::{
     SolverReport, Timings,
 };
 use crate::scene::{ContactLaw, ContactSolver, Rule, Scene};
-use crate::setup::{setup, Setup};
+use crate::setup::{setup, MeshNotes, Setup};
 use crate::ProblemError;
 use contact::{
-    ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, Law, NewtonParams, StopRule,
-    UzawaParams,
+    ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, Law, NewtonParams, PointValues,
+    StopRule, UzawaParams,
 };
 use fe_assembly::{Blocks, CellFields, Discretization, Parallelism};
 use linalg::{equilibrium_residual, CondenseRoute, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
@@ -44,8 +44,12 @@ pub struct ContactResult {
     pub points: ContactPoints,
     /// The mesh node of each point.
     pub nodes: Vec<usize>,
-    /// Multipliers, displacements and status.
+    /// Multipliers, displacements and status, as the contact solver returned them (without
+    /// friction, the displacements have no tangential part).
     pub solution: ContactSolution,
+    /// `u_n` and all `dim - 1` components of `u_t` of the final displacement, whatever the law
+    /// (a frictionless body slides too).
+    pub displacement: PointValues,
 }
 
 /// Solves `scene`. `mesh` is the mesh of a `gmsh` scene, read by the caller (generated meshes
@@ -59,12 +63,17 @@ pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporte
     let setup = setup(scene, mesh)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     reporter.event(&Event::Planned(&setup.plan));
+    if setup.notes != MeshNotes::default() {
+        reporter.event(&Event::MeshNotes(setup.notes));
+    }
     let assembled = assemble(&setup, reporter)?;
+    check_assembled(scene, &assembled)?;
     let mut factored = factor(scene, &setup, &assembled, reporter)?;
     let solved = match factored.boundary.take() {
         Some(boundary) => solve_contact(scene, &setup.plan, &mut factored.solver, boundary, &assembled, reporter)?,
         None => solve_linear(&mut factored.solver, &assembled)?,
     };
+    check_solved(scene, &solved)?;
     let equilibrium = equilibrium(&assembled, &solved);
     reporter.event(&Event::Solved {
         seconds: solved.seconds,
@@ -72,6 +81,15 @@ pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporte
         equilibrium,
     });
     let recovered = recover(scene, &setup, &assembled, &solved, reporter);
+    let c = &recovered.contact;
+    let reported = [
+        equilibrium,
+        c.normal_force,
+        c.tangential_force,
+        recovered.exact.as_ref().map_or(0.0, |e| e.error()),
+    ];
+    ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
+    ProblemError::check_finite(&recovered.fields.stress, "the stress", scene)?;
     let times = Timings {
         setup: t_setup,
         assembly: assembled.seconds,
@@ -98,10 +116,15 @@ pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporte
         u: recovered.u,
         phi: recovered.phi,
         fields: recovered.fields,
-        contact: solved.contact.map(|(b, solution)| ContactResult {
-            points: b.points,
-            nodes: b.nodes,
-            solution,
+        contact: solved.contact.map(|(b, solution)| {
+            let mut displacement = PointValues::zeros(b.points.len(), b.points.n_tangential());
+            b.extract(&solved.u, &mut displacement);
+            ContactResult {
+                points: b.points,
+                nodes: b.nodes,
+                solution,
+                displacement,
+            }
         }),
     })
 }
@@ -137,6 +160,26 @@ fn assemble<'m>(setup: &'m Setup, reporter: &mut dyn Reporter) -> Result<Assembl
         b_phi,
         seconds,
     })
+}
+
+/// Checks the assembled blocks and loads for numbers that overflowed.
+fn check_assembled(scene: &Scene, a: &Assembled<'_>) -> Result<(), ProblemError> {
+    ProblemError::check_finite(&a.b_u, "the mechanical load vector", scene)?;
+    ProblemError::check_finite(&a.b_phi, "the electric load vector", scene)?;
+    ProblemError::check_finite(a.blocks.a.val(), "the stiffness matrix A", scene)?;
+    ProblemError::check_finite(a.blocks.g.val(), "the coupling matrix G", scene)?;
+    ProblemError::check_finite(a.blocks.b.val(), "the dielectric matrix B", scene)
+}
+
+/// Checks the solution for numbers that overflowed.
+fn check_solved(scene: &Scene, s: &Solved) -> Result<(), ProblemError> {
+    ProblemError::check_finite(&s.u, "the displacement", scene)?;
+    ProblemError::check_finite(&s.phi, "the potential", scene)?;
+    if let Some((_, sol)) = &s.contact {
+        ProblemError::check_finite(&sol.lambda.normal, "the contact pressure", scene)?;
+        ProblemError::check_finite(&sol.lambda.tangential, "the tangential multiplier", scene)?;
+    }
+    Ok(())
 }
 
 /// The linear solver the plan asks for, factored once.
@@ -376,14 +419,21 @@ fn solve_contact(
     })
 }
 
-/// The equilibrium residual of the final pair, with the contact forces in the right-hand side.
+/// The equilibrium residual of the final pair, with the contact forces in the right-hand side,
+/// relative to the larger of the loads and the contact forces (they may cancel in the sum: a
+/// load pressing the contact face straight into the foundation).
 fn equilibrium(a: &Assembled<'_>, s: &Solved) -> f64 {
     let mut b_full = a.b_u.clone();
+    let mut scale = linalg::norm(&a.b_u).hypot(linalg::norm(&a.b_phi));
     if let Some((cb, sol)) = &s.contact {
-        cb.add_forces(&sol.lambda, &mut b_full);
+        let forces = cb.forces(&sol.lambda);
+        scale = scale.max(linalg::norm(&forces));
+        for (&j, f) in cb.dofs.iter().zip(&forces) {
+            b_full[j] += f;
+        }
     }
     let b = &a.blocks;
-    equilibrium_residual(&b.a, &b.g, &b.b, &s.u, &s.phi, &b_full, &a.b_phi)
+    equilibrium_residual(&b.a, &b.g, &b.b, &s.u, &s.phi, &b_full, &a.b_phi, scale)
 }
 
 /// The nodal solution, the per-cell fields, and the error against the exact solution.
@@ -463,6 +513,8 @@ fn report(
             n_cells: setup.mesh.n_cells(),
             h: setup.mesh.h_max(),
             cells_per_axis: scene.mesh.cells_per_axis(),
+            reoriented_cells: setup.notes.reoriented_cells,
+            coincident_nodes: setup.notes.coincident_nodes,
         },
         dofs: DofsReport {
             u: a.disc.dofs.n_u,

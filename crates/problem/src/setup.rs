@@ -3,7 +3,7 @@
 //! loads.
 
 use crate::exact::FieldSolution;
-use crate::plan::Plan;
+use crate::plan::{electric_data, Plan};
 use crate::scene::{MaterialModel, MaterialSpec, MeshKind, Scene, SceneError};
 use crate::ProblemError;
 use fe_assembly::{Constraint, Crystal, Field, Load, Material};
@@ -25,6 +25,17 @@ pub struct Setup {
     /// The exact field solution of a `manufactured` or `affine` scene (its Dirichlet data and
     /// loads are in `constraints` and `loads`).
     pub exact: Option<FieldSolution>,
+    /// What the mesh's checks noted without refusing it.
+    pub notes: MeshNotes,
+}
+
+/// What the mesh's checks noted without refusing it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MeshNotes {
+    /// Cells the Gmsh reader turned round (a surface written clockwise).
+    pub reoriented_cells: usize,
+    /// Nodes at the coordinates of another node (a crack, or parts not merged).
+    pub coincident_nodes: usize,
 }
 
 /// Makes the [`Setup`] of a validated scene. `given` is the mesh of a `gmsh` scene, read by
@@ -33,10 +44,22 @@ pub struct Setup {
 /// # Errors
 /// A [`ProblemError`] naming the scene key, mesh group or material at fault.
 pub fn setup(scene: &Scene, given: Option<mesh::Mesh>) -> Result<Setup, ProblemError> {
-    let mesh = mesh(scene, given)?;
+    let (mesh, notes) = mesh(scene, given)?;
     let dim = mesh.dim;
     scene.check_dimension(dim)?;
     let materials = materials(scene, dim)?;
+    if electric_data(scene) && !materials.iter().any(|(_, m)| m.electric) {
+        let key = if scene.electrode.as_ref().is_some_and(|e| e.v != 0.0) {
+            "electrode.v"
+        } else {
+            "dirichlet.phi"
+        };
+        return Err(SceneError::new(
+            key,
+            format!("{key} prescribes a potential, but no material has a permittivity (no electric unknowns): it would be ignored"),
+        )
+        .into());
+    }
     let plan = Plan::new(scene, dim, &materials);
     let materials = if plan.electric {
         materials
@@ -63,12 +86,13 @@ pub fn setup(scene: &Scene, given: Option<mesh::Mesh>) -> Result<Setup, ProblemE
         constraints,
         loads,
         exact,
+        notes,
     })
 }
 
 /// The mesh of the scene, checked, with its regions by box and an `electrode` group where the
-/// scene has one.
-fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<mesh::Mesh, ProblemError> {
+/// scene has one, and what its checks noted.
+fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNotes), ProblemError> {
     let m = &scene.mesh;
     let n = m.cells_per_axis();
     let mut mesh = match (m.kind, given) {
@@ -88,7 +112,11 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<mesh::Mesh, ProblemE
             )))
         }
     };
-    mesh.check()?;
+    let quality = mesh.check()?;
+    let notes = MeshNotes {
+        reoriented_cells: mesh.reoriented_cells,
+        coincident_nodes: quality.coincident_nodes,
+    };
     for r in &m.regions {
         let cells: Vec<usize> = (0..mesh.n_cells())
             .filter(|&c| {
@@ -123,7 +151,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<mesh::Mesh, ProblemE
         }
         mesh.boundaries.insert("electrode".into(), g);
     }
-    Ok(mesh)
+    Ok((mesh, notes))
 }
 
 /// The material of a validated spec in dimension `dim`, in the global frame.
@@ -139,6 +167,7 @@ fn material(spec: &MaterialSpec, dim: usize) -> Result<Material, ProblemError> {
             spec.permittivity.first().copied().unwrap_or(0.0),
         ),
     };
+    // an isotropic material has no poling; the validated crystal has 3 components
     let poling = match spec.poling[..] {
         [a, b, c] => [a, b, c],
         _ => [0.0, 0.0, 1.0],
@@ -185,9 +214,11 @@ fn loads(scene: &Scene, dim: usize) -> Vec<Load> {
     let Some(l) = &scene.load else {
         return vec![];
     };
+    // a direction: normalised (the magnitude is load.p), robustly for tiny or huge entries
+    let len = mesh::scaled_norm(&l.direction);
     let mut t = [0.0; 3];
     for k in 0..dim {
-        t[k] = l.p * l.direction[k];
+        t[k] = l.p * (l.direction[k] / len);
     }
     vec![Load::Traction {
         group: l.group.clone(),

@@ -250,6 +250,55 @@ impl Scene {
     pub fn active_contact(&self) -> Option<&ContactSpec> {
         self.contact.as_ref().filter(|c| c.law != ContactLaw::None)
     }
+
+    /// Every number of the scene with its key (`load.p`, `material.c`, ...).
+    pub fn numbers(&self) -> Vec<(&'static str, f64)> {
+        let mut out: Vec<(&'static str, f64)> = vec![];
+        let mut add = |key: &'static str, values: &[f64]| out.extend(values.iter().map(|&v| (key, v)));
+        let m = &self.mesh;
+        add("mesh.lo", &m.lo);
+        add("mesh.hi", &m.hi);
+        add("mesh.h", m.h.as_slice());
+        for mat in &self.material {
+            add("material.c", &mat.c);
+            add("material.e", &mat.e);
+            add("material.permittivity", &mat.permittivity);
+            add("material.young", mat.young.as_slice());
+            add("material.coupling_scale", mat.coupling_scale.as_slice());
+        }
+        for d in &self.dirichlet {
+            add("dirichlet.u", d.u.as_deref().unwrap_or_default());
+            add("dirichlet.ux", d.ux.as_slice());
+            add("dirichlet.uy", d.uy.as_slice());
+            add("dirichlet.uz", d.uz.as_slice());
+            add("dirichlet.phi", d.phi.as_slice());
+        }
+        if let Some(l) = &self.load {
+            add("load.p", &[l.p]);
+        }
+        if let Some(e) = &self.electrode {
+            add("electrode.v", &[e.v]);
+        }
+        if let Some(c) = &self.contact {
+            add("contact.friction", c.friction.as_slice());
+            add("contact.slip_bound", c.slip_bound.as_slice());
+            add("contact.gap", &[c.gap]);
+            add("contact.gap_curvature", &[c.gap_curvature]);
+        }
+        out
+    }
+
+    /// The scene's numbers far from 1 (beyond 1e100 or below 1e-100 in magnitude), the most
+    /// extreme first: where a result that is not finite most likely comes from.
+    pub fn extreme_numbers(&self) -> Vec<(&'static str, f64)> {
+        let mut out: Vec<(&'static str, f64)> = self
+            .numbers()
+            .into_iter()
+            .filter(|(_, v)| v.abs() > 1e100 || (*v != 0.0 && v.abs() < 1e-100))
+            .collect();
+        out.sort_by(|a, b| b.1.abs().log10().abs().total_cmp(&a.1.abs().log10().abs()));
+        out
+    }
 }
 
 /// How the mesh is made. A generated mesh (`rectangle`, `box`) takes `lo`, `hi` and a size

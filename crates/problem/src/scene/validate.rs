@@ -43,6 +43,9 @@ impl SceneError {
 /// error rather than an allocation failure.
 const MAX_CELLS: f64 = 5e7;
 
+/// The range of a relative tolerance (`solver.tol`, `solver.pcg_tol`).
+pub const TOL_RANGE: (f64, f64) = (1e-15, 0.1);
+
 fn finite(key: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() {
         Ok(())
@@ -99,6 +102,12 @@ impl Scene {
         if let Some(l) = &self.load {
             finite("load.p", l.p)?;
             all_finite("load.direction", &l.direction)?;
+            if !(mesh::scaled_norm(&l.direction) > 0.0) {
+                return Err(SceneError::new(
+                    "load.direction",
+                    "load.direction is the zero vector: give the traction's direction (its magnitude is load.p)",
+                ));
+            }
         }
         if let Some(e) = &self.electrode {
             finite("electrode.v", e.v)?;
@@ -306,8 +315,14 @@ fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
             if m.c.len() != 6 || m.e.len() != 3 || m.permittivity.len() != 2 {
                 return Err(bad("crystal-6mm needs c (6 values), e (3) and permittivity (2)"));
             }
-            if !m.poling.is_empty() && m.poling.len() != 3 {
-                return Err(bad(&format!("poling needs 3 components, not {}", m.poling.len())));
+            if m.poling.len() != 3 {
+                return Err(SceneError::new(
+                    "material.poling",
+                    format!(
+                        "crystal-6mm needs poling, the poling direction (3 components, e.g. [0, 1, 0] for a block poled along y); {} given",
+                        m.poling.len()
+                    ),
+                ));
             }
             if let Some(s) = m.coupling_scale {
                 finite("material.coupling_scale", s)?;
@@ -401,6 +416,28 @@ fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
             "solver.tol",
             format!("solver.tol = {} must be positive", s.tol),
         ));
+    }
+    // the complementarity residual is relative: at λ = 0 it is at most 1, so a tolerance near 1
+    // accepts no contact force at all; below 1e-15 it is under the round-off of the residual
+    if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&s.tol) {
+        return Err(SceneError::new(
+            "solver.tol",
+            format!(
+                "solver.tol = {:e} is outside [{:e}, {:e}]: the complementarity residual is relative, at most 1 with no contact force at all, and round-off keeps it above about 1e-16",
+                s.tol, TOL_RANGE.0, TOL_RANGE.1
+            ),
+        ));
+    }
+    if let Some(t) = s.pcg_tol {
+        if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&t) {
+            return Err(SceneError::new(
+                "solver.pcg_tol",
+                format!(
+                    "solver.pcg_tol = {t:e} is outside [{:e}, {:e}] (a relative residual of the PCG)",
+                    TOL_RANGE.0, TOL_RANGE.1
+                ),
+            ));
+        }
     }
     Ok(())
 }
