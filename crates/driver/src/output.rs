@@ -11,11 +11,28 @@ use vtkio::model::{
     Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, UnstructuredGridPiece, Version, VertexNumbers, Vtk,
 };
 
-/// Files to write together.
+/// Files to write together, as one set that replaces the directory's previous set.
 pub struct Outputs {
     dir: PathBuf,
     files: Vec<(String, Vec<u8>)>,
 }
+
+/// The file in an output directory that lists the files of its set (so that the next run knows
+/// which files are ours to replace, and which are the user's).
+const MANIFEST: &str = ".piezocontact-outputs";
+
+/// The file names a run writes (for a directory written before manifests existed).
+const KNOWN: &[&str] = &[
+    "run.json",
+    "solution.vtu",
+    "contact.csv",
+    "deformed.svg",
+    "deformed.png",
+    "multipliers.svg",
+    "multipliers.png",
+    "potential.svg",
+    "potential.png",
+];
 
 impl Outputs {
     /// Files for directory `dir` (created on commit).
@@ -36,7 +53,17 @@ impl Outputs {
         self.files.extend(files);
     }
 
-    /// Writes every file under a temporary name, then renames them all.
+    /// Writes the set, replacing the directory's previous set as a whole.
+    ///
+    /// Under an exclusive lock on the parent directory (so that two runs into one directory
+    /// never mix their files), every file is written into a fresh hidden sibling directory,
+    /// with a manifest of the set; then, where the directory holds only an earlier set of ours,
+    /// the two directories are exchanged atomically (`renameat2` with `RENAME_EXCHANGE` on
+    /// Linux; elsewhere two renames) and the old one removed. Where the directory also holds
+    /// files that are not ours, those stay: the new files are renamed in one by one and the
+    /// files of the earlier set that the new one lacks are removed. On any error, the staging
+    /// directory is removed and the previous set is as it was; a staging directory left by a
+    /// killed run is removed by the next.
     ///
     /// # Errors
     /// [`DriverError::Output`] naming the path that could not be created, written or renamed.
@@ -45,25 +72,131 @@ impl Outputs {
             what: format!("{what} {}", p.display()),
             source: e,
         };
-        std::fs::create_dir_all(&self.dir).map_err(|e| io("cannot create", &self.dir, e))?;
-        let pid = std::process::id();
-        let mut written: Vec<(PathBuf, PathBuf)> = vec![];
-        for (name, bytes) in &self.files {
-            let tmp = self.dir.join(format!(".{name}.{pid}.tmp"));
-            if let Err(e) = std::fs::write(&tmp, bytes) {
-                for (t, _) in &written {
-                    let _ = std::fs::remove_file(t);
-                }
-                let _ = std::fs::remove_file(&tmp);
-                return Err(io("cannot write", &tmp, e));
-            }
-            written.push((tmp, self.dir.join(name)));
-        }
-        for (tmp, fin) in &written {
-            std::fs::rename(tmp, fin).map_err(|e| io("cannot rename to", fin, e))?;
-        }
-        Ok(())
+        let name = self
+            .dir
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .ok_or_else(|| {
+                io(
+                    "no directory name in",
+                    &self.dir,
+                    std::io::ErrorKind::InvalidInput.into(),
+                )
+            })?;
+        let parent = match self.dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent).map_err(|e| io("cannot create", &parent, e))?;
+        let lock = std::fs::File::open(&parent).map_err(|e| io("cannot open", &parent, e))?;
+        lock.lock().map_err(|e| io("cannot lock", &parent, e))?;
+        remove_stale(&parent, &name);
+        let staging = parent.join(format!(".{name}.piezocontact-new-{}", std::process::id()));
+        let staged = self.stage(&staging).map_err(|(p, e)| {
+            let _ = std::fs::remove_dir_all(&staging);
+            io("cannot write", &p, e)
+        })?;
+        let result = replace(&self.dir, &staging, &parent, &name, &staged);
+        let _ = std::fs::remove_dir_all(&staging);
+        result.map_err(|(p, e)| io("cannot replace", &p, e))
     }
+
+    /// Writes every file and the manifest into a fresh `staging` directory; returns the names.
+    fn stage(&self, staging: &Path) -> Result<Vec<String>, (PathBuf, std::io::Error)> {
+        std::fs::create_dir(staging).map_err(|e| (staging.to_path_buf(), e))?;
+        let mut names = vec![];
+        for (name, bytes) in &self.files {
+            let path = staging.join(name);
+            std::fs::write(&path, bytes).map_err(|e| (path, e))?;
+            names.push(name.clone());
+        }
+        let manifest = staging.join(MANIFEST);
+        std::fs::write(&manifest, names.join("\n") + "\n").map_err(|e| (manifest, e))?;
+        Ok(names)
+    }
+}
+
+/// Removes the staging and retired directories of `name` in `parent` that a killed run left
+/// (called under the lock, so no live run is writing them).
+fn remove_stale(parent: &Path, name: &str) {
+    let prefix = format!(".{name}.piezocontact-");
+    for entry in std::fs::read_dir(parent).into_iter().flatten().flatten() {
+        if entry.file_name().to_string_lossy().starts_with(&prefix) {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
+/// The files of `dir`'s current set: those its manifest lists (with the manifest), or, for a
+/// directory written before manifests, the known output names present.
+fn ours(dir: &Path) -> Vec<String> {
+    match std::fs::read_to_string(dir.join(MANIFEST)) {
+        Ok(text) => text
+            .lines()
+            .filter(|l| !l.is_empty())
+            .map(String::from)
+            .chain([MANIFEST.to_string()])
+            .collect(),
+        Err(_) => KNOWN.iter().map(|s| s.to_string()).collect(),
+    }
+}
+
+/// Puts the staged set in place of `dir`'s.
+fn replace(
+    dir: &Path,
+    staging: &Path,
+    parent: &Path,
+    name: &str,
+    staged: &[String],
+) -> Result<(), (PathBuf, std::io::Error)> {
+    let err = |p: &Path| {
+        let p = p.to_path_buf();
+        move |e| (p, e)
+    };
+    if !dir.exists() {
+        return std::fs::rename(staging, dir).map_err(err(dir));
+    }
+    let old = ours(dir);
+    let present: Vec<String> = std::fs::read_dir(dir)
+        .map_err(err(dir))?
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    if present.iter().all(|f| old.contains(f)) {
+        // only our earlier set: exchange the directories
+        let retired = parent.join(format!(".{name}.piezocontact-old-{}", std::process::id()));
+        exchange(staging, dir, &retired).map_err(err(dir))?;
+        // the old set is now at `staging`
+        std::fs::rename(staging, &retired).map_err(err(&retired))?;
+        let _ = std::fs::remove_dir_all(&retired);
+        return Ok(());
+    }
+    // the user's files stay: ours are renamed in one by one, and the stale ones removed
+    for f in staged.iter().map(String::as_str).chain([MANIFEST]) {
+        std::fs::rename(staging.join(f), dir.join(f)).map_err(err(&dir.join(f)))?;
+    }
+    for f in old
+        .iter()
+        .filter(|f| present.contains(f) && !staged.contains(f) && f.as_str() != MANIFEST)
+    {
+        let _ = std::fs::remove_file(dir.join(f));
+    }
+    Ok(())
+}
+
+/// Exchanges two directories: atomically on Linux (`RENAME_EXCHANGE`); elsewhere, or on a file
+/// system without it, by moving `b` to `aside`, `a` into its place, and the old `b` to `a`.
+fn exchange(a: &Path, b: &Path, aside: &Path) -> std::io::Result<()> {
+    #[cfg(target_os = "linux")]
+    {
+        use rustix::fs::{renameat_with, RenameFlags, CWD};
+        if renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE).is_ok() {
+            return Ok(());
+        }
+    }
+    std::fs::rename(b, aside)?;
+    std::fs::rename(a, b)?;
+    std::fs::rename(aside, a)
 }
 
 /// `run.json`: the report, pretty, its keys in sorted order.
@@ -271,23 +404,120 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, DriverError> {
     plots::panels("multipliers", &[panel])
 }
 
-/// Where a run writes by default: `out/<scene>/`.
+/// Where a run writes by default: `out/<scene>/`, the scene's name made a safe single path
+/// component (letters, digits, `-`, `_` and `.` kept, anything else `_`, no leading dot), so that
+/// a name like `../x` or `/tmp/x` cannot write outside `out/`.
 pub fn default_dir(scene_name: &str) -> PathBuf {
-    Path::new("out").join(scene_name)
+    let safe: String = scene_name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let safe = safe.trim_start_matches('.');
+    Path::new("out").join(if safe.is_empty() { "scene" } else { safe })
 }
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
+    fn commit(dir: &Path, files: &[(&str, &str)]) -> Result<(), DriverError> {
+        let mut o = Outputs::new(dir);
+        for (name, text) in files {
+            o.add(name, text.as_bytes().to_vec());
+        }
+        o.commit()
+    }
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
     #[test]
-    fn failed_commit_leaves_nothing() {
+    fn a_failed_commit_leaves_nothing() {
         let dir = tempfile::tempdir().unwrap();
-        // a directory where a file should go makes the rename fail; the temporaries vanish
         let target = dir.path().join("run");
-        let mut o = super::Outputs::new(&target);
-        o.add("a.txt", b"a".to_vec());
-        o.add("nested/b.txt", b"b".to_vec()); // cannot be written: no such subdirectory
-        assert!(o.commit().is_err());
-        let left: Vec<_> = std::fs::read_dir(&target).unwrap().collect();
-        assert!(left.is_empty(), "{left:?}");
+        // a file in a subdirectory that does not exist cannot be written
+        assert!(commit(&target, &[("a.txt", "a"), ("nested/b.txt", "b")]).is_err());
+        assert!(!target.exists());
+        assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+        // and over an earlier set, the earlier set stays as it was
+        commit(&target, &[("run.json", "1"), ("contact.csv", "1")]).unwrap();
+        assert!(commit(&target, &[("run.json", "2"), ("nested/b.txt", "b")]).is_err());
+        assert_eq!(std::fs::read_to_string(target.join("run.json")).unwrap(), "1");
+        assert_eq!(listing(dir.path()), ["run"]);
+    }
+
+    #[test]
+    fn a_new_set_replaces_the_old_as_a_whole_and_keeps_the_users_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("run");
+        commit(
+            &target,
+            &[("run.json", "1"), ("contact.csv", "1"), ("multipliers.svg", "1")],
+        )
+        .unwrap();
+        // a run without contact: its set has no contact.csv, and none is left behind
+        commit(&target, &[("run.json", "2"), ("solution.vtu", "2")]).unwrap();
+        assert_eq!(listing(&target), [MANIFEST, "run.json", "solution.vtu"]);
+        assert_eq!(std::fs::read_to_string(target.join("run.json")).unwrap(), "2");
+        // a file of the user's stays; ours are replaced, and the stale ones removed
+        std::fs::write(target.join("notes.txt"), "mine").unwrap();
+        commit(&target, &[("run.json", "3"), ("contact.csv", "3")]).unwrap();
+        assert_eq!(listing(&target), [MANIFEST, "contact.csv", "notes.txt", "run.json"]);
+        assert_eq!(std::fs::read_to_string(target.join("notes.txt")).unwrap(), "mine");
+        // no staging or retired directory is left beside it
+        assert_eq!(listing(dir.path()), ["run"]);
+    }
+
+    #[test]
+    fn runs_into_one_directory_do_not_mix() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("run");
+        let threads: Vec<_> = (0..8)
+            .map(|k| {
+                let target = target.clone();
+                std::thread::spawn(move || {
+                    let text = k.to_string();
+                    let files: Vec<(&str, &str)> = if k % 2 == 0 {
+                        vec![("run.json", &text), ("contact.csv", &text)]
+                    } else {
+                        vec![("run.json", &text), ("solution.vtu", &text)]
+                    };
+                    commit(&target, &files).unwrap();
+                })
+            })
+            .collect();
+        for t in threads {
+            t.join().unwrap();
+        }
+        // one set, whole: its files agree and the manifest lists exactly them
+        let files = listing(&target);
+        let manifest = std::fs::read_to_string(target.join(MANIFEST)).unwrap();
+        let listed: Vec<&str> = manifest.lines().collect();
+        assert_eq!(files.len(), listed.len() + 1, "{files:?} {listed:?}");
+        let texts: Vec<String> = listed
+            .iter()
+            .map(|f| std::fs::read_to_string(target.join(f)).unwrap())
+            .collect();
+        assert!(texts.iter().all(|t| t == &texts[0]), "{texts:?}");
+    }
+
+    #[test]
+    fn the_default_directory_stays_under_out() {
+        assert_eq!(default_dir("paper"), Path::new("out/paper"));
+        assert_eq!(default_dir("../x"), Path::new("out/_x"));
+        assert_eq!(default_dir("/tmp/x"), Path::new("out/_tmp_x"));
+        assert_eq!(default_dir(".."), Path::new("out/scene"));
     }
 }

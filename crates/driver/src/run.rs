@@ -21,7 +21,17 @@ pub fn peak_memory_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
-/// Solves `scene` (from `source`), reporting to `reporter`; writes nothing.
+/// Bytes of memory available to a new allocation (`MemAvailable` of /proc/meminfo), `None`
+/// where unknown.
+pub fn available_memory_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find_map(|l| l.strip_prefix("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().next()?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Solves `scene` (from `source`) within the memory this machine has available, reporting to
+/// `reporter`; writes nothing.
 ///
 /// # Errors
 /// [`DriverError::Mesh`] for a Gmsh file that does not read, [`DriverError::Problem`] for the
@@ -31,7 +41,10 @@ pub fn solve(scene: &Scene, source: &Source, reporter: &mut dyn Reporter) -> Res
         (MeshKind::Gmsh, Some(file)) => Some(mesh::read_msh(source.dir.join(file))?),
         _ => None,
     };
-    let mut solution = problem::solve(scene, mesh, reporter)?;
+    let limits = problem::Limits {
+        memory_bytes: available_memory_bytes(),
+    };
+    let mut solution = problem::solve_within(scene, mesh, limits, reporter)?;
     solution.report.scene.source = source.label.clone();
     solution.report.memory.peak_bytes = peak_memory_bytes();
     Ok(solution)

@@ -97,6 +97,9 @@ pub struct SchurPcg {
 
 impl SchurPcg {
     /// Factors `A` and `B` (Cholesky, AMD). `B` may be empty (no electric unknowns).
+    ///
+    /// # Errors
+    /// As [`SparseFactor::new`], naming the block.
     pub fn new(
         a: SparseColMat<usize, f64>,
         g: SparseColMat<usize, f64>,
@@ -104,11 +107,28 @@ impl SchurPcg {
         params: PcgParams,
         par: Par,
     ) -> Result<Self, LinalgError> {
-        let chol_a = SparseFactor::new(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, par)
+        Self::new_within(a, g, b, params, par, None)
+    }
+
+    /// As [`SchurPcg::new`], each factor within a memory `budget` (see
+    /// [`SparseFactor::new_within`]).
+    ///
+    /// # Errors
+    /// As [`SparseFactor::new_within`], naming the block.
+    pub fn new_within(
+        a: SparseColMat<usize, f64>,
+        g: SparseColMat<usize, f64>,
+        b: &SparseColMat<usize, f64>,
+        params: PcgParams,
+        par: Par,
+        budget: Option<usize>,
+    ) -> Result<Self, LinalgError> {
+        let chol_a = SparseFactor::new_within(a.as_ref(), FactorKind::Cholesky, &Ordering::Amd, par, budget)
             .map_err(|e| e.context("the elasticity block A"))?;
+        let left = budget.map(|b| b.saturating_sub(chol_a.values_bytes()));
         let chol_b = if b.nrows() > 0 {
             Some(
-                SparseFactor::new(b.as_ref(), FactorKind::Cholesky, &Ordering::Amd, par)
+                SparseFactor::new_within(b.as_ref(), FactorKind::Cholesky, &Ordering::Amd, par, left)
                     .map_err(|e| e.context("the dielectric block B"))?,
             )
         } else {
@@ -162,6 +182,9 @@ pub struct DirectLdlt {
 impl DirectLdlt {
     /// Builds the lower triangle of `K` and factors it; `ordering` may put chosen dofs last
     /// (indices into `[u; φ]`).
+    ///
+    /// # Errors
+    /// As [`SparseFactor::new`], naming the coupled matrix.
     pub fn new(
         a: &SparseColMat<usize, f64>,
         g: &SparseColMat<usize, f64>,
@@ -169,8 +192,24 @@ impl DirectLdlt {
         ordering: &Ordering,
         par: Par,
     ) -> Result<Self, LinalgError> {
+        Self::new_within(a, g, b, ordering, par, None)
+    }
+
+    /// As [`DirectLdlt::new`], within a memory `budget` for the factor (see
+    /// [`SparseFactor::new_within`]).
+    ///
+    /// # Errors
+    /// As [`SparseFactor::new_within`], naming the coupled matrix.
+    pub fn new_within(
+        a: &SparseColMat<usize, f64>,
+        g: &SparseColMat<usize, f64>,
+        b: &SparseColMat<usize, f64>,
+        ordering: &Ordering,
+        par: Par,
+        budget: Option<usize>,
+    ) -> Result<Self, LinalgError> {
         let k = lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref());
-        let factor = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, ordering, par)
+        let factor = SparseFactor::new_within(k.as_ref(), FactorKind::Ldlt, ordering, par, budget)
             .map_err(|e| e.context("the coupled matrix K"))?;
         Ok(DirectLdlt {
             factor,

@@ -85,11 +85,31 @@ impl SparseFactor {
     ///
     /// `par` is passed to faer's dense kernels inside the supernodes. On this project's
     /// 2-core target `Par::Seq` was measured faster (see `docs/performance.md`).
+    ///
+    /// # Errors
+    /// A non-square or non-finite matrix, an ordering that is not a permutation, a failed
+    /// symbolic analysis, or a matrix that is not (quasi-)definite.
     pub fn new(
         a: SparseColMatRef<'_, usize, f64>,
         kind: FactorKind,
         ordering: &Ordering,
         par: Par,
+    ) -> Result<Self, LinalgError> {
+        Self::new_within(a, kind, ordering, par, None)
+    }
+
+    /// As [`SparseFactor::new`], refusing with [`LinalgError::TooLarge`] before any numeric work
+    /// where the factor and its workspace (known after the symbolic analysis) would take more
+    /// than `budget` bytes.
+    ///
+    /// # Errors
+    /// As [`SparseFactor::new`], and [`LinalgError::TooLarge`].
+    pub fn new_within(
+        a: SparseColMatRef<'_, usize, f64>,
+        kind: FactorKind,
+        ordering: &Ordering,
+        par: Par,
+        budget: Option<usize>,
     ) -> Result<Self, LinalgError> {
         let n = a.nrows();
         if n != a.ncols() {
@@ -138,7 +158,12 @@ impl SparseFactor {
             FactorKind::Cholesky => symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
             FactorKind::Ldlt => symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
         };
-        let solve_mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
+        let solve_req = symbolic.solve_in_place_scratch::<f64>(1, par);
+        let needed = 8 * symbolic.len_val() + factor_req.size_bytes() + solve_req.size_bytes();
+        if let Some(budget) = budget.filter(|&b| needed > b) {
+            return Err(LinalgError::TooLarge { needed, budget });
+        }
+        let solve_mem = MemBuffer::new(solve_req);
         let mut f = SparseFactor {
             kind,
             values: vec![0.0; symbolic.len_val()],

@@ -95,6 +95,15 @@ pub enum LinalgError {
         /// Where.
         what: String,
     },
+    /// A factor that would not fit in the memory allowed (known after the symbolic analysis,
+    /// before any numeric work).
+    #[error("the factor and its workspace need {needed} bytes, more than the {budget} allowed")]
+    TooLarge {
+        /// Bytes the factor needs.
+        needed: usize,
+        /// Bytes allowed.
+        budget: usize,
+    },
     /// Sizes that do not fit.
     #[error("shape mismatch: {0}")]
     Shape(String),

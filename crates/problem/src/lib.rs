@@ -56,6 +56,7 @@
 
 pub mod analytical;
 pub mod boundary;
+pub mod estimate;
 pub mod exact;
 pub mod plan;
 pub mod progress;
@@ -67,13 +68,31 @@ pub mod setup;
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::RunReport;
-pub use run::{solve, ContactResult, Solution};
+pub use run::{solve, solve_within, ContactResult, Limits, Solution};
 pub use scene::{
     ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec, LoadSpec,
     MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy,
 };
 
 use contact::ContactError;
+
+/// "the most extreme inputs are ..." naming the scene's numbers far from 1 (each key once), or
+/// `None` where there are none.
+fn extremes(scene: &Scene) -> Option<String> {
+    let mut named: Vec<String> = vec![];
+    for (k, v) in scene.extreme_numbers() {
+        let item = format!("{k} = {v:e}");
+        if !named.contains(&item) && named.len() < 3 {
+            named.push(item);
+        }
+    }
+    (!named.is_empty()).then(|| {
+        format!(
+            "the most extreme inputs are {} (bring them nearer 1, e.g. by a change of units)",
+            named.join(", ")
+        )
+    })
+}
 
 /// The README's Rust examples, run as doc tests (the library consumer's example among them).
 #[doc = include_str!("../../../README.md")]
@@ -98,6 +117,16 @@ pub enum ProblemError {
     /// A linear-algebra failure.
     #[error("linear solve: {0}")]
     Linalg(#[from] linalg::LinalgError),
+    /// A run that would need more memory than it may use, found before the memory is taken.
+    #[error("the run needs about {:.1} GiB ({what}), more than the {:.1} GiB available: use a coarser mesh (a smaller mesh.n or a larger mesh.h)", *needed as f64 / estimate::GIB, *available as f64 / estimate::GIB)]
+    TooLarge {
+        /// What the estimate counts.
+        what: String,
+        /// Bytes needed (an estimate).
+        needed: u64,
+        /// Bytes available.
+        available: u64,
+    },
     /// A result that is not a finite number: the data overflow (or underflow) double
     /// precision, or the problem is singular.
     #[error("{what} is not finite: {cause}")]
@@ -124,21 +153,33 @@ impl ProblemError {
         if values.iter().all(|v| v.is_finite()) {
             return Ok(());
         }
-        let extreme = scene.extreme_numbers();
-        let cause = if extreme.is_empty() {
-            "no input is extreme (all within 1e-100 to 1e100 in magnitude): the problem may be singular".to_string()
-        } else {
-            let named: Vec<String> = extreme.iter().take(3).map(|(k, v)| format!("{k} = {v:e}")).collect();
-            format!(
-                "the data overflow double precision; the most extreme inputs are {} (bring them nearer 1, e.g. by a change of units)",
-                named.join(", ")
-            )
+        let cause = match extremes(scene) {
+            Some(named) => format!("the data overflow double precision; {named}"),
+            None => {
+                "no input is extreme (all within 1e-100 to 1e100 in magnitude): the problem may be singular".to_string()
+            }
         };
         Err(ProblemError::NotFinite { what, cause })
     }
 
-    /// A contact error of a run of `strategy`, with a hint that names only what it did not try.
-    pub fn contact(source: ContactError, strategy: Strategy) -> Self {
+    /// A contact error of a run of `strategy` on `scene`, with a hint that names only what it
+    /// did not try, or, where its residual is not a number, the scene's most extreme inputs.
+    pub fn contact(source: ContactError, strategy: Strategy, scene: &Scene) -> Self {
+        let residual = match &source {
+            ContactError::NoConvergence { residual, .. }
+            | ContactError::FixedPointNoConvergence { residual, .. }
+            | ContactError::Diverged { residual, .. }
+            | ContactError::NewtonStalled { residual, .. } => *residual,
+            _ => 0.0,
+        };
+        if !residual.is_finite() {
+            if let Some(named) = extremes(scene) {
+                return ProblemError::Contact {
+                    source,
+                    hint: format!("; the data overflow double precision: {named}"),
+                };
+            }
+        }
         let newton = strategy == Strategy::NewtonCondensed;
         let hint = match &source {
             ContactError::NoConvergence { .. } | ContactError::Diverged { .. } if !newton => {

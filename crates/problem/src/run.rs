@@ -52,13 +52,43 @@ pub struct ContactResult {
     pub displacement: PointValues,
 }
 
+/// What a run may use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Limits {
+    /// Bytes of memory the run may take (`None`: no check).
+    pub memory_bytes: Option<u64>,
+}
+
 /// Solves `scene`. `mesh` is the mesh of a `gmsh` scene, read by the caller (generated meshes
 /// are made here); `reporter` receives one event per step and per outer iteration.
 ///
 /// # Errors
 /// A [`ProblemError`] naming the scene key, mesh item, material or solver step at fault.
 pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporter) -> Result<Solution, ProblemError> {
+    solve_within(scene, mesh, Limits::default(), reporter)
+}
+
+/// As [`solve`], within `limits`: a run whose memory estimate exceeds them stops with
+/// [`ProblemError::TooLarge`] before the memory is taken (see [`crate::estimate`]).
+///
+/// # Errors
+/// As [`solve`], and [`ProblemError::TooLarge`].
+pub fn solve_within(
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<Solution, ProblemError> {
     scene.validate()?;
+    if let (Some(available), Some((needed, what))) = (limits.memory_bytes, crate::estimate::before_mesh(scene)) {
+        if needed > available as f64 {
+            return Err(ProblemError::TooLarge {
+                what,
+                needed: needed as u64,
+                available,
+            });
+        }
+    }
     let t_total = Instant::now();
     let setup = setup(scene, mesh)?;
     let t_setup = t_total.elapsed().as_secs_f64();
@@ -68,7 +98,7 @@ pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporte
     }
     let assembled = assemble(&setup, reporter)?;
     check_assembled(scene, &assembled)?;
-    let mut factored = factor(scene, &setup, &assembled, reporter)?;
+    let mut factored = factor(scene, &setup, &assembled, limits, reporter)?;
     let solved = match factored.boundary.take() {
         Some(boundary) => solve_contact(scene, &setup.plan, &mut factored.solver, boundary, &assembled, reporter)?,
         None => solve_linear(&mut factored.solver, &assembled)?,
@@ -216,6 +246,7 @@ fn factor(
     scene: &Scene,
     setup: &Setup,
     a: &Assembled<'_>,
+    limits: Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Factored, ProblemError> {
     let t = Instant::now();
@@ -236,9 +267,12 @@ fn factor(
         None => None,
     };
     let par = faer::Par::Seq;
+    let budget = factor_budget(setup, a, boundary.as_ref(), limits)?;
+    let too_large = |e: linalg::LinalgError| too_large(e, limits);
     let (blocks, mesh) = (&a.blocks, &setup.mesh);
     let solver = if plan.linear_strategy.runs_pcg() {
-        let pcg = SchurPcg::new(blocks.a.clone(), blocks.g.clone(), &blocks.b, pcg_params, par)?;
+        let pcg = SchurPcg::new_within(blocks.a.clone(), blocks.g.clone(), &blocks.b, pcg_params, par, budget)
+            .map_err(too_large)?;
         LinearSolver::SchurPcg(pcg)
     } else {
         let order = a
@@ -252,7 +286,9 @@ fn factor(
             },
             _ => Ordering::Given(order),
         };
-        LinearSolver::Direct(DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &ordering, par)?)
+        LinearSolver::Direct(
+            DirectLdlt::new_within(&blocks.a, &blocks.g, &blocks.b, &ordering, par, budget).map_err(too_large)?,
+        )
     };
     let seconds = t.elapsed().as_secs_f64();
     reporter.event(&Event::Factored { seconds });
@@ -262,6 +298,60 @@ fn factor(
         pcg_params,
         seconds,
     })
+}
+
+/// The bytes left for the factor within `limits`, once the assembled blocks and (condensed
+/// strategies) the dense contact problem are counted; an error where those alone do not fit.
+fn factor_budget(
+    setup: &Setup,
+    a: &Assembled<'_>,
+    boundary: Option<&ContactBoundary>,
+    limits: Limits,
+) -> Result<Option<usize>, ProblemError> {
+    let Some(available) = limits.memory_bytes else {
+        return Ok(None);
+    };
+    let b = &a.blocks;
+    let nnz = b.a.val().len() + b.g.val().len() + b.b.val().len();
+    let held = crate::estimate::assembled(nnz, setup.mesh.n_nodes(), a.disc.dofs.n_u + a.disc.dofs.n_phi);
+    let dense = match boundary {
+        Some(cb) if setup.plan.linear_strategy.is_condensed() => {
+            let m = cb.points.len() * (1 + setup.plan.n_tangential());
+            crate::estimate::dense_contact(cb.dofs.len(), m)
+        }
+        _ => 0.0,
+    };
+    if held + dense > available as f64 {
+        return Err(ProblemError::TooLarge {
+            what: format!(
+                "the assembled system and the dense contact compliance of a condensed strategy ({:.1} GiB)",
+                dense / crate::estimate::GIB
+            ),
+            needed: (held + dense) as u64,
+            available,
+        });
+    }
+    Ok(Some((available as f64 - held - dense) as usize))
+}
+
+/// A linear-algebra error, made [`ProblemError::TooLarge`] where the factor did not fit.
+fn too_large(e: linalg::LinalgError, limits: Limits) -> ProblemError {
+    let inner = match &e {
+        linalg::LinalgError::In { source, .. } => source.as_ref(),
+        other => other,
+    };
+    match (inner, limits.memory_bytes) {
+        (linalg::LinalgError::TooLarge { needed, budget }, Some(available)) => ProblemError::TooLarge {
+            what: format!(
+                "a sparse factor of {:.1} GiB, counted by its symbolic analysis, beside the assembled system",
+                *needed as f64 / crate::estimate::GIB
+            ),
+            // the rest of the run takes what the factor's budget left out
+            needed: (*needed + (available as usize).saturating_sub(*budget)) as u64,
+            available,
+        },
+        _ => ProblemError::Linalg(e),
+    }
 }
 
 /// The solution `(u, φ)` with, where the plan has contact, the boundary and its solution.
@@ -301,6 +391,7 @@ enum Operator<'a> {
 /// How the plan's contact problem is solved: the law on its points, the solver, the tolerance.
 struct ContactSolve<'p> {
     plan: &'p Plan,
+    scene: &'p Scene,
     law: Law,
     tol: f64,
 }
@@ -308,7 +399,7 @@ struct ContactSolve<'p> {
 impl<'p> ContactSolve<'p> {
     /// The plan's contact law on `n` points: frictionless without tangential multipliers,
     /// Tresca with the scene's bound, else Coulomb.
-    fn new(plan: &'p Plan, scene: &Scene, n: usize) -> Self {
+    fn new(plan: &'p Plan, scene: &'p Scene, n: usize) -> Self {
         let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
         let law = match (plan.contact_law, plan.friction) {
             (_, false) => Law::Frictionless,
@@ -322,6 +413,7 @@ impl<'p> ContactSolve<'p> {
         );
         ContactSolve {
             plan,
+            scene,
             law,
             tol: scene.solver.tol,
         }
@@ -364,7 +456,7 @@ impl<'p> ContactSolve<'p> {
                 "semismooth Newton needs the condensed compliance".into(),
             )),
         };
-        solved.map_err(|e| ProblemError::contact(e, self.plan.linear_strategy))
+        solved.map_err(|e| ProblemError::contact(e, self.plan.linear_strategy, self.scene))
     }
 }
 

@@ -228,7 +228,7 @@ pub fn study(
         None => {
             let largest = *sizes.last().unwrap_or(&1);
             let n_ref = spec.reference_n.unwrap_or(4 * largest);
-            if n_ref <= largest || n_ref % largest != 0 {
+            if n_ref <= largest || !n_ref.is_multiple_of(largest) {
                 return Err(DriverError::Usage(format!(
                     "the reference size {n_ref} must be a multiple of the largest size {largest}, and larger"
                 )));

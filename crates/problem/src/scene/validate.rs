@@ -46,6 +46,25 @@ const MAX_CELLS: f64 = 5e7;
 /// The range of a relative tolerance (`solver.tol`, `solver.pcg_tol`).
 pub const TOL_RANGE: (f64, f64) = (1e-15, 0.1);
 
+/// The magnitudes a material constant or a length may have (zero aside): no system of units
+/// needs more, and products of such numbers (a stiffness times a strain, an area) overflow or
+/// underflow double precision.
+pub const PHYSICAL_RANGE: (f64, f64) = (1e-100, 1e100);
+
+/// Checks that every non-zero value of `key` lies in [`PHYSICAL_RANGE`] in magnitude.
+fn physical(key: &str, values: &[f64]) -> Result<(), SceneError> {
+    match values.iter().find(|v| **v != 0.0 && !(PHYSICAL_RANGE.0..=PHYSICAL_RANGE.1).contains(&v.abs())) {
+        Some(v) => Err(SceneError::new(
+            key,
+            format!(
+                "{key} = {v:e} is outside [{:e}, {:e}] in magnitude: no system of units needs it, and its products overflow double precision",
+                PHYSICAL_RANGE.0, PHYSICAL_RANGE.1
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 fn finite(key: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() {
         Ok(())
@@ -252,6 +271,8 @@ fn validate_generated(m: &MeshSpec, d: usize) -> Result<(), SceneError> {
             format!("mesh.lo and mesh.hi need {d} coordinates for a {}", m.kind),
         ));
     }
+    physical("mesh.lo", &m.lo)?;
+    physical("mesh.hi", &m.hi)?;
     for k in 0..d {
         finite("mesh.lo", m.lo[k])?;
         finite("mesh.hi", m.hi[k])?;
@@ -303,9 +324,16 @@ fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
         ("material.poling", &m.poling),
     ] {
         all_finite(key, values)?;
+        physical(key, values)?;
     }
-    if let Some(y) = m.young {
-        finite("material.young", y)?;
+    for (key, v) in [
+        ("material.young", m.young),
+        ("material.coupling_scale", m.coupling_scale),
+    ] {
+        if let Some(v) = v {
+            finite(key, v)?;
+            physical(key, &[v])?;
+        }
     }
     match m.model {
         MaterialModel::Crystal6mm => {
