@@ -373,3 +373,57 @@ fn study_separates_discretisation_and_algebraic_errors() {
     let e = study("paper", &[], &bad, &mut |_| {}).unwrap_err().to_string();
     assert!(e.contains("is not a node of the reference mesh"), "{e}");
 }
+
+/// Frictionless contact: the body slides, and the tangential displacement of the final
+/// solution is reported (it was written as 0, the law carrying no tangential multiplier).
+#[test]
+fn frictionless_contact_reports_the_sliding() {
+    let r = run("paper-frictionless", &["mesh.n=16"]);
+    let c = r.contact.as_ref().unwrap();
+    assert_eq!(c.displacement.n_tangential(), 1);
+    let slide = c.displacement.tangential.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(slide > 1e-5, "largest slide {slide}");
+    // it is the tangential component of the nodal displacement
+    for (i, &node) in c.nodes.iter().enumerate() {
+        let t = c.points.tangent[i][0];
+        let ut = r.u[node][0] * t[0] + r.u[node][1] * t[1];
+        assert!((ut - c.displacement.tangential[i]).abs() <= 1e-12 * slide, "point {i}");
+    }
+}
+
+/// A load pressing the contact face straight into the foundation: the loads and the contact
+/// forces cancel, and the equilibrium residual must stay relative to them (dividing by their
+/// vanishing sum once gave 0.13, reported as converged).
+#[test]
+fn the_equilibrium_residual_stays_meaningful_when_the_loads_cancel() {
+    let r = run("paper", &["mesh.n=8", "load.group=bottom", "load.direction=[0, -1]"]);
+    assert!(
+        r.report.residuals.equilibrium < 1e-12,
+        "{}",
+        r.report.residuals.equilibrium
+    );
+    assert!(r.report.residuals.complementarity <= 1e-10);
+}
+
+/// The hostile inputs of docs/stability.md (issue 12's families) give what they must: a
+/// solution whose residuals meet the tolerance, or the typed error that names the fault.
+#[test]
+fn hostile_inputs_solve_or_are_refused_by_name() {
+    use driver::studies::inputs::{check_solved, Outcome, INPUTS};
+    for input in INPUTS {
+        let sets: Vec<String> = input.sets.iter().map(|s| s.to_string()).collect();
+        let result = driver::studies::solve(input.scene, &sets);
+        match (input.expect, result) {
+            (Outcome::Solves, Ok(r)) => {
+                if let Err(e) = check_solved(&r.report) {
+                    panic!("{} {:?}: {e}", input.scene, input.sets);
+                }
+            }
+            (Outcome::Refused(text), Err(e)) => {
+                assert!(e.to_string().contains(text), "{} {:?}: {e}", input.scene, input.sets)
+            }
+            (expect, Ok(_)) => panic!("{} {:?}: solved, expected {expect:?}", input.scene, input.sets),
+            (expect, Err(e)) => panic!("{} {:?}: {e}, expected {expect:?}", input.scene, input.sets),
+        }
+    }
+}

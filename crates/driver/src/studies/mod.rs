@@ -1,9 +1,10 @@
 //! The studies over many runs, each building its own table and series: a scene along one
 //! parameter ([`sweep`]), the paper's Table 1 ([`table1`]), error against h and run time
-//! ([`convergence`]), the verification report ([`verification`]) and the stiff and extreme
-//! cases ([`stability`]).
+//! ([`convergence`]), the verification report ([`verification`]), the stiff and extreme
+//! cases ([`stability`]) and the hostile inputs ([`inputs`]).
 
 pub mod convergence;
+pub mod inputs;
 pub mod stability;
 pub mod sweep;
 pub mod table1;

@@ -284,7 +284,7 @@ pub fn check(expect: Expect, report: &RunReport) -> Result<String, String> {
 }
 
 /// Runs `cmd` to its end, or kills it after `limit`; its stdout and stderr are collected.
-fn run_with_limit(mut cmd: Command, limit: Duration) -> std::io::Result<std::process::Output> {
+pub(crate) fn run_with_limit(mut cmd: Command, limit: Duration) -> std::io::Result<std::process::Output> {
     use std::io::Read;
     let mut child = cmd.stdout(Stdio::null()).stderr(Stdio::piped()).spawn()?;
     // stderr is drained on a thread, so that a chatty child never blocks on a full pipe
@@ -462,25 +462,33 @@ pub fn write(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<Row>, DriverError> {
     let rows = study(exe, quick, limit, progress);
+    let inputs = super::inputs::study(exe, progress);
     let command = format!(
         "piezocontact stability{} --limit {}",
         if quick { " --quick" } else { "" },
         limit.as_secs()
     );
     let mut out = Outputs::new(dir);
-    out.add("stability.md", markdown(&rows, &command).into_bytes());
+    let page = markdown(&rows, &command) + &super::inputs::markdown(&inputs);
+    out.add("stability.md", page.into_bytes());
     out.commit()?;
-    let bad: Vec<&str> = rows
+    let bad: Vec<String> = rows
         .iter()
         .filter(|r| !r.as_expected)
-        .map(|r| r.case.as_str())
+        .map(|r| r.case.clone())
+        .chain(
+            inputs
+                .iter()
+                .filter(|r| !r.as_expected)
+                .map(|r| format!("{} {:?}", r.input.scene, r.input.sets)),
+        )
         .collect();
     if bad.is_empty() {
         Ok(rows)
     } else {
         Err(DriverError::Unexpected {
             what: "cases not as expected",
-            items: bad.into_iter().map(String::from).collect(),
+            items: bad,
         })
     }
 }
