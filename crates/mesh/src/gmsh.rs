@@ -68,22 +68,8 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
         path: name.to_string(),
         message,
     };
-    if !bytes.starts_with(b"$MeshFormat") {
-        return Err(err("not a Gmsh file: it does not start with `$MeshFormat`".into()));
-    }
-    format_header(bytes).map_err(err)?;
-    // mshio answers most malformed input with an error, but a few inputs reach an
-    // `unimplemented!` in it (found by the mutation fuzzing of driver/tests/fuzz_readers.rs):
-    // those become an error too
-    let parsed = std::panic::catch_unwind(|| mshio::parse_msh_bytes(bytes))
-        .map_err(|_| err("does not parse as MSH 4.1 (the parser gave up on malformed data)".into()))?;
-    let file = parsed.map_err(|e| {
-        let text = e.to_string();
-        let first = text.lines().take(6).collect::<Vec<_>>().join("; ");
-        err(format!("does not parse as MSH 4.1: {first}"))
-    })?;
+    let data = parse(bytes).map_err(err)?;
     let names = physical_names(bytes).map_err(err)?;
-    let data = file.data;
     let entities = data
         .entities
         .ok_or_else(|| err("the file has no `$Entities` section".into()))?;
@@ -93,9 +79,41 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
     let elements = data
         .elements
         .ok_or_else(|| err("the file has no `$Elements` section".into()))?;
+    let (points, index_of) = read_nodes(bytes, &nodes).map_err(err)?;
+    let groups = Groups {
+        physical: physical_tags(&entities),
+        names,
+    };
+    let mut mesh = read_elements(&elements, points, &index_of, &groups).map_err(err)?;
+    flatten_2d(&mut mesh).map_err(err)?;
+    mesh.check().map_err(|e| err(format!("{e}")))?;
+    Ok(mesh)
+}
 
-    // physical tags of each entity
-    let mut phys: HashMap<(i32, i32), Vec<i32>> = HashMap::new();
+type Parsed = mshio::MshData<u64, i32, f64>;
+
+/// Checks the `$MeshFormat` line and parses the body with `mshio`.
+fn parse(bytes: &[u8]) -> Result<Parsed, String> {
+    if !bytes.starts_with(b"$MeshFormat") {
+        return Err("not a Gmsh file: it does not start with `$MeshFormat`".into());
+    }
+    format_header(bytes)?;
+    // mshio answers most malformed input with an error, but a few inputs reach an
+    // `unimplemented!` in it (found by the mutation fuzzing of driver/tests/fuzz_readers.rs):
+    // those become an error too
+    let parsed = std::panic::catch_unwind(|| mshio::parse_msh_bytes(bytes))
+        .map_err(|_| "does not parse as MSH 4.1 (the parser gave up on malformed data)".to_string())?;
+    let file = parsed.map_err(|e| {
+        let text = e.to_string();
+        let first = text.lines().take(6).collect::<Vec<_>>().join("; ");
+        format!("does not parse as MSH 4.1: {first}")
+    })?;
+    Ok(file.data)
+}
+
+/// The physical tags of each entity, by `(dimension, entity tag)`.
+fn physical_tags(entities: &mshio::Entities<i32, f64>) -> HashMap<(i32, i32), Vec<i32>> {
+    let mut phys = HashMap::new();
     for p in &entities.points {
         phys.insert((0, p.tag), p.physical_tags.clone());
     }
@@ -108,154 +126,158 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
     for v in &entities.volumes {
         phys.insert((3, v.tag), v.physical_tags.clone());
     }
+    phys
+}
 
-    // nodes: tag -> index
+/// Coordinates in block order, and the index of each node tag.
+type NodeTable = (Vec<[f64; 3]>, HashMap<u64, usize>);
+
+/// The nodes' coordinates in block order, and the index of each node tag.
+fn read_nodes(bytes: &[u8], nodes: &mshio::Nodes<u64, i32, f64>) -> Result<NodeTable, String> {
     let held: usize = nodes.node_blocks.iter().map(|b| b.nodes.len()).sum();
     if held as u64 != nodes.num_nodes {
-        return Err(err(format!(
+        return Err(format!(
             "the $Nodes header declares {} nodes but its blocks hold {held}",
             nodes.num_nodes
-        )));
+        ));
     }
-    let tags = node_tags(bytes).map_err(err)?;
+    let tags = node_tags(bytes)?;
     if tags.len() != held {
-        return Err(err(format!(
+        return Err(format!(
             "the $Nodes blocks hold {held} nodes but {} node tags",
             tags.len()
-        )));
+        ));
     }
     let mut index_of: HashMap<u64, usize> = HashMap::with_capacity(held);
     for (k, &tag) in tags.iter().enumerate() {
         if index_of.insert(tag, k).is_some() {
-            return Err(err(format!("node tag {tag} is defined twice")));
+            return Err(format!("node tag {tag} is defined twice"));
         }
     }
     let mut points: Vec<[f64; 3]> = Vec::with_capacity(held);
     for block in &nodes.node_blocks {
         points.extend(block.nodes.iter().map(|n| [n.x, n.y, n.z]));
     }
+    Ok((points, index_of))
+}
 
-    // the mesh dimension: the highest dimension of a supported element present
-    let kind_of = |t: ElementType| match t {
+/// The physical groups of the file: the tags of each entity and their names.
+struct Groups {
+    physical: HashMap<(i32, i32), Vec<i32>>,
+    names: HashMap<(i32, i32), String>,
+}
+
+impl Groups {
+    /// The names of the groups of entity `(d, tag)` (a group's tag where it has no name).
+    fn of(&self, d: i32, tag: i32) -> Vec<String> {
+        let name = |p: i32| self.names.get(&(d, p)).cloned().unwrap_or_else(|| p.to_string());
+        self.physical
+            .get(&(d, tag))
+            .into_iter()
+            .flatten()
+            .map(|&p| name(p))
+            .collect()
+    }
+}
+
+/// The cell kind of a supported element type.
+fn kind_of(t: ElementType) -> Option<CellKind> {
+    match t {
         ElementType::Tri3 => Some(CellKind::Tri3),
         ElementType::Qua4 => Some(CellKind::Quad4),
         ElementType::Tet4 => Some(CellKind::Tet4),
         _ => None,
-    };
+    }
+}
+
+/// The elements: cells of the highest dimension present (one kind, each block turned round
+/// where all its cells are negatively oriented) with their regions, and facets one dimension
+/// lower in their boundary groups.
+fn read_elements(
+    elements: &mshio::Elements<u64, i32>,
+    points: Vec<[f64; 3]>,
+    index_of: &HashMap<u64, usize>,
+    groups: &Groups,
+) -> Result<Mesh, String> {
     let dim = elements
         .element_blocks
         .iter()
         .map(|b| b.entity_dim)
         .max()
-        .ok_or_else(|| err("the file has no elements".into()))?;
+        .ok_or("the file has no elements")?;
     if !(2..=3).contains(&dim) {
-        return Err(err(format!(
+        return Err(format!(
             "the highest element dimension is {dim}; a 2D or 3D mesh is needed"
-        )));
+        ));
     }
+    let node_index = |tag: u64, elem: u64| {
+        index_of
+            .get(&tag)
+            .copied()
+            .ok_or_else(|| format!("element {elem} refers to node tag {tag}, which the file does not define"))
+    };
+    let nodes_of = |block: &mshio::ElementBlock<u64, i32>, per: usize| -> Result<Vec<usize>, String> {
+        let mut out = Vec::with_capacity(block.elements.len() * per);
+        for e in &block.elements {
+            if e.nodes.len() != per {
+                return Err(format!("element {} has {} nodes", e.element_tag, e.nodes.len()));
+            }
+            for &t in &e.nodes {
+                out.push(node_index(t, e.element_tag)?);
+            }
+        }
+        Ok(out)
+    };
     let mut kind: Option<CellKind> = None;
-    let mut cells = Vec::new();
-    let mut reoriented = 0;
+    let (mut cells, mut reoriented) = (Vec::new(), 0);
     let mut regions: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut boundaries: BTreeMap<String, FacetGroup> = BTreeMap::new();
-    let group_name = |d: i32, tag: i32| names.get(&(d, tag)).cloned().unwrap_or_else(|| tag.to_string());
-    let node_index = |tag: u64, elem: u64| {
-        index_of.get(&tag).copied().ok_or_else(|| {
-            err(format!(
-                "element {elem} refers to node tag {tag}, which the file does not define"
-            ))
-        })
-    };
     for block in &elements.element_blocks {
         let d = block.entity_dim;
         if d == dim {
-            let k = kind_of(block.element_type).ok_or_else(|| {
-                err(format!(
-                    "element type {:?} is not supported: cells must be 3-node triangles, 4-node \
-                     quadrilaterals or 4-node tetrahedra",
-                    block.element_type
-                ))
-            })?;
-            if k.dim() != dim as usize {
-                return Err(err(format!("{} cells in a {dim}D mesh", k.name())));
-            }
-            match kind {
-                None => kind = Some(k),
-                Some(k0) if k0 != k => {
-                    return Err(err(format!(
-                        "mixed cell kinds ({} and {}): one kind per mesh",
-                        k0.name(),
-                        k.name()
-                    )))
-                }
-                _ => {}
-            }
+            let k = cell_kind(block.element_type, dim, kind)?;
+            kind = Some(k);
             let first = cells.len() / k.n_nodes();
-            for e in &block.elements {
-                if e.nodes.len() != k.n_nodes() {
-                    return Err(err(format!("element {} has {} nodes", e.element_tag, e.nodes.len())));
-                }
-                for &t in &e.nodes {
-                    cells.push(node_index(t, e.element_tag)?);
-                }
-            }
+            cells.extend(nodes_of(block, k.n_nodes())?);
             let last = cells.len() / k.n_nodes();
             reoriented += orient_block(&points, &mut cells, k, first, last);
-            for &p in phys.get(&(d, block.entity_tag)).into_iter().flatten() {
-                regions.entry(group_name(d, p)).or_default().extend(first..last);
+            for g in groups.of(d, block.entity_tag) {
+                regions.entry(g).or_default().extend(first..last);
             }
         } else if d == dim - 1 {
-            let facet_nodes = if dim == 2 { 2 } else { 3 };
-            let ok = matches!(
+            if !matches!(
                 (dim, block.element_type),
                 (2, ElementType::Lin2) | (3, ElementType::Tri3)
-            );
-            if !ok {
-                return Err(err(format!(
+            ) {
+                return Err(format!(
                     "boundary element type {:?} is not supported in a {dim}D mesh",
                     block.element_type
-                )));
+                ));
             }
-            let mut facets = Vec::with_capacity(block.elements.len() * facet_nodes);
-            for e in &block.elements {
-                for &t in &e.nodes {
-                    facets.push(node_index(t, e.element_tag)?);
-                }
-            }
-            for &p in phys.get(&(d, block.entity_tag)).into_iter().flatten() {
-                let g = boundaries.entry(group_name(d, p)).or_insert_with(|| FacetGroup {
-                    nodes_per_facet: facet_nodes,
+            let per = dim as usize;
+            let facets = nodes_of(block, per)?;
+            for g in groups.of(d, block.entity_tag) {
+                let group = boundaries.entry(g).or_insert_with(|| FacetGroup {
+                    nodes_per_facet: per,
                     facets: vec![],
                 });
-                g.facets.extend_from_slice(&facets);
+                group.facets.extend_from_slice(&facets);
             }
         }
     }
-    let kind = kind.ok_or_else(|| err(format!("no {dim}D cells")))?;
-    if dim == 2 {
-        let z0 = points.first().map_or(0.0, |p| p[2]);
-        if let Some((i, p)) = points.iter().enumerate().find(|(_, p)| p[2] != z0) {
-            return Err(err(format!(
-                "a 2D mesh must lie in a plane z = const; node {i} has z = {} (node 0: {z0})",
-                p[2]
-            )));
-        }
-        for p in &mut points {
-            p[2] = 0.0;
-        }
-    }
+    let kind = kind.ok_or_else(|| format!("no {dim}D cells"))?;
     let n_cells = cells.len() / kind.n_nodes();
     if kind == CellKind::Tet4 && reoriented == n_cells {
-        return Err(err(format!(
+        return Err(format!(
             "all {n_cells} tetrahedra are inverted (negative volume): Gmsh writes them positive, so the file is mirrored or its nodes are misnumbered"
-        )));
+        ));
     }
     for v in regions.values_mut() {
         v.sort_unstable();
         v.dedup();
     }
     regions.entry("body".into()).or_insert_with(|| (0..n_cells).collect());
-    let mesh = Mesh {
+    Ok(Mesh {
         dim: dim as usize,
         kind,
         points,
@@ -263,9 +285,43 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
         boundaries,
         regions,
         reoriented_cells: reoriented,
-    };
-    mesh.check().map_err(|e| err(format!("{e}")))?;
-    Ok(mesh)
+    })
+}
+
+/// The cell kind of a block of the mesh's dimension, which must match the kind so far.
+fn cell_kind(t: ElementType, dim: i32, so_far: Option<CellKind>) -> Result<CellKind, String> {
+    let k = kind_of(t).ok_or_else(|| {
+        format!("element type {t:?} is not supported: cells must be 3-node triangles, 4-node quadrilaterals or 4-node tetrahedra")
+    })?;
+    if k.dim() != dim as usize {
+        return Err(format!("{} cells in a {dim}D mesh", k.name()));
+    }
+    match so_far {
+        Some(k0) if k0 != k => Err(format!(
+            "mixed cell kinds ({} and {}): one kind per mesh",
+            k0.name(),
+            k.name()
+        )),
+        _ => Ok(k),
+    }
+}
+
+/// A 2D mesh must lie in a plane `z = const`; it is put at `z = 0`.
+fn flatten_2d(mesh: &mut Mesh) -> Result<(), String> {
+    if mesh.dim != 2 {
+        return Ok(());
+    }
+    let z0 = mesh.points.first().map_or(0.0, |p| p[2]);
+    if let Some((i, p)) = mesh.points.iter().enumerate().find(|(_, p)| p[2] != z0) {
+        return Err(format!(
+            "a 2D mesh must lie in a plane z = const; node {i} has z = {} (node 0: {z0})",
+            p[2]
+        ));
+    }
+    for p in &mut mesh.points {
+        p[2] = 0.0;
+    }
+    Ok(())
 }
 
 /// Turns round every cell of `first..last` when all of them are negatively oriented; returns
