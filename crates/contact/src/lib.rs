@@ -33,20 +33,27 @@
 //! assert_eq!(sol.status[0], Status::Slip); // frictionless contact: slip
 //! ```
 
+mod gauss_seidel;
+mod local;
 mod newton;
 mod operator;
 mod points;
 mod projection;
+pub mod siconos;
 mod solution;
+mod uniqueness;
 mod uzawa;
 
+pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
 pub use newton::{solve_newton, NewtonParams};
-pub use operator::{ContactOperator, DenseContactProblem};
+pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};
 pub use points::{ContactPoints, PointValues, Status};
-pub use projection::{project_disc, project_nonnegative};
+pub use projection::{project_cone, project_disc, project_nonnegative};
 pub use solution::{
-    classify, complementarity_residual, slip_bound, ContactInfo, ContactSolution, Law, Progress, Stage,
+    classify, complementarity_residual, desaxce_residual, slip_bound, ContactInfo, ContactSolution, Interrupt,
+    Interruption, Iterate, Law, Measure, Progress, Stage, Stall,
 };
+pub use uniqueness::slip_bound_expansion;
 pub use uzawa::{solve, StopRule, UzawaParams};
 
 /// A failure of the primal solve behind a [`ContactOperator`], with its cause (for example the
@@ -67,18 +74,22 @@ impl OperatorError {
     }
 }
 
-/// What can go wrong in a contact solve; each variant of a loop that stopped carries its last
-/// residual. The messages name no solver option: the application that chose the solver knows
-/// what else to try.
+/// What can go wrong in a contact solve. Each variant of a loop that stopped carries its
+/// iterations, the residual it stopped at and, where there was one, the best iterate it
+/// found (by the measure it was asked to meet), so that a caller can still use or inspect it.
+/// A loop never reports an error at a residual that meets its tolerance. The messages name no
+/// solver option: the application that chose the solver knows what else to try.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum ContactError {
-    /// The first-order iteration did not reach its tolerance.
-    #[error("Uzawa did not converge in {n_iters} iterations (complementarity residual {residual:.3e})")]
+    /// A first-order iteration reached its iteration limit while still making progress.
+    #[error("Uzawa did not converge in {n_iters} iterations (residual {residual:.3e})")]
     NoConvergence {
         /// Iterations done.
         n_iters: usize,
         /// Last residual.
         residual: f64,
+        /// The best iterate.
+        best: Option<Box<Iterate>>,
     },
     /// The fixed point on the slip bound did not converge.
     #[error("the friction fixed point did not converge in {n_iters} iterations (residual {residual:.3e}); the fixed point on S may cycle under strong coupling or large F")]
@@ -87,8 +98,11 @@ pub enum ContactError {
         n_iters: usize,
         /// Last residual.
         residual: f64,
+        /// The best iterate.
+        best: Option<Box<Iterate>>,
     },
-    /// The iteration diverged even after halving the step.
+    /// The residual grew without bound (or stopped being a number), even after the step was
+    /// halved.
     #[error("Uzawa diverged after {n_iters} iterations (residual {residual:.3e}, step {step:.3e})")]
     Diverged {
         /// Iterations done.
@@ -97,16 +111,50 @@ pub enum ContactError {
         residual: f64,
         /// The last step.
         step: f64,
+        /// The best iterate.
+        best: Option<Box<Iterate>>,
     },
-    /// The semismooth Newton iteration stalled (and its fallback was switched off).
-    #[error("semismooth Newton stalled after {n_iters} steps on {reason} (complementarity residual {residual:.3e})")]
-    NewtonStalled {
-        /// Newton steps done.
+    /// The iteration stopped making progress (its residual did not grow): every remedy the
+    /// solver has was tried.
+    #[error("{} stalled after {n_iters} iterations on {reason} (residual {residual:.3e}; best {:.3e})", .stage.name(), best.as_ref().map_or(f64::NAN, |b| b.residual))]
+    Stalled {
+        /// The loop that stalled last.
+        stage: Stage,
+        /// Iterations done, all loops together.
         n_iters: usize,
-        /// Last residual.
+        /// The residual at the stall.
         residual: f64,
         /// What stopped it.
-        reason: String,
+        reason: Stall,
+        /// The best iterate.
+        best: Option<Box<Iterate>>,
+    },
+    /// The solve was stopped from outside: its deadline passed or it was cancelled.
+    #[error("{why} after {n_iters} iterations (residual {residual:.3e})")]
+    Interrupted {
+        /// Deadline or cancellation.
+        why: Interruption,
+        /// Iterations done.
+        n_iters: usize,
+        /// The residual then.
+        residual: f64,
+        /// The best iterate.
+        best: Option<Box<Iterate>>,
+    },
+    /// Every solver stalled on a Coulomb problem whose fixed point on the slip bound does not
+    /// contract near the best iterate found ([`slip_bound_expansion`]): the contraction on
+    /// which the existence and uniqueness of the solution rest fails there, and the problem
+    /// may have several solutions nearby, or none.
+    #[error("no solver converged (best residual {residual:.3e}), and the data are past the uniqueness of Coulomb's law: near the best iterate the fixed point on the slip bound S = F λ_n expands perturbations by {expansion:.2} (the existence and uniqueness theory needs a contraction, below 1), so the problem may have several solutions or none")]
+    NotUnique {
+        /// The measured expansion of the fixed-point map (at least 1).
+        expansion: f64,
+        /// Iterations done.
+        n_iters: usize,
+        /// The best residual.
+        residual: f64,
+        /// The best iterate.
+        best: Option<Box<Iterate>>,
     },
     /// The multipliers do not move the contact points: the dual operator's largest eigenvalue
     /// is not positive and finite.
@@ -121,4 +169,49 @@ pub enum ContactError {
     /// Bad input.
     #[error("contact input: {0}")]
     Input(String),
+}
+
+impl ContactError {
+    /// The residual the solve stopped at (`None` for errors that are not a stopped loop).
+    pub fn residual(&self) -> Option<f64> {
+        match self {
+            ContactError::NoConvergence { residual, .. }
+            | ContactError::FixedPointNoConvergence { residual, .. }
+            | ContactError::Diverged { residual, .. }
+            | ContactError::Stalled { residual, .. }
+            | ContactError::NotUnique { residual, .. }
+            | ContactError::Interrupted { residual, .. } => Some(*residual),
+            _ => None,
+        }
+    }
+
+    /// The best iterate of a stopped loop, if it kept one.
+    pub fn best(&self) -> Option<&Iterate> {
+        match self {
+            ContactError::NoConvergence { best, .. }
+            | ContactError::FixedPointNoConvergence { best, .. }
+            | ContactError::Diverged { best, .. }
+            | ContactError::Stalled { best, .. }
+            | ContactError::NotUnique { best, .. }
+            | ContactError::Interrupted { best, .. } => best.as_deref(),
+            _ => None,
+        }
+    }
+
+    /// The error with `candidate` as its best iterate where `candidate` is better than the one
+    /// it holds (or it holds none).
+    pub fn with_best(mut self, candidate: Iterate) -> Self {
+        if let ContactError::NoConvergence { best, .. }
+        | ContactError::FixedPointNoConvergence { best, .. }
+        | ContactError::Diverged { best, .. }
+        | ContactError::Stalled { best, .. }
+        | ContactError::NotUnique { best, .. }
+        | ContactError::Interrupted { best, .. } = &mut self
+        {
+            if best.as_ref().is_none_or(|b| !(b.residual <= candidate.residual)) {
+                *best = Some(Box::new(candidate));
+            }
+        }
+        self
+    }
 }

@@ -4,6 +4,7 @@
 
 use crate::points::PointValues;
 use crate::OperatorError;
+use faer::sparse::{SparseRowMat, SparseRowMatRef};
 
 /// The contact problem seen from the multipliers.
 pub trait ContactOperator {
@@ -69,37 +70,183 @@ impl ContactOperator for DenseContactProblem {
         self.nt
     }
     fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
-        self.apply(lambda, out, true);
+        apply(self, lambda, out, true);
         Ok(0)
     }
     fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
-        self.apply(lambda, out, false);
+        apply(self, lambda, out, false);
         Ok(0)
     }
 }
 
-impl DenseContactProblem {
-    /// `out = u0 - D W λ` (`with_loads`) or `-D W λ`.
-    fn apply(&self, lambda: &PointValues, out: &mut PointValues, with_loads: bool) {
-        let n = self.weight.len();
-        let m = self.m();
-        // W λ in the flat layout
-        let mut wl = Vec::with_capacity(m);
-        wl.extend(lambda.normal.iter().zip(&self.weight).map(|(l, w)| l * w));
-        for i in 0..n {
-            for k in 0..self.nt {
-                wl.push(lambda.tangential[i * self.nt + k] * self.weight[i]);
+/// An affine contact problem with a sparse compliance: `u = u0 - D W λ`, `D` in compressed
+/// rows, in the layout `[normal (n); tangential (n·nt)]` (the Delassus operators of multibody
+/// problems: a few entries per row). `D` need not be definite, nor exactly symmetric.
+#[derive(Clone, Debug)]
+pub struct SparseContactProblem {
+    /// Contact displacement under the loads alone (λ = 0).
+    pub u0: PointValues,
+    /// Compliance, `m x m` with `m = n (1 + nt)`.
+    pub compliance: SparseRowMat<usize, f64>,
+    /// Weights `w_i`.
+    pub weight: Vec<f64>,
+    /// Tangential components per point.
+    pub nt: usize,
+}
+
+impl ContactOperator for SparseContactProblem {
+    fn n_points(&self) -> usize {
+        self.weight.len()
+    }
+    fn n_tangential(&self) -> usize {
+        self.nt
+    }
+    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+        apply(self, lambda, out, true);
+        Ok(0)
+    }
+    fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+        apply(self, lambda, out, false);
+        Ok(0)
+    }
+}
+
+/// The compliance of an affine problem, as the solvers read it.
+#[derive(Clone, Copy, Debug)]
+pub enum Compliance<'a> {
+    /// Row-major, `m x m`.
+    Dense(&'a [f64]),
+    /// Compressed rows.
+    Sparse(SparseRowMatRef<'a, usize, f64>),
+}
+
+impl Compliance<'_> {
+    /// Rows (= columns) of the compliance.
+    pub fn size(&self) -> usize {
+        match self {
+            Compliance::Dense(d) => (d.len() as f64).sqrt().round() as usize,
+            Compliance::Sparse(s) => s.nrows(),
+        }
+    }
+
+    /// `out = D x`.
+    pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        match self {
+            Compliance::Dense(d) => {
+                let m = x.len();
+                for (r, o) in out.iter_mut().enumerate() {
+                    *o = dot8(&d[r * m..(r + 1) * m], x);
+                }
+            }
+            Compliance::Sparse(s) => {
+                for (r, o) in out.iter_mut().enumerate() {
+                    *o = s.col_idx_of_row(r).zip(s.val_of_row(r)).map(|(j, v)| v * x[j]).sum();
+                }
             }
         }
-        for r in 0..m {
-            let row = &self.compliance[r * m..(r + 1) * m];
-            let dot = dot8(row, &wl);
-            let (slot, load) = if r < n {
-                (&mut out.normal[r], self.u0.normal[r])
-            } else {
-                (&mut out.tangential[r - n], self.u0.tangential[r - n])
-            };
-            *slot = if with_loads { load - dot } else { -dot };
+    }
+
+    /// Row `r`'s stored entries, `(column, value)`.
+    pub fn row(&self, r: usize) -> Box<dyn Iterator<Item = (usize, f64)> + '_> {
+        match self {
+            Compliance::Dense(d) => {
+                let m = self.size();
+                Box::new(d[r * m..(r + 1) * m].iter().copied().enumerate())
+            }
+            Compliance::Sparse(s) => Box::new(s.col_idx_of_row(r).zip(s.val_of_row(r).iter().copied())),
+        }
+    }
+
+    /// The largest `|D_ij - D_ji|` relative to the largest `|D_ij|` (0 for a symmetric `D`).
+    pub fn asymmetry(&self) -> f64 {
+        let m = self.size();
+        let (mut diff, mut size) = (0.0f64, 0.0f64);
+        match self {
+            Compliance::Dense(d) => {
+                for i in 0..m {
+                    for j in 0..m {
+                        size = size.max(d[i * m + j].abs());
+                        diff = diff.max((d[i * m + j] - d[j * m + i]).abs());
+                    }
+                }
+            }
+            Compliance::Sparse(s) => {
+                let at = |i: usize, j: usize| {
+                    s.col_idx_of_row(i)
+                        .zip(s.val_of_row(i))
+                        .find(|(c, _)| *c == j)
+                        .map_or(0.0, |(_, v)| *v)
+                };
+                for i in 0..m {
+                    for (j, &v) in s.col_idx_of_row(i).zip(s.val_of_row(i)) {
+                        size = size.max(v.abs());
+                        diff = diff.max((v - at(j, i)).abs());
+                    }
+                }
+            }
+        }
+        if size > 0.0 {
+            diff / size
+        } else {
+            0.0
+        }
+    }
+}
+
+/// An affine contact problem given by its data, `u = u0 - D W λ`: what the semismooth Newton
+/// method needs beyond the operator ([`crate::solve_newton`]).
+pub trait AffineProblem: ContactOperator {
+    /// `u0`, the contact displacement under the loads alone.
+    fn loads(&self) -> &PointValues;
+    /// The weights `w_i`.
+    fn weights(&self) -> &[f64];
+    /// The compliance `D`.
+    fn compliance(&self) -> Compliance<'_>;
+}
+
+impl AffineProblem for DenseContactProblem {
+    fn loads(&self) -> &PointValues {
+        &self.u0
+    }
+    fn weights(&self) -> &[f64] {
+        &self.weight
+    }
+    fn compliance(&self) -> Compliance<'_> {
+        Compliance::Dense(&self.compliance)
+    }
+}
+
+impl AffineProblem for SparseContactProblem {
+    fn loads(&self) -> &PointValues {
+        &self.u0
+    }
+    fn weights(&self) -> &[f64] {
+        &self.weight
+    }
+    fn compliance(&self) -> Compliance<'_> {
+        Compliance::Sparse(self.compliance.as_ref())
+    }
+}
+
+/// `out = u0 - D W λ` (`with_loads`) or `-D W λ`, for any [`AffineProblem`].
+fn apply(p: &impl AffineProblem, lambda: &PointValues, out: &mut PointValues, with_loads: bool) {
+    let (n, nt) = (lambda.n_points(), lambda.n_tangential());
+    let w = p.weights();
+    let mut wl = Vec::with_capacity(n * (1 + nt));
+    wl.extend(lambda.normal.iter().zip(w).map(|(l, w)| l * w));
+    for i in 0..n {
+        wl.extend(lambda.tangential_of(i).iter().map(|l| l * w[i]));
+    }
+    let mut dw = vec![0.0; wl.len()];
+    p.compliance().apply(&wl, &mut dw);
+    let u0 = p.loads();
+    let parts = [
+        (&mut out.normal, &u0.normal, &dw[..n]),
+        (&mut out.tangential, &u0.tangential, &dw[n..]),
+    ];
+    for (o, load, d) in parts {
+        for ((o, l), d) in o.iter_mut().zip(load).zip(d) {
+            *o = if with_loads { l - d } else { -d };
         }
     }
 }

@@ -44,6 +44,29 @@ pub fn project_disc(x: &mut [f64], radius: f64) {
     }
 }
 
+/// Projection onto Coulomb's cone `K = {(x_n, x_t): |x_t| ≤ μ x_n}` (Siconos' and De Saxcé's
+/// convention: `x[0]` the normal component, `x[1..]` the tangential ones): `x` itself inside
+/// `K`, `0` in the polar cone `{μ |x_t| ≤ -x_n}`, else the point of the cone's boundary
+/// `t (1, μ x_t/|x_t|)` with `t = (x_n + μ |x_t|) / (1 + μ²)`. `μ = 0` gives `(max(x_n, 0), 0)`.
+#[inline]
+pub fn project_cone(x: &mut [f64], mu: f64) {
+    let (xn, xt) = x.split_first_mut().expect("a point has a normal component");
+    let nt = norm(xt);
+    if nt <= mu * *xn {
+        return;
+    }
+    if mu * nt <= -*xn {
+        *xn = 0.0;
+        xt.iter_mut().for_each(|v| *v = 0.0);
+        return;
+    }
+    let t = (*xn + mu * nt) / (1.0 + mu * mu);
+    *xn = t;
+    // nt > 0 here: nt = 0 with xn < 0 is in the polar cone, with xn ≥ 0 inside K
+    let s = mu * t / nt;
+    xt.iter_mut().for_each(|v| *v *= s);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -57,5 +80,18 @@ mod tests {
         let mut y = [0.1];
         project_disc(&mut y, 0.0);
         assert_eq!(y, [0.0]);
+        // the cone: inside, polar, and the boundary point of a 3-4-5 triangle
+        let mut c = [2.0, 0.3, 0.4];
+        project_cone(&mut c, 1.0);
+        assert_eq!(c, [2.0, 0.3, 0.4]);
+        let mut c = [-2.0, 0.3, 0.4];
+        project_cone(&mut c, 1.0);
+        assert_eq!(c, [0.0, 0.0, 0.0]);
+        let mut c = [0.0, 3.0, 4.0];
+        project_cone(&mut c, 1.0);
+        assert!((c[0] - 2.5).abs() < 1e-15 && (c[1] - 1.5).abs() < 1e-15 && (c[2] - 2.0).abs() < 1e-15);
+        let mut c = [1.0, 3.0];
+        project_cone(&mut c, 0.0);
+        assert_eq!(c, [1.0, 0.0]);
     }
 }

@@ -4,7 +4,7 @@
 
 use crate::operator::ContactOperator;
 use crate::points::{ContactPoints, PointValues, Status};
-use crate::projection::{project_disc, project_nonnegative};
+use crate::projection::{norm, project_cone, project_disc, project_nonnegative};
 use crate::{ContactError, OperatorError};
 
 /// The friction law.
@@ -23,10 +23,13 @@ pub enum Law {
 /// count is 0 (a step `None`) where its loop did not run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactInfo {
-    /// First-order steps (Uzawa or the accelerated gradient), summed over the fixed point.
+    /// First-order steps (Uzawa or the accelerated gradient), summed over the fixed point; or
+    /// the block Gauss–Seidel method's sweeps.
     pub uzawa_iters: usize,
     /// Semismooth Newton steps ([`crate::solve_newton`]).
     pub newton_iters: usize,
+    /// Outer steps of Newton's proximal stage (each a regularised problem solved by Newton).
+    pub proximal_iters: usize,
     /// Step halvings in Newton's line search, summed.
     pub line_search_cuts: usize,
     /// Whether Newton stalled and the accelerated gradient finished the solve.
@@ -41,12 +44,17 @@ pub struct ContactInfo {
     pub operator_calls: usize,
     /// The first-order step `r` last used; `None` when no first-order step was taken.
     pub step: Option<f64>,
-    /// The constant `c` of Newton's natural map (`1/μ_max`); `None` when Newton did not run.
+    /// The constant `c` of Newton's natural map on the problem itself (`1/μ_max`); `None` when
+    /// Newton did not run.
     pub augmentation: Option<f64>,
     /// The estimate of the dual operator's largest eigenvalue.
     pub mu_max: f64,
-    /// Complementarity residual of the returned pair (the law's own radius).
+    /// Complementarity residual of the returned pair (the law's own radius):
+    /// [`complementarity_residual`], whatever the measure the solve was asked to meet.
     pub complementarity: f64,
+    /// The residual of the returned pair by the measure the solve was asked to meet (equal to
+    /// `complementarity` for [`Measure::Complementarity`]).
+    pub residual: f64,
     /// Halvings of the first-order step (divergence or a stall detected).
     pub step_backoffs: usize,
     /// Halvings of the friction fixed point's relaxation factor (a residual that did not fall).
@@ -59,6 +67,7 @@ impl ContactInfo {
         ContactInfo {
             uzawa_iters: 0,
             newton_iters: 0,
+            proximal_iters: 0,
             line_search_cuts: 0,
             fallback: false,
             fixed_point_iters: 0,
@@ -69,6 +78,7 @@ impl ContactInfo {
             augmentation: None,
             mu_max,
             complementarity: f64::NAN,
+            residual: f64::NAN,
             step_backoffs: 0,
             relaxations: 0,
         }
@@ -104,19 +114,140 @@ pub enum Stage {
     FixedPoint,
     /// A semismooth Newton step.
     Newton,
-    /// Newton stalled: the accelerated gradient takes over (one line, then its own steps).
+    /// An outer step of the proximal-point method around Newton (a regularised problem).
+    Proximal,
+    /// A sweep of the block Gauss–Seidel method.
+    GaussSeidel,
+    /// Newton stalled: the last stage takes over (one line, then its own steps).
     Fallback,
 }
 
 impl Stage {
-    /// Lower-case name (`uzawa`, `fixed-point`, `newton`, `fallback`).
+    /// Lower-case name (`uzawa`, `fixed-point`, `newton`, `proximal`, `gauss-seidel`,
+    /// `fallback`).
     pub fn name(self) -> &'static str {
         match self {
             Stage::Uzawa => "uzawa",
             Stage::FixedPoint => "fixed-point",
             Stage::Newton => "newton",
+            Stage::Proximal => "proximal",
+            Stage::GaussSeidel => "gauss-seidel",
             Stage::Fallback => "fallback",
         }
+    }
+}
+
+/// Why a loop stopped making progress.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stall {
+    /// The iteration limit, reached while the residual still fell.
+    IterationLimit,
+    /// A Newton matrix that could not be solved.
+    SingularMatrix,
+    /// A Newton direction along which no step lowered the residual.
+    LineSearch,
+    /// A residual that is not a number.
+    NonFinite,
+    /// Steps that no longer lowered the residual, even with a smaller step size.
+    NoProgress,
+}
+
+impl std::fmt::Display for Stall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Stall::IterationLimit => "the iteration limit",
+            Stall::SingularMatrix => "a singular Newton matrix",
+            Stall::LineSearch => "a failed line search",
+            Stall::NonFinite => "a non-finite residual",
+            Stall::NoProgress => "no progress",
+        })
+    }
+}
+
+/// The residual a solve must bring below its tolerance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Measure {
+    /// This crate's: the natural map with `c = 1/μ_max`, weighted, relative to the multipliers
+    /// or their scale ([`complementarity_residual`]). Free of units and of the solver.
+    #[default]
+    Complementarity,
+    /// Siconos' (and FCLib's): the natural map of De Saxcé's cone complementarity with `c = 1`,
+    /// unweighted, relative to `max(‖u0 - g‖, ‖λ‖, ‖u - g‖)` ([`desaxce_residual`]). It mixes
+    /// the units of forces and displacements, so it means most where the compliance is near 1.
+    DeSaxce,
+}
+
+/// An iterate that a stopped solve hands back: multipliers, the displacement they give, and
+/// the residual (by the measure the solve was asked to meet).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Iterate {
+    /// The multipliers.
+    pub lambda: PointValues,
+    /// The contact displacement of `lambda`.
+    pub u: PointValues,
+    /// Its residual.
+    pub residual: f64,
+}
+
+/// What stops a solve from outside: a deadline, a flag another thread may set (a Ctrl-C
+/// handler, a user interface), or both. Checked once per iteration of every loop. Two are
+/// equal when their deadlines are and they watch the same flag.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Interrupt {
+    /// Stop at this instant.
+    pub deadline: Option<std::time::Instant>,
+    /// Stop once this flag is set.
+    pub cancel: Option<&'static std::sync::atomic::AtomicBool>,
+}
+
+/// Why a solve was interrupted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interruption {
+    /// Its deadline passed.
+    Deadline,
+    /// Its cancel flag was set.
+    Cancelled,
+}
+
+impl std::fmt::Display for Interruption {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Interruption::Deadline => "the deadline passed",
+            Interruption::Cancelled => "cancelled",
+        })
+    }
+}
+
+impl PartialEq for Interrupt {
+    fn eq(&self, other: &Self) -> bool {
+        self.deadline == other.deadline
+            && match (self.cancel, other.cancel) {
+                (Some(a), Some(b)) => std::ptr::eq(a, b),
+                (a, b) => a.is_none() && b.is_none(),
+            }
+    }
+}
+
+impl Eq for Interrupt {}
+
+impl Interrupt {
+    /// No deadline, no flag.
+    pub const NONE: Interrupt = Interrupt {
+        deadline: None,
+        cancel: None,
+    };
+
+    /// Whether the solve must stop now, and why.
+    pub fn check(&self) -> Option<Interruption> {
+        if self
+            .cancel
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+        {
+            return Some(Interruption::Cancelled);
+        }
+        self.deadline
+            .is_some_and(|d| std::time::Instant::now() >= d)
+            .then_some(Interruption::Deadline)
     }
 }
 
@@ -182,6 +313,80 @@ pub fn complementarity_residual(
         num / den
     } else {
         num
+    }
+}
+
+/// Siconos' error measure in this crate's terms ([`Measure::DeSaxce`]). With `r = λ`, the
+/// velocity `v = (g - u_n, -u_t)` (Siconos' `u = W r + q`, `u_N ≥ 0` meaning separation) and
+/// `q = (g - u0_n, -u0_t)`, per point `e = r - P_K(r - ṽ)`: for Coulomb `K` is the cone
+/// `|r_t| ≤ F r_n` and `ṽ = v + F |v_t| e_n` (De Saxcé's change of variable), for Tresca
+/// `K = {r_n ≥ 0, |r_t| ≤ S}` and `ṽ = v`, frictionless `K = {r_n ≥ 0}`. The result is
+/// `‖e‖ / max(‖q‖, ‖r‖, ‖v‖)`, unweighted (`‖e‖` where the three vanish).
+pub fn desaxce_residual(
+    points: &ContactPoints,
+    law: &Law,
+    lambda: &PointValues,
+    u: &PointValues,
+    u0: &PointValues,
+) -> f64 {
+    let nt = lambda.n_tangential();
+    let (mut e2, mut r2, mut v2, mut q2) = (0.0, 0.0, 0.0, 0.0);
+    let mut x = [0.0; 3];
+    for i in 0..points.len() {
+        let g = points.gap[i];
+        let (rn, vn) = (lambda.normal[i], g - u.normal[i]);
+        let (rt, ut) = (lambda.tangential_of(i), u.tangential_of(i));
+        q2 += (g - u0.normal[i]).powi(2) + u0.tangential_of(i).iter().map(|a| a * a).sum::<f64>();
+        r2 += rn * rn + rt.iter().map(|a| a * a).sum::<f64>();
+        v2 += vn * vn + ut.iter().map(|a| a * a).sum::<f64>();
+        // r - ṽ, with v_t = -u_t
+        x[0] = rn - vn;
+        for k in 0..nt {
+            x[1 + k] = rt[k] + ut[k];
+        }
+        match law {
+            Law::Coulomb => {
+                let f = points.friction[i];
+                x[0] -= f * norm(ut);
+                project_cone(&mut x[..1 + nt], f);
+            }
+            Law::Tresca(s) => {
+                x[0] = project_nonnegative(x[0]);
+                project_disc(&mut x[1..1 + nt], s[i]);
+            }
+            Law::Frictionless => x[0] = project_nonnegative(x[0]),
+        }
+        e2 += (rn - x[0]).powi(2) + (0..nt).map(|k| (rt[k] - x[1 + k]).powi(2)).sum::<f64>();
+    }
+    let den = q2.max(r2).max(v2).sqrt();
+    if den > 0.0 {
+        e2.sqrt() / den
+    } else {
+        e2.sqrt()
+    }
+}
+
+impl Measure {
+    /// The residual of `(lambda, u)` by this measure; `c` and `reference` are those of
+    /// [`complementarity_residual`], `u0` the displacement under the loads alone.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn of(
+        self,
+        points: &ContactPoints,
+        law: &Law,
+        lambda: &PointValues,
+        u: &PointValues,
+        u0: &PointValues,
+        c: f64,
+        reference: f64,
+    ) -> f64 {
+        match self {
+            Measure::Complementarity => {
+                let radius = slip_bound(points, law, &lambda.normal);
+                complementarity_residual(points, &radius, lambda, u, c, reference)
+            }
+            Measure::DeSaxce => desaxce_residual(points, law, lambda, u, u0),
+        }
     }
 }
 

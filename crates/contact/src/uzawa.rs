@@ -6,9 +6,10 @@ use crate::operator::ContactOperator;
 use crate::points::{ContactPoints, PointValues};
 use crate::projection::{project_disc, project_nonnegative};
 use crate::solution::{
-    check_input, classify, complementarity_residual, counts, estimate_mu_max, multiplier_scale, slip_bound, Counter,
+    check_input, classify, complementarity_residual, counts, desaxce_residual, estimate_mu_max, multiplier_scale,
+    slip_bound, Counter,
 };
-use crate::{ContactError, ContactInfo, ContactSolution, Law, Progress, Stage};
+use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law, Measure, Progress, Stage, Stall};
 
 /// When the loops stop.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +46,10 @@ pub struct UzawaParams {
     /// Nesterov acceleration of the projected gradient (FISTA) with adaptive restart, step
     /// `1 / μ_max`; only with the tight rule (the paper's rule is plain Uzawa).
     pub accelerate: bool,
+    /// The residual the tight rule brings below its tolerance.
+    pub measure: Measure,
+    /// A deadline or a cancel flag.
+    pub interrupt: Interrupt,
 }
 
 impl Default for UzawaParams {
@@ -58,6 +63,8 @@ impl Default for UzawaParams {
             max_fixed_point: 100,
             report_every: 0,
             accelerate: false,
+            measure: Measure::Complementarity,
+            interrupt: Interrupt::NONE,
         }
     }
 }
@@ -149,9 +156,15 @@ struct Dual<'a, 'b> {
     step: f64,
     /// Counts so far.
     info: ContactInfo,
-    /// A tolerance for the Tresca solves tighter than the rule's, once the friction fixed point
-    /// stalls just above its tolerance (inexact inner solves put a floor under its residual).
+    /// The tolerance of the Tresca solves of the friction fixed point, where it is not the
+    /// rule's: a fraction of the fixed point's last residual, so that the inexact inner solves
+    /// do not put a floor under the outer residual (nor cycle at a loose tolerance).
     inner_tol: Option<f64>,
+    /// The contact displacement under the loads alone.
+    u0: PointValues,
+    /// The best iterate of the law itself (Coulomb: with the radius `F λ_n`) seen by the
+    /// tight rule, with its residual.
+    best: Option<Iterate>,
 }
 
 /// Solves the contact problem for `law` through `op`, from `lambda0` (warm start; zeros when
@@ -179,6 +192,7 @@ pub fn solve(
     let mut c = Counter::new(op);
     let (mu_max, u0) = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
     let estimate_inner = c.inner;
+    let reference = multiplier_scale(points, &u0, 1.0 / mu_max);
     // plain Uzawa converges for r < 2/μ_max; the accelerated gradient wants r ≤ 1/μ_max
     let step = params.step.unwrap_or(if params.accelerate {
         1.0 / mu_max
@@ -194,19 +208,34 @@ pub fn solve(
         points,
         params,
         canon,
-        reference: multiplier_scale(points, &u0, canon),
+        reference,
         step,
         info: ContactInfo::new(mu_max),
         inner_tol: None,
+        u0,
+        best: None,
     };
     let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
     let mut u = PointValues::zeros(n, nt);
-    let fresh = match law {
+    let outcome = match law {
         Law::Frictionless | Law::Tresca(_) => {
             let radius = slip_bound(points, law, &lambda.normal);
-            uzawa(&mut d, &radius, &mut lambda, &mut u, progress)?
+            uzawa(&mut d, Some(law), &radius, &mut lambda, &mut u, progress)
         }
-        Law::Coulomb => fixed_point(&mut d, law, &mut lambda, &mut u, progress)?,
+        Law::Coulomb => fixed_point(&mut d, law, &mut lambda, &mut u, progress),
+    };
+    // a loop that stopped short (an inner solve of the fixed point, say) may have met the law
+    // to the tolerance on the way: that is an answer, not an error
+    let fresh = match outcome {
+        Ok(fresh) => fresh,
+        Err(e) => match d.best.take() {
+            Some(best) if d.tol().is_some_and(|tol| best.residual <= tol) => {
+                (lambda, u) = (best.lambda, best.u);
+                true
+            }
+            Some(best) => return Err(e.with_best(best)),
+            None => return Err(e),
+        },
     };
     if !fresh {
         d.c.call(&lambda, &mut u)?;
@@ -221,7 +250,11 @@ pub fn solve(
 /// The paper starts from `S = 0` (a warm start from λ uses `F λ_n`). The update is relaxed,
 /// `S ← S + ω (F λ_n - S)`: ω = 1 is the paper's iteration; under the tight rule ω halves (down
 /// to 1/64) whenever the residual fails to fall, which damps the two-cycles strong coupling can
-/// cause (the fixed points are the same for every ω > 0).
+/// cause (the fixed points are the same for every ω > 0), and doubles again (up to 1) after
+/// two falls in a row. Under the tight rule each Tresca
+/// solve goes to a tenth of the fixed point's last residual (and at least to the rule's
+/// tolerance): an inner solve only as exact as the outer tolerance leaves an error of that size
+/// in `S`, on which the outer residual can cycle above its tolerance.
 fn fixed_point(
     d: &mut Dual<'_, '_>,
     law: &Law,
@@ -231,11 +264,15 @@ fn fixed_point(
 ) -> Result<bool, ContactError> {
     let (points, params) = (d.points, d.params);
     let mut s = slip_bound(points, law, &lambda.normal);
-    let mut omega = 1.0;
+    let mut omega: f64 = 1.0;
+    let mut falls = 0;
     let mut previous = f64::INFINITY;
     for l in 1..=params.max_fixed_point {
         d.info.fixed_point_iters = l;
-        let mut fresh = uzawa(d, &s, lambda, u, progress)?;
+        if let Some(tol) = d.tol() {
+            d.inner_tol = Some((0.1 * previous).min(tol).max(1e-15));
+        }
+        let mut fresh = uzawa(d, None, &s, lambda, u, progress)?;
         let s_new = slip_bound(points, law, &lambda.normal);
         let residual = match params.rule {
             StopRule::Tight { .. } => {
@@ -243,7 +280,9 @@ fn fixed_point(
                     d.c.call(lambda, u)?;
                     fresh = true;
                 }
-                complementarity_residual(points, &s_new, lambda, u, d.canon, d.reference)
+                let r = d.residual(Some(law), &s_new, lambda, u);
+                d.offer(r, lambda, u);
+                r
             }
             StopRule::Paper => {
                 let diff: f64 = s_new.iter().zip(&s).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
@@ -269,10 +308,14 @@ fn fixed_point(
             if residual >= previous && residual > 100.0 * tol && omega > 1.0 / 64.0 {
                 omega *= 0.5;
                 d.info.relaxations += 1;
-            }
-            // near the tolerance the inner solves' own error shows: solve them tighter
-            if residual <= 100.0 * tol {
-                d.inner_tol = Some(d.inner_tol.unwrap_or(tol).min(0.01 * tol).max(1e-15));
+                falls = 0;
+            } else if residual < previous {
+                // a damping that is no longer needed only slows the iteration down
+                falls += 1;
+                if falls >= 2 && omega < 1.0 {
+                    omega = (2.0 * omega).min(1.0);
+                    falls = 0;
+                }
             }
         }
         previous = residual;
@@ -284,10 +327,19 @@ fn fixed_point(
         if done {
             return Ok(fresh);
         }
+        if let Some(why) = params.interrupt.check() {
+            return Err(ContactError::Interrupted {
+                why,
+                n_iters: d.info.uzawa_iters,
+                residual,
+                best: d.best(),
+            });
+        }
     }
     Err(ContactError::FixedPointNoConvergence {
         n_iters: params.max_fixed_point,
         residual: previous,
+        best: d.best(),
     })
 }
 
@@ -295,16 +347,20 @@ fn fixed_point(
 /// tight rule's tolerance), status and counts.
 fn finish(d: Dual<'_, '_>, law: &Law, lambda: PointValues, u: PointValues) -> Result<ContactSolution, ContactError> {
     let radius = slip_bound(d.points, law, &lambda.normal);
+    let residual = d.residual(Some(law), &radius, &lambda, &u);
+    let best = d.best();
     let mut info = d.info;
     info.complementarity = complementarity_residual(d.points, &radius, &lambda, &u, d.canon, d.reference);
+    info.residual = residual;
     info.operator_calls = d.c.calls;
     info.inner_iters = d.c.inner - info.estimate_inner_iters;
     info.step = Some(d.step);
     if let StopRule::Tight { tol } = d.params.rule {
-        if !(info.complementarity <= tol) {
+        if !(info.residual <= tol) {
             return Err(ContactError::NoConvergence {
                 n_iters: info.uzawa_iters,
-                residual: info.complementarity,
+                residual: info.residual,
+                best,
             });
         }
     }
@@ -317,15 +373,61 @@ fn finish(d: Dual<'_, '_>, law: &Law, lambda: PointValues, u: PointValues) -> Re
 }
 
 impl Dual<'_, '_> {
-    /// Halves the step; a [`ContactError::Diverged`] after [`MAX_BACKOFFS`] halvings.
+    /// The residual of `(λ, u)` by the parameters' measure, for the slip bound `radius`
+    /// (a Tresca solve's) or for `law` itself.
+    fn residual(&self, law: Option<&Law>, radius: &[f64], lambda: &PointValues, u: &PointValues) -> f64 {
+        match (self.params.measure, law) {
+            (Measure::Complementarity, _) => {
+                complementarity_residual(self.points, radius, lambda, u, self.canon, self.reference)
+            }
+            (Measure::DeSaxce, Some(law)) => desaxce_residual(self.points, law, lambda, u, &self.u0),
+            (Measure::DeSaxce, None) => {
+                desaxce_residual(self.points, &Law::Tresca(radius.to_vec()), lambda, u, &self.u0)
+            }
+        }
+    }
+
+    /// Keeps `(λ, u)` if it is the best iterate of the law itself.
+    fn offer(&mut self, residual: f64, lambda: &PointValues, u: &PointValues) {
+        if self
+            .best
+            .as_ref()
+            .is_none_or(|b| residual < b.residual || b.residual.is_nan())
+        {
+            self.best = Some(Iterate {
+                lambda: lambda.clone(),
+                u: u.clone(),
+                residual,
+            });
+        }
+    }
+
+    /// The best iterate, boxed for an error.
+    fn best(&self) -> Option<Box<Iterate>> {
+        self.best.clone().map(Box::new)
+    }
+
+    /// The rule's tolerance (`None` under the paper's rule).
+    fn tol(&self) -> Option<f64> {
+        match self.params.rule {
+            StopRule::Tight { tol } => Some(tol),
+            StopRule::Paper => None,
+        }
+    }
+
+    /// Halves the step after a stall (the residual did not grow: a step too large for an
+    /// under-estimated `μ_max`, or a problem too hard for it); a [`ContactError::Stalled`]
+    /// after [`MAX_BACKOFFS`] halvings.
     fn back_off(&mut self, residual: f64) -> Result<(), ContactError> {
         self.step *= 0.5;
         self.info.step_backoffs += 1;
         if self.info.step_backoffs > MAX_BACKOFFS {
-            return Err(ContactError::Diverged {
+            return Err(ContactError::Stalled {
+                stage: Stage::Uzawa,
                 n_iters: self.info.uzawa_iters,
                 residual,
-                step: self.step,
+                reason: Stall::NoProgress,
+                best: self.best(),
             });
         }
         Ok(())
@@ -334,14 +436,21 @@ impl Dual<'_, '_> {
 
 /// Uzawa iterations for a given radius. Returns whether `u` is the displacement of the final
 /// `lambda` (true under the tight rule; under the paper's rule the last update is not solved).
+///
+/// A residual far above the best seen (a thousandfold, after ten steps) halves the step and,
+/// after [`MAX_BACKOFFS`] halvings, is a [`ContactError::Diverged`]; so is a residual that is
+/// not a number. No 1 % gain on the best over [`STALL_WINDOW`] steps also halves the step (a
+/// step too large for an under-estimated `μ_max`), and is a [`ContactError::Stalled`] in the
+/// end. Where the law itself is met to the rule's tolerance, none of these is an error.
 fn uzawa(
     d: &mut Dual<'_, '_>,
+    law: Option<&Law>,
     radius: &[f64],
     lambda: &mut PointValues,
     u: &mut PointValues,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<bool, ContactError> {
-    let (points, params, canon, reference) = (d.points, d.params, d.canon, d.reference);
+    let (points, params) = (d.points, d.params);
     let mut best = f64::INFINITY;
     let mut window_best = f64::INFINITY;
     let mut window_start = 0;
@@ -349,30 +458,54 @@ fn uzawa(
     let mut momentum = Momentum { t: 1.0, x_prev: None };
     for k in 1..=params.max_iters {
         d.c.call(lambda, u)?;
-        let r = complementarity_residual(points, radius, lambda, u, canon, reference);
+        let r = d.residual(law, radius, lambda, u);
         last = r;
+        if law.is_some() {
+            d.offer(r, lambda, u);
+        }
         if !r.is_finite() {
             return Err(ContactError::Diverged {
                 n_iters: d.info.uzawa_iters,
                 residual: r,
                 step: d.step,
+                best: d.best(),
             });
         }
-        if let StopRule::Tight { tol } = params.rule {
+        if let Some(tol) = d.tol() {
             if r <= d.inner_tol.unwrap_or(tol) {
                 return Ok(true);
             }
         }
-        // a residual far above the best seen (divergence), or no 1 % gain on the best over a
-        // window (a stall): the step is too large for the dual operator (an under-estimated
-        // μ_max); halve it and start the momentum afresh
+        if let Some(why) = params.interrupt.check() {
+            return Err(ContactError::Interrupted {
+                why,
+                n_iters: d.info.uzawa_iters,
+                residual: r,
+                best: d.best(),
+            });
+        }
         let diverging = r > 1e3 * best && k > 10;
         if r < 0.99 * window_best {
             window_best = r;
             window_start = k;
         }
         if diverging || k - window_start >= STALL_WINDOW {
-            d.back_off(r)?;
+            if let Err(e) = d.back_off(r) {
+                // a tighter inner tolerance than the law needs may stall at the law's own
+                if law.is_some() && d.tol().is_some_and(|tol| r <= tol) {
+                    return Ok(true);
+                }
+                return Err(if diverging {
+                    ContactError::Diverged {
+                        n_iters: d.info.uzawa_iters,
+                        residual: r,
+                        step: d.step,
+                        best: d.best(),
+                    }
+                } else {
+                    e
+                });
+            }
             best = r;
             window_best = r;
             window_start = k;
@@ -407,5 +540,6 @@ fn uzawa(
     Err(ContactError::NoConvergence {
         n_iters: d.info.uzawa_iters,
         residual: last,
+        best: d.best(),
     })
 }

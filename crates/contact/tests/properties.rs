@@ -3,8 +3,9 @@
 //! active-set enumeration and a KKT check, and homogeneity in the load.
 
 use contact::{
-    complementarity_residual, project_disc, project_nonnegative, solve, solve_newton, ContactPoints,
-    DenseContactProblem, Law, NewtonParams, PointValues, StopRule, UzawaParams,
+    complementarity_residual, project_cone, project_disc, project_nonnegative, solve, solve_gauss_seidel, solve_newton,
+    ContactError, ContactPoints, DenseContactProblem, GaussSeidelParams, Law, NewtonParams, PointValues, StopRule,
+    UzawaParams,
 };
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -79,6 +80,40 @@ proptest! {
         if nz > radius { z.iter_mut().for_each(|v| *v *= radius / nz); }
         let vi: f64 = (0..nt).map(|k| (x[k] - px[k]) * (z[k] - px[k])).sum();
         prop_assert!(vi <= 1e-10, "VI {vi}");
+    }
+
+    /// The projection onto Coulomb's cone: into the cone, idempotent, non-expansive, and the
+    /// variational inequality `(x - P x)·(y - P x) ≤ 0` for every `y` of the cone.
+    #[test]
+    fn the_cone_projection_is_a_projection(x in prop::collection::vec(-5.0f64..5.0, 3), y in prop::collection::vec(-5.0f64..5.0, 3), mu in 0.0f64..2.0, dim in 2usize..=3) {
+        let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
+        let mut px = x[..dim].to_vec();
+        project_cone(&mut px, mu);
+        prop_assert!(norm(&px[1..]) <= mu * px[0] * (1.0 + 1e-12) + 1e-12);
+        let mut twice = px.clone();
+        project_cone(&mut twice, mu);
+        for (a, b) in twice.iter().zip(&px) { prop_assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs())); }
+        let mut py = y[..dim].to_vec();
+        project_cone(&mut py, mu);
+        let d: Vec<f64> = px.iter().zip(&py).map(|(a, b)| a - b).collect();
+        let e: Vec<f64> = x[..dim].iter().zip(&y[..dim]).map(|(a, b)| a - b).collect();
+        prop_assert!(norm(&d) <= norm(&e) * (1.0 + 1e-12) + 1e-12);
+        // py is a point of the cone
+        let vi: f64 = (0..dim).map(|k| (x[k] - px[k]) * (py[k] - px[k])).sum();
+        prop_assert!(vi <= 1e-10 * (1.0 + norm(&x) * norm(&y)), "VI {vi}");
+    }
+
+    /// Block Gauss–Seidel and Newton find the same Coulomb solution where it is unique (a
+    /// small coefficient on a definite compliance).
+    #[test]
+    fn gauss_seidel_matches_newton(n in 1usize..=5, dim in 2usize..=3, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 5), load in prop::collection::vec(-1.0f64..1.0, 15), f in 0.05f64..0.3) {
+        let nt = dim - 1;
+        let pts = points(n, dim, &w, f);
+        let op = problem(n, nt, &pts, &seed, &load);
+        let newton = solve_newton(&mut op.clone(), &pts, &Law::Coulomb, &NewtonParams { tol: 1e-13, ..Default::default() }, None, &mut |_| {}).unwrap();
+        let gs = solve_gauss_seidel(&mut op.clone(), &pts, &Law::Coulomb, &GaussSeidelParams { tol: 1e-13, ..Default::default() }, None, &mut |_| {}).unwrap();
+        let d = gs.lambda.minus(&newton.lambda).norm();
+        prop_assert!(d <= 1e-8 * newton.lambda.norm().max(1e-300), "{d}");
     }
 
     /// Tiny frictionless problems: Uzawa's answer equals the one found by enumerating the
@@ -435,6 +470,7 @@ fn newton_falls_back_on_the_accelerated_gradient() {
     let none = NewtonParams {
         tol: 1e-12,
         max_iters: 0,
+        max_proximal: 0,
         ..Default::default()
     };
     let sol = solve_newton(&mut op, &pts, &Law::Coulomb, &none, None, &mut |_| {}).unwrap();
@@ -455,7 +491,14 @@ fn newton_falls_back_on_the_accelerated_gradient() {
     )
     .unwrap_err();
     assert!(
-        matches!(&e, contact::ContactError::NewtonStalled { reason, .. } if reason.contains("iteration limit")),
+        matches!(
+            &e,
+            contact::ContactError::Stalled {
+                reason: contact::Stall::IterationLimit,
+                best: Some(_),
+                ..
+            }
+        ),
         "{e}"
     );
 }
@@ -513,6 +556,74 @@ fn solutions_scale_with_the_data_over_the_whole_range() {
                 newton.info.newton_iters, reference.info.newton_iters,
                 "{dim}D, s = {s:e}"
             );
+        }
+    }
+}
+
+/// A stall is not a divergence: a step far too small makes no progress (the residual never
+/// rises) and ends as `Stalled`; a step far too large makes the residual grow and ends as
+/// `Diverged`. Neither is reported where the residual meets the tolerance.
+#[test]
+fn stalls_and_divergences_are_told_apart() {
+    let seed: Vec<f64> = (0..40).map(|i| ((i * 37 % 17) as f64 / 8.5) - 1.0).collect();
+    let pts = points(4, 2, &[0.3, -0.2, 0.9, 0.1], 0.0);
+    let load = [0.8, 0.5, 0.9, 0.2, 0.3, -0.4, 0.1, 0.6];
+    let op = problem(4, 0, &pts, &seed, &load);
+    let run = |step: f64| {
+        let params = UzawaParams {
+            step: Some(step),
+            max_iters: 1_000_000,
+            ..tight(1e-12)
+        };
+        solve(&mut op.clone(), &pts, &Law::Frictionless, &params, None, &mut |_| {})
+    };
+    let e = run(1e-14).unwrap_err();
+    assert!(matches!(e, ContactError::Stalled { best: Some(_), .. }), "{e}");
+    let e = run(1e6).unwrap_err();
+    assert!(matches!(e, ContactError::Diverged { .. }), "{e}");
+    assert!(run(0.5).is_ok());
+}
+
+/// Past uniqueness, a failed solve says so: one 2D point whose normal and tangential
+/// compliances are coupled (`D = [[1, 0.9], [0.9, 1]]`), pressed and pulled, with `F = 2`. At
+/// a sliding point the Tresca pressure moves with the bound by `∓0.9`, so the fixed point on
+/// `S` expands by `F 0.9 = 1.8`; with every stage of Newton switched off the error is
+/// `NotUnique` with that expansion (measured), where `F = 0.5` gives `0.45` and the plain stall.
+#[test]
+fn a_stall_past_uniqueness_is_diagnosed() {
+    for (f, expect_not_unique) in [(2.0, true), (0.5, false)] {
+        let mut pts = points(1, 2, &[0.5], f);
+        pts.weight = vec![1.0];
+        let mut op = DenseContactProblem {
+            u0: PointValues::from_parts(vec![1.0], vec![0.5], 1).unwrap(),
+            compliance: vec![1.0, 0.9, 0.9, 1.0],
+            weight: vec![1.0],
+            nt: 1,
+        };
+        let expansion = contact::slip_bound_expansion(
+            &mut op.clone(),
+            &pts,
+            &PointValues::from_parts(vec![0.5], vec![0.4], 1).unwrap(),
+            &contact::Interrupt::NONE,
+        )
+        .unwrap();
+        assert!((expansion - 0.9 * f).abs() < 1e-6, "F {f}: {expansion}");
+        let params = NewtonParams {
+            tol: 1e-12,
+            max_iters: 0,
+            max_proximal: 0,
+            fallback: false,
+            ..Default::default()
+        };
+        let e = solve_newton(&mut op, &pts, &Law::Coulomb, &params, None, &mut |_| {}).unwrap_err();
+        if expect_not_unique {
+            assert!(
+                matches!(e, ContactError::NotUnique { expansion, .. } if (expansion - 1.8).abs() < 1e-6),
+                "{e}"
+            );
+            assert!(e.to_string().contains("uniqueness"), "{e}");
+        } else {
+            assert!(matches!(e, ContactError::Stalled { .. }), "{e}");
         }
     }
 }

@@ -165,13 +165,7 @@ impl ProblemError {
     /// A contact error of a run of `strategy` on `scene`, with a hint that names only what it
     /// did not try, or, where its residual is not a number, the scene's most extreme inputs.
     pub fn contact(source: ContactError, strategy: Strategy, scene: &Scene) -> Self {
-        let residual = match &source {
-            ContactError::NoConvergence { residual, .. }
-            | ContactError::FixedPointNoConvergence { residual, .. }
-            | ContactError::Diverged { residual, .. }
-            | ContactError::NewtonStalled { residual, .. } => *residual,
-            _ => 0.0,
-        };
+        let residual = source.residual().unwrap_or(0.0);
         if !residual.is_finite() {
             if let Some(named) = extremes(scene) {
                 return ProblemError::Contact {
@@ -182,14 +176,19 @@ impl ProblemError {
         }
         let newton = strategy == Strategy::NewtonCondensed;
         let hint = match &source {
-            ContactError::NoConvergence { .. } | ContactError::Diverged { .. } if !newton => {
-                "; try solver.strategy=newton-condensed (semismooth Newton), or a looser solver.tol"
-            }
-            ContactError::FixedPointNoConvergence { .. } => {
+            ContactError::FixedPointNoConvergence { .. } if !newton => {
                 "; try solver.strategy=newton-condensed, which solves Coulomb's law directly (no fixed point on S)"
             }
-            ContactError::NoConvergence { .. } | ContactError::Diverged { .. } => {
-                "; semismooth Newton stalled and its fallback (the accelerated gradient) did not finish either: a looser solver.tol may be reached, and a smaller contact.friction or material.coupling_scale restores uniqueness of the solution"
+            ContactError::NoConvergence { .. } | ContactError::Diverged { .. } | ContactError::Stalled { .. }
+                if !newton =>
+            {
+                "; try solver.strategy=newton-condensed (semismooth Newton), or a looser solver.tol"
+            }
+            ContactError::NoConvergence { .. }
+            | ContactError::FixedPointNoConvergence { .. }
+            | ContactError::Diverged { .. }
+            | ContactError::Stalled { .. } => {
+                "; semismooth Newton, its proximal stage and its fallback (the accelerated gradient) all stalled: a looser solver.tol may be reached, and a smaller contact.friction or material.coupling_scale restores uniqueness of the solution"
             }
             _ => "",
         };

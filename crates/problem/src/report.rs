@@ -137,11 +137,15 @@ pub struct Iterations {
     pub fixed_point: usize,
     /// First-order steps (Uzawa, or the accelerated gradient's).
     pub uzawa: usize,
-    /// Semismooth Newton steps.
+    /// Semismooth Newton steps (those of the proximal stage's problems included).
     pub newton: usize,
+    /// Outer steps of Newton's proximal stage (each a regularised problem).
+    #[serde(default)]
+    pub proximal: usize,
     /// Halvings in Newton's line search.
     pub line_search_cuts: usize,
-    /// Whether Newton stalled and the accelerated gradient finished.
+    /// Whether Newton stalled and its last stage finished (block Gauss–Seidel for Coulomb's
+    /// law, the accelerated gradient otherwise; its sweeps or steps are counted in `uzawa`).
     pub newton_fallback: bool,
     /// PCG iterations in the contact loops (or the one linear solve).
     pub pcg: usize,
@@ -159,6 +163,7 @@ impl Iterations {
             fixed_point: info.map_or(0, |i| i.fixed_point_iters),
             uzawa: info.map_or(0, |i| i.uzawa_iters),
             newton: info.map_or(0, |i| i.newton_iters),
+            proximal: info.map_or(0, |i| i.proximal_iters),
             line_search_cuts: info.map_or(0, |i| i.line_search_cuts),
             newton_fallback: info.is_some_and(|i| i.fallback),
             pcg,
@@ -173,6 +178,7 @@ impl Iterations {
         let mut parts = vec![];
         for (count, name) in [
             (self.newton, "Newton"),
+            (self.proximal, "proximal"),
             (self.uzawa, "Uzawa"),
             (self.fixed_point, "FP"),
             (self.pcg, "PCG"),

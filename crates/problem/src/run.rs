@@ -57,6 +57,9 @@ pub struct ContactResult {
 pub struct Limits {
     /// Bytes of memory the run may take (`None`: no check).
     pub memory_bytes: Option<u64>,
+    /// A deadline or a cancel flag for the contact solve (a typed
+    /// [`contact::ContactError::Interrupted`], with the best iterate, when it fires).
+    pub interrupt: contact::Interrupt,
 }
 
 /// Solves `scene`. `mesh` is the mesh of a `gmsh` scene, read by the caller (generated meshes
@@ -100,7 +103,10 @@ pub fn solve_within(
     check_assembled(scene, &assembled)?;
     let mut factored = factor(scene, &setup, &assembled, limits, reporter)?;
     let solved = match factored.boundary.take() {
-        Some(boundary) => solve_contact(scene, &setup.plan, &mut factored.solver, boundary, &assembled, reporter)?,
+        Some(boundary) => {
+            let how = ContactSolve::new(&setup.plan, scene, boundary.points.len(), limits.interrupt);
+            solve_contact(&how, &mut factored.solver, boundary, &assembled, reporter)?
+        }
         None => solve_linear(&mut factored.solver, &assembled)?,
     };
     check_solved(scene, &solved)?;
@@ -394,12 +400,13 @@ struct ContactSolve<'p> {
     scene: &'p Scene,
     law: Law,
     tol: f64,
+    interrupt: contact::Interrupt,
 }
 
 impl<'p> ContactSolve<'p> {
     /// The plan's contact law on `n` points: frictionless without tangential multipliers,
     /// Tresca with the scene's bound, else Coulomb.
-    fn new(plan: &'p Plan, scene: &'p Scene, n: usize) -> Self {
+    fn new(plan: &'p Plan, scene: &'p Scene, n: usize, interrupt: contact::Interrupt) -> Self {
         let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
         let law = match (plan.contact_law, plan.friction) {
             (_, false) => Law::Frictionless,
@@ -416,6 +423,7 @@ impl<'p> ContactSolve<'p> {
             scene,
             law,
             tol: scene.solver.tol,
+            interrupt,
         }
     }
 
@@ -432,6 +440,7 @@ impl<'p> ContactSolve<'p> {
             (ContactSolver::Newton, Operator::Condensed(dense)) => {
                 let params = NewtonParams {
                     tol,
+                    interrupt: self.interrupt,
                     ..Default::default()
                 };
                 contact::solve_newton(dense, points, &self.law, &params, None, &mut progress)
@@ -448,6 +457,7 @@ impl<'p> ContactSolve<'p> {
                     },
                     report_every: 50,
                     accelerate,
+                    interrupt: self.interrupt,
                     ..Default::default()
                 };
                 contact::solve(op, points, &self.law, &params, None, &mut progress)
@@ -463,15 +473,14 @@ impl<'p> ContactSolve<'p> {
 /// The contact solve: on the condensed compliance (Newton, or a first-order method), or with
 /// one full primal solve per first-order step; then `(u, φ)` under the contact forces found.
 fn solve_contact(
-    scene: &Scene,
-    plan: &Plan,
+    how: &ContactSolve<'_>,
     solver: &mut LinearSolver,
     boundary: ContactBoundary,
     a: &Assembled<'_>,
     reporter: &mut dyn Reporter,
 ) -> Result<Solved, ProblemError> {
     let t = Instant::now();
-    let how = ContactSolve::new(plan, scene, boundary.points.len());
+    let plan = how.plan;
     let (sol, (u, phi), condense) = match solver {
         LinearSolver::Direct(direct) if plan.linear_strategy.is_condensed() => {
             let t_condense = Instant::now();

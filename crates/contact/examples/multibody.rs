@@ -1,0 +1,89 @@
+//! The robustness study of the contact crate on the class of the hardest third-party problems:
+//! random rigid multibody problems (`contact::siconos::FrictionProblem::multibody`, rank
+//! deficient `W`), 2D and 3D, each solved by the default semismooth Newton to a tolerance.
+//! Prints one line per problem that needed more than Newton, and a summary: problems solved,
+//! median and total time, and the stages used. `--dump DIR` writes the problems in Siconos'
+//! text format instead, for Siconos' own solvers (`bench/siconos/solve.py`).
+//!
+//! ```text
+//! cargo run --release -p contact --example multibody -- [--seeds 100] [--scale 1] [--tol 1e-8] [--measure siconos|crate] [--dump DIR]
+//! ```
+//! Problem `seed` has `scale·(2 + seed mod 7)` bodies and `scale·(2 + 7 seed mod 23)` contacts.
+
+use contact::siconos::FrictionProblem;
+use contact::{Interrupt, Law, Measure, NewtonParams};
+use std::time::{Duration, Instant};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let value = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    let seeds: u64 = value("--seeds").map_or(100, |v| v.parse().expect("--seeds N"));
+    let scale: usize = value("--scale").map_or(1, |v| v.parse().expect("--scale K"));
+    let tol: f64 = value("--tol").map_or(1e-8, |v| v.parse().expect("--tol T"));
+    let measure = match value("--measure").as_deref() {
+        Some("crate") => Measure::Complementarity,
+        _ => Measure::DeSaxce,
+    };
+    let dump = value("--dump");
+    let (mut solved, mut times, mut proximal, mut fallback) = (0, vec![], 0, 0);
+    for seed in 0..seeds {
+        for dim in [2, 3] {
+            let bodies = scale * (2 + (seed as usize % 7));
+            let contacts = scale * (2 + (seed as usize * 7 % 23));
+            let p = FrictionProblem::multibody(dim, bodies, contacts, seed);
+            let name = format!("mb-{dim}d-s{seed}-b{bodies}-c{contacts}");
+            if let Some(dir) = &dump {
+                std::fs::write(format!("{dir}/{name}.dat"), p.to_text()).expect("a writable --dump directory");
+                continue;
+            }
+            let params = NewtonParams {
+                tol,
+                measure,
+                interrupt: Interrupt {
+                    deadline: Some(Instant::now() + Duration::from_secs(60)),
+                    cancel: None,
+                },
+                ..Default::default()
+            };
+            let start = Instant::now();
+            let result = contact::solve_newton(
+                &mut p.sparse_problem(),
+                &p.points(),
+                &Law::Coulomb,
+                &params,
+                None,
+                &mut |_| {},
+            );
+            let t = start.elapsed().as_secs_f64();
+            times.push(t);
+            match result {
+                Ok(s) => {
+                    solved += 1;
+                    proximal += usize::from(s.info.proximal_iters > 0);
+                    fallback += usize::from(s.info.fallback);
+                    if s.info.fallback || t > 1.0 {
+                        println!(
+                            "{name}: {} Newton, {} proximal, fallback {} ({} sweeps), {t:.3} s",
+                            s.info.newton_iters, s.info.proximal_iters, s.info.fallback, s.info.uzawa_iters
+                        );
+                    }
+                }
+                Err(e) => println!("{name}: FAILED {e} ({t:.3} s)"),
+            }
+        }
+    }
+    if dump.is_none() {
+        times.sort_by(f64::total_cmp);
+        let median = times.get(times.len() / 2).copied().unwrap_or(0.0);
+        println!(
+            "solved {solved} of {}: {proximal} needed the proximal stage, {fallback} the fallback; median {median:.4} s, total {:.2} s",
+            times.len(),
+            times.iter().sum::<f64>()
+        );
+    }
+}

@@ -1,0 +1,238 @@
+//! The contact law at one point, solved exactly against a given local compliance: the step of
+//! the block Gauss–Seidel method ([`crate::solve_gauss_seidel`]).
+//!
+//! With the point's multipliers `x` (normal first, then `nt ≤ 2` tangential components), its
+//! displacement `u = b - A x` (`A` the point's block of `D W`, `b` the displacement the other
+//! points' forces and the loads give it) and gap `g`, the natural-map equations are
+//! `x_n - [z_n]₊ = 0`, `x_t - P_R(z_t) = 0` with `z = x + c (u - g e_n)`, `R` the law's radius
+//! (Coulomb `F [z_n]₊`, Tresca `S`, frictionless 0) and `c = 1/‖A‖_F`. They are solved by a
+//! semismooth Newton method on at most 3 unknowns (on the stack), with a monotone Armijo line
+//! search, and, should it stall, the projected fixed point `x ← P(z(x))` with a shrinking `c`.
+//! The answer is the iterate with the least equations' norm.
+
+use crate::projection::{norm, project_disc};
+
+/// The law at one point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum PointLaw {
+    /// Signorini alone.
+    Frictionless,
+    /// Tresca with this slip bound.
+    Tresca(f64),
+    /// Coulomb with this coefficient.
+    Coulomb(f64),
+}
+
+/// One point's problem: `u = b - A x`, gap `g`, `k = 1 + nt` components.
+pub(crate) struct Point {
+    pub(crate) a: [[f64; 3]; 3],
+    pub(crate) b: [f64; 3],
+    pub(crate) g: f64,
+    pub(crate) k: usize,
+    pub(crate) law: PointLaw,
+}
+
+/// Newton steps before the fixed point takes over.
+const NEWTON_STEPS: usize = 40;
+/// Fixed-point steps of the fallback.
+const FIXED_POINT_STEPS: usize = 400;
+
+impl Point {
+    /// `z` and the equations `F` at `x`, with constant `c`.
+    fn equations(&self, x: &[f64; 3], c: f64) -> ([f64; 3], [f64; 3]) {
+        let k = self.k;
+        let mut z = [0.0; 3];
+        for r in 0..k {
+            let u = self.b[r] - (0..k).map(|j| self.a[r][j] * x[j]).sum::<f64>();
+            z[r] = x[r] + c * (u - if r == 0 { self.g } else { 0.0 });
+        }
+        let mut f = [0.0; 3];
+        f[0] = x[0] - z[0].max(0.0);
+        let mut t = [z[1], z[2]];
+        project_disc(&mut t[..k - 1], self.radius(z[0]));
+        for r in 1..k {
+            f[r] = x[r] - t[r - 1];
+        }
+        (z, f)
+    }
+
+    fn radius(&self, zn: f64) -> f64 {
+        match self.law {
+            PointLaw::Frictionless => 0.0,
+            PointLaw::Tresca(s) => s,
+            PointLaw::Coulomb(mu) => mu * zn.max(0.0),
+        }
+    }
+
+    /// The Newton matrix at `z`: `J = ∂F/∂x` on the branch of `z`, with `M = I - c A` the
+    /// derivative of `z`.
+    fn jacobian(&self, z: &[f64; 3], c: f64) -> [[f64; 3]; 3] {
+        let k = self.k;
+        let mut m = [[0.0; 3]; 3];
+        for r in 0..k {
+            for j in 0..k {
+                m[r][j] = if r == j { 1.0 } else { 0.0 } - c * self.a[r][j];
+            }
+        }
+        let mut jac = [[0.0; 3]; 3];
+        for j in 0..k {
+            jac[0][j] = if j == 0 { 1.0 } else { 0.0 } - if z[0] > 0.0 { m[0][j] } else { 0.0 };
+        }
+        let q = [z[1], z[2]];
+        let qn = norm(&q[..k - 1]);
+        let radius = self.radius(z[0]);
+        for r in 1..k {
+            for j in 0..k {
+                let identity = if r == j { 1.0 } else { 0.0 };
+                jac[r][j] = if !(radius > 0.0) {
+                    identity
+                } else if qn <= radius {
+                    identity - m[r][j]
+                } else {
+                    // slip: -(R/|q|)(I - q̂q̂ᵀ) M_t - q̂ dR, dR = F M_n for Coulomb in contact
+                    let mut v = identity;
+                    for l in 1..k {
+                        let proj = if r == l { 1.0 } else { 0.0 } - (q[r - 1] / qn) * (q[l - 1] / qn);
+                        v -= radius / qn * proj * m[l][j];
+                    }
+                    if let PointLaw::Coulomb(mu) = self.law {
+                        if z[0] > 0.0 {
+                            v -= q[r - 1] / qn * mu * m[0][j];
+                        }
+                    }
+                    v
+                };
+            }
+        }
+        jac
+    }
+
+    /// Solves the point's law from `x0`; returns the multipliers.
+    pub(crate) fn solve(&self, x0: [f64; 3]) -> [f64; 3] {
+        let k = self.k;
+        let size: f64 = self.a.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+        if !(size > 0.0 && size.is_finite()) {
+            return x0;
+        }
+        let mut c = 1.0 / size;
+        let two = |v: &[f64; 3]| norm(&v[..k]);
+        let scale = |x: &[f64; 3], c: f64| two(x).max(c * two(&self.b)).max(c * self.g.abs());
+        let done = |f: &[f64; 3], x: &[f64; 3], c: f64| two(f) <= 1e-14 * scale(x, c) || two(f) == 0.0;
+        let mut x = x0;
+        let (mut z, mut f) = self.equations(&x, c);
+        let mut best = (two(&f), x);
+        for _ in 0..NEWTON_STEPS {
+            if done(&f, &x, c) {
+                return x;
+            }
+            let Some(d) = solve_small(self.jacobian(&z, c), f, k) else {
+                break;
+            };
+            let current = two(&f);
+            let mut alpha = 1.0;
+            let mut moved = false;
+            for _ in 0..30 {
+                let mut trial = x;
+                for r in 0..k {
+                    trial[r] -= alpha * d[r];
+                }
+                let (tz, tf) = self.equations(&trial, c);
+                if two(&tf) <= (1.0 - 1e-4 * alpha) * current {
+                    (x, z, f) = (trial, tz, tf);
+                    moved = true;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            if two(&f) < best.0 {
+                best = (two(&f), x);
+            }
+            if !moved {
+                break;
+            }
+        }
+        // the projected fixed point x ← P(z(x)), its constant halved whenever the norm rises
+        x = best.1;
+        let mut previous = f64::INFINITY;
+        for _ in 0..FIXED_POINT_STEPS {
+            (_, f) = self.equations(&x, c);
+            let now = two(&f);
+            if now < best.0 {
+                best = (now, x);
+            }
+            if done(&f, &x, c) {
+                return x;
+            }
+            if now >= previous {
+                c *= 0.5;
+            }
+            previous = now;
+            for r in 0..k {
+                x[r] -= f[r];
+            }
+        }
+        best.1
+    }
+}
+
+/// `J d = f` for `k ≤ 3` by Gaussian elimination with partial pivoting; `None` if singular.
+fn solve_small(mut a: [[f64; 3]; 3], mut f: [f64; 3], k: usize) -> Option<[f64; 3]> {
+    for col in 0..k {
+        let pivot = (col..k).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if !(a[pivot][col].abs() > 1e-300) {
+            return None;
+        }
+        a.swap(col, pivot);
+        f.swap(col, pivot);
+        for r in col + 1..k {
+            let l = a[r][col] / a[col][col];
+            for j in col..k {
+                a[r][j] -= l * a[col][j];
+            }
+            f[r] -= l * f[col];
+        }
+    }
+    let mut d = [0.0; 3];
+    for r in (0..k).rev() {
+        let s: f64 = (r + 1..k).map(|j| a[r][j] * d[j]).sum();
+        d[r] = (f[r] - s) / a[r][r];
+    }
+    d.iter().all(|v| v.is_finite()).then_some(d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The hand solution of the one-contact problem of the Siconos tests (`A = diag(2, 1, 1)`,
+    /// pressed by `b_n = 1`, pulled by `b_t = -0.5`, `F = 0.3`): the point closes with
+    /// `x_n = 1/2` and slides with `|x_t| = 0.15` along `u_t`.
+    #[test]
+    fn one_sliding_contact() {
+        let p = Point {
+            a: [[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            b: [1.0, -0.5, 0.0],
+            g: 0.0,
+            k: 3,
+            law: PointLaw::Coulomb(0.3),
+        };
+        let x = p.solve([0.0; 3]);
+        assert!(
+            (x[0] - 0.5).abs() < 1e-14 && (x[1] + 0.15).abs() < 1e-14 && x[2].abs() < 1e-14,
+            "{x:?}"
+        );
+        // sticking with a large coefficient: u = 0, x = A⁻¹ b
+        let stick = Point {
+            law: PointLaw::Coulomb(10.0),
+            ..p
+        };
+        let x = stick.solve([0.0; 3]);
+        assert!((x[0] - 0.5).abs() < 1e-14 && (x[1] + 0.5).abs() < 1e-14, "{x:?}");
+        // pulled away: separated
+        let away = Point {
+            b: [-1.0, 0.3, 0.2],
+            ..stick
+        };
+        assert_eq!(away.solve([1.0, 1.0, 1.0]), [0.0; 3]);
+    }
+}

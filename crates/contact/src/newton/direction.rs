@@ -1,0 +1,316 @@
+//! The Newton direction `J δ = -f`, three ways: on a dense symmetric positive definite
+//! compliance, through `y = C δ` on the rows of the sliding and separated points only (the
+//! stiffness `(D + σ W⁻¹)⁻¹` once per problem); on any dense compliance, by one LU of the whole
+//! Jacobian; on a sparse compliance, by a sparse LU of the Jacobian (whose rows are sparse
+//! combinations of the compliance's rows), so that no `m x m` dense matrix is formed.
+
+use super::equations::{Flat, RowForm, State};
+use crate::operator::{dot8, Compliance};
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::Mat;
+
+/// Largest relative asymmetry of a dense compliance that is solved through its symmetric part
+/// (a condensed finite-element compliance is symmetric to round-off; Siconos' printed files
+/// are not, by up to 1e-3).
+const SYMMETRIC: f64 = 1e-8;
+
+/// How the Newton directions of one problem are solved.
+pub(super) enum Directions {
+    /// Dense SPD: the reduced system, with the stiffness `(D + σ W⁻¹)⁻¹` (row-major).
+    Reduced(Vec<f64>),
+    /// Dense, not SPD or not symmetric: one LU of `J` per step.
+    DenseLu,
+    /// Sparse: one sparse LU of `J` per step, on a pattern (and its symbolic factorisation)
+    /// fixed for the problem.
+    SparseLu(Box<SparsePattern>),
+}
+
+/// The pattern of every Jacobian of a sparse problem, row by row: row `r` of point `i` may hold
+/// the columns of every row of `D` that belongs to point `i`, and the point's own columns
+/// (whatever the branch); and the symbolic LU of `Jᵀ`, whose columns are `J`'s rows.
+pub(super) struct SparsePattern {
+    /// Row pointers of `J` (= column pointers of `Jᵀ`).
+    ptr: Vec<usize>,
+    /// Column indices of `J`'s rows, sorted.
+    idx: Vec<usize>,
+    symbolic: SymbolicLu<usize>,
+}
+
+impl SparsePattern {
+    fn new(flat: &Flat<'_>) -> Option<Self> {
+        let m = flat.m;
+        let (mut ptr, mut idx) = (vec![0], Vec::new());
+        let mut rows_of = vec![Vec::new(); flat.n];
+        for i in 0..flat.n {
+            rows_of[i] = flat.indices(i).collect::<Vec<_>>();
+        }
+        let owner = |r: usize| if r < flat.n { r } else { (r - flat.n) / flat.nt };
+        let mut mark = vec![usize::MAX; m];
+        for r in 0..m {
+            let start = idx.len();
+            for &own in &rows_of[owner(r)] {
+                for col in std::iter::once(own).chain(flat.d.row(own).map(|(c, _)| c)) {
+                    if mark[col] != r {
+                        mark[col] = r;
+                        idx.push(col);
+                    }
+                }
+            }
+            idx[start..].sort_unstable();
+            ptr.push(idx.len());
+        }
+        let pattern = SymbolicSparseColMatRef::new_checked(m, m, &ptr, None, &idx);
+        let symbolic = SymbolicLu::try_new(pattern).ok()?;
+        Some(SparsePattern { ptr, idx, symbolic })
+    }
+}
+
+impl Directions {
+    /// The way for `flat`: the reduced system where `D + σ W⁻¹` is symmetric and its Cholesky
+    /// factorisation succeeds, else an LU of the Jacobian.
+    pub(super) fn new(flat: &Flat<'_>) -> Self {
+        let d = match flat.d {
+            Compliance::Sparse(_) => {
+                return match SparsePattern::new(flat) {
+                    Some(p) => Directions::SparseLu(Box::new(p)),
+                    None => Directions::DenseLu,
+                }
+            }
+            Compliance::Dense(d) => d,
+        };
+        if flat.d.asymmetry() > SYMMETRIC {
+            return Directions::DenseLu;
+        }
+        let m = flat.m;
+        let shifted = Mat::<f64>::from_fn(m, m, |i, j| {
+            d[i * m + j] + if i == j { flat.sigma / flat.w[i] } else { 0.0 }
+        });
+        match shifted.llt(faer::Side::Lower) {
+            Ok(llt) => {
+                let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);
+                Directions::Reduced((0..m * m).map(|k| inv[(k / m, k % m)]).collect())
+            }
+            Err(_) => Directions::DenseLu,
+        }
+    }
+
+    /// The direction at `s`; `None` where the system is singular.
+    pub(super) fn direction(&self, flat: &Flat<'_>, s: &State, rows: &[RowForm]) -> Option<Vec<f64>> {
+        match self {
+            Directions::Reduced(stiffness) => reduced(flat, s, rows, stiffness).or_else(|| dense_lu(flat, s, rows)),
+            Directions::DenseLu => dense_lu(flat, s, rows),
+            Directions::SparseLu(pattern) => sparse_lu(flat, s, rows, pattern),
+        }
+    }
+}
+
+/// The direction by one LU of the whole `m x m` Jacobian (dense compliance).
+pub(super) fn dense_lu(flat: &Flat<'_>, s: &State, rows: &[RowForm]) -> Option<Vec<f64>> {
+    let (m, c) = (flat.m, &flat.c);
+    let Compliance::Dense(d) = flat.d else {
+        return SparsePattern::new(flat).and_then(|p| sparse_lu(flat, s, rows, &p));
+    };
+    // Jᵀ, column-major: row r of J is column r of Jᵀ, written contiguously
+    let mut jt = Mat::<f64>::zeros(m, m);
+    for (r, form) in rows.iter().enumerate() {
+        for &(j, v) in &form.e {
+            jt[(j, r)] += v;
+        }
+        for &(j, v) in &form.b {
+            for col in 0..m {
+                jt[(col, r)] += v * c[j] * d[j * m + col] * flat.w[col];
+            }
+            jt[(j, r)] += v * c[j] * flat.sigma;
+        }
+    }
+    let lu = jt.partial_piv_lu();
+    let mut rhs = Mat::<f64>::from_fn(m, 1, |r, _| -s.f[r]);
+    lu.solve_transpose_in_place(rhs.as_mut());
+    let delta: Vec<f64> = (0..m).map(|r| rhs[(r, 0)]).collect();
+    delta.iter().all(|v| v.is_finite()).then_some(delta)
+}
+
+/// The direction by a sparse LU of the Jacobian on its fixed pattern: row `r` holds `E_r`
+/// and, for each `(j, v)` of `B_r`, `v c_j` times row `j` of `D W + σ I`. The rows of `J` are
+/// the columns of `Jᵀ`, which is factored; `J δ = -f` is its transposed solve.
+fn sparse_lu(flat: &Flat<'_>, s: &State, rows: &[RowForm], pattern: &SparsePattern) -> Option<Vec<f64>> {
+    let (m, c) = (flat.m, &flat.c);
+    let mut values = vec![0.0; pattern.idx.len()];
+    let mut slot = vec![usize::MAX; m];
+    for (r, form) in rows.iter().enumerate() {
+        let range = pattern.ptr[r]..pattern.ptr[r + 1];
+        for k in range.clone() {
+            slot[pattern.idx[k]] = k;
+        }
+        for &(j, v) in &form.e {
+            values[slot[j]] += v;
+        }
+        for &(j, v) in &form.b {
+            for (col, d) in flat.d.row(j) {
+                values[slot[col]] += v * c[j] * d * flat.w[col];
+            }
+            values[slot[j]] += v * c[j] * flat.sigma;
+        }
+        for k in range {
+            slot[pattern.idx[k]] = usize::MAX;
+        }
+    }
+    let structure = SymbolicSparseColMatRef::new_checked(m, m, &pattern.ptr, None, &pattern.idx);
+    let lu = Lu::try_new_with_symbolic(pattern.symbolic.clone(), SparseColMatRef::new(structure, &values)).ok()?;
+    let mut rhs = Mat::<f64>::from_fn(m, 1, |r, _| -s.f[r]);
+    lu.solve_transpose_in_place(rhs.as_mut());
+    let delta: Vec<f64> = (0..m).map(|r| rhs[(r, 0)]).collect();
+    delta.iter().all(|v| v.is_finite()).then_some(delta)
+}
+
+/// The direction through `y = C δ`: `(E C⁻¹ + B) y = -f`, whose rows are the identity at every
+/// point in contact and sticking, so that only the rows of sliding and separated points form a
+/// dense system (`N x N`, often far smaller than `m x m`, and empty when every point sticks);
+/// then `δ = C⁻¹ y`, with `C⁻¹ = W⁻¹ K diag(1/c)` and `K = (D + σ W⁻¹)⁻¹` (row-major). `None`
+/// where the reduced system is singular.
+fn reduced(flat: &Flat<'_>, s: &State, rows: &[RowForm], stiffness: &[f64]) -> Option<Vec<f64>> {
+    let m = flat.m;
+    let inv_c: Vec<f64> = flat.c.iter().map(|c| 1.0 / c).collect();
+    let mut slot = vec![usize::MAX; m];
+    let others: Vec<usize> = (0..m).filter(|&r| !rows[r].is_c_row(r)).collect();
+    for (k, &r) in others.iter().enumerate() {
+        slot[r] = k;
+    }
+    // y on the identity rows is -f there
+    let mut y: Vec<f64> = (0..m)
+        .map(|r| if slot[r] == usize::MAX { -s.f[r] } else { 0.0 })
+        .collect();
+    let nn = others.len();
+    if nn > 0 {
+        let mut mnn = Mat::<f64>::zeros(nn, nn);
+        let mut rhs = Mat::<f64>::zeros(nn, 1);
+        let mut row = vec![0.0; m];
+        for (k, &r) in others.iter().enumerate() {
+            row.iter_mut().for_each(|v| *v = 0.0);
+            for &(j, v) in &rows[r].e {
+                let scale = v / flat.w[j];
+                for ((x, kj), ic) in row.iter_mut().zip(&stiffness[j * m..(j + 1) * m]).zip(&inv_c) {
+                    *x += scale * kj * ic;
+                }
+            }
+            for &(j, v) in &rows[r].b {
+                row[j] += v;
+            }
+            let mut b = -s.f[r];
+            for col in 0..m {
+                if slot[col] == usize::MAX {
+                    b -= row[col] * y[col];
+                } else {
+                    mnn[(k, slot[col])] = row[col];
+                }
+            }
+            rhs[(k, 0)] = b;
+        }
+        let lu = mnn.partial_piv_lu();
+        lu.solve_in_place(rhs.as_mut());
+        for (k, &r) in others.iter().enumerate() {
+            y[r] = rhs[(k, 0)];
+        }
+    }
+    // δ = C⁻¹ y; on a row that is the identity in J (a separated point) δ_r = -f_r exactly,
+    // which sets its multiplier to exactly zero, not to round-off
+    let y_c: Vec<f64> = y.iter().zip(&inv_c).map(|(y, ic)| y * ic).collect();
+    let delta: Vec<f64> = (0..m)
+        .map(|r| {
+            if rows[r].is_identity(r) {
+                -s.f[r]
+            } else {
+                dot8(&stiffness[r * m..(r + 1) * m], &y_c) / flat.w[r]
+            }
+        })
+        .collect();
+    delta.iter().all(|v| v.is_finite()).then_some(delta)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ContactPoints, Law, PointValues};
+    use faer::sparse::{SparseRowMat, Triplet};
+
+    /// The three ways give one direction, at states with every branch present, with and
+    /// without a proximal shift.
+    #[test]
+    fn the_three_ways_agree() {
+        for (case, law) in [Law::Coulomb, Law::Tresca(vec![0.05; 5]), Law::Frictionless]
+            .into_iter()
+            .enumerate()
+        {
+            for (dim, sigma) in [(2, 0.0), (3, 0.0), (3, 0.3)] {
+                let n = 5;
+                let nt = if matches!(law, Law::Frictionless) { 0 } else { dim - 1 };
+                let m = n * (1 + nt);
+                let points = ContactPoints {
+                    dim,
+                    position: vec![[0.0; 3]; n],
+                    normal: vec![[0.0, 0.0, -1.0]; n],
+                    tangent: vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; n],
+                    weight: (0..n).map(|i| 0.5 + 0.1 * i as f64).collect(),
+                    gap: vec![0.0; n],
+                    friction: vec![0.3; n],
+                };
+                // an SPD compliance with zeros: a Gram matrix plus the identity
+                let g = |i: usize, j: usize| ((i * 7 + j * 3 + case) % 5) as f64 * 0.1 - 0.2;
+                let compliance: Vec<f64> = (0..m * m)
+                    .map(|k| {
+                        let (i, j) = (k / m, k % m);
+                        (0..m).map(|l| g(i, l) * g(j, l)).sum::<f64>() + if i == j { 1.0 } else { 0.0 }
+                    })
+                    .collect();
+                let sparse = SparseRowMat::try_new_from_triplets(
+                    m,
+                    m,
+                    &(0..m * m)
+                        .filter(|&k| compliance[k] != 0.0)
+                        .map(|k| Triplet::new(k / m, k % m, compliance[k]))
+                        .collect::<Vec<_>>(),
+                )
+                .unwrap();
+                let u0: Vec<f64> = (0..m).map(|r| (r as f64 * 1.7).sin()).collect();
+                let u0 = PointValues::from_flat(&u0, n, nt);
+                let center: Vec<f64> = (0..m).map(|r| 0.1 * r as f64).collect();
+                let dense = Flat::new(Compliance::Dense(&compliance), &u0, &points, &law, nt, 0.7);
+                let dense = if sigma > 0.0 {
+                    dense.proximal(sigma, &center)
+                } else {
+                    dense
+                };
+                let mut sparse_flat = dense.clone();
+                sparse_flat.d = Compliance::Sparse(sparse.as_ref());
+                let x: Vec<f64> = (0..m).map(|r| 0.8 * (r as f64 * 2.3 + 0.4).cos()).collect();
+                let s = dense.state(x.clone());
+                assert_eq!(s.f, sparse_flat.state(x).f);
+                let rows = dense.rows(&s);
+                let reduced_rows = (0..m).filter(|&r| !rows[r].is_c_row(r)).count();
+                assert!(
+                    reduced_rows > 0 && reduced_rows < m,
+                    "{law:?} {dim}D: {reduced_rows} of {m}"
+                );
+                let Directions::Reduced(stiffness) = Directions::new(&dense) else {
+                    panic!("an SPD compliance takes the reduced way")
+                };
+                let full = dense_lu(&dense, &s, &rows).unwrap();
+                let Directions::SparseLu(pattern) = Directions::new(&sparse_flat) else {
+                    panic!("a sparse compliance takes the sparse way")
+                };
+                let ways = [
+                    reduced(&dense, &s, &rows, &stiffness).unwrap(),
+                    sparse_lu(&sparse_flat, &s, &rows, &pattern).unwrap(),
+                ];
+                let scale = full.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                for way in ways {
+                    for (a, b) in full.iter().zip(&way) {
+                        assert!((a - b).abs() <= 1e-10 * scale, "{law:?} {dim}D σ {sigma}: {a} vs {b}");
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,281 @@
+//! The natural-map (Alart–Curnier) equations of an affine contact problem and the rows of a
+//! generalised Jacobian, in the flat layout `[normal (n); tangential (n·nt)]`.
+//!
+//! With `u(λ) = u₀ - D W λ - σ λ` (`σ = 0` for the problem itself, `σ > 0` for a proximal
+//! step) and `z = λ + c (u(λ) - g̃)` (`g̃ = (g, 0)`), the equations are `λ_n - [z_n]₊ = 0` and
+//! `λ_t - P_S(z_t) = 0` at every point. A generalised Jacobian picks, per point, the branch of
+//! `z` (separated, stick, slip); each row is `J_r = E_r + B_r C` with `C = c (D W + σ I)` and
+//! `E_r`, `B_r` sparse over the point's own components.
+
+use crate::operator::Compliance;
+use crate::points::{ContactPoints, PointValues};
+use crate::projection::project_disc;
+use crate::Law;
+
+/// One row of the generalised Jacobian, `J_r = E_r + B_r C`: `(index, coefficient)` pairs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct RowForm {
+    pub(super) e: Vec<(usize, f64)>,
+    pub(super) b: Vec<(usize, f64)>,
+}
+
+impl RowForm {
+    /// Whether row `r` is the identity of `y = C δ` (a point in contact and sticking:
+    /// `E_r = 0`, `B_r = e_r`).
+    pub(super) fn is_c_row(&self, r: usize) -> bool {
+        self.e.is_empty() && self.b == [(r, 1.0)]
+    }
+
+    /// Whether row `r` is the identity of `δ` (a separated point: `E_r = e_r`, `B_r = 0`).
+    pub(super) fn is_identity(&self, r: usize) -> bool {
+        self.b.is_empty() && self.e == [(r, 1.0)]
+    }
+}
+
+/// The branch of a point's tangential equations at `z`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Branch {
+    Separated,
+    Stick,
+    Slip,
+}
+
+/// An affine contact problem in the flat layout.
+#[derive(Clone)]
+pub(super) struct Flat<'a> {
+    pub(super) d: Compliance<'a>,
+    pub(super) points: &'a ContactPoints,
+    pub(super) law: &'a Law,
+    pub(super) n: usize,
+    pub(super) nt: usize,
+    pub(super) m: usize,
+    /// The natural map's constant of each flat index: `1/μ_max` for the problem itself, one
+    /// per point for a proximal problem ([`Flat::proximal`]).
+    pub(super) c: Vec<f64>,
+    /// `μ_max`, the largest eigenvalue of `D W`.
+    pub(super) mu_max: f64,
+    /// Weight of each flat index.
+    pub(super) w: Vec<f64>,
+    /// `u₀` (for a proximal step, `u₀ + σ λ_k`).
+    pub(super) u0: Vec<f64>,
+    /// The proximal shift `σ` (0 for the problem itself).
+    pub(super) sigma: f64,
+}
+
+/// The equations and their pieces at one `λ`.
+#[derive(Clone, Debug)]
+pub(super) struct State {
+    pub(super) x: Vec<f64>,
+    pub(super) u: Vec<f64>,
+    pub(super) z: Vec<f64>,
+    pub(super) f: Vec<f64>,
+    /// Weighted norm of `f`, the line search's merit.
+    pub(super) norm: f64,
+}
+
+/// `(Σ w_j x_j²)^½`; where the sum of squares would overflow or underflow, scaled by the
+/// largest entry first.
+pub(super) fn weighted_norm(x: &[f64], w: &[f64]) -> f64 {
+    // divided by s: `1/s` overflows for a subnormal s
+    let sum = |s: f64| x.iter().zip(w).map(|(v, w)| w * (v / s) * (v / s)).sum::<f64>();
+    let plain = sum(1.0);
+    if crate::projection::trusted(plain) || x.iter().all(|v| *v == 0.0) {
+        return plain.sqrt();
+    }
+    let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return if x.iter().any(|v| v.is_nan()) { f64::NAN } else { scale };
+    }
+    scale * sum(scale).sqrt()
+}
+
+impl<'a> Flat<'a> {
+    /// The problem `u = u0 - D W λ` on `points` for `law`; `mu_max` the largest eigenvalue
+    /// of `D W`, whose inverse is the natural map's constant.
+    pub(super) fn new(
+        d: Compliance<'a>,
+        u0: &PointValues,
+        points: &'a ContactPoints,
+        law: &'a Law,
+        nt: usize,
+        mu_max: f64,
+    ) -> Self {
+        let n = points.len();
+        let m = n * (1 + nt);
+        let mut flat = Flat {
+            d,
+            points,
+            law,
+            n,
+            nt,
+            m,
+            c: vec![],
+            mu_max,
+            w: (0..m)
+                .map(|j| points.weight[if j < n { j } else { (j - n) / nt }])
+                .collect(),
+            u0: u0.normal.iter().chain(&u0.tangential).copied().collect(),
+            sigma: 0.0,
+        };
+        flat.c = vec![1.0 / mu_max; m];
+        flat
+    }
+
+    /// The flat indices of point `i`'s components.
+    pub(super) fn indices(&self, i: usize) -> impl Iterator<Item = usize> {
+        let (n, nt) = (self.n, self.nt);
+        std::iter::once(i).chain((0..nt).map(move |k| n + i * nt + k))
+    }
+
+    /// The natural map's constant per flat index: `1/‖B_i‖_F` for point `i`, `B_i` its
+    /// diagonal block of `D W + σ I` (Alart and Curnier's `r`, per contact as Siconos' split
+    /// spectral rule chooses it). A global `1/μ_max` leaves the Jacobian's rows of a point
+    /// whose own compliance is far below `μ_max` nearly zero, and Newton's directions long and
+    /// poor; the local choice makes each point's rows of order one.
+    fn constants(&self) -> Vec<f64> {
+        let mut c = vec![0.0; self.m];
+        for i in 0..self.n {
+            let rows: Vec<usize> = self.indices(i).collect();
+            let mut sum = 0.0;
+            for &r in &rows {
+                for (col, v) in self.d.row(r) {
+                    if rows.contains(&col) {
+                        let e = v * self.w[col] + if col == r { self.sigma } else { 0.0 };
+                        sum += e * e;
+                    }
+                }
+            }
+            let local = (1.0 / sum.sqrt()).clamp(1.0 / self.mu_max, 1e8 / self.mu_max);
+            for &r in &rows {
+                c[r] = local;
+            }
+        }
+        c
+    }
+
+    /// The mean of the diagonal of `D W`: the size of a point's own compliance.
+    pub(super) fn mean_diagonal(&self) -> f64 {
+        let sum: f64 = (0..self.m)
+            .map(|r| self.d.row(r).find(|(c, _)| *c == r).map_or(0.0, |(_, v)| v * self.w[r]))
+            .sum();
+        if sum > 0.0 {
+            sum / self.m as f64
+        } else {
+            self.mu_max
+        }
+    }
+
+    /// The proximal problem about `center`: `u_σ(λ) = u(λ) - σ (λ - center)`, with the natural
+    /// map's constants per point.
+    pub(super) fn proximal(&self, sigma: f64, center: &[f64]) -> Self {
+        let mut p = self.clone();
+        p.sigma = self.sigma + sigma;
+        for (u, x) in p.u0.iter_mut().zip(center) {
+            *u += sigma * x;
+        }
+        p.c = p.constants();
+        p
+    }
+
+    /// The radius of point `i` at `z`: Tresca `S`, Coulomb `F [z_n]₊`.
+    pub(super) fn radius(&self, i: usize, z: &[f64]) -> f64 {
+        match self.law {
+            Law::Frictionless => 0.0,
+            Law::Tresca(s) => s[i],
+            Law::Coulomb => self.points.friction[i] * z[i].max(0.0),
+        }
+    }
+
+    pub(super) fn state(&self, x: Vec<f64>) -> State {
+        let m = self.m;
+        let wx: Vec<f64> = x.iter().zip(&self.w).map(|(a, b)| a * b).collect();
+        let mut u = vec![0.0; m];
+        self.d.apply(&wx, &mut u);
+        let mut z = vec![0.0; m];
+        for r in 0..m {
+            u[r] = self.u0[r] - u[r] - self.sigma * x[r];
+            let g = if r < self.n { self.points.gap[r] } else { 0.0 };
+            z[r] = x[r] + self.c[r] * (u[r] - g);
+        }
+        let mut f = vec![0.0; m];
+        let mut buf = [0.0; 2];
+        for i in 0..self.n {
+            f[i] = x[i] - z[i].max(0.0);
+            if self.nt > 0 {
+                let t = self.n + i * self.nt;
+                buf[..self.nt].copy_from_slice(&z[t..t + self.nt]);
+                project_disc(&mut buf[..self.nt], self.radius(i, &z));
+                for k in 0..self.nt {
+                    f[t + k] = x[t + k] - buf[k];
+                }
+            }
+        }
+        let norm = weighted_norm(&f, &self.w);
+        State { x, u, z, f, norm }
+    }
+
+    /// The rows of a generalised Jacobian at `s`, each as `J_r = E_r + B_r C` with
+    /// `C = diag(c) (D W + σ I)` (so that `M = I - C` is the derivative of `z`).
+    pub(super) fn rows(&self, s: &State) -> Vec<RowForm> {
+        let (n, nt) = (self.n, self.nt);
+        let mut rows = vec![RowForm::default(); self.m];
+        for i in 0..n {
+            // normal: [z_n]₊ has derivative 1 (contact: J = C) or 0 (separated: J = I)
+            if s.z[i] > 0.0 {
+                rows[i].b.push((i, 1.0));
+            } else {
+                rows[i].e.push((i, 1.0));
+            }
+            if nt == 0 {
+                continue;
+            }
+            let t = n + i * nt;
+            let q = &s.z[t..t + nt];
+            let qn = crate::projection::norm(q);
+            let radius = self.radius(i, &s.z);
+            let branch = if !(radius > 0.0) {
+                Branch::Separated
+            } else if qn <= radius {
+                Branch::Stick
+            } else {
+                Branch::Slip
+            };
+            for k in 0..nt {
+                let row = &mut rows[t + k];
+                match branch {
+                    // λ_t - z_t: derivative C
+                    Branch::Stick => row.b.push((t + k, 1.0)),
+                    // λ_t - P_0(z_t) = λ_t (a zero radius): the identity
+                    Branch::Separated => row.e.push((t + k, 1.0)),
+                    Branch::Slip => {
+                        // λ_t - S q/|q|: derivative I - (S/|q|)(I - q̂q̂ᵀ) M_t - q̂ dS, with
+                        // dS = F M_n for Coulomb at a contact point
+                        let ratio = radius / qn;
+                        let slope = match self.law {
+                            Law::Coulomb if s.z[i] > 0.0 => self.points.friction[i],
+                            _ => 0.0,
+                        };
+                        row.e.push((t + k, 1.0));
+                        for l in 0..nt {
+                            let proj = if k == l { 1.0 } else { 0.0 } - (q[k] / qn) * (q[l] / qn);
+                            if proj != 0.0 {
+                                row.e.push((t + l, -ratio * proj));
+                                row.b.push((t + l, ratio * proj));
+                            }
+                        }
+                        if slope > 0.0 {
+                            row.e.push((i, -q[k] / qn * slope));
+                            row.b.push((i, q[k] / qn * slope));
+                        }
+                    }
+                }
+            }
+        }
+        rows
+    }
+
+    /// Flat values as [`PointValues`].
+    pub(super) fn values(&self, x: &[f64]) -> PointValues {
+        PointValues::from_flat(x, self.n, self.nt)
+    }
+}

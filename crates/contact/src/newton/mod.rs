@@ -1,0 +1,568 @@
+//! A semismooth Newton method on an affine contact problem `u = u₀ - D W λ` (the condensed
+//! contact problem, or any problem given by its compliance, dense or sparse): the natural-map
+//! (Alart–Curnier) equations of Signorini contact with Tresca or Coulomb friction, solved for
+//! the multipliers ([`equations`]). Coulomb friction is solved directly (the radius
+//! `F [λ_n + c (u_n - g)]₊` moves with the pressure), without the fixed point on `S`. The
+//! natural map's constant is `c = 1/μ_max` on the problem itself (the residual's own), and one
+//! per point on the proximal problems, `c_i = 1/‖B_i‖_F` with `B_i` the point's block of
+//! `D W + σ I` (Alart and Curnier's `r`; Siconos chooses it so too): each point's rows of the
+//! Newton matrix are then of order one, however far its own compliance is from the largest,
+//! which is what the nearly singular problems of that stage need.
+//!
+//! Three stages, each from the best iterate so far (by the measure the caller asked for), so
+//! that the answer is never worse than the start:
+//! 1. **Newton** on the problem itself, globalised by an Armijo line search on the weighted
+//!    norm of the equations: a full step is compared with the largest of the last norms
+//!    (non-monotone: Grippo, Lampariello and Lucidi), a damped one with the current norm. A
+//!    best norm that no longer falls ends the stage.
+//! 2. **Proximal point** where Newton stalls (a singular Jacobian where `D` is only
+//!    semidefinite, as for rigid multibody problems; a line search that fails; a cycle): a
+//!    sequence of regularised problems `u_σ(λ) = u(λ) - σ (λ - λ_k)`, each solved by Newton
+//!    to a tenth of the current residual, whose solutions converge to a solution of the
+//!    problem itself (Rockafellar's proximal point algorithm; Siconos' PROX solver is this
+//!    method around its Alart–Curnier Newton). `D + σ W⁻¹` is definite for any `σ > 0`; `σ`
+//!    follows the residual (in units of the points' mean compliance), ten times more after an
+//!    inner solve that failed, coming back down by halves.
+//! 3. **Fallback**, capped: for Coulomb's law the block Gauss–Seidel method
+//!    ([`crate::solve_gauss_seidel`]), for the convex laws the accelerated projected gradient
+//!    ([`crate::solve`]).
+//!
+//! Nothing is tuned to a problem: the constants are relative to the problem's own compliance
+//! and residual.
+
+mod direction;
+mod equations;
+
+use crate::operator::AffineProblem;
+use crate::points::{ContactPoints, PointValues};
+use crate::projection::project_disc;
+use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Counter};
+use crate::{
+    ContactError, ContactInfo, ContactSolution, GaussSeidelParams, Interrupt, Interruption, Iterate, Law, Measure,
+    Progress, Stage, Stall, StopRule, UzawaParams,
+};
+use direction::Directions;
+use equations::{Flat, State};
+
+/// Parameters of [`solve_newton`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonParams {
+    /// Tolerance on the residual of [`NewtonParams::measure`].
+    pub tol: f64,
+    /// The residual to bring below `tol`.
+    pub measure: Measure,
+    /// Newton steps on the problem itself before the proximal stage takes over.
+    pub max_iters: usize,
+    /// Outer steps of the proximal stage (0: no proximal stage).
+    pub max_proximal: usize,
+    /// Power iterations for `μ_max`.
+    pub power_iters: usize,
+    /// Whether to fall back on the accelerated projected gradient when both Newton stages
+    /// stall (when false, a stall is a [`ContactError::Stalled`]).
+    pub fallback: bool,
+    /// First-order steps the fallback may take.
+    pub max_fallback_iters: usize,
+    /// A deadline or a cancel flag.
+    pub interrupt: Interrupt,
+}
+
+impl Default for NewtonParams {
+    fn default() -> Self {
+        NewtonParams {
+            tol: 1e-10,
+            measure: Measure::Complementarity,
+            max_iters: 100,
+            max_proximal: 200,
+            power_iters: 30,
+            fallback: true,
+            max_fallback_iters: 200_000,
+            interrupt: Interrupt::NONE,
+        }
+    }
+}
+
+/// Armijo's sufficient-decrease constant.
+const ARMIJO: f64 = 1e-4;
+/// Merit values the non-monotone line search compares with.
+const MEMORY: usize = 8;
+/// Step halvings of the line search before the direction is given up.
+const MAX_HALVINGS: usize = 30;
+/// Newton steps without a 10 % gain on the best norm of the equations before a stall.
+const PATIENCE: usize = 15;
+/// Newton steps of one proximal problem, and steps without a 10 % gain there.
+const INNER_STEPS: usize = 100;
+const INNER_PATIENCE: usize = 100;
+/// The tolerance of one proximal problem's solve, relative to the outer residual.
+const INNER_RATIO: f64 = 0.1;
+/// The proximal shift's bounds, relative to the points' mean compliance.
+const SIGMA_MIN: f64 = 1e-12;
+const SIGMA_MAX: f64 = 1e2;
+
+/// How a run of Newton steps ended.
+enum End {
+    Converged,
+    Stalled(Stall),
+    Interrupted(Interruption),
+}
+
+/// The problem itself, the measure, and the best iterate seen.
+struct Judge<'a> {
+    flat: Flat<'a>,
+    law: &'a Law,
+    points: &'a ContactPoints,
+    u0: &'a PointValues,
+    measure: Measure,
+    reference: f64,
+    tol: f64,
+    best: Option<(State, f64)>,
+}
+
+impl Judge<'_> {
+    /// The residual of a state of the problem itself.
+    fn residual(&self, s: &State) -> f64 {
+        self.residual_of(&self.flat, s)
+    }
+
+    /// The residual, by the measure asked for, of a state of `problem` (the problem itself, or
+    /// a proximal problem: its own loads and constant).
+    fn residual_of(&self, problem: &Flat<'_>, s: &State) -> f64 {
+        let lambda = problem.values(&s.x);
+        let u = problem.values(&s.u);
+        let u0 = problem.values(&problem.u0);
+        self.measure.of(
+            self.points,
+            self.law,
+            &lambda,
+            &u,
+            &u0,
+            1.0 / self.flat.mu_max,
+            self.reference,
+        )
+    }
+
+    /// The complementarity residual of a state of the problem itself, whatever the measure.
+    fn complementarity(&self, s: &State) -> f64 {
+        Measure::Complementarity.of(
+            self.points,
+            self.law,
+            &self.flat.values(&s.x),
+            &self.flat.values(&s.u),
+            self.u0,
+            1.0 / self.flat.mu_max,
+            self.reference,
+        )
+    }
+
+    /// Judges a state of the problem itself: keeps it if it is the best; whether it meets the
+    /// tolerance.
+    fn offer(&mut self, s: &State) -> (f64, bool) {
+        let r = self.residual(s);
+        if self.best.as_ref().is_none_or(|(_, b)| r < *b || b.is_nan()) {
+            self.best = Some((s.clone(), r));
+        }
+        (r, r <= self.tol)
+    }
+
+    fn best_residual(&self) -> f64 {
+        self.best.as_ref().map_or(f64::NAN, |(_, r)| *r)
+    }
+
+    /// The progress line of a state.
+    fn progress(&self, stage: Stage, iter: usize, s: &State, residual: f64) -> Progress {
+        let lambda = self.flat.values(&s.x);
+        Progress {
+            stage,
+            iter,
+            residual,
+            counts: counts(&classify(&lambda, &slip_bound(self.points, self.law, &lambda.normal))),
+        }
+    }
+}
+
+/// Newton steps on `flat` from `s` until `accept` takes a state (returned), a stall, an
+/// interruption or `max_steps` (the state of least merit is returned: the non-monotone line
+/// search may end above it).
+#[allow(clippy::too_many_arguments)]
+fn newton_steps(
+    flat: &Flat<'_>,
+    directions: &Directions,
+    s: State,
+    max_steps: usize,
+    memory: usize,
+    patience: usize,
+    interrupt: &Interrupt,
+    info: &mut ContactInfo,
+    accept: &mut dyn FnMut(&State, &mut ContactInfo) -> bool,
+) -> (State, End) {
+    let mut history = std::collections::VecDeque::with_capacity(memory + 1);
+    let mut since_best = 0;
+    let mut best = s.clone();
+    let mut s = s;
+    let end = 'steps: {
+        for _ in 0..max_steps {
+            if let Some(why) = interrupt.check() {
+                break 'steps End::Interrupted(why);
+            }
+            let rows = flat.rows(&s);
+            let Some(delta) = directions.direction(flat, &s, &rows) else {
+                break 'steps End::Stalled(Stall::SingularMatrix);
+            };
+            // non-monotone Armijo backtracking on the weighted norm of the equations, against
+            // the largest of the last MEMORY norms: a full step that changes a point's branch
+            // may raise the norm for a step on the way to the solution
+            let reference_norm = history.iter().copied().fold(s.norm, f64::max);
+            let mut alpha = 1.0;
+            let mut accepted = None;
+            for _ in 0..=MAX_HALVINGS {
+                let x: Vec<f64> = s.x.iter().zip(&delta).map(|(a, b)| a + alpha * b).collect();
+                let trial = flat.state(x);
+                // the full step against the history; a damped one must lower the norm itself
+                let reference = if alpha == 1.0 { reference_norm } else { s.norm };
+                if trial.norm <= (1.0 - ARMIJO * alpha) * reference {
+                    accepted = Some(trial);
+                    break;
+                }
+                alpha *= 0.5;
+                info.line_search_cuts += 1;
+            }
+            let Some(next) = accepted else {
+                break 'steps End::Stalled(Stall::LineSearch);
+            };
+            history.push_back(s.norm);
+            if history.len() > memory {
+                history.pop_front();
+            }
+            s = next;
+            info.newton_iters += 1;
+            if !s.norm.is_finite() {
+                break 'steps End::Stalled(Stall::NonFinite);
+            }
+            if accept(&s, info) {
+                return (s, End::Converged);
+            }
+            // the non-monotone search lets the norm wander: a best that no longer falls is a
+            // stall
+            if s.norm < 0.9 * best.norm {
+                since_best = 0;
+            } else {
+                since_best += 1;
+            }
+            if s.norm < best.norm {
+                best = s.clone();
+            }
+            if since_best >= patience {
+                break 'steps End::Stalled(Stall::NoProgress);
+            }
+        }
+        End::Stalled(Stall::IterationLimit)
+    };
+    (best, end)
+}
+
+/// The proximal stage from the best iterate: returns how it ended.
+fn proximal_stage(
+    judge: &mut Judge<'_>,
+    params: &NewtonParams,
+    info: &mut ContactInfo,
+    progress: &mut dyn FnMut(&Progress),
+) -> End {
+    let Some((start, r0)) = judge.best.clone() else {
+        return End::Stalled(Stall::NonFinite);
+    };
+    // σ's unit: the points' own compliance, the mean diagonal of D W
+    let unit = judge.flat.mean_diagonal();
+    let mut center = start.x;
+    let mut residual = r0;
+    // σ follows the residual (Siconos' PROX rule): the residual's size in the points' own
+    // compliance after an inner solve that converged, ten times more after one that failed
+    let mut boost = 1.0;
+    let mut last = End::Stalled(Stall::IterationLimit);
+    for outer in 1..=params.max_proximal {
+        if let Some(why) = params.interrupt.check() {
+            return End::Interrupted(why);
+        }
+        let sigma = (boost * residual).clamp(SIGMA_MIN, SIGMA_MAX);
+        let problem = judge.flat.proximal(sigma * unit, &center);
+        let directions = Directions::new(&problem);
+        let s0 = problem.state(center.clone());
+        // an inexact inner solve, in the measure asked for: a tenth of the outer residual
+        let inner_tol = (INNER_RATIO * residual).max(0.5 * params.tol);
+        let (s, end) = newton_steps(
+            &problem,
+            &directions,
+            s0,
+            INNER_STEPS,
+            MEMORY,
+            INNER_PATIENCE,
+            &params.interrupt,
+            info,
+            &mut |s, _| judge.residual_of(&problem, s) <= inner_tol,
+        );
+        info.proximal_iters += 1;
+        let here = judge.flat.state(s.x.clone());
+        let (r, done) = judge.offer(&here);
+        progress(&judge.progress(Stage::Proximal, outer, &here, r));
+        if done {
+            return End::Converged;
+        }
+        // the proximal iterates go on from the inner solve's point (its best, where it
+        // stalled), as Rockafellar's inexact method does
+        center = s.x;
+        residual = r;
+        match end {
+            End::Interrupted(why) => return End::Interrupted(why),
+            // after a failure, come back down to σ = residual gradually: straight back, the
+            // same failure would follow
+            End::Converged => boost = (boost * 0.5).max(1.0),
+            End::Stalled(why) => {
+                // a harder inner problem than σ allows: regularise more
+                last = End::Stalled(why);
+                if sigma >= SIGMA_MAX {
+                    return last;
+                }
+                boost *= 10.0;
+            }
+        }
+        if !residual.is_finite() {
+            return End::Stalled(Stall::NonFinite);
+        }
+    }
+    last
+}
+
+/// Solves the affine contact problem `problem` for `law` by the semismooth Newton method of
+/// this module, from `lambda0` (zeros when `None`). Reports one progress line per Newton step
+/// and per proximal step.
+///
+/// The returned [`ContactInfo`] counts Newton steps in `newton_iters` (the proximal stage's
+/// inner steps included), proximal steps in `proximal_iters`, and gives Newton's constant `c`
+/// in `augmentation` (and the fallback's first-order steps, if any, in `uzawa_iters`, with
+/// their step in `step`); `residual` is the residual of `params.measure`, at most
+/// `params.tol`, and `complementarity` the complementarity residual. The answer is the best
+/// iterate found.
+///
+/// # Errors
+/// [`ContactError::Input`] for inconsistent data; [`ContactError::Stalled`] (with the best
+/// iterate) when every stage stalled; [`ContactError::Interrupted`] at the deadline or on
+/// cancellation.
+pub fn solve_newton<P: AffineProblem>(
+    problem: &mut P,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+    lambda0: Option<PointValues>,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ContactSolution, ContactError> {
+    let nt_given = problem.n_tangential();
+    let (n, nt) = check_input(points, law, problem.weights().len(), nt_given)?;
+    let m = n * (1 + nt);
+    if problem.compliance().size() != m || problem.loads().n_points() != n {
+        return Err(ContactError::Input(format!(
+            "the compliance is {0} x {0} and the loads have {1} points; {n} points with {nt} tangential components need {m} x {m}",
+            problem.compliance().size(),
+            problem.loads().n_points()
+        )));
+    }
+    if !(params.tol > 0.0) {
+        return Err(ContactError::Input(format!(
+            "Newton tolerance {} must be positive",
+            params.tol
+        )));
+    }
+    let (mu_max, reference) = {
+        let mut counter = Counter::new(problem);
+        let (mu, u0) = estimate_mu_max(&mut counter, points, nt, params.power_iters)?;
+        (mu, multiplier_scale(points, &u0, 1.0 / mu))
+    };
+    let x0 = match lambda0 {
+        Some(l) if l.normal.len() == n && l.tangential.len() == n * nt => {
+            l.normal.iter().chain(&l.tangential).copied().collect()
+        }
+        Some(_) => return Err(ContactError::Input("warm start of the wrong size".into())),
+        None => vec![0.0; m],
+    };
+    let mut info = ContactInfo::new(mu_max);
+    let u0 = problem.loads().clone();
+    let flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
+    info.augmentation = Some(1.0 / mu_max);
+    let mut judge = Judge {
+        flat,
+        law,
+        points,
+        u0: &u0,
+        measure: params.measure,
+        reference,
+        tol: params.tol,
+        best: None,
+    };
+    // stage 1: Newton on the problem itself
+    let s = judge.flat.state(x0);
+    let (_, done) = judge.offer(&s);
+    let mut end = if done {
+        End::Converged
+    } else {
+        let directions = Directions::new(&judge.flat);
+        let flat = judge.flat.clone();
+        newton_steps(
+            &flat,
+            &directions,
+            s,
+            params.max_iters,
+            MEMORY,
+            PATIENCE,
+            &params.interrupt,
+            &mut info,
+            &mut |s, info| {
+                let (r, done) = judge.offer(s);
+                progress(&judge.progress(Stage::Newton, info.newton_iters, s, r));
+                done
+            },
+        )
+        .1
+    };
+    // stage 2: the proximal point method
+    if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
+        end = proximal_stage(&mut judge, params, &mut info, progress);
+    }
+    let best_residual = judge.best_residual();
+    let (best, _) = judge.best.take().expect("the start was judged");
+    let lambda = judge.flat.values(&best.x);
+    let u = judge.flat.values(&best.u);
+    let stage = if info.proximal_iters > 0 {
+        Stage::Proximal
+    } else {
+        Stage::Newton
+    };
+    let reason = match end {
+        End::Converged => None,
+        _ if best_residual <= params.tol => None,
+        End::Interrupted(why) => {
+            return Err(ContactError::Interrupted {
+                why,
+                n_iters: info.newton_iters,
+                residual: best_residual,
+                best: Some(Box::new(Iterate {
+                    lambda,
+                    u,
+                    residual: best_residual,
+                })),
+            })
+        }
+        End::Stalled(why) => Some(why),
+    };
+    let Some(reason) = reason else {
+        info.complementarity = judge.complementarity(&best);
+        info.residual = best_residual;
+        return Ok(ContactSolution {
+            status: classify(&lambda, &slip_bound(points, law, &lambda.normal)),
+            lambda,
+            u,
+            info,
+        });
+    };
+    let newton_best = Iterate {
+        lambda: lambda.clone(),
+        u,
+        residual: best_residual,
+    };
+    let failure = if params.fallback {
+        match fallback(
+            problem,
+            points,
+            law,
+            params,
+            lambda,
+            best_residual,
+            info.clone(),
+            progress,
+        ) {
+            Ok(sol) => return Ok(sol),
+            Err(e) => e,
+        }
+    } else {
+        ContactError::Stalled {
+            stage,
+            n_iters: info.newton_iters,
+            residual: best_residual,
+            reason,
+            best: None,
+        }
+    };
+    let failure = failure.with_best(newton_best);
+    if *law != Law::Coulomb || matches!(failure, ContactError::Interrupted { .. }) {
+        return Err(failure);
+    }
+    // is the failure the problem's? Coulomb's law has a unique solution where the fixed point
+    // on the slip bound contracts: measure it at the best iterate
+    let Some(best) = failure.best().cloned() else {
+        return Err(failure);
+    };
+    match crate::slip_bound_expansion(problem, points, &best.lambda, &params.interrupt) {
+        Ok(expansion) if expansion >= 1.0 => Err(ContactError::NotUnique {
+            expansion,
+            n_iters: info.newton_iters,
+            residual: best.residual,
+            best: Some(Box::new(best)),
+        }),
+        _ => Err(failure),
+    }
+}
+
+/// Stage 3: the accelerated projected gradient from the best multipliers, projected onto the
+/// sets.
+#[allow(clippy::too_many_arguments)]
+fn fallback<P: AffineProblem>(
+    problem: &mut P,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+    lambda: PointValues,
+    residual: f64,
+    info: ContactInfo,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ContactSolution, ContactError> {
+    let (n, nt) = (lambda.n_points(), lambda.n_tangential());
+    progress(&Progress {
+        stage: Stage::Fallback,
+        iter: info.newton_iters,
+        residual,
+        counts: counts(&classify(&lambda, &slip_bound(points, law, &lambda.normal))),
+    });
+    let mut start = lambda;
+    start.normal.iter_mut().for_each(|v| *v = v.max(0.0));
+    let radius = slip_bound(points, law, &start.normal);
+    for i in 0..n {
+        project_disc(&mut start.tangential[i * nt..(i + 1) * nt], radius[i]);
+    }
+    let mut sol = if *law == Law::Coulomb {
+        // Coulomb's law directly, point by point
+        let gs = GaussSeidelParams {
+            tol: params.tol,
+            measure: params.measure,
+            max_sweeps: params.max_fallback_iters,
+            power_iters: params.power_iters,
+            report_every: 100,
+            interrupt: params.interrupt,
+        };
+        crate::solve_gauss_seidel(problem, points, law, &gs, Some(start), progress)?
+    } else {
+        // a convex problem: the accelerated gradient converges
+        let apg = UzawaParams {
+            rule: StopRule::Tight { tol: params.tol },
+            measure: params.measure,
+            accelerate: true,
+            power_iters: params.power_iters,
+            max_iters: params.max_fallback_iters,
+            report_every: 500,
+            interrupt: params.interrupt,
+            ..Default::default()
+        };
+        crate::solve(problem, points, law, &apg, Some(start), progress)?
+    };
+    sol.info.newton_iters = info.newton_iters;
+    sol.info.proximal_iters = info.proximal_iters;
+    sol.info.line_search_cuts = info.line_search_cuts;
+    sol.info.augmentation = info.augmentation;
+    sol.info.fallback = true;
+    Ok(sol)
+}
