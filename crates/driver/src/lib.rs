@@ -13,6 +13,7 @@
 //! assert!(solution.report.residuals.equilibrium < 1e-12);
 //! ```
 
+pub mod fclib;
 pub mod output;
 pub mod plots;
 pub mod run;
@@ -26,6 +27,15 @@ pub enum DriverError {
     #[error("scene {file}: {message}")]
     Scene {
         /// The scene's name or path.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An input file (other than a scene or a mesh) that cannot be read, or does not hold what
+    /// it must.
+    #[error("{file}: {message}")]
+    File {
+        /// The file's path.
         file: String,
         /// What is wrong.
         message: String,

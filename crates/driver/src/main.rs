@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use driver::studies::{convergence, stability, sweep, table1, verification};
-use driver::{output, scene_file, DriverError};
+use driver::{fclib, output, scene_file, DriverError};
 use problem::{Event, Strategy};
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -109,6 +109,31 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Solve third-party frictional contact problems (Siconos' text format, e.g. FCLib's test
+    /// problems) with the contact crate alone; prints one line per file.
+    Fclib {
+        /// The problem files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// The solver.
+        #[arg(long, value_enum, default_value_t = fclib::Solver::Newton)]
+        solver: fclib::Solver,
+        /// The tolerance.
+        #[arg(long, default_value_t = 1e-8)]
+        tol: f64,
+        /// The residual that must meet the tolerance.
+        #[arg(long, value_enum, default_value_t = fclib::Criterion::Siconos)]
+        criterion: fclib::Criterion,
+        /// Seconds allowed per file.
+        #[arg(long, default_value_t = 60.0)]
+        time_limit: f64,
+        /// Print the solver's progress (one line per Newton or proximal step).
+        #[arg(long, short)]
+        verbose: bool,
+        /// Directory for summary.json and one CSV of (r, u) per solved file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Run the stiff and extreme cases (SCENES.md section 5), each in its own process, and
     /// write their table to docs/stability.md.
     Stability {
@@ -191,6 +216,26 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
     match command {
         Command::Run { scene, set, unset, out } => run(scene, overrides(set, unset), out),
         Command::Scenes => scenes(),
+        Command::Fclib {
+            files,
+            solver,
+            tol,
+            criterion,
+            time_limit,
+            verbose,
+            out,
+        } => {
+            let options = fclib::Options {
+                solver,
+                tol,
+                criterion,
+                time_limit: std::time::Duration::from_secs_f64(time_limit.max(0.0)),
+                verbose,
+            };
+            let rows = fclib::run(&files, &options, out.as_deref(), &mut |l| say(l))?;
+            print!("{}", fclib::table(&rows));
+            Ok(())
+        }
         Command::Strategies => {
             for s in Strategy::ALL {
                 println!("{:16} {}", s.name(), s.description());

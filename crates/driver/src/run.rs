@@ -43,6 +43,7 @@ pub fn solve(scene: &Scene, source: &Source, reporter: &mut dyn Reporter) -> Res
     };
     let limits = problem::Limits {
         memory_bytes: available_memory_bytes(),
+        ..Default::default()
     };
     let mut solution = problem::solve_within(scene, mesh, limits, reporter)?;
     solution.report.scene.source = source.label.clone();
