@@ -35,3 +35,15 @@ gm = math.exp(sum(map(math.log, ratios)) / len(ratios)) if ratios else float("na
 print(f"\nsolved: ours {n_ours} of {len(ours)}, Siconos (any solver) {n_theirs}; "
       f"where both solve ({n_both}), time ratio ours / Siconos' best: geometric mean {gm:.2f}, "
       f"median {sorted(ratios)[len(ratios)//2] if ratios else float('nan'):.2f}")
+
+# against each Siconos solver on its own: the files both solve, the geometric mean of the ratio
+by_solver = {}
+for f, o in ours.items():
+    for r in theirs.get(f, []):
+        if r["converged"] and o["converged"]:
+            q = max(o["time_s"], 1e-4) / max(r["time_s"], 1e-4)
+            by_solver.setdefault(r["solver"], []).append(q)
+for s, qs in sorted(by_solver.items()):
+    solved = sum(1 for f in ours for r in theirs.get(f, []) if r["solver"] == s and r["converged"])
+    gm = math.exp(sum(map(math.log, qs)) / len(qs))
+    print(f"against {s}: it solves {solved} of {len(ours)}; where both solve ({len(qs)}), ours / its time: geometric mean {gm:.2f}")

@@ -19,12 +19,13 @@ import siconos.numerics as sn
 
 
 def dense_w(p):
+    """W as a dense array (sparse block storage) or a scipy sparse matrix (sparse storage)."""
     m = p.dimension * p.numberOfContacts
     a = sn.NM_convert(p.M)
     if isinstance(a, np.ndarray):
         return a.reshape(m, m)
     if scipy.sparse.issparse(a):
-        return a.toarray()
+        return a.tocsr()
     return np.array([[sn.SBM_get_value(a, i, j) for j in range(m)] for i in range(m)])
 
 
@@ -54,11 +55,17 @@ def error(dim, w, q, mu, r):
 def lifted(dim, w, q, mu):
     """A 2D problem as a 3D one with an uncoupled second tangential direction."""
     nc = len(mu)
-    w3 = np.zeros((3 * nc, 3 * nc))
     q3 = np.zeros(3 * nc)
     idx = np.array([3 * i + k for i in range(nc) for k in range(2)])
-    w3[np.ix_(idx, idx)] = w
     q3[idx] = q
+    if scipy.sparse.issparse(w):
+        c = w.tocoo()
+        rows = np.concatenate([idx[c.row], 3 * np.arange(nc) + 2])
+        cols = np.concatenate([idx[c.col], 3 * np.arange(nc) + 2])
+        vals = np.concatenate([c.data, np.ones(nc)])
+        return scipy.sparse.csc_matrix((vals, (rows, cols)), shape=(3 * nc, 3 * nc)), q3
+    w3 = np.zeros((3 * nc, 3 * nc))
+    w3[np.ix_(idx, idx)] = w
     for i in range(nc):
         w3[3 * i + 2, 3 * i + 2] = 1.0
     return w3, q3

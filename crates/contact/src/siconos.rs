@@ -347,16 +347,41 @@ impl FrictionProblem {
 }
 
 impl FrictionProblem {
-    /// The problem in Siconos' text format, `W` stored densely (for small problems: Siconos
-    /// and this module read it back).
+    /// The problem in Siconos' text format: `W` stored densely where it has at most 10⁶
+    /// entries, else in CSparse's compressed columns (as Siconos writes its large problems).
+    /// This module and Siconos read either back.
     pub fn to_text(&self) -> String {
         let m = self.q.len();
-        let mut s = format!("{}\n{}\n0\n{m}\n{m}\n{m}\t{m}\n", self.dim, self.n_contacts());
-        for col in 0..m {
-            for row in 0..m {
-                s += &format!("{:.17e} ", entry(self, row, col));
+        let mut s = format!("{}\n{}\n", self.dim, self.n_contacts());
+        if m * m <= 1_000_000 {
+            s += &format!("0\n{m}\n{m}\n{m}\t{m}\n");
+            for col in 0..m {
+                for row in 0..m {
+                    s += &format!("{:.17e} ", entry(self, row, col));
+                }
+                s.push('\n');
             }
-            s.push('\n');
+        } else {
+            let csc = self.w.to_col_major().expect("a valid matrix");
+            let csc = csc.as_ref();
+            let nnz = csc.compute_nnz();
+            s += &format!("2\n{m}\n{m}\n2\nCSparse Version 3.1.9 (written by piezocontact)\n");
+            s += &format!("{m}-by-{m}, nzmax: {nnz} nnz: {nnz}, 1-norm: 0\n");
+            let mut at = 0;
+            for col in 0..m {
+                let rows: Vec<(usize, f64)> = csc
+                    .row_idx_of_col(col)
+                    .zip(csc.val_of_col(col).iter().copied())
+                    .collect();
+                s += &format!(
+                    "    col {col} : locations {at} to {}\n",
+                    at as i64 + rows.len() as i64 - 1
+                );
+                for (row, v) in rows {
+                    s += &format!("      {row} : {v:.17e}\n");
+                }
+                at += csc.row_idx_of_col(col).count();
+            }
         }
         for v in &self.q {
             s += &format!("{v:.17e} ");
@@ -371,8 +396,8 @@ impl FrictionProblem {
 
     /// A rigid multibody problem, as the time-stepping schemes of Siconos or LMGC90 make them:
     /// `bodies` rigid bodies (3 velocities each in 2D, 6 in 3D) with random masses and
-    /// inertias `M`, and `contacts` contacts, each between two bodies or a body and the ground,
-    /// with a random frame and lever arms: `H` maps body velocities to contact velocities,
+    /// inertias `M`, laid on a square grid, and `contacts` contacts, each between two
+    /// neighbours on the grid or a body and the ground, with a random frame and lever arms: `H` maps body velocities to contact velocities,
     /// `W = H M⁻¹ Hᵀ` (semidefinite, of rank at most the number of body velocities) and
     /// `q = H v` for random free velocities `v` (so that a solution exists), friction
     /// coefficients in `[0.1, 1]`. The same `seed` gives the same problem. For testing solvers
@@ -392,14 +417,19 @@ impl FrictionProblem {
             })
             .collect();
         let m = contacts * dim;
-        let mut h = vec![0.0; m * nb];
-        for c in 0..contacts {
+        // H by blocks: per contact, the bodies it touches with its dim x dofs block
+        let mut touching: Vec<Vec<(usize, Vec<f64>)>> = vec![Vec::new(); contacts];
+        for touch in touching.iter_mut() {
             let frame = rng.frame(dim);
             let a = rng.below(bodies);
-            let other = rng.unit() < 0.3;
-            let b = (a + 1 + rng.below(bodies.max(2) - 1)) % bodies;
+            let ground = rng.unit() < 0.3 || bodies == 1;
+            // a neighbour of `a` on the square grid of bodies (bodies touch their neighbours,
+            // as in a pile), wrapping around the ends
+            let side = (bodies as f64).sqrt().ceil() as usize;
+            let step = if rng.unit() < 0.5 { 1 } else { side };
+            let b = (a + step) % bodies;
             for (body, sign) in [(a, 1.0), (b, -1.0)] {
-                if sign < 0.0 && (other || bodies == 1) {
+                if sign < 0.0 && ground {
                     continue;
                 }
                 let arm: Vec<f64> = (0..dim).map(|_| 2.0 * rng.unit() - 1.0).collect();
@@ -421,22 +451,40 @@ impl FrictionProblem {
                         }
                     }
                 }
+                let mut block = vec![0.0; dim * dofs];
                 for (k, axis) in frame.iter().enumerate() {
                     for j in 0..dofs {
-                        let v: f64 = (0..dim).map(|i| axis[i] * jac[i][j]).sum();
-                        h[(c * dim + k) * nb + body * dofs + j] += sign * v;
+                        block[k * dofs + j] = sign * (0..dim).map(|i| axis[i] * jac[i][j]).sum::<f64>();
                     }
                 }
+                touch.push((body, block));
             }
         }
         let v: Vec<f64> = (0..nb).map(|_| 2.0 * rng.unit() - 1.0).collect();
-        let q: Vec<f64> = (0..m).map(|r| (0..nb).map(|j| h[r * nb + j] * v[j]).sum()).collect();
+        let mut q = vec![0.0; m];
+        let mut on_body: Vec<Vec<(usize, usize)>> = vec![Vec::new(); bodies];
+        for (c, touch) in touching.iter().enumerate() {
+            for (t, (body, block)) in touch.iter().enumerate() {
+                on_body[*body].push((c, t));
+                for k in 0..dim {
+                    q[c * dim + k] += (0..dofs).map(|j| block[k * dofs + j] * v[body * dofs + j]).sum::<f64>();
+                }
+            }
+        }
+        // W = H M⁻¹ Hᵀ, body by body: the blocks of every pair of contacts on one body
         let mut entries = Vec::new();
-        for i in 0..m {
-            for j in 0..m {
-                let w: f64 = (0..nb).map(|k| h[i * nb + k] * inv_mass[k] * h[j * nb + k]).sum();
-                if w != 0.0 {
-                    entries.push(Triplet::new(i, j, w));
+        for (body, list) in on_body.iter().enumerate() {
+            let inv = &inv_mass[body * dofs..(body + 1) * dofs];
+            for &(c1, t1) in list {
+                let b1 = &touching[c1][t1].1;
+                for &(c2, t2) in list {
+                    let b2 = &touching[c2][t2].1;
+                    for i in 0..dim {
+                        for j in 0..dim {
+                            let w: f64 = (0..dofs).map(|k| b1[i * dofs + k] * inv[k] * b2[j * dofs + k]).sum();
+                            entries.push(Triplet::new(c1 * dim + i, c2 * dim + j, w));
+                        }
+                    }
                 }
             }
         }

@@ -6,7 +6,7 @@
 //! error measure are checked against numbers that Siconos 4.4 itself computed from the same
 //! files (`bench/siconos/solve.py` has the script).
 
-use contact::siconos::FrictionProblem;
+use contact::siconos::{FrictionProblem, Storage};
 use contact::{
     solve_gauss_seidel, solve_newton, ContactError, GaussSeidelParams, Law, Measure, NewtonParams, PointValues,
 };
@@ -403,10 +403,17 @@ proptest::proptest! {
 /// Gram structure: `xᵀ W x ≥ 0`).
 #[test]
 fn multibody_problems_round_trip() {
-    for (dim, bodies, contacts) in [(2, 3, 10), (3, 2, 7)] {
+    // the last one past a million entries: written in CSparse's compressed columns
+    for (dim, bodies, contacts) in [(2, 3, 10), (3, 2, 7), (2, 300, 520)] {
         let p = FrictionProblem::multibody(dim, bodies, contacts, 7);
         assert!(p.asymmetry() < 1e-15);
         let back = FrictionProblem::parse(&p.to_text()).unwrap();
+        let storage = if p.q.len() > 1000 {
+            Storage::Sparse
+        } else {
+            Storage::Dense
+        };
+        assert_eq!(back.storage, storage);
         let x: Vec<f64> = (0..p.q.len()).map(|k| (k as f64 * 0.7).cos()).collect();
         assert_eq!(back.velocity(&x), p.velocity(&x));
         assert_eq!((back.mu.clone(), back.q.clone()), (p.mu.clone(), p.q.clone()));

@@ -188,7 +188,10 @@ impl ProblemError {
             | ContactError::FixedPointNoConvergence { .. }
             | ContactError::Diverged { .. }
             | ContactError::Stalled { .. } => {
-                "; semismooth Newton, its proximal stage and its fallback (the accelerated gradient) all stalled: a looser solver.tol may be reached, and a smaller contact.friction or material.coupling_scale restores uniqueness of the solution"
+                "; semismooth Newton, its proximal stage and its last stage (block Gauss-Seidel for Coulomb's law) all stalled: a looser solver.tol may be reached"
+            }
+            ContactError::NotUnique { .. } => {
+                "; a smaller contact.friction or material.coupling_scale brings the problem back within the uniqueness theory"
             }
             _ => "",
         };

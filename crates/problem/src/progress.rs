@@ -120,7 +120,7 @@ impl fmt::Display for Event<'_> {
             ),
             Event::Contact { progress: p, .. } if p.stage == contact::Stage::Fallback => write!(
                 f,
-                "semismooth Newton stalled after {} steps (residual {:.3e}): the accelerated gradient takes over from its multipliers (run.json: iterations.newton_fallback)",
+                "semismooth Newton and its proximal stage stalled after {} steps (best residual {:.3e}): the last stage (block Gauss-Seidel for Coulomb's law, the accelerated gradient otherwise) takes over from the best multipliers (run.json: iterations.newton_fallback)",
                 p.iter, p.residual
             ),
             Event::Contact { progress: p, .. } => write!(
