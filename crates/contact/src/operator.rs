@@ -62,22 +62,30 @@ impl DenseContactProblem {
     }
 }
 
-impl ContactOperator for DenseContactProblem {
-    fn n_points(&self) -> usize {
-        self.weight.len()
-    }
-    fn n_tangential(&self) -> usize {
-        self.nt
-    }
-    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
-        apply(self, lambda, out, true);
-        Ok(0)
-    }
-    fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
-        apply(self, lambda, out, false);
-        Ok(0)
-    }
+/// The operator of a problem given by its data (`u0`, `D`, weights `weight`, `nt`): `apply`
+/// it, with the forces alone exactly (no difference of two calls).
+macro_rules! affine_operator {
+    ($($t:ty),*) => {$(
+        impl ContactOperator for $t {
+            fn n_points(&self) -> usize {
+                self.weight.len()
+            }
+            fn n_tangential(&self) -> usize {
+                self.nt
+            }
+            fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+                apply(self, lambda, out, true);
+                Ok(0)
+            }
+            fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
+                apply(self, lambda, out, false);
+                Ok(0)
+            }
+        }
+    )*};
 }
+
+affine_operator!(DenseContactProblem, SparseContactProblem);
 
 /// An affine contact problem with a sparse compliance: `u = u0 - D W λ`, `D` in compressed
 /// rows, in the layout `[normal (n); tangential (n·nt)]` (the Delassus operators of multibody
@@ -92,23 +100,6 @@ pub struct SparseContactProblem {
     pub weight: Vec<f64>,
     /// Tangential components per point.
     pub nt: usize,
-}
-
-impl ContactOperator for SparseContactProblem {
-    fn n_points(&self) -> usize {
-        self.weight.len()
-    }
-    fn n_tangential(&self) -> usize {
-        self.nt
-    }
-    fn displacement(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
-        apply(self, lambda, out, true);
-        Ok(0)
-    }
-    fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
-        apply(self, lambda, out, false);
-        Ok(0)
-    }
 }
 
 /// The compliance of an affine problem, as the solvers read it.
