@@ -2,7 +2,11 @@
 //! onto the multiplier sets, Uzawa's algorithm, the fixed point on the friction threshold,
 //! residuals and stick/slip status. It knows no finite elements: it sees the problem only
 //! through [`ContactOperator`] ("given multipliers, return the displacement of the contact
-//! points"), so the same solvers run on the full system and on small dense problems.
+//! points"), so the same solvers run on the full system and on small dense problems. Problems
+//! given by their compliance ([`AffineProblem`], dense or sparse) have two more solvers: the
+//! semismooth Newton method with its proximal and Gauss–Seidel stages ([`solve_newton`]) and
+//! block Gauss–Seidel ([`solve_gauss_seidel`]). [`siconos`] reads the frictional contact
+//! problems of the Siconos project, on which the solvers are judged against Siconos' own.
 //!
 //! # Glossary (signs fixed by DESIGN.md)
 //! - `n`: outward normal of the body; `u_n = u·n`, `u_t = (u·t_k)_k`; gap `g`: `u_n ≤ g`.
@@ -13,7 +17,7 @@
 //! - `μ_max`: the largest eigenvalue of the dual operator (weighted contact compliance); the
 //!   step is `r = 1.8 / μ_max` by default (convergence needs `r < 2 / μ_max`).
 //! - Complementarity residual: the natural map with `c = 1 / μ_max`, weighted, relative to
-//!   `‖λ‖_W` (see [`complementarity_residual`]).
+//!   `‖λ‖_W` (see [`complementarity_residual`]); Siconos' error is the other [`Measure`].
 //!
 //! # Example
 //! ```
