@@ -320,63 +320,43 @@ fn the_proximal_stage_finishes_rank_deficient_problems() {
 #[test]
 fn a_deadline_interrupts() {
     let p = problem("Capsules-i101-404.dat");
-    let interrupt = contact::Interrupt {
+    let (points, law) = (p.points(), Law::Coulomb);
+    let past = contact::Interrupt {
         deadline: Some(std::time::Instant::now()),
         cancel: None,
     };
-    let params = NewtonParams {
-        tol: 1e-8,
-        interrupt,
-        ..Default::default()
-    };
-    let e = solve_newton(
-        &mut p.sparse_problem(),
-        &p.points(),
-        &Law::Coulomb,
-        &params,
-        None,
-        &mut |_| {},
-    )
-    .unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ContactError::Interrupted {
-                why: contact::Interruption::Deadline,
-                best: Some(_),
-                ..
-            }
-        ),
-        "{e}"
-    );
     static CANCEL: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
-    let params = GaussSeidelParams {
-        interrupt: contact::Interrupt {
-            deadline: None,
-            cancel: Some(&CANCEL),
-        },
+    let cancelled = contact::Interrupt {
+        deadline: None,
+        cancel: Some(&CANCEL),
+    };
+    let newton = NewtonParams {
+        tol: 1e-8,
+        interrupt: past,
         ..Default::default()
     };
-    let e = solve_gauss_seidel(
-        &mut p.sparse_problem(),
-        &p.points(),
-        &Law::Coulomb,
-        &params,
-        None,
-        &mut |_| {},
-    )
-    .unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ContactError::Interrupted {
-                why: contact::Interruption::Cancelled,
-                ..
-            }
+    let gauss_seidel = GaussSeidelParams {
+        interrupt: cancelled,
+        ..Default::default()
+    };
+    let results = [
+        (
+            solve_newton(&mut p.sparse_problem(), &points, &law, &newton, None, &mut |_| {}),
+            contact::Interruption::Deadline,
         ),
-        "{e}"
-    );
-    let _: Option<PointValues> = e.best().map(|b| b.lambda.clone());
+        (
+            solve_gauss_seidel(&mut p.sparse_problem(), &points, &law, &gauss_seidel, None, &mut |_| {}),
+            contact::Interruption::Cancelled,
+        ),
+    ];
+    for (result, expected) in results {
+        let e = result.unwrap_err();
+        assert!(
+            matches!(e, ContactError::Interrupted { why, best: Some(_), .. } if why == expected),
+            "{e}"
+        );
+        let _: Option<PointValues> = e.best().map(|b| b.lambda.clone());
+    }
 }
 
 proptest::proptest! {
