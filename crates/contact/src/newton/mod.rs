@@ -57,10 +57,11 @@ pub struct NewtonParams {
     pub max_proximal: usize,
     /// Power iterations for `μ_max`.
     pub power_iters: usize,
-    /// Whether to fall back on the accelerated projected gradient when both Newton stages
-    /// stall (when false, a stall is a [`ContactError::Stalled`]).
+    /// Whether to fall back on a last stage when both Newton stages stall: block Gauss–Seidel
+    /// for Coulomb's law, the accelerated projected gradient for the convex laws (when false,
+    /// a stall is a [`ContactError::Stalled`]).
     pub fallback: bool,
-    /// First-order steps the fallback may take.
+    /// Sweeps or steps the last stage may take.
     pub max_fallback_iters: usize,
     /// A deadline or a cancel flag.
     pub interrupt: Interrupt,
@@ -89,9 +90,9 @@ const MEMORY: usize = 8;
 const MAX_HALVINGS: usize = 30;
 /// Newton steps without a 10 % gain on the best norm of the equations before a stall.
 const PATIENCE: usize = 15;
-/// Newton steps of one proximal problem, and steps without a 10 % gain there.
+/// Newton steps of one proximal problem (no patience rule there: a failed inner solve is
+/// what raises `σ`).
 const INNER_STEPS: usize = 100;
-const INNER_PATIENCE: usize = 100;
 /// The tolerance of one proximal problem's solve, relative to the outer residual.
 const INNER_RATIO: f64 = 0.1;
 /// The proximal shift's bounds, relative to the points' mean compliance.
@@ -293,7 +294,7 @@ fn proximal_stage(
             s0,
             INNER_STEPS,
             MEMORY,
-            INNER_PATIENCE,
+            INNER_STEPS,
             &params.interrupt,
             info,
             &mut |s, _| judge.residual_of(&problem, s) <= inner_tol,
@@ -342,9 +343,11 @@ fn proximal_stage(
 /// iterate found.
 ///
 /// # Errors
-/// [`ContactError::Input`] for inconsistent data; [`ContactError::Stalled`] (with the best
-/// iterate) when every stage stalled; [`ContactError::Interrupted`] at the deadline or on
-/// cancellation.
+/// [`ContactError::Input`] for inconsistent data; when every stage stopped short, the last
+/// stage's error ([`ContactError::Stalled`], or the fallback's own), carrying the best iterate
+/// of all stages, or for Coulomb's law [`ContactError::NotUnique`] where the fixed point on the
+/// slip bound expands near that iterate ([`crate::slip_bound_expansion`]);
+/// [`ContactError::Interrupted`] at the deadline or on cancellation.
 pub fn solve_newton<P: AffineProblem>(
     problem: &mut P,
     points: &ContactPoints,
@@ -508,8 +511,8 @@ pub fn solve_newton<P: AffineProblem>(
     }
 }
 
-/// Stage 3: the accelerated projected gradient from the best multipliers, projected onto the
-/// sets.
+/// Stage 3, from the best multipliers projected onto the sets: block Gauss–Seidel for
+/// Coulomb's law, the accelerated projected gradient for the convex laws.
 #[allow(clippy::too_many_arguments)]
 fn fallback<P: AffineProblem>(
     problem: &mut P,
