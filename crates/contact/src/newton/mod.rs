@@ -196,6 +196,7 @@ fn newton_steps(
     accept: &mut dyn FnMut(&State, &mut ContactInfo) -> bool,
 ) -> (State, End) {
     let mut history = std::collections::VecDeque::with_capacity(memory + 1);
+    let definite = matches!(directions, Directions::Reduced(_));
     let mut since_best = 0;
     let mut best = s.clone();
     let mut s = s;
@@ -217,8 +218,13 @@ fn newton_steps(
             for _ in 0..=MAX_HALVINGS {
                 let x: Vec<f64> = s.x.iter().zip(&delta).map(|(a, b)| a + alpha * b).collect();
                 let trial = flat.state(x);
-                // the full step against the history; a damped one must lower the norm itself
-                let reference = if alpha == 1.0 { reference_norm } else { s.norm };
+                // the full step against the history; a damped one too where `D` is definite, else
+                // it must lower the norm itself
+                let reference = if alpha == 1.0 || definite {
+                    reference_norm
+                } else {
+                    s.norm
+                };
                 if trial.norm <= (1.0 - ARMIJO * alpha) * reference {
                     accepted = Some(trial);
                     break;
