@@ -21,7 +21,10 @@ pub(super) enum Directions {
     /// Dense SPD: the reduced system, with the stiffness `(D + σ W⁻¹)⁻¹` (row-major).
     Reduced(Vec<f64>),
     /// Dense, not SPD or not symmetric: one LU of `J` per step.
-    DenseLu,
+    DenseLu {
+        /// Whether `D` is symmetric (to [`SYMMETRIC`]).
+        symmetric: bool,
+    },
     /// Sparse: one sparse LU of `J` per step, on a pattern (and its symbolic factorisation)
     /// fixed for the problem.
     SparseLu(Box<SparsePattern>),
@@ -75,13 +78,13 @@ impl Directions {
             Compliance::Sparse(_) => {
                 return match SparsePattern::new(flat) {
                     Some(p) => Directions::SparseLu(Box::new(p)),
-                    None => Directions::DenseLu,
+                    None => Directions::DenseLu { symmetric: false },
                 }
             }
             Compliance::Dense(d) => d,
         };
         if flat.d.asymmetry() > SYMMETRIC {
-            return Directions::DenseLu;
+            return Directions::DenseLu { symmetric: false };
         }
         let m = flat.m;
         let shifted = Mat::<f64>::from_fn(m, m, |i, j| {
@@ -92,15 +95,23 @@ impl Directions {
                 let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);
                 Directions::Reduced((0..m * m).map(|k| inv[(k / m, k % m)]).collect())
             }
-            Err(_) => Directions::DenseLu,
+            Err(_) => Directions::DenseLu { symmetric: true },
         }
+    }
+
+    /// Whether `D` is dense and symmetric (a condensed finite-element compliance), where
+    /// Newton's damped steps may rise against the line search's history; not where `D` is
+    /// sparse or asymmetric (multibody Delassus operators, Siconos' files), where such rises
+    /// let the iteration wander (measured: `docs/theory.md`, stage 1).
+    pub(super) fn symmetric_dense(&self) -> bool {
+        matches!(self, Directions::Reduced(_) | Directions::DenseLu { symmetric: true })
     }
 
     /// The direction at `s`; `None` where the system is singular.
     pub(super) fn direction(&self, flat: &Flat<'_>, s: &State, rows: &[RowForm]) -> Option<Vec<f64>> {
         match self {
             Directions::Reduced(stiffness) => reduced(flat, s, rows, stiffness).or_else(|| dense_lu(flat, s, rows)),
-            Directions::DenseLu => dense_lu(flat, s, rows),
+            Directions::DenseLu { .. } => dense_lu(flat, s, rows),
             Directions::SparseLu(pattern) => sparse_lu(flat, s, rows, pattern),
         }
     }

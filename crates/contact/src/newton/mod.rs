@@ -88,7 +88,8 @@ const ARMIJO: f64 = 1e-4;
 const MEMORY: usize = 8;
 /// Step halvings of the line search before the direction is given up.
 const MAX_HALVINGS: usize = 30;
-/// Newton steps without a 10 % gain on the best norm of the equations before a stall.
+/// Newton steps without a 10 % gain on the best norm of the equations before a stall (where
+/// `D` is sparse or asymmetric).
 const PATIENCE: usize = 15;
 /// Newton steps of one proximal problem (no patience rule there: a failed inner solve is
 /// what raises `σ`).
@@ -196,7 +197,11 @@ fn newton_steps(
     accept: &mut dyn FnMut(&State, &mut ContactInfo) -> bool,
 ) -> (State, End) {
     let mut history = std::collections::VecDeque::with_capacity(memory + 1);
-    let definite = matches!(directions, Directions::Reduced(_));
+    // a dense symmetric D (a condensed finite-element compliance): Newton's own rules, damped
+    // steps that may rise against the history and no patience rule (its norm often rests on a
+    // plateau until the active set is found, then drops to round-off in one step)
+    let rises = directions.symmetric_dense();
+    let patience = if rises { max_steps } else { patience };
     let mut since_best = 0;
     let mut best = s.clone();
     let mut s = s;
@@ -218,13 +223,9 @@ fn newton_steps(
             for _ in 0..=MAX_HALVINGS {
                 let x: Vec<f64> = s.x.iter().zip(&delta).map(|(a, b)| a + alpha * b).collect();
                 let trial = flat.state(x);
-                // the full step against the history; a damped one too where `D` is definite, else
-                // it must lower the norm itself
-                let reference = if alpha == 1.0 || definite {
-                    reference_norm
-                } else {
-                    s.norm
-                };
+                // the full step against the history; a damped one too where `D` is dense and
+                // symmetric, else it must lower the norm itself
+                let reference = if alpha == 1.0 || rises { reference_norm } else { s.norm };
                 if trial.norm <= (1.0 - ARMIJO * alpha) * reference {
                     accepted = Some(trial);
                     break;
