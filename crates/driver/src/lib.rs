@@ -62,6 +62,10 @@ pub enum DriverError {
         /// What is wrong.
         message: String,
     },
+    /// PETSc or MPI, in a run of the PETSc backend.
+    #[cfg(feature = "petsc")]
+    #[error(transparent)]
+    Petsc(#[from] petsc::PetscError),
     /// Command-line arguments that do not fit together.
     #[error("{0}")]
     Usage(String),

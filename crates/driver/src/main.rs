@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use driver::studies::{convergence, stability, sweep, table1, verification};
 use driver::{fclib, output, scene_file, DriverError};
-use problem::{Event, Strategy};
+use problem::{Backend, Event, Strategy};
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,6 +34,11 @@ enum Command {
         /// Output directory (default: out/SCENE/).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Options for PETSc's database, as on PETSc's command line, e.g. --petsc "-ksp_monitor
+        /// -fieldsplit_u_pc_type hypre" (with solver.backend=petsc; added to the scene's
+        /// solver.petsc_options).
+        #[arg(long, value_name = "OPTIONS", allow_hyphen_values = true)]
+        petsc: Option<String>,
     },
     /// List the shipped scenes.
     Scenes,
@@ -197,6 +202,7 @@ fn main() -> ExitCode {
         set: vec![],
         unset: vec![],
         out: None,
+        petsc: None,
     });
     match dispatch(command) {
         Ok(()) => ExitCode::SUCCESS,
@@ -214,7 +220,13 @@ fn say(line: &str) {
 
 fn dispatch(command: Command) -> Result<(), DriverError> {
     match command {
-        Command::Run { scene, set, unset, out } => run(scene, overrides(set, unset), out),
+        Command::Run {
+            scene,
+            set,
+            unset,
+            out,
+            petsc,
+        } => run(scene, overrides(set, unset), out, petsc),
         Command::Scenes => scenes(),
         Command::Fclib {
             files,
@@ -281,18 +293,66 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
 }
 
 /// `piezocontact run`: the scene solved, its plan's outputs written.
-fn run(scene: Option<String>, overrides: Vec<String>, out: Option<PathBuf>) -> Result<(), DriverError> {
+fn run(
+    scene: Option<String>,
+    overrides: Vec<String>,
+    out: Option<PathBuf>,
+    petsc: Option<String>,
+) -> Result<(), DriverError> {
     let name = scene.unwrap_or_else(|| "paper".into());
-    let (scene, source) = scene_file::load(&name, &overrides)?;
+    let (mut scene, source) = scene_file::load(&name, &overrides)?;
+    if let Some(extra) = petsc {
+        let all = [scene.solver.petsc_options.take(), Some(extra)];
+        scene.solver.petsc_options = Some(all.into_iter().flatten().collect::<Vec<_>>().join(" "));
+        scene.validate().map_err(|e| DriverError::Scene {
+            file: name.clone(),
+            message: format!("--petsc: {e}"),
+        })?;
+    }
     let dir = out.unwrap_or_else(|| output::default_dir(&scene.name));
     let mut terminal = Terminal {
         bar: None,
         first_residual: None,
     };
-    let solution = driver::run::run(&scene, &source, &dir, &mut terminal)?;
-    let names: Vec<&str> = solution.report.plan.outputs.iter().map(|o| o.name()).collect();
-    say(&format!("wrote {} in {}", names.join(", "), dir.display()));
+    let solution = match scene.solver.backend {
+        Backend::Faer => Some(driver::run::run(&scene, &source, &dir, &mut terminal)?),
+        Backend::Petsc => run_petsc(&scene, &source, &dir, &mut terminal)?,
+    };
+    if let Some(solution) = solution {
+        if let Some(p) = &solution.report.petsc {
+            say(&format!(
+                "PETSc: {} ranks, {} unknowns, {} Krylov iterations ({})",
+                p.ranks, p.unknowns, p.krylov_iterations, p.reason
+            ));
+        }
+        let names: Vec<&str> = solution.report.plan.outputs.iter().map(|o| o.name()).collect();
+        say(&format!("wrote {} in {}", names.join(", "), dir.display()));
+    }
     Ok(())
+}
+
+/// A run of the PETSc backend (rank 0 returns the solution).
+#[cfg(feature = "petsc")]
+fn run_petsc(
+    scene: &problem::Scene,
+    source: &scene_file::Source,
+    dir: &std::path::Path,
+    terminal: &mut Terminal,
+) -> Result<Option<problem::Solution>, DriverError> {
+    driver::run::run_distributed(scene, source, dir, terminal)
+}
+
+/// Without the feature, a run of the PETSc backend is refused by name.
+#[cfg(not(feature = "petsc"))]
+fn run_petsc(
+    _: &problem::Scene,
+    _: &scene_file::Source,
+    _: &std::path::Path,
+    _: &mut Terminal,
+) -> Result<Option<problem::Solution>, DriverError> {
+    Err(DriverError::Usage(
+        "solver.backend = \"petsc\" needs a build with PETSc: cargo build --release --features petsc (with petsc-dev, libclang-dev and pkg-config installed; see the README), then mpirun -np N target/release/piezocontact run ...".into(),
+    ))
 }
 
 /// `piezocontact scenes`: one line per shipped scene.

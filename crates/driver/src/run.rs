@@ -51,6 +51,44 @@ pub fn solve(scene: &Scene, source: &Source, reporter: &mut dyn Reporter) -> Res
     Ok(solution)
 }
 
+/// Solves `scene` on the ranks of an MPI run with the PETSc backend (`solver.backend =
+/// "petsc"`), and writes the outputs from rank 0 (as one set; nothing on error). Every rank
+/// calls it; rank 0 returns the solution, with each rank's peak memory in `run.json`'s `petsc`
+/// section, the others `None`. Only rank 0 reports to `reporter`.
+///
+/// # Errors
+/// As [`run`], and [`DriverError::Petsc`] for PETSc's and MPI's.
+#[cfg(feature = "petsc")]
+pub fn run_distributed(
+    scene: &Scene,
+    source: &Source,
+    dir: &Path,
+    reporter: &mut dyn Reporter,
+) -> Result<Option<Solution>, DriverError> {
+    let petsc = petsc::Petsc::init()?;
+    let mesh = match (scene.mesh.kind, &scene.mesh.file) {
+        (MeshKind::Gmsh, Some(file)) => Some(mesh::read_msh(source.dir.join(file))?),
+        _ => None,
+    };
+    let mut silent = problem::Silent;
+    let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
+    let solved = distributed::solve(scene, mesh, &petsc, reporter).map_err(|e| match e {
+        distributed::DistributedError::Problem(p) => DriverError::Problem(p),
+        distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
+    })?;
+    let peaks = petsc.all_gather(peak_memory_bytes())?;
+    let Some(mut solution) = solved else {
+        return Ok(None);
+    };
+    solution.report.scene.source = source.label.clone();
+    solution.report.memory.peak_bytes = peaks.first().copied().unwrap_or(0);
+    if let Some(p) = solution.report.petsc.as_mut() {
+        p.peak_bytes_per_rank = peaks;
+    }
+    output::write(&solution, dir)?;
+    Ok(Some(solution))
+}
+
 /// As [`solve`], then writes the plan's outputs into `dir` (as one set; nothing on error).
 ///
 /// # Errors

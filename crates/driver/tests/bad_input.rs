@@ -147,3 +147,31 @@ fn extreme_values_solve_and_draw() {
         }
     }
 }
+
+/// Without the feature `petsc`, the PETSc backend is refused by name, with how to build it,
+/// and nothing is written.
+#[cfg(not(feature = "petsc"))]
+#[test]
+fn the_petsc_backend_needs_its_feature() {
+    let tmp = tempfile::tempdir().expect("a temporary directory");
+    let out = tmp.path().join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_piezocontact"))
+        .args([
+            "run",
+            "paper",
+            "--set",
+            "mesh.n=8",
+            "--set",
+            "contact.law=\"none\"",
+            "--set",
+            "solver.backend=\"petsc\"",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .expect("the binary runs");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(stderr.contains("--features petsc"), "{stderr}");
+    assert!(!out.exists());
+}

@@ -67,10 +67,10 @@ pub mod setup;
 
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
-pub use report::RunReport;
+pub use report::{PetscReport, RunReport};
 pub use run::{solve, solve_within, ContactResult, Limits, Solution};
 pub use scene::{
-    ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec, LoadSpec,
+    Backend, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec, LoadSpec,
     MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy,
 };
 

@@ -33,6 +33,35 @@ pub struct RunReport {
     pub memory: Memory,
     /// The solver's parameters.
     pub solver: SolverReport,
+    /// What the PETSc backend did (absent from runs of the default backend).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub petsc: Option<PetscReport>,
+}
+
+/// What a run of the PETSc backend did (`solver.backend = "petsc"`).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct PetscReport {
+    /// MPI ranks.
+    pub ranks: usize,
+    /// Unknowns of the distributed system (prescribed ones included, eliminated in place).
+    pub unknowns: usize,
+    /// Stored entries of the distributed matrix, summed over the ranks.
+    pub nonzeros: f64,
+    /// Iterations of the outer Krylov method.
+    pub krylov_iterations: usize,
+    /// PETSc's reason for stopping (`CONVERGED_RTOL`, ...).
+    pub reason: String,
+    /// The options database the solver was configured from: the backend's defaults, then the
+    /// scene's `solver.petsc_options` (later options win).
+    pub options: String,
+    /// Cells assembled by each rank.
+    pub cells_per_rank: Vec<usize>,
+    /// Unknowns owned by each rank.
+    pub unknowns_per_rank: Vec<usize>,
+    /// Peak resident memory of each rank, bytes (set by the application; empty where unknown).
+    pub peak_bytes_per_rank: Vec<u64>,
+    /// Building the preconditioner (multigrid hierarchies, the Schur approximation), s.
+    pub preconditioner_setup_s: f64,
 }
 
 /// The scene as run.

@@ -643,5 +643,6 @@ fn report(
             smallest_pivot_ratio: direct.map(|d| d.factor().pivot_ratio()),
             ..SolverReport::of(info)
         },
+        petsc: None,
     }
 }

@@ -110,6 +110,18 @@ choice! {
 }
 
 choice! {
+    /// Who does the linear algebra.
+    pub enum Backend ("solver.backend") {
+        /// faer's sparse direct factorisations, on one machine (the default).
+        Faer = "faer",
+        /// PETSc: Krylov methods with algebraic multigrid (a field split with the Schur
+        /// complement of the potentials where the body is electric), on the ranks of an MPI run.
+        /// Needs a build with the feature `petsc`.
+        Petsc = "petsc",
+    }
+}
+
+choice! {
     /// When the contact loops stop.
     pub enum Rule ("solver.rule") {
         /// The complementarity residual at most `solver.tol`.
@@ -609,6 +621,13 @@ pub struct SolverSpec {
     /// its rule).
     #[serde(default)]
     pub pcg_tol: Option<f64>,
+    /// The linear-algebra backend (default `faer`).
+    #[serde(default = "default_backend")]
+    pub backend: Backend,
+    /// Options for PETSc's database, as on PETSc's command line (`backend = "petsc"` only):
+    /// `"-ksp_monitor -fieldsplit_u_pc_type hypre"`.
+    #[serde(default)]
+    pub petsc_options: Option<String>,
 }
 
 fn default_strategy() -> Strategy {
@@ -620,6 +639,9 @@ fn default_tol() -> f64 {
 fn default_rule() -> Rule {
     Rule::Tight
 }
+fn default_backend() -> Backend {
+    Backend::Faer
+}
 
 impl Default for SolverSpec {
     fn default() -> Self {
@@ -628,6 +650,8 @@ impl Default for SolverSpec {
             tol: default_tol(),
             rule: default_rule(),
             pcg_tol: None,
+            backend: default_backend(),
+            petsc_options: None,
         }
     }
 }

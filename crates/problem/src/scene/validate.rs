@@ -5,8 +5,8 @@
 //! mesh is read ([`Scene::check_dimension`]).
 
 use super::{
-    ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, Rule, Scene,
-    SolverSpec,
+    Backend, ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, Rule,
+    Scene, SolverSpec,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -144,6 +144,7 @@ impl Scene {
             validate_contact(c)?;
         }
         validate_solver(&self.solver)?;
+        refuse_backend(self)?;
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
         }
@@ -423,6 +424,20 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
     )
 }
 
+/// What the PETSc backend does not solve yet: contact (it needs the semismooth Newton on the
+/// full system, with Krylov solves of the active-set systems; the condensed compliance of the
+/// default backend is what the PETSc backend exists to avoid).
+fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
+    let contact = s.contact.as_ref().is_some_and(|c| c.law != ContactLaw::None);
+    if s.solver.backend == Backend::Petsc && contact {
+        return Err(SceneError::new(
+            "solver.backend",
+            "solver.backend = `petsc` solves scenes without contact so far (contact.law = \"none\"): contact on PETSc's Krylov solvers is not built yet; use the default backend `faer` for contact",
+        ));
+    }
+    Ok(())
+}
+
 fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
     if s.rule == Rule::Paper && !s.strategy.is_uzawa() {
         return Err(SceneError::new(
@@ -433,6 +448,11 @@ fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
             ),
         ));
     }
+    refuse_if(
+        s.petsc_options.is_some() && s.backend != Backend::Petsc,
+        "solver.petsc_options",
+        "options for PETSc's database, and solver.backend is not `petsc`",
+    )?;
     refuse_if(
         s.pcg_tol.is_some() && !s.strategy.runs_pcg(),
         "solver.pcg_tol",

@@ -1,0 +1,125 @@
+//! Who owns what: the cells partitioned among the ranks, the nodes owned by the lowest rank of
+//! their cells, and each node's unknowns numbered so that every rank owns a contiguous range.
+
+use fe_assembly::{Dof, DofMap};
+use mesh::Mesh;
+use petsc::{partition, Index, Petsc, PetscError};
+
+/// The distribution of a mesh's cells and unknowns among the ranks. The same on every rank.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// Spatial dimension (displacement components per node).
+    pub dim: usize,
+    /// The rank that assembles each cell.
+    pub cell_rank: Vec<usize>,
+    /// The rank that owns each node (the lowest rank among its cells').
+    pub node_rank: Vec<usize>,
+    /// The global number of each node's first unknown; its `dim` displacements follow, then
+    /// its potential where it has one.
+    pub first: Vec<usize>,
+    /// Whether each node carries a potential.
+    pub has_phi: Vec<bool>,
+    /// Each rank's first unknown, and one past the last rank's (`ranks + 1` entries).
+    pub rank_start: Vec<usize>,
+}
+
+impl Layout {
+    /// Partitions `mesh` among the ranks of `petsc` and numbers the unknowns of `dofs`
+    /// (displacements at every node, prescribed or not; potentials where `dofs` has them).
+    /// Collective.
+    pub fn new(petsc: &Petsc, mesh: &Mesh, dofs: &DofMap) -> Result<Layout, PetscError> {
+        let cell_rank = partition_cells(petsc, mesh)?;
+        let (n, dim, ranks) = (mesh.n_nodes(), mesh.dim, petsc.size());
+        let mut node_rank = vec![usize::MAX; n];
+        for (c, cell) in mesh.iter_cells().enumerate() {
+            for &v in cell {
+                node_rank[v] = node_rank[v].min(cell_rank[c]);
+            }
+        }
+        // a node in no cell (refused by the mesh checks) would belong to rank 0
+        for r in &mut node_rank {
+            if *r == usize::MAX {
+                *r = 0;
+            }
+        }
+        let has_phi: Vec<bool> = (0..n).map(|v| !matches!(dofs.phi[v], Dof::Absent)).collect();
+        let mut first = vec![0; n];
+        let mut rank_start = Vec::with_capacity(ranks + 1);
+        let mut next = 0;
+        for r in 0..ranks {
+            rank_start.push(next);
+            for v in (0..n).filter(|&v| node_rank[v] == r) {
+                first[v] = next;
+                next += dim + usize::from(has_phi[v]);
+            }
+        }
+        rank_start.push(next);
+        Ok(Layout {
+            dim,
+            cell_rank,
+            node_rank,
+            first,
+            has_phi,
+            rank_start,
+        })
+    }
+
+    /// Unknowns in all.
+    pub fn n_global(&self) -> usize {
+        *self.rank_start.last().unwrap_or(&0)
+    }
+
+    /// The unknowns `rank` owns.
+    pub fn owned(&self, rank: usize) -> std::ops::Range<usize> {
+        self.rank_start[rank]..self.rank_start[rank + 1]
+    }
+
+    /// The unknowns of node `v`: `dim` displacements, then its potential if it has one.
+    pub fn node_dofs(&self, v: usize) -> std::ops::Range<usize> {
+        self.first[v]..self.first[v] + self.dim + usize::from(self.has_phi[v])
+    }
+
+    /// The nodes `rank` owns, in the order of their unknowns.
+    pub fn owned_nodes(&self, rank: usize) -> impl Iterator<Item = usize> + '_ {
+        (0..self.node_rank.len()).filter(move |&v| self.node_rank[v] == rank)
+    }
+
+    /// A global unknown as PETSc's index.
+    pub fn index(i: usize) -> Index {
+        i as Index
+    }
+}
+
+/// The rank of each cell: the dual graph (cells sharing a facet) of this rank's share of the
+/// cells, partitioned by PETSc, gathered on every rank.
+fn partition_cells(petsc: &Petsc, mesh: &Mesh) -> Result<Vec<usize>, PetscError> {
+    let n_cells = mesh.n_cells();
+    if petsc.size() == 1 {
+        return Ok(vec![0; n_cells]);
+    }
+    let (lo, hi) = petsc.split(n_cells);
+    let (off, node_cells) = mesh.node_cells();
+    let mut offsets = vec![0];
+    let mut neighbours = vec![];
+    for c in lo..hi {
+        let cell = mesh.cell(c);
+        // the other cell on each facet: the cells of the facet's first node that hold all of
+        // the facet's nodes (the cell's nodes but one)
+        for skip in 0..cell.len() {
+            let facet: Vec<usize> = (0..cell.len()).filter(|&i| i != skip).map(|i| cell[i]).collect();
+            let v0 = facet[0];
+            let other = node_cells[off[v0]..off[v0 + 1]]
+                .iter()
+                .copied()
+                .find(|&d| d != c && facet[1..].iter().all(|v| node_cells[off[*v]..off[*v + 1]].contains(&d)));
+            if let Some(d) = other {
+                neighbours.push(d);
+            }
+        }
+        offsets.push(neighbours.len());
+    }
+    let parts = partition(petsc, &offsets, &neighbours, n_cells)?;
+    let local: Vec<i32> = parts.iter().map(|&p| p as i32).collect();
+    let all = petsc.all_gather_i32(&local)?;
+    Ok(all.into_iter().map(|p| p as usize).collect())
+}

@@ -1,0 +1,197 @@
+//! The coupled system on the ranks: each rank's cells assembled into a parallel matrix, the
+//! loads into a parallel vector, prescribed unknowns eliminated.
+//!
+//! ```text
+//! [[A, Gᵀ], [-G, B]] [u; φ] = [b_u; -b_φ]
+//! ```
+//!
+//! is DESIGN.md's `K [u; φ] = [b_u; b_φ]`, `K = [[A, Gᵀ], [G, -B]]`, with the potential's rows
+//! negated: the same solution, and a Schur complement of the potentials, `B + G A⁻¹ Gᵀ`, that
+//! is positive definite, as algebraic multigrid wants. The element matrices are those of
+//! `fe_assembly::kernels` (one column at a time), the loads those of
+//! [`fe_assembly::Discretization::rhs`] (with the prescribed values already lifted).
+
+use crate::layout::Layout;
+use fe_assembly::kernels::{coupling_column, dielectric_column, elasticity_column};
+use fe_assembly::{Discretization, Dof};
+use petsc::{Index, Matrix, Petsc, PetscError, Vector};
+
+/// The assembled system of this rank's rows.
+pub struct System<'p> {
+    /// The matrix, prescribed rows and columns eliminated.
+    pub matrix: Matrix<'p>,
+    /// The right-hand side (prescribed rows: the diagonal times the value).
+    pub rhs: Vector<'p>,
+    /// The norm of the loads (`|(b_u, b_φ)|` over the free unknowns), the scale of the
+    /// equilibrium residual.
+    pub load_norm: f64,
+}
+
+/// Assembles this rank's cells and rows. `b_u`, `b_phi` are the loads over the free unknowns
+/// (as `Discretization::rhs` gives them, the same on every rank). Collective.
+pub fn assemble<'p>(
+    petsc: &'p Petsc,
+    disc: &Discretization<'_>,
+    layout: &Layout,
+    b_u: &[f64],
+    b_phi: &[f64],
+) -> Result<System<'p>, PetscError> {
+    let rank = petsc.rank();
+    let owned = layout.owned(rank);
+    let mut matrix = preallocated(petsc, disc, layout)?;
+    let mut diagonal = [0.0, 0.0]; // sums of A's and B's diagonal entries over this rank's cells
+    let mut counts = [0.0, 0.0];
+    let mesh = disc.mesh;
+    for c in (0..mesh.n_cells()).filter(|&c| layout.cell_rank[c] == rank) {
+        let (rows, ke) = element(disc, layout, c);
+        let ne = rows.len();
+        let nu = layout.dim * mesh.cell(c).len();
+        for i in 0..ne {
+            let which = usize::from(i >= nu);
+            diagonal[which] += ke[i * ne + i];
+            counts[which] += 1.0;
+        }
+        matrix.add_values(&rows, &rows, &ke)?;
+    }
+    matrix.assemble()?;
+    // the mean diagonal entries of A and B: the scale of an eliminated row's diagonal, so that
+    // elimination leaves the conditioning as it was
+    let sums = petsc.sum(&[diagonal[0], diagonal[1], counts[0], counts[1]])?;
+    let scale = [
+        if sums[2] > 0.0 { sums[0] / sums[2] } else { 1.0 },
+        if sums[3] > 0.0 { sums[1] / sums[3] } else { 1.0 },
+    ];
+    let d = &disc.dofs;
+    let (mut fixed_u, mut fixed_phi): (Vec<Index>, Vec<Index>) = (vec![], vec![]);
+    let mut values = vec![0.0; owned.len()];
+    let mut load_sq = 0.0;
+    for v in layout.owned_nodes(rank) {
+        let f = layout.first[v];
+        for k in 0..layout.dim {
+            values[f + k - owned.start] = match d.u[v * layout.dim + k] {
+                Dof::Free(j) => {
+                    load_sq += b_u[j] * b_u[j];
+                    b_u[j]
+                }
+                Dof::Fixed(x) => {
+                    fixed_u.push(Layout::index(f + k));
+                    scale[0] * x
+                }
+                Dof::Absent => 0.0,
+            };
+        }
+        if layout.has_phi[v] {
+            let row = f + layout.dim;
+            values[row - owned.start] = match d.phi[v] {
+                Dof::Free(j) => {
+                    load_sq += b_phi[j] * b_phi[j];
+                    -b_phi[j]
+                }
+                Dof::Fixed(x) => {
+                    fixed_phi.push(Layout::index(row));
+                    scale[1] * x
+                }
+                Dof::Absent => 0.0,
+            };
+        }
+    }
+    eliminate(petsc, &mut matrix, layout, [&fixed_u, &fixed_phi], scale)?;
+    let rhs = Vector::from_local(petsc, &values)?;
+    let load_norm = petsc.sum(&[load_sq])?[0].sqrt();
+    Ok(System { matrix, rhs, load_norm })
+}
+
+/// Zeroes the prescribed rows and columns (`fixed`: the displacements', the potentials'),
+/// with the mean diagonal of their field on the diagonal (the right-hand side is set by the
+/// caller: lifted already, and the value times that diagonal on the prescribed rows).
+/// `MatZeroRowsColumns` takes one diagonal value, so the two fields' rows are eliminated in two
+/// collective calls.
+fn eliminate(
+    petsc: &Petsc,
+    matrix: &mut Matrix<'_>,
+    layout: &Layout,
+    fixed: [&[Index]; 2],
+    scale: [f64; 2],
+) -> Result<(), PetscError> {
+    let x = Vector::mpi(petsc, layout.owned(petsc.rank()).len())?;
+    let mut b = x.duplicate()?;
+    matrix.zero_rows_columns(fixed[0], scale[0], &x, &mut b)?;
+    matrix.zero_rows_columns(fixed[1], scale[1], &x, &mut b)
+}
+
+/// The global rows of cell `c`'s unknowns and its element matrix (row-major), in the order
+/// `u(a, k)` for each node `a` and component `k`, then `φ_a` where the cell is electric.
+pub fn element(disc: &Discretization<'_>, layout: &Layout, c: usize) -> (Vec<Index>, Vec<f64>) {
+    let cell = disc.mesh.cell(c);
+    let (dim, nl) = (layout.dim, cell.len());
+    let electric = disc.cell_electric[c];
+    let nu = nl * dim;
+    let ne = nu + if electric { nl } else { 0 };
+    let mut rows = Vec::with_capacity(ne);
+    for &v in cell {
+        rows.extend((0..dim).map(|k| Layout::index(layout.first[v] + k)));
+    }
+    if electric {
+        rows.extend(cell.iter().map(|&v| Layout::index(layout.first[v] + dim)));
+    }
+    let (m, geo) = (disc.material(c), &disc.geometry[c]);
+    let mut ke = vec![0.0; ne * ne];
+    for a in 0..nl {
+        for k in 0..dim {
+            let col = a * dim + k;
+            let colv = elasticity_column(m, geo, nl, a, k);
+            for b in 0..nl {
+                for l in 0..dim {
+                    ke[(b * dim + l) * ne + col] = colv[b][l];
+                }
+            }
+            if electric {
+                let colg = coupling_column(m, geo, nl, a, k);
+                for b in 0..nl {
+                    // -G in the potential's (negated) rows, Gᵀ in the displacement's
+                    ke[(nu + b) * ne + col] = -colg[b];
+                    ke[col * ne + nu + b] = colg[b];
+                }
+            }
+        }
+        if electric {
+            let colb = dielectric_column(m, geo, nl, a);
+            for b in 0..nl {
+                ke[(nu + b) * ne + nu + a] = colb[b];
+            }
+        }
+    }
+    (rows, ke)
+}
+
+/// The matrix with each owned row's entries counted: a row of node `v` holds the unknowns of
+/// every node that shares a cell with `v`, split into those of this rank and the others'.
+fn preallocated<'p>(petsc: &'p Petsc, disc: &Discretization<'_>, layout: &Layout) -> Result<Matrix<'p>, PetscError> {
+    let rank = petsc.rank();
+    let owned = layout.owned(rank);
+    let (off, adj) = disc.mesh.node_graph();
+    let mut d_nnz = vec![0 as Index; owned.len()];
+    let mut o_nnz = vec![0 as Index; owned.len()];
+    for v in layout.owned_nodes(rank) {
+        let (mut d, mut o) = (0, 0);
+        for &w in &adj[off[v]..off[v + 1]] {
+            let n = layout.node_dofs(w).len() as Index;
+            if layout.node_rank[w] == rank {
+                d += n;
+            } else {
+                o += n;
+            }
+        }
+        for r in layout.node_dofs(v) {
+            d_nnz[r - owned.start] = d;
+            o_nnz[r - owned.start] = o;
+        }
+    }
+    // without potentials every node has `dim` unknowns: blocks for the multigrid
+    let bs = if layout.has_phi.iter().any(|&p| p) {
+        1
+    } else {
+        layout.dim
+    };
+    Matrix::aij_blocked(petsc, owned.len(), layout.n_global(), bs, &d_nnz, &o_nnz)
+}

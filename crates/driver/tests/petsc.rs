@@ -1,0 +1,137 @@
+//! The PETSc backend against the default one (feature `petsc`): the same scenes solved by
+//! faer's direct factorisation and by PETSc's Krylov solvers on 1 and 2 ranks give the same
+//! displacements and potentials. Each test starts itself again under `mpirun -np N` (the child
+//! processes see `OMPI_COMM_WORLD_SIZE`) and passes when every rank passes.
+#![cfg(feature = "petsc")]
+
+use driver::scene_file;
+use petsc::Petsc;
+use std::process::Command;
+
+/// Runs `body` on `ranks` ranks: relaunches this test binary under mpirun unless already in it.
+fn on_ranks(name: &str, ranks: usize, body: impl FnOnce(&Petsc)) {
+    if std::env::var_os("OMPI_COMM_WORLD_SIZE").is_some() {
+        let p = Petsc::init().expect("PETSc starts");
+        body(&p);
+        return;
+    }
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let out = Command::new("timeout")
+        .args([
+            "900",
+            "mpirun",
+            "-np",
+            &ranks.to_string(),
+            "--allow-run-as-root",
+            "--oversubscribe",
+        ])
+        .arg(exe)
+        .args([name, "--exact", "--test-threads=1", "--nocapture"])
+        .output()
+        .expect("mpirun runs");
+    assert!(
+        out.status.success(),
+        "{name} on {ranks} ranks failed:\n{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The largest difference relative to the largest magnitude.
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let diff = a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    if scale > 0.0 {
+        diff / scale
+    } else {
+        diff
+    }
+}
+
+/// Scenes without contact, each by both backends: coupled 2D and 3D, electrodes (a prescribed
+/// non-zero potential), prescribed displacements all round (manufactured), a purely elastic body
+/// (CG with GAMG instead of the field split).
+const CASES: &[(&str, &[&str])] = &[
+    ("paper", &["mesh.n=32", "contact.law=\"none\""]),
+    ("paper-3d", &["mesh.n=6", "contact.law=\"none\""]),
+    ("actuator", &["contact.law=\"none\""]),
+    ("manufactured", &["mesh.n=16"]),
+    ("paper-elastic", &["mesh.n=32", "contact.law=\"none\""]),
+];
+
+fn agree(petsc: &Petsc) {
+    for (name, sets) in CASES {
+        let text = scene_file::SHIPPED
+            .iter()
+            .find(|(n, _)| n == name)
+            .expect("a shipped scene")
+            .1;
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let faer = scene_file::parse(text, name, &sets).expect("the scene reads");
+        let mut with_petsc = sets.clone();
+        with_petsc.push("solver.backend=\"petsc\"".into());
+        let scene = scene_file::parse(text, name, &with_petsc).expect("the scene reads");
+        let dist = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the PETSc run");
+        if petsc.rank() != 0 {
+            assert!(dist.is_none());
+            continue;
+        }
+        let dist = dist.expect("rank 0 has the solution");
+        let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+        let flat = |u: &[[f64; 3]]| u.iter().flat_map(|x| x.iter().copied()).collect::<Vec<f64>>();
+        let du = rel_diff(&flat(&direct.u), &flat(&dist.u));
+        let dphi = rel_diff(&direct.phi, &dist.phi);
+        let report = dist.report.petsc.as_ref().expect("the PETSc section");
+        eprintln!(
+            "{name}: {} ranks, {} unknowns, {} iterations ({}), u {du:.1e}, phi {dphi:.1e}",
+            report.ranks, report.unknowns, report.krylov_iterations, report.reason
+        );
+        assert!(
+            du < 1e-8 && dphi < 1e-8,
+            "{name}: u differs by {du:.2e}, phi by {dphi:.2e}"
+        );
+        assert_eq!(report.ranks, petsc.size());
+        assert_eq!(report.cells_per_rank.iter().sum::<usize>(), direct.mesh.n_cells());
+        assert!(dist.report.residuals.equilibrium < 1e-8, "{name}");
+        if let (Some(a), Some(b)) = (&direct.report.exact, &dist.report.exact) {
+            let (ea, eb) = (a.error(), b.error());
+            assert!(
+                (ea - eb).abs() <= 1e-6 * ea.abs().max(1e-300),
+                "{name}: exact errors {ea} and {eb}"
+            );
+        }
+    }
+}
+
+#[test]
+fn one_rank_agrees_with_the_direct_solver() {
+    on_ranks("one_rank_agrees_with_the_direct_solver", 1, agree);
+}
+
+#[test]
+fn two_ranks_agree_with_the_direct_solver() {
+    on_ranks("two_ranks_agree_with_the_direct_solver", 2, agree);
+}
+
+#[test]
+fn contact_and_bad_options_are_refused_by_name() {
+    on_ranks("contact_and_bad_options_are_refused_by_name", 2, |petsc| {
+        let text = scene_file::SHIPPED
+            .iter()
+            .find(|(n, _)| n.eq(&"paper"))
+            .expect("paper")
+            .1;
+        let sets = ["mesh.n=8".to_string(), "solver.backend=\"petsc\"".to_string()];
+        let e = scene_file::parse(text, "paper", &sets).map(|_| ()).unwrap_err();
+        assert!(e.to_string().contains("solver.backend"), "{e}");
+        let mut sets = sets.to_vec();
+        sets.push("contact.law=\"none\"".into());
+        sets.push("solver.petsc_options=\"-ksp_type nonsense\"".into());
+        let scene = scene_file::parse(text, "paper", &sets).expect("the scene reads");
+        let e = distributed::solve(&scene, None, petsc, &mut problem::Silent)
+            .map(|_| ())
+            .unwrap_err();
+        assert!(e.to_string().contains("nonsense"), "{e}");
+    });
+}
