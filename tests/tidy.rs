@@ -49,7 +49,7 @@ fn crate_dependencies_point_one_way() {
         // the PETSc layer knows no finite elements, as linalg does not
         ("petsc-sys", &[]),
         ("petsc", &["petsc-sys"]),
-        ("distributed", &["mesh", "fe-assembly", "problem", "petsc"]),
+        ("distributed", &["mesh", "fe-assembly", "contact", "problem", "petsc"]),
         ("driver", &["mesh", "contact", "problem", "distributed", "petsc"]),
     ];
     let ours = [

@@ -63,7 +63,7 @@ pub struct ContactInfo {
 
 impl ContactInfo {
     /// Counts at zero for a solve with this estimate of `μ_max`.
-    pub(crate) fn new(mu_max: f64) -> Self {
+    pub fn new(mu_max: f64) -> Self {
         ContactInfo {
             uzawa_iters: 0,
             newton_iters: 0,

@@ -22,12 +22,16 @@
 //! 5. **recover**: the solution gathered on rank 0, which recovers the fields and reports, as
 //!    the default backend does; the other ranks return `None`.
 //!
-//! Contact is not solved on this backend yet (the scene's validation says so).
+//! Contact ([`contact`]) is a primal-dual active set iteration on the full system, each step
+//! one Krylov solve: no dense compliance, whose size grows like the square of the contact
+//! boundary's.
 //!
 //! With the feature `petsc` off the crate is empty.
 // Without the feature the items the docs link to do not exist.
 #![cfg_attr(not(feature = "petsc"), allow(rustdoc::broken_intra_doc_links))]
 
+#[cfg(feature = "petsc")]
+pub mod contact;
 #[cfg(feature = "petsc")]
 mod layout;
 #[cfg(feature = "petsc")]
@@ -38,4 +42,4 @@ pub mod system;
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
-pub use run::{solve, DistributedError, COUPLED_OPTIONS, ELASTIC_OPTIONS};
+pub use run::{solve, DistributedError, COUPLED_OPTIONS, ELASTIC_OPTIONS, MAX_ACTIVE_SET_STEPS};

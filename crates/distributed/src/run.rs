@@ -1,14 +1,20 @@
 //! A run on the ranks: set up, partition, assemble, solve, gather and recover on rank 0.
 
+use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
 use crate::layout::Layout;
 use crate::system::{assemble, System};
+use contact::Law;
 use fe_assembly::{Discretization, Dof};
-use petsc::{Index, IndexSet, Ksp, Petsc, PetscError};
+use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError};
+use problem::boundary::ContactBoundary;
 use problem::report::{
     ContactReport, DofsReport, Iterations, Memory, MeshReport, Residuals, SceneReport, SolverReport, Timings,
 };
 use problem::setup::{setup, MeshNotes, Setup};
-use problem::{Event, PetscReport, ProblemError, Reporter, RunReport, Scene, Solution};
+use problem::{ContactLaw, ContactResult, Event, PetscReport, ProblemError, Reporter, RunReport, Scene, Solution};
+
+/// Steps of the active-set iteration at most.
+pub const MAX_ACTIVE_SET_STEPS: usize = 60;
 use std::time::Instant;
 
 /// What can stop a run of the PETSc backend.
@@ -20,6 +26,9 @@ pub enum DistributedError {
     /// PETSc or MPI.
     #[error(transparent)]
     Petsc(#[from] PetscError),
+    /// The contact iteration did not converge.
+    #[error("contact: {0}")]
+    Contact(ActiveSetError),
 }
 
 impl From<fe_assembly::AssemblyError> for DistributedError {
@@ -36,13 +45,16 @@ impl From<problem::SceneError> for DistributedError {
 
 /// The backend's choices, as options of PETSc's database (the scene's `solver.petsc_options`
 /// come after them and win). With potentials: FGMRES outside (the preconditioner is not a
-/// fixed linear map when its blocks are multigrid cycles), the full Schur factorisation of the
-/// potentials, `selfp` (`B + G diag(A)⁻¹ Gᵀ`) for the Schur complement, one GAMG cycle for
-/// each block. Without: CG with GAMG.
+/// fixed linear map when its blocks are multigrid cycles), the upper-triangular Schur
+/// factorisation of the potentials, `selfp` (`B + G diag(A)⁻¹ Gᵀ`) for the Schur complement,
+/// one GAMG cycle (smoothed aggregation with the rigid-body modes) for the elastic block and
+/// one BoomerAMG cycle (hypre) for the Schur block, where PETSc has hypre, else GAMG. Without
+/// potentials: CG with GAMG. Chosen by measurement on `paper-3d` (docs/performance.md): the
+/// full factorisation with GAMG on both blocks took 2.6 times as long.
 pub const COUPLED_OPTIONS: &str = "-ksp_type fgmres -ksp_gmres_restart 200 -ksp_rtol 1e-10 -ksp_max_it 5000 \
--pc_type fieldsplit -pc_fieldsplit_type schur -pc_fieldsplit_schur_fact_type full \
+-pc_type fieldsplit -pc_fieldsplit_type schur -pc_fieldsplit_schur_fact_type upper \
 -pc_fieldsplit_schur_precondition selfp -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type gamg \
--fieldsplit_phi_ksp_type preonly -fieldsplit_phi_pc_type gamg";
+-fieldsplit_phi_ksp_type preonly -fieldsplit_phi_pc_type hypre";
 
 /// See [`COUPLED_OPTIONS`].
 pub const ELASTIC_OPTIONS: &str = "-ksp_type cg -ksp_rtol 1e-10 -ksp_max_it 5000 -pc_type gamg";
@@ -55,10 +67,10 @@ pub const ELASTIC_OPTIONS: &str = "-ksp_type cg -ksp_rtol 1e-10 -ksp_max_it 5000
 /// # Errors
 /// The default backend's errors for the scene and its data; PETSc's (a Krylov solve that did
 /// not converge among them) as [`DistributedError::Petsc`].
-pub fn solve(
+pub fn solve<'p>(
     scene: &Scene,
     mesh: Option<mesh::Mesh>,
-    petsc: &Petsc,
+    petsc: &'p Petsc,
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DistributedError> {
     scene.validate()?;
@@ -85,15 +97,60 @@ pub fn solve(
         n_phi: disc.dofs.n_phi,
         seconds: t_assembly,
     });
-    let options = configure(petsc, scene, &layout)?;
-    let mut system = system;
-    let (mut ksp, t_pc) = preconditioned(petsc, &setup, &layout, &mut system)?;
-    reporter.event(&Event::Factored { seconds: t_pc });
+    let options = configure(petsc, scene, &setup, &layout)?;
+    let fields = Fields::new(petsc, &setup, &layout);
     let t = Instant::now();
-    let mut x = system.rhs.duplicate()?;
-    let info = ksp.solve(&system.rhs, &mut x)?;
-    let t_solve = t.elapsed().as_secs_f64();
-    let equilibrium = residual(&system, &x)?;
+    let mut t_pc = 0.0;
+    let mut solve_one = |m: &mut Matrix<'p>, b: &petsc::Vector<'p>, x: &mut petsc::Vector<'p>| {
+        let t = Instant::now();
+        let mut ksp = fields.krylov(petsc, m)?;
+        t_pc += t.elapsed().as_secs_f64();
+        let info = ksp.solve(b, x)?;
+        Ok((info.iterations, info.reason))
+    };
+    let (x, contact, krylov, reason) = match &setup.plan.contact_law {
+        ContactLaw::None => {
+            let mut x = system.rhs.duplicate()?;
+            let mut m = system.matrix.duplicate()?;
+            let (its, reason) = solve_one(&mut m, &system.rhs, &mut x)?;
+            (x, None, its, reason)
+        }
+        _ => {
+            let spec = scene.contact.as_ref().ok_or_else(|| {
+                ProblemError::from(problem::SceneError::new(
+                    "contact",
+                    "the plan has contact and the scene no [contact]",
+                ))
+            })?;
+            let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, spec)?;
+            let law = law(scene, &setup, boundary.points.len());
+            let rows = ContactRows::new(petsc, &boundary.points, &boundary.nodes, &layout, &system);
+            let params = ActiveSetParams {
+                tol: scene.solver.tol,
+                max_steps: MAX_ACTIVE_SET_STEPS,
+            };
+            let tol = scene.solver.tol;
+            let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+            let out = active_set(
+                petsc,
+                &layout,
+                &system,
+                &rows,
+                &law,
+                params,
+                &mut solve_one,
+                &mut progress,
+            )
+            .map_err(|e| match e {
+                ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+                other => DistributedError::Contact(other),
+            })?;
+            (out.x, Some((boundary, out.solution)), out.krylov_iterations, out.reason)
+        }
+    };
+    let t_solve = t.elapsed().as_secs_f64() - t_pc;
+    reporter.event(&Event::Factored { seconds: t_pc });
+    let equilibrium = residual(&system, &x, contact.as_ref(), &layout, petsc)?;
     reporter.event(&Event::Solved {
         seconds: t_solve,
         pcg_iters: 0,
@@ -111,12 +168,16 @@ pub fn solve(
     ProblemError::check_finite(&phi_free, "the potential", scene)?;
     let u = disc.dofs.expand_u(&u_free);
     let phi = disc.dofs.expand_phi(&phi_free);
-    let fields = disc.recover(&u, &phi);
-    ProblemError::check_finite(&fields.stress, "the stress", scene)?;
-    let exact = setup
-        .exact
-        .as_ref()
-        .map(|ex| ex.errors(&disc, &u, &phi, setup.plan.electric));
+    let cell_fields = disc.recover(&u, &phi);
+    ProblemError::check_finite(&cell_fields.stress, "the stress", scene)?;
+    let exact = match (&setup.exact, &contact) {
+        (Some(ex), _) => Some(ex.errors(&disc, &u, &phi, setup.plan.electric)),
+        (None, Some((b, sol))) => {
+            let c = ContactReport::of(&b.points, sol);
+            problem::exact::contact_errors(scene, &b.points, sol, c.normal_force, c.tangential_force)
+        }
+        (None, None) => None,
+    };
     if let Some(e) = &exact {
         reporter.event(&Event::Exact {
             kind: e.kind(),
@@ -129,7 +190,7 @@ pub fn solve(
         assembly: t_assembly,
         factorization: t_pc,
         condense: 0.0,
-        contact: 0.0,
+        contact: if contact.is_some() { t_solve } else { 0.0 },
         solve: t_solve,
         total: t_total.elapsed().as_secs_f64(),
     };
@@ -137,35 +198,64 @@ pub fn solve(
         ranks: petsc.size(),
         unknowns: layout.n_global(),
         nonzeros,
-        krylov_iterations: info.iterations,
-        reason: info.reason.clone(),
+        krylov_iterations: krylov,
+        reason,
         options,
         cells_per_rank,
         unknowns_per_rank: (0..petsc.size()).map(|r| layout.owned(r).len()).collect(),
         peak_bytes_per_rank: vec![],
         preconditioner_setup_s: t_pc,
     };
-    let report = report(scene, &setup, &disc, equilibrium, exact, times, petsc_report);
+    let contact_report = contact
+        .as_ref()
+        .map_or_else(ContactReport::default, |(b, sol)| ContactReport::of(&b.points, sol));
+    let info = contact.as_ref().map(|(_, sol)| &sol.info);
+    let report = Report {
+        equilibrium,
+        exact,
+        contact: contact_report,
+        info,
+        timings_s: times,
+        petsc: petsc_report,
+    }
+    .run_report(scene, &setup, &disc);
     Ok(Some(Solution {
         report,
         mesh: setup.mesh,
         u,
         phi,
-        fields,
-        contact: None,
+        fields: cell_fields,
+        contact: contact.map(|(b, solution)| {
+            let displacement = solution.u.clone();
+            ContactResult {
+                points: b.points,
+                nodes: b.nodes,
+                solution,
+                displacement,
+            }
+        }),
     }))
 }
 
 /// Puts the backend's options, then the scene's, into PETSc's database; returns them as one
 /// string.
-fn configure(petsc: &Petsc, scene: &Scene, layout: &Layout) -> Result<String, PetscError> {
-    let defaults = if layout.has_phi.iter().any(|&p| p) {
-        COUPLED_OPTIONS
+fn configure(petsc: &Petsc, scene: &Scene, setup: &Setup, layout: &Layout) -> Result<String, PetscError> {
+    let mut all = if layout.has_phi.iter().any(|&p| p) {
+        let mut o = COUPLED_OPTIONS.to_owned();
+        if !petsc.has_package("hypre")? {
+            o = o.replace("-fieldsplit_phi_pc_type hypre", "-fieldsplit_phi_pc_type gamg");
+        }
+        o
     } else {
-        ELASTIC_OPTIONS
+        ELASTIC_OPTIONS.to_owned()
     };
-    petsc.insert_options(defaults)?;
-    let mut all = defaults.to_owned();
+    if setup.plan.contact_law != ContactLaw::None {
+        // the multipliers are reactions of the Krylov solution: its error bounds the
+        // complementarity residual, which must reach solver.tol
+        let rtol = (1e-2 * scene.solver.tol).min(1e-10);
+        all.push_str(&format!(" -ksp_rtol {rtol:e}"));
+    }
+    petsc.insert_options(&all)?;
     if let Some(user) = &scene.solver.petsc_options {
         petsc.insert_options(user)?;
         all.push(' ');
@@ -174,53 +264,104 @@ fn configure(petsc: &Petsc, scene: &Scene, layout: &Layout) -> Result<String, Pe
     Ok(all)
 }
 
-/// The Krylov solver for the system, configured from the options database, with the fields
-/// (displacements with their rigid-body modes, potentials) named for a field split, and its
-/// preconditioner built (timed).
-fn preconditioned<'p>(
-    petsc: &'p Petsc,
-    setup: &Setup,
-    layout: &Layout,
-    system: &mut System<'p>,
-) -> Result<(Ksp<'p>, f64), PetscError> {
-    let t = Instant::now();
-    let rank = petsc.rank();
-    let dim = layout.dim;
-    let (mut u_rows, mut phi_rows, mut coords) = (vec![], vec![], vec![]);
-    for v in layout.owned_nodes(rank) {
-        let f = layout.first[v];
-        u_rows.extend((0..dim).map(|k| (f + k) as Index));
-        coords.extend_from_slice(&setup.mesh.points[v][..dim]);
-        if layout.has_phi[v] {
-            phi_rows.push((f + dim) as Index);
-        }
-    }
-    let coupled = layout.has_phi.iter().any(|&p| p);
-    if !coupled {
-        // the matrix's own near null space (its rows are the nodes' displacements, in order)
-        system.matrix.set_rigid_body_modes(dim, &coords)?;
-    }
-    let mut ksp = Ksp::new(petsc, &system.matrix)?;
-    if coupled {
-        let mut is_u = IndexSet::new(petsc, &u_rows)?;
-        is_u.set_block_size(dim)?;
-        is_u.set_rigid_body_modes(dim, &coords)?;
-        let is_phi = IndexSet::new(petsc, &phi_rows)?;
-        ksp.set_types("fgmres", "fieldsplit")?;
-        ksp.set_field("u", &is_u)?;
-        ksp.set_field("phi", &is_phi)?;
-    }
-    ksp.set_from_options()?;
-    ksp.set_up()?;
-    Ok((ksp, t.elapsed().as_secs_f64()))
+/// What the Krylov solver needs to know of the unknowns: this rank's rows of the
+/// displacements (with their nodes' coordinates, for the rigid-body modes) and of the
+/// potentials.
+struct Fields {
+    dim: usize,
+    u_rows: Vec<Index>,
+    phi_rows: Vec<Index>,
+    coords: Vec<f64>,
+    coupled: bool,
 }
 
-/// `|K x - b| / |loads|` over all unknowns (the prescribed rows hold exactly).
-fn residual(system: &System<'_>, x: &petsc::Vector<'_>) -> Result<f64, PetscError> {
+impl Fields {
+    fn new(petsc: &Petsc, setup: &Setup, layout: &Layout) -> Self {
+        let dim = layout.dim;
+        let (mut u_rows, mut phi_rows, mut coords) = (vec![], vec![], vec![]);
+        for v in layout.owned_nodes(petsc.rank()) {
+            let f = layout.first[v];
+            u_rows.extend((0..dim).map(|k| (f + k) as Index));
+            coords.extend_from_slice(&setup.mesh.points[v][..dim]);
+            if layout.has_phi[v] {
+                phi_rows.push((f + dim) as Index);
+            }
+        }
+        Fields {
+            dim,
+            u_rows,
+            phi_rows,
+            coords,
+            coupled: layout.has_phi.iter().any(|&p| p),
+        }
+    }
+
+    /// The Krylov solver for `matrix`, configured from the options database, with the fields
+    /// (displacements with their rigid-body modes, potentials) named for a field split, and
+    /// its preconditioner built.
+    fn krylov<'p>(&self, petsc: &'p Petsc, matrix: &mut Matrix<'p>) -> Result<Ksp<'p>, PetscError> {
+        if !self.coupled {
+            // the matrix's own near null space (its rows are the nodes' displacements, in order)
+            matrix.set_rigid_body_modes(self.dim, &self.coords)?;
+        }
+        let mut ksp = Ksp::new(petsc, matrix)?;
+        if self.coupled {
+            let mut is_u = IndexSet::new(petsc, &self.u_rows)?;
+            is_u.set_block_size(self.dim)?;
+            is_u.set_rigid_body_modes(self.dim, &self.coords)?;
+            let is_phi = IndexSet::new(petsc, &self.phi_rows)?;
+            ksp.set_types("fgmres", "fieldsplit")?;
+            ksp.set_field("u", &is_u)?;
+            ksp.set_field("phi", &is_phi)?;
+        }
+        ksp.set_from_options()?;
+        ksp.set_initial_guess_nonzero(true)?;
+        ksp.set_up()?;
+        Ok(ksp)
+    }
+}
+
+/// The plan's contact law on `n` points (as the default backend makes it).
+fn law(scene: &Scene, setup: &Setup, n: usize) -> Law {
+    let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
+    match (setup.plan.contact_law, setup.plan.friction) {
+        (_, false) => Law::Frictionless,
+        (ContactLaw::Tresca, true) => Law::Tresca(vec![slip_bound; n]),
+        _ => Law::Coulomb,
+    }
+}
+
+/// `|K x - b - f_c| / max(|loads|, |f_c|)` over all unknowns, with `f_c` the contact forces
+/// of the multipliers (the prescribed rows hold exactly), as the default backend measures it.
+fn residual(
+    system: &System<'_>,
+    x: &petsc::Vector<'_>,
+    contact: Option<&(ContactBoundary, contact::ContactSolution)>,
+    layout: &Layout,
+    petsc: &Petsc,
+) -> Result<f64, PetscError> {
     let mut r = system.rhs.duplicate()?;
     system.matrix.mult(x, &mut r)?;
     r.axpy(-1.0, &system.rhs)?;
-    let scale = if system.load_norm > 0.0 { system.load_norm } else { 1.0 };
+    let mut scale = system.load_norm;
+    if let Some((b, sol)) = contact {
+        // the points' forces, each added once, by the rank that owns its node
+        let forces = b.forces(&sol.lambda);
+        scale = scale.max(forces.iter().map(|f| f * f).sum::<f64>().sqrt());
+        let dim = layout.dim;
+        let (mut idx, mut vals) = (vec![], vec![]);
+        for (i, &node) in b.nodes.iter().enumerate() {
+            if layout.node_rank[node] == petsc.rank() {
+                for k in 0..dim {
+                    idx.push((layout.first[node] + k) as Index);
+                    vals.push(-forces[i * dim + k]);
+                }
+            }
+        }
+        r.add_values(&idx, &vals)?;
+        r.assemble()?;
+    }
+    let scale = if scale > 0.0 { scale } else { 1.0 };
     Ok(r.norm()? / scale)
 }
 
@@ -249,54 +390,57 @@ fn unpermute(disc: &Discretization<'_>, layout: &Layout, x: &[f64]) -> (Vec<f64>
     (u, phi)
 }
 
-/// The run's report, as the default backend writes it, with the PETSc section.
-#[allow(clippy::too_many_arguments)]
-fn report(
-    scene: &Scene,
-    setup: &Setup,
-    disc: &Discretization<'_>,
+/// The parts of the run's report that the run measured.
+struct Report<'a> {
     equilibrium: f64,
     exact: Option<problem::exact::ExactReport>,
+    contact: ContactReport,
+    info: Option<&'a contact::ContactInfo>,
     timings_s: Timings,
     petsc: PetscReport,
-) -> RunReport {
-    RunReport {
-        scene: SceneReport {
-            name: scene.name.clone(),
-            source: scene.name.clone(),
-            description: scene.description.clone(),
-            settings: scene.clone(),
-        },
-        plan: setup.plan.clone(),
-        mesh: MeshReport {
-            n_nodes: setup.mesh.n_nodes(),
-            n_cells: setup.mesh.n_cells(),
-            h: setup.mesh.h_max(),
-            cells_per_axis: scene.mesh.cells_per_axis(),
-            reoriented_cells: setup.notes.reoriented_cells,
-            coincident_nodes: setup.notes.coincident_nodes,
-        },
-        dofs: DofsReport {
-            u: disc.dofs.n_u,
-            phi: disc.dofs.n_phi,
-        },
-        contact: ContactReport::default(),
-        exact,
-        iterations: Iterations::of(None, 0),
-        residuals: Residuals {
-            equilibrium,
-            complementarity: 0.0,
-            converged_to_tolerance: true,
-        },
-        timings_s,
-        memory: Memory::default(),
-        solver: SolverReport {
-            strategy: scene.solver.strategy,
-            rule: problem::report::rule_in_words(setup.plan.rule).into(),
-            tol: scene.solver.tol,
-            pcg_rel_tol: 0.0,
-            ..SolverReport::of(None)
-        },
-        petsc: Some(petsc),
+}
+
+impl Report<'_> {
+    /// The run's report, as the default backend writes it, with the PETSc section.
+    fn run_report(self, scene: &Scene, setup: &Setup, disc: &Discretization<'_>) -> RunReport {
+        RunReport {
+            scene: SceneReport {
+                name: scene.name.clone(),
+                source: scene.name.clone(),
+                description: scene.description.clone(),
+                settings: scene.clone(),
+            },
+            plan: setup.plan.clone(),
+            mesh: MeshReport {
+                n_nodes: setup.mesh.n_nodes(),
+                n_cells: setup.mesh.n_cells(),
+                h: setup.mesh.h_max(),
+                cells_per_axis: scene.mesh.cells_per_axis(),
+                reoriented_cells: setup.notes.reoriented_cells,
+                coincident_nodes: setup.notes.coincident_nodes,
+            },
+            dofs: DofsReport {
+                u: disc.dofs.n_u,
+                phi: disc.dofs.n_phi,
+            },
+            contact: self.contact,
+            exact: self.exact,
+            iterations: Iterations::of(self.info, 0),
+            residuals: Residuals {
+                equilibrium: self.equilibrium,
+                complementarity: self.info.map_or(0.0, |i| i.complementarity),
+                converged_to_tolerance: true,
+            },
+            timings_s: self.timings_s,
+            memory: Memory::default(),
+            solver: SolverReport {
+                strategy: scene.solver.strategy,
+                rule: problem::report::rule_in_words(setup.plan.rule).into(),
+                tol: scene.solver.tol,
+                pcg_rel_tol: 0.0,
+                ..SolverReport::of(self.info)
+            },
+            petsc: Some(self.petsc),
+        }
     }
 }

@@ -25,6 +25,9 @@ pub struct System<'p> {
     /// The norm of the loads (`|(b_u, b_φ)|` over the free unknowns), the scale of the
     /// equilibrium residual.
     pub load_norm: f64,
+    /// The mean diagonal entries of `A` and of `B`: the diagonal of an eliminated row of each
+    /// field, and the stiffness scale of the contact iteration.
+    pub diagonal: [f64; 2],
 }
 
 /// Assembles this rank's cells and rows. `b_u`, `b_phi` are the loads over the free unknowns
@@ -98,7 +101,12 @@ pub fn assemble<'p>(
     eliminate(petsc, &mut matrix, layout, [&fixed_u, &fixed_phi], scale)?;
     let rhs = Vector::from_local(petsc, &values)?;
     let load_norm = petsc.sum(&[load_sq])?[0].sqrt();
-    Ok(System { matrix, rhs, load_norm })
+    Ok(System {
+        matrix,
+        rhs,
+        load_norm,
+        diagonal: scale,
+    })
 }
 
 /// Zeroes the prescribed rows and columns (`fixed`: the displacements', the potentials'),

@@ -66,6 +66,10 @@ pub enum DriverError {
     #[cfg(feature = "petsc")]
     #[error(transparent)]
     Petsc(#[from] petsc::PetscError),
+    /// The PETSc backend's contact iteration did not converge.
+    #[cfg(feature = "petsc")]
+    #[error("contact: {0}")]
+    ActiveSet(distributed::contact::ActiveSetError),
     /// Command-line arguments that do not fit together.
     #[error("{0}")]
     Usage(String),

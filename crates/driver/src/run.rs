@@ -75,6 +75,7 @@ pub fn run_distributed(
     let solved = distributed::solve(scene, mesh, &petsc, reporter).map_err(|e| match e {
         distributed::DistributedError::Problem(p) => DriverError::Problem(p),
         distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
+        distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),
     })?;
     let peaks = petsc.all_gather(peak_memory_bytes())?;
     let Some(mut solution) = solved else {

@@ -60,6 +60,77 @@ const CASES: &[(&str, &[&str])] = &[
     ("paper-elastic", &["mesh.n=32", "contact.law=\"none\""]),
 ];
 
+/// Scenes with contact: every law, stick and slip zones, 2D and 3D (where the slip direction
+/// turns), separation (the actuator's lift-off), an elastic body.
+const CONTACT_CASES: &[(&str, &[&str])] = &[
+    ("paper", &["mesh.n=32"]),
+    ("paper-slip", &["mesh.n=32"]),
+    ("paper-tresca", &["mesh.n=32"]),
+    ("paper-frictionless", &["mesh.n=32"]),
+    ("paper-3d", &["mesh.n=6"]),
+    ("paper-3d", &["mesh.n=6", "contact.friction=0.1"]),
+    ("actuator", &[]),
+    ("paper-elastic", &["mesh.n=32"]),
+];
+
+/// The weighted relative difference of two sets of multipliers on the same points.
+fn multiplier_diff(a: &problem::ContactResult, b: &problem::ContactResult) -> f64 {
+    let w = &a.points.weight;
+    let d = a.solution.lambda.minus(&b.solution.lambda);
+    d.weighted_norm(w) / a.solution.lambda.weighted_norm(w).max(f64::MIN_POSITIVE)
+}
+
+fn agree_on_contact(petsc: &Petsc) {
+    for (name, sets) in CONTACT_CASES {
+        let text = scene_file::SHIPPED
+            .iter()
+            .find(|(n, _)| n == name)
+            .expect("a shipped scene")
+            .1;
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let faer = scene_file::parse(text, name, &sets).expect("the scene reads");
+        let mut with_petsc = sets.clone();
+        with_petsc.push("solver.backend=\"petsc\"".into());
+        let scene = scene_file::parse(text, name, &with_petsc).expect("the scene reads");
+        let dist = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the PETSc run");
+        let Some(dist) = dist else { continue };
+        let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+        let (a, b) = (
+            direct.contact.as_ref().expect("contact"),
+            dist.contact.as_ref().expect("contact"),
+        );
+        assert_eq!(a.nodes, b.nodes, "{name}: the same points");
+        let dl = multiplier_diff(a, b);
+        let flat = |u: &[[f64; 3]]| u.iter().flat_map(|x| x.iter().copied()).collect::<Vec<f64>>();
+        let du = rel_diff(&flat(&direct.u), &flat(&dist.u));
+        eprintln!(
+            "{name} {sets:?}: {} steps, {} Krylov iterations, residual {:.1e}, lambda {dl:.1e}, u {du:.1e}, counts {:?} / {:?}",
+            dist.report.iterations.newton,
+            dist.report.petsc.as_ref().map_or(0, |p| p.krylov_iterations),
+            dist.report.residuals.complementarity,
+            a.solution.counts(),
+            b.solution.counts()
+        );
+        assert!(dl < 1e-8, "{name} {sets:?}: multipliers differ by {dl:.2e}");
+        assert!(du < 1e-8, "{name} {sets:?}: displacements differ by {du:.2e}");
+        assert!(dist.report.residuals.complementarity <= scene.solver.tol);
+    }
+}
+
+#[test]
+fn contact_on_one_rank_agrees_with_the_direct_solver() {
+    on_ranks("contact_on_one_rank_agrees_with_the_direct_solver", 1, agree_on_contact);
+}
+
+#[test]
+fn contact_on_two_ranks_agrees_with_the_direct_solver() {
+    on_ranks(
+        "contact_on_two_ranks_agrees_with_the_direct_solver",
+        2,
+        agree_on_contact,
+    );
+}
+
 fn agree(petsc: &Petsc) {
     for (name, sets) in CASES {
         let text = scene_file::SHIPPED
@@ -115,18 +186,19 @@ fn two_ranks_agree_with_the_direct_solver() {
 }
 
 #[test]
-fn contact_and_bad_options_are_refused_by_name() {
-    on_ranks("contact_and_bad_options_are_refused_by_name", 2, |petsc| {
+fn bad_options_and_oblique_normals_are_refused_by_name() {
+    on_ranks("bad_options_and_oblique_normals_are_refused_by_name", 2, |petsc| {
         let text = scene_file::SHIPPED
             .iter()
             .find(|(n, _)| n.eq(&"paper"))
             .expect("paper")
             .1;
         let sets = ["mesh.n=8".to_string(), "solver.backend=\"petsc\"".to_string()];
-        let e = scene_file::parse(text, "paper", &sets).map(|_| ()).unwrap_err();
-        assert!(e.to_string().contains("solver.backend"), "{e}");
+        let mut oblique = sets.to_vec();
+        oblique.push("contact.normal=[0.3, -1.0]".into());
+        let e = scene_file::parse(text, "paper", &oblique).map(|_| ()).unwrap_err();
+        assert!(e.to_string().contains("coordinate axis"), "{e}");
         let mut sets = sets.to_vec();
-        sets.push("contact.law=\"none\"".into());
         sets.push("solver.petsc_options=\"-ksp_type nonsense\"".into());
         let scene = scene_file::parse(text, "paper", &sets).expect("the scene reads");
         let e = distributed::solve(&scene, None, petsc, &mut problem::Silent)

@@ -94,6 +94,45 @@ impl<'p> Matrix<'p> {
         Ok(m)
     }
 
+    /// A copy (structure and values; the block size and near null space too).
+    pub fn duplicate(&self) -> Result<Self> {
+        let mut raw: sys::Mat = std::ptr::null_mut();
+        // SAFETY: a live, assembled matrix; `raw` receives the copy.
+        check("MatDuplicate", unsafe {
+            sys::MatDuplicate(self.raw, sys::MatDuplicateOption::MAT_COPY_VALUES, &mut raw)
+        })?;
+        Ok(Matrix {
+            raw,
+            petsc: self.petsc,
+            _not_send: PhantomData,
+        })
+    }
+
+    /// Row `r` (one this rank owns) of an assembled matrix: its columns (global, increasing)
+    /// and values.
+    pub fn row(&self, r: Index) -> Result<(Vec<Index>, Vec<f64>)> {
+        let mut n: Index = 0;
+        let (mut cols, mut vals): (*const Index, *const f64) = (std::ptr::null(), std::ptr::null());
+        // SAFETY: a live, assembled matrix; the arrays hold `n` entries until restored below.
+        unsafe {
+            check("MatGetRow", sys::MatGetRow(self.raw, r, &mut n, &mut cols, &mut vals))?;
+            let len = n.max(0) as usize;
+            let out = if len == 0 {
+                (vec![], vec![])
+            } else {
+                (
+                    std::slice::from_raw_parts(cols, len).to_vec(),
+                    std::slice::from_raw_parts(vals, len).to_vec(),
+                )
+            };
+            check(
+                "MatRestoreRow",
+                sys::MatRestoreRow(self.raw, r, &mut n, &mut cols, &mut vals),
+            )?;
+            Ok(out)
+        }
+    }
+
     /// The rows this rank owns.
     pub fn ownership(&self) -> Result<Range<usize>> {
         let (mut lo, mut hi): (Index, Index) = (0, 0);

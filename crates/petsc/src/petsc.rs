@@ -93,6 +93,18 @@ impl Petsc {
         })
     }
 
+    /// Whether this PETSc was built with the external package `name` (`"hypre"`, `"mumps"`,
+    /// `"ptscotch"`, ...).
+    pub fn has_package(&self, name: &str) -> Result<bool> {
+        let text = CString::new(name).map_err(|_| PetscError::Argument("a package name contains a NUL byte".into()))?;
+        let mut has = sys::PetscBool::PETSC_FALSE;
+        // SAFETY: PETSc is initialised; the name is NUL-terminated.
+        check("PetscHasExternalPackage", unsafe {
+            sys::PetscHasExternalPackage(text.as_ptr(), &mut has)
+        })?;
+        Ok(has == sys::PetscBool::PETSC_TRUE)
+    }
+
     /// PETSc's version, e.g. "Petsc Release Version 3.18.5, ...".
     pub fn version(&self) -> Result<String> {
         let mut buf = vec![0u8; 256];

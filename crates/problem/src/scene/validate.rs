@@ -6,7 +6,7 @@
 
 use super::{
     Backend, ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, Rule,
-    Scene, SolverSpec,
+    Scene, SolverSpec, Strategy,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -424,16 +424,34 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
     )
 }
 
-/// What the PETSc backend does not solve yet: contact (it needs the semismooth Newton on the
-/// full system, with Krylov solves of the active-set systems; the condensed compliance of the
-/// default backend is what the PETSc backend exists to avoid).
+/// What the PETSc backend does not take: a contact normal that is not a coordinate axis (its
+/// active-set iteration holds the normal and tangential components as unknowns of the system),
+/// a strategy or rule of the default backend's contact solvers (it runs its own).
 fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
-    let contact = s.contact.as_ref().is_some_and(|c| c.law != ContactLaw::None);
-    if s.solver.backend == Backend::Petsc && contact {
-        return Err(SceneError::new(
-            "solver.backend",
-            "solver.backend = `petsc` solves scenes without contact so far (contact.law = \"none\"): contact on PETSc's Krylov solvers is not built yet; use the default backend `faer` for contact",
-        ));
+    if s.solver.backend != Backend::Petsc {
+        return Ok(());
+    }
+    refuse_if(
+        s.solver.strategy != Strategy::NewtonCondensed,
+        "solver.strategy",
+        "the PETSc backend runs its own contact solver (a primal-dual active set on the full system, Krylov solves)",
+    )?;
+    refuse_if(
+        s.solver.rule != Rule::Tight,
+        "solver.rule",
+        "the PETSc backend stops on the complementarity residual (the paper's rule is for its Uzawa)",
+    )?;
+    if let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) {
+        let nonzero = c.normal.iter().filter(|&&x| x != 0.0).count();
+        if nonzero != 1 {
+            return Err(SceneError::new(
+                "contact.normal",
+                format!(
+                    "contact.normal = {:?}: the PETSc backend needs a normal along a coordinate axis (its contact iteration holds displacement components); use the default backend for an oblique contact face",
+                    c.normal
+                ),
+            ));
+        }
     }
     Ok(())
 }
