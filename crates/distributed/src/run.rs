@@ -249,6 +249,10 @@ fn configure(petsc: &Petsc, scene: &Scene, setup: &Setup, layout: &Layout) -> Re
     } else {
         ELASTIC_OPTIONS.to_owned()
     };
+    if setup.plan.contact_law == ContactLaw::Coulomb && setup.plan.friction && all.starts_with(ELASTIC_OPTIONS) {
+        // Coulomb's slip rows make the system unsymmetric: GMRES instead of CG
+        all.push_str(" -ksp_type gmres -ksp_gmres_restart 200");
+    }
     if setup.plan.contact_law != ContactLaw::None {
         // the multipliers are reactions of the Krylov solution: its error bounds the
         // complementarity residual, which must reach solver.tol
