@@ -319,7 +319,11 @@ impl Fields {
             ksp.set_field("phi", &is_phi)?;
         }
         ksp.set_from_options()?;
-        ksp.set_initial_guess_nonzero(true)?;
+        // the last step's solution is a good start for an iterative method; a direct solve
+        // (`-ksp_type preonly -pc_type lu`, e.g. with MUMPS) takes none
+        if ksp.kind()? != "preonly" {
+            ksp.set_initial_guess_nonzero(true)?;
+        }
         ksp.set_up()?;
         Ok(ksp)
     }

@@ -207,3 +207,33 @@ fn bad_options_and_oblique_normals_are_refused_by_name() {
         assert!(e.to_string().contains("nonsense"), "{e}");
     });
 }
+
+/// MUMPS, PETSc's distributed direct solver, stays available by options alone: the contact
+/// iteration on it gives the default backend's answer.
+#[test]
+fn mumps_through_the_options_gives_the_same_answer() {
+    on_ranks("mumps_through_the_options_gives_the_same_answer", 2, |petsc| {
+        let text = scene_file::SHIPPED
+            .iter()
+            .find(|(n, _)| n.eq(&"paper-3d"))
+            .expect("paper-3d")
+            .1;
+        let sets = ["mesh.n=6".to_string(), "contact.friction=0.1".to_string()];
+        let faer = scene_file::parse(text, "paper-3d", &sets).expect("the scene reads");
+        let mut with = sets.to_vec();
+        with.push("solver.backend=\"petsc\"".into());
+        with.push("solver.petsc_options=\"-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps\"".into());
+        let scene = scene_file::parse(text, "paper-3d", &with).expect("the scene reads");
+        let Some(dist) = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the MUMPS run") else {
+            return;
+        };
+        let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+        let d = multiplier_diff(
+            direct.contact.as_ref().expect("contact"),
+            dist.contact.as_ref().expect("contact"),
+        );
+        assert!(d < 1e-10, "MUMPS: multipliers differ by {d:.2e}");
+        let report = dist.report.petsc.as_ref().expect("the PETSc section");
+        assert!(report.options.contains("mumps"), "{}", report.options);
+    });
+}

@@ -105,6 +105,18 @@ impl<'p> Ksp<'p> {
         })
     }
 
+    /// The Krylov method's name (`"cg"`, `"fgmres"`, `"preonly"`, ...), as configured.
+    pub fn kind(&self) -> Result<String> {
+        let mut name: sys::KSPType = std::ptr::null();
+        // SAFETY: a live solver; the name is PETSc's static string (or null before a type is set).
+        check("KSPGetType", unsafe { sys::KSPGetType(self.raw, &mut name) })?;
+        if name.is_null() {
+            return Ok(String::new());
+        }
+        // SAFETY: a NUL-terminated string of PETSc's.
+        Ok(unsafe { CStr::from_ptr(name) }.to_string_lossy().into_owned())
+    }
+
     /// Starts from the values in `x` instead of zero.
     pub fn set_initial_guess_nonzero(&mut self, nonzero: bool) -> Result<()> {
         let flag = if nonzero {
