@@ -412,21 +412,9 @@ impl Report<'_> {
     /// The run's report, as the default backend writes it, with the PETSc section.
     fn run_report(self, scene: &Scene, setup: &Setup, disc: &Discretization<'_>) -> RunReport {
         RunReport {
-            scene: SceneReport {
-                name: scene.name.clone(),
-                source: scene.name.clone(),
-                description: scene.description.clone(),
-                settings: scene.clone(),
-            },
+            scene: SceneReport::of(scene),
             plan: setup.plan.clone(),
-            mesh: MeshReport {
-                n_nodes: setup.mesh.n_nodes(),
-                n_cells: setup.mesh.n_cells(),
-                h: setup.mesh.h_max(),
-                cells_per_axis: scene.mesh.cells_per_axis(),
-                reoriented_cells: setup.notes.reoriented_cells,
-                coincident_nodes: setup.notes.coincident_nodes,
-            },
+            mesh: MeshReport::of(scene, setup),
             dofs: DofsReport {
                 u: disc.dofs.n_u,
                 phi: disc.dofs.n_phi,

@@ -5,36 +5,23 @@
 #![cfg(feature = "petsc")]
 
 use driver::scene_file;
+use petsc::testing::on_ranks;
 use petsc::Petsc;
-use std::process::Command;
 
-/// Runs `body` on `ranks` ranks: relaunches this test binary under mpirun unless already in it.
-fn on_ranks(name: &str, ranks: usize, body: impl FnOnce(&Petsc)) {
-    if std::env::var_os("OMPI_COMM_WORLD_SIZE").is_some() {
-        let p = Petsc::init().expect("PETSc starts");
-        body(&p);
-        return;
-    }
-    let exe = std::env::current_exe().expect("the test binary's path");
-    let out = Command::new("timeout")
-        .args([
-            "900",
-            "mpirun",
-            "-np",
-            &ranks.to_string(),
-            "--allow-run-as-root",
-            "--oversubscribe",
-        ])
-        .arg(exe)
-        .args([name, "--exact", "--test-threads=1", "--nocapture"])
-        .output()
-        .expect("mpirun runs");
-    assert!(
-        out.status.success(),
-        "{name} on {ranks} ranks failed:\n{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+/// A shipped scene with the overrides `sets`, for the default backend and for PETSc (with the
+/// PETSc-only overrides `extra` too).
+fn both(name: &str, sets: &[&str], extra: &[&str]) -> (problem::Scene, problem::Scene) {
+    let text = scene_file::SHIPPED
+        .iter()
+        .find(|(n, _)| *n == name)
+        .expect("a shipped scene")
+        .1;
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let faer = scene_file::parse(text, name, &sets).expect("the scene reads");
+    let mut with = sets;
+    with.push("solver.backend=\"petsc\"".into());
+    with.extend(extra.iter().map(|s| s.to_string()));
+    (faer, scene_file::parse(text, name, &with).expect("the scene reads"))
 }
 
 /// The largest difference relative to the largest magnitude.
@@ -82,16 +69,7 @@ fn multiplier_diff(a: &problem::ContactResult, b: &problem::ContactResult) -> f6
 
 fn agree_on_contact(petsc: &Petsc) {
     for (name, sets) in CONTACT_CASES {
-        let text = scene_file::SHIPPED
-            .iter()
-            .find(|(n, _)| n == name)
-            .expect("a shipped scene")
-            .1;
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        let faer = scene_file::parse(text, name, &sets).expect("the scene reads");
-        let mut with_petsc = sets.clone();
-        with_petsc.push("solver.backend=\"petsc\"".into());
-        let scene = scene_file::parse(text, name, &with_petsc).expect("the scene reads");
+        let (faer, scene) = both(name, sets, &[]);
         let dist = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the PETSc run");
         let Some(dist) = dist else { continue };
         let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
@@ -133,16 +111,7 @@ fn contact_on_two_ranks_agrees_with_the_direct_solver() {
 
 fn agree(petsc: &Petsc) {
     for (name, sets) in CASES {
-        let text = scene_file::SHIPPED
-            .iter()
-            .find(|(n, _)| n == name)
-            .expect("a shipped scene")
-            .1;
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        let faer = scene_file::parse(text, name, &sets).expect("the scene reads");
-        let mut with_petsc = sets.clone();
-        with_petsc.push("solver.backend=\"petsc\"".into());
-        let scene = scene_file::parse(text, name, &with_petsc).expect("the scene reads");
+        let (faer, scene) = both(name, sets, &[]);
         let dist = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the PETSc run");
         if petsc.rank() != 0 {
             assert!(dist.is_none());
@@ -213,17 +182,8 @@ fn bad_options_and_oblique_normals_are_refused_by_name() {
 #[test]
 fn mumps_through_the_options_gives_the_same_answer() {
     on_ranks("mumps_through_the_options_gives_the_same_answer", 2, |petsc| {
-        let text = scene_file::SHIPPED
-            .iter()
-            .find(|(n, _)| n.eq(&"paper-3d"))
-            .expect("paper-3d")
-            .1;
-        let sets = ["mesh.n=6".to_string(), "contact.friction=0.1".to_string()];
-        let faer = scene_file::parse(text, "paper-3d", &sets).expect("the scene reads");
-        let mut with = sets.to_vec();
-        with.push("solver.backend=\"petsc\"".into());
-        with.push("solver.petsc_options=\"-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps\"".into());
-        let scene = scene_file::parse(text, "paper-3d", &with).expect("the scene reads");
+        let mumps = "solver.petsc_options=\"-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps\"";
+        let (faer, scene) = both("paper-3d", &["mesh.n=6", "contact.friction=0.1"], &[mumps]);
         let Some(dist) = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the MUMPS run") else {
             return;
         };

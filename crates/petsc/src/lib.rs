@@ -60,6 +60,8 @@ mod partition;
 #[cfg(feature = "bind")]
 mod petsc;
 #[cfg(feature = "bind")]
+pub mod testing;
+#[cfg(feature = "bind")]
 mod vector;
 
 #[cfg(feature = "bind")]

@@ -3,37 +3,26 @@
 //! passes when every rank passes. Needs the feature `bind` (PETSc and Open MPI installed).
 #![cfg(feature = "bind")]
 
+use petsc::testing::on_ranks;
 use petsc::{partition, Index, Ksp, Matrix, Petsc, PetscError, Vector};
-use std::process::Command;
 
-/// Runs `body` on `ranks` ranks: relaunches this test binary under mpirun unless already in it.
-fn on_ranks(name: &str, ranks: usize, body: impl FnOnce(&Petsc)) {
-    if std::env::var_os("OMPI_COMM_WORLD_SIZE").is_some() {
-        let p = Petsc::init().expect("PETSc starts");
-        body(&p);
-        return;
+/// The neighbours of vertex `r` of a k x k grid (the 5-point stencil without the centre).
+fn grid_neighbours(k: usize, r: usize) -> Vec<usize> {
+    let (i, j) = (r / k, r % k);
+    let mut c = vec![];
+    if i > 0 {
+        c.push(r - k);
     }
-    let exe = std::env::current_exe().expect("the test binary's path");
-    // `timeout`: a rank that waits in a collective for a rank that died must not hang the run.
-    let out = Command::new("timeout")
-        .args([
-            "600",
-            "mpirun",
-            "-np",
-            &ranks.to_string(),
-            "--allow-run-as-root",
-            "--oversubscribe",
-        ])
-        .arg(exe)
-        .args([name, "--exact", "--test-threads=1", "--nocapture"])
-        .output()
-        .expect("mpirun runs (apt-get install petsc-dev brings Open MPI)");
-    assert!(
-        out.status.success(),
-        "{name} on {ranks} ranks failed:\n{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    if i + 1 < k {
+        c.push(r + k);
+    }
+    if j > 0 {
+        c.push(r - 1);
+    }
+    if j + 1 < k {
+        c.push(r + 1);
+    }
+    c
 }
 
 /// The 5-point Laplacian of a k x k grid with Dirichlet boundary (rows of this rank's range).
@@ -43,23 +32,7 @@ fn laplacian<'p>(p: &'p Petsc, k: usize) -> Matrix<'p> {
     let own = |c: usize| (lo..hi).contains(&c);
     let mut d_nnz = vec![0 as Index; hi - lo];
     let mut o_nnz = vec![0 as Index; hi - lo];
-    let neighbours = |r: usize| {
-        let (i, j) = (r / k, r % k);
-        let mut c = vec![r];
-        if i > 0 {
-            c.push(r - k);
-        }
-        if i + 1 < k {
-            c.push(r + k);
-        }
-        if j > 0 {
-            c.push(r - 1);
-        }
-        if j + 1 < k {
-            c.push(r + 1);
-        }
-        c
-    };
+    let neighbours = |r: usize| std::iter::once(r).chain(grid_neighbours(k, r)).collect::<Vec<_>>();
     for r in lo..hi {
         for c in neighbours(r) {
             if own(c) {
@@ -188,23 +161,7 @@ fn a_grid_graph_is_split_in_balanced_connected_halves() {
         let k = 30;
         let n = k * k;
         let (lo, hi) = p.split(n);
-        let neighbours = |r: usize| {
-            let (i, j) = (r / k, r % k);
-            let mut c = vec![];
-            if i > 0 {
-                c.push(r - k);
-            }
-            if i + 1 < k {
-                c.push(r + k);
-            }
-            if j > 0 {
-                c.push(r - 1);
-            }
-            if j + 1 < k {
-                c.push(r + 1);
-            }
-            c
-        };
+        let neighbours = |r: usize| grid_neighbours(k, r);
         let mut offsets = vec![0];
         let mut adj = vec![];
         for r in lo..hi {

@@ -38,6 +38,33 @@ pub struct RunReport {
     pub petsc: Option<PetscReport>,
 }
 
+impl SceneReport {
+    /// The scene as run (its source is the scene's name until the application, which read
+    /// it, says where it came from).
+    pub fn of(scene: &Scene) -> Self {
+        SceneReport {
+            name: scene.name.clone(),
+            source: scene.name.clone(),
+            description: scene.description.clone(),
+            settings: scene.clone(),
+        }
+    }
+}
+
+impl MeshReport {
+    /// The sizes of the set-up's mesh, and what its checks noted.
+    pub fn of(scene: &Scene, setup: &crate::setup::Setup) -> Self {
+        MeshReport {
+            n_nodes: setup.mesh.n_nodes(),
+            n_cells: setup.mesh.n_cells(),
+            h: setup.mesh.h_max(),
+            cells_per_axis: scene.mesh.cells_per_axis(),
+            reoriented_cells: setup.notes.reoriented_cells,
+            coincident_nodes: setup.notes.coincident_nodes,
+        }
+    }
+}
+
 /// What a run of the PETSc backend did (`solver.backend = "petsc"`).
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct PetscReport {

@@ -602,21 +602,9 @@ fn report(
         LinearSolver::SchurPcg(p) => p.factor_bytes(),
     };
     RunReport {
-        scene: SceneReport {
-            name: scene.name.clone(),
-            source: scene.name.clone(),
-            description: scene.description.clone(),
-            settings: scene.clone(),
-        },
+        scene: SceneReport::of(scene),
         plan: plan.clone(),
-        mesh: MeshReport {
-            n_nodes: setup.mesh.n_nodes(),
-            n_cells: setup.mesh.n_cells(),
-            h: setup.mesh.h_max(),
-            cells_per_axis: scene.mesh.cells_per_axis(),
-            reoriented_cells: setup.notes.reoriented_cells,
-            coincident_nodes: setup.notes.coincident_nodes,
-        },
+        mesh: MeshReport::of(scene, setup),
         dofs: DofsReport {
             u: a.disc.dofs.n_u,
             phi: a.disc.dofs.n_phi,
