@@ -149,7 +149,11 @@ pub fn solve<'p>(
         }
     };
     let t_solve = t.elapsed().as_secs_f64() - t_pc;
-    reporter.event(&Event::Factored { seconds: t_pc });
+    reporter.event(&Event::Krylov {
+        iterations: krylov,
+        reason: &reason,
+        setup_seconds: t_pc,
+    });
     let equilibrium = residual(&system, &x, contact.as_ref(), &layout, petsc)?;
     reporter.event(&Event::Solved {
         seconds: t_solve,

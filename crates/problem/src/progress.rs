@@ -58,6 +58,15 @@ pub enum Event<'a> {
         /// The equilibrium residual of the final pair.
         equilibrium: f64,
     },
+    /// The Krylov solves of the PETSc backend are done.
+    Krylov {
+        /// Iterations, summed over the solves.
+        iterations: usize,
+        /// PETSc's reason for the last solve's stop.
+        reason: &'a str,
+        /// Building the preconditioners, s.
+        setup_seconds: f64,
+    },
     /// The error against the scene's exact solution.
     Exact {
         /// Which solution.
@@ -137,9 +146,22 @@ impl fmt::Display for Event<'_> {
                 seconds,
                 pcg_iters,
                 equilibrium,
+            } if *pcg_iters == 0 => write!(f, "solve {seconds:.3} s, equilibrium residual {equilibrium:.3e}"),
+            Event::Solved {
+                seconds,
+                pcg_iters,
+                equilibrium,
             } => write!(
                 f,
                 "solve {seconds:.3} s ({pcg_iters} PCG iterations), equilibrium residual {equilibrium:.3e}"
+            ),
+            Event::Krylov {
+                iterations,
+                reason,
+                setup_seconds,
+            } => write!(
+                f,
+                "Krylov: {iterations} iterations in all ({reason}), preconditioners built in {setup_seconds:.3} s"
             ),
             Event::Exact { kind, what, error } => write!(f, "exact ({kind}): {what} = {error:.4e}"),
         }
