@@ -277,8 +277,7 @@ impl<'p> Context<'_, 'p> {
     ) -> Result<(), PetscError> {
         let (petsc, layout, system) = (self.petsc, self.layout, self.system);
         let mut matrix = system.matrix.duplicate()?;
-        let mut b = system.rhs.duplicate()?;
-        b.axpy(1.0, &system.rhs)?;
+        let mut b = system.rhs.copy()?;
         let held = hold(self.rows, layout, law, sets, direction, &mut matrix, &mut b)?;
         let mut values = Vector::mpi(petsc, layout.owned(petsc.rank()).len())?;
         set_held_values(layout, petsc.rank(), &held, &mut values)?;
@@ -542,10 +541,7 @@ fn multipliers(
 ) -> Result<PointValues, PetscError> {
     let p = rows.points;
     let (n, dim, nt) = (p.len(), p.dim, p.n_tangential());
-    let mut r = system.rhs.duplicate()?;
-    system.matrix.mult(x, &mut r)?;
-    r.axpy(-1.0, &system.rhs)?;
-    let local = r.local()?;
+    let local = system.reactions(x)?.local()?;
     let start = layout.owned(petsc.rank()).start;
     let mut flat = vec![0.0; n * (1 + nt)];
     for &i in &rows.mine {

@@ -87,7 +87,7 @@ pub fn solve<'p>(
     ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
     let layout = Layout::new(petsc, &setup.mesh, &disc.dofs)?;
-    let system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
+    let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
     let t_assembly = t.elapsed().as_secs_f64();
     reporter.event(&Event::Assembled {
         n_nodes: setup.mesh.n_nodes(),
@@ -111,8 +111,7 @@ pub fn solve<'p>(
     let (x, contact, krylov, reason) = match &setup.plan.contact_law {
         ContactLaw::None => {
             let mut x = system.rhs.duplicate()?;
-            let mut m = system.matrix.duplicate()?;
-            let (its, reason) = solve_one(&mut m, &system.rhs, &mut x)?;
+            let (its, reason) = solve_one(&mut system.matrix, &system.rhs, &mut x)?;
             (x, None, its, reason)
         }
         _ => {
@@ -352,9 +351,7 @@ fn residual(
     layout: &Layout,
     petsc: &Petsc,
 ) -> Result<f64, PetscError> {
-    let mut r = system.rhs.duplicate()?;
-    system.matrix.mult(x, &mut r)?;
-    r.axpy(-1.0, &system.rhs)?;
+    let mut r = system.reactions(x)?;
     let mut scale = system.load_norm;
     if let Some((b, sol)) = contact {
         // the points' forces, each added once, by the rank that owns its node

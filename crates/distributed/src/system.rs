@@ -30,6 +30,17 @@ pub struct System<'p> {
     pub diagonal: [f64; 2],
 }
 
+impl<'p> System<'p> {
+    /// `K x - b`: the forces that balance the loads at `x` (at a contact point, the contact
+    /// force on the body; elsewhere the equilibrium residual). Collective.
+    pub fn reactions(&self, x: &Vector<'p>) -> Result<Vector<'p>, PetscError> {
+        let mut r = self.rhs.duplicate()?;
+        self.matrix.mult(x, &mut r)?;
+        r.axpy(-1.0, &self.rhs)?;
+        Ok(r)
+    }
+}
+
 /// Assembles this rank's cells and rows. `b_u`, `b_phi` are the loads over the free unknowns
 /// (as `Discretization::rhs` gives them, the same on every rank). Collective.
 pub fn assemble<'p>(

@@ -67,6 +67,14 @@ impl<'p> Vector<'p> {
         Ok(v)
     }
 
+    /// A new vector of the same layout and values.
+    pub fn copy(&self) -> Result<Self> {
+        let v = self.duplicate()?;
+        // SAFETY: live vectors of one layout.
+        check("VecCopy", unsafe { sys::VecCopy(self.raw, v.raw) })?;
+        Ok(v)
+    }
+
     /// The global indices this rank owns.
     pub fn ownership(&self) -> Result<Range<usize>> {
         let (mut lo, mut hi): (Index, Index) = (0, 0);
