@@ -61,7 +61,9 @@ pub const ELASTIC_OPTIONS: &str = "-ksp_type cg -ksp_rtol 1e-10 -ksp_max_it 5000
 
 /// Solves `scene` on the ranks of `petsc`. Every rank calls it (it is collective); rank 0
 /// returns the [`Solution`], as [`problem::solve`] gives it, the others `None`. `mesh` is the
-/// mesh of a `gmsh` scene, read by the caller on every rank. Only rank 0 should pass a
+/// mesh of a `gmsh` scene, read by the caller on every rank. `limits.memory_bytes` is the
+/// memory each rank may take: a generated mesh whose estimate exceeds it is refused before
+/// anything is built ([`problem::estimate::petsc_per_rank`]). Only rank 0 should pass a
 /// reporter that prints.
 ///
 /// # Errors
@@ -71,9 +73,23 @@ pub fn solve<'p>(
     scene: &Scene,
     mesh: Option<mesh::Mesh>,
     petsc: &'p Petsc,
+    limits: problem::Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DistributedError> {
     scene.validate()?;
+    if let (Some(available), Some((needed, what))) = (
+        limits.memory_bytes,
+        problem::estimate::petsc_per_rank(scene, petsc.size()),
+    ) {
+        if needed > available as f64 {
+            return Err(ProblemError::TooLarge {
+                what,
+                needed: needed as u64,
+                available,
+            }
+            .into());
+        }
+    }
     let t_total = Instant::now();
     let setup = setup(scene, mesh)?;
     let t_setup = t_total.elapsed().as_secs_f64();

@@ -72,7 +72,12 @@ pub fn run_distributed(
     };
     let mut silent = problem::Silent;
     let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
-    let solved = distributed::solve(scene, mesh, &petsc, reporter).map_err(|e| match e {
+    // the ranks of one machine share its memory (on several machines this is conservative)
+    let limits = problem::Limits {
+        memory_bytes: available_memory_bytes().map(|b| b / petsc.size() as u64),
+        ..Default::default()
+    };
+    let solved = distributed::solve(scene, mesh, &petsc, limits, reporter).map_err(|e| match e {
         distributed::DistributedError::Problem(p) => DriverError::Problem(p),
         distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
         distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),

@@ -70,7 +70,8 @@ fn multiplier_diff(a: &problem::ContactResult, b: &problem::ContactResult) -> f6
 fn agree_on_contact(petsc: &Petsc) {
     for (name, sets) in CONTACT_CASES {
         let (faer, scene) = both(name, sets, &[]);
-        let dist = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the PETSc run");
+        let dist = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .expect("the PETSc run");
         let Some(dist) = dist else { continue };
         let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
         let (a, b) = (
@@ -112,7 +113,8 @@ fn contact_on_two_ranks_agrees_with_the_direct_solver() {
 fn agree(petsc: &Petsc) {
     for (name, sets) in CASES {
         let (faer, scene) = both(name, sets, &[]);
-        let dist = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the PETSc run");
+        let dist = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .expect("the PETSc run");
         if petsc.rank() != 0 {
             assert!(dist.is_none());
             continue;
@@ -170,7 +172,7 @@ fn bad_options_and_oblique_normals_are_refused_by_name() {
         let mut sets = sets.to_vec();
         sets.push("solver.petsc_options=\"-ksp_type nonsense\"".into());
         let scene = scene_file::parse(text, "paper", &sets).expect("the scene reads");
-        let e = distributed::solve(&scene, None, petsc, &mut problem::Silent)
+        let e = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
             .map(|_| ())
             .unwrap_err();
         assert!(e.to_string().contains("nonsense"), "{e}");
@@ -184,7 +186,9 @@ fn mumps_through_the_options_gives_the_same_answer() {
     on_ranks("mumps_through_the_options_gives_the_same_answer", 2, |petsc| {
         let mumps = "solver.petsc_options=\"-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps\"";
         let (faer, scene) = both("paper-3d", &["mesh.n=6", "contact.friction=0.1"], &[mumps]);
-        let Some(dist) = distributed::solve(&scene, None, petsc, &mut problem::Silent).expect("the MUMPS run") else {
+        let Some(dist) = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .expect("the MUMPS run")
+        else {
             return;
         };
         let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
@@ -195,5 +199,22 @@ fn mumps_through_the_options_gives_the_same_answer() {
         assert!(d < 1e-10, "MUMPS: multipliers differ by {d:.2e}");
         let report = dist.report.petsc.as_ref().expect("the PETSc section");
         assert!(report.options.contains("mumps"), "{}", report.options);
+    });
+}
+
+/// A mesh too large for the memory given is refused before anything is built, with the
+/// estimate, on every rank alike.
+#[test]
+fn a_mesh_too_large_is_refused_by_its_estimate() {
+    on_ranks("a_mesh_too_large_is_refused_by_its_estimate", 2, |petsc| {
+        let (_, scene) = both("paper-3d", &["mesh.n=160"], &[]);
+        let limits = problem::Limits {
+            memory_bytes: Some(8 << 30),
+            ..Default::default()
+        };
+        let e = distributed::solve(&scene, None, petsc, limits, &mut problem::Silent)
+            .map(|_| ())
+            .unwrap_err();
+        assert!(e.to_string().contains("on each of 2 ranks"), "{e}");
     });
 }

@@ -22,18 +22,27 @@ const ALPHA_3D: f64 = 25.0;
 /// solution; measured 1.5 to 1.7 on the shipped scenes, taken low).
 const OVERHEAD: f64 = 1.3;
 
-/// The lower estimate of a run's peak memory on a generated mesh, in bytes, with what it
-/// counts; `None` for a Gmsh mesh (its size is known once read).
-pub fn before_mesh(scene: &Scene) -> Option<(f64, String)> {
+/// A generated mesh's sizes before it is made: `(dimension, nodes, cells, unknowns)`, with
+/// displacements at every node and a potential where the scene has a piezoelectric or
+/// dielectric body; `None` for a Gmsh mesh.
+fn generated(scene: &Scene) -> Option<(usize, f64, f64, f64)> {
     let dim = scene.mesh.dim()?;
-    let cells = scene.mesh.cells_per_axis();
-    let nodes: f64 = cells.iter().map(|&c| c as f64 + 1.0).product();
-    // displacements at every node, and a potential where the scene has a piezoelectric body
+    let axes = scene.mesh.cells_per_axis();
+    let nodes: f64 = axes.iter().map(|&c| c as f64 + 1.0).product();
+    // simplices per square (2) or cube (6, Kuhn's split)
+    let cells = axes.iter().map(|&c| c as f64).product::<f64>() * if dim == 2 { 2.0 } else { 6.0 };
     let electric = scene
         .material
         .iter()
         .any(|m| m.e.iter().any(|&x| x != 0.0) || m.permittivity.first().is_some_and(|&p| p > 0.0));
     let unknowns = nodes * (dim as f64 + if electric { 1.0 } else { 0.0 });
+    Some((dim, nodes, cells, unknowns))
+}
+
+/// The lower estimate of a run's peak memory on a generated mesh, in bytes, with what it
+/// counts; `None` for a Gmsh mesh (its size is known once read).
+pub fn before_mesh(scene: &Scene) -> Option<(f64, String)> {
+    let (_, _, _, unknowns) = generated(scene)?;
     let entries = match scene.mesh.kind {
         MeshKind::Rectangle => ALPHA_2D * unknowns * unknowns.log2().max(1.0),
         _ => ALPHA_3D * unknowns.powf(4.0 / 3.0),
@@ -59,4 +68,26 @@ pub fn dense_contact(k: usize, m: usize) -> f64 {
 /// from them (values and row indices), the mesh and the vectors (a small share).
 pub fn assembled(nnz_blocks: usize, n_nodes: usize, n_unknowns: usize) -> f64 {
     16.0 * 2.0 * nnz_blocks as f64 + 64.0 * n_nodes as f64 + 8.0 * 8.0 * n_unknowns as f64
+}
+
+/// Bytes per unknown on its rank in a run of the PETSc backend: the matrix, its copy for a
+/// contact step, the field split's blocks and both multigrid hierarchies (measured on
+/// `paper-3d` with Coulomb friction: 5.4 KB at n = 64 on 2 ranks; docs/performance.md).
+const PETSC_BYTES_PER_UNKNOWN: f64 = 5.0e3;
+/// Bytes per cell that every rank holds in a run of the PETSc backend (the mesh, its geometry
+/// and dof map are built whole on each rank: 100 MB for 393k cells measured, taken low).
+const PETSC_BYTES_PER_CELL: f64 = 200.0;
+
+/// The estimate of each rank's peak memory in a run of the PETSc backend on `ranks` ranks, in
+/// bytes, with what it counts; `None` for a Gmsh mesh.
+pub fn petsc_per_rank(scene: &Scene, ranks: usize) -> Option<(f64, String)> {
+    let (_, _, cells, unknowns) = generated(scene)?;
+    let share = unknowns / ranks.max(1) as f64;
+    let bytes = PETSC_BYTES_PER_UNKNOWN * share + PETSC_BYTES_PER_CELL * cells;
+    Some((
+        bytes,
+        format!(
+            "on each of {ranks} ranks: {share:.3e} of the {unknowns:.3e} unknowns, and the whole mesh of {cells:.3e} cells"
+        ),
+    ))
 }
