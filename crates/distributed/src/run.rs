@@ -105,14 +105,7 @@ pub fn solve<'p>(
     let layout = Layout::new(petsc, &setup.mesh, &disc.dofs)?;
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
     let t_assembly = t.elapsed().as_secs_f64();
-    reporter.event(&Event::Assembled {
-        n_nodes: setup.mesh.n_nodes(),
-        n_cells: setup.mesh.n_cells(),
-        h: setup.mesh.h_max(),
-        n_u: disc.dofs.n_u,
-        n_phi: disc.dofs.n_phi,
-        seconds: t_assembly,
-    });
+    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
     let options = configure(petsc, scene, &setup, &layout)?;
     let fields = Fields::new(petsc, &setup, &layout);
     let t = Instant::now();

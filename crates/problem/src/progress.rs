@@ -79,6 +79,18 @@ pub enum Event<'a> {
 }
 
 impl Event<'_> {
+    /// The event that ends assembly: the mesh's and the dofs' sizes, and the time taken.
+    pub fn assembled(mesh: &mesh::Mesh, dofs: &fe_assembly::DofMap, seconds: f64) -> Self {
+        Event::Assembled {
+            n_nodes: mesh.n_nodes(),
+            n_cells: mesh.n_cells(),
+            h: mesh.h_max(),
+            n_u: dofs.n_u,
+            n_phi: dofs.n_phi,
+            seconds,
+        }
+    }
+
     /// The line the event prints, `None` for the first-order steps between the 500s (they
     /// report every 50 steps, for a progress bar).
     pub fn line(&self) -> Option<String> {

@@ -181,14 +181,7 @@ fn assemble<'m>(setup: &'m Setup, reporter: &mut dyn Reporter) -> Result<Assembl
     let blocks = disc.assemble(Parallelism::Rayon);
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     let seconds = t.elapsed().as_secs_f64();
-    reporter.event(&Event::Assembled {
-        n_nodes: setup.mesh.n_nodes(),
-        n_cells: setup.mesh.n_cells(),
-        h: setup.mesh.h_max(),
-        n_u: disc.dofs.n_u,
-        n_phi: disc.dofs.n_phi,
-        seconds,
-    });
+    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, seconds));
     Ok(Assembled {
         disc,
         blocks,
