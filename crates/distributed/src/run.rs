@@ -3,7 +3,6 @@
 use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
 use crate::layout::Layout;
 use crate::system::{assemble, System};
-use contact::Law;
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError};
 use problem::boundary::ContactBoundary;
@@ -131,7 +130,7 @@ pub fn solve<'p>(
                 ))
             })?;
             let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, spec)?;
-            let law = law(scene, &setup, boundary.points.len());
+            let law = setup.plan.law(scene, boundary.points.len());
             let rows = ContactRows::new(petsc, &boundary.points, &boundary.nodes, &layout, &system);
             let params = ActiveSetParams {
                 tol: scene.solver.tol,
@@ -338,16 +337,6 @@ impl Fields {
         }
         ksp.set_up()?;
         Ok(ksp)
-    }
-}
-
-/// The plan's contact law on `n` points (as the default backend makes it).
-fn law(scene: &Scene, setup: &Setup, n: usize) -> Law {
-    let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
-    match (setup.plan.contact_law, setup.plan.friction) {
-        (_, false) => Law::Frictionless,
-        (ContactLaw::Tresca, true) => Law::Tresca(vec![slip_bound; n]),
-        _ => Law::Coulomb,
     }
 }
 

@@ -85,6 +85,17 @@ impl Plan {
         }
     }
 
+    /// The plan's contact law on `n` points, as the contact crate takes it: frictionless
+    /// without tangential multipliers, Tresca with the scene's bound, else Coulomb.
+    pub fn law(&self, scene: &Scene, n: usize) -> contact::Law {
+        let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
+        match (self.contact_law, self.friction) {
+            (_, false) => contact::Law::Frictionless,
+            (ContactLaw::Tresca, true) => contact::Law::Tresca(vec![slip_bound; n]),
+            _ => contact::Law::Coulomb,
+        }
+    }
+
     /// Tangential components per contact point: `dim - 1` with friction, else 0.
     pub fn n_tangential(&self) -> usize {
         if self.friction {

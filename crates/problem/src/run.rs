@@ -400,12 +400,7 @@ impl<'p> ContactSolve<'p> {
     /// The plan's contact law on `n` points: frictionless without tangential multipliers,
     /// Tresca with the scene's bound, else Coulomb.
     fn new(plan: &'p Plan, scene: &'p Scene, n: usize, interrupt: contact::Interrupt) -> Self {
-        let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
-        let law = match (plan.contact_law, plan.friction) {
-            (_, false) => Law::Frictionless,
-            (ContactLaw::Tresca, true) => Law::Tresca(vec![slip_bound; n]),
-            _ => Law::Coulomb,
-        };
+        let law = plan.law(scene, n);
         // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
         debug_assert_eq!(
             plan.fixed_point,
