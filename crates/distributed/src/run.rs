@@ -9,6 +9,7 @@ use problem::boundary::ContactBoundary;
 use problem::report::{
     ContactReport, DofsReport, Iterations, Memory, MeshReport, Residuals, SceneReport, SolverReport, Timings,
 };
+use problem::run::recover;
 use problem::setup::{setup, MeshNotes, Setup};
 use problem::{ContactLaw, ContactResult, Event, PetscReport, ProblemError, Reporter, RunReport, Scene, Solution};
 
@@ -177,25 +178,16 @@ pub fn solve<'p>(
     let (u_free, phi_free) = unpermute(&disc, &layout, &x);
     ProblemError::check_finite(&u_free, "the displacement", scene)?;
     ProblemError::check_finite(&phi_free, "the potential", scene)?;
-    let u = disc.dofs.expand_u(&u_free);
-    let phi = disc.dofs.expand_phi(&phi_free);
-    let cell_fields = disc.recover(&u, &phi);
-    ProblemError::check_finite(&cell_fields.stress, "the stress", scene)?;
-    let exact = match (&setup.exact, &contact) {
-        (Some(ex), _) => Some(ex.errors(&disc, &u, &phi, setup.plan.electric)),
-        (None, Some((b, sol))) => {
-            let c = ContactReport::of(&b.points, sol);
-            problem::exact::contact_errors(scene, &b.points, sol, c.normal_force, c.tangential_force)
-        }
-        (None, None) => None,
-    };
-    if let Some(e) = &exact {
-        reporter.event(&Event::Exact {
-            kind: e.kind(),
-            what: e.error_name(),
-            error: e.error(),
-        });
-    }
+    let points = contact.as_ref().map(|(b, sol)| (&b.points, sol));
+    let recovered = recover(
+        scene,
+        &setup,
+        &disc,
+        (&u_free, &phi_free),
+        points,
+        equilibrium,
+        reporter,
+    )?;
     let times = Timings {
         setup: t_setup,
         assembly: t_assembly,
@@ -217,14 +209,11 @@ pub fn solve<'p>(
         peak_bytes_per_rank: vec![],
         preconditioner_setup_s: t_pc,
     };
-    let contact_report = contact
-        .as_ref()
-        .map_or_else(ContactReport::default, |(b, sol)| ContactReport::of(&b.points, sol));
     let info = contact.as_ref().map(|(_, sol)| &sol.info);
     let report = Report {
         equilibrium,
-        exact,
-        contact: contact_report,
+        exact: recovered.exact,
+        contact: recovered.contact,
         info,
         timings_s: times,
         petsc: petsc_report,
@@ -233,9 +222,9 @@ pub fn solve<'p>(
     Ok(Some(Solution {
         report,
         mesh: setup.mesh,
-        u,
-        phi,
-        fields: cell_fields,
+        u: recovered.u,
+        phi: recovered.phi,
+        fields: recovered.fields,
         contact: contact.map(|(b, solution)| {
             let displacement = solution.u.clone();
             ContactResult {

@@ -116,16 +116,16 @@ pub fn solve_within(
         pcg_iters: solved.pcg_iters,
         equilibrium,
     });
-    let recovered = recover(scene, &setup, &assembled, &solved, reporter);
-    let c = &recovered.contact;
-    let reported = [
+    let contact = solved.contact.as_ref().map(|(b, sol)| (&b.points, sol));
+    let recovered = recover(
+        scene,
+        &setup,
+        &assembled.disc,
+        (&solved.u, &solved.phi),
+        contact,
         equilibrium,
-        c.normal_force,
-        c.tangential_force,
-        recovered.exact.as_ref().map_or(0.0, |e| e.error()),
-    ];
-    ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
-    ProblemError::check_finite(&recovered.fields.stress, "the stress", scene)?;
+        reporter,
+    )?;
     let times = Timings {
         setup: t_setup,
         assembly: assembled.seconds,
@@ -525,30 +525,44 @@ fn equilibrium(a: &Assembled<'_>, s: &Solved) -> f64 {
     equilibrium_residual(&b.a, &b.g, &b.b, &s.u, &s.phi, &b_full, &a.b_phi, scale)
 }
 
-/// The nodal solution, the per-cell fields, and the error against the exact solution.
-struct Recovered {
-    u: Vec<[f64; 3]>,
-    phi: Vec<f64>,
-    fields: CellFields,
-    contact: ContactReport,
-    exact: Option<crate::exact::ExactReport>,
+/// The nodal solution, the per-cell fields, the contact counts and forces, and the error
+/// against the exact solution: what a run reports, whichever backend solved it.
+pub struct Recovered {
+    /// Nodal displacements.
+    pub u: Vec<[f64; 3]>,
+    /// Nodal potentials.
+    pub phi: Vec<f64>,
+    /// Per-cell stress, strain, electric displacement and field.
+    pub fields: CellFields,
+    /// The contact boundary's counts and resultant forces (zeros without contact).
+    pub contact: ContactReport,
+    /// The error against the scene's exact solution, where it has one.
+    pub exact: Option<crate::exact::ExactReport>,
 }
 
-/// Expands `(u, φ)` to the nodes, recovers stress and electric displacement per cell, and
-/// measures the error against the scene's exact solution.
-fn recover(scene: &Scene, setup: &Setup, a: &Assembled<'_>, s: &Solved, reporter: &mut dyn Reporter) -> Recovered {
-    let u = a.disc.dofs.expand_u(&s.u);
-    let phi = a.disc.dofs.expand_phi(&s.phi);
-    let fields = a.disc.recover(&u, &phi);
-    let contact = s
-        .contact
-        .as_ref()
-        .map_or_else(ContactReport::default, |(cb, sol)| ContactReport::of(&cb.points, sol));
-    let exact = match (&setup.exact, &s.contact) {
-        (Some(ex), _) => Some(ex.errors(&a.disc, &u, &phi, setup.plan.electric)),
-        (None, Some((cb, sol))) => {
-            contact_errors(scene, &cb.points, sol, contact.normal_force, contact.tangential_force)
-        }
+/// Expands the free unknowns `(u, φ)` to the nodes, recovers stress and electric
+/// displacement per cell, counts the contact solution (on its `points`), measures the error
+/// against the scene's exact solution, and checks that every reported number (with the
+/// run's `equilibrium` residual) is finite.
+///
+/// # Errors
+/// [`ProblemError::NotFinite`], naming the extreme inputs, where the data overflow.
+pub fn recover(
+    scene: &Scene,
+    setup: &Setup,
+    disc: &Discretization<'_>,
+    (u_free, phi_free): (&[f64], &[f64]),
+    contact: Option<(&ContactPoints, &ContactSolution)>,
+    equilibrium: f64,
+    reporter: &mut dyn Reporter,
+) -> Result<Recovered, ProblemError> {
+    let u = disc.dofs.expand_u(u_free);
+    let phi = disc.dofs.expand_phi(phi_free);
+    let fields = disc.recover(&u, &phi);
+    let counts = contact.map_or_else(ContactReport::default, |(points, sol)| ContactReport::of(points, sol));
+    let exact = match (&setup.exact, contact) {
+        (Some(ex), _) => Some(ex.errors(disc, &u, &phi, setup.plan.electric)),
+        (None, Some((points, sol))) => contact_errors(scene, points, sol, counts.normal_force, counts.tangential_force),
         (None, None) => None,
     };
     if let Some(e) = &exact {
@@ -558,13 +572,21 @@ fn recover(scene: &Scene, setup: &Setup, a: &Assembled<'_>, s: &Solved, reporter
             error: e.error(),
         });
     }
-    Recovered {
+    let reported = [
+        equilibrium,
+        counts.normal_force,
+        counts.tangential_force,
+        exact.as_ref().map_or(0.0, |e| e.error()),
+    ];
+    ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
+    ProblemError::check_finite(&fields.stress, "the stress", scene)?;
+    Ok(Recovered {
         u,
         phi,
         fields,
-        contact,
+        contact: counts,
         exact,
-    }
+    })
 }
 
 /// The typed report of the run.
