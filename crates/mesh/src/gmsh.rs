@@ -326,7 +326,13 @@ fn flatten_2d(mesh: &mut Mesh) -> Result<(), String> {
 
 /// Turns round every cell of `first..last` when all of them are negatively oriented; returns
 /// how many were turned.
-fn orient_block(points: &[[f64; 3]], cells: &mut [usize], kind: CellKind, first: usize, last: usize) -> usize {
+pub(crate) fn orient_block(
+    points: &[[f64; 3]],
+    cells: &mut [usize],
+    kind: CellKind,
+    first: usize,
+    last: usize,
+) -> usize {
     let k = kind.n_nodes();
     let sign = |c: &[usize]| -> f64 {
         match kind {

@@ -29,12 +29,14 @@
 mod generate;
 mod gmsh;
 mod ordering;
+mod parts;
 mod quality;
 mod topology;
 
 pub use generate::{box_tet, rectangle_quad, rectangle_tri};
 pub use gmsh::{read_msh, read_msh_bytes};
 pub use ordering::nested_dissection;
+pub use parts::MeshParts;
 pub use quality::QualityReport;
 
 use std::collections::BTreeMap;
@@ -228,6 +230,12 @@ pub enum MeshError {
         /// The file.
         path: String,
         /// The operating system's message.
+        message: String,
+    },
+    /// Arrays handed over as a mesh ([`Mesh::from_parts`]) that do not have a mesh's shape.
+    #[error("mesh arrays: {message}")]
+    Parts {
+        /// What is wrong.
         message: String,
     },
     /// A Gmsh file that does not parse, or holds what we cannot use.

@@ -136,6 +136,16 @@ pub enum ProblemError {
         /// The inputs that most likely overflowed, or what else it may be.
         cause: String,
     },
+    /// The run was stopped from outside (its [`Limits::interrupt`]) between two steps; a stop
+    /// within the contact solve is a [`ProblemError::Contact`] with
+    /// [`ContactError::Interrupted`].
+    #[error("interrupted after {after} ({why})")]
+    Interrupted {
+        /// The last step done.
+        after: &'static str,
+        /// A deadline or the cancel flag.
+        why: contact::Interruption,
+    },
     /// The contact solve failed (with its last residual), and what else to try.
     #[error("contact: {source}{hint}")]
     Contact {
@@ -147,6 +157,19 @@ pub enum ProblemError {
 }
 
 impl ProblemError {
+    /// Whether the run was stopped from outside (its deadline, or its cancel flag), between
+    /// steps or within the contact solve.
+    pub fn is_interrupted(&self) -> bool {
+        matches!(
+            self,
+            ProblemError::Interrupted { .. }
+                | ProblemError::Contact {
+                    source: ContactError::Interrupted { .. },
+                    ..
+                }
+        )
+    }
+
     /// `Ok` when every value is finite, else [`ProblemError::NotFinite`] naming `what` and the
     /// scene's most extreme numbers.
     pub fn check_finite(values: &[f64], what: &'static str, scene: &Scene) -> Result<(), ProblemError> {

@@ -99,9 +99,12 @@ pub fn solve_within(
     if setup.notes != MeshNotes::default() {
         reporter.event(&Event::MeshNotes(setup.notes));
     }
+    stop_if_interrupted(&limits, "set-up")?;
     let assembled = assemble(&setup, reporter)?;
     check_assembled(scene, &assembled)?;
+    stop_if_interrupted(&limits, "assembly")?;
     let mut factored = factor(scene, &setup, &assembled, limits, reporter)?;
+    stop_if_interrupted(&limits, "factorisation")?;
     let solved = match factored.boundary.take() {
         Some(boundary) => {
             let how = ContactSolve::new(&setup.plan, scene, boundary.points.len(), limits.interrupt);
@@ -163,6 +166,14 @@ pub fn solve_within(
             }
         }),
     })
+}
+
+/// [`ProblemError::Interrupted`] after the step `after` where the run's interrupt has fired.
+fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Result<(), ProblemError> {
+    match limits.interrupt.check() {
+        Some(why) => Err(ProblemError::Interrupted { after, why }),
+        None => Ok(()),
+    }
 }
 
 /// The assembled blocks and loads.
@@ -642,5 +653,92 @@ fn report(
             ..SolverReport::of(info)
         },
         petsc: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{ContactSpec, DirichletSpec, LoadSpec, MaterialSpec, MeshSpec};
+    use crate::Silent;
+    use std::sync::atomic::AtomicBool;
+
+    /// The paper's block at `n` cells along its height, with `mesh` as its mesh spec.
+    fn block(mesh: MeshSpec) -> Scene {
+        let clamped = |group: &str| DirichletSpec {
+            group: group.into(),
+            u: Some(vec![0.0, 0.0]),
+            phi: Some(0.0),
+            ..Default::default()
+        };
+        let mut contact = ContactSpec::new("bottom", ContactLaw::Coulomb, &[0.0, -1.0]);
+        contact.friction = Some(0.6);
+        Scene {
+            name: "block".into(),
+            description: String::new(),
+            mesh,
+            material: vec![MaterialSpec::crystal_6mm(
+                "body",
+                [121.0, 75.4, 75.2, 111.0, 21.1, 22.6],
+                [-5.4, 15.8, 12.3],
+                [8.11, 7.35],
+                [0.0, 1.0, 0.0],
+            )],
+            dirichlet: vec![clamped("left"), clamped("right")],
+            load: Some(LoadSpec {
+                group: "top".into(),
+                p: -2.0,
+                direction: vec![0.0, 1.0],
+            }),
+            electrode: None,
+            contact: Some(contact),
+            solver: Default::default(),
+            exact: None,
+        }
+    }
+
+    #[test]
+    fn a_given_mesh_gives_the_answer_of_the_same_generated_mesh() {
+        let generated = solve(
+            &block(MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 4)),
+            None,
+            &mut Silent,
+        )
+        .unwrap();
+        let mesh = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 8, 4);
+        let given = solve(&block(MeshSpec::given()), Some(mesh), &mut Silent).unwrap();
+        assert_eq!(generated.u, given.u);
+        assert_eq!(generated.phi, given.phi);
+        // a given mesh that was not given is named, not taken for an empty one
+        let e = solve(&block(MeshSpec::given()), None, &mut Silent)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("mesh.kind") && e.contains("none was given"), "{e}");
+    }
+
+    #[test]
+    fn a_cancelled_run_stops_between_steps_with_a_typed_error() {
+        static CANCEL: AtomicBool = AtomicBool::new(true);
+        let limits = Limits {
+            interrupt: contact::Interrupt {
+                deadline: None,
+                cancel: Some(&CANCEL),
+            },
+            ..Default::default()
+        };
+        let scene = block(MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 4));
+        let e = solve_within(&scene, None, limits, &mut Silent).err().unwrap();
+        assert!(e.is_interrupted());
+        assert!(
+            matches!(
+                e,
+                ProblemError::Interrupted {
+                    after: "set-up",
+                    why: contact::Interruption::Cancelled
+                }
+            ),
+            "{e}"
+        );
     }
 }

@@ -104,11 +104,17 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
             n[1],
             n[2],
         ),
-        (MeshKind::Gmsh, Some(mesh)) => mesh,
+        (MeshKind::Gmsh | MeshKind::Given, Some(mesh)) => mesh,
         (MeshKind::Gmsh, None) => {
             return Err(ProblemError::Scene(SceneError::new(
                 "mesh.file",
                 "mesh.kind = \"gmsh\": the caller reads the file and hands the mesh over",
+            )))
+        }
+        (MeshKind::Given, None) => {
+            return Err(ProblemError::Scene(SceneError::new(
+                "mesh.kind",
+                "mesh.kind = \"given\": the caller hands the mesh over with the scene, and none was given",
             )))
         }
     };

@@ -65,6 +65,9 @@ choice! {
         Box = "box",
         /// A Gmsh file (MSH 4.1), read by the application.
         Gmsh = "gmsh",
+        /// A mesh the caller hands over with the scene (built in code, or from arrays: the
+        /// Python package's `Scene.set_mesh`).
+        Given = "given",
     }
 }
 
@@ -363,6 +366,11 @@ impl MeshSpec {
         Self::generated(MeshKind::Box, lo.to_vec(), hi.to_vec(), n)
     }
 
+    /// A mesh the caller hands over (to [`crate::solve`]) with the scene.
+    pub fn given() -> Self {
+        Self::generated(MeshKind::Given, vec![], vec![], 0)
+    }
+
     /// A Gmsh file (MSH 4.1), relative to the scene file.
     pub fn gmsh(file: &str) -> Self {
         MeshSpec {
@@ -387,12 +395,13 @@ impl MeshSpec {
         }
     }
 
-    /// The dimension of a generated mesh (`None` for a Gmsh file: known once it is read).
+    /// The dimension of a generated mesh (`None` for a Gmsh file or a given mesh: known once it
+    /// is read or handed over).
     pub fn dim(&self) -> Option<usize> {
         match self.kind {
             MeshKind::Rectangle => Some(2),
             MeshKind::Box => Some(3),
-            MeshKind::Gmsh => None,
+            MeshKind::Gmsh | MeshKind::Given => None,
         }
     }
 

@@ -228,14 +228,18 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
         }
     }
     match m.dim() {
-        None => validate_gmsh(m),
+        None => validate_read(m),
         Some(d) => validate_generated(m, d),
     }
 }
 
-/// A Gmsh mesh: a file, and none of the generator's keys (they would be silently ignored).
-fn validate_gmsh(m: &MeshSpec) -> Result<(), SceneError> {
-    let why = "a Gmsh file fixes the mesh (mesh.kind = \"gmsh\")";
+/// A Gmsh mesh, a file, or a given mesh, no file; and none of the generator's keys (they would
+/// be silently ignored).
+fn validate_read(m: &MeshSpec) -> Result<(), SceneError> {
+    let why = match m.kind {
+        MeshKind::Given => "a given mesh fixes the mesh (mesh.kind = \"given\")",
+        _ => "a Gmsh file fixes the mesh (mesh.kind = \"gmsh\")",
+    };
     for (key, given) in [
         ("mesh.lo", !m.lo.is_empty()),
         ("mesh.hi", !m.hi.is_empty()),
@@ -248,10 +252,14 @@ fn validate_gmsh(m: &MeshSpec) -> Result<(), SceneError> {
     ] {
         refuse_if(given, key, why)?;
     }
-    if m.file.is_none() {
-        return Err(SceneError::new("mesh.file", "mesh.kind = \"gmsh\" needs mesh.file"));
+    match (m.kind, &m.file) {
+        (MeshKind::Gmsh, None) => Err(SceneError::new("mesh.file", "mesh.kind = \"gmsh\" needs mesh.file")),
+        (MeshKind::Given, Some(_)) => Err(SceneError::new(
+            "mesh.file",
+            "does not apply to a given mesh (mesh.kind = \"given\"): the caller hands the mesh over",
+        )),
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// A generated mesh in dimension `d`: its box, size and regions.
