@@ -37,13 +37,29 @@ pub fn available_memory_bytes() -> Option<u64> {
 /// [`DriverError::Mesh`] for a Gmsh file that does not read, [`DriverError::Problem`] for the
 /// run's own errors.
 pub fn solve(scene: &Scene, source: &Source, reporter: &mut dyn Reporter) -> Result<Solution, DriverError> {
-    let mesh = match (scene.mesh.kind, &scene.mesh.file) {
-        (MeshKind::Gmsh, Some(file)) => Some(mesh::read_msh(source.dir.join(file))?),
-        _ => None,
+    solve_with(scene, source, None, contact::Interrupt::NONE, reporter)
+}
+
+/// As [`solve`], with the mesh of a `given` scene (`mesh.kind = "given"`), and stopped by
+/// `interrupt` between steps or within the contact solve (a
+/// [`problem::ProblemError::is_interrupted`] error).
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_with(
+    scene: &Scene,
+    source: &Source,
+    given: Option<mesh::Mesh>,
+    interrupt: contact::Interrupt,
+    reporter: &mut dyn Reporter,
+) -> Result<Solution, DriverError> {
+    let mesh = match (scene.mesh.kind, &scene.mesh.file, given) {
+        (MeshKind::Gmsh, Some(file), None) => Some(mesh::read_msh(source.dir.join(file))?),
+        (_, _, given) => given,
     };
     let limits = problem::Limits {
         memory_bytes: available_memory_bytes(),
-        ..Default::default()
+        interrupt,
     };
     let mut solution = problem::solve_within(scene, mesh, limits, reporter)?;
     solution.report.scene.source = source.label.clone();

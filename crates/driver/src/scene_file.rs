@@ -56,6 +56,18 @@ pub struct Source {
 /// that is not a regular file, TOML that does not parse, an override that does not apply, or
 /// a value that [`Scene::validate`] refuses.
 pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(Scene, Source), DriverError> {
+    let (text, source) = text(name_or_path)?;
+    let scene = parse(&text, name_or_path, overrides)?;
+    Ok((scene, source))
+}
+
+/// The TOML text of a shipped scene by name, or of a scene file by path, and where it came
+/// from (a shipped scene's relative paths resolve against the working directory).
+///
+/// # Errors
+/// [`DriverError::Scene`] naming the scene: no such scene or file, a file that is not a
+/// regular file or does not read.
+pub fn text(name_or_path: &str) -> Result<(String, Source), DriverError> {
     let err = |message: String| DriverError::Scene {
         file: name_or_path.into(),
         message,
@@ -80,12 +92,11 @@ pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(Scene, Source),
             names.join(", ")
         )));
     };
-    let scene = parse(&text, name_or_path, overrides)?;
     let source = Source {
         label: name_or_path.into(),
         dir,
     };
-    Ok((scene, source))
+    Ok((text, source))
 }
 
 /// Parses scene text, applies the overrides to its TOML tree, reads the typed scene and
@@ -102,6 +113,19 @@ pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, Dri
     for o in overrides {
         apply(&mut tree, o).map_err(|m| err(format!("--set {o}: {m}")))?;
     }
+    from_tree(tree, label)
+}
+
+/// Reads the typed scene from a TOML tree (a scene file's, or one built by a program) and
+/// validates it.
+///
+/// # Errors
+/// [`DriverError::Scene`], labelled `label`, naming the key at fault.
+pub fn from_tree(tree: toml::Table, label: &str) -> Result<Scene, DriverError> {
+    let err = |message: String| DriverError::Scene {
+        file: label.into(),
+        message,
+    };
     let scene: Scene = toml::Value::Table(tree)
         .try_into()
         .map_err(|e: toml::de::Error| err(e.to_string()))?;
@@ -118,6 +142,17 @@ fn apply(tree: &mut toml::Table, o: &str) -> Result<(), String> {
             (key, Some(parse_value(raw.trim())?))
         }
     };
+    set(tree, key, value)
+}
+
+/// Sets the dotted `key` of the tree to `value`, or removes it where `value` is `None`;
+/// the tables on the way are made where missing, and a table array of one table (a scene's
+/// one `[[material]]`) is entered as that table.
+///
+/// # Errors
+/// A message naming the part of the key that is not a table, or the key that is not there to
+/// remove.
+pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Result<(), String> {
     let path: Vec<&str> = key.trim().split('.').collect();
     if path.iter().any(|p| p.is_empty()) {
         return Err(format!("`{key}` is not a dotted key"));
