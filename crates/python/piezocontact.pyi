@@ -1,0 +1,193 @@
+"""Static frictional contact of piezoelectric bodies with a rigid foundation: scenes in, NumPy
+arrays out.
+
+    import piezocontact as pc
+    scene = pc.Scene.load("paper", {"mesh.n": 64})
+    result = pc.run(scene, progress=True)
+    result.contact.lambda_n          # contact pressure, one value per contact node
+    result.write("out/paper")        # run.json, solution.vtu, contact.csv, pictures
+"""
+
+import os
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+STICK: int
+"""`Contact.status` of a point that sticks (1)."""
+SLIP: int
+"""`Contact.status` of a point that slides (2)."""
+SEPARATED: int
+"""`Contact.status` of a point off the foundation (3)."""
+
+class PiezocontactError(Exception):
+    """Every error of piezocontact."""
+
+class InputError(PiezocontactError, ValueError):
+    """A scene value, material, file or array that cannot be used; the message names it."""
+
+class MeshError(InputError):
+    """A mesh that does not read, or is broken (a bad cell, a missing group, overlapping cells)."""
+
+class SolverError(PiezocontactError, ArithmeticError):
+    """A numerical failure: a singular system, a result that is not finite, a run too large for the memory."""
+
+class ConvergenceError(SolverError):
+    """The contact solve did not converge; the message gives its last residual and what to try."""
+
+class OutputError(PiezocontactError, OSError):
+    """An output file or directory that cannot be written."""
+
+_Value = Union[bool, int, float, str, Sequence[Any], Mapping[str, Any], None]
+_Path = Union[str, "os.PathLike[str]"]
+
+class Scene:
+    """What to solve: a mesh, materials, boundary conditions, a load, an electrode, the contact
+    law and the solver's settings (the keys of a scene file; see the README's scene keys).
+
+    Every change is validated at once, with the errors of the command line: an `InputError`
+    naming the key, and the scene left unchanged.
+    """
+
+    @staticmethod
+    def load(name: _Path, overrides: Optional[Mapping[str, _Value]] = None) -> "Scene":
+        """A shipped scene by name (`Scene.shipped()`), or a scene file by path, with
+        `overrides` (dotted keys; None removes a key) applied before it is validated."""
+    @staticmethod
+    def from_toml(source: _Path, overrides: Optional[Mapping[str, _Value]] = None) -> "Scene":
+        """A scene from a TOML file (a path, or a string naming a file) or from TOML text."""
+    @staticmethod
+    def from_dict(scene: Mapping[str, Any], overrides: Optional[Mapping[str, _Value]] = None) -> "Scene":
+        """A scene from a dict of its sections, as the TOML file holds them."""
+    @staticmethod
+    def shipped() -> list[str]:
+        """The names of the shipped scenes."""
+    def set(self, *args: Any, **sections: Any) -> None:
+        """Changes keys: `set("mesh.n", 128)`, `set({"contact.law": "signorini",
+        "contact.friction": None})`, or sections as keywords merged key by key:
+        `set(mesh={"n": 128}, solver={"tol": 1e-10})`. None removes a key."""
+    def get(self, key: str, default: Any = None) -> Any:
+        """The value of a dotted key (`scene.get("mesh.n")`), or `default`."""
+    def set_mesh(
+        self,
+        points: npt.ArrayLike,
+        cells: npt.ArrayLike,
+        boundary: Mapping[str, npt.ArrayLike],
+        regions: Optional[Mapping[str, npt.ArrayLike]] = None,
+    ) -> None:
+        """Gives the scene a mesh as arrays (`mesh.kind` becomes "given"): `points` (n, 2) or
+        (n, 3); `cells` (m, 3) triangles or (m, 4) quadrilaterals in 2D, (m, 4) tetrahedra in
+        3D, 0-based; `boundary` named facet arrays ((k, 2) in 2D, (k, 3) in 3D); `regions`
+        named cell-index arrays (default: all cells in "body"). Checked as a file's mesh is
+        (`MeshError`)."""
+    def to_dict(self) -> dict[str, Any]:
+        """The scene as a dict of its sections."""
+    def to_toml(self) -> str:
+        """The scene as TOML text (a mesh given as arrays is not in it)."""
+    def copy(self) -> "Scene":
+        """A copy, to change without changing this one."""
+    def __copy__(self) -> "Scene": ...
+    def __deepcopy__(self, memo: Any) -> "Scene": ...
+    @property
+    def name(self) -> str:
+        """The scene's name."""
+    @property
+    def dim(self) -> Optional[int]:
+        """2 or 3; None for a Gmsh file not yet read."""
+    @property
+    def source(self) -> str:
+        """A shipped scene's name, a path, "<dict>" or "<toml text>"."""
+
+class Contact:
+    """The contact boundary's values, one row per contact point (a node of the contact group).
+    Read-only float64 arrays unless said otherwise."""
+
+    @property
+    def x(self) -> npt.NDArray[np.float64]:
+        """Positions, (m, dim)."""
+    @property
+    def node(self) -> npt.NDArray[np.int64]:
+        """The mesh node of each point, (m,)."""
+    @property
+    def normal(self) -> npt.NDArray[np.float64]:
+        """Outward unit normals of the body, (m, dim)."""
+    @property
+    def weight(self) -> npt.NDArray[np.float64]:
+        """Lumped boundary measure, (m,): the normal force is `sum(weight * lambda_n)`."""
+    @property
+    def gap(self) -> npt.NDArray[np.float64]:
+        """Initial gaps, (m,)."""
+    @property
+    def u_n(self) -> npt.NDArray[np.float64]:
+        """Normal displacement, (m,): `u_n <= gap`."""
+    @property
+    def u_t(self) -> npt.NDArray[np.float64]:
+        """Tangential displacement, (m, dim - 1)."""
+    @property
+    def lambda_n(self) -> npt.NDArray[np.float64]:
+        """Normal multiplier, the contact pressure, (m,), >= 0."""
+    @property
+    def lambda_t(self) -> npt.NDArray[np.float64]:
+        """Tangential multiplier, (m, dim - 1); zeros without friction."""
+    @property
+    def status(self) -> npt.NDArray[np.int8]:
+        """STICK (1), SLIP (2) or SEPARATED (3), (m,)."""
+    def __len__(self) -> int: ...
+
+class Result:
+    """The solution of a run. The arrays are read-only views of the solution's storage."""
+
+    @property
+    def points(self) -> npt.NDArray[np.float64]:
+        """Node coordinates, (n_points, dim)."""
+    @property
+    def cells(self) -> npt.NDArray[np.int64]:
+        """Cell connectivity, (n_cells, nodes per cell), 0-based."""
+    @property
+    def cell_type(self) -> str:
+        """"triangle", "quad" or "tetra" (meshio's names)."""
+    @property
+    def dim(self) -> int:
+        """2 (plane strain) or 3."""
+    @property
+    def u(self) -> npt.NDArray[np.float64]:
+        """Nodal displacements, (n_points, dim)."""
+    @property
+    def phi(self) -> npt.NDArray[np.float64]:
+        """Nodal electric potentials, (n_points,)."""
+    @property
+    def stress(self) -> npt.NDArray[np.float64]:
+        """Stress per cell, Voigt order: (n_cells, 3) in 2D, (n_cells, 6) in 3D."""
+    @property
+    def strain(self) -> npt.NDArray[np.float64]:
+        """Strain per cell, Voigt order with engineering shears, shaped as `stress`."""
+    @property
+    def electric_displacement(self) -> npt.NDArray[np.float64]:
+        """Electric displacement per cell, (n_cells, dim)."""
+    @property
+    def electric_field(self) -> npt.NDArray[np.float64]:
+        """Electric field E = -grad phi per cell, (n_cells, dim)."""
+    @property
+    def contact(self) -> Optional[Contact]:
+        """The contact boundary's values; None for a scene without contact."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """run.json as a dict."""
+    def write(self, directory: _Path) -> None:
+        """Writes run.json, solution.vtu, contact.csv and the plan's pictures into
+        `directory`, as one set (`OutputError`; nothing half-written)."""
+    def to_meshio(self) -> Any:
+        """The solution as a `meshio.Mesh` (needs meshio)."""
+
+def run(
+    scene: Scene,
+    progress: Union[bool, Callable[[str], Any], None] = None,
+    timeout: Optional[float] = None,
+) -> Result:
+    """Solves `scene`. `progress`: False, True (lines on sys.stderr) or a callable taking each
+    line. `timeout`: seconds after which the run stops at its next check (ConvergenceError).
+    Ctrl-C stops the run at its next check and raises KeyboardInterrupt, nothing written.
+    Raises InputError, MeshError, SolverError, ConvergenceError."""

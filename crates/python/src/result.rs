@@ -1,0 +1,342 @@
+//! `Result` and `Contact`: a run's solution as NumPy arrays over the solution's own storage
+//! (read-only, no copy where the layout allows), its report as a dict, and its outputs.
+
+use crate::arrays::{lend, owned};
+use crate::errors::{to_py, Kind};
+use crate::values::from_json;
+use numpy::ndarray::{s, ArrayView1, ArrayView2};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Contact status codes of `Contact.status` (and of `contact_status` in the outputs).
+pub const STICK: i8 = 1;
+/// A point that slides.
+pub const SLIP: i8 = 2;
+/// A point off the foundation.
+pub const SEPARATED: i8 = 3;
+
+/// The solution of a run: the mesh (`points`, `cells`), the nodal fields (`u`, `phi`), the
+/// per-cell fields (`stress`, `strain`, `electric_displacement`, `electric_field`), the contact
+/// boundary's values (`contact`), and the report (`report`, run.json as a dict). The arrays
+/// are read-only views of the solution's storage (float64; `cells` int64).
+#[pyclass(module = "piezocontact", name = "Result", frozen)]
+pub struct RunResult {
+    pub(crate) solution: problem::Solution,
+}
+
+/// The `dim`-column view of `[x, y, z]` rows.
+fn columns(rows: &[[f64; 3]], dim: usize) -> ArrayView2<'_, f64> {
+    let full = ArrayView2::from_shape((rows.len(), 3), rows.as_flattened()).expect("3 values per row");
+    full.slice_move(s![.., ..dim])
+}
+
+/// The `(n / width, width)` view of a flat list.
+fn table(flat: &[f64], width: usize) -> ArrayView2<'_, f64> {
+    let rows = flat.len().checked_div(width).unwrap_or(0);
+    ArrayView2::from_shape((rows, width), flat).expect("whole rows")
+}
+
+impl RunResult {
+    fn dim(&self) -> usize {
+        self.solution.mesh.dim
+    }
+
+    fn nv(&self) -> usize {
+        if self.dim() == 2 {
+            3
+        } else {
+            6
+        }
+    }
+
+    /// The meshio cell type of the mesh's cells.
+    fn cell_type(&self) -> &'static str {
+        match self.solution.mesh.kind {
+            mesh::CellKind::Tri3 => "triangle",
+            mesh::CellKind::Quad4 => "quad",
+            mesh::CellKind::Tet4 => "tetra",
+        }
+    }
+}
+
+#[pymethods]
+impl RunResult {
+    /// Node coordinates, (n_points, dim).
+    #[getter]
+    fn points<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let r = this.get();
+        lend(this.as_any(), columns(&r.solution.mesh.points, r.dim()))
+    }
+
+    /// Cell connectivity, (n_cells, nodes per cell), int64, 0-based; counter-clockwise (2D),
+    /// positively oriented (3D).
+    #[getter]
+    fn cells<'py>(this: &Bound<'py, Self>) -> Bound<'py, PyArray2<i64>> {
+        // a copy: NumPy's index type is signed (arithmetic on unsigned indices turns to floats)
+        let m = &this.get().solution.mesh;
+        let k = m.kind.n_nodes();
+        let flat: Vec<i64> = m.cells.iter().map(|&v| v as i64).collect();
+        owned(
+            this.py(),
+            numpy::ndarray::Array2::from_shape_vec((m.n_cells(), k), flat).expect("whole cells"),
+        )
+    }
+
+    /// The cells' kind, as meshio names it: "triangle", "quad" or "tetra".
+    #[getter(cell_type)]
+    fn py_cell_type(&self) -> &'static str {
+        self.cell_type()
+    }
+
+    /// The spatial dimension, 2 (plane strain) or 3.
+    #[getter(dim)]
+    fn py_dim(&self) -> usize {
+        self.dim()
+    }
+
+    /// Nodal displacements, (n_points, dim).
+    #[getter]
+    fn u<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let r = this.get();
+        lend(this.as_any(), columns(&r.solution.u, r.dim()))
+    }
+
+    /// Nodal electric potentials, (n_points,) (0 where a node has no electric unknown).
+    #[getter]
+    fn phi<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        lend(this.as_any(), ArrayView1::from(&this.get().solution.phi[..]))
+    }
+
+    /// Stress per cell, Voigt order, (n_cells, 3) in 2D (xx, yy, xy), (n_cells, 6) in 3D (xx,
+    /// yy, zz, yz, xz, xy).
+    #[getter]
+    fn stress<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let r = this.get();
+        lend(this.as_any(), table(&r.solution.fields.stress, r.nv()))
+    }
+
+    /// Strain per cell, Voigt order with engineering shears, shaped as `stress`.
+    #[getter]
+    fn strain<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let r = this.get();
+        lend(this.as_any(), table(&r.solution.fields.strain, r.nv()))
+    }
+
+    /// Electric displacement per cell, (n_cells, dim).
+    #[getter]
+    fn electric_displacement<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let r = this.get();
+        lend(this.as_any(), table(&r.solution.fields.electric_displacement, r.dim()))
+    }
+
+    /// Electric field `E = -grad phi` per cell, (n_cells, dim).
+    #[getter]
+    fn electric_field<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let r = this.get();
+        lend(this.as_any(), table(&r.solution.fields.electric_field, r.dim()))
+    }
+
+    /// The contact boundary's values, None for a scene without contact.
+    #[getter]
+    fn contact(this: &Bound<'_, Self>) -> Option<Contact> {
+        this.get().solution.contact.as_ref().map(|_| Contact {
+            owner: this.clone().unbind(),
+        })
+    }
+
+    /// The report (run.json) as a dict: the scene, the plan, the sizes, the iterations, the
+    /// residuals, the contact forces and counts, the timings.
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let bytes = driver::output::run_json(&self.solution.report).map_err(to_py)?;
+        from_json(py, &String::from_utf8_lossy(&bytes))
+    }
+
+    /// Writes the run's outputs into `directory` as the command line does (run.json,
+    /// solution.vtu, contact.csv and the pictures the plan lists), as one set: on error nothing
+    /// is left half-written (`OutputError`).
+    fn write(&self, py: Python<'_>, directory: &Bound<'_, PyAny>) -> PyResult<()> {
+        let dir: String = py.import("os")?.call_method1("fspath", (directory,))?.extract()?;
+        py.detach(|| driver::output::write(&self.solution, std::path::Path::new(&dir)))
+            .map_err(to_py)
+    }
+
+    /// The solution as a `meshio.Mesh` (needs meshio): 3-component points and `u` as ParaView
+    /// takes them, `phi` and `contact_status` as point data, the per-cell fields as cell data;
+    /// from there, `meshio.write`, PyVista (`pyvista.from_meshio`) and the rest.
+    fn to_meshio<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let py = this.py();
+        let meshio = py.import("meshio").map_err(|_| {
+            pyo3::exceptions::PyImportError::new_err(
+                "to_meshio needs meshio (pip install meshio, or pip install piezocontact[meshio])",
+            )
+        })?;
+        let r = this.get();
+        let owner = this.as_any();
+        let points = lend(owner, columns(&r.solution.mesh.points, 3))?;
+        let cells = pyo3::types::PyList::new(py, [(r.cell_type(), Self::cells(this))])?;
+        let point_data = PyDict::new(py);
+        point_data.set_item("u", lend(owner, columns(&r.solution.u, 3))?)?;
+        point_data.set_item("phi", Self::phi(this)?)?;
+        if let Some(c) = &r.solution.contact {
+            let mut status = vec![0i8; r.solution.mesh.n_nodes()];
+            for (i, &node) in c.nodes.iter().enumerate() {
+                status[node] = status_code(c.solution.status[i]);
+            }
+            point_data.set_item("contact_status", status.into_pyarray(py))?;
+        }
+        let cell_data = PyDict::new(py);
+        cell_data.set_item("stress", [Self::stress(this)?])?;
+        cell_data.set_item("strain", [Self::strain(this)?])?;
+        cell_data.set_item("electric_displacement", [Self::electric_displacement(this)?])?;
+        cell_data.set_item("electric_field", [Self::electric_field(this)?])?;
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("point_data", point_data)?;
+        kwargs.set_item("cell_data", cell_data)?;
+        meshio.getattr("Mesh")?.call((points, cells), Some(&kwargs))
+    }
+
+    fn __repr__(&self) -> String {
+        let rep = &self.solution.report;
+        let contact = match &self.solution.contact {
+            Some(c) => {
+                let (stick, slip, sep) = c.solution.counts();
+                format!(", contact: {stick} stick, {slip} slip, {sep} separated")
+            }
+            None => String::new(),
+        };
+        format!(
+            "<piezocontact.Result of {:?}: {} nodes, {} cells{contact}, {:.3} s>",
+            rep.scene.name,
+            self.solution.mesh.n_nodes(),
+            self.solution.mesh.n_cells(),
+            rep.timings_s.total
+        )
+    }
+}
+
+fn status_code(s: contact::Status) -> i8 {
+    match s {
+        contact::Status::Stick => STICK,
+        contact::Status::Slip => SLIP,
+        contact::Status::Separated => SEPARATED,
+    }
+}
+
+/// The contact boundary's values, one row per contact point (a node of the contact group):
+/// position `x`, mesh `node`, outward `normal`, `weight` (lumped boundary measure), initial
+/// `gap`, displacement `u_n` (normal, `u_n <= gap`) and `u_t` (tangential, dim - 1 columns),
+/// multipliers `lambda_n >= 0` (the pressure) and `lambda_t`, and `status` (STICK, SLIP,
+/// SEPARATED). Read-only views of the solution's storage where the layout allows.
+#[pyclass(module = "piezocontact", frozen)]
+pub struct Contact {
+    owner: Py<RunResult>,
+}
+
+impl Contact {
+    fn with<'py, T>(
+        &self,
+        py: Python<'py>,
+        f: impl FnOnce(&Bound<'py, PyAny>, &problem::ContactResult) -> PyResult<T>,
+    ) -> PyResult<T> {
+        let owner = self.owner.bind(py);
+        let c = owner
+            .get()
+            .solution
+            .contact
+            .as_ref()
+            .ok_or_else(|| Kind::Base.err("the run has no contact"))?;
+        f(owner.as_any(), c)
+    }
+}
+
+#[pymethods]
+impl Contact {
+    /// Positions, (m, dim).
+    #[getter]
+    fn x<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.with(py, |o, c| lend(o, columns(&c.points.position, c.points.dim)))
+    }
+
+    /// The mesh node of each point, (m,), int64.
+    #[getter]
+    fn node<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        self.with(py, |_, c| {
+            let nodes: Vec<i64> = c.nodes.iter().map(|&v| v as i64).collect();
+            Ok(owned(py, nodes.into()))
+        })
+    }
+
+    /// Outward unit normals of the body, (m, dim).
+    #[getter]
+    fn normal<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.with(py, |o, c| lend(o, columns(&c.points.normal, c.points.dim)))
+    }
+
+    /// Weights (lumped boundary measure), (m,): the contact force is `sum(weight * lambda_n)`.
+    #[getter]
+    fn weight<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.with(py, |o, c| lend(o, ArrayView1::from(&c.points.weight[..])))
+    }
+
+    /// Initial gaps, (m,).
+    #[getter]
+    fn gap<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.with(py, |o, c| lend(o, ArrayView1::from(&c.points.gap[..])))
+    }
+
+    /// Normal displacement, (m,): `u_n <= gap`.
+    #[getter]
+    fn u_n<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.with(py, |o, c| lend(o, ArrayView1::from(&c.displacement.normal[..])))
+    }
+
+    /// Tangential displacement, (m, dim - 1).
+    #[getter]
+    fn u_t<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.with(py, |o, c| lend(o, table(&c.displacement.tangential, c.points.dim - 1)))
+    }
+
+    /// Normal multiplier (contact pressure), (m,), `>= 0`.
+    #[getter]
+    fn lambda_n<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.with(py, |o, c| lend(o, ArrayView1::from(&c.solution.lambda.normal[..])))
+    }
+
+    /// Tangential multiplier, (m, dim - 1) (zeros without friction).
+    #[getter]
+    fn lambda_t<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.with(py, |o, c| {
+            let nt = c.points.dim - 1;
+            if c.solution.lambda.tangential.len() == c.points.len() * nt {
+                lend(o, table(&c.solution.lambda.tangential, nt))
+            } else {
+                Ok(owned(py, numpy::ndarray::Array2::zeros((c.points.len(), nt))))
+            }
+        })
+    }
+
+    /// Status of each point, (m,), int8: STICK (1), SLIP (2) or SEPARATED (3).
+    #[getter]
+    fn status<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i8>>> {
+        self.with(py, |_, c| {
+            let status: Vec<i8> = c.solution.status.iter().map(|&s| status_code(s)).collect();
+            Ok(owned(py, status.into()))
+        })
+    }
+
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, |_, c| Ok(c.points.len()))
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        self.with(py, |_, c| {
+            let (stick, slip, sep) = c.solution.counts();
+            Ok(format!(
+                "<piezocontact.Contact: {} points, {stick} stick, {slip} slip, {sep} separated>",
+                c.points.len()
+            ))
+        })
+    }
+}

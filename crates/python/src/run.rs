@@ -1,0 +1,156 @@
+//! `run(scene)`: the solve on a worker thread with the GIL released, its progress lines passed
+//! to Python by the calling thread, which also watches for signals: Ctrl-C sets the run's
+//! cancel flag, the run stops at its next check (between steps, or at the next iteration of
+//! the contact solve), and `KeyboardInterrupt` is raised with nothing written.
+
+use crate::errors::to_py;
+use crate::result::RunResult;
+use crate::scene::Scene;
+use pyo3::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::Duration;
+
+thread_local! {
+    /// The cancel flag of this thread's runs (one run at a time per thread; `Interrupt` takes
+    /// a flag that lives for the program, so each thread makes one and keeps it).
+    static CANCEL: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
+}
+
+/// How often the calling thread looks for signals while the solve runs.
+const POLL: Duration = Duration::from_millis(50);
+
+/// A reporter that sends each event's line to the calling thread.
+struct Send(mpsc::Sender<String>);
+
+impl problem::Reporter for Send {
+    fn event(&mut self, event: &problem::Event<'_>) {
+        if let Some(line) = event.line() {
+            // the receiver outlives the solve; a send can only fail once it is gone
+            let _ = self.0.send(line);
+        }
+    }
+}
+
+/// Where the progress lines go.
+enum Progress<'py> {
+    Quiet,
+    Stderr(Bound<'py, PyAny>),
+    Call(Bound<'py, PyAny>),
+}
+
+impl<'py> Progress<'py> {
+    fn of(py: Python<'py>, progress: &Bound<'py, PyAny>) -> PyResult<Self> {
+        if progress.is_callable() {
+            return Ok(Progress::Call(progress.clone()));
+        }
+        Ok(if progress.is_truthy()? {
+            Progress::Stderr(py.import("sys")?.getattr("stderr")?)
+        } else {
+            Progress::Quiet
+        })
+    }
+
+    fn line(&self, line: &str) -> PyResult<()> {
+        match self {
+            Progress::Quiet => {}
+            Progress::Stderr(err) => {
+                err.call_method1("write", (format!("{line}\n"),))?;
+                err.call_method0("flush")?;
+            }
+            Progress::Call(f) => {
+                f.call1((line,))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Solves `scene` and returns its `Result`. `progress`: False (nothing), True (a line per step
+/// and per outer contact iteration on `sys.stderr`), or a callable that takes each line.
+/// `timeout`: seconds after which the run stops at its next check (`ConvergenceError`).
+/// Ctrl-C stops the run at its next check and raises `KeyboardInterrupt`; nothing is
+/// written. Errors: `InputError`, `MeshError`, `SolverError`, `ConvergenceError`.
+#[pyfunction]
+#[pyo3(signature = (scene, progress = None, timeout = None))]
+pub fn run(
+    py: Python<'_>,
+    scene: &Scene,
+    progress: Option<&Bound<'_, PyAny>>,
+    timeout: Option<f64>,
+) -> PyResult<RunResult> {
+    let deadline = match timeout {
+        Some(t) if t.is_finite() && t >= 0.0 => Some(std::time::Instant::now() + Duration::from_secs_f64(t)),
+        Some(t) => {
+            return Err(crate::errors::Kind::Input.err(format!("timeout = {t}: a number of seconds, at least 0")))
+        }
+        None => None,
+    };
+    let progress = match progress {
+        Some(p) => Progress::of(py, p)?,
+        None => Progress::Quiet,
+    };
+    let cancel = CANCEL.with(|c| *c);
+    cancel.store(false, Ordering::Relaxed);
+    let interrupt = contact::Interrupt {
+        deadline,
+        cancel: Some(cancel),
+    };
+    let (tx, rx) = mpsc::channel();
+    // `detach` takes a closure that may cross threads; a receiver is not `Sync`
+    let rx = std::sync::Mutex::new(rx);
+    let given = scene.mesh.as_deref().cloned();
+    let (typed, source) = (&scene.scene, &scene.source);
+    let mut signal: Option<PyErr> = None;
+    let mut callback: Option<PyErr> = None;
+    let solved = std::thread::scope(|s| {
+        let worker = s.spawn(move || {
+            let mut reporter = Send(tx);
+            driver::run::solve_with(typed, source, given, interrupt, &mut reporter)
+        });
+        loop {
+            match py.detach(|| {
+                rx.lock()
+                    .map_or(Err(mpsc::RecvTimeoutError::Disconnected), |r| r.recv_timeout(POLL))
+            }) {
+                Ok(line) => {
+                    if callback.is_none() {
+                        if let Err(e) = progress.line(&line) {
+                            // a progress callback that raises stops the run, and its error is raised
+                            callback = Some(e);
+                            cancel.store(true, Ordering::Relaxed);
+                        }
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+            if signal.is_none() {
+                if let Err(e) = py.check_signals() {
+                    signal = Some(e);
+                    cancel.store(true, Ordering::Relaxed);
+                }
+            }
+        }
+        py.detach(|| worker.join())
+    });
+    let solved = match solved {
+        Ok(s) => s,
+        Err(_) => return Err(crate::errors::Kind::Base.err("the solve panicked (a bug: please report it)")),
+    };
+    if let Some(e) = signal.or(callback) {
+        if let Err(driver::DriverError::Problem(p)) = &solved {
+            if p.is_interrupted() {
+                // say where the run stopped, beside the KeyboardInterrupt
+                let note = format!("piezocontact: the run stopped: {p}");
+                let value = e.value(py);
+                // `add_note` is Python 3.11's; before, the list is only an attribute
+                if value.call_method1("add_note", (&note,)).is_err() {
+                    let _ = value.setattr("__notes__", vec![note]);
+                }
+            }
+        }
+        return Err(e);
+    }
+    solved.map(|solution| RunResult { solution }).map_err(to_py)
+}

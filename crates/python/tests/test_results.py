@@ -1,0 +1,181 @@
+"""Results: the same numbers as the command-line program, arrays of the documented shapes and
+dtypes, read-only views that outlive the result, the report, the outputs."""
+
+import csv
+import gc
+import json
+import subprocess
+
+import meshio
+import numpy as np
+import pytest
+
+import piezocontact as pc
+
+# (scene, overrides): the paper's block and its 3D version, at sizes CI can afford
+CASES = [
+    ("paper", {"mesh.n": 16}),
+    ("paper-3d", {"mesh.n": 3}),
+]
+
+
+def close(a, b, rtol=1e-12):
+    """Equal to round-off, relative to the array's largest entry."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    assert a.shape == b.shape, (a.shape, b.shape)
+    scale = max(np.abs(a).max(initial=0.0), np.abs(b).max(initial=0.0), 1e-300)
+    assert np.abs(a - b).max(initial=0.0) <= rtol * scale, np.abs(a - b).max() / scale
+
+
+def binary_run(binary, name, overrides, out):
+    args = [str(binary), "run", name, "--out", str(out)]
+    for k, v in overrides.items():
+        args += ["--set", f"{k}={v}"]
+    subprocess.run(args, check=True, capture_output=True)
+    return out
+
+
+@pytest.mark.parametrize("name,overrides", CASES)
+def test_the_results_are_the_programs_outputs(binary, tmp_path, name, overrides):
+    out = binary_run(binary, name, overrides, tmp_path / "cli")
+    r = pc.run(pc.Scene.load(name, overrides))
+    vtu = meshio.read(out / "solution.vtu")
+    dim = r.dim
+    close(r.points, vtu.points[:, :dim])
+    assert np.array_equal(r.cells, vtu.cells[0].data)
+    close(r.u, vtu.point_data["u"][:, :dim])
+    close(r.phi, vtu.point_data["phi"].ravel())
+    for field in ["stress", "strain", "electric_displacement", "electric_field"]:
+        close(getattr(r, field), vtu.cell_data[field][0])
+    # contact.csv is written with 13 significant digits
+    with open(out / "contact.csv") as f:
+        rows = list(csv.DictReader(f))
+    c = r.contact
+    assert len(rows) == len(c)
+    col = lambda k: np.array([float(row[k]) for row in rows])  # noqa: E731
+    close(c.x[:, 0], col("x"), 1e-12)
+    close(c.gap, col("gap"), 1e-12)
+    close(c.u_n, col("u_n"), 1e-11)
+    close(c.u_t[:, 0], col("u_t"), 1e-11)
+    close(c.lambda_n, col("lambda_n"), 1e-11)
+    close(c.lambda_t[:, 0], col("lambda_t"), 1e-11)
+    names = {pc.STICK: "stick", pc.SLIP: "slip", pc.SEPARATED: "separated"}
+    assert [names[s] for s in c.status] == [row["status"] for row in rows]
+    # the report is run.json, but for what differs between any two runs (times, memory)
+    program = json.loads((out / "run.json").read_text())
+    ours = r.report
+    for key in ["timings_s", "memory"]:
+        program.pop(key), ours.pop(key)
+    program["scene"].pop("source"), ours["scene"].pop("source")
+    assert ours["contact"]["n_points"] == program["contact"]["n_points"]
+    close(ours["contact"]["normal_force"], program["contact"]["normal_force"])
+    ours["contact"].pop("normal_force"), program["contact"].pop("normal_force")
+    assert ours["plan"] == program["plan"] and ours["dofs"] == program["dofs"]
+    assert ours["iterations"] == program["iterations"]
+
+
+@pytest.mark.parametrize("name,overrides", CASES)
+def test_arrays_have_the_documented_shapes_and_dtypes(name, overrides):
+    r = pc.run(pc.Scene.load(name, overrides))
+    n, dim = len(r.points), r.dim
+    m = len(r.cells)
+    nv = 3 if dim == 2 else 6
+    k = {"triangle": 3, "quad": 4, "tetra": 4}[r.cell_type]
+    assert r.cell_type == ("triangle" if dim == 2 else "tetra")
+    shapes = {
+        "points": (n, dim),
+        "cells": (m, k),
+        "u": (n, dim),
+        "phi": (n,),
+        "stress": (m, nv),
+        "strain": (m, nv),
+        "electric_displacement": (m, dim),
+        "electric_field": (m, dim),
+    }
+    for field, shape in shapes.items():
+        a = getattr(r, field)
+        assert a.shape == shape, field
+        assert a.dtype == (np.int64 if field == "cells" else np.float64), field
+        assert not a.flags.writeable, field
+    c = r.contact
+    mc = len(c)
+    assert mc > 0
+    for field, shape, dtype in [
+        ("x", (mc, dim), np.float64),
+        ("node", (mc,), np.int64),
+        ("normal", (mc, dim), np.float64),
+        ("weight", (mc,), np.float64),
+        ("gap", (mc,), np.float64),
+        ("u_n", (mc,), np.float64),
+        ("u_t", (mc, dim - 1), np.float64),
+        ("lambda_n", (mc,), np.float64),
+        ("lambda_t", (mc, dim - 1), np.float64),
+        ("status", (mc,), np.int8),
+    ]:
+        a = getattr(c, field)
+        assert a.shape == shape and a.dtype == dtype, field
+    # the contact points are mesh nodes, and the force is the report's
+    assert np.allclose(r.points[c.node], c.x)
+    assert np.isclose(np.sum(c.weight * c.lambda_n), r.report["contact"]["normal_force"], rtol=1e-12)
+    assert np.all(c.lambda_n >= 0) and np.all(c.u_n <= c.gap + 1e-12)
+
+
+def test_arrays_are_views_of_the_solution_and_outlive_the_result():
+    r = pc.run(pc.Scene.load("paper", {"mesh.n": 8}))
+    u1, u2 = r.u, r.u
+    # two reads share one storage: no copy was made
+    assert np.shares_memory(u1, u2)
+    assert np.shares_memory(r.contact.lambda_n, r.contact.lambda_n)
+    with pytest.raises(ValueError):
+        u1[0, 0] = 1.0
+    expected = u1.copy()
+    lam = r.contact.lambda_n
+    del r, u2
+    gc.collect()
+    # the arrays keep the result alive
+    assert np.array_equal(u1, expected)
+    assert lam.sum() > 0
+
+
+def test_frictionless_contact_has_zero_tangential_multipliers():
+    r = pc.run(pc.Scene.load("paper-frictionless", {"mesh.n": 8}))
+    assert r.contact.lambda_t.shape == (len(r.contact), 1)
+    assert not r.contact.lambda_t.any()
+    # a frictionless body slides
+    assert np.abs(r.contact.u_t).max() > 0
+
+
+def test_a_scene_without_contact_has_no_contact_values():
+    r = pc.run(pc.Scene.load("paper", {"mesh.n": 8, "contact.law": "none", "contact.friction": None}))
+    assert r.contact is None
+    assert r.report["contact"]["n_points"] == 0 if "contact" in r.report else True
+
+
+def test_write_gives_the_programs_files(tmp_path):
+    r = pc.run(pc.Scene.load("paper", {"mesh.n": 8}))
+    r.write(tmp_path / "out")
+    files = sorted(p.name for p in (tmp_path / "out").iterdir() if not p.name.startswith("."))
+    assert "run.json" in files and "solution.vtu" in files and "contact.csv" in files
+    assert "multipliers.png" in files and "deformed.png" in files and "potential.png" in files
+    assert json.loads((tmp_path / "out" / "run.json").read_text()) == r.report
+
+
+def test_to_meshio_writes_and_reads_back(tmp_path):
+    r = pc.run(pc.Scene.load("paper", {"mesh.n": 8}))
+    m = r.to_meshio()
+    assert m.points.shape == (len(r.points), 3)
+    assert set(m.point_data) == {"u", "phi", "contact_status"}
+    assert set(m.cell_data) == {"stress", "strain", "electric_displacement", "electric_field"}
+    meshio.write(tmp_path / "s.vtu", m)
+    back = meshio.read(tmp_path / "s.vtu")
+    close(back.point_data["u"][:, :2], r.u)
+    on_contact = back.point_data["contact_status"][r.contact.node]
+    assert np.array_equal(on_contact, r.contact.status)
+
+
+def test_progress_reaches_a_callable():
+    lines = []
+    pc.run(pc.Scene.load("paper", {"mesh.n": 8}), progress=lines.append)
+    assert lines[0].startswith("plan:")
+    assert any(line.strip().startswith("newton") for line in lines)
+    assert any(line.startswith("solve") for line in lines)

@@ -1,0 +1,55 @@
+"""Scenes: from a shipped name, a file, TOML text or a dict; changes by dotted key, by mapping
+or by keyword section; the same scene whatever the route."""
+
+import copy
+
+import pytest
+
+import piezocontact as pc
+
+from conftest import REPO
+
+
+def test_every_route_gives_the_same_scene(tmp_path):
+    shipped = pc.Scene.load("paper")
+    path = REPO / "scenes" / "paper.toml"
+    assert pc.Scene.from_toml(path).to_dict() == shipped.to_dict()
+    assert pc.Scene.from_toml(str(path)).to_dict() == shipped.to_dict()
+    assert pc.Scene.from_toml(path.read_text()).to_dict() == shipped.to_dict()
+    assert pc.Scene.from_dict(shipped.to_dict()).to_dict() == shipped.to_dict()
+    assert pc.Scene.from_toml(shipped.to_toml()).to_dict() == shipped.to_dict()
+    assert shipped.name == "paper" and shipped.dim == 2 and shipped.source == "paper"
+    assert "paper" in pc.Scene.shipped() and "paper-3d" in pc.Scene.shipped()
+
+
+def test_changes_by_key_mapping_and_section():
+    s = pc.Scene.load("paper", {"mesh.n": 32})
+    assert s.get("mesh.n") == 32
+    s.set("mesh.n", 16)
+    s.set({"solver.tol": 1e-9, "load.p": -4})
+    s.set(mesh={"n": 12}, contact={"friction": 0.3})
+    assert (s.get("mesh.n"), s.get("solver.tol"), s.get("load.p"), s.get("contact.friction")) == (12, 1e-9, -4, 0.3)
+    # the one [[material]] table is entered by its keys
+    s.set("material.poling", [0.0, -1.0, 0.0])
+    assert s.get("material.poling") == [0.0, -1.0, 0.0]
+    assert s.get("nothing.here", "default") == "default"
+    # numpy scalars are numbers
+    np = pytest.importorskip("numpy")
+    s.set("electrode", {"group": "top", "v": np.float64(0.1), "x_range": np.array([0.25, 1.75])})
+    assert s.get("electrode.v") == 0.1 and s.get("electrode.x_range") == [0.25, 1.75]
+
+
+def test_a_copy_is_independent():
+    a = pc.Scene.load("paper", {"mesh.n": 8})
+    for b in [a.copy(), copy.copy(a), copy.deepcopy(a)]:
+        b.set("mesh.n", 4)
+        assert a.get("mesh.n") == 8 and b.get("mesh.n") == 4
+
+
+def test_a_change_changes_the_run():
+    s = pc.Scene.load("paper", {"mesh.n": 8})
+    f2 = pc.run(s).report["contact"]["normal_force"]
+    s.set("load.p", -4.0)
+    f4 = pc.run(s).report["contact"]["normal_force"]
+    # the pressed block is linear in the load while every point sticks
+    assert f4 == pytest.approx(2 * f2, rel=1e-9)
