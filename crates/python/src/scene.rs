@@ -131,9 +131,11 @@ impl Scene {
     #[staticmethod]
     #[pyo3(signature = (source, overrides = None))]
     fn from_toml(source: &Bound<'_, PyAny>, overrides: Option<&Bound<'_, PyAny>>) -> PyResult<Scene> {
+        // a string is a path where it names a file, or looks like one (one line ending in
+        // `.toml`, so that a mistyped path says "no such file", not a TOML error)
         let is_text = source.is_instance_of::<PyString>() && {
             let s: String = source.extract()?;
-            s.contains('\n') || s.contains('=') || !std::path::Path::new(&s).exists()
+            s.contains('\n') || (!std::path::Path::new(&s).exists() && !s.trim_end().ends_with(".toml"))
         };
         if is_text {
             let s: String = source.extract()?;

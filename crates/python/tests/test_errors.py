@@ -64,6 +64,8 @@ def test_scene_sources_name_what_is_wrong(tmp_path):
         pc.Scene.load("papper")
     with pytest.raises(pc.InputError, match="TOML parse error"):
         pc.Scene.from_toml("name = \n")
+    with pytest.raises(pc.InputError, match="no such file"):
+        pc.Scene.from_toml("scenes/papper.toml")
     with pytest.raises(pc.InputError, match="missing field `mesh`"):
         pc.Scene.from_dict({"name": "x", "description": ""})
     with pytest.raises(pc.InputError, match="is not a regular file"):
