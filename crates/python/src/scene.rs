@@ -228,19 +228,30 @@ impl Scene {
         regions: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         let np = py.import("numpy")?;
-        let points = np.call_method1("ascontiguousarray", (points, "float64"))?;
+        let points = np
+            .call_method1("ascontiguousarray", (points, "float64"))
+            .map_err(|e| Kind::Mesh.err(format!("mesh arrays: points are not an array of numbers ({e})")))?;
         let points: PyReadonlyArray2<'_, f64> = points
             .extract()
             .map_err(|_| Kind::Mesh.err("mesh arrays: points must be a 2-D array, (n, 2) or (n, 3)"))?;
-        let dim = points.shape()[1];
-        if !(dim == 2 || dim == 3) {
+        let columns = points.shape()[1];
+        if !(columns == 2 || columns == 3) {
             return Err(Kind::Mesh.err(format!(
-                "mesh arrays: points have {dim} columns: (n, 2) in 2D, (n, 3) in 3D"
+                "mesh arrays: points have {columns} columns: (n, 2) in 2D, (n, 3) in 3D"
             )));
         }
         let mut xyz = vec![[0.0; 3]; points.shape()[0]];
         for (p, row) in xyz.iter_mut().zip(points.as_array().rows()) {
-            p[..dim].copy_from_slice(row.as_slice().unwrap_or(&row.to_vec()));
+            for (k, x) in row.iter().enumerate() {
+                p[k] = *x;
+            }
+        }
+        // (n, 3) points in one plane z = const are a 2D mesh, as meshio gives a 2D Gmsh mesh
+        // (the Gmsh reader's rule); the plane is put at z = 0
+        let planar = columns == 3 && xyz.windows(2).all(|w| w[0][2] == w[1][2]);
+        let dim = if planar { 2 } else { columns };
+        if planar {
+            xyz.iter_mut().for_each(|p| p[2] = 0.0);
         }
         let (flat, nodes_per_cell) = indices(py, cells, "cells")?;
         let mut boundaries = BTreeMap::new();
@@ -372,7 +383,9 @@ fn indices(py: Python<'_>, v: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<us
 /// index would be cut silently).
 fn integers<'py>(py: Python<'py>, v: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
     let np = py.import("numpy")?;
-    let a = np.call_method1("asarray", (v,))?;
+    let a = np
+        .call_method1("asarray", (v,))
+        .map_err(|e| Kind::Mesh.err(format!("mesh arrays: {what} is not an array of indices ({e})")))?;
     let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
     if !(kind == "i" || kind == "u") && a.getattr("size")?.extract::<usize>()? > 0 {
         return Err(Kind::Mesh.err(format!(

@@ -35,6 +35,11 @@ pub fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
         }
         return Ok(toml::Value::Table(table));
     }
+    // NumPy's booleans and 0-d arrays: their Python value
+    if v.hasattr("dtype")? && v.hasattr("item")? && v.getattr("ndim").and_then(|d| d.extract::<usize>()).ok() == Some(0)
+    {
+        return to_toml(&v.call_method0("item")?, key);
+    }
     // NumPy's scalars: integers have __index__, floats __float__ (and are not sequences)
     if v.hasattr("__index__")? && !v.hasattr("__len__")? {
         if let Ok(i) = v.extract::<i64>() {

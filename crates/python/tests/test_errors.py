@@ -84,6 +84,12 @@ def test_a_mesh_of_bad_arrays_raises_a_mesh_error():
         s.set_mesh(points, [[0, 1, 2], [0, 2, -1]], bottom)
     with pytest.raises(pc.MeshError, match="must hold integer indices"):
         s.set_mesh(points, np.array([[0, 1, 2], [0, 2, 3]]) + 0.5, bottom)
+    with pytest.raises(pc.MeshError, match="not an array of indices"):
+        s.set_mesh(points, [[0, 1, 2], [0, 2]], bottom)
+    with pytest.raises(pc.MeshError, match="non-finite coordinate"):
+        s.set_mesh([[0.0, 0.0], [1.0, float("nan")], [1.0, 1.0], [0.0, 1.0]], [[0, 1, 2], [0, 2, 3]], bottom)
+    with pytest.raises(pc.MeshError, match="the mesh has no cells"):
+        s.set_mesh(points, np.zeros((0, 3), dtype=int), bottom)
     with pytest.raises(pc.MeshError, match="cells of 5 nodes"):
         s.set_mesh(points, [[0, 1, 2, 3, 0]], bottom)
     with pytest.raises(pc.MeshError, match="facets of 3 nodes"):
@@ -94,6 +100,18 @@ def test_a_mesh_of_bad_arrays_raises_a_mesh_error():
     s.set_mesh(points, [[0, 1, 2], [0, 2, 3]], bottom)
     with pytest.raises(pc.MeshError, match="boundary group `left` is missing"):
         pc.run(s)
+
+
+def test_a_contact_solve_that_does_not_converge_raises_a_convergence_error():
+    # docs/stability.md: Uzawa's steps shrink with the near-incompressible body's conditioning,
+    # and its iterations run out (about a second on the condensed problem)
+    s = pc.Scene.load("near-incompressible", {"mesh.n": 32, "solver.strategy": "uzawa-condensed"})
+    with pytest.raises(pc.ConvergenceError, match="Uzawa did not converge in .* iterations") as info:
+        pc.run(s)
+    assert "try solver.strategy=newton-condensed" in str(info.value)
+    # and the hint is right
+    s.set("solver.strategy", "newton-condensed")
+    assert pc.run(s).report["residuals"]["converged_to_tolerance"]
 
 
 def test_a_run_out_of_time_raises_a_convergence_error():

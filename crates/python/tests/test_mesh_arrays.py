@@ -29,7 +29,7 @@ def gmsh_arrays(path):
             cells.append(block.data)
     boundary = {k: np.concatenate(v) for k, v in boundary.items()}
     regions = {k: np.concatenate(v) for k, v in regions.items()}
-    return m.points[:, :2], np.concatenate(cells), boundary, regions
+    return m.points, np.concatenate(cells), boundary, regions
 
 
 def by_position(points, values):
@@ -42,10 +42,15 @@ def test_a_gmsh_mesh_as_arrays_gives_the_files_answer():
     from_file = pc.run(pc.Scene.from_toml(SCENE))
     scene = pc.Scene.from_toml(SCENE)
     points, cells, boundary, regions = gmsh_arrays(MSH)
+    # meshio's points of a 2D mesh have three columns, z = 0: a plane, so a 2D mesh
+    assert points.shape[1] == 3
     scene.set_mesh(points, cells, boundary, regions)
     assert scene.get("mesh.kind") == "given" and scene.get("mesh.file") is None
     from_arrays = pc.run(scene)
-    assert len(from_arrays.points) == len(from_file.points)
+    assert len(from_arrays.points) == len(from_file.points) and from_arrays.dim == 2
+    # as two columns, the same mesh
+    scene.set_mesh(points[:, :2], cells, {k: v.tolist() for k, v in boundary.items()}, regions)
+    assert np.array_equal(pc.run(scene).u, from_arrays.u)
     for field in ["u", "phi"]:
         a = by_position(from_arrays.points, getattr(from_arrays, field))
         b = by_position(from_file.points, getattr(from_file, field))

@@ -37,6 +37,9 @@ def test_changes_by_key_mapping_and_section():
     np = pytest.importorskip("numpy")
     s.set("electrode", {"group": "top", "v": np.float64(0.1), "x_range": np.array([0.25, 1.75])})
     assert s.get("electrode.v") == 0.1 and s.get("electrode.x_range") == [0.25, 1.75]
+    s.set({"mesh.n": np.int64(10), "solver.tol": np.array(1e-9), "load.p": np.float32(-2.0)})
+    assert (s.get("mesh.n"), s.get("solver.tol"), s.get("load.p")) == (10, 1e-9, -2.0)
+    assert type(s.get("mesh.n")) is int
 
 
 def test_a_copy_is_independent():
