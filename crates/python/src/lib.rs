@@ -1,8 +1,8 @@
 //! The Python package `piezocontact`: a thin layer over the typed library core (`problem`) and
 //! the application's scene files and outputs (`driver`). No method logic lives here: a
-//! [`scene::Scene`] is the scene file's TOML tree and the typed scene it validates to,
-//! [`run::run`] calls the same solve as the command line, and a [`result::RunResult`] lends
-//! the solution's arrays to NumPy without copies.
+//! `Scene` (module `scene`) is the scene file's TOML tree and the typed scene it validates to,
+//! `run` (module `run`) calls the same solve as the command line, and a `Result` (module
+//! `result`) lends the solution's arrays to NumPy without copies.
 //!
 //! Built with maturin (`pip install ./crates/python`); tested by pytest (`crates/python/tests`).
 //! The type stubs are `piezocontact.pyi`.
