@@ -13,6 +13,24 @@ from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import final
+
+__all__ = [
+    "__version__",
+    "Scene",
+    "Result",
+    "Contact",
+    "run",
+    "STICK",
+    "SLIP",
+    "SEPARATED",
+    "PiezocontactError",
+    "InputError",
+    "MeshError",
+    "SolverError",
+    "ConvergenceError",
+    "OutputError",
+]
 
 __version__: str
 
@@ -44,6 +62,7 @@ class OutputError(PiezocontactError, OSError):
 _Value = Union[bool, int, float, str, Sequence[Any], Mapping[str, Any], None]
 _Path = Union[str, "os.PathLike[str]"]
 
+@final
 class Scene:
     """What to solve: a mesh, materials, boundary conditions, a load, an electrode, the contact
     law and the solver's settings (the keys of a scene file; see the README's scene keys).
@@ -101,6 +120,7 @@ class Scene:
     def source(self) -> str:
         """A shipped scene's name, a path, "<dict>" or "<toml text>"."""
 
+@final
 class Contact:
     """The contact boundary's values, one row per contact point (a node of the contact group).
     Read-only float64 arrays unless said otherwise."""
@@ -137,6 +157,7 @@ class Contact:
         """STICK (1), SLIP (2) or SEPARATED (3), (m,)."""
     def __len__(self) -> int: ...
 
+@final
 class Result:
     """The solution of a run. The arrays are read-only views of the solution's storage."""
 
