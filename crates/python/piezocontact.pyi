@@ -72,22 +72,26 @@ class Scene:
     """
 
     @staticmethod
-    def load(name: _Path, overrides: Optional[Mapping[str, _Value]] = None) -> "Scene":
+    def load(name: _Path, overrides: Optional[Mapping[str, _Value]] = None, **keywords: Any) -> "Scene":
         """A shipped scene by name (`Scene.shipped()`), or a scene file by path, with
-        `overrides` (dotted keys; None removes a key) applied before it is validated."""
+        `overrides` (dotted keys; None removes a key) and keywords (as `set` takes them:
+        `mesh__n=128`, `solver={"tol": 1e-10}`) applied before it is validated."""
     @staticmethod
-    def from_toml(source: _Path, overrides: Optional[Mapping[str, _Value]] = None) -> "Scene":
+    def from_toml(source: _Path, overrides: Optional[Mapping[str, _Value]] = None, **keywords: Any) -> "Scene":
         """A scene from a TOML file (a path, or a string naming a file) or from TOML text."""
     @staticmethod
-    def from_dict(scene: Mapping[str, Any], overrides: Optional[Mapping[str, _Value]] = None) -> "Scene":
+    def from_dict(
+        scene: Mapping[str, Any], overrides: Optional[Mapping[str, _Value]] = None, **keywords: Any
+    ) -> "Scene":
         """A scene from a dict of its sections, as the TOML file holds them."""
     @staticmethod
     def shipped() -> list[str]:
         """The names of the shipped scenes."""
     def set(self, *args: Any, **sections: Any) -> None:
         """Changes keys: `set("mesh.n", 128)`, `set({"contact.law": "signorini",
-        "contact.friction": None})`, or sections as keywords merged key by key:
-        `set(mesh={"n": 128}, solver={"tol": 1e-10})`. None removes a key."""
+        "contact.friction": None})`, or keywords: a key with `__` for its dots
+        (`set(mesh__n=128)`) or a section merged key by key (`set(mesh={"n": 128})`). None
+        removes a key."""
     def get(self, key: str, default: Any = None) -> Any:
         """The value of a dotted key (`scene.get("mesh.n")`), or `default`."""
     def set_mesh(

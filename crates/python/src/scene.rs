@@ -31,7 +31,8 @@ fn here() -> PathBuf {
 }
 
 /// The dotted keys and values of a `set` call: a key and a value, a mapping of dotted keys, or
-/// sections as keywords (a dict merged key by key). `None` removes a key.
+/// keywords (a section as a dict merged key by key, or a key with `__` for its dots). `None`
+/// removes a key.
 fn changes(
     key: Option<&Bound<'_, PyAny>>,
     value: Option<&Bound<'_, PyAny>>,
@@ -60,7 +61,8 @@ fn changes(
     }
     if let Some(sections) = sections {
         for (name, v) in sections.iter() {
-            flatten(&name.extract::<String>()?, &v, &mut out)?;
+            // `mesh__n=128` is `mesh.n` (a keyword holds no dot)
+            flatten(&name.extract::<String>()?.replace("__", "."), &v, &mut out)?;
         }
     }
     Ok(out)
@@ -105,32 +107,46 @@ impl Scene {
         })
     }
 
-    fn from_text(text: &str, source: Source, overrides: Option<&Bound<'_, PyAny>>) -> PyResult<Scene> {
+    fn from_text(
+        text: &str,
+        source: Source,
+        overrides: Option<&Bound<'_, PyAny>>,
+        keywords: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Scene> {
         let tree: toml::Table = text
             .parse()
             .map_err(|e: toml::de::Error| Kind::Input.err(format!("scene {}: {e}", source.label)))?;
-        Self::of(tree, source, changes(overrides, None, None)?, None)
+        Self::of(tree, source, changes(overrides, None, keywords)?, None)
     }
 }
 
 #[pymethods]
 impl Scene {
     /// A shipped scene by name (see `Scene.shipped()`), or a scene file by path, with
-    /// `overrides` (a dict of dotted keys; None removes a key) applied before it is validated.
+    /// `overrides` (a dict of dotted keys; None removes a key) and keywords (as `set` takes
+    /// them: `mesh__n=128`, `solver={"tol": 1e-10}`) applied before it is validated.
     #[staticmethod]
-    #[pyo3(signature = (name, overrides = None))]
-    fn load(name: &Bound<'_, PyAny>, overrides: Option<&Bound<'_, PyAny>>) -> PyResult<Scene> {
+    #[pyo3(signature = (name, overrides = None, **keywords))]
+    fn load(
+        name: &Bound<'_, PyAny>,
+        overrides: Option<&Bound<'_, PyAny>>,
+        keywords: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Scene> {
         let name = name.str()?.to_string();
         let (text, source) = scene_file::text(&name).map_err(to_py)?;
-        Self::from_text(&text, source, overrides)
+        Self::from_text(&text, source, overrides, keywords)
     }
 
     /// A scene from a TOML file (a path, or a string naming a file) or from TOML text. Relative
     /// paths in the scene (a Gmsh file) resolve against the file's directory, or for text
     /// against the working directory.
     #[staticmethod]
-    #[pyo3(signature = (source, overrides = None))]
-    fn from_toml(source: &Bound<'_, PyAny>, overrides: Option<&Bound<'_, PyAny>>) -> PyResult<Scene> {
+    #[pyo3(signature = (source, overrides = None, **keywords))]
+    fn from_toml(
+        source: &Bound<'_, PyAny>,
+        overrides: Option<&Bound<'_, PyAny>>,
+        keywords: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Scene> {
         // a string is a path where it names a file, or looks like one (one line ending in
         // `.toml`, so that a mistyped path says "no such file", not a TOML error)
         let is_text = source.is_instance_of::<PyString>() && {
@@ -140,7 +156,7 @@ impl Scene {
         if is_text {
             let s: String = source.extract()?;
             let label = "<toml text>".to_string();
-            return Self::from_text(&s, Source { label, dir: here() }, overrides);
+            return Self::from_text(&s, Source { label, dir: here() }, overrides, keywords);
         }
         let path = source
             .py()
@@ -149,20 +165,24 @@ impl Scene {
             .extract::<String>()
             .map_err(|_| Kind::Input.err("from_toml takes a path or TOML text"))?;
         let (text, source) = scene_file::text(&path).map_err(to_py)?;
-        Self::from_text(&text, source, overrides)
+        Self::from_text(&text, source, overrides, keywords)
     }
 
     /// A scene from a dict of its sections, as the TOML file would hold them (`{"mesh":
     /// {"kind": "rectangle", ...}, "material": [{...}], ...}`).
     #[staticmethod]
-    #[pyo3(signature = (scene, overrides = None))]
-    fn from_dict(scene: &Bound<'_, PyAny>, overrides: Option<&Bound<'_, PyAny>>) -> PyResult<Scene> {
+    #[pyo3(signature = (scene, overrides = None, **keywords))]
+    fn from_dict(
+        scene: &Bound<'_, PyAny>,
+        overrides: Option<&Bound<'_, PyAny>>,
+        keywords: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Scene> {
         let tree = to_table(scene)?;
         let source = Source {
             label: "<dict>".into(),
             dir: here(),
         };
-        Self::of(tree, source, changes(overrides, None, None)?, None)
+        Self::of(tree, source, changes(overrides, None, keywords)?, None)
     }
 
     /// The names of the shipped scenes.
@@ -172,8 +192,8 @@ impl Scene {
     }
 
     /// Changes keys: `set("mesh.n", 128)`, `set({"contact.law": "signorini", "contact.friction":
-    /// None})`, or sections as keywords, merged key by key: `set(mesh={"n": 128},
-    /// solver={"tol": 1e-10})`. None removes a key. The changes are validated together and
+    /// None})`, or keywords: a key with `__` for its dots (`set(mesh__n=128)`), or a section
+    /// merged key by key (`set(mesh={"n": 128}, solver={"tol": 1e-10})`). None removes a key. The changes are validated together and
     /// made only if the scene they give is valid (else `InputError`, the scene unchanged).
     #[pyo3(signature = (*args, **sections))]
     fn set(&mut self, args: &Bound<'_, PyTuple>, sections: Option<&Bound<'_, PyDict>>) -> PyResult<()> {

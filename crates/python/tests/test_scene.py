@@ -29,6 +29,13 @@ def test_changes_by_key_mapping_and_section():
     s.set({"solver.tol": 1e-9, "load.p": -4})
     s.set(mesh={"n": 12}, contact={"friction": 0.3})
     assert (s.get("mesh.n"), s.get("solver.tol"), s.get("load.p"), s.get("contact.friction")) == (12, 1e-9, -4, 0.3)
+    s.set(mesh__n=10, solver__tol=1e-8)
+    assert (s.get("mesh.n"), s.get("solver.tol")) == (10, 1e-8)
+    # keywords on the constructors too, the same as set()
+    assert pc.Scene.load("paper", mesh__n=7).get("mesh.n") == 7
+    assert pc.Scene.load("paper", {"mesh.n": 5}, solver={"tol": 1e-9}).to_dict() == pc.Scene.from_dict(
+        pc.Scene.load("paper").to_dict(), mesh__n=5, solver__tol=1e-9
+    ).to_dict()
     # the one [[material]] table is entered by its keys
     s.set("material.poling", [0.0, -1.0, 0.0])
     assert s.get("material.poling") == [0.0, -1.0, 0.0]
