@@ -10,7 +10,7 @@ use crate::report::{
     rule_in_words, ContactReport, DofsReport, Iterations, Memory, MeshReport, Residuals, RunReport, SceneReport,
     SolverReport, Timings,
 };
-use crate::scene::{ContactLaw, ContactSolver, Rule, Scene};
+use crate::scene::{Backend, ContactLaw, ContactSolver, Rule, Scene, SceneError};
 use crate::setup::{setup, MeshNotes, Setup};
 use crate::ProblemError;
 use contact::{
@@ -83,6 +83,17 @@ pub fn solve_within(
     reporter: &mut dyn Reporter,
 ) -> Result<Solution, ProblemError> {
     scene.validate()?;
+    if scene.solver.backend != Backend::Faer {
+        // the scene asks for another backend: solving it here would ignore that silently
+        return Err(SceneError::new(
+            "solver.backend",
+            format!(
+                "solver.backend = \"{}\" is solved by the distributed backend (the program built with the `petsc` feature, under mpirun; distributed::solve); this is the default backend's solve: remove solver.backend, or set it to \"faer\"",
+                scene.solver.backend
+            ),
+        )
+        .into());
+    }
     if let (Some(available), Some((needed, what))) = (limits.memory_bytes, crate::estimate::before_mesh(scene)) {
         if needed > available as f64 {
             return Err(ProblemError::TooLarge {
@@ -715,6 +726,17 @@ mod tests {
             .unwrap()
             .to_string();
         assert!(e.contains("mesh.kind") && e.contains("none was given"), "{e}");
+    }
+
+    #[test]
+    fn a_scene_for_another_backend_is_refused_not_solved_here() {
+        let mut scene = block(MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 4));
+        scene.solver.backend = Backend::Petsc;
+        let e = solve(&scene, None, &mut Silent).err().unwrap().to_string();
+        assert!(
+            e.contains("solver.backend = \"petsc\" is solved by the distributed backend"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -59,6 +59,12 @@ def test_scene_errors_name_the_key_and_leave_the_scene_unchanged():
         s.set("mesh.n")
 
 
+def test_a_scene_for_the_petsc_backend_is_refused_not_solved_by_the_default_one():
+    s = pc.Scene.load("paper", {"mesh.n": 4, "solver.backend": "petsc"})
+    with pytest.raises(pc.InputError, match='solver.backend = "petsc" is solved by the distributed backend'):
+        pc.run(s)
+
+
 def test_scene_sources_name_what_is_wrong(tmp_path):
     with pytest.raises(pc.InputError, match="no shipped scene of that name"):
         pc.Scene.load("papper")
