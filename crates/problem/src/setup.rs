@@ -96,8 +96,18 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     let m = &scene.mesh;
     let n = m.cells_per_axis();
     let mut mesh = match (m.kind, given) {
-        (MeshKind::Rectangle, _) => mesh::rectangle_tri([m.lo[0], m.lo[1]], [m.hi[0], m.hi[1]], n[0], n[1]),
-        (MeshKind::Box, _) => mesh::box_tet(
+        // a mesh handed over to a scene that makes its own would be ignored
+        (MeshKind::Rectangle | MeshKind::Box, Some(_)) => {
+            return Err(ProblemError::Scene(SceneError::new(
+                "mesh.kind",
+                format!(
+                    "mesh.kind = \"{}\" makes its mesh, and a mesh was handed over too: mesh.kind = \"given\" uses the one handed over",
+                    m.kind
+                ),
+            )))
+        }
+        (MeshKind::Rectangle, None) => mesh::rectangle_tri([m.lo[0], m.lo[1]], [m.hi[0], m.hi[1]], n[0], n[1]),
+        (MeshKind::Box, None) => mesh::box_tet(
             [m.lo[0], m.lo[1], m.lo[2]],
             [m.hi[0], m.hi[1], m.hi[2]],
             n[0],

@@ -99,6 +99,8 @@ impl Scene {
             })?;
         }
         let scene = scene_file::from_tree(tree.clone(), &source.label).map_err(to_py)?;
+        // the arrays go with `mesh.kind = "given"`; a change of the mesh's kind lets them go
+        let mesh = mesh.filter(|_| scene.mesh.kind == problem::MeshKind::Given);
         Ok(Scene {
             tree,
             scene,

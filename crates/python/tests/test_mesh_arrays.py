@@ -81,6 +81,10 @@ def test_the_paper_mesh_as_arrays_gives_the_generated_answer():
     assert np.array_equal(given.cells, generated.cells[:, [2, 0, 1]])
     assert np.abs(given.u - generated.u).max() <= 1e-12 * np.abs(generated.u).max()
     assert np.abs(given.contact.lambda_n - generated.contact.lambda_n).max() <= 1e-12 * generated.contact.lambda_n.max()
+    # back to a generated mesh: the arrays go, and the generated mesh is run
+    scene.set("mesh", {"kind": "rectangle", "lo": [0.0, 0.0], "hi": [2.0, 1.0], "n": 4})
+    assert "mesh given" not in repr(scene)
+    assert len(pc.run(scene).points) == 9 * 5
 
 
 def test_a_3d_mesh_as_arrays_gives_the_generated_answer():
