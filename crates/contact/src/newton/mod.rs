@@ -9,7 +9,7 @@
 //! Newton matrix are then of order one, however far its own compliance is from the largest,
 //! which is what the nearly singular problems of that stage need.
 //!
-//! Three stages, each from the best iterate so far (by the measure the caller asked for), so
+//! Three stages (and a half), each from the best iterate so far (by the measure the caller asked for), so
 //! that the answer is never worse than the start:
 //! 1. **Newton** on the problem itself, globalised by an Armijo line search on the weighted
 //!    norm of the equations: a full step is compared with the largest of the last norms
@@ -23,6 +23,11 @@
 //!    method around its Alart–Curnier Newton). `D + σ W⁻¹` is definite for any `σ > 0`; `σ`
 //!    follows the residual (in units of the points' mean compliance), ten times more after an
 //!    inner solve that failed, coming back down by halves.
+//!
+//!    Then, where `D` is sparse or asymmetric and both stages stalled, Newton again under the
+//!    rules of a dense symmetric `D` (damped steps against the history, no patience rule),
+//!    for at most ten times `max_iters` steps: stage 1's stricter rules keep it cheap on the
+//!    problems it solves, and can stop it short of an active set a longer search finds.
 //! 3. **Fallback**, capped: for Coulomb's law the block Gauss–Seidel method
 //!    ([`crate::solve_gauss_seidel`]), for the convex laws the accelerated projected gradient
 //!    ([`crate::solve`]).
@@ -91,6 +96,8 @@ const MAX_HALVINGS: usize = 30;
 /// Newton steps without a 10 % gain on the best norm of the equations before a stall (where
 /// `D` is sparse or asymmetric).
 const PATIENCE: usize = 15;
+/// The lenient Newton stage's steps, in units of `max_iters`.
+const LENIENT_STEPS: usize = 10;
 /// Newton steps of one proximal problem (no patience rule there: a failed inner solve is
 /// what raises `σ`).
 const INNER_STEPS: usize = 100;
@@ -192,15 +199,17 @@ fn newton_steps(
     max_steps: usize,
     memory: usize,
     patience: usize,
+    lenient: bool,
     interrupt: &Interrupt,
     info: &mut ContactInfo,
     accept: &mut dyn FnMut(&State, &mut ContactInfo) -> bool,
 ) -> (State, End) {
     let mut history = std::collections::VecDeque::with_capacity(memory + 1);
-    // a dense symmetric D (a condensed finite-element compliance): Newton's own rules, damped
-    // steps that may rise against the history and no patience rule (its norm often rests on a
-    // plateau until the active set is found, then drops to round-off in one step)
-    let rises = directions.symmetric_dense();
+    // a dense symmetric D (a condensed finite-element compliance), or a caller that asks:
+    // Newton's own rules, damped steps that may rise against the history and no patience rule
+    // (its norm often rests on a plateau until the active set is found, then drops to
+    // round-off in one step)
+    let rises = lenient || directions.symmetric_dense();
     let patience = if rises { max_steps } else { patience };
     let mut since_best = 0;
     let mut best = s.clone();
@@ -302,6 +311,7 @@ fn proximal_stage(
             INNER_STEPS,
             MEMORY,
             INNER_STEPS,
+            false,
             &params.interrupt,
             info,
             &mut |s, _| judge.residual_of(&problem, s) <= inner_tol,
@@ -420,6 +430,7 @@ pub fn solve_newton<P: AffineProblem>(
             params.max_iters,
             MEMORY,
             PATIENCE,
+            false,
             &params.interrupt,
             &mut info,
             &mut |s, info| {
@@ -433,6 +444,36 @@ pub fn solve_newton<P: AffineProblem>(
     // stage 2: the proximal point method
     if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
         end = proximal_stage(&mut judge, params, &mut info, progress);
+    }
+    // stage 2b: where the compliance is sparse or asymmetric, stage 1 ran under stricter rules
+    // (damped steps must lower the norm; a patience rule) that keep it cheap on the problems it
+    // solves, and can stop it short of an active set that a longer, non-monotone search finds:
+    // before the last stage, Newton's own rules from the best iterate, as on a dense symmetric D
+    if matches!(end, End::Stalled(_)) {
+        let flat = judge.flat.clone();
+        let directions = Directions::new(&flat);
+        if !directions.symmetric_dense() {
+            if let Some((start, _)) = judge.best.clone() {
+                let steps = LENIENT_STEPS * params.max_iters;
+                end = newton_steps(
+                    &flat,
+                    &directions,
+                    start,
+                    steps,
+                    MEMORY,
+                    steps,
+                    true,
+                    &params.interrupt,
+                    &mut info,
+                    &mut |s, info| {
+                        let (r, done) = judge.offer(s);
+                        progress(&judge.progress(Stage::Newton, info.newton_iters, s, r));
+                        done
+                    },
+                )
+                .1;
+            }
+        }
     }
     let best_residual = judge.best_residual();
     let (best, _) = judge.best.take().expect("the start was judged");
