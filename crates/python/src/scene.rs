@@ -39,11 +39,8 @@ fn changes(
     sections: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<(String, Option<toml::Value>)>> {
     let mut out = vec![];
-    let one = |k: &str, v: &Bound<'_, PyAny>| -> PyResult<(String, Option<toml::Value>)> {
-        Ok((k.to_string(), if v.is_none() { None } else { Some(to_toml(v, k)?) }))
-    };
     match (key, value) {
-        (Some(k), Some(v)) if k.is_instance_of::<PyString>() => out.push(one(&k.extract::<String>()?, v)?),
+        (Some(k), Some(v)) if k.is_instance_of::<PyString>() => out.push(change(&k.extract::<String>()?, v)?),
         (Some(k), None) if k.is_instance_of::<PyString>() => {
             return Err(Kind::Input.err(format!("set(\"{k}\") needs a value (None removes the key)")))
         }
@@ -53,7 +50,7 @@ fn changes(
                 .map_err(|_| Kind::Input.err("set() takes a dotted key and a value, or a dict of them"))?;
             for item in m.items()?.iter() {
                 let (k, v): (String, Bound<'_, PyAny>) = item.extract()?;
-                out.push(one(&k, &v)?);
+                out.push(change(&k, &v)?);
             }
         }
         (Some(_), Some(_)) => return Err(Kind::Input.err("set(key, value): the key is a dotted string")),
@@ -76,11 +73,13 @@ fn flatten(prefix: &str, v: &Bound<'_, PyAny>, out: &mut Vec<(String, Option<tom
         }
         return Ok(());
     }
-    out.push((
-        prefix.to_string(),
-        if v.is_none() { None } else { Some(to_toml(v, prefix)?) },
-    ));
+    out.push(change(prefix, v)?);
     Ok(())
+}
+
+/// One key's change: its TOML value, or `None` (removal) for Python's None.
+fn change(key: &str, v: &Bound<'_, PyAny>) -> PyResult<(String, Option<toml::Value>)> {
+    Ok((key.to_string(), if v.is_none() { None } else { Some(to_toml(v, key)?) }))
 }
 
 impl Scene {
