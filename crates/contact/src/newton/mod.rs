@@ -9,8 +9,8 @@
 //! Newton matrix are then of order one, however far its own compliance is from the largest,
 //! which is what the nearly singular problems of that stage need.
 //!
-//! Three stages (and a half), each from the best iterate so far (by the measure the caller asked for), so
-//! that the answer is never worse than the start:
+//! Three stages (and a half), each from the best iterate so far (by the measure the caller
+//! asked for), so that the answer is never worse than the start:
 //! 1. **Newton** on the problem itself, globalised by an Armijo line search on the weighted
 //!    norm of the equations: a full step is compared with the largest of the last norms
 //!    (non-monotone: Grippo, Lampariello and Lucidi), a damped one with the current norm. A
