@@ -276,6 +276,48 @@ fn newton_steps(
     (best, end)
 }
 
+/// The rules of a run of Newton steps on the problem itself.
+struct Rules {
+    /// Steps at most.
+    steps: usize,
+    /// Steps without a 10 % gain on the best norm before a stall.
+    patience: usize,
+    /// Damped steps compared with the history, as on a dense symmetric `D`.
+    lenient: bool,
+}
+
+/// Newton steps on the problem itself from `start`, each offered to the judge (the best
+/// iterate, the stop) and reported as a Newton step.
+fn judged_steps(
+    judge: &mut Judge<'_>,
+    directions: &Directions,
+    start: State,
+    rules: Rules,
+    params: &NewtonParams,
+    info: &mut ContactInfo,
+    progress: &mut dyn FnMut(&Progress),
+) -> End {
+    let flat = judge.flat.clone();
+    let accept = &mut |s: &State, info: &mut ContactInfo| {
+        let (r, done) = judge.offer(s);
+        progress(&judge.progress(Stage::Newton, info.newton_iters, s, r));
+        done
+    };
+    let (_, end) = newton_steps(
+        &flat,
+        directions,
+        start,
+        rules.steps,
+        MEMORY,
+        rules.patience,
+        rules.lenient,
+        &params.interrupt,
+        info,
+        accept,
+    );
+    end
+}
+
 /// The proximal stage from the best iterate: returns how it ended.
 fn proximal_stage(
     judge: &mut Judge<'_>,
@@ -418,28 +460,16 @@ pub fn solve_newton<P: AffineProblem>(
     // stage 1: Newton on the problem itself
     let s = judge.flat.state(x0);
     let (_, done) = judge.offer(&s);
+    let directions = Directions::new(&judge.flat);
     let mut end = if done {
         End::Converged
     } else {
-        let directions = Directions::new(&judge.flat);
-        let flat = judge.flat.clone();
-        newton_steps(
-            &flat,
-            &directions,
-            s,
-            params.max_iters,
-            MEMORY,
-            PATIENCE,
-            false,
-            &params.interrupt,
-            &mut info,
-            &mut |s, info| {
-                let (r, done) = judge.offer(s);
-                progress(&judge.progress(Stage::Newton, info.newton_iters, s, r));
-                done
-            },
-        )
-        .1
+        let rules = Rules {
+            steps: params.max_iters,
+            patience: PATIENCE,
+            lenient: false,
+        };
+        judged_steps(&mut judge, &directions, s, rules, params, &mut info, progress)
     };
     // stage 2: the proximal point method
     if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
@@ -449,30 +479,15 @@ pub fn solve_newton<P: AffineProblem>(
     // (damped steps must lower the norm; a patience rule) that keep it cheap on the problems it
     // solves, and can stop it short of an active set that a longer, non-monotone search finds:
     // before the last stage, Newton's own rules from the best iterate, as on a dense symmetric D
-    if matches!(end, End::Stalled(_)) {
-        let flat = judge.flat.clone();
-        let directions = Directions::new(&flat);
-        if !directions.symmetric_dense() {
-            if let Some((start, _)) = judge.best.clone() {
-                let steps = LENIENT_STEPS * params.max_iters;
-                end = newton_steps(
-                    &flat,
-                    &directions,
-                    start,
-                    steps,
-                    MEMORY,
-                    steps,
-                    true,
-                    &params.interrupt,
-                    &mut info,
-                    &mut |s, info| {
-                        let (r, done) = judge.offer(s);
-                        progress(&judge.progress(Stage::Newton, info.newton_iters, s, r));
-                        done
-                    },
-                )
-                .1;
-            }
+    if matches!(end, End::Stalled(_)) && !directions.symmetric_dense() {
+        if let Some((start, _)) = judge.best.clone() {
+            let steps = LENIENT_STEPS * params.max_iters;
+            let rules = Rules {
+                steps,
+                patience: steps,
+                lenient: true,
+            };
+            end = judged_steps(&mut judge, &directions, start, rules, params, &mut info, progress);
         }
     }
     let best_residual = judge.best_residual();
