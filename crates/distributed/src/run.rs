@@ -9,8 +9,8 @@ use problem::boundary::ContactBoundary;
 use problem::report::{
     ContactReport, DofsReport, Iterations, Memory, MeshReport, Residuals, SceneReport, SolverReport, Timings,
 };
-use problem::run::recover;
-use problem::setup::{setup, MeshNotes, Setup};
+use problem::run::{begin, recover};
+use problem::setup::Setup;
 use problem::{ContactLaw, ContactResult, Event, PetscReport, ProblemError, Reporter, RunReport, Scene, Solution};
 
 /// Steps of the active-set iteration at most.
@@ -77,26 +77,10 @@ pub fn solve<'p>(
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DistributedError> {
     scene.validate()?;
-    if let (Some(available), Some((needed, what))) = (
-        limits.memory_bytes,
-        problem::estimate::petsc_per_rank(scene, petsc.size()),
-    ) {
-        if needed > available as f64 {
-            return Err(ProblemError::TooLarge {
-                what,
-                needed: needed as u64,
-                available,
-            }
-            .into());
-        }
-    }
     let t_total = Instant::now();
-    let setup = setup(scene, mesh)?;
+    let estimate = problem::estimate::petsc_per_rank(scene, petsc.size());
+    let setup = begin(scene, mesh, estimate, &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
-    reporter.event(&Event::Planned(&setup.plan));
-    if setup.notes != MeshNotes::default() {
-        reporter.event(&Event::MeshNotes(setup.notes));
-    }
     let t = Instant::now();
     let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;

@@ -94,22 +94,9 @@ pub fn solve_within(
         )
         .into());
     }
-    if let (Some(available), Some((needed, what))) = (limits.memory_bytes, crate::estimate::before_mesh(scene)) {
-        if needed > available as f64 {
-            return Err(ProblemError::TooLarge {
-                what,
-                needed: needed as u64,
-                available,
-            });
-        }
-    }
     let t_total = Instant::now();
-    let setup = setup(scene, mesh)?;
+    let setup = begin(scene, mesh, crate::estimate::before_mesh(scene), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
-    reporter.event(&Event::Planned(&setup.plan));
-    if setup.notes != MeshNotes::default() {
-        reporter.event(&Event::MeshNotes(setup.notes));
-    }
     stop_if_interrupted(&limits, "set-up")?;
     let assembled = assemble(&setup, reporter)?;
     check_assembled(scene, &assembled)?;
@@ -177,6 +164,36 @@ pub fn solve_within(
             }
         }),
     })
+}
+
+/// The start of a run on either backend: the memory `estimate` (bytes, and what it counts)
+/// checked against `limits` before the memory is taken, then the [`Setup`], its plan and what
+/// the mesh's checks noted reported.
+///
+/// # Errors
+/// [`ProblemError::TooLarge`], and the set-up's errors.
+pub fn begin(
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    estimate: Option<(f64, String)>,
+    limits: &Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<Setup, ProblemError> {
+    if let (Some(available), Some((needed, what))) = (limits.memory_bytes, estimate) {
+        if needed > available as f64 {
+            return Err(ProblemError::TooLarge {
+                what,
+                needed: needed as u64,
+                available,
+            });
+        }
+    }
+    let setup = setup(scene, mesh)?;
+    reporter.event(&Event::Planned(&setup.plan));
+    if setup.notes != MeshNotes::default() {
+        reporter.event(&Event::MeshNotes(setup.notes));
+    }
+    Ok(setup)
 }
 
 /// [`ProblemError::Interrupted`] after the step `after` where the run's interrupt has fired.
