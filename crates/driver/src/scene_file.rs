@@ -147,7 +147,9 @@ fn apply(tree: &mut toml::Table, o: &str) -> Result<(), String> {
 
 /// Sets the dotted `key` of the tree to `value`, or removes it where `value` is `None`;
 /// the tables on the way are made where missing, and a table array of one table (a scene's
-/// one `[[material]]`) is entered as that table.
+/// one `[[material]]`) is entered as that table. A relative `mesh.file` is made absolute
+/// against the working directory: it was typed there (on the command line, or in Python), not
+/// in the scene file's directory, against which the file's own paths resolve.
 ///
 /// # Errors
 /// A message naming the part of the key that is not a table, or the key that is not there to
@@ -173,6 +175,10 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
         };
     }
     match value {
+        Some(toml::Value::String(file)) if key.trim() == "mesh.file" && Path::new(&file).is_relative() => {
+            let typed_here = std::env::current_dir().map_or_else(|_| PathBuf::from(&file), |d| d.join(&file));
+            table.insert(last.to_string(), toml::Value::String(typed_here.display().to_string()));
+        }
         Some(v) => {
             table.insert(last.to_string(), v);
         }

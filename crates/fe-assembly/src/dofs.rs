@@ -72,7 +72,7 @@ pub struct DofMap {
 
 impl DofMap {
     /// Builds the map: `has_phi[node]` says which nodes carry a potential; `constraints` are
-    /// applied in order. A node constrained twice to values that differ by more than 1e-12
+    /// applied in order; a node that no cell uses has its displacement held at 0 (no unknown). A node constrained twice to values that differ by more than 1e-12
     /// (relative) is an error, and so is a condition that reaches no dof.
     pub fn new(mesh: &Mesh, has_phi: &[bool], constraints: &[Constraint]) -> Result<DofMap, AssemblyError> {
         let (n, dim) = (mesh.n_nodes(), mesh.dim);
@@ -127,11 +127,19 @@ impl DofMap {
                 )));
             }
         }
+        // a node that no cell uses (the centre of a Gmsh arc) has no stiffness: its displacement
+        // is no unknown (held at 0, as the mesh reports)
+        let mut used = vec![false; n];
+        for &v in &mesh.cells {
+            used[v] = true;
+        }
         let mut n_u = 0;
         let u = u
             .into_iter()
-            .map(|s| match s {
+            .enumerate()
+            .map(|(i, s)| match s {
                 Some((v, _)) => Dof::Fixed(v),
+                None if !used[i / dim] => Dof::Fixed(0.0),
                 None => {
                     n_u += 1;
                     Dof::Free(n_u - 1)

@@ -6,8 +6,9 @@
 //! - cell: a P1 triangle ([`CellKind::Tri3`]), a Q1 quadrilateral ([`CellKind::Quad4`]) or a
 //!   P1 tetrahedron ([`CellKind::Tet4`]); node order is counter-clockwise (2D) or positively
 //!   oriented (3D, `det[p1-p0, p2-p0, p3-p0] > 0`), checked by [`Mesh::check`].
-//! - facet: a boundary entity of dimension `dim - 1` (a segment in 2D, a triangle in 3D).
-//! - boundary group: a named list of facets (`left`, `right`, `bottom`, `top`, and in 3D also
+//! - facet: an entity of dimension `dim - 1` (a segment in 2D, a triangle in 3D), on the
+//!   boundary (one cell holds it) or inside (two cells do).
+//! - boundary group: a named list of facets, on the boundary or inside (an interface) (`left`, `right`, `bottom`, `top`, and in 3D also
 //!   `front` (y = y0) and `back` (y = y1) for the generators; Gmsh physical groups of dimension
 //!   `dim - 1` for files).
 //! - region: a named list of cells (`body` for the generators; Gmsh physical groups of
@@ -84,7 +85,9 @@ impl CellKind {
     }
 }
 
-/// A named set of boundary facets, each given by its `facet_n_nodes` node indices.
+/// A named set of facets, each given by its `facet_n_nodes` node indices: on the boundary, or
+/// inside the mesh (a material interface, an internal electrode; see
+/// [`Mesh::interior_facets`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FacetGroup {
     /// Nodes per facet (2 in 2D, 3 in 3D).
@@ -166,14 +169,6 @@ pub enum MeshError {
         measure: f64,
         /// The cell's nodes.
         nodes: Vec<usize>,
-    },
-    /// A node no cell uses.
-    #[error("{count} node(s) belong to no cell, the first is node {first}")]
-    UnusedNodes {
-        /// How many nodes are unused.
-        count: usize,
-        /// The first unused node.
-        first: usize,
     },
     /// A cell or facet that names a node that does not exist.
     #[error("{item} refers to node {node}, but the mesh has {n_nodes} nodes")]

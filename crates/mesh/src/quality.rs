@@ -1,5 +1,5 @@
 //! Quality checks: finite coordinates, node indices in range, no degenerate or inverted cell,
-//! no unused node, and the topology of `topology.rs`.
+//! and the topology of `topology.rs`; nodes that no cell uses are counted.
 
 use crate::generate::signed_volume;
 use crate::{CellKind, Mesh, MeshError};
@@ -20,6 +20,12 @@ pub struct QualityReport {
     pub max_aspect: f64,
     /// Nodes that share their coordinates with another node (a crack, or parts not merged).
     pub coincident_nodes: usize,
+    /// Nodes that no cell uses (the centre of a Gmsh circle arc, a point of the geometry off
+    /// the body): they carry no unknown.
+    pub unused_nodes: usize,
+    /// Facets of boundary groups that lie inside the mesh (a material interface, an internal
+    /// electrode), over all groups.
+    pub interior_group_facets: usize,
 }
 
 /// A cell whose measure is below this fraction of `h^dim` (its longest edge to the power of
@@ -33,7 +39,7 @@ impl Mesh {
     /// [`MeshError::NonFiniteCoordinate`], [`MeshError::NodeOutOfRange`] (cells, facets,
     /// region entries), [`MeshError::BadCell`] (degenerate: `|measure| <= 1e-12 h^dim`;
     /// inverted: negative measure, or for a quadrilateral a non-positive corner Jacobian),
-    /// [`MeshError::UnusedNodes`], then the topology: [`MeshError::OverlappingCells`],
+    /// then the topology: [`MeshError::OverlappingCells`],
     /// [`MeshError::DuplicateCell`], [`MeshError::BadBoundaryFacet`].
     pub fn check(&self) -> Result<QualityReport, MeshError> {
         if self.n_cells() == 0 {
@@ -75,6 +81,8 @@ impl Mesh {
             h_min: f64::INFINITY,
             max_aspect: 0.0,
             coincident_nodes: 0,
+            unused_nodes: 0,
+            interior_group_facets: 0,
         };
         let measure_name = if self.dim == 2 { "area" } else { "volume" };
         for (c, cell) in self.iter_cells().enumerate() {
@@ -112,16 +120,8 @@ impl Mesh {
             };
             report.max_aspect = report.max_aspect.max(reference * scale / measure);
         }
-        let mut used = vec![false; n_nodes];
-        for &v in &self.cells {
-            used[v] = true;
-        }
-        let count = used.iter().filter(|u| !**u).count();
-        if count > 0 {
-            let first = used.iter().position(|u| !u).unwrap_or(0);
-            return Err(MeshError::UnusedNodes { count, first });
-        }
-        report.coincident_nodes = self.check_topology()?;
+        report.unused_nodes = self.unused_nodes().len();
+        (report.coincident_nodes, report.interior_group_facets) = self.check_topology()?;
         Ok(report)
     }
 
@@ -188,7 +188,8 @@ mod tests {
     fn unused_nodes_nan_and_missing_groups() {
         let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1);
         m.points.push([5.0, 5.0, 0.0]);
-        assert_eq!(m.check(), Err(MeshError::UnusedNodes { count: 1, first: 4 }));
+        assert_eq!(m.check().map(|r| r.unused_nodes), Ok(1));
+        assert_eq!(m.unused_nodes(), vec![4]);
         let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1);
         m.points[2][1] = f64::NAN;
         assert!(matches!(m.check(), Err(MeshError::NonFiniteCoordinate { node: 2, .. })));

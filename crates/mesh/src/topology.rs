@@ -1,10 +1,12 @@
 //! Topology checks and the outward normals of boundary facets.
 //!
 //! A conforming mesh has every facet on one cell (the boundary) or two (the interior); no two
-//! cells with the same nodes; boundary groups made of boundary facets, each listed once (a
+//! cells with the same nodes; facet groups made of facets of the cells, each listed once (a
 //! facet listed twice, as two physical groups of one name on one curve give, would count its
-//! load or contact twice). Nodes at the same coordinates (a crack, or a mesh glued from parts
-//! that were not merged) are allowed and counted.
+//! load or contact twice). A group may hold interior facets (a material interface, an internal
+//! electrode): they are counted, and refused only where a boundary is needed (a traction, a
+//! contact face, an outward normal). Nodes at the same coordinates (a crack, or a mesh glued
+//! from parts that were not merged) are allowed and counted.
 
 use crate::{CellKind, Mesh, MeshError};
 
@@ -48,13 +50,14 @@ impl Mesh {
     }
 
     /// Checks the topology: every facet on one or two cells, no two cells with the same
-    /// nodes, every facet of a boundary group a boundary facet listed once. Returns the number
-    /// of nodes that share their coordinates with another node.
+    /// nodes, every facet of a group a facet of the cells, listed once. Returns the number of
+    /// nodes that share their coordinates with another node, and of the groups' facets that
+    /// lie inside the mesh.
     ///
     /// # Errors
     /// [`MeshError::OverlappingCells`], [`MeshError::DuplicateCell`],
     /// [`MeshError::BadBoundaryFacet`].
-    pub(crate) fn check_topology(&self) -> Result<usize, MeshError> {
+    pub(crate) fn check_topology(&self) -> Result<(usize, usize), MeshError> {
         let facets = self.cell_facets();
         // runs of one facet: its cells
         let mut i = 0;
@@ -76,6 +79,7 @@ impl Mesh {
                 second: w[0].1.max(w[1].1),
             });
         }
+        let mut interior = 0;
         for (name, group) in &self.boundaries {
             let mut seen: Vec<(Key, usize)> = group.iter().enumerate().map(|(f, n)| (key(n), f)).collect();
             seen.sort_unstable();
@@ -94,16 +98,41 @@ impl Mesh {
                 match on {
                     0 => return Err(bad(*f, "is not a facet of any cell")),
                     1 => {}
-                    _ => {
-                        return Err(bad(
-                            *f,
-                            "lies inside the mesh (two cells share it): a boundary group holds boundary facets only",
-                        ))
-                    }
+                    _ => interior += 1,
                 }
             }
         }
-        Ok(self.coincident_nodes())
+        Ok((self.coincident_nodes(), interior))
+    }
+
+    /// The facets of group `group` that lie inside the mesh (shared by two cells), by their
+    /// index in the group.
+    ///
+    /// # Errors
+    /// [`MeshError::MissingBoundary`].
+    pub fn interior_facets(&self, group: &str) -> Result<Vec<usize>, MeshError> {
+        let g = self.boundary(group)?;
+        let facets = self.cell_facets();
+        Ok(g.iter()
+            .enumerate()
+            .filter(|(_, f)| {
+                let k = key(f);
+                let at = facets.partition_point(|x| x.0 < k);
+                facets[at..].iter().take_while(|x| x.0 == k).count() > 1
+            })
+            .map(|(i, _)| i)
+            .collect())
+    }
+
+    /// The nodes that no cell uses, sorted.
+    pub fn unused_nodes(&self) -> Vec<usize> {
+        let mut used = vec![false; self.n_nodes()];
+        for &v in &self.cells {
+            if let Some(u) = used.get_mut(v) {
+                *u = true;
+            }
+        }
+        (0..used.len()).filter(|&v| !used[v]).collect()
     }
 
     /// Nodes whose coordinates equal those of another node (each such node but the first).
@@ -122,9 +151,17 @@ impl Mesh {
     ///
     /// # Errors
     /// [`MeshError::MissingBoundary`]; [`MeshError::BadBoundaryFacet`] for a facet that no cell
-    /// holds.
+    /// holds, or that two cells hold (inside the mesh, it has no outward side).
     pub fn outward_normals(&self, group: &str) -> Result<Vec<[f64; 3]>, MeshError> {
         let g = self.boundary(group)?;
+        if let Some(&f) = self.interior_facets(group)?.first() {
+            return Err(MeshError::BadBoundaryFacet {
+                group: group.into(),
+                facet: f,
+                nodes: g.facet(f).to_vec(),
+                problem: "lies inside the mesh (two cells share it): it has no outward normal",
+            });
+        }
         let (offsets, node_cells) = self.node_cells();
         let mut out = Vec::with_capacity(g.n_facets());
         for (f, facet) in g.iter().enumerate() {
@@ -169,7 +206,7 @@ mod tests {
     #[test]
     fn a_conforming_mesh_passes_and_its_normals_point_out() {
         let m = rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2);
-        assert_eq!(m.check_topology(), Ok(0));
+        assert_eq!(m.check_topology(), Ok((0, 0)));
         for (g, n) in [
             ("bottom", [0.0, -1.0]),
             ("top", [0.0, 1.0]),
@@ -181,7 +218,7 @@ mod tests {
             }
         }
         let b = box_tet([0.0; 3], [1.0, 2.0, 1.0], 2, 2, 2);
-        assert_eq!(b.check_topology(), Ok(0));
+        assert_eq!(b.check_topology(), Ok((0, 0)));
         for v in b.outward_normals("bottom").unwrap() {
             assert!((v[2] + 1.0).abs() < 1e-14, "{v:?}");
         }
@@ -201,7 +238,8 @@ mod tests {
         g.facets.extend_from_slice(&first);
         let e = m.check_topology().unwrap_err().to_string();
         assert!(e.contains("listed twice"), "{e}");
-        // an interior facet in a group: the diagonal of the first square
+        // an interior facet in a group (the diagonal of the first square): counted, and refused
+        // where an outward normal is asked for
         let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 2, 2);
         let diag = {
             let c = m.cell(0);
@@ -210,8 +248,13 @@ mod tests {
             shared
         };
         m.boundaries.get_mut("top").unwrap().facets.extend_from_slice(&diag);
-        let e = m.check_topology().unwrap_err().to_string();
-        assert!(e.contains("lies inside the mesh"), "{e}");
+        assert_eq!(m.check_topology(), Ok((0, 1)));
+        assert_eq!(m.interior_facets("top"), Ok(vec![2]));
+        let e = m.outward_normals("top").unwrap_err().to_string();
+        assert!(
+            e.contains("lies inside the mesh") && e.contains("no outward normal"),
+            "{e}"
+        );
         // a crack: the diagonal of a square with its two nodes doubled is counted, not refused
         let mut m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1);
         let (c0, c1) = (m.cell(0).to_vec(), m.cell(1).to_vec());
@@ -227,6 +270,6 @@ mod tests {
             assert!(k < 2);
         }
         m.boundaries.clear();
-        assert_eq!(m.check_topology(), Ok(2));
+        assert_eq!(m.check_topology(), Ok((2, 0)));
     }
 }

@@ -306,3 +306,24 @@ fn a_wholly_inverted_tet_mesh_is_refused() {
     let e = read_msh_bytes(&out, "mirrored.msh").unwrap_err().to_string();
     assert!(e.contains("tetrahedra are inverted"), "{e}");
 }
+
+/// Two physical groups of one name (on one curve, or on two) are one group: the union of
+/// their facets, each once (listed twice, a facet would count its load or contact twice).
+#[test]
+fn physical_groups_of_one_name_are_one_group() {
+    let m = read_msh(fixture("duplicate-group.msh")).unwrap();
+    let g = m.boundary("bottom").unwrap();
+    let mut keys: Vec<Vec<usize>> = g
+        .iter()
+        .map(|f| {
+            let mut k = f.to_vec();
+            k.sort_unstable();
+            k
+        })
+        .collect();
+    let n = keys.len();
+    keys.sort();
+    keys.dedup();
+    assert_eq!(keys.len(), n, "each facet once");
+    assert!((length(&m, "bottom") - 2.0).abs() < 1e-12);
+}
