@@ -79,6 +79,7 @@ fn main() {
         weight: vec![h; n],
         gap: vec![0.0; n],
         friction: vec![friction; n],
+        held: vec![[false; 2]; n],
     };
     let mut problem = DenseContactProblem {
         u0,

@@ -136,6 +136,7 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
                     Law::Tresca(s) => PointLaw::Tresca(s[i]),
                     Law::Coulomb => PointLaw::Coulomb(points.friction[i]),
                 },
+                held: points.held[i],
             };
             let mut x0 = [0.0; 3];
             x0[0] = lambda.normal[i];

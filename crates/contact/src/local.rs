@@ -23,13 +23,15 @@ pub(crate) enum PointLaw {
     Coulomb(f64),
 }
 
-/// One point's problem: `u = b - A x`, gap `g`, `k = 1 + nt` components.
+/// One point's problem: `u = b - A x`, gap `g`, `k = 1 + nt` components, the tangential
+/// directions a support holds (their multiplier 0).
 pub(crate) struct Point {
     pub(crate) a: [[f64; 3]; 3],
     pub(crate) b: [f64; 3],
     pub(crate) g: f64,
     pub(crate) k: usize,
     pub(crate) law: PointLaw,
+    pub(crate) held: [bool; 2],
 }
 
 /// Newton steps before the fixed point takes over.
@@ -49,11 +51,21 @@ impl Point {
         let mut f = [0.0; 3];
         f[0] = x[0] - z[0].max(0.0);
         let mut t = [z[1], z[2]];
+        self.hold(&mut t);
         project_disc(&mut t[..k - 1], self.radius(z[0]));
         for r in 1..k {
             f[r] = x[r] - t[r - 1];
         }
         (z, f)
+    }
+
+    /// Sets the held tangential components to 0.
+    fn hold(&self, t: &mut [f64; 2]) {
+        for (v, &h) in t.iter_mut().zip(&self.held) {
+            if h {
+                *v = 0.0;
+            }
+        }
     }
 
     fn radius(&self, zn: f64) -> f64 {
@@ -78,20 +90,21 @@ impl Point {
         for j in 0..k {
             jac[0][j] = if j == 0 { 1.0 } else { 0.0 } - if z[0] > 0.0 { m[0][j] } else { 0.0 };
         }
-        let q = [z[1], z[2]];
+        let mut q = [z[1], z[2]];
+        self.hold(&mut q);
         let qn = norm(&q[..k - 1]);
         let radius = self.radius(z[0]);
         for r in 1..k {
             for j in 0..k {
                 let identity = if r == j { 1.0 } else { 0.0 };
-                jac[r][j] = if !(radius > 0.0) {
+                jac[r][j] = if self.held[r - 1] || !(radius > 0.0) {
                     identity
                 } else if qn <= radius {
                     identity - m[r][j]
                 } else {
                     // slip: -(R/|q|)(I - q̂q̂ᵀ) M_t - q̂ dR, dR = F M_n for Coulomb in contact
                     let mut v = identity;
-                    for l in 1..k {
+                    for l in (1..k).filter(|&l| !self.held[l - 1]) {
                         let proj = if r == l { 1.0 } else { 0.0 } - (q[r - 1] / qn) * (q[l - 1] / qn);
                         v -= radius / qn * proj * m[l][j];
                     }
@@ -215,6 +228,7 @@ mod tests {
             g: 0.0,
             k: 3,
             law: PointLaw::Coulomb(0.3),
+            held: [false; 2],
         };
         let x = p.solve([0.0; 3]);
         assert!(

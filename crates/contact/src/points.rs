@@ -19,6 +19,11 @@ pub struct ContactPoints {
     pub gap: Vec<f64>,
     /// Coulomb coefficients `F`.
     pub friction: Vec<f64>,
+    /// The tangential directions of each point that a support holds (a Dirichlet condition on
+    /// that component of the body's motion): the multiplier there is 0, the support taking the
+    /// force, and the law acts in the other directions. `[false; 2]` where the point may slide
+    /// in every direction; only the first `dim - 1` entries are read.
+    pub held: Vec<[bool; 2]>,
 }
 
 impl ContactPoints {
@@ -34,6 +39,32 @@ impl ContactPoints {
     pub fn n_tangential(&self) -> usize {
         self.dim - 1
     }
+    /// `x` (point `i`'s tangential components) projected onto the point's friction set: the disc
+    /// `|x| ≤ radius` in the directions it may slide in, 0 in those a support holds. (The set
+    /// lies in the subspace of the free directions, so the projection is the subspace's, then
+    /// the disc's.)
+    #[inline]
+    pub fn project_friction(&self, i: usize, x: &mut [f64], radius: f64) {
+        self.hold(i, x);
+        crate::projection::project_disc(x, radius);
+    }
+
+    /// Sets to 0 the components of point `i`'s tangential `x` that a support holds.
+    #[inline]
+    pub fn hold(&self, i: usize, x: &mut [f64]) {
+        for (v, &h) in x.iter_mut().zip(&self.held[i]) {
+            if h {
+                *v = 0.0;
+            }
+        }
+    }
+
+    /// Whether tangential direction `q` of point `i` is held by a support.
+    #[inline]
+    pub fn is_held(&self, i: usize, q: usize) -> bool {
+        self.held[i][q]
+    }
+
     /// Checks sizes and values; returns a message naming the first bad item.
     pub fn validate(&self) -> Result<(), String> {
         let n = self.len();
@@ -42,6 +73,7 @@ impl ContactPoints {
             || self.tangent.len() != n
             || self.gap.len() != n
             || self.friction.len() != n
+            || self.held.len() != n
         {
             return Err("contact points: arrays of different lengths".into());
         }

@@ -281,6 +281,7 @@ impl FrictionProblem {
             weight: vec![1.0; nc],
             gap: vec![0.0; nc],
             friction: self.mu.clone(),
+            held: vec![[false; 2]; nc],
         }
     }
 

@@ -301,7 +301,7 @@ pub fn complementarity_residual(
             for k in 0..nt {
                 buf[k] = lambda.tangential[i * nt + k] + c * u.tangential[i * nt + k];
             }
-            project_disc(&mut buf[..nt], radius[i]);
+            points.project_friction(i, &mut buf[..nt], radius[i]);
             for k in 0..nt {
                 r.tangential[i * nt + k] = lambda.tangential[i * nt + k] - buf[k];
             }
@@ -344,10 +344,15 @@ pub fn desaxce_residual(
         for k in 0..nt {
             x[1 + k] = rt[k] + ut[k];
         }
+        // a held direction is no direction of the set: the projection is the subspace's first
+        points.hold(i, &mut x[1..1 + nt]);
         match law {
             Law::Coulomb => {
                 let f = points.friction[i];
-                x[0] -= f * norm(ut);
+                let mut slip = [0.0; 2];
+                slip[..nt].copy_from_slice(ut);
+                points.hold(i, &mut slip[..nt]);
+                x[0] -= f * norm(&slip[..nt]);
                 project_cone(&mut x[..1 + nt], f);
             }
             Law::Tresca(s) => {

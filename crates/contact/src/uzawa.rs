@@ -4,7 +4,7 @@
 
 use crate::operator::ContactOperator;
 use crate::points::{ContactPoints, PointValues};
-use crate::projection::{project_disc, project_nonnegative};
+use crate::projection::project_nonnegative;
 use crate::solution::{
     check_input, classify, complementarity_residual, counts, desaxce_residual, estimate_mu_max, multiplier_scale,
     slip_bound, Counter,
@@ -126,7 +126,7 @@ fn projected_step(
             for q in 0..nt {
                 buf[q] = lambda.tangential[i * nt + q] + r * u.tangential[i * nt + q];
             }
-            project_disc(&mut buf[..nt], radius[i]);
+            points.project_friction(i, &mut buf[..nt], radius[i]);
             for q in 0..nt {
                 diff2 += (buf[q] - lambda.tangential[i * nt + q]).powi(2);
                 norm2 += buf[q] * buf[q];

@@ -19,6 +19,7 @@ fn points(n: usize, dim: usize, w: &[f64], friction: f64) -> ContactPoints {
         weight: w[..n].iter().map(|x| 0.5 + x.abs()).collect(),
         gap: vec![0.0; n],
         friction: vec![friction; n],
+        held: vec![[false; 2]; n],
     }
 }
 
@@ -624,6 +625,93 @@ fn a_stall_past_uniqueness_is_diagnosed() {
             assert!(e.to_string().contains("uniqueness"), "{e}");
         } else {
             assert!(matches!(e, ContactError::Stalled { .. }), "{e}");
+        }
+    }
+}
+
+/// The compliance of a problem whose held directions move with no force: their rows and columns
+/// of `D` zero, as the condensation of a body whose support holds those components gives, with
+/// `u0` there the prescribed value.
+fn held_problem(op: &DenseContactProblem, pts: &ContactPoints) -> DenseContactProblem {
+    let (n, nt) = (pts.len(), op.nt);
+    let m = n * (1 + nt);
+    let held = |r: usize| r >= n && pts.is_held((r - n) / nt, (r - n) % nt);
+    let mut out = op.clone();
+    for r in 0..m {
+        for c in 0..m {
+            if held(r) || held(c) {
+                out.compliance[r * m + c] = 0.0;
+            }
+        }
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// A tangential direction held by a support carries no multiplier, and the law acts in the
+    /// others: in 2D a held tangent is a frictionless point (the same answer as `F = 0` there);
+    /// in 3D, Newton, Gauss–Seidel and Uzawa agree, every held multiplier is exactly 0, and
+    /// Coulomb's law holds in the free direction (stick: `u_t = 0` there; slip: `λ_t` along
+    /// `u_t` at `F λ_n`).
+    #[test]
+    fn held_directions_carry_no_multiplier(n in 2usize..=5, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 5), load in prop::collection::vec(-1.0f64..1.0, 15), mask in prop::collection::vec(0u8..4, 5), f in 0.05f64..0.4) {
+        // 2D: held ⇔ frictionless at that point
+        let mut pts = points(n, 2, &w, f);
+        for i in 0..n {
+            pts.held[i][0] = mask[i] & 1 == 1;
+        }
+        let op = held_problem(&problem(n, 1, &pts, &seed, &load), &pts);
+        let params = NewtonParams { tol: 1e-13, ..Default::default() };
+        let held = solve_newton(&mut op.clone(), &pts, &Law::Coulomb, &params, None, &mut |_| {}).unwrap();
+        let mut free = pts.clone();
+        for i in 0..n {
+            if free.held[i][0] {
+                free.held[i][0] = false;
+                free.friction[i] = 0.0;
+            }
+        }
+        let frictionless = solve_newton(&mut op.clone(), &free, &Law::Coulomb, &params, None, &mut |_| {}).unwrap();
+        let d = held.lambda.minus(&frictionless.lambda).norm();
+        prop_assert!(d <= 1e-9 * held.lambda.norm().max(1e-300), "2D: {d}");
+        // 3D, any mask of the two tangents
+        let mut pts = points(n, 3, &w, f);
+        for i in 0..n {
+            pts.held[i] = [mask[i] & 1 == 1, mask[i] & 2 == 2];
+        }
+        let op = held_problem(&problem(n, 2, &pts, &seed, &load), &pts);
+        let newton = solve_newton(&mut op.clone(), &pts, &Law::Coulomb, &params, None, &mut |_| {}).unwrap();
+        let gs = solve_gauss_seidel(&mut op.clone(), &pts, &Law::Coulomb, &GaussSeidelParams { tol: 1e-13, ..Default::default() }, None, &mut |_| {}).unwrap();
+        let scale = newton.lambda.norm().max(1e-300);
+        prop_assert!(gs.lambda.minus(&newton.lambda).norm() <= 1e-8 * scale);
+        let tresca_bound: Vec<f64> = newton.lambda.normal.iter().map(|l| f * l.max(0.0)).collect();
+        let uzawa = solve(&mut op.clone(), &pts, &Law::Tresca(tresca_bound), &tight(1e-12), None, &mut |_| {}).unwrap();
+        prop_assert!(uzawa.lambda.minus(&newton.lambda).norm() <= 1e-7 * scale, "Tresca at Newton's bound");
+        for sol in [&newton, &gs, &uzawa] {
+            for i in 0..n {
+                for q in 0..2 {
+                    if pts.held[i][q] {
+                        prop_assert_eq!(sol.lambda.tangential[2 * i + q], 0.0);
+                    }
+                }
+            }
+        }
+        for i in 0..n {
+            let (ln, lt, ut) = (newton.lambda.normal[i], newton.lambda.tangential_of(i), newton.u.tangential_of(i));
+            let free: Vec<usize> = (0..2).filter(|&q| !pts.held[i][q]).collect();
+            let lt_norm = free.iter().map(|&q| lt[q] * lt[q]).sum::<f64>().sqrt();
+            let ut_norm = free.iter().map(|&q| ut[q] * ut[q]).sum::<f64>().sqrt();
+            prop_assert!(lt_norm <= f * ln * (1.0 + 1e-9) + 1e-12 * scale);
+            if ln > 1e-9 * scale && lt_norm < f * ln * (1.0 - 1e-6) {
+                prop_assert!(ut_norm <= 1e-8 * (1.0 + scale), "a sticking point slides: {ut_norm}");
+            }
+            if ut_norm > 1e-8 * (1.0 + scale) {
+                for &q in &free {
+                    let along = f * ln * ut[q] / ut_norm;
+                    prop_assert!((lt[q] - along).abs() <= 1e-7 * (1.0 + scale), "slip direction");
+                }
+            }
         }
     }
 }

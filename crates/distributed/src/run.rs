@@ -115,6 +115,17 @@ pub fn solve<'p>(
                 ))
             })?;
             let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, spec)?;
+            boundary.report_held(&spec.group, reporter);
+            if let Some(node) = boundary.first_held_tangent() {
+                return Err(ProblemError::from(problem::SceneError::new(
+                    "contact.group",
+                    format!(
+                        "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face): the PETSc backend's active sets do not hold a tangent of a contact point; the default backend does",
+                        spec.group
+                    ),
+                ))
+                .into());
+            }
             let law = setup.plan.law(scene, boundary.points.len());
             let rows = ContactRows::new(petsc, &boundary.points, &boundary.nodes, &layout, &system);
             let params = ActiveSetParams {
@@ -162,13 +173,12 @@ pub fn solve<'p>(
     let (u_free, phi_free) = unpermute(&disc, &layout, &x);
     ProblemError::check_finite(&u_free, "the displacement", scene)?;
     ProblemError::check_finite(&phi_free, "the potential", scene)?;
-    let points = contact.as_ref().map(|(b, sol)| (&b.points, sol));
     let recovered = recover(
         scene,
         &setup,
         &disc,
         (&u_free, &phi_free),
-        points,
+        contact.as_ref().map(|(b, sol)| (b, sol)),
         equilibrium,
         reporter,
     )?;

@@ -18,8 +18,58 @@ pub struct ContactBoundary {
     pub points: ContactPoints,
     /// Mesh node of each point.
     pub nodes: Vec<usize>,
-    /// Free u dof of each component of each point's node (`dim` per point).
+    /// The free u dofs of the points' nodes, point by point, components in order: the dofs the
+    /// condensation puts last.
     pub dofs: Vec<usize>,
+    /// Each component (`dim` per point) of the points' displacement: free (its place in
+    /// `dofs`) or prescribed by a Dirichlet condition.
+    slots: Vec<Slot>,
+    /// Nodes of the group whose normal displacement a Dirichlet condition prescribes: the
+    /// support holds them, and they are no contact points (a clamped corner).
+    pub held_nodes: usize,
+    /// Those of them that the condition holds past the gap, inside the foundation (a clamped
+    /// corner of a body pressed in by a negative gap): the condition wins.
+    pub held_inside: usize,
+}
+
+/// One displacement component of a contact point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Slot {
+    /// A free dof, by its place in [`ContactBoundary::dofs`].
+    Free(usize),
+    /// A prescribed value.
+    Fixed(f64),
+}
+
+/// How a contact direction (the normal, or a tangent) meets a node's prescribed components.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Direction {
+    /// No prescribed component moves along it: contact acts.
+    Free,
+    /// Prescribed components alone span it: the support holds it.
+    Held,
+    /// Both: neither contact nor the support alone decides the motion along it.
+    Mixed,
+}
+
+/// Directions within this of the free or the prescribed components are taken as along them.
+const ALIGNED: f64 = 1e-9;
+
+fn direction(d: &[f64; 3], fixed: &[bool], dim: usize) -> Direction {
+    let part = |held: bool| {
+        (0..dim)
+            .filter(|&k| fixed[k] == held)
+            .map(|k| d[k] * d[k])
+            .sum::<f64>()
+            .sqrt()
+    };
+    if part(true) <= ALIGNED {
+        Direction::Free
+    } else if part(false) <= ALIGNED {
+        Direction::Held
+    } else {
+        Direction::Mixed
+    }
 }
 
 /// `t1` = the first axis made orthogonal to `n`; in 3D `t2 = t1 x n` (so that n = -z gives
@@ -111,12 +161,19 @@ fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup) -> Vec<f64> {
 }
 
 impl ContactBoundary {
-    /// The contact points of the group of `spec`: its nodes whose displacement is entirely free
-    /// (clamped nodes are left out), weighted by their lumped boundary mass, with the gap
-    /// `gap + |x - c|²_t / (2R)` (uniform, plus the parabola of a curved body along the face).
+    /// The contact points of the group of `spec`: its nodes, weighted by their lumped boundary
+    /// mass, with the gap `gap + |x - c|²_t / (2R)` (uniform, plus the parabola of a curved
+    /// body along the face). A node some of whose displacement components a Dirichlet condition
+    /// prescribes is a contact point in its free directions: a tangent that the prescribed
+    /// components span is held (its multiplier 0: the support takes the force, as on a symmetry
+    /// plane); a normal they span leaves the node to its support (it is no contact point,
+    /// counted in `held_nodes`, and in `held_inside` where the condition holds it past the gap).
     ///
     /// # Errors
-    /// A missing group, a zero normal, or a group with no free node.
+    /// A missing group, a group with facets inside the mesh, a zero normal or one beyond
+    /// [`MAX_NORMAL_ANGLE_DEG`] of a facet; a node whose prescribed components lie across the
+    /// normal or a tangent (neither along nor orthogonal to it); a group with no contact point
+    /// left.
     pub fn new(mesh: &mesh::Mesh, dofs: &DofMap, spec: &ContactSpec) -> Result<Self, ProblemError> {
         let dim = mesh.dim;
         let center = match &spec.gap_center {
@@ -124,6 +181,7 @@ impl ContactBoundary {
             None => [0.0; 3],
         };
         let nv = unit_normal(spec, dim)?;
+        check_boundary(mesh, &spec.group, "contact.group", "contact face")?;
         check_normal(mesh, spec, nv)?;
         let tangents = tangent_basis(dim, nv);
         let group = mesh.boundary(&spec.group)?;
@@ -137,35 +195,101 @@ impl ContactBoundary {
             weight: vec![],
             gap: vec![],
             friction: vec![],
+            held: vec![],
         };
-        let (mut nodes, mut point_dofs) = (vec![], vec![]);
+        let (mut nodes, mut point_dofs, mut slots) = (vec![], vec![], vec![]);
+        let (mut held_nodes, mut held_inside) = (0, 0);
         for node in group.nodes() {
-            let free: Vec<usize> = (0..dim)
-                .filter_map(|k| match dofs.u[node * dim + k] {
-                    Dof::Free(j) => Some(j),
-                    _ => None,
-                })
-                .collect();
-            if free.len() != dim {
-                continue;
-            }
-            nodes.push(node);
-            point_dofs.extend_from_slice(&free);
             let x = mesh.points[node];
             let d = [x[0] - center[0], x[1] - center[1], x[2] - center[2]];
             let along_n: f64 = (0..3).map(|k| d[k] * nv[k]).sum();
             let dist2 = (0..3).map(|k| d[k] * d[k]).sum::<f64>() - along_n * along_n;
+            let gap = spec.gap + 0.5 * spec.gap_curvature * dist2.max(0.0);
+            let comps: Vec<Dof> = (0..dim).map(|k| dofs.u[node * dim + k]).collect();
+            let fixed: Vec<bool> = comps.iter().map(|c| !matches!(c, Dof::Free(_))).collect();
+            let at = |what: String| {
+                SceneError::new(
+                    "contact.group",
+                    format!(
+                        "node {node} of contact group `{}` (at {:?}): {what}",
+                        spec.group,
+                        &x[..dim]
+                    ),
+                )
+            };
+            let prescribed = |k: usize| match comps[k] {
+                Dof::Fixed(v) => v,
+                _ => 0.0,
+            };
+            let names = |dir: &[f64; 3]| -> String {
+                let axes: Vec<&str> = (0..dim)
+                    .filter(|&k| fixed[k] && dir[k].abs() > ALIGNED)
+                    .map(|k| ["ux", "uy", "uz"][k])
+                    .collect();
+                axes.join(", ")
+            };
+            match direction(&nv, &fixed, dim) {
+                Direction::Held => {
+                    // the support holds the normal: the node is no contact point (the
+                    // Dirichlet condition wins, even where it holds the node past the gap)
+                    let u_n: f64 = (0..dim).map(|k| nv[k] * prescribed(k)).sum();
+                    held_nodes += 1;
+                    if u_n > gap + 1e-12 * (u_n.abs() + gap.abs()) {
+                        held_inside += 1;
+                    }
+                    continue;
+                }
+                Direction::Mixed => {
+                    return Err(at(format!(
+                        "a Dirichlet condition prescribes {}, which lies across the contact normal {:?} (neither along nor orthogonal to it): prescribe components along the normal or the tangents, or none",
+                        names(&nv),
+                        &nv[..dim]
+                    ))
+                    .into())
+                }
+                Direction::Free => {}
+            }
+            let mut held = [false; 2];
+            for q in 0..dim - 1 {
+                match direction(&tangents[q], &fixed, dim) {
+                    Direction::Free => {}
+                    Direction::Held => held[q] = true,
+                    Direction::Mixed => {
+                        return Err(at(format!(
+                            "a Dirichlet condition prescribes {}, which lies across the contact tangent {:?} (neither along nor orthogonal to it): prescribe components along the normal or the tangents, or none",
+                            names(&tangents[q]),
+                            &tangents[q][..dim]
+                        ))
+                        .into())
+                    }
+                }
+            }
+            for c in &comps {
+                slots.push(match *c {
+                    Dof::Free(j) => {
+                        point_dofs.push(j);
+                        Slot::Free(point_dofs.len() - 1)
+                    }
+                    Dof::Fixed(v) => Slot::Fixed(v),
+                    Dof::Absent => Slot::Fixed(0.0),
+                });
+            }
+            nodes.push(node);
             points.position.push(x);
             points.normal.push(nv);
             points.tangent.push(tangents);
             points.weight.push(weight[node]);
-            points.gap.push(spec.gap + 0.5 * spec.gap_curvature * dist2.max(0.0));
+            points.gap.push(gap);
             points.friction.push(friction);
+            points.held.push(held);
         }
         if nodes.is_empty() {
             return Err(SceneError::new(
                 "contact.group",
-                format!("contact group `{}` has no node with a free displacement", spec.group),
+                format!(
+                    "contact group `{}` has no contact point: Dirichlet conditions prescribe the normal displacement of all its {held_nodes} nodes, so the support holds them and contact never acts (remove the contact, or the condition on the normal component)",
+                    spec.group
+                ),
             )
             .into());
         }
@@ -173,21 +297,55 @@ impl ContactBoundary {
             points,
             nodes,
             dofs: point_dofs,
+            slots,
+            held_nodes,
+            held_inside,
         })
     }
 
-    /// The contact forces `-Nᵀ W λ_n - Tᵀ W λ_t` on the contact dofs, in the order of `dofs`.
+    /// Tells `reporter` what Dirichlet conditions hold of the group `group` where it is more
+    /// than nodes clamped within the gap (the corners of a clamped body): held tangents, or
+    /// nodes held inside the foundation.
+    pub fn report_held(&self, group: &str, reporter: &mut dyn crate::Reporter) {
+        let nt = self.points.n_tangential();
+        let tangents = (0..self.points.len())
+            .filter(|&i| self.points.held[i][..nt].iter().any(|&h| h))
+            .count();
+        if tangents + self.held_inside > 0 {
+            reporter.event(&crate::Event::ContactHeld {
+                group,
+                tangents,
+                nodes: self.held_nodes,
+                inside: self.held_inside,
+            });
+        }
+    }
+
+    /// The first point with a tangent held by a support, as its mesh node (for a backend that
+    /// cannot hold a tangent of a contact point).
+    pub fn first_held_tangent(&self) -> Option<usize> {
+        let nt = self.points.n_tangential();
+        (0..self.points.len())
+            .find(|&i| self.points.held[i][..nt].iter().any(|&h| h))
+            .map(|i| self.nodes[i])
+    }
+
+    /// The contact forces `-Nᵀ W λ_n - Tᵀ W λ_t` on the contact dofs, in the order of `dofs`
+    /// (the components a support holds take theirs from it).
     pub fn forces(&self, lambda: &PointValues) -> Vec<f64> {
         let p = &self.points;
         let (dim, nt) = (p.dim, lambda.n_tangential());
         let mut out = vec![0.0; self.dofs.len()];
         for i in 0..p.len() {
             for k in 0..dim {
+                let Slot::Free(j) = self.slots[i * dim + k] else {
+                    continue;
+                };
                 let mut f = lambda.normal[i] * p.normal[i][k];
                 for q in 0..nt {
                     f += lambda.tangential[i * nt + q] * p.tangent[i][q][k];
                 }
-                out[i * dim + k] = -p.weight[i] * f;
+                out[j] = -p.weight[i] * f;
             }
         }
         out
@@ -200,12 +358,23 @@ impl ContactBoundary {
         }
     }
 
+    /// Point `i`'s displacement from the values `u_c` at the contact dofs (in the order of
+    /// `dofs`) and the prescribed components.
+    fn point_u(&self, i: usize, u_c: &[f64]) -> [f64; 3] {
+        let dim = self.points.dim;
+        std::array::from_fn(|k| match self.slots.get(i * dim + k) {
+            Some(Slot::Free(j)) if k < dim => u_c[*j],
+            Some(Slot::Fixed(v)) if k < dim => *v,
+            _ => 0.0,
+        })
+    }
+
     /// `u_n` and `u_t` of the values `u_c` at the contact dofs (in the order of `dofs`).
     fn project(&self, u_c: &[f64], out: &mut PointValues) {
         let p = &self.points;
         let (dim, nt) = (p.dim, out.n_tangential());
         for i in 0..p.len() {
-            let ui = &u_c[i * dim..(i + 1) * dim];
+            let ui = self.point_u(i, u_c);
             out.normal[i] = (0..dim).map(|k| ui[k] * p.normal[i][k]).sum();
             for q in 0..nt {
                 out.tangential[i * nt + q] = (0..dim).map(|k| ui[k] * p.tangent[i][q][k]).sum();
@@ -237,7 +406,7 @@ impl ContactBoundary {
         let p = &self.points;
         let (n, dim) = (p.len(), p.dim);
         let m = n * (1 + nt);
-        // rows of R: the normal, then the tangents, of each point, over its dim dofs
+        // rows of R: the normal, then the tangents, of each point, over its free dofs
         let dir = |r: usize| -> (usize, [f64; 3]) {
             if r < n {
                 (r, p.normal[r])
@@ -246,21 +415,31 @@ impl ContactBoundary {
                 (i, p.tangent[i][q])
             }
         };
+        let free = |i: usize| -> Vec<(usize, usize)> {
+            (0..dim)
+                .filter_map(|x| match self.slots[i * dim + x] {
+                    Slot::Free(j) => Some((x, j)),
+                    Slot::Fixed(_) => None,
+                })
+                .collect()
+        };
+        let free: Vec<Vec<(usize, usize)>> = (0..n).map(free).collect();
         let mut d = vec![0.0; m * m];
         for r in 0..m {
             let (i, a) = dir(r);
             for c in 0..=r {
                 let (j, b) = dir(c);
                 let mut v = 0.0;
-                for x in 0..dim {
-                    for y in 0..dim {
-                        v += a[x] * inv[(i * dim + x) * k + j * dim + y] * b[y];
+                for &(x, jx) in &free[i] {
+                    for &(y, jy) in &free[j] {
+                        v += a[x] * inv[jx * k + jy] * b[y];
                     }
                 }
                 d[r * m + c] = v;
                 d[c * m + r] = v;
             }
         }
+        hold_rows(&mut d, m, n, nt, p);
         let mut u0 = PointValues::zeros(n, nt);
         self.project(&condensed.loads.solution, &mut u0);
         let problem = DenseContactProblem {
@@ -287,6 +466,46 @@ impl ContactBoundary {
     ) -> Result<(Vec<f64>, Vec<f64>), ProblemError> {
         Ok(solver.solve_with_update(loads, b_u, b_phi, &self.forces(lambda))?)
     }
+}
+
+/// A held tangent moves with no force (its rows and columns of `D` vanish) and its multiplier
+/// is 0 whatever `D` holds there: its diagonal is set to the mean of the others, so that `D`
+/// stays definite for the solvers that factor it, without changing the solution.
+fn hold_rows(d: &mut [f64], m: usize, n: usize, nt: usize, p: &ContactPoints) {
+    let held = |r: usize| r >= n && p.is_held((r - n) / nt, (r - n) % nt);
+    let (sum, count) = (0..m)
+        .filter(|&r| !held(r))
+        .fold((0.0, 0usize), |(s, c), r| (s + d[r * m + r], c + 1));
+    let mean = if count > 0 && sum > 0.0 {
+        sum / count as f64
+    } else {
+        1.0
+    };
+    for r in (0..m).filter(|&r| held(r)) {
+        d[r * m + r] = mean;
+    }
+}
+
+/// The facets of `group` must lie on the boundary where `what` needs a boundary (a traction, a
+/// contact face): the scene `key` names the group.
+///
+/// # Errors
+/// A scene error naming `key` where the group has facets inside the mesh.
+pub(crate) fn check_boundary(mesh: &mesh::Mesh, group: &str, key: &str, what: &str) -> Result<(), ProblemError> {
+    let inside = mesh.interior_facets(group)?;
+    if let Some(&f) = inside.first() {
+        let at = mesh.points[mesh.boundary(group)?.facet(f)[0]];
+        return Err(SceneError::new(
+            key,
+            format!(
+                "{key} `{group}` has {} facet(s) inside the mesh (shared by two cells, the first at {:?}): a {what} lies on the boundary (an interior group serves as an electrode or a Dirichlet condition)",
+                inside.len(),
+                &at[..mesh.dim]
+            ),
+        )
+        .into());
+    }
+    Ok(())
 }
 
 /// One full primal solve per call (warm-started: the iterative linear solver starts from the

@@ -13,6 +13,17 @@ pub enum Event<'a> {
     Planned(&'a Plan),
     /// The mesh's checks noted something without refusing the mesh.
     MeshNotes(crate::setup::MeshNotes),
+    /// Dirichlet conditions hold some nodes or directions of the contact group.
+    ContactHeld {
+        /// The group.
+        group: &'a str,
+        /// Contact points with a tangent held (no multiplier there).
+        tangents: usize,
+        /// Nodes whose normal displacement is prescribed: no contact points.
+        nodes: usize,
+        /// Those of them held past the gap, inside the foundation.
+        inside: usize,
+    },
     /// The blocks and loads are assembled.
     Assembled {
         /// Mesh nodes.
@@ -118,11 +129,52 @@ impl fmt::Display for Event<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Event::Planned(plan) => write!(f, "{plan}"),
-            Event::MeshNotes(n) => write!(
-                f,
-                "note: the mesh reader turned {} cells round (a surface written clockwise); {} nodes lie at the coordinates of another node (a crack, or parts not merged)",
-                n.reoriented_cells, n.coincident_nodes
-            ),
+            Event::MeshNotes(n) => {
+                let mut notes = vec![];
+                if n.reoriented_cells > 0 {
+                    notes.push(format!(
+                        "the mesh reader turned {} cells round (a surface written clockwise)",
+                        n.reoriented_cells
+                    ));
+                }
+                if n.coincident_nodes > 0 {
+                    notes.push(format!(
+                        "{} nodes lie at the coordinates of another node (a crack, or parts not merged)",
+                        n.coincident_nodes
+                    ));
+                }
+                if n.unused_nodes > 0 {
+                    notes.push(format!(
+                        "{} nodes belong to no cell (the centre of an arc, a point off the body): they carry no unknown",
+                        n.unused_nodes
+                    ));
+                }
+                write!(f, "note: {}", notes.join("; "))
+            }
+            Event::ContactHeld {
+                group,
+                tangents,
+                nodes,
+                inside,
+            } => {
+                let mut notes = vec![];
+                if *tangents > 0 {
+                    notes.push(format!(
+                        "{tangents} contact points have a tangent held by a Dirichlet condition (no friction force there: the support takes it)"
+                    ));
+                }
+                if *nodes > 0 {
+                    notes.push(format!(
+                        "{nodes} nodes have their normal displacement prescribed and are left to their supports"
+                    ));
+                }
+                if *inside > 0 {
+                    notes.push(format!(
+                        "{inside} of them held past the gap, inside the foundation (the Dirichlet condition wins)"
+                    ));
+                }
+                write!(f, "note: contact group `{group}`: {}", notes.join("; "))
+            }
             Event::Assembled {
                 n_nodes,
                 n_cells,

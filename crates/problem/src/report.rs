@@ -61,6 +61,7 @@ impl MeshReport {
             cells_per_axis: scene.mesh.cells_per_axis(),
             reoriented_cells: setup.notes.reoriented_cells,
             coincident_nodes: setup.notes.coincident_nodes,
+            unused_nodes: setup.notes.unused_nodes,
         }
     }
 }
@@ -122,6 +123,9 @@ pub struct MeshReport {
     /// Nodes at the coordinates of another node (a crack, or parts not merged).
     #[serde(default)]
     pub coincident_nodes: usize,
+    /// Nodes that no cell uses (the centre of a Gmsh arc): they carry no unknown.
+    #[serde(default)]
+    pub unused_nodes: usize,
 }
 
 /// Free unknowns.
@@ -158,6 +162,17 @@ pub struct ContactReport {
     /// The largest contact pressure (absent without contact).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_lambda_n: Option<f64>,
+    /// Points with a tangent that a Dirichlet condition holds (no multiplier there: the
+    /// support takes the force, as on a symmetry plane).
+    #[serde(default)]
+    pub held_tangent_points: usize,
+    /// Nodes of the contact group whose normal displacement a Dirichlet condition prescribes:
+    /// the support holds them, and they are no contact points.
+    #[serde(default)]
+    pub held_nodes: usize,
+    /// Those of them held past the gap, inside the foundation (the condition wins).
+    #[serde(default)]
+    pub held_inside: usize,
 }
 
 impl ContactReport {
@@ -182,6 +197,11 @@ impl ContactReport {
             normal_force,
             tangential_force: linalg::norm(&t),
             max_lambda_n: Some(sol.lambda.normal.iter().cloned().fold(0.0f64, f64::max)),
+            held_tangent_points: (0..points.len())
+                .filter(|&i| points.held[i][..points.n_tangential()].iter().any(|&h| h))
+                .count(),
+            held_nodes: 0,
+            held_inside: 0,
         }
     }
 }

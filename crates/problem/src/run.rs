@@ -117,7 +117,7 @@ pub fn solve_within(
         pcg_iters: solved.pcg_iters,
         equilibrium,
     });
-    let contact = solved.contact.as_ref().map(|(b, sol)| (&b.points, sol));
+    let contact = solved.contact.as_ref().map(|(b, sol)| (b, sol));
     let recovered = recover(
         scene,
         &setup,
@@ -304,6 +304,9 @@ fn factor(
         Some(spec) => Some(ContactBoundary::new(&setup.mesh, &a.disc.dofs, spec)?),
         None => None,
     };
+    if let (Some(b), Some(spec)) = (&boundary, &scene.contact) {
+        b.report_held(&spec.group, reporter);
+    }
     let par = faer::Par::Seq;
     let budget = factor_budget(setup, a, boundary.as_ref(), limits)?;
     let too_large = |e: linalg::LinalgError| too_large(e, limits);
@@ -580,7 +583,7 @@ pub struct Recovered {
 }
 
 /// Expands the free unknowns `(u, φ)` to the nodes, recovers stress and electric
-/// displacement per cell, counts the contact solution (on its `points`), measures the error
+/// displacement per cell, counts the contact solution (on its boundary), measures the error
 /// against the scene's exact solution, and checks that every reported number (with the
 /// run's `equilibrium` residual) is finite.
 ///
@@ -591,17 +594,21 @@ pub fn recover(
     setup: &Setup,
     disc: &Discretization<'_>,
     (u_free, phi_free): (&[f64], &[f64]),
-    contact: Option<(&ContactPoints, &ContactSolution)>,
+    contact: Option<(&ContactBoundary, &ContactSolution)>,
     equilibrium: f64,
     reporter: &mut dyn Reporter,
 ) -> Result<Recovered, ProblemError> {
     let u = disc.dofs.expand_u(u_free);
     let phi = disc.dofs.expand_phi(phi_free);
     let fields = disc.recover(&u, &phi);
-    let counts = contact.map_or_else(ContactReport::default, |(points, sol)| ContactReport::of(points, sol));
+    let counts = contact.map_or_else(ContactReport::default, |(b, sol)| ContactReport {
+        held_nodes: b.held_nodes,
+        held_inside: b.held_inside,
+        ..ContactReport::of(&b.points, sol)
+    });
     let exact = match (&setup.exact, contact) {
         (Some(ex), _) => Some(ex.errors(disc, &u, &phi, setup.plan.electric)),
-        (None, Some((points, sol))) => contact_errors(scene, points, sol, counts.normal_force, counts.tangential_force),
+        (None, Some((b, sol))) => contact_errors(scene, &b.points, sol, counts.normal_force, counts.tangential_force),
         (None, None) => None,
     };
     if let Some(e) = &exact {

@@ -36,6 +36,8 @@ pub struct MeshNotes {
     pub reoriented_cells: usize,
     /// Nodes at the coordinates of another node (a crack, or parts not merged).
     pub coincident_nodes: usize,
+    /// Nodes that no cell uses (the centre of a Gmsh arc): carried with no unknown.
+    pub unused_nodes: usize,
 }
 
 /// Makes the [`Setup`] of a validated scene. `given` is the mesh of a `gmsh` scene, read by
@@ -132,7 +134,11 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     let notes = MeshNotes {
         reoriented_cells: mesh.reoriented_cells,
         coincident_nodes: quality.coincident_nodes,
+        unused_nodes: quality.unused_nodes,
     };
+    if let Some(l) = &scene.load {
+        crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;
+    }
     for r in &m.regions {
         let cells: Vec<usize> = (0..mesh.n_cells())
             .filter(|&c| {

@@ -266,6 +266,7 @@ mod tests {
                     weight: (0..n).map(|i| 0.5 + 0.1 * i as f64).collect(),
                     gap: vec![0.0; n],
                     friction: vec![0.3; n],
+                    held: vec![[false; 2]; n],
                 };
                 // an SPD compliance with zeros: a Gram matrix plus the identity
                 let g = |i: usize, j: usize| ((i * 7 + j * 3 + case) % 5) as f64 * 0.1 - 0.2;

@@ -9,7 +9,6 @@
 
 use crate::operator::Compliance;
 use crate::points::{ContactPoints, PointValues};
-use crate::projection::project_disc;
 use crate::Law;
 
 /// One row of the generalised Jacobian, `J_r = E_r + B_r C`: `(index, coefficient)` pairs.
@@ -204,7 +203,7 @@ impl<'a> Flat<'a> {
             if self.nt > 0 {
                 let t = self.n + i * self.nt;
                 buf[..self.nt].copy_from_slice(&z[t..t + self.nt]);
-                project_disc(&mut buf[..self.nt], self.radius(i, &z));
+                self.points.project_friction(i, &mut buf[..self.nt], self.radius(i, &z));
                 for k in 0..self.nt {
                     f[t + k] = x[t + k] - buf[k];
                 }
@@ -230,7 +229,11 @@ impl<'a> Flat<'a> {
                 continue;
             }
             let t = n + i * nt;
-            let q = &s.z[t..t + nt];
+            // the projection sees the free directions only (a held one's multiplier is 0)
+            let mut held_out = [0.0; 2];
+            held_out[..nt].copy_from_slice(&s.z[t..t + nt]);
+            self.points.hold(i, &mut held_out[..nt]);
+            let q = &held_out[..nt];
             let qn = crate::projection::norm(q);
             let radius = self.radius(i, &s.z);
             let branch = if !(radius > 0.0) {
@@ -242,6 +245,11 @@ impl<'a> Flat<'a> {
             };
             for k in 0..nt {
                 let row = &mut rows[t + k];
+                if self.points.is_held(i, k) {
+                    // λ_t,k = 0: the identity
+                    row.e.push((t + k, 1.0));
+                    continue;
+                }
                 match branch {
                     // λ_t - z_t: derivative C
                     Branch::Stick => row.b.push((t + k, 1.0)),
@@ -256,7 +264,7 @@ impl<'a> Flat<'a> {
                             _ => 0.0,
                         };
                         row.e.push((t + k, 1.0));
-                        for l in 0..nt {
+                        for l in (0..nt).filter(|&l| !self.points.is_held(i, l)) {
                             let proj = if k == l { 1.0 } else { 0.0 } - (q[k] / qn) * (q[l] / qn);
                             if proj != 0.0 {
                                 row.e.push((t + l, -ratio * proj));

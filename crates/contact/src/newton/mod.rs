@@ -40,7 +40,6 @@ mod equations;
 
 use crate::operator::AffineProblem;
 use crate::points::{ContactPoints, PointValues};
-use crate::projection::project_disc;
 use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Counter};
 use crate::{
     ContactError, ContactInfo, ContactSolution, GaussSeidelParams, Interrupt, Interruption, Iterate, Law, Measure,
@@ -598,7 +597,7 @@ fn fallback<P: AffineProblem>(
     start.normal.iter_mut().for_each(|v| *v = v.max(0.0));
     let radius = slip_bound(points, law, &start.normal);
     for i in 0..n {
-        project_disc(&mut start.tangential[i * nt..(i + 1) * nt], radius[i]);
+        points.project_friction(i, &mut start.tangential[i * nt..(i + 1) * nt], radius[i]);
     }
     let mut sol = if *law == Law::Coulomb {
         // Coulomb's law directly, point by point
