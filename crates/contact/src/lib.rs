@@ -163,7 +163,7 @@ pub enum ContactError {
     },
     /// The multipliers do not move the contact points: the dual operator's largest eigenvalue
     /// is not positive and finite.
-    #[error("the dual operator's largest eigenvalue estimate is {mu_max}: the contact points are not loaded by their multipliers")]
+    #[error("the compliance's largest eigenvalue estimate is {mu_max} (the dual operator D W, Siconos' W): the multipliers move no contact point, so the compliance is zero, or not positive semidefinite, or not finite")]
     NotLoaded {
         /// The estimate.
         mu_max: f64,

@@ -7,7 +7,9 @@
 //! contiguous, normal first: `[r_N, r_T1 (, r_T2)]`.
 //!
 //! The file holds, whitespace-separated: the dimension (2 or 3), the number of contacts, the
-//! matrix `W`, then `q` (one value per row) and `μ` (one per contact). `W` is a Siconos
+//! matrix `W`, then `q` (one value per row) and `μ` (one per contact), and, from Siconos'
+//! older printers, the flag `isComplete` (0 or 1); nothing else (a file with more data than its
+//! counts announce is refused). `W` is a Siconos
 //! "NumericsMatrix": its storage (0 dense, 1 sparse block, 2 sparse), its two sizes, then
 //! - dense: the two sizes again and the values column by column;
 //! - sparse block: the number of blocks, of block rows and of block columns, the cumulative
@@ -193,7 +195,46 @@ impl FrictionProblem {
                 mu[i]
             )));
         }
+        // Siconos' `isComplete` flag, which its older printers write after μ
+        let before_flag = (c.pos, c.line);
+        if !matches!(c.token(""), Ok(("0" | "1", _))) {
+            (c.pos, c.line) = before_flag;
+        }
+        // the file is read exactly: data after μ mean that the counts do not fit the data
+        if let Ok((extra, line)) = c.token("") {
+            return Err(FormatError::Invalid(format!(
+                "line {line}: `{}` after the {nc} friction coefficients: the file holds more than its header announces (a count of contacts too small, or a second problem)",
+                extra.chars().take(40).collect::<String>()
+            )));
+        }
         Ok(FrictionProblem { dim, w, q, mu, storage })
+    }
+
+    /// Why `W` is not a Delassus operator (`H M⁻¹ Hᵀ`, positive semidefinite), where a
+    /// contact's own block shows it: a block whose symmetric part has a negative eigenvalue
+    /// (beyond round-off of the block's size) makes `W` indefinite, a problem no contact
+    /// solver's theory covers. `None` where every block is semidefinite.
+    pub fn indefinite(&self) -> Option<String> {
+        let d = self.dim;
+        for c in 0..self.n_contacts() {
+            let mut b = [[0.0f64; 3]; 3];
+            for (i, row) in b.iter_mut().enumerate().take(d) {
+                for (j, v) in row.iter_mut().enumerate().take(d) {
+                    *v = 0.5 * (entry(self, c * d + i, c * d + j) + entry(self, c * d + j, c * d + i));
+                }
+            }
+            let size = b.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+            let m = faer::Mat::<f64>::from_fn(d, d, |i, j| b[i][j]);
+            let lowest = m
+                .self_adjoint_eigenvalues(faer::Side::Lower)
+                .map_or(f64::NAN, |e| e.first().copied().unwrap_or(0.0));
+            if !(lowest >= -1e-12 * size) {
+                return Some(format!(
+                    "W is indefinite: the block of contact {c} has the eigenvalue {lowest:.3e} (a Delassus operator W = H M⁻¹ Hᵀ is positive semidefinite)"
+                ));
+            }
+        }
+        None
     }
 
     /// Number of contacts.
@@ -674,7 +715,8 @@ fn sparse(c: &mut Cursor<'_>, m: usize) -> Result<Entries, FormatError> {
         .and_then(|(_, rest)| rest.trim().split(|ch: char| ch == ',' || ch.is_whitespace()).next())
         .and_then(|t| t.parse().ok())
         .ok_or_else(|| unexpected("`nnz: N` in CSparse's header", header, line))?;
-    let mut entries = Vec::with_capacity(nnz);
+    // an untrusted count: the text left bounds the entries it can hold (4 bytes each at least)
+    let mut entries = Vec::with_capacity(nnz.min((c.text.len() - c.pos) / 4));
     // "i : x" (compressed) or "i j : x" (triplet)
     let mut entry = |c: &mut Cursor<'_>, col: Option<usize>| -> Result<(), FormatError> {
         let expected = if col.is_some() { "`i : x`" } else { "`i j : x`" };

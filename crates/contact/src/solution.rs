@@ -175,6 +175,9 @@ pub enum Measure {
     /// unweighted, relative to `max(‖u0 - g‖, ‖λ‖, ‖u - g‖)` ([`desaxce_residual`]). It mixes
     /// the units of forces and displacements, so it means most where the compliance is near 1.
     DeSaxce,
+    /// The larger of the two: a solve that meets it meets both (where one measure breaks down,
+    /// a huge `μ` or a tiny `q` making Siconos' error vanish at `r = 0`, the other does not).
+    Both,
 }
 
 /// An iterate that a stopped solve hands back: multipliers, the displacement they give, and
@@ -391,6 +394,9 @@ impl Measure {
                 complementarity_residual(points, &radius, lambda, u, c, reference)
             }
             Measure::DeSaxce => desaxce_residual(points, law, lambda, u, u0),
+            Measure::Both => Measure::Complementarity
+                .of(points, law, lambda, u, u0, c, reference)
+                .max(Measure::DeSaxce.of(points, law, lambda, u, u0, c, reference)),
         }
     }
 }

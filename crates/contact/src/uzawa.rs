@@ -384,6 +384,15 @@ impl Dual<'_, '_> {
             (Measure::DeSaxce, None) => {
                 desaxce_residual(self.points, &Law::Tresca(radius.to_vec()), lambda, u, &self.u0)
             }
+            (Measure::Both, law) => {
+                let complementarity =
+                    complementarity_residual(self.points, radius, lambda, u, self.canon, self.reference);
+                let siconos = match law {
+                    Some(law) => desaxce_residual(self.points, law, lambda, u, &self.u0),
+                    None => desaxce_residual(self.points, &Law::Tresca(radius.to_vec()), lambda, u, &self.u0),
+                };
+                complementarity.max(siconos)
+            }
         }
     }
 

@@ -24,10 +24,14 @@ pub enum Solver {
     Nsgs,
 }
 
-/// The residual a solve must meet, as the command names it.
+/// The residual the solver iterates on, as the command names it. Whichever it is, a file is
+/// solved only where both residuals meet the tolerance (each breaks down where the other does
+/// not: Siconos' error vanishes at `r = 0` for a huge `μ` or a tiny `q`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Criterion {
+    /// The larger of the two (the default).
+    Both,
     /// Siconos' error (De Saxcé's natural map, relative to max(|q|, |r|, |u|)).
     Siconos,
     /// The contact crate's complementarity residual.
@@ -37,11 +41,16 @@ pub enum Criterion {
 impl Criterion {
     fn measure(self) -> Measure {
         match self {
+            Criterion::Both => Measure::Both,
             Criterion::Siconos => Measure::DeSaxce,
             Criterion::Crate => Measure::Complementarity,
         }
     }
 }
+
+/// The tolerances a file can be solved to: below 1e-15 round-off keeps either residual above
+/// it; at 1 and beyond, every point (even `r = 0`) passes.
+pub const TOLERANCES: (f64, f64) = (1e-15, 1e-1);
 
 impl Solver {
     /// The name the command line takes.
@@ -60,14 +69,31 @@ impl Solver {
 pub struct Options {
     /// The solver.
     pub solver: Solver,
-    /// The tolerance.
+    /// The tolerance, in [`TOLERANCES`].
     pub tol: f64,
-    /// The residual that must meet it.
+    /// The residual the solver iterates on.
     pub criterion: Criterion,
-    /// Time allowed per file.
-    pub time_limit: std::time::Duration,
+    /// Time allowed per file (`None`: no limit).
+    pub time_limit: Option<std::time::Duration>,
     /// Whether to print the solver's progress lines.
     pub verbose: bool,
+}
+
+impl Options {
+    /// Checks the tolerance's range.
+    ///
+    /// # Errors
+    /// [`DriverError::Usage`] naming the option.
+    pub fn check(&self) -> Result<(), DriverError> {
+        let (lo, hi) = TOLERANCES;
+        if !(self.tol >= lo && self.tol <= hi) {
+            return Err(DriverError::Usage(format!(
+                "--tol {} is outside [{lo:e}, {hi:e}]: below it round-off keeps the residuals above it, above it every point passes (even r = 0)",
+                self.tol
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// One file's line of the summary.
@@ -89,10 +115,13 @@ pub struct Row {
     pub residual: f64,
     /// Siconos' error of the answer.
     pub siconos_error: f64,
-    /// Whether the solver reached the tolerance.
+    /// Whether both residuals meet the tolerance (the file is solved).
     pub converged: bool,
     /// `solved`, or the solver's error.
     pub outcome: String,
+    /// The CSV of `(r, u)` in the output set (solved files, with `--out`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub csv: Option<String>,
 }
 
 /// A solution in Siconos' terms: the reactions `r` and the velocities `u = W r + q`.
@@ -107,8 +136,17 @@ pub fn read(path: &Path) -> Result<FrictionProblem, DriverError> {
         file: path.display().to_string(),
         message,
     };
+    // a FIFO or a device would block the read, or never end it
+    let meta = std::fs::metadata(path).map_err(|e| bad(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(bad("is not a regular file (a directory, a FIFO or a device)".into()));
+    }
     let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
-    FrictionProblem::parse(&text).map_err(|e| bad(e.to_string()))
+    let problem = FrictionProblem::parse(&text).map_err(|e| bad(e.to_string()))?;
+    if let Some(why) = problem.indefinite() {
+        return Err(bad(why));
+    }
+    Ok(problem)
 }
 
 /// Solves the problem of file `file` (its name, for the row); the solution (when there is one)
@@ -122,7 +160,7 @@ pub fn solve(
     let points = problem.points();
     let start = Instant::now();
     let interrupt = Interrupt {
-        deadline: Some(start + options.time_limit),
+        deadline: options.time_limit.and_then(|l| start.checked_add(l)),
         cancel: None,
     };
     let mut sparse = problem.sparse_problem();
@@ -180,6 +218,7 @@ pub fn solve(
         siconos_error: f64::NAN,
         converged: false,
         outcome: String::new(),
+        csv: None,
     };
     match solved {
         Ok(sol) => {
@@ -188,9 +227,27 @@ pub fn solve(
             row.iterations = sol.info.newton_iters + sol.info.uzawa_iters;
             row.residual = sol.info.complementarity;
             row.siconos_error = problem.error(&r);
-            row.converged = true;
-            row.outcome = "solved".into();
-            (row, Some((r, u)))
+            let tol = options.tol;
+            let failed: Vec<String> = [
+                ("the contact crate's complementarity residual", row.residual),
+                ("Siconos' error", row.siconos_error),
+            ]
+            .iter()
+            .filter(|(_, v)| !(*v <= tol))
+            .map(|(what, v)| format!("{what} {v:.2e}"))
+            .collect();
+            row.converged = failed.is_empty();
+            row.outcome = if row.converged {
+                "solved".into()
+            } else {
+                format!(
+                    "not solved: {} above the tolerance {tol:e} (the solver met its criterion, {})",
+                    failed.join(" and "),
+                    options.criterion.name()
+                )
+            };
+            let solved = row_solution(row.converged, r, u);
+            (row, solved)
         }
         Err(e) => {
             if let Some(best) = e.best() {
@@ -200,6 +257,22 @@ pub fn solve(
             }
             row.outcome = e.to_string();
             (row, None)
+        }
+    }
+}
+
+/// The solution of a solved row (`None` for one that is not).
+fn row_solution(solved: bool, r: Vec<f64>, u: Vec<f64>) -> Option<Reactions> {
+    solved.then_some((r, u))
+}
+
+impl Criterion {
+    /// The name the command line takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Criterion::Both => "both",
+            Criterion::Siconos => "siconos",
+            Criterion::Crate => "crate",
         }
     }
 }
@@ -248,6 +321,34 @@ pub fn solution_csv(dim: usize, r: &[f64], u: &[f64]) -> String {
     s
 }
 
+/// The name of the CSV of the file at `path`: its stem made a safe file name, with `-2`, `-3`,
+/// ... where files of one name from several directories would share it.
+fn csv_name<'a>(path: &Path, taken: impl Iterator<Item = &'a str>) -> String {
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "problem".to_string(), |s| s.to_string_lossy().into_owned());
+    let safe: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let safe = safe.trim_start_matches('.');
+    let base = if safe.is_empty() { "problem" } else { safe };
+    let taken: Vec<&str> = taken.collect();
+    let mut name = format!("{base}.csv");
+    let mut k = 2;
+    while taken.contains(&name.as_str()) || name == "summary.json" {
+        name = format!("{base}-{k}.csv");
+        k += 1;
+    }
+    name
+}
+
 /// Reads every file (so that a broken one stops the command before any solve), solves each,
 /// and with `out` writes `summary.json` and one CSV of `(r, u)` per solved file, as one set.
 ///
@@ -271,9 +372,11 @@ pub fn run(
             "{}: {} in {:.3} s, siconos error {:.2e}",
             row.file, row.outcome, row.time_s, row.siconos_error
         ));
+        let mut row = row;
         if let (Some(outputs), Some((r, u))) = (outputs.as_mut(), solution) {
-            let stem = row.file.trim_end_matches(".dat");
-            outputs.add(&format!("{stem}.csv"), solution_csv(row.dim, &r, &u).into_bytes());
+            let csv = csv_name(path, outputs.names());
+            outputs.add(&csv, solution_csv(row.dim, &r, &u).into_bytes());
+            row.csv = Some(csv);
         }
         rows.push(row);
     }

@@ -14,6 +14,7 @@
 //! ```
 
 pub mod fclib;
+pub mod limits;
 pub mod output;
 pub mod plots;
 pub mod run;
@@ -54,6 +55,15 @@ pub enum DriverError {
         /// The error of the file system.
         source: std::io::Error,
     },
+    /// An output that would remove or change what the program did not write, or a set's name
+    /// that is not a plain file name.
+    #[error("output: {path} {reason}")]
+    OutputConflict {
+        /// The path at fault.
+        path: String,
+        /// Why.
+        reason: String,
+    },
     /// A picture or file that cannot be made.
     #[error("output: {name}: {message}")]
     Picture {
@@ -70,7 +80,8 @@ pub enum DriverError {
     #[cfg(feature = "petsc")]
     #[error("contact: {0}")]
     ActiveSet(distributed::contact::ActiveSetError),
-    /// Command-line arguments that do not fit together.
+    /// Command-line arguments (or a library caller's) that do not fit together, or are out of
+    /// their range.
     #[error("{0}")]
     Usage(String),
     /// Cases of a study that did not end as they must.

@@ -126,10 +126,11 @@ enum Command {
         /// The tolerance.
         #[arg(long, default_value_t = 1e-8)]
         tol: f64,
-        /// The residual that must meet the tolerance.
-        #[arg(long, value_enum, default_value_t = fclib::Criterion::Siconos)]
+        /// The residual the solver iterates on (a file is solved where both meet the
+        /// tolerance).
+        #[arg(long, value_enum, default_value_t = fclib::Criterion::Both)]
         criterion: fclib::Criterion,
-        /// Seconds allowed per file.
+        /// Seconds allowed per file (`inf`: no limit).
         #[arg(long, default_value_t = 60.0)]
         time_limit: f64,
         /// Print the solver's progress (one line per Newton or proximal step).
@@ -241,12 +242,25 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
                 solver,
                 tol,
                 criterion,
-                time_limit: std::time::Duration::from_secs_f64(time_limit.max(0.0)),
+                time_limit: driver::limits::seconds(time_limit, "--time-limit")?,
                 verbose,
             };
+            options.check()?;
             let rows = fclib::run(&files, &options, out.as_deref(), &mut |l| say(l))?;
             print!("{}", fclib::table(&rows));
-            Ok(())
+            let unsolved: Vec<String> = rows
+                .iter()
+                .filter(|r| !r.converged)
+                .map(|r| format!("{}: {}", r.file, r.outcome))
+                .collect();
+            if unsolved.is_empty() {
+                Ok(())
+            } else {
+                Err(DriverError::Unexpected {
+                    what: "files not solved",
+                    items: unsolved,
+                })
+            }
         }
         Command::Strategies => {
             for s in Strategy::ALL {
@@ -263,15 +277,18 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             set,
             out,
         } => {
-            let stem = scene.trim_end_matches(".toml");
-            let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}-sweep")));
+            // the default under out/, named by the scene file's stem made a safe name
+            let stem = std::path::Path::new(&scene)
+                .file_stem()
+                .map_or_else(|| scene.clone(), |s| s.to_string_lossy().into_owned());
+            let dir = out.unwrap_or_else(|| output::default_dir(&format!("{stem}-sweep")));
             let spec = sweep::SweepSpec { param, from, to, steps };
             sweep::sweep(&scene, &set, &spec, Some(&dir), &mut say).map(|_| ())
         }
         Command::Table1 { loose, tight, out } => {
             let md = table1::markdown(&table1::table1(&loose, &tight, &mut say)?);
             println!("{md}");
-            let mut o = output::Outputs::new(&out.unwrap_or_else(|| PathBuf::from("out").join("table1")));
+            let mut o = output::Outputs::documents(&out.unwrap_or_else(|| PathBuf::from("out").join("table1")));
             o.add("table1.md", md.into_bytes());
             o.commit()
         }
@@ -426,7 +443,7 @@ fn study(
     if strategies.is_empty() {
         strategies.push(base.solver.strategy);
     }
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-study", base.name)));
+    let dir = out.unwrap_or_else(|| output::default_dir(&format!("{}-study", base.name)));
     let spec = convergence::StudySpec {
         sizes,
         strategies,

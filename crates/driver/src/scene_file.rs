@@ -155,23 +155,51 @@ fn apply(tree: &mut toml::Table, o: &str) -> Result<(), String> {
 /// A message naming the part of the key that is not a table, or the key that is not there to
 /// remove.
 pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Result<(), String> {
-    let path: Vec<&str> = key.trim().split('.').collect();
-    if path.iter().any(|p| p.is_empty()) {
-        return Err(format!("`{key}` is not a dotted key"));
-    }
+    let path = key_path(key)?;
     let (last, parents) = path.split_last().ok_or("an empty key")?;
     let mut table = tree;
-    for part in parents {
+    let mut walked = String::new();
+    let mut parts = parents.iter().peekable();
+    while let Some(part) = parts.next() {
+        if !walked.is_empty() {
+            walked.push('.');
+        }
+        walked.push_str(part);
         let entry = table
             .entry(part.to_string())
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
         table = match entry {
             toml::Value::Table(t) => t,
-            toml::Value::Array(a) if a.len() == 1 => match &mut a[0] {
-                toml::Value::Table(t) => t,
-                _ => return Err(format!("`{part}` is not a table")),
-            },
-            _ => return Err(format!("`{part}` is not a table")),
+            toml::Value::Array(a) => {
+                // an array of tables: entered by a 0-based index, or as its one table
+                let at = match parts.peek().and_then(|p| p.parse::<usize>().ok()) {
+                    Some(i) => {
+                        parts.next();
+                        walked.push_str(&format!(".{i}"));
+                        i
+                    }
+                    None if a.len() == 1 => 0,
+                    None => {
+                        return Err(format!(
+                            "`{walked}` holds {} tables: name one by its 0-based index, as `{walked}.0.{}` (or `{walked}[0]`)",
+                            a.len(),
+                            path[walked.matches('.').count() + 1..].join(".")
+                        ))
+                    }
+                };
+                let n = a.len();
+                match a.get_mut(at) {
+                    Some(toml::Value::Table(t)) => t,
+                    Some(_) => return Err(format!("`{walked}` is not a table")),
+                    None => {
+                        return Err(format!(
+                            "`{walked}` is beyond the {n} tables of `{part}` (indices 0 to {})",
+                            n.saturating_sub(1)
+                        ))
+                    }
+                }
+            }
+            _ => return Err(format!("`{walked}` is not a table")),
         };
     }
     match value {
@@ -180,22 +208,74 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
             table.insert(last.to_string(), toml::Value::String(typed_here.display().to_string()));
         }
         Some(v) => {
+            // mesh.h and mesh.n are two ways to give one size: the one set replaces the other
+            if let Some(other) = alternative(&path) {
+                table.remove(other);
+            }
             table.insert(last.to_string(), v);
         }
         None => {
             table
-                .remove(*last)
+                .remove(last.as_str())
                 .ok_or_else(|| format!("the scene has no `{key}` to remove"))?;
         }
     }
     Ok(())
 }
 
+/// The key that gives the same quantity as the dotted `path` another way (`mesh.h` and
+/// `mesh.n`), which a change of `path` replaces.
+fn alternative(path: &[String]) -> Option<&'static str> {
+    match path {
+        [mesh, key] if mesh == "mesh" && key == "h" => Some("n"),
+        [mesh, key] if mesh == "mesh" && key == "n" => Some("h"),
+        _ => None,
+    }
+}
+
+/// A dotted key's parts, with `name[i]` read as `name.i` (an array of tables' entry).
+fn key_path(key: &str) -> Result<Vec<String>, String> {
+    let mut out = vec![];
+    for part in key.trim().split('.') {
+        match part.split_once('[') {
+            Some((name, rest)) => {
+                let index = rest.strip_suffix(']').filter(|i| i.parse::<usize>().is_ok());
+                match index {
+                    Some(i) if !name.is_empty() => {
+                        out.push(name.to_string());
+                        out.push(i.to_string());
+                    }
+                    _ => return Err(format!("`{part}` in `{key}` is not `name[index]`")),
+                }
+            }
+            None if part.is_empty() => return Err(format!("`{key}` is not a dotted key")),
+            None => out.push(part.to_string()),
+        }
+    }
+    Ok(out)
+}
+
 fn parse_value(raw: &str) -> Result<toml::Value, String> {
+    let digits = raw.strip_prefix(['-', '+']).unwrap_or(raw);
+    let overflows = |x: f64| x.is_infinite() && !digits.to_ascii_lowercase().starts_with("inf");
+    if raw.parse::<f64>().is_ok_and(overflows) {
+        return Err(format!(
+            "`{raw}` is beyond double precision (a magnitude above {:e})",
+            f64::MAX
+        ));
+    }
     if let Ok(t) = format!("v = {raw}").parse::<toml::Table>() {
         if let Some(v) = t.get("v") {
             return Ok(v.clone());
         }
+    }
+    // a number TOML does not hold is named as one, not taken for a string
+    if !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit() || c == '_') {
+        return Err(format!("`{raw}` is an integer beyond 64 bits (at most {})", i64::MAX));
+    }
+    if let Ok(x) = raw.parse::<f64>() {
+        // forms TOML lacks but Rust reads: `1.`, `.5`, `1e5` with a capital E and the like
+        return Ok(toml::Value::Float(x));
     }
     if let Some((p, q)) = raw.split_once('/') {
         if let (Ok(p), Ok(q)) = (p.trim().parse::<f64>(), q.trim().parse::<f64>()) {
@@ -215,7 +295,7 @@ mod tests {
     #[test]
     fn overrides_set_and_remove_keys_and_name_what_does_not_apply() {
         let (s, _) = load("paper", &["mesh.n=16".into(), "mesh.h=1/32".into()]).unwrap();
-        assert_eq!(s.mesh.n, Some(16));
+        assert_eq!(s.mesh.n, None, "mesh.h replaces mesh.n");
         assert_eq!(s.mesh.h, Some(1.0 / 32.0));
         // signorini with the paper's friction coefficient left in: refused, naming the key
         let e = load("paper", &["contact.law=signorini".into()])
@@ -229,5 +309,38 @@ mod tests {
         // a choice that does not exist names itself and its key
         let e = load("paper", &["solver.strategy=fast".into()]).unwrap_err().to_string();
         assert!(e.contains("fast") && e.contains("solver.strategy"), "{e}");
+    }
+
+    #[test]
+    fn numbers_out_of_range_are_named_as_numbers() {
+        for (set, says) in [
+            ("load.p=1e400", "beyond double precision"),
+            ("load.p=-1e400", "beyond double precision"),
+            ("mesh.n=99999999999999999999", "an integer beyond 64 bits"),
+        ] {
+            let e = load("paper", &[set.into()]).unwrap_err().to_string();
+            assert!(e.contains(says) && !e.contains("invalid type: string"), "{set}: {e}");
+        }
+        let (s, _) = load("paper", &["load.p=-2.5E0".into()]).unwrap();
+        assert_eq!(s.load.unwrap().p, -2.5);
+    }
+
+    #[test]
+    fn mesh_h_and_mesh_n_replace_each_other_and_arrays_of_tables_are_reached_by_index() {
+        let (s, _) = load("paper", &["mesh.h=1/16".into()]).unwrap();
+        assert_eq!((s.mesh.n, s.mesh.h), (None, Some(1.0 / 16.0)));
+        let (s, _) = load("paper", &["mesh.h=1/16".into(), "mesh.n=8".into()]).unwrap();
+        assert_eq!((s.mesh.n, s.mesh.h), (Some(8), None));
+        // the second material of a two-material scene, by index either way
+        let (s, _) = load("layered", &["material.1.young=0.02".into()]).unwrap();
+        assert_eq!(s.material[1].young, Some(0.02));
+        let (s, _) = load("layered", &["material[1].poisson=0.25".into()]).unwrap();
+        assert_eq!(s.material[1].poisson, Some(0.25));
+        let e = load("layered", &["material.young=1".into()]).unwrap_err().to_string();
+        assert!(e.contains("holds 2 tables") && e.contains("material.0.young"), "{e}");
+        let e = load("layered", &["material.5.young=1".into()]).unwrap_err().to_string();
+        assert!(e.contains("beyond the 2 tables"), "{e}");
+        let (s, _) = load("paper", &["dirichlet.1.phi=0.5".into()]).unwrap();
+        assert_eq!(s.dirichlet[1].phi, Some(0.5));
     }
 }

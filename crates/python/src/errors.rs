@@ -148,7 +148,7 @@ pub fn kind_of(e: &DriverError) -> Kind {
         DriverError::Scene { .. } | DriverError::File { .. } | DriverError::Usage(_) => Kind::Input,
         DriverError::Mesh(_) => Kind::Mesh,
         DriverError::Problem(p) => kind_of_problem(p),
-        DriverError::Output { .. } | DriverError::Picture { .. } => Kind::Output,
+        DriverError::Output { .. } | DriverError::OutputConflict { .. } | DriverError::Picture { .. } => Kind::Output,
         // `Unexpected`, and the PETSc backend's errors where a build enables it
         #[allow(unreachable_patterns)]
         _ => Kind::Base,

@@ -12,9 +12,30 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 thread_local! {
-    /// The cancel flag of this thread's runs (one run at a time per thread; `Interrupt` takes
-    /// a flag that lives for the program, so each thread makes one and keeps it).
-    static CANCEL: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
+    /// The cancel flags this thread's runs are not using. `Interrupt` takes a flag that lives
+    /// for the program, so a flag is made once and kept; each run takes its own (a run started
+    /// from a progress callback of another is nested in it, and must not share its flag) and
+    /// gives it back when it ends.
+    static FREE: std::cell::RefCell<Vec<&'static AtomicBool>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// A cancel flag of its own for one run, cleared, given back to [`FREE`] when dropped.
+struct Flag(&'static AtomicBool);
+
+impl Flag {
+    fn take() -> Self {
+        let flag = FREE
+            .with(|f| f.borrow_mut().pop())
+            .unwrap_or_else(|| Box::leak(Box::new(AtomicBool::new(false))));
+        flag.store(false, Ordering::Relaxed);
+        Flag(flag)
+    }
+}
+
+impl Drop for Flag {
+    fn drop(&mut self) {
+        FREE.with(|f| f.borrow_mut().push(self.0));
+    }
 }
 
 /// How often the calling thread looks for signals while the solve runs.
@@ -79,19 +100,22 @@ pub fn run(
     progress: Option<&Bound<'_, PyAny>>,
     timeout: Option<f64>,
 ) -> PyResult<RunResult> {
+    let now = std::time::Instant::now();
     let deadline = match timeout {
-        Some(t) if t.is_finite() && t >= 0.0 => Some(std::time::Instant::now() + Duration::from_secs_f64(t)),
-        Some(t) => {
-            return Err(crate::errors::Kind::Input.err(format!("timeout = {t}: a number of seconds, at least 0")))
-        }
+        // 0: stop at the first check
+        Some(0.0) => Some(now),
+        // a positive number of seconds, or inf (and a limit beyond the clock's end): no limit
+        Some(t) => driver::limits::seconds(t, "timeout =")
+            .map_err(to_py)?
+            .and_then(|d| now.checked_add(d)),
         None => None,
     };
     let progress = match progress {
         Some(p) => Progress::of(py, p)?,
         None => Progress::Quiet,
     };
-    let cancel = CANCEL.with(|c| *c);
-    cancel.store(false, Ordering::Relaxed);
+    let flag = Flag::take();
+    let cancel = flag.0;
     let interrupt = contact::Interrupt {
         deadline,
         cancel: Some(cancel),

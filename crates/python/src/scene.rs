@@ -249,8 +249,19 @@ impl Scene {
         regions: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         let np = py.import("numpy")?;
+        let raw = np
+            .call_method1("asarray", (points,))
+            .map_err(|e| Kind::Mesh.err(format!("mesh arrays: points are not an array of numbers ({e})")))?;
+        let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
+        if !matches!(kind.as_str(), "f" | "i" | "u") && raw.getattr("size")?.extract::<usize>()? > 0 {
+            // a complex array would lose its imaginary parts to the cast with a mere warning
+            return Err(Kind::Mesh.err(format!(
+                "mesh arrays: points must hold real numbers, not {}",
+                raw.getattr("dtype")?.str()?
+            )));
+        }
         let points = np
-            .call_method1("ascontiguousarray", (points, "float64"))
+            .call_method1("ascontiguousarray", (raw, "float64"))
             .map_err(|e| Kind::Mesh.err(format!("mesh arrays: points are not an array of numbers ({e})")))?;
         let points: PyReadonlyArray2<'_, f64> = points
             .extract()

@@ -468,7 +468,7 @@ pub fn write(
         if quick { " --quick" } else { "" },
         limit.as_secs()
     );
-    let mut out = Outputs::new(dir);
+    let mut out = Outputs::documents(dir);
     let page = markdown(&rows, &command) + &super::inputs::markdown(&inputs);
     out.add("stability.md", page.into_bytes());
     out.commit()?;

@@ -60,11 +60,24 @@ pub fn sweep(
     if *steps < 2 {
         return Err(DriverError::Usage("sweep needs --steps of at least 2".into()));
     }
+    for (name, v) in [("--from", from), ("--to", to)] {
+        if !v.is_finite() {
+            return Err(DriverError::Usage(format!("sweep {name} {v} is not a finite number")));
+        }
+    }
     let mut rows = vec![];
     for k in 0..*steps {
-        let value = from + (to - from) * k as f64 / (steps - 1) as f64;
+        // a weighted mean of the bounds: finite for any finite bounds (their difference may
+        // overflow), and the bounds themselves at the ends
+        let t = k as f64 / (steps - 1) as f64;
+        let value = if k + 1 == *steps {
+            *to
+        } else {
+            from * (1.0 - t) + to * t
+        };
         let mut s = sets.to_vec();
-        s.push(format!("{param}={value}"));
+        // the shortest digits that read back to the value (`{:?}`: 1e300, not 301 digits)
+        s.push(format!("{param}={value:?}"));
         let t = Instant::now();
         let r = solve(scene, &s)?.report;
         let c = &r.contact;
@@ -105,7 +118,7 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
     let mut csv = format!("{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds\n");
     for r in rows {
         csv.push_str(&format!(
-            "{:.12e},{},{},{},{:.12e},{:.12e},{:.3e},{:.3e},{},{},{:.4}\n",
+            "{:e},{},{},{},{:e},{:e},{:.3e},{:.3e},{},{},{:.4}\n",
             r.value,
             r.counts.0,
             r.counts.1,

@@ -281,7 +281,7 @@ pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result
         .iter()
         .filter_map(|(name, _, _, _, r)| r.as_ref().err().map(|e| format!("smoke run of `{name}`: {e}")))
         .collect();
-    let mut pictures = Outputs::new(&docs.join("img"));
+    let mut pictures = Outputs::documents(&docs.join("img"));
     let mut studies = vec![];
     for entry in ENTRIES {
         let (done, failure) = run_entry(entry, full, &mut pictures, progress)?;
@@ -290,7 +290,7 @@ pub fn report(full: bool, docs: &Path, progress: &mut dyn FnMut(&str)) -> Result
     }
     let md = page(full, t0.elapsed().as_secs_f64(), &studies, &smoke_rows);
     pictures.commit()?;
-    let mut page = Outputs::new(docs);
+    let mut page = Outputs::documents(docs);
     page.add("verification.md", md.into_bytes());
     page.commit()?;
     Ok(failures)

@@ -292,6 +292,12 @@ fn validate_generated(m: &MeshSpec, d: usize) -> Result<(), SceneError> {
             ));
         }
     }
+    if m.h.is_some() && m.n.is_some() {
+        return Err(SceneError::new(
+            "mesh.h",
+            "mesh.h and mesh.n both give the mesh's size (mesh.h would win): give one (a --set of either replaces the other)",
+        ));
+    }
     if let Some(h) = m.h {
         if !(h > 0.0 && h.is_finite()) {
             return Err(SceneError::new(

@@ -1,0 +1,250 @@
+//! The files of a run, exactly those its plan lists (`run.json`, `solution.vtu`,
+//! `contact.csv`, the pictures), written as one set ([`Outputs`], in `set`): the new set
+//! appears all at once, in place of the previous one, or not at all.
+
+mod set;
+
+pub use set::Outputs;
+
+use crate::plots::{self, Mark, Panel, Series};
+use crate::DriverError;
+use problem::{ContactResult, Output, RunReport, Solution};
+use std::path::{Path, PathBuf};
+use vtkio::model::{
+    Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, UnstructuredGridPiece, Version, VertexNumbers, Vtk,
+};
+
+/// `run.json`: the report, pretty, its keys in sorted order.
+///
+/// # Errors
+/// [`DriverError::Picture`] if serde cannot write it (it always can).
+pub fn run_json(report: &RunReport) -> Result<Vec<u8>, DriverError> {
+    let encode = |e: serde_json::Error| DriverError::Picture {
+        name: "run.json".into(),
+        message: e.to_string(),
+    };
+    let tree = serde_json::to_value(report).map_err(encode)?;
+    serde_json::to_vec_pretty(&tree).map_err(encode)
+}
+
+/// The files of a solution, those its plan lists.
+///
+/// # Errors
+/// [`DriverError::Picture`] where a file cannot be made.
+pub fn files(solution: &Solution) -> Result<Outputs, DriverError> {
+    let mut out = Outputs::new(Path::new(""));
+    let missing = |what: &str| DriverError::Picture {
+        name: what.into(),
+        message: "the plan lists it, but the run has nothing to draw it from".into(),
+    };
+    for &output in &solution.report.plan.outputs {
+        match output {
+            Output::RunJson => out.add("run.json", run_json(&solution.report)?),
+            Output::SolutionVtu => out.add("solution.vtu", vtu(solution)?),
+            Output::ContactCsv => {
+                let c = solution.contact.as_ref().ok_or_else(|| missing("contact.csv"))?;
+                out.add("contact.csv", contact_csv(c));
+            }
+            Output::Multipliers => {
+                let c = solution.contact.as_ref().ok_or_else(|| missing("multipliers"))?;
+                out.extend(multipliers_picture(c)?);
+            }
+            Output::Deformed => {
+                let pic = plots::mesh_view::deformed_picture(&solution.mesh, &solution.u)?;
+                out.extend(pic.ok_or_else(|| missing("deformed"))?);
+            }
+            Output::Potential => {
+                let pic = plots::mesh_view::potential_picture(&solution.mesh, &solution.u, &solution.phi)?;
+                out.extend(pic.ok_or_else(|| missing("potential"))?);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Writes the files of a solution into `dir`, as one set.
+///
+/// # Errors
+/// As [`files`] and [`Outputs::commit`].
+pub fn write(solution: &Solution, dir: &Path) -> Result<(), DriverError> {
+    files(solution)?.into(dir).commit()
+}
+
+/// The solution as a VTK XML unstructured grid: point data `u` (3 components), `phi`; cell
+/// data `stress` (Voigt), `strain`, `electric_displacement`, `electric_field`; and, with
+/// contact, point data `contact_status` (0 none, 1 stick, 2 slip, 3 separated).
+fn vtu(solution: &Solution) -> Result<Vec<u8>, DriverError> {
+    let (mesh, fields) = (&solution.mesh, &solution.fields);
+    let points: Vec<f64> = mesh.points.iter().flatten().copied().collect();
+    let k = mesh.kind.n_nodes();
+    let connectivity: Vec<u64> = mesh.cells.iter().map(|&v| v as u64).collect();
+    let offsets: Vec<u64> = (1..=mesh.n_cells()).map(|c| (c * k) as u64).collect();
+    let ct = match mesh.kind {
+        mesh::CellKind::Tri3 => CellType::Triangle,
+        mesh::CellKind::Quad4 => CellType::Quad,
+        mesh::CellKind::Tet4 => CellType::Tetra,
+    };
+    let dim = mesh.dim;
+    let nv = if dim == 2 { 3 } else { 6 };
+    let mut point = vec![
+        Attribute::generic("u", 3).with_data(solution.u.iter().flatten().copied().collect::<Vec<f64>>()),
+        Attribute::scalars("phi", 1).with_data(solution.phi.clone()),
+    ];
+    if let Some(c) = &solution.contact {
+        let mut status = vec![0.0; mesh.n_nodes()];
+        for (i, &node) in c.nodes.iter().enumerate() {
+            status[node] = match c.solution.status[i] {
+                contact::Status::Stick => 1.0,
+                contact::Status::Slip => 2.0,
+                contact::Status::Separated => 3.0,
+            };
+        }
+        point.push(Attribute::scalars("contact_status", 1).with_data(status));
+    }
+    let cell = vec![
+        Attribute::generic("stress", nv as u32).with_data(fields.stress.clone()),
+        Attribute::generic("strain", nv as u32).with_data(fields.strain.clone()),
+        Attribute::generic("electric_displacement", dim as u32).with_data(fields.electric_displacement.clone()),
+        Attribute::generic("electric_field", dim as u32).with_data(fields.electric_field.clone()),
+    ];
+    let vtk = Vtk {
+        version: Version::new((1, 0)),
+        title: "piezocontact solution".into(),
+        byte_order: ByteOrder::LittleEndian,
+        file_path: None,
+        data: DataSet::inline(UnstructuredGridPiece {
+            points: points.into(),
+            cells: Cells {
+                cell_verts: VertexNumbers::XML { connectivity, offsets },
+                types: vec![ct; mesh.n_cells()],
+            },
+            data: Attributes { point, cell },
+        }),
+    };
+    let mut buf = Vec::new();
+    vtk.write_xml(&mut buf).map_err(|e| DriverError::Picture {
+        name: "solution.vtu".into(),
+        message: e.to_string(),
+    })?;
+    Ok(buf)
+}
+
+/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`;
+/// the displacements are those of the final solution (a frictionless body slides: its `u_t`
+/// is written too), the tangential multipliers 0 where the law carries none.
+fn contact_csv(c: &ContactResult) -> Vec<u8> {
+    let (points, sol, u) = (&c.points, &c.solution, &c.displacement);
+    let dim = points.dim;
+    let nt = sol.lambda.n_tangential();
+    let mut s = String::new();
+    s.push_str(if dim == 2 {
+        "x,y,gap,u_n,u_t,lambda_n,lambda_t,status\n"
+    } else {
+        "x,y,z,gap,u_n,u_t,u_t2,lambda_n,lambda_t,lambda_t2,status\n"
+    });
+    for i in 0..points.len() {
+        // `{:e}`: the shortest digits that read back to the same double
+        let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| format!("{x:e}")).collect();
+        row.push(format!("{:e}", points.gap[i]));
+        row.push(format!("{:e}", u.normal[i]));
+        for &ut in u.tangential_of(i) {
+            row.push(format!("{ut:e}"));
+        }
+        row.push(format!("{:e}", sol.lambda.normal[i]));
+        for q in 0..dim - 1 {
+            row.push(format!(
+                "{:e}",
+                if nt > 0 { sol.lambda.tangential[i * nt + q] } else { 0.0 }
+            ));
+        }
+        row.push(sol.status[i].name().to_string());
+        s.push_str(&row.join(","));
+        s.push('\n');
+    }
+    s.into_bytes()
+}
+
+/// The multipliers along the contact boundary (in 3D, along the contact face's middle line
+/// y = y_mid), like the paper's figures: `λ_n`, `λ_t` (first component), the Coulomb bound
+/// `F λ_n`, and the sliding points.
+fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, DriverError> {
+    let (p, s) = (&c.points, &c.solution);
+    let nt = s.lambda.n_tangential();
+    let mut idx: Vec<usize> = (0..p.len()).collect();
+    if p.dim == 3 {
+        let ys: Vec<f64> = p.position.iter().map(|x| x[1]).collect();
+        let (ymin, ymax) = ys
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| (a.min(y), b.max(y)));
+        let mid = 0.5 * (ymin + ymax);
+        let best = ys.iter().map(|y| (y - mid).abs()).fold(f64::INFINITY, f64::min);
+        idx.retain(|&i| ((ys[i] - mid).abs() - best).abs() < 1e-12);
+    }
+    idx.sort_by(|&a, &b| p.position[a][0].total_cmp(&p.position[b][0]));
+    let along = |f: &dyn Fn(usize) -> f64| idx.iter().map(|&i| (p.position[i][0], f(i))).collect::<Vec<_>>();
+    let mut series = vec![Series::line("lambda_n (pressure)", along(&|i| s.lambda.normal[i]))];
+    if nt > 0 {
+        let name = if nt > 1 {
+            "lambda_t (first component)"
+        } else {
+            "lambda_t"
+        };
+        series.push(Series::line(name, along(&|i| s.lambda.tangential[i * nt])));
+        series.push(Series {
+            name: "slipping point".into(),
+            points: idx
+                .iter()
+                .filter(|&&i| s.status[i] == contact::Status::Slip)
+                .map(|&i| (p.position[i][0], s.lambda.tangential[i * nt]))
+                .collect(),
+            mark: Mark::Dots,
+        });
+        series.push(Series {
+            name: "F lambda_n (Coulomb bound)".into(),
+            points: along(&|i| p.friction[i] * s.lambda.normal[i]),
+            mark: Mark::Reference,
+        });
+    }
+    let title = if p.dim == 3 {
+        "Multipliers on the contact face's middle line"
+    } else {
+        "Multipliers along the contact boundary"
+    };
+    let panel = Panel {
+        title: title.into(),
+        labels: ("x".into(), "multiplier".into()),
+        series,
+    };
+    plots::panels("multipliers", &[panel])
+}
+
+/// Where a run writes by default: `out/<scene>/`, the scene's name made a safe single path
+/// component (letters, digits, `-`, `_` and `.` kept, anything else `_`, no leading dot), so that
+/// a name like `../x` or `/tmp/x` cannot write outside `out/`.
+pub fn default_dir(scene_name: &str) -> PathBuf {
+    let safe: String = scene_name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let safe = safe.trim_start_matches('.');
+    Path::new("out").join(if safe.is_empty() { "scene" } else { safe })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_directory_stays_under_out() {
+        assert_eq!(default_dir("paper"), Path::new("out/paper"));
+        assert_eq!(default_dir("../x"), Path::new("out/_x"));
+        assert_eq!(default_dir("/tmp/x"), Path::new("out/_tmp_x"));
+        assert_eq!(default_dir(".."), Path::new("out/scene"));
+    }
+}

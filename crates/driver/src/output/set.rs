@@ -1,0 +1,597 @@
+//! A set of files written together ([`Outputs`]): a run's set replaces the directory's previous
+//! set as a whole, and nothing that the program did not write is removed or changed.
+//!
+//! # The layout (Unix)
+//!
+//! ```text
+//! DIR/run.json      -> .piezocontact/current/run.json    (one link per file of the set)
+//! DIR/contact.csv   -> .piezocontact/current/contact.csv
+//! DIR/notes.txt                                           (the user's: never touched)
+//! DIR/.piezocontact/current -> set-4711-1733140000123456789
+//! DIR/.piezocontact/set-4711-1733140000123456789/run.json ...
+//! DIR/.piezocontact/README, lock
+//! ```
+//!
+//! A commit writes the new set into a fresh directory under `.piezocontact/`, makes the links
+//! its files need, then turns the one link `current` to it by a rename (atomic), then removes
+//! the links of the files the new set lacks and the old set's directory. A reader sees the old
+//! set or the new one at every instant: a link whose file the current set lacks is an absent
+//! file. `DIR` itself is never renamed, so `--out` may be `.`, `..`, a mount point, a link to a
+//! directory (written through, into its target) or a directory full of the user's files; a
+//! name of the set that the directory holds as a file of the user's (not one of our links)
+//! stops the commit before anything is written. Commits into one directory are serialised by a
+//! lock; what a killed commit left is removed by the next.
+//!
+//! A directory written by an earlier version (regular files listed in `.piezocontact-outputs`)
+//! is taken over without a visible step: its files are hard-linked into a set of their own,
+//! which becomes `current`, and each file is then replaced by its link to the same content.
+//!
+//! Documents ([`Outputs::documents`]: the pages the studies write into `docs/`) are files kept
+//! in a source tree: each is replaced in place, atomically by itself (written beside it, then
+//! renamed over it), and nothing else in the directory is touched.
+
+use crate::DriverError;
+use std::path::{Path, PathBuf};
+
+/// The hidden directory of a set, inside the output directory.
+const HIDDEN: &str = ".piezocontact";
+/// The link in [`HIDDEN`] to the current set.
+const CURRENT: &str = "current";
+/// The file in [`HIDDEN`] that says what the directory is (and that it is ours).
+const README: &str = "README";
+/// The lock file in [`HIDDEN`].
+const LOCK: &str = "lock";
+/// The manifest of the sets of earlier versions (regular files in the directory itself).
+const LEGACY_MANIFEST: &str = ".piezocontact-outputs";
+
+const README_TEXT: &str = "This directory holds the output sets of piezocontact runs. `current` is a link to the\n\
+set of the last run; the files of the directory above are links into it, so that a new set\n\
+replaces the old one as a whole. Copy the directory above with its links (cp -r, tar) or\n\
+with their files (cp -rL); do not edit this directory by hand.\n";
+
+/// How the files are put in place.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    /// A run's output set, replaced as a whole.
+    Set,
+    /// Documents in a source tree, each replaced by itself.
+    Documents,
+}
+
+/// Files to write together: a run's output set, or documents.
+pub struct Outputs {
+    dir: PathBuf,
+    files: Vec<(String, Vec<u8>)>,
+    mode: Mode,
+}
+
+impl Outputs {
+    /// A run's output set for directory `dir` (made on commit), replacing its previous set.
+    pub fn new(dir: &Path) -> Self {
+        Outputs {
+            dir: dir.to_path_buf(),
+            files: vec![],
+            mode: Mode::Set,
+        }
+    }
+
+    /// Documents for directory `dir` (a source tree's `docs/`): each file replaced in place by
+    /// itself, as plain files.
+    pub fn documents(dir: &Path) -> Self {
+        Outputs {
+            mode: Mode::Documents,
+            ..Self::new(dir)
+        }
+    }
+
+    /// The same files, for directory `dir`.
+    pub fn into(self, dir: &Path) -> Self {
+        Outputs {
+            dir: dir.to_path_buf(),
+            ..self
+        }
+    }
+
+    /// Adds a file's bytes.
+    pub fn add(&mut self, name: &str, bytes: Vec<u8>) {
+        self.files.push((name.to_string(), bytes));
+    }
+
+    /// Adds several files.
+    pub fn extend(&mut self, files: crate::plots::Files) {
+        self.files.extend(files);
+    }
+
+    /// The names of the files, in the order they were added.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.files.iter().map(|(n, _)| n.as_str())
+    }
+
+    /// Writes the files: a set replaces the directory's previous set as a whole (see the
+    /// module's documentation), documents replace their namesakes one by one.
+    ///
+    /// # Errors
+    /// [`DriverError::OutputConflict`] where a name is not a plain file name, or names a file
+    /// of the user's; [`DriverError::Output`] naming the path that could not be created,
+    /// written or renamed. Nothing is changed where the error comes before the set is turned
+    /// to (every error but a failure to remove what the old set leaves).
+    pub fn commit(self) -> Result<(), DriverError> {
+        let mut seen = std::collections::BTreeSet::new();
+        for (name, _) in &self.files {
+            check_name(&self.dir, name)?;
+            if !seen.insert(name.as_str()) {
+                return Err(conflict(
+                    &self.dir.join(name),
+                    "is twice in the set: two files would write one name",
+                ));
+            }
+        }
+        match self.mode {
+            Mode::Documents => self.commit_documents(),
+            Mode::Set => self.commit_set(),
+        }
+    }
+
+    fn commit_documents(self) -> Result<(), DriverError> {
+        std::fs::create_dir_all(&self.dir).map_err(|e| io("cannot create", &self.dir, e))?;
+        for (name, bytes) in &self.files {
+            let path = self.dir.join(name);
+            let tmp = self.dir.join(format!(".{name}.piezocontact-{}", std::process::id()));
+            std::fs::write(&tmp, bytes)
+                .and_then(|()| std::fs::rename(&tmp, &path))
+                .map_err(|e| {
+                    let _ = std::fs::remove_file(&tmp);
+                    io("cannot write", &path, e)
+                })?;
+        }
+        // the manifest earlier versions left among the documents
+        let _ = std::fs::remove_file(self.dir.join(LEGACY_MANIFEST));
+        Ok(())
+    }
+
+    #[cfg(not(unix))]
+    fn commit_set(self) -> Result<(), DriverError> {
+        // without links, each file is replaced by itself
+        Outputs {
+            mode: Mode::Documents,
+            ..self
+        }
+        .commit_documents()
+    }
+
+    #[cfg(unix)]
+    fn commit_set(self) -> Result<(), DriverError> {
+        let dir = &self.dir;
+        match std::fs::metadata(dir) {
+            Ok(m) if !m.is_dir() => return Err(conflict(dir, "is not a directory")),
+            Ok(_) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                if std::fs::symlink_metadata(dir).is_ok() {
+                    return Err(conflict(
+                        dir,
+                        "is a link to nothing: make its target, or give another --out",
+                    ));
+                }
+            }
+            Err(e) => return Err(io("cannot read", dir, e)),
+        }
+        let made_dir = !dir.exists();
+        let result = unix::commit(dir, &self.files);
+        if result.is_err() && made_dir {
+            // nothing of this run stays where nothing was
+            let _ = std::fs::remove_dir_all(dir);
+        }
+        result
+    }
+}
+
+/// A set's file name: one plain component, not hidden, not ours.
+fn check_name(dir: &Path, name: &str) -> Result<(), DriverError> {
+    let mut parts = Path::new(name).components();
+    let plain = matches!(parts.next(), Some(std::path::Component::Normal(_))) && parts.next().is_none();
+    if !plain || name.starts_with('.') || name.contains('/') {
+        return Err(conflict(
+            &dir.join(name),
+            "is not a plain file name (one component, not hidden)",
+        ));
+    }
+    Ok(())
+}
+
+fn io(what: &str, p: &Path, e: std::io::Error) -> DriverError {
+    DriverError::Output {
+        what: format!("{what} {}", p.display()),
+        source: e,
+    }
+}
+
+fn conflict(p: &Path, why: &str) -> DriverError {
+    DriverError::OutputConflict {
+        path: p.display().to_string(),
+        reason: why.into(),
+    }
+}
+
+#[cfg(unix)]
+mod unix {
+    use super::{conflict, io, CURRENT, HIDDEN, LEGACY_MANIFEST, LOCK, README, README_TEXT};
+    use crate::DriverError;
+    use std::os::unix::fs::symlink;
+    use std::path::{Path, PathBuf};
+
+    /// The link of file `name`, as it reads from the output directory.
+    fn link_target(name: &str) -> PathBuf {
+        Path::new(HIDDEN).join(CURRENT).join(name)
+    }
+
+    /// Whether `path` is the link of file `name`.
+    fn is_our_link(path: &Path, name: &str) -> bool {
+        std::fs::read_link(path).is_ok_and(|t| t == link_target(name))
+    }
+
+    /// The names of the files of the set `current` points to (empty without one).
+    fn current_names(hidden: &Path) -> Vec<String> {
+        std::fs::read_dir(hidden.join(CURRENT))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect()
+    }
+
+    /// The regular files of an earlier version's set, by its manifest.
+    fn legacy_names(dir: &Path) -> Vec<String> {
+        std::fs::read_to_string(dir.join(LEGACY_MANIFEST))
+            .map(|t| {
+                t.lines()
+                    .filter(|l| !l.is_empty() && !l.contains('/'))
+                    .filter(|l| std::fs::symlink_metadata(dir.join(l)).is_ok_and(|m| m.is_file()))
+                    .map(String::from)
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// Whether an entry of the hidden directory is one this module makes.
+    fn ours(name: &str) -> bool {
+        [CURRENT, README, LOCK].contains(&name) || ["set-", "turning-"].iter().any(|p| name.starts_with(p))
+    }
+
+    /// The hidden directory, made where missing (by this commit or one beside it); refused
+    /// where something else has its name.
+    fn hidden_dir(dir: &Path) -> Result<PathBuf, DriverError> {
+        let hidden = dir.join(HIDDEN);
+        let foreign = || {
+            conflict(
+                &hidden,
+                "is not piezocontact's (it holds what no run made): move it, or choose another --out; nothing was written",
+            )
+        };
+        match std::fs::symlink_metadata(&hidden) {
+            Ok(m) if !m.is_dir() => return Err(foreign()),
+            Ok(_) if hidden.join(README).is_file() => return Ok(hidden),
+            Ok(_) => {
+                let all_ours = std::fs::read_dir(&hidden)
+                    .map_err(|e| io("cannot read", &hidden, e))?
+                    .flatten()
+                    .all(|e| ours(&e.file_name().to_string_lossy()));
+                if !all_ours {
+                    return Err(foreign());
+                }
+            }
+            Err(_) => std::fs::create_dir_all(&hidden).map_err(|e| io("cannot create", &hidden, e))?,
+        }
+        let tmp = fresh(&hidden, "turning");
+        std::fs::write(&tmp, README_TEXT)
+            .and_then(|()| std::fs::rename(&tmp, hidden.join(README)))
+            .map_err(|e| io("cannot write", &hidden.join(README), e))?;
+        Ok(hidden)
+    }
+
+    /// A fresh name in `hidden`: the process, the time and a count of this process's names.
+    fn fresh(hidden: &Path, what: &str) -> PathBuf {
+        static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        hidden.join(format!("{what}-{}-{nanos}-{k}", std::process::id()))
+    }
+
+    /// Turns `current` to `set` (a name in `hidden`): one rename.
+    fn turn(hidden: &Path, set: &Path) -> Result<(), DriverError> {
+        let name = set.file_name().unwrap_or_default();
+        let tmp = fresh(hidden, "turning");
+        symlink(name, &tmp).map_err(|e| io("cannot link", &tmp, e))?;
+        std::fs::rename(&tmp, hidden.join(CURRENT)).map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            io("cannot turn", &hidden.join(CURRENT), e)
+        })
+    }
+
+    /// The set directories, and stray links, that `current` does not point to (a killed
+    /// commit's).
+    fn remove_stale(hidden: &Path) {
+        let live = std::fs::read_link(hidden.join(CURRENT)).ok();
+        for entry in std::fs::read_dir(hidden).into_iter().flatten().flatten() {
+            let name = entry.file_name();
+            let keep = [CURRENT, README, LOCK].iter().any(|k| name == *k)
+                || live.as_deref() == Some(Path::new(&name))
+                || !ours(&name.to_string_lossy());
+            if !keep {
+                let _ = std::fs::remove_dir_all(entry.path()).or_else(|_| std::fs::remove_file(entry.path()));
+            }
+        }
+    }
+
+    /// Takes over the set an earlier version wrote as regular files: hard-linked into a set of
+    /// its own that becomes `current`, then each file replaced by its link (the same content).
+    fn adopt_legacy(dir: &Path, hidden: &Path) -> Result<(), DriverError> {
+        let names = legacy_names(dir);
+        if names.is_empty() {
+            let _ = std::fs::remove_file(dir.join(LEGACY_MANIFEST));
+            return Ok(());
+        }
+        let set = fresh(hidden, "set");
+        std::fs::create_dir(&set).map_err(|e| io("cannot create", &set, e))?;
+        for name in &names {
+            std::fs::hard_link(dir.join(name), set.join(name)).map_err(|e| io("cannot link", &dir.join(name), e))?;
+        }
+        turn(hidden, &set)?;
+        for name in &names {
+            let tmp = dir.join(format!(".{name}.piezocontact-link"));
+            let _ = std::fs::remove_file(&tmp);
+            symlink(link_target(name), &tmp)
+                .and_then(|()| std::fs::rename(&tmp, dir.join(name)))
+                .map_err(|e| io("cannot link", &dir.join(name), e))?;
+        }
+        let _ = std::fs::remove_file(dir.join(LEGACY_MANIFEST));
+        Ok(())
+    }
+
+    /// The commit of a set into `dir` (see the module's documentation).
+    pub(super) fn commit(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), DriverError> {
+        // before anything is made: a name of the set that is the user's stops the commit
+        let legacy = legacy_names(dir);
+        for (name, _) in files {
+            let path = dir.join(name);
+            let free = match std::fs::symlink_metadata(&path) {
+                Err(_) => true,
+                Ok(_) => is_our_link(&path, name) || legacy.contains(name),
+            };
+            if !free {
+                return Err(conflict(
+                    &path,
+                    "is not a file of an earlier run (it is yours, or another program's): move or rename it, or choose another --out; nothing was written",
+                ));
+            }
+        }
+        let hidden = hidden_dir(dir)?;
+        let lock = std::fs::File::create(hidden.join(LOCK)).map_err(|e| io("cannot open", &hidden.join(LOCK), e))?;
+        lock.lock().map_err(|e| io("cannot lock", &hidden.join(LOCK), e))?;
+        remove_stale(&hidden);
+        adopt_legacy(dir, &hidden)?;
+        let old = current_names(&hidden);
+        let old_set = std::fs::read_link(hidden.join(CURRENT)).ok().map(|t| hidden.join(t));
+        // the new set, beside the current one, then the turn to it
+        let set = fresh(&hidden, "set");
+        let staged = (|| -> Result<(), DriverError> {
+            std::fs::create_dir(&set).map_err(|e| io("cannot create", &set, e))?;
+            for (name, bytes) in files {
+                let path = set.join(name);
+                std::fs::write(&path, bytes).map_err(|e| io("cannot write", &dir.join(name), e))?;
+            }
+            // the links the new set's files need (each an absent file until the turn)
+            for (name, _) in files {
+                let path = dir.join(name);
+                if !is_our_link(&path, name) {
+                    symlink(link_target(name), &path).map_err(|e| io("cannot link", &path, e))?;
+                }
+            }
+            turn(&hidden, &set)
+        })();
+        if let Err(e) = staged {
+            let _ = std::fs::remove_dir_all(&set);
+            for (name, _) in files.iter().filter(|(n, _)| !old.contains(n)) {
+                let path = dir.join(name);
+                if is_our_link(&path, name) {
+                    let _ = std::fs::remove_file(&path);
+                }
+            }
+            return Err(e);
+        }
+        // what the old set had and the new one lacks
+        for name in old.iter().filter(|n| !files.iter().any(|(f, _)| f == *n)) {
+            let path = dir.join(name);
+            if is_our_link(&path, name) {
+                let _ = std::fs::remove_file(&path);
+            }
+        }
+        if let Some(old_set) = old_set {
+            let _ = std::fs::remove_dir_all(old_set);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+
+    fn commit(dir: &Path, files: &[(&str, &str)]) -> Result<(), DriverError> {
+        let mut o = Outputs::new(dir);
+        for (name, text) in files {
+            o.add(name, text.as_bytes().to_vec());
+        }
+        o.commit()
+    }
+
+    /// The visible names of `dir` (the hidden directory aside).
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n != HIDDEN)
+            .collect();
+        v.sort();
+        v
+    }
+
+    fn read(dir: &Path, name: &str) -> String {
+        std::fs::read_to_string(dir.join(name)).unwrap()
+    }
+
+    #[test]
+    fn a_failed_commit_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("run");
+        // a name that is no plain file name
+        assert!(commit(&target, &[("a.txt", "a"), ("nested/b.txt", "b")]).is_err());
+        assert!(!target.exists());
+        // over an earlier set, the earlier set stays as it was
+        commit(&target, &[("run.json", "1"), ("contact.csv", "1")]).unwrap();
+        assert!(commit(&target, &[("run.json", "2"), ("../b.txt", "b")]).is_err());
+        assert_eq!(read(&target, "run.json"), "1");
+        assert_eq!(listing(dir.path()), ["run"]);
+    }
+
+    #[test]
+    fn a_new_set_replaces_the_old_as_a_whole_and_keeps_the_users_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("run");
+        commit(
+            &target,
+            &[("run.json", "1"), ("contact.csv", "1"), ("multipliers.svg", "1")],
+        )
+        .unwrap();
+        // a run without contact: its set has no contact.csv, and none is left behind
+        commit(&target, &[("run.json", "2"), ("solution.vtu", "2")]).unwrap();
+        assert_eq!(listing(&target), ["run.json", "solution.vtu"]);
+        assert_eq!(read(&target, "run.json"), "2");
+        // a file and a directory of the user's stay, untouched
+        std::fs::write(target.join("notes.txt"), "mine").unwrap();
+        std::fs::create_dir(target.join("mine")).unwrap();
+        commit(&target, &[("run.json", "3"), ("contact.csv", "3")]).unwrap();
+        assert_eq!(listing(&target), ["contact.csv", "mine", "notes.txt", "run.json"]);
+        assert_eq!(read(&target, "notes.txt"), "mine");
+        // one set in the hidden directory, nothing left beside the output directory
+        let sets = std::fs::read_dir(target.join(HIDDEN))
+            .unwrap()
+            .filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().starts_with("set-"))
+            .count();
+        assert_eq!(sets, 1);
+        assert_eq!(listing(dir.path()), ["run"]);
+    }
+
+    #[test]
+    fn a_users_file_named_like_an_output_stops_the_commit_before_anything_changes() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("run");
+        commit(&target, &[("run.json", "1")]).unwrap();
+        std::fs::write(target.join("contact.csv"), "mine").unwrap();
+        std::fs::create_dir(target.join("solution.vtu")).unwrap();
+        let e = commit(&target, &[("run.json", "2"), ("contact.csv", "2")])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("contact.csv") && e.contains("is not a file of an earlier run"),
+            "{e}"
+        );
+        let e = commit(&target, &[("run.json", "2"), ("solution.vtu", "2")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("solution.vtu"), "{e}");
+        assert_eq!(read(&target, "contact.csv"), "mine");
+        assert!(target.join("solution.vtu").is_dir());
+        assert_eq!(read(&target, "run.json"), "1");
+        // a file of the user's named like an output, in a directory no run wrote
+        let fresh = dir.path().join("fresh");
+        std::fs::create_dir(&fresh).unwrap();
+        std::fs::write(fresh.join("run.json"), "mine").unwrap();
+        assert!(commit(&fresh, &[("run.json", "1")]).is_err());
+        assert_eq!(read(&fresh, "run.json"), "mine");
+        assert!(!fresh.join(HIDDEN).exists());
+    }
+
+    #[test]
+    fn a_linked_directory_dir_dot_dir_parent_and_long_names_are_written_into() {
+        let dir = tempfile::tempdir().unwrap();
+        // a link to a directory: written through, into its target, the link kept
+        let real = dir.path().join("real");
+        std::fs::create_dir(&real).unwrap();
+        let link = dir.path().join("link");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        commit(&link, &[("run.json", "1")]).unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(read(&real, "run.json"), "1");
+        // `DIR/.` and `DIR/sub/..` are DIR
+        commit(&real.join("."), &[("run.json", "2")]).unwrap();
+        assert_eq!(read(&real, "run.json"), "2");
+        std::fs::create_dir(real.join("sub")).unwrap();
+        commit(&real.join("sub").join(".."), &[("run.json", "3")]).unwrap();
+        assert_eq!(read(&real, "run.json"), "3");
+        // a name of 200 characters
+        let long = dir.path().join("x".repeat(200));
+        commit(&long, &[("run.json", "4")]).unwrap();
+        assert_eq!(read(&long, "run.json"), "4");
+        // (`.`, the working directory, is run by crates/driver/tests/outputs.rs: a test here
+        // must not move the working directory of its siblings)
+    }
+
+    #[test]
+    fn a_set_of_an_earlier_version_is_taken_over() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("run");
+        std::fs::create_dir(&target).unwrap();
+        for f in ["run.json", "contact.csv"] {
+            std::fs::write(target.join(f), "old").unwrap();
+        }
+        std::fs::write(target.join("notes.txt"), "mine").unwrap();
+        std::fs::write(target.join(LEGACY_MANIFEST), "run.json\ncontact.csv\n").unwrap();
+        commit(&target, &[("run.json", "new")]).unwrap();
+        assert_eq!(listing(&target), ["notes.txt", "run.json"]);
+        assert_eq!(read(&target, "run.json"), "new");
+    }
+
+    #[test]
+    fn runs_into_one_directory_do_not_mix() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("run");
+        let threads: Vec<_> = (0..8)
+            .map(|k| {
+                let target = target.clone();
+                std::thread::spawn(move || {
+                    let text = k.to_string();
+                    let files: Vec<(&str, &str)> = if k % 2 == 0 {
+                        vec![("run.json", &text), ("contact.csv", &text)]
+                    } else {
+                        vec![("run.json", &text), ("solution.vtu", &text)]
+                    };
+                    commit(&target, &files).unwrap();
+                })
+            })
+            .collect();
+        for t in threads {
+            t.join().unwrap();
+        }
+        // one set, whole: every visible file is of it, and they agree
+        let files = listing(&target);
+        assert_eq!(files.len(), 2, "{files:?}");
+        let texts: Vec<String> = files.iter().map(|f| read(&target, f)).collect();
+        assert!(texts.iter().all(|t| t == &texts[0]), "{texts:?}");
+    }
+
+    #[test]
+    fn documents_are_plain_files_replaced_in_place() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("theory.md"), "mine").unwrap();
+        let mut d = Outputs::documents(dir.path());
+        d.add("stability.md", b"page".to_vec());
+        d.commit().unwrap();
+        assert!(std::fs::symlink_metadata(dir.path().join("stability.md"))
+            .unwrap()
+            .is_file());
+        assert_eq!(read(dir.path(), "theory.md"), "mine");
+        assert_eq!(listing(dir.path()), ["stability.md", "theory.md"]);
+    }
+}
