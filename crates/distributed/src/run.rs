@@ -407,7 +407,8 @@ impl Report<'_> {
             residuals: Residuals {
                 equilibrium: self.equilibrium,
                 complementarity: self.info.map_or(0.0, |i| i.complementarity),
-                converged_to_tolerance: true,
+                converged_to_tolerance: self.equilibrium <= problem::EQUILIBRIUM_TOL
+                    && self.info.is_none_or(|i| i.complementarity <= scene.solver.tol),
             },
             timings_s: self.timings_s,
             memory: Memory::default(),

@@ -15,6 +15,7 @@
 
 pub mod fclib;
 pub mod limits;
+pub mod memory;
 pub mod output;
 pub mod plots;
 pub mod run;

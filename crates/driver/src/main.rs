@@ -197,6 +197,7 @@ fn contact_bar() -> indicatif::ProgressBar {
 }
 
 fn main() -> ExitCode {
+    driver::memory::bound_heaps_under_an_address_space_limit();
     let cli = Cli::parse();
     let command = cli.command.unwrap_or(Command::Run {
         scene: None,

@@ -11,23 +11,16 @@ use std::path::Path;
 
 /// Bytes of peak resident memory of this process (VmHWM), 0 where unknown.
 pub fn peak_memory_bytes() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find_map(|l| l.strip_prefix("VmHWM:"))
-                .and_then(|l| l.split_whitespace().next().and_then(|kb| kb.parse::<u64>().ok()))
-        })
-        .map_or(0, |kb| kb * 1024)
+    crate::memory::peak_bytes()
 }
 
-/// Bytes of memory available to a new allocation (`MemAvailable` of /proc/meminfo), `None`
-/// where unknown.
-pub fn available_memory_bytes() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find_map(|l| l.strip_prefix("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().next()?.parse().ok()?;
-    Some(kb * 1024)
+/// The memory limits of a run in this process: what [`crate::memory::available`] finds,
+/// shared among `ranks` processes of one machine.
+fn memory_limits(ranks: u64) -> (Option<u64>, Option<&'static str>) {
+    match crate::memory::available() {
+        Some(a) => (Some(a.bytes / ranks.max(1)), Some(a.limit)),
+        None => (None, None),
+    }
 }
 
 /// Solves `scene` (from `source`) within the memory this machine has available, reporting to
@@ -57,8 +50,10 @@ pub fn solve_with(
         (MeshKind::Gmsh, Some(file), None) => Some(mesh::read_msh(source.dir.join(file))?),
         (_, _, given) => given,
     };
+    let (memory_bytes, memory_limit) = memory_limits(1);
     let limits = problem::Limits {
-        memory_bytes: available_memory_bytes(),
+        memory_bytes,
+        memory_limit,
         interrupt,
     };
     let mut solution = problem::solve_within(scene, mesh, limits, reporter)?;
@@ -89,8 +84,10 @@ pub fn run_distributed(
     let mut silent = problem::Silent;
     let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
     // the ranks of one machine share its memory (on several machines this is conservative)
+    let (memory_bytes, memory_limit) = memory_limits(petsc.size() as u64);
     let limits = problem::Limits {
-        memory_bytes: available_memory_bytes().map(|b| b / petsc.size() as u64),
+        memory_bytes,
+        memory_limit,
         ..Default::default()
     };
     let solved = distributed::solve(scene, mesh, &petsc, limits, reporter).map_err(|e| match e {

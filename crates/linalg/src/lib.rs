@@ -43,7 +43,8 @@ pub mod sparse;
 
 pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{
-    equilibrium_residual, CoupledSolver, DirectLdlt, FactorPreconditioner, SchurOperator, SchurPcg, SolveInfo,
+    equilibrium_residual, refine, CoupledBlocks, CoupledSolver, DirectLdlt, FactorPreconditioner, Refined,
+    SchurOperator, SchurPcg, SolveInfo,
 };
 pub use factor::{FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};

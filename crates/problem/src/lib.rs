@@ -68,7 +68,7 @@ pub mod setup;
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
-pub use run::{solve, solve_within, ContactResult, Limits, Solution};
+pub use run::{solve, solve_within, ContactResult, Limits, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     Backend, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec, LoadSpec,
     MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy,
@@ -78,6 +78,69 @@ use contact::ContactError;
 
 /// "the most extreme inputs are ..." naming the scene's numbers far from 1 (each key once), or
 /// `None` where there are none.
+/// The scene's conditioning factors above 1e3, in words (at most three), or its largest.
+fn conditioning_in_words(scene: &Scene) -> String {
+    let factors = scene.conditioning();
+    let large: Vec<String> = factors
+        .iter()
+        .filter(|(_, v)| *v > 1e3)
+        .take(3)
+        .map(|(k, v)| format!("{k} is {v:.1e}"))
+        .collect();
+    match (large.is_empty(), factors.first()) {
+        (false, _) => format!(
+            "its largest conditioning factors: {} (about 1 is well posed; each decade of them costs one of the 16 digits of a double)",
+            large.join(", ")
+        ),
+        (true, Some((k, v))) => format!("no input makes it so ({k}, the largest factor, is {v:.1e}): the mesh's cells may be degenerate"),
+        (true, None) => "no input makes it so: the mesh's cells may be degenerate".into(),
+    }
+}
+
+impl ProblemError {
+    /// A factorisation's error on `scene`: where the scene's conditioning factors are large, an
+    /// [`ProblemError::IllConditioned`] that names them; else the error itself (a body left free,
+    /// whose message says so).
+    pub fn linear(e: linalg::LinalgError, scene: &Scene) -> Self {
+        let inner = match &e {
+            linalg::LinalgError::In { source, .. } => source.as_ref(),
+            other => other,
+        };
+        let breakdown = matches!(
+            inner,
+            linalg::LinalgError::NotPositiveDefinite { .. }
+                | linalg::LinalgError::ZeroPivot { .. }
+                | linalg::LinalgError::NearlySingular { .. }
+        );
+        let large = scene.conditioning().first().is_some_and(|(_, v)| *v > 1e6);
+        if breakdown && large {
+            ProblemError::IllConditioned {
+                what: format!("linear solve: {e}"),
+                factors: conditioning_in_words(scene),
+            }
+        } else {
+            ProblemError::Linalg(e)
+        }
+    }
+
+    /// The error, with a linear solver's breakdown made [`ProblemError::IllConditioned`] where
+    /// the scene is ([`ProblemError::linear`]).
+    pub fn on_scene(self, scene: &Scene) -> Self {
+        match self {
+            ProblemError::Linalg(e) => ProblemError::linear(e, scene),
+            other => other,
+        }
+    }
+
+    /// A run whose residual `what` (`value`) is above its tolerance `tol` after refinement.
+    pub fn inaccurate(what: &str, value: f64, tol: f64, scene: &Scene) -> Self {
+        ProblemError::IllConditioned {
+            what: format!("the {what} {value:.2e} is above its tolerance {tol:e} after iterative refinement"),
+            factors: conditioning_in_words(scene),
+        }
+    }
+}
+
 fn extremes(scene: &Scene) -> Option<String> {
     let mut named: Vec<String> = vec![];
     for (k, v) in scene.extreme_numbers() {
@@ -117,8 +180,18 @@ pub enum ProblemError {
     /// A linear-algebra failure.
     #[error("linear solve: {0}")]
     Linalg(#[from] linalg::LinalgError),
+    /// A solve that double precision cannot make accurate: a factorisation that broke down, or
+    /// residuals above their tolerances after iterative refinement, on a scene whose
+    /// conditioning factors ([`Scene::conditioning`]) are large; the message names them.
+    #[error("{what}: the coupled system is too ill-conditioned for double precision; {factors}")]
+    IllConditioned {
+        /// What failed (the linear solver's error, or the residual above its tolerance).
+        what: String,
+        /// The scene's largest conditioning factors, in words.
+        factors: String,
+    },
     /// A run that would need more memory than it may use, found before the memory is taken.
-    #[error("the run needs about {:.1} GiB ({what}), more than the {:.1} GiB available: use a coarser mesh (a smaller mesh.n or a larger mesh.h)", *needed as f64 / estimate::GIB, *available as f64 / estimate::GIB)]
+    #[error("the run needs about {:.1} GiB ({what}), more than the {:.1} GiB that {limit} leaves: use a coarser mesh (a smaller mesh.n or a larger mesh.h)", *needed as f64 / estimate::GIB, *available as f64 / estimate::GIB)]
     TooLarge {
         /// What the estimate counts.
         what: String,
@@ -126,6 +199,9 @@ pub enum ProblemError {
         needed: u64,
         /// Bytes available.
         available: u64,
+        /// What limits them (the machine's available memory, an address-space limit, a
+        /// memory cgroup).
+        limit: &'static str,
     },
     /// A result that is not a finite number: the data overflow (or underflow) double
     /// precision, or the problem is singular.

@@ -360,6 +360,10 @@ pub struct SolverReport {
     pub condense_route: Option<String>,
     /// The smallest `|pivot| / |diagonal entry|` of the `L D Lᵀ` (direct strategies).
     pub smallest_pivot_ratio: Option<f64>,
+    /// Steps of iterative refinement of the last solve (direct strategies; 0 where its
+    /// residual was at round-off already).
+    #[serde(default)]
+    pub refinement_steps: usize,
 }
 
 impl SolverReport {
@@ -378,6 +382,7 @@ impl SolverReport {
             fixed_point_relaxations: info.map_or(0, |i| i.relaxations),
             condense_route: None,
             smallest_pivot_ratio: None,
+            refinement_steps: 0,
         }
     }
 }

@@ -129,7 +129,10 @@ pub fn kind_of_problem(e: &ProblemError) -> Kind {
         // a group the scene names and the mesh lacks is the mesh's error, wherever it is found
         ProblemError::Mesh(_) | ProblemError::Assembly(fe_assembly::AssemblyError::Mesh(_)) => Kind::Mesh,
         ProblemError::Scene(_) | ProblemError::Assembly(_) | ProblemError::Material(_) => Kind::Input,
-        ProblemError::Linalg(_) | ProblemError::NotFinite { .. } | ProblemError::TooLarge { .. } => Kind::Solver,
+        ProblemError::Linalg(_)
+        | ProblemError::NotFinite { .. }
+        | ProblemError::TooLarge { .. }
+        | ProblemError::IllConditioned { .. } => Kind::Solver,
         // a residual that is not a number: the data overflowed, the solve did not fail to converge
         ProblemError::Contact { source, .. } if source.residual().is_some_and(|r| !r.is_finite()) => Kind::Solver,
         // not converged: within its iterations, or within the time `run` was given

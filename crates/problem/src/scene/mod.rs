@@ -303,6 +303,60 @@ impl Scene {
         out
     }
 
+    /// What makes the coupled system ill-conditioned, largest first: each piezoelectric
+    /// material's coupling number `e²/(c ε)` (its largest `e`, scaled by `coupling_scale`,
+    /// over its smallest diagonal `c` and `ε`: the stiffening `G B⁻¹ Gᵀ` brings to `A`), each
+    /// isotropic material's `1/(1 - 2ν)` (near incompressibility), and the contrast of the
+    /// stiffnesses; dimensionless, about 1 for a well-posed scene.
+    pub fn conditioning(&self) -> Vec<(String, f64)> {
+        let mut out: Vec<(String, f64)> = vec![];
+        let mut stiffness: Vec<f64> = vec![];
+        for m in &self.material {
+            let scale = m.coupling_scale.unwrap_or(1.0);
+            match m.model {
+                MaterialModel::Crystal6mm => {
+                    // the diagonal constants (c11, c33, c44, c66)
+                    let c: Vec<f64> = [0, 3, 4, 5].iter().filter_map(|&k| m.c.get(k).copied()).collect();
+                    let c_min = c.iter().copied().fold(f64::INFINITY, f64::min);
+                    stiffness.extend(&c);
+                    let e = m.e.iter().fold(0.0f64, |a, x| a.max(x.abs())) * scale.abs();
+                    let eps = m.permittivity.iter().copied().fold(f64::INFINITY, f64::min);
+                    if e > 0.0 && c_min > 0.0 && eps > 0.0 {
+                        let name = if scale != 1.0 {
+                            format!("the coupling number e²/(c ε) of material `{}` (with material.coupling_scale = {scale:e})", m.region)
+                        } else {
+                            format!("the coupling number e²/(c ε) of material `{}`", m.region)
+                        };
+                        out.push((name, e * e / (c_min * eps)));
+                    }
+                }
+                MaterialModel::Isotropic => {
+                    if let (Some(young), Some(nu)) = (m.young, m.poisson) {
+                        stiffness.push(young);
+                        if nu < 0.5 {
+                            out.push((
+                                format!("1/(1 - 2ν) of material `{}` (poisson = {nu})", m.region),
+                                1.0 / (1.0 - 2.0 * nu),
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        let (lo, hi) = stiffness
+            .iter()
+            .filter(|c| **c > 0.0)
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &c| (lo.min(c), hi.max(c)));
+        if hi > 0.0 && lo.is_finite() {
+            out.push((
+                "the stiffness contrast between and within the materials".into(),
+                hi / lo,
+            ));
+        }
+        out.sort_by(|a, b| b.1.total_cmp(&a.1));
+        out
+    }
+
     /// The scene's numbers far from 1 (beyond 1e100 or below 1e-100 in magnitude), the most
     /// extreme first: where a result that is not finite most likely comes from.
     pub fn extreme_numbers(&self) -> Vec<(&'static str, f64)> {

@@ -329,6 +329,11 @@ fn validate_generated(m: &MeshSpec, d: usize) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// The largest coupling number `e²/(c ε)` of a material that the solver honours (equilibrium
+/// to 1e-8 and complementarity to the tolerance after refinement; measured on paper,
+/// paper-3d and actuator, docs/stability.md).
+pub const MAX_COUPLING_NUMBER: f64 = 2e12;
+
 /// A material's constants for its model (the caller names the region in the message).
 fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
     let bad = |what: &str| SceneError::new("material", what);
@@ -369,6 +374,23 @@ fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
             }
             if let Some(s) = m.coupling_scale {
                 finite("material.coupling_scale", s)?;
+            }
+            // the coupling the solver honours: beyond it, double precision keeps too few digits
+            let c_min = [0, 3, 4, 5].iter().map(|&k| m.c[k]).fold(f64::INFINITY, f64::min);
+            let e_max = m.e.iter().fold(0.0f64, |a, x| a.max(x.abs())) * m.coupling_scale.unwrap_or(1.0).abs();
+            let eps_min = m.permittivity.iter().copied().fold(f64::INFINITY, f64::min);
+            if c_min > 0.0 && eps_min > 0.0 {
+                let k = e_max * e_max / (c_min * eps_min);
+                if !(k <= MAX_COUPLING_NUMBER) {
+                    return Err(SceneError::new(
+                        if m.coupling_scale.is_some() { "material.coupling_scale" } else { "material.e" },
+                        format!(
+                            "the coupling number e²/(c ε) of material `{}` is {k:.2e} (largest e{} over the smallest diagonal c and ε), beyond {MAX_COUPLING_NUMBER:.0e}: past it the coupled system loses the digits the tolerances need (measured in docs/stability.md: PZT-5A with material.coupling_scale up to 1e6, a coupling number of 1.6e12, is solved to its tolerances; 1e7 is not)",
+                            m.region,
+                            if m.coupling_scale.is_some() { " times material.coupling_scale" } else { "" }
+                        ),
+                    ));
+                }
             }
         }
         MaterialModel::Isotropic => {
