@@ -65,3 +65,32 @@ fn past_the_accepted_coupling_the_scene_is_refused_with_the_measured_reason() {
         );
     }
 }
+
+/// A friction fixed point that no longer improves (strong coupling, the first-order strategies)
+/// stops after its patience with the measured ratio of its steps, not at its limit of 100
+/// steps (11 minutes before, on paper at n = 64).
+#[test]
+fn a_fixed_point_that_stops_improving_is_told_early() {
+    for strategy in ["uzawa-condensed", "apg-condensed"] {
+        let set = format!("solver.strategy={strategy}");
+        let sets: Vec<String> = ["mesh.n=32", "material.coupling_scale=100", &set]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let e = driver::studies::solve("paper", &sets)
+            .err()
+            .expect("the fixed point does not converge");
+        match e {
+            driver::DriverError::Problem(problem::ProblemError::Contact {
+                source:
+                    contact::ContactError::FixedPointNoConvergence {
+                        n_iters,
+                        contraction: Some(_),
+                        ..
+                    },
+                ..
+            }) => assert!(n_iters < 100, "{strategy}: {n_iters}"),
+            other => panic!("{strategy}: {other}"),
+        }
+    }
+}

@@ -59,7 +59,7 @@ pub use solution::{
     Interruption, Iterate, Law, Measure, Progress, Stage, Stall,
 };
 pub use uniqueness::slip_bound_expansion;
-pub use uzawa::{solve, StopRule, UzawaParams};
+pub use uzawa::{solve, StopRule, UzawaParams, FIXED_POINT_PATIENCE};
 
 /// A failure of the primal solve behind a [`ContactOperator`], with its cause (for example the
 /// linear solver's own error), which [`std::error::Error::source`] returns.
@@ -96,13 +96,35 @@ pub enum ContactError {
         /// The best iterate.
         best: Option<Box<Iterate>>,
     },
-    /// The fixed point on the slip bound did not converge.
-    #[error("the friction fixed point did not converge in {n_iters} iterations (residual {residual:.3e}); the fixed point on S may cycle under strong coupling or large F")]
+    /// The fixed point on the slip bound did not converge: it reached its iteration limit, or
+    /// stopped early where its steps no longer contracted (no better residual over
+    /// [`FIXED_POINT_PATIENCE`] steps, its relaxation at its floor or not).
+    #[error("the friction fixed point did not converge in {n_iters} iterations (residual {residual:.3e}){}", contraction.map_or(String::new(), |q| format!("; it stopped improving: no residual a tenth below its best over its last {FIXED_POINT_PATIENCE} steps, each of which moved the slip bound by {q:.2} times the step before (a fixed point that contracts gains digits at every step), so it was stopped there")))]
     FixedPointNoConvergence {
-        /// Iterations done.
+        /// Fixed-point iterations done.
         n_iters: usize,
+        /// The measured ratio of successive changes of the slip bound (the map's contraction,
+        /// geometric mean over the last steps), where the loop stopped for it.
+        contraction: Option<f64>,
         /// Last residual.
         residual: f64,
+        /// The best iterate.
+        best: Option<Box<Iterate>>,
+    },
+    /// A first-order loop that falls, but at a rate that would not reach its target within its
+    /// iteration limit: stopped at once (measured over the last iterations).
+    #[error("a first-order loop falls too slowly: at its measured rate it would need about {needed} more iterations to go from {residual:.3e} to {target:.1e}, beyond its limit of {limit} (the dual problem is ill-conditioned: strong coupling, or a fine mesh)")]
+    TooSlow {
+        /// Iterations done.
+        n_iters: usize,
+        /// The residual now.
+        residual: f64,
+        /// The residual it must reach.
+        target: f64,
+        /// The iterations it would need, at its rate.
+        needed: usize,
+        /// Its limit.
+        limit: usize,
         /// The best iterate.
         best: Option<Box<Iterate>>,
     },
@@ -181,6 +203,7 @@ impl ContactError {
     pub fn residual(&self) -> Option<f64> {
         match self {
             ContactError::NoConvergence { residual, .. }
+            | ContactError::TooSlow { residual, .. }
             | ContactError::FixedPointNoConvergence { residual, .. }
             | ContactError::Diverged { residual, .. }
             | ContactError::Stalled { residual, .. }
@@ -194,6 +217,7 @@ impl ContactError {
     pub fn best(&self) -> Option<&Iterate> {
         match self {
             ContactError::NoConvergence { best, .. }
+            | ContactError::TooSlow { best, .. }
             | ContactError::FixedPointNoConvergence { best, .. }
             | ContactError::Diverged { best, .. }
             | ContactError::Stalled { best, .. }
@@ -207,6 +231,7 @@ impl ContactError {
     /// it holds (or it holds none).
     pub fn with_best(mut self, candidate: Iterate) -> Self {
         if let ContactError::NoConvergence { best, .. }
+        | ContactError::TooSlow { best, .. }
         | ContactError::FixedPointNoConvergence { best, .. }
         | ContactError::Diverged { best, .. }
         | ContactError::Stalled { best, .. }

@@ -251,10 +251,13 @@ pub fn solve(
 /// `S ← S + ω (F λ_n - S)`: ω = 1 is the paper's iteration; under the tight rule ω halves (down
 /// to 1/64) whenever the residual fails to fall, which damps the two-cycles strong coupling can
 /// cause (the fixed points are the same for every ω > 0), and doubles again (up to 1) after
-/// two falls in a row. Under the tight rule each Tresca
-/// solve goes to a tenth of the fixed point's last residual (and at least to the rule's
-/// tolerance): an inner solve only as exact as the outer tolerance leaves an error of that size
-/// in `S`, on which the outer residual can cycle above its tolerance.
+/// two falls in a row. Under the tight rule each Tresca solve goes to a tenth of the fixed
+/// point's last residual (1e-3 at most, a tenth of the rule's tolerance at least): solving the
+/// first Tresca problems to round-off while `S` is far from its fixed point only costs time
+/// (minutes of full solves, measured), and an inner solve only as exact as the outer tolerance
+/// would leave an error of that size in `S`, on which the outer residual could cycle above it.
+/// Steps that no longer contract ([`FIXED_POINT_PATIENCE`] without a better residual) stop the
+/// loop with the measured contraction.
 fn fixed_point(
     d: &mut Dual<'_, '_>,
     law: &Law,
@@ -267,10 +270,15 @@ fn fixed_point(
     let mut omega: f64 = 1.0;
     let mut falls = 0;
     let mut previous = f64::INFINITY;
+    // the map's measured contraction: the changes of S, and the best residual's age
+    let mut moves: Vec<f64> = vec![];
+    let (mut best, mut since_best) = (f64::INFINITY, 0);
     for l in 1..=params.max_fixed_point {
         d.info.fixed_point_iters = l;
         if let Some(tol) = d.tol() {
-            d.inner_tol = Some((0.1 * previous).min(tol).max(1e-15));
+            // a tenth of the last outer residual (no tighter than needed while S is far from
+            // its fixed point), and a tenth of the tolerance at the end
+            d.inner_tol = Some((0.1 * previous).min(1e-3).max(0.1 * tol).max(1e-15));
         }
         let mut fresh = uzawa(d, None, &s, lambda, u, progress)?;
         let s_new = slip_bound(points, law, &lambda.normal);
@@ -319,6 +327,7 @@ fn fixed_point(
             }
         }
         previous = residual;
+        moves.push(s_new.iter().zip(&s).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt());
         s = if omega == 1.0 {
             s_new
         } else {
@@ -326,6 +335,20 @@ fn fixed_point(
         };
         if done {
             return Ok(fresh);
+        }
+        if residual < 0.9 * best {
+            (best, since_best) = (residual, 0);
+        } else {
+            since_best += 1;
+        }
+        if params.rule != StopRule::Paper && since_best >= FIXED_POINT_PATIENCE {
+            // steps that no longer contract: more of them would only cost time
+            return Err(ContactError::FixedPointNoConvergence {
+                n_iters: l,
+                contraction: contraction(&moves),
+                residual,
+                best: d.best(),
+            });
         }
         if let Some(why) = params.interrupt.check() {
             return Err(ContactError::Interrupted {
@@ -338,9 +361,25 @@ fn fixed_point(
     }
     Err(ContactError::FixedPointNoConvergence {
         n_iters: params.max_fixed_point,
+        contraction: None,
         residual: previous,
         best: d.best(),
     })
+}
+
+/// Fixed-point steps without a residual a tenth below the best before the loop is stopped as
+/// not contracting (enough for the relaxation to fall from 1 to its floor 1/64 and try there).
+pub const FIXED_POINT_PATIENCE: usize = 12;
+
+/// The geometric mean of the ratios of successive changes over the last steps.
+fn contraction(moves: &[f64]) -> Option<f64> {
+    let last = &moves[moves.len().saturating_sub(FIXED_POINT_PATIENCE)..];
+    let ratios: Vec<f64> = last
+        .windows(2)
+        .filter(|w| w[0] > 0.0 && w[1] > 0.0)
+        .map(|w| (w[1] / w[0]).ln())
+        .collect();
+    (!ratios.is_empty()).then(|| (ratios.iter().sum::<f64>() / ratios.len() as f64).exp())
 }
 
 /// The solution of a finished solve: its residual with the law's radius (checked against the
@@ -443,6 +482,38 @@ impl Dual<'_, '_> {
     }
 }
 
+/// Iterations over which the rate of a first-order loop is measured.
+const RATE_WINDOW: usize = 2000;
+
+/// The residual at the last mark, a window ago.
+#[derive(Default)]
+struct Rate {
+    at_mark: Option<f64>,
+}
+
+impl Rate {
+    fn mark(&mut self, r: f64) {
+        self.at_mark = Some(r);
+    }
+
+    /// The iterations the loop needs from `r` to `target` at the rate of the last window;
+    /// `None` where it fell by less than 1 % (a stall, which the loop's own rules handle, with
+    /// a smaller step first).
+    fn needed(&self, r: f64, target: f64) -> Option<usize> {
+        let before = self.at_mark?;
+        if !(r < 0.99 * before && r > target && target > 0.0) {
+            return None;
+        }
+        let per_step = (r / before).ln() / RATE_WINDOW as f64;
+        let steps = (target / r).ln() / per_step;
+        Some(if steps.is_finite() && steps < 1e15 {
+            steps.ceil() as usize
+        } else {
+            usize::MAX / 2
+        })
+    }
+}
+
 /// Uzawa iterations for a given radius. Returns whether `u` is the displacement of the final
 /// `lambda` (true under the tight rule; under the paper's rule the last update is not solved).
 ///
@@ -465,6 +536,7 @@ fn uzawa(
     let mut window_start = 0;
     let mut last = f64::NAN;
     let mut momentum = Momentum { t: 1.0, x_prev: None };
+    let mut rate = Rate::default();
     for k in 1..=params.max_iters {
         d.c.call(lambda, u)?;
         let r = d.residual(law, radius, lambda, u);
@@ -521,6 +593,24 @@ fn uzawa(
             momentum = Momentum { t: 1.0, x_prev: None };
         }
         best = best.min(r);
+        // a loop whose measured rate would not reach the target within its limit is stopped
+        // now, not at the limit (hours of full solves, on an ill-conditioned dual)
+        if let (Some(tol), true) = (d.tol(), k % RATE_WINDOW == 0) {
+            let target = d.inner_tol.unwrap_or(tol);
+            if let Some(needed) = rate.needed(r, target) {
+                if k + needed > params.max_iters {
+                    return Err(ContactError::TooSlow {
+                        n_iters: d.info.uzawa_iters,
+                        residual: r,
+                        target,
+                        needed,
+                        limit: params.max_iters,
+                        best: d.best(),
+                    });
+                }
+            }
+            rate.mark(r);
+        }
         d.info.uzawa_iters += 1;
         let y_old = if params.accelerate { Some(lambda.clone()) } else { None };
         let (diff2, norm2) = projected_step(points, radius, d.step, lambda, u);

@@ -715,3 +715,39 @@ proptest! {
         }
     }
 }
+
+/// Slow failures end early (issue 20, class 9): a first-order loop whose measured rate would
+/// not reach its target within its limit stops after a few measuring windows with
+/// `TooSlow`, not at the limit. (A fixed point that stops improving: tests/accuracy.rs.)
+#[test]
+fn slow_failures_are_told_early() {
+    // a diagonal compliance from 1 down to 1e-5: plain Uzawa gains 2e-5 of the slow mode per
+    // step, a million steps to 1e-12 (a fall too slow for the limit, too fast for a stall)
+    let n = 6;
+    let pts = points(n, 2, &[0.0; 6], 0.0);
+    let m = n;
+    let mut d = vec![0.0; m * m];
+    for i in 0..m {
+        d[i * m + i] = 10f64.powf(-5.0 * i as f64 / (m - 1) as f64) / pts.weight[i];
+    }
+    let mut op = DenseContactProblem {
+        u0: PointValues::from_parts(vec![1.0; n], vec![], 0).unwrap(),
+        compliance: d,
+        weight: pts.weight.clone(),
+        nt: 0,
+    };
+    let params = UzawaParams {
+        max_iters: 200_000,
+        ..tight(1e-12)
+    };
+    let e = solve(&mut op, &pts, &Law::Frictionless, &params, None, &mut |_| {}).unwrap_err();
+    match e {
+        ContactError::TooSlow {
+            n_iters, needed, limit, ..
+        } => {
+            assert!(n_iters <= 20_000, "measured early, a tenth of the limit: {n_iters}");
+            assert!(needed > limit, "{needed} {limit}");
+        }
+        other => panic!("{other}"),
+    }
+}

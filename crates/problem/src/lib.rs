@@ -278,7 +278,10 @@ impl ProblemError {
             ContactError::FixedPointNoConvergence { .. } if !newton => {
                 "; try solver.strategy=newton-condensed, which solves Coulomb's law directly (no fixed point on S)"
             }
-            ContactError::NoConvergence { .. } | ContactError::Diverged { .. } | ContactError::Stalled { .. }
+            ContactError::NoConvergence { .. }
+            | ContactError::TooSlow { .. }
+            | ContactError::Diverged { .. }
+            | ContactError::Stalled { .. }
                 if !newton =>
             {
                 "; try solver.strategy=newton-condensed (semismooth Newton), or a looser solver.tol"
