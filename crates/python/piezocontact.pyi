@@ -213,6 +213,7 @@ def run(
     timeout: Optional[float] = None,
 ) -> Result:
     """Solves `scene`. `progress`: False, True (lines on sys.stderr) or a callable taking each
-    line. `timeout`: seconds after which the run stops at its next check (ConvergenceError).
+    line. `timeout`: seconds after which the run stops at its next check (ConvergenceError);
+    inf (or a limit beyond the clock) is no limit, NaN and negatives are refused (InputError).
     Ctrl-C stops the run at its next check and raises KeyboardInterrupt, nothing written.
     Raises InputError, MeshError, SolverError, ConvergenceError."""

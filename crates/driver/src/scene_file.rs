@@ -188,6 +188,11 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
                     }
                 };
                 let n = a.len();
+                if at == n {
+                    // one past the last: a new table (`--set dirichlet.2.group=bottom` adds a
+                    // third condition)
+                    a.push(toml::Value::Table(toml::Table::new()));
+                }
                 match a.get_mut(at) {
                     Some(toml::Value::Table(t)) => t,
                     Some(_) => return Err(format!("`{walked}` is not a table")),
@@ -342,5 +347,8 @@ mod tests {
         assert!(e.contains("beyond the 2 tables"), "{e}");
         let (s, _) = load("paper", &["dirichlet.1.phi=0.5".into()]).unwrap();
         assert_eq!(s.dirichlet[1].phi, Some(0.5));
+        // one past the last adds a table
+        let (s, _) = load("paper", &["dirichlet.2.group=bottom".into(), "dirichlet.2.ux=0".into()]).unwrap();
+        assert_eq!((s.dirichlet.len(), s.dirichlet[2].ux), (3, Some(0.0)));
     }
 }

@@ -176,6 +176,17 @@ fn bad_options_and_oblique_normals_are_refused_by_name() {
             .map(|_| ())
             .unwrap_err();
         assert!(e.to_string().contains("nonsense"), "{e}");
+        // a roller through the contact face: held tangents, which the active sets do not hold
+        let mut roller = ["mesh.n=8".to_string(), "solver.backend=\"petsc\"".to_string()].to_vec();
+        roller.extend(["~dirichlet.1.u".to_string(), "dirichlet.1.ux=0".to_string()]);
+        let scene = scene_file::parse(text, "paper", &roller).expect("the scene reads");
+        let e = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .map(|_| ())
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("do not hold a tangent of a contact point"),
+            "{e}"
+        );
     });
 }
 

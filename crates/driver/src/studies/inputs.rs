@@ -179,6 +179,73 @@ pub const INPUTS: &[Input] = &[
         &["mesh.n=8", "~material.poling"],
         Refused("crystal-6mm needs poling"),
     ),
+    // issue 20: prescribed components on contact nodes (a roller through the contact face)
+    input(
+        "prescribed components on contact nodes",
+        "paper",
+        &["mesh.n=8", "~dirichlet.1.u", "dirichlet.1.ux=0"],
+        Solves,
+    ),
+    input(
+        "prescribed components on contact nodes",
+        "paper-3d",
+        &["mesh.n=2", "~dirichlet.1.u", "dirichlet.1.ux=0"],
+        Solves,
+    ),
+    input(
+        "prescribed components on contact nodes",
+        "paper",
+        &["mesh.n=8", "dirichlet.2.group=bottom", "dirichlet.2.ux=0"],
+        Solves,
+    ),
+    input(
+        "prescribed components on contact nodes",
+        "paper",
+        &["mesh.n=8", "dirichlet.2.group=bottom", "dirichlet.2.uy=0"],
+        Refused("contact never acts"),
+    ),
+    input(
+        "prescribed components on contact nodes",
+        "paper",
+        &["mesh.n=8", "contact.gap=-1e-3"],
+        Solves,
+    ),
+    input(
+        "numbers",
+        "paper",
+        &["mesh.n=8", "load.p=1e400"],
+        Refused("is beyond double precision"),
+    ),
+    input(
+        "numbers",
+        "paper",
+        &["mesh.n=99999999999999999999"],
+        Refused("an integer beyond 64 bits"),
+    ),
+    input("numbers", "paper", &["mesh.h=1/8"], Solves),
+    input("numbers", "layered", &["mesh.n=10", "material.1.young=0.02"], Solves),
+    input(
+        "accepted means honoured",
+        "paper",
+        &["mesh.n=8", "material.coupling_scale=1e6"],
+        Solves,
+    ),
+    input(
+        "accepted means honoured",
+        "paper",
+        &["mesh.n=8", "material.coupling_scale=1e8"],
+        Refused("the coupling number e²/(c ε)"),
+    ),
+    input(
+        "slow failures",
+        "paper",
+        &[
+            "mesh.n=32",
+            "material.coupling_scale=100",
+            "solver.strategy=uzawa-condensed",
+        ],
+        Refused("it stopped improving"),
+    ),
     input("memory", "paper", &["mesh.n=4000"], Refused("more than the")),
     input("memory", "paper-3d", &["mesh.n=60"], Refused("more than the")),
 ];
