@@ -83,6 +83,7 @@ pub fn solve<'p>(
     let t_setup = t_total.elapsed().as_secs_f64();
     let t = Instant::now();
     let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
+    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;

@@ -171,6 +171,12 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
         table = match entry {
             toml::Value::Table(t) => t,
             toml::Value::Array(a) => {
+                // a whole table of the array, by its index (`~dirichlet.1` removes the second)
+                if parts.peek().is_none() {
+                    if let Ok(i) = last.parse::<usize>() {
+                        return set_table(a, i, value, &format!("{walked}.{i}"));
+                    }
+                }
                 // an array of tables: entered by a 0-based index, or as its one table
                 let at = match parts.peek().and_then(|p| p.parse::<usize>().ok()) {
                     Some(i) => {
@@ -226,6 +232,29 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
         }
     }
     Ok(())
+}
+
+/// Removes (`value` `None`) or replaces the table at `i` of an array of tables; one past the
+/// last appends. `key` names it in messages.
+fn set_table(a: &mut Vec<toml::Value>, i: usize, value: Option<toml::Value>, key: &str) -> Result<(), String> {
+    let n = a.len();
+    match value {
+        None if i < n => {
+            a.remove(i);
+            Ok(())
+        }
+        None => Err(format!("the scene has no `{key}` to remove (it has {n} tables, indices 0 to {})", n.saturating_sub(1))),
+        Some(t @ toml::Value::Table(_)) if i <= n => {
+            if i == n {
+                a.push(t);
+            } else {
+                a[i] = t;
+            }
+            Ok(())
+        }
+        Some(toml::Value::Table(_)) => Err(format!("`{key}` is beyond the {n} tables (indices 0 to {})", n.saturating_sub(1))),
+        Some(v) => Err(format!("`{key}` is a table of the array: give one, as `{key}={{ ... }}`, or set its keys as `{key}.KEY=VALUE` (not {v})")),
+    }
 }
 
 /// The key that gives the same quantity as the dotted `path` another way (`mesh.h` and
@@ -347,6 +376,13 @@ mod tests {
         assert!(e.contains("beyond the 2 tables"), "{e}");
         let (s, _) = load("paper", &["dirichlet.1.phi=0.5".into()]).unwrap();
         assert_eq!(s.dirichlet[1].phi, Some(0.5));
+        // a whole table removed by its index, and only one that is there
+        let (s, _) = load("paper", &["~dirichlet.1".into()]).unwrap();
+        assert_eq!((s.dirichlet.len(), s.dirichlet[0].group.as_str()), (1, "left"));
+        let e = load("paper", &["~dirichlet.2".into()]).unwrap_err().to_string();
+        assert!(e.contains("no `dirichlet.2` to remove (it has 2 tables"), "{e}");
+        let e = load("paper", &["dirichlet.0=3".into()]).unwrap_err().to_string();
+        assert!(e.contains("`dirichlet.0` is a table of the array"), "{e}");
         // one past the last adds a table
         let (s, _) = load("paper", &["dirichlet.2.group=bottom".into(), "dirichlet.2.ux=0".into()]).unwrap();
         assert_eq!((s.dirichlet.len(), s.dirichlet[2].ux), (3, Some(0.0)));

@@ -12,7 +12,7 @@
 //! give the same matrices (a test checks it).
 
 use crate::kernels::{coupling_column, dielectric_column, elasticity_column, SimplexGeometry};
-use crate::{AssemblyError, Constraint, Dof, DofMap, Material};
+use crate::{AssemblyError, Constraint, Dof, DofMap, Material, Unheld};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use mesh::{CellKind, Mesh};
 use rayon::prelude::*;
@@ -127,6 +127,12 @@ impl<'m> Discretization<'m> {
             geometry,
             cell_electric,
         })
+    }
+
+    /// Checks that the Dirichlet conditions hold every rigid motion and every potential of
+    /// each connected part of the mesh ([`crate::held::check`]): `K` is invertible only then.
+    pub fn check_held(&self) -> Result<(), Unheld> {
+        crate::held::check(self.mesh, &self.dofs, &self.cell_electric)
     }
 
     /// The material of cell `c`.

@@ -44,6 +44,7 @@
 mod assembly;
 mod dofs;
 pub mod exact;
+pub mod held;
 pub mod kernels;
 mod loads;
 mod material;
@@ -52,6 +53,7 @@ mod recovery;
 pub use assembly::{Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field};
 pub use exact::{ErrorNorms, Exact};
+pub use held::Unheld;
 pub use loads::{facet_measure, Load};
 pub use material::{voigt, Crystal, Material, MaterialError};
 pub use recovery::CellFields;
@@ -75,4 +77,7 @@ pub enum AssemblyError {
     /// Inconsistent input (materials, conditions, loads), with a message naming the item.
     #[error("{0}")]
     Input(String),
+    /// A rigid motion or a potential the Dirichlet conditions leave free.
+    #[error(transparent)]
+    Unheld(#[from] Unheld),
 }

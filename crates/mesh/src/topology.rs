@@ -49,6 +49,49 @@ impl Mesh {
         all
     }
 
+    /// The parts of the mesh that hold together as solids: cells joined through a shared facet
+    /// (an edge in 2D, a face in 3D), not through a lone node or edge (a hinge, about which
+    /// two parts turn freely). Returns each cell's part (numbered by their first cells) and
+    /// the number of parts.
+    pub fn solid_parts(&self) -> (Vec<usize>, usize) {
+        let mut up: Vec<usize> = (0..self.n_cells()).collect();
+        fn root(up: &mut [usize], mut c: usize) -> usize {
+            while up[c] != c {
+                up[c] = up[up[c]];
+                c = up[c];
+            }
+            c
+        }
+        // a facet's other cell is among the cells of its first node (no sort of every facet)
+        let (offsets, node_cells) = self.node_cells();
+        let k = self.kind.n_nodes();
+        for (c, cell) in self.iter_cells().enumerate() {
+            for f in self.kind.facets() {
+                let first = cell[f[0]];
+                for &c2 in &node_cells[offsets[first]..offsets[first + 1]] {
+                    let other = &self.cells[c2 * k..(c2 + 1) * k];
+                    if c2 > c && f.iter().all(|&l| other.contains(&cell[l])) {
+                        let (a, b) = (root(&mut up, c), root(&mut up, c2));
+                        up[a.max(b)] = a.min(b);
+                    }
+                }
+            }
+        }
+        let mut number = vec![usize::MAX; self.n_cells()];
+        let mut n = 0;
+        let part = (0..self.n_cells())
+            .map(|c| {
+                let r = root(&mut up, c);
+                if number[r] == usize::MAX {
+                    number[r] = n;
+                    n += 1;
+                }
+                number[r]
+            })
+            .collect();
+        (part, n)
+    }
+
     /// Checks the topology: every facet on one or two cells, no two cells with the same
     /// nodes, every facet of a group a facet of the cells, listed once. Returns the number of
     /// nodes that share their coordinates with another node, and of the groups' facets that

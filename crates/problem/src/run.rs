@@ -240,6 +240,7 @@ struct Assembled<'m> {
 fn assemble<'m>(setup: &'m Setup, reporter: &mut dyn Reporter) -> Result<Assembled<'m>, ProblemError> {
     let t = Instant::now();
     let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
+    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
     let blocks = disc.assemble(Parallelism::Rayon);
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     let seconds = t.elapsed().as_secs_f64();

@@ -1,0 +1,514 @@
+//! What the Dirichlet conditions hold: every connected part of the mesh must have its rigid
+//! motions and, where it carries a potential, its potential fixed, or `K` is singular.
+//!
+//! The paper's theory (its `Γ1` of positive measure, which makes the displacement space a
+//! Hilbert space with Korn's inequality; its `Γa` for the potential) assumes this, and every
+//! solve here needs `A` and `B` invertible: contact alone does not hold a body. A body held
+//! only by contact (sides on rollers, nothing fixing the vertical translation) is refused
+//! here, before any factorisation, with the motion that is free, instead of failing as a
+//! pivot somewhere in a sparse factor.
+//!
+//! The test: the infinitesimal rigid motions of a part (cells joined through facets), `r(x) = a + ω × (x - c)` (3 in 2D: two
+//! translations and the rotation about z; 6 in 3D), are held when the only one that vanishes
+//! on every prescribed component of the part's nodes is zero. Each prescribed component
+//! `(node, k)` gives a linear condition `r_k(x_node) = 0` on `(a, ω)`; the part's motions are
+//! held when these conditions have full rank, judged on the eigenvalues of their Gram matrix
+//! (coordinates taken from the part's centroid and scaled by its size, so that the test is
+//! independent of units and position).
+
+use crate::{Dof, DofMap};
+use mesh::Mesh;
+use nalgebra::{DMatrix, SymmetricEigen};
+
+/// A part of the mesh the Dirichlet conditions leave free.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Unheld {
+    /// Rigid motions of a part are free.
+    #[error(
+        "the Dirichlet conditions leave {count} rigid motion{s} of the body free ({motions}) \
+         in its part with cell {cell} ({cells} cells): contact alone does not hold a body in \
+         this solver (the paper's Γ1 has positive measure: every solve needs the stiffness \
+         invertible); prescribe that motion on a boundary group, e.g. the component along it on \
+         a face that contact does not need",
+        s = if *count == 1 { "" } else { "s" }
+    )]
+    Motion {
+        /// How many independent motions are free.
+        count: usize,
+        /// Each free motion, in words.
+        motions: String,
+        /// A cell of the part.
+        cell: usize,
+        /// The part's number of cells.
+        cells: usize,
+    },
+    /// The potential of an electric part is free (no condition on φ reaches it).
+    #[error(
+        "the potential is floating in the electric part with cell {cell} ({cells} cells): no \
+         Dirichlet condition on φ reaches it, so it is fixed only up to a constant; prescribe φ \
+         on a group of that part (an electrode at 0 V, say)"
+    )]
+    Potential {
+        /// A cell of the part.
+        cell: usize,
+        /// The part's number of cells.
+        cells: usize,
+    },
+}
+
+/// Union-find over nodes, with path halving.
+struct Parts(Vec<usize>);
+
+impl Parts {
+    fn new(n: usize) -> Self {
+        Parts((0..n).collect())
+    }
+    fn root(&mut self, mut v: usize) -> usize {
+        while self.0[v] != v {
+            self.0[v] = self.0[self.0[v]];
+            v = self.0[v];
+        }
+        v
+    }
+    fn join(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.root(a), self.root(b));
+        if ra != rb {
+            self.0[ra.max(rb)] = ra.min(rb);
+        }
+    }
+}
+
+/// The connected parts of the mesh joined by the cells `keep` selects: each node's part
+/// (`None` for a node of no such cell), and each part's first cell and number of cells.
+fn parts(mesh: &Mesh, keep: impl Fn(usize) -> bool) -> (Vec<Option<usize>>, Vec<(usize, usize)>) {
+    let mut p = Parts::new(mesh.n_nodes());
+    let mut used = vec![false; mesh.n_nodes()];
+    for (_, cell) in mesh.iter_cells().enumerate().filter(|(c, _)| keep(*c)) {
+        for w in cell.windows(2) {
+            p.join(w[0], w[1]);
+        }
+        for &v in cell {
+            used[v] = true;
+        }
+    }
+    let mut part_of_root = vec![usize::MAX; mesh.n_nodes()];
+    let mut found: Vec<(usize, usize)> = vec![];
+    for (c, cell) in mesh.iter_cells().enumerate().filter(|(c, _)| keep(*c)) {
+        let r = p.root(cell[0]);
+        if part_of_root[r] == usize::MAX {
+            part_of_root[r] = found.len();
+            found.push((c, 0));
+        }
+        found[part_of_root[r]].1 += 1;
+    }
+    let part = (0..mesh.n_nodes())
+        .map(|v| used[v].then(|| part_of_root[p.root(v)]))
+        .collect();
+    (part, found)
+}
+
+/// The rigid-motion parameters `(a, ω)` of component `k` at the scaled point `y`: the row of
+/// the condition `r_k(y) = 0` (2D: `a = (a_x, a_y)`, `ω` about z; 3D: `a`, `ω` in R³).
+fn rigid_row(dim: usize, k: usize, y: [f64; 3]) -> Vec<f64> {
+    if dim == 2 {
+        // r = (a_x - ω y, a_y + ω x)
+        match k {
+            0 => vec![1.0, 0.0, -y[1]],
+            _ => vec![0.0, 1.0, y[0]],
+        }
+    } else {
+        // r = a + ω × y
+        let mut row = vec![0.0; 6];
+        row[k] = 1.0;
+        let (w, cross) = match k {
+            0 => ([1, 2], [y[2], -y[1]]), // ω_y z - ω_z y
+            1 => ([2, 0], [y[0], -y[2]]), // ω_z x - ω_x z
+            _ => ([0, 1], [y[1], -y[0]]), // ω_x y - ω_y x
+        };
+        row[3 + w[0]] = cross[0];
+        row[3 + w[1]] = cross[1];
+        row
+    }
+}
+
+/// A free rigid motion in words, from its scaled parameters `v` about the centroid `c` of a
+/// part of size `size`.
+fn describe(dim: usize, v: &[f64], c: [f64; 3], size: f64) -> String {
+    let fmt = |x: &[f64]| {
+        let n = x.iter().map(|a| a * a).sum::<f64>().sqrt();
+        // round-off below the printed digits shown as 0, without a sign
+        let parts: Vec<String> = x.iter().map(|a| format!("{:.3}", snap(a / n, 1.0))).collect();
+        format!("[{}]", parts.join(", "))
+    };
+    let (a, w) = v.split_at(dim);
+    let (na, nw) = (
+        a.iter().map(|x| x * x).sum::<f64>().sqrt(),
+        w.iter().map(|x| x * x).sum::<f64>().sqrt(),
+    );
+    if nw <= 1e-6 * na {
+        return format!("a translation along {}", fmt(a));
+    }
+    if dim == 2 {
+        // a_x - ω y = -ω (y - p_y), a_y + ω x = ω (x - p_x): p = (-a_y / ω, a_x / ω)
+        let p = [c[0] - size * a[1] / w[0], c[1] + size * a[0] / w[0]];
+        return format!(
+            "a rotation about the point ({:.4e}, {:.4e})",
+            snap(p[0], size),
+            snap(p[1], size)
+        );
+    }
+    // a = -ω × p + t ω: p = ω × a / |ω|²
+    let p = [
+        (w[1] * a[2] - w[2] * a[1]) / (nw * nw),
+        (w[2] * a[0] - w[0] * a[2]) / (nw * nw),
+        (w[0] * a[1] - w[1] * a[0]) / (nw * nw),
+    ];
+    let slide = (a[0] * w[0] + a[1] * w[1] + a[2] * w[2]).abs() / (na.max(f64::MIN_POSITIVE) * nw);
+    format!(
+        "a rotation about the axis along {} through ({:.4e}, {:.4e}, {:.4e}){}",
+        fmt(w),
+        snap(c[0] + size * p[0], size),
+        snap(c[1] + size * p[1], size),
+        snap(c[2] + size * p[2], size),
+        if slide > 1e-6 && na > 1e-6 * nw {
+            ", with a slide along it"
+        } else {
+            ""
+        }
+    )
+}
+
+/// `x`, or 0 where it is round-off next to `scale`.
+fn snap(x: f64, scale: f64) -> f64 {
+    if x.abs() <= 1e-9 * scale {
+        0.0
+    } else {
+        x
+    }
+}
+
+/// Below this fraction of the largest eigenvalue of the conditions' Gram matrix, a rigid
+/// motion is free (the Gram matrix is a sum of unit-scale rows: its eigenvalues are at least
+/// one for a held motion held by one node, and grow with the nodes; a motion held only by a
+/// lever of 1e-6 of the part's size is free in double precision anyway).
+const FREE: f64 = 1e-12;
+
+/// Checks that every solid part of the mesh ([`Mesh::solid_parts`]) has its rigid motions
+/// held by the prescribed displacement components of its nodes, and every electric part
+/// (joined by the `cell_electric` cells through any node) its potential by a prescribed φ.
+///
+/// # Errors
+/// [`Unheld::Motion`] with the free motions of the first part that has any, or
+/// [`Unheld::Potential`].
+pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool]) -> Result<(), Unheld> {
+    let dim = dofs.dim;
+    let n_modes = if dim == 2 { 3 } else { 6 };
+    // the solid parts (joined through facets: two parts on a hinge node turn about it), and
+    // each part's nodes (a hinge node is in both)
+    let (cell_part, n_parts) = mesh.solid_parts();
+    // (part, node): each node once in its first cell's part, and again in any other part it
+    // hinges (few)
+    let mut node_part = vec![usize::MAX; mesh.n_nodes()];
+    let mut hinges = vec![];
+    for (c, cell) in mesh.iter_cells().enumerate() {
+        let p = cell_part[c];
+        for &v in cell {
+            if node_part[v] == usize::MAX {
+                node_part[v] = p;
+            } else if node_part[v] != p {
+                hinges.push((p, v));
+            }
+        }
+    }
+    hinges.sort_unstable();
+    hinges.dedup();
+    let members: Vec<(usize, usize)> = (0..mesh.n_nodes())
+        .filter(|&v| node_part[v] != usize::MAX)
+        .map(|v| (node_part[v], v))
+        .chain(hinges)
+        .collect();
+    let mut first = vec![usize::MAX; n_parts];
+    let mut cells = vec![0usize; n_parts];
+    for (c, &p) in cell_part.iter().enumerate() {
+        first[p] = first[p].min(c);
+        cells[p] += 1;
+    }
+    // each part's centroid and bounding box
+    let mut count = vec![0usize; n_parts];
+    let mut centroid = vec![[0.0; 3]; n_parts];
+    let mut lo = vec![[f64::INFINITY; 3]; n_parts];
+    let mut hi = vec![[f64::NEG_INFINITY; 3]; n_parts];
+    for &(i, v) in &members {
+        let x = mesh.points[v];
+        count[i] += 1;
+        for k in 0..dim {
+            centroid[i][k] += x[k];
+            lo[i][k] = lo[i][k].min(x[k]);
+            hi[i][k] = hi[i][k].max(x[k]);
+        }
+    }
+    // the largest extent (a sum of squares would underflow on a mesh in units of 1e-170)
+    let size: Vec<f64> = (0..n_parts)
+        .map(|i| (0..dim).map(|k| hi[i][k] - lo[i][k]).fold(f64::MIN_POSITIVE, f64::max))
+        .collect();
+    for (i, c) in centroid.iter_mut().enumerate() {
+        for x in c.iter_mut() {
+            *x /= count[i] as f64;
+        }
+    }
+    // the Gram matrix of the conditions the prescribed components put on each part's motions
+    let mut gram = vec![DMatrix::<f64>::zeros(n_modes, n_modes); n_parts];
+    for &(i, v) in &members {
+        let x = mesh.points[v];
+        let mut y = [0.0; 3];
+        for k in 0..dim {
+            y[k] = (x[k] - centroid[i][k]) / size[i];
+        }
+        for k in 0..dim {
+            if let Dof::Fixed(_) = dofs.u[v * dim + k] {
+                let row = nalgebra::DVector::from_vec(rigid_row(dim, k, y));
+                gram[i] += &row * row.transpose();
+            }
+        }
+    }
+    for (i, g) in gram.into_iter().enumerate() {
+        let eig = SymmetricEigen::new(g);
+        let largest = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+        let free: Vec<usize> = (0..n_modes)
+            .filter(|&j| !(eig.eigenvalues[j] > FREE * largest))
+            .collect();
+        if !free.is_empty() {
+            let motions: Vec<String> = free
+                .iter()
+                .map(|&j| {
+                    let v: Vec<f64> = eig.eigenvectors.column(j).iter().cloned().collect();
+                    describe(dim, &v, centroid[i], size[i])
+                })
+                .collect();
+            return Err(Unheld::Motion {
+                count: free.len(),
+                motions: motions.join("; "),
+                cell: first[i],
+                cells: cells[i],
+            });
+        }
+    }
+    // the electric parts: joined by electric cells only
+    let (part, found) = parts(mesh, |c| cell_electric[c]);
+    let mut held = vec![false; found.len()];
+    for (v, d) in dofs.phi.iter().enumerate() {
+        if let (Dof::Fixed(_), Some(i)) = (d, part[v]) {
+            held[i] = true;
+        }
+    }
+    if let Some(i) = held.iter().position(|h| !h) {
+        return Err(Unheld::Potential {
+            cell: found[i].0,
+            cells: found[i].1,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Constraint, Field};
+    use proptest::prelude::*;
+
+    /// The dof map with the components `fixed(x, k)` selects held at 0, and φ where `phi(x)`.
+    fn dofs(mesh: &Mesh, fixed: impl Fn(&[f64], usize) -> bool, phi: impl Fn(&[f64]) -> bool) -> DofMap {
+        let mut d = DofMap::new(mesh, &vec![true; mesh.n_nodes()], &[]).unwrap();
+        for v in 0..mesh.n_nodes() {
+            for k in 0..mesh.dim {
+                if fixed(mesh.point(v), k) {
+                    d.u[v * mesh.dim + k] = Dof::Fixed(0.0);
+                }
+            }
+            if phi(mesh.point(v)) {
+                d.phi[v] = Dof::Fixed(0.0);
+            }
+        }
+        d
+    }
+
+    fn free(r: Result<(), Unheld>) -> usize {
+        match r {
+            Ok(()) => 0,
+            Err(Unheld::Motion { count, .. }) => count,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// Two copies of `mesh`, the second shifted by `dx` along x (two bodies).
+    fn two_bodies(mesh: &Mesh, dx: f64) -> Mesh {
+        let mut m = mesh.clone();
+        let n = mesh.n_nodes();
+        m.points.extend(mesh.points.iter().map(|p| [p[0] + dx, p[1], p[2]]));
+        m.cells.extend(mesh.cells.iter().map(|v| v + n));
+        m
+    }
+
+    #[test]
+    fn the_motions_left_free_in_2d_are_counted_and_named() {
+        let m = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 8, 4);
+        let all = vec![true; m.n_cells()];
+        let left = |x: &[f64]| x[0] < 1e-12;
+        let sides = |x: &[f64]| x[0] < 1e-12 || x[0] > 2.0 - 1e-12;
+        // clamped on one side: held
+        assert_eq!(free(check(&m, &dofs(&m, |x, _| left(x), left), &all)), 0);
+        // nothing held: two translations and the rotation
+        assert_eq!(free(check(&m, &dofs(&m, |_, _| false, left), &all)), 3);
+        // both sides on rollers (ux = 0): the vertical translation
+        let e = check(&m, &dofs(&m, |x, k| k == 0 && sides(x), left), &all).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("1 rigid motion of the body free (a translation along [0.000, 1.000])"),
+            "{e}"
+        );
+        // one node pinned: the rotation about it
+        let pin = |x: &[f64]| x[0] < 1e-12 && x[1] < 1e-12;
+        let e = check(&m, &dofs(&m, |x, _| pin(x), left), &all).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("a rotation about the point (0.0000e0, 0.0000e0)"),
+            "{e}"
+        );
+        // pinned and rollered elsewhere: held
+        assert_eq!(
+            free(check(
+                &m,
+                &dofs(&m, |x, k| pin(x) || (k == 1 && x[0] > 2.0 - 1e-12), left),
+                &all
+            )),
+            0
+        );
+    }
+
+    #[test]
+    fn a_body_fixed_on_a_line_in_3d_can_turn_about_it() {
+        let m = mesh::box_tet([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], 3, 3, 3);
+        let all = vec![true; m.n_cells()];
+        let edge = |x: &[f64]| x[0] < 1e-12 && x[1] < 1e-12;
+        let e = check(&m, &dofs(&m, |x, _| edge(x), edge), &all).unwrap_err();
+        let s = e.to_string();
+        assert!(
+            s.contains("1 rigid motion") && s.contains("axis along [0.000, 0.000, 1.000]")
+                || s.contains("axis along [0.000, 0.000, -1.000]"),
+            "{s}"
+        );
+        assert!(s.contains("through (0.0000e0, 0.0000e0,"), "{s}");
+        // a face clamped: held; a face on rollers (uz = 0 on z = 0): three motions free
+        let bottom = |x: &[f64]| x[2] < 1e-12;
+        assert_eq!(free(check(&m, &dofs(&m, |x, _| bottom(x), edge), &all)), 0);
+        assert_eq!(free(check(&m, &dofs(&m, |x, k| k == 2 && bottom(x), edge), &all)), 3);
+    }
+
+    #[test]
+    fn each_body_of_a_mesh_needs_its_own_hold() {
+        let m = two_bodies(&mesh::rectangle_tri([0.0, 0.0], [1.0, 1.0], 4, 4), 3.0);
+        let all = vec![true; m.n_cells()];
+        let left = |x: &[f64]| x[0] < 1e-12;
+        let both = |x: &[f64]| x[0] < 1e-12 || (x[0] - 3.0).abs() < 1e-12;
+        let e = check(&m, &dofs(&m, |x, _| left(x), both), &all).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Unheld::Motion {
+                    count: 3,
+                    cell: 32,
+                    cells: 32,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert_eq!(free(check(&m, &dofs(&m, |x, _| both(x), both), &all)), 0);
+        // the second body's potential floats
+        let e = check(&m, &dofs(&m, |x, _| both(x), left), &all).unwrap_err();
+        assert_eq!(e, Unheld::Potential { cell: 32, cells: 32 });
+        // unless it is elastic only
+        let first: Vec<bool> = (0..m.n_cells()).map(|c| c < 32).collect();
+        assert_eq!(check(&m, &dofs(&m, |x, _| both(x), left), &first), Ok(()));
+    }
+
+    #[test]
+    fn two_parts_on_a_hinge_node_turn_about_it() {
+        // squares (0,1)² and (1,2)², sharing the node (1, 1) only
+        let a = mesh::rectangle_tri([0.0, 0.0], [1.0, 1.0], 2, 2);
+        let mut m = two_bodies(&a, 1.0);
+        let n = a.n_nodes();
+        let shared_a = a.points.iter().position(|p| p[0] == 1.0 && p[1] == 1.0).unwrap();
+        let shared_b = a.points.iter().position(|p| p[0] == 0.0 && p[1] == 0.0).unwrap() + n;
+        for p in m.points[n..].iter_mut() {
+            p[1] += 1.0;
+        }
+        for v in m.cells.iter_mut() {
+            if *v == shared_b {
+                *v = shared_a;
+            }
+        }
+        let all = vec![true; m.n_cells()];
+        // the first square clamped on its left, the hinge pinned: the second turns about it
+        let held = |x: &[f64], _| x[0] == 0.0 || (x[0] == 1.0 && x[1] == 1.0);
+        let e = check(&m, &dofs(&m, held, |x| x[0] == 0.0), &all).unwrap_err();
+        assert!(e.to_string().contains("1 rigid motion of the body free (a rotation about the point (1.0000e0, 1.0000e0)) in its part with cell 8 (8 cells)"), "{e}");
+        // the potential is continuous through the node: one electric part
+        let both = |x: &[f64], _| x[0] == 0.0 || x[0] == 2.0;
+        assert_eq!(check(&m, &dofs(&m, both, |x| x[0] == 0.0), &all), Ok(()));
+    }
+
+    #[test]
+    fn a_dof_map_built_from_conditions_is_judged_the_same() {
+        let m = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 8, 4);
+        let c = [
+            Constraint::constant("left", Field::Displacement(0), 0.0),
+            Constraint::constant("right", Field::Displacement(0), 0.0),
+            Constraint::constant("left", Field::Potential, 0.0),
+        ];
+        let d = DofMap::new(&m, &vec![true; m.n_nodes()], &c).unwrap();
+        assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()])), 1);
+    }
+
+    proptest! {
+        /// The verdict does not depend on units or position: the mesh scaled by any factor
+        /// and moved anywhere gives the same count of free motions.
+        #[test]
+        fn the_verdict_is_independent_of_units_and_position(
+            scale in -200.0f64..200.0,
+            shift in prop::array::uniform3(-1e6f64..1e6),
+            which in 0usize..5,
+        ) {
+            let s = 10f64.powf(scale);
+            let mut m = mesh::box_tet([0.0, 0.0, 0.0], [2.0, 1.0, 1.0], 2, 2, 2);
+            let base = m.clone();
+            for p in m.points.iter_mut() {
+                for k in 0..3 {
+                    p[k] = p[k] * s + shift[k] * s;
+                }
+            }
+            // conditions chosen on the unscaled coordinates
+            let pick = |v: usize, k: usize| {
+                let x = base.points[v];
+                match which {
+                    0 => x[0] == 0.0,
+                    1 => x[0] == 0.0 && k == 0,
+                    2 => x[0] == 0.0 && x[1] == 0.0,
+                    3 => (x[0] == 0.0 && x[1] == 0.0 && x[2] == 0.0) || (x[0] == 2.0 && k != 0),
+                    _ => false,
+                }
+            };
+            let expected = [0, 3, 1, 0, 6][which];
+            let mut d = DofMap::new(&m, &vec![true; m.n_nodes()], &[]).unwrap();
+            for v in 0..m.n_nodes() {
+                for k in 0..3 {
+                    if pick(v, k) {
+                        d.u[v * 3 + k] = Dof::Fixed(0.0);
+                    }
+                }
+            }
+            d.phi[0] = Dof::Fixed(0.0);
+            prop_assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()])), expected);
+        }
+    }
+}
