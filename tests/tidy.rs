@@ -124,43 +124,105 @@ fn the_core_crate_does_no_file_io() {
     }
 }
 
-/// The top-level module of the crate a file belongs to (`crates/X/src/a/b.rs` -> `a`; `lib.rs`
-/// and `main.rs` -> the crate root, left out).
-fn top_module(src: &Path, file: &Path) -> Option<String> {
-    let rel = file.strip_prefix(src).ok()?;
-    let first = rel.components().next()?.as_os_str().to_string_lossy().into_owned();
-    let name = first.trim_end_matches(".rs").to_string();
-    (name != "lib" && name != "main").then_some(name)
+/// The module path of a file of a crate's `src`: `a/b.rs` -> `[a, b]`, `a/mod.rs` -> `[a]`,
+/// `lib.rs` and `main.rs` -> `[]` (the crate root).
+fn module_path(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).unwrap();
+    let mut out: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let last = out.pop().unwrap();
+    let last = last.trim_end_matches(".rs");
+    if !(last == "mod" || (out.is_empty() && (last == "lib" || last == "main"))) {
+        out.push(last.to_string());
+    }
+    out
 }
 
-/// The first segments of the paths after each `crate::` in `text`: `crate::a::b` gives `a`,
-/// `crate::{a::b, c}` gives `a` and `c`.
-fn crate_paths(text: &str) -> Vec<String> {
-    let ident = |s: &str| -> String { s.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect() };
-    let mut out = vec![];
-    for (at, _) in text.match_indices("crate::") {
-        let rest = text[at + 7..].trim_start();
-        if let Some(group) = rest.strip_prefix('{') {
-            // the top-level items of the group
-            let mut depth = 0;
-            let mut start = 0;
-            for (i, c) in group.char_indices() {
-                match c {
-                    '{' => depth += 1,
-                    '}' if depth == 0 => {
-                        out.push(ident(group[start..].trim_start()));
-                        break;
+/// The paths of a use tree starting at `text` (just after `crate::` or `super::`), each as its
+/// segments: `a::b` gives `[a, b]`, `a::{b::c, d}` gives `[a, b, c]` and `[a, d]`.
+fn use_tree(text: &str) -> Vec<Vec<String>> {
+    fn tree(chars: &[char], at: &mut usize, prefix: Vec<String>, out: &mut Vec<Vec<String>>) {
+        let mut path = prefix;
+        loop {
+            while *at < chars.len() && chars[*at].is_whitespace() {
+                *at += 1;
+            }
+            if *at < chars.len() && chars[*at] == '{' {
+                *at += 1;
+                loop {
+                    tree(chars, at, path.clone(), out);
+                    while *at < chars.len() && chars[*at].is_whitespace() {
+                        *at += 1;
                     }
-                    '}' => depth -= 1,
-                    ',' if depth == 0 => {
-                        out.push(ident(group[start..].trim_start()));
-                        start = i + 1;
+                    match chars.get(*at) {
+                        Some(',') => *at += 1,
+                        Some('}') => {
+                            *at += 1;
+                            return;
+                        }
+                        _ => return,
                     }
-                    _ => {}
+                    while *at < chars.len() && chars[*at].is_whitespace() {
+                        *at += 1;
+                    }
+                    if chars.get(*at) == Some(&'}') {
+                        *at += 1;
+                        return;
+                    }
                 }
             }
-        } else {
-            out.push(ident(rest));
+            let start = *at;
+            while *at < chars.len() && (chars[*at].is_alphanumeric() || chars[*at] == '_') {
+                *at += 1;
+            }
+            if *at == start {
+                out.push(path);
+                return;
+            }
+            path.push(chars[start..*at].iter().collect());
+            if chars.get(*at) == Some(&':') && chars.get(*at + 1) == Some(&':') {
+                *at += 2;
+            } else {
+                out.push(path);
+                return;
+            }
+        }
+    }
+    let chars: Vec<char> = text.chars().take(2000).collect();
+    let mut out = vec![];
+    tree(&chars, &mut 0, vec![], &mut out);
+    out
+}
+
+/// The absolute module paths `text` (the file of module `here`) refers to through `crate::`
+/// and `super::` (its inline test module left out: its `super` is the file's module).
+fn referenced_paths(text: &str, here: &[String]) -> Vec<Vec<String>> {
+    let text = text.split("#[cfg(test)]\nmod tests").next().unwrap();
+    let mut out = vec![];
+    for (at, _) in text.match_indices("crate::") {
+        if text[..at].ends_with(|c: char| c.is_alphanumeric() || c == '_' || c == '$') {
+            continue;
+        }
+        out.extend(use_tree(&text[at + 7..]));
+    }
+    for (at, _) in text.match_indices("super::") {
+        if text[..at].ends_with("super::") || text[..at].ends_with(|c: char| c.is_alphanumeric() || c == '_') {
+            continue;
+        }
+        let mut rest = &text[at..];
+        let mut base = here.to_vec();
+        // a file `a/b.rs` is module a::b, whose super is a; `a/mod.rs` is module a, whose
+        // super is the root
+        while let Some(r) = rest.strip_prefix("super::") {
+            base.pop();
+            rest = r;
+        }
+        for p in use_tree(rest) {
+            let mut full = base.clone();
+            full.extend(p);
+            out.push(full);
         }
     }
     out
@@ -168,57 +230,126 @@ fn crate_paths(text: &str) -> Vec<String> {
 
 #[test]
 fn no_import_cycle_between_the_modules_of_a_crate() {
-    for krate in ["mesh", "fe-assembly", "linalg", "contact", "problem", "driver"] {
+    use std::collections::{BTreeMap, BTreeSet};
+    for krate in [
+        "mesh",
+        "fe-assembly",
+        "linalg",
+        "contact",
+        "problem",
+        "driver",
+        "distributed",
+        "petsc",
+        "python",
+    ] {
         let src = root().join("crates").join(krate).join("src");
         let mut files = vec![];
         rust_files(&src, &mut files);
-        let mut modules: Vec<String> = files.iter().filter_map(|f| top_module(&src, f)).collect();
-        modules.sort();
-        modules.dedup();
-        // edges between top-level modules (a module's own sub-modules are part of it)
-        let mut edges: std::collections::BTreeMap<String, std::collections::BTreeSet<String>> = Default::default();
+        let modules: BTreeSet<Vec<String>> = files.iter().map(|f| module_path(&src, f)).collect();
+        // edges between sibling modules, at every level: a reference from a::b::x to a::c::y is
+        // an edge b -> c among the children of a (a module's own sub-modules are part of it)
+        let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = Default::default();
         for f in &files {
-            let Some(from) = top_module(&src, f) else { continue };
+            let from = module_path(&src, f);
             let text = std::fs::read_to_string(f).unwrap();
-            for to in crate_paths(&text) {
-                if to != from && modules.contains(&to) {
-                    edges.entry(from.clone()).or_default().insert(to);
+            for path in referenced_paths(&text, &from) {
+                // the longest prefix of the path that is a module
+                let to = (0..=path.len())
+                    .rev()
+                    .map(|n| path[..n].to_vec())
+                    .find(|p| modules.contains(p))
+                    .unwrap_or_default();
+                let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
+                if common < from.len() && common < to.len() {
+                    edges
+                        .entry(from[..=common].to_vec())
+                        .or_default()
+                        .insert(to[..=common].to_vec());
                 }
             }
         }
         // a depth-first search for a back edge
         fn visit(
-            m: &str,
-            edges: &std::collections::BTreeMap<String, std::collections::BTreeSet<String>>,
-            path: &mut Vec<String>,
-            done: &mut std::collections::BTreeSet<String>,
-        ) -> Option<Vec<String>> {
+            m: &[String],
+            edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>,
+            path: &mut Vec<Vec<String>>,
+            done: &mut BTreeSet<Vec<String>>,
+        ) -> Option<Vec<Vec<String>>> {
             if let Some(at) = path.iter().position(|p| p == m) {
                 let mut cycle = path[at..].to_vec();
-                cycle.push(m.to_string());
+                cycle.push(m.to_vec());
                 return Some(cycle);
             }
             if done.contains(m) {
                 return None;
             }
-            path.push(m.to_string());
+            path.push(m.to_vec());
             for next in edges.get(m).into_iter().flatten() {
                 if let Some(c) = visit(next, edges, path, done) {
                     return Some(c);
                 }
             }
             path.pop();
-            done.insert(m.to_string());
+            done.insert(m.to_vec());
             None
         }
         let mut done = Default::default();
         for m in &modules {
             if let Some(cycle) = visit(m, &edges, &mut vec![], &mut done) {
+                let names: Vec<String> = cycle.iter().map(|p| p.join("::")).collect();
                 panic!(
                     "crate `{krate}`: an import cycle between modules: {}",
-                    cycle.join(" -> ")
+                    names.join(" -> ")
                 );
             }
         }
     }
+}
+
+/// The cycle check sees nested modules and `super::` paths: a circle between two modules of
+/// one directory is found.
+#[test]
+fn the_cycle_check_reads_nested_paths() {
+    let here = vec!["studies".to_string(), "inputs".to_string()];
+    let paths = referenced_paths(
+        "use super::stability::run_with_limit;\nuse crate::{a::{b, c::d}, e};",
+        &here,
+    );
+    assert!(
+        paths.contains(&vec!["studies".into(), "stability".into(), "run_with_limit".into()]),
+        "{paths:?}"
+    );
+    assert!(paths.contains(&vec!["a".into(), "c".into(), "d".into()]), "{paths:?}");
+    assert!(paths.contains(&vec!["e".into()]), "{paths:?}");
+}
+
+/// The function lengths of `cargo xtask metrics`, from its own lexer (comments and strings
+/// skipped).
+#[allow(dead_code)]
+#[path = "../xtask/src/metrics.rs"]
+mod metrics;
+
+/// No function of a crate's sources runs over 100 lines: a longer one is several steps that
+/// want their names (a table of data is a `const`, not a function).
+#[test]
+fn no_function_over_a_hundred_lines() {
+    let mut long = vec![];
+    for entry in std::fs::read_dir(root().join("crates")).unwrap() {
+        let src = entry.unwrap().path().join("src");
+        let mut files = vec![];
+        rust_files(&src, &mut files);
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap();
+            for (name, line, len) in metrics::functions(&text) {
+                if len > 100 {
+                    long.push(format!(
+                        "{}:{line} {name} ({len} lines)",
+                        f.strip_prefix(root()).unwrap().display()
+                    ));
+                }
+            }
+        }
+    }
+    long.sort();
+    assert!(long.is_empty(), "functions over 100 lines:\n{}", long.join("\n"));
 }

@@ -131,7 +131,7 @@ fn prev_is_ident(b: &[char], i: usize) -> bool {
 }
 
 /// `(name, first line, length in lines)` of every function with a body.
-fn functions(src: &str) -> Vec<(String, usize, usize)> {
+pub fn functions(src: &str) -> Vec<(String, usize, usize)> {
     let code = code_only(src);
     let lines: Vec<&str> = code.lines().collect();
     let mut out = vec![];

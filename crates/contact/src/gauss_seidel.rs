@@ -7,9 +7,9 @@
 //! linearly, so it is the last stage of [`crate::solve_newton`] for Coulomb's law.
 
 use crate::local::{Point, PointLaw};
-use crate::operator::AffineProblem;
-use crate::points::{ContactPoints, PointValues};
-use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Counter};
+use crate::operator::{AffineProblem, Compliance};
+use crate::points::{ContactPoints, Flat, PointValues};
+use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Best, Counter};
 use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law, Measure, Progress, Stage, Stall};
 
 /// Parameters of [`solve_gauss_seidel`].
@@ -72,113 +72,18 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
         Some(_) => return Err(ContactError::Input("warm start of the wrong size".into())),
         None => PointValues::zeros(n, nt),
     };
-    let d = problem.compliance();
-    let w = problem.weights().to_vec();
-    let index = |i: usize, k: usize| if k == 0 { i } else { n + i * nt + k - 1 };
-    let m = n * (1 + nt);
-    // the flat index's point, and each point's block of D W
-    let owner: Vec<(usize, usize)> = (0..m)
-        .map(|r| {
-            if r < n {
-                (r, 0)
-            } else {
-                ((r - n) / nt, 1 + (r - n) % nt)
-            }
-        })
-        .collect();
-    let mut blocks = vec![[[0.0; 3]; 3]; n];
-    for r in 0..m {
-        let (i, kr) = owner[r];
-        for (col, v) in d.row(r) {
-            let (j, kc) = owner[col];
-            if j == i {
-                blocks[i][kr][kc] = v * w[i];
-            }
-        }
-    }
+    let sweeper = Sweeper::new(problem, Flat { n, nt });
     let mut info = ContactInfo::new(mu_max);
-    let mut flat = vec![0.0; m];
-    let mut best: Option<Iterate> = None;
-    let mut since_best = 0;
+    let mut best = Best::new(0.99);
     let mut residual = f64::NAN;
     for sweep in 1..=params.max_sweeps {
-        for i in 0..n {
-            // b = u0_i - Σ_{j ≠ i} D_ij w_j λ_j, from the latest multipliers
-            let mut b = [0.0; 3];
-            for k in 0..=nt {
-                let r = index(i, k);
-                let u0r = if k == 0 {
-                    u0.normal[i]
-                } else {
-                    u0.tangential[i * nt + k - 1]
-                };
-                let mut acc = 0.0;
-                for (col, v) in d.row(r) {
-                    let (j, kc) = owner[col];
-                    if j != i {
-                        let l = if kc == 0 {
-                            lambda.normal[j]
-                        } else {
-                            lambda.tangential[j * nt + kc - 1]
-                        };
-                        acc += v * w[j] * l;
-                    }
-                }
-                b[k] = u0r - acc;
-            }
-            let point = Point {
-                a: blocks[i],
-                b,
-                g: points.gap[i],
-                k: 1 + nt,
-                law: match law {
-                    Law::Frictionless => PointLaw::Frictionless,
-                    Law::Tresca(s) => PointLaw::Tresca(s[i]),
-                    Law::Coulomb => PointLaw::Coulomb(points.friction[i]),
-                },
-                held: points.held[i],
-            };
-            let mut x0 = [0.0; 3];
-            x0[0] = lambda.normal[i];
-            x0[1..=nt].copy_from_slice(lambda.tangential_of(i));
-            let x = point.solve(x0);
-            lambda.normal[i] = x[0];
-            lambda.tangential[i * nt..(i + 1) * nt].copy_from_slice(&x[1..=nt]);
-        }
+        sweeper.sweep(points, law, &u0, &mut lambda);
         info.uzawa_iters = sweep;
-        // the sweep's residual, on u = u0 - D W λ
-        for (r, slot) in flat.iter_mut().enumerate() {
-            let (i, k) = owner[r];
-            *slot = w[i]
-                * if k == 0 {
-                    lambda.normal[i]
-                } else {
-                    lambda.tangential[i * nt + k - 1]
-                };
-        }
-        let mut dw = vec![0.0; m];
-        d.apply(&flat, &mut dw);
-        let mut u = u0.clone();
-        for (r, v) in dw.iter().enumerate() {
-            let (i, k) = owner[r];
-            if k == 0 {
-                u.normal[i] -= v;
-            } else {
-                u.tangential[i * nt + k - 1] -= v;
-            }
-        }
+        let u = sweeper.displacement(&u0, &lambda);
         residual = params
             .measure
             .of(points, law, &lambda, &u, &u0, 1.0 / mu_max, reference);
-        let improved = best.as_ref().is_none_or(|b| residual < 0.99 * b.residual);
-        if best.as_ref().is_none_or(|b| residual < b.residual) {
-            best = Some(Iterate {
-                lambda: lambda.clone(),
-                u: u.clone(),
-                residual,
-            });
-        }
-        since_best = if improved { 0 } else { since_best + 1 };
+        best.offer(&lambda, &u, residual);
         if params.report_every > 0 && sweep % params.report_every == 0 {
             progress(&Progress {
                 stage: Stage::GaussSeidel,
@@ -191,21 +96,21 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
             break;
         }
         if !residual.is_finite() {
-            return Err(stopped(Stall::NonFinite, sweep, residual, best));
+            return Err(stopped(Stall::NonFinite, sweep, residual, best.take()));
         }
         if let Some(why) = params.interrupt.check() {
             return Err(ContactError::Interrupted {
                 why,
                 n_iters: sweep,
                 residual,
-                best: best.map(Box::new),
+                best: best.boxed(),
             });
         }
-        if since_best >= STALL_SWEEPS {
-            return Err(stopped(Stall::NoProgress, sweep, residual, best));
+        if best.since() >= STALL_SWEEPS {
+            return Err(stopped(Stall::NoProgress, sweep, residual, best.take()));
         }
     }
-    let best = match best {
+    let best = match best.take() {
         Some(b) if b.residual <= params.tol => b,
         best => {
             return Err(ContactError::NoConvergence {
@@ -227,6 +132,89 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
     })
 }
 
+/// The sweeps' data: the compliance `D` (its rows in the flat layout), the weights `W`, and
+/// each point's own block of `D W`, which its local problem inverts.
+struct Sweeper<'p> {
+    d: Compliance<'p>,
+    w: Vec<f64>,
+    flat: Flat,
+    blocks: Vec<[[f64; 3]; 3]>,
+}
+
+impl<'p> Sweeper<'p> {
+    fn new<P: AffineProblem>(problem: &'p P, flat: Flat) -> Self {
+        let d = problem.compliance();
+        let w = problem.weights().to_vec();
+        let mut blocks = vec![[[0.0; 3]; 3]; flat.n];
+        for r in 0..flat.len() {
+            let (i, kr) = flat.owner(r);
+            for (col, v) in d.row(r) {
+                let (j, kc) = flat.owner(col);
+                if j == i {
+                    blocks[i][kr][kc] = v * w[i];
+                }
+            }
+        }
+        Sweeper { d, w, flat, blocks }
+    }
+
+    /// One sweep: each point in turn solves its own law exactly against
+    /// `b = u0_i - Σ_{j ≠ i} D_ij w_j λ_j`, from the latest multipliers.
+    fn sweep(&self, points: &ContactPoints, law: &Law, u0: &PointValues, lambda: &mut PointValues) {
+        let nt = self.flat.nt;
+        for i in 0..self.flat.n {
+            let mut b = [0.0; 3];
+            for (k, bk) in b.iter_mut().enumerate().take(1 + nt) {
+                let mut acc = 0.0;
+                for (col, v) in self.d.row(self.flat.index(i, k)) {
+                    let (j, kc) = self.flat.owner(col);
+                    if j != i {
+                        acc += v * self.w[j] * lambda.component(j, kc);
+                    }
+                }
+                *bk = u0.component(i, k) - acc;
+            }
+            let point = Point {
+                a: self.blocks[i],
+                b,
+                g: points.gap[i],
+                k: 1 + nt,
+                law: match law {
+                    Law::Frictionless => PointLaw::Frictionless,
+                    Law::Tresca(s) => PointLaw::Tresca(s[i]),
+                    Law::Coulomb => PointLaw::Coulomb(points.friction[i]),
+                },
+                held: points.held[i],
+            };
+            let mut x0 = [0.0; 3];
+            for (k, x) in x0.iter_mut().enumerate().take(1 + nt) {
+                *x = lambda.component(i, k);
+            }
+            let x = point.solve(x0);
+            for (k, &xk) in x.iter().enumerate().take(1 + nt) {
+                *lambda.component_mut(i, k) = xk;
+            }
+        }
+    }
+
+    /// The contact displacement `u = u0 - D W λ`.
+    fn displacement(&self, u0: &PointValues, lambda: &PointValues) -> PointValues {
+        let flat: Vec<f64> = (0..self.flat.len())
+            .map(|r| {
+                let (i, k) = self.flat.owner(r);
+                self.w[i] * lambda.component(i, k)
+            })
+            .collect();
+        let mut dw = vec![0.0; self.flat.len()];
+        self.d.apply(&flat, &mut dw);
+        let mut u = u0.clone();
+        for (r, v) in dw.iter().enumerate() {
+            let (i, k) = self.flat.owner(r);
+            *u.component_mut(i, k) -= v;
+        }
+        u
+    }
+}
 /// A Gauss–Seidel stall, with the best iterate.
 fn stopped(reason: Stall, sweeps: usize, residual: f64, best: Option<Iterate>) -> ContactError {
     ContactError::Stalled {

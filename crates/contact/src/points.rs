@@ -133,6 +133,24 @@ impl PointValues {
         Ok(PointValues { normal, tangential, nt })
     }
 
+    /// Component `k` of point `i`: the normal for `k = 0`, tangent `k - 1` after.
+    pub fn component(&self, i: usize, k: usize) -> f64 {
+        if k == 0 {
+            self.normal[i]
+        } else {
+            self.tangential[i * self.nt + k - 1]
+        }
+    }
+
+    /// Component `k` of point `i`, to change it.
+    pub fn component_mut(&mut self, i: usize, k: usize) -> &mut f64 {
+        if k == 0 {
+            &mut self.normal[i]
+        } else {
+            &mut self.tangential[i * self.nt + k - 1]
+        }
+    }
+
     /// The values of a flat vector in the layout `[normal (n); tangential (n·nt)]`.
     pub(crate) fn from_flat(x: &[f64], n: usize, nt: usize) -> Self {
         PointValues {
@@ -254,6 +272,41 @@ impl Status {
             Status::Stick => "stick",
             Status::Slip => "slip",
             Status::Separated => "separated",
+        }
+    }
+}
+
+/// The flat layout of the compliance's rows and columns: `[normal (n); tangential (n·nt)]`,
+/// point `i`'s component `k` (0 the normal) at [`Flat::index`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Flat {
+    /// Points.
+    pub n: usize,
+    /// Tangential components per point.
+    pub nt: usize,
+}
+
+impl Flat {
+    /// Rows in all.
+    pub fn len(self) -> usize {
+        self.n * (1 + self.nt)
+    }
+
+    /// The row of component `k` of point `i`.
+    pub fn index(self, i: usize, k: usize) -> usize {
+        if k == 0 {
+            i
+        } else {
+            self.n + i * self.nt + k - 1
+        }
+    }
+
+    /// The point and component of row `r`.
+    pub fn owner(self, r: usize) -> (usize, usize) {
+        if r < self.n {
+            (r, 0)
+        } else {
+            ((r - self.n) / self.nt, 1 + (r - self.n) % self.nt)
         }
     }
 }

@@ -542,3 +542,52 @@ pub(crate) fn estimate_mu_max(
     }
     Ok((mu, u0))
 }
+
+/// The best iterate of a loop, and how many steps ago the residual last fell by a gain (a
+/// fraction, 0.99 for 1 %) below the best: the bookkeeping of every solver's stall test.
+#[derive(Debug)]
+pub(crate) struct Best {
+    iterate: Option<Iterate>,
+    gain: f64,
+    since: usize,
+}
+
+impl Best {
+    /// No iterate yet; a step improves when its residual is below `gain` times the best.
+    pub fn new(gain: f64) -> Self {
+        Best {
+            iterate: None,
+            gain,
+            since: 0,
+        }
+    }
+
+    /// Keeps `(λ, u)` where its residual is the lowest yet, and counts the steps without gain.
+    pub fn offer(&mut self, lambda: &crate::PointValues, u: &crate::PointValues, residual: f64) {
+        let best = self.iterate.as_ref().map(|b| b.residual);
+        let improved = best.is_none_or(|b| residual < self.gain * b);
+        if best.is_none_or(|b| residual < b) {
+            self.iterate = Some(Iterate {
+                lambda: lambda.clone(),
+                u: u.clone(),
+                residual,
+            });
+        }
+        self.since = if improved { 0 } else { self.since + 1 };
+    }
+
+    /// Steps since the last gain.
+    pub fn since(&self) -> usize {
+        self.since
+    }
+
+    /// The best iterate, boxed for an error.
+    pub fn boxed(&self) -> Option<Box<Iterate>> {
+        self.iterate.clone().map(Box::new)
+    }
+
+    /// The best iterate.
+    pub fn take(self) -> Option<Iterate> {
+        self.iterate
+    }
+}

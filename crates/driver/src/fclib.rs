@@ -157,13 +157,11 @@ pub fn solve(
     options: &Options,
     say: &mut dyn FnMut(&str),
 ) -> (Row, Option<Reactions>) {
-    let points = problem.points();
     let start = Instant::now();
     let interrupt = Interrupt {
         deadline: options.time_limit.and_then(|l| start.checked_add(l)),
         cancel: None,
     };
-    let mut sparse = problem.sparse_problem();
     let mut progress = |p: &contact::Progress| {
         if options.verbose {
             let (stick, slip, separated) = p.counts;
@@ -175,37 +173,7 @@ pub fn solve(
             ));
         }
     };
-    let solved: Result<ContactSolution, ContactError> = match options.solver {
-        Solver::Newton => {
-            let params = NewtonParams {
-                tol: options.tol,
-                measure: options.criterion.measure(),
-                interrupt,
-                ..Default::default()
-            };
-            contact::solve_newton(&mut sparse, &points, &Law::Coulomb, &params, None, &mut progress)
-        }
-        Solver::Nsgs => {
-            let params = contact::GaussSeidelParams {
-                tol: options.tol,
-                measure: options.criterion.measure(),
-                interrupt,
-                report_every: 10,
-                ..Default::default()
-            };
-            contact::solve_gauss_seidel(&mut sparse, &points, &Law::Coulomb, &params, None, &mut progress)
-        }
-        Solver::Apg | Solver::Uzawa => {
-            let params = UzawaParams {
-                rule: StopRule::Tight { tol: options.tol },
-                accelerate: options.solver == Solver::Apg,
-                measure: options.criterion.measure(),
-                interrupt,
-                ..Default::default()
-            };
-            contact::solve(&mut sparse, &points, &Law::Coulomb, &params, None, &mut progress)
-        }
-    };
+    let solved = run_solver(problem, options, interrupt, &mut progress);
     let time_s = start.elapsed().as_secs_f64();
     let mut row = Row {
         file: file.to_string(),
@@ -257,6 +225,48 @@ pub fn solve(
             }
             row.outcome = e.to_string();
             (row, None)
+        }
+    }
+}
+
+/// Runs the solver `options` name on `problem`, reporting to `progress`.
+fn run_solver(
+    problem: &FrictionProblem,
+    options: &Options,
+    interrupt: Interrupt,
+    progress: &mut dyn FnMut(&contact::Progress),
+) -> Result<ContactSolution, ContactError> {
+    let mut sparse = problem.sparse_problem();
+    let points = problem.points();
+    match options.solver {
+        Solver::Newton => {
+            let params = NewtonParams {
+                tol: options.tol,
+                measure: options.criterion.measure(),
+                interrupt,
+                ..Default::default()
+            };
+            contact::solve_newton(&mut sparse, &points, &Law::Coulomb, &params, None, progress)
+        }
+        Solver::Nsgs => {
+            let params = contact::GaussSeidelParams {
+                tol: options.tol,
+                measure: options.criterion.measure(),
+                interrupt,
+                report_every: 10,
+                ..Default::default()
+            };
+            contact::solve_gauss_seidel(&mut sparse, &points, &Law::Coulomb, &params, None, progress)
+        }
+        Solver::Apg | Solver::Uzawa => {
+            let params = UzawaParams {
+                rule: StopRule::Tight { tol: options.tol },
+                accelerate: options.solver == Solver::Apg,
+                measure: options.criterion.measure(),
+                interrupt,
+                ..Default::default()
+            };
+            contact::solve(&mut sparse, &points, &Law::Coulomb, &params, None, progress)
         }
     }
 }

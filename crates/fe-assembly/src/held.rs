@@ -201,99 +201,131 @@ const FREE: f64 = 1e-12;
 /// [`Unheld::Motion`] with the free motions of the first part that has any, or
 /// [`Unheld::Potential`].
 pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool]) -> Result<(), Unheld> {
-    let dim = dofs.dim;
-    let n_modes = if dim == 2 { 3 } else { 6 };
-    // the solid parts (joined through facets: two parts on a hinge node turn about it), and
-    // each part's nodes (a hinge node is in both)
-    let (cell_part, n_parts) = mesh.solid_parts();
-    // (part, node): each node once in its first cell's part, and again in any other part it
-    // hinges (few)
-    let mut node_part = vec![usize::MAX; mesh.n_nodes()];
-    let mut hinges = vec![];
-    for (c, cell) in mesh.iter_cells().enumerate() {
-        let p = cell_part[c];
-        for &v in cell {
-            if node_part[v] == usize::MAX {
-                node_part[v] = p;
-            } else if node_part[v] != p {
-                hinges.push((p, v));
-            }
-        }
-    }
-    hinges.sort_unstable();
-    hinges.dedup();
-    let members: Vec<(usize, usize)> = (0..mesh.n_nodes())
-        .filter(|&v| node_part[v] != usize::MAX)
-        .map(|v| (node_part[v], v))
-        .chain(hinges)
-        .collect();
-    let mut first = vec![usize::MAX; n_parts];
-    let mut cells = vec![0usize; n_parts];
-    for (c, &p) in cell_part.iter().enumerate() {
-        first[p] = first[p].min(c);
-        cells[p] += 1;
-    }
-    // each part's centroid and bounding box
-    let mut count = vec![0usize; n_parts];
-    let mut centroid = vec![[0.0; 3]; n_parts];
-    let mut lo = vec![[f64::INFINITY; 3]; n_parts];
-    let mut hi = vec![[f64::NEG_INFINITY; 3]; n_parts];
-    for &(i, v) in &members {
-        let x = mesh.points[v];
-        count[i] += 1;
-        for k in 0..dim {
-            centroid[i][k] += x[k];
-            lo[i][k] = lo[i][k].min(x[k]);
-            hi[i][k] = hi[i][k].max(x[k]);
-        }
-    }
-    // the largest extent (a sum of squares would underflow on a mesh in units of 1e-170)
-    let size: Vec<f64> = (0..n_parts)
-        .map(|i| (0..dim).map(|k| hi[i][k] - lo[i][k]).fold(f64::MIN_POSITIVE, f64::max))
-        .collect();
-    for (i, c) in centroid.iter_mut().enumerate() {
-        for x in c.iter_mut() {
-            *x /= count[i] as f64;
-        }
-    }
-    // the Gram matrix of the conditions the prescribed components put on each part's motions
-    let mut gram = vec![DMatrix::<f64>::zeros(n_modes, n_modes); n_parts];
-    for &(i, v) in &members {
-        let x = mesh.points[v];
-        let mut y = [0.0; 3];
-        for k in 0..dim {
-            y[k] = (x[k] - centroid[i][k]) / size[i];
-        }
-        for k in 0..dim {
-            if let Dof::Fixed(_) = dofs.u[v * dim + k] {
-                let row = nalgebra::DVector::from_vec(rigid_row(dim, k, y));
-                gram[i] += &row * row.transpose();
-            }
-        }
-    }
-    for (i, g) in gram.into_iter().enumerate() {
-        let eig = SymmetricEigen::new(g);
-        let largest = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
-        let free: Vec<usize> = (0..n_modes)
-            .filter(|&j| !(eig.eigenvalues[j] > FREE * largest))
-            .collect();
-        if !free.is_empty() {
-            let motions: Vec<String> = free
-                .iter()
-                .map(|&j| {
-                    let v: Vec<f64> = eig.eigenvectors.column(j).iter().cloned().collect();
-                    describe(dim, &v, centroid[i], size[i])
-                })
-                .collect();
+    let solids = Solids::new(mesh);
+    for i in 0..solids.first.len() {
+        let motions = solids.free_motions(mesh, dofs, i);
+        if !motions.is_empty() {
             return Err(Unheld::Motion {
-                count: free.len(),
+                count: motions.len(),
                 motions: motions.join("; "),
-                cell: first[i],
-                cells: cells[i],
+                cell: solids.first[i],
+                cells: solids.cells[i],
             });
         }
     }
-    // the electric parts: joined by electric cells only
+    floating_potential(mesh, dofs, cell_electric)
+}
+
+/// The solid parts of a mesh with their nodes, centroids and sizes.
+struct Solids {
+    /// `(part, node)`, sorted: each node once in its first cell's part, and again in any other
+    /// part it hinges; part `i`'s at `members[start[i]..start[i + 1]]`.
+    members: Vec<(usize, usize)>,
+    start: Vec<usize>,
+    /// Each part's first cell and number of cells.
+    first: Vec<usize>,
+    cells: Vec<usize>,
+    /// Each part's centroid and largest extent.
+    centroid: Vec<[f64; 3]>,
+    size: Vec<f64>,
+}
+
+impl Solids {
+    fn new(mesh: &Mesh) -> Self {
+        let dim = mesh.dim;
+        let (cell_part, n_parts) = mesh.solid_parts();
+        let mut node_part = vec![usize::MAX; mesh.n_nodes()];
+        let mut hinges = vec![];
+        for (c, cell) in mesh.iter_cells().enumerate() {
+            let p = cell_part[c];
+            for &v in cell {
+                if node_part[v] == usize::MAX {
+                    node_part[v] = p;
+                } else if node_part[v] != p {
+                    hinges.push((p, v));
+                }
+            }
+        }
+        hinges.sort_unstable();
+        hinges.dedup();
+        let mut members: Vec<(usize, usize)> = (0..mesh.n_nodes())
+            .filter(|&v| node_part[v] != usize::MAX)
+            .map(|v| (node_part[v], v))
+            .chain(hinges)
+            .collect();
+        members.sort_unstable();
+        let mut start = vec![0usize; n_parts + 1];
+        for &(p, _) in &members {
+            start[p + 1] += 1;
+        }
+        for p in 0..n_parts {
+            start[p + 1] += start[p];
+        }
+        let (mut first, mut cells) = (vec![usize::MAX; n_parts], vec![0usize; n_parts]);
+        for (c, &p) in cell_part.iter().enumerate() {
+            first[p] = first[p].min(c);
+            cells[p] += 1;
+        }
+        let mut count = vec![0usize; n_parts];
+        let mut centroid = vec![[0.0; 3]; n_parts];
+        let (mut lo, mut hi) = (vec![[f64::INFINITY; 3]; n_parts], vec![[f64::NEG_INFINITY; 3]; n_parts]);
+        for &(i, v) in &members {
+            let x = mesh.points[v];
+            count[i] += 1;
+            for k in 0..dim {
+                centroid[i][k] += x[k];
+                lo[i][k] = lo[i][k].min(x[k]);
+                hi[i][k] = hi[i][k].max(x[k]);
+            }
+        }
+        for (i, c) in centroid.iter_mut().enumerate() {
+            c.iter_mut().for_each(|x| *x /= count[i] as f64);
+        }
+        // the largest extent (a sum of squares would underflow on a mesh in units of 1e-170)
+        let size = (0..n_parts)
+            .map(|i| (0..dim).map(|k| hi[i][k] - lo[i][k]).fold(f64::MIN_POSITIVE, f64::max))
+            .collect();
+        Solids {
+            members,
+            start,
+            first,
+            cells,
+            centroid,
+            size,
+        }
+    }
+
+    /// The rigid motions of part `i` that its prescribed components leave free, in words:
+    /// the null space of the Gram matrix of the conditions they put on its motions.
+    fn free_motions(&self, mesh: &Mesh, dofs: &DofMap, i: usize) -> Vec<String> {
+        let dim = dofs.dim;
+        let n_modes = if dim == 2 { 3 } else { 6 };
+        let mut gram = DMatrix::<f64>::zeros(n_modes, n_modes);
+        for &(_, v) in &self.members[self.start[i]..self.start[i + 1]] {
+            let mut y = [0.0; 3];
+            for k in 0..dim {
+                y[k] = (mesh.points[v][k] - self.centroid[i][k]) / self.size[i];
+            }
+            for k in (0..dim).filter(|&k| matches!(dofs.u[v * dim + k], Dof::Fixed(_))) {
+                let row = nalgebra::DVector::from_vec(rigid_row(dim, k, y));
+                gram += &row * row.transpose();
+            }
+        }
+        let eig = SymmetricEigen::new(gram);
+        let largest = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+        (0..n_modes)
+            .filter(|&j| !(eig.eigenvalues[j] > FREE * largest))
+            .map(|j| {
+                let v: Vec<f64> = eig.eigenvectors.column(j).iter().cloned().collect();
+                describe(dim, &v, self.centroid[i], self.size[i])
+            })
+            .collect()
+    }
+}
+
+/// The first electric part (joined by electric cells through any node) that no prescribed φ
+/// reaches.
+fn floating_potential(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool]) -> Result<(), Unheld> {
     let (part, found) = parts(mesh, |c| cell_electric[c]);
     let mut held = vec![false; found.len()];
     for (v, d) in dofs.phi.iter().enumerate() {
@@ -301,13 +333,13 @@ pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool]) -> Result<(), U
             held[i] = true;
         }
     }
-    if let Some(i) = held.iter().position(|h| !h) {
-        return Err(Unheld::Potential {
+    match held.iter().position(|h| !h) {
+        Some(i) => Err(Unheld::Potential {
             cell: found[i].0,
             cells: found[i].1,
-        });
+        }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 #[cfg(test)]

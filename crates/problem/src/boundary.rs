@@ -206,64 +206,18 @@ impl ContactBoundary {
             let dist2 = (0..3).map(|k| d[k] * d[k]).sum::<f64>() - along_n * along_n;
             let gap = spec.gap + 0.5 * spec.gap_curvature * dist2.max(0.0);
             let comps: Vec<Dof> = (0..dim).map(|k| dofs.u[node * dim + k]).collect();
-            let fixed: Vec<bool> = comps.iter().map(|c| !matches!(c, Dof::Free(_))).collect();
-            let at = |what: String| {
-                SceneError::new(
-                    "contact.group",
-                    format!(
-                        "node {node} of contact group `{}` (at {:?}): {what}",
-                        spec.group,
-                        &x[..dim]
-                    ),
-                )
-            };
-            let prescribed = |k: usize| match comps[k] {
-                Dof::Fixed(v) => v,
-                _ => 0.0,
-            };
-            let names = |dir: &[f64; 3]| -> String {
-                let axes: Vec<&str> = (0..dim)
-                    .filter(|&k| fixed[k] && dir[k].abs() > ALIGNED)
-                    .map(|k| ["ux", "uy", "uz"][k])
-                    .collect();
-                axes.join(", ")
-            };
-            match direction(&nv, &fixed, dim) {
-                Direction::Held => {
+            let held = match held_directions(spec, node, &x, &comps, &nv, &tangents)? {
+                Held::Normal(u_n) => {
                     // the support holds the normal: the node is no contact point (the
                     // Dirichlet condition wins, even where it holds the node past the gap)
-                    let u_n: f64 = (0..dim).map(|k| nv[k] * prescribed(k)).sum();
                     held_nodes += 1;
                     if u_n > gap + 1e-12 * (u_n.abs() + gap.abs()) {
                         held_inside += 1;
                     }
                     continue;
                 }
-                Direction::Mixed => {
-                    return Err(at(format!(
-                        "a Dirichlet condition prescribes {}, which lies across the contact normal {:?} (neither along nor orthogonal to it): prescribe components along the normal or the tangents, or none",
-                        names(&nv),
-                        &nv[..dim]
-                    ))
-                    .into())
-                }
-                Direction::Free => {}
-            }
-            let mut held = [false; 2];
-            for q in 0..dim - 1 {
-                match direction(&tangents[q], &fixed, dim) {
-                    Direction::Free => {}
-                    Direction::Held => held[q] = true,
-                    Direction::Mixed => {
-                        return Err(at(format!(
-                            "a Dirichlet condition prescribes {}, which lies across the contact tangent {:?} (neither along nor orthogonal to it): prescribe components along the normal or the tangents, or none",
-                            names(&tangents[q]),
-                            &tangents[q][..dim]
-                        ))
-                        .into())
-                    }
-                }
-            }
+                Held::Tangents(held) => held,
+            };
             for c in &comps {
                 slots.push(match *c {
                     Dof::Free(j) => {
@@ -556,4 +510,67 @@ impl ContactOperator for FullSolve<'_> {
         self.boundary.extract(&u, out);
         Ok(info.pcg_iters)
     }
+}
+
+/// What the Dirichlet conditions of a contact node hold.
+enum Held {
+    /// The normal, at the prescribed normal displacement: no contact point.
+    Normal(f64),
+    /// The tangents marked (none, one or both): a contact point.
+    Tangents([bool; 2]),
+}
+
+/// Classifies the prescribed components `comps` of contact node `node` (at `x`) against the
+/// normal `nv` and the `tangents`.
+///
+/// # Errors
+/// Prescribed components that lie across the normal or a tangent (neither along nor
+/// orthogonal to it).
+fn held_directions(
+    spec: &ContactSpec,
+    node: usize,
+    x: &[f64; 3],
+    comps: &[Dof],
+    nv: &[f64; 3],
+    tangents: &[[f64; 3]; 2],
+) -> Result<Held, ProblemError> {
+    let dim = comps.len();
+    let fixed: Vec<bool> = comps.iter().map(|c| !matches!(c, Dof::Free(_))).collect();
+    let across = |dir: &[f64; 3], what: &str| -> ProblemError {
+        let axes: Vec<&str> = (0..dim)
+            .filter(|&k| fixed[k] && dir[k].abs() > ALIGNED)
+            .map(|k| ["ux", "uy", "uz"][k])
+            .collect();
+        SceneError::new(
+            "contact.group",
+            format!(
+                "node {node} of contact group `{}` (at {:?}): a Dirichlet condition prescribes {}, which lies across the contact {what} {:?} (neither along nor orthogonal to it): prescribe components along the normal or the tangents, or none",
+                spec.group,
+                &x[..dim],
+                axes.join(", "),
+                &dir[..dim]
+            ),
+        )
+        .into()
+    };
+    match direction(nv, &fixed, dim) {
+        Direction::Held => {
+            let prescribed = |k: usize| match comps[k] {
+                Dof::Fixed(v) => v,
+                _ => 0.0,
+            };
+            return Ok(Held::Normal((0..dim).map(|k| nv[k] * prescribed(k)).sum()));
+        }
+        Direction::Mixed => return Err(across(nv, "normal")),
+        Direction::Free => {}
+    }
+    let mut held = [false; 2];
+    for q in 0..dim - 1 {
+        match direction(&tangents[q], &fixed, dim) {
+            Direction::Free => {}
+            Direction::Held => held[q] = true,
+            Direction::Mixed => return Err(across(&tangents[q], "tangent")),
+        }
+    }
+    Ok(Held::Tangents(held))
 }

@@ -129,52 +129,17 @@ impl fmt::Display for Event<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Event::Planned(plan) => write!(f, "{plan}"),
-            Event::MeshNotes(n) => {
-                let mut notes = vec![];
-                if n.reoriented_cells > 0 {
-                    notes.push(format!(
-                        "the mesh reader turned {} cells round (a surface written clockwise)",
-                        n.reoriented_cells
-                    ));
-                }
-                if n.coincident_nodes > 0 {
-                    notes.push(format!(
-                        "{} nodes lie at the coordinates of another node (a crack, or parts not merged)",
-                        n.coincident_nodes
-                    ));
-                }
-                if n.unused_nodes > 0 {
-                    notes.push(format!(
-                        "{} nodes belong to no cell (the centre of an arc, a point off the body): they carry no unknown",
-                        n.unused_nodes
-                    ));
-                }
-                write!(f, "note: {}", notes.join("; "))
-            }
+            Event::MeshNotes(n) => write!(f, "note: {}", mesh_notes(n).join("; ")),
             Event::ContactHeld {
                 group,
                 tangents,
                 nodes,
                 inside,
-            } => {
-                let mut notes = vec![];
-                if *tangents > 0 {
-                    notes.push(format!(
-                        "{tangents} contact points have a tangent held by a Dirichlet condition (no friction force there: the support takes it)"
-                    ));
-                }
-                if *nodes > 0 {
-                    notes.push(format!(
-                        "{nodes} nodes have their normal displacement prescribed and are left to their supports"
-                    ));
-                }
-                if *inside > 0 {
-                    notes.push(format!(
-                        "{inside} of them held past the gap, inside the foundation (the Dirichlet condition wins)"
-                    ));
-                }
-                write!(f, "note: contact group `{group}`: {}", notes.join("; "))
-            }
+            } => write!(
+                f,
+                "note: contact group `{group}`: {}",
+                held_notes(*tangents, *nodes, *inside).join("; ")
+            ),
             Event::Assembled {
                 n_nodes,
                 n_cells,
@@ -230,6 +195,51 @@ impl fmt::Display for Event<'_> {
             Event::Exact { kind, what, error } => write!(f, "exact ({kind}): {what} = {error:.4e}"),
         }
     }
+}
+
+/// The notes on a mesh that is read but unusual.
+fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
+    let mut notes = vec![];
+    if n.reoriented_cells > 0 {
+        notes.push(format!(
+            "the mesh reader turned {} cells round (a surface written clockwise)",
+            n.reoriented_cells
+        ));
+    }
+    if n.coincident_nodes > 0 {
+        notes.push(format!(
+            "{} nodes lie at the coordinates of another node (a crack, or parts not merged)",
+            n.coincident_nodes
+        ));
+    }
+    if n.unused_nodes > 0 {
+        notes.push(format!(
+            "{} nodes belong to no cell (the centre of an arc, a point off the body): they carry no unknown",
+            n.unused_nodes
+        ));
+    }
+    notes
+}
+
+/// The notes on contact points where Dirichlet conditions hold some directions.
+fn held_notes(tangents: usize, nodes: usize, inside: usize) -> Vec<String> {
+    let mut notes = vec![];
+    if tangents > 0 {
+        notes.push(format!(
+            "{tangents} contact points have a tangent held by a Dirichlet condition (no friction force there: the support takes it)"
+        ));
+    }
+    if nodes > 0 {
+        notes.push(format!(
+            "{nodes} nodes have their normal displacement prescribed and are left to their supports"
+        ));
+    }
+    if inside > 0 {
+        notes.push(format!(
+            "{inside} of them held past the gap, inside the foundation (the Dirichlet condition wins)"
+        ));
+    }
+    notes
 }
 
 /// Receives the events of a run.

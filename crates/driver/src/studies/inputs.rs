@@ -4,7 +4,7 @@
 //! nothing is written. `piezocontact stability` runs them, each in its own process with a time
 //! limit, into a section of docs/stability.md; a test runs them in process.
 
-use super::stability::run_with_limit;
+use super::child::run_with_limit;
 use problem::RunReport;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -3,6 +3,7 @@
 //! ([`convergence`]), the verification report ([`verification`]), the stiff and extreme
 //! cases ([`stability`]) and the hostile inputs ([`inputs`]).
 
+pub mod child;
 pub mod convergence;
 pub mod inputs;
 pub mod stability;

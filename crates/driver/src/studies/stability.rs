@@ -6,12 +6,13 @@
 //! stuck for F = 1e6, ...) or stops with the typed error it printed. The table goes to
 //! `docs/stability.md`.
 
+use super::child::run_with_limit;
 use crate::output::Outputs;
 use crate::DriverError;
 use problem::{RunReport, Strategy};
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::Duration;
 
 /// What a case must show beyond convergence.
@@ -336,36 +337,6 @@ pub fn check(expect: Expect, report: &RunReport) -> Result<String, String> {
     } else {
         Err(format!("{counts}: expected {expect:?}"))
     }
-}
-
-/// Runs `cmd` to its end, or kills it after `limit`; its stdout and stderr are collected.
-pub(crate) fn run_with_limit(mut cmd: Command, limit: Duration) -> std::io::Result<std::process::Output> {
-    use std::io::Read;
-    let mut child = cmd.stdout(Stdio::null()).stderr(Stdio::piped()).spawn()?;
-    // stderr is drained on a thread, so that a chatty child never blocks on a full pipe
-    let mut pipe = child.stderr.take().expect("stderr is piped");
-    let reader = std::thread::spawn(move || {
-        let mut buf = Vec::new();
-        let _ = pipe.read_to_end(&mut buf);
-        buf
-    });
-    let started = std::time::Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait()? {
-            break status;
-        }
-        if started.elapsed() >= limit {
-            let _ = child.kill();
-            break child.wait()?;
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    let stderr = reader.join().unwrap_or_default();
-    Ok(std::process::Output {
-        status,
-        stdout: vec![],
-        stderr,
-    })
 }
 
 /// Runs one case with one strategy through `exe run`, in a scratch directory that is removed.
