@@ -267,8 +267,7 @@ fn fixed_point(
 ) -> Result<bool, ContactError> {
     let (points, params) = (d.points, d.params);
     let mut s = slip_bound(points, law, &lambda.normal);
-    let mut omega: f64 = 1.0;
-    let mut falls = 0;
+    let mut relax = Relaxation { omega: 1.0, falls: 0 };
     let mut previous = f64::INFINITY;
     // the map's measured contraction: the changes of S, and the best residual's age
     let mut moves: Vec<f64> = vec![];
@@ -313,19 +312,11 @@ fn fixed_point(
             counts: counts(&classify(lambda, &s_new)),
         });
         if let StopRule::Tight { tol } = params.rule {
-            if residual >= previous && residual > 100.0 * tol && omega > 1.0 / 64.0 {
-                omega *= 0.5;
+            if relax.update(residual, previous, tol) {
                 d.info.relaxations += 1;
-                falls = 0;
-            } else if residual < previous {
-                // a damping that is no longer needed only slows the iteration down
-                falls += 1;
-                if falls >= 2 && omega < 1.0 {
-                    omega = (2.0 * omega).min(1.0);
-                    falls = 0;
-                }
             }
         }
+        let omega = relax.omega;
         previous = residual;
         moves.push(s_new.iter().zip(&s).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt());
         s = if omega == 1.0 {
@@ -365,6 +356,33 @@ fn fixed_point(
         residual: previous,
         best: d.best(),
     })
+}
+
+/// The relaxation `ω` of the fixed point on `S`: halved where a step did not lower the
+/// residual (down to 1/64), doubled back after two steps that did (a damping that is no longer
+/// needed only slows the iteration down).
+struct Relaxation {
+    omega: f64,
+    falls: usize,
+}
+
+impl Relaxation {
+    /// Updates `ω` from the step's residual and the previous one; true where it halved.
+    fn update(&mut self, residual: f64, previous: f64, tol: f64) -> bool {
+        if residual >= previous && residual > 100.0 * tol && self.omega > 1.0 / 64.0 {
+            self.omega *= 0.5;
+            self.falls = 0;
+            return true;
+        }
+        if residual < previous {
+            self.falls += 1;
+            if self.falls >= 2 && self.omega < 1.0 {
+                self.omega = (2.0 * self.omega).min(1.0);
+                self.falls = 0;
+            }
+        }
+        false
+    }
 }
 
 /// Fixed-point steps without a residual a tenth below the best before the loop is stopped as
@@ -450,6 +468,16 @@ impl Dual<'_, '_> {
         }
     }
 
+    /// The loop's divergence at the residual `r`, with the best iterate.
+    fn diverged(&self, r: f64) -> ContactError {
+        ContactError::Diverged {
+            n_iters: self.info.uzawa_iters,
+            residual: r,
+            step: self.step,
+            best: self.best(),
+        }
+    }
+
     /// The best iterate, boxed for an error.
     fn best(&self) -> Option<Box<Iterate>> {
         self.best.clone().map(Box::new)
@@ -514,6 +542,30 @@ impl Rate {
     }
 }
 
+/// Stops a loop whose measured rate would not reach its target within its limit now, not at
+/// the limit (hours of full solves, on an ill-conditioned dual): every [`RATE_WINDOW`] steps,
+/// from the residual `r` at step `k`.
+fn too_slow(d: &Dual<'_, '_>, rate: &mut Rate, k: usize, r: f64) -> Result<(), ContactError> {
+    let (Some(tol), true) = (d.tol(), k.is_multiple_of(RATE_WINDOW)) else {
+        return Ok(());
+    };
+    let target = d.inner_tol.unwrap_or(tol);
+    if let Some(needed) = rate.needed(r, target) {
+        if k + needed > d.params.max_iters {
+            return Err(ContactError::TooSlow {
+                n_iters: d.info.uzawa_iters,
+                residual: r,
+                target,
+                needed,
+                limit: d.params.max_iters,
+                best: d.best(),
+            });
+        }
+    }
+    rate.mark(r);
+    Ok(())
+}
+
 /// Uzawa iterations for a given radius. Returns whether `u` is the displacement of the final
 /// `lambda` (true under the tight rule; under the paper's rule the last update is not solved).
 ///
@@ -545,12 +597,7 @@ fn uzawa(
             d.offer(r, lambda, u);
         }
         if !r.is_finite() {
-            return Err(ContactError::Diverged {
-                n_iters: d.info.uzawa_iters,
-                residual: r,
-                step: d.step,
-                best: d.best(),
-            });
+            return Err(d.diverged(r));
         }
         if let Some(tol) = d.tol() {
             if r <= d.inner_tol.unwrap_or(tol) {
@@ -576,16 +623,7 @@ fn uzawa(
                 if law.is_some() && d.tol().is_some_and(|tol| r <= tol) {
                     return Ok(true);
                 }
-                return Err(if diverging {
-                    ContactError::Diverged {
-                        n_iters: d.info.uzawa_iters,
-                        residual: r,
-                        step: d.step,
-                        best: d.best(),
-                    }
-                } else {
-                    e
-                });
+                return Err(if diverging { d.diverged(r) } else { e });
             }
             best = r;
             window_best = r;
@@ -593,24 +631,7 @@ fn uzawa(
             momentum = Momentum { t: 1.0, x_prev: None };
         }
         best = best.min(r);
-        // a loop whose measured rate would not reach the target within its limit is stopped
-        // now, not at the limit (hours of full solves, on an ill-conditioned dual)
-        if let (Some(tol), true) = (d.tol(), k % RATE_WINDOW == 0) {
-            let target = d.inner_tol.unwrap_or(tol);
-            if let Some(needed) = rate.needed(r, target) {
-                if k + needed > params.max_iters {
-                    return Err(ContactError::TooSlow {
-                        n_iters: d.info.uzawa_iters,
-                        residual: r,
-                        target,
-                        needed,
-                        limit: params.max_iters,
-                        best: d.best(),
-                    });
-                }
-            }
-            rate.mark(r);
-        }
+        too_slow(d, &mut rate, k, r)?;
         d.info.uzawa_iters += 1;
         let y_old = if params.accelerate { Some(lambda.clone()) } else { None };
         let (diff2, norm2) = projected_step(points, radius, d.step, lambda, u);

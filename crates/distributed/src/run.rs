@@ -1,6 +1,6 @@
 //! A run on the ranks: set up, partition, assemble, solve, gather and recover on rank 0.
 
-use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
+use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows, LinearSolve};
 use crate::layout::Layout;
 use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
@@ -83,12 +83,7 @@ pub fn solve<'p>(
     let t_setup = t_total.elapsed().as_secs_f64();
     let t = Instant::now();
     let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
-    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
-    let (b_u, b_phi) = disc.rhs(&setup.loads)?;
-    ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
-    ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
-    let layout = Layout::new(petsc, &setup.mesh, &disc.dofs)?;
-    let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
+    let (layout, mut system) = distribute(petsc, scene, &setup, &disc)?;
     let t_assembly = t.elapsed().as_secs_f64();
     reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
     let options = configure(petsc, scene, &setup, &layout)?;
@@ -103,54 +98,8 @@ pub fn solve<'p>(
         Ok((info.iterations, info.reason))
     };
     let (x, contact, krylov, reason) = match &setup.plan.contact_law {
-        ContactLaw::None => {
-            let mut x = system.rhs.duplicate()?;
-            let (its, reason) = solve_one(&mut system.matrix, &system.rhs, &mut x)?;
-            (x, None, its, reason)
-        }
-        _ => {
-            let spec = scene.contact.as_ref().ok_or_else(|| {
-                ProblemError::from(problem::SceneError::new(
-                    "contact",
-                    "the plan has contact and the scene no [contact]",
-                ))
-            })?;
-            let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, spec)?;
-            boundary.report_held(&spec.group, reporter);
-            if let Some(node) = boundary.first_held_tangent() {
-                return Err(ProblemError::from(problem::SceneError::new(
-                    "contact.group",
-                    format!(
-                        "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face): the PETSc backend's active sets do not hold a tangent of a contact point; the default backend does",
-                        spec.group
-                    ),
-                ))
-                .into());
-            }
-            let law = setup.plan.law(scene, boundary.points.len());
-            let rows = ContactRows::new(petsc, &boundary.points, &boundary.nodes, &layout, &system);
-            let params = ActiveSetParams {
-                tol: scene.solver.tol,
-                max_steps: MAX_ACTIVE_SET_STEPS,
-            };
-            let tol = scene.solver.tol;
-            let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-            let out = active_set(
-                petsc,
-                &layout,
-                &system,
-                &rows,
-                &law,
-                params,
-                &mut solve_one,
-                &mut progress,
-            )
-            .map_err(|e| match e {
-                ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
-                other => DistributedError::Contact(other),
-            })?;
-            (out.x, Some((boundary, out.solution)), out.krylov_iterations, out.reason)
-        }
+        ContactLaw::None => solve_linear(&mut system, &mut solve_one)?,
+        _ => solve_contact(petsc, scene, &setup, &disc, &layout, &system, &mut solve_one, reporter)?,
     };
     let t_solve = t.elapsed().as_secs_f64() - t_pc;
     reporter.event(&Event::Krylov {
@@ -192,18 +141,14 @@ pub fn solve<'p>(
         solve: t_solve,
         total: t_total.elapsed().as_secs_f64(),
     };
-    let petsc_report = PetscReport {
-        ranks: petsc.size(),
-        unknowns: layout.n_global(),
-        nonzeros,
-        krylov_iterations: krylov,
+    let petsc_report = petsc_report(
+        petsc,
+        &layout,
+        (nonzeros, krylov, t_pc),
         reason,
         options,
         cells_per_rank,
-        unknowns_per_rank: (0..petsc.size()).map(|r| layout.owned(r).len()).collect(),
-        peak_bytes_per_rank: vec![],
-        preconditioner_setup_s: t_pc,
-    };
+    );
     let info = contact.as_ref().map(|(_, sol)| &sol.info);
     let report = Report {
         equilibrium,
@@ -220,16 +165,126 @@ pub fn solve<'p>(
         u: recovered.u,
         phi: recovered.phi,
         fields: recovered.fields,
-        contact: contact.map(|(b, solution)| {
-            let displacement = solution.u.clone();
-            ContactResult {
-                points: b.points,
-                nodes: b.nodes,
-                solution,
-                displacement,
-            }
-        }),
+        contact: contact.map(contact_result),
     }))
+}
+
+/// The dofs laid out over the ranks, and the system assembled on them (the loads checked
+/// finite, the Dirichlet conditions checked to hold the body).
+fn distribute<'p>(
+    petsc: &'p Petsc,
+    scene: &Scene,
+    setup: &Setup,
+    disc: &Discretization<'_>,
+) -> Result<(Layout, System<'p>), DistributedError> {
+    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
+    let (b_u, b_phi) = disc.rhs(&setup.loads)?;
+    ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
+    ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
+    let layout = Layout::new(petsc, &setup.mesh, &disc.dofs)?;
+    let system = assemble(petsc, disc, &layout, &b_u, &b_phi)?;
+    Ok((layout, system))
+}
+
+/// The PETSc section of the report: the layout, the matrix's `nonzeros`, the Krylov
+/// iterations and the preconditioners' set-up time (`counts`), and the options in force.
+fn petsc_report(
+    petsc: &Petsc,
+    layout: &Layout,
+    (nonzeros, krylov, t_pc): (f64, usize, f64),
+    reason: String,
+    options: String,
+    cells_per_rank: Vec<usize>,
+) -> PetscReport {
+    PetscReport {
+        ranks: petsc.size(),
+        unknowns: layout.n_global(),
+        nonzeros,
+        krylov_iterations: krylov,
+        reason,
+        options,
+        cells_per_rank,
+        unknowns_per_rank: (0..petsc.size()).map(|r| layout.owned(r).len()).collect(),
+        peak_bytes_per_rank: vec![],
+        preconditioner_setup_s: t_pc,
+    }
+}
+
+/// The contact part of the solution, from the boundary and the contact solve.
+fn contact_result((b, solution): (ContactBoundary, contact::ContactSolution)) -> ContactResult {
+    let displacement = solution.u.clone();
+    ContactResult {
+        points: b.points,
+        nodes: b.nodes,
+        solution,
+        displacement,
+    }
+}
+
+/// A solve's vector, its contact boundary and solution (with contact), its Krylov iterations
+/// and the last solve's reason.
+type Solved<'p> = (
+    petsc::Vector<'p>,
+    Option<(ContactBoundary, contact::ContactSolution)>,
+    usize,
+    String,
+);
+
+/// The linear problem (no contact) on the PETSc backend: one Krylov solve.
+fn solve_linear<'p>(
+    system: &mut System<'p>,
+    solve_one: &mut LinearSolve<'_, 'p>,
+) -> Result<Solved<'p>, DistributedError> {
+    let mut x = system.rhs.duplicate()?;
+    let (its, reason) = solve_one(&mut system.matrix, &system.rhs, &mut x)?;
+    Ok((x, None, its, reason))
+}
+
+/// The contact problem on the PETSc backend: the contact boundary (a held tangent refused by
+/// name), then the active-set iteration over the distributed system.
+#[allow(clippy::too_many_arguments)]
+fn solve_contact<'p>(
+    petsc: &'p Petsc,
+    scene: &Scene,
+    setup: &Setup,
+    disc: &Discretization<'_>,
+    layout: &Layout,
+    system: &System<'p>,
+    solve_one: &mut LinearSolve<'_, 'p>,
+    reporter: &mut dyn Reporter,
+) -> Result<Solved<'p>, DistributedError> {
+    let spec = scene.contact.as_ref().ok_or_else(|| {
+        ProblemError::from(problem::SceneError::new(
+            "contact",
+            "the plan has contact and the scene no [contact]",
+        ))
+    })?;
+    let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, spec)?;
+    boundary.report_held(&spec.group, reporter);
+    if let Some(node) = boundary.first_held_tangent() {
+        return Err(ProblemError::from(problem::SceneError::new(
+            "contact.group",
+            format!(
+                "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face): the PETSc backend's active sets do not hold a tangent of a contact point; the default backend does",
+                spec.group
+            ),
+        ))
+        .into());
+    }
+    let law = setup.plan.law(scene, boundary.points.len());
+    let rows = ContactRows::new(petsc, &boundary.points, &boundary.nodes, layout, system);
+    let params = ActiveSetParams {
+        tol: scene.solver.tol,
+        max_steps: MAX_ACTIVE_SET_STEPS,
+    };
+    let tol = scene.solver.tol;
+    let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+    let out =
+        active_set(petsc, layout, system, &rows, &law, params, solve_one, &mut progress).map_err(|e| match e {
+            ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+            other => DistributedError::Contact(other),
+        })?;
+    Ok((out.x, Some((boundary, out.solution)), out.krylov_iterations, out.reason))
 }
 
 /// Puts the backend's options, then the scene's, into PETSc's database; returns them as one

@@ -414,22 +414,7 @@ pub fn solve_newton<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    let nt_given = problem.n_tangential();
-    let (n, nt) = check_input(points, law, problem.weights().len(), nt_given)?;
-    let m = n * (1 + nt);
-    if problem.compliance().size() != m || problem.loads().n_points() != n {
-        return Err(ContactError::Input(format!(
-            "the compliance is {0} x {0} and the loads have {1} points; {n} points with {nt} tangential components need {m} x {m}",
-            problem.compliance().size(),
-            problem.loads().n_points()
-        )));
-    }
-    if !(params.tol > 0.0) {
-        return Err(ContactError::Input(format!(
-            "Newton tolerance {} must be positive",
-            params.tol
-        )));
-    }
+    let (n, nt, m) = check_newton_input(problem, points, law, params)?;
     let (mu_max, reference) = {
         let mut counter = Counter::new(problem);
         let (mu, u0) = estimate_mu_max(&mut counter, points, nt, params.power_iters)?;
@@ -456,87 +441,69 @@ pub fn solve_newton<P: AffineProblem>(
         tol: params.tol,
         best: None,
     };
-    // stage 1: Newton on the problem itself
-    let s = judge.flat.state(x0);
-    let (_, done) = judge.offer(&s);
-    let directions = Directions::new(&judge.flat);
-    let mut end = if done {
-        End::Converged
-    } else {
-        let rules = Rules {
-            steps: params.max_iters,
-            patience: PATIENCE,
-            lenient: false,
-        };
-        judged_steps(&mut judge, &directions, s, rules, params, &mut info, progress)
-    };
-    // stage 2: the proximal point method
-    if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
-        end = proximal_stage(&mut judge, params, &mut info, progress);
-    }
-    // stage 2b: where the compliance is sparse or asymmetric, stage 1 ran under stricter rules
-    // (damped steps must lower the norm; a patience rule) that keep it cheap on the problems it
-    // solves, and can stop it short of an active set that a longer, non-monotone search finds:
-    // before the last stage, Newton's own rules from the best iterate, as on a dense symmetric D
-    if matches!(end, End::Stalled(_)) && !directions.symmetric_dense() {
-        if let Some((start, _)) = judge.best.clone() {
-            let steps = LENIENT_STEPS * params.max_iters;
-            let rules = Rules {
-                steps,
-                patience: steps,
-                lenient: true,
-            };
-            end = judged_steps(&mut judge, &directions, start, rules, params, &mut info, progress);
-        }
-    }
+    let end = newton_stages(&mut judge, x0, params, &mut info, progress);
     let best_residual = judge.best_residual();
     let (best, _) = judge.best.take().expect("the start was judged");
     let lambda = judge.flat.values(&best.x);
     let u = judge.flat.values(&best.u);
-    let stage = if info.proximal_iters > 0 {
-        Stage::Proximal
-    } else {
-        Stage::Newton
-    };
     let reason = match end {
         End::Converged => None,
         _ if best_residual <= params.tol => None,
         End::Interrupted(why) => {
+            let best = Iterate {
+                lambda,
+                u,
+                residual: best_residual,
+            };
             return Err(ContactError::Interrupted {
                 why,
                 n_iters: info.newton_iters,
                 residual: best_residual,
-                best: Some(Box::new(Iterate {
-                    lambda,
-                    u,
-                    residual: best_residual,
-                })),
-            })
+                best: Some(Box::new(best)),
+            });
         }
         End::Stalled(why) => Some(why),
     };
     let Some(reason) = reason else {
         info.complementarity = judge.complementarity(&best);
         info.residual = best_residual;
+        let status = classify(&lambda, &slip_bound(points, law, &lambda.normal));
         return Ok(ContactSolution {
-            status: classify(&lambda, &slip_bound(points, law, &lambda.normal)),
+            status,
             lambda,
             u,
             info,
         });
     };
-    let newton_best = Iterate {
-        lambda: lambda.clone(),
+    let stalled = Iterate {
+        lambda,
         u,
         residual: best_residual,
     };
+    after_stall(problem, points, law, params, stalled, reason, info, progress)
+}
+
+/// After Newton's stages stalled at the iterate `stalled`: stage 3 (the fallback, where the
+/// parameters ask for it), and then whose failure it is ([`whose_failure`]).
+#[allow(clippy::too_many_arguments)]
+fn after_stall<P: AffineProblem>(
+    problem: &mut P,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+    stalled: Iterate,
+    reason: Stall,
+    info: ContactInfo,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ContactSolution, ContactError> {
+    let best_residual = stalled.residual;
     let failure = if params.fallback {
         match fallback(
             problem,
             points,
             law,
             params,
-            lambda,
+            stalled.lambda.clone(),
             best_residual,
             info.clone(),
             progress,
@@ -546,30 +513,124 @@ pub fn solve_newton<P: AffineProblem>(
         }
     } else {
         ContactError::Stalled {
-            stage,
+            stage: if info.proximal_iters > 0 {
+                Stage::Proximal
+            } else {
+                Stage::Newton
+            },
             n_iters: info.newton_iters,
             residual: best_residual,
             reason,
             best: None,
         }
     };
-    let failure = failure.with_best(newton_best);
-    if *law != Law::Coulomb || matches!(failure, ContactError::Interrupted { .. }) {
-        return Err(failure);
+    Err(whose_failure(
+        problem,
+        points,
+        law,
+        params,
+        failure.with_best(stalled),
+        &info,
+    ))
+}
+
+/// Checks the data of [`solve_newton`]: `(n, nt, m)`, the points, their tangential components
+/// and the compliance's size.
+fn check_newton_input<P: AffineProblem>(
+    problem: &P,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+) -> Result<(usize, usize, usize), ContactError> {
+    let (n, nt) = check_input(points, law, problem.weights().len(), problem.n_tangential())?;
+    let m = n * (1 + nt);
+    if problem.compliance().size() != m || problem.loads().n_points() != n {
+        return Err(ContactError::Input(format!(
+            "the compliance is {0} x {0} and the loads have {1} points; {n} points with {nt} tangential components need {m} x {m}",
+            problem.compliance().size(),
+            problem.loads().n_points()
+        )));
     }
-    // is the failure the problem's? Coulomb's law has a unique solution where the fixed point
-    // on the slip bound contracts: measure it at the best iterate
+    if !(params.tol > 0.0) {
+        return Err(ContactError::Input(format!(
+            "Newton tolerance {} must be positive",
+            params.tol
+        )));
+    }
+    Ok((n, nt, m))
+}
+
+/// Newton's stages from `x0` (docs/theory.md, "Semismooth Newton"), each from the best iterate
+/// of those before, each run only where the ones before stalled:
+///
+/// | stage | what | where |
+/// |---|---|---|
+/// | 1 | Newton on the problem itself, with a patience rule | always |
+/// | 2 | the proximal point method | `max_proximal > 0` |
+/// | 2b | Newton under its own lenient rules (non-monotone, no patience) | a sparse or asymmetric compliance, where stage 1 ran under stricter rules |
+///
+/// (Stage 3, the first-order fallback, is [`fallback`].)
+fn newton_stages(
+    judge: &mut Judge<'_>,
+    x0: Vec<f64>,
+    params: &NewtonParams,
+    info: &mut ContactInfo,
+    progress: &mut dyn FnMut(&Progress),
+) -> End {
+    let s = judge.flat.state(x0);
+    let (_, done) = judge.offer(&s);
+    if done {
+        return End::Converged;
+    }
+    let directions = Directions::new(&judge.flat);
+    let strict = Rules {
+        steps: params.max_iters,
+        patience: PATIENCE,
+        lenient: false,
+    };
+    let mut end = judged_steps(judge, &directions, s, strict, params, info, progress);
+    if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
+        end = proximal_stage(judge, params, info, progress);
+    }
+    if matches!(end, End::Stalled(_)) && !directions.symmetric_dense() {
+        if let Some((start, _)) = judge.best.clone() {
+            let steps = LENIENT_STEPS * params.max_iters;
+            let lenient = Rules {
+                steps,
+                patience: steps,
+                lenient: true,
+            };
+            end = judged_steps(judge, &directions, start, lenient, params, info, progress);
+        }
+    }
+    end
+}
+
+/// Whose failure a failure of every stage is: for Coulomb's law, the problem's where the fixed
+/// point on the slip bound expands at the best iterate (the contraction the uniqueness
+/// theorem rests on fails: [`ContactError::NotUnique`]), else the solvers' (`failure` itself).
+fn whose_failure<P: AffineProblem>(
+    problem: &mut P,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+    failure: ContactError,
+    info: &ContactInfo,
+) -> ContactError {
+    if *law != Law::Coulomb || matches!(failure, ContactError::Interrupted { .. }) {
+        return failure;
+    }
     let Some(best) = failure.best().cloned() else {
-        return Err(failure);
+        return failure;
     };
     match crate::slip_bound_expansion(problem, points, &best.lambda, &params.interrupt) {
-        Ok(expansion) if expansion >= 1.0 => Err(ContactError::NotUnique {
+        Ok(expansion) if expansion >= 1.0 => ContactError::NotUnique {
             expansion,
             n_iters: info.newton_iters,
             residual: best.residual,
             best: Some(Box::new(best)),
-        }),
-        _ => Err(failure),
+        },
+        _ => failure,
     }
 }
 
