@@ -56,57 +56,6 @@ pub enum Unheld {
     },
 }
 
-/// Union-find over nodes, with path halving.
-struct Parts(Vec<usize>);
-
-impl Parts {
-    fn new(n: usize) -> Self {
-        Parts((0..n).collect())
-    }
-    fn root(&mut self, mut v: usize) -> usize {
-        while self.0[v] != v {
-            self.0[v] = self.0[self.0[v]];
-            v = self.0[v];
-        }
-        v
-    }
-    fn join(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.root(a), self.root(b));
-        if ra != rb {
-            self.0[ra.max(rb)] = ra.min(rb);
-        }
-    }
-}
-
-/// The connected parts of the mesh joined by the cells `keep` selects: each node's part
-/// (`None` for a node of no such cell), and each part's first cell and number of cells.
-fn parts(mesh: &Mesh, keep: impl Fn(usize) -> bool) -> (Vec<Option<usize>>, Vec<(usize, usize)>) {
-    let mut p = Parts::new(mesh.n_nodes());
-    let mut used = vec![false; mesh.n_nodes()];
-    for (_, cell) in mesh.iter_cells().enumerate().filter(|(c, _)| keep(*c)) {
-        for w in cell.windows(2) {
-            p.join(w[0], w[1]);
-        }
-        for &v in cell {
-            used[v] = true;
-        }
-    }
-    let mut part_of_root = vec![usize::MAX; mesh.n_nodes()];
-    let mut found: Vec<(usize, usize)> = vec![];
-    for (c, cell) in mesh.iter_cells().enumerate().filter(|(c, _)| keep(*c)) {
-        let r = p.root(cell[0]);
-        if part_of_root[r] == usize::MAX {
-            part_of_root[r] = found.len();
-            found.push((c, 0));
-        }
-        found[part_of_root[r]].1 += 1;
-    }
-    let part = (0..mesh.n_nodes())
-        .map(|v| used[v].then(|| part_of_root[p.root(v)]))
-        .collect();
-    (part, found)
-}
-
 /// The rigid-motion parameters `(a, ω)` of component `k` at the scaled point `y`: the row of
 /// the condition `r_k(y) = 0` (2D: `a = (a_x, a_y)`, `ω` about z; 3D: `a`, `ω` in R³).
 fn rigid_row(dim: usize, k: usize, y: [f64; 3]) -> Vec<f64> {
@@ -326,7 +275,7 @@ impl Solids {
 /// The first electric part (joined by electric cells through any node) that no prescribed φ
 /// reaches.
 fn floating_potential(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool]) -> Result<(), Unheld> {
-    let (part, found) = parts(mesh, |c| cell_electric[c]);
+    let (part, found) = mesh.node_parts(|c| cell_electric[c]);
     let mut held = vec![false; found.len()];
     for (v, d) in dofs.phi.iter().enumerate() {
         if let (Dof::Fixed(_), Some(i)) = (d, part[v]) {

@@ -54,14 +54,7 @@ impl Mesh {
     /// two parts turn freely). Returns each cell's part (numbered by their first cells) and
     /// the number of parts.
     pub fn solid_parts(&self) -> (Vec<usize>, usize) {
-        let mut up: Vec<usize> = (0..self.n_cells()).collect();
-        fn root(up: &mut [usize], mut c: usize) -> usize {
-            while up[c] != c {
-                up[c] = up[up[c]];
-                c = up[c];
-            }
-            c
-        }
+        let mut cells = UnionFind::new(self.n_cells());
         // a facet's other cell is among the cells of its first node (no sort of every facet)
         let (offsets, node_cells) = self.node_cells();
         let k = self.kind.n_nodes();
@@ -71,8 +64,7 @@ impl Mesh {
                 for &c2 in &node_cells[offsets[first]..offsets[first + 1]] {
                     let other = &self.cells[c2 * k..(c2 + 1) * k];
                     if c2 > c && f.iter().all(|&l| other.contains(&cell[l])) {
-                        let (a, b) = (root(&mut up, c), root(&mut up, c2));
-                        up[a.max(b)] = a.min(b);
+                        cells.join(c, c2);
                     }
                 }
             }
@@ -81,7 +73,7 @@ impl Mesh {
         let mut n = 0;
         let part = (0..self.n_cells())
             .map(|c| {
-                let r = root(&mut up, c);
+                let r = cells.root(c);
                 if number[r] == usize::MAX {
                     number[r] = n;
                     n += 1;
@@ -90,6 +82,36 @@ impl Mesh {
             })
             .collect();
         (part, n)
+    }
+
+    /// The parts of the mesh joined through any shared node by the cells `keep` selects (the
+    /// parts a continuous scalar field, such as the potential, spans): each node's part
+    /// (`None` for a node of no such cell), and each part's first cell and number of cells.
+    pub fn node_parts(&self, keep: impl Fn(usize) -> bool) -> (Vec<Option<usize>>, Vec<(usize, usize)>) {
+        let mut nodes = UnionFind::new(self.n_nodes());
+        let mut used = vec![false; self.n_nodes()];
+        for (_, cell) in self.iter_cells().enumerate().filter(|(c, _)| keep(*c)) {
+            for w in cell.windows(2) {
+                nodes.join(w[0], w[1]);
+            }
+            for &v in cell {
+                used[v] = true;
+            }
+        }
+        let mut part_of_root = vec![usize::MAX; self.n_nodes()];
+        let mut found: Vec<(usize, usize)> = vec![];
+        for (c, cell) in self.iter_cells().enumerate().filter(|(c, _)| keep(*c)) {
+            let r = nodes.root(cell[0]);
+            if part_of_root[r] == usize::MAX {
+                part_of_root[r] = found.len();
+                found.push((c, 0));
+            }
+            found[part_of_root[r]].1 += 1;
+        }
+        let part = (0..self.n_nodes())
+            .map(|v| used[v].then(|| part_of_root[nodes.root(v)]))
+            .collect();
+        (part, found)
     }
 
     /// Checks the topology: every facet on one or two cells, no two cells with the same
@@ -239,6 +261,28 @@ impl Mesh {
             out.push(n.map(|x| x * s));
         }
         Ok(out)
+    }
+}
+
+/// Union-find with path halving; a root is the smallest member of its set.
+struct UnionFind(Vec<usize>);
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind((0..n).collect())
+    }
+
+    fn root(&mut self, mut v: usize) -> usize {
+        while self.0[v] != v {
+            self.0[v] = self.0[self.0[v]];
+            v = self.0[v];
+        }
+        v
+    }
+
+    fn join(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.root(a), self.root(b));
+        self.0[ra.max(rb)] = ra.min(rb);
     }
 }
 

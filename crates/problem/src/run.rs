@@ -415,9 +415,9 @@ fn factor_budget(
         }
         _ => 0.0,
     };
-    // the peak of a run is 1.2 to 1.45 times the assembled system and the factor together
-    // (the factorisation's workspace, the recovery), measured on paper and paper-3d at several
-    // sizes (docs/performance.md): the factor's budget leaves that margin
+    // the peak of a run is the assembled system and the factor together, times PEAK_RATIO, and
+    // BASE_BYTES beside (the factorisation's workspace, the recovery; measured on paper and
+    // paper-3d at several sizes): the factor's budget leaves that margin
     let available_f = ((available as f64) - crate::estimate::BASE_BYTES).max(0.0) / crate::estimate::PEAK_RATIO;
     if held + dense > available_f {
         return Err(ProblemError::TooLarge {
