@@ -315,7 +315,7 @@ fn hertz_pressure_is_johnsons() {
 #[test]
 fn cattaneo_mindlin_stick_zone() {
     let r = run("cattaneo-mindlin", &["mesh.n=192"]);
-    let Some(problem::exact::ExactReport::Contact(x)) = &r.report.exact else {
+    let Some(problem::ExactReport::Contact(x)) = &r.report.exact else {
         panic!("no contact errors reported");
     };
     let (a, c, c_h) = (x.a, x.c.unwrap(), x.c_h.unwrap());

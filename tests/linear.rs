@@ -50,12 +50,12 @@ fn paper_3d_runs() {
 #[test]
 fn supernodal_ldlt_has_the_inertia_of_k() {
     let (scene, _) = driver::scene_file::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
-    let problem::setup::Setup {
+    let problem::backend::Setup {
         mesh,
         materials: mats,
         constraints: bcs,
         ..
-    } = problem::setup::setup(&scene, None).expect("setup");
+    } = problem::backend::setup(&scene, None).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).unwrap();
     let b = disc.assemble(Parallelism::Rayon);
     let f = DirectLdlt::new(&b.a, &b.g, &b.b, &Ordering::Amd, faer::Par::Seq).unwrap();

@@ -2,9 +2,10 @@
 //! "petsc"`): Krylov methods whose cost grows linearly with the mesh, and several processes
 //! (or machines), where the default backend factors one sparse matrix on one machine.
 //!
-//! The run, as [`problem::solve`] reads it, on every rank:
+//! The run is [`problem::run`]'s, with this crate's [`PetscBackend`] for what differs; on every
+//! rank:
 //!
-//! 1. **set up**: the scene's mesh, materials, conditions and loads ([`problem::setup::setup`]),
+//! 1. **set up**: the scene's mesh, materials, conditions and loads ([`problem::backend::setup`]),
 //!    the same on every rank (a mesh is small beside its matrix);
 //! 2. **partition** ([`Layout`]): the cells' dual graph (cells sharing a facet) partitioned among
 //!    the ranks by PETSc's `MatPartitioning` (PT-Scotch); a node belongs to the lowest rank of
@@ -42,4 +43,6 @@ pub mod system;
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
-pub use run::{solve, DistributedError, COUPLED_OPTIONS, ELASTIC_OPTIONS, MAX_ACTIVE_SET_STEPS};
+pub use run::{
+    solve, Assembled, DistributedError, PetscBackend, Prepared, COUPLED_OPTIONS, ELASTIC_OPTIONS, MAX_ACTIVE_SET_STEPS,
+};

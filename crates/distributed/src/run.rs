@@ -1,21 +1,19 @@
-//! A run on the ranks: set up, partition, assemble, solve, gather and recover on rank 0.
+//! A run on the ranks: the PETSc backend of [`problem::run`]. It partitions and assembles the
+//! system in parallel, configures the Krylov solvers, solves by one Krylov solve or by the
+//! active-set iteration, and gathers the solution on rank 0; the run around it (set-up,
+//! contact boundary, checks, recovery, report) is the default backend's.
 
-use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows, LinearSolve};
+use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
 use crate::layout::Layout;
 use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
-use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError};
-use problem::boundary::ContactBoundary;
-use problem::report::{
-    ContactReport, DofsReport, Iterations, Memory, MeshReport, Residuals, SceneReport, SolverReport, Timings,
-};
-use problem::run::{begin, recover};
-use problem::setup::Setup;
-use problem::{ContactLaw, ContactResult, Event, PetscReport, ProblemError, Reporter, RunReport, Scene, Solution};
+use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError, Vector};
+use problem::backend::{Backend, ContactBoundary, ContactSolve, Figures, Finished, Posed, Setup, Solved};
+use problem::{BackendChoice, ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, SceneError, Solution};
+use std::time::Instant;
 
 /// Steps of the active-set iteration at most.
 pub const MAX_ACTIVE_SET_STEPS: usize = 60;
-use std::time::Instant;
 
 /// What can stop a run of the PETSc backend.
 #[derive(Debug, thiserror::Error)]
@@ -63,228 +61,258 @@ pub const ELASTIC_OPTIONS: &str = "-ksp_type cg -ksp_rtol 1e-10 -ksp_max_it 5000
 /// returns the [`Solution`], as [`problem::solve`] gives it, the others `None`. `mesh` is the
 /// mesh of a `gmsh` scene, read by the caller on every rank. `limits.memory_bytes` is the
 /// memory each rank may take: a generated mesh whose estimate exceeds it is refused before
-/// anything is built ([`problem::estimate::petsc_per_rank`]). Only rank 0 should pass a
-/// reporter that prints.
+/// anything is built. Only rank 0 should pass a reporter that prints.
 ///
 /// # Errors
 /// The default backend's errors for the scene and its data; PETSc's (a Krylov solve that did
 /// not converge among them) as [`DistributedError::Petsc`].
-pub fn solve<'p>(
+pub fn solve(
     scene: &Scene,
     mesh: Option<mesh::Mesh>,
-    petsc: &'p Petsc,
+    petsc: &Petsc,
     limits: problem::Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DistributedError> {
-    scene.validate()?;
-    let t_total = Instant::now();
-    let estimate = problem::estimate::petsc_per_rank(scene, petsc.size());
-    let setup = begin(scene, mesh, estimate, &limits, reporter)?;
-    let t_setup = t_total.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
-    let (layout, mut system) = distribute(petsc, scene, &setup, &disc)?;
-    let t_assembly = t.elapsed().as_secs_f64();
-    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
-    let options = configure(petsc, scene, &setup, &layout)?;
-    let fields = Fields::new(petsc, &setup, &layout);
-    let t = Instant::now();
-    let mut t_pc = 0.0;
-    let mut solve_one = |m: &mut Matrix<'p>, b: &petsc::Vector<'p>, x: &mut petsc::Vector<'p>| {
-        let t = Instant::now();
-        let mut ksp = fields.krylov(petsc, m)?;
-        t_pc += t.elapsed().as_secs_f64();
-        let info = ksp.solve(b, x)?;
-        Ok((info.iterations, info.reason))
-    };
-    let (x, contact, krylov, reason) = match &setup.plan.contact_law {
-        ContactLaw::None => solve_linear(&mut system, &mut solve_one)?,
-        _ => solve_contact(petsc, scene, &setup, &disc, &layout, &system, &mut solve_one, reporter)?,
-    };
-    let t_solve = t.elapsed().as_secs_f64() - t_pc;
-    reporter.event(&Event::Krylov {
-        iterations: krylov,
-        reason: &reason,
-        setup_seconds: t_pc,
-    });
-    let equilibrium = residual(&system, &x, contact.as_ref(), &layout, petsc)?;
-    reporter.event(&Event::Solved {
-        seconds: t_solve,
-        pcg_iters: 0,
-        equilibrium,
-    });
-    let (nonzeros, _) = system.matrix.local_info()?;
-    let nonzeros = petsc.sum(&[nonzeros])?[0];
-    let gathered = x.gather()?;
-    let cells_per_rank = per_rank(petsc, &layout)?;
-    let Some(x) = gathered else {
-        return Ok(None);
-    };
-    let (u_free, phi_free) = unpermute(&disc, &layout, &x);
-    ProblemError::check_finite(&u_free, "the displacement", scene)?;
-    ProblemError::check_finite(&phi_free, "the potential", scene)?;
-    let recovered = recover(
-        scene,
-        &setup,
-        &disc,
-        (&u_free, &phi_free),
-        contact.as_ref().map(|(b, sol)| (b, sol)),
-        equilibrium,
-        reporter,
-    )?;
-    let times = Timings {
-        setup: t_setup,
-        assembly: t_assembly,
-        factorization: t_pc,
-        condense: 0.0,
-        contact: if contact.is_some() { t_solve } else { 0.0 },
-        solve: t_solve,
-        total: t_total.elapsed().as_secs_f64(),
-    };
-    let petsc_report = petsc_report(
-        petsc,
-        &layout,
-        (nonzeros, krylov, t_pc),
-        reason,
-        options,
-        cells_per_rank,
-    );
-    let info = contact.as_ref().map(|(_, sol)| &sol.info);
-    let report = Report {
-        equilibrium,
-        exact: recovered.exact,
-        contact: recovered.contact,
-        info,
-        timings_s: times,
-        petsc: petsc_report,
-    }
-    .run_report(scene, &setup, &disc);
-    Ok(Some(Solution {
-        report,
-        mesh: setup.mesh,
-        u: recovered.u,
-        phi: recovered.phi,
-        fields: recovered.fields,
-        contact: contact.map(contact_result),
-    }))
+    problem::run(&mut PetscBackend { petsc }, scene, mesh, limits, reporter)
 }
 
-/// The dofs laid out over the ranks, and the system assembled on them (the loads checked
-/// finite, the Dirichlet conditions checked to hold the body).
-fn distribute<'p>(
-    petsc: &'p Petsc,
-    scene: &Scene,
-    setup: &Setup,
-    disc: &Discretization<'_>,
-) -> Result<(Layout, System<'p>), DistributedError> {
-    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
-    let (b_u, b_phi) = disc.rhs(&setup.loads)?;
-    ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
-    ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
-    let layout = Layout::new(petsc, &setup.mesh, &disc.dofs)?;
-    let system = assemble(petsc, disc, &layout, &b_u, &b_phi)?;
-    Ok((layout, system))
+/// The PETSc backend (`solver.backend = "petsc"`), on the ranks of `petsc`.
+pub struct PetscBackend<'p> {
+    /// PETSc, initialised on the ranks of the run.
+    pub petsc: &'p Petsc,
 }
 
-/// The PETSc section of the report: the layout, the matrix's `nonzeros`, the Krylov
-/// iterations and the preconditioners' set-up time (`counts`), and the options in force.
-fn petsc_report(
-    petsc: &Petsc,
-    layout: &Layout,
-    (nonzeros, krylov, t_pc): (f64, usize, f64),
-    reason: String,
+/// The dofs laid out over the ranks, and the system assembled on them.
+pub struct Assembled<'p> {
+    layout: Layout,
+    system: System<'p>,
+}
+
+/// The assembled system with its Krylov solvers configured, and what the solves measured.
+pub struct Prepared<'p> {
+    layout: Layout,
+    system: System<'p>,
+    fields: Fields,
+    /// The options in force.
     options: String,
-    cells_per_rank: Vec<usize>,
-) -> PetscReport {
-    PetscReport {
-        ranks: petsc.size(),
-        unknowns: layout.n_global(),
-        nonzeros,
-        krylov_iterations: krylov,
-        reason,
-        options,
-        cells_per_rank,
-        unknowns_per_rank: (0..petsc.size()).map(|r| layout.owned(r).len()).collect(),
-        peak_bytes_per_rank: vec![],
-        preconditioner_setup_s: t_pc,
-    }
+    /// Wall time of the preconditioners' set-up, s.
+    t_pc: f64,
+    /// Krylov iterations, and the last solve's reason.
+    krylov: usize,
+    reason: String,
 }
 
-/// The contact part of the solution, from the boundary and the contact solve.
-fn contact_result((b, solution): (ContactBoundary, contact::ContactSolution)) -> ContactResult {
-    let displacement = solution.u.clone();
-    ContactResult {
-        points: b.points,
-        nodes: b.nodes,
-        solution,
-        displacement,
-    }
-}
+impl<'p> Backend for PetscBackend<'p> {
+    type Assembled = Assembled<'p>;
+    type System = Prepared<'p>;
+    type Solution = Vector<'p>;
+    type Error = DistributedError;
+    const HELD_TO_TOLERANCE: bool = false;
 
-/// A solve's vector, its contact boundary and solution (with contact), its Krylov iterations
-/// and the last solve's reason.
-type Solved<'p> = (
-    petsc::Vector<'p>,
-    Option<(ContactBoundary, contact::ContactSolution)>,
-    usize,
-    String,
-);
-
-/// The linear problem (no contact) on the PETSc backend: one Krylov solve.
-fn solve_linear<'p>(
-    system: &mut System<'p>,
-    solve_one: &mut LinearSolve<'_, 'p>,
-) -> Result<Solved<'p>, DistributedError> {
-    let mut x = system.rhs.duplicate()?;
-    let (its, reason) = solve_one(&mut system.matrix, &system.rhs, &mut x)?;
-    Ok((x, None, its, reason))
-}
-
-/// The contact problem on the PETSc backend: the contact boundary (a held tangent refused by
-/// name), then the active-set iteration over the distributed system.
-#[allow(clippy::too_many_arguments)]
-fn solve_contact<'p>(
-    petsc: &'p Petsc,
-    scene: &Scene,
-    setup: &Setup,
-    disc: &Discretization<'_>,
-    layout: &Layout,
-    system: &System<'p>,
-    solve_one: &mut LinearSolve<'_, 'p>,
-    reporter: &mut dyn Reporter,
-) -> Result<Solved<'p>, DistributedError> {
-    let spec = scene.contact.as_ref().ok_or_else(|| {
-        ProblemError::from(problem::SceneError::new(
-            "contact",
-            "the plan has contact and the scene no [contact]",
-        ))
-    })?;
-    let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, spec)?;
-    boundary.report_held(&spec.group, reporter);
-    if let Some(node) = boundary.first_held_tangent() {
-        return Err(ProblemError::from(problem::SceneError::new(
-            "contact.group",
+    fn refuse(&self, scene: &Scene) -> Result<(), DistributedError> {
+        if scene.solver.backend == BackendChoice::Petsc {
+            return Ok(());
+        }
+        Err(ProblemError::from(SceneError::new(
+            "solver.backend",
             format!(
-                "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face): the PETSc backend's active sets do not hold a tangent of a contact point; the default backend does",
-                spec.group
+                "solver.backend = \"{}\" is the default backend's (problem::solve); this is the PETSc backend's run: set solver.backend = \"petsc\"",
+                scene.solver.backend
             ),
         ))
-        .into());
+        .into())
     }
-    let law = setup.plan.law(scene, boundary.points.len());
-    let rows = ContactRows::new(petsc, &boundary.points, &boundary.nodes, layout, system);
-    let params = ActiveSetParams {
-        tol: scene.solver.tol,
-        max_steps: MAX_ACTIVE_SET_STEPS,
-    };
-    let tol = scene.solver.tol;
-    let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-    let out =
-        active_set(petsc, layout, system, &rows, &law, params, solve_one, &mut progress).map_err(|e| match e {
+
+    fn estimate(&self, scene: &Scene) -> Option<(f64, String)> {
+        per_rank_estimate(scene, self.petsc.size())
+    }
+
+    fn assemble(&mut self, posed: &Posed<'_>) -> Result<Assembled<'p>, DistributedError> {
+        let layout = Layout::new(self.petsc, &posed.setup.mesh, &posed.disc.dofs)?;
+        let system = assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?;
+        Ok(Assembled { layout, system })
+    }
+
+    fn prepare(
+        &mut self,
+        posed: &Posed<'_>,
+        Assembled { layout, system }: Assembled<'p>,
+        _: Option<&ContactBoundary>,
+        _: problem::Limits,
+        _: &mut dyn Reporter,
+    ) -> Result<Prepared<'p>, DistributedError> {
+        let options = configure(self.petsc, posed.scene, posed.setup, &layout)?;
+        let fields = Fields::new(self.petsc, posed.setup, &layout);
+        Ok(Prepared {
+            layout,
+            system,
+            fields,
+            options,
+            t_pc: 0.0,
+            krylov: 0,
+            reason: String::new(),
+        })
+    }
+
+    /// One Krylov solve.
+    fn solve_linear(
+        &mut self,
+        _: &Posed<'_>,
+        s: &mut Prepared<'p>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Solved<Vector<'p>>, DistributedError> {
+        let t = Instant::now();
+        let mut x = s.system.rhs.duplicate()?;
+        (s.krylov, s.reason) =
+            krylov_solve(self.petsc, &s.fields, &mut s.t_pc)(&mut s.system.matrix, &s.system.rhs, &mut x)?;
+        Ok(s.solved(t, x, None, reporter))
+    }
+
+    /// The active-set iteration over the distributed system, each step one Krylov solve (a
+    /// tangent of a contact point held by a Dirichlet condition refused by name).
+    fn solve_contact(
+        &mut self,
+        posed: &Posed<'_>,
+        s: &mut Prepared<'p>,
+        boundary: ContactBoundary,
+        how: &ContactSolve<'_>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Solved<Vector<'p>>, DistributedError> {
+        let t = Instant::now();
+        refuse_held_tangent(posed.scene, &boundary)?;
+        let rows = ContactRows::new(self.petsc, &boundary.points, &boundary.nodes, &s.layout, &s.system);
+        let params = ActiveSetParams {
+            tol: how.tol,
+            max_steps: MAX_ACTIVE_SET_STEPS,
+        };
+        let tol = how.tol;
+        let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+        let mut solve_one = krylov_solve(self.petsc, &s.fields, &mut s.t_pc);
+        let out = active_set(
+            self.petsc,
+            &s.layout,
+            &s.system,
+            &rows,
+            &how.law,
+            params,
+            &mut solve_one,
+            &mut progress,
+        )
+        .map_err(|e| match e {
             ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
             other => DistributedError::Contact(other),
         })?;
-    Ok((out.x, Some((boundary, out.solution)), out.krylov_iterations, out.reason))
+        drop(solve_one);
+        (s.krylov, s.reason) = (out.krylov_iterations, out.reason);
+        Ok(s.solved(t, out.x, Some((boundary, out.solution)), reporter))
+    }
+
+    fn equilibrium(
+        &mut self,
+        _: &Posed<'_>,
+        s: &Prepared<'p>,
+        solved: &Solved<Vector<'p>>,
+    ) -> Result<f64, DistributedError> {
+        Ok(residual(
+            &s.system,
+            &solved.x,
+            solved.contact.as_ref(),
+            &s.layout,
+            self.petsc,
+        )?)
+    }
+
+    /// Gathers the solution on rank 0 (collective), with the PETSc section of the report.
+    fn finish(
+        &mut self,
+        posed: &Posed<'_>,
+        s: Prepared<'p>,
+        x: Vector<'p>,
+    ) -> Result<Option<Finished>, DistributedError> {
+        let petsc = self.petsc;
+        let (nonzeros, _) = s.system.matrix.local_info()?;
+        let nonzeros = petsc.sum(&[nonzeros])?[0];
+        let gathered = x.gather()?;
+        let cells_per_rank = per_rank(petsc, &s.layout)?;
+        let Some(x) = gathered else {
+            return Ok(None);
+        };
+        let (u, phi) = unpermute(posed.disc, &s.layout, &x);
+        let report = PetscReport {
+            ranks: petsc.size(),
+            unknowns: s.layout.n_global(),
+            nonzeros,
+            krylov_iterations: s.krylov,
+            reason: s.reason,
+            options: s.options,
+            cells_per_rank,
+            unknowns_per_rank: (0..petsc.size()).map(|r| s.layout.owned(r).len()).collect(),
+            peak_bytes_per_rank: vec![],
+            preconditioner_setup_s: s.t_pc,
+        };
+        let figures = Figures {
+            factor_seconds: s.t_pc,
+            petsc: Some(report),
+            ..Figures::default()
+        };
+        Ok(Some(Finished { u, phi, figures }))
+    }
+}
+
+impl<'p> Prepared<'p> {
+    /// The solve's result, timed from `t` without the preconditioners' set-up, its Krylov
+    /// figures reported.
+    fn solved(
+        &self,
+        t: Instant,
+        x: Vector<'p>,
+        contact: Option<(ContactBoundary, contact::ContactSolution)>,
+        reporter: &mut dyn Reporter,
+    ) -> Solved<Vector<'p>> {
+        reporter.event(&Event::Krylov {
+            iterations: self.krylov,
+            reason: &self.reason,
+            setup_seconds: self.t_pc,
+        });
+        Solved {
+            x,
+            contact,
+            seconds: t.elapsed().as_secs_f64() - self.t_pc,
+            pcg_iters: 0,
+        }
+    }
+}
+
+/// One Krylov solve with the options in force, the preconditioner's set-up time added to
+/// `t_pc`.
+fn krylov_solve<'a, 'p: 'a>(
+    petsc: &'p Petsc,
+    fields: &'a Fields,
+    t_pc: &'a mut f64,
+) -> impl FnMut(&mut Matrix<'p>, &Vector<'p>, &mut Vector<'p>) -> Result<(usize, String), PetscError> + 'a {
+    move |m, b, x| {
+        let t = Instant::now();
+        let mut ksp = fields.krylov(petsc, m)?;
+        *t_pc += t.elapsed().as_secs_f64();
+        let info = ksp.solve(b, x)?;
+        Ok((info.iterations, info.reason))
+    }
+}
+
+/// The active sets hold the normal and tangential components of a contact point as unknowns
+/// of the system: a tangent prescribed by a Dirichlet condition is refused, naming its node.
+fn refuse_held_tangent(scene: &Scene, boundary: &ContactBoundary) -> Result<(), ProblemError> {
+    let (Some(node), Some(spec)) = (boundary.first_held_tangent(), &scene.contact) else {
+        return Ok(());
+    };
+    Err(SceneError::new(
+        "contact.group",
+        format!(
+            "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face): the PETSc backend's active sets do not hold a tangent of a contact point; the default backend does",
+            spec.group
+        ),
+    )
+    .into())
 }
 
 /// Puts the backend's options, then the scene's, into PETSc's database; returns them as one
@@ -436,46 +464,24 @@ fn unpermute(disc: &Discretization<'_>, layout: &Layout, x: &[f64]) -> (Vec<f64>
     (u, phi)
 }
 
-/// The parts of the run's report that the run measured.
-struct Report<'a> {
-    equilibrium: f64,
-    exact: Option<problem::exact::ExactReport>,
-    contact: ContactReport,
-    info: Option<&'a contact::ContactInfo>,
-    timings_s: Timings,
-    petsc: PetscReport,
-}
+/// Bytes per unknown on its rank in a run of the PETSc backend: the matrix, its copy for a
+/// contact step, the field split's blocks and both multigrid hierarchies (measured on
+/// `paper-3d` with Coulomb friction: 5.4 KB at n = 64 on 2 ranks; docs/performance.md).
+const BYTES_PER_UNKNOWN: f64 = 5.0e3;
+/// Bytes per cell that every rank holds in a run of the PETSc backend (the mesh, its geometry
+/// and dof map are built whole on each rank: 100 MB for 393k cells measured, taken low).
+const BYTES_PER_CELL: f64 = 200.0;
 
-impl Report<'_> {
-    /// The run's report, as the default backend writes it, with the PETSc section.
-    fn run_report(self, scene: &Scene, setup: &Setup, disc: &Discretization<'_>) -> RunReport {
-        RunReport {
-            scene: SceneReport::of(scene),
-            plan: setup.plan.clone(),
-            mesh: MeshReport::of(scene, setup),
-            dofs: DofsReport {
-                u: disc.dofs.n_u,
-                phi: disc.dofs.n_phi,
-            },
-            contact: self.contact,
-            exact: self.exact,
-            iterations: Iterations::of(self.info, 0),
-            residuals: Residuals {
-                equilibrium: self.equilibrium,
-                complementarity: self.info.map_or(0.0, |i| i.complementarity),
-                converged_to_tolerance: self.equilibrium <= problem::EQUILIBRIUM_TOL
-                    && self.info.is_none_or(|i| i.complementarity <= scene.solver.tol),
-            },
-            timings_s: self.timings_s,
-            memory: Memory::default(),
-            solver: SolverReport {
-                strategy: scene.solver.strategy,
-                rule: problem::report::rule_in_words(setup.plan.rule).into(),
-                tol: scene.solver.tol,
-                pcg_rel_tol: 0.0,
-                ..SolverReport::of(self.info)
-            },
-            petsc: Some(self.petsc),
-        }
-    }
+/// The estimate of each rank's peak memory in a run of the PETSc backend on `ranks` ranks, in
+/// bytes, with what it counts; `None` for a Gmsh mesh.
+fn per_rank_estimate(scene: &Scene, ranks: usize) -> Option<(f64, String)> {
+    let (_, _, cells, unknowns) = problem::backend::generated_sizes(scene)?;
+    let share = unknowns / ranks.max(1) as f64;
+    let bytes = BYTES_PER_UNKNOWN * share + BYTES_PER_CELL * cells;
+    Some((
+        bytes,
+        format!(
+            "on each of {ranks} ranks: {share:.3e} of the {unknowns:.3e} unknowns, and the whole mesh of {cells:.3e} cells"
+        ),
+    ))
 }

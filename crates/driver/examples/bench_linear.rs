@@ -22,13 +22,13 @@ fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(64);
     let (scene, _) =
         driver::scene_file::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("paper scene");
-    let problem::setup::Setup {
+    let problem::backend::Setup {
         mesh,
         materials: mats,
         constraints: bcs,
         loads,
         ..
-    } = problem::setup::setup(&scene, None).expect("setup");
+    } = problem::backend::setup(&scene, None).expect("setup");
     let (mut t_asm, mut t_sym, mut t_num, mut t_solve, mut t_chol, mut t_pcg) =
         (vec![], vec![], vec![], vec![], vec![], vec![]);
     let mut iters = 0;

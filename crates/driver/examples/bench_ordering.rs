@@ -18,12 +18,12 @@ fn main() {
     let name = std::env::args().nth(2).unwrap_or_else(|| "paper".into());
     let (scene, _) =
         driver::scene_file::load(&name, &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
-    let problem::setup::Setup {
+    let problem::backend::Setup {
         mesh,
         materials: mats,
         constraints: bcs,
         ..
-    } = problem::setup::setup(&scene, None).expect("setup");
+    } = problem::backend::setup(&scene, None).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).expect("setup");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());

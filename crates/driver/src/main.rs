@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use driver::studies::{convergence, stability, sweep, table1, verification};
 use driver::{fclib, output, scene_file, DriverError};
-use problem::{Backend, Event, Strategy};
+use problem::{BackendChoice, Event, Strategy};
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -333,8 +333,8 @@ fn run(
         first_residual: None,
     };
     let solution = match scene.solver.backend {
-        Backend::Faer => Some(driver::run::run(&scene, &source, &dir, &mut terminal)?),
-        Backend::Petsc => run_petsc(&scene, &source, &dir, &mut terminal)?,
+        BackendChoice::Faer => Some(driver::run::run(&scene, &source, &dir, &mut terminal)?),
+        BackendChoice::Petsc => run_petsc(&scene, &source, &dir, &mut terminal)?,
     };
     if let Some(solution) = solution {
         if let Some(p) = &solution.report.petsc {

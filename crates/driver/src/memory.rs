@@ -195,9 +195,17 @@ mod tests {
 
     #[test]
     fn the_least_limit_is_found_and_named() {
+        // the memory of a shared machine moves between two reads: the bound is the larger of
+        // the reads before and after, with a slack for what moved within them
+        let before = meminfo_kib("MemAvailable:").unwrap() * 1024;
         let a = available().expect("Linux knows its memory");
+        let after = meminfo_kib("MemAvailable:").unwrap() * 1024;
         assert!(a.bytes > 0);
-        assert!(a.bytes <= meminfo_kib("MemAvailable:").unwrap() * 1024);
+        assert!(
+            a.bytes <= before.max(after) + (1 << 30),
+            "{} > {before}, {after}",
+            a.bytes
+        );
         assert!(!a.limit.is_empty());
         assert!(peak_bytes() > 0);
         assert_eq!(kib_of("VmSize:\t  1234 kB\n", "VmSize:"), Some(1234));

@@ -35,7 +35,7 @@ const OVERHEAD: f64 = 1.3;
 /// A generated mesh's sizes before it is made: `(dimension, nodes, cells, unknowns)`, with
 /// displacements at every node and a potential where the scene has a piezoelectric or
 /// dielectric body; `None` for a Gmsh mesh.
-fn generated(scene: &Scene) -> Option<(usize, f64, f64, f64)> {
+pub(crate) fn generated(scene: &Scene) -> Option<(usize, f64, f64, f64)> {
     let dim = scene.mesh.dim()?;
     let axes = scene.mesh.cells_per_axis();
     let nodes: f64 = axes.iter().map(|&c| c as f64 + 1.0).product();
@@ -97,26 +97,4 @@ pub fn dense_contact(k: usize, m: usize) -> f64 {
 /// from them (values and row indices), the mesh and the vectors (a small share).
 pub fn assembled(nnz_blocks: usize, n_nodes: usize, n_unknowns: usize) -> f64 {
     16.0 * 2.0 * nnz_blocks as f64 + 64.0 * n_nodes as f64 + 8.0 * 8.0 * n_unknowns as f64
-}
-
-/// Bytes per unknown on its rank in a run of the PETSc backend: the matrix, its copy for a
-/// contact step, the field split's blocks and both multigrid hierarchies (measured on
-/// `paper-3d` with Coulomb friction: 5.4 KB at n = 64 on 2 ranks; docs/performance.md).
-const PETSC_BYTES_PER_UNKNOWN: f64 = 5.0e3;
-/// Bytes per cell that every rank holds in a run of the PETSc backend (the mesh, its geometry
-/// and dof map are built whole on each rank: 100 MB for 393k cells measured, taken low).
-const PETSC_BYTES_PER_CELL: f64 = 200.0;
-
-/// The estimate of each rank's peak memory in a run of the PETSc backend on `ranks` ranks, in
-/// bytes, with what it counts; `None` for a Gmsh mesh.
-pub fn petsc_per_rank(scene: &Scene, ranks: usize) -> Option<(f64, String)> {
-    let (_, _, cells, unknowns) = generated(scene)?;
-    let share = unknowns / ranks.max(1) as f64;
-    let bytes = PETSC_BYTES_PER_UNKNOWN * share + PETSC_BYTES_PER_CELL * cells;
-    Some((
-        bytes,
-        format!(
-            "on each of {ranks} ranks: {share:.3e} of the {unknowns:.3e} unknowns, and the whole mesh of {cells:.3e} cells"
-        ),
-    ))
 }

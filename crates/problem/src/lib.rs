@@ -54,24 +54,30 @@
 //! assert!(contact.nodes.iter().all(|&v| -solution.u[v][1] <= 1e-12));
 //! ```
 
-pub mod analytical;
-pub mod boundary;
-pub mod estimate;
-pub mod exact;
-pub mod plan;
-pub mod progress;
+mod analytical;
+pub mod backend;
+mod boundary;
+mod estimate;
+mod exact;
+mod faer_backend;
+mod plan;
+mod progress;
 pub mod report;
-pub mod run;
-pub mod scene;
-pub mod setup;
+mod run;
+mod scene;
+mod setup;
 
+pub use backend::Limits;
+pub use exact::ExactReport;
+pub use faer_backend::Faer;
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
-pub use run::{solve, solve_within, ContactResult, Limits, Solution, EQUILIBRIUM_TOL};
+pub use run::{run, solve, solve_within, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
-    Backend, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec, LoadSpec,
-    MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy,
+    BackendChoice, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec,
+    LoadSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec,
+    Strategy,
 };
 
 use contact::ContactError;

@@ -1,24 +1,23 @@
-//! A run, read as the method (as deal.II's step-41 reads): set up, assemble, factor, solve the
-//! contact problem (or the one linear system), recover the fields, report. Each step is one
-//! function; [`solve`] calls them in order and times them.
+//! A run, read as the method (as deal.II's step-41 reads): set up, discretise, assemble,
+//! factor (or prepare the Krylov solvers), solve the contact problem (or the one linear
+//! system), check, recover the fields, report. [`run`] calls the steps in order on any
+//! [`Backend`] and builds the report once; [`solve`] runs the default backend.
 
-use crate::boundary::{ContactBoundary, FullSolve};
+use crate::backend::{Backend, ContactSolve, Figures, Finished, Limits, Loads, Posed, Solved};
+use crate::boundary::ContactBoundary;
 use crate::exact::contact_errors;
+use crate::faer_backend::Faer;
 use crate::plan::Plan;
 use crate::progress::{Event, Reporter};
 use crate::report::{
     rule_in_words, ContactReport, DofsReport, Iterations, Memory, MeshReport, Residuals, RunReport, SceneReport,
     SolverReport, Timings,
 };
-use crate::scene::{Backend, ContactLaw, ContactSolver, Rule, Scene, SceneError};
+use crate::scene::{ContactLaw, Rule, Scene};
 use crate::setup::{setup, MeshNotes, Setup};
 use crate::ProblemError;
-use contact::{
-    ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, Law, NewtonParams, PointValues,
-    StopRule, UzawaParams,
-};
-use fe_assembly::{Blocks, CellFields, Discretization, Parallelism};
-use linalg::{equilibrium_residual, CondenseRoute, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
+use contact::{ContactPoints, ContactSolution, PointValues};
+use fe_assembly::{AssemblyError, CellFields, Discretization};
 use std::time::Instant;
 
 /// What a run produced: its report, the mesh, the nodal solution, the per-cell fields, and the
@@ -52,21 +51,9 @@ pub struct ContactResult {
     pub displacement: PointValues,
 }
 
-/// What a run may use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Limits {
-    /// Bytes of memory the run may take (`None`: no check).
-    pub memory_bytes: Option<u64>,
-    /// What sets `memory_bytes`, in words (for the message of a run too large): the
-    /// machine's available memory, an address-space limit, a memory cgroup.
-    pub memory_limit: Option<&'static str>,
-    /// A deadline or a cancel flag for the contact solve (a typed
-    /// [`contact::ContactError::Interrupted`], with the best iterate, when it fires).
-    pub interrupt: contact::Interrupt,
-}
-
-/// Solves `scene`. `mesh` is the mesh of a `gmsh` scene, read by the caller (generated meshes
-/// are made here); `reporter` receives one event per step and per outer iteration.
+/// Solves `scene` on the default backend ([`Faer`]). `mesh` is the mesh of a `gmsh` scene,
+/// read by the caller (generated meshes are made here); `reporter` receives one event per
+/// step and per outer iteration.
 ///
 /// # Errors
 /// A [`ProblemError`] naming the scene key, mesh item, material or solver step at fault.
@@ -75,7 +62,7 @@ pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporte
 }
 
 /// As [`solve`], within `limits`: a run whose memory estimate exceeds them stops with
-/// [`ProblemError::TooLarge`] before the memory is taken (see [`crate::estimate`]).
+/// [`ProblemError::TooLarge`] before the memory is taken.
 ///
 /// # Errors
 /// As [`solve`], and [`ProblemError::TooLarge`].
@@ -85,99 +72,102 @@ pub fn solve_within(
     limits: Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Solution, ProblemError> {
-    scene.validate()?;
-    if scene.solver.backend != Backend::Faer {
-        // the scene asks for another backend: solving it here would ignore that silently
-        return Err(SceneError::new(
-            "solver.backend",
-            format!(
-                "solver.backend = \"{}\" is solved by the distributed backend (the program built with the `petsc` feature, under mpirun; distributed::solve); this is the default backend's solve: remove solver.backend, or set it to \"faer\"",
-                scene.solver.backend
-            ),
-        )
-        .into());
-    }
+    let solution = run(&mut Faer, scene, mesh, limits, reporter)?;
+    Ok(solution.expect("the default backend runs in one process, which holds the solution"))
+}
+
+/// Solves `scene` on `backend`, within `limits`: validate, refuse what the backend does not
+/// take, set up (the memory estimate checked first), discretise, assemble, build the contact
+/// boundary, prepare (factor), solve, measure the equilibrium, gather, check, recover,
+/// report. `mesh` is the mesh of a `gmsh` scene, read by the caller. A backend on several
+/// processes returns the solution on the one that gathers it, `None` on the others.
+///
+/// # Errors
+/// The problem's errors ([`ProblemError`], naming the scene key, mesh item, material or
+/// solver step at fault) and the backend's own.
+pub fn run<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<Option<Solution>, B::Error> {
+    scene.validate().map_err(ProblemError::from)?;
+    backend.refuse(scene)?;
     let t_total = Instant::now();
-    let setup = begin(scene, mesh, crate::estimate::before_mesh(scene), &limits, reporter)?;
+    let setup = begin(scene, mesh, backend.estimate(scene), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
-    let assembled = assemble(&setup, reporter)?;
-    check_assembled(scene, &assembled)?;
+    let t = Instant::now();
+    let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints).map_err(ProblemError::from)?;
+    let posed = pose(scene, &setup, &disc)?;
+    let assembled = backend.assemble(&posed)?;
+    let t_assembly = t.elapsed().as_secs_f64();
+    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
     stop_if_interrupted(&limits, "assembly")?;
-    let mut factored = factor(scene, &setup, &assembled, limits, reporter)?;
+    let boundary = contact_boundary(&posed, reporter)?;
+    let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
     stop_if_interrupted(&limits, "factorisation")?;
-    let solved = match factored.boundary.take() {
-        Some(boundary) => {
-            let how = ContactSolve::new(&setup.plan, scene, boundary.points.len(), limits.interrupt);
-            solve_contact(&how, &mut factored.solver, boundary, &assembled, reporter).map_err(|e| e.on_scene(scene))?
+    let solved = match boundary {
+        Some(b) => {
+            let how = ContactSolve::new(&setup.plan, scene, b.points.len(), limits.interrupt);
+            backend.solve_contact(&posed, &mut system, b, &how, reporter)?
         }
-        None => solve_linear(&mut factored.solver, &assembled).map_err(|e| e.on_scene(scene))?,
+        None => backend.solve_linear(&posed, &mut system, reporter)?,
     };
-    check_solved(scene, &solved)?;
-    let equilibrium = equilibrium(&assembled, &solved);
+    let equilibrium = backend.equilibrium(&posed, &system, &solved)?;
     reporter.event(&Event::Solved {
         seconds: solved.seconds,
         pcg_iters: solved.pcg_iters,
         equilibrium,
     });
-    ProblemError::check_finite(&[equilibrium], "the equilibrium residual", scene)?;
-    check_accurate(scene, &setup.plan, &solved, equilibrium)?;
-    let contact = solved.contact.as_ref().map(|(b, sol)| (b, sol));
-    let recovered = recover(
-        scene,
-        &setup,
-        &assembled.disc,
-        (&solved.u, &solved.phi),
+    let Solved {
+        x,
         contact,
-        equilibrium,
-        reporter,
-    )?;
-    let times = Timings {
+        seconds,
+        pcg_iters,
+    } = solved;
+    let Some(Finished { u, phi, figures }) = backend.finish(&posed, system, x)? else {
+        return Ok(None);
+    };
+    check_solved(scene, (&u, &phi), contact.as_ref(), equilibrium)?;
+    if B::HELD_TO_TOLERANCE {
+        check_accurate(scene, &setup.plan, contact.as_ref(), equilibrium)?;
+    }
+    let contact_pair = contact.as_ref().map(|(b, sol)| (b, sol));
+    let recovered = recover(scene, &setup, &disc, (&u, &phi), contact_pair, equilibrium, reporter)?;
+    let timings_s = Timings {
         setup: t_setup,
-        assembly: assembled.seconds,
-        factorization: factored.seconds,
-        condense: solved.condense.map_or(0.0, |c| c.1),
-        contact: if solved.contact.is_some() { solved.seconds } else { 0.0 },
-        solve: solved.seconds,
+        assembly: t_assembly,
+        factorization: figures.factor_seconds,
+        condense: figures.condense.map_or(0.0, |c| c.1),
+        contact: if contact.is_some() { seconds } else { 0.0 },
+        solve: seconds,
         total: t_total.elapsed().as_secs_f64(),
     };
-    let report = report(
-        scene,
-        &setup,
-        &assembled,
-        &factored,
-        &solved,
-        &recovered,
+    let measured = Measured {
+        info: contact.as_ref().map(|(_, sol)| &sol.info),
+        pcg_iters,
         equilibrium,
-        times,
-    );
-    drop(assembled);
-    Ok(Solution {
+        timings_s,
+        figures,
+    };
+    let report = report(&posed, measured, &recovered);
+    drop(posed);
+    Ok(Some(Solution {
         report,
+        contact: contact.map(|(b, solution)| contact_result(b, solution, &u)),
         mesh: setup.mesh,
         u: recovered.u,
         phi: recovered.phi,
         fields: recovered.fields,
-        contact: solved.contact.map(|(b, solution)| {
-            let mut displacement = PointValues::zeros(b.points.len(), b.points.n_tangential());
-            b.extract(&solved.u, &mut displacement);
-            ContactResult {
-                points: b.points,
-                nodes: b.nodes,
-                solution,
-                displacement,
-            }
-        }),
-    })
+    }))
 }
 
-/// The start of a run on either backend: the memory `estimate` (bytes, and what it counts)
-/// checked against `limits` before the memory is taken, then the [`Setup`], its plan and what
-/// the mesh's checks noted reported.
-///
-/// # Errors
-/// [`ProblemError::TooLarge`], and the set-up's errors.
-pub fn begin(
+/// The start of a run: the memory `estimate` (bytes, and what it counts) checked against
+/// `limits` before the memory is taken, then the [`Setup`], its plan and what the mesh's
+/// checks noted reported.
+fn begin(
     scene: &Scene,
     mesh: Option<mesh::Mesh>,
     estimate: Option<(f64, String)>,
@@ -212,13 +202,6 @@ fn check_memory(limits: &Limits, estimate: Option<(f64, String)>) -> Result<(), 
     Ok(())
 }
 
-impl Limits {
-    /// What limits the memory, in words.
-    fn limit(&self) -> &'static str {
-        self.memory_limit.unwrap_or("the memory available")
-    }
-}
-
 /// [`ProblemError::Interrupted`] after the step `after` where the run's interrupt has fired.
 fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Result<(), ProblemError> {
     match limits.interrupt.check() {
@@ -227,57 +210,76 @@ fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Result<(), Probl
     }
 }
 
-/// The assembled blocks and loads.
-struct Assembled<'m> {
-    disc: Discretization<'m>,
-    blocks: Blocks,
-    b_u: Vec<f64>,
-    b_phi: Vec<f64>,
-    seconds: f64,
-}
-
-/// Assembles `A`, `G`, `B` and the loads over the free dofs.
-fn assemble<'m>(setup: &'m Setup, reporter: &mut dyn Reporter) -> Result<Assembled<'m>, ProblemError> {
-    let t = Instant::now();
-    let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
-    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
-    let blocks = disc.assemble(Parallelism::Rayon);
+/// The discrete problem: the Dirichlet conditions checked to hold the body, the loads on the
+/// free dofs, checked finite.
+fn pose<'a>(scene: &'a Scene, setup: &'a Setup, disc: &'a Discretization<'a>) -> Result<Posed<'a>, ProblemError> {
+    disc.check_held().map_err(AssemblyError::from)?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
-    let seconds = t.elapsed().as_secs_f64();
-    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, seconds));
-    Ok(Assembled {
+    ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
+    ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
+    Ok(Posed {
+        scene,
+        setup,
         disc,
-        blocks,
-        b_u,
-        b_phi,
-        seconds,
+        loads: Loads { b_u, b_phi },
     })
 }
 
-/// Checks the assembled blocks and loads for numbers that overflowed.
-fn check_assembled(scene: &Scene, a: &Assembled<'_>) -> Result<(), ProblemError> {
-    ProblemError::check_finite(&a.b_u, "the mechanical load vector", scene)?;
-    ProblemError::check_finite(&a.b_phi, "the electric load vector", scene)?;
-    ProblemError::check_finite(a.blocks.a.val(), "the stiffness matrix A", scene)?;
-    ProblemError::check_finite(a.blocks.g.val(), "the coupling matrix G", scene)?;
-    ProblemError::check_finite(a.blocks.b.val(), "the dielectric matrix B", scene)
+/// The contact boundary, where the plan has contact; its nodes that the Dirichlet conditions
+/// hold reported.
+fn contact_boundary(posed: &Posed<'_>, reporter: &mut dyn Reporter) -> Result<Option<ContactBoundary>, ProblemError> {
+    let Some(spec) = posed
+        .scene
+        .contact
+        .as_ref()
+        .filter(|_| posed.plan().contact_law != ContactLaw::None)
+    else {
+        return Ok(None);
+    };
+    let boundary = ContactBoundary::new(&posed.setup.mesh, &posed.disc.dofs, spec)?;
+    boundary.report_held(&spec.group, reporter);
+    Ok(Some(boundary))
 }
 
-/// Checks the solution for numbers that overflowed.
-fn check_solved(scene: &Scene, s: &Solved) -> Result<(), ProblemError> {
-    ProblemError::check_finite(&s.u, "the displacement", scene)?;
-    ProblemError::check_finite(&s.phi, "the potential", scene)?;
-    if let Some((_, sol)) = &s.contact {
+/// The contact part of the solution: the boundary, the contact solve, and the displacement of
+/// the points in the free displacements `u`.
+fn contact_result(b: ContactBoundary, solution: ContactSolution, u: &[f64]) -> ContactResult {
+    let mut displacement = PointValues::zeros(b.points.len(), b.points.n_tangential());
+    b.extract(u, &mut displacement);
+    ContactResult {
+        points: b.points,
+        nodes: b.nodes,
+        solution,
+        displacement,
+    }
+}
+
+/// Checks the solution, the multipliers and the equilibrium residual for numbers that
+/// overflowed.
+fn check_solved(
+    scene: &Scene,
+    (u, phi): (&[f64], &[f64]),
+    contact: Option<&(ContactBoundary, ContactSolution)>,
+    equilibrium: f64,
+) -> Result<(), ProblemError> {
+    ProblemError::check_finite(u, "the displacement", scene)?;
+    ProblemError::check_finite(phi, "the potential", scene)?;
+    if let Some((_, sol)) = contact {
         ProblemError::check_finite(&sol.lambda.normal, "the contact pressure", scene)?;
         ProblemError::check_finite(&sol.lambda.tangential, "the tangential multiplier", scene)?;
     }
-    Ok(())
+    ProblemError::check_finite(&[equilibrium], "the equilibrium residual", scene)
 }
 
 /// Under the tight rule, every reported residual meets its tolerance, or the run fails naming
 /// what makes the system ill-conditioned: the equilibrium residual ([`EQUILIBRIUM_TOL`]) and
 /// the complementarity residual of the final fields (`solver.tol`).
-fn check_accurate(scene: &Scene, plan: &Plan, s: &Solved, equilibrium: f64) -> Result<(), ProblemError> {
+fn check_accurate(
+    scene: &Scene,
+    plan: &Plan,
+    contact: Option<&(ContactBoundary, ContactSolution)>,
+    equilibrium: f64,
+) -> Result<(), ProblemError> {
     if plan.rule != Rule::Tight {
         return Ok(());
     }
@@ -289,7 +291,7 @@ fn check_accurate(scene: &Scene, plan: &Plan, s: &Solved, equilibrium: f64) -> R
             scene,
         ));
     }
-    if let Some((_, sol)) = &s.contact {
+    if let Some((_, sol)) = contact {
         let c = sol.info.complementarity;
         if !(c <= scene.solver.tol) {
             return Err(ProblemError::inaccurate(
@@ -303,457 +305,32 @@ fn check_accurate(scene: &Scene, plan: &Plan, s: &Solved, equilibrium: f64) -> R
     Ok(())
 }
 
-/// The linear solver the plan asks for, factored once.
-#[allow(clippy::large_enum_variant)] // one per run, moved never
-enum LinearSolver {
-    /// One `L D Lᵀ` of `K`.
-    Direct(DirectLdlt),
-    /// The paper's Schur-complement PCG (Cholesky factors of `A` and `B`).
-    SchurPcg(SchurPcg),
-}
-
-impl LinearSolver {
-    fn coupled(&mut self) -> &mut dyn CoupledSolver {
-        match self {
-            LinearSolver::Direct(d) => d,
-            LinearSolver::SchurPcg(p) => p,
-        }
-    }
-}
-
-/// The factored solver, and the contact boundary (built with it: its dofs order the factor).
-struct Factored {
-    solver: LinearSolver,
-    boundary: Option<ContactBoundary>,
-    pcg_params: PcgParams,
-    seconds: f64,
-}
-
-/// Builds the contact boundary (where the plan has contact) and factors the linear solver:
-/// the Schur PCG's Cholesky factors, or the `L D Lᵀ` of `K` in geometric nested dissection
-/// (measured no slower than AMD in 2D and 1.6x faster in 3D, docs/performance.md), with the
-/// contact dofs last for the condensed strategies, to read the contact block off the factor.
-fn factor(
-    scene: &Scene,
-    setup: &Setup,
-    a: &Assembled<'_>,
-    limits: Limits,
-    reporter: &mut dyn Reporter,
-) -> Result<Factored, ProblemError> {
-    let t = Instant::now();
-    let plan = &setup.plan;
-    let paper = plan.rule == Rule::Paper;
-    let pcg_params = PcgParams {
-        rel_tol: scene.solver.pcg_tol.unwrap_or(if paper { 1e-2 } else { 1e-12 }),
-        max_iters: 10_000,
-        stop: if paper {
-            PcgStop::PaperRz
-        } else {
-            PcgStop::RelativeResidual
-        },
-        ..Default::default()
-    };
-    let boundary = match scene.contact.as_ref().filter(|_| plan.contact_law != ContactLaw::None) {
-        Some(spec) => Some(ContactBoundary::new(&setup.mesh, &a.disc.dofs, spec)?),
-        None => None,
-    };
-    if let (Some(b), Some(spec)) = (&boundary, &scene.contact) {
-        b.report_held(&spec.group, reporter);
-    }
-    let par = faer::Par::Seq;
-    let budget = factor_budget(setup, a, boundary.as_ref(), limits)?;
-    let too_large = |e: linalg::LinalgError| too_large(e, limits, scene);
-    let (blocks, mesh) = (&a.blocks, &setup.mesh);
-    let solver = if plan.linear_strategy.runs_pcg() {
-        let pcg = SchurPcg::new_within(blocks.a.clone(), blocks.g.clone(), &blocks.b, pcg_params, par, budget)
-            .map_err(too_large)?;
-        LinearSolver::SchurPcg(pcg)
-    } else {
-        let order = a
-            .disc
-            .dofs
-            .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
-        let ordering = match (&boundary, plan.linear_strategy.is_condensed()) {
-            (Some(cb), true) => Ordering::GivenThenLast {
-                order,
-                last: cb.dofs.clone(),
-            },
-            _ => Ordering::Given(order),
-        };
-        LinearSolver::Direct(
-            DirectLdlt::new_within(&blocks.a, &blocks.g, &blocks.b, &ordering, par, budget).map_err(too_large)?,
-        )
-    };
-    let seconds = t.elapsed().as_secs_f64();
-    reporter.event(&Event::Factored { seconds });
-    Ok(Factored {
-        solver,
-        boundary,
-        pcg_params,
-        seconds,
-    })
-}
-
-/// The bytes left for the factor within `limits`, once the assembled blocks and (condensed
-/// strategies) the dense contact problem are counted; an error where those alone do not fit.
-fn factor_budget(
-    setup: &Setup,
-    a: &Assembled<'_>,
-    boundary: Option<&ContactBoundary>,
-    limits: Limits,
-) -> Result<Option<usize>, ProblemError> {
-    let Some(available) = limits.memory_bytes else {
-        return Ok(None);
-    };
-    let b = &a.blocks;
-    let nnz = b.a.val().len() + b.g.val().len() + b.b.val().len();
-    let held = crate::estimate::assembled(nnz, setup.mesh.n_nodes(), a.disc.dofs.n_u + a.disc.dofs.n_phi);
-    let dense = match boundary {
-        Some(cb) if setup.plan.linear_strategy.is_condensed() => {
-            let m = cb.points.len() * (1 + setup.plan.n_tangential());
-            crate::estimate::dense_contact(cb.dofs.len(), m)
-        }
-        _ => 0.0,
-    };
-    // the peak of a run is the assembled system and the factor together, times PEAK_RATIO, and
-    // BASE_BYTES beside (the factorisation's workspace, the recovery; measured on paper and
-    // paper-3d at several sizes): the factor's budget leaves that margin
-    let available_f = ((available as f64) - crate::estimate::BASE_BYTES).max(0.0) / crate::estimate::PEAK_RATIO;
-    if held + dense > available_f {
-        return Err(ProblemError::TooLarge {
-            what: format!(
-                "the assembled system and the dense contact compliance of a condensed strategy ({:.1} GiB)",
-                dense / crate::estimate::GIB
-            ),
-            needed: ((held + dense) * crate::estimate::PEAK_RATIO + crate::estimate::BASE_BYTES) as u64,
-            available,
-            limit: limits.limit(),
-        });
-    }
-    Ok(Some((available_f - held - dense) as usize))
-}
-
-/// A linear-algebra error, made [`ProblemError::TooLarge`] where the factor did not fit, and
-/// [`ProblemError::IllConditioned`] where it broke down on an ill-conditioned scene.
-fn too_large(e: linalg::LinalgError, limits: Limits, scene: &Scene) -> ProblemError {
-    let inner = match &e {
-        linalg::LinalgError::In { source, .. } => source.as_ref(),
-        other => other,
-    };
-    match (inner, limits.memory_bytes) {
-        (linalg::LinalgError::TooLarge { needed, budget }, Some(available)) => ProblemError::TooLarge {
-            what: format!(
-                "a sparse factor of {:.1} GiB, counted by its symbolic analysis, beside the assembled system",
-                *needed as f64 / crate::estimate::GIB
-            ),
-            // the rest of the run takes what the factor's budget left out
-            needed: (*needed + (available as usize).saturating_sub(*budget)) as u64,
-            available,
-            limit: limits.limit(),
-        },
-        _ => ProblemError::linear(e, scene),
-    }
-}
-
-/// The solution `(u, φ)` with, where the plan has contact, the boundary and its solution.
-struct Solved {
-    u: Vec<f64>,
-    phi: Vec<f64>,
-    contact: Option<(ContactBoundary, ContactSolution)>,
-    pcg_iters: usize,
-    /// Steps of iterative refinement of the last solve.
-    refinement: usize,
-    /// How the contact compliance was formed, and in how long (condensed strategies).
-    condense: Option<(CondenseRoute, f64)>,
-    seconds: f64,
-}
-
-/// The one linear solve of a run without contact.
-fn solve_linear(solver: &mut LinearSolver, a: &Assembled<'_>) -> Result<Solved, ProblemError> {
-    let t = Instant::now();
-    let (mut u, mut phi) = (vec![0.0; a.disc.dofs.n_u], vec![0.0; a.disc.dofs.n_phi]);
-    let info = solver.coupled().solve(&a.b_u, &a.b_phi, &mut u, &mut phi)?;
-    let refinement = match solver {
-        LinearSolver::Direct(direct) => {
-            let (b, scale) = rhs_with_contact(a, None);
-            refine(direct, a, &b, scale, &mut u, &mut phi)?.steps
-        }
-        LinearSolver::SchurPcg(_) => 0,
-    };
-    Ok(Solved {
-        u,
-        phi,
-        contact: None,
-        pcg_iters: info.pcg_iters,
-        refinement,
-        condense: None,
-        seconds: t.elapsed().as_secs_f64(),
-    })
-}
-
-/// The contact problem as its solvers see it.
-enum Operator<'a> {
-    /// The condensed compliance (Newton, or a first-order method).
-    Condensed(&'a mut DenseContactProblem),
-    /// One full primal solve per call (first-order methods).
-    FullSolves(&'a mut dyn ContactOperator),
-}
-
-/// How the plan's contact problem is solved: the law on its points, the solver, the tolerance.
-struct ContactSolve<'p> {
-    plan: &'p Plan,
-    scene: &'p Scene,
-    law: Law,
-    tol: f64,
-    interrupt: contact::Interrupt,
-}
-
-impl<'p> ContactSolve<'p> {
-    /// The plan's contact law on `n` points: frictionless without tangential multipliers,
-    /// Tresca with the scene's bound, else Coulomb.
-    fn new(plan: &'p Plan, scene: &'p Scene, n: usize, interrupt: contact::Interrupt) -> Self {
-        let law = plan.law(scene, n);
-        // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
-        debug_assert_eq!(
-            plan.fixed_point,
-            law == Law::Coulomb && matches!(plan.linear_strategy.contact_solver(), ContactSolver::FirstOrder { .. })
-        );
-        ContactSolve {
-            plan,
-            scene,
-            law,
-            tol: scene.solver.tol,
-            interrupt,
-        }
-    }
-
-    /// Runs the strategy's contact solver on `problem`, reporting each outer iteration.
-    fn run(
-        &self,
-        problem: Operator<'_>,
-        points: &ContactPoints,
-        start: Option<PointValues>,
-        reporter: &mut dyn Reporter,
-    ) -> Result<ContactSolution, ProblemError> {
-        let tol = self.tol;
-        let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-        let solved = match (self.plan.linear_strategy.contact_solver(), problem) {
-            (ContactSolver::Newton, Operator::Condensed(dense)) => {
-                let params = NewtonParams {
-                    tol,
-                    interrupt: self.interrupt,
-                    ..Default::default()
-                };
-                contact::solve_newton(dense, points, &self.law, &params, start, &mut progress)
-            }
-            (ContactSolver::FirstOrder { accelerate }, problem) => {
-                let op: &mut dyn ContactOperator = match problem {
-                    Operator::Condensed(dense) => dense,
-                    Operator::FullSolves(op) => op,
-                };
-                let params = UzawaParams {
-                    rule: match self.plan.rule {
-                        Rule::Paper => StopRule::Paper,
-                        Rule::Tight => StopRule::Tight { tol },
-                    },
-                    report_every: 50,
-                    accelerate,
-                    interrupt: self.interrupt,
-                    ..Default::default()
-                };
-                contact::solve(op, points, &self.law, &params, start, &mut progress)
-            }
-            (ContactSolver::Newton, Operator::FullSolves(_)) => Err(ContactError::Input(
-                "semismooth Newton needs the condensed compliance".into(),
-            )),
-        };
-        solved.map_err(|e| ProblemError::contact(e, self.plan.linear_strategy, self.scene))
-    }
-}
-
-/// The contact solve: on the condensed compliance (Newton, or a first-order method), or with
-/// one full primal solve per first-order step; then `(u, φ)` under the contact forces found.
-fn solve_contact(
-    how: &ContactSolve<'_>,
-    solver: &mut LinearSolver,
-    boundary: ContactBoundary,
-    a: &Assembled<'_>,
-    reporter: &mut dyn Reporter,
-) -> Result<Solved, ProblemError> {
-    let t = Instant::now();
-    let plan = how.plan;
-    let mut refinement = 0;
-    let ((sol, (u, phi)), condense) = match solver {
-        LinearSolver::Direct(direct) if plan.linear_strategy.is_condensed() => {
-            let t_condense = Instant::now();
-            let (mut dense, loads) = boundary.condense(direct, &a.b_u, &a.b_phi, plan.n_tangential())?;
-            let condense = (loads.route, t_condense.elapsed().as_secs_f64());
-            reporter.event(&Event::Condensed {
-                m: dense.m(),
-                route: condense.0,
-                seconds: condense.1,
-            });
-            let mut sol = how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?;
-            let u0 = dense.u0.clone();
-            let (mut u, mut phi) = boundary.recover(direct, loads, &sol.lambda, &a.b_u, &a.b_phi)?;
-            // the fields are those of the last solve: refined, and the contact law judged on
-            // them (not on the condensed problem's own displacement); where the compliance lost
-            // digits to an ill-conditioned system, its defect at the points is corrected
-            let mut corrections = 0;
-            loop {
-                let (b_full, scale) = rhs_with_contact(a, Some((&boundary, &sol)));
-                refinement += refine(direct, a, &b_full, scale, &mut u, &mut phi)?.steps;
-                sol.info.complementarity = law_residual(&boundary, &sol, &how.law, &u0, &u);
-                if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
-                    break;
-                }
-                let actual = fields_at_points(&boundary, &u, sol.lambda.n_tangential());
-                for (d, (x, model)) in dense.u0.normal.iter_mut().chain(dense.u0.tangential.iter_mut()).zip(
-                    actual
-                        .normal
-                        .iter()
-                        .chain(&actual.tangential)
-                        .zip(sol.u.normal.iter().chain(&sol.u.tangential)),
-                ) {
-                    *d += x - model;
-                }
-                let start = sol.lambda.clone();
-                sol = how.run(Operator::Condensed(&mut dense), &boundary.points, Some(start), reporter)?;
-                let (b_full, _) = rhs_with_contact(a, Some((&boundary, &sol)));
-                direct.solve(&b_full, &a.b_phi, &mut u, &mut phi)?;
-                corrections += 1;
-            }
-            sol.info.residual = sol.info.residual.max(sol.info.complementarity);
-            drop(dense);
-            ((sol, (u, phi)), Some(condense))
-        }
-        other => {
-            let mut op = FullSolve {
-                boundary: &boundary,
-                solver: other.coupled(),
-                b_u: &a.b_u,
-                b_phi: &a.b_phi,
-                nt: plan.n_tangential(),
-                u: vec![0.0; a.disc.dofs.n_u],
-                phi: vec![0.0; a.disc.dofs.n_phi],
-            };
-            let sol = how.run(Operator::FullSolves(&mut op), &boundary.points, None, reporter)?;
-            ((sol, (op.u, op.phi)), None)
-        }
-    };
-    Ok(Solved {
-        u,
-        phi,
-        pcg_iters: sol.info.inner_iters,
-        refinement,
-        contact: Some((boundary, sol)),
-        condense,
-        seconds: t.elapsed().as_secs_f64(),
-    })
-}
-
-/// The equilibrium residual of the final pair, with the contact forces in the right-hand side,
-/// relative to the larger of the loads and the contact forces (they may cancel in the sum: a
-/// load pressing the contact face straight into the foundation).
-fn equilibrium(a: &Assembled<'_>, s: &Solved) -> f64 {
-    let (b_full, scale) = rhs_with_contact(a, s.contact.as_ref().map(|(b, sol)| (b, sol)));
-    let b = &a.blocks;
-    equilibrium_residual(&b.a, &b.g, &b.b, &s.u, &s.phi, &b_full, &a.b_phi, scale)
-}
-
-/// The mechanical right-hand side with the contact forces of `contact`, and the size of its
-/// parts (the loads, the contact forces: they may cancel in the sum).
-fn rhs_with_contact(a: &Assembled<'_>, contact: Option<(&ContactBoundary, &ContactSolution)>) -> (Vec<f64>, f64) {
-    let mut b_full = a.b_u.clone();
-    let mut scale = linalg::norm(&a.b_u).hypot(linalg::norm(&a.b_phi));
-    if let Some((cb, sol)) = contact {
-        let forces = cb.forces(&sol.lambda);
-        scale = scale.max(linalg::norm(&forces));
-        for (&j, f) in cb.dofs.iter().zip(&forces) {
-            b_full[j] += f;
-        }
-    }
-    (b_full, scale)
-}
-
-/// The equilibrium residual a run must reach (relative, as [`equilibrium_residual`]): eight
-/// digits of the loads balanced. The direct solves reach 1e-13 to 1e-15 on the shipped scenes;
-/// a solve above it is refined, and a run still above it under the tight rule fails, naming
-/// the inputs that make the system ill-conditioned.
+/// The equilibrium residual a run must reach (relative, as [`linalg::equilibrium_residual`]):
+/// eight digits of the loads balanced. The direct solves reach 1e-13 to 1e-15 on the shipped
+/// scenes; a solve above it is refined, and a run still above it under the tight rule fails,
+/// naming the inputs that make the system ill-conditioned.
 pub const EQUILIBRIUM_TOL: f64 = 1e-8;
-
-/// Iterative refinement of the last solve (with `K`'s factors), towards round-off: at most 3
-/// corrections, each kept only where it lowers the residual.
-fn refine(
-    direct: &mut DirectLdlt,
-    a: &Assembled<'_>,
-    b_u: &[f64],
-    scale: f64,
-    u: &mut [f64],
-    phi: &mut [f64],
-) -> Result<linalg::Refined, ProblemError> {
-    let b = &a.blocks;
-    let k = linalg::CoupledBlocks {
-        a: &b.a,
-        g: &b.g,
-        b: &b.b,
-    };
-    Ok(linalg::refine(direct, k, b_u, &a.b_phi, u, phi, scale, 1e-14, 3)?)
-}
-
-/// Corrections of the condensed problem by its defect at the points, at most (each a warm
-/// Newton solve and one solve with the factors): where the compliance is accurate to a
-/// fraction, each gains that fraction's digits.
-const MAX_CORRECTIONS: usize = 4;
-
-/// The displacement of the points in the free vector `u`, in the contact problem's layout
-/// (`nt` tangential components: none without friction).
-fn fields_at_points(boundary: &ContactBoundary, u: &[f64], nt: usize) -> PointValues {
-    let points = &boundary.points;
-    let mut all = PointValues::zeros(points.len(), points.n_tangential());
-    boundary.extract(u, &mut all);
-    let tangential = if nt > 0 { all.tangential } else { vec![] };
-    PointValues::from_parts(all.normal, tangential, nt).unwrap_or_else(|_| PointValues::zeros(points.len(), nt))
-}
-
-/// The complementarity residual of the law on the final fields: the multipliers of `sol` with
-/// the displacement of the points in `u` (the last, refined solve), against the loads' `u0`.
-fn law_residual(boundary: &ContactBoundary, sol: &ContactSolution, law: &Law, u0: &PointValues, u: &[f64]) -> f64 {
-    let points = &boundary.points;
-    let at = fields_at_points(boundary, u, sol.lambda.n_tangential());
-    let c = 1.0 / sol.info.mu_max;
-    let mut free = u0.clone();
-    for (v, g) in free.normal.iter_mut().zip(&points.gap) {
-        *v -= g;
-    }
-    let reference = c * free.weighted_norm(&points.weight);
-    let radius = contact::slip_bound(points, law, &sol.lambda.normal);
-    contact::complementarity_residual(points, &radius, &sol.lambda, &at, c, reference)
-}
 
 /// The nodal solution, the per-cell fields, the contact counts and forces, and the error
 /// against the exact solution: what a run reports, whichever backend solved it.
-pub struct Recovered {
+struct Recovered {
     /// Nodal displacements.
-    pub u: Vec<[f64; 3]>,
+    u: Vec<[f64; 3]>,
     /// Nodal potentials.
-    pub phi: Vec<f64>,
+    phi: Vec<f64>,
     /// Per-cell stress, strain, electric displacement and field.
-    pub fields: CellFields,
+    fields: CellFields,
     /// The contact boundary's counts and resultant forces (zeros without contact).
-    pub contact: ContactReport,
+    contact: ContactReport,
     /// The error against the scene's exact solution, where it has one.
-    pub exact: Option<crate::exact::ExactReport>,
+    exact: Option<crate::exact::ExactReport>,
 }
 
 /// Expands the free unknowns `(u, φ)` to the nodes, recovers stress and electric
 /// displacement per cell, counts the contact solution (on its boundary), measures the error
 /// against the scene's exact solution, and checks that every reported number (with the
 /// run's `equilibrium` residual) is finite.
-///
-/// # Errors
-/// [`ProblemError::NotFinite`], naming the extreme inputs, where the data overflow.
-pub fn recover(
+fn recover(
     scene: &Scene,
     setup: &Setup,
     disc: &Discretization<'_>,
@@ -799,71 +376,62 @@ pub fn recover(
     })
 }
 
-/// The typed report of the run.
-#[allow(clippy::too_many_arguments)]
-fn report(
-    scene: &Scene,
-    setup: &Setup,
-    a: &Assembled<'_>,
-    f: &Factored,
-    s: &Solved,
-    r: &Recovered,
+/// What the run measured beside the recovered fields, for its report.
+struct Measured<'a> {
+    info: Option<&'a contact::ContactInfo>,
+    pcg_iters: usize,
     equilibrium: f64,
     timings_s: Timings,
-) -> RunReport {
-    let plan = &setup.plan;
-    let info = s.contact.as_ref().map(|(_, sol)| &sol.info);
-    let direct = match &f.solver {
-        LinearSolver::Direct(d) => Some(d),
-        LinearSolver::SchurPcg(_) => None,
-    };
-    let factor_bytes = match &f.solver {
-        LinearSolver::Direct(d) => d.factor_bytes(),
-        LinearSolver::SchurPcg(p) => p.factor_bytes(),
-    };
+    figures: Figures,
+}
+
+/// The typed report of the run, whichever backend solved it.
+fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunReport {
+    let (scene, plan) = (posed.scene, posed.plan());
+    let (info, equilibrium, figures) = (m.info, m.equilibrium, m.figures);
     RunReport {
         scene: SceneReport::of(scene),
         plan: plan.clone(),
-        mesh: MeshReport::of(scene, setup),
+        mesh: MeshReport::of(scene, posed.setup),
         dofs: DofsReport {
-            u: a.disc.dofs.n_u,
-            phi: a.disc.dofs.n_phi,
+            u: posed.disc.dofs.n_u,
+            phi: posed.disc.dofs.n_phi,
         },
         contact: r.contact.clone(),
         exact: r.exact.clone(),
-        iterations: Iterations::of(info, s.pcg_iters),
+        iterations: Iterations::of(info, m.pcg_iters),
         residuals: Residuals {
             equilibrium,
             complementarity: info.map_or(0.0, |i| i.complementarity),
-            // under the tight rule a run reaches here only with every residual within its
-            // tolerance (check_accurate)
+            // under the tight rule a run of a backend held to its tolerances reaches here only
+            // with every residual within them (check_accurate)
             converged_to_tolerance: plan.rule == Rule::Tight
                 && equilibrium <= EQUILIBRIUM_TOL
                 && info.is_none_or(|i| i.complementarity <= scene.solver.tol),
         },
-        timings_s,
+        timings_s: m.timings_s,
         memory: Memory {
             peak_bytes: 0,
-            factor_bytes,
+            factor_bytes: figures.factor_bytes,
         },
         solver: SolverReport {
             strategy: plan.linear_strategy,
             rule: rule_in_words(plan.rule).into(),
             tol: scene.solver.tol,
-            pcg_rel_tol: f.pcg_params.rel_tol,
-            condense_route: s.condense.map(|(route, _)| format!("{route:?}")),
-            smallest_pivot_ratio: direct.map(|d| d.factor().pivot_ratio()),
-            refinement_steps: s.refinement,
+            pcg_rel_tol: figures.pcg_rel_tol,
+            condense_route: figures.condense.map(|(route, _)| format!("{route:?}")),
+            smallest_pivot_ratio: figures.smallest_pivot_ratio,
+            refinement_steps: figures.refinement_steps,
             ..SolverReport::of(info)
         },
-        petsc: None,
+        petsc: figures.petsc,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{ContactSpec, DirichletSpec, LoadSpec, MaterialSpec, MeshSpec};
+    use crate::scene::{BackendChoice, ContactSpec, DirichletSpec, LoadSpec, MaterialSpec, MeshSpec};
     use crate::Silent;
     use std::sync::atomic::AtomicBool;
 
@@ -924,7 +492,7 @@ mod tests {
     #[test]
     fn a_scene_for_another_backend_is_refused_not_solved_here() {
         let mut scene = block(MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 4));
-        scene.solver.backend = Backend::Petsc;
+        scene.solver.backend = BackendChoice::Petsc;
         let e = solve(&scene, None, &mut Silent).err().unwrap().to_string();
         assert!(
             e.contains("solver.backend = \"petsc\" is solved by the distributed backend"),

@@ -114,7 +114,7 @@ choice! {
 
 choice! {
     /// Who does the linear algebra.
-    pub enum Backend ("solver.backend") {
+    pub enum BackendChoice ("solver.backend") {
         /// faer's sparse direct factorisations, on one machine (the default).
         Faer = "faer",
         /// PETSc: Krylov methods with algebraic multigrid (a field split with the Schur
@@ -686,7 +686,7 @@ pub struct SolverSpec {
     pub pcg_tol: Option<f64>,
     /// The linear-algebra backend (default `faer`).
     #[serde(default = "default_backend")]
-    pub backend: Backend,
+    pub backend: BackendChoice,
     /// Options for PETSc's database, as on PETSc's command line (`backend = "petsc"` only):
     /// `"-ksp_monitor -fieldsplit_u_pc_type hypre"`.
     #[serde(default)]
@@ -702,8 +702,8 @@ fn default_tol() -> f64 {
 fn default_rule() -> Rule {
     Rule::Tight
 }
-fn default_backend() -> Backend {
-    Backend::Faer
+fn default_backend() -> BackendChoice {
+    BackendChoice::Faer
 }
 
 impl Default for SolverSpec {

@@ -5,8 +5,8 @@
 //! mesh is read ([`Scene::check_dimension`]).
 
 use super::{
-    Backend, ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, Rule,
-    Scene, SolverSpec, Strategy,
+    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec,
+    Rule, Scene, SolverSpec, Strategy,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -464,7 +464,7 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
 /// active-set iteration holds the normal and tangential components as unknowns of the system),
 /// a strategy or rule of the default backend's contact solvers (it runs its own).
 fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
-    if s.solver.backend != Backend::Petsc {
+    if s.solver.backend != BackendChoice::Petsc {
         return Ok(());
     }
     refuse_if(
@@ -503,7 +503,7 @@ fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
         ));
     }
     refuse_if(
-        s.petsc_options.is_some() && s.backend != Backend::Petsc,
+        s.petsc_options.is_some() && s.backend != BackendChoice::Petsc,
         "solver.petsc_options",
         "options for PETSc's database, and solver.backend is not `petsc`",
     )?;

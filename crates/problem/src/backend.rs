@@ -1,0 +1,261 @@
+//! What differs between the backends that solve a scene, as one trait: the run
+//! (the crate's `run`) sets up, discretises, builds the contact boundary, checks, recovers and
+//! reports once; a [`Backend`] assembles the system, prepares it (factors it, or configures
+//! its Krylov solvers), solves the linear or the contact problem on it, measures its
+//! equilibrium residual, and hands the free unknowns back.
+//!
+//! Two backends implement it: [`Faer`] (this crate's default: faer's sparse factorisations on
+//! one machine, the condensed contact problem and its semismooth Newton) and the `distributed`
+//! crate's PETSc backend (Krylov solves with algebraic multigrid on the ranks of an MPI run).
+//! The run knows neither by name.
+
+use crate::progress::Reporter;
+use crate::report::PetscReport;
+use crate::scene::{ContactSolver, Scene};
+use crate::ProblemError;
+use contact::{ContactSolution, Law};
+use fe_assembly::Discretization;
+use linalg::CondenseRoute;
+
+pub use crate::boundary::{ContactBoundary, MAX_NORMAL_ANGLE_DEG};
+pub use crate::plan::Plan;
+pub use crate::setup::{setup, MeshNotes, Setup};
+
+/// What a run may use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Limits {
+    /// Bytes of memory the run may take (`None`: no check).
+    pub memory_bytes: Option<u64>,
+    /// What sets `memory_bytes`, in words (for the message of a run too large): the
+    /// machine's available memory, an address-space limit, a memory cgroup.
+    pub memory_limit: Option<&'static str>,
+    /// A deadline or a cancel flag for the contact solve (a typed
+    /// [`contact::ContactError::Interrupted`], with the best iterate, when it fires).
+    pub interrupt: contact::Interrupt,
+}
+
+impl Limits {
+    /// What limits the memory, in words.
+    pub(crate) fn limit(&self) -> &'static str {
+        self.memory_limit.unwrap_or("the memory available")
+    }
+}
+
+/// A backend: how the discrete problem of a run is assembled and solved. Every method is
+/// called once per run, in the order of the run: [`refuse`](Backend::refuse),
+/// [`estimate`](Backend::estimate), [`assemble`](Backend::assemble),
+/// [`prepare`](Backend::prepare), one of [`solve_linear`](Backend::solve_linear) and
+/// [`solve_contact`](Backend::solve_contact), [`equilibrium`](Backend::equilibrium),
+/// [`finish`](Backend::finish). A backend whose steps are collective (MPI) makes them
+/// collective on every rank; only [`finish`](Backend::finish) may return `None` (a rank that
+/// does not hold the gathered solution).
+pub trait Backend {
+    /// The assembled system, before it is prepared.
+    type Assembled;
+    /// The system ready to be solved (factored, or its solvers configured).
+    type System;
+    /// A solution `(u, φ)` in the backend's own layout.
+    type Solution;
+    /// The backend's error: the problem's errors and its own.
+    type Error: From<ProblemError>;
+
+    /// Whether the backend's solution is held to the tight rule's tolerances (the run fails,
+    /// naming the ill-conditioned inputs, where it misses them): a direct backend refines to
+    /// round-off and is; a Krylov backend's accuracy is its solver's tolerance, and its report
+    /// says whether it met them.
+    const HELD_TO_TOLERANCE: bool;
+
+    /// Refuses, before anything is built, a scene this backend does not solve (its
+    /// `solver.backend`, a law or condition it does not support), naming the key.
+    ///
+    /// # Errors
+    /// The refusal.
+    fn refuse(&self, scene: &Scene) -> Result<(), Self::Error>;
+
+    /// The lower estimate of the run's peak memory in bytes (per process), with what it
+    /// counts, before the mesh is made; `None` where it cannot be told (a mesh read from a
+    /// file, whose size the run checks once read).
+    fn estimate(&self, scene: &Scene) -> Option<(f64, String)>;
+
+    /// Assembles the system of `posed`.
+    ///
+    /// # Errors
+    /// Numbers that overflowed, the backend's own.
+    fn assemble(&mut self, posed: &Posed<'_>) -> Result<Self::Assembled, Self::Error>;
+
+    /// Prepares the assembled system for the solves: where the plan has contact, `boundary`
+    /// is its contact boundary (a direct backend orders its dofs last), within `limits`.
+    ///
+    /// # Errors
+    /// A factor too large for `limits`, a factorisation that broke down, the backend's own.
+    fn prepare(
+        &mut self,
+        posed: &Posed<'_>,
+        assembled: Self::Assembled,
+        boundary: Option<&ContactBoundary>,
+        limits: Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Self::System, Self::Error>;
+
+    /// The one linear solve of a run without contact.
+    ///
+    /// # Errors
+    /// A solve that failed.
+    fn solve_linear(
+        &mut self,
+        posed: &Posed<'_>,
+        system: &mut Self::System,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Solved<Self::Solution>, Self::Error>;
+
+    /// The contact problem on `boundary`, solved as `how` says (the law, the tolerance, the
+    /// interrupt), each outer iteration reported.
+    ///
+    /// # Errors
+    /// A contact solve that did not converge (with its best iterate), a solve that failed.
+    fn solve_contact(
+        &mut self,
+        posed: &Posed<'_>,
+        system: &mut Self::System,
+        boundary: ContactBoundary,
+        how: &ContactSolve<'_>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Solved<Self::Solution>, Self::Error>;
+
+    /// `‖K x - b - f_c‖ / max(‖b‖, ‖f_c‖)` of the solution, with `f_c` the contact forces of
+    /// its multipliers (they may cancel the loads in the sum).
+    ///
+    /// # Errors
+    /// The backend's own.
+    fn equilibrium(
+        &mut self,
+        posed: &Posed<'_>,
+        system: &Self::System,
+        solved: &Solved<Self::Solution>,
+    ) -> Result<f64, Self::Error>;
+
+    /// The solution as the free unknowns of the discretisation, with what the backend
+    /// measured; the system is dropped (its memory freed before the recovery). `None` on a
+    /// process that does not hold the gathered solution.
+    ///
+    /// # Errors
+    /// The backend's own.
+    fn finish(
+        &mut self,
+        posed: &Posed<'_>,
+        system: Self::System,
+        solution: Self::Solution,
+    ) -> Result<Option<Finished>, Self::Error>;
+}
+
+/// The discrete problem a backend solves: the validated scene, its set-up, the discretisation
+/// (dof map, cells) and the loads on the free dofs.
+pub struct Posed<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Its mesh, materials, plan, conditions.
+    pub setup: &'a Setup,
+    /// The discretisation on the mesh.
+    pub disc: &'a Discretization<'a>,
+    /// The loads on the free dofs, checked finite.
+    pub loads: Loads,
+}
+
+impl Posed<'_> {
+    /// The plan of the run.
+    pub fn plan(&self) -> &Plan {
+        &self.setup.plan
+    }
+}
+
+/// The loads on the free dofs: `b_u` on the displacements, `b_φ` on the potentials.
+pub struct Loads {
+    /// On the free displacements.
+    pub b_u: Vec<f64>,
+    /// On the free potentials.
+    pub b_phi: Vec<f64>,
+}
+
+/// A backend's solution: `x` in its layout, and where the plan has contact, the boundary with
+/// its solution.
+pub struct Solved<X> {
+    /// The solution `(u, φ)`, in the backend's layout.
+    pub x: X,
+    /// The contact boundary and the contact solution.
+    pub contact: Option<(ContactBoundary, ContactSolution)>,
+    /// Wall time of the solve, contact included, without a preconditioner's set-up.
+    pub seconds: f64,
+    /// PCG iterations (the Schur-complement strategy; 0 elsewhere).
+    pub pcg_iters: usize,
+}
+
+/// The free unknowns `(u, φ)` of the discretisation, and what the backend measured.
+pub struct Finished {
+    /// The free displacements.
+    pub u: Vec<f64>,
+    /// The free potentials.
+    pub phi: Vec<f64>,
+    /// The backend's figures for the report.
+    pub figures: Figures,
+}
+
+/// What a backend measured, for the run's report.
+#[derive(Clone, Debug, Default)]
+pub struct Figures {
+    /// Wall time of the factorisation, or of the preconditioners' set-up, s.
+    pub factor_seconds: f64,
+    /// How the contact compliance was formed, and in how long (condensed strategies).
+    pub condense: Option<(CondenseRoute, f64)>,
+    /// The PCG's relative tolerance (0 where none ran).
+    pub pcg_rel_tol: f64,
+    /// The smallest `|pivot| / |diagonal entry|` of an `L D Lᵀ`.
+    pub smallest_pivot_ratio: Option<f64>,
+    /// Steps of iterative refinement of the last solve.
+    pub refinement_steps: usize,
+    /// Bytes of the factors' values.
+    pub factor_bytes: usize,
+    /// The PETSc backend's section of the report.
+    pub petsc: Option<PetscReport>,
+}
+
+/// How the plan's contact problem is solved: the law on its points, the tolerance, the
+/// interrupt.
+pub struct ContactSolve<'p> {
+    /// The plan.
+    pub plan: &'p Plan,
+    /// The scene (for the messages of its errors).
+    pub scene: &'p Scene,
+    /// The law on the points: frictionless, Tresca's bound per point, or Coulomb.
+    pub law: Law,
+    /// The complementarity tolerance (`solver.tol`).
+    pub tol: f64,
+    /// A deadline or a cancel flag.
+    pub interrupt: contact::Interrupt,
+}
+
+impl<'p> ContactSolve<'p> {
+    /// The plan's contact law on `n` points: frictionless without tangential multipliers,
+    /// Tresca with the scene's bound, else Coulomb.
+    pub fn new(plan: &'p Plan, scene: &'p Scene, n: usize, interrupt: contact::Interrupt) -> Self {
+        let law = plan.law(scene, n);
+        // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
+        debug_assert_eq!(
+            plan.fixed_point,
+            law == Law::Coulomb && matches!(plan.linear_strategy.contact_solver(), ContactSolver::FirstOrder { .. })
+        );
+        ContactSolve {
+            plan,
+            scene,
+            law,
+            tol: scene.solver.tol,
+            interrupt,
+        }
+    }
+}
+
+/// A generated mesh's sizes before it is made: `(dimension, nodes, cells, unknowns)`, with
+/// displacements at every node and a potential where the scene has a piezoelectric or
+/// dielectric body; `None` for a Gmsh mesh. For a backend's memory estimate.
+pub fn generated_sizes(scene: &Scene) -> Option<(usize, f64, f64, f64)> {
+    crate::estimate::generated(scene)
+}
