@@ -81,7 +81,7 @@ fn a_fixed_point_that_stops_improving_is_told_early() {
             .err()
             .expect("the fixed point does not converge");
         match e {
-            driver::DriverError::Problem(problem::ProblemError::Contact {
+            files::Error::Problem(problem::ProblemError::Contact {
                 source:
                     contact::ContactError::FixedPointNoConvergence {
                         n_iters,

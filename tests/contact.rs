@@ -171,8 +171,8 @@ fn paper_rule_is_labelled_and_reproduces_the_table_counts() {
 
 #[test]
 fn every_shipped_scene_runs_at_its_smoke_size() {
-    for (name, text) in driver::scene_file::SHIPPED {
-        let scene = driver::scene_file::parse(text, name, &[]).unwrap();
+    for (name, text) in files::scene_file::SHIPPED {
+        let scene = files::scene_file::parse(text, name, &[]).unwrap();
         let n = scene.mesh.smoke_n.expect("every shipped scene has a smoke size");
         let r = run(name, &[&format!("mesh.n={n}")]);
         let eq = r.report.residuals.equilibrium;
@@ -239,7 +239,7 @@ fn stability_cases_hold_at_smoke_size() {
         }
         if let Some(p) = &case.paper_sets {
             let sets: Vec<String> = p.iter().map(|s| s.to_string()).collect();
-            driver::scene_file::load(case.scene, &sets).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+            files::scene_file::load(case.scene, &sets).unwrap_or_else(|e| panic!("{}: {e}", case.name));
         }
     }
 }

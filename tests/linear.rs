@@ -49,7 +49,7 @@ fn paper_3d_runs() {
 
 #[test]
 fn supernodal_ldlt_has_the_inertia_of_k() {
-    let (scene, _) = driver::scene_file::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
+    let (scene, _) = files::scene_file::load("paper", &["mesh.n=64".into(), "contact.law=none".into()]).unwrap();
     let problem::backend::Setup {
         mesh,
         materials: mats,
@@ -66,8 +66,8 @@ fn supernodal_ldlt_has_the_inertia_of_k() {
 fn outputs_are_written_and_bad_input_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ok");
-    let (scene, source) = driver::scene_file::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
-    driver::run::run(&scene, &source, &out, &mut Silent).unwrap();
+    let (scene, source) = files::scene_file::load("paper", &["mesh.n=4".into(), "contact.law=none".into()]).unwrap();
+    files::run::run(&scene, &source, &out, &mut Silent).unwrap();
     let json: RunReport = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(json.scene.name, "paper");
     let vtu = std::fs::read_to_string(out.join("solution.vtu")).unwrap();
@@ -75,19 +75,19 @@ fn outputs_are_written_and_bad_input_writes_nothing() {
     assert!(vtu.contains("Name=\"phi\"") && vtu.contains("Name=\"stress\""));
     // a missing boundary group: a typed error naming it, and no output directory
     let bad = dir.path().join("bad");
-    let (scene, source) = driver::scene_file::load(
+    let (scene, source) = files::scene_file::load(
         "paper",
         &["mesh.n=4".into(), "contact.law=none".into(), "load.group=lid".into()],
     )
     .unwrap();
-    let e = driver::run::run(&scene, &source, &bad, &mut Silent).err().unwrap();
+    let e = files::run::run(&scene, &source, &bad, &mut Silent).err().unwrap();
     assert!(e.to_string().contains("boundary group `lid` is missing"), "{e}");
     assert!(!bad.exists());
     // an unknown key names itself
-    let e = driver::scene_file::load("paper", &["mesh.nn=4".into()]).unwrap_err();
+    let e = files::scene_file::load("paper", &["mesh.nn=4".into()]).unwrap_err();
     assert!(e.to_string().contains("unknown field `nn`"), "{e}");
     // a non-positive-definite material
-    let (scene, source) = driver::scene_file::load(
+    let (scene, source) = files::scene_file::load(
         "paper",
         &[
             "mesh.n=4".into(),
@@ -96,7 +96,7 @@ fn outputs_are_written_and_bad_input_writes_nothing() {
         ],
     )
     .unwrap();
-    let e = driver::run::solve(&scene, &source, &mut Silent).err().unwrap();
+    let e = files::run::solve(&scene, &source, &mut Silent).err().unwrap();
     assert!(e.to_string().contains("C is not positive definite"), "{e}");
 }
 

@@ -10,6 +10,7 @@ use crate::local::{Point, PointLaw};
 use crate::operator::{AffineProblem, Compliance};
 use crate::points::{ContactPoints, Flat, PointValues};
 use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Best, Counter};
+use crate::InputError;
 use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law, Measure, Progress, Stage, Stall};
 
 /// Parameters of [`solve_gauss_seidel`].
@@ -69,7 +70,7 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
     };
     let mut lambda = match lambda0 {
         Some(l) if l.n_points() == n && l.n_tangential() == nt => l,
-        Some(_) => return Err(ContactError::Input("warm start of the wrong size".into())),
+        Some(_) => return Err(InputError::WarmStart.into()),
         None => PointValues::zeros(n, nt),
     };
     let sweeper = Sweeper::new(problem, Flat { n, nt });

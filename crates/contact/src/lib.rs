@@ -195,7 +195,76 @@ pub enum ContactError {
     Operator(#[source] OperatorError),
     /// Bad input.
     #[error("contact input: {0}")]
-    Input(String),
+    Input(#[from] InputError),
+}
+
+/// What is wrong with the input of a contact solve: the first bad item, by name.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InputError {
+    /// The arrays of the contact points do not all have one entry per point.
+    #[error("contact points: arrays of different lengths")]
+    PointArrays,
+    /// A point's value out of its range: a weight that is not positive, a gap that is not
+    /// finite, a friction coefficient that is negative or not finite.
+    #[error("contact point {point}: {field} {value} {must}")]
+    PointValue {
+        /// The point.
+        point: usize,
+        /// The field (`weight`, `gap`, `friction`).
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be, in words.
+        must: &'static str,
+    },
+    /// Values of the wrong shape: `tangential` values for `points` points of `nt` components.
+    #[error("{tangential} tangential values for {points} points with {nt} components each")]
+    TangentialShape {
+        /// Tangential values given.
+        tangential: usize,
+        /// Points.
+        points: usize,
+        /// Tangential components per point.
+        nt: usize,
+    },
+    /// A problem whose size does not match its points.
+    #[error("the problem has {points} points with {tangential} tangential components; expected {expected_points} with {expected_tangential}")]
+    ProblemSize {
+        /// The problem's points.
+        points: usize,
+        /// The problem's tangential components per point.
+        tangential: usize,
+        /// The points given.
+        expected_points: usize,
+        /// The tangential components the law needs.
+        expected_tangential: usize,
+    },
+    /// A compliance whose size does not match its loads.
+    #[error("the compliance is {size} x {size} and the loads have {points} points; {n} points with {nt} tangential components need {m} x {m}")]
+    ComplianceSize {
+        /// The compliance's order.
+        size: usize,
+        /// The loads' points.
+        points: usize,
+        /// The points.
+        n: usize,
+        /// Tangential components per point.
+        nt: usize,
+        /// The order they need.
+        m: usize,
+    },
+    /// Tresca's bounds are not one finite non-negative value per point.
+    #[error("Tresca slip bounds: one finite non-negative value per point")]
+    TrescaBounds,
+    /// A warm start whose shape is not the problem's.
+    #[error("warm start of the wrong size")]
+    WarmStart,
+    /// A parameter out of its range (a tolerance or a step that is not positive), in words.
+    #[error("{0}")]
+    Parameter(String),
+    /// A solver handed a problem of a kind it does not solve.
+    #[error("{0}")]
+    Unsupported(&'static str),
 }
 
 impl ContactError {

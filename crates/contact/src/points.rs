@@ -1,6 +1,7 @@
 //! Contact points and the multiplier / displacement vectors on them.
 
 use crate::ContactError;
+use crate::InputError;
 
 /// The contact points: geometry, weights, gaps and friction coefficients.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,8 +66,11 @@ impl ContactPoints {
         self.held[i][q]
     }
 
-    /// Checks sizes and values; returns a message naming the first bad item.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks sizes and values.
+    ///
+    /// # Errors
+    /// The first bad item.
+    pub fn validate(&self) -> Result<(), InputError> {
         let n = self.len();
         if self.position.len() != n
             || self.normal.len() != n
@@ -75,20 +79,23 @@ impl ContactPoints {
             || self.friction.len() != n
             || self.held.len() != n
         {
-            return Err("contact points: arrays of different lengths".into());
+            return Err(InputError::PointArrays);
         }
+        let bad = |point, field, value, must| InputError::PointValue {
+            point,
+            field,
+            value,
+            must,
+        };
         for i in 0..n {
             if !(self.weight[i] > 0.0 && self.weight[i].is_finite()) {
-                return Err(format!("contact point {i}: weight {} is not positive", self.weight[i]));
+                return Err(bad(i, "weight", self.weight[i], "is not positive"));
             }
             if !self.gap[i].is_finite() {
-                return Err(format!("contact point {i}: gap {} is not finite", self.gap[i]));
+                return Err(bad(i, "gap", self.gap[i], "is not finite"));
             }
             if !(self.friction[i] >= 0.0 && self.friction[i].is_finite()) {
-                return Err(format!(
-                    "contact point {i}: friction {} must be finite and non-negative",
-                    self.friction[i]
-                ));
+                return Err(bad(i, "friction", self.friction[i], "must be finite and non-negative"));
             }
         }
         Ok(())
@@ -124,11 +131,12 @@ impl PointValues {
     /// [`ContactError::Input`] where `tangential` does not hold `nt` values per point.
     pub fn from_parts(normal: Vec<f64>, tangential: Vec<f64>, nt: usize) -> Result<Self, ContactError> {
         if tangential.len() != normal.len() * nt {
-            return Err(ContactError::Input(format!(
-                "{} tangential values for {} points with {nt} components each",
-                tangential.len(),
-                normal.len()
-            )));
+            return Err(InputError::TangentialShape {
+                tangential: tangential.len(),
+                points: normal.len(),
+                nt,
+            }
+            .into());
         }
         Ok(PointValues { normal, tangential, nt })
     }

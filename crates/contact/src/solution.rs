@@ -5,6 +5,7 @@
 use crate::operator::ContactOperator;
 use crate::points::{ContactPoints, PointValues, Status};
 use crate::projection::{norm, project_cone, project_disc, project_nonnegative};
+use crate::InputError;
 use crate::{ContactError, OperatorError};
 
 /// The friction law.
@@ -432,7 +433,7 @@ pub(crate) fn check_input(
     n_points: usize,
     n_tangential: usize,
 ) -> Result<(usize, usize), ContactError> {
-    points.validate().map_err(ContactError::Input)?;
+    points.validate()?;
     let n = points.len();
     let nt = if matches!(law, Law::Frictionless) {
         0
@@ -440,15 +441,17 @@ pub(crate) fn check_input(
         points.n_tangential()
     };
     if n_points != n || n_tangential != nt {
-        return Err(ContactError::Input(format!(
-            "the problem has {n_points} points with {n_tangential} tangential components; expected {n} with {nt}"
-        )));
+        return Err(InputError::ProblemSize {
+            points: n_points,
+            tangential: n_tangential,
+            expected_points: n,
+            expected_tangential: nt,
+        }
+        .into());
     }
     if let Law::Tresca(s) = law {
         if s.len() != n || s.iter().any(|x| !(*x >= 0.0 && x.is_finite())) {
-            return Err(ContactError::Input(
-                "Tresca slip bounds: one finite non-negative value per point".into(),
-            ));
+            return Err(InputError::TrescaBounds.into());
         }
     }
     Ok((n, nt))

@@ -9,6 +9,7 @@ use crate::solution::{
     check_input, classify, complementarity_residual, counts, desaxce_residual, estimate_mu_max, multiplier_scale,
     slip_bound, Counter,
 };
+use crate::InputError;
 use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law, Measure, Progress, Stage, Stall};
 
 /// When the loops stop.
@@ -185,9 +186,9 @@ pub fn solve(
 ) -> Result<ContactSolution, ContactError> {
     let (n, nt) = check_input(points, law, op.n_points(), op.n_tangential())?;
     if params.accelerate && params.rule == StopRule::Paper {
-        return Err(ContactError::Input(
-            "acceleration needs the tight rule (the paper's rule is plain Uzawa)".into(),
-        ));
+        return Err(
+            InputError::Unsupported("acceleration needs the tight rule (the paper's rule is plain Uzawa)").into(),
+        );
     }
     let mut c = Counter::new(op);
     let (mu_max, u0) = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
@@ -200,7 +201,7 @@ pub fn solve(
         params.safety / mu_max
     });
     if !(step > 0.0 && step.is_finite()) {
-        return Err(ContactError::Input(format!("Uzawa step {step} must be positive")));
+        return Err(InputError::Parameter(format!("Uzawa step {step} must be positive")).into());
     }
     let canon = 1.0 / mu_max;
     let mut d = Dual {

@@ -213,7 +213,7 @@ fn main() {
     println!("{md}");
     println!(
         "peak memory of the process: {} MiB",
-        driver::run::peak_memory_bytes() >> 20
+        files::run::peak_memory_bytes() >> 20
     );
     if let Some(path) = o.csv {
         std::fs::write(&path, csv).expect("write the CSV");

@@ -21,7 +21,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(64);
     let (scene, _) =
-        driver::scene_file::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("paper scene");
+        files::scene_file::load("paper", &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("paper scene");
     let problem::backend::Setup {
         mesh,
         materials: mats,
@@ -89,6 +89,6 @@ fn main() {
         iters,
         median(t_pcg),
         diff,
-        driver::run::peak_memory_bytes() as f64 / 1048576.0
+        files::run::peak_memory_bytes() as f64 / 1048576.0
     );
 }

@@ -17,7 +17,7 @@ fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(128);
     let name = std::env::args().nth(2).unwrap_or_else(|| "paper".into());
     let (scene, _) =
-        driver::scene_file::load(&name, &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
+        files::scene_file::load(&name, &[format!("mesh.n={n}"), "contact.law=none".into()]).expect("scene");
     let problem::backend::Setup {
         mesh,
         materials: mats,

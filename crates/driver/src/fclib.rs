@@ -2,10 +2,10 @@
 //! problems Siconos and FCLib compare solvers on) solved by the contact crate alone, each
 //! reported with the crate's own residual and Siconos' error computed independently.
 
-use crate::output::Outputs;
 use crate::DriverError;
 use contact::siconos::FrictionProblem;
 use contact::{ContactError, ContactSolution, Interrupt, Law, Measure, NewtonParams, StopRule, UzawaParams};
+use files::output::Outputs;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -130,11 +130,14 @@ pub type Reactions = (Vec<f64>, Vec<f64>);
 /// Reads one file.
 ///
 /// # Errors
-/// [`DriverError::File`] when the file cannot be read or is not a problem.
+/// [`files::Error::File`] when the file cannot be read or is not a problem.
 pub fn read(path: &Path) -> Result<FrictionProblem, DriverError> {
-    let bad = |message: String| DriverError::File {
-        file: path.display().to_string(),
-        message,
+    let bad = |message: String| -> DriverError {
+        files::Error::File {
+            file: path.display().to_string(),
+            message,
+        }
+        .into()
     };
     // a FIFO or a device would block the read, or never end it
     let meta = std::fs::metadata(path).map_err(|e| bad(e.to_string()))?;
@@ -391,7 +394,7 @@ pub fn run(
         rows.push(row);
     }
     if let Some(mut outputs) = outputs {
-        let json = serde_json::to_vec_pretty(&rows).map_err(|e| DriverError::Picture {
+        let json = serde_json::to_vec_pretty(&rows).map_err(|e| files::Error::Picture {
             name: "summary.json".into(),
             message: e.to_string(),
         })?;

@@ -2,7 +2,8 @@
 
 use clap::{Parser, Subcommand};
 use driver::studies::{convergence, stability, sweep, table1, verification};
-use driver::{fclib, output, scene_file, DriverError};
+use driver::{fclib, DriverError};
+use files::{output, scene_file};
 use problem::{BackendChoice, Event, Strategy};
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -197,7 +198,7 @@ fn contact_bar() -> indicatif::ProgressBar {
 }
 
 fn main() -> ExitCode {
-    driver::memory::bound_heaps_under_an_address_space_limit();
+    files::memory::bound_heaps_under_an_address_space_limit();
     let cli = Cli::parse();
     let command = cli.command.unwrap_or(Command::Run {
         scene: None,
@@ -243,7 +244,7 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
                 solver,
                 tol,
                 criterion,
-                time_limit: driver::limits::seconds(time_limit, "--time-limit")?,
+                time_limit: files::limits::seconds(time_limit, "--time-limit")?,
                 verbose,
             };
             options.check()?;
@@ -291,7 +292,7 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             println!("{md}");
             let mut o = output::Outputs::documents(&out.unwrap_or_else(|| PathBuf::from("out").join("table1")));
             o.add("table1.md", md.into_bytes());
-            o.commit()
+            Ok(o.commit()?)
         }
         Command::Study {
             scene,
@@ -322,10 +323,8 @@ fn run(
     if let Some(extra) = petsc {
         let all = [scene.solver.petsc_options.take(), Some(extra)];
         scene.solver.petsc_options = Some(all.into_iter().flatten().collect::<Vec<_>>().join(" "));
-        scene.validate().map_err(|e| DriverError::Scene {
-            file: name.clone(),
-            message: format!("--petsc: {e}"),
-        })?;
+        // the options joined are the scene's `solver.petsc_options`: its key names them
+        scene.validate().map_err(|e| files::Error::scene(&name, e))?;
     }
     let dir = out.unwrap_or_else(|| output::default_dir(&scene.name));
     let mut terminal = Terminal {
@@ -333,7 +332,7 @@ fn run(
         first_residual: None,
     };
     let solution = match scene.solver.backend {
-        BackendChoice::Faer => Some(driver::run::run(&scene, &source, &dir, &mut terminal)?),
+        BackendChoice::Faer => Some(files::run::run(&scene, &source, &dir, &mut terminal)?),
         BackendChoice::Petsc => run_petsc(&scene, &source, &dir, &mut terminal)?,
     };
     if let Some(solution) = solution {
@@ -357,7 +356,7 @@ fn run_petsc(
     dir: &std::path::Path,
     terminal: &mut Terminal,
 ) -> Result<Option<problem::Solution>, DriverError> {
-    driver::run::run_distributed(scene, source, dir, terminal)
+    driver::petsc_run::run_distributed(scene, source, dir, terminal)
 }
 
 /// Without the feature, a run of the PETSc backend is refused by name.
@@ -406,7 +405,7 @@ fn verification(full: bool, out: &std::path::Path) -> Result<(), DriverError> {
 
 /// `piezocontact stability`: the cases, each in a child process of this program.
 fn stability(quick: bool, out: &std::path::Path, limit: u64) -> Result<(), DriverError> {
-    let exe = std::env::current_exe().map_err(|e| DriverError::Output {
+    let exe = std::env::current_exe().map_err(|e| files::Error::Output {
         what: "cannot find this program's path to run the cases".into(),
         source: e,
     })?;

@@ -197,21 +197,21 @@ proptest! {
     /// A mutated shipped scene reads, or gives a typed error; one that reads runs whole on a
     /// small mesh (the mesh size is forced down), to an answer or a typed error.
     #[test]
-    fn mutated_scenes_never_panic(which in 0usize..driver::scene_file::SHIPPED.len(), edits in prop::collection::vec(value_edit(), 1..4)) {
-        let (name, text) = driver::scene_file::SHIPPED[which];
+    fn mutated_scenes_never_panic(which in 0usize..files::scene_file::SHIPPED.len(), edits in prop::collection::vec(value_edit(), 1..4)) {
+        let (name, text) = files::scene_file::SHIPPED[which];
         let bytes = apply(text.as_bytes().to_vec(), &edits);
         let text = String::from_utf8_lossy(&bytes);
-        let Ok(scene) = driver::scene_file::parse(&text, name, &[]) else { return Ok(()) };
+        let Ok(scene) = files::scene_file::parse(&text, name, &[]) else { return Ok(()) };
         // the mesh forced down to 3 cells along each axis it has
         let mut small = vec!["mesh.n=3".to_string(), "mesh.nx=3".into(), "mesh.ny=3".into()];
         if scene.mesh.kind == MeshKind::Box {
             small.push("mesh.nz=3".into());
         }
-        if let Ok(scene) = driver::scene_file::parse(&text, name, &small) {
+        if let Ok(scene) = files::scene_file::parse(&text, name, &small) {
             // a tolerance below round-off only makes the solvers run to their iteration limits
             if scene.solver.tol >= 1e-13 && scene.mesh.kind != MeshKind::Gmsh {
-                let source = driver::scene_file::Source { label: name.into(), dir: ".".into() };
-                let _ = driver::run::solve(&scene, &source, &mut problem::Silent);
+                let source = files::scene_file::Source { label: name.into(), dir: ".".into() };
+                let _ = files::run::solve(&scene, &source, &mut problem::Silent);
             }
         }
     }

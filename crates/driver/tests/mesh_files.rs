@@ -62,12 +62,12 @@ fn an_internal_electrode_on_an_interface_gives_the_closed_form_in_every_form_of_
     files.sort();
     assert!(files.len() >= 10, "{files:?}");
     for file in &files {
-        let scene = driver::scene_file::parse(&stack(file), "stack", &[]).unwrap();
-        let source = driver::scene_file::Source {
+        let scene = files::scene_file::parse(&stack(file), "stack", &[]).unwrap();
+        let source = files::scene_file::Source {
             label: "stack".into(),
             dir: PathBuf::new(),
         };
-        let s = driver::run::solve(&scene, &source, &mut problem::Silent)
+        let s = files::run::solve(&scene, &source, &mut problem::Silent)
             .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         let mut checked = 0;
         for (v, x) in s.mesh.points.iter().enumerate() {

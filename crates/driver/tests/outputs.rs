@@ -164,7 +164,7 @@ fn the_studies_default_paths_stay_under_out() {
     let tmp = tempfile::tempdir().unwrap();
     let scenes = tmp.path().join("elsewhere");
     std::fs::create_dir(&scenes).unwrap();
-    let text = driver::scene_file::SHIPPED
+    let text = files::scene_file::SHIPPED
         .iter()
         .find(|(n, _)| *n == "paper")
         .unwrap()

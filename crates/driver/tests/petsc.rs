@@ -4,7 +4,7 @@
 //! processes see `OMPI_COMM_WORLD_SIZE`) and passes when every rank passes.
 #![cfg(feature = "petsc")]
 
-use driver::scene_file;
+use files::scene_file;
 use petsc::testing::on_ranks;
 use petsc::Petsc;
 

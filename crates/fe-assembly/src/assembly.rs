@@ -12,6 +12,7 @@
 //! give the same matrices (a test checks it).
 
 use crate::kernels::{coupling_column, dielectric_column, elasticity_column, SimplexGeometry};
+use crate::InputError;
 use crate::{AssemblyError, Constraint, Dof, DofMap, Material, Unheld};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use mesh::{CellKind, Mesh};
@@ -62,35 +63,37 @@ impl<'m> Discretization<'m> {
         constraints: &[Constraint],
     ) -> Result<Self, AssemblyError> {
         if !matches!(mesh.kind, CellKind::Tri3 | CellKind::Tet4) {
-            return Err(AssemblyError::Input(format!(
-                "{} cells are not supported: the kernels are P1 simplices",
-                mesh.kind.name()
-            )));
+            return Err(InputError::CellKind { kind: mesh.kind.name() }.into());
         }
         let n_cells = mesh.n_cells();
         let mut cell_material = vec![usize::MAX; n_cells];
         for (mi, (region, m)) in materials.iter().enumerate() {
             if m.dim != mesh.dim {
-                return Err(AssemblyError::Input(format!(
-                    "material of region `{region}` is {}D, the mesh is {}D",
-                    m.dim, mesh.dim
-                )));
+                return Err(InputError::MaterialDimension {
+                    region: region.clone(),
+                    material: m.dim,
+                    mesh: mesh.dim,
+                }
+                .into());
             }
             for &c in mesh.region(region)? {
                 if cell_material[c] != usize::MAX {
-                    return Err(AssemblyError::Input(format!(
-                        "cell {c} lies in region `{region}` and in region `{}`: one material per cell",
-                        materials[cell_material[c]].0
-                    )));
+                    return Err(InputError::TwoMaterials {
+                        cell: c,
+                        first: region.clone(),
+                        second: materials[cell_material[c]].0.clone(),
+                    }
+                    .into());
                 }
                 cell_material[c] = mi;
             }
         }
         if let Some(c) = cell_material.iter().position(|&m| m == usize::MAX) {
-            return Err(AssemblyError::Input(format!(
-                "cell {c} has no material (regions given: {})",
-                materials.iter().map(|(r, _)| r.as_str()).collect::<Vec<_>>().join(", ")
-            )));
+            return Err(InputError::NoMaterial {
+                cell: c,
+                regions: materials.iter().map(|(r, _)| r.clone()).collect(),
+            }
+            .into());
         }
         let k = mesh.kind.n_nodes();
         let geometry: Vec<SimplexGeometry> = (0..n_cells)

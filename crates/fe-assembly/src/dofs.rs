@@ -4,6 +4,7 @@
 //! separately, so that the columns of one node are contiguous in every block. A node carries a
 //! potential only if an electric cell (a material with a permittivity) holds it.
 
+use crate::InputError;
 use crate::{AssemblyError, ScalarFn};
 use mesh::Mesh;
 
@@ -85,46 +86,48 @@ impl DofMap {
                 let slot = match c.field {
                     Field::Displacement(k) if k < dim => &mut u[node * dim + k],
                     Field::Displacement(k) => {
-                        return Err(AssemblyError::Input(format!(
-                            "condition on `{}` prescribes displacement component {k} in a {dim}D problem",
-                            c.group
-                        )))
+                        return Err(InputError::Component {
+                            group: c.group.clone(),
+                            component: k,
+                            dim,
+                        }
+                        .into())
                     }
                     Field::Potential if has_phi[node] => &mut phi[node],
                     Field::Potential => continue,
                 };
                 let v = (c.value)(mesh.point(node));
                 if !v.is_finite() {
-                    return Err(AssemblyError::Input(format!(
-                        "condition on `{}` gives the non-finite value {v} at node {node}",
-                        c.group
-                    )));
+                    return Err(InputError::NotFiniteCondition {
+                        group: c.group.clone(),
+                        value: v,
+                        node,
+                    }
+                    .into());
                 }
                 if let Some((old, from)) = *slot {
                     if (old - v).abs() > 1e-12 * old.abs().max(v.abs()) {
-                        return Err(AssemblyError::Input(format!(
-                            "node {node} at {:?} gets {:?} = {old} from `{}` and {v} from `{}`",
-                            mesh.point(node),
-                            c.field,
-                            constraints[from].group,
-                            c.group
-                        )));
+                        return Err(InputError::Conflicting {
+                            node,
+                            at: mesh.point(node).to_vec(),
+                            field: c.field,
+                            first: constraints[from].group.clone(),
+                            first_value: old,
+                            second: c.group.clone(),
+                            second_value: v,
+                        }
+                        .into());
                     }
                 }
                 *slot = Some((v, ci));
                 reached += 1;
             }
             if reached == 0 {
-                return Err(AssemblyError::Input(format!(
-                    "condition {:?} on `{}` reaches no degree of freedom{}",
-                    c.field,
-                    c.group,
-                    if c.field == Field::Potential {
-                        " (no node of it carries a potential)"
-                    } else {
-                        ""
-                    }
-                )));
+                return Err(InputError::ReachesNothing {
+                    field: c.field,
+                    group: c.group.clone(),
+                }
+                .into());
             }
         }
         // a node that no cell uses (the centre of a Gmsh arc) has no stiffness: its displacement

@@ -65,6 +65,99 @@ pub type ScalarFn = Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>;
 /// A vector function of position (`dim` meaningful components of the result).
 pub type VectorFn = Arc<dyn Fn(&[f64]) -> [f64; 3] + Send + Sync>;
 
+/// Inconsistent input of a discretisation: the first bad item, by name.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InputError {
+    /// The mesh's cells are not P1 simplices.
+    #[error("{kind} cells are not supported: the kernels are P1 simplices")]
+    CellKind {
+        /// The cells' name.
+        kind: &'static str,
+    },
+    /// A material of another dimension than the mesh.
+    #[error("material of region `{region}` is {material}D, the mesh is {mesh}D")]
+    MaterialDimension {
+        /// The region.
+        region: String,
+        /// The material's dimension.
+        material: usize,
+        /// The mesh's.
+        mesh: usize,
+    },
+    /// A cell in two regions of the materials.
+    #[error("cell {cell} lies in region `{first}` and in region `{second}`: one material per cell")]
+    TwoMaterials {
+        /// The cell.
+        cell: usize,
+        /// The region of its first material.
+        first: String,
+        /// The other region.
+        second: String,
+    },
+    /// A cell in no region of the materials.
+    #[error("cell {cell} has no material (regions given: {})", .regions.join(", "))]
+    NoMaterial {
+        /// The cell.
+        cell: usize,
+        /// The regions of the materials.
+        regions: Vec<String>,
+    },
+    /// A condition on a displacement component the problem does not have.
+    #[error("condition on `{group}` prescribes displacement component {component} in a {dim}D problem")]
+    Component {
+        /// The condition's group.
+        group: String,
+        /// The component.
+        component: usize,
+        /// The problem's dimension.
+        dim: usize,
+    },
+    /// A condition whose value is not finite at a node.
+    #[error("condition on `{group}` gives the non-finite value {value} at node {node}")]
+    NotFiniteCondition {
+        /// The condition's group.
+        group: String,
+        /// The value.
+        value: f64,
+        /// The node.
+        node: usize,
+    },
+    /// Two conditions that prescribe different values to one unknown.
+    #[error("node {node} at {at:?} gets {field:?} = {first_value} from `{first}` and {second_value} from `{second}`")]
+    Conflicting {
+        /// The node.
+        node: usize,
+        /// Its coordinates.
+        at: Vec<f64>,
+        /// The field.
+        field: Field,
+        /// The first condition's group, and its value.
+        first: String,
+        /// The first value.
+        first_value: f64,
+        /// The second condition's group.
+        second: String,
+        /// The second value.
+        second_value: f64,
+    },
+    /// A condition that reaches no unknown.
+    #[error("condition {field:?} on `{group}` reaches no degree of freedom{}", if *.field == Field::Potential { " (no node of it carries a potential)" } else { "" })]
+    ReachesNothing {
+        /// The field.
+        field: Field,
+        /// The condition's group.
+        group: String,
+    },
+    /// A load whose value is not finite.
+    #[error("{what} is not finite ({value})")]
+    NotFiniteLoad {
+        /// The load (`the body force`, `the traction`, ...).
+        what: &'static str,
+        /// The value.
+        value: f64,
+    },
+}
+
 /// What can go wrong while setting up or assembling.
 #[derive(Debug, thiserror::Error)]
 pub enum AssemblyError {
@@ -74,9 +167,9 @@ pub enum AssemblyError {
     /// A material problem.
     #[error(transparent)]
     Material(#[from] MaterialError),
-    /// Inconsistent input (materials, conditions, loads), with a message naming the item.
-    #[error("{0}")]
-    Input(String),
+    /// Inconsistent input (materials, conditions, loads), naming the item.
+    #[error(transparent)]
+    Input(#[from] InputError),
     /// A rigid motion or a potential the Dirichlet conditions leave free.
     #[error(transparent)]
     Unheld(#[from] Unheld),

@@ -7,6 +7,7 @@
 //! Integrals use rules exact for quadratics (degree 2), enough for O(h²) in L2 with P1.
 
 use crate::kernels::{coupling_column, coupling_row, dielectric_column, elasticity_column};
+use crate::InputError;
 use crate::{AssemblyError, Discretization, Dof, ScalarFn, VectorFn};
 
 /// A load on the body or on a boundary group.
@@ -104,11 +105,11 @@ impl Discretization<'_> {
             }
             x
         };
-        let check = |what: &str, v: f64| {
+        let check = |what: &'static str, v: f64| {
             if v.is_finite() {
                 Ok(v)
             } else {
-                Err(AssemblyError::Input(format!("{what} is not finite ({v})")))
+                Err(AssemblyError::from(InputError::NotFiniteLoad { what, value: v }))
             }
         };
         for load in loads {

@@ -11,6 +11,7 @@
 
 use crate::coupled::DirectLdlt;
 use crate::LinalgError;
+use crate::ShapeError;
 
 /// How a condensation was formed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,7 +55,7 @@ impl DirectLdlt {
     pub fn condense(&mut self, b_u: &[f64], b_phi: &[f64], dofs: &[usize]) -> Result<Condensed, LinalgError> {
         let b: Vec<f64> = b_u.iter().chain(b_phi).copied().collect();
         if let Some(&bad) = dofs.iter().find(|&&d| d >= b.len()) {
-            return Err(LinalgError::Shape(format!("condensation: dof {bad} of {}", b.len())));
+            return Err(ShapeError::CondensedDof { dof: bad, n: b.len() }.into());
         }
         if let Some(condensed) = self.condense_from_factor(&b, dofs)? {
             return Ok(condensed);
@@ -75,11 +76,11 @@ impl DirectLdlt {
         d: &[f64],
     ) -> Result<(Vec<f64>, Vec<f64>), LinalgError> {
         if d.len() != loads.dofs.len() {
-            return Err(LinalgError::Shape(format!(
-                "{} values for {} condensed dofs",
-                d.len(),
-                loads.dofs.len()
-            )));
+            return Err(ShapeError::CondensedValues {
+                values: d.len(),
+                dofs: loads.dofs.len(),
+            }
+            .into());
         }
         let n_u = b_u.len();
         if let Some(mut y) = loads.forward {

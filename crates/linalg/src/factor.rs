@@ -3,6 +3,7 @@
 //! in place when the values change, and solves reuse their workspace (no allocation).
 
 use crate::LinalgError;
+use crate::ShapeError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
@@ -113,11 +114,11 @@ impl SparseFactor {
     ) -> Result<Self, LinalgError> {
         let n = a.nrows();
         if n != a.ncols() {
-            return Err(LinalgError::Shape(format!(
-                "a {}x{} matrix is not square",
-                n,
-                a.ncols()
-            )));
+            return Err(ShapeError::NotSquare {
+                rows: n,
+                cols: a.ncols(),
+            }
+            .into());
         }
         if let Some(i) = a.val().iter().position(|x| !x.is_finite()) {
             return Err(LinalgError::NonFinite {
@@ -580,9 +581,11 @@ fn inverse_permutation(fwd: &[usize]) -> Result<Vec<usize>, LinalgError> {
     let mut inv = vec![usize::MAX; n];
     for (new, &old) in fwd.iter().enumerate() {
         if old >= n || inv[old] != usize::MAX {
-            return Err(LinalgError::Shape(format!(
-                "ordering: {old} is out of range or repeated"
-            )));
+            return Err(ShapeError::Ordering {
+                what: "entry",
+                index: old,
+            }
+            .into());
         }
         inv[old] = new;
     }
@@ -609,9 +612,11 @@ fn mark(n: usize, last: &[usize]) -> Result<Vec<bool>, LinalgError> {
     let mut is_last = vec![false; n];
     for &i in last {
         if i >= n || is_last[i] {
-            return Err(LinalgError::Shape(format!(
-                "ordering: index {i} is out of range or repeated"
-            )));
+            return Err(ShapeError::Ordering {
+                what: "index",
+                index: i,
+            }
+            .into());
         }
         is_last[i] = true;
     }

@@ -107,7 +107,7 @@ pub enum LinalgError {
     },
     /// Sizes that do not fit.
     #[error("shape mismatch: {0}")]
-    Shape(String),
+    Shape(#[from] ShapeError),
     /// The symbolic analysis failed.
     #[error("symbolic factorisation failed: {0}")]
     Symbolic(String),
@@ -118,6 +118,55 @@ pub enum LinalgError {
         what: &'static str,
         /// The error.
         source: Box<LinalgError>,
+    },
+}
+
+/// Sizes that do not fit, by what they are.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ShapeError {
+    /// A matrix that is not square.
+    #[error("a {rows}x{cols} matrix is not square")]
+    NotSquare {
+        /// Its rows.
+        rows: usize,
+        /// Its columns.
+        cols: usize,
+    },
+    /// An ordering that is not a permutation (an index out of range or repeated).
+    #[error("ordering: {what} {index} is out of range or repeated")]
+    Ordering {
+        /// Which part of the ordering (`index` of the trailing dofs, or the permutation's entry).
+        what: &'static str,
+        /// The index.
+        index: usize,
+    },
+    /// A condensation dof out of range.
+    #[error("condensation: dof {dof} of {n}")]
+    CondensedDof {
+        /// The dof.
+        dof: usize,
+        /// The unknowns.
+        n: usize,
+    },
+    /// Values for the condensed dofs that are not one per dof.
+    #[error("{values} values for {dofs} condensed dofs")]
+    CondensedValues {
+        /// Values given.
+        values: usize,
+        /// Condensed dofs.
+        dofs: usize,
+    },
+    /// Vectors of PCG whose sizes are not the operator's.
+    #[error("pcg: operator {operator}, preconditioner {preconditioner}, b {b}, x {x}")]
+    Pcg {
+        /// The operator's order.
+        operator: usize,
+        /// The preconditioner's.
+        preconditioner: usize,
+        /// The right-hand side's length.
+        b: usize,
+        /// The solution's length.
+        x: usize,
     },
 }
 

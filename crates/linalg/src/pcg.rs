@@ -1,6 +1,7 @@
 //! Preconditioned conjugate gradients (the paper's Algorithm 3) on an operator trait.
 
 use crate::LinalgError;
+use crate::ShapeError;
 
 /// A linear map `out = M x` on vectors of length `n()`. Preconditioners are operators too:
 /// they apply `P⁻¹`. `apply` takes `&mut self` so that an operator may keep its scratch.
@@ -77,12 +78,13 @@ pub fn pcg(
 ) -> Result<PcgInfo, LinalgError> {
     let n = op.n();
     if b.len() != n || x.len() != n || precond.n() != n {
-        return Err(LinalgError::Shape(format!(
-            "pcg: operator {n}, preconditioner {}, b {}, x {}",
-            precond.n(),
-            b.len(),
-            x.len()
-        )));
+        return Err(ShapeError::Pcg {
+            operator: n,
+            preconditioner: precond.n(),
+            b: b.len(),
+            x: x.len(),
+        }
+        .into());
     }
     let norm_b = norm(b);
     let scale = if norm_b > 0.0 { norm_b } else { 1.0 };

@@ -354,7 +354,7 @@ impl ContactSolve<'_> {
                 contact::solve(op, points, &self.law, &params, start, &mut progress)
             }
             (ContactSolver::Newton, Operator::FullSolves(_)) => Err(ContactError::Input(
-                "semismooth Newton needs the condensed compliance".into(),
+                contact::InputError::Unsupported("semismooth Newton needs the condensed compliance"),
             )),
         };
         solved.map_err(|e| ProblemError::contact(e, self.plan.linear_strategy, self.scene))

@@ -10,7 +10,7 @@
 //! └── OutputError(PiezocontactError, OSError)     a file that cannot be written
 //! ```
 
-use driver::DriverError;
+use files::Error;
 use problem::ProblemError;
 use pyo3::exceptions::{PyArithmeticError, PyException, PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -145,21 +145,18 @@ pub fn kind_of_problem(e: &ProblemError) -> Kind {
     }
 }
 
-/// The kind of an application error.
-pub fn kind_of(e: &DriverError) -> Kind {
+/// The kind of an error of the files or the run.
+pub fn kind_of(e: &Error) -> Kind {
     match e {
-        DriverError::Scene { .. } | DriverError::File { .. } | DriverError::Usage(_) => Kind::Input,
-        DriverError::Mesh(_) => Kind::Mesh,
-        DriverError::Problem(p) => kind_of_problem(p),
-        DriverError::Output { .. } | DriverError::OutputConflict { .. } | DriverError::Picture { .. } => Kind::Output,
-        // `Unexpected`, and the PETSc backend's errors where a build enables it
-        #[allow(unreachable_patterns)]
-        _ => Kind::Base,
+        Error::Scene { .. } | Error::File { .. } | Error::Usage(_) => Kind::Input,
+        Error::Mesh(_) => Kind::Mesh,
+        Error::Problem(p) => kind_of_problem(p),
+        Error::Output { .. } | Error::OutputConflict { .. } | Error::Picture { .. } => Kind::Output,
     }
 }
 
-/// The exception of an application error, with its message.
-pub fn to_py(e: DriverError) -> PyErr {
+/// The exception of an error of the files or the run, with its message.
+pub fn to_py(e: Error) -> PyErr {
     kind_of(&e).err(e.to_string())
 }
 

@@ -1,5 +1,5 @@
 //! The Python package `piezocontact`: a thin layer over the typed library core (`problem`) and
-//! the application's scene files and outputs (`driver`). No method logic lives here: a
+//! the scene files, mesh files and outputs of the `files` crate. No method logic lives here: a
 //! `Scene` (module `scene`) is the scene file's TOML tree and the typed scene it validates to,
 //! `run` (module `run`) calls the same solve as the command line, and a `Result` (module
 //! `result`) lends the solution's arrays to NumPy without copies.

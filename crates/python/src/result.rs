@@ -149,7 +149,7 @@ impl RunResult {
     /// residuals, the contact forces and counts, the timings.
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let bytes = driver::output::run_json(&self.solution.report).map_err(to_py)?;
+        let bytes = files::output::run_json(&self.solution.report).map_err(to_py)?;
         from_json(py, &String::from_utf8_lossy(&bytes))
     }
 
@@ -158,7 +158,7 @@ impl RunResult {
     /// is left half-written (`OutputError`).
     fn write(&self, py: Python<'_>, directory: &Bound<'_, PyAny>) -> PyResult<()> {
         let dir: String = py.import("os")?.call_method1("fspath", (directory,))?.extract()?;
-        py.detach(|| driver::output::write(&self.solution, std::path::Path::new(&dir)))
+        py.detach(|| files::output::write(&self.solution, std::path::Path::new(&dir)))
             .map_err(to_py)
     }
 

@@ -105,7 +105,7 @@ pub fn run(
         // 0: stop at the first check
         Some(0.0) => Some(now),
         // a positive number of seconds, or inf (and a limit beyond the clock's end): no limit
-        Some(t) => driver::limits::seconds(t, "timeout =")
+        Some(t) => files::limits::seconds(t, "timeout =")
             .map_err(to_py)?
             .and_then(|d| now.checked_add(d)),
         None => None,
@@ -130,7 +130,7 @@ pub fn run(
     let solved = std::thread::scope(|s| {
         let worker = s.spawn(move || {
             let mut reporter = Send(tx);
-            driver::run::solve_with(typed, source, given, interrupt, &mut reporter)
+            files::run::solve_with(typed, source, given, interrupt, &mut reporter)
         });
         loop {
             match py.detach(|| {
@@ -163,7 +163,7 @@ pub fn run(
         Err(_) => return Err(crate::errors::Kind::Base.err("the solve panicked (a bug: please report it)")),
     };
     if let Some(e) = signal.or(callback) {
-        if let Err(driver::DriverError::Problem(p)) = &solved {
+        if let Err(files::Error::Problem(p)) = &solved {
             if p.is_interrupted() {
                 // say where the run stopped, beside the KeyboardInterrupt
                 let note = format!("piezocontact: the run stopped: {p}");

@@ -4,7 +4,7 @@
 
 use crate::errors::{mesh_err, to_py, Kind};
 use crate::values::{from_table, from_toml, to_table, to_toml};
-use driver::scene_file::{self, Source};
+use files::scene_file::{self, Source};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyMapping, PyString, PyTuple};

@@ -41,6 +41,7 @@ mod equations;
 use crate::operator::AffineProblem;
 use crate::points::{ContactPoints, PointValues};
 use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Counter};
+use crate::InputError;
 use crate::{
     ContactError, ContactInfo, ContactSolution, GaussSeidelParams, Interrupt, Interruption, Iterate, Law, Measure,
     Progress, Stage, Stall, StopRule, UzawaParams,
@@ -424,7 +425,7 @@ pub fn solve_newton<P: AffineProblem>(
         Some(l) if l.normal.len() == n && l.tangential.len() == n * nt => {
             l.normal.iter().chain(&l.tangential).copied().collect()
         }
-        Some(_) => return Err(ContactError::Input("warm start of the wrong size".into())),
+        Some(_) => return Err(InputError::WarmStart.into()),
         None => vec![0.0; m],
     };
     let mut info = ContactInfo::new(mu_max);
@@ -545,17 +546,17 @@ fn check_newton_input<P: AffineProblem>(
     let (n, nt) = check_input(points, law, problem.weights().len(), problem.n_tangential())?;
     let m = n * (1 + nt);
     if problem.compliance().size() != m || problem.loads().n_points() != n {
-        return Err(ContactError::Input(format!(
-            "the compliance is {0} x {0} and the loads have {1} points; {n} points with {nt} tangential components need {m} x {m}",
-            problem.compliance().size(),
-            problem.loads().n_points()
-        )));
+        return Err(InputError::ComplianceSize {
+            size: problem.compliance().size(),
+            points: problem.loads().n_points(),
+            n,
+            nt,
+            m,
+        }
+        .into());
     }
     if !(params.tol > 0.0) {
-        return Err(ContactError::Input(format!(
-            "Newton tolerance {} must be positive",
-            params.tol
-        )));
+        return Err(InputError::Parameter(format!("Newton tolerance {} must be positive", params.tol)).into());
     }
     Ok((n, nt, m))
 }

@@ -15,8 +15,8 @@
 //! measure); the *total* error is the run's own error against the reference.
 
 use super::solve;
-use crate::plots::{self, Series};
 use crate::DriverError;
+use files::plots::{self, Series};
 use problem::{ContactLaw, Solution, Strategy};
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -213,7 +213,7 @@ pub fn study(
     let mut sizes = spec.sizes.clone();
     sizes.sort_unstable();
     sizes.dedup();
-    let (base, _) = crate::scene_file::load(scene_name, sets)?;
+    let (base, _) = files::scene_file::load(scene_name, sets)?;
     let has_contact = base.contact_law() != ContactLaw::None;
     let mut one = |n: usize, strategy: Strategy, tol: f64| -> Result<Solution, DriverError> {
         let r = solve(scene_name, &settings(sets, n, strategy, tol, has_contact))?;

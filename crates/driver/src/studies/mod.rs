@@ -11,15 +11,14 @@ pub mod sweep;
 pub mod table1;
 pub mod verification;
 
-use crate::scene_file;
-use crate::DriverError;
+use files::scene_file;
 use problem::{Silent, Solution};
 
 /// Solves a shipped scene or scene file with overrides, silently, writing nothing.
 ///
 /// # Errors
 /// The scene's or the run's error.
-pub fn solve(scene: &str, sets: &[String]) -> Result<Solution, DriverError> {
+pub fn solve(scene: &str, sets: &[String]) -> Result<Solution, files::Error> {
     let (scene, source) = scene_file::load(scene, sets)?;
-    crate::run::solve(&scene, &source, &mut Silent)
+    files::run::solve(&scene, &source, &mut Silent)
 }

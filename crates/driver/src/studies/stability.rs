@@ -7,8 +7,8 @@
 //! `docs/stability.md`.
 
 use super::child::run_with_limit;
-use crate::output::Outputs;
 use crate::DriverError;
+use files::output::Outputs;
 use problem::{RunReport, Strategy};
 use std::fmt::Write as _;
 use std::path::Path;

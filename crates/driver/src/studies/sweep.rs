@@ -2,9 +2,9 @@
 //! residuals against the parameter, as CSV and a picture of two panels.
 
 use super::solve;
-use crate::output::Outputs;
-use crate::plots::{self, Panel, Series};
 use crate::DriverError;
+use files::output::Outputs;
+use files::plots::{self, Panel, Series};
 use std::path::Path;
 use std::time::Instant;
 
@@ -158,5 +158,5 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
             Series::line("tangential |sum w lambda_t|", along(|r| r.tangential_force)),
         ],
     };
-    plots::panels("sweep", &[states, forces])
+    Ok(plots::panels("sweep", &[states, forces])?)
 }

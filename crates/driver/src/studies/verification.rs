@@ -4,9 +4,9 @@
 //! its plots, so the page cannot drift from the code.
 
 use super::convergence::{self, Study, StudySpec};
-use crate::output::Outputs;
-use crate::scene_file;
 use crate::DriverError;
+use files::output::Outputs;
+use files::scene_file;
 use problem::Strategy::{self, ApgCondensed, NewtonCondensed, UzawaCondensed, UzawaSchurPcg};
 use std::fmt::Write as _;
 use std::path::Path;

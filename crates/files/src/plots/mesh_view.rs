@@ -3,7 +3,7 @@
 //! `front` (y = lo), seen in the x-z plane.
 
 use super::{both, Files, FONT};
-use crate::DriverError;
+use crate::Error;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -73,8 +73,8 @@ impl View {
 /// named `deformed`; `None` where the mesh has no view (a 3D mesh without a `front` face).
 ///
 /// # Errors
-/// [`DriverError::Picture`] where plotters cannot draw.
-pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]]) -> Result<Option<Files>, DriverError> {
+/// [`Error::Picture`] where plotters cannot draw.
+pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]]) -> Result<Option<Files>, Error> {
     View::new(mesh, u)
         .map(|view| both!("deformed", |a| deformed(a, &view)))
         .transpose()
@@ -84,8 +84,8 @@ pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]]) -> Result<Option<File
 /// `potential`; `None` where the mesh has no view.
 ///
 /// # Errors
-/// [`DriverError::Picture`] where plotters cannot draw.
-pub fn potential_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], phi: &[f64]) -> Result<Option<Files>, DriverError> {
+/// [`Error::Picture`] where plotters cannot draw.
+pub fn potential_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], phi: &[f64]) -> Result<Option<Files>, Error> {
     View::new(mesh, u)
         .map(|view| both!("potential", |a| potential(a, &view, phi)))
         .transpose()

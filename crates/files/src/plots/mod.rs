@@ -8,7 +8,7 @@
 
 pub mod mesh_view;
 
-use crate::DriverError;
+use crate::Error;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::Once;
@@ -27,8 +27,8 @@ fn register_font() {
     });
 }
 
-fn err(what: &str, e: impl std::fmt::Display) -> DriverError {
-    DriverError::Picture {
+fn err(what: &str, e: impl std::fmt::Display) -> Error {
+    Error::Picture {
         name: what.into(),
         message: e.to_string(),
     }
@@ -40,7 +40,7 @@ type DrawSvg<'a> = &'a dyn Fn(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(),
 type DrawPng<'a> = &'a dyn Fn(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>;
 
 /// Draws with `draw` into an SVG string and a PNG image.
-pub(crate) fn render(name: &str, draw: DrawSvg<'_>, draw_png: DrawPng<'_>) -> Result<Files, DriverError> {
+pub(crate) fn render(name: &str, draw: DrawSvg<'_>, draw_png: DrawPng<'_>) -> Result<Files, Error> {
     register_font();
     let mut svg = String::new();
     {
@@ -239,8 +239,8 @@ fn draw_panels<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panels: &[Pane
 /// named `name`.
 ///
 /// # Errors
-/// [`DriverError::Picture`] where plotters cannot draw.
-pub fn panels(name: &str, panels: &[Panel]) -> Result<Files, DriverError> {
+/// [`Error::Picture`] where plotters cannot draw.
+pub fn panels(name: &str, panels: &[Panel]) -> Result<Files, Error> {
     both!(name, |a| draw_panels(a, panels))
 }
 
@@ -332,8 +332,8 @@ fn draw_loglog<DB: DrawingBackend>(
 /// are left out; y is clamped to the axis.
 ///
 /// # Errors
-/// [`DriverError::Picture`] where plotters cannot draw.
-pub fn loglog(name: &str, title: &str, labels: (&str, &str), series: &[Series]) -> Result<Files, DriverError> {
+/// [`Error::Picture`] where plotters cannot draw.
+pub fn loglog(name: &str, title: &str, labels: (&str, &str), series: &[Series]) -> Result<Files, Error> {
     both!(name, |a| draw_loglog(a, title, labels, series))
 }
 

@@ -1,17 +1,17 @@
 //! Limits given as numbers by a user: a time limit in seconds, read once, the same way by the
 //! command line and by Python.
 
-use crate::DriverError;
+use crate::Error;
 use std::time::Duration;
 
 /// A time limit of `value` seconds (the option or argument `what`, for the message): `None`
 /// for no limit (`inf`, or a limit beyond what a clock counts, such as 1e19 s).
 ///
 /// # Errors
-/// [`DriverError::Usage`] for NaN, zero or a negative number.
-pub fn seconds(value: f64, what: &str) -> Result<Option<Duration>, DriverError> {
+/// [`Error::Usage`] for NaN, zero or a negative number.
+pub fn seconds(value: f64, what: &str) -> Result<Option<Duration>, Error> {
     if !(value > 0.0) {
-        return Err(DriverError::Usage(format!(
+        return Err(Error::Usage(format!(
             "{what} {value} is not a positive number of seconds (inf for no limit)"
         )));
     }

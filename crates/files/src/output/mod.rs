@@ -7,7 +7,7 @@ mod set;
 pub use set::Outputs;
 
 use crate::plots::{self, Mark, Panel, Series};
-use crate::DriverError;
+use crate::Error;
 use problem::{ContactResult, Output, RunReport, Solution};
 use std::path::{Path, PathBuf};
 use vtkio::model::{
@@ -17,9 +17,9 @@ use vtkio::model::{
 /// `run.json`: the report, pretty, its keys in sorted order.
 ///
 /// # Errors
-/// [`DriverError::Picture`] if serde cannot write it (it always can).
-pub fn run_json(report: &RunReport) -> Result<Vec<u8>, DriverError> {
-    let encode = |e: serde_json::Error| DriverError::Picture {
+/// [`Error::Picture`] if serde cannot write it (it always can).
+pub fn run_json(report: &RunReport) -> Result<Vec<u8>, Error> {
+    let encode = |e: serde_json::Error| Error::Picture {
         name: "run.json".into(),
         message: e.to_string(),
     };
@@ -30,10 +30,10 @@ pub fn run_json(report: &RunReport) -> Result<Vec<u8>, DriverError> {
 /// The files of a solution, those its plan lists.
 ///
 /// # Errors
-/// [`DriverError::Picture`] where a file cannot be made.
-pub fn files(solution: &Solution) -> Result<Outputs, DriverError> {
+/// [`Error::Picture`] where a file cannot be made.
+pub fn files(solution: &Solution) -> Result<Outputs, Error> {
     let mut out = Outputs::new(Path::new(""));
-    let missing = |what: &str| DriverError::Picture {
+    let missing = |what: &str| Error::Picture {
         name: what.into(),
         message: "the plan lists it, but the run has nothing to draw it from".into(),
     };
@@ -66,14 +66,14 @@ pub fn files(solution: &Solution) -> Result<Outputs, DriverError> {
 ///
 /// # Errors
 /// As [`files`] and [`Outputs::commit`].
-pub fn write(solution: &Solution, dir: &Path) -> Result<(), DriverError> {
+pub fn write(solution: &Solution, dir: &Path) -> Result<(), Error> {
     files(solution)?.into(dir).commit()
 }
 
 /// The solution as a VTK XML unstructured grid: point data `u` (3 components), `phi`; cell
 /// data `stress` (Voigt), `strain`, `electric_displacement`, `electric_field`; and, with
 /// contact, point data `contact_status` (0 none, 1 stick, 2 slip, 3 separated).
-fn vtu(solution: &Solution) -> Result<Vec<u8>, DriverError> {
+fn vtu(solution: &Solution) -> Result<Vec<u8>, Error> {
     let (mesh, fields) = (&solution.mesh, &solution.fields);
     let points: Vec<f64> = mesh.points.iter().flatten().copied().collect();
     let k = mesh.kind.n_nodes();
@@ -122,7 +122,7 @@ fn vtu(solution: &Solution) -> Result<Vec<u8>, DriverError> {
         }),
     };
     let mut buf = Vec::new();
-    vtk.write_xml(&mut buf).map_err(|e| DriverError::Picture {
+    vtk.write_xml(&mut buf).map_err(|e| Error::Picture {
         name: "solution.vtu".into(),
         message: e.to_string(),
     })?;
@@ -167,7 +167,7 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
 /// The multipliers along the contact boundary (in 3D, along the contact face's middle line
 /// y = y_mid), like the paper's figures: `λ_n`, `λ_t` (first component), the Coulomb bound
 /// `F λ_n`, and the sliding points.
-fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, DriverError> {
+fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
     let (p, s) = (&c.points, &c.solution);
     let nt = s.lambda.n_tangential();
     let mut idx: Vec<usize> = (0..p.len()).collect();

@@ -30,7 +30,7 @@
 //! in a source tree: each is replaced in place, atomically by itself (written beside it, then
 //! renamed over it), and nothing else in the directory is touched.
 
-use crate::DriverError;
+use crate::Error;
 use std::path::{Path, PathBuf};
 
 /// The hidden directory of a set, inside the output directory.
@@ -111,11 +111,11 @@ impl Outputs {
     /// module's documentation), documents replace their namesakes one by one.
     ///
     /// # Errors
-    /// [`DriverError::OutputConflict`] where a name is not a plain file name, or names a file
-    /// of the user's; [`DriverError::Output`] naming the path that could not be created,
+    /// [`Error::OutputConflict`] where a name is not a plain file name, or names a file
+    /// of the user's; [`Error::Output`] naming the path that could not be created,
     /// written or renamed. Nothing is changed where the error comes before the set is turned
     /// to (every error but a failure to remove what the old set leaves).
-    pub fn commit(self) -> Result<(), DriverError> {
+    pub fn commit(self) -> Result<(), Error> {
         let mut seen = std::collections::BTreeSet::new();
         for (name, _) in &self.files {
             check_name(&self.dir, name)?;
@@ -132,7 +132,7 @@ impl Outputs {
         }
     }
 
-    fn commit_documents(self) -> Result<(), DriverError> {
+    fn commit_documents(self) -> Result<(), Error> {
         std::fs::create_dir_all(&self.dir).map_err(|e| io("cannot create", &self.dir, e))?;
         for (name, bytes) in &self.files {
             let path = self.dir.join(name);
@@ -150,7 +150,7 @@ impl Outputs {
     }
 
     #[cfg(not(unix))]
-    fn commit_set(self) -> Result<(), DriverError> {
+    fn commit_set(self) -> Result<(), Error> {
         // without links, each file is replaced by itself
         Outputs {
             mode: Mode::Documents,
@@ -160,7 +160,7 @@ impl Outputs {
     }
 
     #[cfg(unix)]
-    fn commit_set(self) -> Result<(), DriverError> {
+    fn commit_set(self) -> Result<(), Error> {
         let dir = &self.dir;
         match std::fs::metadata(dir) {
             Ok(m) if !m.is_dir() => return Err(conflict(dir, "is not a directory")),
@@ -186,7 +186,7 @@ impl Outputs {
 }
 
 /// A set's file name: one plain component, not hidden, not ours.
-fn check_name(dir: &Path, name: &str) -> Result<(), DriverError> {
+fn check_name(dir: &Path, name: &str) -> Result<(), Error> {
     let mut parts = Path::new(name).components();
     let plain = matches!(parts.next(), Some(std::path::Component::Normal(_))) && parts.next().is_none();
     if !plain || name.starts_with('.') || name.contains('/') {
@@ -198,15 +198,15 @@ fn check_name(dir: &Path, name: &str) -> Result<(), DriverError> {
     Ok(())
 }
 
-fn io(what: &str, p: &Path, e: std::io::Error) -> DriverError {
-    DriverError::Output {
+fn io(what: &str, p: &Path, e: std::io::Error) -> Error {
+    Error::Output {
         what: format!("{what} {}", p.display()),
         source: e,
     }
 }
 
-fn conflict(p: &Path, why: &str) -> DriverError {
-    DriverError::OutputConflict {
+fn conflict(p: &Path, why: &str) -> Error {
+    Error::OutputConflict {
         path: p.display().to_string(),
         reason: why.into(),
     }
@@ -215,7 +215,7 @@ fn conflict(p: &Path, why: &str) -> DriverError {
 #[cfg(unix)]
 mod unix {
     use super::{conflict, io, CURRENT, HIDDEN, LEGACY_MANIFEST, LOCK, README, README_TEXT};
-    use crate::DriverError;
+    use crate::Error;
     use std::os::unix::fs::symlink;
     use std::path::{Path, PathBuf};
 
@@ -259,7 +259,7 @@ mod unix {
 
     /// The hidden directory, made where missing (by this commit or one beside it); refused
     /// where something else has its name.
-    fn hidden_dir(dir: &Path) -> Result<PathBuf, DriverError> {
+    fn hidden_dir(dir: &Path) -> Result<PathBuf, Error> {
         let hidden = dir.join(HIDDEN);
         let foreign = || {
             conflict(
@@ -299,7 +299,7 @@ mod unix {
     }
 
     /// Turns `current` to `set` (a name in `hidden`): one rename.
-    fn turn(hidden: &Path, set: &Path) -> Result<(), DriverError> {
+    fn turn(hidden: &Path, set: &Path) -> Result<(), Error> {
         let name = set.file_name().unwrap_or_default();
         let tmp = fresh(hidden, "turning");
         symlink(name, &tmp).map_err(|e| io("cannot link", &tmp, e))?;
@@ -326,7 +326,7 @@ mod unix {
 
     /// Takes over the set an earlier version wrote as regular files: hard-linked into a set of
     /// its own that becomes `current`, then each file replaced by its link (the same content).
-    fn adopt_legacy(dir: &Path, hidden: &Path) -> Result<(), DriverError> {
+    fn adopt_legacy(dir: &Path, hidden: &Path) -> Result<(), Error> {
         let names = legacy_names(dir);
         if names.is_empty() {
             let _ = std::fs::remove_file(dir.join(LEGACY_MANIFEST));
@@ -350,7 +350,7 @@ mod unix {
     }
 
     /// The commit of a set into `dir` (see the module's documentation).
-    pub(super) fn commit(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), DriverError> {
+    pub(super) fn commit(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), Error> {
         // before anything is made: a name of the set that is the user's stops the commit
         let legacy = legacy_names(dir);
         for (name, _) in files {
@@ -375,7 +375,7 @@ mod unix {
         let old_set = std::fs::read_link(hidden.join(CURRENT)).ok().map(|t| hidden.join(t));
         // the new set, beside the current one, then the turn to it
         let set = fresh(&hidden, "set");
-        let staged = (|| -> Result<(), DriverError> {
+        let staged = (|| -> Result<(), Error> {
             std::fs::create_dir(&set).map_err(|e| io("cannot create", &set, e))?;
             for (name, bytes) in files {
                 let path = set.join(name);
@@ -418,7 +418,7 @@ mod unix {
 mod tests {
     use super::*;
 
-    fn commit(dir: &Path, files: &[(&str, &str)]) -> Result<(), DriverError> {
+    fn commit(dir: &Path, files: &[(&str, &str)]) -> Result<(), Error> {
         let mut o = Outputs::new(dir);
         for (name, text) in files {
             o.add(name, text.as_bytes().to_vec());

@@ -7,7 +7,7 @@
 //! that does not apply once another is changed, e.g. `--set contact.law=signorini --set
 //! ~contact.friction`.
 
-use crate::DriverError;
+use crate::{Error, SceneFileError};
 use problem::Scene;
 use std::path::{Path, PathBuf};
 
@@ -52,10 +52,10 @@ pub struct Source {
 /// Reads a shipped scene by name, or a scene file by path, and applies the overrides.
 ///
 /// # Errors
-/// [`DriverError::Scene`] naming the scene and what is wrong: no such scene or file, a file
+/// [`Error::Scene`] naming the scene and what is wrong: no such scene or file, a file
 /// that is not a regular file, TOML that does not parse, an override that does not apply, or
 /// a value that [`Scene::validate`] refuses.
-pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(Scene, Source), DriverError> {
+pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(Scene, Source), Error> {
     let (text, source) = text(name_or_path)?;
     let scene = parse(&text, name_or_path, overrides)?;
     Ok((scene, source))
@@ -65,32 +65,27 @@ pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(Scene, Source),
 /// from (a shipped scene's relative paths resolve against the working directory).
 ///
 /// # Errors
-/// [`DriverError::Scene`] naming the scene: no such scene or file, a file that is not a
+/// [`Error::Scene`] naming the scene: no such scene or file, a file that is not a
 /// regular file or does not read.
-pub fn text(name_or_path: &str) -> Result<(String, Source), DriverError> {
-    let err = |message: String| DriverError::Scene {
-        file: name_or_path.into(),
-        message,
-    };
+pub fn text(name_or_path: &str) -> Result<(String, Source), Error> {
+    let err = |e: SceneFileError| Error::scene(name_or_path, e);
     let (text, dir) = if let Some((_, text)) = SHIPPED.iter().find(|(n, _)| *n == name_or_path) {
         (text.to_string(), std::env::current_dir().unwrap_or_default())
     } else if Path::new(name_or_path).exists() {
         // a FIFO or a device would block the read, or never end it
         if !std::fs::metadata(name_or_path).is_ok_and(|m| m.is_file()) {
-            return Err(err("is not a regular file".into()));
+            return Err(err(SceneFileError::NotAFile));
         }
-        let text = std::fs::read_to_string(name_or_path).map_err(|e| err(e.to_string()))?;
+        let text = std::fs::read_to_string(name_or_path).map_err(|e| err(SceneFileError::Read(e)))?;
         let dir = Path::new(name_or_path)
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_default();
         (text, dir)
     } else {
-        let names: Vec<&str> = SHIPPED.iter().map(|(n, _)| *n).collect();
-        return Err(err(format!(
-            "no shipped scene of that name and no such file (shipped: {})",
-            names.join(", ")
-        )));
+        return Err(err(SceneFileError::NotFound {
+            shipped: SHIPPED.iter().map(|(n, _)| *n).collect(),
+        }));
     };
     let source = Source {
         label: name_or_path.into(),
@@ -103,15 +98,19 @@ pub fn text(name_or_path: &str) -> Result<(String, Source), DriverError> {
 /// validates it.
 ///
 /// # Errors
-/// [`DriverError::Scene`], labelled `label`.
-pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, DriverError> {
-    let err = |message: String| DriverError::Scene {
-        file: label.into(),
-        message,
-    };
-    let mut tree: toml::Table = text.parse().map_err(|e: toml::de::Error| err(e.to_string()))?;
+/// [`Error::Scene`], labelled `label`.
+pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, Error> {
+    let mut tree: toml::Table = text.parse().map_err(|e: toml::de::Error| Error::scene(label, e))?;
     for o in overrides {
-        apply(&mut tree, o).map_err(|m| err(format!("--set {o}: {m}")))?;
+        apply(&mut tree, o).map_err(|message| {
+            Error::scene(
+                label,
+                SceneFileError::Override {
+                    set: o.clone(),
+                    message,
+                },
+            )
+        })?;
     }
     from_tree(tree, label)
 }
@@ -120,16 +119,12 @@ pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, Dri
 /// validates it.
 ///
 /// # Errors
-/// [`DriverError::Scene`], labelled `label`, naming the key at fault.
-pub fn from_tree(tree: toml::Table, label: &str) -> Result<Scene, DriverError> {
-    let err = |message: String| DriverError::Scene {
-        file: label.into(),
-        message,
-    };
+/// [`Error::Scene`], labelled `label`, naming the key at fault.
+pub fn from_tree(tree: toml::Table, label: &str) -> Result<Scene, Error> {
     let scene: Scene = toml::Value::Table(tree)
         .try_into()
-        .map_err(|e: toml::de::Error| err(e.to_string()))?;
-    scene.validate().map_err(|e| err(e.to_string()))?;
+        .map_err(|e: toml::de::Error| Error::scene(label, e))?;
+    scene.validate().map_err(|e| Error::scene(label, e))?;
     Ok(scene)
 }
 

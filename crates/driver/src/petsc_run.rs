@@ -1,0 +1,54 @@
+//! The run of one scene on the ranks of an MPI run, with the PETSc backend (the feature
+//! `petsc`): the mesh read on every rank, the problem solved by `distributed`, the outputs
+//! written by rank 0.
+
+use crate::DriverError;
+use files::run::{memory_limits, peak_memory_bytes};
+use files::{output, scene_file::Source};
+use problem::{MeshKind, Reporter, Scene, Solution};
+use std::path::Path;
+
+/// Solves `scene` on the ranks of an MPI run with the PETSc backend (`solver.backend =
+/// "petsc"`), and writes the outputs from rank 0 (as one set; nothing on error). Every rank
+/// calls it; rank 0 returns the solution, with each rank's peak memory in `run.json`'s `petsc`
+/// section, the others `None`. Only rank 0 reports to `reporter`.
+///
+/// # Errors
+/// As [`files::run::run`], and [`DriverError::Petsc`] for PETSc's and MPI's.
+pub fn run_distributed(
+    scene: &Scene,
+    source: &Source,
+    dir: &Path,
+    reporter: &mut dyn Reporter,
+) -> Result<Option<Solution>, DriverError> {
+    let petsc = petsc::Petsc::init()?;
+    let mesh = match (scene.mesh.kind, &scene.mesh.file) {
+        (MeshKind::Gmsh, Some(file)) => Some(mesh::read_msh(source.dir.join(file)).map_err(files::Error::from)?),
+        _ => None,
+    };
+    let mut silent = problem::Silent;
+    let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
+    // the ranks of one machine share its memory (on several machines this is conservative)
+    let (memory_bytes, memory_limit) = memory_limits(petsc.size() as u64);
+    let limits = problem::Limits {
+        memory_bytes,
+        memory_limit,
+        ..Default::default()
+    };
+    let solved = distributed::solve(scene, mesh, &petsc, limits, reporter).map_err(|e| match e {
+        distributed::DistributedError::Problem(p) => DriverError::from(p),
+        distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
+        distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),
+    })?;
+    let peaks = petsc.all_gather(peak_memory_bytes())?;
+    let Some(mut solution) = solved else {
+        return Ok(None);
+    };
+    solution.report.scene.source = source.label.clone();
+    solution.report.memory.peak_bytes = peaks.first().copied().unwrap_or(0);
+    if let Some(p) = solution.report.petsc.as_mut() {
+        p.peak_bytes_per_rank = peaks;
+    }
+    output::write(&solution, dir)?;
+    Ok(Some(solution))
+}
