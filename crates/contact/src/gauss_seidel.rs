@@ -9,8 +9,7 @@
 use crate::local::{Point, PointLaw};
 use crate::operator::{AffineProblem, Compliance};
 use crate::points::{ContactPoints, Flat, PointValues};
-use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Best, Counter};
-use crate::InputError;
+use crate::solution::{classify, counts, slip_bound, Best, Counter, Preamble};
 use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law, Measure, Progress, Stage, Stall};
 
 /// Parameters of [`solve_gauss_seidel`].
@@ -62,17 +61,15 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    let (n, nt) = check_input(points, law, problem.weights().len(), problem.n_tangential())?;
-    let (mu_max, reference, u0) = {
-        let mut counter = Counter::new(problem);
-        let (mu, u0) = estimate_mu_max(&mut counter, points, nt, params.power_iters)?;
-        (mu, multiplier_scale(points, &u0, 1.0 / mu), u0)
-    };
-    let mut lambda = match lambda0 {
-        Some(l) if l.n_points() == n && l.n_tangential() == nt => l,
-        Some(_) => return Err(InputError::WarmStart.into()),
-        None => PointValues::zeros(n, nt),
-    };
+    let pre = Preamble::new(&mut Counter::new(problem), points, law, params.power_iters)?;
+    let mut lambda = pre.start(lambda0)?;
+    let Preamble {
+        n,
+        nt,
+        mu_max,
+        u0,
+        reference,
+    } = pre;
     let sweeper = Sweeper::new(problem, Flat { n, nt });
     let mut info = ContactInfo::new(mu_max);
     let mut best = Best::new(0.99);

@@ -49,7 +49,7 @@ impl Point {
             z[r] = x[r] + c * (u - if r == 0 { self.g } else { 0.0 });
         }
         let mut f = [0.0; 3];
-        f[0] = x[0] - z[0].max(0.0);
+        f[0] = x[0] - crate::project_nonnegative(z[0]);
         let mut t = [z[1], z[2]];
         self.hold(&mut t);
         project_disc(&mut t[..k - 1], self.radius(z[0]));
@@ -72,7 +72,7 @@ impl Point {
         match self.law {
             PointLaw::Frictionless => 0.0,
             PointLaw::Tresca(s) => s,
-            PointLaw::Coulomb(mu) => mu * zn.max(0.0),
+            PointLaw::Coulomb(mu) => crate::coulomb_radius(mu, zn),
         }
     }
 

@@ -183,6 +183,11 @@ impl PointValues {
         &self.tangential[i * self.nt..(i + 1) * self.nt]
     }
 
+    /// The tangential components of point `i`, to change.
+    pub fn tangential_of_mut(&mut self, i: usize) -> &mut [f64] {
+        &mut self.tangential[i * self.nt..(i + 1) * self.nt]
+    }
+
     /// The Euclidean norm of the tangential components of point `i`.
     pub fn tangential_norm(&self, i: usize) -> f64 {
         crate::projection::norm(self.tangential_of(i))

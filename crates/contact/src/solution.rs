@@ -268,14 +268,28 @@ pub struct Progress {
     pub counts: (usize, usize, usize),
 }
 
-/// The slip bound of each point for a law and multipliers: Tresca `S`, Coulomb `F λ_n`,
-/// frictionless 0.
+/// The slip bound of each point for a law and multipliers: Tresca `S`, Coulomb `F [λ_n]₊`,
+/// frictionless 0 ([`Law::radius`] at each point).
 pub fn slip_bound(points: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f64> {
-    match law {
-        Law::Frictionless => vec![0.0; points.len()],
-        Law::Tresca(s) => s.clone(),
-        Law::Coulomb => points.friction.iter().zip(lambda_n).map(|(f, l)| f * l).collect(),
+    (0..points.len()).map(|i| law.radius(points, i, lambda_n[i])).collect()
+}
+
+impl Law {
+    /// The slip radius of point `i` at the normal value `z_n` (a multiplier, or Newton's
+    /// augmented `z_n`): Tresca's `S_i`, Coulomb's `F_i [z_n]₊` ([`coulomb_radius`]), 0
+    /// without friction. The one place the radius is written.
+    pub fn radius(&self, points: &ContactPoints, i: usize, z_n: f64) -> f64 {
+        match self {
+            Law::Frictionless => 0.0,
+            Law::Tresca(s) => s[i],
+            Law::Coulomb => coulomb_radius(points.friction[i], z_n),
+        }
     }
+}
+
+/// Coulomb's slip radius `F [z_n]₊` for the friction coefficient `friction`.
+pub fn coulomb_radius(friction: f64, z_n: f64) -> f64 {
+    friction * crate::project_nonnegative(z_n)
 }
 
 /// The natural-map residual of DESIGN.md with step `c`:
@@ -302,12 +316,13 @@ pub fn complementarity_residual(
     for i in 0..n {
         r.normal[i] = lambda.normal[i] - project_nonnegative(lambda.normal[i] + c * (u.normal[i] - points.gap[i]));
         if nt > 0 {
+            let (l, ut) = (lambda.tangential_of(i), u.tangential_of(i));
             for k in 0..nt {
-                buf[k] = lambda.tangential[i * nt + k] + c * u.tangential[i * nt + k];
+                buf[k] = l[k] + c * ut[k];
             }
             points.project_friction(i, &mut buf[..nt], radius[i]);
-            for k in 0..nt {
-                r.tangential[i * nt + k] = lambda.tangential[i * nt + k] - buf[k];
+            for (rk, (lk, bk)) in r.tangential_of_mut(i).iter_mut().zip(l.iter().zip(&buf)) {
+                *rk = lk - bk;
             }
         }
     }
@@ -427,7 +442,7 @@ pub(crate) fn counts(status: &[Status]) -> (usize, usize, usize) {
 
 /// Checks the points, the law's data, and the size of the problem (`n_points` points with
 /// `n_tangential` tangential components each) against them; returns `(n, nt)`.
-pub(crate) fn check_input(
+fn check_input(
     points: &ContactPoints,
     law: &Law,
     n_points: usize,
@@ -457,9 +472,56 @@ pub(crate) fn check_input(
     Ok((n, nt))
 }
 
+/// What every solver computes before its first step: the problem's size checked against its
+/// points and law, the dual operator's largest eigenvalue `μ_max`, the contact displacement
+/// under the loads alone `u(0)`, and the multiplier scale of the residual.
+pub(crate) struct Preamble {
+    /// Points.
+    pub n: usize,
+    /// Tangential components per point (0 without friction).
+    pub nt: usize,
+    /// The estimate of the dual operator's largest eigenvalue.
+    pub mu_max: f64,
+    /// The contact displacement under the loads alone.
+    pub u0: PointValues,
+    /// The multiplier scale `c ‖u(0) - g‖_W` with `c = 1/μ_max` ([`multiplier_scale`]).
+    pub reference: f64,
+}
+
+impl Preamble {
+    /// Checks the input of a solve through `c` and estimates `μ_max` by `power_iters` steps.
+    pub fn new(
+        c: &mut Counter<'_>,
+        points: &ContactPoints,
+        law: &Law,
+        power_iters: usize,
+    ) -> Result<Self, ContactError> {
+        let (n, nt) = check_input(points, law, c.op.n_points(), c.op.n_tangential())?;
+        let (mu_max, u0) = estimate_mu_max(c, points, nt, power_iters)?;
+        let reference = multiplier_scale(points, &u0, 1.0 / mu_max);
+        Ok(Preamble {
+            n,
+            nt,
+            mu_max,
+            u0,
+            reference,
+        })
+    }
+
+    /// The first iterate: the warm start `lambda0` where its shape is the problem's, zeros
+    /// where there is none.
+    pub fn start(&self, lambda0: Option<PointValues>) -> Result<PointValues, ContactError> {
+        match lambda0 {
+            Some(l) if l.n_points() == self.n && l.n_tangential() == self.nt => Ok(l),
+            Some(_) => Err(InputError::WarmStart.into()),
+            None => Ok(PointValues::zeros(self.n, self.nt)),
+        }
+    }
+}
+
 /// The multiplier scale of the problem, `c ‖u(0) - g‖_W` (the floor of the residual's
 /// denominator, see [`complementarity_residual`]).
-pub(crate) fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64 {
+fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64 {
     let mut free = u0.clone();
     for (u, g) in free.normal.iter_mut().zip(&points.gap) {
         *u -= g;
@@ -500,7 +562,7 @@ impl<'a> Counter<'a> {
 /// by power iteration (a Rayleigh quotient, so a lower estimate), applied through
 /// [`ContactOperator::forces_alone`] (no cancellation against the loads, whatever their size);
 /// also returns `u(0)`, the contact displacement under the loads alone.
-pub(crate) fn estimate_mu_max(
+fn estimate_mu_max(
     c: &mut Counter<'_>,
     points: &ContactPoints,
     nt: usize,
@@ -546,35 +608,34 @@ pub(crate) fn estimate_mu_max(
     Ok((mu, u0))
 }
 
-/// The best iterate of a loop, and how many steps ago the residual last fell by a gain (a
-/// fraction, 0.99 for 1 %) below the best: the bookkeeping of every solver's stall test.
-#[derive(Debug)]
-pub(crate) struct Best {
-    iterate: Option<Iterate>,
+/// The best iterate of a loop by its residual, and how many steps ago the residual last fell
+/// by a gain (a fraction, 0.99 for 1 %) below the best: the bookkeeping of every solver's
+/// best-iterate answer and stall test. `T` is the solver's iterate ([`Iterate`], or Newton's
+/// own state). A kept residual that is not a number is replaced by any other.
+#[derive(Clone, Debug)]
+pub(crate) struct Best<T = Iterate> {
+    kept: Option<(T, f64)>,
     gain: f64,
     since: usize,
 }
 
-impl Best {
+impl<T: Clone> Best<T> {
     /// No iterate yet; a step improves when its residual is below `gain` times the best.
     pub fn new(gain: f64) -> Self {
         Best {
-            iterate: None,
+            kept: None,
             gain,
             since: 0,
         }
     }
 
-    /// Keeps `(λ, u)` where its residual is the lowest yet, and counts the steps without gain.
-    pub fn offer(&mut self, lambda: &crate::PointValues, u: &crate::PointValues, residual: f64) {
-        let best = self.iterate.as_ref().map(|b| b.residual);
-        let improved = best.is_none_or(|b| residual < self.gain * b);
-        if best.is_none_or(|b| residual < b) {
-            self.iterate = Some(Iterate {
-                lambda: lambda.clone(),
-                u: u.clone(),
-                residual,
-            });
+    /// Keeps the iterate `make` gives where `residual` is the lowest yet (or the kept one's is
+    /// NaN), and counts the steps without gain.
+    pub fn offer_with(&mut self, residual: f64, make: impl FnOnce() -> T) {
+        let best = self.residual();
+        let improved = best.is_none_or(|b| residual < self.gain * b || b.is_nan());
+        if best.is_none_or(|b| residual < b || b.is_nan()) {
+            self.kept = Some((make(), residual));
         }
         self.since = if improved { 0 } else { self.since + 1 };
     }
@@ -584,13 +645,39 @@ impl Best {
         self.since
     }
 
+    /// The best residual, where an iterate was offered.
+    pub fn residual(&self) -> Option<f64> {
+        self.kept.as_ref().map(|(_, r)| *r)
+    }
+
+    /// The best iterate and its residual.
+    pub fn get(&self) -> Option<&(T, f64)> {
+        self.kept.as_ref()
+    }
+
+    /// The best iterate and its residual, taken.
+    pub fn take_kept(&mut self) -> Option<(T, f64)> {
+        self.kept.take()
+    }
+}
+
+impl Best<Iterate> {
+    /// Keeps `(λ, u)` where its residual is the lowest yet, and counts the steps without gain.
+    pub fn offer(&mut self, lambda: &crate::PointValues, u: &crate::PointValues, residual: f64) {
+        self.offer_with(residual, || Iterate {
+            lambda: lambda.clone(),
+            u: u.clone(),
+            residual,
+        });
+    }
+
     /// The best iterate, boxed for an error.
     pub fn boxed(&self) -> Option<Box<Iterate>> {
-        self.iterate.clone().map(Box::new)
+        self.get().map(|(it, _)| Box::new(it.clone()))
     }
 
     /// The best iterate.
-    pub fn take(self) -> Option<Iterate> {
-        self.iterate
+    pub fn take(&mut self) -> Option<Iterate> {
+        self.take_kept().map(|(it, _)| it)
     }
 }

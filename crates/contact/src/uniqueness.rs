@@ -6,7 +6,7 @@
 
 use crate::operator::AffineProblem;
 use crate::points::{ContactPoints, PointValues};
-use crate::{ContactError, Interrupt, Law, NewtonParams};
+use crate::{slip_bound, ContactError, Interrupt, Law, NewtonParams};
 
 /// Power steps of the estimate.
 const PROBES: usize = 4;
@@ -25,7 +25,7 @@ pub fn slip_bound_expansion<P: AffineProblem>(
     interrupt: &Interrupt,
 ) -> Result<f64, ContactError> {
     let n = points.len();
-    let s0: Vec<f64> = (0..n).map(|i| points.friction[i] * lambda.normal[i].max(0.0)).collect();
+    let s0 = slip_bound(points, &Law::Coulomb, &lambda.normal);
     let params = NewtonParams {
         tol: 1e-12,
         interrupt: *interrupt,
@@ -46,7 +46,7 @@ pub fn slip_bound_expansion<P: AffineProblem>(
     let w = &points.weight;
     let norm = |v: &[f64]| v.iter().zip(w).map(|(x, w)| w * x * x).sum::<f64>().sqrt();
     // the step's scale: the bound, or (at a start with no pressure) the bound it maps to
-    let mapped: Vec<f64> = (0..n).map(|i| points.friction[i] * base.normal[i].max(0.0)).collect();
+    let mapped = slip_bound(points, &Law::Coulomb, &base.normal);
     let size = norm(&s0).max(norm(&mapped)).max(f64::MIN_POSITIVE);
     // a deterministic start without symmetry, on the points that carry friction
     let mut v: Vec<f64> = (0..n)

@@ -6,8 +6,7 @@ use crate::operator::ContactOperator;
 use crate::points::{ContactPoints, PointValues};
 use crate::projection::project_nonnegative;
 use crate::solution::{
-    check_input, classify, complementarity_residual, counts, desaxce_residual, estimate_mu_max, multiplier_scale,
-    slip_bound, Counter,
+    classify, complementarity_residual, counts, desaxce_residual, slip_bound, Best, Counter, Preamble,
 };
 use crate::InputError;
 use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law, Measure, Progress, Stage, Stall};
@@ -124,14 +123,15 @@ fn projected_step(
         norm2 += new * new;
         lambda.normal[i] = new;
         if nt > 0 {
+            let (l, ut) = (lambda.tangential_of_mut(i), u.tangential_of(i));
             for q in 0..nt {
-                buf[q] = lambda.tangential[i * nt + q] + r * u.tangential[i * nt + q];
+                buf[q] = l[q] + r * ut[q];
             }
             points.project_friction(i, &mut buf[..nt], radius[i]);
             for q in 0..nt {
-                diff2 += (buf[q] - lambda.tangential[i * nt + q]).powi(2);
+                diff2 += (buf[q] - l[q]).powi(2);
                 norm2 += buf[q] * buf[q];
-                lambda.tangential[i * nt + q] = buf[q];
+                l[q] = buf[q];
             }
         }
     }
@@ -165,7 +165,7 @@ struct Dual<'a, 'b> {
     u0: PointValues,
     /// The best iterate of the law itself (Coulomb: with the radius `F λ_n`) seen by the
     /// tight rule, with its residual.
-    best: Option<Iterate>,
+    best: Best,
 }
 
 /// Solves the contact problem for `law` through `op`, from `lambda0` (warm start; zeros when
@@ -184,16 +184,22 @@ pub fn solve(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    let (n, nt) = check_input(points, law, op.n_points(), op.n_tangential())?;
     if params.accelerate && params.rule == StopRule::Paper {
         return Err(
             InputError::Unsupported("acceleration needs the tight rule (the paper's rule is plain Uzawa)").into(),
         );
     }
     let mut c = Counter::new(op);
-    let (mu_max, u0) = estimate_mu_max(&mut c, points, nt, params.power_iters)?;
+    let pre = Preamble::new(&mut c, points, law, params.power_iters)?;
+    let mut lambda = pre.start(lambda0)?;
+    let Preamble {
+        n,
+        nt,
+        mu_max,
+        u0,
+        reference,
+    } = pre;
     let estimate_inner = c.inner;
-    let reference = multiplier_scale(points, &u0, 1.0 / mu_max);
     // plain Uzawa converges for r < 2/μ_max; the accelerated gradient wants r ≤ 1/μ_max
     let step = params.step.unwrap_or(if params.accelerate {
         1.0 / mu_max
@@ -214,9 +220,8 @@ pub fn solve(
         info: ContactInfo::new(mu_max),
         inner_tol: None,
         u0,
-        best: None,
+        best: Best::new(1.0),
     };
-    let mut lambda = lambda0.unwrap_or_else(|| PointValues::zeros(n, nt));
     let mut u = PointValues::zeros(n, nt);
     let outcome = match law {
         Law::Frictionless | Law::Tresca(_) => {
@@ -456,17 +461,7 @@ impl Dual<'_, '_> {
 
     /// Keeps `(λ, u)` if it is the best iterate of the law itself.
     fn offer(&mut self, residual: f64, lambda: &PointValues, u: &PointValues) {
-        if self
-            .best
-            .as_ref()
-            .is_none_or(|b| residual < b.residual || b.residual.is_nan())
-        {
-            self.best = Some(Iterate {
-                lambda: lambda.clone(),
-                u: u.clone(),
-                residual,
-            });
-        }
+        self.best.offer(lambda, u, residual);
     }
 
     /// The loop's divergence at the residual `r`, with the best iterate.
@@ -481,7 +476,7 @@ impl Dual<'_, '_> {
 
     /// The best iterate, boxed for an error.
     fn best(&self) -> Option<Box<Iterate>> {
-        self.best.clone().map(Box::new)
+        self.best.boxed()
     }
 
     /// The rule's tolerance (`None` under the paper's rule).

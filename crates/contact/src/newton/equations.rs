@@ -122,8 +122,13 @@ impl<'a> Flat<'a> {
 
     /// The flat indices of point `i`'s components.
     pub(super) fn indices(&self, i: usize) -> impl Iterator<Item = usize> {
-        let (n, nt) = (self.n, self.nt);
-        std::iter::once(i).chain((0..nt).map(move |k| n + i * nt + k))
+        let layout = self.layout();
+        (0..=self.nt).map(move |k| layout.index(i, k))
+    }
+
+    /// The flat layout `[normal (n); tangential (n·nt)]`.
+    pub(super) fn layout(&self) -> crate::points::Flat {
+        crate::points::Flat { n: self.n, nt: self.nt }
     }
 
     /// The natural map's constant per flat index: `1/‖B_i‖_F` for point `i`, `B_i` its
@@ -178,11 +183,7 @@ impl<'a> Flat<'a> {
 
     /// The radius of point `i` at `z`: Tresca `S`, Coulomb `F [z_n]₊`.
     pub(super) fn radius(&self, i: usize, z: &[f64]) -> f64 {
-        match self.law {
-            Law::Frictionless => 0.0,
-            Law::Tresca(s) => s[i],
-            Law::Coulomb => self.points.friction[i] * z[i].max(0.0),
-        }
+        self.law.radius(self.points, i, z[i])
     }
 
     pub(super) fn state(&self, x: Vec<f64>) -> State {
@@ -199,9 +200,9 @@ impl<'a> Flat<'a> {
         let mut f = vec![0.0; m];
         let mut buf = [0.0; 2];
         for i in 0..self.n {
-            f[i] = x[i] - z[i].max(0.0);
+            f[i] = x[i] - crate::project_nonnegative(z[i]);
             if self.nt > 0 {
-                let t = self.n + i * self.nt;
+                let t = self.layout().index(i, 1);
                 buf[..self.nt].copy_from_slice(&z[t..t + self.nt]);
                 self.points.project_friction(i, &mut buf[..self.nt], self.radius(i, &z));
                 for k in 0..self.nt {
@@ -228,7 +229,7 @@ impl<'a> Flat<'a> {
             if nt == 0 {
                 continue;
             }
-            let t = n + i * nt;
+            let t = self.layout().index(i, 1);
             // the projection sees the free directions only (a held one's multiplier is 0)
             let mut held_out = [0.0; 2];
             held_out[..nt].copy_from_slice(&s.z[t..t + nt]);

@@ -40,7 +40,7 @@ mod equations;
 
 use crate::operator::AffineProblem;
 use crate::points::{ContactPoints, PointValues};
-use crate::solution::{check_input, classify, counts, estimate_mu_max, multiplier_scale, slip_bound, Counter};
+use crate::solution::{classify, counts, slip_bound, Best, Counter, Preamble};
 use crate::InputError;
 use crate::{
     ContactError, ContactInfo, ContactSolution, GaussSeidelParams, Interrupt, Interruption, Iterate, Law, Measure,
@@ -123,7 +123,7 @@ struct Judge<'a> {
     measure: Measure,
     reference: f64,
     tol: f64,
-    best: Option<(State, f64)>,
+    best: Best<State>,
 }
 
 impl Judge<'_> {
@@ -166,14 +166,12 @@ impl Judge<'_> {
     /// tolerance.
     fn offer(&mut self, s: &State) -> (f64, bool) {
         let r = self.residual(s);
-        if self.best.as_ref().is_none_or(|(_, b)| r < *b || b.is_nan()) {
-            self.best = Some((s.clone(), r));
-        }
+        self.best.offer_with(r, || s.clone());
         (r, r <= self.tol)
     }
 
     fn best_residual(&self) -> f64 {
-        self.best.as_ref().map_or(f64::NAN, |(_, r)| *r)
+        self.best.residual().unwrap_or(f64::NAN)
     }
 
     /// The progress line of a state.
@@ -325,7 +323,7 @@ fn proximal_stage(
     info: &mut ContactInfo,
     progress: &mut dyn FnMut(&Progress),
 ) -> End {
-    let Some((start, r0)) = judge.best.clone() else {
+    let Some((start, r0)) = judge.best.get().cloned() else {
         return End::Stalled(Stall::NonFinite);
     };
     // σ's unit: the points' own compliance, the mean diagonal of D W
@@ -415,19 +413,11 @@ pub fn solve_newton<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    let (n, nt, m) = check_newton_input(problem, points, law, params)?;
-    let (mu_max, reference) = {
-        let mut counter = Counter::new(problem);
-        let (mu, u0) = estimate_mu_max(&mut counter, points, nt, params.power_iters)?;
-        (mu, multiplier_scale(points, &u0, 1.0 / mu))
-    };
-    let x0 = match lambda0 {
-        Some(l) if l.normal.len() == n && l.tangential.len() == n * nt => {
-            l.normal.iter().chain(&l.tangential).copied().collect()
-        }
-        Some(_) => return Err(InputError::WarmStart.into()),
-        None => vec![0.0; m],
-    };
+    let nt = check_newton_input(problem, params)?;
+    let pre = Preamble::new(&mut Counter::new(problem), points, law, params.power_iters)?;
+    let start = pre.start(lambda0)?;
+    let x0: Vec<f64> = start.normal.iter().chain(&start.tangential).copied().collect();
+    let (mu_max, reference) = (pre.mu_max, pre.reference);
     let mut info = ContactInfo::new(mu_max);
     let u0 = problem.loads().clone();
     let flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
@@ -440,11 +430,11 @@ pub fn solve_newton<P: AffineProblem>(
         measure: params.measure,
         reference,
         tol: params.tol,
-        best: None,
+        best: Best::new(1.0),
     };
     let end = newton_stages(&mut judge, x0, params, &mut info, progress);
     let best_residual = judge.best_residual();
-    let (best, _) = judge.best.take().expect("the start was judged");
+    let (best, _) = judge.best.take_kept().expect("the start was judged");
     let lambda = judge.flat.values(&best.x);
     let u = judge.flat.values(&best.u);
     let reason = match end {
@@ -535,15 +525,11 @@ fn after_stall<P: AffineProblem>(
     ))
 }
 
-/// Checks the data of [`solve_newton`]: `(n, nt, m)`, the points, their tangential components
-/// and the compliance's size.
-fn check_newton_input<P: AffineProblem>(
-    problem: &P,
-    points: &ContactPoints,
-    law: &Law,
-    params: &NewtonParams,
-) -> Result<(usize, usize, usize), ContactError> {
-    let (n, nt) = check_input(points, law, problem.weights().len(), problem.n_tangential())?;
+/// Checks what [`solve_newton`] needs beside the input every solver checks (before the
+/// compliance is applied): the compliance's size against the loads', and the tolerance;
+/// returns the tangential components per point.
+fn check_newton_input<P: AffineProblem>(problem: &P, params: &NewtonParams) -> Result<usize, ContactError> {
+    let (n, nt) = (problem.weights().len(), problem.n_tangential());
     let m = n * (1 + nt);
     if problem.compliance().size() != m || problem.loads().n_points() != n {
         return Err(InputError::ComplianceSize {
@@ -558,7 +544,7 @@ fn check_newton_input<P: AffineProblem>(
     if !(params.tol > 0.0) {
         return Err(InputError::Parameter(format!("Newton tolerance {} must be positive", params.tol)).into());
     }
-    Ok((n, nt, m))
+    Ok(nt)
 }
 
 /// Newton's stages from `x0` (docs/theory.md, "Semismooth Newton"), each from the best iterate
@@ -594,7 +580,7 @@ fn newton_stages(
         end = proximal_stage(judge, params, info, progress);
     }
     if matches!(end, End::Stalled(_)) && !directions.symmetric_dense() {
-        if let Some((start, _)) = judge.best.clone() {
+        if let Some((start, _)) = judge.best.get().cloned() {
             let steps = LENIENT_STEPS * params.max_iters;
             let lenient = Rules {
                 steps,
@@ -648,7 +634,7 @@ fn fallback<P: AffineProblem>(
     info: ContactInfo,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    let (n, nt) = (lambda.n_points(), lambda.n_tangential());
+    let n = lambda.n_points();
     progress(&Progress {
         stage: Stage::Fallback,
         iter: info.newton_iters,
@@ -656,10 +642,13 @@ fn fallback<P: AffineProblem>(
         counts: counts(&classify(&lambda, &slip_bound(points, law, &lambda.normal))),
     });
     let mut start = lambda;
-    start.normal.iter_mut().for_each(|v| *v = v.max(0.0));
+    start
+        .normal
+        .iter_mut()
+        .for_each(|v| *v = crate::project_nonnegative(*v));
     let radius = slip_bound(points, law, &start.normal);
     for i in 0..n {
-        points.project_friction(i, &mut start.tangential[i * nt..(i + 1) * nt], radius[i]);
+        points.project_friction(i, start.tangential_of_mut(i), radius[i]);
     }
     let mut sol = if *law == Law::Coulomb {
         // Coulomb's law directly, point by point
