@@ -55,7 +55,7 @@ fn supernodal_ldlt_has_the_inertia_of_k() {
         materials: mats,
         constraints: bcs,
         ..
-    } = problem::backend::setup(&scene, None).expect("setup");
+    } = problem::backend::setup(scene.validate().expect("a valid scene"), None).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).unwrap();
     let b = disc.assemble(Parallelism::Rayon);
     let f = DirectLdlt::new(&b.a, &b.g, &b.b, &Ordering::Amd, faer::Par::Seq).unwrap();

@@ -141,7 +141,7 @@ impl<'p> Backend for PetscBackend<'p> {
         _: problem::Limits,
         _: &mut dyn Reporter,
     ) -> Result<Prepared<'p>, DistributedError> {
-        let options = configure(self.petsc, posed.scene, posed.setup, &layout)?;
+        let options = configure(self.petsc, &posed.scene, posed.setup, &layout)?;
         let fields = Fields::new(self.petsc, posed.setup, &layout);
         Ok(Prepared {
             layout,
@@ -179,7 +179,7 @@ impl<'p> Backend for PetscBackend<'p> {
         reporter: &mut dyn Reporter,
     ) -> Result<Solved<Vector<'p>>, DistributedError> {
         let t = Instant::now();
-        refuse_held_tangent(posed.scene, &boundary)?;
+        refuse_held_tangent(&posed.scene, &boundary)?;
         let rows = ContactRows::new(self.petsc, &boundary.points, &boundary.nodes, &s.layout, &s.system);
         let params = ActiveSetParams {
             tol: how.tol,
@@ -334,7 +334,7 @@ fn configure(petsc: &Petsc, scene: &Scene, setup: &Setup, layout: &Layout) -> Re
     if setup.plan.contact_law != ContactLaw::None {
         // the multipliers are reactions of the Krylov solution: its error bounds the
         // complementarity residual, which must reach solver.tol
-        let rtol = (1e-2 * scene.solver.tol).min(1e-10);
+        let rtol = (1e-2 * setup.plan.tol).min(1e-10);
         all.push_str(&format!(" -ksp_rtol {rtol:e}"));
     }
     petsc.insert_options(&all)?;

@@ -28,7 +28,7 @@ fn main() {
         constraints: bcs,
         loads,
         ..
-    } = problem::backend::setup(&scene, None).expect("setup");
+    } = problem::backend::setup(scene.validate().expect("a valid scene"), None).expect("setup");
     let (mut t_asm, mut t_sym, mut t_num, mut t_solve, mut t_chol, mut t_pcg) =
         (vec![], vec![], vec![], vec![], vec![], vec![]);
     let mut iters = 0;

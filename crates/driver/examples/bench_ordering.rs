@@ -23,7 +23,7 @@ fn main() {
         materials: mats,
         constraints: bcs,
         ..
-    } = problem::backend::setup(&scene, None).expect("setup");
+    } = problem::backend::setup(scene.validate().expect("a valid scene"), None).expect("setup");
     let disc = Discretization::new(&mesh, &mats, &bcs).expect("setup");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());

@@ -11,7 +11,7 @@
 
 use crate::progress::Reporter;
 use crate::report::PetscReport;
-use crate::scene::{ContactSolver, Scene};
+use crate::scene::{ContactSolver, Scene, Valid};
 use crate::ProblemError;
 use contact::{ContactSolution, Law};
 use fe_assembly::Discretization;
@@ -151,8 +151,8 @@ pub trait Backend {
 /// The discrete problem a backend solves: the validated scene, its set-up, the discretisation
 /// (dof map, cells) and the loads on the free dofs.
 pub struct Posed<'a> {
-    /// The scene.
-    pub scene: &'a Scene,
+    /// The scene, validated.
+    pub scene: Valid<'a>,
     /// Its mesh, materials, plan, conditions.
     pub setup: &'a Setup,
     /// The discretisation on the mesh.
@@ -237,7 +237,7 @@ impl<'p> ContactSolve<'p> {
     /// The plan's contact law on `n` points: frictionless without tangential multipliers,
     /// Tresca with the scene's bound, else Coulomb.
     pub fn new(plan: &'p Plan, scene: &'p Scene, n: usize, interrupt: contact::Interrupt) -> Self {
-        let law = plan.law(scene, n);
+        let law = plan.law(n);
         // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
         debug_assert_eq!(
             plan.fixed_point,
@@ -247,7 +247,7 @@ impl<'p> ContactSolve<'p> {
             plan,
             scene,
             law,
-            tol: scene.solver.tol,
+            tol: plan.tol,
             interrupt,
         }
     }

@@ -51,7 +51,7 @@ impl Backend for Faer {
     /// Assembles `A`, `G`, `B` over the free dofs (on rayon's threads), checked finite.
     fn assemble(&mut self, posed: &Posed<'_>) -> Result<Blocks, ProblemError> {
         let blocks = posed.disc.assemble(Parallelism::Rayon);
-        let scene = posed.scene;
+        let scene = posed.scene.scene();
         ProblemError::check_finite(blocks.a.val(), "the stiffness matrix A", scene)?;
         ProblemError::check_finite(blocks.g.val(), "the coupling matrix G", scene)?;
         ProblemError::check_finite(blocks.b.val(), "the dielectric matrix B", scene)?;
@@ -75,7 +75,7 @@ impl Backend for Faer {
         system: &mut Factored,
         _: &mut dyn Reporter,
     ) -> Result<Solved<Self::Solution>, ProblemError> {
-        solve_linear(system, posed).map_err(|e| e.on_scene(posed.scene))
+        solve_linear(system, posed).map_err(|e| e.on_scene(&posed.scene))
     }
 
     fn solve_contact(
@@ -86,7 +86,7 @@ impl Backend for Faer {
         how: &ContactSolve<'_>,
         reporter: &mut dyn Reporter,
     ) -> Result<Solved<Self::Solution>, ProblemError> {
-        solve_contact(how, system, boundary, posed, reporter).map_err(|e| e.on_scene(posed.scene))
+        solve_contact(how, system, boundary, posed, reporter).map_err(|e| e.on_scene(&posed.scene))
     }
 
     fn equilibrium(
@@ -178,10 +178,10 @@ fn factor(
     reporter: &mut dyn Reporter,
 ) -> Result<Factored, ProblemError> {
     let t = Instant::now();
-    let (scene, plan) = (posed.scene, posed.plan());
+    let (scene, plan) = (posed.scene.scene(), posed.plan());
     let paper = plan.rule == Rule::Paper;
     let pcg_params = PcgParams {
-        rel_tol: scene.solver.pcg_tol.unwrap_or(if paper { 1e-2 } else { 1e-12 }),
+        rel_tol: plan.pcg_tol,
         max_iters: 10_000,
         stop: if paper {
             PcgStop::PaperRz

@@ -77,7 +77,7 @@ pub use run::{run, solve, solve_within, ContactResult, Solution, EQUILIBRIUM_TOL
 pub use scene::{
     BackendChoice, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind, ExactSpec,
     LoadSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec,
-    Strategy,
+    Strategy, Valid,
 };
 
 use contact::ContactError;

@@ -46,6 +46,16 @@ pub struct Plan {
     pub rule: Rule,
     /// The files the run writes.
     pub outputs: Vec<Output>,
+    /// The contact solve's complementarity tolerance (`solver.tol`).
+    #[serde(skip)]
+    pub tol: f64,
+    /// The PCG's relative tolerance: `solver.pcg_tol`, else 1e-2 under the paper's rule (its
+    /// Table 1) and 1e-12 under the tight rule.
+    #[serde(skip)]
+    pub pcg_tol: f64,
+    /// Tresca's slip bound `S` (`contact.slip_bound`; 0 where the law is not Tresca's).
+    #[serde(skip)]
+    pub slip_bound: f64,
 }
 
 impl Plan {
@@ -82,16 +92,21 @@ impl Plan {
             linear_strategy: strategy,
             rule: scene.solver.rule,
             outputs,
+            tol: scene.solver.tol,
+            pcg_tol: scene.solver.pcg_tol.unwrap_or(match scene.solver.rule {
+                Rule::Paper => 1e-2,
+                Rule::Tight => 1e-12,
+            }),
+            slip_bound: scene.contact.as_ref().map_or(0.0, |c| c.slip_bound()),
         }
     }
 
     /// The plan's contact law on `n` points, as the contact crate takes it: frictionless
     /// without tangential multipliers, Tresca with the scene's bound, else Coulomb.
-    pub fn law(&self, scene: &Scene, n: usize) -> contact::Law {
-        let slip_bound = scene.contact.as_ref().map_or(0.0, |c| c.slip_bound());
+    pub fn law(&self, n: usize) -> contact::Law {
         match (self.contact_law, self.friction) {
             (_, false) => contact::Law::Frictionless,
-            (ContactLaw::Tresca, true) => contact::Law::Tresca(vec![slip_bound; n]),
+            (ContactLaw::Tresca, true) => contact::Law::Tresca(vec![self.slip_bound; n]),
             _ => contact::Law::Coulomb,
         }
     }

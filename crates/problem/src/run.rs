@@ -13,7 +13,7 @@ use crate::report::{
     rule_in_words, ContactReport, DofsReport, Iterations, Memory, MeshReport, Residuals, RunReport, SceneReport,
     SolverReport, Timings,
 };
-use crate::scene::{ContactLaw, Rule, Scene};
+use crate::scene::{ContactLaw, Rule, Scene, Valid};
 use crate::setup::{setup, MeshNotes, Setup};
 use crate::ProblemError;
 use contact::{ContactPoints, ContactSolution, PointValues};
@@ -92,10 +92,10 @@ pub fn run<B: Backend>(
     limits: Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, B::Error> {
-    scene.validate().map_err(ProblemError::from)?;
-    backend.refuse(scene)?;
+    let scene = scene.validate().map_err(ProblemError::from)?;
+    backend.refuse(&scene)?;
     let t_total = Instant::now();
-    let setup = begin(scene, mesh, backend.estimate(scene), &limits, reporter)?;
+    let setup = begin(scene, mesh, backend.estimate(&scene), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
     let t = Instant::now();
@@ -110,7 +110,7 @@ pub fn run<B: Backend>(
     stop_if_interrupted(&limits, "factorisation")?;
     let solved = match boundary {
         Some(b) => {
-            let how = ContactSolve::new(&setup.plan, scene, b.points.len(), limits.interrupt);
+            let how = ContactSolve::new(&setup.plan, &scene, b.points.len(), limits.interrupt);
             backend.solve_contact(&posed, &mut system, b, &how, reporter)?
         }
         None => backend.solve_linear(&posed, &mut system, reporter)?,
@@ -130,12 +130,12 @@ pub fn run<B: Backend>(
     let Some(Finished { u, phi, figures }) = backend.finish(&posed, system, x)? else {
         return Ok(None);
     };
-    check_solved(scene, (&u, &phi), contact.as_ref(), equilibrium)?;
+    check_solved(&scene, (&u, &phi), contact.as_ref(), equilibrium)?;
     if B::HELD_TO_TOLERANCE {
-        check_accurate(scene, &setup.plan, contact.as_ref(), equilibrium)?;
+        check_accurate(&scene, &setup.plan, contact.as_ref(), equilibrium)?;
     }
     let contact_pair = contact.as_ref().map(|(b, sol)| (b, sol));
-    let recovered = recover(scene, &setup, &disc, (&u, &phi), contact_pair, equilibrium, reporter)?;
+    let recovered = recover(&scene, &setup, &disc, (&u, &phi), contact_pair, equilibrium, reporter)?;
     let timings_s = Timings {
         setup: t_setup,
         assembly: t_assembly,
@@ -168,7 +168,7 @@ pub fn run<B: Backend>(
 /// `limits` before the memory is taken, then the [`Setup`], its plan and what the mesh's
 /// checks noted reported.
 fn begin(
-    scene: &Scene,
+    scene: Valid<'_>,
     mesh: Option<mesh::Mesh>,
     estimate: Option<(f64, String)>,
     limits: &Limits,
@@ -212,11 +212,11 @@ fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Result<(), Probl
 
 /// The discrete problem: the Dirichlet conditions checked to hold the body, the loads on the
 /// free dofs, checked finite.
-fn pose<'a>(scene: &'a Scene, setup: &'a Setup, disc: &'a Discretization<'a>) -> Result<Posed<'a>, ProblemError> {
+fn pose<'a>(scene: Valid<'a>, setup: &'a Setup, disc: &'a Discretization<'a>) -> Result<Posed<'a>, ProblemError> {
     disc.check_held().map_err(AssemblyError::from)?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
-    ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
-    ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
+    ProblemError::check_finite(&b_u, "the mechanical load vector", &scene)?;
+    ProblemError::check_finite(&b_phi, "the electric load vector", &scene)?;
     Ok(Posed {
         scene,
         setup,
@@ -293,11 +293,11 @@ fn check_accurate(
     }
     if let Some((_, sol)) = contact {
         let c = sol.info.complementarity;
-        if !(c <= scene.solver.tol) {
+        if !(c <= plan.tol) {
             return Err(ProblemError::inaccurate(
                 "complementarity residual of the final fields",
                 c,
-                scene.solver.tol,
+                plan.tol,
                 scene,
             ));
         }
@@ -387,7 +387,7 @@ struct Measured<'a> {
 
 /// The typed report of the run, whichever backend solved it.
 fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunReport {
-    let (scene, plan) = (posed.scene, posed.plan());
+    let (scene, plan) = (posed.scene.scene(), posed.plan());
     let (info, equilibrium, figures) = (m.info, m.equilibrium, m.figures);
     RunReport {
         scene: SceneReport::of(scene),
@@ -407,7 +407,7 @@ fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunReport {
             // with every residual within them (check_accurate)
             converged_to_tolerance: plan.rule == Rule::Tight
                 && equilibrium <= EQUILIBRIUM_TOL
-                && info.is_none_or(|i| i.complementarity <= scene.solver.tol),
+                && info.is_none_or(|i| i.complementarity <= plan.tol),
         },
         timings_s: m.timings_s,
         memory: Memory {
@@ -417,7 +417,7 @@ fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunReport {
         solver: SolverReport {
             strategy: plan.linear_strategy,
             rule: rule_in_words(plan.rule).into(),
-            tol: scene.solver.tol,
+            tol: plan.tol,
             pcg_rel_tol: figures.pcg_rel_tol,
             condense_route: figures.condense.map(|(route, _)| format!("{route:?}")),
             smallest_pivot_ratio: figures.smallest_pivot_ratio,

@@ -4,7 +4,7 @@
 
 use crate::exact::FieldSolution;
 use crate::plan::{electric_data, Plan};
-use crate::scene::{MaterialModel, MaterialSpec, MeshKind, Scene, SceneError};
+use crate::scene::{MaterialModel, MaterialSpec, MeshKind, Scene, SceneError, Valid};
 use crate::ProblemError;
 use fe_assembly::{Constraint, Crystal, Field, Load, Material};
 use std::sync::Arc;
@@ -40,12 +40,13 @@ pub struct MeshNotes {
     pub unused_nodes: usize,
 }
 
-/// Makes the [`Setup`] of a validated scene. `given` is the mesh of a `gmsh` scene, read by
-/// the caller (this crate does no IO); a generated mesh is made here.
+/// Makes the [`Setup`] of a validated scene ([`Scene::validate`]). `given` is the mesh of a
+/// `gmsh` scene, read by the caller (this crate does no IO); a generated mesh is made here.
 ///
 /// # Errors
 /// A [`ProblemError`] naming the scene key, mesh group or material at fault.
-pub fn setup(scene: &Scene, given: Option<mesh::Mesh>) -> Result<Setup, ProblemError> {
+pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, ProblemError> {
+    let scene = scene.scene();
     let (mesh, notes) = mesh(scene, given)?;
     let dim = mesh.dim;
     scene.check_dimension(dim)?;

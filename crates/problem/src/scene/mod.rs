@@ -9,7 +9,7 @@ mod validate;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
-pub use validate::SceneError;
+pub use validate::{SceneError, Valid};
 
 /// An enum of named choices: serde reads and writes the names, `name()` gives them, `ALL` lists
 /// the variants, and `FromStr` parses a name (with a message that names the key and lists the

@@ -85,12 +85,37 @@ fn refuse_if(given: bool, key: &str, reason: &str) -> Result<(), SceneError> {
     }
 }
 
+/// A scene that [`Scene::validate`] accepted: the one way into a run's set-up, so that a step
+/// given one knows its values are in range and its keys apply. It reads as the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Valid<'a>(&'a Scene);
+
+impl std::ops::Deref for Valid<'_> {
+    type Target = Scene;
+    fn deref(&self) -> &Scene {
+        self.0
+    }
+}
+
+impl<'a> Valid<'a> {
+    /// The scene.
+    pub fn scene(self) -> &'a Scene {
+        self.0
+    }
+}
+
 impl Scene {
-    /// Checks the whole scene.
+    /// Checks the whole scene; the scene as [`Valid`] where it passes.
     ///
     /// # Errors
     /// The first [`SceneError`] found, naming its key.
-    pub fn validate(&self) -> Result<(), SceneError> {
+    pub fn validate(&self) -> Result<Valid<'_>, SceneError> {
+        self.check_all()?;
+        Ok(Valid(self))
+    }
+
+    /// Every check of [`Scene::validate`].
+    fn check_all(&self) -> Result<(), SceneError> {
         validate_mesh(&self.mesh)?;
         if self.material.is_empty() {
             return Err(SceneError::new("material", "the scene has no [[material]]"));
