@@ -44,6 +44,9 @@ SEPARATED: int
 class PiezocontactError(Exception):
     """Every error of piezocontact."""
 
+    key: str | None
+    """The scene key at fault where the error is a scene value's (e.g. "contact.friction"), else None."""
+
 class InputError(PiezocontactError, ValueError):
     """A scene value, material, file or array that cannot be used; the message names it."""
 

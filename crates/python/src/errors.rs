@@ -105,6 +105,10 @@ impl Kind {
         let namespace = PyDict::new(py);
         namespace.set_item("__module__", "piezocontact")?;
         namespace.set_item("__doc__", doc)?;
+        if self == Kind::Base {
+            // the scene key at fault, on the instances of a scene value's error (to_py)
+            namespace.set_item("key", py.None())?;
+        }
         let class = py
             .get_type::<PyType>()
             .call1((name, PyTuple::new(py, bases)?, namespace))?
@@ -155,9 +159,40 @@ pub fn kind_of(e: &Error) -> Kind {
     }
 }
 
-/// The exception of an error of the files or the run, with its message.
+/// The exception of an error of the files or the run, with its message; where the error is a
+/// scene value's, its `key` attribute names the key (`None` elsewhere).
 pub fn to_py(e: Error) -> PyErr {
-    kind_of(&e).err(e.to_string())
+    let err = kind_of(&e).err(e.to_string());
+    let key = scene_key(&e);
+    Python::attach(|py| {
+        // an exception without the attribute is still the right exception
+        let _ = err.value(py).setattr("key", key);
+    });
+    err
+}
+
+/// The scene key an error names: a value the scene's validation refused, or the key of an
+/// override that does not apply.
+pub fn scene_key(e: &Error) -> Option<String> {
+    match e {
+        Error::Scene {
+            source: files::SceneFileError::Invalid(s),
+            ..
+        }
+        | Error::Problem(ProblemError::Scene(s)) => Some(s.key.clone()),
+        Error::Scene {
+            source: files::SceneFileError::Override { set, .. },
+            ..
+        } => Some(
+            set.trim_start_matches('~')
+                .split('=')
+                .next()
+                .unwrap_or(set)
+                .trim()
+                .to_string(),
+        ),
+        _ => None,
+    }
 }
 
 /// The exception of a mesh error, with its message.

@@ -46,8 +46,10 @@ def test_scene_errors_name_the_key_and_leave_the_scene_unchanged():
     with pytest.raises(pc.InputError, match="unknown field `nn`"):
         s.set("mesh.nn", 3)
     # friction does not apply to Signorini's law: the two changes go together
-    with pytest.raises(pc.InputError, match="contact.friction does not apply"):
+    with pytest.raises(pc.InputError, match="contact.friction does not apply") as info:
         s.set("contact.law", "signorini")
+    # the key is kept as data, not only in the message
+    assert info.value.key == "contact.friction"
     assert s.get("contact.law") == "coulomb" and s.get("mesh.n") == 8
     s.set({"contact.law": "signorini", "contact.friction": None})
     assert s.get("contact.law") == "signorini" and s.get("contact.friction") is None
@@ -61,8 +63,15 @@ def test_scene_errors_name_the_key_and_leave_the_scene_unchanged():
 
 def test_a_scene_for_the_petsc_backend_is_refused_not_solved_by_the_default_one():
     s = pc.Scene.load("paper", {"mesh.n": 4, "solver.backend": "petsc"})
-    with pytest.raises(pc.InputError, match='solver.backend = "petsc" is solved by the distributed backend'):
+    with pytest.raises(pc.InputError, match='solver.backend = "petsc" is solved by the distributed backend') as info:
         pc.run(s)
+    assert info.value.key == "solver.backend"
+
+
+def test_an_error_that_is_no_scene_values_has_no_key():
+    with pytest.raises(pc.InputError) as info:
+        pc.Scene.load("papper")
+    assert info.value.key is None
 
 
 def test_scene_sources_name_what_is_wrong(tmp_path):
