@@ -368,7 +368,7 @@ pub fn markdown(s: &Study, img: &str) -> String {
 /// per strategy, at its tightest tolerance). Names start with `prefix`.
 ///
 /// # Errors
-/// [`DriverError::Picture`] where plotters cannot draw.
+/// [`files::Error::Picture`] where plotters cannot draw.
 pub fn pictures(prefix: &str, s: &Study) -> Result<plots::Files, DriverError> {
     let mut strategies: Vec<Strategy> = vec![];
     for r in &s.rows {

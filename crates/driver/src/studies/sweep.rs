@@ -138,7 +138,7 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
 /// Two panels against the parameter: the contact states, and the contact forces.
 ///
 /// # Errors
-/// [`DriverError::Picture`] where plotters cannot draw.
+/// [`files::Error::Picture`] where plotters cannot draw.
 pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverError> {
     let along = |f: fn(&SweepRow) -> f64| rows.iter().map(|r| (r.value, f(r))).collect::<Vec<_>>();
     let states = Panel {
