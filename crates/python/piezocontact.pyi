@@ -149,7 +149,8 @@ class Contact:
         """Initial gaps, (m,)."""
     @property
     def u_n(self) -> npt.NDArray[np.float64]:
-        """Normal displacement, (m,): `u_n <= gap`."""
+        """Normal displacement, (m,): `u_n <= gap` on a rigid foundation; the penetration
+        `u_n - gap` gives the pressure `k [u_n - gap]_+^m` on a compliant one."""
     @property
     def u_t(self) -> npt.NDArray[np.float64]:
         """Tangential displacement, (m, dim - 1)."""

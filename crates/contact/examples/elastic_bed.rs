@@ -80,6 +80,7 @@ fn main() {
         gap: vec![0.0; n],
         friction: vec![friction; n],
         held: vec![[false; 2]; n],
+        foundation: Default::default(),
     };
     let mut problem = DenseContactProblem {
         u0,

@@ -183,6 +183,7 @@ impl<'p> Sweeper<'p> {
                     Law::Coulomb => PointLaw::Coulomb(points.friction[i]),
                 },
                 held: points.held[i],
+                foundation: points.foundation,
             };
             let mut x0 = [0.0; 3];
             for (k, x) in x0.iter_mut().enumerate().take(1 + nt) {

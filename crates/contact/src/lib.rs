@@ -28,6 +28,7 @@
 //!     dim: 2, position: vec![[0.0; 3]], normal: vec![[0.0, -1.0, 0.0]],
 //!     tangent: vec![[[1.0, 0.0, 0.0], [0.0; 3]]], weight: vec![1.0], gap: vec![0.0], friction: vec![0.0],
 //!     held: vec![[false; 2]],
+//!     foundation: Default::default(),
 //! };
 //! let mut op = DenseContactProblem {
 //!     u0: PointValues::from_parts(vec![1.0], vec![], 0).unwrap(),
@@ -52,7 +53,7 @@ mod uzawa;
 pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
 pub use newton::{solve_newton, NewtonParams};
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};
-pub use points::{ContactPoints, PointValues, Status};
+pub use points::{ContactPoints, Foundation, PointValues, Status};
 pub use projection::{project_cone, project_disc, project_nonnegative};
 pub use solution::{
     classify, complementarity_residual, coulomb_radius, desaxce_residual, slip_bound, ContactInfo, ContactSolution,
@@ -252,6 +253,16 @@ pub enum InputError {
         nt: usize,
         /// The order they need.
         m: usize,
+    },
+    /// A foundation's parameter out of its range.
+    #[error("normal compliance: {what} {value} {must}")]
+    Foundation {
+        /// `stiffness` or `exponent`.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        must: &'static str,
     },
     /// Tresca's bounds are not one finite non-negative value per point.
     #[error("Tresca slip bounds: one finite non-negative value per point")]

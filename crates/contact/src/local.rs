@@ -10,6 +10,7 @@
 //! search, and, should it stall, the projected fixed point `x ← P(z(x))` with a shrinking `c`.
 //! The answer is the iterate with the least equations' norm.
 
+use crate::points::Foundation;
 use crate::projection::{norm, project_disc};
 
 /// The law at one point.
@@ -32,6 +33,8 @@ pub(crate) struct Point {
     pub(crate) k: usize,
     pub(crate) law: PointLaw,
     pub(crate) held: [bool; 2],
+    /// The foundation, which gives the normal law.
+    pub(crate) foundation: Foundation,
 }
 
 /// Newton steps before the fixed point takes over.
@@ -49,10 +52,11 @@ impl Point {
             z[r] = x[r] + c * (u - if r == 0 { self.g } else { 0.0 });
         }
         let mut f = [0.0; 3];
-        f[0] = x[0] - crate::project_nonnegative(z[0]);
+        // the penetration u_n - g = (z_n - x_n) / c
+        f[0] = self.foundation.normal_residual(x[0], (z[0] - x[0]) / c, c);
         let mut t = [z[1], z[2]];
         self.hold(&mut t);
-        project_disc(&mut t[..k - 1], self.radius(z[0]));
+        project_disc(&mut t[..k - 1], self.radius(self.normal(x, &z)));
         for r in 1..k {
             f[r] = x[r] - t[r - 1];
         }
@@ -68,6 +72,15 @@ impl Point {
         }
     }
 
+    /// The normal value the radius is taken at: `z_n` on a rigid foundation, the pressure
+    /// `x_n` on a compliant one.
+    fn normal(&self, x: &[f64; 3], z: &[f64; 3]) -> f64 {
+        match self.foundation {
+            Foundation::Rigid => z[0],
+            Foundation::Compliant { .. } => x[0],
+        }
+    }
+
     fn radius(&self, zn: f64) -> f64 {
         match self.law {
             PointLaw::Frictionless => 0.0,
@@ -78,7 +91,7 @@ impl Point {
 
     /// The Newton matrix at `z`: `J = ∂F/∂x` on the branch of `z`, with `M = I - c A` the
     /// derivative of `z`.
-    fn jacobian(&self, z: &[f64; 3], c: f64) -> [[f64; 3]; 3] {
+    fn jacobian(&self, x: &[f64; 3], z: &[f64; 3], c: f64) -> [[f64; 3]; 3] {
         let k = self.k;
         let mut m = [[0.0; 3]; 3];
         for r in 0..k {
@@ -87,13 +100,20 @@ impl Point {
             }
         }
         let mut jac = [[0.0; 3]; 3];
+        let compliance = self.foundation.equation(x[0], (z[0] - x[0]) / c, c);
         for j in 0..k {
-            jac[0][j] = if j == 0 { 1.0 } else { 0.0 } - if z[0] > 0.0 { m[0][j] } else { 0.0 };
+            let e = if j == 0 { 1.0 } else { 0.0 };
+            jac[0][j] = match compliance {
+                None => e - if z[0] > 0.0 { m[0][j] } else { 0.0 },
+                // (x_n - k [b_n - (A x)_n - g]₊^m) / s, the scale held
+                Some((_, scale, slope)) => (e + slope * self.a[0][j]) / scale,
+            };
         }
         let mut q = [z[1], z[2]];
         self.hold(&mut q);
         let qn = norm(&q[..k - 1]);
-        let radius = self.radius(z[0]);
+        let normal = self.normal(x, z);
+        let radius = self.radius(normal);
         for r in 1..k {
             for j in 0..k {
                 let identity = if r == j { 1.0 } else { 0.0 };
@@ -109,8 +129,19 @@ impl Point {
                         v -= radius / qn * proj * m[l][j];
                     }
                     if let PointLaw::Coulomb(mu) = self.law {
-                        if z[0] > 0.0 {
-                            v -= q[r - 1] / qn * mu * m[0][j];
+                        if normal > 0.0 {
+                            // dR = F M_n (rigid: R = F [z_n]₊), F e_n (compliant: R = F x_n)
+                            let dn = match compliance {
+                                None => m[0][j],
+                                Some(_) => {
+                                    if j == 0 {
+                                        1.0
+                                    } else {
+                                        0.0
+                                    }
+                                }
+                            };
+                            v -= q[r - 1] / qn * mu * dn;
                         }
                     }
                     v
@@ -138,7 +169,7 @@ impl Point {
             if done(&f, &x, c) {
                 return x;
             }
-            let Some(d) = solve_small(self.jacobian(&z, c), f, k) else {
+            let Some(d) = solve_small(self.jacobian(&x, &z, c), f, k) else {
                 break;
             };
             let current = two(&f);
@@ -229,6 +260,7 @@ mod tests {
             k: 3,
             law: PointLaw::Coulomb(0.3),
             held: [false; 2],
+            foundation: Foundation::Rigid,
         };
         let x = p.solve([0.0; 3]);
         assert!(
@@ -248,5 +280,36 @@ mod tests {
             ..stick
         };
         assert_eq!(away.solve([1.0, 1.0, 1.0]), [0.0; 3]);
+    }
+
+    /// A point on a linear spring bed (`m = 1`, `k = 4`), `A = diag(2, 1)`, pressed by
+    /// `b_n = 1`, pulled by `b_t = -0.5`, `F = 0.3`: `x_n = k (b_n - 2 x_n)` gives
+    /// `x_n = k b_n / (1 + 2 k) = 4/9`; the slip bound `F x_n = 2/15` is below the stick force
+    /// `|b_t| = 1/2`, so the point slides with `|x_t| = 2/15`. With `m = 2` (`k = 4`),
+    /// `x_n = 4 (1 - 2 x_n)²`, the root below 1/2: `x_n = (17 - √33)/32`.
+    #[test]
+    fn a_point_on_a_compliant_bed() {
+        let at = |exponent: f64| {
+            Point {
+                a: [[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]],
+                b: [1.0, -0.5, 0.0],
+                g: 0.0,
+                k: 2,
+                law: PointLaw::Coulomb(0.3),
+                held: [false; 2],
+                foundation: Foundation::Compliant {
+                    stiffness: 4.0,
+                    exponent,
+                },
+            }
+            .solve([0.0; 3])
+        };
+        let x = at(1.0);
+        assert!((x[0] - 4.0 / 9.0).abs() < 1e-14, "{x:?}");
+        assert!((x[1] + 0.3 * 4.0 / 9.0).abs() < 1e-14, "{x:?}");
+        let x = at(2.0);
+        let xn = (17.0 - 33f64.sqrt()) / 32.0;
+        assert!((x[0] - xn).abs() < 1e-14, "{x:?} {xn}");
+        assert!((x[1] + 0.3 * xn).abs() < 1e-14, "{x:?}");
     }
 }

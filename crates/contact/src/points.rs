@@ -25,6 +25,67 @@ pub struct ContactPoints {
     /// force, and the law acts in the other directions. `[false; 2]` where the point may slide
     /// in every direction; only the first `dim - 1` entries are read.
     pub held: Vec<[bool; 2]>,
+    /// What the points press on: a rigid foundation (Signorini's conditions) or a deformable
+    /// one (normal compliance).
+    pub foundation: Foundation,
+}
+
+/// The foundation under the contact points, which gives the normal law.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Foundation {
+    /// Rigid: Signorini's conditions `u_n ≤ g`, `λ_n ≥ 0`, `λ_n (u_n - g) = 0`.
+    #[default]
+    Rigid,
+    /// Deformable, by normal compliance: `λ_n = k [u_n - g]₊^m` (the penetration's power
+    /// law; `m = 1` a linear spring bed).
+    Compliant {
+        /// `k > 0`: pressure per unit penetration to the power `m`.
+        stiffness: f64,
+        /// `m ≥ 1`.
+        exponent: f64,
+    },
+}
+
+impl Foundation {
+    /// The pressure of the foundation at the penetration `p = u_n - g` (compliance), with its
+    /// derivative: `(k [p]₊^m, k m [p]₊^(m-1))`; `None` for a rigid foundation.
+    pub fn pressure(self, p: f64) -> Option<(f64, f64)> {
+        match self {
+            Foundation::Rigid => None,
+            Foundation::Compliant { stiffness, exponent } => {
+                let q = crate::project_nonnegative(p);
+                if q == 0.0 {
+                    return Some((0.0, 0.0));
+                }
+                Some((
+                    stiffness * q.powf(exponent),
+                    stiffness * exponent * q.powf(exponent - 1.0),
+                ))
+            }
+        }
+    }
+
+    /// The compliance's equation at a point, `f = (λ_n - k [p]₊^m) / s` with
+    /// `s = 1 + k m [p]₊^(m-1) / c` (`p = u_n - g`, `c` the natural map's constant), and the
+    /// derivative of `λ_n - k [p]₊^m` in `p`, `k m [p]₊^(m-1)`: `(f, s, slope)`; `None` on a
+    /// rigid foundation. The scale `s` makes the equation of order one in both limits: a soft
+    /// bed's `λ_n - k p^m`, a stiff one's `c (λ_n / (k m p^(m-1)) - p / m)`, which tends to
+    /// Signorini's `-c (u_n - g)` in contact (unscaled, the equation of a stiff bed holds only
+    /// to `k` times the round-off of `u_n`).
+    pub fn equation(self, lambda_n: f64, penetration: f64, c: f64) -> Option<(f64, f64, f64)> {
+        let (pressure, slope) = self.pressure(penetration)?;
+        let scale = 1.0 + slope / c;
+        Some(((lambda_n - pressure) / scale, scale, slope))
+    }
+
+    /// The normal part of the natural-map residual: Signorini's `λ_n - [λ_n + c (u_n - g)]₊`,
+    /// or the compliance's scaled equation ([`Foundation::equation`]).
+    pub fn normal_residual(self, lambda_n: f64, penetration: f64, c: f64) -> f64 {
+        match self.equation(lambda_n, penetration, c) {
+            None => lambda_n - crate::project_nonnegative(lambda_n + c * penetration),
+            Some((f, _, _)) => f,
+        }
+    }
 }
 
 impl ContactPoints {
@@ -96,6 +157,22 @@ impl ContactPoints {
             }
             if !(self.friction[i] >= 0.0 && self.friction[i].is_finite()) {
                 return Err(bad(i, "friction", self.friction[i], "must be finite and non-negative"));
+            }
+        }
+        if let Foundation::Compliant { stiffness, exponent } = self.foundation {
+            if !(stiffness > 0.0 && stiffness.is_finite()) {
+                return Err(InputError::Foundation {
+                    what: "stiffness",
+                    value: stiffness,
+                    must: "must be positive and finite",
+                });
+            }
+            if !(exponent >= 1.0 && exponent.is_finite()) {
+                return Err(InputError::Foundation {
+                    what: "exponent",
+                    value: exponent,
+                    must: "must be finite and at least 1",
+                });
             }
         }
         Ok(())

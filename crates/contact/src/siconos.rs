@@ -323,6 +323,7 @@ impl FrictionProblem {
             gap: vec![0.0; nc],
             friction: self.mu.clone(),
             held: vec![[false; 2]; nc],
+            foundation: Default::default(),
         }
     }
 

@@ -314,7 +314,9 @@ pub fn complementarity_residual(
     let mut r = PointValues::zeros(n, nt);
     let mut buf = [0.0; 2];
     for i in 0..n {
-        r.normal[i] = lambda.normal[i] - project_nonnegative(lambda.normal[i] + c * (u.normal[i] - points.gap[i]));
+        r.normal[i] = points
+            .foundation
+            .normal_residual(lambda.normal[i], u.normal[i] - points.gap[i], c);
         if nt > 0 {
             let (l, ut) = (lambda.tangential_of(i), u.tangential_of(i));
             for k in 0..nt {

@@ -184,6 +184,14 @@ pub fn solve(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
+    if points.foundation != crate::Foundation::Rigid {
+        // its projections are onto Signorini's cone: a compliant foundation's law is no
+        // projection
+        return Err(InputError::Unsupported(
+            "normal compliance is solved by semismooth Newton or block Gauss-Seidel (solve_newton, solve_gauss_seidel), not by Uzawa's projections",
+        )
+        .into());
+    }
     if params.accelerate && params.rule == StopRule::Paper {
         return Err(
             InputError::Unsupported("acceleration needs the tight rule (the paper's rule is plain Uzawa)").into(),

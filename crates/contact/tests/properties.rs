@@ -20,6 +20,7 @@ fn points(n: usize, dim: usize, w: &[f64], friction: f64) -> ContactPoints {
         gap: vec![0.0; n],
         friction: vec![friction; n],
         held: vec![[false; 2]; n],
+        foundation: Default::default(),
     }
 }
 
@@ -115,6 +116,37 @@ proptest! {
         let gs = solve_gauss_seidel(&mut op.clone(), &pts, &Law::Coulomb, &GaussSeidelParams { tol: 1e-13, ..Default::default() }, None, &mut |_| {}).unwrap();
         let d = gs.lambda.minus(&newton.lambda).norm();
         prop_assert!(d <= 1e-8 * newton.lambda.norm().max(1e-300), "{d}");
+    }
+
+    /// On a compliant foundation (`λ_n = k [u_n - g]₊^m`, `k` over nine decades, `m` from 1
+    /// to 3), with Coulomb's law, Tresca's or none: Newton and block Gauss-Seidel find the same
+    /// solution, and it meets the law (the pressure the bed gives, friction within its
+    /// bound).
+    #[test]
+    fn compliant_foundations_newton_and_gauss_seidel_agree(n in 1usize..=5, dim in 2usize..=3, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 5), load in prop::collection::vec(-1.0f64..1.0, 15), f in 0.05f64..0.3, log_k in -3.0f64..6.0, m in 1.0f64..3.0, which in 0usize..3) {
+        let nt = dim - 1;
+        let mut pts = points(n, dim, &w, f);
+        pts.foundation = contact::Foundation::Compliant { stiffness: 10f64.powf(log_k), exponent: m };
+        let law = match which {
+            0 => Law::Coulomb,
+            1 => Law::Tresca(vec![0.1; n]),
+            _ => Law::Frictionless,
+        };
+        let nt = if which == 2 { 0 } else { nt };
+        let op = problem(n, nt, &pts, &seed, &load);
+        let newton = solve_newton(&mut op.clone(), &pts, &law, &NewtonParams { tol: 1e-12, ..Default::default() }, None, &mut |_| {}).unwrap();
+        let gs = solve_gauss_seidel(&mut op.clone(), &pts, &law, &GaussSeidelParams { tol: 1e-12, ..Default::default() }, None, &mut |_| {}).unwrap();
+        let scale = newton.lambda.norm().max(1e-12);
+        prop_assert!(gs.lambda.minus(&newton.lambda).norm() <= 1e-7 * scale, "{:?} {:?}", gs.lambda, newton.lambda);
+        let k = 10f64.powf(log_k);
+        for i in 0..n {
+            let pressure = k * newton.u.normal[i].max(0.0).powf(m);
+            prop_assert!((newton.lambda.normal[i] - pressure).abs() <= 1e-8 * (1.0 + pressure) * (1.0 + k), "point {i}");
+        }
+        prop_assert!(newton.info.complementarity <= 1e-12);
+        // Uzawa refuses a law that is no projection, by a typed error
+        let e = solve(&mut op.clone(), &pts, &law, &tight(1e-10), None, &mut |_| {}).unwrap_err();
+        prop_assert!(matches!(e, ContactError::Input(contact::InputError::Unsupported(_))), "{e}");
     }
 
     /// Tiny frictionless problems: Uzawa's answer equals the one found by enumerating the

@@ -21,6 +21,10 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ),
     ("paper-stick", include_str!("../../../scenes/paper-stick.toml")),
     ("paper-tresca", include_str!("../../../scenes/paper-tresca.toml")),
+    (
+        "paper-compliance",
+        include_str!("../../../scenes/paper-compliance.toml"),
+    ),
     ("paper-elastic", include_str!("../../../scenes/paper-elastic.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),

@@ -196,6 +196,13 @@ impl ContactBoundary {
             gap: vec![],
             friction: vec![],
             held: vec![],
+            foundation: match spec.compliance {
+                Some(k) => contact::Foundation::Compliant {
+                    stiffness: k.stiffness,
+                    exponent: k.exponent,
+                },
+                None => contact::Foundation::Rigid,
+            },
         };
         let (mut nodes, mut point_dofs, mut slots) = (vec![], vec![], vec![]);
         let (mut held_nodes, mut held_inside) = (0, 0);

@@ -3,7 +3,7 @@
 //! out is not built (no electric unknowns, no contact boundary, no tangential multipliers, no
 //! output file), and the printed plan is this same value.
 
-use crate::scene::{choice, ContactLaw, ContactSolver, MeshKind, Rule, Scene, Strategy};
+use crate::scene::{choice, ComplianceSpec, ContactLaw, ContactSolver, MeshKind, Rule, Scene, Strategy};
 use fe_assembly::Material;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -46,6 +46,10 @@ pub struct Plan {
     pub rule: Rule,
     /// The files the run writes.
     pub outputs: Vec<Output>,
+    /// The foundation's normal compliance (absent: a rigid foundation, Signorini's
+    /// conditions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<ComplianceSpec>,
     /// The contact solve's complementarity tolerance (`solver.tol`).
     #[serde(skip)]
     pub tol: f64,
@@ -92,6 +96,11 @@ impl Plan {
             linear_strategy: strategy,
             rule: scene.solver.rule,
             outputs,
+            compliance: scene
+                .contact
+                .as_ref()
+                .filter(|_| law != ContactLaw::None)
+                .and_then(|c| c.compliance),
             tol: scene.solver.tol,
             pcg_tol: scene.solver.pcg_tol.unwrap_or(match scene.solver.rule {
                 Rule::Paper => 1e-2,
@@ -138,10 +147,14 @@ impl fmt::Display for Plan {
         let outputs: Vec<&str> = self.outputs.iter().map(|o| o.name()).collect();
         write!(
             f,
-            "plan: {}D, electric unknowns: {}, contact: {}{}{}, linear: {}, rule: {}, outputs: {}",
+            "plan: {}D, electric unknowns: {}, contact: {}{}{}{}, linear: {}, rule: {}, outputs: {}",
             self.dim,
             if self.electric { "yes" } else { "left out" },
             self.contact_law,
+            match self.compliance {
+                Some(k) => format!(" on a compliant foundation (k = {:e}, m = {})", k.stiffness, k.exponent),
+                None => String::new(),
+            },
             if self.friction { " (tangential multipliers)" } else { "" },
             if self.fixed_point { " + fixed point on S" } else { "" },
             self.linear_strategy,

@@ -179,3 +179,17 @@ def test_progress_reaches_a_callable():
     assert lines[0].startswith("plan:")
     assert any(line.strip().startswith("newton") for line in lines)
     assert any(line.startswith("solve") for line in lines)
+
+
+def test_a_compliant_foundation_gives_the_pressure_of_its_law():
+    """`contact.compliance` from Python, as from a scene file: every point's pressure is the
+    bed's `k [u_n - g]_+^m` of its penetration, and a first-order strategy is refused by key."""
+    k, m = 100.0, 2.0
+    s = pc.Scene.load("paper", {"mesh.n": 8, "contact.compliance": {"stiffness": k, "exponent": m}})
+    c = pc.run(s).contact
+    pressure = k * np.maximum(c.u_n - c.gap, 0.0) ** m
+    assert np.allclose(c.lambda_n, pressure, rtol=1e-8, atol=1e-12 * pressure.max())
+    assert (c.u_n > c.gap).any(), "the bed is pressed in"
+    with pytest.raises(pc.InputError) as info:
+        s.set("solver.strategy", "uzawa-condensed")
+    assert info.value.key == "contact.compliance"

@@ -267,6 +267,7 @@ mod tests {
                     gap: vec![0.0; n],
                     friction: vec![0.3; n],
                     held: vec![[false; 2]; n],
+                    foundation: Default::default(),
                 };
                 // an SPD compliance with zeros: a Gram matrix plus the identity
                 let g = |i: usize, j: usize| ((i * 7 + j * 3 + case) % 5) as f64 * 0.1 - 0.2;

@@ -8,7 +8,7 @@
 //! `E_r`, `B_r` sparse over the point's own components.
 
 use crate::operator::Compliance;
-use crate::points::{ContactPoints, PointValues};
+use crate::points::{ContactPoints, Foundation, PointValues};
 use crate::Law;
 
 /// One row of the generalised Jacobian, `J_r = E_r + B_r C`: `(index, coefficient)` pairs.
@@ -181,9 +181,14 @@ impl<'a> Flat<'a> {
         p
     }
 
-    /// The radius of point `i` at `z`: Tresca `S`, Coulomb `F [z_n]₊`.
-    pub(super) fn radius(&self, i: usize, z: &[f64]) -> f64 {
-        self.law.radius(self.points, i, z[i])
+    /// The radius of point `i` at `z` (the multipliers `x`): Tresca `S`, Coulomb `F [z_n]₊`
+    /// on a rigid foundation, `F [λ_n]₊` on a compliant one (whose `λ_n` is the pressure).
+    pub(super) fn radius(&self, i: usize, z: &[f64], x: &[f64]) -> f64 {
+        let normal = match self.points.foundation {
+            Foundation::Rigid => z[i],
+            Foundation::Compliant { .. } => x[i],
+        };
+        self.law.radius(self.points, i, normal)
     }
 
     pub(super) fn state(&self, x: Vec<f64>) -> State {
@@ -200,11 +205,15 @@ impl<'a> Flat<'a> {
         let mut f = vec![0.0; m];
         let mut buf = [0.0; 2];
         for i in 0..self.n {
-            f[i] = x[i] - crate::project_nonnegative(z[i]);
+            f[i] = self
+                .points
+                .foundation
+                .normal_residual(x[i], u[i] - self.points.gap[i], self.c[i]);
             if self.nt > 0 {
                 let t = self.layout().index(i, 1);
                 buf[..self.nt].copy_from_slice(&z[t..t + self.nt]);
-                self.points.project_friction(i, &mut buf[..self.nt], self.radius(i, &z));
+                self.points
+                    .project_friction(i, &mut buf[..self.nt], self.radius(i, &z, &x));
                 for k in 0..self.nt {
                     f[t + k] = x[t + k] - buf[k];
                 }
@@ -220,11 +229,19 @@ impl<'a> Flat<'a> {
         let (n, nt) = (self.n, self.nt);
         let mut rows = vec![RowForm::default(); self.m];
         for i in 0..n {
-            // normal: [z_n]₊ has derivative 1 (contact: J = C) or 0 (separated: J = I)
-            if s.z[i] > 0.0 {
-                rows[i].b.push((i, 1.0));
-            } else {
-                rows[i].e.push((i, 1.0));
+            let penetration = s.u[i] - self.points.gap[i];
+            match self.points.foundation.equation(s.x[i], penetration, self.c[i]) {
+                // normal: [z_n]₊ has derivative 1 (contact: J = C) or 0 (separated: J = I)
+                None if s.z[i] > 0.0 => rows[i].b.push((i, 1.0)),
+                None => rows[i].e.push((i, 1.0)),
+                // (λ_n - k [u_n - g]₊^m) / s, with ∂u/∂λ = -(D W + σ I) = -C / c and the scale
+                // s held: J = (I + (k'/c) C) / s
+                Some((_, scale, slope)) => {
+                    rows[i].e.push((i, 1.0 / scale));
+                    if slope > 0.0 {
+                        rows[i].b.push((i, slope / (self.c[i] * scale)));
+                    }
+                }
             }
             if nt == 0 {
                 continue;
@@ -236,7 +253,7 @@ impl<'a> Flat<'a> {
             self.points.hold(i, &mut held_out[..nt]);
             let q = &held_out[..nt];
             let qn = crate::projection::norm(q);
-            let radius = self.radius(i, &s.z);
+            let radius = self.radius(i, &s.z, &s.x);
             let branch = if !(radius > 0.0) {
                 Branch::Separated
             } else if qn <= radius {
@@ -260,8 +277,10 @@ impl<'a> Flat<'a> {
                         // λ_t - S q/|q|: derivative I - (S/|q|)(I - q̂q̂ᵀ) M_t - q̂ dS, with
                         // dS = F M_n for Coulomb at a contact point
                         let ratio = radius / qn;
+                        let rigid = self.points.foundation == Foundation::Rigid;
                         let slope = match self.law {
-                            Law::Coulomb if s.z[i] > 0.0 => self.points.friction[i],
+                            Law::Coulomb if rigid && s.z[i] > 0.0 => self.points.friction[i],
+                            Law::Coulomb if !rigid && s.x[i] > 0.0 => self.points.friction[i],
                             _ => 0.0,
                         };
                         row.e.push((t + k, 1.0));
@@ -273,8 +292,12 @@ impl<'a> Flat<'a> {
                             }
                         }
                         if slope > 0.0 {
+                            // dS = F M_n = F (I - C)_n on a rigid foundation (S = F [z_n]₊),
+                            // F e_n on a compliant one (S = F λ_n)
                             row.e.push((i, -q[k] / qn * slope));
-                            row.b.push((i, q[k] / qn * slope));
+                            if rigid {
+                                row.b.push((i, q[k] / qn * slope));
+                            }
                         }
                     }
                 }

@@ -650,8 +650,8 @@ fn fallback<P: AffineProblem>(
     for i in 0..n {
         points.project_friction(i, start.tangential_of_mut(i), radius[i]);
     }
-    let mut sol = if *law == Law::Coulomb {
-        // Coulomb's law directly, point by point
+    let mut sol = if *law == Law::Coulomb || points.foundation != crate::Foundation::Rigid {
+        // Coulomb's law, or a compliant foundation's, directly, point by point
         let gs = GaussSeidelParams {
             tol: params.tol,
             measure: params.measure,

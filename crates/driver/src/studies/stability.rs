@@ -267,6 +267,38 @@ pub const CASES: &[Case] = &[
         fine: true,
     },
     Case {
+        name: "soft bed",
+        why: "normal compliance k = 0.1 GPa/m, 1e-3 of the block's stiffness c33 / H",
+        scene: "paper-compliance",
+        sets: &["mesh.n=128", "contact.compliance.stiffness=0.1"],
+        // the paper's Uzawa projects onto Signorini's cone: compliance is refused by key
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "stiff bed",
+        why: "normal compliance k = 1e14 GPa/m, 1e12 of c33 / H: tends to the rigid foundation",
+        scene: "paper-compliance",
+        sets: &["mesh.n=128", "contact.compliance.stiffness=1e14"],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "quadratic bed",
+        why: "normal compliance m = 2 (k = 1e4 GPa/m²): the law's slope vanishes at first touch",
+        scene: "paper-compliance",
+        sets: &[
+            "mesh.n=128",
+            "contact.compliance.stiffness=1e4",
+            "contact.compliance.exponent=2",
+        ],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "n = 1024",
         why: "2D, 6.3 million unknowns",
         scene: "paper",

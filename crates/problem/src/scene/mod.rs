@@ -639,6 +639,27 @@ pub struct ContactSpec {
     pub gap_center: Option<Vec<f64>>,
     /// Outward normal of the contact face.
     pub normal: Vec<f64>,
+    /// A deformable foundation (normal compliance, `λ_n = k [u_n - g]₊^m`); absent: a rigid
+    /// one (Signorini's conditions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<ComplianceSpec>,
+}
+
+/// Normal compliance: the foundation's pressure `λ_n = k [u_n - g]₊^m` at the penetration
+/// `u_n - g` (Oden and Martins 1985; docs/theory.md).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ComplianceSpec {
+    /// `k > 0`: pressure per unit penetration to the power `m` (the scene's units: GPa per
+    /// m^m in the scaled scenes).
+    pub stiffness: f64,
+    /// `m ≥ 1` (1 by default: a linear spring bed).
+    #[serde(default = "one")]
+    pub exponent: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 impl ContactSpec {
@@ -653,6 +674,7 @@ impl ContactSpec {
             gap_curvature: 0.0,
             gap_center: None,
             normal: normal.to_vec(),
+            compliance: None,
         }
     }
 

@@ -169,6 +169,7 @@ impl Scene {
             validate_contact(c)?;
         }
         validate_solver(&self.solver)?;
+        refuse_compliance(self)?;
         refuse_backend(self)?;
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
@@ -459,6 +460,26 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
     }
     all_finite("contact.gap_center", c.gap_center.as_deref().unwrap_or_default())?;
     all_finite("contact.normal", &c.normal)?;
+    if let Some(k) = &c.compliance {
+        if !(k.stiffness > 0.0 && k.stiffness.is_finite()) {
+            return Err(SceneError::new(
+                "contact.compliance.stiffness",
+                format!(
+                    "contact.compliance.stiffness = {} must be positive and finite (a rigid foundation: remove contact.compliance)",
+                    k.stiffness
+                ),
+            ));
+        }
+        if !(k.exponent >= 1.0 && k.exponent.is_finite()) {
+            return Err(SceneError::new(
+                "contact.compliance.exponent",
+                format!(
+                    "contact.compliance.exponent = {} must be finite and at least 1 (below 1 the law is not Lipschitz at first touch)",
+                    k.exponent
+                ),
+            ));
+        }
+    }
     match c.law {
         ContactLaw::Signorini => {
             let why = "friction, and contact.law = \"signorini\" is frictionless";
@@ -488,6 +509,32 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
 /// What the PETSc backend does not take: a contact normal that is not a coordinate axis (its
 /// active-set iteration holds the normal and tangential components as unknowns of the system),
 /// a strategy or rule of the default backend's contact solvers (it runs its own).
+/// A compliant foundation's law is no projection: only semismooth Newton (with block
+/// Gauss-Seidel as its last stage) solves it, and the PETSc backend's active sets do not.
+fn refuse_compliance(s: &Scene) -> Result<(), SceneError> {
+    if !s
+        .contact
+        .as_ref()
+        .is_some_and(|c| c.compliance.is_some() && c.law != ContactLaw::None)
+    {
+        return Ok(());
+    }
+    if s.solver.backend == BackendChoice::Petsc {
+        return Err(SceneError::new(
+            "contact.compliance",
+            "contact.compliance (a deformable foundation): the PETSc backend's active sets hold Signorini's conditions only; use the default backend",
+        ));
+    }
+    refuse_if(
+        s.solver.strategy != Strategy::NewtonCondensed,
+        "contact.compliance",
+        &format!(
+            "a deformable foundation, and solver.strategy = \"{}\" projects onto Signorini's conditions: normal compliance is solved by newton-condensed",
+            s.solver.strategy
+        ),
+    )
+}
+
 fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
     if s.solver.backend != BackendChoice::Petsc {
         return Ok(());
