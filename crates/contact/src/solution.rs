@@ -60,6 +60,12 @@ pub struct ContactInfo {
     pub step_backoffs: usize,
     /// Halvings of the friction fixed point's relaxation factor (a residual that did not fall).
     pub relaxations: usize,
+    /// The measured contraction of an outer fixed point (the largest ratio of successive
+    /// changes of slip-weakening friction's coefficients, [`crate::solve_slip_weakening`]);
+    /// `None` where none ran, or it took fewer than two steps. At or above 1 the map was not
+    /// contractive along the way: the static problem may have several solutions, and this is
+    /// the branch reached from the stick start.
+    pub contraction: Option<f64>,
 }
 
 impl ContactInfo {
@@ -82,6 +88,7 @@ impl ContactInfo {
             residual: f64::NAN,
             step_backoffs: 0,
             relaxations: 0,
+            contraction: None,
         }
     }
 }

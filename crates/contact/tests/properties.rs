@@ -783,3 +783,77 @@ fn slow_failures_are_told_early() {
         other => panic!("{other}"),
     }
 }
+
+/// One point, `D W = diag(2, 1)`, pressed by `u0_n = 1`, pulled by `u0_t = -0.5`: it closes
+/// with `λ_n = 1/2` and, where `μ/2 < 1/2`, slides by `s = (1 - μ)/2`. With the linear
+/// slip-weakening law `μ(s) = μ_s - (μ_s - μ_d) s / L` (`s < L`) the fixed point is
+/// `μ* = (μ_s - Δ/(2L)) / (1 - Δ/(2L))`, `Δ = μ_s - μ_d`; the map's slope `Δ/(2L)` is its
+/// contraction. Equal coefficients give Coulomb's answer to round-off.
+#[test]
+fn slip_weakening_on_one_point_is_its_hand_solution() {
+    use contact::{solve_slip_weakening, SlipWeakening, Weakening, WeakeningParams};
+    let pts = ContactPoints {
+        weight: vec![1.0],
+        ..points(1, 2, &[0.5], 0.6)
+    };
+    let op = DenseContactProblem {
+        u0: PointValues::from_parts(vec![1.0], vec![-0.5], 1).unwrap(),
+        compliance: vec![2.0, 0.0, 0.0, 1.0],
+        weight: vec![1.0],
+        nt: 1,
+    };
+    let law = SlipWeakening {
+        static_coefficient: 0.6,
+        dynamic_coefficient: 0.3,
+        slip_length: 1.0,
+        form: Weakening::Linear,
+    };
+    let params = WeakeningParams {
+        tol: 1e-13,
+        newton: NewtonParams {
+            tol: 1e-14,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let sol = solve_slip_weakening(&mut op.clone(), &pts, &law, &params, &mut |_| {}).unwrap();
+    let half_slope = 0.5 * (0.6 - 0.3) / 1.0;
+    let mu = (0.6 - half_slope) / (1.0 - half_slope);
+    assert!((sol.lambda.normal[0] - 0.5).abs() < 1e-14);
+    assert!(
+        (sol.lambda.tangential[0] + 0.5 * mu).abs() < 1e-12,
+        "{:?} {mu}",
+        sol.lambda
+    );
+    assert!((sol.u.tangential[0] + 0.5 * (1.0 - mu)).abs() < 1e-12);
+    let c = sol.info.contraction.unwrap();
+    assert!(
+        (c - half_slope).abs() < 1e-6,
+        "measured contraction {c}, slope {half_slope}"
+    );
+    // equal coefficients: Coulomb's law itself, to round-off
+    let flat = SlipWeakening {
+        dynamic_coefficient: 0.6,
+        ..law
+    };
+    let sw = solve_slip_weakening(&mut op.clone(), &pts, &flat, &params, &mut |_| {}).unwrap();
+    let coulomb = solve_newton(&mut op.clone(), &pts, &Law::Coulomb, &params.newton, None, &mut |_| {}).unwrap();
+    assert_eq!(sw.lambda, coulomb.lambda);
+    assert_eq!(sw.info.fixed_point_iters, 1);
+    // a dynamic coefficient above the static one is refused by a typed error
+    let up = SlipWeakening {
+        dynamic_coefficient: 0.7,
+        ..law
+    };
+    let e = solve_slip_weakening(&mut op.clone(), &pts, &up, &params, &mut |_| {}).unwrap_err();
+    assert!(matches!(e, ContactError::Input(_)), "{e}");
+    // the exponential form: μ(s) = μ_d + Δ exp(-s/L), its fixed point checked by its equation
+    let exp = SlipWeakening {
+        form: Weakening::Exponential,
+        ..law
+    };
+    let s = solve_slip_weakening(&mut op.clone(), &pts, &exp, &params, &mut |_| {}).unwrap();
+    let slip = -s.u.tangential[0];
+    let mu = -s.lambda.tangential[0] / 0.5;
+    assert!((mu - exp.coefficient(slip)).abs() < 1e-12 && (slip - 0.5 * (1.0 - mu)).abs() < 1e-12);
+}

@@ -25,6 +25,10 @@ pub const SHIPPED: &[(&str, &str)] = &[
         "paper-compliance",
         include_str!("../../../scenes/paper-compliance.toml"),
     ),
+    (
+        "paper-slip-weakening",
+        include_str!("../../../scenes/paper-slip-weakening.toml"),
+    ),
     ("paper-elastic", include_str!("../../../scenes/paper-elastic.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),

@@ -231,9 +231,23 @@ pub struct ContactSolve<'p> {
     pub tol: f64,
     /// A deadline or a cancel flag.
     pub interrupt: contact::Interrupt,
+    /// Slip-weakening friction (Coulomb's law with a coefficient that falls with the slip).
+    pub weakening: Option<contact::SlipWeakening>,
 }
 
 impl<'p> ContactSolve<'p> {
+    /// The points with the coefficients the law gives at the slips of `sol` (slip
+    /// weakening), or as they are.
+    pub fn points_at(&self, points: &contact::ContactPoints, sol: &ContactSolution) -> contact::ContactPoints {
+        let mut at = points.clone();
+        if let Some(w) = &self.weakening {
+            at.friction = (0..points.len())
+                .map(|i| w.coefficient(sol.u.tangential_norm(i)))
+                .collect();
+        }
+        at
+    }
+
     /// The plan's contact law on `n` points: frictionless without tangential multipliers,
     /// Tresca with the scene's bound, else Coulomb.
     pub fn new(plan: &'p Plan, scene: &'p Scene, n: usize, interrupt: contact::Interrupt) -> Self {
@@ -249,6 +263,7 @@ impl<'p> ContactSolve<'p> {
             law,
             tol: plan.tol,
             interrupt,
+            weakening: plan.weakening,
         }
     }
 }

@@ -10,7 +10,7 @@ use crate::progress::{Event, Reporter};
 use crate::scene::{BackendChoice, ContactSolver, Rule, Scene, SceneError};
 use crate::ProblemError;
 use contact::{
-    ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, Law, NewtonParams, PointValues,
+    ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, NewtonParams, PointValues,
     StopRule, UzawaParams,
 };
 use fe_assembly::{Blocks, Parallelism};
@@ -334,7 +334,18 @@ impl ContactSolve<'_> {
                     interrupt: self.interrupt,
                     ..Default::default()
                 };
-                contact::solve_newton(dense, points, &self.law, &params, start, &mut progress)
+                match &self.weakening {
+                    // the branch from the stick start, whatever the warm start
+                    Some(w) => {
+                        let params = contact::WeakeningParams {
+                            newton: params,
+                            tol,
+                            ..Default::default()
+                        };
+                        contact::solve_slip_weakening(dense, points, w, &params, &mut progress)
+                    }
+                    None => contact::solve_newton(dense, points, &self.law, &params, start, &mut progress),
+                }
             }
             (ContactSolver::FirstOrder { accelerate }, problem) => {
                 let op: &mut dyn ContactOperator = match problem {
@@ -448,7 +459,7 @@ impl Refining<'_> {
         loop {
             let (b_full, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
             self.refinement += refine(self.direct, self.blocks, posed, &b_full, scale, u, phi)?.steps;
-            sol.info.complementarity = law_residual(boundary, &sol, &how.law, &u0, u);
+            sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u);
             if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
                 break;
             }
@@ -535,8 +546,15 @@ fn fields_at_points(boundary: &ContactBoundary, u: &[f64], nt: usize) -> PointVa
 
 /// The complementarity residual of the law on the final fields: the multipliers of `sol` with
 /// the displacement of the points in `u` (the last, refined solve), against the loads' `u0`.
-fn law_residual(boundary: &ContactBoundary, sol: &ContactSolution, law: &Law, u0: &PointValues, u: &[f64]) -> f64 {
-    let points = &boundary.points;
+fn law_residual(
+    boundary: &ContactBoundary,
+    how: &ContactSolve<'_>,
+    sol: &ContactSolution,
+    u0: &PointValues,
+    u: &[f64],
+) -> f64 {
+    let law = &how.law;
+    let points = &how.points_at(&boundary.points, sol);
     let at = fields_at_points(boundary, u, sol.lambda.n_tangential());
     let c = 1.0 / sol.info.mu_max;
     let mut free = u0.clone();

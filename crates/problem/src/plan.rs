@@ -50,6 +50,9 @@ pub struct Plan {
     /// conditions).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compliance: Option<ComplianceSpec>,
+    /// Slip-weakening friction's law (absent: a constant coefficient).
+    #[serde(skip)]
+    pub weakening: Option<contact::SlipWeakening>,
     /// The contact solve's complementarity tolerance (`solver.tol`).
     #[serde(skip)]
     pub tol: f64,
@@ -101,6 +104,11 @@ impl Plan {
                 .as_ref()
                 .filter(|_| law != ContactLaw::None)
                 .and_then(|c| c.compliance),
+            weakening: scene
+                .contact
+                .as_ref()
+                .filter(|_| law == ContactLaw::Coulomb)
+                .and_then(|c| c.slip_weakening()),
             tol: scene.solver.tol,
             pcg_tol: scene.solver.pcg_tol.unwrap_or(match scene.solver.rule {
                 Rule::Paper => 1e-2,
@@ -147,12 +155,19 @@ impl fmt::Display for Plan {
         let outputs: Vec<&str> = self.outputs.iter().map(|o| o.name()).collect();
         write!(
             f,
-            "plan: {}D, electric unknowns: {}, contact: {}{}{}{}, linear: {}, rule: {}, outputs: {}",
+            "plan: {}D, electric unknowns: {}, contact: {}{}{}{}{}, linear: {}, rule: {}, outputs: {}",
             self.dim,
             if self.electric { "yes" } else { "left out" },
             self.contact_law,
             match self.compliance {
                 Some(k) => format!(" on a compliant foundation (k = {:e}, m = {})", k.stiffness, k.exponent),
+                None => String::new(),
+            },
+            match self.weakening {
+                Some(w) => format!(
+                    " with slip weakening ({} -> {} over {:e}) by a fixed point on the coefficients",
+                    w.static_coefficient, w.dynamic_coefficient, w.slip_length
+                ),
                 None => String::new(),
             },
             if self.friction { " (tangential multipliers)" } else { "" },

@@ -364,6 +364,11 @@ pub struct SolverReport {
     /// residual was at round-off already).
     #[serde(default)]
     pub refinement_steps: usize,
+    /// Slip weakening: the measured contraction of the fixed point on the coefficients (at or
+    /// above 1, the map was not contractive along the way: the static problem may have
+    /// several solutions, and this one is the branch from the stick start); absent elsewhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_map_contraction: Option<f64>,
 }
 
 impl SolverReport {
@@ -383,6 +388,7 @@ impl SolverReport {
             condense_route: None,
             smallest_pivot_ratio: None,
             refinement_steps: 0,
+            friction_map_contraction: info.and_then(|i| i.contraction),
         }
     }
 }

@@ -299,6 +299,15 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "strong weakening",
+        why: "slip weakening μ_s = 100 μ_d (0.1 -> 0.001 over 0.1 mm): a non-monotone law far from Coulomb's",
+        scene: "paper-slip-weakening",
+        sets: &["mesh.n=128", "contact.friction_dynamic=0.001"],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "n = 1024",
         why: "2D, 6.3 million unknowns",
         scene: "paper",

@@ -97,6 +97,27 @@ choice! {
 }
 
 choice! {
+    /// The form of Coulomb's coefficient (`contact.friction_law`).
+    pub enum FrictionLaw ("contact.friction_law") {
+        /// A constant coefficient, `contact.friction`.
+        Coulomb = "coulomb",
+        /// A coefficient that falls with the slip, from `friction_static` to `friction_dynamic`
+        /// over `slip_length` (a non-monotone law).
+        SlipWeakening = "slip-weakening",
+    }
+}
+
+choice! {
+    /// How slip-weakening friction's coefficient falls (`contact.weakening`).
+    pub enum WeakeningForm ("contact.weakening") {
+        /// Linearly, reaching the dynamic value at the slip length.
+        Linear = "linear",
+        /// Exponentially, by `exp(-s / L)`.
+        Exponential = "exponential",
+    }
+}
+
+choice! {
     /// How the contact problem and its linear systems are solved (`piezocontact strategies`).
     pub enum Strategy ("solver.strategy") {
         /// Semismooth Newton on the contact compliance read off the `L D Lᵀ` of `K`.
@@ -643,6 +664,22 @@ pub struct ContactSpec {
     /// one (Signorini's conditions).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compliance: Option<ComplianceSpec>,
+    /// Coulomb's coefficient constant (`coulomb`, the default) or falling with the slip
+    /// (`slip-weakening`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_law: Option<FrictionLaw>,
+    /// Slip weakening: the coefficient at no slip.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_static: Option<f64>,
+    /// Slip weakening: the coefficient once slid far (`≤ friction_static`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_dynamic: Option<f64>,
+    /// Slip weakening: the slip over which the coefficient falls (`> 0`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slip_length: Option<f64>,
+    /// Slip weakening: `linear` (the default) or `exponential`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weakening: Option<WeakeningForm>,
 }
 
 /// Normal compliance: the foundation's pressure `λ_n = k [u_n - g]₊^m` at the penetration
@@ -675,12 +712,35 @@ impl ContactSpec {
             gap_center: None,
             normal: normal.to_vec(),
             compliance: None,
+            friction_law: None,
+            friction_static: None,
+            friction_dynamic: None,
+            slip_length: None,
+            weakening: None,
         }
     }
 
-    /// The Coulomb coefficient F (0 where not given).
+    /// The Coulomb coefficient F (0 where not given); under slip weakening, the static one
+    /// (the stick start).
     pub fn friction(&self) -> f64 {
-        self.friction.unwrap_or(0.0)
+        match self.slip_weakening() {
+            Some(w) => w.static_coefficient,
+            None => self.friction.unwrap_or(0.0),
+        }
+    }
+
+    /// The slip-weakening law, where `friction_law = "slip-weakening"` (the keys checked by
+    /// [`Scene::validate`]; a missing one reads as 0).
+    pub fn slip_weakening(&self) -> Option<contact::SlipWeakening> {
+        (self.friction_law == Some(FrictionLaw::SlipWeakening)).then(|| contact::SlipWeakening {
+            static_coefficient: self.friction_static.unwrap_or(0.0),
+            dynamic_coefficient: self.friction_dynamic.unwrap_or(0.0),
+            slip_length: self.slip_length.unwrap_or(0.0),
+            form: match self.weakening.unwrap_or(WeakeningForm::Linear) {
+                WeakeningForm::Linear => contact::Weakening::Linear,
+                WeakeningForm::Exponential => contact::Weakening::Exponential,
+            },
+        })
     }
 
     /// The Tresca slip bound S (0 where not given).

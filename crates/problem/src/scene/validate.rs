@@ -170,6 +170,7 @@ impl Scene {
         }
         validate_solver(&self.solver)?;
         refuse_compliance(self)?;
+        refuse_weakening(self)?;
         refuse_backend(self)?;
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
@@ -530,6 +531,77 @@ fn refuse_compliance(s: &Scene) -> Result<(), SceneError> {
         "contact.compliance",
         &format!(
             "a deformable foundation, and solver.strategy = \"{}\" projects onto Signorini's conditions: normal compliance is solved by newton-condensed",
+            s.solver.strategy
+        ),
+    )
+}
+
+/// Slip-weakening friction's keys, where `contact.friction_law = "slip-weakening"`: the three
+/// numbers given and in range, Coulomb's law, no constant coefficient; solved by
+/// `newton-condensed` on the default backend. Elsewhere its keys do not apply.
+fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
+    let Some(c) = &s.contact else {
+        return Ok(());
+    };
+    let keys = [
+        ("contact.friction_static", c.friction_static),
+        ("contact.friction_dynamic", c.friction_dynamic),
+        ("contact.slip_length", c.slip_length),
+    ];
+    if c.friction_law != Some(crate::scene::FrictionLaw::SlipWeakening) {
+        let why = "slip weakening, and contact.friction_law is not \"slip-weakening\"";
+        for (key, v) in keys {
+            refuse_if(v.is_some(), key, why)?;
+        }
+        return refuse_if(c.weakening.is_some(), "contact.weakening", why);
+    }
+    refuse_if(
+        c.law != ContactLaw::Coulomb,
+        "contact.friction_law",
+        "slip weakening (Coulomb's bound with a falling coefficient), and contact.law is not \"coulomb\"",
+    )?;
+    refuse_if(
+        c.friction.is_some(),
+        "contact.friction",
+        "a constant coefficient, and contact.friction_law = \"slip-weakening\" takes contact.friction_static and contact.friction_dynamic",
+    )?;
+    for (key, v) in keys {
+        let Some(v) = v else {
+            return Err(SceneError::new(
+                key,
+                format!("{key} is needed by contact.friction_law = \"slip-weakening\""),
+            ));
+        };
+        finite(key, v)?;
+    }
+    let (ms, md, l) = (
+        c.friction_static.unwrap_or(0.0),
+        c.friction_dynamic.unwrap_or(0.0),
+        c.slip_length.unwrap_or(0.0),
+    );
+    if !(md >= 0.0 && md <= ms) {
+        return Err(SceneError::new(
+            "contact.friction_dynamic",
+            format!("contact.friction_dynamic = {md} must lie in [0, contact.friction_static = {ms}] (a coefficient that weakens with the slip)"),
+        ));
+    }
+    if !(l > 0.0) {
+        return Err(SceneError::new(
+            "contact.slip_length",
+            format!("contact.slip_length = {l} must be positive"),
+        ));
+    }
+    if s.solver.backend == BackendChoice::Petsc {
+        return Err(SceneError::new(
+            "contact.friction_law",
+            "contact.friction_law = \"slip-weakening\": the PETSc backend's active sets hold a constant coefficient only; use the default backend",
+        ));
+    }
+    refuse_if(
+        s.solver.strategy != Strategy::NewtonCondensed,
+        "contact.friction_law",
+        &format!(
+            "slip weakening, and solver.strategy = \"{}\": its fixed point on the coefficients runs semismooth Newton (newton-condensed)",
             s.solver.strategy
         ),
     )

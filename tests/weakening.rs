@@ -1,0 +1,85 @@
+//! Slip-weakening friction (`contact.friction_law = "slip-weakening"`) on the shipped scene
+//! against its limits: equal coefficients are Coulomb's law to round-off; a falling one lets
+//! more of the face slip and carries less tangential force; the answer meets the law at its own
+//! slips; the keys that do not fit are refused by name.
+
+use files::scene_file;
+use problem::Silent;
+
+fn solve(scene: &str, sets: &[&str]) -> problem::Solution {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let (scene, _) = scene_file::load(scene, &sets).unwrap();
+    problem::solve(&scene, None, &mut Silent).unwrap()
+}
+
+#[test]
+fn equal_coefficients_are_coulombs_law_to_round_off() {
+    let weak = solve("paper-slip-weakening", &["mesh.n=16", "contact.friction_dynamic=0.1"]);
+    let coulomb = solve("paper-slip", &["mesh.n=16"]);
+    let (a, b) = (&weak.contact.unwrap().solution, &coulomb.contact.unwrap().solution);
+    assert_eq!(a.lambda, b.lambda);
+    assert_eq!(weak.report.iterations.fixed_point, 1);
+}
+
+#[test]
+fn a_weakening_coefficient_lets_more_slip_and_meets_its_law() {
+    let (mu_s, mu_d, length) = (0.1, 0.05, 1e-4);
+    let weak = solve("paper-slip-weakening", &["mesh.n=32"]);
+    let coulomb = solve("paper-slip", &["mesh.n=32"]);
+    let (w, c) = (weak.contact.as_ref().unwrap(), coulomb.contact.as_ref().unwrap());
+    let slips = |r: &problem::ContactResult| {
+        r.solution
+            .status
+            .iter()
+            .filter(|s| **s == contact::Status::Slip)
+            .count()
+    };
+    assert!(slips(w) > slips(c), "{} against {}", slips(w), slips(c));
+    assert!(weak.report.contact.tangential_force.abs() < coulomb.report.contact.tangential_force.abs());
+    // every slipping point carries μ(s) λ_n, with s its own slip
+    for i in 0..w.points.len() {
+        if w.solution.status[i] != contact::Status::Slip {
+            continue;
+        }
+        let s = w.solution.u.tangential_norm(i);
+        let mu = mu_s - (mu_s - mu_d) * (s / length).min(1.0);
+        let (lt, ln) = (w.solution.lambda.tangential_norm(i), w.solution.lambda.normal[i]);
+        assert!(
+            (lt - mu * ln).abs() <= 1e-8 * ln,
+            "point {i}: |λ_t| {lt}, μ(s) λ_n {}",
+            mu * ln
+        );
+    }
+    assert!(weak.report.residuals.converged_to_tolerance);
+    assert!(weak.report.solver.friction_map_contraction.is_some_and(|c| c < 1.0));
+}
+
+#[test]
+fn keys_that_do_not_fit_slip_weakening_are_refused_by_name() {
+    let refused = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        match scene_file::load("paper-slip-weakening", &sets).unwrap_err() {
+            files::Error::Scene {
+                source: files::SceneFileError::Invalid(e),
+                ..
+            } => e.key,
+            other => panic!("{other}"),
+        }
+    };
+    assert_eq!(refused(&["contact.friction=0.3"]), "contact.friction");
+    assert_eq!(refused(&["contact.friction_dynamic=0.2"]), "contact.friction_dynamic");
+    assert_eq!(refused(&["contact.slip_length=0"]), "contact.slip_length");
+    assert_eq!(refused(&["~contact.slip_length"]), "contact.slip_length");
+    assert_eq!(refused(&["solver.strategy=uzawa-condensed"]), "contact.friction_law");
+    assert_eq!(refused(&["solver.backend=petsc"]), "contact.friction_law");
+    assert_eq!(
+        refused(&["contact.law=signorini", "~contact.friction_static"]),
+        "contact.friction_law"
+    );
+    let (_, _) = scene_file::load("paper-slip", &["contact.slip_length=1".into()])
+        .map(|_| panic!("slip_length without slip weakening"))
+        .unwrap_or_else(|e| {
+            assert!(e.to_string().contains("contact.slip_length does not apply"), "{e}");
+            (0, 0)
+        });
+}
