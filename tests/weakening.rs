@@ -76,10 +76,49 @@ fn keys_that_do_not_fit_slip_weakening_are_refused_by_name() {
         refused(&["contact.law=signorini", "~contact.friction_static"]),
         "contact.friction_law"
     );
+    // contact switched off: the section's keys are kept, unused, as everywhere
+    assert!(scene_file::load("paper-slip-weakening", &["contact.law=none".into()]).is_ok());
     let (_, _) = scene_file::load("paper-slip", &["contact.slip_length=1".into()])
         .map(|_| panic!("slip_length without slip weakening"))
         .unwrap_or_else(|e| {
             assert!(e.to_string().contains("contact.slip_length does not apply"), "{e}");
             (0, 0)
         });
+}
+
+#[test]
+fn slip_weakening_in_three_dimensions_meets_its_law() {
+    let sets = [
+        "mesh.n=4",
+        "~contact.friction",
+        "contact.friction_law=\"slip-weakening\"",
+        "contact.friction_static=0.1",
+        "contact.friction_dynamic=0.05",
+        "contact.slip_length=1e-4",
+        "contact.weakening=\"exponential\"",
+    ];
+    let weak = solve("paper-3d", &sets);
+    let w = weak.contact.as_ref().unwrap();
+    let law = contact::SlipWeakening {
+        static_coefficient: 0.1,
+        dynamic_coefficient: 0.05,
+        slip_length: 1e-4,
+        form: contact::Weakening::Exponential,
+    };
+    let mut slipping = 0;
+    for i in 0..w.points.len() {
+        let (lt, ln) = (w.solution.lambda.tangential_norm(i), w.solution.lambda.normal[i]);
+        let mu = law.coefficient(w.solution.u.tangential_norm(i));
+        assert!(
+            lt <= mu * ln * (1.0 + 1e-8) + 1e-12,
+            "point {i}: |λ_t| {lt} above μ(s) λ_n {}",
+            mu * ln
+        );
+        if w.solution.status[i] == contact::Status::Slip {
+            slipping += 1;
+            assert!((lt - mu * ln).abs() <= 1e-8 * ln, "point {i}");
+        }
+    }
+    assert!(slipping > 0);
+    assert!(weak.report.residuals.converged_to_tolerance);
 }

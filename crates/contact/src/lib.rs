@@ -62,7 +62,7 @@ pub use solution::{
 };
 pub use uniqueness::slip_bound_expansion;
 pub use uzawa::{solve, StopRule, UzawaParams, FIXED_POINT_PATIENCE};
-pub use weakening::{solve_slip_weakening, SlipWeakening, Weakening, WeakeningParams};
+pub use weakening::{solve_slip_weakening, Inner, SlipWeakening, Weakening, WeakeningParams};
 
 /// A failure of the primal solve behind a [`ContactOperator`], with its cause (for example the
 /// linear solver's own error), which [`std::error::Error::source`] returns.

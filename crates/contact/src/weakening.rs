@@ -8,7 +8,10 @@
 use crate::operator::AffineProblem;
 use crate::points::ContactPoints;
 use crate::solution::{classify, counts, slip_bound, Best, Iterate};
-use crate::{solve_newton, ContactError, ContactSolution, InputError, Law, NewtonParams, Progress, Stage};
+use crate::{
+    solve_gauss_seidel, solve_newton, ContactError, ContactSolution, GaussSeidelParams, InputError, Law, NewtonParams,
+    Progress, Stage,
+};
 
 /// Changes below this many times the tolerance are taken as round-off in the contraction's
 /// measure.
@@ -60,11 +63,24 @@ impl SlipWeakening {
     }
 }
 
+/// The solver of each fixed-point step (Coulomb's law with the coefficients frozen).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Inner {
+    /// Semismooth Newton on the whole problem (the default).
+    #[default]
+    Newton,
+    /// Block Gauss-Seidel, point by point (a second method, for checks).
+    GaussSeidel,
+}
+
 /// Parameters of [`solve_slip_weakening`].
 #[derive(Clone, Copy, Debug)]
 pub struct WeakeningParams {
-    /// Newton's parameters for each step (its tolerance the complementarity residual's).
+    /// Newton's parameters for each step (its tolerance the complementarity residual's; the
+    /// Gauss-Seidel steps take the same tolerance, interrupt and measure).
     pub newton: NewtonParams,
+    /// The solver of each step.
+    pub inner: Inner,
     /// The fixed point stops where no coefficient changes by more than this times `μ_s`.
     pub tol: f64,
     /// Fixed-point steps at most.
@@ -75,6 +91,7 @@ impl Default for WeakeningParams {
     fn default() -> Self {
         WeakeningParams {
             newton: NewtonParams::default(),
+            inner: Inner::Newton,
             tol: 1e-10,
             max_iters: 100,
         }
@@ -108,7 +125,19 @@ pub fn solve_slip_weakening<P: AffineProblem>(
     let (mut last_change, mut contraction): (Option<f64>, Option<f64>) = (None, None);
     let mut best = Best::new(1.0);
     for k in 1..=params.max_iters {
-        let mut sol = solve_newton(problem, &frozen, &Law::Coulomb, &params.newton, start.take(), progress)?;
+        let mut sol = match params.inner {
+            Inner::Newton => solve_newton(problem, &frozen, &Law::Coulomb, &params.newton, start.take(), progress)?,
+            Inner::GaussSeidel => {
+                let gs = GaussSeidelParams {
+                    tol: params.newton.tol,
+                    measure: params.newton.measure,
+                    interrupt: params.newton.interrupt,
+                    power_iters: params.newton.power_iters,
+                    ..Default::default()
+                };
+                solve_gauss_seidel(problem, &frozen, &Law::Coulomb, &gs, start.take(), progress)?
+            }
+        };
         newton_iters += sol.info.newton_iters;
         let next: Vec<f64> = (0..n).map(|i| law.coefficient(sol.u.tangential_norm(i))).collect();
         let change = next

@@ -540,7 +540,8 @@ fn refuse_compliance(s: &Scene) -> Result<(), SceneError> {
 /// numbers given and in range, Coulomb's law, no constant coefficient; solved by
 /// `newton-condensed` on the default backend. Elsewhere its keys do not apply.
 fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
-    let Some(c) = &s.contact else {
+    // contact switched off: the section is kept as it is, unused
+    let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
         return Ok(());
     };
     let keys = [
