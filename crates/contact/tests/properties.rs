@@ -864,6 +864,14 @@ fn slip_weakening_on_one_point_is_its_hand_solution() {
         (c - half_slope).abs() < 1e-6,
         "measured contraction {c}, slope {half_slope}"
     );
+    // Anderson's mixing: the same (unique) answer, in fewer steps
+    let fast = WeakeningParams {
+        accelerate: true,
+        ..params
+    };
+    let mixed = solve_slip_weakening(&mut op.clone(), &pts, &law, &fast, &mut |_| {}).unwrap();
+    assert!((mixed.lambda.tangential[0] - sol.lambda.tangential[0]).abs() < 1e-12);
+    assert!(mixed.info.fixed_point_iters < sol.info.fixed_point_iters);
     // equal coefficients: Coulomb's law itself, to round-off
     let flat = SlipWeakening {
         dynamic_coefficient: 0.6,
