@@ -61,7 +61,7 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    let pre = Preamble::new(&mut Counter::new(problem), points, law, params.power_iters)?;
+    let pre = Preamble::new(&mut Counter::new(problem), points, law, params.power_iters, None)?;
     let mut lambda = pre.start(lambda0)?;
     let Preamble {
         n,

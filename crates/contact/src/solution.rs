@@ -498,15 +498,24 @@ pub(crate) struct Preamble {
 }
 
 impl Preamble {
-    /// Checks the input of a solve through `c` and estimates `μ_max` by `power_iters` steps.
+    /// Checks the input of a solve through `c` and estimates `μ_max` by `power_iters` steps,
+    /// or takes the `known` estimate (then only `u(0)` is computed).
     pub fn new(
         c: &mut Counter<'_>,
         points: &ContactPoints,
         law: &Law,
         power_iters: usize,
+        known: Option<f64>,
     ) -> Result<Self, ContactError> {
         let (n, nt) = check_input(points, law, c.op.n_points(), c.op.n_tangential())?;
-        let (mu_max, u0) = estimate_mu_max(c, points, nt, power_iters)?;
+        let (mu_max, u0) = match known.filter(|m| *m > 0.0 && m.is_finite()) {
+            Some(mu) => {
+                let mut u0 = PointValues::zeros(n, nt);
+                c.call(&PointValues::zeros(n, nt), &mut u0)?;
+                (mu, u0)
+            }
+            None => estimate_mu_max(c, points, nt, power_iters)?,
+        };
         let reference = multiplier_scale(points, &u0, 1.0 / mu_max);
         Ok(Preamble {
             n,

@@ -198,7 +198,7 @@ pub fn solve(
         );
     }
     let mut c = Counter::new(op);
-    let pre = Preamble::new(&mut c, points, law, params.power_iters)?;
+    let pre = Preamble::new(&mut c, points, law, params.power_iters, None)?;
     let mut lambda = pre.start(lambda0)?;
     let Preamble {
         n,

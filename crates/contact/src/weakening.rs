@@ -243,9 +243,10 @@ pub fn solve_slip_weakening<P: AffineProblem>(
     let mut best = Best::new(1.0);
     let mut anderson = Anderson::new(ANDERSON_DEPTH);
     let mut previous: Option<(Vec<f64>, Vec<f64>)> = None;
+    let mut newton = params.newton;
     for k in 1..=params.max_iters {
         let mut sol = match params.inner {
-            Inner::Newton => solve_newton(problem, &frozen, &Law::Coulomb, &params.newton, start.take(), progress)?,
+            Inner::Newton => solve_newton(problem, &frozen, &Law::Coulomb, &newton, start.take(), progress)?,
             Inner::GaussSeidel => {
                 let gs = GaussSeidelParams {
                     tol: params.newton.tol,
@@ -258,6 +259,8 @@ pub fn solve_slip_weakening<P: AffineProblem>(
             }
         };
         newton_iters += sol.info.newton_iters;
+        // the operator is the same at every step: its μ_max once
+        newton.mu_max = Some(sol.info.mu_max);
         let next: Vec<f64> = (0..n).map(|i| law.coefficient(sol.u.tangential_norm(i))).collect();
         let change = next
             .iter()

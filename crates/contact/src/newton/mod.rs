@@ -62,6 +62,10 @@ pub struct NewtonParams {
     pub max_proximal: usize,
     /// Power iterations for `μ_max`.
     pub power_iters: usize,
+    /// A known estimate of `μ_max` for this problem (a solve of the same operator again, as
+    /// the steps of a fixed point on the friction coefficients): the power iteration is
+    /// skipped. `None`: estimated.
+    pub mu_max: Option<f64>,
     /// Whether to fall back on a last stage when both Newton stages stall: block Gauss–Seidel
     /// for Coulomb's law, the accelerated projected gradient for the convex laws (when false,
     /// a stall is a [`ContactError::Stalled`]).
@@ -80,6 +84,7 @@ impl Default for NewtonParams {
             max_iters: 100,
             max_proximal: 200,
             power_iters: 30,
+            mu_max: None,
             fallback: true,
             max_fallback_iters: 200_000,
             interrupt: Interrupt::NONE,
@@ -414,7 +419,13 @@ pub fn solve_newton<P: AffineProblem>(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
     let nt = check_newton_input(problem, params)?;
-    let pre = Preamble::new(&mut Counter::new(problem), points, law, params.power_iters)?;
+    let pre = Preamble::new(
+        &mut Counter::new(problem),
+        points,
+        law,
+        params.power_iters,
+        params.mu_max,
+    )?;
     let start = pre.start(lambda0)?;
     let x0: Vec<f64> = start.normal.iter().chain(&start.tangential).copied().collect();
     let (mu_max, reference) = (pre.mu_max, pre.reference);
