@@ -17,6 +17,10 @@ use crate::{
 /// measure.
 const NOISE: f64 = 1e4;
 
+/// The change of the coefficients (relative to `μ_s`) below which Newton on the law itself
+/// takes over from the fixed point.
+const POLISH: f64 = 1e-2;
+
 /// Steps of history in Anderson's mixing (Walker and Ni, SIAM J. Numer. Anal. 49 (2011) 1715).
 const ANDERSON_DEPTH: usize = 3;
 
@@ -159,6 +163,25 @@ impl SlipWeakening {
         }
     }
 
+    /// `dμ/ds` at the slip `s ≥ 0` (the linear form's right derivative at `s = L`: 0).
+    pub fn slope(&self, slip: f64) -> f64 {
+        let (ms, md, l) = (self.static_coefficient, self.dynamic_coefficient, self.slip_length);
+        match self.form {
+            Weakening::Linear if slip < l => -(ms - md) / l,
+            Weakening::Linear => 0.0,
+            Weakening::Exponential => -(ms - md) / l * (-slip / l).exp(),
+        }
+    }
+
+    /// Points with the coefficients the law gives at the slips of `u`.
+    pub fn points_at(&self, points: &ContactPoints, u: &crate::PointValues) -> ContactPoints {
+        let mut at = points.clone();
+        at.friction = (0..points.len())
+            .map(|i| self.coefficient(u.tangential_norm(i)))
+            .collect();
+        at
+    }
+
     /// Checks the law's data.
     fn check(&self) -> Result<(), InputError> {
         let (ms, md, l) = (self.static_coefficient, self.dynamic_coefficient, self.slip_length);
@@ -215,6 +238,38 @@ impl Default for WeakeningParams {
     }
 }
 
+/// One step of the fixed point: Coulomb's law with the coefficients of `frozen`, by `inner`.
+fn frozen_step<P: AffineProblem>(
+    problem: &mut P,
+    frozen: &ContactPoints,
+    inner: Inner,
+    newton: &NewtonParams,
+    start: Option<crate::PointValues>,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ContactSolution, ContactError> {
+    match inner {
+        Inner::Newton => solve_newton(problem, frozen, &Law::Coulomb, newton, start, progress),
+        Inner::GaussSeidel => {
+            let gs = GaussSeidelParams {
+                tol: newton.tol,
+                measure: newton.measure,
+                interrupt: newton.interrupt,
+                power_iters: newton.power_iters,
+                ..Default::default()
+            };
+            solve_gauss_seidel(problem, frozen, &Law::Coulomb, &gs, start, progress)
+        }
+    }
+}
+
+/// `|G(x) - G(x₀)|_∞ / |x - x₀|_∞` (relative to `scale`) between the last pair `(x₀, G(x₀))`
+/// and `(x, G(x))`, where the step stands above [`NOISE`] times `tol`.
+fn secant_ratio(last: Option<&(Vec<f64>, Vec<f64>)>, (x, g): (&[f64], &[f64]), scale: f64, tol: f64) -> Option<f64> {
+    let (x0, g0) = last?;
+    let dx = max_difference(x, x0) / scale;
+    (dx > NOISE * tol).then(|| max_difference(g, g0) / scale / dx)
+}
+
 /// Solves Coulomb's law with the slip-weakening coefficient `law` on `points` (their own
 /// coefficients are not read) by the fixed point on the coefficients, from the stick start.
 /// The returned solution's `info` counts the fixed-point steps (`fixed_point_iters`), Newton's
@@ -244,20 +299,9 @@ pub fn solve_slip_weakening<P: AffineProblem>(
     let mut anderson = Anderson::new(ANDERSON_DEPTH);
     let mut previous: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut newton = params.newton;
+    let mut polished = false;
     for k in 1..=params.max_iters {
-        let mut sol = match params.inner {
-            Inner::Newton => solve_newton(problem, &frozen, &Law::Coulomb, &newton, start.take(), progress)?,
-            Inner::GaussSeidel => {
-                let gs = GaussSeidelParams {
-                    tol: params.newton.tol,
-                    measure: params.newton.measure,
-                    interrupt: params.newton.interrupt,
-                    power_iters: params.newton.power_iters,
-                    ..Default::default()
-                };
-                solve_gauss_seidel(problem, &frozen, &Law::Coulomb, &gs, start.take(), progress)?
-            }
-        };
+        let mut sol = frozen_step(problem, &frozen, params.inner, &newton, start.take(), progress)?;
         newton_iters += sol.info.newton_iters;
         // the operator is the same at every step: its μ_max once
         newton.mu_max = Some(sol.info.mu_max);
@@ -270,12 +314,8 @@ pub fn solve_slip_weakening<P: AffineProblem>(
             / scale;
         // the map's secant ratio |G(μ_k) - G(μ_j)| / |μ_k - μ_j| between successive iterates,
         // where the step stands above the round-off of the step's own solve
-        if let Some((x0, g0)) = &previous {
-            let dx = max_difference(&frozen.friction, x0) / scale;
-            if dx > NOISE * params.tol {
-                let ratio = max_difference(&next, g0) / scale / dx;
-                contraction = Some(contraction.unwrap_or(0.0).max(ratio));
-            }
+        if let Some(ratio) = secant_ratio(previous.as_ref(), (&frozen.friction, &next), scale, params.tol) {
+            contraction = Some(contraction.unwrap_or(0.0).max(ratio));
         }
         previous = Some((frozen.friction.clone(), next.clone()));
         best.offer(&sol.lambda, &sol.u, change);
@@ -288,6 +328,29 @@ pub fn solve_slip_weakening<P: AffineProblem>(
                 &slip_bound(&frozen, &Law::Coulomb, &sol.lambda.normal),
             )),
         });
+        // near the fixed point, Newton on the law itself: the same branch (the solution near
+        // the iterate), in a few quadratic steps; where it does not converge, the fixed point
+        // goes on
+        if change > params.tol && change <= POLISH && !polished && params.inner == Inner::Newton {
+            polished = true;
+            let direct = NewtonParams {
+                weakening: Some(*law),
+                ..newton
+            };
+            if let Ok(mut polish) = solve_newton(
+                problem,
+                &frozen,
+                &Law::Coulomb,
+                &direct,
+                Some(sol.lambda.clone()),
+                progress,
+            ) {
+                polish.info.fixed_point_iters = k;
+                polish.info.newton_iters += newton_iters;
+                polish.info.contraction = contraction;
+                return Ok(polish);
+            }
+        }
         if change <= params.tol {
             sol.info.fixed_point_iters = k;
             sol.info.newton_iters = newton_iters;

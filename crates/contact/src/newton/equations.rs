@@ -59,6 +59,9 @@ pub(super) struct Flat<'a> {
     pub(super) u0: Vec<f64>,
     /// The proximal shift `σ` (0 for the problem itself).
     pub(super) sigma: f64,
+    /// Slip-weakening friction: Coulomb's radius with the coefficient `μ(|u_t|)` of each
+    /// point's own slip.
+    pub(super) weakening: Option<crate::SlipWeakening>,
 }
 
 /// The equations and their pieces at one `λ`.
@@ -115,6 +118,7 @@ impl<'a> Flat<'a> {
                 .collect(),
             u0: u0.normal.iter().chain(&u0.tangential).copied().collect(),
             sigma: 0.0,
+            weakening: None,
         };
         flat.c = vec![1.0 / mu_max; m];
         flat
@@ -183,12 +187,30 @@ impl<'a> Flat<'a> {
 
     /// The radius of point `i` at `z` (the multipliers `x`): Tresca `S`, Coulomb `F [z_n]₊`
     /// on a rigid foundation, `F [λ_n]₊` on a compliant one (whose `λ_n` is the pressure).
-    pub(super) fn radius(&self, i: usize, z: &[f64], x: &[f64]) -> f64 {
-        let normal = match self.points.foundation {
+    pub(super) fn radius(&self, i: usize, z: &[f64], x: &[f64], u: &[f64]) -> f64 {
+        let normal = self.radius_normal(i, z, x);
+        match &self.weakening {
+            Some(w) => crate::coulomb_radius(w.coefficient(self.slip(i, u)), normal),
+            None => self.law.radius(self.points, i, normal),
+        }
+    }
+
+    /// The normal value Coulomb's radius is taken at: `z_n` on a rigid foundation, the
+    /// pressure `x_n` on a compliant one.
+    fn radius_normal(&self, i: usize, z: &[f64], x: &[f64]) -> f64 {
+        match self.points.foundation {
             Foundation::Rigid => z[i],
             Foundation::Compliant { .. } => x[i],
-        };
-        self.law.radius(self.points, i, normal)
+        }
+    }
+
+    /// The slip `|u_t|` of point `i` in the flat `u`.
+    fn slip(&self, i: usize, u: &[f64]) -> f64 {
+        if self.nt == 0 {
+            return 0.0;
+        }
+        let t = self.layout().index(i, 1);
+        crate::projection::norm(&u[t..t + self.nt])
     }
 
     pub(super) fn state(&self, x: Vec<f64>) -> State {
@@ -213,7 +235,7 @@ impl<'a> Flat<'a> {
                 let t = self.layout().index(i, 1);
                 buf[..self.nt].copy_from_slice(&z[t..t + self.nt]);
                 self.points
-                    .project_friction(i, &mut buf[..self.nt], self.radius(i, &z, &x));
+                    .project_friction(i, &mut buf[..self.nt], self.radius(i, &z, &x, &u));
                 for k in 0..self.nt {
                     f[t + k] = x[t + k] - buf[k];
                 }
@@ -253,7 +275,13 @@ impl<'a> Flat<'a> {
             self.points.hold(i, &mut held_out[..nt]);
             let q = &held_out[..nt];
             let qn = crate::projection::norm(q);
-            let radius = self.radius(i, &s.z, &s.x);
+            let radius = self.radius(i, &s.z, &s.x, &s.u);
+            // slip weakening: the coefficient at the point's slip, and its slope there
+            let slip = self.slip(i, &s.u);
+            let (coefficient, weakens) = match &self.weakening {
+                Some(w) => (w.coefficient(slip), w.slope(slip)),
+                None => (self.points.friction[i], 0.0),
+            };
             let branch = if !(radius > 0.0) {
                 Branch::Separated
             } else if qn <= radius {
@@ -279,8 +307,8 @@ impl<'a> Flat<'a> {
                         let ratio = radius / qn;
                         let rigid = self.points.foundation == Foundation::Rigid;
                         let slope = match self.law {
-                            Law::Coulomb if rigid && s.z[i] > 0.0 => self.points.friction[i],
-                            Law::Coulomb if !rigid && s.x[i] > 0.0 => self.points.friction[i],
+                            Law::Coulomb if rigid && s.z[i] > 0.0 => coefficient,
+                            Law::Coulomb if !rigid && s.x[i] > 0.0 => coefficient,
                             _ => 0.0,
                         };
                         row.e.push((t + k, 1.0));
@@ -297,6 +325,17 @@ impl<'a> Flat<'a> {
                             row.e.push((i, -q[k] / qn * slope));
                             if rigid {
                                 row.b.push((i, q[k] / qn * slope));
+                            }
+                        }
+                        // slip weakening: dS ∋ [n]₊ μ'(s) û_t · du_t, with du = -(C δ) / c
+                        let normal = crate::project_nonnegative(self.radius_normal(i, &s.z, &s.x));
+                        if weakens != 0.0 && slip > 0.0 && normal > 0.0 {
+                            for l in (0..nt).filter(|&l| !self.points.is_held(i, l)) {
+                                let u_hat = s.u[t + l] / slip;
+                                let v = q[k] / qn * normal * weakens * u_hat / self.c[t + l];
+                                if v != 0.0 {
+                                    row.b.push((t + l, v));
+                                }
                             }
                         }
                     }

@@ -66,6 +66,12 @@ pub struct NewtonParams {
     /// the steps of a fixed point on the friction coefficients): the power iteration is
     /// skipped. `None`: estimated.
     pub mu_max: Option<f64>,
+    /// Slip-weakening friction solved directly (Coulomb's radius with the coefficient of each
+    /// point's own slip, differentiated through the slip), with `Law::Coulomb`; the points'
+    /// coefficients are not read. No last stage runs (its solvers hold a constant
+    /// coefficient): a stall is the caller's to handle ([`crate::solve_slip_weakening`] goes on
+    /// with its fixed point).
+    pub weakening: Option<crate::SlipWeakening>,
     /// Whether to fall back on a last stage when both Newton stages stall: block Gauss–Seidel
     /// for Coulomb's law, the accelerated projected gradient for the convex laws (when false,
     /// a stall is a [`ContactError::Stalled`]).
@@ -85,6 +91,7 @@ impl Default for NewtonParams {
             max_proximal: 200,
             power_iters: 30,
             mu_max: None,
+            weakening: None,
             fallback: true,
             max_fallback_iters: 200_000,
             interrupt: Interrupt::NONE,
@@ -132,6 +139,15 @@ struct Judge<'a> {
 }
 
 impl Judge<'_> {
+    /// The points with the coefficients of the law at the slips of `u` (slip weakening), or
+    /// as they are.
+    fn points_at(&self, u: &PointValues) -> std::borrow::Cow<'_, ContactPoints> {
+        match &self.flat.weakening {
+            Some(w) => std::borrow::Cow::Owned(w.points_at(self.points, u)),
+            None => std::borrow::Cow::Borrowed(self.points),
+        }
+    }
+
     /// The residual of a state of the problem itself.
     fn residual(&self, s: &State) -> f64 {
         self.residual_of(&self.flat, s)
@@ -144,7 +160,7 @@ impl Judge<'_> {
         let u = problem.values(&s.u);
         let u0 = problem.values(&problem.u0);
         self.measure.of(
-            self.points,
+            &self.points_at(&u),
             self.law,
             &lambda,
             &u,
@@ -156,11 +172,12 @@ impl Judge<'_> {
 
     /// The complementarity residual of a state of the problem itself, whatever the measure.
     fn complementarity(&self, s: &State) -> f64 {
+        let u = self.flat.values(&s.u);
         Measure::Complementarity.of(
-            self.points,
+            &self.points_at(&u),
             self.law,
             &self.flat.values(&s.x),
-            &self.flat.values(&s.u),
+            &u,
             self.u0,
             1.0 / self.flat.mu_max,
             self.reference,
@@ -431,7 +448,8 @@ pub fn solve_newton<P: AffineProblem>(
     let (mu_max, reference) = (pre.mu_max, pre.reference);
     let mut info = ContactInfo::new(mu_max);
     let u0 = problem.loads().clone();
-    let flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
+    let mut flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
+    flat.weakening = params.weakening;
     info.augmentation = Some(1.0 / mu_max);
     let mut judge = Judge {
         flat,
@@ -469,7 +487,7 @@ pub fn solve_newton<P: AffineProblem>(
     let Some(reason) = reason else {
         info.complementarity = judge.complementarity(&best);
         info.residual = best_residual;
-        let status = classify(&lambda, &slip_bound(points, law, &lambda.normal));
+        let status = classify(&lambda, &slip_bound(&judge.points_at(&u), law, &lambda.normal));
         return Ok(ContactSolution {
             status,
             lambda,
@@ -499,7 +517,7 @@ fn after_stall<P: AffineProblem>(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
     let best_residual = stalled.residual;
-    let failure = if params.fallback {
+    let failure = if params.fallback && params.weakening.is_none() {
         match fallback(
             problem,
             points,
