@@ -185,6 +185,10 @@ fn compliance_is_refused_where_it_is_not_solved() {
     let mut s = block(2, Some(spec), false);
     s.solver.backend = problem::BackendChoice::Petsc;
     assert_eq!(s.validate().unwrap_err().key, "contact.compliance");
+    // Hertz's closed form is a rigid foundation's: not compared against a compliant one
+    let (mut hertz, _) = files::scene_file::load("hertz", &[]).unwrap();
+    hertz.contact.as_mut().unwrap().compliance = Some(spec);
+    assert_eq!(hertz.validate().unwrap_err().key, "contact.compliance");
     let bad = ComplianceSpec {
         stiffness: 1.0,
         exponent: 0.5,

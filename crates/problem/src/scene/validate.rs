@@ -742,6 +742,16 @@ fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
 /// material.
 fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
     let (law, kind) = (s.contact_law(), x.kind);
+    if let Some(c) = s.contact.as_ref().filter(|_| law != ContactLaw::None) {
+        // the closed forms are a rigid foundation's, with a constant coefficient
+        let why = format!("exact.kind = \"{kind}\" is the closed form of a rigid foundation with a constant friction coefficient: remove [exact], or the key");
+        refuse_if(c.compliance.is_some(), "contact.compliance", &why)?;
+        refuse_if(
+            c.friction_law.is_some_and(|f| f != crate::scene::FrictionLaw::Coulomb),
+            "contact.friction_law",
+            &why,
+        )?;
+    }
     let why = "a field solution's data, and exact.kind is a contact solution";
     refuse_if(!x.groups.is_empty(), "exact.groups", why)?;
     refuse_if(
