@@ -72,13 +72,9 @@ impl Point {
         }
     }
 
-    /// The normal value the radius is taken at: `z_n` on a rigid foundation, the pressure
-    /// `x_n` on a compliant one.
+    /// The normal value the radius is taken at ([`Foundation::radius_normal`]).
     fn normal(&self, x: &[f64; 3], z: &[f64; 3]) -> f64 {
-        match self.foundation {
-            Foundation::Rigid => z[0],
-            Foundation::Compliant { .. } => x[0],
-        }
+        self.foundation.radius_normal(z[0], x[0])
     }
 
     fn radius(&self, zn: f64) -> f64 {

@@ -65,6 +65,16 @@ impl Foundation {
         }
     }
 
+    /// The normal value Coulomb's radius `F [·]₊` is taken at: Newton's augmented `z_n` on a
+    /// rigid foundation (`[z_n]₊ = λ_n` at a solution), the pressure `λ_n` itself on a
+    /// compliant one.
+    pub fn radius_normal(self, z_n: f64, lambda_n: f64) -> f64 {
+        match self {
+            Foundation::Rigid => z_n,
+            Foundation::Compliant { .. } => lambda_n,
+        }
+    }
+
     /// The compliance's equation at a point, `f = (λ_n - k [p]₊^m) / s` with
     /// `s = 1 + k m [p]₊^(m-1) / c` (`p = u_n - g`, `c` the natural map's constant), and the
     /// derivative of `λ_n - k [p]₊^m` in `p`, `k m [p]₊^(m-1)`: `(f, s, slope)`; `None` on a

@@ -173,13 +173,19 @@ impl SlipWeakening {
         }
     }
 
+    /// The coefficient of each point at its slip `|u_t|` in `u`.
+    pub fn coefficients(&self, u: &crate::PointValues) -> Vec<f64> {
+        (0..u.n_points())
+            .map(|i| self.coefficient(u.tangential_norm(i)))
+            .collect()
+    }
+
     /// Points with the coefficients the law gives at the slips of `u`.
     pub fn points_at(&self, points: &ContactPoints, u: &crate::PointValues) -> ContactPoints {
-        let mut at = points.clone();
-        at.friction = (0..points.len())
-            .map(|i| self.coefficient(u.tangential_norm(i)))
-            .collect();
-        at
+        ContactPoints {
+            friction: self.coefficients(u),
+            ..points.clone()
+        }
     }
 
     /// Checks the law's data.
@@ -305,13 +311,8 @@ pub fn solve_slip_weakening<P: AffineProblem>(
         newton_iters += sol.info.newton_iters;
         // the operator is the same at every step: its μ_max once
         newton.mu_max = Some(sol.info.mu_max);
-        let next: Vec<f64> = (0..n).map(|i| law.coefficient(sol.u.tangential_norm(i))).collect();
-        let change = next
-            .iter()
-            .zip(&frozen.friction)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max)
-            / scale;
+        let next = law.coefficients(&sol.u);
+        let change = max_difference(&next, &frozen.friction) / scale;
         // the map's secant ratio |G(μ_k) - G(μ_j)| / |μ_k - μ_j| between successive iterates,
         // where the step stands above the round-off of the step's own solve
         if let Some(ratio) = secant_ratio(previous.as_ref(), (&frozen.friction, &next), scale, params.tol) {

@@ -238,14 +238,15 @@ pub struct ContactSolve<'p> {
 impl<'p> ContactSolve<'p> {
     /// The points with the coefficients the law gives at the slips of `sol` (slip
     /// weakening), or as they are.
-    pub fn points_at(&self, points: &contact::ContactPoints, sol: &ContactSolution) -> contact::ContactPoints {
-        let mut at = points.clone();
-        if let Some(w) = &self.weakening {
-            at.friction = (0..points.len())
-                .map(|i| w.coefficient(sol.u.tangential_norm(i)))
-                .collect();
+    pub fn points_at<'a>(
+        &self,
+        points: &'a contact::ContactPoints,
+        sol: &ContactSolution,
+    ) -> std::borrow::Cow<'a, contact::ContactPoints> {
+        match &self.weakening {
+            Some(w) => std::borrow::Cow::Owned(w.points_at(points, &sol.u)),
+            None => std::borrow::Cow::Borrowed(points),
         }
-        at
     }
 
     /// The plan's contact law on `n` points: frictionless without tangential multipliers,

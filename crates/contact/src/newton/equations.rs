@@ -198,10 +198,7 @@ impl<'a> Flat<'a> {
     /// The normal value Coulomb's radius is taken at: `z_n` on a rigid foundation, the
     /// pressure `x_n` on a compliant one.
     fn radius_normal(&self, i: usize, z: &[f64], x: &[f64]) -> f64 {
-        match self.points.foundation {
-            Foundation::Rigid => z[i],
-            Foundation::Compliant { .. } => x[i],
-        }
+        self.points.foundation.radius_normal(z[i], x[i])
     }
 
     /// The slip `|u_t|` of point `i` in the flat `u`.
@@ -306,9 +303,10 @@ impl<'a> Flat<'a> {
                         // dS = F M_n for Coulomb at a contact point
                         let ratio = radius / qn;
                         let rigid = self.points.foundation == Foundation::Rigid;
+                        // the normal value the radius is taken at, in contact where positive
+                        let normal = crate::project_nonnegative(self.radius_normal(i, &s.z, &s.x));
                         let slope = match self.law {
-                            Law::Coulomb if rigid && s.z[i] > 0.0 => coefficient,
-                            Law::Coulomb if !rigid && s.x[i] > 0.0 => coefficient,
+                            Law::Coulomb if normal > 0.0 => coefficient,
                             _ => 0.0,
                         };
                         row.e.push((t + k, 1.0));
@@ -328,7 +326,6 @@ impl<'a> Flat<'a> {
                             }
                         }
                         // slip weakening: dS ∋ [n]₊ μ'(s) û_t · du_t, with du = -(C δ) / c
-                        let normal = crate::project_nonnegative(self.radius_normal(i, &s.z, &s.x));
                         if weakens != 0.0 && slip > 0.0 && normal > 0.0 {
                             for l in (0..nt).filter(|&l| !self.points.is_held(i, l)) {
                                 let u_hat = s.u[t + l] / slip;
