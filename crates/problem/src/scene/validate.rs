@@ -520,19 +520,29 @@ fn refuse_compliance(s: &Scene) -> Result<(), SceneError> {
     {
         return Ok(());
     }
+    newton_on_the_default_backend(
+        s,
+        "contact.compliance",
+        "contact.compliance (a deformable foundation): the PETSc backend's active sets hold Signorini's conditions only; use the default backend",
+        |strategy| format!("a deformable foundation, and solver.strategy = \"{strategy}\" projects onto Signorini's conditions: normal compliance is solved by newton-condensed"),
+    )
+}
+
+/// A law only `newton-condensed` on the default backend solves: refused by `key` with
+/// `petsc` for the PETSc backend, with the reason `strategy` gives for another strategy.
+fn newton_on_the_default_backend(
+    s: &Scene,
+    key: &str,
+    petsc: &str,
+    strategy: impl FnOnce(Strategy) -> String,
+) -> Result<(), SceneError> {
     if s.solver.backend == BackendChoice::Petsc {
-        return Err(SceneError::new(
-            "contact.compliance",
-            "contact.compliance (a deformable foundation): the PETSc backend's active sets hold Signorini's conditions only; use the default backend",
-        ));
+        return Err(SceneError::new(key, petsc));
     }
     refuse_if(
         s.solver.strategy != Strategy::NewtonCondensed,
-        "contact.compliance",
-        &format!(
-            "a deformable foundation, and solver.strategy = \"{}\" projects onto Signorini's conditions: normal compliance is solved by newton-condensed",
-            s.solver.strategy
-        ),
+        key,
+        &strategy(s.solver.strategy),
     )
 }
 
@@ -592,19 +602,11 @@ fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
             format!("contact.slip_length = {l} must be positive"),
         ));
     }
-    if s.solver.backend == BackendChoice::Petsc {
-        return Err(SceneError::new(
-            "contact.friction_law",
-            "contact.friction_law = \"slip-weakening\": the PETSc backend's active sets hold a constant coefficient only; use the default backend",
-        ));
-    }
-    refuse_if(
-        s.solver.strategy != Strategy::NewtonCondensed,
+    newton_on_the_default_backend(
+        s,
         "contact.friction_law",
-        &format!(
-            "slip weakening, and solver.strategy = \"{}\": its fixed point on the coefficients runs semismooth Newton (newton-condensed)",
-            s.solver.strategy
-        ),
+        "contact.friction_law = \"slip-weakening\": the PETSc backend's active sets hold a constant coefficient only; use the default backend",
+        |strategy| format!("slip weakening, and solver.strategy = \"{strategy}\": its fixed point on the coefficients runs semismooth Newton (newton-condensed)"),
     )
 }
 
