@@ -340,18 +340,7 @@ fn csv_name<'a>(path: &Path, taken: impl Iterator<Item = &'a str>) -> String {
     let stem = path
         .file_stem()
         .map_or_else(|| "problem".to_string(), |s| s.to_string_lossy().into_owned());
-    let safe: String = stem
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    let safe = safe.trim_start_matches('.');
-    let base = if safe.is_empty() { "problem" } else { safe };
+    let base = files::output::safe_file_name(&stem, "problem");
     let taken: Vec<&str> = taken.collect();
     let mut name = format!("{base}.csv");
     let mut k = 2;

@@ -105,6 +105,8 @@ pub enum SceneFileError {
     Override {
         /// The override as given.
         set: String,
+        /// The key it names (before `=`, without a leading `~`).
+        key: String,
         /// Why it does not apply.
         message: String,
     },

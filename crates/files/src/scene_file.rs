@@ -115,6 +115,7 @@ pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, Err
                 label,
                 SceneFileError::Override {
                     set: o.clone(),
+                    key: override_key(o).trim().to_string(),
                     message,
                 },
             )
@@ -138,14 +139,23 @@ pub fn from_tree(tree: toml::Table, label: &str) -> Result<Scene, Error> {
 
 /// Applies one override, `a.b.c=value` or `~a.b.c`, to the tree.
 fn apply(tree: &mut toml::Table, o: &str) -> Result<(), String> {
-    let (key, value) = match o.strip_prefix('~') {
-        Some(key) => (key, None),
+    let value = match o.strip_prefix('~') {
+        Some(_) => None,
         None => {
-            let (key, raw) = o.split_once('=').ok_or("expected KEY=VALUE, or ~KEY to remove a key")?;
-            (key, Some(parse_value(raw.trim())?))
+            let (_, raw) = o.split_once('=').ok_or("expected KEY=VALUE, or ~KEY to remove a key")?;
+            Some(parse_value(raw.trim())?)
         }
     };
-    set(tree, key, value)
+    set(tree, override_key(o), value)
+}
+
+/// The key of an override: `KEY` of `KEY=VALUE` or of `~KEY` (the whole text where it has
+/// neither form).
+fn override_key(o: &str) -> &str {
+    match o.strip_prefix('~') {
+        Some(key) => key,
+        None => o.split_once('=').map_or(o, |(key, _)| key),
+    }
 }
 
 /// Sets the dotted `key` of the tree to `value`, or removes it where `value` is `None`;
@@ -341,8 +351,17 @@ mod tests {
         assert!(e.contains("contact.friction does not apply"), "{e}");
         let (s, _) = load("paper", &["contact.law=signorini".into(), "~contact.friction".into()]).unwrap();
         assert_eq!(s.contact_law(), problem::ContactLaw::Signorini);
-        let e = load("paper", &["~contact.nothing".into()]).unwrap_err().to_string();
-        assert!(e.contains("no `contact.nothing` to remove"), "{e}");
+        let e = load("paper", &["~contact.nothing".into()]).unwrap_err();
+        assert!(e.to_string().contains("no `contact.nothing` to remove"), "{e}");
+        // the override's key is kept as data, as a scene value's is
+        let crate::Error::Scene {
+            source: crate::SceneFileError::Override { key, .. },
+            ..
+        } = &e
+        else {
+            panic!("{e}")
+        };
+        assert_eq!(key, "contact.nothing");
         // a choice that does not exist names itself and its key
         let e = load("paper", &["solver.strategy=fast".into()]).unwrap_err().to_string();
         assert!(e.contains("fast") && e.contains("solver.strategy"), "{e}");

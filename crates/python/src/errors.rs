@@ -181,16 +181,9 @@ pub fn scene_key(e: &Error) -> Option<String> {
         }
         | Error::Problem(ProblemError::Scene(s)) => Some(s.key.clone()),
         Error::Scene {
-            source: files::SceneFileError::Override { set, .. },
+            source: files::SceneFileError::Override { key, .. },
             ..
-        } => Some(
-            set.trim_start_matches('~')
-                .split('=')
-                .next()
-                .unwrap_or(set)
-                .trim()
-                .to_string(),
-        ),
+        } => Some(key.clone()),
         _ => None,
     }
 }

@@ -222,7 +222,13 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
 /// component (letters, digits, `-`, `_` and `.` kept, anything else `_`, no leading dot), so that
 /// a name like `../x` or `/tmp/x` cannot write outside `out/`.
 pub fn default_dir(scene_name: &str) -> PathBuf {
-    let safe: String = scene_name
+    Path::new("out").join(safe_file_name(scene_name, "scene"))
+}
+
+/// `name` made a safe single path component: letters, digits, `-`, `_` and `.` kept, anything
+/// else `_`, no leading dot; `fallback` where nothing is left.
+pub fn safe_file_name(name: &str, fallback: &str) -> String {
+    let safe: String = name
         .chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || "-_.".contains(c) {
@@ -233,7 +239,7 @@ pub fn default_dir(scene_name: &str) -> PathBuf {
         })
         .collect();
     let safe = safe.trim_start_matches('.');
-    Path::new("out").join(if safe.is_empty() { "scene" } else { safe })
+    if safe.is_empty() { fallback } else { safe }.to_string()
 }
 
 #[cfg(test)]
