@@ -127,6 +127,7 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
         lambda: best.lambda,
         u: best.u,
         info,
+        electric: None,
     })
 }
 

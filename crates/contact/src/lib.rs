@@ -39,6 +39,7 @@
 //! assert_eq!(sol.status[0], Status::Slip); // frictionless contact: slip
 //! ```
 
+mod electric;
 mod gauss_seidel;
 mod local;
 mod newton;
@@ -51,6 +52,7 @@ mod uniqueness;
 mod uzawa;
 mod weakening;
 
+pub use electric::{solve_newton_electric, ElectricContact, ElectricContactProblem, ElectricLaw, ElectricValues};
 pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
 pub use newton::{solve_newton, NewtonParams};
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};
@@ -255,6 +257,16 @@ pub enum InputError {
         nt: usize,
         /// The order they need.
         m: usize,
+    },
+    /// An electrical contact's value out of its range.
+    #[error("electrical contact: {what} {value} {must}")]
+    Electric {
+        /// The value (`conductance`, `foundation potential`, `point`).
+        what: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be, in words.
+        must: &'static str,
     },
     /// A foundation's parameter out of its range.
     #[error("normal compliance: {what} {value} {must}")]

@@ -104,6 +104,9 @@ pub struct ContactSolution {
     pub status: Vec<Status>,
     /// Counts and residuals.
     pub info: ContactInfo,
+    /// The flux and potential of the points with electrical contact
+    /// ([`crate::solve_newton_electric`]); `None` without.
+    pub electric: Option<crate::ElectricValues>,
 }
 
 impl ContactSolution {

@@ -440,6 +440,7 @@ fn finish(d: Dual<'_, '_>, law: &Law, lambda: PointValues, u: PointValues) -> Re
         lambda,
         u,
         info,
+        electric: None,
     })
 }
 

@@ -316,6 +316,7 @@ impl<'p> Context<'_, 'p> {
                 u: it.u,
                 status,
                 info,
+                electric: None,
             },
             x: it.x,
             krylov_iterations: it.krylov,

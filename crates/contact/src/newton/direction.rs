@@ -18,11 +18,13 @@ const SYMMETRIC: f64 = 1e-8;
 
 /// How the Newton directions of one problem are solved.
 pub(super) enum Directions {
-    /// Dense SPD: the reduced system, with the stiffness `(D + σ W⁻¹)⁻¹` (row-major).
+    /// Dense SPD, or positive real with electric rows: the reduced system, with the stiffness
+    /// `(D + σ W⁻¹)⁻¹` (row-major).
     Reduced(Vec<f64>),
     /// Dense, not SPD or not symmetric: one LU of `J` per step.
     DenseLu {
-        /// Whether `D` is symmetric (to [`SYMMETRIC`]).
+        /// Whether `D` is symmetric (to [`SYMMETRIC`]), or a condensed finite-element
+        /// compliance with electric rows: Newton's lenient rules.
         symmetric: bool,
     },
     /// Sparse: one sparse LU of `J` per step, on a pattern (and its symbolic factorisation)
@@ -83,13 +85,25 @@ impl Directions {
             }
             Compliance::Dense(d) => d,
         };
-        if flat.d.asymmetry() > SYMMETRIC {
-            return Directions::DenseLu { symmetric: false };
-        }
         let m = flat.m;
         let shifted = Mat::<f64>::from_fn(m, m, |i, j| {
             d[i * m + j] + if i == j { flat.sigma / flat.w[i] } else { 0.0 }
         });
+        if flat.electric.is_some() {
+            // positive real, not symmetric (the electric couplings are opposite): the reduced
+            // system with the stiffness from one LU; a condensed finite-element compliance
+            // all the same, under its rules
+            let inv = faer::linalg::solvers::DenseSolveCore::inverse(&shifted.partial_piv_lu());
+            let inv: Vec<f64> = (0..m * m).map(|k| inv[(k / m, k % m)]).collect();
+            return if inv.iter().all(|v| v.is_finite()) {
+                Directions::Reduced(inv)
+            } else {
+                Directions::DenseLu { symmetric: true }
+            };
+        }
+        if flat.d.asymmetry() > SYMMETRIC {
+            return Directions::DenseLu { symmetric: false };
+        }
         match shifted.llt(faer::Side::Lower) {
             Ok(llt) => {
                 let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);

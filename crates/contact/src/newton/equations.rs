@@ -7,6 +7,7 @@
 //! `z` (separated, stick, slip); each row is `J_r = E_r + B_r C` with `C = c (D W + σ I)` and
 //! `E_r`, `B_r` sparse over the point's own components.
 
+use crate::electric::ElectricContact;
 use crate::operator::Compliance;
 use crate::points::{ContactPoints, Foundation, PointValues};
 use crate::Law;
@@ -62,6 +63,18 @@ pub(super) struct Flat<'a> {
     /// Slip-weakening friction: Coulomb's radius with the coefficient `μ(|u_t|)` of each
     /// point's own slip.
     pub(super) weakening: Option<crate::SlipWeakening>,
+    /// Electrical contact: the rows after the mechanical ones.
+    pub(super) electric: Option<ElectricRows<'a>>,
+}
+
+/// The electric rows of a problem with electrical contact: one per electric point, from
+/// `start` (the mechanical rows' count) on.
+#[derive(Clone)]
+pub(super) struct ElectricRows<'a> {
+    pub(super) contact: &'a ElectricContact,
+    pub(super) start: usize,
+    /// The flux scale of the electric residual, `‖c (φ₀ - φ_F)‖_W`.
+    pub(super) reference: f64,
 }
 
 /// The equations and their pieces at one `λ`.
@@ -119,9 +132,80 @@ impl<'a> Flat<'a> {
             u0: u0.normal.iter().chain(&u0.tangential).copied().collect(),
             sigma: 0.0,
             weakening: None,
+            electric: None,
         };
         flat.c = vec![1.0 / mu_max; m];
         flat
+    }
+
+    /// The problem with the electric rows of `contact` after the mechanical ones: `d` the
+    /// whole compliance, `phi0` the potentials under the loads alone. Each electric row's
+    /// constant is its own, `1/(D_rr w_r)` (within the mechanical rows' range).
+    pub(super) fn with_electric(mut self, d: Compliance<'a>, contact: &'a ElectricContact, phi0: &[f64]) -> Self {
+        let start = self.m;
+        self.d = d;
+        self.m = start + contact.points.len();
+        self.w.extend(contact.points.iter().map(|&i| self.points.weight[i]));
+        self.u0.extend_from_slice(phi0);
+        for r in start..self.m {
+            let own = self
+                .d
+                .row(r)
+                .find(|(col, _)| *col == r)
+                .map_or(0.0, |(_, v)| v * self.w[r]);
+            self.c.push(self.local_constant(own));
+        }
+        let free: Vec<f64> = (start..self.m)
+            .map(|r| self.c[r] * (self.u0[r] - contact.potential))
+            .collect();
+        let reference = weighted_norm(&free, &self.w[start..]);
+        self.electric = Some(ElectricRows {
+            contact,
+            start,
+            reference,
+        });
+        self
+    }
+
+    /// The natural map's constant of a row whose own compliance is `own`: its inverse, within
+    /// `[1/μ_max, 10⁸/μ_max]`.
+    fn local_constant(&self, own: f64) -> f64 {
+        (1.0 / own.abs()).clamp(1.0 / self.mu_max, 1e8 / self.mu_max)
+    }
+
+    /// The mechanical rows' count.
+    pub(super) fn mechanical(&self) -> usize {
+        self.n * (1 + self.nt)
+    }
+
+    /// The electric residual of `s`: the weighted norm of the electric equations relative to
+    /// the flux's, `‖f_e‖_W / max(‖q‖_W, reference)`; 0 without electric rows.
+    pub(super) fn electric_residual(&self, s: &State) -> f64 {
+        let Some(e) = &self.electric else {
+            return 0.0;
+        };
+        let rows = e.start..self.m;
+        let num = weighted_norm(&s.f[rows.clone()], &self.w[rows.clone()]);
+        let den = weighted_norm(&s.x[rows.clone()], &self.w[rows]).max(e.reference);
+        if den > 0.0 {
+            num / den
+        } else {
+            num
+        }
+    }
+
+    /// Point `i`'s `p` for the electric law and its contact status: on a rigid foundation
+    /// the augmented `z_n` (whose `[z_n]₊` is the pressure `λ_n` at a solution, as for
+    /// Coulomb's radius: from the start, a point pressed in conducts, and the derivative sees
+    /// it), on a compliant one the penetration.
+    fn contact_of(&self, i: usize, s_u: &[f64], s_z: &[f64]) -> (f64, bool) {
+        match self.points.foundation {
+            Foundation::Rigid => (s_z[i], s_z[i] > 0.0),
+            Foundation::Compliant { .. } => {
+                let pen = s_u[i] - self.points.gap[i];
+                (pen, pen > 0.0)
+            }
+        }
     }
 
     /// The flat indices of point `i`'s components.
@@ -153,10 +237,18 @@ impl<'a> Flat<'a> {
                     }
                 }
             }
-            let local = (1.0 / sum.sqrt()).clamp(1.0 / self.mu_max, 1e8 / self.mu_max);
+            let local = self.local_constant(sum.sqrt());
             for &r in &rows {
                 c[r] = local;
             }
+        }
+        for r in self.mechanical()..self.m {
+            let own = self
+                .d
+                .row(r)
+                .find(|(col, _)| *col == r)
+                .map_or(0.0, |(_, v)| v * self.w[r]);
+            c[r] = self.local_constant(own + self.sigma);
         }
         c
     }
@@ -216,9 +308,17 @@ impl<'a> Flat<'a> {
         let mut u = vec![0.0; m];
         self.d.apply(&wx, &mut u);
         let mut z = vec![0.0; m];
+        let potential = self.electric.as_ref().map_or(0.0, |e| e.contact.potential);
+        let mechanical = self.mechanical();
         for r in 0..m {
             u[r] = self.u0[r] - u[r] - self.sigma * x[r];
-            let g = if r < self.n { self.points.gap[r] } else { 0.0 };
+            let g = if r < self.n {
+                self.points.gap[r]
+            } else if r >= mechanical {
+                potential
+            } else {
+                0.0
+            };
             z[r] = x[r] + self.c[r] * (u[r] - g);
         }
         let mut f = vec![0.0; m];
@@ -236,6 +336,13 @@ impl<'a> Flat<'a> {
                 for k in 0..self.nt {
                     f[t + k] = x[t + k] - buf[k];
                 }
+            }
+        }
+        if let Some(e) = &self.electric {
+            for (k, &i) in e.contact.points.iter().enumerate() {
+                let r = e.start + k;
+                let (p, contact) = self.contact_of(i, &u, &z);
+                f[r] = e.contact.row(x[r], u[r], self.c[r], p, contact).f;
             }
         }
         let norm = weighted_norm(&f, &self.w);
@@ -339,11 +446,42 @@ impl<'a> Flat<'a> {
                 }
             }
         }
+        self.electric_rows(s, &mut rows);
         rows
     }
 
-    /// Flat values as [`PointValues`].
+    /// The electric rows of the generalised Jacobian at `s` (none without electrical contact).
+    fn electric_rows(&self, s: &State, rows: &mut [RowForm]) {
+        let Some(e) = &self.electric else {
+            return;
+        };
+        for (k, &i) in e.contact.points.iter().enumerate() {
+            let r = e.start + k;
+            let (p, contact) = self.contact_of(i, &s.u, &s.z);
+            let row = e.contact.row(s.x[r], s.u[r], self.c[r], p, contact);
+            let form = &mut rows[r];
+            if row.identity != 0.0 {
+                form.e.push((r, row.identity));
+            }
+            if row.along_c != 0.0 {
+                form.b.push((r, row.along_c));
+            }
+            if row.along_p != 0.0 {
+                match self.points.foundation {
+                    // p = [z_n]₊: ∂p = (I - C)_i
+                    Foundation::Rigid => {
+                        form.e.push((i, row.along_p));
+                        form.b.push((i, -row.along_p));
+                    }
+                    // p = u_n - g: ∂p = -C_i / c_i
+                    Foundation::Compliant { .. } => form.b.push((i, -row.along_p / self.c[i])),
+                }
+            }
+        }
+    }
+
+    /// The mechanical part of flat values as [`PointValues`].
     pub(super) fn values(&self, x: &[f64]) -> PointValues {
-        PointValues::from_flat(x, self.n, self.nt)
+        PointValues::from_flat(&x[..self.mechanical()], self.n, self.nt)
     }
 }

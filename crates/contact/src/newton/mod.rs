@@ -38,7 +38,9 @@
 mod direction;
 mod equations;
 
+use crate::electric::{ElectricContactProblem, ElectricValues};
 use crate::operator::AffineProblem;
+use crate::operator::Compliance;
 use crate::points::{ContactPoints, PointValues};
 use crate::solution::{classify, counts, slip_bound, Best, Counter, Preamble};
 use crate::InputError;
@@ -159,29 +161,33 @@ impl Judge<'_> {
         let lambda = problem.values(&s.x);
         let u = problem.values(&s.u);
         let u0 = problem.values(&problem.u0);
-        self.measure.of(
-            &self.points_at(&u),
-            self.law,
-            &lambda,
-            &u,
-            &u0,
-            1.0 / self.flat.mu_max,
-            self.reference,
-        )
+        self.measure
+            .of(
+                &self.points_at(&u),
+                self.law,
+                &lambda,
+                &u,
+                &u0,
+                1.0 / self.flat.mu_max,
+                self.reference,
+            )
+            .max(problem.electric_residual(s))
     }
 
     /// The complementarity residual of a state of the problem itself, whatever the measure.
     fn complementarity(&self, s: &State) -> f64 {
         let u = self.flat.values(&s.u);
-        Measure::Complementarity.of(
-            &self.points_at(&u),
-            self.law,
-            &self.flat.values(&s.x),
-            &u,
-            self.u0,
-            1.0 / self.flat.mu_max,
-            self.reference,
-        )
+        Measure::Complementarity
+            .of(
+                &self.points_at(&u),
+                self.law,
+                &self.flat.values(&s.x),
+                &u,
+                self.u0,
+                1.0 / self.flat.mu_max,
+                self.reference,
+            )
+            .max(self.flat.electric_residual(s))
     }
 
     /// Judges a state of the problem itself: keeps it if it is the best; whether it meets the
@@ -493,6 +499,7 @@ pub fn solve_newton<P: AffineProblem>(
             lambda,
             u,
             info,
+            electric: None,
         });
     };
     let stalled = Iterate {
@@ -501,6 +508,104 @@ pub fn solve_newton<P: AffineProblem>(
         residual: best_residual,
     };
     after_stall(problem, points, law, params, stalled, reason, info, progress)
+}
+
+/// [`crate::solve_newton_electric`] on the scaled problem: stages 1 and 2 on the mechanical
+/// and electric rows together; a stall is a [`ContactError::Stalled`] with the best iterate.
+pub(crate) fn solve_electric(
+    problem: &mut ElectricContactProblem,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ContactSolution, ContactError> {
+    if !(params.tol > 0.0) {
+        return Err(InputError::Parameter(format!("Newton tolerance {} must be positive", params.tol)).into());
+    }
+    let pre = Preamble::new(
+        &mut Counter::new(problem),
+        points,
+        law,
+        params.power_iters,
+        params.mu_max,
+    )?;
+    let (mu_max, reference) = (pre.mu_max, pre.reference);
+    let mut info = ContactInfo::new(mu_max);
+    info.augmentation = Some(1.0 / mu_max);
+    let u0 = problem.u0.clone();
+    let flat = Flat::new(Compliance::Dense(&problem.compliance), &u0, points, law, pre.nt, mu_max).with_electric(
+        Compliance::Dense(&problem.compliance),
+        &problem.electric,
+        &problem.phi0,
+    );
+    let x0 = vec![0.0; flat.m];
+    let mut judge = Judge {
+        flat,
+        law,
+        points,
+        u0: &u0,
+        measure: params.measure,
+        reference,
+        tol: params.tol,
+        best: Best::new(1.0),
+    };
+    let end = newton_stages(&mut judge, x0, params, &mut info, progress);
+    let best_residual = judge.best_residual();
+    let (best, _) = judge.best.take_kept().expect("the start was judged");
+    let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
+    let converged = matches!(end, End::Converged) || best_residual <= params.tol;
+    let stall = match end {
+        _ if converged => None,
+        End::Interrupted(why) => {
+            let best = Iterate {
+                lambda,
+                u,
+                residual: best_residual,
+            };
+            return Err(ContactError::Interrupted {
+                why,
+                n_iters: info.newton_iters,
+                residual: best_residual,
+                best: Some(Box::new(best)),
+            });
+        }
+        End::Stalled(why) => Some(why),
+        End::Converged => None,
+    };
+    if let Some(reason) = stall {
+        let best = Iterate {
+            lambda,
+            u,
+            residual: best_residual,
+        };
+        return Err(ContactError::Stalled {
+            stage: if info.proximal_iters > 0 {
+                Stage::Proximal
+            } else {
+                Stage::Newton
+            },
+            n_iters: info.newton_iters,
+            residual: best_residual,
+            reason,
+            best: Some(Box::new(best)),
+        });
+    }
+    info.complementarity = judge.complementarity(&best);
+    info.residual = best_residual;
+    let start = judge.flat.mechanical();
+    let electric = ElectricValues {
+        points: problem.electric.points.clone(),
+        flux: best.x[start..].to_vec(),
+        potential: best.u[start..].to_vec(),
+    };
+    let status = classify(&lambda, &slip_bound(points, law, &lambda.normal));
+    Ok(ContactSolution {
+        status,
+        lambda,
+        u,
+        info,
+        electric: Some(electric),
+    })
 }
 
 /// After Newton's stages stalled at the iterate `stalled`: stage 3 (the fallback, where the
