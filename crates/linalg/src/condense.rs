@@ -49,15 +49,15 @@ impl DirectLdlt {
     /// Condenses `K` onto `dofs` (indices into `[u; φ]`) with the loads `[b_u; b_φ]`.
     ///
     /// # Errors
-    /// [`LinalgError::NotPositiveDefinite`] where a pivot of the trailing block is not positive
-    /// (the dofs must be displacements, on which `K` is positive definite);
+    /// [`LinalgError::NotPositiveDefinite`] where a pivot of the trailing block has not its
+    /// dof's sign (positive on a displacement, negative on a potential: `K` is quasi-definite);
     /// [`LinalgError::Shape`] for a dof out of range.
     pub fn condense(&mut self, b_u: &[f64], b_phi: &[f64], dofs: &[usize]) -> Result<Condensed, LinalgError> {
         let b: Vec<f64> = b_u.iter().chain(b_phi).copied().collect();
         if let Some(&bad) = dofs.iter().find(|&&d| d >= b.len()) {
             return Err(ShapeError::CondensedDof { dof: bad, n: b.len() }.into());
         }
-        if let Some(condensed) = self.condense_from_factor(&b, dofs)? {
+        if let Some(condensed) = self.condense_from_factor(&b, dofs, b_u.len())? {
             return Ok(condensed);
         }
         self.condense_by_solves(b, dofs)
@@ -101,13 +101,13 @@ impl DirectLdlt {
     }
 
     /// The trailing-block route, where the factor's order ends with `dofs`; `None` otherwise.
-    fn condense_from_factor(&self, b: &[f64], dofs: &[usize]) -> Result<Option<Condensed>, LinalgError> {
+    fn condense_from_factor(&self, b: &[f64], dofs: &[usize], n_u: usize) -> Result<Option<Condensed>, LinalgError> {
         let k = dofs.len();
         let fwd = self.factor.permutation();
         if k == 0 || fwd[fwd.len() - k..] != *dofs {
             return Ok(None);
         }
-        let Some(inverse) = self.factor.trailing_schur_inverse(k)? else {
+        let Some(inverse) = self.factor.trailing_schur_inverse(k, &|j| dofs[j] >= n_u)? else {
             return Ok(None);
         };
         let Some(forward) = self.factor.forward(b) else {

@@ -376,14 +376,21 @@ impl SparseFactor {
     /// inverse on the last `k` indices, with no further factorisation (one unit-triangular
     /// inverse and one triangular product, `2k³/3` flops). `None` unless the factor is a
     /// supernodal `L D Lᵀ` whose last supernode holds all `k` columns;
-    /// [`LinalgError::NotPositiveDefinite`] where a pivot of the block is not positive (the
-    /// block of a quasi-definite matrix on its positive-definite dofs has only positive ones).
-    pub(crate) fn trailing_schur_inverse(&self, k: usize) -> Result<Option<Vec<f64>>, LinalgError> {
+    /// [`LinalgError::NotPositiveDefinite`] where a pivot of the block has not the sign of its
+    /// kind: the pivots of a quasi-definite matrix, in any order, are positive on its
+    /// positive-definite dofs and negative on the others (Vanderbei, SIAM J. Optim. 5 (1995));
+    /// `negative(j)` says which the block's `j`-th index is.
+    pub(crate) fn trailing_schur_inverse(
+        &self,
+        k: usize,
+        negative: &dyn Fn(usize) -> bool,
+    ) -> Result<Option<Vec<f64>>, LinalgError> {
         let Some(l) = self.trailing_block(k) else {
             return Ok(None);
         };
         let d: Vec<f64> = (0..k).map(|j| l[(j, j)]).collect();
-        if let Some(j) = d.iter().position(|x| !(*x > 0.0)) {
+        let wrong_sign = |j: usize, x: f64| if negative(j) { !(x < 0.0) } else { !(x > 0.0) };
+        if let Some(j) = (0..k).find(|&j| wrong_sign(j, d[j])) {
             return Err(LinalgError::NotPositiveDefinite {
                 pivot: self.n() - k + j,
             });

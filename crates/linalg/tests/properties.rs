@@ -211,15 +211,19 @@ fn condensation_is_the_block_of_the_inverse() {
         &(0..n).map(|i| Triplet::new(i, i, 0.7)).collect::<Vec<_>>(),
     )
     .unwrap();
-    // the "contact" dofs: the u dofs of the grid's first row
-    let last: Vec<usize> = (0..m).collect();
-    // AMD on the rest, or a given order of all (reversed) with the contact dofs taken out
-    let given = Ordering::GivenThenLast {
-        order: (0..2 * n).rev().collect(),
-        last: last.clone(),
-    };
-    for ordering in [Ordering::AmdThenLast(last.clone()), given] {
-        check_trailing_block(&a, &g, &b, &ordering, &last);
+    // the "contact" dofs: the u dofs of the grid's first row; then with their potentials too
+    // (electrical contact: the trailing block is indefinite, its pivots of both signs)
+    let u_only: Vec<usize> = (0..m).collect();
+    let with_phi: Vec<usize> = (0..m).chain(n..n + m).collect();
+    for last in [u_only, with_phi] {
+        // AMD on the rest, or a given order of all (reversed) with the contact dofs taken out
+        let given = Ordering::GivenThenLast {
+            order: (0..2 * n).rev().collect(),
+            last: last.clone(),
+        };
+        for ordering in [Ordering::AmdThenLast(last.clone()), given] {
+            check_trailing_block(&a, &g, &b, &ordering, &last);
+        }
     }
 }
 
