@@ -29,6 +29,14 @@ pub const SHIPPED: &[(&str, &str)] = &[
         "paper-slip-weakening",
         include_str!("../../../scenes/paper-slip-weakening.toml"),
     ),
+    (
+        "paper-conductive",
+        include_str!("../../../scenes/paper-conductive.toml"),
+    ),
+    (
+        "paper-conducting",
+        include_str!("../../../scenes/paper-conducting.toml"),
+    ),
     ("paper-elastic", include_str!("../../../scenes/paper-elastic.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),

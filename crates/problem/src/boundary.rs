@@ -8,7 +8,9 @@
 
 use crate::scene::{ContactSpec, SceneError};
 use crate::ProblemError;
-use contact::{ContactOperator, ContactPoints, DenseContactProblem, OperatorError, PointValues};
+use contact::{
+    ContactOperator, ContactPoints, DenseContactProblem, ElectricContactProblem, OperatorError, PointValues,
+};
 use fe_assembly::{facet_measure, Dof, DofMap};
 use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
 
@@ -30,6 +32,9 @@ pub struct ContactBoundary {
     /// Those of them that the condition holds past the gap, inside the foundation (a clamped
     /// corner of a body pressed in by a negative gap): the condition wins.
     pub held_inside: usize,
+    /// Electrical contact: the law and the points with a free potential, and those potentials'
+    /// dofs (indices into `[u; φ]`), condensed after `dofs`.
+    pub electric: Option<(contact::ElectricContact, Vec<usize>)>,
 }
 
 /// One displacement component of a contact point.
@@ -254,6 +259,7 @@ impl ContactBoundary {
             )
             .into());
         }
+        let electric = electric_points(spec, dofs, &nodes)?;
         Ok(ContactBoundary {
             points,
             nodes,
@@ -261,7 +267,27 @@ impl ContactBoundary {
             slots,
             held_nodes,
             held_inside,
+            electric,
         })
+    }
+
+    /// The dofs the condensation puts last: the points' free displacements, then (electrical
+    /// contact) their free potentials.
+    pub fn condensed_dofs(&self) -> Vec<usize> {
+        let phi = self.electric.as_ref().map_or(&[][..], |(_, d)| d.as_slice());
+        self.dofs.iter().chain(phi).copied().collect()
+    }
+
+    /// The flux of `sol` as the change of the electric right-hand side (the potential's rows
+    /// negated: `+w q` at each electric point's potential), as `(index into φ, value)`.
+    pub fn electric_charges(&self, sol: &contact::ContactSolution, n_u: usize) -> Vec<(usize, f64)> {
+        let (Some((_, dofs)), Some(e)) = (&self.electric, &sol.electric) else {
+            return vec![];
+        };
+        dofs.iter()
+            .zip(e.points.iter().zip(&e.flux))
+            .map(|(&d, (&i, q))| (d - n_u, self.points.weight[i] * q))
+            .collect()
     }
 
     /// Tells `reporter` what Dirichlet conditions hold of the group `group` where it is more
@@ -363,45 +389,9 @@ impl ContactBoundary {
         nt: usize,
     ) -> Result<(DenseContactProblem, CondensedLoads), ProblemError> {
         let condensed = solver.condense(b_u, b_phi, &self.dofs)?;
-        let (k, inv) = (self.dofs.len(), condensed.inverse);
         let p = &self.points;
-        let (n, dim) = (p.len(), p.dim);
-        let m = n * (1 + nt);
-        // rows of R: the normal, then the tangents, of each point, over its free dofs
-        let dir = |r: usize| -> (usize, [f64; 3]) {
-            if r < n {
-                (r, p.normal[r])
-            } else {
-                let (i, q) = ((r - n) / nt, (r - n) % nt);
-                (i, p.tangent[i][q])
-            }
-        };
-        let free = |i: usize| -> Vec<(usize, usize)> {
-            (0..dim)
-                .filter_map(|x| match self.slots[i * dim + x] {
-                    Slot::Free(j) => Some((x, j)),
-                    Slot::Fixed(_) => None,
-                })
-                .collect()
-        };
-        let free: Vec<Vec<(usize, usize)>> = (0..n).map(free).collect();
-        let mut d = vec![0.0; m * m];
-        for r in 0..m {
-            let (i, a) = dir(r);
-            for c in 0..=r {
-                let (j, b) = dir(c);
-                let mut v = 0.0;
-                for &(x, jx) in &free[i] {
-                    for &(y, jy) in &free[j] {
-                        v += a[x] * inv[jx * k + jy] * b[y];
-                    }
-                }
-                d[r * m + c] = v;
-                d[c * m + r] = v;
-            }
-        }
-        hold_rows(&mut d, m, n, nt, p);
-        let mut u0 = PointValues::zeros(n, nt);
+        let d = self.mechanical_block(&condensed.inverse, self.dofs.len(), nt);
+        let mut u0 = PointValues::zeros(p.len(), nt);
         self.project(&condensed.loads.solution, &mut u0);
         let problem = DenseContactProblem {
             u0,
@@ -410,6 +400,115 @@ impl ContactBoundary {
             nt,
         };
         Ok((problem, condensed.loads))
+    }
+
+    /// The contact problem with electrical contact condensed onto the points' displacements
+    /// and free potentials: `D` of order `m + n_e` with `D_uu = R (K⁻¹)_uu Rᵀ`,
+    /// `D_eu = (K⁻¹)_φu Rᵀ`, `D_ue = -R (K⁻¹)_uφ`, `D_ee = -(K⁻¹)_φφ` (the flux `q = D·ν`
+    /// enters the negated electric rows as `+W q`), and the loads' part for
+    /// [`ContactBoundary::recover`].
+    ///
+    /// # Errors
+    /// The condensation's linear-algebra error.
+    pub fn condense_electric(
+        &self,
+        electric: &contact::ElectricContact,
+        solver: &mut DirectLdlt,
+        b_u: &[f64],
+        b_phi: &[f64],
+        nt: usize,
+    ) -> Result<(ElectricContactProblem, CondensedLoads), ProblemError> {
+        let all = self.condensed_dofs();
+        let condensed = solver.condense(b_u, b_phi, &all)?;
+        let (inv, kk, k) = (&condensed.inverse, all.len(), self.dofs.len());
+        let p = &self.points;
+        let (n, m) = (p.len(), p.len() * (1 + nt));
+        let ne = kk - k;
+        let o = m + ne;
+        let mech = self.mechanical_block(inv, kk, nt);
+        let mut d = vec![0.0; o * o];
+        for r in 0..m {
+            d[r * o..r * o + m].copy_from_slice(&mech[r * m..(r + 1) * m]);
+        }
+        let free = self.free_slots();
+        for r in 0..m {
+            let (i, a) = self.direction_of(r, nt);
+            for e in 0..ne {
+                let v: f64 = free[i].iter().map(|&(x, jx)| a[x] * inv[(k + e) * kk + jx]).sum();
+                d[(m + e) * o + r] = v;
+                d[r * o + m + e] = -v;
+            }
+        }
+        for e in 0..ne {
+            for f in 0..ne {
+                d[(m + e) * o + m + f] = -inv[(k + e) * kk + k + f];
+            }
+        }
+        let mut u0 = PointValues::zeros(n, nt);
+        self.project(&condensed.loads.solution[..k], &mut u0);
+        let problem = ElectricContactProblem {
+            u0,
+            phi0: condensed.loads.solution[k..].to_vec(),
+            compliance: d,
+            weight: p.weight.clone(),
+            nt,
+            electric: electric.clone(),
+        };
+        Ok((problem, condensed.loads))
+    }
+
+    /// The free dofs of each point: `(component, place in the condensed dofs)`.
+    fn free_slots(&self) -> Vec<Vec<(usize, usize)>> {
+        let dim = self.points.dim;
+        (0..self.points.len())
+            .map(|i| {
+                (0..dim)
+                    .filter_map(|x| match self.slots[i * dim + x] {
+                        Slot::Free(j) => Some((x, j)),
+                        Slot::Fixed(_) => None,
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Row `r` of `R`: its point, and the direction (the point's normal, then its `nt`
+    /// tangents).
+    fn direction_of(&self, r: usize, nt: usize) -> (usize, [f64; 3]) {
+        let p = &self.points;
+        let n = p.len();
+        if r < n {
+            (r, p.normal[r])
+        } else {
+            let (i, q) = ((r - n) / nt, (r - n) % nt);
+            (i, p.tangent[i][q])
+        }
+    }
+
+    /// `D = R (K⁻¹)_cc Rᵀ` on the points' displacements, from the condensed inverse `inv`
+    /// (row-major, of order `stride`, the displacements first), with the held tangents'
+    /// diagonal set ([`hold_rows`]).
+    fn mechanical_block(&self, inv: &[f64], stride: usize, nt: usize) -> Vec<f64> {
+        let p = &self.points;
+        let (n, m) = (p.len(), p.len() * (1 + nt));
+        let free = self.free_slots();
+        let mut d = vec![0.0; m * m];
+        for r in 0..m {
+            let (i, a) = self.direction_of(r, nt);
+            for c in 0..=r {
+                let (j, b) = self.direction_of(c, nt);
+                let mut v = 0.0;
+                for &(x, jx) in &free[i] {
+                    for &(y, jy) in &free[j] {
+                        v += a[x] * inv[jx * stride + jy] * b[y];
+                    }
+                }
+                d[r * m + c] = v;
+                d[c * m + r] = v;
+            }
+        }
+        hold_rows(&mut d, m, n, nt, p);
+        d
     }
 
     /// `u` and `φ` under the loads and the contact forces of `lambda`, finishing the
@@ -427,6 +526,55 @@ impl ContactBoundary {
     ) -> Result<(Vec<f64>, Vec<f64>), ProblemError> {
         Ok(solver.solve_with_update(loads, b_u, b_phi, &self.forces(lambda))?)
     }
+
+    /// `u` and `φ` under the loads, the contact forces and the electric flux of `sol`
+    /// (electrical contact), finishing the condensation's solve.
+    ///
+    /// # Errors
+    /// The solve's linear-algebra error.
+    pub fn recover_electric(
+        &self,
+        solver: &mut DirectLdlt,
+        loads: CondensedLoads,
+        sol: &contact::ContactSolution,
+        b_u: &[f64],
+        b_phi: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), ProblemError> {
+        let mut d = self.forces(&sol.lambda);
+        d.extend(self.electric_charges(sol, b_u.len()).iter().map(|(_, v)| v));
+        Ok(solver.solve_with_update(loads, b_u, b_phi, &d)?)
+    }
+}
+
+/// The electric points of a conductive or conducting foundation: the contact points whose
+/// potential is free (one on an electrode has it prescribed).
+///
+/// # Errors
+/// `contact.electric` on a body without electric unknowns.
+fn electric_points(
+    spec: &ContactSpec,
+    dofs: &DofMap,
+    nodes: &[usize],
+) -> Result<Option<(contact::ElectricContact, Vec<usize>)>, ProblemError> {
+    let Some((law, potential)) = spec.electric_law() else {
+        return Ok(None);
+    };
+    if dofs.n_phi == 0 {
+        return Err(SceneError::new(
+            "contact.electric",
+            "electrical contact needs electric unknowns, and no material has a permittivity (or the electrodes prescribe every potential): remove contact.electric",
+        )
+        .into());
+    }
+    let (mut points, mut phi) = (vec![], vec![]);
+    for (i, &node) in nodes.iter().enumerate() {
+        if let Dof::Free(j) = dofs.phi[node] {
+            points.push(i);
+            phi.push(dofs.n_u + j);
+        }
+    }
+    let contact = contact::ElectricContact { law, potential, points };
+    Ok(Some((contact, phi)))
 }
 
 /// A held tangent moves with no force (its rows and columns of `D` vanish) and its multiplier

@@ -95,17 +95,10 @@ impl Backend for Faer {
         system: &Factored,
         solved: &Solved<Self::Solution>,
     ) -> Result<f64, ProblemError> {
-        let (b_full, scale) = rhs_with_contact(posed, solved.contact.as_ref().map(|(b, sol)| (b, sol)));
+        let (b_full, b_phi, scale) = rhs_with_contact(posed, solved.contact.as_ref().map(|(b, sol)| (b, sol)));
         let (b, (u, phi)) = (&system.blocks, &solved.x);
         Ok(linalg::equilibrium_residual(
-            &b.a,
-            &b.g,
-            &b.b,
-            u,
-            phi,
-            &b_full,
-            &posed.loads.b_phi,
-            scale,
+            &b.a, &b.g, &b.b, u, phi, &b_full, &b_phi, scale,
         ))
     }
 
@@ -206,7 +199,7 @@ fn factor(
         let ordering = match (boundary, plan.linear_strategy.is_condensed()) {
             (Some(cb), true) => Ordering::GivenThenLast {
                 order,
-                last: cb.dofs.clone(),
+                last: cb.condensed_dofs(),
             },
             _ => Ordering::Given(order),
         };
@@ -242,8 +235,9 @@ fn factor_budget(
     let held = crate::estimate::assembled(nnz, posed.setup.mesh.n_nodes(), dofs.n_u + dofs.n_phi);
     let dense = match boundary {
         Some(cb) if plan.linear_strategy.is_condensed() => {
-            let m = cb.points.len() * (1 + plan.n_tangential());
-            crate::estimate::dense_contact(cb.dofs.len(), m)
+            let k = cb.condensed_dofs().len();
+            let m = cb.points.len() * (1 + plan.n_tangential()) + (k - cb.dofs.len());
+            crate::estimate::dense_contact(k, m)
         }
         _ => 0.0,
     };
@@ -297,8 +291,8 @@ fn solve_linear(system: &mut Factored, posed: &Posed<'_>) -> Result<Solved<Field
         .coupled()
         .solve(&loads.b_u, &loads.b_phi, &mut u, &mut phi)?;
     if let LinearSolver::Direct(direct) = &mut system.solver {
-        let (b, scale) = rhs_with_contact(posed, None);
-        system.refinement = refine(direct, &system.blocks, posed, &b, scale, &mut u, &mut phi)?.steps;
+        let (b, b_phi, scale) = rhs_with_contact(posed, None);
+        system.refinement = refine(direct, &system.blocks, &b, &b_phi, scale, &mut u, &mut phi)?.steps;
     }
     Ok(Solved {
         x: (u, phi),
@@ -383,8 +377,17 @@ fn solve_contact(
 ) -> Result<Solved<Fields>, ProblemError> {
     let t = Instant::now();
     let nt = how.plan.n_tangential();
-    let (sol, (u, phi)) = match &mut system.solver {
-        LinearSolver::Direct(direct) if how.plan.linear_strategy.is_condensed() => {
+    let condensed = how.plan.linear_strategy.is_condensed();
+    let electric = boundary.electric.as_ref().map(|(e, _)| e);
+    let (sol, (u, phi)) = match (&mut system.solver, electric) {
+        (LinearSolver::Direct(direct), Some(electric)) if condensed => {
+            let (sol, fields, condense, refinement) =
+                electric_contact(how, electric, direct, &system.blocks, &boundary, posed, reporter)?;
+            system.condense = Some(condense);
+            system.refinement = refinement;
+            (sol, fields)
+        }
+        (LinearSolver::Direct(direct), None) if condensed => {
             let t_condense = Instant::now();
             let loads = &posed.loads;
             let (mut dense, condensed) = boundary.condense(direct, &loads.b_u, &loads.b_phi, nt)?;
@@ -408,7 +411,7 @@ fn solve_contact(
             system.refinement = on.refinement;
             (sol, (u, phi))
         }
-        other => {
+        (other, _) => {
             let mut op = FullSolve {
                 boundary: &boundary,
                 solver: other.coupled(),
@@ -428,6 +431,55 @@ fn solve_contact(
         contact: Some((boundary, sol)),
         seconds: t.elapsed().as_secs_f64(),
     })
+}
+
+/// The contact solve with electrical contact: the condensation onto the points'
+/// displacements and free potentials, semismooth Newton on all their rows, the fields under
+/// the forces and the flux found, refined; the law judged on the refined fields. Returns the
+/// solution, the fields, how the condensation was formed and in how long, and the refinement
+/// steps.
+#[allow(clippy::too_many_arguments)]
+fn electric_contact(
+    how: &ContactSolve<'_>,
+    electric: &contact::ElectricContact,
+    direct: &mut DirectLdlt,
+    blocks: &Blocks,
+    boundary: &ContactBoundary,
+    posed: &Posed<'_>,
+    reporter: &mut dyn Reporter,
+) -> Result<(ContactSolution, Fields, (CondenseRoute, f64), usize), ProblemError> {
+    let t = Instant::now();
+    let loads = &posed.loads;
+    let nt = how.plan.n_tangential();
+    let (problem, condensed) = boundary.condense_electric(electric, direct, &loads.b_u, &loads.b_phi, nt)?;
+    let condense = (condensed.route, t.elapsed().as_secs_f64());
+    reporter.event(&Event::Condensed {
+        m: problem.order(),
+        route: condense.0,
+        seconds: condense.1,
+    });
+    let tol = how.tol;
+    let params = NewtonParams {
+        tol,
+        interrupt: how.interrupt,
+        ..Default::default()
+    };
+    let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+    let mut sol = contact::solve_newton_electric(&problem, &boundary.points, &how.law, &params, &mut progress)
+        .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))?;
+    let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
+    let (b_u, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
+    let refinement = refine(direct, blocks, &b_u, &b_phi, scale, &mut u, &mut phi)?.steps;
+    // the potentials reported are the refined fields'
+    if let (Some(e), Some((_, dofs))) = (&mut sol.electric, &boundary.electric) {
+        let n_u = loads.b_u.len();
+        for (v, &d) in e.potential.iter_mut().zip(dofs) {
+            *v = phi[d - n_u];
+        }
+    }
+    sol.info.complementarity = law_residual(boundary, how, &sol, &problem.u0, &u);
+    sol.info.residual = sol.info.residual.max(sol.info.complementarity);
+    Ok((sol, (u, phi), condense, refinement))
 }
 
 /// The fields of a condensed contact solve, refined with the factors of `K`.
@@ -457,8 +509,8 @@ impl Refining<'_> {
         let u0 = dense.u0.clone();
         let mut corrections = 0;
         loop {
-            let (b_full, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
-            self.refinement += refine(self.direct, self.blocks, posed, &b_full, scale, u, phi)?.steps;
+            let (b_full, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
+            self.refinement += refine(self.direct, self.blocks, &b_full, &b_phi, scale, u, phi)?.steps;
             sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u);
             if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
                 break;
@@ -475,8 +527,8 @@ impl Refining<'_> {
             }
             let start = sol.lambda.clone();
             sol = how.run(Operator::Condensed(dense), &boundary.points, Some(start), reporter)?;
-            let (b_full, _) = rhs_with_contact(posed, Some((boundary, &sol)));
-            self.direct.solve(&b_full, &posed.loads.b_phi, u, phi)?;
+            let (b_full, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
+            self.direct.solve(&b_full, &b_phi, u, phi)?;
             corrections += 1;
         }
         sol.info.residual = sol.info.residual.max(sol.info.complementarity);
@@ -484,11 +536,15 @@ impl Refining<'_> {
     }
 }
 
-/// The mechanical right-hand side with the contact forces of `contact`, and the size of its
-/// parts (the loads, the contact forces: they may cancel in the sum).
-fn rhs_with_contact(posed: &Posed<'_>, contact: Option<(&ContactBoundary, &ContactSolution)>) -> (Vec<f64>, f64) {
+/// The right-hand sides with the contact forces of `contact` (and the electric flux, with
+/// electrical contact), and the size of their parts (the loads, the contact forces: they may
+/// cancel in the sum).
+fn rhs_with_contact(
+    posed: &Posed<'_>,
+    contact: Option<(&ContactBoundary, &ContactSolution)>,
+) -> (Vec<f64>, Vec<f64>, f64) {
     let loads = &posed.loads;
-    let mut b_full = loads.b_u.clone();
+    let (mut b_full, mut b_phi) = (loads.b_u.clone(), loads.b_phi.clone());
     let mut scale = linalg::norm(&loads.b_u).hypot(linalg::norm(&loads.b_phi));
     if let Some((cb, sol)) = contact {
         let forces = cb.forces(&sol.lambda);
@@ -496,8 +552,14 @@ fn rhs_with_contact(posed: &Posed<'_>, contact: Option<(&ContactBoundary, &Conta
         for (&j, f) in cb.dofs.iter().zip(&forces) {
             b_full[j] += f;
         }
+        let charges = cb.electric_charges(sol, loads.b_u.len());
+        let charge_norm = charges.iter().map(|(_, q)| q * q).sum::<f64>().sqrt();
+        scale = scale.max(charge_norm);
+        for (j, q) in charges {
+            b_phi[j] += q;
+        }
     }
-    (b_full, scale)
+    (b_full, b_phi, scale)
 }
 
 /// Iterative refinement of the last solve (with `K`'s factors), towards round-off: at most 3
@@ -505,8 +567,8 @@ fn rhs_with_contact(posed: &Posed<'_>, contact: Option<(&ContactBoundary, &Conta
 fn refine(
     direct: &mut DirectLdlt,
     b: &Blocks,
-    posed: &Posed<'_>,
     b_u: &[f64],
+    b_phi: &[f64],
     scale: f64,
     u: &mut [f64],
     phi: &mut [f64],
@@ -516,17 +578,7 @@ fn refine(
         g: &b.g,
         b: &b.b,
     };
-    Ok(linalg::refine(
-        direct,
-        k,
-        b_u,
-        &posed.loads.b_phi,
-        u,
-        phi,
-        scale,
-        1e-14,
-        3,
-    )?)
+    Ok(linalg::refine(direct, k, b_u, b_phi, u, phi, scale, 1e-14, 3)?)
 }
 
 /// Corrections of the condensed problem by its defect at the points, at most (each a warm

@@ -75,9 +75,9 @@ pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
 pub use run::{run, solve, solve_within, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
-    BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectrodeSpec, ExactKind,
-    ExactSpec, LoadSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule, Scene, SceneError,
-    SolverSpec, Strategy, Valid,
+    BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectricCondition,
+    ElectrodeSpec, ExactKind, ExactSpec, LoadSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule,
+    Scene, SceneError, SolverSpec, Strategy, Valid,
 };
 
 use contact::ContactError;

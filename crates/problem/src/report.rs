@@ -173,6 +173,14 @@ pub struct ContactReport {
     /// Those of them held past the gap, inside the foundation (the condition wins).
     #[serde(default)]
     pub held_inside: usize,
+    /// Electrical contact: the charge through the contact zone, `Σ w q` with `q = D·ν` the
+    /// outward flux (C, or C/m in plane strain: the scene's units; positive leaving the body).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charge: Option<f64>,
+    /// Electrical contact: the points whose potential is free (the others sit on an
+    /// electrode).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub electric_points: Option<usize>,
 }
 
 impl ContactReport {
@@ -202,6 +210,8 @@ impl ContactReport {
                 .count(),
             held_nodes: 0,
             held_inside: 0,
+            charge: sol.electric.as_ref().map(|e| e.charge(&points.weight)),
+            electric_points: sol.electric.as_ref().map(|e| e.points.len()),
         }
     }
 }

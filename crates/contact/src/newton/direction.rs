@@ -340,4 +340,91 @@ mod tests {
             }
         }
     }
+
+    /// The rows of the Jacobian with electric rows are the derivative of the equations: a
+    /// difference quotient along random directions, away from the kinks, on a positive-real
+    /// compliance (rigid and compliant foundations, both electric laws).
+    #[test]
+    fn electric_rows_are_the_derivative() {
+        use crate::{ElectricContact, ElectricLaw, Foundation};
+        let (n, nt) = (4, 1);
+        let m = n * (1 + nt);
+        let o = m + n;
+        let laws = [ElectricLaw::Conductive { conductance: 3.0 }, ElectricLaw::Conducting];
+        let foundations = [
+            Foundation::Rigid,
+            Foundation::Compliant {
+                stiffness: 2.0,
+                exponent: 1.5,
+            },
+        ];
+        for (law, foundation) in laws.iter().flat_map(|l| foundations.iter().map(move |f| (*l, *f))) {
+            let points = ContactPoints {
+                dim: 2,
+                position: vec![[0.0; 3]; n],
+                normal: vec![[0.0, -1.0, 0.0]; n],
+                tangent: vec![[[1.0, 0.0, 0.0], [0.0; 3]]; n],
+                weight: (0..n).map(|i| 0.5 + 0.1 * i as f64).collect(),
+                gap: vec![0.0; n],
+                friction: vec![0.3; n],
+                held: vec![[false; 2]; n],
+                foundation,
+            };
+            let g = |i: usize, j: usize| ((i * 5 + j * 3) % 7) as f64 * 0.1 - 0.3;
+            // symmetric SPD part plus an antisymmetric coupling between u and φ rows
+            let d: Vec<f64> = (0..o * o)
+                .map(|k| {
+                    let (i, j) = (k / o, k % o);
+                    let sym = (0..o).map(|l| g(i, l) * g(j, l)).sum::<f64>() + if i == j { 1.0 } else { 0.0 };
+                    let anti = match (i >= m, j >= m) {
+                        (true, false) => 0.2 * g(i, j),
+                        (false, true) => -0.2 * g(j, i),
+                        _ => 0.0,
+                    };
+                    if (i >= m) == (j >= m) {
+                        sym
+                    } else {
+                        anti
+                    }
+                })
+                .collect();
+            let u0: Vec<f64> = (0..m).map(|r| 0.7 * (r as f64 * 1.7).sin() + 0.4).collect();
+            let u0 = PointValues::from_flat(&u0, n, nt);
+            let phi0: Vec<f64> = (0..n).map(|k| 0.3 * (k as f64 + 0.5).cos()).collect();
+            let contact = ElectricContact {
+                law,
+                potential: 0.1,
+                points: (0..n).collect(),
+            };
+            let law_m = Law::Coulomb;
+            let flat = Flat::new(Compliance::Dense(&d), &u0, &points, &law_m, nt, 2.0).with_electric(
+                Compliance::Dense(&d),
+                &contact,
+                &phi0,
+            );
+            let x: Vec<f64> = (0..o).map(|r| 0.5 * (r as f64 * 2.3 + 0.4).cos() + 0.3).collect();
+            let s = flat.state(x.clone());
+            let rows = flat.rows(&s);
+            let v: Vec<f64> = (0..o).map(|r| ((r * 7 % 5) as f64 - 2.0) * 0.3).collect();
+            // J v from the rows: E v + B C v, C = diag(c) D W
+            let wv: Vec<f64> = v.iter().zip(&flat.w).map(|(a, b)| a * b).collect();
+            let cv: Vec<f64> = (0..o)
+                .map(|r| flat.c[r] * (0..o).map(|j| d[r * o + j] * wv[j]).sum::<f64>())
+                .collect();
+            let eps = 1e-7;
+            let xp: Vec<f64> = x.iter().zip(&v).map(|(a, b)| a + eps * b).collect();
+            let sp = flat.state(xp);
+            // (a compliant foundation's normal rows hold their scale: not their exact derivative)
+            let first = if foundation == Foundation::Rigid { 0 } else { n };
+            for r in first..o {
+                let jv: f64 = rows[r].e.iter().map(|&(j, a)| a * v[j]).sum::<f64>()
+                    + rows[r].b.iter().map(|&(j, a)| a * cv[j]).sum::<f64>();
+                let fd = (sp.f[r] - s.f[r]) / eps;
+                assert!(
+                    (jv - fd).abs() <= 1e-5 * (1.0 + fd.abs()),
+                    "{law:?} {foundation:?} row {r}: {jv} vs {fd}"
+                );
+            }
+        }
+    }
 }

@@ -194,6 +194,46 @@ impl<'a> Flat<'a> {
         }
     }
 
+    /// The flux of the electric rows with the mechanical multipliers of `x` held (its
+    /// electric part ignored): the electric law is then linear in the flux. `None` where the
+    /// linear system is singular.
+    pub(super) fn electric_given_mechanics(&self, x: &[f64]) -> Option<Vec<f64>> {
+        let e = self.electric.as_ref()?;
+        let Compliance::Dense(d) = self.d else {
+            return None;
+        };
+        let (m, start) = (self.m, e.start);
+        let ne = m - start;
+        let mut held = x.to_vec();
+        held[start..].iter_mut().for_each(|v| *v = 0.0);
+        let s = self.state(held);
+        // at no flux: φ = φ(λ); with the flux, φ - D_ee W q
+        let mut a = faer::Mat::<f64>::zeros(ne, ne);
+        let mut rhs = faer::Mat::<f64>::zeros(ne, 1);
+        for (k, &i) in e.contact.points.iter().enumerate() {
+            let r = start + k;
+            let (p, contact) = self.contact_of(i, &s.u, &s.z);
+            let du = s.u[r] - e.contact.potential;
+            let (diag, coupled, b) = match e.contact.law {
+                crate::ElectricLaw::Conductive { conductance } => {
+                    let sp = conductance * crate::project_nonnegative(p);
+                    (1.0, sp, sp * du)
+                }
+                crate::ElectricLaw::Conducting if contact => (0.0, 1.0, du),
+                crate::ElectricLaw::Conducting => (1.0, 0.0, 0.0),
+            };
+            for l in 0..ne {
+                a[(k, l)] = coupled * d[r * m + start + l] * self.w[start + l];
+            }
+            a[(k, k)] += diag;
+            rhs[(k, 0)] = b;
+        }
+        let lu = a.partial_piv_lu();
+        faer::linalg::solvers::SolveCore::solve_in_place_with_conj(&lu, faer::Conj::No, rhs.as_mut());
+        let q: Vec<f64> = (0..ne).map(|k| rhs[(k, 0)]).collect();
+        q.iter().all(|v| v.is_finite()).then_some(q)
+    }
+
     /// Point `i`'s `p` for the electric law and its contact status: on a rigid foundation
     /// the augmented `z_n` (whose `[z_n]₊` is the pressure `λ_n` at a solution, as for
     /// Coulomb's radius: from the start, a point pressed in conducts, and the derivative sees

@@ -108,6 +108,20 @@ choice! {
 }
 
 choice! {
+    /// The electric condition on the contact zone (`contact.electric`).
+    pub enum ElectricCondition ("contact.electric") {
+        /// An insulating foundation, `D·ν = 0` on the whole zone (the paper's; the default).
+        Insulated = "insulated",
+        /// A foundation at `foundation_potential` that conducts where it touches,
+        /// `D·ν = σ_c p (φ - φ_F)` (`σ_c` = `conductance`; `p` the pressure, or the
+        /// penetration under normal compliance).
+        Conductive = "conductive",
+        /// An ideal conductor: `φ = φ_F` where in contact, `D·ν = 0` where separated.
+        Conducting = "conducting",
+    }
+}
+
+choice! {
     /// How slip-weakening friction's coefficient falls (`contact.weakening`).
     pub enum WeakeningForm ("contact.weakening") {
         /// Linearly, reaching the dynamic value at the slip length.
@@ -680,6 +694,17 @@ pub struct ContactSpec {
     /// Slip weakening: `linear` (the default) or `exponential`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weakening: Option<WeakeningForm>,
+    /// The electric condition on the zone: `insulated` (the default), `conductive`,
+    /// `conducting`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub electric: Option<ElectricCondition>,
+    /// `φ_F`, the potential of a conductive or conducting foundation (V; 0 by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub foundation_potential: Option<f64>,
+    /// `σ_c ≥ 0`, a conductive foundation's conductance (flux per unit potential and unit
+    /// pressure, or unit penetration under normal compliance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub conductance: Option<f64>,
 }
 
 /// Normal compliance: the foundation's pressure `λ_n = k [u_n - g]₊^m` at the penetration
@@ -717,7 +742,23 @@ impl ContactSpec {
             friction_dynamic: None,
             slip_length: None,
             weakening: None,
+            electric: None,
+            foundation_potential: None,
+            conductance: None,
         }
+    }
+
+    /// The electric law of a conductive or conducting foundation, with its potential `φ_F`;
+    /// `None` for an insulating one.
+    pub fn electric_law(&self) -> Option<(contact::ElectricLaw, f64)> {
+        let law = match self.electric? {
+            ElectricCondition::Insulated => return None,
+            ElectricCondition::Conductive => contact::ElectricLaw::Conductive {
+                conductance: self.conductance.unwrap_or(0.0),
+            },
+            ElectricCondition::Conducting => contact::ElectricLaw::Conducting,
+        };
+        Some((law, self.foundation_potential.unwrap_or(0.0)))
     }
 
     /// The Coulomb coefficient F (0 where not given); under slip weakening, the static one

@@ -171,6 +171,7 @@ impl Scene {
         validate_solver(&self.solver)?;
         refuse_compliance(self)?;
         refuse_weakening(self)?;
+        refuse_electric(self)?;
         refuse_backend(self)?;
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
@@ -610,6 +611,59 @@ fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
     )
 }
 
+/// Electrical contact's keys: `foundation_potential` where the foundation conducts,
+/// `conductance` where it is conductive (given, finite, `>= 0`); solved by `newton-condensed`
+/// on the default backend, not with slip weakening. (A body without electric unknowns is
+/// refused once the plan knows it.)
+fn refuse_electric(s: &Scene) -> Result<(), SceneError> {
+    use crate::scene::ElectricCondition as E;
+    let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
+        return Ok(());
+    };
+    let condition = c.electric.unwrap_or(E::Insulated);
+    if let Some(v) = c.foundation_potential {
+        finite("contact.foundation_potential", v)?;
+    }
+    refuse_if(
+        condition == E::Insulated && c.foundation_potential.is_some(),
+        "contact.foundation_potential",
+        "a foundation's potential, and contact.electric is \"insulated\" (set contact.electric = \"conductive\" or \"conducting\")",
+    )?;
+    refuse_if(
+        condition != E::Conductive && c.conductance.is_some(),
+        "contact.conductance",
+        &format!("a conductance, and contact.electric = \"{condition}\" (it is contact.electric = \"conductive\"'s)"),
+    )?;
+    if condition == E::Insulated {
+        return Ok(());
+    }
+    if condition == E::Conductive {
+        let Some(sigma) = c.conductance else {
+            return Err(SceneError::new(
+                "contact.conductance",
+                "contact.conductance is needed by contact.electric = \"conductive\" (0 is an insulator)",
+            ));
+        };
+        if !(sigma >= 0.0 && sigma.is_finite()) {
+            return Err(SceneError::new(
+                "contact.conductance",
+                format!("contact.conductance = {sigma} must be finite and non-negative"),
+            ));
+        }
+    }
+    refuse_if(
+        c.friction_law == Some(crate::scene::FrictionLaw::SlipWeakening),
+        "contact.electric",
+        "electrical contact with slip-weakening friction: the two are not solved together (use contact.friction_law = \"coulomb\", or an insulating foundation)",
+    )?;
+    newton_on_the_default_backend(
+        s,
+        "contact.electric",
+        &format!("contact.electric = \"{condition}\": the PETSc backend's active sets hold an insulating foundation only; use the default backend"),
+        |strategy| format!("electrical contact, and solver.strategy = \"{strategy}\": the potentials of the contact points join the condensed unknowns of semismooth Newton (newton-condensed)"),
+    )
+}
+
 fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
     if s.solver.backend != BackendChoice::Petsc {
         return Ok(());
@@ -748,6 +802,7 @@ fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError>
         // the closed forms are a rigid foundation's, with a constant coefficient
         let why = format!("exact.kind = \"{kind}\" is the closed form of a rigid foundation with a constant friction coefficient: remove [exact], or the key");
         refuse_if(c.compliance.is_some(), "contact.compliance", &why)?;
+        refuse_if(c.electric_law().is_some(), "contact.electric", &why)?;
         refuse_if(
             c.friction_law.is_some_and(|f| f != crate::scene::FrictionLaw::Coulomb),
             "contact.friction_law",
