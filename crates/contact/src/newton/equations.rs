@@ -32,6 +32,10 @@ impl RowForm {
     }
 }
 
+/// The floor of the electric residual's denominator, relative to the ideal conductor's flux
+/// scale ([`Flat::electric_residual`]).
+const ELECTRIC_FLOOR: f64 = 1e-6;
+
 /// The branch of a point's tangential equations at `z`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Branch {
@@ -179,14 +183,17 @@ impl<'a> Flat<'a> {
     }
 
     /// The electric residual of `s`: the weighted norm of the electric equations relative to
-    /// the flux's, `‖f_e‖_W / max(‖q‖_W, reference)`; 0 without electric rows.
+    /// the flux's, `‖f_e‖_W / max(‖q‖_W, 10⁻⁶ reference)`; 0 without electric rows.
     pub(super) fn electric_residual(&self, s: &State) -> f64 {
         let Some(e) = &self.electric else {
             return 0.0;
         };
         let rows = e.start..self.m;
         let num = weighted_norm(&s.f[rows.clone()], &self.w[rows.clone()]);
-        let den = weighted_norm(&s.x[rows.clone()], &self.w[rows]).max(e.reference);
+        // relative to the flux itself: a poor conductor's flux is far below the ideal
+        // conductor's scale, and must be known to its own digits; the floor, a millionth of
+        // that scale, keeps a vanishing flux reachable
+        let den = weighted_norm(&s.x[rows.clone()], &self.w[rows]).max(ELECTRIC_FLOOR * e.reference);
         if den > 0.0 {
             num / den
         } else {

@@ -1,0 +1,240 @@
+//! Electrical contact (`contact.electric`) against its closed form: a piezoelectric block
+//! poled along the contact normal, held laterally by rollers, pushed down by `δ` at its top
+//! with the top's potential `V` given, on a foundation at `φ_F`, is in uniaxial strain and a
+//! uniform field along the normal (P1 elements hold it exactly). With the 6mm constants along
+//! the poling, `σ = c33 ε + e33 φ'` and `D = e33 ε - ε33 φ'` (DESIGN.md's signs), `ε = -δ/H`:
+//! - conducting: `φ(0) = φ_F`, so `φ' = (V - φ_F)/H`; the pressure `λ = -σ`, the flux through
+//!   the contact face `q = D·ν = -D`;
+//! - conductive: `q = σ_c λ (φ(0) - φ_F)` with `λ` and `q` affine in `a = φ(0)`: a quadratic in
+//!   `a`, whose root between the insulated one (`D = 0`) and `φ_F` is the answer;
+//! - insulated: `D = 0`.
+//!
+//! The finite element answer is the closed form to round-off, in 2D and 3D, for `σ_c` from 0
+//! to 1e12, and tends to the conducting one as `σ_c → ∞`.
+
+use problem::{ContactLaw, ContactSpec, DirichletSpec, ElectricCondition, MaterialSpec, MeshSpec, Scene, Silent};
+
+const C33: f64 = 111.0;
+const E33: f64 = 15.8;
+const EPS33: f64 = 7.35;
+const DELTA: f64 = 0.01;
+const V: f64 = 0.0;
+const PHI_F: f64 = 0.05;
+
+/// The block (height 1) in `dim` dimensions on a foundation with the electric `condition`.
+fn block(dim: usize, condition: ElectricCondition, conductance: Option<f64>) -> Scene {
+    let roller = |group: &str, axis: usize| DirichletSpec {
+        group: group.into(),
+        ux: (axis == 0).then_some(0.0),
+        uy: (axis == 1).then_some(0.0),
+        ..Default::default()
+    };
+    let (mesh, normal, top_u, poling, mut dirichlet) = if dim == 2 {
+        (
+            MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 4),
+            vec![0.0, -1.0],
+            vec![0.0, -DELTA],
+            [0.0, 1.0, 0.0],
+            vec![roller("left", 0), roller("right", 0)],
+        )
+    } else {
+        (
+            MeshSpec::cuboid([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], 3),
+            vec![0.0, 0.0, -1.0],
+            vec![0.0, 0.0, -DELTA],
+            [0.0, 0.0, 1.0],
+            vec![
+                roller("left", 0),
+                roller("right", 0),
+                roller("front", 1),
+                roller("back", 1),
+            ],
+        )
+    };
+    dirichlet.push(DirichletSpec {
+        group: "top".into(),
+        u: Some(top_u),
+        phi: Some(V),
+        ..Default::default()
+    });
+    let mut contact = ContactSpec::new("bottom", ContactLaw::Coulomb, &normal);
+    contact.friction = Some(0.5);
+    contact.electric = Some(condition);
+    if condition != ElectricCondition::Insulated {
+        contact.foundation_potential = Some(PHI_F);
+    }
+    contact.conductance = conductance;
+    Scene {
+        name: "electric-block".into(),
+        description: String::new(),
+        mesh,
+        material: vec![MaterialSpec::crystal_6mm(
+            "body",
+            [121.0, 75.4, 75.2, C33, 21.1, 22.6],
+            [-5.4, E33, 12.3],
+            [8.11, EPS33],
+            poling,
+        )],
+        dirichlet,
+        load: None,
+        electrode: None,
+        contact: Some(contact),
+        solver: Default::default(),
+        exact: None,
+    }
+}
+
+/// `(λ, q)` at the bottom potential `a`.
+fn at(a: f64) -> (f64, f64) {
+    let (strain, field) = (-DELTA, V - a);
+    (-(C33 * strain + E33 * field), -(E33 * strain - EPS33 * field))
+}
+
+/// The bottom potential of the closed form: `φ_F` (conducting), the root of
+/// `q(a) = σ λ(a) (a - φ_F)` between the insulated one and `φ_F` (conductive), the insulated
+/// `q(a) = 0` (no conductance).
+fn bottom_potential(condition: ElectricCondition, sigma: f64) -> f64 {
+    // q(a) = q0 + q1 a, λ(a) = l0 + l1 a
+    let (l0, q0) = at(0.0);
+    let (l1, q1) = (at(1.0).0 - l0, at(1.0).1 - q0);
+    let insulated = -q0 / q1;
+    match condition {
+        ElectricCondition::Conducting => PHI_F,
+        ElectricCondition::Insulated => insulated,
+        ElectricCondition::Conductive if sigma == 0.0 => insulated,
+        ElectricCondition::Conductive => {
+            // σ (l0 + l1 a)(a - φ_F) - q0 - q1 a = 0
+            let (a2, a1, a0) = (sigma * l1, sigma * (l0 - l1 * PHI_F) - q1, -sigma * l0 * PHI_F - q0);
+            let disc = (a1 * a1 - 4.0 * a2 * a0).sqrt();
+            // the stable pair of roots
+            let r1 = (-a1 - a1.signum() * disc) / (2.0 * a2);
+            let r2 = a0 / (a2 * r1);
+            let between = |r: f64| (r - insulated) * (r - PHI_F) <= 0.0;
+            if between(r1) {
+                r1
+            } else {
+                assert!(between(r2), "no root between {insulated} and {PHI_F}: {r1} {r2}");
+                r2
+            }
+        }
+    }
+}
+
+/// The largest relative errors of the pressure and of the flux at the points, and of the
+/// potential at the points with a free potential.
+fn errors(dim: usize, condition: ElectricCondition, sigma: Option<f64>) -> (f64, f64, f64) {
+    let solution = problem::solve(&block(dim, condition, sigma), None, &mut Silent).unwrap();
+    assert!(solution.report.residuals.converged_to_tolerance);
+    let contact = solution.contact.as_ref().unwrap();
+    let a = bottom_potential(condition, sigma.unwrap_or(0.0));
+    let (lambda, q) = at(a);
+    assert!(lambda > 0.0, "the block is in contact: λ = {lambda}");
+    let rel = |x: f64, y: f64, scale: f64| (x - y).abs() / scale;
+    let e_lambda = contact
+        .solution
+        .lambda
+        .normal
+        .iter()
+        .map(|l| rel(*l, lambda, lambda))
+        .fold(0.0, f64::max);
+    let Some(e) = &contact.solution.electric else {
+        assert_eq!(condition, ElectricCondition::Insulated);
+        return (e_lambda, 0.0, 0.0);
+    };
+    let q_scale = q.abs().max(1e-300);
+    let e_q = e.flux.iter().map(|f| rel(*f, q, q_scale)).fold(0.0, f64::max);
+    let e_phi = e.potential.iter().map(|p| rel(*p, a, PHI_F)).fold(0.0, f64::max);
+    // the charge through the zone reported: q times the face's area
+    let area = if dim == 2 { 2.0 } else { 1.0 };
+    let charge = solution.report.contact.charge.unwrap();
+    assert!(
+        (charge - q * area).abs() <= 1e-9 * (q * area).abs().max(1e-12),
+        "{charge} vs {}",
+        q * area
+    );
+    (e_lambda, e_q, e_phi)
+}
+
+#[test]
+fn a_block_on_a_conducting_or_conductive_foundation_is_the_closed_form_to_round_off() {
+    for dim in [2, 3] {
+        let (el, eq, ep) = errors(dim, ElectricCondition::Conducting, None);
+        assert!(
+            el < 1e-10 && eq < 1e-10 && ep < 1e-10,
+            "{dim}D conducting: {el:e} {eq:e} {ep:e}"
+        );
+        for sigma in [0.0, 1e-2, 1.0, 1e2, 1e4, 1e8, 1e12] {
+            let (el, eq, ep) = errors(dim, ElectricCondition::Conductive, Some(sigma));
+            // at σ = 0 the flux is 0: its error is absolute
+            let eq = if sigma == 0.0 { eq * 1e-300 } else { eq };
+            assert!(
+                el < 1e-9 && eq < 1e-8 && ep < 1e-9,
+                "{dim}D σ_c = {sigma:e}: {el:e} {eq:e} {ep:e}"
+            );
+        }
+    }
+}
+
+/// No conductance is the insulated foundation (the paper's), to round-off; a large one the
+/// conducting foundation, at the rate 1/σ_c.
+#[test]
+fn the_conductive_foundation_tends_to_its_limits() {
+    let pressure = |condition, sigma| {
+        let s = problem::solve(&block(2, condition, sigma), None, &mut Silent).unwrap();
+        s.contact.unwrap().solution.lambda.normal
+    };
+    let insulated = pressure(ElectricCondition::Insulated, None);
+    let none = pressure(ElectricCondition::Conductive, Some(0.0));
+    for (a, b) in none.iter().zip(&insulated) {
+        assert!((a - b).abs() <= 1e-12 * b.abs(), "σ_c = 0: {a} vs insulated {b}");
+    }
+    let ideal = pressure(ElectricCondition::Conducting, None);
+    let gap = |sigma: f64| {
+        let p = pressure(ElectricCondition::Conductive, Some(sigma));
+        p.iter().zip(&ideal).map(|(a, b)| (a - b).abs() / b).fold(0.0, f64::max)
+    };
+    let (d1, d2) = (gap(1e2), gap(1e4));
+    let rate = (d1 / d2).log10() / 2.0;
+    assert!((rate - 1.0).abs() < 0.05, "rate {rate}: {d1:e} at 1e2, {d2:e} at 1e4");
+}
+
+#[test]
+fn keys_that_do_not_fit_electrical_contact_are_refused_by_name() {
+    let refused = |scene: &str, sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        match files::scene_file::load(scene, &sets).unwrap_err() {
+            files::Error::Scene {
+                source: files::SceneFileError::Invalid(e),
+                ..
+            } => e.key,
+            other => panic!("{other}"),
+        }
+    };
+    let c = "paper-conductive";
+    assert_eq!(refused(c, &["~contact.conductance"]), "contact.conductance");
+    assert_eq!(refused(c, &["contact.conductance=-1"]), "contact.conductance");
+    assert_eq!(refused(c, &["contact.electric=\"conducting\""]), "contact.conductance");
+    assert_eq!(
+        refused(c, &["contact.electric=\"insulated\"", "~contact.conductance"]),
+        "contact.foundation_potential"
+    );
+    assert_eq!(refused(c, &["solver.strategy=\"uzawa-condensed\""]), "contact.electric");
+    assert_eq!(refused(c, &["solver.backend=\"petsc\""]), "contact.electric");
+    assert_eq!(
+        refused("paper-conducting", &["contact.foundation_potential=nan"]),
+        "contact.foundation_potential"
+    );
+    assert_eq!(
+        refused("paper-slip-weakening", &["contact.electric=\"conducting\""]),
+        "contact.electric"
+    );
+    // a body without electric unknowns: refused once the plan knows it
+    let elastic = files::scene_file::load("paper-elastic", &["contact.electric=\"conducting\"".into()]).unwrap();
+    match problem::solve(&elastic.0, None, &mut Silent) {
+        Err(problem::ProblemError::Scene(e)) => assert_eq!(e.key, "contact.electric"),
+        Err(other) => panic!("{other}"),
+        Ok(_) => panic!("an elastic body with electrical contact was solved"),
+    }
+    // contact switched off: the section's keys are kept, unused, as everywhere
+    assert!(files::scene_file::load(c, &["contact.law=\"none\"".into()]).is_ok());
+}
