@@ -161,6 +161,10 @@ class Contact:
     def lambda_t(self) -> npt.NDArray[np.float64]:
         """Tangential multiplier, (m, dim - 1); zeros without friction."""
     @property
+    def flux(self) -> Optional[npt.NDArray[np.float64]]:
+        """Electrical contact: the outward flux D.nu through each point, (m,); NaN where an
+        electrode prescribes the potential; None on an insulating foundation."""
+    @property
     def status(self) -> npt.NDArray[np.int8]:
         """STICK (1), SLIP (2) or SEPARATED (3), (m,)."""
     def __len__(self) -> int: ...

@@ -15,13 +15,12 @@
 //! mechanical rows, `n_e` the points whose potential is free). Its mechanical block is the
 //! contact compliance; the electric one, `-(K⁻¹)_φφ`, is positive definite; the couplings are
 //! opposite, `D_ue = -D_euᵀ`, so that `D` is positive real, not symmetric: the paper's
-//! non-symmetric coercive form. [`solve_newton_electric`] solves it by the semismooth Newton
+//! non-symmetric coercive form. [`crate::solve_newton_electric`] solves it by the semismooth Newton
 //! method on all its rows at once (docs/theory.md, "Electrical contact").
 
-use crate::newton::{self, NewtonParams};
 use crate::operator::{Compliance, ContactOperator, DenseContactProblem};
 use crate::points::{ContactPoints, PointValues};
-use crate::{ContactError, ContactSolution, InputError, Law, OperatorError, Progress};
+use crate::{ContactError, InputError, OperatorError};
 
 /// The electric law at the contact points where the foundation conducts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -220,7 +219,7 @@ impl ElectricContactProblem {
             .collect()
     }
 
-    fn check(&self, points: &ContactPoints) -> Result<(), ContactError> {
+    pub(crate) fn check(&self, points: &ContactPoints) -> Result<(), ContactError> {
         self.electric.validate(points.len())?;
         let o = self.order();
         if self.compliance.len() != o * o
@@ -243,7 +242,7 @@ impl ElectricContactProblem {
     /// the flux `q = s q̃`, the potential `φ = φ̃ / s`, so that the electric block's mean
     /// diagonal is the normal block's (`D̃_ee = s² D_ee`, `D̃_ue = s D_ue`) and both kinds of
     /// rows weigh alike in Newton's merit; `φ_F` and `σ_c` follow (`s φ_F`, `σ_c / s²`).
-    fn scaled(&self) -> (ElectricContactProblem, f64) {
+    pub(crate) fn scaled(&self) -> (ElectricContactProblem, f64) {
         let (n, m, o) = (self.weight.len(), self.m(), self.order());
         let mean = |rows: std::ops::Range<usize>| {
             let k = rows.len().max(1) as f64;
@@ -305,35 +304,4 @@ impl ContactOperator for ElectricContactProblem {
         }
         Ok(0)
     }
-}
-
-/// Solves the contact problem with electrical contact, `problem`, for `law` by the semismooth
-/// Newton method on the mechanical and electric rows together (stages 1 and 2 of
-/// [`crate::solve_newton`]; no first-order fallback, whose solvers hold no electric rows).
-/// The solution carries the flux and potential of the electric points
-/// ([`ContactSolution::electric`]); its residuals are the larger of the mechanical one (the
-/// measure asked for) and the electric equations' own, relative to the flux.
-///
-/// # Errors
-/// [`ContactError::Input`] for inconsistent data or slip-weakening parameters (not solved with
-/// electrical contact); [`ContactError::Stalled`] where both stages stopped short, with the
-/// best iterate; [`ContactError::Interrupted`].
-pub fn solve_newton_electric(
-    problem: &ElectricContactProblem,
-    points: &ContactPoints,
-    law: &Law,
-    params: &NewtonParams,
-    progress: &mut dyn FnMut(&Progress),
-) -> Result<ContactSolution, ContactError> {
-    problem.check(points)?;
-    if params.weakening.is_some() {
-        return Err(InputError::Unsupported("slip-weakening friction with electrical contact").into());
-    }
-    let (mut scaled, s) = problem.scaled();
-    let mut sol = newton::solve_electric(&mut scaled, points, law, params, progress)?;
-    if let Some(e) = &mut sol.electric {
-        e.flux.iter_mut().for_each(|q| *q *= s);
-        e.potential.iter_mut().for_each(|v| *v /= s);
-    }
-    Ok(sol)
 }

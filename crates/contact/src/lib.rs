@@ -52,9 +52,9 @@ mod uniqueness;
 mod uzawa;
 mod weakening;
 
-pub use electric::{solve_newton_electric, ElectricContact, ElectricContactProblem, ElectricLaw, ElectricValues};
+pub use electric::{ElectricContact, ElectricContactProblem, ElectricLaw, ElectricValues};
 pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
-pub use newton::{solve_newton, NewtonParams};
+pub use newton::{solve_newton, solve_newton_electric, NewtonParams};
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};
 pub use points::{ContactPoints, Foundation, PointValues, Status};
 pub use projection::{project_cone, project_disc, project_nonnegative};

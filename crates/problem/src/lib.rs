@@ -280,7 +280,24 @@ impl ProblemError {
             }
         }
         let newton = strategy == Strategy::NewtonCondensed;
-        let hint = match &source {
+        let electric = scene
+            .contact
+            .as_ref()
+            .and_then(|c| c.electric_law())
+            .map(|(law, _)| law);
+        let hint = match (&source, electric) {
+            (ContactError::Stalled { .. }, Some(contact::ElectricLaw::Conducting)) => {
+                "; semismooth Newton and its proximal stage stalled on the coupled rows (electrical contact has no first-order stage): an ideally conducting foundation whose potential lifts the body off where it touches may have no solution (contact gives the potential that lifts, lift-off takes it away); contact.electric = \"conductive\" with a finite contact.conductance is the regularised law, solved there"
+            }
+            (ContactError::Stalled { .. }, Some(_)) => {
+                "; semismooth Newton and its proximal stage stalled on the coupled rows (electrical contact has no first-order stage): a looser solver.tol, or a smaller contact.conductance (the papers' existence needs it small), may be reached"
+            }
+            _ => "",
+        };
+        let hint = if !hint.is_empty() {
+            hint
+        } else {
+            match &source {
             ContactError::FixedPointNoConvergence { .. } if !newton => {
                 "; try solver.strategy=newton-condensed, which solves Coulomb's law directly (no fixed point on S)"
             }
@@ -302,6 +319,7 @@ impl ProblemError {
                 "; a smaller contact.friction or material.coupling_scale brings the problem back within the uniqueness theory"
             }
             _ => "",
+            }
         };
         ProblemError::Contact {
             source,

@@ -317,6 +317,24 @@ impl Contact {
         })
     }
 
+    /// Electrical contact (`contact.electric` conductive or conducting): the outward flux
+    /// `D·nu` through each point, (m,) (charge per unit area; NaN where an electrode
+    /// prescribes the point's potential); None on an insulating foundation. The charge through
+    /// the zone is `nansum(weight * flux)` (`report["contact"]["charge"]`).
+    #[getter]
+    fn flux<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+        self.with(py, |_, c| {
+            let Some(e) = &c.solution.electric else {
+                return Ok(None);
+            };
+            let mut flux = vec![f64::NAN; c.points.len()];
+            for (&i, q) in e.points.iter().zip(&e.flux) {
+                flux[i] = *q;
+            }
+            Ok(Some(owned(py, flux.into())))
+        })
+    }
+
     /// Status of each point, (m,), int8: STICK (1), SLIP (2) or SEPARATED (3).
     #[getter]
     fn status<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i8>>> {

@@ -208,3 +208,26 @@ def test_slip_weakening_friction_from_python():
     # an error: the fixed point still settled, on the branch from the stick start)
     assert r.report["solver"]["friction_map_contraction"] > 0.0
     assert r.report["residuals"]["converged_to_tolerance"]
+
+
+def test_electrical_contact_from_python():
+    """`contact.electric`: a conducting foundation holds the potential of the points in contact
+    at its own, the flux sums to the reported charge, no conductance is the insulated answer,
+    and the PETSc backend is refused by key."""
+    phi_f = 0.05
+    r = pc.run(pc.Scene.load("paper-conducting", {"mesh.n": 8}))
+    c = r.contact
+    touching = c.lambda_n > 0
+    assert touching.any()
+    assert np.allclose(r.phi[c.node[touching]], phi_f, rtol=0, atol=1e-12)
+    charge = np.nansum(c.weight * c.flux)
+    assert np.isclose(charge, r.report["contact"]["charge"], rtol=1e-12)
+    insulated = pc.run(pc.Scene.load("paper", {"mesh.n": 8})).contact
+    assert insulated.flux is None
+    s = pc.Scene.load("paper-conductive", {"mesh.n": 8, "contact.conductance": 0.0})
+    none = pc.run(s).contact
+    assert np.allclose(none.lambda_n, insulated.lambda_n, rtol=1e-12, atol=1e-14)
+    assert np.all(none.flux == 0.0)
+    with pytest.raises(pc.InputError) as info:
+        s.set("solver.backend", "petsc")
+    assert info.value.key == "contact.electric"

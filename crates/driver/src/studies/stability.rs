@@ -308,6 +308,36 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "no conductance",
+        why: "a conductive foundation with σ_c = 0: the insulated answer",
+        scene: "paper-conductive",
+        sets: &["mesh.n=128", "contact.conductance=0"],
+        // the paper's Uzawa holds no electric rows: electrical contact is refused by key
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "ideal conductance",
+        why: "a conductive foundation with σ_c = 1e12: tends to the conducting one",
+        scene: "paper-conductive",
+        sets: &["mesh.n=128", "contact.conductance=1e12"],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "conducting, lift-off",
+        why: "an ideally conducting foundation at φ_F = -0.1 GV under the paper's load: where it touches, the potential lifts the block off",
+        scene: "paper-conducting",
+        sets: &["mesh.n=128", "contact.foundation_potential=-0.1"],
+        paper_sets: None,
+        // contact gives the potential that lifts, lift-off takes it away: no solution of the
+        // ideal switch was found (the conductive law's is, 0.5 s: docs/theory.md)
+        expect: Expect::Refused("may have no solution"),
+        fine: false,
+    },
+    Case {
         name: "n = 1024",
         why: "2D, 6.3 million unknowns",
         scene: "paper",
