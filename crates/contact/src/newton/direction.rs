@@ -17,6 +17,7 @@ use faer::Mat;
 const SYMMETRIC: f64 = 1e-8;
 
 /// How the Newton directions of one problem are solved.
+#[derive(Clone)]
 pub(super) enum Directions {
     /// Dense SPD, or positive real with electric rows: the reduced system, with the stiffness
     /// `(D + σ W⁻¹)⁻¹` (row-major).
@@ -35,6 +36,7 @@ pub(super) enum Directions {
 /// The pattern of every Jacobian of a sparse problem, row by row: row `r` of point `i` may hold
 /// the columns of every row of `D` that belongs to point `i`, and the point's own columns
 /// (whatever the branch); and the symbolic LU of `Jᵀ`, whose columns are `J`'s rows.
+#[derive(Clone)]
 pub(super) struct SparsePattern {
     /// Row pointers of `J` (= column pointers of `Jᵀ`).
     ptr: Vec<usize>,

@@ -485,7 +485,7 @@ pub fn solve_newton<P: AffineProblem>(
         tol: params.tol,
         best: Best::new(1.0),
     };
-    let end = newton_stages(&mut judge, x0, params, &mut info, progress);
+    let end = newton_stages(&mut judge, x0, params, &mut info, progress, &mut None);
     let best_residual = judge.best_residual();
     let (best, _) = judge.best.take_kept().expect("the start was judged");
     let lambda = judge.flat.values(&best.x);
@@ -551,7 +551,7 @@ pub fn solve_newton_electric(
         return Err(InputError::Unsupported("slip-weakening friction with electrical contact").into());
     }
     let (mut scaled, s) = problem.scaled();
-    let mut sol = solve_electric(&mut scaled, points, law, params, progress)?;
+    let mut sol = solve_electric(&mut scaled, points, law, params, progress, &mut Shared::default())?;
     if let Some(e) = &mut sol.electric {
         e.flux.iter_mut().for_each(|q| *q *= s);
         e.potential.iter_mut().for_each(|v| *v /= s);
@@ -561,12 +561,15 @@ pub fn solve_newton_electric(
 
 /// [`crate::solve_newton_electric`] on the scaled problem: stages 1 and 2 on the mechanical
 /// and electric rows together; a stall is a [`ContactError::Stalled`] with the best iterate.
-pub(crate) fn solve_electric(
+/// What the solves of one `D` under its electric laws share ([`Shared`]) comes from `cache`
+/// where it is there, and is left there.
+fn solve_electric(
     problem: &mut ElectricContactProblem,
     points: &ContactPoints,
     law: &Law,
     params: &NewtonParams,
     progress: &mut dyn FnMut(&Progress),
+    cache: &mut Shared,
 ) -> Result<ContactSolution, ContactError> {
     if !(params.tol > 0.0) {
         return Err(InputError::Parameter(format!("Newton tolerance {} must be positive", params.tol)).into());
@@ -588,7 +591,7 @@ pub(crate) fn solve_electric(
         &problem.phi0,
     );
     // the start's own Newton steps count among the run's
-    let (x0, steps) = electric_start(problem, &flat, points, law, params);
+    let (x0, steps) = electric_start(problem, &flat, points, law, params, cache);
     info.newton_iters += steps;
     let mut judge = Judge {
         flat,
@@ -600,7 +603,7 @@ pub(crate) fn solve_electric(
         tol: params.tol,
         best: Best::new(1.0),
     };
-    let end = newton_stages(&mut judge, x0, params, &mut info, progress);
+    let end = newton_stages(&mut judge, x0, params, &mut info, progress, &mut cache.directions);
     let best_residual = judge.best_residual();
     let (best, _) = judge.best.take_kept().expect("the start was judged");
     let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
@@ -659,6 +662,15 @@ pub(crate) fn solve_electric(
     })
 }
 
+/// What the solves of one coupled problem under different electric laws share: the Newton
+/// directions' factorisation of `D`, and the insulated problem's answer (`Some(None)` where its
+/// solve failed).
+#[derive(Default)]
+struct Shared {
+    directions: Option<Directions>,
+    insulated: Option<Option<PointValues>>,
+}
+
 /// The start of the coupled Newton (with the Newton steps it took): one sweep of the fixed point that alternates the two
 /// problems, from the better of two mechanical states. The mechanical state is the insulated
 /// problem's (no flux) and, for a conductive foundation, the ideal conductor's too (its limit
@@ -672,6 +684,7 @@ fn electric_start(
     points: &ContactPoints,
     law: &Law,
     params: &NewtonParams,
+    cache: &mut Shared,
 ) -> (Vec<f64>, usize) {
     let zero = vec![0.0; flat.m];
     let mut steps = 0;
@@ -685,14 +698,18 @@ fn electric_start(
         ..*params
     };
     let mut mechanical = vec![];
-    if let Ok(sol) = solve_newton(&mut problem.insulated(), points, law, &quiet, None, &mut |_| {}) {
-        steps += sol.info.newton_iters;
-        mechanical.push(sol.lambda);
+    if cache.insulated.is_none() {
+        let sol = solve_newton(&mut problem.insulated(), points, law, &quiet, None, &mut |_| {});
+        steps += sol.as_ref().map_or(0, |s| s.info.newton_iters);
+        cache.insulated = Some(sol.ok().map(|s| s.lambda));
+    }
+    if let Some(Some(lambda)) = &cache.insulated {
+        mechanical.push(lambda.clone());
     }
     if matches!(problem.electric.law, crate::ElectricLaw::Conductive { .. }) {
         let mut ideal = problem.clone();
         ideal.electric.law = crate::ElectricLaw::Conducting;
-        if let Ok(sol) = solve_electric(&mut ideal, points, law, &quiet, &mut |_| {}) {
+        if let Ok(sol) = solve_electric(&mut ideal, points, law, &quiet, &mut |_| {}, cache) {
             steps += sol.info.newton_iters;
             mechanical.push(sol.lambda);
         }
@@ -797,20 +814,22 @@ fn check_newton_input<P: AffineProblem>(problem: &P, params: &NewtonParams) -> R
 /// | 2 | the proximal point method | `max_proximal > 0` |
 /// | 2b | Newton under its own lenient rules (non-monotone, no patience) | a sparse or asymmetric compliance, where stage 1 ran under stricter rules |
 ///
-/// (Stage 3, the first-order fallback, is [`fallback`].)
+/// (Stage 3, the first-order fallback, is [`fallback`].) The directions' factorisation is
+/// taken from `cache`, or made and left there (problems of one compliance share it).
 fn newton_stages(
     judge: &mut Judge<'_>,
     x0: Vec<f64>,
     params: &NewtonParams,
     info: &mut ContactInfo,
     progress: &mut dyn FnMut(&Progress),
+    cache: &mut Option<Directions>,
 ) -> End {
     let s = judge.flat.state(x0);
     let (_, done) = judge.offer(&s);
     if done {
         return End::Converged;
     }
-    let directions = Directions::new(&judge.flat);
+    let directions = cache.get_or_insert_with(|| Directions::new(&judge.flat)).clone();
     let strict = Rules {
         steps: params.max_iters,
         patience: PATIENCE,

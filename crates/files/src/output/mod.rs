@@ -129,7 +129,8 @@ fn vtu(solution: &Solution) -> Result<Vec<u8>, Error> {
     Ok(buf)
 }
 
-/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`;
+/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
+/// and, with electrical contact, `flux,potential` (`nan` where an electrode holds the point);
 /// the displacements are those of the final solution (a frictionless body slides: its `u_t`
 /// is written too), the tangential multipliers 0 where the law carries none.
 fn contact_csv(c: &ContactResult) -> Vec<u8> {
@@ -138,10 +139,19 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
     let nt = sol.lambda.n_tangential();
     let mut s = String::new();
     s.push_str(if dim == 2 {
-        "x,y,gap,u_n,u_t,lambda_n,lambda_t,status\n"
+        "x,y,gap,u_n,u_t,lambda_n,lambda_t,status"
     } else {
-        "x,y,z,gap,u_n,u_t,u_t2,lambda_n,lambda_t,lambda_t2,status\n"
+        "x,y,z,gap,u_n,u_t,u_t2,lambda_n,lambda_t,lambda_t2,status"
     });
+    // electrical contact: the flux D.n and the potential of each point (nan on an electrode)
+    let electric = sol.electric.as_ref().map(|e| {
+        let mut at = vec![(f64::NAN, f64::NAN); points.len()];
+        for (k, &i) in e.points.iter().enumerate() {
+            at[i] = (e.flux[k], e.potential[k]);
+        }
+        at
+    });
+    s.push_str(if electric.is_some() { ",flux,potential\n" } else { "\n" });
     for i in 0..points.len() {
         // `{:e}`: the shortest digits that read back to the same double
         let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| format!("{x:e}")).collect();
@@ -158,6 +168,10 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
             ));
         }
         row.push(sol.status[i].name().to_string());
+        if let Some(at) = &electric {
+            row.push(format!("{:e}", at[i].0));
+            row.push(format!("{:e}", at[i].1));
+        }
         s.push_str(&row.join(","));
         s.push('\n');
     }
@@ -210,12 +224,29 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
     } else {
         "Multipliers along the contact boundary"
     };
-    let panel = Panel {
+    let mut panels = vec![Panel {
         title: title.into(),
         labels: ("x".into(), "multiplier".into()),
         series,
-    };
-    plots::panels("multipliers", &[panel])
+    }];
+    if let Some(e) = &s.electric {
+        // the flux through the points (those with a free potential), along the same line
+        let flux: Vec<(f64, f64)> = idx
+            .iter()
+            .filter_map(|&i| {
+                e.points
+                    .iter()
+                    .position(|&j| j == i)
+                    .map(|k| (p.position[i][0], e.flux[k]))
+            })
+            .collect();
+        panels.push(Panel {
+            title: "Electric flux D.n through the contact boundary".into(),
+            labels: ("x".into(), "flux".into()),
+            series: vec![Series::line("D.n (leaving the body)", flux)],
+        });
+    }
+    plots::panels("multipliers", &panels)
 }
 
 /// Where a run writes by default: `out/<scene>/`, the scene's name made a safe single path
