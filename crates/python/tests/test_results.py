@@ -214,8 +214,8 @@ def test_electrical_contact_from_python():
     """`contact.electric`: a conducting foundation holds the potential of the points in contact
     at its own, the flux sums to the reported charge, no conductance is the insulated answer,
     and the PETSc backend is refused by key."""
-    phi_f = 0.05
-    r = pc.run(pc.Scene.load("paper-conducting", {"mesh.n": 8}))
+    phi_f = 0.02
+    r = pc.run(pc.Scene.load("paper-conducting", {"mesh.n": 8, "contact.foundation_potential": phi_f}))
     c = r.contact
     touching = c.lambda_n > 0
     assert touching.any()
