@@ -222,7 +222,8 @@ def test_electrical_contact_from_python():
     assert np.allclose(r.phi[c.node[touching]], phi_f, rtol=0, atol=1e-12)
     charge = np.nansum(c.weight * c.flux)
     assert np.isclose(charge, r.report["contact"]["charge"], rtol=1e-12)
-    insulated = pc.run(pc.Scene.load("paper", {"mesh.n": 8})).contact
+    bare = {"contact.electric": "insulated", "contact.conductance": None, "contact.foundation_potential": None}
+    insulated = pc.run(pc.Scene.load("paper-conductive", {"mesh.n": 8, **bare})).contact
     assert insulated.flux is None
     s = pc.Scene.load("paper-conductive", {"mesh.n": 8, "contact.conductance": 0.0})
     none = pc.run(s).contact
