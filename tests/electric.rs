@@ -238,3 +238,45 @@ fn keys_that_do_not_fit_electrical_contact_are_refused_by_name() {
     // contact switched off: the section's keys are kept, unused, as everywhere
     assert!(files::scene_file::load(c, &["contact.law=\"none\"".into()]).is_ok());
 }
+
+/// The manufactured solution in sticking contact with an ideally conducting foundation on the
+/// whole contact face (`exact.kind = "manufactured-conducting"`): P1 converges as O(h) in the
+/// energy norm and O(h²) in L2, in 2D and 3D, every point in contact and sticking.
+#[test]
+fn the_manufactured_solution_on_a_conducting_foundation_converges_at_order_one() {
+    for (dim, sizes) in [(2, [8, 16, 32]), (3, [2, 4, 8])] {
+        let mut energy = vec![];
+        let mut l2 = vec![];
+        for n in sizes {
+            let mut sets = vec![format!("mesh.n={n}")];
+            if dim == 3 {
+                sets.extend(
+                    [
+                        "mesh.kind=\"box\"",
+                        "mesh.lo=[0.0, 0.0, 0.0]",
+                        "mesh.hi=[1.0, 1.0, 1.0]",
+                        "material.0.poling=[0.0, 0.0, 1.0]",
+                        "contact.normal=[0.0, 0.0, -1.0]",
+                        "contact.gap_center=[0.5, 0.5, 0.0]",
+                    ]
+                    .map(String::from),
+                );
+            }
+            let (scene, _) = files::scene_file::load("manufactured-conducting", &sets).unwrap();
+            let s = problem::solve(&scene, None, &mut Silent).unwrap();
+            let c = s.contact.as_ref().unwrap();
+            let (stick, slip, separated) = c.solution.counts();
+            assert!(slip == 0 && separated == 0 && stick > 0, "{dim}D n = {n}: {stick} {slip} {separated}");
+            let Some(problem::ExactReport::Field(e)) = &s.report.exact else {
+                panic!("a field solution's errors")
+            };
+            energy.push(e.rel_energy);
+            l2.push(e.rel_l2_u);
+        }
+        for k in 1..energy.len() {
+            let order = |v: &[f64]| (v[k - 1] / v[k]).log2();
+            assert!((order(&energy) - 1.0).abs() < 0.1, "{dim}D energy order {}", order(&energy));
+            assert!(order(&l2) > 1.8, "{dim}D L2 order {}", order(&l2));
+        }
+    }
+}

@@ -80,6 +80,68 @@ impl Exact {
         }
     }
 
+    /// A solution in contact everywhere on the face `x_n = s0` (`n = dim - 1`, the outward
+    /// normal `-e_n`) with a rigid, ideally conducting foundation whose gap is
+    /// `g(t) = g0 + κ |t - c|² / 2` (`t` the tangential coordinates) and whose potential is
+    /// `φ_F`, the points sticking: with `s = x_n - s0`,
+    /// `u_k = 10⁻³ s sin(π t_k / 2 + 0.3)` (`k < n`: no slip on the face),
+    /// `u_n = -g(t) - s (10⁻² + 10⁻³ sin(π t_0 / 2))` (`u·(-e_n) = g` on the face: contact, and a
+    /// compression below it), `φ = φ_F + s (10⁻² + 5·10⁻³ cos(π t_0 / 2))` (`φ = φ_F` on the face).
+    /// Whether the pressure is positive and the shear within the friction bound depends on the
+    /// material and the coefficient: the caller checks the run's status.
+    pub fn on_conducting_foundation(dim: usize, s0: f64, g0: f64, curvature: f64, center: [f64; 3], phi_f: f64) -> Self {
+        let n = dim - 1;
+        let h = PI / 2.0;
+        Exact {
+            dim,
+            u: Arc::new(move |x| {
+                let s = x[n] - s0;
+                let mut out = [(0.0, [0.0; 3], [[0.0; 3]; 3]); 3];
+                for (k, o) in out.iter_mut().enumerate().take(n) {
+                    let (sn, cs) = ((h * x[k] + 0.3).sin(), (h * x[k] + 0.3).cos());
+                    let a = 1e-3;
+                    let mut g = [0.0; 3];
+                    let mut hh = [[0.0; 3]; 3];
+                    g[k] = a * s * h * cs;
+                    g[n] = a * sn;
+                    hh[k][k] = -a * s * h * h * sn;
+                    hh[k][n] = a * h * cs;
+                    hh[n][k] = a * h * cs;
+                    *o = (a * s * sn, g, hh);
+                }
+                let (sn, cs) = ((h * x[0]).sin(), (h * x[0]).cos());
+                let (delta, b) = (1e-2, 1e-3);
+                let gap = g0 + 0.5 * curvature * (0..n).map(|k| (x[k] - center[k]).powi(2)).sum::<f64>();
+                let mut g = [0.0; 3];
+                let mut hh = [[0.0; 3]; 3];
+                for k in 0..n {
+                    g[k] = -curvature * (x[k] - center[k]);
+                    hh[k][k] = -curvature;
+                }
+                g[0] -= s * b * h * cs;
+                g[n] = -(delta + b * sn);
+                hh[0][0] += s * b * h * h * sn;
+                hh[0][n] = -b * h * cs;
+                hh[n][0] = -b * h * cs;
+                out[n] = (-gap - s * (delta + b * sn), g, hh);
+                out
+            }),
+            phi: Arc::new(move |x| {
+                let s = x[n] - s0;
+                let (sn, cs) = ((h * x[0]).sin(), (h * x[0]).cos());
+                let (p1, p2) = (1e-2, 5e-3);
+                let mut g = [0.0; 3];
+                let mut hh = [[0.0; 3]; 3];
+                g[0] = -s * p2 * h * sn;
+                g[n] = p1 + p2 * cs;
+                hh[0][0] = -s * p2 * h * h * cs;
+                hh[0][n] = -p2 * h * sn;
+                hh[n][0] = -p2 * h * sn;
+                (phi_f + s * (p1 + p2 * cs), g, hh)
+            }),
+        }
+    }
+
     /// An affine solution `u = u0 + (∇u) x`, `φ = φ0 + ∇φ · x`: what a patch test reproduces to
     /// round-off. `grad_u[k][j] = ∂_j u_k`.
     pub fn affine(dim: usize, u0: [f64; 3], grad_u: [[f64; 3]; 3], phi0: f64, grad_phi: [f64; 3]) -> Self {
@@ -293,6 +355,46 @@ mod tests {
             for j in 0..3 {
                 assert!(((gp[j] - gm[j]) / (2.0 * d) - h[j][i]).abs() < 1e-8);
             }
+        }
+    }
+
+    /// The jets of the solution on a conducting foundation against central differences, in
+    /// 2D and 3D, and its contact face's values: the gap's normal displacement, no slip,
+    /// the foundation's potential.
+    #[test]
+    fn the_conducting_foundation_solution_has_consistent_jets() {
+        for dim in [2, 3] {
+            let e = Exact::on_conducting_foundation(dim, 0.1, 0.02, 0.3, [1.0, 0.5, 0.0], 0.04);
+            let x = [0.3, 0.7, 0.45];
+            let jets = |x: &[f64]| {
+                let u = (e.u)(x);
+                let mut all: Vec<Jet> = u[..dim].to_vec();
+                all.push((e.phi)(x));
+                all
+            };
+            let d = 1e-5;
+            let at = jets(&x);
+            for i in 0..dim {
+                let (mut xp, mut xm) = (x, x);
+                xp[i] += d;
+                xm[i] -= d;
+                let (p, m) = (jets(&xp), jets(&xm));
+                for f in 0..=dim {
+                    assert!(((p[f].0 - m[f].0) / (2.0 * d) - at[f].1[i]).abs() < 1e-8, "{dim}D field {f} d{i}");
+                    for j in 0..dim {
+                        let fd = (p[f].1[j] - m[f].1[j]) / (2.0 * d);
+                        assert!((fd - at[f].2[j][i]).abs() < 1e-7, "{dim}D field {f} d{j}d{i}");
+                    }
+                }
+            }
+            // on the face x_n = 0.1
+            let mut y = x;
+            y[dim - 1] = 0.1;
+            let face = jets(&y);
+            let gap = 0.02 + 0.15 * (0..dim - 1).map(|k| (y[k] - [1.0, 0.5][k]).powi(2)).sum::<f64>();
+            assert!((-face[dim - 1].0 - gap).abs() < 1e-15);
+            assert!((0..dim - 1).all(|k| face[k].0 == 0.0));
+            assert!((face[dim].0 - 0.04).abs() < 1e-15);
         }
     }
 }

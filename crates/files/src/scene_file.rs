@@ -37,6 +37,10 @@ pub const SHIPPED: &[(&str, &str)] = &[
         "paper-conducting",
         include_str!("../../../scenes/paper-conducting.toml"),
     ),
+    (
+        "manufactured-conducting",
+        include_str!("../../../scenes/manufactured-conducting.toml"),
+    ),
     ("paper-elastic", include_str!("../../../scenes/paper-elastic.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),

@@ -31,6 +31,19 @@ impl FieldSolution {
         };
         let exact = if x.kind == ExactKind::Manufactured {
             Exact::manufactured(dim)
+        } else if x.kind == ExactKind::ManufacturedConducting {
+            // validated: a box or rectangle, contact on its bottom face
+            let c = scene.contact.as_ref()?;
+            let center = pad(c.gap_center.as_deref().unwrap_or_default(), 3);
+            let s0 = scene.mesh.lo.get(dim - 1).copied().unwrap_or(0.0);
+            Exact::on_conducting_foundation(
+                dim,
+                s0,
+                c.gap,
+                c.gap_curvature,
+                [center[0], center[1], center[2]],
+                c.foundation_potential.unwrap_or(0.0),
+            )
         } else {
             let (u0, g, gp) = (pad(&x.u0, 3), pad(&x.grad_u, dim * dim), pad(&x.grad_phi, 3));
             let mut grad_u = [[0.0; 3]; 3];

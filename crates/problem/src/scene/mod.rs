@@ -176,6 +176,10 @@ choice! {
         Manufactured = "manufactured",
         /// An affine `(u, φ)` (a patch test).
         Affine = "affine",
+        /// A smooth `(u, φ)` in sticking contact with a rigid, ideally conducting foundation
+        /// on the whole contact face (`fe_assembly::Exact::on_conducting_foundation`, from the
+        /// scene's gap and foundation potential).
+        ManufacturedConducting = "manufactured-conducting",
         /// Hertz's frictionless cylinder on a half-plane.
         Hertz = "hertz",
         /// Cattaneo-Mindlin's partial slip under a tangential force.
@@ -245,6 +249,9 @@ impl ExactKind {
         match self {
             ExactKind::Manufactured => "relative energy-norm error of (u, φ) against the manufactured solution",
             ExactKind::Affine => "relative energy-norm error against the affine solution (a patch test: round-off)",
+            ExactKind::ManufacturedConducting => {
+                "relative energy-norm error of (u, φ) against the manufactured solution on a conducting foundation"
+            }
             ExactKind::Hertz => "relative l2 error of the nodal contact pressure against Hertz's, over |x| ≤ 1.5 a",
             ExactKind::CattaneoMindlin => {
                 "relative l2 error of the nodal tangential traction against Cattaneo-Mindlin's, over |x| ≤ 1.5 a"
@@ -252,9 +259,13 @@ impl ExactKind {
         }
     }
 
-    /// Whether it is a field solution without contact (manufactured, affine).
+    /// Whether it is a field solution (manufactured, affine; and the manufactured solution on
+    /// a conducting foundation, the one with contact).
     pub fn is_field(self) -> bool {
-        matches!(self, ExactKind::Manufactured | ExactKind::Affine)
+        matches!(
+            self,
+            ExactKind::Manufactured | ExactKind::Affine | ExactKind::ManufacturedConducting
+        )
     }
 }
 
@@ -882,6 +893,15 @@ impl ExactSpec {
     pub fn groups(&self, mesh: &MeshSpec) -> Vec<String> {
         if !self.groups.is_empty() {
             return self.groups.clone();
+        }
+        if self.kind == ExactKind::ManufacturedConducting {
+            // the contact face is the foundation's
+            let sides: &[&str] = if mesh.dim() == Some(3) {
+                &["left", "right", "top", "front", "back"]
+            } else {
+                &["left", "right", "top"]
+            };
+            return sides.iter().map(|g| g.to_string()).collect();
         }
         let sides: &[&str] = if mesh.dim() == Some(3) {
             &["left", "right", "bottom", "top", "front", "back"]

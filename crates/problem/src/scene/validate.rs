@@ -756,7 +756,9 @@ fn validate_exact(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
 /// A manufactured or affine solution: no contact, one material, its groups and data.
 fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
     let kind = x.kind;
-    if s.contact_law() != ContactLaw::None {
+    if kind == ExactKind::ManufacturedConducting {
+        validate_conducting_solution(s)?;
+    } else if s.contact_law() != ContactLaw::None {
         return Err(SceneError::new(
             "exact.kind",
             format!("exact.kind `{kind}` is a solution without contact; set contact.law = \"none\""),
@@ -784,12 +786,38 @@ fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
         ]
         .concat(),
     )?;
-    if kind == ExactKind::Manufactured {
-        let why = "data of an affine solution, and exact.kind is `manufactured`";
+    if kind != ExactKind::Affine {
+        let why = "data of an affine solution, and exact.kind is a manufactured one";
         refuse_if(!x.u0.is_empty(), "exact.u0", why)?;
         refuse_if(!x.grad_u.is_empty(), "exact.grad_u", why)?;
         refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
         refuse_if(!x.grad_phi.is_empty(), "exact.grad_phi", why)?;
+    }
+    Ok(())
+}
+
+/// The manufactured solution on a conducting foundation: a generated rectangle or box, Coulomb
+/// contact on its `bottom` face with the outward normal `-e_n`, a rigid, ideally conducting
+/// foundation (the solution sticks everywhere on the face, at the foundation's potential).
+fn validate_conducting_solution(s: &Scene) -> Result<(), SceneError> {
+    let why = "exact.kind = \"manufactured-conducting\" is a solution in sticking contact with a rigid, ideally conducting foundation under the bottom face";
+    let Some(c) = s.contact.as_ref().filter(|c| c.law == ContactLaw::Coulomb) else {
+        return Err(SceneError::new("contact.law", format!("{why}: it needs contact.law = \"coulomb\"")));
+    };
+    refuse_if(c.compliance.is_some(), "contact.compliance", why)?;
+    refuse_if(c.friction_law.is_some_and(|f| f != crate::scene::FrictionLaw::Coulomb), "contact.friction_law", why)?;
+    if c.electric != Some(crate::scene::ElectricCondition::Conducting) {
+        return Err(SceneError::new("contact.electric", format!("{why}: it needs contact.electric = \"conducting\"")));
+    }
+    let Some(dim) = s.mesh.dim().filter(|_| matches!(s.mesh.kind, MeshKind::Rectangle | MeshKind::Box)) else {
+        return Err(SceneError::new("mesh.kind", format!("{why}: it needs a generated rectangle or box")));
+    };
+    let down: Vec<f64> = (0..dim).map(|k| if k + 1 == dim { -1.0 } else { 0.0 }).collect();
+    if c.group != "bottom" || c.normal != down {
+        return Err(SceneError::new(
+            "contact.group",
+            format!("{why}: it needs contact.group = \"bottom\" with contact.normal = {down:?}"),
+        ));
     }
     Ok(())
 }
