@@ -240,15 +240,20 @@ fn keys_that_do_not_fit_electrical_contact_are_refused_by_name() {
 }
 
 /// The manufactured solution in sticking contact with an ideally conducting foundation on the
-/// whole contact face (`exact.kind = "manufactured-conducting"`): P1 converges as O(h) in the
-/// energy norm and O(h²) in L2, in 2D and 3D, every point in contact and sticking.
+/// whole contact face (`exact.kind = "manufactured-conducting"`), rigid or a linear bed (normal
+/// compliance): P1 converges as O(h) in the energy norm and O(h²) in L2, in 2D and 3D, every
+/// point in contact and sticking.
 #[test]
 fn the_manufactured_solution_on_a_conducting_foundation_converges_at_order_one() {
-    for (dim, sizes) in [(2, [8, 16, 32]), (3, [2, 4, 8])] {
+    let cases = [(2, [8, 16, 32]), (3, [2, 4, 8])];
+    for ((dim, sizes), bed) in cases.iter().flat_map(|c| [None, Some(100.0)].map(|b| (*c, b))) {
         let mut energy = vec![];
         let mut l2 = vec![];
         for n in sizes {
             let mut sets = vec![format!("mesh.n={n}")];
+            if let Some(k) = bed {
+                sets.push(format!("contact.compliance.stiffness={k}"));
+            }
             if dim == 3 {
                 sets.extend(
                     [
@@ -266,7 +271,21 @@ fn the_manufactured_solution_on_a_conducting_foundation_converges_at_order_one()
             let s = problem::solve(&scene, None, &mut Silent).unwrap();
             let c = s.contact.as_ref().unwrap();
             let (stick, slip, separated) = c.solution.counts();
-            assert!(slip == 0 && separated == 0 && stick > 0, "{dim}D n = {n}: {stick} {slip} {separated}");
+            assert!(
+                slip == 0 && separated == 0 && stick > 0,
+                "{dim}D n = {n}: {stick} {slip} {separated}"
+            );
+            if let Some(k) = bed {
+                // sunk into the bed by its own law: the penetration is the pressure over k
+                for (u, (g, l)) in c
+                    .displacement
+                    .normal
+                    .iter()
+                    .zip(c.points.gap.iter().zip(&c.solution.lambda.normal))
+                {
+                    assert!(((u - g) - l / k).abs() <= 1e-9 * (l / k), "{dim}D n = {n}: {u} {g} {l}");
+                }
+            }
             let Some(problem::ExactReport::Field(e)) = &s.report.exact else {
                 panic!("a field solution's errors")
             };
@@ -275,7 +294,11 @@ fn the_manufactured_solution_on_a_conducting_foundation_converges_at_order_one()
         }
         for k in 1..energy.len() {
             let order = |v: &[f64]| (v[k - 1] / v[k]).log2();
-            assert!((order(&energy) - 1.0).abs() < 0.1, "{dim}D energy order {}", order(&energy));
+            assert!(
+                (order(&energy) - 1.0).abs() < 0.1,
+                "{dim}D energy order {}",
+                order(&energy)
+            );
             assert!(order(&l2) > 1.8, "{dim}D L2 order {}", order(&l2));
         }
     }

@@ -12,6 +12,18 @@ use crate::{kernels, voigt, Constraint, Discretization, Field, Load, Material};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+/// A linear bed under a face, for [`Exact::on_conducting_foundation`]: its stiffness `k` and
+/// the material's `c33` and `e33` along the normal (a 6mm crystal poled along it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bed {
+    /// `k`, pressure per unit penetration.
+    pub stiffness: f64,
+    /// The stiffness along the normal.
+    pub c33: f64,
+    /// The piezoelectric constant along the normal.
+    pub e33: f64,
+}
+
 /// Value, gradient and Hessian of a scalar field at a point (unused components zero).
 pub type Jet = (f64, [f64; 3], [[f64; 3]; 3]);
 
@@ -87,11 +99,37 @@ impl Exact {
     /// `u_k = 10⁻³ s sin(π t_k / 2 + 0.3)` (`k < n`: no slip on the face),
     /// `u_n = -g(t) - s (10⁻² + 10⁻³ sin(π t_0 / 2))` (`u·(-e_n) = g` on the face: contact, and a
     /// compression below it), `φ = φ_F + s (10⁻² + 5·10⁻³ cos(π t_0 / 2))` (`φ = φ_F` on the face).
+    /// On a linear bed (`bed`: normal compliance `λ_n = k [u_n - g]₊`, the material poled along
+    /// the normal) the face sinks into it by the penetration `λ_n / k`, with the pressure
+    /// `λ_n = -σ_nn = c33 (10⁻² + 10⁻³ sin(π t_0/2)) - e33 (10⁻² + 5·10⁻³ cos(π t_0/2))` the
+    /// fields give on the face (`ε_tt = 0` there): `u_n = -(g + λ_n/k) - ...`.
     /// Whether the pressure is positive and the shear within the friction bound depends on the
     /// material and the coefficient: the caller checks the run's status.
-    pub fn on_conducting_foundation(dim: usize, s0: f64, g0: f64, curvature: f64, center: [f64; 3], phi_f: f64) -> Self {
+    pub fn on_conducting_foundation(
+        dim: usize,
+        s0: f64,
+        g0: f64,
+        curvature: f64,
+        center: [f64; 3],
+        phi_f: f64,
+        bed: Option<Bed>,
+    ) -> Self {
         let n = dim - 1;
         let h = PI / 2.0;
+        let (delta, b, p1, p2) = (1e-2, 1e-3, 1e-2, 5e-3);
+        // the penetration into a linear bed: the pressure on the face over k, with its jet in t_0
+        let penetration = move |t0: f64| -> (f64, f64, f64) {
+            let Some(bed) = bed else {
+                return (0.0, 0.0, 0.0);
+            };
+            let (l0, l1, l2) = (bed.c33 * delta - bed.e33 * p1, bed.c33 * b, -bed.e33 * p2);
+            let (sn, cs) = ((h * t0).sin(), (h * t0).cos());
+            (
+                (l0 + l1 * sn + l2 * cs) / bed.stiffness,
+                h * (l1 * cs - l2 * sn) / bed.stiffness,
+                -h * h * (l1 * sn + l2 * cs) / bed.stiffness,
+            )
+        };
         Exact {
             dim,
             u: Arc::new(move |x| {
@@ -110,14 +148,16 @@ impl Exact {
                     *o = (a * s * sn, g, hh);
                 }
                 let (sn, cs) = ((h * x[0]).sin(), (h * x[0]).cos());
-                let (delta, b) = (1e-2, 1e-3);
-                let gap = g0 + 0.5 * curvature * (0..n).map(|k| (x[k] - center[k]).powi(2)).sum::<f64>();
+                let (pen, dpen, ddpen) = penetration(x[0]);
+                let gap = g0 + pen + 0.5 * curvature * (0..n).map(|k| (x[k] - center[k]).powi(2)).sum::<f64>();
                 let mut g = [0.0; 3];
                 let mut hh = [[0.0; 3]; 3];
                 for k in 0..n {
                     g[k] = -curvature * (x[k] - center[k]);
                     hh[k][k] = -curvature;
                 }
+                g[0] -= dpen;
+                hh[0][0] -= ddpen;
                 g[0] -= s * b * h * cs;
                 g[n] = -(delta + b * sn);
                 hh[0][0] += s * b * h * h * sn;
@@ -129,7 +169,6 @@ impl Exact {
             phi: Arc::new(move |x| {
                 let s = x[n] - s0;
                 let (sn, cs) = ((h * x[0]).sin(), (h * x[0]).cos());
-                let (p1, p2) = (1e-2, 5e-3);
                 let mut g = [0.0; 3];
                 let mut hh = [[0.0; 3]; 3];
                 g[0] = -s * p2 * h * sn;
@@ -363,8 +402,16 @@ mod tests {
     /// the foundation's potential.
     #[test]
     fn the_conducting_foundation_solution_has_consistent_jets() {
-        for dim in [2, 3] {
-            let e = Exact::on_conducting_foundation(dim, 0.1, 0.02, 0.3, [1.0, 0.5, 0.0], 0.04);
+        let beds = [
+            None,
+            Some(Bed {
+                stiffness: 50.0,
+                c33: 111.0,
+                e33: 15.8,
+            }),
+        ];
+        for (dim, bed) in [2, 3].into_iter().flat_map(|d| beds.map(|b| (d, b))) {
+            let e = Exact::on_conducting_foundation(dim, 0.1, 0.02, 0.3, [1.0, 0.5, 0.0], 0.04, bed);
             let x = [0.3, 0.7, 0.45];
             let jets = |x: &[f64]| {
                 let u = (e.u)(x);
@@ -380,7 +427,10 @@ mod tests {
                 xm[i] -= d;
                 let (p, m) = (jets(&xp), jets(&xm));
                 for f in 0..=dim {
-                    assert!(((p[f].0 - m[f].0) / (2.0 * d) - at[f].1[i]).abs() < 1e-8, "{dim}D field {f} d{i}");
+                    assert!(
+                        ((p[f].0 - m[f].0) / (2.0 * d) - at[f].1[i]).abs() < 1e-8,
+                        "{dim}D field {f} d{i}"
+                    );
                     for j in 0..dim {
                         let fd = (p[f].1[j] - m[f].1[j]) / (2.0 * d);
                         assert!((fd - at[f].2[j][i]).abs() < 1e-7, "{dim}D field {f} d{j}d{i}");
@@ -392,7 +442,13 @@ mod tests {
             y[dim - 1] = 0.1;
             let face = jets(&y);
             let gap = 0.02 + 0.15 * (0..dim - 1).map(|k| (y[k] - [1.0, 0.5][k]).powi(2)).sum::<f64>();
-            assert!((-face[dim - 1].0 - gap).abs() < 1e-15);
+            // the pressure from the jets: -σ_nn = -(c33 ε_nn + e33 φ_n), the tangential strain
+            // being 0 on the face
+            let n = dim - 1;
+            assert!((0..n).all(|k| face[k].1[k] == 0.0));
+            let pressure = bed.map_or(0.0, |b| -(b.c33 * face[n].1[n] + b.e33 * face[dim].1[n]));
+            let sink = bed.map_or(0.0, |b| pressure / b.stiffness);
+            assert!((-face[dim - 1].0 - gap - sink).abs() < 1e-15);
             assert!((0..dim - 1).all(|k| face[k].0 == 0.0));
             assert!((face[dim].0 - 0.04).abs() < 1e-15);
         }

@@ -43,6 +43,12 @@ impl FieldSolution {
                 c.gap_curvature,
                 [center[0], center[1], center[2]],
                 c.foundation_potential.unwrap_or(0.0),
+                // validated: a linear bed, one 6mm crystal poled along the normal
+                c.compliance.map(|k| fe_assembly::Bed {
+                    stiffness: k.stiffness,
+                    c33: scene.material[0].c.get(3).copied().unwrap_or(0.0),
+                    e33: scene.material[0].e.get(1).copied().unwrap_or(0.0),
+                }),
             )
         } else {
             let (u0, g, gp) = (pad(&x.u0, 3), pad(&x.grad_u, dim * dim), pad(&x.grad_phi, 3));

@@ -802,15 +802,40 @@ fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
 fn validate_conducting_solution(s: &Scene) -> Result<(), SceneError> {
     let why = "exact.kind = \"manufactured-conducting\" is a solution in sticking contact with a rigid, ideally conducting foundation under the bottom face";
     let Some(c) = s.contact.as_ref().filter(|c| c.law == ContactLaw::Coulomb) else {
-        return Err(SceneError::new("contact.law", format!("{why}: it needs contact.law = \"coulomb\"")));
+        return Err(SceneError::new(
+            "contact.law",
+            format!("{why}: it needs contact.law = \"coulomb\""),
+        ));
     };
-    refuse_if(c.compliance.is_some(), "contact.compliance", why)?;
-    refuse_if(c.friction_law.is_some_and(|f| f != crate::scene::FrictionLaw::Coulomb), "contact.friction_law", why)?;
-    if c.electric != Some(crate::scene::ElectricCondition::Conducting) {
-        return Err(SceneError::new("contact.electric", format!("{why}: it needs contact.electric = \"conducting\"")));
+    if let Some(k) = c.compliance {
+        let on_bed = "exact.kind = \"manufactured-conducting\" on a deformable foundation takes a linear bed (contact.compliance.exponent = 1) under one 6mm crystal poled along the contact normal";
+        let m = &s.material;
+        let poled = m.len() == 1
+            && m[0].model == crate::scene::MaterialModel::Crystal6mm
+            && m[0].poling.iter().zip(&c.normal).all(|(p, n)| (p + n).abs() < 1e-12);
+        refuse_if(k.exponent != 1.0, "contact.compliance.exponent", on_bed)?;
+        refuse_if(!poled, "material.poling", on_bed)?;
     }
-    let Some(dim) = s.mesh.dim().filter(|_| matches!(s.mesh.kind, MeshKind::Rectangle | MeshKind::Box)) else {
-        return Err(SceneError::new("mesh.kind", format!("{why}: it needs a generated rectangle or box")));
+    refuse_if(
+        c.friction_law.is_some_and(|f| f != crate::scene::FrictionLaw::Coulomb),
+        "contact.friction_law",
+        why,
+    )?;
+    if c.electric != Some(crate::scene::ElectricCondition::Conducting) {
+        return Err(SceneError::new(
+            "contact.electric",
+            format!("{why}: it needs contact.electric = \"conducting\""),
+        ));
+    }
+    let Some(dim) = s
+        .mesh
+        .dim()
+        .filter(|_| matches!(s.mesh.kind, MeshKind::Rectangle | MeshKind::Box))
+    else {
+        return Err(SceneError::new(
+            "mesh.kind",
+            format!("{why}: it needs a generated rectangle or box"),
+        ));
     };
     let down: Vec<f64> = (0..dim).map(|k| if k + 1 == dim { -1.0 } else { 0.0 }).collect();
     if c.group != "bottom" || c.normal != down {
