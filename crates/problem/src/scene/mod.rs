@@ -345,6 +345,15 @@ impl Scene {
             add("contact.slip_bound", c.slip_bound.as_slice());
             add("contact.gap", &[c.gap]);
             add("contact.gap_curvature", &[c.gap_curvature]);
+            add(
+                "contact.compliance.stiffness",
+                &c.compliance.map(|k| k.stiffness).into_iter().collect::<Vec<_>>(),
+            );
+            add("contact.friction_static", c.friction_static.as_slice());
+            add("contact.friction_dynamic", c.friction_dynamic.as_slice());
+            add("contact.slip_length", c.slip_length.as_slice());
+            add("contact.foundation_potential", c.foundation_potential.as_slice());
+            add("contact.conductance", c.conductance.as_slice());
         }
         out
     }
