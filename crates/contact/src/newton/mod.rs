@@ -158,6 +158,65 @@ struct Judge<'a> {
     best: Best<State>,
 }
 
+impl<'a> Judge<'a> {
+    /// The judge of `flat`, the problem itself, with the preamble's multiplier scale
+    /// `reference`; no iterate judged yet.
+    fn new(
+        flat: Flat<'a>,
+        law: &'a Law,
+        points: &'a ContactPoints,
+        u0: &'a PointValues,
+        params: &NewtonParams,
+        reference: f64,
+    ) -> Self {
+        Judge {
+            flat,
+            law,
+            points,
+            u0,
+            measure: params.measure,
+            reference,
+            tol: params.tol,
+            best: Best::new(1.0),
+        }
+    }
+
+    /// Newton's stages from `x0`, and how they ended: the best state of all and its residual
+    /// (taken from the judge), with the stall's reason where it is short of the tolerance; an
+    /// interruption is an error carrying the best iterate.
+    fn run_stages(
+        &mut self,
+        x0: Vec<f64>,
+        params: &NewtonParams,
+        info: &mut ContactInfo,
+        progress: &mut dyn FnMut(&Progress),
+        cache: &mut Option<Directions>,
+    ) -> Result<(State, f64, Option<Stall>), ContactError> {
+        let end = newton_stages(self, x0, params, info, progress, cache);
+        let (best, best_residual) = self.best.take_kept().expect("the start was judged");
+        match end {
+            End::Converged => Ok((best, best_residual, None)),
+            _ if best_residual <= params.tol => Ok((best, best_residual, None)),
+            End::Interrupted(why) => Err(ContactError::Interrupted {
+                why,
+                n_iters: info.newton_iters,
+                residual: best_residual,
+                best: Some(Box::new(self.iterate(&best, best_residual))),
+            }),
+            End::Stalled(why) => Ok((best, best_residual, Some(why))),
+        }
+    }
+
+    /// The state `s` of the problem itself as an iterate, with its residual.
+    fn iterate(&self, s: &State, residual: f64) -> Iterate {
+        Iterate {
+            lambda: self.flat.values(&s.x),
+            u: self.flat.values(&s.u),
+            residual,
+        }
+    }
+}
+
 impl Judge<'_> {
     /// The points with the coefficients of the law at the slips of `u` (slip weakening), or
     /// as they are.
@@ -214,10 +273,6 @@ impl Judge<'_> {
         let r = self.residual(s);
         self.best.offer_with(r, || s.clone());
         (r, r <= self.tol)
-    }
-
-    fn best_residual(&self) -> f64 {
-        self.best.residual().unwrap_or(f64::NAN)
     }
 
     /// The progress line of a state.
@@ -475,40 +530,10 @@ pub fn solve_newton<P: AffineProblem>(
     let mut flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
     flat.weakening = params.weakening;
     info.augmentation = Some(1.0 / mu_max);
-    let mut judge = Judge {
-        flat,
-        law,
-        points,
-        u0: &u0,
-        measure: params.measure,
-        reference,
-        tol: params.tol,
-        best: Best::new(1.0),
-    };
-    let end = newton_stages(&mut judge, x0, params, &mut info, progress, &mut None);
-    let best_residual = judge.best_residual();
-    let (best, _) = judge.best.take_kept().expect("the start was judged");
-    let lambda = judge.flat.values(&best.x);
-    let u = judge.flat.values(&best.u);
-    let reason = match end {
-        End::Converged => None,
-        _ if best_residual <= params.tol => None,
-        End::Interrupted(why) => {
-            let best = Iterate {
-                lambda,
-                u,
-                residual: best_residual,
-            };
-            return Err(ContactError::Interrupted {
-                why,
-                n_iters: info.newton_iters,
-                residual: best_residual,
-                best: Some(Box::new(best)),
-            });
-        }
-        End::Stalled(why) => Some(why),
-    };
-    let Some(reason) = reason else {
+    let mut judge = Judge::new(flat, law, points, &u0, params, reference);
+    let (best, best_residual, stall) = judge.run_stages(x0, params, &mut info, progress, &mut None)?;
+    let Some(reason) = stall else {
+        let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
         info.complementarity = judge.complementarity(&best);
         info.residual = best_residual;
         let status = classify(&lambda, &slip_bound(&judge.points_at(&u), law, &lambda.normal));
@@ -520,11 +545,7 @@ pub fn solve_newton<P: AffineProblem>(
             electric: None,
         });
     };
-    let stalled = Iterate {
-        lambda,
-        u,
-        residual: best_residual,
-    };
+    let stalled = judge.iterate(&best, best_residual);
     after_stall(problem, points, law, params, stalled, reason, info, progress)
 }
 
@@ -571,9 +592,7 @@ fn solve_electric(
     progress: &mut dyn FnMut(&Progress),
     cache: &mut Shared,
 ) -> Result<ContactSolution, ContactError> {
-    if !(params.tol > 0.0) {
-        return Err(InputError::Parameter(format!("Newton tolerance {} must be positive", params.tol)).into());
-    }
+    check_tolerance(params)?;
     let pre = Preamble::new(
         &mut Counter::new(problem),
         points,
@@ -593,57 +612,13 @@ fn solve_electric(
     // the start's own Newton steps count among the run's
     let (x0, steps) = electric_start(problem, &flat, points, law, params, cache);
     info.newton_iters += steps;
-    let mut judge = Judge {
-        flat,
-        law,
-        points,
-        u0: &u0,
-        measure: params.measure,
-        reference,
-        tol: params.tol,
-        best: Best::new(1.0),
-    };
-    let end = newton_stages(&mut judge, x0, params, &mut info, progress, &mut cache.directions);
-    let best_residual = judge.best_residual();
-    let (best, _) = judge.best.take_kept().expect("the start was judged");
-    let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
-    let converged = matches!(end, End::Converged) || best_residual <= params.tol;
-    let stall = match end {
-        _ if converged => None,
-        End::Interrupted(why) => {
-            let best = Iterate {
-                lambda,
-                u,
-                residual: best_residual,
-            };
-            return Err(ContactError::Interrupted {
-                why,
-                n_iters: info.newton_iters,
-                residual: best_residual,
-                best: Some(Box::new(best)),
-            });
-        }
-        End::Stalled(why) => Some(why),
-        End::Converged => None,
-    };
+    let mut judge = Judge::new(flat, law, points, &u0, params, reference);
+    let (best, best_residual, stall) = judge.run_stages(x0, params, &mut info, progress, &mut cache.directions)?;
     if let Some(reason) = stall {
-        let best = Iterate {
-            lambda,
-            u,
-            residual: best_residual,
-        };
-        return Err(ContactError::Stalled {
-            stage: if info.proximal_iters > 0 {
-                Stage::Proximal
-            } else {
-                Stage::Newton
-            },
-            n_iters: info.newton_iters,
-            residual: best_residual,
-            reason,
-            best: Some(Box::new(best)),
-        });
+        let best = judge.iterate(&best, best_residual);
+        return Err(stall_error(&info, best_residual, reason, Some(best)));
     }
+    let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
     info.complementarity = judge.complementarity(&best);
     info.residual = best_residual;
     let start = judge.flat.mechanical();
@@ -761,17 +736,7 @@ fn after_stall<P: AffineProblem>(
             Err(e) => e,
         }
     } else {
-        ContactError::Stalled {
-            stage: if info.proximal_iters > 0 {
-                Stage::Proximal
-            } else {
-                Stage::Newton
-            },
-            n_iters: info.newton_iters,
-            residual: best_residual,
-            reason,
-            best: None,
-        }
+        stall_error(&info, best_residual, reason, None)
     };
     Err(whose_failure(
         problem,
@@ -799,10 +764,32 @@ fn check_newton_input<P: AffineProblem>(problem: &P, params: &NewtonParams) -> R
         }
         .into());
     }
+    check_tolerance(params)?;
+    Ok(nt)
+}
+
+/// The tolerance must be positive.
+fn check_tolerance(params: &NewtonParams) -> Result<(), ContactError> {
     if !(params.tol > 0.0) {
         return Err(InputError::Parameter(format!("Newton tolerance {} must be positive", params.tol)).into());
     }
-    Ok(nt)
+    Ok(())
+}
+
+/// Newton's stall at `residual` for `reason`, in the stage it reached, with the best iterate
+/// where the caller gives it.
+fn stall_error(info: &ContactInfo, residual: f64, reason: Stall, best: Option<Iterate>) -> ContactError {
+    ContactError::Stalled {
+        stage: if info.proximal_iters > 0 {
+            Stage::Proximal
+        } else {
+            Stage::Newton
+        },
+        n_iters: info.newton_iters,
+        residual,
+        reason,
+        best: best.map(Box::new),
+    }
 }
 
 /// Newton's stages from `x0` (docs/theory.md, "Semismooth Newton"), each from the best iterate
