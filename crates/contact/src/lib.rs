@@ -59,8 +59,8 @@ pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProbl
 pub use points::{ContactPoints, Foundation, PointValues, Status};
 pub use projection::{project_cone, project_disc, project_nonnegative};
 pub use solution::{
-    classify, complementarity_residual, coulomb_radius, desaxce_residual, slip_bound, ContactInfo, ContactSolution,
-    Interrupt, Interruption, Iterate, Law, Measure, Progress, Stage, Stall,
+    classify, complementarity_residual, coulomb_radius, desaxce_residual, multiplier_scale, slip_bound, ContactInfo,
+    ContactSolution, Interrupt, Interruption, Iterate, Law, Measure, Progress, Stage, Stall,
 };
 pub use uniqueness::slip_bound_expansion;
 pub use uzawa::{solve, StopRule, UzawaParams, FIXED_POINT_PATIENCE};

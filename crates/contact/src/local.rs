@@ -156,7 +156,13 @@ impl Point {
         }
         let mut c = 1.0 / size;
         let two = |v: &[f64; 3]| norm(&v[..k]);
-        let scale = |x: &[f64; 3], c: f64| two(x).max(c * two(&self.b)).max(c * self.g.abs());
+        // round-off of the multipliers: the rigid scale (c times the free motion), or a soft
+        // bed's pressure at the free penetration where that is smaller
+        let floor = |c: f64| {
+            let rigid = (c * two(&self.b)).max(c * self.g.abs());
+            self.foundation.multiplier_floor(rigid, self.b[0] - self.g)
+        };
+        let scale = |x: &[f64; 3], c: f64| two(x).max(floor(c));
         let done = |f: &[f64; 3], x: &[f64; 3], c: f64| two(f) <= 1e-14 * scale(x, c) || two(f) == 0.0;
         let mut x = x0;
         let (mut z, mut f) = self.equations(&x, c);

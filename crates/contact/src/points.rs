@@ -65,6 +65,18 @@ impl Foundation {
         }
     }
 
+    /// The scale below which multipliers are round-off, given the rigid one (`c` times the
+    /// free motion's size) and the free penetration `p`: the rigid scale on a rigid
+    /// foundation; on a compliant one the smaller of it and the bed's pressure `k [p]₊^m` (a
+    /// soft bed under a small load carries pressures many decades below the rigid scale, and a
+    /// floor there would take their round-off for the answer).
+    pub fn multiplier_floor(self, rigid: f64, p: f64) -> f64 {
+        match self.pressure(p) {
+            Some((pressure, _)) if !pressure.is_nan() => rigid.min(pressure),
+            _ => rigid,
+        }
+    }
+
     /// The normal value Coulomb's radius `F [·]₊` is taken at: Newton's augmented `z_n` on a
     /// rigid foundation (`[z_n]₊ = λ_n` at a solution), the pressure `λ_n` itself on a
     /// compliant one.

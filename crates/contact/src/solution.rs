@@ -3,7 +3,7 @@
 //! scale-free complementarity residual and the stick/slip status of DESIGN.md.
 
 use crate::operator::ContactOperator;
-use crate::points::{ContactPoints, PointValues, Status};
+use crate::points::{ContactPoints, Foundation, PointValues, Status};
 use crate::projection::{norm, project_cone, project_disc, project_nonnegative};
 use crate::InputError;
 use crate::{ContactError, OperatorError};
@@ -496,7 +496,7 @@ pub(crate) struct Preamble {
     pub mu_max: f64,
     /// The contact displacement under the loads alone.
     pub u0: PointValues,
-    /// The multiplier scale `c ‖u(0) - g‖_W` with `c = 1/μ_max` ([`multiplier_scale`]).
+    /// The multiplier scale with `c = 1/μ_max` ([`multiplier_scale`]).
     pub reference: f64,
 }
 
@@ -540,14 +540,36 @@ impl Preamble {
     }
 }
 
-/// The multiplier scale of the problem, `c ‖u(0) - g‖_W` (the floor of the residual's
-/// denominator, see [`complementarity_residual`]).
-fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64 {
+/// The multiplier scale of the problem (the floor of the residual's denominator, see
+/// [`complementarity_residual`]): on a rigid foundation `c ‖u(0) - g‖_W`, the multipliers that
+/// push the free motion back by its own size; on a compliant one the smaller of that and the
+/// bed's pressure at the free penetration, `‖k [u(0)_n - g]₊^m‖_W` (a soft bed under a small
+/// load carries pressures many decades below `c ‖u(0) - g‖`, and a floor at the rigid scale
+/// would accept their round-off as the answer: 1e-7 of a pressure of 1e-6 on `k = 3e-3`,
+/// `m = 2.4`, found by the property tests).
+pub fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64 {
     let mut free = u0.clone();
     for (u, g) in free.normal.iter_mut().zip(&points.gap) {
         *u -= g;
     }
-    c * free.weighted_norm(&points.weight)
+    let rigid = c * free.weighted_norm(&points.weight);
+    if points.foundation == Foundation::Rigid {
+        return rigid;
+    }
+    // the bed's pressures at the free penetrations, weighted like the multipliers
+    let mut bed = PointValues::zeros(free.n_points(), 0);
+    for (p, penetration) in bed.normal.iter_mut().zip(&free.normal) {
+        *p = points
+            .foundation
+            .pressure(*penetration)
+            .map_or(0.0, |(pressure, _)| pressure);
+    }
+    let bed = bed.weighted_norm(&points.weight);
+    if bed.is_nan() {
+        rigid
+    } else {
+        rigid.min(bed)
+    }
 }
 
 /// The operator with a count of its calls and of the inner iterations they report.

@@ -311,6 +311,15 @@ enum Operator<'a> {
 }
 
 impl ContactSolve<'_> {
+    /// Semismooth Newton's parameters for this solve: its tolerance and interrupt.
+    fn newton_params(&self) -> NewtonParams {
+        NewtonParams {
+            tol: self.tol,
+            interrupt: self.interrupt,
+            ..Default::default()
+        }
+    }
+
     /// Runs the strategy's contact solver on `problem`, reporting each outer iteration.
     fn run(
         &self,
@@ -323,11 +332,7 @@ impl ContactSolve<'_> {
         let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
         let solved = match (self.plan.linear_strategy.contact_solver(), problem) {
             (ContactSolver::Newton, Operator::Condensed(dense)) => {
-                let params = NewtonParams {
-                    tol,
-                    interrupt: self.interrupt,
-                    ..Default::default()
-                };
+                let params = self.newton_params();
                 match &self.weakening {
                     // the branch from the stick start, whatever the warm start
                     Some(w) => {
@@ -459,14 +464,15 @@ fn electric_contact(
         seconds: condense.1,
     });
     let tol = how.tol;
-    let params = NewtonParams {
-        tol,
-        interrupt: how.interrupt,
-        ..Default::default()
-    };
     let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-    let mut sol = contact::solve_newton_electric(&problem, &boundary.points, &how.law, &params, &mut progress)
-        .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))?;
+    let mut sol = contact::solve_newton_electric(
+        &problem,
+        &boundary.points,
+        &how.law,
+        &how.newton_params(),
+        &mut progress,
+    )
+    .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))?;
     let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
     let (b_u, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
     let refinement = refine(direct, blocks, &b_u, &b_phi, scale, &mut u, &mut phi)?.steps;
@@ -609,11 +615,7 @@ fn law_residual(
     let points = &how.points_at(&boundary.points, sol);
     let at = fields_at_points(boundary, u, sol.lambda.n_tangential());
     let c = 1.0 / sol.info.mu_max;
-    let mut free = u0.clone();
-    for (v, g) in free.normal.iter_mut().zip(&points.gap) {
-        *v -= g;
-    }
-    let reference = c * free.weighted_norm(&points.weight);
+    let reference = contact::multiplier_scale(points, u0, c);
     let radius = contact::slip_bound(points, law, &sol.lambda.normal);
     contact::complementarity_residual(points, &radius, &sol.lambda, &at, c, reference)
 }
