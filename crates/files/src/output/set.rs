@@ -102,6 +102,11 @@ impl Outputs {
         self.files.extend(files);
     }
 
+    /// The files, in the order they were added.
+    pub fn into_files(self) -> Vec<(String, Vec<u8>)> {
+        self.files
+    }
+
     /// The names of the files, in the order they were added.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.files.iter().map(|(n, _)| n.as_str())
@@ -281,11 +286,19 @@ mod unix {
             }
             Err(_) => std::fs::create_dir_all(&hidden).map_err(|e| io("cannot create", &hidden, e))?,
         }
-        let tmp = fresh(&hidden, "turning");
+        Ok(hidden)
+    }
+
+    /// The hidden directory's README, written where missing; under the lock, since another
+    /// commit's clean-up ([`remove_stale`]) removes the temporary names it does not own.
+    fn write_readme(hidden: &Path) -> Result<(), Error> {
+        if hidden.join(README).is_file() {
+            return Ok(());
+        }
+        let tmp = fresh(hidden, "turning");
         std::fs::write(&tmp, README_TEXT)
             .and_then(|()| std::fs::rename(&tmp, hidden.join(README)))
-            .map_err(|e| io("cannot write", &hidden.join(README), e))?;
-        Ok(hidden)
+            .map_err(|e| io("cannot write", &hidden.join(README), e))
     }
 
     /// A fresh name in `hidden`: the process, the time and a count of this process's names.
@@ -370,6 +383,7 @@ mod unix {
         let lock = std::fs::File::create(hidden.join(LOCK)).map_err(|e| io("cannot open", &hidden.join(LOCK), e))?;
         lock.lock().map_err(|e| io("cannot lock", &hidden.join(LOCK), e))?;
         remove_stale(&hidden);
+        write_readme(&hidden)?;
         adopt_legacy(dir, &hidden)?;
         let old = current_names(&hidden);
         let old_set = std::fs::read_link(hidden.join(CURRENT)).ok().map(|t| hidden.join(t));
