@@ -72,6 +72,7 @@ fn block(dim: usize, compliance: Option<ComplianceSpec>, friction: bool) -> Scen
         contact: Some(contact),
         solver: Default::default(),
         exact: None,
+        path: None,
     }
 }
 

@@ -81,6 +81,7 @@ fn block(dim: usize, condition: ElectricCondition, conductance: Option<f64>) -> 
         contact: Some(contact),
         solver: Default::default(),
         exact: None,
+        path: None,
     }
 }
 

@@ -127,6 +127,7 @@ fn block(dim: usize, law: ContactLaw, gap: f64, half: bool) -> Scene {
         contact: Some(contact),
         solver: Default::default(),
         exact: None,
+        path: None,
     }
 }
 

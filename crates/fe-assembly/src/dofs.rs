@@ -72,6 +72,21 @@ pub struct DofMap {
 }
 
 impl DofMap {
+    /// The same map with its prescribed values scaled: displacement component `k` by `u[k]`,
+    /// potentials by `phi` (the same dofs free: a load path's instant).
+    pub fn scaled(&self, u: [f64; 3], phi: f64) -> DofMap {
+        let dim = self.dim;
+        let scale = |d: &Dof, f: f64| match *d {
+            Dof::Fixed(v) => Dof::Fixed(v * f),
+            other => other,
+        };
+        DofMap {
+            u: self.u.iter().enumerate().map(|(i, d)| scale(d, u[i % dim])).collect(),
+            phi: self.phi.iter().map(|d| scale(d, phi)).collect(),
+            ..self.clone()
+        }
+    }
+
     /// Builds the map: `has_phi[node]` says which nodes carry a potential; `constraints` are
     /// applied in order; a node that no cell uses has its displacement held at 0 (no unknown). A node constrained twice to values that differ by more than 1e-12
     /// (relative) is an error, and so is a condition that reaches no dof.

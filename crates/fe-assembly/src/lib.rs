@@ -54,7 +54,7 @@ pub use assembly::{Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field};
 pub use exact::{Bed, ErrorNorms, Exact};
 pub use held::Unheld;
-pub use loads::{facet_measure, Load};
+pub use loads::{facet_measure, Load, RhsParts};
 pub use material::{voigt, Crystal, Material, MaterialError};
 pub use recovery::CellFields;
 

@@ -89,6 +89,35 @@ impl Discretization<'_> {
     /// the prescribed values lifted: `b_u = f - A_ud u_d - Gᵀ_uφd φ_d`,
     /// `b_φ = -q - G_φud u_d + B_φφd φ_d`.
     pub fn rhs(&self, loads: &[Load]) -> Result<(Vec<f64>, Vec<f64>), AssemblyError> {
+        let (mut bu, mut bphi) = self.load_vectors(loads)?;
+        self.lift(&mut bu, &mut bphi, Lifted::All);
+        Ok((bu, bphi))
+    }
+
+    /// The right-hand side of [`Discretization::rhs`] in parts, each linear in its own data:
+    /// the loads alone, the lifting of each component of the prescribed displacements, the
+    /// lifting of the prescribed potentials (`rhs = loads + Σ_k displacements[k] +
+    /// potentials`). A load path scales each by its factor over time without assembling
+    /// again.
+    ///
+    /// # Errors
+    /// As [`Discretization::rhs`].
+    pub fn rhs_parts(&self, loads: &[Load]) -> Result<RhsParts, AssemblyError> {
+        let lifted = |which| {
+            let mut bu = vec![0.0; self.dofs.n_u];
+            let mut bphi = vec![0.0; self.dofs.n_phi];
+            self.lift(&mut bu, &mut bphi, which);
+            (bu, bphi)
+        };
+        Ok(RhsParts {
+            loads: self.load_vectors(loads)?,
+            displacements: (0..self.mesh.dim).map(|k| lifted(Lifted::Component(k))).collect(),
+            potentials: lifted(Lifted::Potentials),
+        })
+    }
+
+    /// The loads' vectors on the free dofs, without the lifting.
+    fn load_vectors(&self, loads: &[Load]) -> Result<(Vec<f64>, Vec<f64>), AssemblyError> {
         let mesh = self.mesh;
         let dim = mesh.dim;
         let d = &self.dofs;
@@ -178,27 +207,29 @@ impl Discretization<'_> {
                 }
             }
         }
-        self.lift(&mut bu, &mut bphi);
         Ok((bu, bphi))
     }
 
-    /// Subtracts the columns of `K` of the prescribed dofs times their values.
-    fn lift(&self, bu: &mut [f64], bphi: &mut [f64]) {
+    /// Subtracts the columns of `K` of the prescribed dofs (those of `which`) times their
+    /// values.
+    fn lift(&self, bu: &mut [f64], bphi: &mut [f64], which: Lifted) {
         let mesh = self.mesh;
         let dim = mesh.dim;
         let nl = dim + 1;
         let d = &self.dofs;
         for (c, cell) in mesh.iter_cells().enumerate() {
+            let lifts_u = |k: usize| matches!(which, Lifted::All) || which == Lifted::Component(k);
             let fixed_u = cell
                 .iter()
-                .any(|&v| (0..dim).any(|k| matches!(d.u[v * dim + k], Dof::Fixed(x) if x != 0.0)));
-            let fixed_phi = cell.iter().any(|&v| matches!(d.phi[v], Dof::Fixed(x) if x != 0.0));
+                .any(|&v| (0..dim).any(|k| lifts_u(k) && matches!(d.u[v * dim + k], Dof::Fixed(x) if x != 0.0)));
+            let lifts_phi = matches!(which, Lifted::All | Lifted::Potentials);
+            let fixed_phi = lifts_phi && cell.iter().any(|&v| matches!(d.phi[v], Dof::Fixed(x) if x != 0.0));
             if !fixed_u && !fixed_phi {
                 continue;
             }
             let (m, geo) = (self.material(c), &self.geometry[c]);
             for (a, &va) in cell.iter().enumerate() {
-                for k in 0..dim {
+                for k in (0..dim).filter(|&k| lifts_u(k)) {
                     let Dof::Fixed(val) = d.u[va * dim + k] else {
                         continue;
                     };
@@ -220,7 +251,7 @@ impl Discretization<'_> {
                         }
                     }
                 }
-                if !self.cell_electric[c] {
+                if !self.cell_electric[c] || !fixed_phi {
                     continue;
                 }
                 let Dof::Fixed(val) = d.phi[va] else { continue };
@@ -242,4 +273,26 @@ impl Discretization<'_> {
             }
         }
     }
+}
+
+/// Which prescribed values [`Discretization::rhs`]'s lifting takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Lifted {
+    /// Every prescribed value.
+    All,
+    /// Component `k` of the prescribed displacements.
+    Component(usize),
+    /// The prescribed potentials.
+    Potentials,
+}
+
+/// The right-hand side in parts ([`Discretization::rhs_parts`]), each `(b_u, b_φ)`.
+#[derive(Clone, Debug)]
+pub struct RhsParts {
+    /// The loads (body forces and charges, tractions, surface charges).
+    pub loads: (Vec<f64>, Vec<f64>),
+    /// The lifting of each component (x, y, z) of the prescribed displacements.
+    pub displacements: Vec<(Vec<f64>, Vec<f64>)>,
+    /// The lifting of the prescribed potentials.
+    pub potentials: (Vec<f64>, Vec<f64>),
 }

@@ -144,3 +144,66 @@ fn patch_test_2d() {
 fn patch_test_3d() {
     run_patch(3);
 }
+
+/// The right-hand side in parts: loads, each component's lifting, the potentials' lifting sum
+/// to `rhs`, and a map with its prescribed values scaled gives `rhs` = the parts scaled the
+/// same way (what a load path relies on), 2D and 3D, a manufactured solution's data.
+#[test]
+fn the_right_hand_side_is_the_sum_of_its_parts() {
+    for dim in [2, 3] {
+        let mesh = if dim == 2 {
+            mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 6, 3)
+        } else {
+            mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2)
+        };
+        let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
+        let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap();
+        let exact = fe_assembly::Exact::manufactured(dim);
+        let groups: &[&str] = &["left", "right", "bottom"];
+        let mats = [("body".to_string(), m.clone())];
+        let mut disc = Discretization::new(&mesh, &mats, &exact.constraints(groups)).unwrap();
+        let loads = exact.loads(&m);
+        let (bu, bphi) = disc.rhs(&loads).unwrap();
+        let parts = disc.rhs_parts(&loads).unwrap();
+        let f = [0.3, -1.7, 2.5];
+        let fphi = -0.6;
+        let fl = 1.9;
+        let combine = |fl: f64, f: [f64; 3], fphi: f64, electric: bool| -> Vec<f64> {
+            let pick = |p: &(Vec<f64>, Vec<f64>)| if electric { p.1.clone() } else { p.0.clone() };
+            let mut out: Vec<f64> = pick(&parts.loads).iter().map(|v| fl * v).collect();
+            for (k, d) in parts.displacements.iter().enumerate() {
+                for (o, v) in out.iter_mut().zip(pick(d)) {
+                    *o += f[k] * v;
+                }
+            }
+            for (o, v) in out.iter_mut().zip(pick(&parts.potentials)) {
+                *o += fphi * v;
+            }
+            out
+        };
+        let close = |a: &[f64], b: &[f64]| {
+            let scale = a.iter().chain(b).fold(0.0f64, |m, v| m.max(v.abs()));
+            a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-13 * scale)
+        };
+        assert!(close(&combine(1.0, [1.0; 3], 1.0, false), &bu), "{dim}D: b_u");
+        assert!(close(&combine(1.0, [1.0; 3], 1.0, true), &bphi), "{dim}D: b_phi");
+        assert!(
+            parts.displacements.iter().all(|d| d.0.iter().any(|v| *v != 0.0)),
+            "{dim}D: each component lifts"
+        );
+        // the scaled map's right-hand side with the loads scaled: the scaled parts
+        disc.dofs = disc.dofs.scaled(f, fphi);
+        let scaled_loads: Vec<Load> = exact
+            .loads(&m)
+            .into_iter()
+            .map(|l| match l {
+                Load::BodyForce(g) => Load::BodyForce(Arc::new(move |x| g(x).map(|v| fl * v))),
+                Load::BodyCharge(q) => Load::BodyCharge(Arc::new(move |x| fl * q(x))),
+                other => panic!("unexpected load {other:?}"),
+            })
+            .collect();
+        let (su, sphi) = disc.rhs(&scaled_loads).unwrap();
+        assert!(close(&combine(fl, f, fphi, false), &su), "{dim}D: scaled b_u");
+        assert!(close(&combine(fl, f, fphi, true), &sphi), "{dim}D: scaled b_phi");
+    }
+}

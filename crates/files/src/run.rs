@@ -62,11 +62,57 @@ pub fn solve_with(
     Ok(solution)
 }
 
+/// Solves a scene with a `[path]` (the quasi-static process), as [`solve_with`] does one
+/// instant, gathering the files of every step ([`output::PathFiles`]); writes nothing.
+///
+/// # Errors
+/// As [`solve`], and [`Error::Picture`] for a step's file.
+pub fn solve_path(
+    scene: &Scene,
+    source: &Source,
+    interrupt: contact::Interrupt,
+    reporter: &mut dyn Reporter,
+) -> Result<(Solution, output::Outputs), Error> {
+    let mesh = match (scene.mesh.kind, &scene.mesh.file) {
+        (MeshKind::Gmsh, Some(file)) => Some(mesh::read_msh(source.dir.join(file))?),
+        _ => None,
+    };
+    let (memory_bytes, memory_limit) = memory_limits(1);
+    let limits = problem::Limits {
+        memory_bytes,
+        memory_limit,
+        interrupt,
+    };
+    // every plan writes solution.vtu: the series too
+    let mut files = output::PathFiles::new(&[problem::Output::SolutionVtu]);
+    let mut failed = None;
+    let solved = problem::solve_path(scene, mesh, limits, reporter, &mut |step| {
+        files.step(&step).map_err(|e| {
+            let message = e.to_string();
+            failed = Some(e);
+            problem::SceneError::new("path", message).into()
+        })
+    });
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let mut solution = solved?.last;
+    solution.report.scene.source = source.label.clone();
+    solution.report.memory.peak_bytes = peak_memory_bytes();
+    let out = files.finish(&solution)?;
+    Ok((solution, out))
+}
+
 /// As [`solve`], then writes the plan's outputs into `dir` (as one set; nothing on error).
 ///
 /// # Errors
 /// As [`solve`], and [`Error::Output`] or [`Error::Picture`] for the files.
 pub fn run(scene: &Scene, source: &Source, dir: &Path, reporter: &mut dyn Reporter) -> Result<Solution, Error> {
+    if scene.path.is_some() {
+        let (solution, out) = solve_path(scene, source, contact::Interrupt::NONE, reporter)?;
+        out.into(dir).commit()?;
+        return Ok(solution);
+    }
     let solution = solve(scene, source, reporter)?;
     output::write(&solution, dir)?;
     Ok(solution)

@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 pub const SHIPPED: &[(&str, &str)] = &[
     ("paper", include_str!("../../../scenes/paper.toml")),
     ("paper-slip", include_str!("../../../scenes/paper-slip.toml")),
+    ("paper-cycle", include_str!("../../../scenes/paper-cycle.toml")),
     (
         "paper-frictionless",
         include_str!("../../../scenes/paper-frictionless.toml"),
@@ -54,6 +55,10 @@ pub const SHIPPED: &[(&str, &str)] = &[
     (
         "cattaneo-mindlin",
         include_str!("../../../scenes/cattaneo-mindlin.toml"),
+    ),
+    (
+        "cattaneo-mindlin-cycle",
+        include_str!("../../../scenes/cattaneo-mindlin-cycle.toml"),
     ),
     ("manufactured", include_str!("../../../scenes/manufactured.toml")),
     ("manufactured-3d", include_str!("../../../scenes/manufactured-3d.toml")),

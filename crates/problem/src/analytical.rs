@@ -36,6 +36,29 @@ pub fn cattaneo_traction(x: f64, f: f64, a: f64, p0: f64, c: f64) -> f64 {
     slip - stick
 }
 
+/// Cattaneo-Mindlin's traction under the tangential load `q` (`|q| ≤ F p`), signed as `q`.
+pub fn cattaneo_at(x: f64, f: f64, (a, p0, p): (f64, f64, f64), q: f64) -> f64 {
+    let c = cattaneo_stick_half_width(a, q.abs(), f, p);
+    q.signum() * cattaneo_traction(x, f, a, p0, c)
+}
+
+/// Mindlin and Deresiewicz's traction along a cycle of the tangential load under a constant
+/// normal one (Johnson 1985, section 7.2; Mindlin & Deresiewicz, J. Appl. Mech. 20 (1953)
+/// 327): `reversals` are the loads where the direction turned (`[]` on the first loading,
+/// `[Q₁]` after the first turn, `[Q₁, Q₂]` after the second), `q` the load now. Each turn
+/// adds twice a Cattaneo distribution of half the change since it (Masing's rule):
+/// `q(x) = cat(Q₁) - 2 cat((Q₁ - Q)/2)` unloading from `Q₁`, and from a second turn at `Q₂`,
+/// `q₁(x; Q₂) + 2 cat((Q - Q₂)/2)`; its stick zone the half-width of the last term.
+pub fn mindlin_deresiewicz_traction(x: f64, f: f64, hertz: (f64, f64, f64), reversals: &[f64], q: f64) -> f64 {
+    match reversals {
+        [] => cattaneo_at(x, f, hertz, q),
+        [.., last] => {
+            let before = mindlin_deresiewicz_traction(x, f, hertz, &reversals[..reversals.len() - 1], *last);
+            before + 2.0 * cattaneo_at(x, f, hertz, (q - last) / 2.0)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -62,5 +85,20 @@ mod tests {
             .map(|i| hertz_pressure(-a + (i as f64 + 0.5) * h, a, p0) * h)
             .sum();
         assert!((pressure - 1.0).abs() < 1e-5, "{pressure}");
+        // Mindlin-Deresiewicz: continuous at each turn, the full reversal to -Q* is -q*, and
+        // the unloading traction integrates to the load now
+        let hz = (a, p0, 1.0);
+        let q_star = 0.4;
+        for x in [-0.9 * a, -0.3 * a, 0.0, 0.5 * a] {
+            let q1 = mindlin_deresiewicz_traction(x, f, hz, &[], q_star);
+            assert!((mindlin_deresiewicz_traction(x, f, hz, &[q_star], q_star) - q1).abs() < 1e-15);
+            assert!((mindlin_deresiewicz_traction(x, f, hz, &[q_star], -q_star) + q1).abs() < 1e-14);
+            let q2 = mindlin_deresiewicz_traction(x, f, hz, &[q_star], -0.1);
+            assert!((mindlin_deresiewicz_traction(x, f, hz, &[q_star, -0.1], -0.1) - q2).abs() < 1e-15);
+        }
+        let down: f64 = (0..n)
+            .map(|i| mindlin_deresiewicz_traction(-a + (i as f64 + 0.5) * h, f, hz, &[q_star], 0.1) * h)
+            .sum();
+        assert!((down - 0.1).abs() < 1e-5, "{down}");
     }
 }

@@ -169,6 +169,7 @@ impl Posed<'_> {
 }
 
 /// The loads on the free dofs: `b_u` on the displacements, `b_φ` on the potentials.
+#[derive(Default)]
 pub struct Loads {
     /// On the free displacements.
     pub b_u: Vec<f64>,

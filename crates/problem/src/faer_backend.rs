@@ -108,19 +108,7 @@ impl Backend for Faer {
         system: Factored,
         (u, phi): Self::Solution,
     ) -> Result<Option<Finished>, ProblemError> {
-        let (smallest_pivot_ratio, factor_bytes) = match &system.solver {
-            LinearSolver::Direct(d) => (Some(d.factor().pivot_ratio()), d.factor_bytes()),
-            LinearSolver::SchurPcg(p) => (None, p.factor_bytes()),
-        };
-        let figures = Figures {
-            factor_seconds: system.seconds,
-            condense: system.condense,
-            pcg_rel_tol: system.pcg_params.rel_tol,
-            smallest_pivot_ratio,
-            refinement_steps: system.refinement,
-            factor_bytes,
-            petsc: None,
-        };
+        let figures = system.figures();
         Ok(Some(Finished { u, phi, figures }))
     }
 }
@@ -157,6 +145,31 @@ pub struct Factored {
     refinement: usize,
     /// How the contact compliance was formed, and in how long (condensed strategies).
     condense: Option<(CondenseRoute, f64)>,
+}
+
+impl Factored {
+    /// What the factorisation and the solves on it measured, for the report.
+    pub(crate) fn figures(&self) -> Figures {
+        let (smallest_pivot_ratio, factor_bytes) = match &self.solver {
+            LinearSolver::Direct(d) => (Some(d.factor().pivot_ratio()), d.factor_bytes()),
+            LinearSolver::SchurPcg(p) => (None, p.factor_bytes()),
+        };
+        Figures {
+            factor_seconds: self.seconds,
+            condense: self.condense,
+            pcg_rel_tol: self.pcg_params.rel_tol,
+            smallest_pivot_ratio,
+            refinement_steps: self.refinement,
+            factor_bytes,
+            petsc: None,
+        }
+    }
+
+    /// The equilibrium residual of `(u, φ)` against the right-hand sides (their size `scale`).
+    pub(crate) fn equilibrium_of(&self, u: &[f64], phi: &[f64], b_u: &[f64], b_phi: &[f64], scale: f64) -> f64 {
+        let b = &self.blocks;
+        linalg::equilibrium_residual(&b.a, &b.g, &b.b, u, phi, b_u, b_phi, scale)
+    }
 }
 
 /// Factors the linear solver: the Schur PCG's Cholesky factors, or the `L D Lᵀ` of `K` in
@@ -292,7 +305,7 @@ fn solve_linear(system: &mut Factored, posed: &Posed<'_>) -> Result<Solved<Field
         .solve(&loads.b_u, &loads.b_phi, &mut u, &mut phi)?;
     if let LinearSolver::Direct(direct) = &mut system.solver {
         let (b, b_phi, scale) = rhs_with_contact(posed, None);
-        system.refinement = refine(direct, &system.blocks, &b, &b_phi, scale, &mut u, &mut phi)?.steps;
+        system.refinement = refine(direct, &system.blocks, &b, &b_phi, scale, &mut u, &mut phi, REFINE_TOL)?.steps;
     }
     Ok(Solved {
         x: (u, phi),
@@ -411,6 +424,8 @@ fn solve_contact(
                 posed,
                 boundary: &boundary,
                 refinement: 0,
+                shift: None,
+                refine_tol: REFINE_TOL,
             };
             let sol = on.correct(how, &mut dense, sol, (&mut u, &mut phi), reporter)?;
             system.refinement = on.refinement;
@@ -475,7 +490,7 @@ fn electric_contact(
     .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))?;
     let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
     let (b_u, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
-    let refinement = refine(direct, blocks, &b_u, &b_phi, scale, &mut u, &mut phi)?.steps;
+    let refinement = refine(direct, blocks, &b_u, &b_phi, scale, &mut u, &mut phi, REFINE_TOL)?.steps;
     // the potentials reported are the refined fields'
     if let (Some(e), Some((_, dofs))) = (&mut sol.electric, &boundary.electric) {
         let n_u = loads.b_u.len();
@@ -483,7 +498,7 @@ fn electric_contact(
             *v = phi[d - n_u];
         }
     }
-    sol.info.complementarity = law_residual(boundary, how, &sol, &problem.u0, &u);
+    sol.info.complementarity = law_residual(boundary, how, &sol, &problem.u0, &u, None);
     sol.info.residual = sol.info.residual.max(sol.info.complementarity);
     Ok((sol, (u, phi), condense, refinement))
 }
@@ -496,7 +511,22 @@ struct Refining<'a> {
     boundary: &'a ContactBoundary,
     /// Steps of iterative refinement of the last solve.
     refinement: usize,
+    /// A path's step: the tangential displacement of the points at the step before, which
+    /// the friction law's slip is measured from (the contact problem's frame).
+    shift: Option<&'a PointValues>,
+    /// The equilibrium residual above which the fields are refined ([`REFINE_TOL`] for one
+    /// instant; a path's steps refine only what a direct solve did not reach,
+    /// [`PATH_REFINE_TOL`]).
+    refine_tol: f64,
 }
+
+/// The equilibrium residual a run's fields are refined to.
+const REFINE_TOL: f64 = 1e-14;
+
+/// The equilibrium residual above which a path's step refines its fields: a direct solve
+/// reaches 1e-13 to 1e-15 on the shipped scenes, and a refinement step costs a solve, the
+/// step's own cost (measured on `paper-cycle`, n = 128: 1 to 3 refinement steps tripled it).
+const PATH_REFINE_TOL: f64 = 1e-12;
 
 impl Refining<'_> {
     /// The fields are those of the last solve: refined, and the contact law judged on them
@@ -516,12 +546,22 @@ impl Refining<'_> {
         let mut corrections = 0;
         loop {
             let (b_full, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
-            self.refinement += refine(self.direct, self.blocks, &b_full, &b_phi, scale, u, phi)?.steps;
-            sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u);
+            self.refinement += refine(
+                self.direct,
+                self.blocks,
+                &b_full,
+                &b_phi,
+                scale,
+                u,
+                phi,
+                self.refine_tol,
+            )?
+            .steps;
+            sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u, self.shift);
             if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
                 break;
             }
-            let actual = fields_at_points(boundary, u, sol.lambda.n_tangential());
+            let actual = in_frame(fields_at_points(boundary, u, sol.lambda.n_tangential()), self.shift);
             for (d, (x, model)) in dense.u0.normal.iter_mut().chain(dense.u0.tangential.iter_mut()).zip(
                 actual
                     .normal
@@ -545,7 +585,7 @@ impl Refining<'_> {
 /// The right-hand sides with the contact forces of `contact` (and the electric flux, with
 /// electrical contact), and the size of their parts (the loads, the contact forces: they may
 /// cancel in the sum).
-fn rhs_with_contact(
+pub(crate) fn rhs_with_contact(
     posed: &Posed<'_>,
     contact: Option<(&ContactBoundary, &ContactSolution)>,
 ) -> (Vec<f64>, Vec<f64>, f64) {
@@ -568,8 +608,9 @@ fn rhs_with_contact(
     (b_full, b_phi, scale)
 }
 
-/// Iterative refinement of the last solve (with `K`'s factors), towards round-off: at most 3
-/// corrections, each kept only where it lowers the residual.
+/// Iterative refinement of the last solve (with `K`'s factors), to the equilibrium residual
+/// `tol`: at most 3 corrections, each kept only where it lowers the residual.
+#[allow(clippy::too_many_arguments)]
 fn refine(
     direct: &mut DirectLdlt,
     b: &Blocks,
@@ -578,13 +619,14 @@ fn refine(
     scale: f64,
     u: &mut [f64],
     phi: &mut [f64],
+    tol: f64,
 ) -> Result<linalg::Refined, ProblemError> {
     let k = linalg::CoupledBlocks {
         a: &b.a,
         g: &b.g,
         b: &b.b,
     };
-    Ok(linalg::refine(direct, k, b_u, b_phi, u, phi, scale, 1e-14, 3)?)
+    Ok(linalg::refine(direct, k, b_u, b_phi, u, phi, scale, tol, 3)?)
 }
 
 /// Corrections of the condensed problem by its defect at the points, at most (each a warm
@@ -602,6 +644,17 @@ fn fields_at_points(boundary: &ContactBoundary, u: &[f64], nt: usize) -> PointVa
     PointValues::from_parts(all.normal, tangential, nt).unwrap_or_else(|_| PointValues::zeros(points.len(), nt))
 }
 
+/// The points' displacement `at` in the frame of a path's step: its tangential part less
+/// `shift` (the step before's), the slip increment the friction law reads.
+fn in_frame(mut at: PointValues, shift: Option<&PointValues>) -> PointValues {
+    if let Some(s) = shift {
+        for (v, s) in at.tangential.iter_mut().zip(&s.tangential) {
+            *v -= s;
+        }
+    }
+    at
+}
+
 /// The complementarity residual of the law on the final fields: the multipliers of `sol` with
 /// the displacement of the points in `u` (the last, refined solve), against the loads' `u0`.
 fn law_residual(
@@ -610,12 +663,118 @@ fn law_residual(
     sol: &ContactSolution,
     u0: &PointValues,
     u: &[f64],
+    shift: Option<&PointValues>,
 ) -> f64 {
     let law = &how.law;
     let points = &how.points_at(&boundary.points, sol);
-    let at = fields_at_points(boundary, u, sol.lambda.n_tangential());
+    let at = in_frame(fields_at_points(boundary, u, sol.lambda.n_tangential()), shift);
     let c = 1.0 / sol.info.mu_max;
     let reference = contact::multiplier_scale(points, u0, c);
     let radius = contact::slip_bound(points, law, &sol.lambda.normal);
     contact::complementarity_residual(points, &radius, &sol.lambda, &at, c, reference)
+}
+
+/// What stays from step to step of a load path on one factorisation: the condensed compliance
+/// and the solutions of `K x = b_q` for each part `q` of the right-hand side (the loads, each
+/// displacement component's lifting, the potentials' lifting), whose sum with the step's
+/// factors is the loads' solution of the step.
+pub(crate) struct PathSystem {
+    dense: DenseContactProblem,
+    /// `x_q`'s displacement part, per part, in the order of [`PathSystem::factors`].
+    parts: Vec<Vec<f64>>,
+}
+
+impl PathSystem {
+    /// The condensation of `K` on the boundary's dofs (once) and the parts' solutions (one
+    /// solve each). `parts` are the right-hand side's parts in the order loads, x, y, z
+    /// displacements (as many as the dimension), potentials.
+    pub(crate) fn new(
+        system: &mut Factored,
+        boundary: &ContactBoundary,
+        parts: &[(Vec<f64>, Vec<f64>)],
+        nt: usize,
+        reporter: &mut dyn Reporter,
+    ) -> Result<PathSystem, ProblemError> {
+        let LinearSolver::Direct(direct) = &mut system.solver else {
+            return Err(not_direct());
+        };
+        let t = Instant::now();
+        let (b_u, b_phi) = &parts[0];
+        let (dense, condensed) = boundary.condense(direct, b_u, b_phi, nt)?;
+        let condense = (condensed.route, t.elapsed().as_secs_f64());
+        reporter.event(&Event::Condensed {
+            m: dense.m(),
+            route: condense.0,
+            seconds: condense.1,
+        });
+        system.condense = Some(condense);
+        let mut solved = Vec::with_capacity(parts.len());
+        for (b_u, b_phi) in parts {
+            let (mut u, mut phi) = (vec![0.0; b_u.len()], vec![0.0; b_phi.len()]);
+            direct.solve(b_u, b_phi, &mut u, &mut phi)?;
+            solved.push(u);
+        }
+        Ok(PathSystem { dense, parts: solved })
+    }
+
+    /// One step: the loads' displacement at the points for the step's `factors` (the parts
+    /// summed), the contact problem in the frame of the step before's tangential displacement
+    /// `shift` (friction on the slip increment), warm-started from `start`; the fields under
+    /// the loads and the contact forces, refined, the law judged on them. Returns the solution
+    /// (its displacements the total ones) and the free fields.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn step(
+        &mut self,
+        how: &ContactSolve<'_>,
+        system: &mut Factored,
+        boundary: &ContactBoundary,
+        posed: &Posed<'_>,
+        factors: &[f64],
+        shift: &PointValues,
+        start: Option<PointValues>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(ContactSolution, Fields), ProblemError> {
+        let LinearSolver::Direct(direct) = &mut system.solver else {
+            return Err(not_direct());
+        };
+        let n_u = self.parts[0].len();
+        let mut x0 = vec![0.0; n_u];
+        for (part, f) in self.parts.iter().zip(factors) {
+            if *f != 0.0 {
+                for (x, p) in x0.iter_mut().zip(part) {
+                    *x += f * p;
+                }
+            }
+        }
+        let nt = self.dense.nt;
+        self.dense.u0 = in_frame(fields_at_points(boundary, &x0, nt), Some(shift));
+        let sol = how.run(Operator::Condensed(&mut self.dense), &boundary.points, start, reporter)?;
+        let (b_u, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
+        let (mut u, mut phi) = (vec![0.0; n_u], vec![0.0; b_phi.len()]);
+        direct.solve(&b_u, &b_phi, &mut u, &mut phi)?;
+        let mut on = Refining {
+            direct,
+            blocks: &system.blocks,
+            posed,
+            boundary,
+            refinement: 0,
+            shift: Some(shift),
+            refine_tol: PATH_REFINE_TOL,
+        };
+        let mut sol = on.correct(how, &mut self.dense, sol, (&mut u, &mut phi), reporter)?;
+        system.refinement = on.refinement;
+        for (v, s) in sol.u.tangential.iter_mut().zip(&shift.tangential) {
+            *v += s;
+        }
+        Ok((sol, (u, phi)))
+    }
+}
+
+/// A path on a strategy without the `L D Lᵀ` of `K` (the scene's checks refuse it first).
+fn not_direct() -> ProblemError {
+    SceneError::new(
+        "path",
+        "a path carries friction's history on the condensed compliance of the L D Lᵀ of K: use a condensed strategy",
+    )
+    .into()
 }

@@ -39,6 +39,7 @@
 //!     contact: Some(contact),
 //!     solver: Default::default(),
 //!     exact: None,
+//!     path: None,
 //! };
 //! let solution = problem::solve(&scene, None, &mut Silent).unwrap();
 //! let contact = solution.contact.as_ref().unwrap();
@@ -60,6 +61,7 @@ mod boundary;
 mod estimate;
 mod exact;
 mod faer_backend;
+mod path;
 mod plan;
 mod progress;
 pub mod report;
@@ -67,17 +69,20 @@ mod run;
 mod scene;
 mod setup;
 
+pub use analytical::{hertz, mindlin_deresiewicz_traction};
 pub use backend::Limits;
 pub use exact::ExactReport;
 pub use faer_backend::Faer;
+pub use fe_assembly::CellFields;
+pub use path::{solve_path, PathSolution, Step};
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
 pub use run::{run, solve, solve_within, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectricCondition,
-    ElectrodeSpec, ExactKind, ExactSpec, LoadSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, RegionSpec, Rule,
-    Scene, SceneError, SolverSpec, Strategy, Valid,
+    ElectrodeSpec, ExactKind, ExactSpec, Factors, LoadSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec,
+    RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy, Valid,
 };
 
 use contact::ContactError;
@@ -228,6 +233,16 @@ pub enum ProblemError {
         /// A deadline or the cancel flag.
         why: contact::Interruption,
     },
+    /// A step of a load path failed: the step, its instant, and the error.
+    #[error("path step {step} (t = {t}): {source}")]
+    AtStep {
+        /// The step (0 for the path's first instant).
+        step: usize,
+        /// Its instant.
+        t: f64,
+        /// What failed.
+        source: Box<ProblemError>,
+    },
     /// The contact solve failed (with its last residual), and what else to try.
     #[error("contact: {source}{hint}")]
     Contact {
@@ -242,6 +257,9 @@ impl ProblemError {
     /// Whether the run was stopped from outside (its deadline, or its cancel flag), between
     /// steps or within the contact solve.
     pub fn is_interrupted(&self) -> bool {
+        if let ProblemError::AtStep { source, .. } = self {
+            return source.is_interrupted();
+        }
         matches!(
             self,
             ProblemError::Interrupted { .. }
@@ -250,6 +268,15 @@ impl ProblemError {
                     ..
                 }
         )
+    }
+
+    /// This error at step `step` (instant `t`) of a load path.
+    pub fn at_step(self, step: usize, t: f64) -> ProblemError {
+        ProblemError::AtStep {
+            step,
+            t,
+            source: Box::new(self),
+        }
     }
 
     /// `Ok` when every value is finite, else [`ProblemError::NotFinite`] naming `what` and the

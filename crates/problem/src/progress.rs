@@ -69,6 +69,15 @@ pub enum Event<'a> {
         /// The equilibrium residual of the final pair.
         equilibrium: f64,
     },
+    /// A step of a load path begins.
+    PathStep {
+        /// The step (0 for the path's first instant).
+        step: usize,
+        /// The last step.
+        of: usize,
+        /// Its instant.
+        t: f64,
+    },
     /// The Krylov solves of the PETSc backend are done.
     Krylov {
         /// Iterations, summed over the solves.
@@ -152,6 +161,7 @@ impl fmt::Display for Event<'_> {
                 "mesh: {n_nodes} nodes, {n_cells} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
             ),
             Event::Factored { seconds } => write!(f, "factorisation {seconds:.3} s"),
+            Event::PathStep { step, of, t } => write!(f, "path step {step}/{of}: t = {t}"),
             Event::Condensed { m, route, seconds } => write!(
                 f,
                 "condensed the contact compliance ({m} x {m}, {route:?}) in {seconds:.3} s"

@@ -36,6 +36,56 @@ pub struct RunReport {
     /// What the PETSc backend did (absent from runs of the default backend).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub petsc: Option<PetscReport>,
+    /// A load path's figures (absent from a run of one instant).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathReport>,
+}
+
+/// A load path's figures (`run.json`'s `path`): its steps, one row each, and what was reused.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PathReport {
+    /// Instants solved (`t[0]` and the steps after it).
+    pub instants: usize,
+    /// Factorisations of `K` over the whole path (1: the matrix does not change).
+    pub factorisations: usize,
+    /// Condensations of `K` onto the contact dofs over the whole path.
+    pub condensations: usize,
+    /// Wall time of the steps after the factorisation and condensation, s.
+    pub steps_s: f64,
+    /// One row per instant.
+    pub rows: Vec<StepRow>,
+}
+
+/// One instant of a load path (a row of `path.csv`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct StepRow {
+    /// The step (0 for `t[0]`).
+    pub step: usize,
+    /// The instant.
+    pub t: f64,
+    /// The factors at `t`: load, voltage, displacement x, y, z, gap.
+    pub factors: [f64; 6],
+    /// The total normal contact force (the pressures integrated).
+    pub normal_force: f64,
+    /// The total tangential contact force, signed along the first tangent (2D), or its
+    /// magnitude's vector sum along the first tangent (3D: the first component).
+    pub tangential_force: f64,
+    /// The largest tangential displacement of a point in contact (the slip from rest).
+    pub max_slip: f64,
+    /// The largest slip of a point in contact in this step (the increment's).
+    pub max_slip_increment: f64,
+    /// Points that stick, slip, are separated.
+    pub n_stick: usize,
+    /// Points that slip.
+    pub n_slip: usize,
+    /// Points separated.
+    pub n_separated: usize,
+    /// Newton (or first-order) iterations of the step.
+    pub iterations: usize,
+    /// The complementarity residual of the step.
+    pub complementarity: f64,
+    /// The equilibrium residual of the step.
+    pub equilibrium: f64,
 }
 
 impl SceneReport {

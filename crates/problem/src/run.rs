@@ -130,9 +130,10 @@ pub fn run<B: Backend>(
     let Some(Finished { u, phi, figures }) = backend.finish(&posed, system, x)? else {
         return Ok(None);
     };
-    check_solved(&scene, (&u, &phi), contact.as_ref(), equilibrium)?;
+    let sol = contact.as_ref().map(|(_, sol)| sol);
+    check_solved(&scene, (&u, &phi), sol, equilibrium)?;
     if B::HELD_TO_TOLERANCE {
-        check_accurate(&scene, &setup.plan, contact.as_ref(), equilibrium)?;
+        check_accurate(&scene, &setup.plan, sol, equilibrium)?;
     }
     let contact_pair = contact.as_ref().map(|(b, sol)| (b, sol));
     let recovered = recover(&scene, &setup, &disc, (&u, &phi), contact_pair, equilibrium, reporter)?;
@@ -167,7 +168,7 @@ pub fn run<B: Backend>(
 /// The start of a run: the memory `estimate` (bytes, and what it counts) checked against
 /// `limits` before the memory is taken, then the [`Setup`], its plan and what the mesh's
 /// checks noted reported.
-fn begin(
+pub(crate) fn begin(
     scene: Valid<'_>,
     mesh: Option<mesh::Mesh>,
     estimate: Option<(f64, String)>,
@@ -203,7 +204,7 @@ fn check_memory(limits: &Limits, estimate: Option<(f64, String)>) -> Result<(), 
 }
 
 /// [`ProblemError::Interrupted`] after the step `after` where the run's interrupt has fired.
-fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Result<(), ProblemError> {
+pub(crate) fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Result<(), ProblemError> {
     match limits.interrupt.check() {
         Some(why) => Err(ProblemError::Interrupted { after, why }),
         None => Ok(()),
@@ -243,7 +244,7 @@ fn contact_boundary(posed: &Posed<'_>, reporter: &mut dyn Reporter) -> Result<Op
 
 /// The contact part of the solution: the boundary, the contact solve, and the displacement of
 /// the points in the free displacements `u`.
-fn contact_result(b: ContactBoundary, solution: ContactSolution, u: &[f64]) -> ContactResult {
+pub(crate) fn contact_result(b: ContactBoundary, solution: ContactSolution, u: &[f64]) -> ContactResult {
     let mut displacement = PointValues::zeros(b.points.len(), b.points.n_tangential());
     b.extract(u, &mut displacement);
     ContactResult {
@@ -256,15 +257,15 @@ fn contact_result(b: ContactBoundary, solution: ContactSolution, u: &[f64]) -> C
 
 /// Checks the solution, the multipliers and the equilibrium residual for numbers that
 /// overflowed.
-fn check_solved(
+pub(crate) fn check_solved(
     scene: &Scene,
     (u, phi): (&[f64], &[f64]),
-    contact: Option<&(ContactBoundary, ContactSolution)>,
+    contact: Option<&ContactSolution>,
     equilibrium: f64,
 ) -> Result<(), ProblemError> {
     ProblemError::check_finite(u, "the displacement", scene)?;
     ProblemError::check_finite(phi, "the potential", scene)?;
-    if let Some((_, sol)) = contact {
+    if let Some(sol) = contact {
         ProblemError::check_finite(&sol.lambda.normal, "the contact pressure", scene)?;
         ProblemError::check_finite(&sol.lambda.tangential, "the tangential multiplier", scene)?;
     }
@@ -274,10 +275,10 @@ fn check_solved(
 /// Under the tight rule, every reported residual meets its tolerance, or the run fails naming
 /// what makes the system ill-conditioned: the equilibrium residual ([`EQUILIBRIUM_TOL`]) and
 /// the complementarity residual of the final fields (`solver.tol`).
-fn check_accurate(
+pub(crate) fn check_accurate(
     scene: &Scene,
     plan: &Plan,
-    contact: Option<&(ContactBoundary, ContactSolution)>,
+    contact: Option<&ContactSolution>,
     equilibrium: f64,
 ) -> Result<(), ProblemError> {
     if plan.rule != Rule::Tight {
@@ -292,7 +293,7 @@ fn check_accurate(
             scene,
         ));
     }
-    if let Some((_, sol)) = contact {
+    if let Some(sol) = contact {
         let c = sol.info.complementarity;
         if !(c <= plan.tol) {
             return Err(ProblemError::inaccurate(
@@ -326,24 +327,24 @@ fn equilibrium_tol(plan: &Plan) -> f64 {
 
 /// The nodal solution, the per-cell fields, the contact counts and forces, and the error
 /// against the exact solution: what a run reports, whichever backend solved it.
-struct Recovered {
+pub(crate) struct Recovered {
     /// Nodal displacements.
-    u: Vec<[f64; 3]>,
+    pub(crate) u: Vec<[f64; 3]>,
     /// Nodal potentials.
-    phi: Vec<f64>,
+    pub(crate) phi: Vec<f64>,
     /// Per-cell stress, strain, electric displacement and field.
-    fields: CellFields,
+    pub(crate) fields: CellFields,
     /// The contact boundary's counts and resultant forces (zeros without contact).
-    contact: ContactReport,
+    pub(crate) contact: ContactReport,
     /// The error against the scene's exact solution, where it has one.
-    exact: Option<crate::exact::ExactReport>,
+    pub(crate) exact: Option<crate::exact::ExactReport>,
 }
 
 /// Expands the free unknowns `(u, φ)` to the nodes, recovers stress and electric
 /// displacement per cell, counts the contact solution (on its boundary), measures the error
 /// against the scene's exact solution, and checks that every reported number (with the
 /// run's `equilibrium` residual) is finite.
-fn recover(
+pub(crate) fn recover(
     scene: &Scene,
     setup: &Setup,
     disc: &Discretization<'_>,
@@ -390,16 +391,16 @@ fn recover(
 }
 
 /// What the run measured beside the recovered fields, for its report.
-struct Measured<'a> {
-    info: Option<&'a contact::ContactInfo>,
-    pcg_iters: usize,
-    equilibrium: f64,
-    timings_s: Timings,
-    figures: Figures,
+pub(crate) struct Measured<'a> {
+    pub(crate) info: Option<&'a contact::ContactInfo>,
+    pub(crate) pcg_iters: usize,
+    pub(crate) equilibrium: f64,
+    pub(crate) timings_s: Timings,
+    pub(crate) figures: Figures,
 }
 
 /// The typed report of the run, whichever backend solved it.
-fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunReport {
+pub(crate) fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunReport {
     let (scene, plan) = (posed.scene.scene(), posed.plan());
     let (info, equilibrium, figures) = (m.info, m.equilibrium, m.figures);
     RunReport {
@@ -427,6 +428,7 @@ fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunReport {
             peak_bytes: 0,
             factor_bytes: figures.factor_bytes,
         },
+        path: None,
         solver: SolverReport {
             strategy: plan.linear_strategy,
             rule: rule_in_words(plan.rule).into(),
@@ -479,6 +481,7 @@ mod tests {
             contact: Some(contact),
             solver: Default::default(),
             exact: None,
+            path: None,
         }
     }
 

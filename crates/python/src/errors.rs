@@ -130,6 +130,7 @@ impl Kind {
 /// The kind of a run's error.
 pub fn kind_of_problem(e: &ProblemError) -> Kind {
     match e {
+        ProblemError::AtStep { source, .. } => kind_of_problem(source),
         // a group the scene names and the mesh lacks is the mesh's error, wherever it is found
         ProblemError::Mesh(_) | ProblemError::Assembly(fe_assembly::AssemblyError::Mesh(_)) => Kind::Mesh,
         ProblemError::Scene(_) | ProblemError::Assembly(_) | ProblemError::Material(_) => Kind::Input,

@@ -40,7 +40,15 @@ pub fn files(solution: &Solution) -> Result<Outputs, Error> {
     for &output in &solution.report.plan.outputs {
         match output {
             Output::RunJson => out.add("run.json", run_json(&solution.report)?),
-            Output::SolutionVtu => out.add("solution.vtu", vtu(solution)?),
+            Output::SolutionVtu => out.add(
+                "solution.vtu",
+                vtu(
+                    &solution.mesh,
+                    (&solution.u, &solution.phi),
+                    &solution.fields,
+                    solution.contact.as_ref(),
+                )?,
+            ),
             Output::ContactCsv => {
                 let c = solution.contact.as_ref().ok_or_else(|| missing("contact.csv"))?;
                 out.add("contact.csv", contact_csv(c));
@@ -73,8 +81,12 @@ pub fn write(solution: &Solution, dir: &Path) -> Result<(), Error> {
 /// The solution as a VTK XML unstructured grid: point data `u` (3 components), `phi`; cell
 /// data `stress` (Voigt), `strain`, `electric_displacement`, `electric_field`; and, with
 /// contact, point data `contact_status` (0 none, 1 stick, 2 slip, 3 separated).
-fn vtu(solution: &Solution) -> Result<Vec<u8>, Error> {
-    let (mesh, fields) = (&solution.mesh, &solution.fields);
+fn vtu(
+    mesh: &mesh::Mesh,
+    (u, phi): (&[[f64; 3]], &[f64]),
+    fields: &problem::CellFields,
+    contact: Option<&ContactResult>,
+) -> Result<Vec<u8>, Error> {
     let points: Vec<f64> = mesh.points.iter().flatten().copied().collect();
     let k = mesh.kind.n_nodes();
     let connectivity: Vec<u64> = mesh.cells.iter().map(|&v| v as u64).collect();
@@ -87,10 +99,10 @@ fn vtu(solution: &Solution) -> Result<Vec<u8>, Error> {
     let dim = mesh.dim;
     let nv = if dim == 2 { 3 } else { 6 };
     let mut point = vec![
-        Attribute::generic("u", 3).with_data(solution.u.iter().flatten().copied().collect::<Vec<f64>>()),
-        Attribute::scalars("phi", 1).with_data(solution.phi.clone()),
+        Attribute::generic("u", 3).with_data(u.iter().flatten().copied().collect::<Vec<f64>>()),
+        Attribute::scalars("phi", 1).with_data(phi.to_vec()),
     ];
-    if let Some(c) = &solution.contact {
+    if let Some(c) = contact {
         let mut status = vec![0.0; mesh.n_nodes()];
         for (i, &node) in c.nodes.iter().enumerate() {
             status[node] = match c.solution.status[i] {
@@ -247,6 +259,124 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
         });
     }
     plots::panels("multipliers", &panels)
+}
+
+/// The files of a load path, gathered step by step ([`PathFiles::step`]) and finished with
+/// the last instant's solution ([`PathFiles::finish`]): the plan's files of the last instant,
+/// and `path.csv` (one row per instant), `path.pvd` with `step-NNNN.vtu` (a ParaView time
+/// series, where the plan has `solution.vtu`), `path.svg`/`.png` (the contact forces against
+/// time, and the tangential force against the prescribed x displacement: friction's loop).
+pub struct PathFiles {
+    out: Outputs,
+    series: Vec<(f64, String)>,
+    vtu: bool,
+}
+
+impl PathFiles {
+    /// For a run whose plan lists `outputs`.
+    pub fn new(outputs: &[Output]) -> Self {
+        PathFiles {
+            out: Outputs::new(Path::new("")),
+            series: vec![],
+            vtu: outputs.contains(&Output::SolutionVtu),
+        }
+    }
+
+    /// Adds one instant's files.
+    ///
+    /// # Errors
+    /// [`Error::Picture`] where its VTU cannot be made.
+    pub fn step(&mut self, step: &problem::Step<'_>) -> Result<(), Error> {
+        if self.vtu {
+            let name = format!("step-{:04}.vtu", step.row.step);
+            self.out
+                .add(&name, vtu(step.mesh, (step.u, step.phi), step.fields, step.contact)?);
+            self.series.push((step.row.t, name));
+        }
+        Ok(())
+    }
+
+    /// The set: the last instant's files and the path's own.
+    ///
+    /// # Errors
+    /// As [`files`].
+    pub fn finish(self, last: &Solution) -> Result<Outputs, Error> {
+        let mut out = files(last)?;
+        out.extend(self.out.into_files());
+        if let Some(path) = &last.report.path {
+            out.add("path.csv", path_csv(&path.rows));
+            if !self.series.is_empty() {
+                out.add("path.pvd", pvd(&self.series));
+            }
+            out.extend(path_picture(&path.rows)?);
+        }
+        Ok(out)
+    }
+}
+
+/// `path.csv`: one row per instant.
+fn path_csv(rows: &[problem::report::StepRow]) -> Vec<u8> {
+    let mut s = String::from(
+        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium\n",
+    );
+    for r in rows {
+        let mut row = vec![r.step.to_string(), format!("{:e}", r.t)];
+        row.extend(r.factors.iter().map(|f| format!("{f:e}")));
+        row.extend(
+            [r.normal_force, r.tangential_force, r.max_slip, r.max_slip_increment]
+                .iter()
+                .map(|v| format!("{v:e}")),
+        );
+        row.extend(
+            [r.n_stick, r.n_slip, r.n_separated, r.iterations]
+                .iter()
+                .map(|v| v.to_string()),
+        );
+        row.push(format!("{:e}", r.complementarity));
+        row.push(format!("{:e}", r.equilibrium));
+        s.push_str(&row.join(","));
+        s.push('\n');
+    }
+    s.into_bytes()
+}
+
+/// `path.pvd`: ParaView's collection of the steps' files, each at its instant.
+fn pvd(series: &[(f64, String)]) -> Vec<u8> {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+    );
+    for (t, name) in series {
+        s.push_str(&format!(
+            "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
+        ));
+    }
+    s.push_str("  </Collection>\n</VTKFile>\n");
+    s.into_bytes()
+}
+
+/// The path's global curves: the contact forces against time, and the tangential force
+/// against the prescribed x displacement's factor (friction's loop).
+fn path_picture(rows: &[problem::report::StepRow]) -> Result<plots::Files, Error> {
+    let over = |f: &dyn Fn(&problem::report::StepRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
+    let panels = [
+        Panel {
+            title: "Contact forces along the path".into(),
+            labels: ("t".into(), "force".into()),
+            series: vec![
+                Series::line("normal force", over(&|r| (r.t, r.normal_force))),
+                Series::line("tangential force", over(&|r| (r.t, r.tangential_force))),
+            ],
+        },
+        Panel {
+            title: "Tangential force against the prescribed x displacement (factor)".into(),
+            labels: ("ux factor".into(), "tangential force".into()),
+            series: vec![Series::line(
+                "tangential force",
+                over(&|r| (r.factors[2], r.tangential_force)),
+            )],
+        },
+    ];
+    plots::panels("path", &panels)
 }
 
 /// Where a run writes by default: `out/<scene>/`, the scene's name made a safe single path

@@ -299,6 +299,134 @@ pub struct Scene {
     /// A known solution, for verification: the run reports its error against it.
     #[serde(default)]
     pub exact: Option<ExactSpec>,
+    /// A load path: the quasi-static process over instants, friction on the slip increment.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathSpec>,
+}
+
+/// A quasi-static load path (`[path]`): instants `t` and, per quantity, its factor at each
+/// instant (piecewise linear between them; a quantity without a table keeps factor 1). The
+/// run solves at `t[0]` from rest and then at `steps` instants evenly spaced up to the last
+/// `t`, each step with the friction law on the slip since the step before (backward Euler of
+/// the quasi-static law).
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PathSpec {
+    /// The instants, strictly increasing (at least two).
+    pub t: Vec<f64>,
+    /// Steps after `t[0]` (default: one per later instant of `t`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<usize>,
+    /// The factor on the load (`load.p`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<Vec<f64>>,
+    /// The factor on every prescribed potential (`electrode.v`, `dirichlet.phi`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub voltage: Option<Vec<f64>>,
+    /// The factor on every prescribed displacement component (where `ux`, `uy`, `uz` give
+    /// none of their own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement: Option<Vec<f64>>,
+    /// The factor on the prescribed x components.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ux: Option<Vec<f64>>,
+    /// The factor on the prescribed y components.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uy: Option<Vec<f64>>,
+    /// The factor on the prescribed z components.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uz: Option<Vec<f64>>,
+    /// The factor on the uniform gap (`contact.gap`; the curvature's part stays).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gap: Option<Vec<f64>>,
+}
+
+/// The factors of one instant of a path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Factors {
+    /// On the load.
+    pub load: f64,
+    /// On the prescribed potentials.
+    pub voltage: f64,
+    /// On the prescribed displacement components x, y, z.
+    pub displacement: [f64; 3],
+    /// On the uniform gap.
+    pub gap: f64,
+}
+
+impl Factors {
+    /// Every factor 1: the scene as written.
+    pub const ONE: Factors = Factors {
+        load: 1.0,
+        voltage: 1.0,
+        displacement: [1.0; 3],
+        gap: 1.0,
+    };
+}
+
+impl PathSpec {
+    /// The number of steps after `t[0]`.
+    pub fn n_steps(&self) -> usize {
+        self.steps.unwrap_or(self.t.len().saturating_sub(1))
+    }
+
+    /// The instants solved: `t[0]`, then `n_steps` evenly spaced up to the last `t`.
+    pub fn instants(&self) -> Vec<f64> {
+        let (t0, t1) = (self.t[0], self.t[self.t.len() - 1]);
+        let n = self.n_steps();
+        if self.steps.is_none() {
+            return self.t.clone();
+        }
+        (0..=n)
+            .map(|k| {
+                if k == n {
+                    t1
+                } else {
+                    t0 + (t1 - t0) * k as f64 / n as f64
+                }
+            })
+            .collect()
+    }
+
+    /// The factors at instant `t` (piecewise linear in the tables, constant beyond their ends).
+    pub fn factors(&self, t: f64) -> Factors {
+        let at =
+            |table: &Option<Vec<f64>>, default: f64| table.as_ref().map_or(default, |f| interpolate(&self.t, f, t));
+        let d = at(&self.displacement, 1.0);
+        Factors {
+            load: at(&self.load, 1.0),
+            voltage: at(&self.voltage, 1.0),
+            displacement: [at(&self.ux, d), at(&self.uy, d), at(&self.uz, d)],
+            gap: at(&self.gap, 1.0),
+        }
+    }
+
+    /// The factor tables with their keys.
+    pub(crate) fn tables(&self) -> [(&'static str, &Option<Vec<f64>>); 7] {
+        [
+            ("path.load", &self.load),
+            ("path.voltage", &self.voltage),
+            ("path.displacement", &self.displacement),
+            ("path.ux", &self.ux),
+            ("path.uy", &self.uy),
+            ("path.uz", &self.uz),
+            ("path.gap", &self.gap),
+        ]
+    }
+}
+
+/// The piecewise-linear interpolant of `(t, f)` at `x`, constant beyond the ends.
+fn interpolate(t: &[f64], f: &[f64], x: f64) -> f64 {
+    if x <= t[0] {
+        return f[0];
+    }
+    for k in 1..t.len() {
+        if x <= t[k] {
+            let s = (x - t[k - 1]) / (t[k] - t[k - 1]);
+            return f[k - 1] + s * (f[k] - f[k - 1]);
+        }
+    }
+    f[f.len() - 1]
 }
 
 impl Scene {

@@ -5,8 +5,8 @@
 //! mesh is read ([`Scene::check_dimension`]).
 
 use super::{
-    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec,
-    Rule, Scene, SolverSpec, Strategy,
+    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, FrictionLaw, MaterialModel, MaterialSpec, MeshKind,
+    MeshSpec, PathSpec, Rule, Scene, SolverSpec, Strategy,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -176,6 +176,9 @@ impl Scene {
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
         }
+        if let Some(p) = &self.path {
+            validate_path(p, self)?;
+        }
         if let Some(dim) = self.mesh.dim() {
             self.check_dimension(dim)?;
         }
@@ -237,6 +240,80 @@ impl Scene {
             None => Ok(()),
         }
     }
+}
+
+/// Most steps a path may take.
+const MAX_PATH_STEPS: usize = 1_000_000;
+
+/// A path: at least two strictly increasing finite instants, each table as long as `t` and
+/// finite, `steps` in range; refused where the run cannot carry friction's history (a solver
+/// without the condensed compliance, slip weakening, electrical contact, an exact solution).
+fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
+    all_finite("path.t", &p.t)?;
+    if p.t.len() < 2 || p.t.windows(2).any(|w| !(w[0] < w[1])) {
+        return Err(SceneError::new(
+            "path.t",
+            format!(
+                "path.t needs at least two instants, strictly increasing (got {:?})",
+                p.t
+            ),
+        ));
+    }
+    for (key, table) in p.tables() {
+        let Some(f) = table else { continue };
+        all_finite(key, f)?;
+        if f.len() != p.t.len() {
+            return Err(SceneError::new(
+                key,
+                format!("{key} has {} factors for the {} instants of path.t", f.len(), p.t.len()),
+            ));
+        }
+    }
+    if let Some(n) = p.steps {
+        if n == 0 || n > MAX_PATH_STEPS {
+            return Err(SceneError::new(
+                "path.steps",
+                format!("path.steps = {n}: give between 1 and {MAX_PATH_STEPS} steps"),
+            ));
+        }
+    }
+    let applies = |given: bool, key: &str, what: &str| {
+        refuse_if(
+            given && p.tables().iter().any(|(k, t)| *k == key && t.is_some()),
+            key,
+            what,
+        )
+    };
+    applies(scene.load.is_none(), "path.load", "the scene has no [load]")?;
+    applies(scene.active_contact().is_none(), "path.gap", "the scene has no contact")?;
+    refuse_if(
+        scene.exact.is_some(),
+        "path",
+        "an exact solution is checked at one instant; a path solves many (remove [exact] or [path])",
+    )?;
+    if let Some(c) = scene.active_contact() {
+        refuse_if(
+            c.friction_law.is_some_and(|l| l != FrictionLaw::Coulomb),
+            "path",
+            "slip-weakening friction along a path (its coefficient on the accumulated slip) is not built yet: solve its instants one by one",
+        )?;
+        refuse_if(
+            c.electric_law().is_some(),
+            "path",
+            "electrical contact along a path is not built yet: solve its instants one by one",
+        )?;
+        refuse_if(
+            !scene.solver.strategy.is_condensed(),
+            "path",
+            "a path carries friction's history on the condensed compliance: use solver.strategy = \"newton-condensed\", \"apg-condensed\" or \"uzawa-condensed\"",
+        )?;
+    }
+    refuse_if(
+        scene.solver.backend != BackendChoice::Faer,
+        "path",
+        "the PETSc backend solves one instant; a path reuses one factorisation, which the faer backend has (solver.backend = \"faer\")",
+    )?;
+    Ok(())
 }
 
 fn on_group(e: SceneError, group: &str) -> SceneError {

@@ -1,0 +1,393 @@
+//! The quasi-static process along a load path (`[path]`): the scene's loads, prescribed
+//! displacements, potentials and gap scaled by their factors at each instant, the contact
+//! problem solved at each with the friction law on the slip since the instant before
+//! (backward Euler of the quasi-static law: friction remembers), on one factorisation of `K`
+//! and one condensation onto the contact dofs (the matrix does not change along the path).
+//!
+//! Each step's right-hand side is the sum of the parts of [`Discretization::rhs_parts`]
+//! scaled by the step's factors, and so is the loads' displacement at the points: the parts
+//! are solved once, a step costs the contact solve (warm-started from the step before) and
+//! the solve for its fields.
+
+use crate::backend::{ContactSolve, Limits, Loads, Posed};
+use crate::boundary::ContactBoundary;
+use crate::faer_backend::{Faer, PathSystem};
+use crate::progress::{Event, Reporter};
+use crate::report::{PathReport, RunReport, StepRow, Timings};
+use crate::run::{
+    begin, check_accurate, check_solved, contact_result, recover, report, stop_if_interrupted, ContactResult, Measured,
+};
+use crate::scene::{Factors, PathSpec, Scene, SceneError};
+use crate::ProblemError;
+use crate::{backend::Backend, Solution};
+use contact::PointValues;
+use fe_assembly::{CellFields, Discretization, RhsParts};
+use std::time::Instant;
+
+/// One instant of a path, as its step hands it to the caller (to write its files): the
+/// step's row, its nodal fields, per-cell fields and contact solution, on the path's mesh.
+pub struct Step<'a> {
+    /// The step's row (`path.csv`).
+    pub row: &'a StepRow,
+    /// The mesh.
+    pub mesh: &'a mesh::Mesh,
+    /// Nodal displacements.
+    pub u: &'a [[f64; 3]],
+    /// Nodal potentials.
+    pub phi: &'a [f64],
+    /// Per-cell fields.
+    pub fields: &'a CellFields,
+    /// The contact solution of the step.
+    pub contact: Option<&'a ContactResult>,
+}
+
+/// What a path produced: the last instant's solution (its report with the path's section)
+/// and every step's row.
+pub struct PathSolution {
+    /// The solution at the last instant; `report.path` holds the rows.
+    pub last: Solution,
+}
+
+/// Solves `scene`'s path on the default backend: the instants of `scene.path` one after the
+/// other, friction on the slip increment; `each` is called once per instant, in order (to
+/// write its files: nothing of a step is kept after it but its row). A scene without a path
+/// is solved as the one instant it describes, which [`crate::solve`] gives.
+///
+/// # Errors
+/// The errors of [`crate::solve`], naming the step where one happened; `path` refused by the
+/// scene's checks where the run cannot carry friction's history; the error `each` returns.
+pub fn solve_path(
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+    each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+) -> Result<PathSolution, ProblemError> {
+    let spec = scene.path.clone().unwrap_or_else(|| PathSpec {
+        t: vec![0.0, 1.0],
+        steps: Some(1),
+        ..Default::default()
+    });
+    let instants = if scene.path.is_some() {
+        spec.instants()
+    } else {
+        vec![1.0]
+    };
+    let valid = scene.validate()?;
+    Faer.refuse(&valid)?;
+    let Some(spec_contact) = scene.active_contact().cloned() else {
+        return Err(SceneError::new("path", "a path carries friction's history: the scene has no contact").into());
+    };
+    let t_total = Instant::now();
+    let setup = begin(valid, mesh, Faer.estimate(&valid), &limits, reporter)?;
+    let t_setup = t_total.elapsed().as_secs_f64();
+    stop_if_interrupted(&limits, "set-up")?;
+    let t = Instant::now();
+    let mut disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
+    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
+    let parts = disc.rhs_parts(&setup.loads)?;
+    let walk = Walk {
+        scene,
+        valid,
+        setup: &setup,
+        spec: &spec,
+        contact: &spec_contact,
+        parts: &parts,
+        base_dofs: disc.dofs.clone(),
+    };
+    let posed = Posed {
+        scene: valid,
+        setup: &setup,
+        disc: &disc,
+        loads: step_loads(&parts, &spec.factors(instants[0]), scene)?,
+    };
+    let assembled = Faer.assemble(&posed)?;
+    let t_assembly = t.elapsed().as_secs_f64();
+    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
+    let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, &spec_contact)?;
+    boundary.report_held(&spec_contact.group, reporter);
+    let mut system = Faer.prepare(&posed, assembled, Some(&boundary), limits, reporter)?;
+    drop(posed);
+    stop_if_interrupted(&limits, "factorisation")?;
+    let how = ContactSolve::new(&setup.plan, scene, boundary.points.len(), limits.interrupt);
+    let ordered: Vec<(Vec<f64>, Vec<f64>)> = std::iter::once(parts.loads.clone())
+        .chain(parts.displacements.iter().cloned())
+        .chain(std::iter::once(parts.potentials.clone()))
+        .collect();
+    let mut path = PathSystem::new(&mut system, &boundary, &ordered, setup.plan.n_tangential(), reporter)?;
+    let t_steps = Instant::now();
+    let mut state = History::new(boundary.points.len(), setup.plan.n_tangential(), instants.len());
+    for (k, &t) in instants.iter().enumerate() {
+        reporter.event(&Event::PathStep {
+            step: k,
+            of: instants.len() - 1,
+            t,
+        });
+        let at = |e: ProblemError| e.at_step(k, t);
+        let done = walk
+            .step((k, t), &mut disc, (&mut system, &mut path), &how, &mut state, reporter)
+            .map_err(at)?;
+        each(Step {
+            row: &done.row,
+            mesh: &setup.mesh,
+            u: &done.recovered.u,
+            phi: &done.recovered.phi,
+            fields: &done.recovered.fields,
+            contact: Some(&done.result),
+        })?;
+        state.rows.push(done.row.clone());
+        if k + 1 == instants.len() {
+            state.last = Some(done);
+        }
+    }
+    let steps_s = t_steps.elapsed().as_secs_f64();
+    let timings = (t_setup, t_assembly, steps_s, t_total);
+    let (report, done) = walk.finish(&disc, &system, state, timings);
+    drop(disc);
+    let recovered = done.recovered;
+    Ok(PathSolution {
+        last: Solution {
+            report,
+            contact: Some(done.result),
+            mesh: setup.mesh,
+            u: recovered.u,
+            phi: recovered.phi,
+            fields: recovered.fields,
+        },
+    })
+}
+
+/// What stays the same along a path: the scene, its set-up, the parts of the right-hand side.
+struct Walk<'a> {
+    scene: &'a Scene,
+    valid: crate::Valid<'a>,
+    setup: &'a crate::setup::Setup,
+    spec: &'a PathSpec,
+    contact: &'a crate::ContactSpec,
+    parts: &'a RhsParts,
+    /// The dof map with the scene's prescribed values (scaled at each step).
+    base_dofs: fe_assembly::DofMap,
+}
+
+/// What a path carries from step to step: the tangential displacement of the points at the
+/// step before (friction's frame), the multipliers (the warm start), the rows so far, and the
+/// last instant.
+struct History {
+    shift: PointValues,
+    start: Option<PointValues>,
+    rows: Vec<StepRow>,
+    last: Option<Done>,
+}
+
+impl History {
+    fn new(n: usize, nt: usize, instants: usize) -> Self {
+        History {
+            shift: PointValues::zeros(n, nt),
+            start: None,
+            rows: Vec::with_capacity(instants),
+            last: None,
+        }
+    }
+}
+
+/// One instant solved.
+struct Done {
+    row: StepRow,
+    recovered: crate::run::Recovered,
+    result: ContactResult,
+    equilibrium: f64,
+    loads: Loads,
+}
+
+impl Walk<'_> {
+    /// The instant `(k, t)`: its prescribed values, gap and loads scaled, the contact problem
+    /// in the frame of the step before, the fields recovered and checked.
+    fn step(
+        &self,
+        (k, t): (usize, f64),
+        disc: &mut Discretization<'_>,
+        (system, path): (&mut crate::faer_backend::Factored, &mut PathSystem),
+        how: &ContactSolve<'_>,
+        state: &mut History,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Done, ProblemError> {
+        let (scene, setup) = (self.scene, self.setup);
+        let f = self.spec.factors(t);
+        disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
+        let mut spec_k = self.contact.clone();
+        spec_k.gap *= f.gap;
+        let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, &spec_k)?;
+        let posed = Posed {
+            scene: self.valid,
+            setup,
+            disc,
+            loads: step_loads(self.parts, &f, scene)?,
+        };
+        let mut factors = vec![f.load];
+        factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
+        factors.push(f.voltage);
+        let (sol, (u, phi)) = path.step(
+            how,
+            system,
+            &boundary,
+            &posed,
+            &factors,
+            &state.shift,
+            state.start.take(),
+            reporter,
+        )?;
+        let (b_full, b_phi, scale) = crate::faer_backend::rhs_with_contact(&posed, Some((&boundary, &sol)));
+        let equilibrium = system.equilibrium_of(&u, &phi, &b_full, &b_phi, scale);
+        check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
+        check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
+        let recovered = recover(
+            scene,
+            setup,
+            disc,
+            (&u, &phi),
+            Some((&boundary, &sol)),
+            equilibrium,
+            reporter,
+        )?;
+        // the next step's frame: the tangential displacement of the points now
+        let mut now = PointValues::zeros(boundary.points.len(), boundary.points.n_tangential());
+        boundary.extract(&u, &mut now);
+        let row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift, equilibrium);
+        if setup.plan.n_tangential() > 0 {
+            state.shift.tangential.clone_from(&now.tangential);
+        }
+        state.start = Some(sol.lambda.clone());
+        Ok(Done {
+            row,
+            recovered,
+            result: contact_result(boundary, sol, &u),
+            equilibrium,
+            loads: posed.loads,
+        })
+    }
+
+    /// The report of the last instant with the path's section, and the last instant.
+    fn finish(
+        self,
+        disc: &Discretization<'_>,
+        system: &crate::faer_backend::Factored,
+        state: History,
+        (t_setup, t_assembly, steps_s, t_total): (f64, f64, f64, Instant),
+    ) -> (RunReport, Done) {
+        let mut done = state.last.expect("a path has at least one instant");
+        let figures = system.figures();
+        let timings_s = Timings {
+            setup: t_setup,
+            assembly: t_assembly,
+            factorization: figures.factor_seconds,
+            condense: figures.condense.map_or(0.0, |c| c.1),
+            contact: steps_s,
+            solve: steps_s,
+            total: t_total.elapsed().as_secs_f64(),
+        };
+        let posed = Posed {
+            scene: self.valid,
+            setup: self.setup,
+            disc,
+            loads: std::mem::take(&mut done.loads),
+        };
+        let measured = Measured {
+            info: Some(&done.result.solution.info),
+            pcg_iters: 0,
+            equilibrium: done.equilibrium,
+            timings_s,
+            figures,
+        };
+        let mut report: RunReport = report(&posed, measured, &done.recovered);
+        report.path = Some(PathReport {
+            instants: state.rows.len(),
+            factorisations: 1,
+            condensations: 1,
+            steps_s,
+            rows: state.rows,
+        });
+        (report, done)
+    }
+}
+
+/// One part of the right-hand side: its mechanical and electric entries.
+type Part = (Vec<f64>, Vec<f64>);
+
+/// The step's loads: the parts of the right-hand side scaled by its factors, checked finite.
+fn step_loads(parts: &RhsParts, f: &Factors, scene: &Scene) -> Result<Loads, ProblemError> {
+    let combine = |pick: fn(&Part) -> &Vec<f64>| {
+        let mut out: Vec<f64> = pick(&parts.loads).iter().map(|v| f.load * v).collect();
+        for (d, fk) in parts.displacements.iter().zip(f.displacement) {
+            for (o, v) in out.iter_mut().zip(pick(d)) {
+                *o += fk * v;
+            }
+        }
+        for (o, v) in out.iter_mut().zip(pick(&parts.potentials)) {
+            *o += f.voltage * v;
+        }
+        out
+    };
+    let b_u = combine(|p| &p.0);
+    let b_phi = combine(|p| &p.1);
+    ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
+    ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
+    Ok(Loads { b_u, b_phi })
+}
+
+/// The row of a step: its forces (the multipliers weighted), slips and counts.
+#[allow(clippy::too_many_arguments)]
+fn step_row(
+    step: usize,
+    t: f64,
+    f: &Factors,
+    boundary: &ContactBoundary,
+    sol: &contact::ContactSolution,
+    now: &PointValues,
+    before: &PointValues,
+    equilibrium: f64,
+) -> StepRow {
+    let points = &boundary.points;
+    let counts = crate::report::ContactReport::of(points, sol);
+    let nt = sol.lambda.n_tangential();
+    let tangential_force = if nt > 0 {
+        (0..points.len())
+            .map(|i| points.weight[i] * sol.lambda.tangential_of(i)[0])
+            .sum()
+    } else {
+        0.0
+    };
+    let mut max_slip = 0.0f64;
+    let mut max_inc = 0.0f64;
+    // the slips of the points in contact (a separated point moves freely)
+    for i in (0..points.len()).filter(|&i| sol.status[i] != contact::Status::Separated) {
+        let u = now.tangential_of(i);
+        max_slip = max_slip.max(u.iter().map(|v| v * v).sum::<f64>().sqrt());
+        if nt > 0 {
+            let b = before.tangential_of(i);
+            let d: f64 = u.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+            max_inc = max_inc.max(d);
+        }
+    }
+    StepRow {
+        step,
+        t,
+        factors: [
+            f.load,
+            f.voltage,
+            f.displacement[0],
+            f.displacement[1],
+            f.displacement[2],
+            f.gap,
+        ],
+        normal_force: counts.normal_force,
+        tangential_force,
+        max_slip,
+        max_slip_increment: max_inc,
+        n_stick: counts.n_stick,
+        n_slip: counts.n_slip,
+        n_separated: counts.n_separated,
+        iterations: sol.info.newton_iters + sol.info.uzawa_iters,
+        complementarity: sol.info.complementarity,
+        equilibrium,
+    }
+}
