@@ -496,3 +496,20 @@ fn a_body_left_free_is_refused_by_what_is_free() {
         "solved, motion free, potential floating: {seen:?}"
     );
 }
+
+/// Semismooth Newton's steps on the problem itself do not grow with the mesh (its nested
+/// start: the problem on every other contact point first, `contact`'s `coarse` module). From
+/// zero multipliers they did: 4, 6, 7 on `paper-slip` at n = 32, 64, 128; 6, 7, 8 on
+/// `paper-compliance`; 5, 7, 8 on `paper-conducting`; 8, 10, 11 on `paper-conductive`.
+#[test]
+fn newton_steps_do_not_grow_with_the_mesh() {
+    for scene in ["paper-slip", "paper-compliance", "paper-conducting", "paper-conductive"] {
+        let steps: Vec<usize> = [32, 64, 128]
+            .iter()
+            .map(|n| run(scene, &[&format!("mesh.n={n}")]).report.iterations.newton)
+            .collect();
+        eprintln!("{scene}: Newton steps {steps:?} at n = 32, 64, 128");
+        assert!(steps.iter().all(|&s| s <= steps[0] + 1), "{scene}: {steps:?}");
+        assert!(steps.iter().all(|&s| s <= 7), "{scene}: {steps:?}");
+    }
+}

@@ -39,6 +39,7 @@
 //! assert_eq!(sol.status[0], Status::Slip); // frictionless contact: slip
 //! ```
 
+mod coarse;
 mod electric;
 mod gauss_seidel;
 mod local;

@@ -29,6 +29,9 @@ pub struct ContactInfo {
     pub uzawa_iters: usize,
     /// Semismooth Newton steps ([`crate::solve_newton`]).
     pub newton_iters: usize,
+    /// Newton steps on the coarser problems of Newton's nested start (each on a fraction of
+    /// the points: [`crate::solve_newton`]), not counted in `newton_iters`.
+    pub coarse_newton_iters: usize,
     /// Outer steps of Newton's proximal stage (each a regularised problem solved by Newton).
     pub proximal_iters: usize,
     /// Step halvings in Newton's line search, summed.
@@ -74,6 +77,7 @@ impl ContactInfo {
         ContactInfo {
             uzawa_iters: 0,
             newton_iters: 0,
+            coarse_newton_iters: 0,
             proximal_iters: 0,
             line_search_cuts: 0,
             fallback: false,

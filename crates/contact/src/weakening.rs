@@ -5,12 +5,13 @@
 //! (semismooth Newton, warm-started from the last step), from the stick start (the static
 //! coefficient everywhere). The map's contraction is measured and reported.
 
+use crate::newton::{solve_newton_sharing, Shared};
 use crate::operator::AffineProblem;
 use crate::points::ContactPoints;
 use crate::solution::{classify, counts, slip_bound, Best, Iterate};
 use crate::{
-    solve_gauss_seidel, solve_newton, ContactError, ContactSolution, GaussSeidelParams, InputError, Law, NewtonParams,
-    Progress, Stage,
+    solve_gauss_seidel, ContactError, ContactSolution, GaussSeidelParams, InputError, Law, NewtonParams, Progress,
+    Stage,
 };
 
 /// Changes below this many times the tolerance are taken as round-off in the contraction's
@@ -252,9 +253,10 @@ fn frozen_step<P: AffineProblem>(
     newton: &NewtonParams,
     start: Option<crate::PointValues>,
     progress: &mut dyn FnMut(&Progress),
+    shared: &mut Shared,
 ) -> Result<ContactSolution, ContactError> {
     match inner {
-        Inner::Newton => solve_newton(problem, frozen, &Law::Coulomb, newton, start, progress),
+        Inner::Newton => solve_newton_sharing(problem, frozen, &Law::Coulomb, newton, start, progress, shared),
         Inner::GaussSeidel => {
             let gs = GaussSeidelParams {
                 tol: newton.tol,
@@ -306,8 +308,18 @@ pub fn solve_slip_weakening<P: AffineProblem>(
     let mut previous: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut newton = params.newton;
     let mut polished = false;
+    // D, and so the directions' factorisation, is the same at every step
+    let mut shared = Shared::default();
     for k in 1..=params.max_iters {
-        let mut sol = frozen_step(problem, &frozen, params.inner, &newton, start.take(), progress)?;
+        let mut sol = frozen_step(
+            problem,
+            &frozen,
+            params.inner,
+            &newton,
+            start.take(),
+            progress,
+            &mut shared,
+        )?;
         newton_iters += sol.info.newton_iters;
         // the operator is the same at every step: its μ_max once
         newton.mu_max = Some(sol.info.mu_max);
@@ -338,13 +350,14 @@ pub fn solve_slip_weakening<P: AffineProblem>(
                 weakening: Some(*law),
                 ..newton
             };
-            if let Ok(mut polish) = solve_newton(
+            if let Ok(mut polish) = solve_newton_sharing(
                 problem,
                 &frozen,
                 &Law::Coulomb,
                 &direct,
                 Some(sol.lambda.clone()),
                 progress,
+                &mut shared,
             ) {
                 polish.info.fixed_point_iters = k;
                 polish.info.newton_iters += newton_iters;

@@ -275,6 +275,10 @@ pub struct Iterations {
     pub uzawa: usize,
     /// Semismooth Newton steps (those of the proximal stage's problems included).
     pub newton: usize,
+    /// Newton steps on the coarser problems of Newton's nested start (each on a fraction of
+    /// the contact points), not counted in `newton`.
+    #[serde(default)]
+    pub coarse_newton: usize,
     /// Outer steps of Newton's proximal stage (each a regularised problem).
     #[serde(default)]
     pub proximal: usize,
@@ -299,6 +303,7 @@ impl Iterations {
             fixed_point: info.map_or(0, |i| i.fixed_point_iters),
             uzawa: info.map_or(0, |i| i.uzawa_iters),
             newton: info.map_or(0, |i| i.newton_iters),
+            coarse_newton: info.map_or(0, |i| i.coarse_newton_iters),
             proximal: info.map_or(0, |i| i.proximal_iters),
             line_search_cuts: info.map_or(0, |i| i.line_search_cuts),
             newton_fallback: info.is_some_and(|i| i.fallback),
@@ -314,6 +319,7 @@ impl Iterations {
         let mut parts = vec![];
         for (count, name) in [
             (self.newton, "Newton"),
+            (self.coarse_newton, "coarse Newton"),
             (self.proximal, "proximal"),
             (self.uzawa, "Uzawa"),
             (self.fixed_point, "FP"),

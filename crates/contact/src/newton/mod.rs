@@ -38,6 +38,7 @@
 mod direction;
 mod equations;
 
+use crate::coarse;
 use crate::electric::{ElectricContactProblem, ElectricValues};
 use crate::operator::AffineProblem;
 use crate::operator::Compliance;
@@ -80,6 +81,10 @@ pub struct NewtonParams {
     pub fallback: bool,
     /// Sweeps or steps the last stage may take.
     pub max_fallback_iters: usize,
+    /// Whether a solve from zero multipliers starts from the answer of the problem on a
+    /// coarser set of its points, solved first by this method ([`solve_newton`]'s nested
+    /// start): the step count then does not grow with the number of points.
+    pub nested_start: bool,
     /// A deadline or a cancel flag.
     pub interrupt: Interrupt,
 }
@@ -96,6 +101,7 @@ impl Default for NewtonParams {
             weakening: None,
             fallback: true,
             max_fallback_iters: 200_000,
+            nested_start: true,
             interrupt: Interrupt::NONE,
         }
     }
@@ -156,6 +162,9 @@ struct Judge<'a> {
     reference: f64,
     tol: f64,
     best: Best<State>,
+    /// The norm of the equations at zero multipliers where Newton starts elsewhere by its
+    /// nested start ([`nested_start`]): the first steps may rise to it.
+    seed: Option<f64>,
 }
 
 impl<'a> Judge<'a> {
@@ -178,6 +187,7 @@ impl<'a> Judge<'a> {
             reference,
             tol: params.tol,
             best: Best::new(1.0),
+            seed: None,
         }
     }
 
@@ -299,11 +309,15 @@ fn newton_steps(
     memory: usize,
     patience: usize,
     lenient: bool,
+    seed: Option<f64>,
     interrupt: &Interrupt,
     info: &mut ContactInfo,
     accept: &mut dyn FnMut(&State, &mut ContactInfo) -> bool,
 ) -> (State, End) {
     let mut history = std::collections::VecDeque::with_capacity(memory + 1);
+    // a start that stands for an earlier iterate (the nested start, for zero multipliers):
+    // the non-monotone search compares with that iterate's norm too
+    history.extend(seed);
     // a dense symmetric D (a condensed finite-element compliance), or a caller that asks:
     // Newton's own rules, damped steps that may rise against the history and no patience rule
     // (its norm often rests on a plateau until the active set is found, then drops to
@@ -383,6 +397,8 @@ struct Rules {
     patience: usize,
     /// Damped steps compared with the history, as on a dense symmetric `D`.
     lenient: bool,
+    /// A norm the history starts with (see [`newton_steps`]).
+    seed: Option<f64>,
 }
 
 /// Newton steps on the problem itself from `start`, each offered to the judge (the best
@@ -410,6 +426,7 @@ fn judged_steps(
         MEMORY,
         rules.patience,
         rules.lenient,
+        rules.seed,
         &params.interrupt,
         info,
         accept,
@@ -453,6 +470,7 @@ fn proximal_stage(
             MEMORY,
             INNER_STEPS,
             false,
+            None,
             &params.interrupt,
             info,
             &mut |s, _| judge.residual_of(&problem, s) <= inner_tol,
@@ -514,6 +532,30 @@ pub fn solve_newton<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
+    solve_newton_sharing(problem, points, law, params, lambda0, progress, &mut Shared::default())
+}
+
+/// What the Newton solves of one problem share, whatever its law's data (the friction
+/// coefficients of a fixed point's steps): the directions' factorisation of `D` (its inverse,
+/// `m³` flops: at 1022 rows 0.05 s, more than the steps of a warm-started solve).
+#[derive(Default)]
+pub(crate) struct Shared {
+    directions: Option<Directions>,
+    /// The insulated problem's answer of a coupled problem (`Some(None)` where its solve
+    /// failed).
+    insulated: Option<Option<PointValues>>,
+}
+
+/// [`solve_newton`], with what it shares with the other solves of `problem` in `cache`.
+pub(crate) fn solve_newton_sharing<P: AffineProblem>(
+    problem: &mut P,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+    lambda0: Option<PointValues>,
+    progress: &mut dyn FnMut(&Progress),
+    cache: &mut Shared,
+) -> Result<ContactSolution, ContactError> {
     let nt = check_newton_input(problem, params)?;
     let pre = Preamble::new(
         &mut Counter::new(problem),
@@ -522,16 +564,28 @@ pub fn solve_newton<P: AffineProblem>(
         params.power_iters,
         params.mu_max,
     )?;
-    let start = pre.start(lambda0)?;
-    let x0: Vec<f64> = start.normal.iter().chain(&start.tangential).copied().collect();
     let (mu_max, reference) = (pre.mu_max, pre.reference);
     let mut info = ContactInfo::new(mu_max);
+    let start = match lambda0 {
+        Some(l) => pre.start(Some(l))?,
+        None => match nested_start(problem, points, law, params) {
+            Some((l, steps)) => {
+                info.coarse_newton_iters = steps;
+                l
+            }
+            None => pre.start(None)?,
+        },
+    };
+    let x0: Vec<f64> = start.normal.iter().chain(&start.tangential).copied().collect();
     let u0 = problem.loads().clone();
     let mut flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
     flat.weakening = params.weakening;
     info.augmentation = Some(1.0 / mu_max);
     let mut judge = Judge::new(flat, law, points, &u0, params, reference);
-    let (best, best_residual, stall) = judge.run_stages(x0, params, &mut info, progress, &mut None)?;
+    if info.coarse_newton_iters > 0 {
+        judge.seed = Some(judge.flat.state(vec![0.0; x0.len()]).norm);
+    }
+    let (best, best_residual, stall) = judge.run_stages(x0, params, &mut info, progress, &mut cache.directions)?;
     let Some(reason) = stall else {
         let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
         info.complementarity = judge.complementarity(&best);
@@ -547,6 +601,40 @@ pub fn solve_newton<P: AffineProblem>(
     };
     let stalled = judge.iterate(&best, best_residual);
     after_stall(problem, points, law, params, stalled, reason, info, progress)
+}
+
+/// Newton's start from the answer of the problem on a coarser set of the points
+/// ([`crate::coarse`], nested iteration), solved by this same method (so from a coarser one
+/// still), with its steps on all coarser problems; `None` where the points make no coarser
+/// set, `D` is not dense, or the coarser solve fails (Newton then starts from zero).
+fn nested_start<P: AffineProblem>(
+    problem: &P,
+    points: &ContactPoints,
+    law: &Law,
+    params: &NewtonParams,
+) -> Option<(PointValues, usize)> {
+    if !params.nested_start {
+        return None;
+    }
+    let coarsening = coarse::coarsen(points)?;
+    let mut coarse = coarsening.problem(problem.compliance(), problem.loads(), points)?;
+    let quiet = NewtonParams {
+        fallback: false,
+        max_proximal: 0,
+        mu_max: None,
+        ..*params
+    };
+    let sol = solve_newton(
+        &mut coarse,
+        &coarsening.points(points),
+        &coarsening.law(law, points),
+        &quiet,
+        None,
+        &mut |_| {},
+    )
+    .ok()?;
+    let steps = sol.info.newton_iters + sol.info.coarse_newton_iters;
+    Some((coarsening.prolong(&sol.lambda, points), steps))
 }
 
 /// Solves the contact problem with electrical contact, `problem`, for `law` by the semismooth
@@ -635,15 +723,6 @@ fn solve_electric(
         info,
         electric: Some(electric),
     })
-}
-
-/// What the solves of one coupled problem under different electric laws share: the Newton
-/// directions' factorisation of `D`, and the insulated problem's answer (`Some(None)` where its
-/// solve failed).
-#[derive(Default)]
-struct Shared {
-    directions: Option<Directions>,
-    insulated: Option<Option<PointValues>>,
 }
 
 /// The start of the coupled Newton (with the Newton steps it took): one sweep of the fixed point that alternates the two
@@ -821,6 +900,7 @@ fn newton_stages(
         steps: params.max_iters,
         patience: PATIENCE,
         lenient: false,
+        seed: judge.seed,
     };
     let mut end = judged_steps(judge, &directions, s, strict, params, info, progress);
     if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
@@ -833,6 +913,7 @@ fn newton_stages(
                 steps,
                 patience: steps,
                 lenient: true,
+                seed: None,
             };
             end = judged_steps(judge, &directions, start, lenient, params, info, progress);
         }
