@@ -12,16 +12,34 @@ use crate::{kernels, voigt, Constraint, Discretization, Field, Load, Material};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-/// A linear bed under a face, for [`Exact::on_conducting_foundation`]: its stiffness `k` and
-/// the material's `c33` and `e33` along the normal (a 6mm crystal poled along it).
+/// The law of the contact face of [`Exact::on_foundation`]: the bed under it and its electric
+/// condition, with the constants of the material along the normal (a 6mm crystal poled along
+/// it) that make the face's pressure and flux.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Bed {
-    /// `k`, pressure per unit penetration.
-    pub stiffness: f64,
-    /// The stiffness along the normal.
-    pub c33: f64,
-    /// The piezoelectric constant along the normal.
-    pub e33: f64,
+pub struct Face {
+    /// `c33`, `e33`, `ε33` along the normal.
+    pub constants: [f64; 3],
+    /// A deformable foundation, normal compliance `λ_n = k [u_n - g]₊^m`: `(k, m)`; `None`
+    /// for a rigid one.
+    pub bed: Option<(f64, f64)>,
+    /// The electric condition of the face.
+    pub electric: FaceElectric,
+}
+
+/// The electric condition of the contact face of [`Exact::on_foundation`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FaceElectric {
+    /// An ideal conductor: `φ = φ_F` on the face.
+    Conducting,
+    /// A conductive foundation, `D·ν = σ_c p (φ - φ_F)` with `p` the pressure (rigid) or the
+    /// penetration (a linear bed), the face at `φ_F + offset`; `conductance = 0` is the
+    /// insulated face `D·ν = 0`.
+    Conductive {
+        /// `σ_c ≥ 0`.
+        conductance: f64,
+        /// The potential of the face above the foundation's, `φ - φ_F`.
+        offset: f64,
+    },
 }
 
 /// Value, gradient and Hessian of a scalar field at a point (unused components zero).
@@ -93,42 +111,60 @@ impl Exact {
     }
 
     /// A solution in contact everywhere on the face `x_n = s0` (`n = dim - 1`, the outward
-    /// normal `-e_n`) with a rigid, ideally conducting foundation whose gap is
-    /// `g(t) = g0 + κ |t - c|² / 2` (`t` the tangential coordinates) and whose potential is
-    /// `φ_F`, the points sticking: with `s = x_n - s0`,
+    /// normal `-e_n`) with a foundation whose gap is `g(t) = g0 + κ |t - c|² / 2` (`t` the
+    /// tangential coordinates) and whose potential is `φ_F`, the points sticking. With
+    /// `s = x_n - s0` and `E(t) = 10⁻² + 10⁻³ sin(π t_0 / 2)`:
     /// `u_k = 10⁻³ s sin(π t_k / 2 + 0.3)` (`k < n`: no slip on the face),
-    /// `u_n = -g(t) - s (10⁻² + 10⁻³ sin(π t_0 / 2))` (`u·(-e_n) = g` on the face: contact, and a
-    /// compression below it), `φ = φ_F + s (10⁻² + 5·10⁻³ cos(π t_0 / 2))` (`φ = φ_F` on the face).
-    /// On a linear bed (`bed`: normal compliance `λ_n = k [u_n - g]₊`, the material poled along
-    /// the normal) the face sinks into it by the penetration `λ_n / k`, with the pressure
-    /// `λ_n = -σ_nn = c33 (10⁻² + 10⁻³ sin(π t_0/2)) - e33 (10⁻² + 5·10⁻³ cos(π t_0/2))` the
-    /// fields give on the face (`ε_tt = 0` there): `u_n = -(g + λ_n/k) - ...`.
-    /// Whether the pressure is positive and the shear within the friction bound depends on the
-    /// material and the coefficient: the caller checks the run's status.
-    pub fn on_conducting_foundation(
+    /// `u_n = -g(t) - δ(t) - s E(t)` (`ε_nn = -E`: a compression; `δ` the penetration into the
+    /// bed, 0 on a rigid foundation), and by the face's electric condition:
+    /// - conducting: `φ = φ_F + s (10⁻² + 5·10⁻³ cos(π t_0 / 2))` (`φ = φ_F` on the face);
+    /// - conductive: `φ = φ_F + a + s ϰ E(t)`, `a` the face's offset, with `ϰ` the slope that
+    ///   makes the flux the law's: on the face (`ε_tt = 0`) the pressure is
+    ///   `λ_n = -σ_nn = c33 E - e33 ∂_s φ` and the flux `D·ν = e33 E + ε33 ∂_s φ`, so
+    ///   `D·ν = σ' a λ_n` (`σ' = σ_c`, or `σ_c / k` on a linear bed, whose penetration is
+    ///   `λ_n / k`) gives `ϰ = (σ' a c33 - e33) / (ε33 + σ' a e33)`; `σ_c = 0` is the insulated
+    ///   face. (On a bed with `m ≠ 1` the penetration is not linear in the pressure and the
+    ///   slope has no closed form: there `σ_c` must be 0.)
+    ///
+    /// On a bed the face sinks by `δ = (λ_n / k)^(1/m)`, `λ_n` the pressure the fields give on
+    /// the face. Whether the pressure is positive and the shear within the friction bound
+    /// depends on the material and the coefficient: the caller checks the run's status.
+    pub fn on_foundation(
         dim: usize,
         s0: f64,
-        g0: f64,
-        curvature: f64,
-        center: [f64; 3],
+        (g0, curvature, center): (f64, f64, [f64; 3]),
         phi_f: f64,
-        bed: Option<Bed>,
+        face: Face,
     ) -> Self {
         let n = dim - 1;
         let h = PI / 2.0;
-        let (delta, b, p1, p2) = (1e-2, 1e-3, 1e-2, 5e-3);
-        // the penetration into a linear bed: the pressure on the face over k, with its jet in t_0
+        let (delta, b) = (1e-2, 1e-3);
+        let [c33, e33, eps33] = face.constants;
+        // ∂_s φ on the face as `p0 + p1 sin(h t0) + p2 cos(h t0)`, and its value there
+        let (slope, face_phi) = match face.electric {
+            FaceElectric::Conducting => ([1e-2, 0.0, 5e-3], phi_f),
+            FaceElectric::Conductive { conductance, offset } => {
+                let sigma = conductance / face.bed.map_or(1.0, |(k, _)| k);
+                let kappa = (sigma * offset * c33 - e33) / (eps33 + sigma * offset * e33);
+                ([kappa * delta, kappa * b, 0.0], phi_f + offset)
+            }
+        };
+        // the pressure on the face, `l0 + l1 sin + l2 cos`, and the penetration's jet in t_0
+        let pressure = [c33 * delta - e33 * slope[0], c33 * b - e33 * slope[1], -e33 * slope[2]];
         let penetration = move |t0: f64| -> (f64, f64, f64) {
-            let Some(bed) = bed else {
+            let Some((k, m)) = face.bed else {
                 return (0.0, 0.0, 0.0);
             };
-            let (l0, l1, l2) = (bed.c33 * delta - bed.e33 * p1, bed.c33 * b, -bed.e33 * p2);
             let (sn, cs) = ((h * t0).sin(), (h * t0).cos());
-            (
-                (l0 + l1 * sn + l2 * cs) / bed.stiffness,
-                h * (l1 * cs - l2 * sn) / bed.stiffness,
-                -h * h * (l1 * sn + l2 * cs) / bed.stiffness,
-            )
+            let l = (pressure[0] + pressure[1] * sn + pressure[2] * cs) / k;
+            let dl = h * (pressure[1] * cs - pressure[2] * sn) / k;
+            let ddl = -h * h * (pressure[1] * sn + pressure[2] * cs) / k;
+            // δ = l^(1/m)
+            let r = 1.0 / m;
+            let v = l.powf(r);
+            let dv = r * l.powf(r - 1.0) * dl;
+            let ddv = r * (r - 1.0) * l.powf(r - 2.0) * dl * dl + r * l.powf(r - 1.0) * ddl;
+            (v, dv, ddv)
         };
         Exact {
             dim,
@@ -169,14 +205,18 @@ impl Exact {
             phi: Arc::new(move |x| {
                 let s = x[n] - s0;
                 let (sn, cs) = ((h * x[0]).sin(), (h * x[0]).cos());
+                let [p0, p1, p2] = slope;
+                let value = p0 + p1 * sn + p2 * cs;
+                let dvalue = h * (p1 * cs - p2 * sn);
+                let ddvalue = -h * h * (p1 * sn + p2 * cs);
                 let mut g = [0.0; 3];
                 let mut hh = [[0.0; 3]; 3];
-                g[0] = -s * p2 * h * sn;
-                g[n] = p1 + p2 * cs;
-                hh[0][0] = -s * p2 * h * h * cs;
-                hh[0][n] = -p2 * h * sn;
-                hh[n][0] = -p2 * h * sn;
-                (phi_f + s * (p1 + p2 * cs), g, hh)
+                g[0] = s * dvalue;
+                g[n] = value;
+                hh[0][0] = s * ddvalue;
+                hh[0][n] = dvalue;
+                hh[n][0] = dvalue;
+                (face_phi + s * value, g, hh)
             }),
         }
     }
@@ -397,60 +437,88 @@ mod tests {
         }
     }
 
-    /// The jets of the solution on a conducting foundation against central differences, in
-    /// 2D and 3D, and its contact face's values: the gap's normal displacement, no slip,
-    /// the foundation's potential.
+    /// The jets of the solution on a foundation against central differences, in 2D and 3D,
+    /// rigid and on beds, conducting, conductive and insulated, and its contact face's values:
+    /// the gap's normal displacement (and the bed's penetration `(λ_n/k)^(1/m)`), no slip, the
+    /// face's potential, and the conductive law's flux `σ' (φ - φ_F) λ_n`.
     #[test]
-    fn the_conducting_foundation_solution_has_consistent_jets() {
-        let beds = [
-            None,
-            Some(Bed {
-                stiffness: 50.0,
-                c33: 111.0,
-                e33: 15.8,
-            }),
+    fn the_foundation_solution_has_consistent_jets_and_its_face_law() {
+        let constants = [111.0, 15.8, 7.35];
+        let beds = [None, Some((50.0, 1.0)), Some((3.0, 2.5))];
+        let electric = [
+            FaceElectric::Conducting,
+            FaceElectric::Conductive {
+                conductance: 20.0,
+                offset: 0.01,
+            },
+            FaceElectric::Conductive {
+                conductance: 0.0,
+                offset: -0.3,
+            },
         ];
-        for (dim, bed) in [2, 3].into_iter().flat_map(|d| beds.map(|b| (d, b))) {
-            let e = Exact::on_conducting_foundation(dim, 0.1, 0.02, 0.3, [1.0, 0.5, 0.0], 0.04, bed);
-            let x = [0.3, 0.7, 0.45];
-            let jets = |x: &[f64]| {
-                let u = (e.u)(x);
-                let mut all: Vec<Jet> = u[..dim].to_vec();
-                all.push((e.phi)(x));
-                all
-            };
-            let d = 1e-5;
-            let at = jets(&x);
-            for i in 0..dim {
-                let (mut xp, mut xm) = (x, x);
-                xp[i] += d;
-                xm[i] -= d;
-                let (p, m) = (jets(&xp), jets(&xm));
-                for f in 0..=dim {
-                    assert!(
-                        ((p[f].0 - m[f].0) / (2.0 * d) - at[f].1[i]).abs() < 1e-8,
-                        "{dim}D field {f} d{i}"
-                    );
-                    for j in 0..dim {
-                        let fd = (p[f].1[j] - m[f].1[j]) / (2.0 * d);
-                        assert!((fd - at[f].2[j][i]).abs() < 1e-7, "{dim}D field {f} d{j}d{i}");
+        for dim in [2, 3] {
+            for (bed, electric) in beds.iter().flat_map(|b| electric.map(|e| (*b, e))) {
+                let nonlinear = bed.is_some_and(|(_, m)| m != 1.0);
+                if nonlinear && matches!(electric, FaceElectric::Conductive { conductance, .. } if conductance > 0.0) {
+                    continue; // no closed form (see on_foundation)
+                }
+                let face = Face {
+                    constants,
+                    bed,
+                    electric,
+                };
+                let e = Exact::on_foundation(dim, 0.1, (0.02, 0.3, [1.0, 0.5, 0.0]), 0.04, face);
+                let x = [0.3, 0.7, 0.45];
+                let jets = |x: &[f64]| {
+                    let u = (e.u)(x);
+                    let mut all: Vec<Jet> = u[..dim].to_vec();
+                    all.push((e.phi)(x));
+                    all
+                };
+                let d = 1e-5;
+                let at = jets(&x);
+                for i in 0..dim {
+                    let (mut xp, mut xm) = (x, x);
+                    xp[i] += d;
+                    xm[i] -= d;
+                    let (p, m) = (jets(&xp), jets(&xm));
+                    for f in 0..=dim {
+                        assert!(
+                            ((p[f].0 - m[f].0) / (2.0 * d) - at[f].1[i]).abs() < 1e-8,
+                            "{dim}D field {f} d{i}"
+                        );
+                        for j in 0..dim {
+                            let fd = (p[f].1[j] - m[f].1[j]) / (2.0 * d);
+                            assert!((fd - at[f].2[j][i]).abs() < 1e-7, "{dim}D field {f} d{j}d{i}");
+                        }
+                    }
+                }
+                // on the face x_n = 0.1
+                let mut y = x;
+                y[dim - 1] = 0.1;
+                let face_jets = jets(&y);
+                let gap = 0.02 + 0.15 * (0..dim - 1).map(|k| (y[k] - [1.0, 0.5][k]).powi(2)).sum::<f64>();
+                // the pressure and flux from the jets: -σ_nn = -(c33 ε_nn + e33 φ_n) and
+                // D·ν = -(e33 ε_nn - ε33 φ_n), the tangential strain being 0 on the face
+                let n = dim - 1;
+                assert!((0..n).all(|k| face_jets[k].1[k] == 0.0));
+                let (eps_nn, phi_n) = (face_jets[n].1[n], face_jets[dim].1[n]);
+                let pressure = -(constants[0] * eps_nn + constants[1] * phi_n);
+                let flux = -(constants[1] * eps_nn - constants[2] * phi_n);
+                assert!(pressure > 0.0);
+                let sink = bed.map_or(0.0, |(k, m)| (pressure / k).powf(1.0 / m));
+                assert!((-face_jets[n].0 - gap - sink).abs() < 1e-15);
+                assert!((0..n).all(|k| face_jets[k].0 == 0.0));
+                match electric {
+                    FaceElectric::Conducting => assert!((face_jets[dim].0 - 0.04).abs() < 1e-15),
+                    FaceElectric::Conductive { conductance, offset } => {
+                        assert!((face_jets[dim].0 - 0.04 - offset).abs() < 1e-15);
+                        // the law: σ_c p (φ - φ_F), p the pressure, or the penetration
+                        let p = if bed.is_some() { sink } else { pressure };
+                        assert!((flux - conductance * p * offset).abs() < 1e-13, "{flux}");
                     }
                 }
             }
-            // on the face x_n = 0.1
-            let mut y = x;
-            y[dim - 1] = 0.1;
-            let face = jets(&y);
-            let gap = 0.02 + 0.15 * (0..dim - 1).map(|k| (y[k] - [1.0, 0.5][k]).powi(2)).sum::<f64>();
-            // the pressure from the jets: -σ_nn = -(c33 ε_nn + e33 φ_n), the tangential strain
-            // being 0 on the face
-            let n = dim - 1;
-            assert!((0..n).all(|k| face[k].1[k] == 0.0));
-            let pressure = bed.map_or(0.0, |b| -(b.c33 * face[n].1[n] + b.e33 * face[dim].1[n]));
-            let sink = bed.map_or(0.0, |b| pressure / b.stiffness);
-            assert!((-face[dim - 1].0 - gap - sink).abs() < 1e-15);
-            assert!((0..dim - 1).all(|k| face[k].0 == 0.0));
-            assert!((face[dim].0 - 0.04).abs() < 1e-15);
         }
     }
 }

@@ -4,10 +4,15 @@
 //! stick zones). The formulas of the contact solutions are in [`crate::analytical`].
 
 use crate::analytical::{cattaneo_stick_half_width, cattaneo_traction, hertz, hertz_pressure};
-use crate::scene::{ExactKind, Scene};
+use crate::scene::{ElectricCondition, ExactKind, Scene};
 use contact::{ContactPoints, ContactSolution, Status};
-use fe_assembly::{Discretization, Exact};
+use fe_assembly::{Discretization, Exact, Face, FaceElectric};
 use serde::{Deserialize, Serialize};
+
+/// The potential of the contact face above the foundation's in the manufactured solution on a
+/// conductive or insulated foundation (`φ - φ_F`, in the scene's unit: of the order of the
+/// solution's own potentials, 10⁻² s).
+const FACE_OFFSET: f64 = 1e-2;
 
 /// A field solution set up for a run: the exact fields and the groups they are prescribed on.
 pub struct FieldSolution {
@@ -31,25 +36,32 @@ impl FieldSolution {
         };
         let exact = if x.kind == ExactKind::Manufactured {
             Exact::manufactured(dim)
-        } else if x.kind == ExactKind::ManufacturedConducting {
-            // validated: a box or rectangle, contact on its bottom face
+        } else if x.kind == ExactKind::ManufacturedContact {
+            // validated: a box or rectangle, contact on its bottom face; a bed or an electric
+            // face other than the conducting one under one 6mm crystal poled along the normal
             let c = scene.contact.as_ref()?;
             let center = pad(c.gap_center.as_deref().unwrap_or_default(), 3);
             let s0 = scene.mesh.lo.get(dim - 1).copied().unwrap_or(0.0);
-            Exact::on_conducting_foundation(
-                dim,
-                s0,
-                c.gap,
-                c.gap_curvature,
-                [center[0], center[1], center[2]],
-                c.foundation_potential.unwrap_or(0.0),
-                // validated: a linear bed, one 6mm crystal poled along the normal
-                c.compliance.map(|k| fe_assembly::Bed {
-                    stiffness: k.stiffness,
-                    c33: scene.material[0].c.get(3).copied().unwrap_or(0.0),
-                    e33: scene.material[0].e.get(1).copied().unwrap_or(0.0),
-                }),
-            )
+            let m = &scene.material[0];
+            let at = |v: &[f64], k: usize| v.get(k).copied().unwrap_or(0.0);
+            let electric = match c.electric.unwrap_or(ElectricCondition::Insulated) {
+                ElectricCondition::Conducting => FaceElectric::Conducting,
+                ElectricCondition::Conductive => FaceElectric::Conductive {
+                    conductance: c.conductance.unwrap_or(0.0),
+                    offset: FACE_OFFSET,
+                },
+                ElectricCondition::Insulated => FaceElectric::Conductive {
+                    conductance: 0.0,
+                    offset: FACE_OFFSET,
+                },
+            };
+            let face = Face {
+                constants: [at(&m.c, 3), at(&m.e, 1), at(&m.permittivity, 1)],
+                bed: c.compliance.map(|k| (k.stiffness, k.exponent)),
+                electric,
+            };
+            let gap = (c.gap, c.gap_curvature, [center[0], center[1], center[2]]);
+            Exact::on_foundation(dim, s0, gap, c.foundation_potential.unwrap_or(0.0), face)
         } else {
             let (u0, g, gp) = (pad(&x.u0, 3), pad(&x.grad_u, dim * dim), pad(&x.grad_phi, 3));
             let mut grad_u = [[0.0; 3]; 3];

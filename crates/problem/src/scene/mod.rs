@@ -176,10 +176,10 @@ choice! {
         Manufactured = "manufactured",
         /// An affine `(u, φ)` (a patch test).
         Affine = "affine",
-        /// A smooth `(u, φ)` in sticking contact with a rigid, ideally conducting foundation
-        /// on the whole contact face (`fe_assembly::Exact::on_conducting_foundation`, from the
-        /// scene's gap and foundation potential).
-        ManufacturedConducting = "manufactured-conducting",
+        /// A smooth `(u, φ)` in sticking contact with the scene's foundation on the whole
+        /// contact face (`fe_assembly::Exact::on_foundation`, from the scene's gap, bed and
+        /// electric condition: conducting, conductive or insulated).
+        ManufacturedContact = "manufactured-contact",
         /// Hertz's frictionless cylinder on a half-plane.
         Hertz = "hertz",
         /// Cattaneo-Mindlin's partial slip under a tangential force.
@@ -249,8 +249,8 @@ impl ExactKind {
         match self {
             ExactKind::Manufactured => "relative energy-norm error of (u, φ) against the manufactured solution",
             ExactKind::Affine => "relative energy-norm error against the affine solution (a patch test: round-off)",
-            ExactKind::ManufacturedConducting => {
-                "relative energy-norm error of (u, φ) against the manufactured solution on a conducting foundation"
+            ExactKind::ManufacturedContact => {
+                "relative energy-norm error of (u, φ) against the manufactured solution in contact with the foundation"
             }
             ExactKind::Hertz => "relative l2 error of the nodal contact pressure against Hertz's, over |x| ≤ 1.5 a",
             ExactKind::CattaneoMindlin => {
@@ -260,11 +260,11 @@ impl ExactKind {
     }
 
     /// Whether it is a field solution (manufactured, affine; and the manufactured solution on
-    /// a conducting foundation, the one with contact).
+    /// the foundation, the one with contact).
     pub fn is_field(self) -> bool {
         matches!(
             self,
-            ExactKind::Manufactured | ExactKind::Affine | ExactKind::ManufacturedConducting
+            ExactKind::Manufactured | ExactKind::Affine | ExactKind::ManufacturedContact
         )
     }
 }
@@ -1031,7 +1031,7 @@ impl ExactSpec {
         if !self.groups.is_empty() {
             return self.groups.clone();
         }
-        if self.kind == ExactKind::ManufacturedConducting {
+        if self.kind == ExactKind::ManufacturedContact {
             // the contact face is the foundation's
             let sides: &[&str] = if mesh.dim() == Some(3) {
                 &["left", "right", "top", "front", "back"]

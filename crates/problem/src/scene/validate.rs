@@ -833,8 +833,8 @@ fn validate_exact(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
 /// A manufactured or affine solution: no contact, one material, its groups and data.
 fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
     let kind = x.kind;
-    if kind == ExactKind::ManufacturedConducting {
-        validate_conducting_solution(s)?;
+    if kind == ExactKind::ManufacturedContact {
+        validate_manufactured_contact(s)?;
     } else if s.contact_law() != ContactLaw::None {
         return Err(SceneError::new(
             "exact.kind",
@@ -873,37 +873,42 @@ fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// The manufactured solution on a conducting foundation: a generated rectangle or box, Coulomb
-/// contact on its `bottom` face with the outward normal `-e_n`, a rigid, ideally conducting
-/// foundation (the solution sticks everywhere on the face, at the foundation's potential).
-fn validate_conducting_solution(s: &Scene) -> Result<(), SceneError> {
-    let why = "exact.kind = \"manufactured-conducting\" is a solution in sticking contact with a rigid, ideally conducting foundation under the bottom face";
+/// The manufactured solution in contact: a generated rectangle or box, Coulomb contact on its
+/// `bottom` face with the outward normal `-e_n` (the solution sticks everywhere on the face);
+/// a bed, or an electric face other than the ideal conductor's, under one 6mm crystal poled
+/// along the normal (its constants make the face's pressure and flux); a conductive face on a
+/// bed only where the bed is linear (the closed form).
+fn validate_manufactured_contact(s: &Scene) -> Result<(), SceneError> {
+    let why = "exact.kind = \"manufactured-contact\" is a solution in sticking contact with the foundation under the bottom face";
     let Some(c) = s.contact.as_ref().filter(|c| c.law == ContactLaw::Coulomb) else {
         return Err(SceneError::new(
             "contact.law",
             format!("{why}: it needs contact.law = \"coulomb\""),
         ));
     };
-    if let Some(k) = c.compliance {
-        let on_bed = "exact.kind = \"manufactured-conducting\" on a deformable foundation takes a linear bed (contact.compliance.exponent = 1) under one 6mm crystal poled along the contact normal";
+    let electric = c.electric.unwrap_or(crate::scene::ElectricCondition::Insulated);
+    let conducting = electric == crate::scene::ElectricCondition::Conducting;
+    if c.compliance.is_some() || !conducting {
         let m = &s.material;
         let poled = m.len() == 1
             && m[0].model == crate::scene::MaterialModel::Crystal6mm
             && m[0].poling.iter().zip(&c.normal).all(|(p, n)| (p + n).abs() < 1e-12);
-        refuse_if(k.exponent != 1.0, "contact.compliance.exponent", on_bed)?;
-        refuse_if(!poled, "material.poling", on_bed)?;
+        let on_face = "exact.kind = \"manufactured-contact\" on a deformable, conductive or insulated foundation takes one 6mm crystal poled along the contact normal (its c33, e33 and eps33 make the face's pressure and flux)";
+        refuse_if(!poled, "material.poling", on_face)?;
+    }
+    if let Some(k) = c.compliance {
+        let linear = "exact.kind = \"manufactured-contact\" on a conductive foundation takes a linear bed (contact.compliance.exponent = 1): on a power-law bed the flux's condition has no closed form";
+        refuse_if(
+            k.exponent != 1.0 && electric == crate::scene::ElectricCondition::Conductive,
+            "contact.compliance.exponent",
+            linear,
+        )?;
     }
     refuse_if(
         c.friction_law.is_some_and(|f| f != crate::scene::FrictionLaw::Coulomb),
         "contact.friction_law",
         why,
     )?;
-    if c.electric != Some(crate::scene::ElectricCondition::Conducting) {
-        return Err(SceneError::new(
-            "contact.electric",
-            format!("{why}: it needs contact.electric = \"conducting\""),
-        ));
-    }
     let Some(dim) = s
         .mesh
         .dim()
