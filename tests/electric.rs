@@ -338,3 +338,92 @@ fn the_manufactured_solution_in_contact_converges_at_order_one() {
         other => panic!("{:?}", other.map(|_| ())),
     }
 }
+
+/// The manufactured solution with its face sliding (`exact.slip`): the slip
+/// `A (1 + sin(π x/2)/2)` along the first tangent and the shear `μ(U) λ_n` along it, for
+/// Coulomb's constant coefficient and for slip-weakening friction (exponential, and linear below
+/// its slip length; on an insulating foundation, since slip weakening is not solved with
+/// electrical contact); P1 converges as O(h) in energy and O(h²) in L2, in 2D and 3D, every
+/// point in contact and slipping.
+#[test]
+fn the_manufactured_sliding_solution_converges_at_order_one() {
+    let laws: [(&str, &[&str]); 3] = [
+        ("coulomb", &["contact.friction=0.3", "exact.slip=2e-3"]),
+        (
+            "exponential weakening",
+            &[
+                "~contact.friction",
+                "contact.friction_law=\"slip-weakening\"",
+                "contact.friction_static=0.4",
+                "contact.friction_dynamic=0.25",
+                "contact.slip_length=4e-3",
+                "contact.weakening=\"exponential\"",
+                "exact.slip=2e-3",
+                "contact.electric=\"insulated\"",
+                "~contact.foundation_potential",
+            ],
+        ),
+        (
+            "linear weakening",
+            &[
+                "~contact.friction",
+                "contact.friction_law=\"slip-weakening\"",
+                "contact.friction_static=0.4",
+                "contact.friction_dynamic=0.25",
+                "contact.slip_length=4e-3",
+                "exact.slip=2e-3",
+                "contact.electric=\"insulated\"",
+                "~contact.foundation_potential",
+            ],
+        ),
+    ];
+    let cases = [(2, [8, 16, 32]), (3, [2, 4, 8])];
+    for (dim, sizes) in cases {
+        for (law, law_sets) in laws {
+            let mut energy = vec![];
+            let mut l2 = vec![];
+            for n in sizes {
+                let mut sets = vec![format!("mesh.n={n}")];
+                sets.extend(law_sets.iter().map(|s| s.to_string()));
+                if dim == 3 {
+                    sets.extend(
+                        [
+                            "mesh.kind=\"box\"",
+                            "mesh.lo=[0.0, 0.0, 0.0]",
+                            "mesh.hi=[1.0, 1.0, 1.0]",
+                            "material.0.poling=[0.0, 0.0, 1.0]",
+                            "contact.normal=[0.0, 0.0, -1.0]",
+                            "contact.gap_center=[0.5, 0.5, 0.0]",
+                        ]
+                        .map(String::from),
+                    );
+                }
+                let what = format!("{dim}D n = {n}, {law}");
+                let (scene, _) = files::scene_file::load("manufactured-conducting", &sets).unwrap();
+                let s = problem::solve(&scene, None, &mut Silent).unwrap_or_else(|e| panic!("{what}: {e}"));
+                let c = s.contact.as_ref().unwrap();
+                let (stick, slip, separated) = c.solution.counts();
+                assert!(
+                    stick == 0 && separated == 0 && slip > 0,
+                    "{what}: {stick} {slip} {separated}"
+                );
+                let Some(problem::ExactReport::Field(e)) = &s.report.exact else {
+                    panic!("a field solution's errors")
+                };
+                energy.push(e.rel_energy);
+                l2.push(e.rel_l2_u);
+            }
+            eprintln!("{dim}D {law}: energy {energy:?}, L2 {l2:?}");
+            for k in 1..energy.len() {
+                let order = |v: &[f64]| (v[k - 1] / v[k]).log2();
+                let what = format!("{dim}D {law}");
+                assert!(
+                    (order(&energy) - 1.0).abs() < 0.1,
+                    "{what}: energy order {}",
+                    order(&energy)
+                );
+                assert!(order(&l2) > 1.8, "{what}: L2 order {}", order(&l2));
+            }
+        }
+    }
+}

@@ -174,6 +174,15 @@ impl SlipWeakening {
         }
     }
 
+    /// `d²μ/ds²` at the slip `s ≥ 0` (0 on the linear form, its kink at `s = L` aside).
+    pub fn curvature(&self, slip: f64) -> f64 {
+        let (ms, md, l) = (self.static_coefficient, self.dynamic_coefficient, self.slip_length);
+        match self.form {
+            Weakening::Linear => 0.0,
+            Weakening::Exponential => (ms - md) / (l * l) * (-slip / l).exp(),
+        }
+    }
+
     /// The coefficient of each point at its slip `|u_t|` in `u`.
     pub fn coefficients(&self, u: &crate::PointValues) -> Vec<f64> {
         (0..u.n_points())

@@ -12,18 +12,37 @@ use crate::{kernels, voigt, Constraint, Discretization, Field, Load, Material};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-/// The law of the contact face of [`Exact::on_foundation`]: the bed under it and its electric
-/// condition, with the constants of the material along the normal (a 6mm crystal poled along
-/// it) that make the face's pressure and flux.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The law of the contact face of [`Exact::on_foundation`]: the bed under it, its electric
+/// condition and its friction, with the constants of the material (a 6mm crystal poled along
+/// the normal) that make the face's pressure, flux and shear.
+#[derive(Clone)]
 pub struct Face {
-    /// `c33`, `e33`, `ε33` along the normal.
-    pub constants: [f64; 3],
+    /// The material's constants.
+    pub constants: FaceConstants,
     /// A deformable foundation, normal compliance `λ_n = k [u_n - g]₊^m`: `(k, m)`; `None`
     /// for a rigid one.
     pub bed: Option<(f64, f64)>,
     /// The electric condition of the face.
     pub electric: FaceElectric,
+    /// The face slides along the first tangent (`None`: it sticks).
+    pub sliding: Option<Sliding>,
+}
+
+/// The constants of a 6mm crystal poled along the normal of [`Exact::on_foundation`]'s face.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FaceConstants {
+    /// `c33`, along the normal.
+    pub c33: f64,
+    /// `c13`, the normal stress of a tangential strain.
+    pub c13: f64,
+    /// `c44`, the shear across the face.
+    pub c44: f64,
+    /// `e33`.
+    pub e33: f64,
+    /// `e31`.
+    pub e31: f64,
+    /// `ε33`, the permittivity along the normal.
+    pub eps33: f64,
 }
 
 /// The electric condition of the contact face of [`Exact::on_foundation`].
@@ -40,6 +59,107 @@ pub enum FaceElectric {
         /// The potential of the face above the foundation's, `φ - φ_F`.
         offset: f64,
     },
+}
+
+/// The coefficient of friction at a slip `s`, with its first two derivatives in `s`.
+pub type FrictionFn = Arc<dyn Fn(f64) -> [f64; 3] + Send + Sync>;
+
+/// A face that slides along the first tangent by `U(t₀) = A (1 + sin(π t₀ / 2) / 2)`, its
+/// shear the friction law's `μ(U) λ_n` along the slip.
+#[derive(Clone)]
+pub struct Sliding {
+    /// `A > 0`.
+    pub amplitude: f64,
+    /// `μ(s)`, `μ'(s)`, `μ''(s)`: the law's coefficient at the slip `s`.
+    pub friction: FrictionFn,
+}
+
+/// `a0 + a1 sin(h t) + a2 cos(h t)` with `h = π/2`, and its derivatives.
+#[derive(Clone, Copy, Debug)]
+struct Trig([f64; 3]);
+
+impl Trig {
+    /// The value and the first three derivatives at `t`.
+    fn at(self, t: f64) -> [f64; 4] {
+        let h = PI / 2.0;
+        let [a0, a1, a2] = self.0;
+        let (sn, cs) = ((h * t).sin(), (h * t).cos());
+        [
+            a0 + a1 * sn + a2 * cs,
+            h * (a1 * cs - a2 * sn),
+            -h * h * (a1 * sn + a2 * cs),
+            -h * h * h * (a1 * cs - a2 * sn),
+        ]
+    }
+}
+
+/// The tangential jets of [`Exact::on_foundation`]'s sticking face:
+/// `u_k = 10⁻³ s sin(π t_k / 2 + 0.3)`.
+fn sticking(x: &[f64], s: f64, n: usize, out: &mut [Jet; 3]) {
+    let h = PI / 2.0;
+    for (k, o) in out.iter_mut().enumerate().take(n) {
+        let (sn, cs) = ((h * x[k] + 0.3).sin(), (h * x[k] + 0.3).cos());
+        let a = 1e-3;
+        let mut g = [0.0; 3];
+        let mut hh = [[0.0; 3]; 3];
+        g[k] = a * s * h * cs;
+        g[n] = a * sn;
+        hh[k][k] = -a * s * h * h * sn;
+        hh[k][n] = a * h * cs;
+        hh[n][k] = a * h * cs;
+        *o = (a * s * sn, g, hh);
+    }
+}
+
+/// The tangential jets of [`Exact::on_foundation`]'s sliding face: `u_0 = U + s W`,
+/// `W = μ(U) λ_n / c44 + ∂_0 (g + δ)`, and in 3D `u_1 = s κ (t_1 - c_1)`; `l` and `pen` the
+/// pressure's and the penetration's derivatives in `t_0`.
+fn sliding_face(
+    x: &[f64],
+    s: f64,
+    (dim, c44): (usize, f64),
+    (slip, law, l, pen): (Trig, &Sliding, [f64; 4], [f64; 4]),
+    (curvature, center): (f64, [f64; 3]),
+    out: &mut [Jet; 3],
+) {
+    let n = dim - 1;
+    let u = slip.at(x[0]);
+    let [mu, dmu, ddmu] = (law.friction)(u[0]);
+    // μ(U(t)) and its derivatives in t
+    let m = [mu, dmu * u[1], ddmu * u[1] * u[1] + dmu * u[2]];
+    let w = [
+        m[0] * l[0] / c44 + curvature * (x[0] - center[0]) + pen[1],
+        (m[1] * l[0] + m[0] * l[1]) / c44 + curvature + pen[2],
+        (m[2] * l[0] + 2.0 * m[1] * l[1] + m[0] * l[2]) / c44 + pen[3],
+    ];
+    let mut g = [0.0; 3];
+    let mut hh = [[0.0; 3]; 3];
+    g[0] = u[1] + s * w[1];
+    g[n] = w[0];
+    hh[0][0] = u[2] + s * w[2];
+    hh[0][n] = w[1];
+    hh[n][0] = w[1];
+    out[0] = (u[0] + s * w[0], g, hh);
+    if dim == 3 {
+        let mut g = [0.0; 3];
+        let mut hh = [[0.0; 3]; 3];
+        g[1] = s * curvature;
+        g[n] = curvature * (x[1] - center[1]);
+        hh[1][n] = curvature;
+        hh[n][1] = curvature;
+        out[1] = (s * curvature * (x[1] - center[1]), g, hh);
+    }
+}
+
+/// `l^r` with its first three derivatives from those of `l`.
+fn power([l, dl, ddl, dddl]: [f64; 4], r: f64) -> [f64; 4] {
+    let p = |k: f64| l.powf(r - k);
+    [
+        p(0.0),
+        r * p(1.0) * dl,
+        r * (r - 1.0) * p(2.0) * dl * dl + r * p(1.0) * ddl,
+        r * (r - 1.0) * (r - 2.0) * p(3.0) * dl.powi(3) + 3.0 * r * (r - 1.0) * p(2.0) * dl * ddl + r * p(1.0) * dddl,
+    ]
 }
 
 /// Value, gradient and Hessian of a scalar field at a point (unused components zero).
@@ -112,23 +232,27 @@ impl Exact {
 
     /// A solution in contact everywhere on the face `x_n = s0` (`n = dim - 1`, the outward
     /// normal `-e_n`) with a foundation whose gap is `g(t) = g0 + κ |t - c|² / 2` (`t` the
-    /// tangential coordinates) and whose potential is `φ_F`, the points sticking. With
-    /// `s = x_n - s0` and `E(t) = 10⁻² + 10⁻³ sin(π t_0 / 2)`:
-    /// `u_k = 10⁻³ s sin(π t_k / 2 + 0.3)` (`k < n`: no slip on the face),
-    /// `u_n = -g(t) - δ(t) - s E(t)` (`ε_nn = -E`: a compression; `δ` the penetration into the
-    /// bed, 0 on a rigid foundation), and by the face's electric condition:
-    /// - conducting: `φ = φ_F + s (10⁻² + 5·10⁻³ cos(π t_0 / 2))` (`φ = φ_F` on the face);
-    /// - conductive: `φ = φ_F + a + s ϰ E(t)`, `a` the face's offset, with `ϰ` the slope that
-    ///   makes the flux the law's: on the face (`ε_tt = 0`) the pressure is
-    ///   `λ_n = -σ_nn = c33 E - e33 ∂_s φ` and the flux `D·ν = e33 E + ε33 ∂_s φ`, so
+    /// tangential coordinates) and whose potential is `φ_F`. With `s = x_n - s0`,
+    /// `E(t) = 10⁻² + 10⁻³ sin(π t₀ / 2)` and `U(t₀)` the face's slip (0 where it sticks):
+    /// - `u_n = -g(t) - δ(t) - s E(t)` (`ε_nn = -E`: a compression; `δ` the penetration into
+    ///   the bed, 0 on a rigid foundation);
+    /// - sticking: `u_k = 10⁻³ s sin(π t_k / 2 + 0.3)` (`k < n`: no slip on the face);
+    /// - sliding along the first tangent: `u_0 = U + s W` with
+    ///   `W = μ(U) λ_n / c44 + ∂_0 (g + δ)`, so that the face's shear
+    ///   `σ_0n = c44 (∂_0 u_n + ∂_s u_0) = μ(U) λ_n` is the friction law's along the slip, and
+    ///   in 3D `u_1 = s κ (t_1 - c_1)` (no shear across the slip);
+    /// - the potential by the face's electric condition: conducting,
+    ///   `φ = φ_F + s (10⁻² + 5·10⁻³ cos(π t₀ / 2))`; conductive, `φ = φ_F + a + s Q(t₀)` with
+    ///   `Q` the slope that makes the flux the law's. On the face the fields give the pressure
+    ///   `λ_n = -σ_nn = c33 E - e33 Q - c13 U'` and the flux `D·ν = e33 E + ε33 Q - e31 U'`, so
     ///   `D·ν = σ' a λ_n` (`σ' = σ_c`, or `σ_c / k` on a linear bed, whose penetration is
-    ///   `λ_n / k`) gives `ϰ = (σ' a c33 - e33) / (ε33 + σ' a e33)`; `σ_c = 0` is the insulated
-    ///   face. (On a bed with `m ≠ 1` the penetration is not linear in the pressure and the
-    ///   slope has no closed form: there `σ_c` must be 0.)
+    ///   `λ_n / k`) gives `Q = ((σ' a c33 - e33) E + (e31 - σ' a c13) U') / (ε33 + σ' a e33)`;
+    ///   `σ_c = 0` is the insulated face. (On a bed with `m ≠ 1` the penetration is not linear
+    ///   in the pressure and `Q` has no closed form: there `σ_c` must be 0.)
     ///
-    /// On a bed the face sinks by `δ = (λ_n / k)^(1/m)`, `λ_n` the pressure the fields give on
-    /// the face. Whether the pressure is positive and the shear within the friction bound
-    /// depends on the material and the coefficient: the caller checks the run's status.
+    /// On a bed the face sinks by `δ = (λ_n / k)^(1/m)`. Whether the pressure is positive and,
+    /// on a sticking face, the shear within the friction bound depends on the material and the
+    /// coefficient: the caller checks the run's status.
     pub fn on_foundation(
         dim: usize,
         s0: f64,
@@ -139,76 +263,64 @@ impl Exact {
         let n = dim - 1;
         let h = PI / 2.0;
         let (delta, b) = (1e-2, 1e-3);
-        let [c33, e33, eps33] = face.constants;
-        // ∂_s φ on the face as `p0 + p1 sin(h t0) + p2 cos(h t0)`, and its value there
+        let k = face.constants;
+        let e = Trig([delta, b, 0.0]);
+        let amplitude = face.sliding.as_ref().map_or(0.0, |sl| sl.amplitude);
+        let slip = Trig([amplitude, 0.5 * amplitude, 0.0]);
+        // U' = A h cos / 2, as a Trig
+        let slip_rate = [0.0, 0.0, 0.5 * amplitude * h];
+        // ∂_s φ on the face, and the face's potential
         let (slope, face_phi) = match face.electric {
-            FaceElectric::Conducting => ([1e-2, 0.0, 5e-3], phi_f),
+            FaceElectric::Conducting => (Trig([1e-2, 0.0, 5e-3]), phi_f),
             FaceElectric::Conductive { conductance, offset } => {
-                let sigma = conductance / face.bed.map_or(1.0, |(k, _)| k);
-                let kappa = (sigma * offset * c33 - e33) / (eps33 + sigma * offset * e33);
-                ([kappa * delta, kappa * b, 0.0], phi_f + offset)
+                let sigma = conductance / face.bed.map_or(1.0, |(stiffness, _)| stiffness) * offset;
+                let d = k.eps33 + sigma * k.e33;
+                let (from_e, from_u) = ((sigma * k.c33 - k.e33) / d, (k.e31 - sigma * k.c13) / d);
+                let q = [0, 1, 2].map(|j| from_e * e.0[j] + from_u * slip_rate[j]);
+                (Trig(q), phi_f + offset)
             }
         };
-        // the pressure on the face, `l0 + l1 sin + l2 cos`, and the penetration's jet in t_0
-        let pressure = [c33 * delta - e33 * slope[0], c33 * b - e33 * slope[1], -e33 * slope[2]];
-        let penetration = move |t0: f64| -> (f64, f64, f64) {
-            let Some((k, m)) = face.bed else {
-                return (0.0, 0.0, 0.0);
-            };
-            let (sn, cs) = ((h * t0).sin(), (h * t0).cos());
-            let l = (pressure[0] + pressure[1] * sn + pressure[2] * cs) / k;
-            let dl = h * (pressure[1] * cs - pressure[2] * sn) / k;
-            let ddl = -h * h * (pressure[1] * sn + pressure[2] * cs) / k;
-            // δ = l^(1/m)
-            let r = 1.0 / m;
-            let v = l.powf(r);
-            let dv = r * l.powf(r - 1.0) * dl;
-            let ddv = r * (r - 1.0) * l.powf(r - 2.0) * dl * dl + r * l.powf(r - 1.0) * ddl;
-            (v, dv, ddv)
+        let pressure = Trig([0, 1, 2].map(|j| k.c33 * e.0[j] - k.e33 * slope.0[j] - k.c13 * slip_rate[j]));
+        // the penetration into the bed, with its derivatives in t_0
+        let penetration = move |t0: f64| -> [f64; 4] {
+            match face.bed {
+                None => [0.0; 4],
+                Some((stiffness, m)) => power(pressure.at(t0).map(|v| v / stiffness), 1.0 / m),
+            }
         };
+        let sliding = face.sliding.clone();
         Exact {
             dim,
             u: Arc::new(move |x| {
                 let s = x[n] - s0;
                 let mut out = [(0.0, [0.0; 3], [[0.0; 3]; 3]); 3];
-                for (k, o) in out.iter_mut().enumerate().take(n) {
-                    let (sn, cs) = ((h * x[k] + 0.3).sin(), (h * x[k] + 0.3).cos());
-                    let a = 1e-3;
-                    let mut g = [0.0; 3];
-                    let mut hh = [[0.0; 3]; 3];
-                    g[k] = a * s * h * cs;
-                    g[n] = a * sn;
-                    hh[k][k] = -a * s * h * h * sn;
-                    hh[k][n] = a * h * cs;
-                    hh[n][k] = a * h * cs;
-                    *o = (a * s * sn, g, hh);
+                let pen = penetration(x[0]);
+                match &sliding {
+                    None => sticking(x, s, n, &mut out),
+                    Some(sl) => {
+                        let l = pressure.at(x[0]);
+                        sliding_face(x, s, (dim, k.c44), (slip, sl, l, pen), (curvature, center), &mut out);
+                    }
                 }
-                let (sn, cs) = ((h * x[0]).sin(), (h * x[0]).cos());
-                let (pen, dpen, ddpen) = penetration(x[0]);
-                let gap = g0 + pen + 0.5 * curvature * (0..n).map(|k| (x[k] - center[k]).powi(2)).sum::<f64>();
+                let ev = e.at(x[0]);
+                let gap = g0 + pen[0] + 0.5 * curvature * (0..n).map(|k| (x[k] - center[k]).powi(2)).sum::<f64>();
                 let mut g = [0.0; 3];
                 let mut hh = [[0.0; 3]; 3];
                 for k in 0..n {
                     g[k] = -curvature * (x[k] - center[k]);
                     hh[k][k] = -curvature;
                 }
-                g[0] -= dpen;
-                hh[0][0] -= ddpen;
-                g[0] -= s * b * h * cs;
-                g[n] = -(delta + b * sn);
-                hh[0][0] += s * b * h * h * sn;
-                hh[0][n] = -b * h * cs;
-                hh[n][0] = -b * h * cs;
-                out[n] = (-gap - s * (delta + b * sn), g, hh);
+                g[0] -= pen[1] + s * ev[1];
+                hh[0][0] -= pen[2] + s * ev[2];
+                g[n] = -ev[0];
+                hh[0][n] = -ev[1];
+                hh[n][0] = -ev[1];
+                out[n] = (-gap - s * ev[0], g, hh);
                 out
             }),
             phi: Arc::new(move |x| {
                 let s = x[n] - s0;
-                let (sn, cs) = ((h * x[0]).sin(), (h * x[0]).cos());
-                let [p0, p1, p2] = slope;
-                let value = p0 + p1 * sn + p2 * cs;
-                let dvalue = h * (p1 * cs - p2 * sn);
-                let ddvalue = -h * h * (p1 * sn + p2 * cs);
+                let [value, dvalue, ddvalue, _] = slope.at(x[0]);
                 let mut g = [0.0; 3];
                 let mut hh = [[0.0; 3]; 3];
                 g[0] = s * dvalue;
@@ -437,13 +549,18 @@ mod tests {
         }
     }
 
-    /// The jets of the solution on a foundation against central differences, in 2D and 3D,
-    /// rigid and on beds, conducting, conductive and insulated, and its contact face's values:
-    /// the gap's normal displacement (and the bed's penetration `(λ_n/k)^(1/m)`), no slip, the
-    /// face's potential, and the conductive law's flux `σ' (φ - φ_F) λ_n`.
-    #[test]
-    fn the_foundation_solution_has_consistent_jets_and_its_face_law() {
-        let constants = [111.0, 15.8, 7.35];
+    /// Faces of every kind: rigid and on beds (linear, `m = 2.5`), conducting, conductive and
+    /// insulated, sticking, sliding under Coulomb's law and under an exponential weakening
+    /// (not the conductive face on a nonlinear bed: no closed form).
+    fn faces() -> Vec<Face> {
+        let constants = FaceConstants {
+            c33: 111.0,
+            c13: 75.2,
+            c44: 21.1,
+            e33: 15.8,
+            e31: -5.4,
+            eps33: 7.35,
+        };
         let beds = [None, Some((50.0, 1.0)), Some((3.0, 2.5))];
         let electric = [
             FaceElectric::Conducting,
@@ -456,59 +573,126 @@ mod tests {
                 offset: -0.3,
             },
         ];
-        for dim in [2, 3] {
-            for (bed, electric) in beds.iter().flat_map(|b| electric.map(|e| (*b, e))) {
+        let (ms, md, l) = (0.6, 0.2, 1.5e-3);
+        let weakening: FrictionFn = Arc::new(move |s: f64| {
+            let x = (-s / l).exp();
+            [md + (ms - md) * x, -(ms - md) / l * x, (ms - md) / (l * l) * x]
+        });
+        let slides = [
+            None,
+            Some(Sliding {
+                amplitude: 2e-3,
+                friction: Arc::new(|_| [0.3, 0.0, 0.0]),
+            }),
+            Some(Sliding {
+                amplitude: 1e-3,
+                friction: weakening,
+            }),
+        ];
+        let mut out = vec![];
+        for bed in beds {
+            for electric in electric {
                 let nonlinear = bed.is_some_and(|(_, m)| m != 1.0);
                 if nonlinear && matches!(electric, FaceElectric::Conductive { conductance, .. } if conductance > 0.0) {
-                    continue; // no closed form (see on_foundation)
+                    continue;
                 }
-                let face = Face {
-                    constants,
-                    bed,
-                    electric,
-                };
+                for sliding in slides.clone() {
+                    out.push(Face {
+                        constants,
+                        bed,
+                        electric,
+                        sliding,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The first and second derivatives of `e`'s jets at `x` against central differences.
+    fn jets_match_differences(e: &Exact, x: [f64; 3]) {
+        let dim = e.dim;
+        let jets = |x: &[f64]| {
+            let u = (e.u)(x);
+            let mut all: Vec<Jet> = u[..dim].to_vec();
+            all.push((e.phi)(x));
+            all
+        };
+        let d = 1e-5;
+        let at = jets(&x);
+        for i in 0..dim {
+            let (mut xp, mut xm) = (x, x);
+            xp[i] += d;
+            xm[i] -= d;
+            let (p, m) = (jets(&xp), jets(&xm));
+            for f in 0..=dim {
+                assert!(
+                    ((p[f].0 - m[f].0) / (2.0 * d) - at[f].1[i]).abs() < 1e-8,
+                    "{dim}D field {f} d{i}"
+                );
+                for j in 0..dim {
+                    let fd = (p[f].1[j] - m[f].1[j]) / (2.0 * d);
+                    assert!((fd - at[f].2[j][i]).abs() < 1e-7, "{dim}D field {f} d{j}d{i}");
+                }
+            }
+        }
+    }
+
+    /// The jets of the solution on a foundation against central differences, in 2D and 3D,
+    /// rigid and on beds, conducting, conductive and insulated, sticking and sliding; and its
+    /// contact face's values: the gap's normal displacement (and the bed's penetration
+    /// `(λ_n/k)^(1/m)`), the slip, the face's potential, the conductive law's flux
+    /// `σ_c p (φ - φ_F)`, and a sliding face's shear `μ(U) λ_n`.
+    #[test]
+    fn the_foundation_solution_has_consistent_jets_and_its_face_law() {
+        for dim in [2, 3] {
+            for face in faces() {
+                let (constants, bed, electric, sliding) =
+                    (face.constants, face.bed, face.electric, face.sliding.clone());
                 let e = Exact::on_foundation(dim, 0.1, (0.02, 0.3, [1.0, 0.5, 0.0]), 0.04, face);
                 let x = [0.3, 0.7, 0.45];
+                jets_match_differences(&e, x);
                 let jets = |x: &[f64]| {
                     let u = (e.u)(x);
                     let mut all: Vec<Jet> = u[..dim].to_vec();
                     all.push((e.phi)(x));
                     all
                 };
-                let d = 1e-5;
-                let at = jets(&x);
-                for i in 0..dim {
-                    let (mut xp, mut xm) = (x, x);
-                    xp[i] += d;
-                    xm[i] -= d;
-                    let (p, m) = (jets(&xp), jets(&xm));
-                    for f in 0..=dim {
-                        assert!(
-                            ((p[f].0 - m[f].0) / (2.0 * d) - at[f].1[i]).abs() < 1e-8,
-                            "{dim}D field {f} d{i}"
-                        );
-                        for j in 0..dim {
-                            let fd = (p[f].1[j] - m[f].1[j]) / (2.0 * d);
-                            assert!((fd - at[f].2[j][i]).abs() < 1e-7, "{dim}D field {f} d{j}d{i}");
-                        }
-                    }
-                }
                 // on the face x_n = 0.1
                 let mut y = x;
                 y[dim - 1] = 0.1;
                 let face_jets = jets(&y);
                 let gap = 0.02 + 0.15 * (0..dim - 1).map(|k| (y[k] - [1.0, 0.5][k]).powi(2)).sum::<f64>();
-                // the pressure and flux from the jets: -σ_nn = -(c33 ε_nn + e33 φ_n) and
-                // D·ν = -(e33 ε_nn - ε33 φ_n), the tangential strain being 0 on the face
+                // the pressure, flux and shear from the jets (the face's tangential strain is
+                // ε_00 = U' alone)
                 let n = dim - 1;
-                assert!((0..n).all(|k| face_jets[k].1[k] == 0.0));
+                let eps_tt: f64 = (0..n).map(|k| face_jets[k].1[k]).sum();
                 let (eps_nn, phi_n) = (face_jets[n].1[n], face_jets[dim].1[n]);
-                let pressure = -(constants[0] * eps_nn + constants[1] * phi_n);
-                let flux = -(constants[1] * eps_nn - constants[2] * phi_n);
+                let pressure = -(constants.c13 * eps_tt + constants.c33 * eps_nn + constants.e33 * phi_n);
+                let flux = -(constants.e31 * eps_tt + constants.e33 * eps_nn - constants.eps33 * phi_n);
+                let shear = |k: usize| constants.c44 * (face_jets[n].1[k] + face_jets[k].1[n]);
                 assert!(pressure > 0.0);
                 let sink = bed.map_or(0.0, |(k, m)| (pressure / k).powf(1.0 / m));
                 assert!((-face_jets[n].0 - gap - sink).abs() < 1e-15);
-                assert!((0..n).all(|k| face_jets[k].0 == 0.0));
+                assert!(
+                    (0..dim).all(|k| face_jets[dim].1[k] == 0.0 || k == n),
+                    "the face is equipotential"
+                );
+                match &sliding {
+                    None => assert!((0..n).all(|k| face_jets[k].0 == 0.0)),
+                    Some(sl) => {
+                        let u = face_jets[0].0;
+                        assert!((u - sl.amplitude * (1.0 + 0.5 * (PI / 2.0 * y[0]).sin())).abs() < 1e-15);
+                        let mu = (sl.friction)(u)[0];
+                        assert!(
+                            (shear(0) - mu * pressure).abs() < 1e-12,
+                            "{} {}",
+                            shear(0),
+                            mu * pressure
+                        );
+                        assert!(n == 1 || (face_jets[1].0 == 0.0 && shear(1).abs() < 1e-14));
+                    }
+                }
                 match electric {
                     FaceElectric::Conducting => assert!((face_jets[dim].0 - 0.04).abs() < 1e-15),
                     FaceElectric::Conductive { conductance, offset } => {

@@ -6,8 +6,9 @@
 use crate::analytical::{cattaneo_stick_half_width, cattaneo_traction, hertz, hertz_pressure};
 use crate::scene::{ElectricCondition, ExactKind, Scene};
 use contact::{ContactPoints, ContactSolution, Status};
-use fe_assembly::{Discretization, Exact, Face, FaceElectric};
+use fe_assembly::{Discretization, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// The potential of the contact face above the foundation's in the manufactured solution on a
 /// conductive or insulated foundation (`φ - φ_F`, in the scene's unit: of the order of the
@@ -55,10 +56,26 @@ impl FieldSolution {
                     offset: FACE_OFFSET,
                 },
             };
+            let constants = FaceConstants {
+                c33: at(&m.c, 3),
+                c13: at(&m.c, 2),
+                c44: at(&m.c, 4),
+                e33: at(&m.e, 1),
+                e31: at(&m.e, 0),
+                eps33: at(&m.permittivity, 1),
+            };
+            let friction: FrictionFn = match c.slip_weakening() {
+                Some(w) => Arc::new(move |s| [w.coefficient(s), w.slope(s), w.curvature(s)]),
+                None => {
+                    let f = c.friction();
+                    Arc::new(move |_| [f, 0.0, 0.0])
+                }
+            };
             let face = Face {
-                constants: [at(&m.c, 3), at(&m.e, 1), at(&m.permittivity, 1)],
+                constants,
                 bed: c.compliance.map(|k| (k.stiffness, k.exponent)),
                 electric,
+                sliding: x.slip.map(|amplitude| Sliding { amplitude, friction }),
             };
             let gap = (c.gap, c.gap_curvature, [center[0], center[1], center[2]]);
             Exact::on_foundation(dim, s0, gap, c.foundation_potential.unwrap_or(0.0), face)

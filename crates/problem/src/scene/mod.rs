@@ -1022,6 +1022,10 @@ pub struct ExactSpec {
     /// `affine`: `∇φ`.
     #[serde(default)]
     pub grad_phi: Vec<f64>,
+    /// `manufactured-contact`: the face slides along the first tangent by
+    /// `A (1 + sin(π t₀ / 2) / 2)`, this `A > 0` (absent: it sticks).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slip: Option<f64>,
 }
 
 impl ExactSpec {

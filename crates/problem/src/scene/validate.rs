@@ -863,6 +863,18 @@ fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
         ]
         .concat(),
     )?;
+    if let Some(a) = x.slip {
+        refuse_if(
+            kind != ExactKind::ManufacturedContact,
+            "exact.slip",
+            "the slip of the face of exact.kind = \"manufactured-contact\", and exact.kind is another",
+        )?;
+        refuse_if(
+            !(a > 0.0 && a.is_finite()),
+            "exact.slip",
+            &format!("exact.slip = {a}: the face's slip amplitude must be positive and finite"),
+        )?;
+    }
     if kind != ExactKind::Affine {
         let why = "data of an affine solution, and exact.kind is a manufactured one";
         refuse_if(!x.u0.is_empty(), "exact.u0", why)?;
@@ -888,12 +900,13 @@ fn validate_manufactured_contact(s: &Scene) -> Result<(), SceneError> {
     };
     let electric = c.electric.unwrap_or(crate::scene::ElectricCondition::Insulated);
     let conducting = electric == crate::scene::ElectricCondition::Conducting;
-    if c.compliance.is_some() || !conducting {
+    let slides = s.exact.as_ref().is_some_and(|x| x.slip.is_some());
+    if c.compliance.is_some() || !conducting || slides {
         let m = &s.material;
         let poled = m.len() == 1
             && m[0].model == crate::scene::MaterialModel::Crystal6mm
             && m[0].poling.iter().zip(&c.normal).all(|(p, n)| (p + n).abs() < 1e-12);
-        let on_face = "exact.kind = \"manufactured-contact\" on a deformable, conductive or insulated foundation takes one 6mm crystal poled along the contact normal (its c33, e33 and eps33 make the face's pressure and flux)";
+        let on_face = "exact.kind = \"manufactured-contact\" on a deformable, conductive or insulated foundation, or sliding, takes one 6mm crystal poled along the contact normal (its constants make the face's pressure, flux and shear)";
         refuse_if(!poled, "material.poling", on_face)?;
     }
     if let Some(k) = c.compliance {
@@ -904,11 +917,6 @@ fn validate_manufactured_contact(s: &Scene) -> Result<(), SceneError> {
             linear,
         )?;
     }
-    refuse_if(
-        c.friction_law.is_some_and(|f| f != crate::scene::FrictionLaw::Coulomb),
-        "contact.friction_law",
-        why,
-    )?;
     let Some(dim) = s
         .mesh
         .dim()
@@ -952,6 +960,7 @@ fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError>
         why,
     )?;
     refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
+    refuse_if(x.slip.is_some(), "exact.slip", why)?;
     if s.mesh.kind != MeshKind::Rectangle {
         return Err(SceneError::new(
             "exact.kind",
