@@ -69,6 +69,13 @@ pub enum Event<'a> {
         /// The equilibrium residual of the final pair.
         equilibrium: f64,
     },
+    /// Slip weakening's fixed point on the coefficients was not contractive on its way (its
+    /// largest secant ratio at or above 1): the static problem may have several solutions,
+    /// and the one found is the branch from the stick start.
+    NotContractive {
+        /// The largest secant ratio of the map.
+        contraction: f64,
+    },
     /// A step of a load path begins.
     PathStep {
         /// The step (0 for the path's first instant).
@@ -161,6 +168,10 @@ impl fmt::Display for Event<'_> {
                 "mesh: {n_nodes} nodes, {n_cells} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
             ),
             Event::Factored { seconds } => write!(f, "factorisation {seconds:.3} s"),
+            Event::NotContractive { contraction } => write!(
+                f,
+                "note: the fixed point on the friction coefficients was not contractive on its way (largest ratio {contraction:.3}): the problem may have several solutions; this one is the branch from the stick start"
+            ),
             Event::PathStep { step, of, t } => write!(f, "path step {step}/{of}: t = {t}"),
             Event::Condensed { m, route, seconds } => write!(
                 f,

@@ -116,6 +116,11 @@ pub fn run<B: Backend>(
         None => backend.solve_linear(&posed, &mut system, reporter)?,
     };
     let equilibrium = backend.equilibrium(&posed, &system, &solved)?;
+    if let Some(contraction) = solved.contact.as_ref().and_then(|(_, sol)| sol.info.contraction) {
+        if contraction >= 1.0 {
+            reporter.event(&Event::NotContractive { contraction });
+        }
+    }
     reporter.event(&Event::Solved {
         seconds: solved.seconds,
         pcg_iters: solved.pcg_iters,

@@ -544,6 +544,8 @@ pub(crate) struct Shared {
     /// The insulated problem's answer of a coupled problem (`Some(None)` where its solve
     /// failed).
     insulated: Option<Option<PointValues>>,
+    /// The estimate of `μ_max` of a coupled problem's `D`, whatever its electric law.
+    mu_max: Option<f64>,
 }
 
 /// [`solve_newton`], with what it shares with the other solves of `problem` in `cache`.
@@ -681,14 +683,16 @@ fn solve_electric(
     cache: &mut Shared,
 ) -> Result<ContactSolution, ContactError> {
     check_tolerance(params)?;
+    // the candidates and the coupled problem share `D`, and so its largest eigenvalue
     let pre = Preamble::new(
         &mut Counter::new(problem),
         points,
         law,
         params.power_iters,
-        params.mu_max,
+        params.mu_max.or(cache.mu_max),
     )?;
     let (mu_max, reference) = (pre.mu_max, pre.reference);
+    cache.mu_max = Some(mu_max);
     let mut info = ContactInfo::new(mu_max);
     info.augmentation = Some(1.0 / mu_max);
     let u0 = problem.u0.clone();
