@@ -130,6 +130,17 @@ fn errors(dim: usize, condition: ElectricCondition, sigma: Option<f64>) -> (f64,
     let a = bottom_potential(condition, sigma.unwrap_or(0.0));
     let (lambda, q) = at(a);
     assert!(lambda > 0.0, "the block is in contact: λ = {lambda}");
+    // the top terminal carries the flux out through the top, `D·e_n = -q`, over its area (the
+    // electric equation's reaction at its nodes)
+    let area = if dim == 2 { 2.0 } else { 1.0 };
+    let top = solution.report.terminals.iter().find(|t| t.group == "top").unwrap();
+    assert!(
+        (top.charge + q * area).abs() <= 1e-9 * (q * area).abs().max(E33 * DELTA),
+        "{dim}D {condition:?}: top charge {} vs {}",
+        top.charge,
+        -q * area
+    );
+    assert!((top.potential - V).abs() < 1e-15);
     let rel = |x: f64, y: f64, scale: f64| (x - y).abs() / scale;
     let e_lambda = contact
         .solution
@@ -146,7 +157,6 @@ fn errors(dim: usize, condition: ElectricCondition, sigma: Option<f64>) -> (f64,
     let e_q = e.flux.iter().map(|f| rel(*f, q, q_scale)).fold(0.0, f64::max);
     let e_phi = e.potential.iter().map(|p| rel(*p, a, PHI_F)).fold(0.0, f64::max);
     // the charge through the zone reported: q times the face's area
-    let area = if dim == 2 { 2.0 } else { 1.0 };
     let charge = solution.report.contact.charge.unwrap();
     assert!(
         (charge - q * area).abs() <= 1e-9 * (q * area).abs().max(1e-12),

@@ -157,16 +157,64 @@ enum Command {
     },
 }
 
-/// Lines to stderr, and a progress bar for the contact solve when stderr is a terminal.
+/// Lines to stderr, and a progress bar for the contact solve when stderr is a terminal; along
+/// a load path, one line per step and a bar over the steps (the steps' own contact lines left
+/// out).
 struct Terminal {
     bar: Option<indicatif::ProgressBar>,
     first_residual: Option<f64>,
+    path: Option<indicatif::ProgressBar>,
+}
+
+impl Terminal {
+    fn new() -> Self {
+        Terminal {
+            bar: None,
+            first_residual: None,
+            path: None,
+        }
+    }
+
+    /// Along a path: the bar over its steps; `true` where the event's own line is left out.
+    fn path_event(&mut self, event: &Event<'_>) -> bool {
+        match event {
+            Event::PathStep { step, of, t } => {
+                let bar = self.path.get_or_insert_with(|| path_bar(*of as u64 + 1));
+                bar.set_position(*step as u64);
+                bar.set_message(format!("t = {t}"));
+                true
+            }
+            Event::PathStepDone { row, of } => {
+                if let Some(bar) = &self.path {
+                    bar.set_position(row.step as u64 + 1);
+                    if row.step == *of {
+                        bar.finish_and_clear();
+                    }
+                }
+                false
+            }
+            Event::Contact { .. } | Event::NotContractive { .. } => self.path.is_some(),
+            _ => false,
+        }
+    }
+}
+
+/// The progress bar over a load path's steps.
+fn path_bar(steps: u64) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::with_draw_target(Some(steps), indicatif::ProgressDrawTarget::stderr());
+    if let Ok(style) = indicatif::ProgressStyle::with_template("path [{bar:40}] {pos}/{len} steps, {msg}, {elapsed}") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
 }
 
 impl problem::Reporter for Terminal {
     fn event(&mut self, event: &Event<'_>) {
+        if self.path_event(event) {
+            return;
+        }
         if let Some(line) = event.line() {
-            match &self.bar {
+            match self.path.as_ref().or(self.bar.as_ref()) {
                 Some(bar) if !bar.is_hidden() => bar.println(line),
                 _ => eprintln!("{line}"),
             }
@@ -327,10 +375,7 @@ fn run(
         scene.validate().map_err(|e| files::Error::scene(&name, e))?;
     }
     let dir = out.unwrap_or_else(|| output::default_dir(&scene.name));
-    let mut terminal = Terminal {
-        bar: None,
-        first_residual: None,
-    };
+    let mut terminal = Terminal::new();
     let solution = match scene.solver.backend {
         BackendChoice::Faer => Some(files::run::run(&scene, &source, &dir, &mut terminal)?),
         BackendChoice::Petsc => run_petsc(&scene, &source, &dir, &mut terminal)?,
@@ -342,7 +387,19 @@ fn run(
                 p.ranks, p.unknowns, p.krylov_iterations, p.reason
             ));
         }
-        let names: Vec<&str> = solution.report.plan.outputs.iter().map(|o| o.name()).collect();
+        let mut names: Vec<String> = solution
+            .report
+            .plan
+            .outputs
+            .iter()
+            .map(|o| o.name().to_string())
+            .collect();
+        if let Some(path) = &solution.report.path {
+            names.push(format!(
+                "path.csv, path.svg/png, path.pvd with step-0000.vtu ... step-{:04}.vtu",
+                path.instants.saturating_sub(1)
+            ));
+        }
         say(&format!("wrote {} in {}", names.join(", "), dir.display()));
     }
     Ok(())

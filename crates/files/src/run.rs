@@ -63,19 +63,22 @@ pub fn solve_with(
 }
 
 /// Solves a scene with a `[path]` (the quasi-static process), as [`solve_with`] does one
-/// instant, gathering the files of every step ([`output::PathFiles`]); writes nothing.
+/// instant, calling `each` with every instant in order (to write its files: a step's fields
+/// are dropped once it returns); the last instant is returned, its report with the path's rows.
 ///
 /// # Errors
-/// As [`solve`], and [`Error::Picture`] for a step's file.
-pub fn solve_path(
+/// As [`solve`], and the error `each` returns.
+pub fn solve_path_with(
     scene: &Scene,
     source: &Source,
+    given: Option<mesh::Mesh>,
     interrupt: contact::Interrupt,
     reporter: &mut dyn Reporter,
-) -> Result<(Solution, output::Outputs), Error> {
-    let mesh = match (scene.mesh.kind, &scene.mesh.file) {
-        (MeshKind::Gmsh, Some(file)) => Some(mesh::read_msh(source.dir.join(file))?),
-        _ => None,
+    each: &mut dyn FnMut(problem::Step<'_>) -> Result<(), Error>,
+) -> Result<Solution, Error> {
+    let mesh = match (scene.mesh.kind, &scene.mesh.file, given) {
+        (MeshKind::Gmsh, Some(file), None) => Some(mesh::read_msh(source.dir.join(file))?),
+        (_, _, given) => given,
     };
     let (memory_bytes, memory_limit) = memory_limits(1);
     let limits = problem::Limits {
@@ -83,14 +86,13 @@ pub fn solve_path(
         memory_limit,
         interrupt,
     };
-    // every plan writes solution.vtu: the series too
-    let mut files = output::PathFiles::new(&[problem::Output::SolutionVtu]);
+    // the caller's error, carried past the problem's
     let mut failed = None;
     let solved = problem::solve_path(scene, mesh, limits, reporter, &mut |step| {
-        files.step(&step).map_err(|e| {
+        each(step).map_err(|e| {
             let message = e.to_string();
             failed = Some(e);
-            problem::SceneError::new("path", message).into()
+            problem::ProblemError::from(problem::SceneError::new("path", message))
         })
     });
     if let Some(e) = failed {
@@ -99,8 +101,25 @@ pub fn solve_path(
     let mut solution = solved?.last;
     solution.report.scene.source = source.label.clone();
     solution.report.memory.peak_bytes = peak_memory_bytes();
-    let out = files.finish(&solution)?;
-    Ok((solution, out))
+    Ok(solution)
+}
+
+/// Solves a scene with a `[path]` and writes its set into `dir` as it goes: each instant's
+/// `step-NNNN.vtu` written and dropped (not held), then the last instant's files, `path.csv`,
+/// `path.pvd` and the path's pictures, the set turned to as a whole at the end (nothing on
+/// error).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_path(scene: &Scene, source: &Source, dir: &Path, reporter: &mut dyn Reporter) -> Result<Solution, Error> {
+    let mut writer = output::SetWriter::begin(dir, &output::PathFiles::expected_names(scene))?;
+    let mut files = output::PathFiles::default();
+    let solution = solve_path_with(scene, source, None, contact::Interrupt::NONE, reporter, &mut |step| {
+        files.step(&step, &mut writer)
+    })?;
+    writer.write_all(files.finish(&solution)?)?;
+    writer.finish()?;
+    Ok(solution)
 }
 
 /// As [`solve`], then writes the plan's outputs into `dir` (as one set; nothing on error).
@@ -109,9 +128,7 @@ pub fn solve_path(
 /// As [`solve`], and [`Error::Output`] or [`Error::Picture`] for the files.
 pub fn run(scene: &Scene, source: &Source, dir: &Path, reporter: &mut dyn Reporter) -> Result<Solution, Error> {
     if scene.path.is_some() {
-        let (solution, out) = solve_path(scene, source, contact::Interrupt::NONE, reporter)?;
-        out.into(dir).commit()?;
-        return Ok(solution);
+        return run_path(scene, source, dir, reporter);
     }
     let solution = solve(scene, source, reporter)?;
     output::write(&solution, dir)?;

@@ -78,7 +78,7 @@ pub use path::{solve_path, PathSolution, Step};
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
-pub use run::{run, solve, solve_within, ContactResult, Solution, EQUILIBRIUM_TOL};
+pub use run::{run, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectricCondition,
     ElectrodeSpec, ExactKind, ExactSpec, Factors, LoadSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec,
@@ -86,6 +86,35 @@ pub use scene::{
 };
 
 use contact::ContactError;
+
+/// Solves `scene` on the default backend ([`Faer`]). `mesh` is the mesh of a `gmsh` scene,
+/// read by the caller (generated meshes are made here); `reporter` receives one event per
+/// step and per outer iteration.
+///
+/// # Errors
+/// A [`ProblemError`] naming the scene key, mesh item, material or solver step at fault.
+pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporter) -> Result<Solution, ProblemError> {
+    solve_within(scene, mesh, Limits::default(), reporter)
+}
+
+/// As [`solve`], within `limits`: a run whose memory estimate exceeds them stops with
+/// [`ProblemError::TooLarge`] before the memory is taken.
+///
+/// # Errors
+/// As [`solve`], and [`ProblemError::TooLarge`].
+pub fn solve_within(
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<Solution, ProblemError> {
+    if scene.path.is_some() {
+        // a path's instants, each step's files unwritten: the last instant, with the rows
+        return Ok(path::solve_path(scene, mesh, limits, reporter, &mut |_| Ok(()))?.last);
+    }
+    let solution = run::run(&mut Faer, scene, mesh, limits, reporter)?;
+    Ok(solution.expect("the default backend runs in one process, which holds the solution"))
+}
 
 /// "the most extreme inputs are ..." naming the scene's numbers far from 1 (each key once), or
 /// `None` where there are none.

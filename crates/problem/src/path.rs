@@ -117,29 +117,15 @@ pub fn solve_path(
     let mut path = PathSystem::new(&mut system, &boundary, &ordered, setup.plan.n_tangential(), reporter)?;
     let t_steps = Instant::now();
     let mut state = History::new(boundary.points.len(), setup.plan.n_tangential(), instants.len());
-    for (k, &t) in instants.iter().enumerate() {
-        reporter.event(&Event::PathStep {
-            step: k,
-            of: instants.len() - 1,
-            t,
-        });
-        let at = |e: ProblemError| e.at_step(k, t);
-        let done = walk
-            .step((k, t), &mut disc, (&mut system, &mut path), &how, &mut state, reporter)
-            .map_err(at)?;
-        each(Step {
-            row: &done.row,
-            mesh: &setup.mesh,
-            u: &done.recovered.u,
-            phi: &done.recovered.phi,
-            fields: &done.recovered.fields,
-            contact: Some(&done.result),
-        })?;
-        state.rows.push(done.row.clone());
-        if k + 1 == instants.len() {
-            state.last = Some(done);
-        }
-    }
+    walk.all_steps(
+        &instants,
+        &mut disc,
+        (&mut system, &mut path),
+        &how,
+        &mut state,
+        reporter,
+        each,
+    )?;
     let steps_s = t_steps.elapsed().as_secs_f64();
     let timings = (t_setup, t_assembly, steps_s, t_total);
     let (report, done) = walk.finish(&disc, &system, state, timings);
@@ -200,6 +186,42 @@ struct Done {
 }
 
 impl Walk<'_> {
+    /// Every instant in order, each handed to `each` and its row kept; the last kept whole.
+    #[allow(clippy::too_many_arguments)]
+    fn all_steps(
+        &self,
+        instants: &[f64],
+        disc: &mut Discretization<'_>,
+        (system, path): (&mut crate::faer_backend::Factored, &mut PathSystem),
+        how: &ContactSolve<'_>,
+        state: &mut History,
+        reporter: &mut dyn Reporter,
+        each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+    ) -> Result<(), ProblemError> {
+        let of = instants.len() - 1;
+        for (k, &t) in instants.iter().enumerate() {
+            reporter.event(&Event::PathStep { step: k, of, t });
+            let at = |e: ProblemError| e.at_step(k, t);
+            let done = self
+                .step((k, t), disc, (system, path), how, state, reporter)
+                .map_err(at)?;
+            reporter.event(&Event::PathStepDone { row: &done.row, of });
+            each(Step {
+                row: &done.row,
+                mesh: &self.setup.mesh,
+                u: &done.recovered.u,
+                phi: &done.recovered.phi,
+                fields: &done.recovered.fields,
+                contact: Some(&done.result),
+            })?;
+            state.rows.push(done.row.clone());
+            if k == of {
+                state.last = Some(done);
+            }
+        }
+        Ok(())
+    }
+
     /// The instant `(k, t)`: its prescribed values, gap and loads scaled, the contact problem
     /// in the frame of the step before, the fields recovered and checked.
     fn step(
@@ -252,7 +274,8 @@ impl Walk<'_> {
         // the next step's frame: the tangential displacement of the points now
         let mut now = PointValues::zeros(boundary.points.len(), boundary.points.n_tangential());
         boundary.extract(&u, &mut now);
-        let row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift, equilibrium);
+        let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift, equilibrium);
+        row.charges = recovered.terminals.iter().map(|x| x.charge).collect();
         if setup.plan.n_tangential() > 0 {
             state.shift.tangential.clone_from(&now.tangential);
         }
@@ -387,6 +410,7 @@ fn step_row(
         n_slip: counts.n_slip,
         n_separated: counts.n_separated,
         iterations: sol.info.newton_iters + sol.info.uzawa_iters,
+        charges: vec![],
         complementarity: sol.info.complementarity,
         equilibrium,
     }

@@ -76,6 +76,13 @@ pub enum Event<'a> {
         /// The largest secant ratio of the map.
         contraction: f64,
     },
+    /// A step of a load path is solved: its row.
+    PathStepDone {
+        /// The row (`path.csv`'s).
+        row: &'a crate::report::StepRow,
+        /// The last step.
+        of: usize,
+    },
     /// A step of a load path begins.
     PathStep {
         /// The step (0 for the path's first instant).
@@ -171,6 +178,11 @@ impl fmt::Display for Event<'_> {
             Event::NotContractive { contraction } => write!(
                 f,
                 "note: the fixed point on the friction coefficients was not contractive on its way (largest ratio {contraction:.3}): the problem may have several solutions; this one is the branch from the stick start"
+            ),
+            Event::PathStepDone { row, of } => write!(
+                f,
+                "path step {}/{of}, t = {}: normal force {:.4e}, tangential {:.4e}; stick {}, slip {}, separated {}; {} iterations",
+                row.step, row.t, row.normal_force, row.tangential_force, row.n_stick, row.n_slip, row.n_separated, row.iterations
             ),
             Event::PathStep { step, of, t } => write!(f, "path step {step}/{of}: t = {t}"),
             Event::Condensed { m, route, seconds } => write!(

@@ -39,6 +39,22 @@ pub struct RunReport {
     /// A load path's figures (absent from a run of one instant).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<PathReport>,
+    /// The boundary groups where the potential is prescribed (the electrode, grounded sides),
+    /// each with its potential and the charge through it (absent without electric unknowns).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub terminals: Vec<TerminalReport>,
+}
+
+/// A boundary group at a prescribed potential (`run.json`'s `terminals`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct TerminalReport {
+    /// The boundary group (`electrode` for the scene's `[electrode]`).
+    pub group: String,
+    /// Its potential (at its first node, where the prescribed value varies).
+    pub potential: f64,
+    /// The charge through it, `∫ D·ν ds` (`ν` out of the body; the electrode's own charge is
+    /// its negative), as the electric equation's reaction at its nodes.
+    pub charge: f64,
 }
 
 /// A load path's figures (`run.json`'s `path`): its steps, one row each, and what was reused.
@@ -82,6 +98,9 @@ pub struct StepRow {
     pub n_separated: usize,
     /// Newton (or first-order) iterations of the step.
     pub iterations: usize,
+    /// The charge through each terminal, in the order of [`RunReport::terminals`].
+    #[serde(default)]
+    pub charges: Vec<f64>,
     /// The complementarity residual of the step.
     pub complementarity: f64,
     /// The equilibrium residual of the step.

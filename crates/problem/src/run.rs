@@ -6,7 +6,6 @@
 use crate::backend::{Backend, ContactSolve, Figures, Finished, Limits, Loads, Posed, Solved};
 use crate::boundary::ContactBoundary;
 use crate::exact::contact_errors;
-use crate::faer_backend::Faer;
 use crate::plan::Plan;
 use crate::progress::{Event, Reporter};
 use crate::report::{
@@ -51,31 +50,6 @@ pub struct ContactResult {
     pub displacement: PointValues,
 }
 
-/// Solves `scene` on the default backend ([`Faer`]). `mesh` is the mesh of a `gmsh` scene,
-/// read by the caller (generated meshes are made here); `reporter` receives one event per
-/// step and per outer iteration.
-///
-/// # Errors
-/// A [`ProblemError`] naming the scene key, mesh item, material or solver step at fault.
-pub fn solve(scene: &Scene, mesh: Option<mesh::Mesh>, reporter: &mut dyn Reporter) -> Result<Solution, ProblemError> {
-    solve_within(scene, mesh, Limits::default(), reporter)
-}
-
-/// As [`solve`], within `limits`: a run whose memory estimate exceeds them stops with
-/// [`ProblemError::TooLarge`] before the memory is taken.
-///
-/// # Errors
-/// As [`solve`], and [`ProblemError::TooLarge`].
-pub fn solve_within(
-    scene: &Scene,
-    mesh: Option<mesh::Mesh>,
-    limits: Limits,
-    reporter: &mut dyn Reporter,
-) -> Result<Solution, ProblemError> {
-    let solution = run(&mut Faer, scene, mesh, limits, reporter)?;
-    Ok(solution.expect("the default backend runs in one process, which holds the solution"))
-}
-
 /// Solves `scene` on `backend`, within `limits`: validate, refuse what the backend does not
 /// take, set up (the memory estimate checked first), discretise, assemble, build the contact
 /// boundary, prepare (factor), solve, measure the equilibrium, gather, check, recover,
@@ -93,6 +67,10 @@ pub fn run<B: Backend>(
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, B::Error> {
     let scene = scene.validate().map_err(ProblemError::from)?;
+    if scene.scene().path.is_some() {
+        let why = "a load path is solved by problem::solve or problem::solve_path (its steps share one factorisation), not one instant of a backend";
+        return Err(ProblemError::from(crate::SceneError::new("path", why)).into());
+    }
     backend.refuse(&scene)?;
     let t_total = Instant::now();
     let setup = begin(scene, mesh, backend.estimate(&scene), &limits, reporter)?;
@@ -343,6 +321,8 @@ pub(crate) struct Recovered {
     pub(crate) contact: ContactReport,
     /// The error against the scene's exact solution, where it has one.
     pub(crate) exact: Option<crate::exact::ExactReport>,
+    /// The groups at a prescribed potential, with their charges.
+    pub(crate) terminals: Vec<crate::report::TerminalReport>,
 }
 
 /// Expands the free unknowns `(u, φ)` to the nodes, recovers stress and electric
@@ -386,13 +366,53 @@ pub(crate) fn recover(
     ];
     ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
     ProblemError::check_finite(&fields.stress, "the stress", scene)?;
+    let terminals = terminals(setup, disc, &fields, &phi)?;
     Ok(Recovered {
         u,
         phi,
         fields,
         contact: counts,
         exact,
+        terminals,
     })
+}
+
+/// The groups where the potential is prescribed, each with its potential and the charge
+/// through it (none without electric unknowns).
+fn terminals(
+    setup: &Setup,
+    disc: &Discretization<'_>,
+    fields: &CellFields,
+    phi: &[f64],
+) -> Result<Vec<crate::report::TerminalReport>, ProblemError> {
+    if !setup.plan.electric {
+        return Ok(vec![]);
+    }
+    let mut groups: Vec<&str> = vec![];
+    for c in setup
+        .constraints
+        .iter()
+        .filter(|c| c.field == fe_assembly::Field::Potential)
+    {
+        if !groups.contains(&c.group.as_str()) {
+            groups.push(&c.group);
+        }
+    }
+    let charges = disc.charges(fields, &groups, &setup.loads)?;
+    let mut out = vec![];
+    for (group, charge) in groups.iter().zip(charges) {
+        let first = setup
+            .mesh
+            .boundary(group)
+            .map_err(fe_assembly::AssemblyError::from)?
+            .nodes();
+        out.push(crate::report::TerminalReport {
+            group: group.to_string(),
+            potential: first.first().map_or(0.0, |&v| phi[v]),
+            charge,
+        });
+    }
+    Ok(out)
 }
 
 /// What the run measured beside the recovered fields, for its report.
@@ -434,6 +454,7 @@ pub(crate) fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunRe
             factor_bytes: figures.factor_bytes,
         },
         path: None,
+        terminals: r.terminals.clone(),
         solver: SolverReport {
             strategy: plan.linear_strategy,
             rule: rule_in_words(plan.rule).into(),
@@ -452,7 +473,7 @@ pub(crate) fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunRe
 mod tests {
     use super::*;
     use crate::scene::{BackendChoice, ContactSpec, DirichletSpec, LoadSpec, MaterialSpec, MeshSpec};
-    use crate::Silent;
+    use crate::{solve, solve_within, Silent};
     use std::sync::atomic::AtomicBool;
 
     /// The paper's block at `n` cells along its height, with `mesh` as its mesh spec.

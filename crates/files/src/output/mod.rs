@@ -4,7 +4,7 @@
 
 mod set;
 
-pub use set::Outputs;
+pub use set::{Outputs, SetWriter};
 
 use crate::plots::{self, Mark, Panel, Series};
 use crate::Error;
@@ -27,7 +27,8 @@ pub fn run_json(report: &RunReport) -> Result<Vec<u8>, Error> {
     serde_json::to_vec_pretty(&tree).map_err(encode)
 }
 
-/// The files of a solution, those its plan lists.
+/// The files of a solution, those its plan lists (and, for the last instant of a load path,
+/// `path.csv` and its pictures).
 ///
 /// # Errors
 /// [`Error::Picture`] where a file cannot be made.
@@ -67,6 +68,8 @@ pub fn files(solution: &Solution) -> Result<Outputs, Error> {
             }
         }
     }
+    // a load path's rows and curves
+    out.extend(path_files(solution)?);
     Ok(out)
 }
 
@@ -261,64 +264,78 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
     plots::panels("multipliers", &panels)
 }
 
-/// The files of a load path, gathered step by step ([`PathFiles::step`]) and finished with
-/// the last instant's solution ([`PathFiles::finish`]): the plan's files of the last instant,
-/// and `path.csv` (one row per instant), `path.pvd` with `step-NNNN.vtu` (a ParaView time
-/// series, where the plan has `solution.vtu`), `path.svg`/`.png` (the contact forces against
-/// time, and the tangential force against the prescribed x displacement: friction's loop).
+/// The files of a load path, written step by step ([`PathFiles::step`]: each instant's
+/// `step-NNNN.vtu`, a ParaView time series) and finished with the last instant's solution
+/// ([`PathFiles::finish`]): the plan's files of the last instant, `path.csv` (one row per
+/// instant), `path.pvd` (the series' collection), and `path.svg`/`.png` (the contact forces
+/// against time, and the tangential force against the prescribed x displacement: friction's
+/// loop).
+#[derive(Default)]
 pub struct PathFiles {
-    out: Outputs,
     series: Vec<(f64, String)>,
-    vtu: bool,
 }
 
 impl PathFiles {
-    /// For a run whose plan lists `outputs`.
-    pub fn new(outputs: &[Output]) -> Self {
-        PathFiles {
-            out: Outputs::new(Path::new("")),
-            series: vec![],
-            vtu: outputs.contains(&Output::SolutionVtu),
-        }
+    /// The names a path's set is sure to hold (checked before anything is written): its steps'
+    /// files, the path's own, and the last instant's report, solution and contact table.
+    pub fn expected_names(scene: &problem::Scene) -> Vec<String> {
+        let steps = scene.path.as_ref().map_or(1, |p| p.instants().len());
+        let mut names: Vec<String> = (0..steps).map(step_name).collect();
+        names.extend(["path.csv", "path.pvd", "run.json", "solution.vtu", "contact.csv"].map(String::from));
+        names
     }
 
-    /// Adds one instant's files.
+    /// Writes one instant's `step-NNNN.vtu` into the set.
     ///
     /// # Errors
-    /// [`Error::Picture`] where its VTU cannot be made.
-    pub fn step(&mut self, step: &problem::Step<'_>) -> Result<(), Error> {
-        if self.vtu {
-            let name = format!("step-{:04}.vtu", step.row.step);
-            self.out
-                .add(&name, vtu(step.mesh, (step.u, step.phi), step.fields, step.contact)?);
-            self.series.push((step.row.t, name));
-        }
+    /// [`Error::Picture`] where its VTU cannot be made, [`Error::Output`] where it cannot be
+    /// written.
+    pub fn step(&mut self, step: &problem::Step<'_>, writer: &mut SetWriter) -> Result<(), Error> {
+        let name = step_name(step.row.step);
+        writer.write(&name, &vtu(step.mesh, (step.u, step.phi), step.fields, step.contact)?)?;
+        self.series.push((step.row.t, name));
         Ok(())
     }
 
-    /// The set: the last instant's files and the path's own.
+    /// The files of the last instant and the path's own.
     ///
     /// # Errors
     /// As [`files`].
     pub fn finish(self, last: &Solution) -> Result<Outputs, Error> {
         let mut out = files(last)?;
-        out.extend(self.out.into_files());
-        if let Some(path) = &last.report.path {
-            out.add("path.csv", path_csv(&path.rows));
-            if !self.series.is_empty() {
-                out.add("path.pvd", pvd(&self.series));
-            }
-            out.extend(path_picture(&path.rows)?);
+        if !self.series.is_empty() {
+            out.add("path.pvd", pvd(&self.series));
         }
         Ok(out)
     }
 }
 
-/// `path.csv`: one row per instant.
-fn path_csv(rows: &[problem::report::StepRow]) -> Vec<u8> {
+/// The name of a path's instant `k` in its series.
+fn step_name(k: usize) -> String {
+    format!("step-{k:04}.vtu")
+}
+
+/// A path's own files without its series: `path.csv` and the pictures of its global curves
+/// (none for a run of one instant).
+fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
+    let Some(path) = &solution.report.path else {
+        return Ok(vec![]);
+    };
+    let terminals: Vec<&str> = solution.report.terminals.iter().map(|t| t.group.as_str()).collect();
+    let mut out = vec![("path.csv".to_string(), path_csv(&path.rows, &terminals))];
+    out.extend(path_picture(&path.rows)?);
+    Ok(out)
+}
+
+/// `path.csv`: one row per instant, with the charge through each terminal (`charge_GROUP`).
+fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
     let mut s = String::from(
-        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium\n",
+        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium",
     );
+    for t in terminals {
+        s.push_str(&format!(",charge_{t}"));
+    }
+    s.push('\n');
     for r in rows {
         let mut row = vec![r.step.to_string(), format!("{:e}", r.t)];
         row.extend(r.factors.iter().map(|f| format!("{f:e}")));
@@ -334,6 +351,7 @@ fn path_csv(rows: &[problem::report::StepRow]) -> Vec<u8> {
         );
         row.push(format!("{:e}", r.complementarity));
         row.push(format!("{:e}", r.equilibrium));
+        row.extend(r.charges.iter().map(|q| format!("{q:e}")));
         s.push_str(&row.join(","));
         s.push('\n');
     }

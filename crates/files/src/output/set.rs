@@ -166,27 +166,96 @@ impl Outputs {
 
     #[cfg(unix)]
     fn commit_set(self) -> Result<(), Error> {
-        let dir = &self.dir;
-        match std::fs::metadata(dir) {
-            Ok(m) if !m.is_dir() => return Err(conflict(dir, "is not a directory")),
-            Ok(_) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                if std::fs::symlink_metadata(dir).is_ok() {
-                    return Err(conflict(
-                        dir,
-                        "is a link to nothing: make its target, or give another --out",
-                    ));
-                }
+        check_dir(&self.dir)?;
+        unix::commit(&self.dir, &self.files)
+    }
+}
+
+/// An output directory: a directory, or nothing yet (a link to nothing is refused).
+fn check_dir(dir: &Path) -> Result<(), Error> {
+    match std::fs::metadata(dir) {
+        Ok(m) if !m.is_dir() => Err(conflict(dir, "is not a directory")),
+        Ok(_) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            if std::fs::symlink_metadata(dir).is_ok() {
+                Err(conflict(
+                    dir,
+                    "is a link to nothing: make its target, or give another --out",
+                ))
+            } else {
+                Ok(())
             }
-            Err(e) => return Err(io("cannot read", dir, e)),
         }
-        let made_dir = !dir.exists();
-        let result = unix::commit(dir, &self.files);
-        if result.is_err() && made_dir {
-            // nothing of this run stays where nothing was
-            let _ = std::fs::remove_dir_all(dir);
+        Err(e) => Err(io("cannot read", dir, e)),
+    }
+}
+
+/// A run's output set written file by file as the run makes them (the steps of a load path,
+/// each written and dropped, not held), then turned to as a whole by [`SetWriter::finish`]:
+/// the same set as [`Outputs::commit`] makes, with what is not finished removed.
+pub struct SetWriter {
+    #[cfg(unix)]
+    inner: unix::Writer,
+    #[cfg(not(unix))]
+    out: Outputs,
+    dir: PathBuf,
+}
+
+impl SetWriter {
+    /// Begins a set in `dir`. `names` known in advance are checked first: a name that is not a
+    /// plain file name, or a file of the user's, stops it before anything is written.
+    ///
+    /// # Errors
+    /// As [`Outputs::commit`].
+    pub fn begin(dir: &Path, names: &[String]) -> Result<Self, Error> {
+        for name in names {
+            check_name(dir, name)?;
         }
-        result
+        check_dir(dir)?;
+        Ok(SetWriter {
+            #[cfg(unix)]
+            inner: unix::Writer::begin(dir, names)?,
+            #[cfg(not(unix))]
+            out: Outputs::new(dir),
+            dir: dir.to_path_buf(),
+        })
+    }
+
+    /// Writes one file of the set (visible once the set is finished).
+    ///
+    /// # Errors
+    /// As [`Outputs::commit`].
+    pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), Error> {
+        check_name(&self.dir, name)?;
+        #[cfg(unix)]
+        return self.inner.write(name, bytes);
+        #[cfg(not(unix))]
+        {
+            self.out.add(name, bytes.to_vec());
+            Ok(())
+        }
+    }
+
+    /// Writes every file of `outputs`.
+    ///
+    /// # Errors
+    /// As [`SetWriter::write`].
+    pub fn write_all(&mut self, outputs: Outputs) -> Result<(), Error> {
+        for (name, bytes) in outputs.files {
+            self.write(&name, &bytes)?;
+        }
+        Ok(())
+    }
+
+    /// Turns the directory to the set.
+    ///
+    /// # Errors
+    /// As [`Outputs::commit`].
+    pub fn finish(self) -> Result<(), Error> {
+        #[cfg(unix)]
+        return self.inner.finish();
+        #[cfg(not(unix))]
+        self.out.commit()
     }
 }
 
@@ -362,69 +431,156 @@ mod unix {
         Ok(())
     }
 
-    /// The commit of a set into `dir` (see the module's documentation).
-    pub(super) fn commit(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), Error> {
-        // before anything is made: a name of the set that is the user's stops the commit
-        let legacy = legacy_names(dir);
-        for (name, _) in files {
-            let path = dir.join(name);
-            let free = match std::fs::symlink_metadata(&path) {
-                Err(_) => true,
-                Ok(_) => is_our_link(&path, name) || legacy.contains(name),
+    /// Whether `name` in `dir` is free for a set: absent, our link, or an earlier version's
+    /// file (`legacy`); else the error that stops the writing.
+    fn check_free(dir: &Path, name: &str, legacy: &[String]) -> Result<(), Error> {
+        let path = dir.join(name);
+        let free = match std::fs::symlink_metadata(&path) {
+            Err(_) => true,
+            Ok(_) => is_our_link(&path, name) || legacy.iter().any(|l| l == name),
+        };
+        if free {
+            Ok(())
+        } else {
+            Err(conflict(
+                &path,
+                "is not a file of an earlier run (it is yours, or another program's): move or rename it, or choose another --out; nothing was written",
+            ))
+        }
+    }
+
+    /// A set being written into `dir`, file by file, under the directory's lock: the files
+    /// go into a fresh set directory beside the current one, and [`Writer::finish`] turns to
+    /// it. Dropped unfinished, it removes what it made.
+    pub(super) struct Writer {
+        dir: PathBuf,
+        hidden: PathBuf,
+        set: PathBuf,
+        legacy: Vec<String>,
+        names: Vec<String>,
+        /// What the writer made that was not there: the directory itself, its hidden one.
+        made: (bool, bool),
+        _lock: std::fs::File,
+        done: bool,
+    }
+
+    impl Writer {
+        /// Begins a set in `dir`; `names` known in advance are checked before anything is
+        /// made (a name that is the user's stops the writing there).
+        pub(super) fn begin(dir: &Path, names: &[String]) -> Result<Writer, Error> {
+            let legacy = legacy_names(dir);
+            for name in names {
+                check_free(dir, name, &legacy)?;
+            }
+            let made = (!dir.exists(), !dir.join(HIDDEN).exists());
+            let undo = |e: Error| {
+                unmake(dir, made);
+                e
             };
-            if !free {
+            let hidden = hidden_dir(dir).map_err(undo)?;
+            let lock =
+                std::fs::File::create(hidden.join(LOCK)).map_err(|e| undo(io("cannot open", &hidden.join(LOCK), e)))?;
+            lock.lock()
+                .map_err(|e| undo(io("cannot lock", &hidden.join(LOCK), e)))?;
+            remove_stale(&hidden);
+            write_readme(&hidden).map_err(undo)?;
+            adopt_legacy(dir, &hidden).map_err(undo)?;
+            let set = fresh(&hidden, "set");
+            std::fs::create_dir(&set).map_err(|e| undo(io("cannot create", &set, e)))?;
+            Ok(Writer {
+                dir: dir.to_path_buf(),
+                hidden,
+                set,
+                legacy,
+                names: vec![],
+                made,
+                _lock: lock,
+                done: false,
+            })
+        }
+
+        /// Writes one file of the set (not yet visible).
+        pub(super) fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), Error> {
+            check_free(&self.dir, name, &self.legacy)?;
+            if self.names.iter().any(|n| n == name) {
                 return Err(conflict(
-                    &path,
-                    "is not a file of an earlier run (it is yours, or another program's): move or rename it, or choose another --out; nothing was written",
+                    &self.dir.join(name),
+                    "is twice in the set: two files would write one name",
                 ));
             }
+            std::fs::write(self.set.join(name), bytes).map_err(|e| io("cannot write", &self.dir.join(name), e))?;
+            self.names.push(name.to_string());
+            Ok(())
         }
-        let hidden = hidden_dir(dir)?;
-        let lock = std::fs::File::create(hidden.join(LOCK)).map_err(|e| io("cannot open", &hidden.join(LOCK), e))?;
-        lock.lock().map_err(|e| io("cannot lock", &hidden.join(LOCK), e))?;
-        remove_stale(&hidden);
-        write_readme(&hidden)?;
-        adopt_legacy(dir, &hidden)?;
-        let old = current_names(&hidden);
-        let old_set = std::fs::read_link(hidden.join(CURRENT)).ok().map(|t| hidden.join(t));
-        // the new set, beside the current one, then the turn to it
-        let set = fresh(&hidden, "set");
-        let staged = (|| -> Result<(), Error> {
-            std::fs::create_dir(&set).map_err(|e| io("cannot create", &set, e))?;
-            for (name, bytes) in files {
-                let path = set.join(name);
-                std::fs::write(&path, bytes).map_err(|e| io("cannot write", &dir.join(name), e))?;
-            }
-            // the links the new set's files need (each an absent file until the turn)
-            for (name, _) in files {
-                let path = dir.join(name);
-                if !is_our_link(&path, name) {
-                    symlink(link_target(name), &path).map_err(|e| io("cannot link", &path, e))?;
+
+        /// Makes the set the directory's: the links its files need, the turn of `current`
+        /// to it, then the links and files of the old set that it lacks removed.
+        pub(super) fn finish(mut self) -> Result<(), Error> {
+            let (dir, hidden) = (&self.dir, &self.hidden);
+            let old = current_names(hidden);
+            let old_set = std::fs::read_link(hidden.join(CURRENT)).ok().map(|t| hidden.join(t));
+            let staged = (|| -> Result<(), Error> {
+                // the links the new set's files need (each an absent file until the turn)
+                for name in &self.names {
+                    let path = dir.join(name);
+                    if !is_our_link(&path, name) {
+                        symlink(link_target(name), &path).map_err(|e| io("cannot link", &path, e))?;
+                    }
                 }
+                turn(hidden, &self.set)
+            })();
+            if let Err(e) = staged {
+                for name in self.names.iter().filter(|n| !old.contains(n)) {
+                    let path = dir.join(name);
+                    if is_our_link(&path, name) {
+                        let _ = std::fs::remove_file(&path);
+                    }
+                }
+                return Err(e);
             }
-            turn(&hidden, &set)
-        })();
-        if let Err(e) = staged {
-            let _ = std::fs::remove_dir_all(&set);
-            for (name, _) in files.iter().filter(|(n, _)| !old.contains(n)) {
+            self.done = true;
+            // what the old set had and the new one lacks
+            for name in old.iter().filter(|n| !self.names.contains(n)) {
                 let path = dir.join(name);
                 if is_our_link(&path, name) {
                     let _ = std::fs::remove_file(&path);
                 }
             }
-            return Err(e);
-        }
-        // what the old set had and the new one lacks
-        for name in old.iter().filter(|n| !files.iter().any(|(f, _)| f == *n)) {
-            let path = dir.join(name);
-            if is_our_link(&path, name) {
-                let _ = std::fs::remove_file(&path);
+            if let Some(old_set) = old_set {
+                let _ = std::fs::remove_dir_all(old_set);
             }
+            Ok(())
         }
-        if let Some(old_set) = old_set {
-            let _ = std::fs::remove_dir_all(old_set);
+    }
+
+    impl Drop for Writer {
+        fn drop(&mut self) {
+            if self.done {
+                return;
+            }
+            let _ = std::fs::remove_dir_all(&self.set);
+            unmake(&self.dir, self.made);
         }
-        Ok(())
+    }
+
+    /// Removes what an unfinished writer made: the directory, or its hidden directory where
+    /// no set is current in it (an earlier version's files taken over keep theirs).
+    fn unmake(dir: &Path, (made_dir, made_hidden): (bool, bool)) {
+        if made_dir {
+            let _ = std::fs::remove_dir_all(dir);
+        } else if made_hidden && std::fs::symlink_metadata(dir.join(HIDDEN).join(CURRENT)).is_err() {
+            let _ = std::fs::remove_dir_all(dir.join(HIDDEN));
+        }
+    }
+
+    /// The commit of a set into `dir` (see the module's documentation).
+    pub(super) fn commit(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), Error> {
+        let names: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
+        let mut writer = Writer::begin(dir, &names)?;
+        for (name, bytes) in files {
+            writer.write(name, bytes)?;
+        }
+        writer.finish()
     }
 }
 

@@ -284,6 +284,11 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
             what,
         )
     };
+    refuse_if(
+        scene.active_contact().is_none(),
+        "path",
+        "a path carries friction's history from step to step, and the scene has no contact (contact.law = \"none\"): without it each instant is the static answer scaled",
+    )?;
     applies(scene.load.is_none(), "path.load", "the scene has no [load]")?;
     applies(scene.active_contact().is_none(), "path.gap", "the scene has no contact")?;
     refuse_if(
