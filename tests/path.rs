@@ -168,3 +168,57 @@ fn what_a_path_cannot_carry_is_refused_by_key() {
         assert_eq!(e.key, key, "{sets:?}: {e}");
     }
 }
+
+/// The multipliers of a path's instant `k` (every instant kept).
+fn path_lambdas(name: &str, sets: &[&str]) -> Vec<contact::PointValues> {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let (scene, _) = scene_file::load(name, &sets).unwrap();
+    let mut all = vec![];
+    problem::solve_path(&scene, None, Limits::default(), &mut Silent, &mut |step| {
+        all.push(step.contact.unwrap().solution.lambda.clone());
+        Ok(())
+    })
+    .unwrap();
+    all
+}
+
+/// The static answer of a shipped scene with `sets`, its path removed.
+fn static_lambda(name: &str, sets: &[&str]) -> contact::PointValues {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let (mut scene, _) = scene_file::load(name, &sets).unwrap();
+    scene.path = None;
+    let s = problem::solve(&scene, None, &mut Silent).unwrap();
+    s.contact.unwrap().solution.lambda
+}
+
+/// Where the theory says a path must equal the static solve (proportional loading, the slip
+/// never reversing: `paper-slip`'s load raised in 10 steps, its gap 0), it does at every instant
+/// (the answer is homogeneous in the load); and where the load turns back and forth under a
+/// held preload (`actuator-cycle`: the voltage up, down, up) it must not: back at the start's
+/// voltage the points that slid hold shear tractions the static answer has not.
+#[test]
+fn a_monotone_path_is_the_static_solve_and_a_reversal_is_not() {
+    let ramp = ["mesh.n=16", "path.t=[0.0, 1.0]", "path.load=[0.0, 1.0]", "path.steps=10"];
+    let path = path_lambdas("paper-slip", &ramp);
+    let full = static_lambda("paper-slip", &["mesh.n=16"]);
+    for (k, l) in path.iter().enumerate() {
+        // the static answer at the load factor k/10 is the full one scaled
+        let mut expected = full.clone();
+        expected.normal.iter_mut().for_each(|v| *v *= k as f64 / 10.0);
+        expected.tangential.iter_mut().for_each(|v| *v *= k as f64 / 10.0);
+        let d = l.minus(&expected).norm();
+        assert!(d <= 1e-9 * full.norm(), "step {k}: {d:e}");
+    }
+    let cycle = path_lambdas("actuator-cycle", &["mesh.n=16"]);
+    let at_rest = static_lambda("actuator-cycle", &["mesh.n=16", "electrode.v=0.0"]);
+    let tangential = |l: &contact::PointValues| l.tangential.clone();
+    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let diff = |a: &[f64], b: &[f64]| norm(&a.iter().zip(b).map(|(x, y)| x - y).collect::<Vec<_>>());
+    let (first, back) = (tangential(&cycle[0]), tangential(&cycle[20]));
+    let reference = norm(&tangential(&at_rest));
+    // the first instant is the static answer at V = 0; back at V = 0 after the cycle it is not
+    assert!(diff(&first, &tangential(&at_rest)) <= 1e-9 * reference);
+    let memory = diff(&back, &tangential(&at_rest)) / reference;
+    eprintln!("back at V = 0: the shear tractions differ from the static ones by {memory:.3} of their size");
+    assert!(memory > 0.1, "{memory}");
+}

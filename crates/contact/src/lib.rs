@@ -55,7 +55,7 @@ mod weakening;
 
 pub use electric::{ElectricContact, ElectricContactProblem, ElectricLaw, ElectricValues};
 pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
-pub use newton::{solve_newton, solve_newton_electric, NewtonParams};
+pub use newton::{solve_newton, solve_newton_cached, solve_newton_electric, NewtonCache, NewtonParams};
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};
 pub use points::{ContactPoints, Foundation, PointValues, Status};
 pub use projection::{project_cone, project_disc, project_nonnegative};
@@ -65,7 +65,9 @@ pub use solution::{
 };
 pub use uniqueness::slip_bound_expansion;
 pub use uzawa::{solve, StopRule, UzawaParams, FIXED_POINT_PATIENCE};
-pub use weakening::{solve_slip_weakening, Inner, SlipWeakening, Weakening, WeakeningParams};
+pub use weakening::{
+    solve_slip_weakening, solve_slip_weakening_cached, Inner, SlipWeakening, Weakening, WeakeningParams,
+};
 
 /// A failure of the primal solve behind a [`ContactOperator`], with its cause (for example the
 /// linear solver's own error), which [`std::error::Error::source`] returns.

@@ -5,7 +5,7 @@
 //! (semismooth Newton, warm-started from the last step), from the stick start (the static
 //! coefficient everywhere). The map's contraction is measured and reported.
 
-use crate::newton::{solve_newton_sharing, Shared};
+use crate::newton::{solve_newton_cached, NewtonCache};
 use crate::operator::AffineProblem;
 use crate::points::ContactPoints;
 use crate::solution::{classify, counts, slip_bound, Best, Iterate};
@@ -262,10 +262,10 @@ fn frozen_step<P: AffineProblem>(
     newton: &NewtonParams,
     start: Option<crate::PointValues>,
     progress: &mut dyn FnMut(&Progress),
-    shared: &mut Shared,
+    shared: &mut NewtonCache,
 ) -> Result<ContactSolution, ContactError> {
     match inner {
-        Inner::Newton => solve_newton_sharing(problem, frozen, &Law::Coulomb, newton, start, progress, shared),
+        Inner::Newton => solve_newton_cached(problem, frozen, &Law::Coulomb, newton, start, progress, shared),
         Inner::GaussSeidel => {
             let gs = GaussSeidelParams {
                 tol: newton.tol,
@@ -305,6 +305,22 @@ pub fn solve_slip_weakening<P: AffineProblem>(
     params: &WeakeningParams,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
+    solve_slip_weakening_cached(problem, points, law, params, progress, &mut NewtonCache::default())
+}
+
+/// [`solve_slip_weakening`], its Newton solves sharing what they may with the other solves of
+/// `problem`'s compliance in `cache` ([`NewtonCache`]).
+///
+/// # Errors
+/// As [`solve_slip_weakening`].
+pub fn solve_slip_weakening_cached<P: AffineProblem>(
+    problem: &mut P,
+    points: &ContactPoints,
+    law: &SlipWeakening,
+    params: &WeakeningParams,
+    progress: &mut dyn FnMut(&Progress),
+    shared: &mut NewtonCache,
+) -> Result<ContactSolution, ContactError> {
     law.check()?;
     let n = points.len();
     let mut frozen = points.clone();
@@ -317,8 +333,6 @@ pub fn solve_slip_weakening<P: AffineProblem>(
     let mut previous: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut newton = params.newton;
     let mut polished = false;
-    // D, and so the directions' factorisation, is the same at every step
-    let mut shared = Shared::default();
     for k in 1..=params.max_iters {
         let mut sol = frozen_step(
             problem,
@@ -327,7 +341,7 @@ pub fn solve_slip_weakening<P: AffineProblem>(
             &newton,
             start.take(),
             progress,
-            &mut shared,
+            shared,
         )?;
         newton_iters += sol.info.newton_iters;
         // the operator is the same at every step: its μ_max once
@@ -359,14 +373,14 @@ pub fn solve_slip_weakening<P: AffineProblem>(
                 weakening: Some(*law),
                 ..newton
             };
-            if let Ok(mut polish) = solve_newton_sharing(
+            if let Ok(mut polish) = solve_newton_cached(
                 problem,
                 &frozen,
                 &Law::Coulomb,
                 &direct,
                 Some(sol.lambda.clone()),
                 progress,
-                &mut shared,
+                shared,
             ) {
                 polish.info.fixed_point_iters = k;
                 polish.info.newton_iters += newton_iters;

@@ -16,6 +16,11 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ("paper", include_str!("../../../scenes/paper.toml")),
     ("paper-slip", include_str!("../../../scenes/paper-slip.toml")),
     ("paper-cycle", include_str!("../../../scenes/paper-cycle.toml")),
+    ("actuator-cycle", include_str!("../../../scenes/actuator-cycle.toml")),
+    (
+        "mindlin-sphere-cycle",
+        include_str!("../../../scenes/mindlin-sphere-cycle.toml"),
+    ),
     (
         "paper-frictionless",
         include_str!("../../../scenes/paper-frictionless.toml"),

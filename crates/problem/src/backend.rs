@@ -234,6 +234,10 @@ pub struct ContactSolve<'p> {
     pub interrupt: contact::Interrupt,
     /// Slip-weakening friction (Coulomb's law with a coefficient that falls with the slip).
     pub weakening: Option<contact::SlipWeakening>,
+    /// What Newton's solves of the run's one condensed compliance share (a solve's
+    /// corrections, a load path's steps): the factorisation of `D` for the directions, the
+    /// estimate of `μ_max`.
+    pub cache: std::cell::RefCell<contact::NewtonCache>,
 }
 
 impl<'p> ContactSolve<'p> {
@@ -266,6 +270,7 @@ impl<'p> ContactSolve<'p> {
             tol: plan.tol,
             interrupt,
             weakening: plan.weakening,
+            cache: Default::default(),
         }
     }
 }

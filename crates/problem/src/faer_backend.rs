@@ -354,9 +354,13 @@ impl ContactSolve<'_> {
                             tol,
                             ..Default::default()
                         };
-                        contact::solve_slip_weakening(dense, points, w, &params, &mut progress)
+                        let cache = &mut self.cache.borrow_mut();
+                        contact::solve_slip_weakening_cached(dense, points, w, &params, &mut progress, cache)
                     }
-                    None => contact::solve_newton(dense, points, &self.law, &params, start, &mut progress),
+                    None => {
+                        let cache = &mut self.cache.borrow_mut();
+                        contact::solve_newton_cached(dense, points, &self.law, &params, start, &mut progress, cache)
+                    }
                 }
             }
             (ContactSolver::FirstOrder { accelerate }, problem) => {

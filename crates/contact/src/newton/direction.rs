@@ -126,36 +126,79 @@ impl Directions {
     /// The direction at `s`; `None` where the system is singular.
     pub(super) fn direction(&self, flat: &Flat<'_>, s: &State, rows: &[RowForm]) -> Option<Vec<f64>> {
         match self {
-            Directions::Reduced(stiffness) => reduced(flat, s, rows, stiffness).or_else(|| dense_lu(flat, s, rows)),
+            Directions::Reduced(stiffness) => {
+                // the smaller of the two systems: the rows that are not `C`'s identity (the
+                // reduced one), or those that are not `δ`'s (the separated points' rows
+                // eliminated: where most points are separated, as under an indenter)
+                let n_reduced = (0..flat.m).filter(|&r| !rows[r].is_c_row(r)).count();
+                let n_free = (0..flat.m).filter(|&r| !rows[r].is_identity(r)).count();
+                if n_free < n_reduced {
+                    dense_lu(flat, s, rows).or_else(|| reduced(flat, s, rows, stiffness))
+                } else {
+                    reduced(flat, s, rows, stiffness).or_else(|| dense_lu(flat, s, rows))
+                }
+            }
             Directions::DenseLu { .. } => dense_lu(flat, s, rows),
             Directions::SparseLu(pattern) => sparse_lu(flat, s, rows, pattern),
         }
     }
 }
 
-/// The direction by one LU of the whole `m x m` Jacobian (dense compliance).
+/// The direction by one LU of the Jacobian (dense compliance), its identity rows (separated
+/// points: `δ_r = -f_r`) eliminated first: the rows and columns of the other points make an
+/// `N x N` system, `N` the points in contact times their components.
 pub(super) fn dense_lu(flat: &Flat<'_>, s: &State, rows: &[RowForm]) -> Option<Vec<f64>> {
     let (m, c) = (flat.m, &flat.c);
     let Compliance::Dense(d) = flat.d else {
         return SparsePattern::new(flat).and_then(|p| sparse_lu(flat, s, rows, &p));
     };
-    // Jᵀ, column-major: row r of J is column r of Jᵀ, written contiguously
-    let mut jt = Mat::<f64>::zeros(m, m);
-    for (r, form) in rows.iter().enumerate() {
-        for &(j, v) in &form.e {
-            jt[(j, r)] += v;
-        }
-        for &(j, v) in &form.b {
-            for col in 0..m {
-                jt[(col, r)] += v * c[j] * d[j * m + col] * flat.w[col];
-            }
-            jt[(j, r)] += v * c[j] * flat.sigma;
+    let mut delta: Vec<f64> = vec![0.0; m];
+    let mut slot = vec![usize::MAX; m];
+    let mut free = vec![];
+    for r in 0..m {
+        if rows[r].is_identity(r) {
+            delta[r] = -s.f[r];
+        } else {
+            slot[r] = free.len();
+            free.push(r);
         }
     }
+    let n = free.len();
+    if n == 0 {
+        return Some(delta);
+    }
+    // Jᵀ on the free rows and columns, column-major (row r of J is column r of Jᵀ); the known
+    // δ of the identity rows moved to the right-hand side
+    let mut jt = Mat::<f64>::zeros(n, n);
+    let mut rhs = Mat::<f64>::zeros(n, 1);
+    let mut row = vec![0.0; m];
+    for (k, &r) in free.iter().enumerate() {
+        row.iter_mut().for_each(|v| *v = 0.0);
+        let form = &rows[r];
+        for &(j, v) in &form.e {
+            row[j] += v;
+        }
+        for &(j, v) in &form.b {
+            let scale = v * c[j];
+            for ((x, dj), w) in row.iter_mut().zip(&d[j * m..(j + 1) * m]).zip(&flat.w) {
+                *x += scale * dj * w;
+            }
+            row[j] += scale * flat.sigma;
+        }
+        let mut b = -s.f[r];
+        for (col, x) in row.iter().enumerate() {
+            match slot[col] {
+                usize::MAX => b -= x * delta[col],
+                kc => jt[(kc, k)] = *x,
+            }
+        }
+        rhs[(k, 0)] = b;
+    }
     let lu = jt.partial_piv_lu();
-    let mut rhs = Mat::<f64>::from_fn(m, 1, |r, _| -s.f[r]);
     lu.solve_transpose_in_place(rhs.as_mut());
-    let delta: Vec<f64> = (0..m).map(|r| rhs[(r, 0)]).collect();
+    for (k, &r) in free.iter().enumerate() {
+        delta[r] = rhs[(k, 0)];
+    }
     delta.iter().all(|v| v.is_finite()).then_some(delta)
 }
 

@@ -532,14 +532,16 @@ pub fn solve_newton<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    solve_newton_sharing(problem, points, law, params, lambda0, progress, &mut Shared::default())
+    solve_newton_cached(problem, points, law, params, lambda0, progress, &mut NewtonCache::default())
 }
 
-/// What the Newton solves of one problem share, whatever its law's data (the friction
-/// coefficients of a fixed point's steps): the directions' factorisation of `D` (its inverse,
-/// `m³` flops: at 1022 rows 0.05 s, more than the steps of a warm-started solve).
+/// What the Newton solves of one compliance `D` share, whatever their loads `u₀` and their
+/// law's data (a load path's steps, a fixed point's steps on the friction coefficients, the
+/// corrections of a solve by the refined fields): the directions' factorisation of `D` (its
+/// inverse, `m³` flops: at 1022 rows 0.05 s, more than the steps of a warm-started solve), and
+/// the estimate of `μ_max`. Hand the same cache only to solves of one `D` (and weights).
 #[derive(Default)]
-pub(crate) struct Shared {
+pub struct NewtonCache {
     directions: Option<Directions>,
     /// The insulated problem's answer of a coupled problem (`Some(None)` where its solve
     /// failed).
@@ -548,15 +550,19 @@ pub(crate) struct Shared {
     mu_max: Option<f64>,
 }
 
-/// [`solve_newton`], with what it shares with the other solves of `problem` in `cache`.
-pub(crate) fn solve_newton_sharing<P: AffineProblem>(
+/// [`solve_newton`], with what it shares with the other solves of `problem`'s compliance in
+/// `cache` (taken from it where there, left in it).
+///
+/// # Errors
+/// As [`solve_newton`].
+pub fn solve_newton_cached<P: AffineProblem>(
     problem: &mut P,
     points: &ContactPoints,
     law: &Law,
     params: &NewtonParams,
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
-    cache: &mut Shared,
+    cache: &mut NewtonCache,
 ) -> Result<ContactSolution, ContactError> {
     let nt = check_newton_input(problem, params)?;
     let pre = Preamble::new(
@@ -564,9 +570,10 @@ pub(crate) fn solve_newton_sharing<P: AffineProblem>(
         points,
         law,
         params.power_iters,
-        params.mu_max,
+        params.mu_max.or(cache.mu_max),
     )?;
     let (mu_max, reference) = (pre.mu_max, pre.reference);
+    cache.mu_max = Some(mu_max);
     let mut info = ContactInfo::new(mu_max);
     let start = match lambda0 {
         Some(l) => pre.start(Some(l))?,
@@ -662,7 +669,7 @@ pub fn solve_newton_electric(
         return Err(InputError::Unsupported("slip-weakening friction with electrical contact").into());
     }
     let (mut scaled, s) = problem.scaled();
-    let mut sol = solve_electric(&mut scaled, points, law, params, progress, &mut Shared::default())?;
+    let mut sol = solve_electric(&mut scaled, points, law, params, progress, &mut NewtonCache::default())?;
     if let Some(e) = &mut sol.electric {
         e.flux.iter_mut().for_each(|q| *q *= s);
         e.potential.iter_mut().for_each(|v| *v /= s);
@@ -672,7 +679,7 @@ pub fn solve_newton_electric(
 
 /// [`crate::solve_newton_electric`] on the scaled problem: stages 1 and 2 on the mechanical
 /// and electric rows together; a stall is a [`ContactError::Stalled`] with the best iterate.
-/// What the solves of one `D` under its electric laws share ([`Shared`]) comes from `cache`
+/// What the solves of one `D` under its electric laws share ([`NewtonCache`]) comes from `cache`
 /// where it is there, and is left there.
 fn solve_electric(
     problem: &mut ElectricContactProblem,
@@ -680,7 +687,7 @@ fn solve_electric(
     law: &Law,
     params: &NewtonParams,
     progress: &mut dyn FnMut(&Progress),
-    cache: &mut Shared,
+    cache: &mut NewtonCache,
 ) -> Result<ContactSolution, ContactError> {
     check_tolerance(params)?;
     // the candidates and the coupled problem share `D`, and so its largest eigenvalue
@@ -742,7 +749,7 @@ fn electric_start(
     points: &ContactPoints,
     law: &Law,
     params: &NewtonParams,
-    cache: &mut Shared,
+    cache: &mut NewtonCache,
 ) -> (Vec<f64>, usize) {
     let zero = vec![0.0; flat.m];
     let mut steps = 0;
