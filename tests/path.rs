@@ -21,8 +21,8 @@ fn cycle(n: usize) -> Vec<(f64, f64, f64, f64)> {
     let mut reversals: Vec<f64> = vec![];
     let mut last_q: Option<f64> = None;
     let mut rising = true;
-    problem::solve_path(&scene, None, Limits::default(), &mut Silent, &mut |step| {
-        let r = step.contact.unwrap();
+    problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |step| {
+        let r = step.contact;
         let (p, q) = (step.row.normal_force, step.row.tangential_force);
         if let Some(lq) = last_q {
             let now_rising = q > lq;
@@ -85,9 +85,9 @@ fn the_cycle_follows_mindlin_deresiewicz() {
 fn the_first_instant_is_the_static_solve() {
     let (mut scene, _) = scene_file::load("cattaneo-mindlin-cycle", &["mesh.n=24".into()]).unwrap();
     let mut first = None;
-    let path = problem::solve_path(&scene, None, Limits::default(), &mut Silent, &mut |step| {
+    let path = problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |step| {
         if first.is_none() {
-            first = Some(step.contact.unwrap().solution.lambda.clone());
+            first = Some(step.contact.solution.lambda.clone());
         }
         Ok(())
     })
@@ -114,7 +114,7 @@ fn the_end_of_the_cycle_converges_in_the_steps() {
     let end = |steps: usize| {
         let sets = ["mesh.n=24".to_string(), format!("path.steps={steps}")];
         let (scene, _) = scene_file::load("cattaneo-mindlin-cycle", &sets).unwrap();
-        let path = problem::solve_path(&scene, None, Limits::default(), &mut Silent, &mut |_| Ok(())).unwrap();
+        let path = problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())).unwrap();
         path.last.contact.unwrap().solution.lambda
     };
     let (l6, l12, l48) = (end(6), end(12), end(48));
@@ -158,7 +158,7 @@ fn what_a_path_cannot_carry_is_refused_by_key() {
             }) => e,
             Err(other) => panic!("{sets:?}: {other}"),
             Ok((scene, _)) => {
-                match problem::solve_path(&scene, None, Limits::default(), &mut Silent, &mut |_| Ok(())) {
+                match problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())) {
                     Err(problem::ProblemError::Scene(e)) => e,
                     Err(other) => panic!("{sets:?}: {other}"),
                     Ok(_) => panic!("{sets:?} ran"),
@@ -174,8 +174,8 @@ fn path_lambdas(name: &str, sets: &[&str]) -> Vec<contact::PointValues> {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let (scene, _) = scene_file::load(name, &sets).unwrap();
     let mut all = vec![];
-    problem::solve_path(&scene, None, Limits::default(), &mut Silent, &mut |step| {
-        all.push(step.contact.unwrap().solution.lambda.clone());
+    problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |step| {
+        all.push(step.contact.solution.lambda.clone());
         Ok(())
     })
     .unwrap();
@@ -198,7 +198,12 @@ fn static_lambda(name: &str, sets: &[&str]) -> contact::PointValues {
 /// voltage the points that slid hold shear tractions the static answer has not.
 #[test]
 fn a_monotone_path_is_the_static_solve_and_a_reversal_is_not() {
-    let ramp = ["mesh.n=16", "path.t=[0.0, 1.0]", "path.load=[0.0, 1.0]", "path.steps=10"];
+    let ramp = [
+        "mesh.n=16",
+        "path.t=[0.0, 1.0]",
+        "path.load=[0.0, 1.0]",
+        "path.steps=10",
+    ];
     let path = path_lambdas("paper-slip", &ramp);
     let full = static_lambda("paper-slip", &["mesh.n=16"]);
     for (k, l) in path.iter().enumerate() {
@@ -221,4 +226,33 @@ fn a_monotone_path_is_the_static_solve_and_a_reversal_is_not() {
     let memory = diff(&back, &tangential(&at_rest)) / reference;
     eprintln!("back at V = 0: the shear tractions differ from the static ones by {memory:.3} of their size");
     assert!(memory > 0.1, "{memory}");
+}
+
+/// The rows of a path are its instants' whether or not their fields are computed: the charges
+/// through the terminals by their functionals (`Σ f_q Q_q - Σ w λ · z`, no fields) against the
+/// charges of the fields (the electric equation's reaction), and the forces, on the actuator's
+/// voltage cycle (an electrode and two grounded sides).
+#[test]
+fn the_rows_without_fields_are_the_rows_with_them() {
+    let (scene, _) = scene_file::load("actuator-cycle", &["mesh.n=16".into()]).unwrap();
+    let rows = |with_fields: bool| {
+        let p = problem::solve_path(&scene, None, Limits::default(), &mut Silent, with_fields, &mut |_| {
+            Ok(())
+        })
+        .unwrap();
+        p.last.report.path.unwrap().rows
+    };
+    let (functional, fields) = (rows(false), rows(true));
+    let scale = fields
+        .iter()
+        .flat_map(|r| r.charges.iter())
+        .fold(0.0f64, |m, q| m.max(q.abs()));
+    assert!(scale > 0.0 && fields[0].charges.len() == 3);
+    for (a, b) in functional.iter().zip(&fields) {
+        for (qa, qb) in a.charges.iter().zip(&b.charges) {
+            assert!((qa - qb).abs() <= 1e-9 * scale, "step {}: {qa} against {qb}", a.step);
+        }
+        assert!((a.normal_force - b.normal_force).abs() <= 1e-12 * b.normal_force.abs().max(1.0));
+        assert!(a.equilibrium.is_none() == (a.step + 1 < functional.len()) && b.equilibrium.is_some());
+    }
 }

@@ -334,15 +334,7 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
     let mut newton = params.newton;
     let mut polished = false;
     for k in 1..=params.max_iters {
-        let mut sol = frozen_step(
-            problem,
-            &frozen,
-            params.inner,
-            &newton,
-            start.take(),
-            progress,
-            shared,
-        )?;
+        let mut sol = frozen_step(problem, &frozen, params.inner, &newton, start.take(), progress, shared)?;
         newton_iters += sol.info.newton_iters;
         // the operator is the same at every step: its μ_max once
         newton.mu_max = Some(sol.info.mu_max);

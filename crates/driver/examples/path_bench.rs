@@ -26,6 +26,7 @@ fn main() {
             None,
             problem::Limits::default(),
             &mut problem::Silent,
+            false,
             &mut |_| Ok(()),
         )
         .expect("the path solves");

@@ -56,7 +56,7 @@ pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn
 pub use held::Unheld;
 pub use loads::{facet_measure, Load, RhsParts};
 pub use material::{voigt, Crystal, Material, MaterialError};
-pub use recovery::CellFields;
+pub use recovery::{CellFields, ChargeFunctional};
 
 use std::sync::Arc;
 

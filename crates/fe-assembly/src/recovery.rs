@@ -17,6 +17,9 @@ pub struct CellFields {
     pub electric_field: Vec<f64>,
 }
 
+/// A charge's coefficients on the free unknowns: `(a_u, a_φ)`.
+pub type ChargeFunctional = (Vec<f64>, Vec<f64>);
+
 impl Discretization<'_> {
     /// Stress, strain, electric displacement and field on every cell, from nodal `u` and `φ`.
     pub fn recover(&self, u: &[[f64; 3]], phi: &[f64]) -> CellFields {
@@ -76,14 +79,7 @@ impl Discretization<'_> {
     ) -> Result<Vec<f64>, crate::AssemblyError> {
         let mesh = self.mesh;
         let dim = mesh.dim;
-        let mut owner = vec![usize::MAX; mesh.n_nodes()];
-        for (g, name) in groups.iter().enumerate() {
-            for v in mesh.boundary(name)?.nodes() {
-                if owner[v] == usize::MAX {
-                    owner[v] = g;
-                }
-            }
-        }
+        let owner = self.owners(groups)?;
         let q0 = loads.iter().find_map(|l| match l {
             crate::Load::BodyCharge(q) => Some(q),
             _ => None,
@@ -108,6 +104,66 @@ impl Discretization<'_> {
                 if owner[v] != usize::MAX {
                     let flux: f64 = (0..dim).map(|k| d[k] * g.grads[a][k]).sum();
                     out[owner[v]] += g.measure * (flux + source);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// For each node, the index in `groups` of the first group holding it (`usize::MAX`: none).
+    fn owners(&self, groups: &[&str]) -> Result<Vec<usize>, crate::AssemblyError> {
+        let mut owner = vec![usize::MAX; self.mesh.n_nodes()];
+        for (g, name) in groups.iter().enumerate() {
+            for v in self.mesh.boundary(name)?.nodes() {
+                if owner[v] == usize::MAX {
+                    owner[v] = g;
+                }
+            }
+        }
+        Ok(owner)
+    }
+
+    /// The part of [`Discretization::charges`] that the free unknowns make: for each group,
+    /// the coefficients `(a_u, a_φ)` on the free displacements and potentials with
+    /// `charge = a_u · u + a_φ · φ` plus what the prescribed values and the body charge add
+    /// (`|T| (e B_b)ᵀ ∇ψ_a` on `u_b`, `-|T| ∇ψ_aᵀ β ∇ψ_b` on `φ_b`, for each node `a` of the group
+    /// in a cell `T` and each node `b` of `T`). A load path's charges at every step come from
+    /// them without the fields.
+    ///
+    /// # Errors
+    /// [`crate::AssemblyError`] where a group is not in the mesh.
+    pub fn charge_functionals(&self, groups: &[&str]) -> Result<Vec<ChargeFunctional>, crate::AssemblyError> {
+        let mesh = self.mesh;
+        let dim = mesh.dim;
+        let nv = if dim == 2 { 3 } else { 6 };
+        let owner = self.owners(groups)?;
+        let mut out = vec![(vec![0.0; self.dofs.n_u], vec![0.0; self.dofs.n_phi]); groups.len()];
+        for (c, cell) in mesh.iter_cells().enumerate() {
+            if !cell.iter().any(|&v| owner[v] != usize::MAX) {
+                continue;
+            }
+            let (g, m) = (&self.geometry[c], self.material(c));
+            for (a, &va) in cell.iter().enumerate() {
+                let Some((a_u, a_phi)) = out.get_mut(owner[va]) else {
+                    continue;
+                };
+                let grad_a = &g.grads[a];
+                for (b, &vb) in cell.iter().enumerate() {
+                    let columns = crate::kernels::strain_columns(dim, &g.grads[b]);
+                    for (k, column) in columns.iter().enumerate().take(dim) {
+                        if let crate::Dof::Free(j) = self.dofs.u[vb * dim + k] {
+                            let d: f64 = (0..dim)
+                                .map(|l| grad_a[l] * (0..nv).map(|v| m.e[l * nv + v] * column[v]).sum::<f64>())
+                                .sum();
+                            a_u[j] += g.measure * d;
+                        }
+                    }
+                    if let (true, crate::Dof::Free(j)) = (self.cell_electric[c], self.dofs.phi[vb]) {
+                        let d: f64 = (0..dim)
+                            .map(|l| grad_a[l] * (0..dim).map(|q| m.beta[l * dim + q] * g.grads[b][q]).sum::<f64>())
+                            .sum();
+                        a_phi[j] -= g.measure * d;
+                    }
                 }
             }
         }

@@ -63,8 +63,9 @@ pub fn solve_with(
 }
 
 /// Solves a scene with a `[path]` (the quasi-static process), as [`solve_with`] does one
-/// instant, calling `each` with every instant in order (to write its files: a step's fields
-/// are dropped once it returns); the last instant is returned, its report with the path's rows.
+/// instant, calling `each` with every instant in order, with its fields where `with_fields`
+/// (every `path.output_every`-th instant: to write its files, a step's fields dropped once it
+/// returns); the last instant is returned, its report with the path's rows.
 ///
 /// # Errors
 /// As [`solve`], and the error `each` returns.
@@ -72,7 +73,7 @@ pub fn solve_path_with(
     scene: &Scene,
     source: &Source,
     given: Option<mesh::Mesh>,
-    interrupt: contact::Interrupt,
+    (interrupt, with_fields): (contact::Interrupt, bool),
     reporter: &mut dyn Reporter,
     each: &mut dyn FnMut(problem::Step<'_>) -> Result<(), Error>,
 ) -> Result<Solution, Error> {
@@ -88,7 +89,7 @@ pub fn solve_path_with(
     };
     // the caller's error, carried past the problem's
     let mut failed = None;
-    let solved = problem::solve_path(scene, mesh, limits, reporter, &mut |step| {
+    let solved = problem::solve_path(scene, mesh, limits, reporter, with_fields, &mut |step| {
         each(step).map_err(|e| {
             let message = e.to_string();
             failed = Some(e);
@@ -114,9 +115,14 @@ pub fn solve_path_with(
 pub fn run_path(scene: &Scene, source: &Source, dir: &Path, reporter: &mut dyn Reporter) -> Result<Solution, Error> {
     let mut writer = output::SetWriter::begin(dir, &output::PathFiles::expected_names(scene))?;
     let mut files = output::PathFiles::default();
-    let solution = solve_path_with(scene, source, None, contact::Interrupt::NONE, reporter, &mut |step| {
-        files.step(&step, &mut writer)
-    })?;
+    let solution = solve_path_with(
+        scene,
+        source,
+        None,
+        (contact::Interrupt::NONE, true),
+        reporter,
+        &mut |step| files.step(&step, &mut writer),
+    )?;
     writer.write_all(files.finish(&solution)?)?;
     writer.finish()?;
     Ok(solution)

@@ -369,6 +369,23 @@ impl ContactBoundary {
         }
     }
 
+    /// `u_n` and `u_t` of a free displacement vector `u` that prescribes nothing (a response to
+    /// a load, its prescribed components 0): the components at the free slots alone.
+    pub fn extract_free(&self, u: &[f64], out: &mut PointValues) {
+        let p = &self.points;
+        let (dim, nt) = (p.dim, out.n_tangential());
+        for i in 0..p.len() {
+            let ui: [f64; 3] = std::array::from_fn(|k| match self.slots.get(i * dim + k) {
+                Some(Slot::Free(j)) if k < dim => u[self.dofs[*j]],
+                _ => 0.0,
+            });
+            out.normal[i] = (0..dim).map(|k| ui[k] * p.normal[i][k]).sum();
+            for q in 0..nt {
+                out.tangential[i * nt + q] = (0..dim).map(|k| ui[k] * p.tangent[i][q][k]).sum();
+            }
+        }
+    }
+
     /// `u_n` and `u_t` of the free displacement vector `u`.
     pub fn extract(&self, u: &[f64], out: &mut PointValues) {
         let u_c: Vec<f64> = self.dofs.iter().map(|&j| u[j]).collect();

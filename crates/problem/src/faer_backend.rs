@@ -114,7 +114,7 @@ impl Backend for Faer {
 }
 
 /// The free unknowns `(u, φ)`.
-type Fields = (Vec<f64>, Vec<f64>);
+pub(crate) type Fields = (Vec<f64>, Vec<f64>);
 
 /// The linear solver the plan asks for, factored once.
 #[allow(clippy::large_enum_variant)] // one per run, moved never
@@ -684,21 +684,21 @@ fn law_residual(
 /// factors is the loads' solution of the step.
 pub(crate) struct PathSystem {
     dense: DenseContactProblem,
-    /// `x_q`'s displacement part, per part, in the order of [`PathSystem::factors`].
+    /// `x_q`'s displacement part, per part, in the order of the parts.
     parts: Vec<Vec<f64>>,
 }
 
 impl PathSystem {
     /// The condensation of `K` on the boundary's dofs (once) and the parts' solutions (one
-    /// solve each). `parts` are the right-hand side's parts in the order loads, x, y, z
-    /// displacements (as many as the dimension), potentials.
+    /// solve each), returned whole. `parts` are the right-hand side's parts in the order loads,
+    /// x, y, z displacements (as many as the dimension), potentials.
     pub(crate) fn new(
         system: &mut Factored,
         boundary: &ContactBoundary,
         parts: &[(Vec<f64>, Vec<f64>)],
         nt: usize,
         reporter: &mut dyn Reporter,
-    ) -> Result<PathSystem, ProblemError> {
+    ) -> Result<(PathSystem, Vec<Fields>), ProblemError> {
         let LinearSolver::Direct(direct) = &mut system.solver else {
             return Err(not_direct());
         };
@@ -714,35 +714,36 @@ impl PathSystem {
         system.condense = Some(condense);
         let mut solved = Vec::with_capacity(parts.len());
         for (b_u, b_phi) in parts {
-            let (mut u, mut phi) = (vec![0.0; b_u.len()], vec![0.0; b_phi.len()]);
-            direct.solve(b_u, b_phi, &mut u, &mut phi)?;
-            solved.push(u);
+            solved.push(Self::solve(system, b_u, b_phi)?);
         }
-        Ok(PathSystem { dense, parts: solved })
+        let parts = solved.iter().map(|(u, _)| u.clone()).collect();
+        Ok((PathSystem { dense, parts }, solved))
     }
 
-    /// One step: the loads' displacement at the points for the step's `factors` (the parts
-    /// summed), the contact problem in the frame of the step before's tangential displacement
-    /// `shift` (friction on the slip increment), warm-started from `start`; the fields under
-    /// the loads and the contact forces, refined, the law judged on them. Returns the solution
-    /// (its displacements the total ones) and the free fields.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn step(
+    /// `K⁻¹ [b_u; b_φ]` with the factors of `K`.
+    pub(crate) fn solve(system: &mut Factored, b_u: &[f64], b_phi: &[f64]) -> Result<Fields, ProblemError> {
+        let LinearSolver::Direct(direct) = &mut system.solver else {
+            return Err(not_direct());
+        };
+        let (mut u, mut phi) = (vec![0.0; b_u.len()], vec![0.0; b_phi.len()]);
+        direct.solve(b_u, b_phi, &mut u, &mut phi)?;
+        Ok((u, phi))
+    }
+
+    /// The contact problem of a step: the loads' displacement at the points for the step's
+    /// `factors` (the parts summed), in the frame of the step before's tangential displacement
+    /// `shift` (friction on the slip increment), warm-started from `start`. Its displacements
+    /// are in that frame.
+    pub(crate) fn contact(
         &mut self,
         how: &ContactSolve<'_>,
-        system: &mut Factored,
         boundary: &ContactBoundary,
-        posed: &Posed<'_>,
         factors: &[f64],
         shift: &PointValues,
         start: Option<PointValues>,
         reporter: &mut dyn Reporter,
-    ) -> Result<(ContactSolution, Fields), ProblemError> {
-        let LinearSolver::Direct(direct) = &mut system.solver else {
-            return Err(not_direct());
-        };
-        let n_u = self.parts[0].len();
-        let mut x0 = vec![0.0; n_u];
+    ) -> Result<ContactSolution, ProblemError> {
+        let mut x0 = vec![0.0; self.parts[0].len()];
         for (part, f) in self.parts.iter().zip(factors) {
             if *f != 0.0 {
                 for (x, p) in x0.iter_mut().zip(part) {
@@ -752,10 +753,28 @@ impl PathSystem {
         }
         let nt = self.dense.nt;
         self.dense.u0 = in_frame(fields_at_points(boundary, &x0, nt), Some(shift));
-        let sol = how.run(Operator::Condensed(&mut self.dense), &boundary.points, start, reporter)?;
+        how.run(Operator::Condensed(&mut self.dense), &boundary.points, start, reporter)
+    }
+
+    /// The fields of a step under the loads of `posed` and the contact forces of `sol` (in
+    /// the frame `shift`), refined, the law judged on them (and the contact solve corrected
+    /// where they miss it).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn fields(
+        &mut self,
+        how: &ContactSolve<'_>,
+        system: &mut Factored,
+        boundary: &ContactBoundary,
+        posed: &Posed<'_>,
+        shift: &PointValues,
+        sol: ContactSolution,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(ContactSolution, Fields), ProblemError> {
         let (b_u, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
-        let (mut u, mut phi) = (vec![0.0; n_u], vec![0.0; b_phi.len()]);
-        direct.solve(&b_u, &b_phi, &mut u, &mut phi)?;
+        let (mut u, mut phi) = Self::solve(system, &b_u, &b_phi)?;
+        let LinearSolver::Direct(direct) = &mut system.solver else {
+            return Err(not_direct());
+        };
         let mut on = Refining {
             direct,
             blocks: &system.blocks,
@@ -765,11 +784,8 @@ impl PathSystem {
             shift: Some(shift),
             refine_tol: PATH_REFINE_TOL,
         };
-        let mut sol = on.correct(how, &mut self.dense, sol, (&mut u, &mut phi), reporter)?;
+        let sol = on.correct(how, &mut self.dense, sol, (&mut u, &mut phi), reporter)?;
         system.refinement = on.refinement;
-        for (v, s) in sol.u.tangential.iter_mut().zip(&shift.tangential) {
-            *v += s;
-        }
         Ok((sol, (u, phi)))
     }
 }

@@ -110,7 +110,7 @@ pub fn solve_within(
 ) -> Result<Solution, ProblemError> {
     if scene.path.is_some() {
         // a path's instants, each step's files unwritten: the last instant, with the rows
-        return Ok(path::solve_path(scene, mesh, limits, reporter, &mut |_| Ok(()))?.last);
+        return Ok(path::solve_path(scene, mesh, limits, reporter, false, &mut |_| Ok(()))?.last);
     }
     let solution = run::run(&mut Faer, scene, mesh, limits, reporter)?;
     Ok(solution.expect("the default backend runs in one process, which holds the solution"))

@@ -6,39 +6,52 @@
 //!
 //! Each step's right-hand side is the sum of the parts of [`Discretization::rhs_parts`]
 //! scaled by the step's factors, and so is the loads' displacement at the points: the parts
-//! are solved once, a step costs the contact solve (warm-started from the step before) and
-//! the solve for its fields.
+//! are solved once. A step is then its contact solve on the condensed compliance,
+//! warm-started from the step before: its row (forces, slips, counts, the charges through the
+//! terminals) comes from the multipliers alone, the charges by their functionals
+//! ([`Discretization::charge_functionals`]: `Σ_q f_q Q_q - Σ_i w_i λ_i · z_i`, `Q_q` the
+//! charge of part `q`'s solution and `z` the response `K⁻¹ a` of the functional `a` at the
+//! points, both computed once). The fields (a solve with `K`'s factors, refined, and the
+//! recovery) are computed only at the instants whose files are written, and at the last.
 
 use crate::backend::{ContactSolve, Limits, Loads, Posed};
 use crate::boundary::ContactBoundary;
-use crate::faer_backend::{Faer, PathSystem};
+use crate::faer_backend::{Factored, Faer, Fields, PathSystem};
 use crate::progress::{Event, Reporter};
 use crate::report::{PathReport, RunReport, StepRow, Timings};
 use crate::run::{
-    begin, check_accurate, check_solved, contact_result, recover, report, stop_if_interrupted, ContactResult, Measured,
+    begin, check_accurate, check_solved, contact_result, recover, report, stop_if_interrupted, terminal_groups,
+    ContactResult, Measured, Recovered,
 };
 use crate::scene::{Factors, PathSpec, Scene, SceneError};
+use crate::setup::Setup;
 use crate::ProblemError;
 use crate::{backend::Backend, Solution};
-use contact::PointValues;
+use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization, RhsParts};
 use std::time::Instant;
 
-/// One instant of a path, as its step hands it to the caller (to write its files): the
-/// step's row, its nodal fields, per-cell fields and contact solution, on the path's mesh.
+/// One instant of a path, as its step hands it to the caller: the step's row, its contact
+/// solution, and, at the instants whose fields are computed, its fields.
 pub struct Step<'a> {
     /// The step's row (`path.csv`).
     pub row: &'a StepRow,
     /// The mesh.
     pub mesh: &'a mesh::Mesh,
+    /// The contact solution of the step (its displacements the total ones).
+    pub contact: &'a ContactResult,
+    /// The fields, at the instants that have them ([`solve_path`]).
+    pub fields: Option<StepFields<'a>>,
+}
+
+/// The fields of an instant of a path.
+pub struct StepFields<'a> {
     /// Nodal displacements.
     pub u: &'a [[f64; 3]],
     /// Nodal potentials.
     pub phi: &'a [f64],
     /// Per-cell fields.
     pub fields: &'a CellFields,
-    /// The contact solution of the step.
-    pub contact: Option<&'a ContactResult>,
 }
 
 /// What a path produced: the last instant's solution (its report with the path's section)
@@ -49,9 +62,11 @@ pub struct PathSolution {
 }
 
 /// Solves `scene`'s path on the default backend: the instants of `scene.path` one after the
-/// other, friction on the slip increment; `each` is called once per instant, in order (to
-/// write its files: nothing of a step is kept after it but its row). A scene without a path
-/// is solved as the one instant it describes, which [`crate::solve`] gives.
+/// other, friction on the slip increment; `each` is called once per instant, in order, with
+/// the instant's row and contact solution, and, where `with_fields` asks for them, the fields
+/// of every `path.output_every`-th instant (and of the last, which the returned solution
+/// holds). Nothing of a step is kept after it but its row. A scene without a path is solved
+/// as the one instant it describes, which [`crate::solve`] gives.
 ///
 /// # Errors
 /// The errors of [`crate::solve`], naming the step where one happened; `path` refused by the
@@ -61,6 +76,7 @@ pub fn solve_path(
     mesh: Option<mesh::Mesh>,
     limits: Limits,
     reporter: &mut dyn Reporter,
+    with_fields: bool,
     each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
 ) -> Result<PathSolution, ProblemError> {
     let spec = scene.path.clone().unwrap_or_else(|| PathSpec {
@@ -82,11 +98,10 @@ pub fn solve_path(
     let setup = begin(valid, mesh, Faer.estimate(&valid), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
-    let t = Instant::now();
     let mut disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
     disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
     let parts = disc.rhs_parts(&setup.loads)?;
-    let walk = Walk {
+    let mut walk = Walk {
         scene,
         valid,
         setup: &setup,
@@ -94,27 +109,18 @@ pub fn solve_path(
         contact: &spec_contact,
         parts: &parts,
         base_dofs: disc.dofs.clone(),
+        with_fields,
+        terminals: Terminals::default(),
     };
-    let posed = Posed {
-        scene: valid,
-        setup: &setup,
-        disc: &disc,
-        loads: step_loads(&parts, &spec.factors(instants[0]), scene)?,
-    };
-    let assembled = Faer.assemble(&posed)?;
-    let t_assembly = t.elapsed().as_secs_f64();
-    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
-    let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, &spec_contact)?;
-    boundary.report_held(&spec_contact.group, reporter);
-    let mut system = Faer.prepare(&posed, assembled, Some(&boundary), limits, reporter)?;
-    drop(posed);
-    stop_if_interrupted(&limits, "factorisation")?;
+    let (mut system, boundary, t_assembly) = walk.factor(&disc, &instants, &limits, reporter)?;
     let how = ContactSolve::new(&setup.plan, scene, boundary.points.len(), limits.interrupt);
     let ordered: Vec<(Vec<f64>, Vec<f64>)> = std::iter::once(parts.loads.clone())
         .chain(parts.displacements.iter().cloned())
         .chain(std::iter::once(parts.potentials.clone()))
         .collect();
-    let mut path = PathSystem::new(&mut system, &boundary, &ordered, setup.plan.n_tangential(), reporter)?;
+    let (mut path, solved) = PathSystem::new(&mut system, &boundary, &ordered, setup.plan.n_tangential(), reporter)?;
+    walk.terminals = Terminals::new(&walk, &disc, &mut system, &boundary, &solved)?;
+    drop(solved);
     let t_steps = Instant::now();
     let mut state = History::new(boundary.points.len(), setup.plan.n_tangential(), instants.len());
     walk.all_steps(
@@ -130,7 +136,7 @@ pub fn solve_path(
     let timings = (t_setup, t_assembly, steps_s, t_total);
     let (report, done) = walk.finish(&disc, &system, state, timings);
     drop(disc);
-    let recovered = done.recovered;
+    let (recovered, _, _) = done.fields.expect("the last instant has its fields");
     Ok(PathSolution {
         last: Solution {
             report,
@@ -147,12 +153,89 @@ pub fn solve_path(
 struct Walk<'a> {
     scene: &'a Scene,
     valid: crate::Valid<'a>,
-    setup: &'a crate::setup::Setup,
+    setup: &'a Setup,
     spec: &'a PathSpec,
     contact: &'a crate::ContactSpec,
     parts: &'a RhsParts,
     /// The dof map with the scene's prescribed values (scaled at each step).
     base_dofs: fe_assembly::DofMap,
+    /// Whether the fields of the output instants are computed ([`PathSpec::has_fields`]; the
+    /// last instant's always are).
+    with_fields: bool,
+    /// The charges' functionals.
+    terminals: Terminals,
+}
+
+/// The charges through the terminals (the groups at a prescribed potential) at any step from
+/// its factors and multipliers: `Σ_q f_q Q_q - Σ_i w_i λ_i · z_i`.
+#[derive(Default)]
+struct Terminals {
+    /// Per terminal, the charge of each part's solution `Q_q` (its prescribed values lifted).
+    of_parts: Vec<Vec<f64>>,
+    /// Per terminal, `z = K⁻¹ a` at the points (`a` its functional on the free unknowns).
+    at_points: Vec<PointValues>,
+}
+
+impl Terminals {
+    /// The functionals of the setup's terminals: each part's charge, from its solution's
+    /// fields, and the response of each functional at the points (one solve each).
+    fn new(
+        walk: &Walk<'_>,
+        disc: &Discretization<'_>,
+        system: &mut Factored,
+        boundary: &ContactBoundary,
+        solved: &[Fields],
+    ) -> Result<Terminals, ProblemError> {
+        let setup = walk.setup;
+        let groups = terminal_groups(setup);
+        if groups.is_empty() {
+            return Ok(Terminals::default());
+        }
+        let dim = setup.mesh.dim;
+        let mut of_parts = vec![vec![]; groups.len()];
+        for (q, (u, phi)) in solved.iter().enumerate() {
+            // the part's own prescribed values: part q's factor 1, every other 0
+            let unit = |k: usize| if q == k + 1 { 1.0 } else { 0.0 };
+            let dofs = walk
+                .base_dofs
+                .scaled([unit(0), unit(1), unit(2)], if q == dim + 1 { 1.0 } else { 0.0 });
+            let fields = disc.recover(&dofs.expand_u(u), &dofs.expand_phi(phi));
+            let loads: &[fe_assembly::Load] = if q == 0 { &setup.loads } else { &[] };
+            for (g, charge) in disc.charges(&fields, &groups, loads)?.into_iter().enumerate() {
+                of_parts[g].push(charge);
+            }
+        }
+        let mut at_points = vec![];
+        for (a_u, a_phi) in disc.charge_functionals(&groups)? {
+            let (z, _) = PathSystem::solve(system, &a_u, &a_phi)?;
+            let points = &boundary.points;
+            let mut out = PointValues::zeros(points.len(), points.n_tangential());
+            boundary.extract_free(&z, &mut out);
+            at_points.push(out);
+        }
+        Ok(Terminals { of_parts, at_points })
+    }
+
+    /// The charges at a step of `factors` (in the order of the parts) and multipliers.
+    fn charges(&self, factors: &[f64], lambda: &PointValues, weight: &[f64]) -> Vec<f64> {
+        let nt = lambda.n_tangential();
+        self.of_parts
+            .iter()
+            .zip(&self.at_points)
+            .map(|(parts, z)| {
+                let loads: f64 = parts.iter().zip(factors).map(|(q, f)| q * f).sum();
+                let contact: f64 = (0..weight.len())
+                    .map(|i| {
+                        let t: f64 = (0..nt.min(z.n_tangential()))
+                            .map(|k| lambda.tangential_of(i)[k] * z.tangential_of(i)[k])
+                            .sum();
+                        weight[i] * (lambda.normal[i] * z.normal[i] + t)
+                    })
+                    .sum();
+                loads - contact
+            })
+            .collect()
+    }
 }
 
 /// What a path carries from step to step: the tangential displacement of the points at the
@@ -176,23 +259,48 @@ impl History {
     }
 }
 
-/// One instant solved.
+/// One instant solved: its row, its contact solution, and where computed its fields (with the
+/// equilibrium residual and the step's loads).
 struct Done {
     row: StepRow,
-    recovered: crate::run::Recovered,
     result: ContactResult,
-    equilibrium: f64,
-    loads: Loads,
+    fields: Option<(Recovered, f64, Loads)>,
 }
 
 impl Walk<'_> {
+    /// Assembles and factors `K` with the boundary's dofs last (at the first instant's
+    /// factors); the boundary, and the assembly's time.
+    fn factor(
+        &self,
+        disc: &Discretization<'_>,
+        instants: &[f64],
+        limits: &Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(Factored, ContactBoundary, f64), ProblemError> {
+        let t = Instant::now();
+        let posed = Posed {
+            scene: self.valid,
+            setup: self.setup,
+            disc,
+            loads: step_loads(self.parts, &self.spec.factors(instants[0]), self.scene)?,
+        };
+        let assembled = Faer.assemble(&posed)?;
+        let t_assembly = t.elapsed().as_secs_f64();
+        reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
+        let boundary = ContactBoundary::new(&self.setup.mesh, &disc.dofs, self.contact)?;
+        boundary.report_held(&self.contact.group, reporter);
+        let system = Faer.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
+        stop_if_interrupted(limits, "factorisation")?;
+        Ok((system, boundary, t_assembly))
+    }
+
     /// Every instant in order, each handed to `each` and its row kept; the last kept whole.
     #[allow(clippy::too_many_arguments)]
     fn all_steps(
         &self,
         instants: &[f64],
         disc: &mut Discretization<'_>,
-        (system, path): (&mut crate::faer_backend::Factored, &mut PathSystem),
+        (system, path): (&mut Factored, &mut PathSystem),
         how: &ContactSolve<'_>,
         state: &mut History,
         reporter: &mut dyn Reporter,
@@ -202,17 +310,20 @@ impl Walk<'_> {
         for (k, &t) in instants.iter().enumerate() {
             reporter.event(&Event::PathStep { step: k, of, t });
             let at = |e: ProblemError| e.at_step(k, t);
+            let fields = k == of || (self.with_fields && self.spec.has_fields(k, of + 1));
             let done = self
-                .step((k, t), disc, (system, path), how, state, reporter)
+                .step((k, t), fields, disc, (system, path), how, state, reporter)
                 .map_err(at)?;
             reporter.event(&Event::PathStepDone { row: &done.row, of });
             each(Step {
                 row: &done.row,
                 mesh: &self.setup.mesh,
-                u: &done.recovered.u,
-                phi: &done.recovered.phi,
-                fields: &done.recovered.fields,
-                contact: Some(&done.result),
+                contact: &done.result,
+                fields: done.fields.as_ref().map(|(r, _, _)| StepFields {
+                    u: &r.u,
+                    phi: &r.phi,
+                    fields: &r.fields,
+                }),
             })?;
             state.rows.push(done.row.clone());
             if k == of {
@@ -223,12 +334,14 @@ impl Walk<'_> {
     }
 
     /// The instant `(k, t)`: its prescribed values, gap and loads scaled, the contact problem
-    /// in the frame of the step before, the fields recovered and checked.
+    /// in the frame of the step before; where `with_fields`, the fields recovered and checked.
+    #[allow(clippy::too_many_arguments)]
     fn step(
         &self,
         (k, t): (usize, f64),
+        with_fields: bool,
         disc: &mut Discretization<'_>,
-        (system, path): (&mut crate::faer_backend::Factored, &mut PathSystem),
+        (system, path): (&mut Factored, &mut PathSystem),
         how: &ContactSolve<'_>,
         state: &mut History,
         reporter: &mut dyn Reporter,
@@ -239,53 +352,62 @@ impl Walk<'_> {
         let mut spec_k = self.contact.clone();
         spec_k.gap *= f.gap;
         let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, &spec_k)?;
-        let posed = Posed {
-            scene: self.valid,
-            setup,
-            disc,
-            loads: step_loads(self.parts, &f, scene)?,
-        };
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
         factors.push(f.voltage);
-        let (sol, (u, phi)) = path.step(
-            how,
-            system,
-            &boundary,
-            &posed,
-            &factors,
-            &state.shift,
-            state.start.take(),
-            reporter,
-        )?;
-        let (b_full, b_phi, scale) = crate::faer_backend::rhs_with_contact(&posed, Some((&boundary, &sol)));
-        let equilibrium = system.equilibrium_of(&u, &phi, &b_full, &b_phi, scale);
-        check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
-        check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
-        let recovered = recover(
-            scene,
-            setup,
-            disc,
-            (&u, &phi),
-            Some((&boundary, &sol)),
-            equilibrium,
-            reporter,
-        )?;
-        // the next step's frame: the tangential displacement of the points now
-        let mut now = PointValues::zeros(boundary.points.len(), boundary.points.n_tangential());
-        boundary.extract(&u, &mut now);
-        let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift, equilibrium);
-        row.charges = recovered.terminals.iter().map(|x| x.charge).collect();
+        let sol = path.contact(how, &boundary, &factors, &state.shift, state.start.take(), reporter)?;
+        let (mut sol, fields) = if with_fields {
+            let posed = Posed {
+                scene: self.valid,
+                setup,
+                disc,
+                loads: step_loads(self.parts, &f, scene)?,
+            };
+            let (sol, (u, phi)) = path.fields(how, system, &boundary, &posed, &state.shift, sol, reporter)?;
+            let (b_full, b_phi, scale) = crate::faer_backend::rhs_with_contact(&posed, Some((&boundary, &sol)));
+            let equilibrium = system.equilibrium_of(&u, &phi, &b_full, &b_phi, scale);
+            check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
+            check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
+            let pair = Some((&boundary, &sol));
+            let recovered = recover(scene, setup, disc, (&u, &phi), pair, equilibrium, reporter)?;
+            (sol, Some((recovered, equilibrium, posed.loads, u)))
+        } else {
+            check_solved(scene, (&[], &[]), Some(&sol), 0.0)?;
+            check_accurate(scene, &setup.plan, Some(&sol), 0.0)?;
+            (sol, None)
+        };
+        // the multipliers and displacements of the step in the body's frame
+        for (v, s) in sol.u.tangential.iter_mut().zip(&state.shift.tangential) {
+            *v += s;
+        }
+        let now = match &fields {
+            Some((_, _, _, u)) => {
+                let mut now = PointValues::zeros(boundary.points.len(), boundary.points.n_tangential());
+                boundary.extract(u, &mut now);
+                now
+            }
+            None => sol.u.clone(),
+        };
+        let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift);
+        // the charges of the fields where they are computed, else of the functionals (equal to
+        // the condensed solve's accuracy: tests/path.rs)
+        row.charges = match &fields {
+            Some((recovered, _, _, _)) => recovered.terminals.iter().map(|x| x.charge).collect(),
+            None => self.terminals.charges(&factors, &sol.lambda, &boundary.points.weight),
+        };
+        row.equilibrium = fields.as_ref().map(|(_, e, _, _)| *e);
         if setup.plan.n_tangential() > 0 {
             state.shift.tangential.clone_from(&now.tangential);
         }
         state.start = Some(sol.lambda.clone());
+        let result = match &fields {
+            Some((_, _, _, u)) => contact_result(boundary, sol, u),
+            None => ContactResult::condensed(boundary, sol),
+        };
         Ok(Done {
             row,
-            recovered,
-            result: contact_result(boundary, sol, &u),
-            equilibrium,
-            loads: posed.loads,
+            result,
+            fields: fields.map(|(r, e, l, _)| (r, e, l)),
         })
     }
 
@@ -293,7 +415,7 @@ impl Walk<'_> {
     fn finish(
         self,
         disc: &Discretization<'_>,
-        system: &crate::faer_backend::Factored,
+        system: &Factored,
         state: History,
         (t_setup, t_assembly, steps_s, t_total): (f64, f64, f64, Instant),
     ) -> (RunReport, Done) {
@@ -308,20 +430,21 @@ impl Walk<'_> {
             solve: steps_s,
             total: t_total.elapsed().as_secs_f64(),
         };
+        let (recovered, equilibrium, loads) = done.fields.as_mut().expect("the last instant has its fields");
         let posed = Posed {
             scene: self.valid,
             setup: self.setup,
             disc,
-            loads: std::mem::take(&mut done.loads),
+            loads: std::mem::take(loads),
         };
         let measured = Measured {
             info: Some(&done.result.solution.info),
             pcg_iters: 0,
-            equilibrium: done.equilibrium,
+            equilibrium: *equilibrium,
             timings_s,
             figures,
         };
-        let mut report: RunReport = report(&posed, measured, &done.recovered);
+        let mut report: RunReport = report(&posed, measured, recovered);
         report.path = Some(PathReport {
             instants: state.rows.len(),
             factorisations: 1,
@@ -357,17 +480,16 @@ fn step_loads(parts: &RhsParts, f: &Factors, scene: &Scene) -> Result<Loads, Pro
     Ok(Loads { b_u, b_phi })
 }
 
-/// The row of a step: its forces (the multipliers weighted), slips and counts.
-#[allow(clippy::too_many_arguments)]
+/// The row of a step: its forces (the multipliers weighted), slips and counts; its charges
+/// and equilibrium residual are the caller's to fill.
 fn step_row(
     step: usize,
     t: f64,
     f: &Factors,
     boundary: &ContactBoundary,
-    sol: &contact::ContactSolution,
+    sol: &ContactSolution,
     now: &PointValues,
     before: &PointValues,
-    equilibrium: f64,
 ) -> StepRow {
     let points = &boundary.points;
     let counts = crate::report::ContactReport::of(points, sol);
@@ -412,6 +534,6 @@ fn step_row(
         iterations: sol.info.newton_iters + sol.info.uzawa_iters,
         charges: vec![],
         complementarity: sol.info.complementarity,
-        equilibrium,
+        equilibrium: None,
     }
 }

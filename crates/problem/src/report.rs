@@ -103,8 +103,9 @@ pub struct StepRow {
     pub charges: Vec<f64>,
     /// The complementarity residual of the step.
     pub complementarity: f64,
-    /// The equilibrium residual of the step.
-    pub equilibrium: f64,
+    /// The equilibrium residual of the step, where its fields were computed (the instants
+    /// whose files are written, and the last).
+    pub equilibrium: Option<f64>,
 }
 
 impl SceneReport {

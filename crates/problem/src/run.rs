@@ -225,6 +225,25 @@ fn contact_boundary(posed: &Posed<'_>, reporter: &mut dyn Reporter) -> Result<Op
     Ok(Some(boundary))
 }
 
+impl ContactResult {
+    /// The contact part of a solution whose fields were not computed: the displacement of
+    /// the points the contact solve's own (all tangential components 0 where it has none).
+    pub(crate) fn condensed(b: ContactBoundary, solution: ContactSolution) -> ContactResult {
+        let n_t = b.points.n_tangential();
+        let mut displacement = PointValues::zeros(b.points.len(), n_t);
+        displacement.normal.clone_from(&solution.u.normal);
+        if solution.u.n_tangential() == n_t {
+            displacement.tangential.clone_from(&solution.u.tangential);
+        }
+        ContactResult {
+            nodes: b.nodes,
+            points: b.points,
+            solution,
+            displacement,
+        }
+    }
+}
+
 /// The contact part of the solution: the boundary, the contact solve, and the displacement of
 /// the points in the free displacements `u`.
 pub(crate) fn contact_result(b: ContactBoundary, solution: ContactSolution, u: &[f64]) -> ContactResult {
@@ -377,18 +396,13 @@ pub(crate) fn recover(
     })
 }
 
-/// The groups where the potential is prescribed, each with its potential and the charge
-/// through it (none without electric unknowns).
-fn terminals(
-    setup: &Setup,
-    disc: &Discretization<'_>,
-    fields: &CellFields,
-    phi: &[f64],
-) -> Result<Vec<crate::report::TerminalReport>, ProblemError> {
-    if !setup.plan.electric {
-        return Ok(vec![]);
-    }
+/// The groups where the potential is prescribed (none without electric unknowns), each once,
+/// in the order of the conditions.
+pub(crate) fn terminal_groups(setup: &Setup) -> Vec<&str> {
     let mut groups: Vec<&str> = vec![];
+    if !setup.plan.electric {
+        return groups;
+    }
     for c in setup
         .constraints
         .iter()
@@ -397,6 +411,21 @@ fn terminals(
         if !groups.contains(&c.group.as_str()) {
             groups.push(&c.group);
         }
+    }
+    groups
+}
+
+/// The groups where the potential is prescribed, each with its potential and the charge
+/// through it (none without electric unknowns).
+fn terminals(
+    setup: &Setup,
+    disc: &Discretization<'_>,
+    fields: &CellFields,
+    phi: &[f64],
+) -> Result<Vec<crate::report::TerminalReport>, ProblemError> {
+    let groups = terminal_groups(setup);
+    if groups.is_empty() {
+        return Ok(vec![]);
     }
     let charges = disc.charges(fields, &groups, &setup.loads)?;
     let mut out = vec![];

@@ -532,7 +532,15 @@ pub fn solve_newton<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    solve_newton_cached(problem, points, law, params, lambda0, progress, &mut NewtonCache::default())
+    solve_newton_cached(
+        problem,
+        points,
+        law,
+        params,
+        lambda0,
+        progress,
+        &mut NewtonCache::default(),
+    )
 }
 
 /// What the Newton solves of one compliance `D` share, whatever their loads `u₀` and their

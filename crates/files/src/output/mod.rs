@@ -280,7 +280,8 @@ impl PathFiles {
     /// files, the path's own, and the last instant's report, solution and contact table.
     pub fn expected_names(scene: &problem::Scene) -> Vec<String> {
         let steps = scene.path.as_ref().map_or(1, |p| p.instants().len());
-        let mut names: Vec<String> = (0..steps).map(step_name).collect();
+        let written = |k: &usize| scene.path.as_ref().is_none_or(|p| p.has_fields(*k, steps));
+        let mut names: Vec<String> = (0..steps).filter(written).map(step_name).collect();
         names.extend(["path.csv", "path.pvd", "run.json", "solution.vtu", "contact.csv"].map(String::from));
         names
     }
@@ -291,8 +292,11 @@ impl PathFiles {
     /// [`Error::Picture`] where its VTU cannot be made, [`Error::Output`] where it cannot be
     /// written.
     pub fn step(&mut self, step: &problem::Step<'_>, writer: &mut SetWriter) -> Result<(), Error> {
+        let Some(f) = &step.fields else {
+            return Ok(());
+        };
         let name = step_name(step.row.step);
-        writer.write(&name, &vtu(step.mesh, (step.u, step.phi), step.fields, step.contact)?)?;
+        writer.write(&name, &vtu(step.mesh, (f.u, f.phi), f.fields, Some(step.contact))?)?;
         self.series.push((step.row.t, name));
         Ok(())
     }
@@ -350,7 +354,7 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
                 .map(|v| v.to_string()),
         );
         row.push(format!("{:e}", r.complementarity));
-        row.push(format!("{:e}", r.equilibrium));
+        row.push(r.equilibrium.map_or(String::new(), |e| format!("{e:e}")));
         row.extend(r.charges.iter().map(|q| format!("{q:e}")));
         s.push_str(&row.join(","));
         s.push('\n');

@@ -339,6 +339,10 @@ pub struct PathSpec {
     /// The factor on the uniform gap (`contact.gap`; the curvature's part stays).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gap: Option<Vec<f64>>,
+    /// The fields (and a run's `step-NNNN.vtu`) of every `output_every`-th instant (1, the
+    /// default: every one; 0: the last alone); the rows of `path.csv` are every instant's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_every: Option<usize>,
 }
 
 /// The factors of one instant of a path.
@@ -386,6 +390,13 @@ impl PathSpec {
                 }
             })
             .collect()
+    }
+
+    /// Whether instant `k` of `n` has its fields (and a run its `step-NNNN.vtu`): every
+    /// `output_every`-th (1 by default; 0: none), and the last.
+    pub fn has_fields(&self, k: usize, n: usize) -> bool {
+        let every = self.output_every.unwrap_or(1);
+        k + 1 == n || (every > 0 && k.is_multiple_of(every))
     }
 
     /// The factors at instant `t` (piecewise linear in the tables, constant beyond their ends).

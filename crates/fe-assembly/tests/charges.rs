@@ -1,0 +1,59 @@
+//! The charges through the groups at a prescribed potential (`Discretization::charges`, from the
+//! recovered fields) against their functionals on the free unknowns
+//! (`Discretization::charge_functionals`): with the prescribed values zero and no body charge,
+//! `charge = a_u · u + a_φ · φ` for any `(u, φ)`, on a jittered mesh with a piezoelectric and an
+//! elastic region, in 2D and 3D.
+
+use fe_assembly::{Constraint, Crystal, Discretization, Field, Material};
+
+fn check(dim: usize) {
+    let mut mesh = if dim == 2 {
+        mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 6, 4)
+    } else {
+        mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2)
+    };
+    let (lo, hi) = mesh.bounding_box();
+    let mut seed = 99u64;
+    let mut random = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for p in &mut mesh.points {
+        if (0..dim).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
+            for k in 0..dim {
+                p[k] += 0.08 * random();
+            }
+        }
+    }
+    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
+    let mat = Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap();
+    let materials = vec![("body".to_string(), mat)];
+    let constraints = vec![
+        Constraint::constant("left", Field::Displacement(0), 0.0),
+        Constraint::constant("left", Field::Displacement(1), 0.0),
+        Constraint::constant("top", Field::Potential, 0.0),
+        Constraint::constant("bottom", Field::Potential, 0.0),
+    ];
+    let disc = Discretization::new(&mesh, &materials, &constraints).unwrap();
+    let u_free: Vec<f64> = (0..disc.dofs.n_u).map(|_| 1e-3 * random()).collect();
+    let phi_free: Vec<f64> = (0..disc.dofs.n_phi).map(|_| 1e-2 * random()).collect();
+    let (u, phi) = (disc.dofs.expand_u(&u_free), disc.dofs.expand_phi(&phi_free));
+    let fields = disc.recover(&u, &phi);
+    let groups = ["top", "bottom"];
+    let charges = disc.charges(&fields, &groups, &[]).unwrap();
+    let functionals = disc.charge_functionals(&groups).unwrap();
+    for (q, (a_u, a_phi)) in charges.iter().zip(&functionals) {
+        let from: f64 = a_u.iter().zip(&u_free).map(|(a, x)| a * x).sum::<f64>()
+            + a_phi.iter().zip(&phi_free).map(|(a, x)| a * x).sum::<f64>();
+        assert!(
+            (q - from).abs() <= 1e-12 * q.abs().max(1e-6),
+            "{dim}D: {q} against {from}"
+        );
+    }
+}
+
+#[test]
+fn the_charge_functionals_are_the_charges_of_the_fields() {
+    check(2);
+    check(3);
+}
