@@ -271,6 +271,29 @@ impl ContactBoundary {
         })
     }
 
+    /// The boundary at an instant of a load path: the uniform part `g0` of every gap
+    /// (`contact.gap`) scaled by `gap`, and each prescribed displacement component `k` of a
+    /// point by `displacement[k]` (the points, their dofs and weights are the same).
+    pub fn at_factors(&self, g0: f64, gap: f64, displacement: [f64; 3]) -> ContactBoundary {
+        let dim = self.points.dim;
+        let mut b = ContactBoundary {
+            points: self.points.clone(),
+            nodes: self.nodes.clone(),
+            dofs: self.dofs.clone(),
+            slots: self.slots.clone(),
+            held_nodes: self.held_nodes,
+            held_inside: self.held_inside,
+            electric: self.electric.clone(),
+        };
+        b.points.gap.iter_mut().for_each(|g| *g += (gap - 1.0) * g0);
+        for (j, slot) in b.slots.iter_mut().enumerate() {
+            if let Slot::Fixed(v) = slot {
+                *v *= displacement[j % dim];
+            }
+        }
+        b
+    }
+
     /// The dofs the condensation puts last: the points' free displacements, then (electrical
     /// contact) their free potentials.
     pub fn condensed_dofs(&self) -> Vec<usize> {

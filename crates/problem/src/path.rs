@@ -124,7 +124,7 @@ pub fn solve_path(
     let t_steps = Instant::now();
     let mut state = History::new(boundary.points.len(), setup.plan.n_tangential(), instants.len());
     walk.all_steps(
-        &instants,
+        (&instants, &boundary),
         &mut disc,
         (&mut system, &mut path),
         &how,
@@ -298,7 +298,7 @@ impl Walk<'_> {
     #[allow(clippy::too_many_arguments)]
     fn all_steps(
         &self,
-        instants: &[f64],
+        (instants, base): (&[f64], &ContactBoundary),
         disc: &mut Discretization<'_>,
         (system, path): (&mut Factored, &mut PathSystem),
         how: &ContactSolve<'_>,
@@ -312,7 +312,7 @@ impl Walk<'_> {
             let at = |e: ProblemError| e.at_step(k, t);
             let fields = k == of || (self.with_fields && self.spec.has_fields(k, of + 1));
             let done = self
-                .step((k, t), fields, disc, (system, path), how, state, reporter)
+                .step((k, t), (fields, base), disc, (system, path), how, state, reporter)
                 .map_err(at)?;
             reporter.event(&Event::PathStepDone { row: &done.row, of });
             each(Step {
@@ -339,7 +339,7 @@ impl Walk<'_> {
     fn step(
         &self,
         (k, t): (usize, f64),
-        with_fields: bool,
+        (with_fields, base): (bool, &ContactBoundary),
         disc: &mut Discretization<'_>,
         (system, path): (&mut Factored, &mut PathSystem),
         how: &ContactSolve<'_>,
@@ -349,9 +349,7 @@ impl Walk<'_> {
         let (scene, setup) = (self.scene, self.setup);
         let f = self.spec.factors(t);
         disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
-        let mut spec_k = self.contact.clone();
-        spec_k.gap *= f.gap;
-        let boundary = ContactBoundary::new(&setup.mesh, &disc.dofs, &spec_k)?;
+        let boundary = base.at_factors(self.contact.gap, f.gap, f.displacement);
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
         factors.push(f.voltage);
