@@ -149,6 +149,11 @@ impl Coarsening {
             friction: self.mean(&points.friction, points),
             held: self.chosen.iter().map(|&i| points.held[i]).collect(),
             foundation: points.foundation,
+            slipped: if points.slipped.is_empty() {
+                vec![]
+            } else {
+                self.mean(&points.slipped, points)
+            },
         }
     }
 
@@ -281,6 +286,7 @@ mod tests {
             friction: vec![0.3; m],
             held: vec![[false; 2]; m],
             foundation: Default::default(),
+            slipped: vec![],
         }
     }
 

@@ -28,6 +28,10 @@ pub struct ContactPoints {
     /// What the points press on: a rigid foundation (Signorini's conditions) or a deformable
     /// one (normal compliance).
     pub foundation: Foundation,
+    /// The slip each point has accumulated before this problem (the earlier steps of a load
+    /// path): slip-weakening friction takes its coefficient at this plus the problem's own
+    /// slip `|u_t|`. Empty: none (zeros).
+    pub slipped: Vec<f64>,
 }
 
 /// The foundation under the contact points, which gives the normal law.
@@ -119,6 +123,13 @@ impl ContactPoints {
     pub fn is_empty(&self) -> bool {
         self.weight.is_empty()
     }
+
+    /// The slip point `i` accumulated before this problem ([`ContactPoints::slipped`]).
+    #[inline]
+    pub fn slipped(&self, i: usize) -> f64 {
+        self.slipped.get(i).copied().unwrap_or(0.0)
+    }
+
     /// Tangential components per point.
     pub fn n_tangential(&self) -> usize {
         self.dim - 1
@@ -161,6 +172,7 @@ impl ContactPoints {
             || self.gap.len() != n
             || self.friction.len() != n
             || self.held.len() != n
+            || !(self.slipped.is_empty() || self.slipped.len() == n)
         {
             return Err(InputError::PointArrays);
         }
@@ -179,6 +191,9 @@ impl ContactPoints {
             }
             if !(self.friction[i] >= 0.0 && self.friction[i].is_finite()) {
                 return Err(bad(i, "friction", self.friction[i], "must be finite and non-negative"));
+            }
+            if !(self.slipped(i) >= 0.0 && self.slipped(i).is_finite()) {
+                return Err(bad(i, "slipped", self.slipped(i), "must be finite and non-negative"));
             }
         }
         if let Foundation::Compliant { stiffness, exponent } = self.foundation {

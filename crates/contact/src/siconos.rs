@@ -324,6 +324,7 @@ impl FrictionProblem {
             friction: self.mu.clone(),
             held: vec![[false; 2]; nc],
             foundation: Default::default(),
+            slipped: vec![],
         }
     }
 

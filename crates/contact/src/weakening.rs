@@ -183,17 +183,18 @@ impl SlipWeakening {
         }
     }
 
-    /// The coefficient of each point at its slip `|u_t|` in `u`.
-    pub fn coefficients(&self, u: &crate::PointValues) -> Vec<f64> {
+    /// The coefficient of each point at its slip: what it slipped before the problem
+    /// ([`ContactPoints::slipped`]) and its slip `|u_t|` in `u`.
+    pub fn coefficients(&self, points: &ContactPoints, u: &crate::PointValues) -> Vec<f64> {
         (0..u.n_points())
-            .map(|i| self.coefficient(u.tangential_norm(i)))
+            .map(|i| self.coefficient(points.slipped(i) + u.tangential_norm(i)))
             .collect()
     }
 
-    /// Points with the coefficients the law gives at the slips of `u`.
+    /// Points with the coefficients the law gives at their slips with `u`.
     pub fn points_at(&self, points: &ContactPoints, u: &crate::PointValues) -> ContactPoints {
         ContactPoints {
-            friction: self.coefficients(u),
+            friction: self.coefficients(points, u),
             ..points.clone()
         }
     }
@@ -324,7 +325,8 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
     law.check()?;
     let n = points.len();
     let mut frozen = points.clone();
-    frozen.friction = vec![law.static_coefficient; n];
+    // the stick start: each point's coefficient at what it slipped before (μ_s where nothing)
+    frozen.friction = (0..n).map(|i| law.coefficient(points.slipped(i))).collect();
     let scale = law.static_coefficient.max(f64::MIN_POSITIVE);
     let (mut start, mut newton_iters) = (None, 0);
     let mut contraction: Option<f64> = None;
@@ -338,7 +340,7 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
         newton_iters += sol.info.newton_iters;
         // the operator is the same at every step: its μ_max once
         newton.mu_max = Some(sol.info.mu_max);
-        let next = law.coefficients(&sol.u);
+        let next = law.coefficients(points, &sol.u);
         let change = max_difference(&next, &frozen.friction) / scale;
         // the map's secant ratio |G(μ_k) - G(μ_j)| / |μ_k - μ_j| between successive iterates,
         // where the step stands above the round-off of the step's own solve

@@ -193,7 +193,7 @@ impl Terminal {
                 }
                 false
             }
-            Event::Contact { .. } | Event::NotContractive { .. } => self.path.is_some(),
+            Event::Contact { .. } => self.path.is_some(),
             _ => false,
         }
     }

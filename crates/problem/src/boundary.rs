@@ -208,6 +208,7 @@ impl ContactBoundary {
                 },
                 None => contact::Foundation::Rigid,
             },
+            slipped: vec![],
         };
         let (mut nodes, mut point_dofs, mut slots) = (vec![], vec![], vec![]);
         let (mut held_nodes, mut held_inside) = (0, 0);

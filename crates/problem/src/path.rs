@@ -243,6 +243,8 @@ impl Terminals {
 /// last instant.
 struct History {
     shift: PointValues,
+    /// The slip each point accumulated in contact (slip-weakening friction's argument).
+    slipped: Vec<f64>,
     start: Option<PointValues>,
     rows: Vec<StepRow>,
     last: Option<Done>,
@@ -252,10 +254,27 @@ impl History {
     fn new(n: usize, nt: usize, instants: usize) -> Self {
         History {
             shift: PointValues::zeros(n, nt),
+            slipped: vec![0.0; n],
             start: None,
             rows: Vec::with_capacity(instants),
             last: None,
         }
+    }
+
+    /// The step is done: its tangential displacement `now` the next step's frame, the slip of
+    /// its points in contact added to what they slipped, its multipliers the next start.
+    fn advance(&mut self, now: &PointValues, sol: &ContactSolution) {
+        let nt = self.shift.n_tangential();
+        if nt > 0 {
+            for i in 0..self.slipped.len() {
+                if sol.status[i] != contact::Status::Separated {
+                    let (a, b) = (now.tangential_of(i), self.shift.tangential_of(i));
+                    self.slipped[i] += a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+                }
+            }
+            self.shift.tangential.clone_from(&now.tangential);
+        }
+        self.start = Some(sol.lambda.clone());
     }
 }
 
@@ -349,11 +368,17 @@ impl Walk<'_> {
         let (scene, setup) = (self.scene, self.setup);
         let f = self.spec.factors(t);
         disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
-        let boundary = base.at_factors(self.contact.gap, f.gap, f.displacement);
+        let mut boundary = base.at_factors(self.contact.gap, f.gap, f.displacement);
+        if how.weakening.is_some() {
+            boundary.points.slipped.clone_from(&state.slipped);
+        }
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
         factors.push(f.voltage);
         let sol = path.contact(how, &boundary, &factors, &state.shift, state.start.take(), reporter)?;
+        if let Some(contraction) = sol.info.contraction.filter(|c| *c >= 1.0) {
+            reporter.event(&Event::NotContractive { contraction });
+        }
         let (mut sol, fields) = if with_fields {
             let posed = Posed {
                 scene: self.valid,
@@ -394,10 +419,7 @@ impl Walk<'_> {
             None => self.terminals.charges(&factors, &sol.lambda, &boundary.points.weight),
         };
         row.equilibrium = fields.as_ref().map(|(_, e, _, _)| *e);
-        if setup.plan.n_tangential() > 0 {
-            state.shift.tangential.clone_from(&now.tangential);
-        }
-        state.start = Some(sol.lambda.clone());
+        state.advance(&now, &sol);
         let result = match &fields {
             Some((_, _, _, u)) => contact_result(boundary, sol, u),
             None => ContactResult::condensed(boundary, sol),

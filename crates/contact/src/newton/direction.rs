@@ -327,6 +327,7 @@ mod tests {
                     friction: vec![0.3; n],
                     held: vec![[false; 2]; n],
                     foundation: Default::default(),
+                    slipped: vec![],
                 };
                 // an SPD compliance with zeros: a Gram matrix plus the identity
                 let g = |i: usize, j: usize| ((i * 7 + j * 3 + case) % 5) as f64 * 0.1 - 0.2;
@@ -414,6 +415,7 @@ mod tests {
                 friction: vec![0.3; n],
                 held: vec![[false; 2]; n],
                 foundation,
+                slipped: vec![],
             };
             let g = |i: usize, j: usize| ((i * 5 + j * 3) % 7) as f64 * 0.1 - 0.3;
             // symmetric SPD part plus an antisymmetric coupling between u and φ rows

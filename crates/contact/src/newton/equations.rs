@@ -329,7 +329,7 @@ impl<'a> Flat<'a> {
     pub(super) fn radius(&self, i: usize, z: &[f64], x: &[f64], u: &[f64]) -> f64 {
         let normal = self.radius_normal(i, z, x);
         match &self.weakening {
-            Some(w) => crate::coulomb_radius(w.coefficient(self.slip(i, u)), normal),
+            Some(w) => crate::coulomb_radius(w.coefficient(self.points.slipped(i) + self.slip(i, u)), normal),
             None => self.law.radius(self.points, i, normal),
         }
     }
@@ -428,9 +428,11 @@ impl<'a> Flat<'a> {
             let qn = crate::projection::norm(q);
             let radius = self.radius(i, &s.z, &s.x, &s.u);
             // slip weakening: the coefficient at the point's slip, and its slope there
+            // (at what it slipped before the problem and its slip in it)
             let slip = self.slip(i, &s.u);
+            let total = self.points.slipped(i) + slip;
             let (coefficient, weakens) = match &self.weakening {
-                Some(w) => (w.coefficient(slip), w.slope(slip)),
+                Some(w) => (w.coefficient(total), w.slope(total)),
                 None => (self.points.friction[i], 0.0),
             };
             let branch = if !(radius > 0.0) {

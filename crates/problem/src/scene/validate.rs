@@ -5,8 +5,8 @@
 //! mesh is read ([`Scene::check_dimension`]).
 
 use super::{
-    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, FrictionLaw, MaterialModel, MaterialSpec, MeshKind,
-    MeshSpec, PathSpec, Rule, Scene, SolverSpec, Strategy,
+    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec,
+    PathSpec, Rule, Scene, SolverSpec, Strategy,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -297,11 +297,6 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "an exact solution is checked at one instant; a path solves many (remove [exact] or [path])",
     )?;
     if let Some(c) = scene.active_contact() {
-        refuse_if(
-            c.friction_law.is_some_and(|l| l != FrictionLaw::Coulomb),
-            "path",
-            "slip-weakening friction along a path (its coefficient on the accumulated slip) is not built yet: solve its instants one by one",
-        )?;
         refuse_if(
             c.electric_law().is_some(),
             "path",
