@@ -207,6 +207,13 @@ class Result:
     def contact(self) -> Optional[Contact]:
         """The contact boundary's values; None for a scene without contact."""
     @property
+    def path(self) -> Optional[dict[str, Any]]:
+        """A load path's series (None for one instant): NumPy arrays over its instants, the
+        path.csv columns (`t`, the factors, `normal_force`, `tangential_force`, `max_slip`, ...,
+        `equilibrium` NaN where the fields were not computed), `charges` (n_instants,
+        n_terminals) with `terminals` their groups; with `run(..., series=True)` also
+        `lambda_n`, `lambda_t`, `u_n`, `u_t`, `status`, (n_instants, n_points)."""
+    @property
     def report(self) -> dict[str, Any]:
         """run.json as a dict."""
     def write(self, directory: _Path) -> None:
@@ -219,9 +226,12 @@ def run(
     scene: Scene,
     progress: Union[bool, Callable[[str], Any], None] = None,
     timeout: Optional[float] = None,
+    series: bool = False,
 ) -> Result:
     """Solves `scene`. `progress`: False, True (lines on sys.stderr) or a callable taking each
     line. `timeout`: seconds after which the run stops at its next check (ConvergenceError);
     inf (or a limit beyond the clock) is no limit, NaN and negatives are refused (InputError).
+    `series`: for a scene with a [path], keep every point's contact values at every instant
+    (`Result.path`).
     Ctrl-C stops the run at its next check and raises KeyboardInterrupt, nothing written.
     Raises InputError, MeshError, SolverError, ConvergenceError."""

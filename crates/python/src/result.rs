@@ -23,6 +23,52 @@ pub const SEPARATED: i8 = 3;
 #[pyclass(module = "piezocontact", name = "Result", frozen)]
 pub struct RunResult {
     pub(crate) solution: problem::Solution,
+    /// A load path's contact values at every instant, where the run was asked for them.
+    pub(crate) series: Option<Series>,
+}
+
+/// A load path's contact values at every instant (`run(..., series=True)`): one row of
+/// `n_points` per instant, flat.
+#[derive(Default)]
+pub struct Series {
+    /// Points per instant.
+    pub n_points: usize,
+    /// `λ_n`.
+    pub lambda_n: Vec<f64>,
+    /// `λ_t` along the first tangent.
+    pub lambda_t: Vec<f64>,
+    /// `u_n`.
+    pub u_n: Vec<f64>,
+    /// `u_t` along the first tangent.
+    pub u_t: Vec<f64>,
+    /// Contact status codes.
+    pub status: Vec<i8>,
+}
+
+impl Series {
+    /// Adds an instant's contact solution.
+    pub fn push(&mut self, c: &problem::ContactResult) {
+        let n = c.points.len();
+        self.n_points = n;
+        let (lambda, u) = (&c.solution.lambda, &c.displacement);
+        let first = |v: &contact::PointValues, i: usize| v.tangential_of(i).first().copied().unwrap_or(0.0);
+        for i in 0..n {
+            self.lambda_n.push(lambda.normal[i]);
+            self.lambda_t.push(first(lambda, i));
+            self.u_n.push(u.normal[i]);
+            self.u_t.push(first(u, i));
+            self.status.push(status_code(c.solution.status[i]));
+        }
+    }
+}
+
+/// The code of a contact status.
+pub fn status_code(s: contact::Status) -> i8 {
+    match s {
+        contact::Status::Stick => STICK,
+        contact::Status::Slip => SLIP,
+        contact::Status::Separated => SEPARATED,
+    }
 }
 
 /// The `dim`-column view of `[x, y, z]` rows.
@@ -145,6 +191,68 @@ impl RunResult {
         })
     }
 
+    /// A load path's series (None for a run of one instant), a dict of NumPy arrays over its
+    /// instants: the `path.csv` columns (`step`, `t`, the factors `load`, `voltage`, `ux`, `uy`,
+    /// `uz`, `gap`, `normal_force`, `tangential_force`, `max_slip`, `max_slip_increment`,
+    /// `n_stick`, `n_slip`, `n_separated`, `iterations`, `complementarity`, `equilibrium` (NaN
+    /// where the instant's fields were not computed)), `charges` (n_instants, n_terminals) with
+    /// `terminals` their groups; and with `run(..., series=True)` the contact values of every
+    /// point at every instant, (n_instants, n_points): `lambda_n`, `lambda_t`, `u_n`, `u_t`
+    /// (along the first tangent) and `status`.
+    #[getter]
+    fn path<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(path) = &self.solution.report.path else {
+            return Ok(None);
+        };
+        let rows = &path.rows;
+        let out = PyDict::new(py);
+        let column = |f: &dyn Fn(&problem::report::StepRow) -> f64| {
+            owned(py, numpy::ndarray::Array1::from_iter(rows.iter().map(f)))
+        };
+        out.set_item("step", column(&|r| r.step as f64))?;
+        out.set_item("t", column(&|r| r.t))?;
+        for (k, name) in ["load", "voltage", "ux", "uy", "uz", "gap"].iter().enumerate() {
+            out.set_item(*name, column(&|r| r.factors[k]))?;
+        }
+        out.set_item("normal_force", column(&|r| r.normal_force))?;
+        out.set_item("tangential_force", column(&|r| r.tangential_force))?;
+        out.set_item("max_slip", column(&|r| r.max_slip))?;
+        out.set_item("max_slip_increment", column(&|r| r.max_slip_increment))?;
+        out.set_item("n_stick", column(&|r| r.n_stick as f64))?;
+        out.set_item("n_slip", column(&|r| r.n_slip as f64))?;
+        out.set_item("n_separated", column(&|r| r.n_separated as f64))?;
+        out.set_item("iterations", column(&|r| r.iterations as f64))?;
+        out.set_item("complementarity", column(&|r| r.complementarity))?;
+        out.set_item("equilibrium", column(&|r| r.equilibrium.unwrap_or(f64::NAN)))?;
+        let terminals: Vec<&str> = self
+            .solution
+            .report
+            .terminals
+            .iter()
+            .map(|t| t.group.as_str())
+            .collect();
+        let charges: Vec<f64> = rows.iter().flat_map(|r| r.charges.iter().copied()).collect();
+        let shape = (rows.len(), terminals.len());
+        let charges =
+            numpy::ndarray::Array2::from_shape_vec(shape, charges).map_err(|e| Kind::Base.err(e.to_string()))?;
+        out.set_item("charges", owned(py, charges))?;
+        out.set_item("terminals", terminals)?;
+        if let Some(series) = &self.series {
+            let shape = (rows.len(), series.n_points);
+            let table = |v: &[f64]| {
+                numpy::ndarray::Array2::from_shape_vec(shape, v.to_vec()).map_err(|e| Kind::Base.err(e.to_string()))
+            };
+            out.set_item("lambda_n", owned(py, table(&series.lambda_n)?))?;
+            out.set_item("lambda_t", owned(py, table(&series.lambda_t)?))?;
+            out.set_item("u_n", owned(py, table(&series.u_n)?))?;
+            out.set_item("u_t", owned(py, table(&series.u_t)?))?;
+            let status = numpy::ndarray::Array2::from_shape_vec(shape, series.status.clone())
+                .map_err(|e| Kind::Base.err(e.to_string()))?;
+            out.set_item("status", owned(py, status))?;
+        }
+        Ok(Some(out))
+    }
+
     /// The report (run.json) as a dict: the scene, the plan, the sizes, the iterations, the
     /// residuals, the contact forces and counts, the timings.
     #[getter]
@@ -213,14 +321,6 @@ impl RunResult {
             self.solution.mesh.n_cells(),
             rep.timings_s.total
         )
-    }
-}
-
-fn status_code(s: contact::Status) -> i8 {
-    match s {
-        contact::Status::Stick => STICK,
-        contact::Status::Slip => SLIP,
-        contact::Status::Separated => SEPARATED,
     }
 }
 

@@ -4,7 +4,7 @@
 //! the contact solve), and `KeyboardInterrupt` is raised with nothing written.
 
 use crate::errors::to_py;
-use crate::result::RunResult;
+use crate::result::{RunResult, Series};
 use crate::scene::Scene;
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -89,16 +89,19 @@ impl<'py> Progress<'py> {
 
 /// Solves `scene` and returns its `Result`. `progress`: False (nothing), True (a line per step
 /// and per outer contact iteration on `sys.stderr`), or a callable that takes each line.
+/// `series`: for a scene with a `[path]`, keep the contact values of every point at every
+/// instant (`Result.path`'s `lambda_n`, ...); the rows are kept either way.
 /// `timeout`: seconds after which the run stops at its next check (`ConvergenceError`).
 /// Ctrl-C stops the run at its next check and raises `KeyboardInterrupt`; nothing is
 /// written. Errors: `InputError`, `MeshError`, `SolverError`, `ConvergenceError`.
 #[pyfunction]
-#[pyo3(signature = (scene, progress = None, timeout = None))]
+#[pyo3(signature = (scene, progress = None, timeout = None, series = false))]
 pub fn run(
     py: Python<'_>,
     scene: &Scene,
     progress: Option<&Bound<'_, PyAny>>,
     timeout: Option<f64>,
+    series: bool,
 ) -> PyResult<RunResult> {
     let now = std::time::Instant::now();
     let deadline = match timeout {
@@ -130,7 +133,17 @@ pub fn run(
     let solved = std::thread::scope(|s| {
         let worker = s.spawn(move || {
             let mut reporter = Send(tx);
-            files::run::solve_with(typed, source, given, interrupt, &mut reporter)
+            if !(series && typed.path.is_some()) {
+                return files::run::solve_with(typed, source, given, interrupt, &mut reporter).map(|s| (s, None));
+            }
+            // every instant's contact values, kept
+            let mut kept = Series::default();
+            let each = &mut |step: problem::Step<'_>| {
+                kept.push(step.contact);
+                Ok(())
+            };
+            let solved = files::run::solve_path_with(typed, source, given, (interrupt, false), &mut reporter, each);
+            solved.map(|s| (s, Some(kept)))
         });
         loop {
             match py.detach(|| {
@@ -176,5 +189,7 @@ pub fn run(
         }
         return Err(e);
     }
-    solved.map(|solution| RunResult { solution }).map_err(to_py)
+    solved
+        .map(|(solution, series)| RunResult { solution, series })
+        .map_err(to_py)
 }
