@@ -13,6 +13,29 @@ pub fn hertz(p: f64, radius: f64, young: f64, poisson: f64) -> (f64, f64) {
     (a, 2.0 * p / (PI * a))
 }
 
+/// Hertz's contact radius `a` for the load `p` on a sphere of radius `radius` against a rigid
+/// flat (Johnson 1985, eq. (4.22)): `a³ = 3 P R / (4 E*)`, `E* = E / (1 - ν²)`.
+pub fn hertz_sphere(p: f64, radius: f64, young: f64, poisson: f64) -> f64 {
+    let e_star = young / (1.0 - poisson * poisson);
+    (3.0 * p * radius / (4.0 * e_star)).cbrt()
+}
+
+/// The energy friction dissipates in one cycle of the tangential load between `±q_star` on a
+/// sphere of contact radius `a` under the normal load `p` against a rigid flat, coefficient `f`
+/// (Mindlin and Deresiewicz 1953; Johnson 1985, section 7.2). The loading curve is Johnson's
+/// eq. (7.42), `δ(Q) = (3 F P / (16 a)) ((2 - ν)/G) [1 - (1 - Q/(F P))^(2/3)]`; unloading and
+/// reloading follow it at twice the scale from each turn (Masing's rule), so the loop's area is
+/// `4 Q* δ(Q*) - 8 ∫₀^Q* δ`:
+/// `W = (9 F² P² (2 - ν) / (10 a G)) [1 - (1 - x)^(5/3) - (5x/6)(1 + (1 - x)^(2/3))]`,
+/// `x = Q*/(F P) ≤ 1`, `G = E / (2 (1 + ν))`.
+pub fn mindlin_deresiewicz_dissipation(p: f64, q_star: f64, f: f64, a: f64, young: f64, poisson: f64) -> f64 {
+    let g = young / (2.0 * (1.0 + poisson));
+    let x = (q_star / (f * p)).min(1.0);
+    let y = 1.0 - x;
+    9.0 * f * f * p * p * (2.0 - poisson) / (10.0 * a * g)
+        * (1.0 - y.powf(5.0 / 3.0) - 5.0 * x / 6.0 * (1.0 + y.powf(2.0 / 3.0)))
+}
+
 /// Hertz's pressure at `x` from the centre: `p0 √(1 - x²/a²)` inside the contact, 0 outside.
 pub fn hertz_pressure(x: f64, a: f64, p0: f64) -> f64 {
     p0 * (1.0 - x * x / (a * a)).max(0.0).sqrt()
@@ -100,5 +123,23 @@ mod tests {
             .map(|i| mindlin_deresiewicz_traction(-a + (i as f64 + 0.5) * h, f, hz, &[q_star], 0.1) * h)
             .sum();
         assert!((down - 0.1).abs() < 1e-5, "{down}");
+        // the sphere's loop: its area by quadrature of Masing's branches of Johnson's (7.42)
+        let (p, fr, a3, e, nu) = (2.0, 0.4, 0.5, 100.0, 0.3);
+        let g = e / (2.0 * (1.0 + nu));
+        let delta = |q: f64| 3.0 * fr * p / (16.0 * a3) * (2.0 - nu) / g * (1.0 - (1.0 - q / (fr * p)).powf(2.0 / 3.0));
+        let q_star = 0.6;
+        let m = 20_000;
+        let hq = 2.0 * q_star / m as f64;
+        let area: f64 = (0..m)
+            .map(|i| {
+                let q = -q_star + (i as f64 + 0.5) * hq;
+                // the unloading branch's displacement less the reloading one's
+                let down = delta(q_star) - 2.0 * delta((q_star - q) / 2.0);
+                let up = -delta(q_star) + 2.0 * delta((q + q_star) / 2.0);
+                (down - up) * hq
+            })
+            .sum();
+        let w = mindlin_deresiewicz_dissipation(p, q_star, fr, a3, e, nu);
+        assert!((area - w).abs() < 1e-6 * w, "{area} {w}");
     }
 }

@@ -69,7 +69,7 @@ mod run;
 mod scene;
 mod setup;
 
-pub use analytical::{hertz, mindlin_deresiewicz_traction};
+pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindlin_deresiewicz_traction};
 pub use backend::Limits;
 pub use exact::ExactReport;
 pub use faer_backend::Faer;
