@@ -83,7 +83,10 @@ fn the_cycle_follows_mindlin_deresiewicz() {
     let (zc, zf) = (zones(&coarse), zones(&fine));
     eprintln!("worst traction error: n = 48 {wc:.4}, n = 96 {wf:.4}; stick zone's half-width {zc:.4} a, {zf:.4} a");
     for s in &fine {
-        eprintln!("t {:.2} Q {:+.4} P {:.4} error {:.4} zone {:.4}", s.0, s.1, s.2, s.3, s.4);
+        eprintln!(
+            "t {:.2} Q {:+.4} P {:.4} error {:.4} zone {:.4}",
+            s.0, s.1, s.2, s.3, s.4
+        );
     }
     // measured: 0.52 at n = 48, 0.28 at n = 96 (O(h), as the static Cattaneo-Mindlin's)
     assert!(wf < 0.65 * wc, "no convergence: {wc} -> {wf}");

@@ -327,7 +327,7 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     };
     let terminals: Vec<&str> = solution.report.terminals.iter().map(|t| t.group.as_str()).collect();
     let mut out = vec![("path.csv".to_string(), path_csv(&path.rows, &terminals))];
-    out.extend(path_picture(&path.rows)?);
+    out.extend(path_picture(&path.rows, &terminals)?);
     Ok(out)
 }
 
@@ -376,11 +376,22 @@ fn pvd(series: &[(f64, String)]) -> Vec<u8> {
     s.into_bytes()
 }
 
-/// The path's global curves: the contact forces against time, and the tangential force
-/// against the prescribed x displacement's factor (friction's loop).
-fn path_picture(rows: &[problem::report::StepRow]) -> Result<plots::Files, Error> {
+/// The path's global curves: the contact forces against time; the forces against the factor
+/// that drives the path (the one that varies most: a load, a voltage, a displacement), whose
+/// loop is friction's hysteresis; and the charges through the terminals against time.
+fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result<plots::Files, Error> {
     let over = |f: &dyn Fn(&problem::report::StepRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
-    let panels = [
+    const FACTORS: [&str; 6] = ["load", "voltage", "ux", "uy", "uz", "gap"];
+    let range = |k: usize| {
+        let (lo, hi) = rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+            (lo.min(r.factors[k]), hi.max(r.factors[k]))
+        });
+        hi - lo
+    };
+    let driver = (0..FACTORS.len())
+        .max_by(|&a, &b| range(a).total_cmp(&range(b)))
+        .unwrap_or(0);
+    let mut panels = vec![
         Panel {
             title: "Contact forces along the path".into(),
             labels: ("t".into(), "force".into()),
@@ -390,15 +401,29 @@ fn path_picture(rows: &[problem::report::StepRow]) -> Result<plots::Files, Error
             ],
         },
         Panel {
-            title: "Tangential force against the prescribed x displacement (factor)".into(),
-            labels: ("ux factor".into(), "tangential force".into()),
+            title: format!(
+                "Tangential force against the {} factor (friction's loop)",
+                FACTORS[driver]
+            ),
+            labels: (format!("{} factor", FACTORS[driver]), "tangential force".into()),
             series: vec![Series::line(
                 "tangential force",
-                over(&|r| (r.factors[2], r.tangential_force)),
+                over(&|r| (r.factors[driver], r.tangential_force)),
             )],
         },
     ];
-    plots::panels("path", &panels)
+    if !terminals.is_empty() {
+        panels.push(Panel {
+            title: "Charge through each terminal".into(),
+            labels: ("t".into(), "charge".into()),
+            series: terminals
+                .iter()
+                .enumerate()
+                .map(|(g, name)| Series::line(name, over(&|r| (r.t, r.charges.get(g).copied().unwrap_or(f64::NAN)))))
+                .collect(),
+        });
+    }
+    plots::panels_apart("path", &panels)
 }
 
 /// Where a run writes by default: `out/<scene>/`, the scene's name made a safe single path

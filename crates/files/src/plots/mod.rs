@@ -225,11 +225,20 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
         .map_err(e)
 }
 
-fn draw_panels<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panels: &[Panel]) -> Result<(), String> {
+fn draw_panels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panels: &[Panel],
+    shared: bool,
+) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
     let x = x_range(panels);
     for (sub, panel) in area.split_evenly((panels.len().max(1), 1)).iter().zip(panels) {
+        let x = if shared {
+            x
+        } else {
+            x_range(std::slice::from_ref(panel))
+        };
         draw_panel(sub, panel, x)?;
     }
     Ok(())
@@ -241,7 +250,15 @@ fn draw_panels<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panels: &[Pane
 /// # Errors
 /// [`Error::Picture`] where plotters cannot draw.
 pub fn panels(name: &str, panels: &[Panel]) -> Result<Files, Error> {
-    both!(name, |a| draw_panels(a, panels))
+    both!(name, |a| draw_panels(a, panels, true))
+}
+
+/// Panels stacked in one picture as [`panels`] draws them, each on its own x range.
+///
+/// # Errors
+/// As [`panels`].
+pub fn panels_apart(name: &str, panels: &[Panel]) -> Result<Files, Error> {
+    both!(name, |a| draw_panels(a, panels, false))
 }
 
 /// A log-log chart of `series` with markers and lines.
