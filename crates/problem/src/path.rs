@@ -242,6 +242,8 @@ impl Terminals {
 /// step before (friction's frame), the multipliers (the warm start), the rows so far, and the
 /// last instant.
 struct History {
+    /// The contact solves' iterations, summed over the steps.
+    iterations: crate::report::Iterations,
     shift: PointValues,
     /// The slip each point accumulated in contact (slip-weakening friction's argument).
     slipped: Vec<f64>,
@@ -253,6 +255,7 @@ struct History {
 impl History {
     fn new(n: usize, nt: usize, instants: usize) -> Self {
         History {
+            iterations: Default::default(),
             shift: PointValues::zeros(n, nt),
             slipped: vec![0.0; n],
             start: None,
@@ -264,6 +267,7 @@ impl History {
     /// The step is done: its tangential displacement `now` the next step's frame, the slip of
     /// its points in contact added to what they slipped, its multipliers the next start.
     fn advance(&mut self, now: &PointValues, sol: &ContactSolution) {
+        self.iterations.add(&crate::report::Iterations::of(Some(&sol.info), 0));
         let nt = self.shift.n_tangential();
         if nt > 0 {
             for i in 0..self.slipped.len() {
@@ -465,6 +469,8 @@ impl Walk<'_> {
             figures,
         };
         let mut report: RunReport = report(&posed, measured, recovered);
+        // the path's iterations are its steps' summed
+        report.iterations = state.iterations;
         report.path = Some(PathReport {
             instants: state.rows.len(),
             factorisations: 1,

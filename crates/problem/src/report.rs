@@ -23,7 +23,7 @@ pub struct RunReport {
     pub contact: ContactReport,
     /// The error against the scene's exact solution, where it has one.
     pub exact: Option<ExactReport>,
-    /// Iteration counts (0 where a loop is not in the plan).
+    /// Iteration counts (0 where a loop is not in the plan; a load path's, its steps' summed).
     pub iterations: Iterations,
     /// Scale-free residuals of the final state.
     pub residuals: Residuals,
@@ -331,6 +331,20 @@ impl Iterations {
             primal_solves: info.map_or(1, |i| i.operator_calls),
             pcg_in_step_estimate: info.map_or(0, |i| i.estimate_inner_iters),
         }
+    }
+
+    /// The counts of `other` added to these (a load path's steps summed).
+    pub fn add(&mut self, other: &Iterations) {
+        self.fixed_point += other.fixed_point;
+        self.uzawa += other.uzawa;
+        self.newton += other.newton;
+        self.coarse_newton += other.coarse_newton;
+        self.proximal += other.proximal;
+        self.line_search_cuts += other.line_search_cuts;
+        self.newton_fallback |= other.newton_fallback;
+        self.pcg += other.pcg;
+        self.primal_solves += other.primal_solves;
+        self.pcg_in_step_estimate += other.pcg_in_step_estimate;
     }
 
     /// One line: the counts of the loops that ran (`4 Newton`, `39 Uzawa, 3 FP, 812 PCG`),
