@@ -42,6 +42,9 @@ pub struct Discretization<'m> {
     pub geometry: Vec<SimplexGeometry>,
     /// Whether each cell's material is electric.
     pub cell_electric: Vec<bool>,
+    /// A body of revolution about the y axis, meshed in its meridian plane (its materials'
+    /// [`Material::axisymmetric`]): every integral carries `2π r`.
+    pub axisymmetric: bool,
 }
 
 /// The assembled blocks of the coupled system (free dofs only).
@@ -57,6 +60,9 @@ pub struct Blocks {
 impl<'m> Discretization<'m> {
     /// Sets up the discretisation: `materials` pairs a region name with its material; every
     /// cell must lie in exactly one of these regions. Only P1 simplices are supported.
+    /// Axisymmetric materials ([`Material::from_crystal_axisymmetric`]) make the 2D mesh the
+    /// meridian section of a body of revolution about the y axis (every node at `x >= 0`);
+    /// the caller holds the radial displacement of the nodes on the axis (`u_r = 0` there).
     pub fn new(
         mesh: &'m Mesh,
         materials: &[(String, Material)],
@@ -95,12 +101,33 @@ impl<'m> Discretization<'m> {
             }
             .into());
         }
+        let axisymmetric = materials.first().is_some_and(|(_, m)| m.axisymmetric);
+        if let Some((region, m)) = materials.iter().find(|(_, m)| m.axisymmetric != axisymmetric) {
+            return Err(InputError::MixedKinematics {
+                region: region.clone(),
+                axisymmetric: m.axisymmetric,
+            }
+            .into());
+        }
+        if axisymmetric {
+            if let Some(node) = mesh.points.iter().position(|x| !(x[0] >= 0.0)) {
+                return Err(InputError::NegativeRadius {
+                    node,
+                    at: mesh.points[node][..2].to_vec(),
+                }
+                .into());
+            }
+        }
         let k = mesh.kind.n_nodes();
         let geometry: Vec<SimplexGeometry> = (0..n_cells)
             .into_par_iter()
             .map(|c| {
                 let x: Vec<[f64; 3]> = mesh.cells[c * k..(c + 1) * k].iter().map(|&v| mesh.points[v]).collect();
-                SimplexGeometry::new(mesh.dim, &x)
+                if axisymmetric {
+                    SimplexGeometry::axisymmetric(&x)
+                } else {
+                    SimplexGeometry::new(mesh.dim, &x)
+                }
             })
             .collect();
         if let Some(c) = geometry.iter().position(|g| !(g.measure > 0.0)) {
@@ -129,13 +156,14 @@ impl<'m> Discretization<'m> {
             dofs,
             geometry,
             cell_electric,
+            axisymmetric,
         })
     }
 
     /// Checks that the Dirichlet conditions hold every rigid motion and every potential of
     /// each connected part of the mesh ([`crate::held::check`]): `K` is invertible only then.
     pub fn check_held(&self) -> Result<(), Unheld> {
-        crate::held::check(self.mesh, &self.dofs, &self.cell_electric)
+        crate::held::check(self.mesh, &self.dofs, &self.cell_electric, self.axisymmetric)
     }
 
     /// The material of cell `c`.

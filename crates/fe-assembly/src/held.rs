@@ -149,10 +149,17 @@ const FREE: f64 = 1e-12;
 /// # Errors
 /// [`Unheld::Motion`] with the free motions of the first part that has any, or
 /// [`Unheld::Potential`].
-pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool]) -> Result<(), Unheld> {
+///
+/// A body of revolution (`axisymmetric`) has one rigid motion, the translation along its axis
+/// (a radial one strains the hoops).
+pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool], axisymmetric: bool) -> Result<(), Unheld> {
     let solids = Solids::new(mesh);
     for i in 0..solids.first.len() {
-        let motions = solids.free_motions(mesh, dofs, i);
+        let motions = if axisymmetric {
+            solids.free_axial_motion(dofs, i)
+        } else {
+            solids.free_motions(mesh, dofs, i)
+        };
         if !motions.is_empty() {
             return Err(Unheld::Motion {
                 count: motions.len(),
@@ -241,6 +248,19 @@ impl Solids {
             cells,
             centroid,
             size,
+        }
+    }
+
+    /// The translation along the axis of part `i` of a body of revolution, in words, where no
+    /// prescribed axial component holds it.
+    fn free_axial_motion(&self, dofs: &DofMap, i: usize) -> Vec<String> {
+        let held = self.members[self.start[i]..self.start[i + 1]]
+            .iter()
+            .any(|&(_, v)| matches!(dofs.u[v * 2 + 1], Dof::Fixed(_)));
+        if held {
+            vec![]
+        } else {
+            vec!["a translation along the axis [0, 1]".into()]
         }
     }
 
@@ -337,11 +357,11 @@ mod tests {
         let left = |x: &[f64]| x[0] < 1e-12;
         let sides = |x: &[f64]| x[0] < 1e-12 || x[0] > 2.0 - 1e-12;
         // clamped on one side: held
-        assert_eq!(free(check(&m, &dofs(&m, |x, _| left(x), left), &all)), 0);
+        assert_eq!(free(check(&m, &dofs(&m, |x, _| left(x), left), &all, false)), 0);
         // nothing held: two translations and the rotation
-        assert_eq!(free(check(&m, &dofs(&m, |_, _| false, left), &all)), 3);
+        assert_eq!(free(check(&m, &dofs(&m, |_, _| false, left), &all, false)), 3);
         // both sides on rollers (ux = 0): the vertical translation
-        let e = check(&m, &dofs(&m, |x, k| k == 0 && sides(x), left), &all).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, k| k == 0 && sides(x), left), &all, false).unwrap_err();
         assert!(
             e.to_string()
                 .contains("1 rigid motion of the body free (a translation along [0.000, 1.000])"),
@@ -349,7 +369,7 @@ mod tests {
         );
         // one node pinned: the rotation about it
         let pin = |x: &[f64]| x[0] < 1e-12 && x[1] < 1e-12;
-        let e = check(&m, &dofs(&m, |x, _| pin(x), left), &all).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| pin(x), left), &all, false).unwrap_err();
         assert!(
             e.to_string()
                 .contains("a rotation about the point (0.0000e0, 0.0000e0)"),
@@ -360,7 +380,8 @@ mod tests {
             free(check(
                 &m,
                 &dofs(&m, |x, k| pin(x) || (k == 1 && x[0] > 2.0 - 1e-12), left),
-                &all
+                &all,
+                false
             )),
             0
         );
@@ -371,7 +392,7 @@ mod tests {
         let m = mesh::box_tet([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], 3, 3, 3);
         let all = vec![true; m.n_cells()];
         let edge = |x: &[f64]| x[0] < 1e-12 && x[1] < 1e-12;
-        let e = check(&m, &dofs(&m, |x, _| edge(x), edge), &all).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| edge(x), edge), &all, false).unwrap_err();
         let s = e.to_string();
         assert!(
             s.contains("1 rigid motion") && s.contains("axis along [0.000, 0.000, 1.000]")
@@ -381,8 +402,11 @@ mod tests {
         assert!(s.contains("through (0.0000e0, 0.0000e0,"), "{s}");
         // a face clamped: held; a face on rollers (uz = 0 on z = 0): three motions free
         let bottom = |x: &[f64]| x[2] < 1e-12;
-        assert_eq!(free(check(&m, &dofs(&m, |x, _| bottom(x), edge), &all)), 0);
-        assert_eq!(free(check(&m, &dofs(&m, |x, k| k == 2 && bottom(x), edge), &all)), 3);
+        assert_eq!(free(check(&m, &dofs(&m, |x, _| bottom(x), edge), &all, false)), 0);
+        assert_eq!(
+            free(check(&m, &dofs(&m, |x, k| k == 2 && bottom(x), edge), &all, false)),
+            3
+        );
     }
 
     #[test]
@@ -391,7 +415,7 @@ mod tests {
         let all = vec![true; m.n_cells()];
         let left = |x: &[f64]| x[0] < 1e-12;
         let both = |x: &[f64]| x[0] < 1e-12 || (x[0] - 3.0).abs() < 1e-12;
-        let e = check(&m, &dofs(&m, |x, _| left(x), both), &all).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| left(x), both), &all, false).unwrap_err();
         assert!(
             matches!(
                 e,
@@ -404,13 +428,13 @@ mod tests {
             ),
             "{e}"
         );
-        assert_eq!(free(check(&m, &dofs(&m, |x, _| both(x), both), &all)), 0);
+        assert_eq!(free(check(&m, &dofs(&m, |x, _| both(x), both), &all, false)), 0);
         // the second body's potential floats
-        let e = check(&m, &dofs(&m, |x, _| both(x), left), &all).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| both(x), left), &all, false).unwrap_err();
         assert_eq!(e, Unheld::Potential { cell: 32, cells: 32 });
         // unless it is elastic only
         let first: Vec<bool> = (0..m.n_cells()).map(|c| c < 32).collect();
-        assert_eq!(check(&m, &dofs(&m, |x, _| both(x), left), &first), Ok(()));
+        assert_eq!(check(&m, &dofs(&m, |x, _| both(x), left), &first, false), Ok(()));
     }
 
     #[test]
@@ -432,11 +456,11 @@ mod tests {
         let all = vec![true; m.n_cells()];
         // the first square clamped on its left, the hinge pinned: the second turns about it
         let held = |x: &[f64], _| x[0] == 0.0 || (x[0] == 1.0 && x[1] == 1.0);
-        let e = check(&m, &dofs(&m, held, |x| x[0] == 0.0), &all).unwrap_err();
+        let e = check(&m, &dofs(&m, held, |x| x[0] == 0.0), &all, false).unwrap_err();
         assert!(e.to_string().contains("1 rigid motion of the body free (a rotation about the point (1.0000e0, 1.0000e0)) in its part with cell 8 (8 cells)"), "{e}");
         // the potential is continuous through the node: one electric part
         let both = |x: &[f64], _| x[0] == 0.0 || x[0] == 2.0;
-        assert_eq!(check(&m, &dofs(&m, both, |x| x[0] == 0.0), &all), Ok(()));
+        assert_eq!(check(&m, &dofs(&m, both, |x| x[0] == 0.0), &all, false), Ok(()));
     }
 
     #[test]
@@ -448,7 +472,7 @@ mod tests {
             Constraint::constant("left", Field::Potential, 0.0),
         ];
         let d = DofMap::new(&m, &vec![true; m.n_nodes()], &c).unwrap();
-        assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()])), 1);
+        assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()], false)), 1);
     }
 
     proptest! {
@@ -489,7 +513,7 @@ mod tests {
                 }
             }
             d.phi[0] = Dof::Fixed(0.0);
-            prop_assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()])), expected);
+            prop_assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()], false)), expected);
         }
     }
 }

@@ -7,6 +7,11 @@
 //!
 //! with `N` the P1 shape functions, whose gradients are constant on the cell, so that each
 //! integral is the cell's measure times the integrand.
+//!
+//! A body of revolution (axisymmetric, meshed in its meridian plane `(r, z) = (x, y)`) adds the
+//! hoop strain `ε_θθ = u_r / r` (Voigt entry 3 after `[rr, zz, rz]`) and integrates over the
+//! whole body, `dx = 2π r dr dz`: the three-point interior rule of the triangle (degree 2,
+//! points at `r > 0` even on a cell touching the axis), so that forces and charges are totals.
 
 use crate::Material;
 
@@ -17,7 +22,27 @@ pub struct SimplexGeometry {
     pub measure: f64,
     /// `grads[a][k] = ∂N_a / ∂x_k`.
     pub grads: [[f64; 3]; 4],
+    /// The radii `r = x` of the vertices of a cell of a body of revolution; `None` in plane
+    /// strain and 3D.
+    pub radii: Option<[f64; 3]>,
 }
+
+/// A point of a cell's quadrature: its weight (the measure it stands for, `2π r` included in a
+/// body of revolution) and `N_a / r` there (0 off a body of revolution).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CellPoint {
+    /// Weight.
+    pub weight: f64,
+    /// `hoop[a] = N_a / r` at the point.
+    pub hoop: [f64; 4],
+}
+
+/// The barycentric coordinates of the triangle's interior three-point rule (degree 2).
+const TRIANGLE_RULE: [[f64; 3]; 3] = [
+    [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
+    [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+    [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
+];
 
 impl SimplexGeometry {
     /// The geometry of the simplex with vertices `x` (`dim + 1` points).
@@ -61,6 +86,65 @@ impl SimplexGeometry {
         }
         g
     }
+
+    /// The same cell as a meridian section of a body of revolution about the y axis (its
+    /// vertices' `x` are their radii).
+    pub fn axisymmetric(x: &[[f64; 3]]) -> Self {
+        SimplexGeometry {
+            radii: Some([x[0][0], x[1][0], x[2][0]]),
+            ..Self::new(2, x)
+        }
+    }
+
+    /// The points of the cell's quadrature: one (the measure, the integrands being constant)
+    /// in plane strain and 3D; three on a body of revolution (`2π r` in the weights, the hoop
+    /// terms `N_a / r` varying over the cell). Returns the points and how many are used.
+    pub fn points(&self) -> ([CellPoint; 3], usize) {
+        let mut out = [CellPoint::default(); 3];
+        let Some(r) = self.radii else {
+            out[0].weight = self.measure;
+            return (out, 1);
+        };
+        for (p, bary) in out.iter_mut().zip(&TRIANGLE_RULE) {
+            let rq: f64 = (0..3).map(|a| bary[a] * r[a]).sum();
+            p.weight = std::f64::consts::TAU * rq * self.measure / 3.0;
+            for a in 0..3 {
+                p.hoop[a] = bary[a] / rq;
+            }
+        }
+        (out, 3)
+    }
+
+    /// The cell's volume: its measure, or `2π r̄` times it for a meridian section (`r̄` the
+    /// centroid's radius: Pappus).
+    pub fn volume(&self) -> f64 {
+        match self.radii {
+            Some(r) => std::f64::consts::TAU * (r[0] + r[1] + r[2]) / 3.0 * self.measure,
+            None => self.measure,
+        }
+    }
+
+    /// `N_a / r` at the centroid of a meridian section (`1 / (3 r̄)` for every vertex); 0
+    /// otherwise.
+    pub fn centroid_hoop(&self) -> [f64; 4] {
+        match self.radii {
+            Some(r) => {
+                let h = 1.0 / (r[0] + r[1] + r[2]);
+                [h, h, h, 0.0]
+            }
+            None => [0.0; 4],
+        }
+    }
+}
+
+/// `B_a` at a point where `N_a / r = hoop` (0 off a body of revolution): [`strain_columns`]
+/// with the hoop strain `u_r / r` of the radial component in Voigt entry 3 (`[rr, zz, rz, θθ]`).
+pub fn strain_columns_at(dim: usize, grad: &[f64; 3], hoop: f64) -> [[f64; 6]; 3] {
+    let mut b = strain_columns(dim, grad);
+    if dim == 2 {
+        b[0][3] = hoop;
+    }
+    b
 }
 
 /// `B_a`, the strain of the displacement `N_a e_k` for `k = 0..dim`, as a column-major
@@ -92,28 +176,34 @@ pub fn strain_columns(dim: usize, grad: &[f64; 3]) -> [[f64; 6]; 3] {
 /// Column `(a, k)` of `A_e = ∫ Bᵀ C B`: `out[b][l]` is the entry of row `(b, l)`.
 pub fn elasticity_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize, k: usize) -> [[f64; 3]; 4] {
     let (dim, nv) = (m.dim, m.nv());
-    let ba = strain_columns(dim, &g.grads[a])[k];
-    let mut cb = [0.0; 6];
-    for i in 0..nv {
-        cb[i] = (0..nv).map(|j| m.c[i * nv + j] * ba[j]).sum::<f64>() * g.measure;
-    }
     let mut out = [[0.0; 3]; 4];
-    for (b, row) in out.iter_mut().enumerate().take(n_local) {
-        let bb = strain_columns(dim, &g.grads[b]);
-        for (l, v) in row.iter_mut().enumerate().take(dim) {
-            *v = (0..nv).map(|i| bb[l][i] * cb[i]).sum();
+    let (points, n_points) = g.points();
+    for p in &points[..n_points] {
+        let ba = strain_columns_at(dim, &g.grads[a], p.hoop[a])[k];
+        let mut cb = [0.0; 6];
+        for i in 0..nv {
+            cb[i] = (0..nv).map(|j| m.c[i * nv + j] * ba[j]).sum::<f64>() * p.weight;
+        }
+        for (b, row) in out.iter_mut().enumerate().take(n_local) {
+            let bb = strain_columns_at(dim, &g.grads[b], p.hoop[b]);
+            for (l, v) in row.iter_mut().enumerate().take(dim) {
+                *v += (0..nv).map(|i| bb[l][i] * cb[i]).sum::<f64>();
+            }
         }
     }
     out
 }
 
-/// Column `(a, k)` of `G_e = ∫ ∇Nᵀ e B` (rows ψ_b): `out[b] = |T| ∇N_b · (e B_a e_k)`.
+/// Column `(a, k)` of `G_e = ∫ ∇Nᵀ e B` (rows ψ_b): `out[b] = Σ_q w_q ∇N_b · (e B_a(q) e_k)`.
 pub fn coupling_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize, k: usize) -> [f64; 4] {
     let (dim, nv) = (m.dim, m.nv());
-    let ba = strain_columns(dim, &g.grads[a])[k];
     let mut eb = [0.0; 3];
-    for (i, v) in eb.iter_mut().enumerate().take(dim) {
-        *v = (0..nv).map(|j| m.e[i * nv + j] * ba[j]).sum::<f64>() * g.measure;
+    let (points, n_points) = g.points();
+    for p in &points[..n_points] {
+        let ba = strain_columns_at(dim, &g.grads[a], p.hoop[a])[k];
+        for (i, v) in eb.iter_mut().enumerate().take(dim) {
+            *v += (0..nv).map(|j| m.e[i * nv + j] * ba[j]).sum::<f64>() * p.weight;
+        }
     }
     let mut out = [0.0; 4];
     for (b, v) in out.iter_mut().enumerate().take(n_local) {
@@ -122,31 +212,38 @@ pub fn coupling_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usi
     out
 }
 
-/// Row `b` of `G_e` as columns `(a, k)`: `out[a][k] = |T| ∇N_b · (e B_a e_k)`; this is the
-/// column `b` of `G_eᵀ` (rows u).
+/// Row `b` of `G_e` as columns `(a, k)`: `out[a][k] = Σ_q w_q ∇N_b · (e B_a(q) e_k)`; this is
+/// the column `b` of `G_eᵀ` (rows u).
 pub fn coupling_row(m: &Material, g: &SimplexGeometry, n_local: usize, b: usize) -> [[f64; 3]; 4] {
     let (dim, nv) = (m.dim, m.nv());
     // eT grad_b (nv), then B_a^T (eT grad_b)
     let mut etg = [0.0; 6];
     for (j, v) in etg.iter_mut().enumerate().take(nv) {
-        *v = (0..dim).map(|i| m.e[i * nv + j] * g.grads[b][i]).sum::<f64>() * g.measure;
+        *v = (0..dim).map(|i| m.e[i * nv + j] * g.grads[b][i]).sum::<f64>();
     }
     let mut out = [[0.0; 3]; 4];
-    for (a, row) in out.iter_mut().enumerate().take(n_local) {
-        let ba = strain_columns(dim, &g.grads[a]);
-        for (k, v) in row.iter_mut().enumerate().take(dim) {
-            *v = (0..nv).map(|j| ba[k][j] * etg[j]).sum();
+    let (points, n_points) = g.points();
+    for p in &points[..n_points] {
+        let mut weighted = [0.0; 6];
+        for (w, e) in weighted.iter_mut().zip(&etg).take(nv) {
+            *w = e * p.weight;
+        }
+        for (a, row) in out.iter_mut().enumerate().take(n_local) {
+            let ba = strain_columns_at(dim, &g.grads[a], p.hoop[a]);
+            for (k, v) in row.iter_mut().enumerate().take(dim) {
+                *v += (0..nv).map(|j| ba[k][j] * weighted[j]).sum::<f64>();
+            }
         }
     }
     out
 }
 
-/// Column `a` of `B_e = ∫ ∇Nᵀ β ∇N`: `out[b] = |T| ∇N_b · β ∇N_a`.
+/// Column `a` of `B_e = ∫ ∇Nᵀ β ∇N`: `out[b] = |T| ∇N_b · β ∇N_a` (`|T|` the cell's volume).
 pub fn dielectric_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize) -> [f64; 4] {
     let dim = m.dim;
     let mut bg = [0.0; 3];
     for (i, v) in bg.iter_mut().enumerate().take(dim) {
-        *v = (0..dim).map(|j| m.beta[i * dim + j] * g.grads[a][j]).sum::<f64>() * g.measure;
+        *v = (0..dim).map(|j| m.beta[i * dim + j] * g.grads[a][j]).sum::<f64>() * g.volume();
     }
     let mut out = [0.0; 4];
     for (b, v) in out.iter_mut().enumerate().take(n_local) {
@@ -155,12 +252,22 @@ pub fn dielectric_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: u
     out
 }
 
-/// Voigt strain of a P1 displacement on a cell: `ε = Σ_a B_a u_a`.
+/// Voigt strain of a P1 displacement on a cell: `ε = Σ_a B_a u_a` (at the centroid, where the
+/// hoop strain of a body of revolution varies).
 pub fn cell_strain(dim: usize, g: &SimplexGeometry, u_local: &[[f64; 3]]) -> [f64; 6] {
+    strain_at(dim, g, &g.centroid_hoop(), u_local)
+}
+
+/// Voigt strain of a P1 displacement at a point where `N_a / r = hoop[a]`.
+pub fn strain_at(dim: usize, g: &SimplexGeometry, hoop: &[f64; 4], u_local: &[[f64; 3]]) -> [f64; 6] {
     let mut eps = [0.0; 6];
-    let nv = if dim == 2 { 3 } else { 6 };
+    let nv = match (dim, g.radii.is_some()) {
+        (2, false) => 3,
+        (2, true) => 4,
+        _ => 6,
+    };
     for (a, ua) in u_local.iter().enumerate() {
-        let b = strain_columns(dim, &g.grads[a]);
+        let b = strain_columns_at(dim, &g.grads[a], hoop[a]);
         for k in 0..dim {
             for v in 0..nv {
                 eps[v] += b[k][v] * ua[k];

@@ -148,6 +148,23 @@ pub enum InputError {
         /// The condition's group.
         group: String,
     },
+    /// Materials of a body of revolution beside plane ones, or a body of revolution that is not
+    /// a 2D mesh.
+    #[error("region `{region}`'s material is {} and another's is not: a body is axisymmetric as a whole", if *.axisymmetric { "axisymmetric" } else { "plane" })]
+    MixedKinematics {
+        /// The region.
+        region: String,
+        /// Whether its material is axisymmetric.
+        axisymmetric: bool,
+    },
+    /// A node of a body of revolution's meridian section on the negative side of the axis.
+    #[error("node {node} at {at:?} has r = x < 0: a body of revolution is meshed in its meridian plane r >= 0 (the axis is x = 0)")]
+    NegativeRadius {
+        /// The node.
+        node: usize,
+        /// Its coordinates.
+        at: Vec<f64>,
+    },
     /// A load whose value is not finite.
     #[error("{what} is not finite ({value})")]
     NotFiniteLoad {

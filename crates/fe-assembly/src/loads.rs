@@ -134,6 +134,14 @@ impl Discretization<'_> {
             }
             x
         };
+        // a body of revolution integrates over the whole body: 2π r at each point
+        let ring = |x: &[f64; 3]| {
+            if self.axisymmetric {
+                std::f64::consts::TAU * x[0]
+            } else {
+                1.0
+            }
+        };
         let check = |what: &'static str, v: f64| {
             if v.is_finite() {
                 Ok(v)
@@ -147,7 +155,9 @@ impl Discretization<'_> {
                     for (c, cell) in mesh.iter_cells().enumerate() {
                         let vol = self.geometry[c].measure;
                         for (w, p) in w_cell.iter().zip(&p_cell) {
-                            let fx = f(&at(cell, p)[..dim]);
+                            let x = at(cell, p);
+                            let fx = f(&x[..dim]);
+                            let vol = vol * ring(&x);
                             for (a, &v) in cell.iter().enumerate() {
                                 for k in 0..dim {
                                     if let Dof::Free(j) = d.u[v * dim + k] {
@@ -165,7 +175,9 @@ impl Discretization<'_> {
                         }
                         let vol = self.geometry[c].measure;
                         for (w, p) in w_cell.iter().zip(&p_cell) {
-                            let qx = check("the body charge", q0(&at(cell, p)[..dim]))?;
+                            let x = at(cell, p);
+                            let qx = check("the body charge", q0(&x[..dim]))?;
+                            let vol = vol * ring(&x);
                             for (a, &v) in cell.iter().enumerate() {
                                 if let Dof::Free(j) = d.phi[v] {
                                     bphi[j] -= qx * w * vol * p[a];
@@ -179,7 +191,9 @@ impl Discretization<'_> {
                         let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
                         let len = facet_measure(&x);
                         for (w, p) in w_facet.iter().zip(&p_facet) {
-                            let t = value(&at(f, p)[..dim]);
+                            let y = at(f, p);
+                            let t = value(&y[..dim]);
+                            let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {
                                 for k in 0..dim {
                                     if let Dof::Free(j) = d.u[v * dim + k] {
@@ -195,7 +209,9 @@ impl Discretization<'_> {
                         let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
                         let len = facet_measure(&x);
                         for (w, p) in w_facet.iter().zip(&p_facet) {
-                            let qx = check("the surface charge", value(&at(f, p)[..dim]))?;
+                            let y = at(f, p);
+                            let qx = check("the surface charge", value(&y[..dim]))?;
+                            let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {
                                 if let Dof::Free(j) = d.phi[v] {
                                     // q has -∫ q2 ψ, and b_φ = -q

@@ -94,6 +94,9 @@ pub struct Material {
     pub beta: Vec<f64>,
     /// Whether the material carries electric unknowns (a non-zero permittivity).
     pub electric: bool,
+    /// A body of revolution about the y axis, meshed in its meridian plane `(r, z) = (x, y)`:
+    /// the Voigt order is `[rr, zz, rz, θθ]` (`nv = 4`), the hoop strain `u_r / r` last.
+    pub axisymmetric: bool,
 }
 
 /// A material that cannot be used.
@@ -128,6 +131,17 @@ pub enum MaterialError {
         what: &'static str,
         /// Its smallest eigenvalue.
         min_eig: f64,
+    },
+    /// An axisymmetric body whose material is not symmetric about the body's axis.
+    #[error(
+        "material `{material}`: an axisymmetric body needs a material symmetric about its axis \
+         (y), and this one is not (poled along {poling:?}: pole it along [0, 1, 0])"
+    )]
+    NotAxisymmetric {
+        /// The material's name.
+        material: String,
+        /// The poling direction given.
+        poling: [f64; 3],
     },
     /// The poling direction is zero or not finite.
     #[error("material `{material}`: the poling direction {dir:?} is not a non-zero vector")]
@@ -200,102 +214,76 @@ impl Material {
             material: name.into(),
             dir: poling,
         })?;
-        let finite = |what, v: &[f64]| {
-            if v.iter().all(|x| x.is_finite()) {
-                Ok(())
-            } else {
-                Err(MaterialError::NonFinite {
-                    material: name.into(),
-                    what,
-                })
-            }
-        };
-        finite("C", crystal.c.as_flattened())?;
-        finite("e", crystal.e.as_flattened())?;
-        finite("the permittivity", crystal.permittivity.as_flattened())?;
-        // rotate: T'_{ij..} = q_{ia} q_{jb} .. T_{ab..}
-        let mut c3 = [[0.0; 6]; 6];
-        let mut e3 = [[0.0; 6]; 3];
-        let mut b3 = [[0.0; 3]; 3];
-        let r = |i: usize, a: usize| q[(i, a)];
-        for i in 0..3 {
-            for j in i..3 {
-                for k in 0..3 {
-                    for l in k..3 {
-                        let mut s = 0.0;
-                        for a in 0..3 {
-                            for b in 0..3 {
-                                for cc in 0..3 {
-                                    for d in 0..3 {
-                                        let v = crystal.c[voigt(3, a, b)][voigt(3, cc, d)];
-                                        if v != 0.0 {
-                                            s += r(i, a) * r(j, b) * r(k, cc) * r(l, d) * v;
-                                        }
-                                    }
-                                }
-                            }
-                        }
-                        c3[voigt(3, i, j)][voigt(3, k, l)] = s;
-                    }
-                }
-            }
-        }
-        for i in 0..3 {
-            for j in 0..3 {
-                for k in j..3 {
-                    let mut s = 0.0;
-                    for a in 0..3 {
-                        for b in 0..3 {
-                            for cc in 0..3 {
-                                s += r(i, a) * r(j, b) * r(k, cc) * crystal.e[a][voigt(3, b, cc)];
-                            }
-                        }
-                    }
-                    e3[i][voigt(3, j, k)] = s;
-                }
-                let mut s = 0.0;
-                for a in 0..3 {
-                    for b in 0..3 {
-                        s += r(i, a) * r(j, b) * crystal.permittivity[a][b];
-                    }
-                }
-                b3[i][j] = s;
-            }
-        }
-        clean(c3.as_flattened_mut());
-        clean(e3.as_flattened_mut());
-        clean(b3.as_flattened_mut());
+        finite(name, crystal)?;
+        let (c3, e3, b3) = rotated(crystal, &q);
         let (rows, fields): (Vec<usize>, Vec<usize>) = match dim {
             2 => (vec![0, 1, 5], vec![0, 1]),
             _ => ((0..6).collect(), (0..3).collect()),
         };
-        let c: Vec<f64> = rows.iter().flat_map(|&i| rows.iter().map(move |&j| c3[i][j])).collect();
-        let e: Vec<f64> = fields
-            .iter()
-            .flat_map(|&i| rows.iter().map(move |&j| e3[i][j]))
-            .collect();
-        let beta: Vec<f64> = fields
-            .iter()
-            .flat_map(|&i| fields.iter().map(move |&j| b3[i][j]))
-            .collect();
-        let electric = beta.iter().any(|&x| x != 0.0);
-        let m = Material {
-            dim,
-            c,
-            e,
-            beta,
-            electric,
-        };
-        m.validate(name)?;
-        Ok(m)
+        reduced(name, &(c3, e3, b3), &rows, &fields, dim, false)
     }
 
-    /// Number of Voigt strain components (3 in 2D, 6 in 3D).
+    /// The crystal rotated so that its 3-axis points along `poling`, for a body of revolution
+    /// about the y axis meshed in its meridian plane (`x = r`, `y = z`, the hoop direction the
+    /// third): the Voigt rows `[rr, zz, rz, θθ]` and the fields `[r, z]` of the 3D tensors.
+    /// The material must be symmetric about y (checked: its tensors unchanged by a rotation
+    /// about y, to 1 % of each tensor's largest constant, since tables round the 6mm identity
+    /// `c66 = (c11 - c12) / 2`, which the meridian plane does not use), as a 6mm crystal poled
+    /// along y or an isotropic solid are.
+    ///
+    /// ```
+    /// use fe_assembly::{Crystal, Material};
+    /// let m = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
+    /// // [rr, zz, rz, θθ]: c11, c13, 0, c12 on the first row
+    /// assert_eq!(&m.c[..4], &[121.0, 75.2, 0.0, 75.4]);
+    /// assert!(Material::from_crystal_axisymmetric("x", &Crystal::pzt5a(), [1.0, 0.0, 0.0]).is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Material::from_crystal`], and [`MaterialError::NotAxisymmetric`].
+    pub fn from_crystal_axisymmetric(
+        name: &str,
+        crystal: &Crystal,
+        poling: [f64; 3],
+    ) -> Result<Material, MaterialError> {
+        let q = crystal_frame(poling).ok_or_else(|| MaterialError::BadPoling {
+            material: name.into(),
+            dir: poling,
+        })?;
+        finite(name, crystal)?;
+        let (c3, e3, b3) = rotated(crystal, &q);
+        // symmetric about y: the same tensors after a rotation by 1 rad about y (to the 1 % of
+        // tabulated data: PZT-5A's c66 is 22.6 beside (c11 - c12) / 2 = 22.8)
+        let (s, c) = 1f64.sin_cos();
+        let about_y = Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c);
+        let global = Crystal {
+            c: c3,
+            e: e3,
+            permittivity: b3,
+        };
+        let (c4, e4, b4) = rotated(&global, &about_y);
+        let differs = |a: &[f64], b: &[f64]| {
+            let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            a.iter().zip(b).any(|(x, y)| (x - y).abs() > 1e-2 * scale)
+        };
+        if differs(c3.as_flattened(), c4.as_flattened())
+            || differs(e3.as_flattened(), e4.as_flattened())
+            || differs(b3.as_flattened(), b4.as_flattened())
+        {
+            return Err(MaterialError::NotAxisymmetric {
+                material: name.into(),
+                poling,
+            });
+        }
+        reduced(name, &(c3, e3, b3), &[0, 1, 5, 2], &[0, 1], 2, true)
+    }
+
+    /// Number of Voigt strain components (3 in plane strain, 4 axisymmetric, 6 in 3D).
     pub fn nv(&self) -> usize {
-        if self.dim == 2 {
-            3
-        } else {
-            6
+        match (self.dim, self.axisymmetric) {
+            (2, false) => 3,
+            (2, true) => 4,
+            _ => 6,
         }
     }
 
@@ -331,6 +319,115 @@ impl Material {
         }
         Ok(())
     }
+}
+
+/// Checks that every constant of the crystal is finite.
+fn finite(name: &str, crystal: &Crystal) -> Result<(), MaterialError> {
+    for (what, v) in [
+        ("C", crystal.c.as_flattened()),
+        ("e", crystal.e.as_flattened()),
+        ("the permittivity", crystal.permittivity.as_flattened()),
+    ] {
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(MaterialError::NonFinite {
+                material: name.into(),
+                what,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// 3D tensors in the global frame: `(C, e, β)`.
+type Tensors3 = ([[f64; 6]; 6], [[f64; 6]; 3], [[f64; 3]; 3]);
+
+/// The crystal's tensors rotated by `q` (column `a` of `q`: crystal axis `a` in global
+/// coordinates): `T'_{ij..} = q_{ia} q_{jb} .. T_{ab..}`, round-off cleaned.
+fn rotated(crystal: &Crystal, q: &Matrix3<f64>) -> Tensors3 {
+    let mut c3 = [[0.0; 6]; 6];
+    let mut e3 = [[0.0; 6]; 3];
+    let mut b3 = [[0.0; 3]; 3];
+    let r = |i: usize, a: usize| q[(i, a)];
+    for i in 0..3 {
+        for j in i..3 {
+            for k in 0..3 {
+                for l in k..3 {
+                    let mut s = 0.0;
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            for cc in 0..3 {
+                                for d in 0..3 {
+                                    let v = crystal.c[voigt(3, a, b)][voigt(3, cc, d)];
+                                    if v != 0.0 {
+                                        s += r(i, a) * r(j, b) * r(k, cc) * r(l, d) * v;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    c3[voigt(3, i, j)][voigt(3, k, l)] = s;
+                }
+            }
+        }
+    }
+    for i in 0..3 {
+        for j in 0..3 {
+            for k in j..3 {
+                let mut s = 0.0;
+                for a in 0..3 {
+                    for b in 0..3 {
+                        for cc in 0..3 {
+                            s += r(i, a) * r(j, b) * r(k, cc) * crystal.e[a][voigt(3, b, cc)];
+                        }
+                    }
+                }
+                e3[i][voigt(3, j, k)] = s;
+            }
+            let mut s = 0.0;
+            for a in 0..3 {
+                for b in 0..3 {
+                    s += r(i, a) * r(j, b) * crystal.permittivity[a][b];
+                }
+            }
+            b3[i][j] = s;
+        }
+    }
+    clean(c3.as_flattened_mut());
+    clean(e3.as_flattened_mut());
+    clean(b3.as_flattened_mut());
+    (c3, e3, b3)
+}
+
+/// The material of the Voigt `rows` and field components `fields` of the 3D tensors,
+/// validated.
+fn reduced(
+    name: &str,
+    (c3, e3, b3): &Tensors3,
+    rows: &[usize],
+    fields: &[usize],
+    dim: usize,
+    axisymmetric: bool,
+) -> Result<Material, MaterialError> {
+    let c: Vec<f64> = rows.iter().flat_map(|&i| rows.iter().map(move |&j| c3[i][j])).collect();
+    let e: Vec<f64> = fields
+        .iter()
+        .flat_map(|&i| rows.iter().map(move |&j| e3[i][j]))
+        .collect();
+    let beta: Vec<f64> = fields
+        .iter()
+        .flat_map(|&i| fields.iter().map(move |&j| b3[i][j]))
+        .collect();
+    let electric = beta.iter().any(|&x| x != 0.0);
+    let m = Material {
+        dim,
+        c,
+        e,
+        beta,
+        electric,
+        axisymmetric,
+    };
+    m.validate(name)?;
+    Ok(m)
 }
 
 /// Rounds entries that are round-off of zero (below 1e-14 of the largest) to exactly zero.

@@ -1,8 +1,9 @@
 //! Recovery of the stress `σ = C ε(u) + eᵀ ∇φ` and the electric displacement
 //! `D = e ε(u) - β ∇φ` (DESIGN.md's law; `E = -∇φ`), constant on each P1 cell.
 
-use crate::kernels::{cell_gradient, cell_strain};
+use crate::kernels::{cell_gradient, cell_strain, strain_at};
 use crate::Discretization;
+use crate::Material;
 
 /// Per-cell fields, Voigt order for the stress (`[xx, yy, xy]` in 2D, 6 entries in 3D).
 #[derive(Clone, Debug, PartialEq)]
@@ -25,7 +26,7 @@ impl Discretization<'_> {
     pub fn recover(&self, u: &[[f64; 3]], phi: &[f64]) -> CellFields {
         let mesh = self.mesh;
         let dim = mesh.dim;
-        let nv = if dim == 2 { 3 } else { 6 };
+        let nv = self.nv();
         let n = mesh.n_cells();
         let mut out = CellFields {
             stress: Vec::with_capacity(n * nv),
@@ -50,14 +51,23 @@ impl Discretization<'_> {
                 out.stress.push(s);
                 out.strain.push(eps[i]);
             }
+            let d = displacement(m, &eps, &grad);
             for k in 0..dim {
-                let dk: f64 = (0..nv).map(|j| m.e[k * nv + j] * eps[j]).sum::<f64>()
-                    - (0..dim).map(|l| m.beta[k * dim + l] * grad[l]).sum::<f64>();
-                out.electric_displacement.push(dk);
+                out.electric_displacement.push(d[k]);
                 out.electric_field.push(-grad[k]);
             }
         }
         out
+    }
+
+    /// Voigt strain components: 3 in plane strain, 4 on a body of revolution (`[rr, zz, rz,
+    /// θθ]`), 6 in 3D.
+    pub fn nv(&self) -> usize {
+        match (self.mesh.dim, self.axisymmetric) {
+            (2, false) => 3,
+            (2, true) => 4,
+            _ => 6,
+        }
     }
 
     /// The charge through each of `groups` (boundary groups where the potential is
@@ -65,15 +75,17 @@ impl Discretization<'_> {
     /// as the reaction of the electric equation at the group's nodes: with `div D = q0`, the
     /// weak form gives `∫_Γ (D·ν) ψ_i = ∫_Ω D·∇ψ_i + ∫_Ω q0 ψ_i` for each hat function `ψ_i`,
     /// and the hats of a group's nodes sum to 1 on it (P1: `D` constant per cell, so each
-    /// cell adds `|T| D_T·∇ψ_i`; the body charge `q0` of `loads`, where there is one, at the
-    /// cell's centroid). A node of several groups counts for the first. The variationally consistent
+    /// cell adds `|T| D_T·∇ψ_i`, or its quadrature on a body of revolution, where `D` varies
+    /// with the hoop strain; the body charge `q0` of `loads`, where there is one, at the
+    /// cell's centroid), from the nodal `u` and `φ`. A node of several groups counts for the first. The variationally consistent
     /// charge: exact for the discrete solution, at the order of the energy norm's error in `h`.
     ///
     /// # Errors
     /// [`crate::AssemblyError`] where a group is not in the mesh.
     pub fn charges(
         &self,
-        fields: &CellFields,
+        u: &[[f64; 3]],
+        phi: &[f64],
         groups: &[&str],
         loads: &[crate::Load],
     ) -> Result<Vec<f64>, crate::AssemblyError> {
@@ -89,8 +101,14 @@ impl Discretization<'_> {
             if !cell.iter().any(|&v| owner[v] != usize::MAX) {
                 continue;
             }
-            let g = &self.geometry[c];
-            let d = &fields.electric_displacement[c * dim..(c + 1) * dim];
+            let (g, m) = (&self.geometry[c], self.material(c));
+            let ul: Vec<[f64; 3]> = cell.iter().map(|&v| u[v]).collect();
+            let pl: Vec<f64> = cell.iter().map(|&v| phi[v]).collect();
+            let grad = if self.cell_electric[c] {
+                cell_gradient(dim, g, &pl)
+            } else {
+                [0.0; 3]
+            };
             let source = q0.map_or(0.0, |q| {
                 let mut x = [0.0; 3];
                 for &v in cell {
@@ -100,11 +118,17 @@ impl Discretization<'_> {
                 }
                 q(&x[..dim]) / cell.len() as f64
             });
+            let (points, n_points) = g.points();
             for (a, &v) in cell.iter().enumerate() {
-                if owner[v] != usize::MAX {
-                    let flux: f64 = (0..dim).map(|k| d[k] * g.grads[a][k]).sum();
-                    out[owner[v]] += g.measure * (flux + source);
+                if owner[v] == usize::MAX {
+                    continue;
                 }
+                for p in &points[..n_points] {
+                    let d = displacement(m, &strain_at(dim, g, &p.hoop, &ul), &grad);
+                    let flux: f64 = (0..dim).map(|k| d[k] * g.grads[a][k]).sum();
+                    out[owner[v]] += p.weight * flux;
+                }
+                out[owner[v]] += g.volume() * source;
             }
         }
         Ok(out)
@@ -135,7 +159,7 @@ impl Discretization<'_> {
     pub fn charge_functionals(&self, groups: &[&str]) -> Result<Vec<ChargeFunctional>, crate::AssemblyError> {
         let mesh = self.mesh;
         let dim = mesh.dim;
-        let nv = if dim == 2 { 3 } else { 6 };
+        let nv = self.nv();
         let owner = self.owners(groups)?;
         let mut out = vec![(vec![0.0; self.dofs.n_u], vec![0.0; self.dofs.n_phi]); groups.len()];
         for (c, cell) in mesh.iter_cells().enumerate() {
@@ -143,30 +167,44 @@ impl Discretization<'_> {
                 continue;
             }
             let (g, m) = (&self.geometry[c], self.material(c));
+            let (points, n_points) = g.points();
             for (a, &va) in cell.iter().enumerate() {
                 let Some((a_u, a_phi)) = out.get_mut(owner[va]) else {
                     continue;
                 };
                 let grad_a = &g.grads[a];
                 for (b, &vb) in cell.iter().enumerate() {
-                    let columns = crate::kernels::strain_columns(dim, &g.grads[b]);
-                    for (k, column) in columns.iter().enumerate().take(dim) {
-                        if let crate::Dof::Free(j) = self.dofs.u[vb * dim + k] {
-                            let d: f64 = (0..dim)
-                                .map(|l| grad_a[l] * (0..nv).map(|v| m.e[l * nv + v] * column[v]).sum::<f64>())
-                                .sum();
-                            a_u[j] += g.measure * d;
+                    for p in &points[..n_points] {
+                        let columns = crate::kernels::strain_columns_at(dim, &g.grads[b], p.hoop[b]);
+                        for (k, column) in columns.iter().enumerate().take(dim) {
+                            if let crate::Dof::Free(j) = self.dofs.u[vb * dim + k] {
+                                let d: f64 = (0..dim)
+                                    .map(|l| grad_a[l] * (0..nv).map(|v| m.e[l * nv + v] * column[v]).sum::<f64>())
+                                    .sum();
+                                a_u[j] += p.weight * d;
+                            }
                         }
                     }
                     if let (true, crate::Dof::Free(j)) = (self.cell_electric[c], self.dofs.phi[vb]) {
                         let d: f64 = (0..dim)
                             .map(|l| grad_a[l] * (0..dim).map(|q| m.beta[l * dim + q] * g.grads[b][q]).sum::<f64>())
                             .sum();
-                        a_phi[j] -= g.measure * d;
+                        a_phi[j] -= g.volume() * d;
                     }
                 }
             }
         }
         Ok(out)
     }
+}
+
+/// `D = e ε - β ∇φ` at a point.
+fn displacement(m: &Material, eps: &[f64; 6], grad: &[f64; 3]) -> [f64; 3] {
+    let (dim, nv) = (m.dim, m.nv());
+    let mut d = [0.0; 3];
+    for (k, dk) in d.iter_mut().enumerate().take(dim) {
+        *dk = (0..nv).map(|j| m.e[k * nv + j] * eps[j]).sum::<f64>()
+            - (0..dim).map(|l| m.beta[k * dim + l] * grad[l]).sum::<f64>();
+    }
+    d
 }

@@ -199,9 +199,9 @@ impl Terminals {
             let dofs = walk
                 .base_dofs
                 .scaled([unit(0), unit(1), unit(2)], if q == dim + 1 { 1.0 } else { 0.0 });
-            let fields = disc.recover(&dofs.expand_u(u), &dofs.expand_phi(phi));
+            let (u, phi) = (dofs.expand_u(u), dofs.expand_phi(phi));
             let loads: &[fe_assembly::Load] = if q == 0 { &setup.loads } else { &[] };
-            for (g, charge) in disc.charges(&fields, &groups, loads)?.into_iter().enumerate() {
+            for (g, charge) in disc.charges(&u, &phi, &groups, loads)?.into_iter().enumerate() {
                 of_parts[g].push(charge);
             }
         }

@@ -385,7 +385,7 @@ pub(crate) fn recover(
     ];
     ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
     ProblemError::check_finite(&fields.stress, "the stress", scene)?;
-    let terminals = terminals(setup, disc, &fields, &phi)?;
+    let terminals = terminals(setup, disc, &u, &phi)?;
     Ok(Recovered {
         u,
         phi,
@@ -420,14 +420,14 @@ pub(crate) fn terminal_groups(setup: &Setup) -> Vec<&str> {
 fn terminals(
     setup: &Setup,
     disc: &Discretization<'_>,
-    fields: &CellFields,
+    u: &[[f64; 3]],
     phi: &[f64],
 ) -> Result<Vec<crate::report::TerminalReport>, ProblemError> {
     let groups = terminal_groups(setup);
     if groups.is_empty() {
         return Ok(vec![]);
     }
-    let charges = disc.charges(fields, &groups, &setup.loads)?;
+    let charges = disc.charges(u, phi, &groups, &setup.loads)?;
     let mut out = vec![];
     for (group, charge) in groups.iter().zip(charges) {
         let first = setup

@@ -1,0 +1,169 @@
+//! Bodies of revolution (the hoop strain `u_r / r`, `dx = 2π r dr dz`) against closed forms:
+//!
+//! - Lamé's thick cylinder under internal pressure in plane strain (Timoshenko & Goodier,
+//!   Theory of Elasticity, 3rd ed., §28): `u_r = (1 + ν) p a² / (E (b² - a²)) ((1 - 2ν) r +
+//!   b² / r)`, not in the P1 space: the nodal error (root mean square) falls like h²;
+//! - a poled disc between electrodes (a uniform field along the axis, no load): the strain
+//!   `ε = -C⁻¹ eᵀ ∇φ` is uniform, `u_r = ε_rr r` and `u_z = ε_zz z` are linear and P1 holds them
+//!   to round-off (a patch test of the hoop terms), and the charge on the top electrode is
+//!   `D_z π R²`, the whole disc's (the `2π r` of every integral);
+//! - a cylinder pressed between sliding plates (uniaxial stress): its lateral expansion
+//!   `ν δ r / H` and its force `E (δ / H) π R²` through the cells' volumes of revolution.
+
+use fe_assembly::{Constraint, Crystal, Discretization, Field, Load, Material, Parallelism};
+use linalg::{CoupledSolver, DirectLdlt, Ordering};
+use std::sync::Arc;
+
+fn solve(disc: &Discretization<'_>, loads: &[Load]) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let blocks = disc.assemble(Parallelism::Rayon);
+    let (bu, bphi) = disc.rhs(loads).unwrap();
+    let mut direct = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq).unwrap();
+    let (mut u, mut p) = (vec![0.0; disc.dofs.n_u], vec![0.0; disc.dofs.n_phi]);
+    direct.solve(&bu, &bphi, &mut u, &mut p).unwrap();
+    (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&p))
+}
+
+fn jitter(m: &mut mesh::Mesh, amount: f64) {
+    let (lo, hi) = m.bounding_box();
+    let mut seed = 777u64;
+    for p in &mut m.points {
+        for k in 0..2 {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let r = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            if (0..2).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
+                p[k] += amount * r;
+            }
+        }
+    }
+}
+
+#[test]
+fn lame_cylinder_converges_at_second_order() {
+    let (a, b, e, nu, p) = (1.0, 2.0, 100.0, 0.3, 1.5);
+    let exact = |r: f64| (1.0 + nu) * p * a * a / (e * (b * b - a * a)) * ((1.0 - 2.0 * nu) * r + b * b / r);
+    let mut errors = vec![];
+    for n in [4, 8, 16] {
+        let mesh = mesh::rectangle_tri([a, 0.0], [b, 0.25], 4 * n, n);
+        let mat = Material::from_crystal_axisymmetric("steel", &Crystal::isotropic(e, nu, 0.0), [0.0, 1.0, 0.0]).unwrap();
+        let bcs = vec![
+            Constraint::constant("top", Field::Displacement(1), 0.0),
+            Constraint::constant("bottom", Field::Displacement(1), 0.0),
+        ];
+        let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
+        assert!(disc.axisymmetric);
+        disc.check_held().unwrap();
+        // the inner face pushed outwards: σ n = -p n with n = -e_r
+        let load = Load::Traction {
+            group: "left".into(),
+            value: Arc::new(move |_| [p, 0.0, 0.0]),
+        };
+        let (u, _) = solve(&disc, &[load]);
+        let scale = exact(a);
+        // the nodal error's root mean square (the maximum carries P1's log h)
+        let sum: f64 = mesh
+            .points
+            .iter()
+            .zip(&u)
+            .map(|(x, u)| (u[0] - exact(x[0])).powi(2) + u[1].powi(2))
+            .sum();
+        errors.push((sum / mesh.n_nodes() as f64).sqrt() / scale);
+    }
+    let rates: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    // measured: 5.6e-4, 1.4e-4, 3.4e-5 (rates 2.01, 2.03; 2.03, 2.02 on to n = 64)
+    assert!(errors[2] < 4e-5, "errors {errors:?}");
+    assert!(rates.iter().all(|&r| r > 1.95), "errors {errors:?}, rates {rates:?}");
+}
+
+#[test]
+fn a_disc_between_electrodes_is_reproduced_and_its_charge_is_the_whole_discs() {
+    let (radius, height, volts) = (1.0, 0.5, 0.02);
+    let mut mesh = mesh::rectangle_tri([0.0, 0.0], [radius, height], 8, 4);
+    jitter(&mut mesh, 0.04);
+    let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
+    let bcs = vec![
+        Constraint::constant("left", Field::Displacement(0), 0.0),
+        Constraint::constant("bottom", Field::Displacement(1), 0.0),
+        Constraint::constant("bottom", Field::Potential, 0.0),
+        Constraint::constant("top", Field::Potential, volts),
+    ];
+    let disc = Discretization::new(&mesh, &[("body".into(), mat.clone())], &bcs).unwrap();
+    let (u, phi) = solve(&disc, &[]);
+    // the stress-free strain of the field: C ε = -eᵀ ∇φ on [rr, zz, rz, θθ]
+    let grad = [0.0, volts / height];
+    let c = nalgebra::DMatrix::from_row_slice(4, 4, &mat.c);
+    let rhs = nalgebra::DVector::from_iterator(4, (0..4).map(|v| -(0..2).map(|k| mat.e[k * 4 + v] * grad[k]).sum::<f64>()));
+    let eps = c.lu().solve(&rhs).unwrap();
+    assert!((eps[0] - eps[3]).abs() < 1e-14, "ε_rr = ε_θθ: {eps}");
+    let scale = eps.amax() * radius;
+    for (x, (u, p)) in mesh.points.iter().zip(u.iter().zip(&phi)) {
+        assert!((u[0] - eps[0] * x[0]).abs() < 1e-11 * scale, "u_r at {x:?}: {} against {}", u[0], eps[0] * x[0]);
+        assert!((u[1] - eps[1] * x[1]).abs() < 1e-11 * scale, "u_z at {x:?}");
+        assert!((p - volts * x[1] / height).abs() < 1e-12 * volts, "φ at {x:?}");
+    }
+    let d_z: f64 = (0..4).map(|v| mat.e[4 + v] * eps[v]).sum::<f64>() - mat.beta[3] * grad[1];
+    let charges = disc.charges(&u, &phi, &["top", "bottom"], &[]).unwrap();
+    let whole = d_z * std::f64::consts::PI * radius * radius;
+    assert!((charges[0] - whole).abs() < 1e-11 * whole.abs(), "top {} against {whole}", charges[0]);
+    assert!((charges[1] + whole).abs() < 1e-11 * whole.abs(), "bottom {} against {}", charges[1], -whole);
+    let fields = disc.recover(&u, &phi);
+    assert_eq!(fields.stress.len(), 4 * mesh.n_cells());
+    assert!(fields.stress.iter().all(|s| s.abs() < 1e-9 * mat.c[0] * eps.amax()));
+}
+
+#[test]
+fn a_pressed_cylinder_carries_e_eps_pi_r_squared() {
+    // uniaxial stress: the plates slide freely (u_r free on them), the top moved by -δ
+    let (radius, height, e, nu, delta) = (0.5, 1.0, 70.0, 0.25, 1e-3);
+    let mesh = mesh::rectangle_tri([0.0, 0.0], [radius, height], 4, 8);
+    let mat = Material::from_crystal_axisymmetric("al", &Crystal::isotropic(e, nu, 0.0), [0.0, 1.0, 0.0]).unwrap();
+    let bcs = vec![
+        Constraint::constant("left", Field::Displacement(0), 0.0),
+        Constraint::constant("bottom", Field::Displacement(1), 0.0),
+        Constraint::constant("top", Field::Displacement(1), -delta),
+    ];
+    let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
+    let (u, _) = solve(&disc, &[]);
+    for (x, u) in mesh.points.iter().zip(&u) {
+        assert!((u[0] - nu * delta / height * x[0]).abs() < 1e-13, "lateral expansion at {x:?}");
+    }
+    // the plates' force: σ_zz over the cross-section, ∫ σ_zz dV / H with the cells' volumes of
+    // revolution, -E (δ/H) π R²
+    let fields = disc.recover(&u, &vec![0.0; mesh.n_nodes()]);
+    let sigma_zz = fields.stress[1];
+    assert!((sigma_zz + e * delta / height).abs() < 1e-10 * e * delta, "σ_zz = {sigma_zz}");
+    let force = disc
+        .geometry
+        .iter()
+        .enumerate()
+        .map(|(c, g)| g.volume() * fields.stress[4 * c + 1])
+        .sum::<f64>()
+        / height;
+    let expected = -e * delta / height * std::f64::consts::PI * radius * radius;
+    assert!((force - expected).abs() < 1e-10 * expected.abs(), "{force} against {expected}");
+}
+
+#[test]
+fn bodies_of_revolution_are_refused_where_they_cannot_be() {
+    let mesh = mesh::rectangle_tri([-1.0, 0.0], [1.0, 1.0], 4, 2);
+    let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
+    let e = Discretization::new(&mesh, &[("body".into(), mat.clone())], &[]).err().unwrap();
+    assert!(e.to_string().contains("r = x < 0"), "{e}");
+    let plane = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
+    let mut mesh = mesh::rectangle_tri([0.0, 0.0], [1.0, 1.0], 4, 2);
+    let n = mesh.n_cells();
+    mesh.regions.insert("upper".into(), (0..n / 2).collect());
+    mesh.regions.insert("lower".into(), (n / 2..n).collect());
+    let e = Discretization::new(&mesh, &[("upper".into(), mat), ("lower".into(), plane)], &[])
+        .err()
+        .unwrap();
+    assert!(e.to_string().contains("axisymmetric as a whole"), "{e}");
+    let e = Material::from_crystal_axisymmetric("tilted", &Crystal::pzt5a(), [1.0, 1.0, 0.0]).unwrap_err();
+    assert!(e.to_string().contains("symmetric about its axis"), "{e}");
+    // a body of revolution held only radially is free along its axis
+    let mat = Material::from_crystal_axisymmetric("al", &Crystal::isotropic(70.0, 0.3, 0.0), [0.0, 1.0, 0.0]).unwrap();
+    let mesh = mesh::rectangle_tri([0.0, 0.0], [1.0, 1.0], 4, 4);
+    let bcs = vec![Constraint::constant("right", Field::Displacement(0), 0.0)];
+    let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
+    let e = disc.check_held().unwrap_err();
+    assert!(e.to_string().contains("translation along the axis"), "{e}");
+}
