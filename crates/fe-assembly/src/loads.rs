@@ -69,6 +69,15 @@ fn simplex_rule(dim: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
     }
 }
 
+/// `v`, or the error naming the load `what` where it is not finite.
+fn check(what: &'static str, v: f64) -> Result<f64, AssemblyError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(AssemblyError::from(InputError::NotFiniteLoad { what, value: v }))
+    }
+}
+
 /// Measure of a facet (segment length or triangle area).
 pub fn facet_measure(x: &[[f64; 3]]) -> f64 {
     let d = |q: usize, k: usize| x[q][k] - x[0][k];
@@ -125,30 +134,10 @@ impl Discretization<'_> {
         let mut bphi = vec![0.0; d.n_phi];
         let (w_cell, p_cell) = simplex_rule(dim);
         let (w_facet, p_facet) = simplex_rule(dim - 1);
-        let at = |nodes: &[usize], bary: &[f64; 4]| {
-            let mut x = [0.0; 3];
-            for (q, &v) in nodes.iter().enumerate() {
-                for k in 0..3 {
-                    x[k] += bary[q] * mesh.points[v][k];
-                }
-            }
-            x
-        };
-        // a body of revolution integrates over the whole body: 2π r at each point
-        let ring = |x: &[f64; 3]| {
-            if self.axisymmetric {
-                std::f64::consts::TAU * x[0]
-            } else {
-                1.0
-            }
-        };
-        let check = |what: &'static str, v: f64| {
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(AssemblyError::from(InputError::NotFiniteLoad { what, value: v }))
-            }
-        };
+        let (at, ring) = (
+            |nodes: &[usize], bary: &[f64; 4]| self.point_at(nodes, bary),
+            |x: &[f64; 3]| self.ring(x),
+        );
         for load in loads {
             match load {
                 Load::BodyForce(f) => {
@@ -224,6 +213,27 @@ impl Discretization<'_> {
             }
         }
         Ok((bu, bphi))
+    }
+
+    /// The point of barycentric coordinates `bary` on the simplex of `nodes`.
+    fn point_at(&self, nodes: &[usize], bary: &[f64; 4]) -> [f64; 3] {
+        let mut x = [0.0; 3];
+        for (q, &v) in nodes.iter().enumerate() {
+            for k in 0..3 {
+                x[k] += bary[q] * self.mesh.points[v][k];
+            }
+        }
+        x
+    }
+
+    /// The measure's factor at `x`: `2π r` on a body of revolution (its integrals are over the
+    /// whole body), 1 otherwise.
+    fn ring(&self, x: &[f64; 3]) -> f64 {
+        if self.axisymmetric {
+            std::f64::consts::TAU * x[0]
+        } else {
+            1.0
+        }
     }
 
     /// Subtracts the columns of `K` of the prescribed dofs (those of `which`) times their

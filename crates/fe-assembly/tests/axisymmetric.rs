@@ -44,7 +44,8 @@ fn lame_cylinder_converges_at_second_order() {
     let mut errors = vec![];
     for n in [4, 8, 16] {
         let mesh = mesh::rectangle_tri([a, 0.0], [b, 0.25], 4 * n, n);
-        let mat = Material::from_crystal_axisymmetric("steel", &Crystal::isotropic(e, nu, 0.0), [0.0, 1.0, 0.0]).unwrap();
+        let mat =
+            Material::from_crystal_axisymmetric("steel", &Crystal::isotropic(e, nu, 0.0), [0.0, 1.0, 0.0]).unwrap();
         let bcs = vec![
             Constraint::constant("top", Field::Displacement(1), 0.0),
             Constraint::constant("bottom", Field::Displacement(1), 0.0),
@@ -91,20 +92,37 @@ fn a_disc_between_electrodes_is_reproduced_and_its_charge_is_the_whole_discs() {
     // the stress-free strain of the field: C ε = -eᵀ ∇φ on [rr, zz, rz, θθ]
     let grad = [0.0, volts / height];
     let c = nalgebra::DMatrix::from_row_slice(4, 4, &mat.c);
-    let rhs = nalgebra::DVector::from_iterator(4, (0..4).map(|v| -(0..2).map(|k| mat.e[k * 4 + v] * grad[k]).sum::<f64>()));
+    let rhs = nalgebra::DVector::from_iterator(
+        4,
+        (0..4).map(|v| -(0..2).map(|k| mat.e[k * 4 + v] * grad[k]).sum::<f64>()),
+    );
     let eps = c.lu().solve(&rhs).unwrap();
     assert!((eps[0] - eps[3]).abs() < 1e-14, "ε_rr = ε_θθ: {eps}");
     let scale = eps.amax() * radius;
     for (x, (u, p)) in mesh.points.iter().zip(u.iter().zip(&phi)) {
-        assert!((u[0] - eps[0] * x[0]).abs() < 1e-11 * scale, "u_r at {x:?}: {} against {}", u[0], eps[0] * x[0]);
+        assert!(
+            (u[0] - eps[0] * x[0]).abs() < 1e-11 * scale,
+            "u_r at {x:?}: {} against {}",
+            u[0],
+            eps[0] * x[0]
+        );
         assert!((u[1] - eps[1] * x[1]).abs() < 1e-11 * scale, "u_z at {x:?}");
         assert!((p - volts * x[1] / height).abs() < 1e-12 * volts, "φ at {x:?}");
     }
     let d_z: f64 = (0..4).map(|v| mat.e[4 + v] * eps[v]).sum::<f64>() - mat.beta[3] * grad[1];
     let charges = disc.charges(&u, &phi, &["top", "bottom"], &[]).unwrap();
     let whole = d_z * std::f64::consts::PI * radius * radius;
-    assert!((charges[0] - whole).abs() < 1e-11 * whole.abs(), "top {} against {whole}", charges[0]);
-    assert!((charges[1] + whole).abs() < 1e-11 * whole.abs(), "bottom {} against {}", charges[1], -whole);
+    assert!(
+        (charges[0] - whole).abs() < 1e-11 * whole.abs(),
+        "top {} against {whole}",
+        charges[0]
+    );
+    assert!(
+        (charges[1] + whole).abs() < 1e-11 * whole.abs(),
+        "bottom {} against {}",
+        charges[1],
+        -whole
+    );
     let fields = disc.recover(&u, &phi);
     assert_eq!(fields.stress.len(), 4 * mesh.n_cells());
     assert!(fields.stress.iter().all(|s| s.abs() < 1e-9 * mat.c[0] * eps.amax()));
@@ -124,13 +142,19 @@ fn a_pressed_cylinder_carries_e_eps_pi_r_squared() {
     let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
     let (u, _) = solve(&disc, &[]);
     for (x, u) in mesh.points.iter().zip(&u) {
-        assert!((u[0] - nu * delta / height * x[0]).abs() < 1e-13, "lateral expansion at {x:?}");
+        assert!(
+            (u[0] - nu * delta / height * x[0]).abs() < 1e-13,
+            "lateral expansion at {x:?}"
+        );
     }
     // the plates' force: σ_zz over the cross-section, ∫ σ_zz dV / H with the cells' volumes of
     // revolution, -E (δ/H) π R²
     let fields = disc.recover(&u, &vec![0.0; mesh.n_nodes()]);
     let sigma_zz = fields.stress[1];
-    assert!((sigma_zz + e * delta / height).abs() < 1e-10 * e * delta, "σ_zz = {sigma_zz}");
+    assert!(
+        (sigma_zz + e * delta / height).abs() < 1e-10 * e * delta,
+        "σ_zz = {sigma_zz}"
+    );
     let force = disc
         .geometry
         .iter()
@@ -139,14 +163,19 @@ fn a_pressed_cylinder_carries_e_eps_pi_r_squared() {
         .sum::<f64>()
         / height;
     let expected = -e * delta / height * std::f64::consts::PI * radius * radius;
-    assert!((force - expected).abs() < 1e-10 * expected.abs(), "{force} against {expected}");
+    assert!(
+        (force - expected).abs() < 1e-10 * expected.abs(),
+        "{force} against {expected}"
+    );
 }
 
 #[test]
 fn bodies_of_revolution_are_refused_where_they_cannot_be() {
     let mesh = mesh::rectangle_tri([-1.0, 0.0], [1.0, 1.0], 4, 2);
     let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
-    let e = Discretization::new(&mesh, &[("body".into(), mat.clone())], &[]).err().unwrap();
+    let e = Discretization::new(&mesh, &[("body".into(), mat.clone())], &[])
+        .err()
+        .unwrap();
     assert!(e.to_string().contains("r = x < 0"), "{e}");
     let plane = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
     let mut mesh = mesh::rectangle_tri([0.0, 0.0], [1.0, 1.0], 4, 2);

@@ -48,6 +48,7 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../../scenes/manufactured-conducting.toml"),
     ),
     ("paper-elastic", include_str!("../../../scenes/paper-elastic.toml")),
+    ("hertz-sphere", include_str!("../../../scenes/hertz-sphere.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),
     ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),

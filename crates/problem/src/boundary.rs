@@ -11,7 +11,7 @@ use crate::ProblemError;
 use contact::{
     ContactOperator, ContactPoints, DenseContactProblem, ElectricContactProblem, OperatorError, PointValues,
 };
-use fe_assembly::{facet_measure, Dof, DofMap};
+use fe_assembly::{facet_measure, Discretization, Dof, DofMap};
 use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
 
 /// The contact points of a boundary group and the u dofs of their nodes.
@@ -152,12 +152,20 @@ fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(
 }
 
 /// Lumped boundary mass of each node on `group`: each facet's measure shared equally among its
-/// nodes.
-fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup) -> Vec<f64> {
+/// nodes; on a body of revolution (`axisymmetric`), the ring's, `∫ N_a 2π r ds = 2π L (2 r_a +
+/// r_b) / 6` for the segment of length L from node a to node b.
+fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup, axisymmetric: bool) -> Vec<f64> {
     let mut weight = vec![0.0; mesh.n_nodes()];
     for f in group.iter() {
         let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
-        let m = facet_measure(&x) / f.len() as f64;
+        let len = facet_measure(&x);
+        if axisymmetric {
+            let (ra, rb) = (x[0][0], x[1][0]);
+            weight[f[0]] += std::f64::consts::TAU * len * (2.0 * ra + rb) / 6.0;
+            weight[f[1]] += std::f64::consts::TAU * len * (ra + 2.0 * rb) / 6.0;
+            continue;
+        }
+        let m = len / f.len() as f64;
         for &v in f {
             weight[v] += m;
         }
@@ -179,18 +187,15 @@ impl ContactBoundary {
     /// [`MAX_NORMAL_ANGLE_DEG`] of a facet; a node whose prescribed components lie across the
     /// normal or a tangent (neither along nor orthogonal to it); a group with no contact point
     /// left.
-    pub fn new(mesh: &mesh::Mesh, dofs: &DofMap, spec: &ContactSpec) -> Result<Self, ProblemError> {
+    pub fn new(disc: &Discretization<'_>, spec: &ContactSpec) -> Result<Self, ProblemError> {
+        let (mesh, dofs) = (disc.mesh, &disc.dofs);
         let dim = mesh.dim;
-        let center = match &spec.gap_center {
-            Some(c) => [c[0], c[1], c.get(2).copied().unwrap_or(0.0)],
-            None => [0.0; 3],
-        };
         let nv = unit_normal(spec, dim)?;
         check_boundary(mesh, &spec.group, "contact.group", "contact face")?;
         check_normal(mesh, spec, nv)?;
         let tangents = tangent_basis(dim, nv);
         let group = mesh.boundary(&spec.group)?;
-        let weight = lumped_weights(mesh, group);
+        let weight = lumped_weights(mesh, group, disc.axisymmetric);
         let friction = spec.friction();
         let mut points = ContactPoints {
             dim,
@@ -211,13 +216,14 @@ impl ContactBoundary {
             slipped: vec![],
         };
         let (mut nodes, mut point_dofs, mut slots) = (vec![], vec![], vec![]);
-        let (mut held_nodes, mut held_inside) = (0, 0);
+        let (mut held_nodes, mut held_inside, mut out_of_reach) = (0, 0, 0);
         for node in group.nodes() {
             let x = mesh.points[node];
-            let d = [x[0] - center[0], x[1] - center[1], x[2] - center[2]];
-            let along_n: f64 = (0..3).map(|k| d[k] * nv[k]).sum();
-            let dist2 = (0..3).map(|k| d[k] * d[k]).sum::<f64>() - along_n * along_n;
-            let gap = spec.gap + 0.5 * spec.gap_curvature * dist2.max(0.0);
+            let Some(gap) = spec.gap_at(&x, &nv) else {
+                // beyond the indenter's shape (a punch's edge, a sphere's equator)
+                out_of_reach += 1;
+                continue;
+            };
             let comps: Vec<Dof> = (0..dim).map(|k| dofs.u[node * dim + k]).collect();
             let held = match held_directions(spec, node, &x, &comps, &nv, &tangents)? {
                 Held::Normal(u_n) => {
@@ -249,6 +255,16 @@ impl ContactBoundary {
             points.gap.push(gap);
             points.friction.push(friction);
             points.held.push(held);
+        }
+        if nodes.is_empty() && out_of_reach > 0 {
+            return Err(SceneError::new(
+                "contact.indenter",
+                format!(
+                    "the indenter reaches no node of contact group `{}`: all its {out_of_reach} free nodes lie beyond the shape's reach (its radius, or its profile's last point)",
+                    spec.group
+                ),
+            )
+            .into());
         }
         if nodes.is_empty() {
             return Err(SceneError::new(

@@ -3,7 +3,7 @@
 //! and the contact tractions of Hertz and Cattaneo-Mindlin (profile errors, the contact and
 //! stick zones). The formulas of the contact solutions are in [`crate::analytical`].
 
-use crate::analytical::{cattaneo_stick_half_width, cattaneo_traction, hertz, hertz_pressure};
+use crate::analytical::{cattaneo_stick_half_width, cattaneo_traction, hertz, hertz_pressure, hertz_sphere};
 use crate::scene::{ElectricCondition, ExactKind, Scene};
 use contact::{ContactPoints, ContactSolution, Status};
 use fe_assembly::{Discretization, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
@@ -210,6 +210,16 @@ pub struct ContactErrors {
     pub error: f64,
     /// What `error` measures.
     pub error_name: String,
+    /// A body of revolution under a sphere or paraboloid pushed in by `depth` (Hertz's sphere):
+    /// the force Hertz gives at that depth, `(4/3) E* √R d^(3/2)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_hertz: Option<f64>,
+    /// `|P - force_hertz| / force_hertz`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_error: Option<f64>,
+    /// Hertz's contact radius at that depth, `√(R d)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub a_depth: Option<f64>,
     /// Cattaneo-Mindlin: the tangential reaction Q.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load_q: Option<f64>,
@@ -271,11 +281,38 @@ pub fn contact_errors(
     let c = scene.contact.as_ref()?;
     let m = scene.material.first()?;
     let (young, poisson) = (m.young?, m.poisson?);
-    let radius = 1.0 / c.gap_curvature;
+    let radius = c.hertz_radius()?;
     let x0 = c.gap_center.as_ref().and_then(|v| v.first().copied()).unwrap_or(0.0);
     let xs: Vec<f64> = points.position.iter().map(|p| p[0] - x0).collect();
-    let (a, p0) = hertz(p, radius, young, poisson);
-    let (a_h, centre) = extent(&xs, |i| sol.lambda.normal[i] > 0.0);
+    let sphere = scene.mesh.axisymmetric;
+    let (a, p0) = if sphere {
+        // Johnson (4.22): a³ = 3PR/(4E*), p0 = 3P/(2πa²)
+        let a = hertz_sphere(p, radius, young, poisson);
+        (a, 3.0 * p / (2.0 * std::f64::consts::PI * a * a))
+    } else {
+        hertz(p, radius, young, poisson)
+    };
+    let (a_h, centre) = if sphere {
+        // the contact zone is a disc about the axis: its radius
+        let r = xs
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| sol.lambda.normal[i] > 0.0)
+            .fold(0.0, |m: f64, (_, x)| m.max(*x));
+        (r, 0.0)
+    } else {
+        extent(&xs, |i| sol.lambda.normal[i] > 0.0)
+    };
+    // pushed in by d = -(the uniform gap): Hertz's force and radius at that depth (Johnson
+    // (4.23): d = a²/R, P = (4/3) E* R^(1/2) d^(3/2))
+    let depth = -c.uniform_gap();
+    let e_star = young / (1.0 - poisson * poisson);
+    let at_depth = (sphere && depth > 0.0).then(|| {
+        (
+            4.0 / 3.0 * e_star * radius.sqrt() * depth.powf(1.5),
+            (radius * depth).sqrt(),
+        )
+    });
     let pressure_error = profile_error(&xs, &sol.lambda.normal, 1.5 * a, |x| hertz_pressure(x, a, p0));
     let peak = sol.lambda.normal.iter().cloned().fold(0.0, f64::max);
     let mut out = ContactErrors {
@@ -291,6 +328,9 @@ pub fn contact_errors(
         pressure_error,
         error: pressure_error,
         error_name: x.kind.measures().into(),
+        force_hertz: at_depth.map(|(f, _)| f),
+        force_error: at_depth.map(|(f, _)| (p - f).abs() / f),
+        a_depth: at_depth.map(|(_, a)| a),
         load_q: None,
         c: None,
         c_h: None,

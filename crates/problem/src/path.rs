@@ -310,7 +310,7 @@ impl Walk<'_> {
         let assembled = Faer.assemble(&posed)?;
         let t_assembly = t.elapsed().as_secs_f64();
         reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
-        let boundary = ContactBoundary::new(&self.setup.mesh, &disc.dofs, self.contact)?;
+        let boundary = ContactBoundary::new(disc, self.contact)?;
         boundary.report_held(&self.contact.group, reporter);
         let system = Faer.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
         stop_if_interrupted(limits, "factorisation")?;
@@ -372,7 +372,7 @@ impl Walk<'_> {
         let (scene, setup) = (self.scene, self.setup);
         let f = self.spec.factors(t);
         disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
-        let mut boundary = base.at_factors(self.contact.gap, f.gap, f.displacement);
+        let mut boundary = base.at_factors(self.contact.uniform_gap(), f.gap, f.displacement);
         if how.weakening.is_some() {
             boundary.points.slipped.clone_from(&state.slipped);
         }
@@ -396,7 +396,11 @@ impl Walk<'_> {
             check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
             check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
             let pair = Some((&boundary, &sol));
-            let recovered = recover(scene, setup, disc, (&u, &phi), pair, equilibrium, reporter)?;
+            let mut recovered = recover(scene, setup, disc, (&u, &phi), pair, equilibrium, reporter)?;
+            if let Some(ind) = &mut recovered.indenter {
+                // the depth at this instant: the uniform gap's factor scales it
+                ind.depth *= f.gap;
+            }
             (sol, Some((recovered, equilibrium, posed.loads, u)))
         } else {
             check_solved(scene, (&[], &[]), Some(&sol), 0.0)?;

@@ -43,6 +43,26 @@ pub struct RunReport {
     /// each with its potential and the charge through it (absent without electric unknowns).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub terminals: Vec<TerminalReport>,
+    /// A rigid indenter's figures (absent without `contact.indenter`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indenter: Option<IndenterReport>,
+}
+
+/// A rigid indenter's figures (`run.json`'s `indenter`), in the scene's units (a body of
+/// revolution's force is the whole body's).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct IndenterReport {
+    /// The shape.
+    pub shape: String,
+    /// How far its tip is pushed along `-n` (`contact.indenter.depth`, less `contact.gap`).
+    pub depth: f64,
+    /// The total normal force the body carries from it.
+    pub force: f64,
+    /// The largest distance from its axis of a contact point that carries pressure (0 where
+    /// none does): the contact zone's radius, to the mesh's resolution.
+    pub contact_radius: f64,
+    /// Contact points carrying pressure.
+    pub points_in_contact: usize,
 }
 
 /// A boundary group at a prescribed potential (`run.json`'s `terminals`).

@@ -220,7 +220,7 @@ fn contact_boundary(posed: &Posed<'_>, reporter: &mut dyn Reporter) -> Result<Op
     else {
         return Ok(None);
     };
-    let boundary = ContactBoundary::new(&posed.setup.mesh, &posed.disc.dofs, spec)?;
+    let boundary = ContactBoundary::new(posed.disc, spec)?;
     boundary.report_held(&spec.group, reporter);
     Ok(Some(boundary))
 }
@@ -342,6 +342,8 @@ pub(crate) struct Recovered {
     pub(crate) exact: Option<crate::exact::ExactReport>,
     /// The groups at a prescribed potential, with their charges.
     pub(crate) terminals: Vec<crate::report::TerminalReport>,
+    /// A rigid indenter's figures.
+    pub(crate) indenter: Option<crate::report::IndenterReport>,
 }
 
 /// Expands the free unknowns `(u, φ)` to the nodes, recovers stress and electric
@@ -386,6 +388,7 @@ pub(crate) fn recover(
     ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
     ProblemError::check_finite(&fields.stress, "the stress", scene)?;
     let terminals = terminals(setup, disc, &u, &phi)?;
+    let indenter = contact.and_then(|(b, sol)| indenter_report(scene, &b.points, sol, counts.normal_force, 1.0));
     Ok(Recovered {
         u,
         phi,
@@ -393,6 +396,35 @@ pub(crate) fn recover(
         contact: counts,
         exact,
         terminals,
+        indenter,
+    })
+}
+
+/// A rigid indenter's figures at the solution `sol` on `points`, the body carrying
+/// `normal_force`, the uniform gap scaled by `gap_factor` (a load path's); `None` without
+/// `contact.indenter`.
+pub(crate) fn indenter_report(
+    scene: &Scene,
+    points: &contact::ContactPoints,
+    sol: &ContactSolution,
+    normal_force: f64,
+    gap_factor: f64,
+) -> Option<crate::report::IndenterReport> {
+    let c = scene.contact.as_ref()?;
+    let ind = c.indenter.as_ref()?;
+    let (mut radius, mut count) = (0.0f64, 0);
+    for (i, x) in points.position.iter().enumerate() {
+        if sol.lambda.normal[i] > 0.0 {
+            radius = radius.max(ind.local(x, &points.normal[i]).1);
+            count += 1;
+        }
+    }
+    Some(crate::report::IndenterReport {
+        shape: ind.shape.to_string(),
+        depth: -c.uniform_gap() * gap_factor,
+        force: normal_force,
+        contact_radius: radius,
+        points_in_contact: count,
     })
 }
 
@@ -484,6 +516,7 @@ pub(crate) fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunRe
         },
         path: None,
         terminals: r.terminals.clone(),
+        indenter: r.indenter.clone(),
         solver: SolverReport {
             strategy: plan.linear_strategy,
             rule: rule_in_words(plan.rule).into(),

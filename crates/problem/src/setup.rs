@@ -70,6 +70,10 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         materials.into_iter().map(|(r, m)| (r, m.without_electric())).collect()
     };
     let mut constraints = constraints(scene, &plan);
+    if mesh.boundaries.contains_key("axis") && scene.mesh.axisymmetric {
+        // the axis of a body of revolution: no radial displacement
+        constraints.push(Constraint::constant("axis", Field::Displacement(0), 0.0));
+    }
     let mut loads = loads(scene, dim);
     let exact = FieldSolution::of(scene, dim);
     if let Some(ex) = &exact {
@@ -131,6 +135,9 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
             )))
         }
     };
+    if let Some(g) = &m.grading {
+        grade(&mut mesh, m, &g.ratios());
+    }
     let quality = mesh.check()?;
     let notes = MeshNotes {
         reoriented_cells: mesh.reoriented_cells,
@@ -174,11 +181,79 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         }
         mesh.boundaries.insert("electrode".into(), g);
     }
+    if m.axisymmetric {
+        axis_group(&mut mesh)?;
+    }
     Ok((mesh, notes))
 }
 
-/// The material of a validated spec in dimension `dim`, in the global frame.
-fn material(spec: &MaterialSpec, dim: usize) -> Result<Material, ProblemError> {
+/// The group `axis` of a body of revolution's meridian section: its boundary segments on
+/// `x = 0` (where `u_r = 0` is prescribed), unless the mesh names its own `axis` group (then
+/// checked to lie on `x = 0`). A body off the axis (a ring) has none.
+fn axis_group(mesh: &mut mesh::Mesh) -> Result<(), ProblemError> {
+    let (lo, hi) = mesh.bounding_box();
+    let tol = 1e-12 * (0..2).map(|k| hi[k] - lo[k]).fold(f64::MIN_POSITIVE, f64::max);
+    if let Ok(g) = mesh.boundary("axis") {
+        if let Some(&v) = g.nodes().iter().find(|&&v| mesh.points[v][0].abs() > tol) {
+            return Err(SceneError::new(
+                "mesh.axisymmetric",
+                format!(
+                    "the mesh's group `axis` has node {v} at r = {:e}, off the axis x = 0 (where a body of revolution's radial displacement is held)",
+                    mesh.points[v][0]
+                ),
+            )
+            .into());
+        }
+        return Ok(());
+    }
+    let on_axis = |v: usize| mesh.points[v][0].abs() <= tol;
+    let mut facets = vec![];
+    for cell in mesh.iter_cells() {
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            if on_axis(cell[a]) && on_axis(cell[b]) {
+                facets.extend_from_slice(&[cell[a], cell[b]]);
+            }
+        }
+    }
+    if !facets.is_empty() {
+        mesh.boundaries.insert(
+            "axis".into(),
+            mesh::FacetGroup {
+                nodes_per_facet: 2,
+                facets,
+            },
+        );
+    }
+    Ok(())
+}
+
+/// Grades a generated mesh towards `lo`: along axis k the cells' sizes grow by the ratio
+/// `grading[k]` (or the one ratio given) from one cell to the next, the nodes keeping their
+/// places in the structured grid.
+fn grade(mesh: &mut mesh::Mesh, m: &crate::scene::MeshSpec, grading: &[f64]) {
+    let n = m.cells_per_axis();
+    for (k, &cells) in n.iter().enumerate().take(mesh.dim) {
+        let q = grading.get(k).or(grading.first()).copied().unwrap_or(1.0);
+        // cell widths q^i, scaled by the largest so that no power overflows
+        let top = if q >= 1.0 { (cells - 1) as f64 } else { 0.0 };
+        let widths: Vec<f64> = (0..cells).map(|i| q.powf(i as f64 - top)).collect();
+        let total: f64 = widths.iter().sum();
+        let mut at = vec![0.0; cells + 1];
+        for i in 0..cells {
+            at[i + 1] = at[i] + widths[i] / total;
+        }
+        at[cells] = 1.0;
+        let (lo, len) = (m.lo[k], m.hi[k] - m.lo[k]);
+        for p in &mut mesh.points {
+            let i = (((p[k] - lo) / len) * cells as f64).round().clamp(0.0, cells as f64) as usize;
+            p[k] = lo + len * at[i];
+        }
+    }
+}
+
+/// The material of a validated spec in dimension `dim`, in the global frame (of a body of
+/// revolution about y where `axisymmetric`).
+fn material(spec: &MaterialSpec, dim: usize, axisymmetric: bool) -> Result<Material, ProblemError> {
     let crystal = match spec.model {
         MaterialModel::Crystal6mm => {
             let (c, e, p) = (&spec.c, &spec.e, &spec.permittivity);
@@ -193,10 +268,16 @@ fn material(spec: &MaterialSpec, dim: usize) -> Result<Material, ProblemError> {
     // an isotropic material has no poling; the validated crystal has 3 components
     let poling = match spec.poling[..] {
         [a, b, c] => [a, b, c],
+        _ if axisymmetric => [0.0, 1.0, 0.0],
         _ => [0.0, 0.0, 1.0],
     };
     let scale = spec.coupling_scale.unwrap_or(1.0);
-    Ok(Material::from_crystal(&spec.region, &crystal, poling, dim)?.with_coupling_scale(scale))
+    let material = if axisymmetric {
+        Material::from_crystal_axisymmetric(&spec.region, &crystal, poling)?
+    } else {
+        Material::from_crystal(&spec.region, &crystal, poling, dim)?
+    };
+    Ok(material.with_coupling_scale(scale))
 }
 
 /// The materials of the scene by region, in the global frame.
@@ -204,7 +285,7 @@ fn materials(scene: &Scene, dim: usize) -> Result<Vec<(String, Material)>, Probl
     scene
         .material
         .iter()
-        .map(|s| Ok((s.region.clone(), material(s, dim)?)))
+        .map(|s| Ok((s.region.clone(), material(s, dim, scene.mesh.axisymmetric)?)))
         .collect()
 }
 

@@ -88,12 +88,10 @@ impl RunResult {
         self.solution.mesh.dim
     }
 
+    /// Voigt components per cell: 3 in plane strain, 4 on a body of revolution (`[rr, zz,
+    /// rz, θθ]`), 6 in 3D.
     fn nv(&self) -> usize {
-        if self.dim() == 2 {
-            3
-        } else {
-            6
-        }
+        self.solution.fields.stress.len() / self.solution.mesh.n_cells().max(1)
     }
 
     /// The meshio cell type of the mesh's cells.

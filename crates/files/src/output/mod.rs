@@ -100,7 +100,9 @@ fn vtu(
         mesh::CellKind::Tet4 => CellType::Tetra,
     };
     let dim = mesh.dim;
-    let nv = if dim == 2 { 3 } else { 6 };
+    // Voigt components per cell: 3 in plane strain, 4 on a body of revolution ([rr, zz, rz,
+    // θθ]), 6 in 3D
+    let nv = fields.stress.len() / mesh.n_cells().max(1);
     let mut point = vec![
         Attribute::generic("u", 3).with_data(u.iter().flatten().copied().collect::<Vec<f64>>()),
         Attribute::scalars("phi", 1).with_data(phi.to_vec()),

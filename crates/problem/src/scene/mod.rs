@@ -122,6 +122,30 @@ choice! {
 }
 
 choice! {
+    /// The shape of a rigid indenter (`contact.indenter.shape`): its height `h(ρ)` above its
+    /// tip at the distance `ρ` from its axis.
+    pub enum IndenterShape ("contact.indenter.shape") {
+        /// A flat rigid plane, `h = 0` (a foundation).
+        Plane = "plane",
+        /// A sphere of `radius` R, `h = R - √(R² - ρ²)` (points beyond `ρ = R` out of reach).
+        Sphere = "sphere",
+        /// Hertz's paraboloid of tip radius R, `h = ρ² / (2R)`.
+        Paraboloid = "paraboloid",
+        /// A cone of semi-vertical angle `half_angle` (degrees), `h = ρ / tan(half_angle)`.
+        Cone = "cone",
+        /// A flat-ended cylindrical punch of `radius` a, `h = 0` for `ρ ≤ a` (points beyond out
+        /// of reach).
+        Punch = "punch",
+        /// A cylinder of `radius` R lying on the face along `axis` (3D; in 2D the plane-strain
+        /// cylinder), `h = R - √(R² - ρ²)` with `ρ` the distance across its axis.
+        Cylinder = "cylinder",
+        /// An axisymmetric profile tabulated as `profile = [[ρ, h], ...]` (ρ increasing from 0,
+        /// linear between; points beyond the last ρ out of reach).
+        Profile = "profile",
+    }
+}
+
+choice! {
     /// How slip-weakening friction's coefficient falls (`contact.weakening`).
     pub enum WeakeningForm ("contact.weakening") {
         /// Linearly, reaching the dynamic value at the slip length.
@@ -336,7 +360,7 @@ pub struct PathSpec {
     /// The factor on the prescribed z components.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uz: Option<Vec<f64>>,
-    /// The factor on the uniform gap (`contact.gap`; the curvature's part stays).
+    /// The factor on the uniform gap (`contact.gap` less an indenter's `depth`; the shape's part stays).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gap: Option<Vec<f64>>,
     /// The fields (and a run's `step-NNNN.vtu`) of every `output_every`-th instant (1, the
@@ -601,6 +625,35 @@ pub struct MeshSpec {
     /// Named cell regions of a generated mesh, by box (`[[mesh.region]]`).
     #[serde(default, rename = "region")]
     pub regions: Vec<RegionSpec>,
+    /// A body of revolution about the y axis: the 2D mesh is its meridian section, `x = r ≥ 0`
+    /// (the radial displacement held on the axis; forces and charges are the whole body's).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub axisymmetric: bool,
+    /// A generated mesh graded towards `lo`: along each axis, each cell `grading` times the
+    /// size of the one before it (one ratio per axis, or one for all; 1 is uniform), as for a
+    /// contact zone at a corner of a large body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grading: Option<Grading>,
+}
+
+/// `mesh.grading`: one ratio for every axis, or one per axis.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Grading {
+    /// The same ratio along every axis.
+    One(f64),
+    /// A ratio per axis.
+    PerAxis(Vec<f64>),
+}
+
+impl Grading {
+    /// The ratios given (one, or one per axis).
+    pub fn ratios(&self) -> Vec<f64> {
+        match self {
+            Grading::One(q) => vec![*q],
+            Grading::PerAxis(v) => v.clone(),
+        }
+    }
 }
 
 impl MeshSpec {
@@ -640,6 +693,8 @@ impl MeshSpec {
             file: None,
             smoke_n: None,
             regions: vec![],
+            axisymmetric: false,
+            grading: None,
         }
     }
 
@@ -864,6 +919,81 @@ pub struct ContactSpec {
     /// pressure, or unit penetration under normal compliance).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub conductance: Option<f64>,
+    /// A rigid indenter of a given shape (the obstacle), instead of a flat or parabolic gap.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indenter: Option<IndenterSpec>,
+}
+
+/// A rigid indenter (`contact.indenter`): its shape, its tip and how far the tip is pushed
+/// along the contact normal into the body. The gap of a contact point `x` is measured along the
+/// contact normal `n` (small deformations): `g(x) = gap + (tip - x)·n + h(ρ) - depth`, `ρ` the
+/// distance of `x` from the indenter's axis (through the tip along `n`).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct IndenterSpec {
+    /// The shape.
+    pub shape: IndenterShape,
+    /// Sphere, paraboloid, cylinder: R; punch: its radius a.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Cone: the semi-vertical angle, degrees (0 < θ < 90).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_angle: Option<f64>,
+    /// Profile: `[[ρ, h], ...]`, ρ from 0 increasing, `h(0) = 0`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<Vec<[f64; 2]>>,
+    /// The tip's position before it is pushed (default: the origin; on a body of revolution
+    /// the axis, `[0, z]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip: Option<Vec<f64>>,
+    /// Cylinder in 3D: the direction of its axis (in the face's plane).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<Vec<f64>>,
+    /// How far the tip is pushed into the body along `-n` (depth control; a load path's `gap`
+    /// factor scales it with `contact.gap`).
+    #[serde(default)]
+    pub depth: f64,
+}
+
+impl IndenterSpec {
+    /// The point `x` in the indenter's frame: its distance along the normal `n` from the tip,
+    /// and its distance `ρ` from the indenter's axis (across a cylinder's axis).
+    pub fn local(&self, x: &[f64; 3], n: &[f64; 3]) -> (f64, f64) {
+        let tip = self.tip.as_deref().unwrap_or_default();
+        let d: Vec<f64> = (0..3).map(|k| x[k] - tip.get(k).copied().unwrap_or(0.0)).collect();
+        let along: f64 = (0..3).map(|k| d[k] * n[k]).sum();
+        let mut across: Vec<f64> = (0..3).map(|k| d[k] - along * n[k]).collect();
+        if let (IndenterShape::Cylinder, Some(axis)) = (self.shape, self.axis.as_deref()) {
+            // the distance across the cylinder's axis: remove the component along it
+            let len = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
+            let t: Vec<f64> = (0..3).map(|k| axis.get(k).copied().unwrap_or(0.0) / len).collect();
+            let along_axis: f64 = (0..3).map(|k| across[k] * t[k]).sum();
+            across.iter_mut().zip(&t).for_each(|(a, t)| *a -= along_axis * t);
+        }
+        (along, across.iter().map(|a| a * a).sum::<f64>().sqrt())
+    }
+
+    /// The height `h(ρ)` of the shape above its tip at the distance `ρ ≥ 0` from its axis;
+    /// `None` beyond the shape's reach (a sphere's radius, a punch's, a profile's last point).
+    /// The keys are those [`Scene::validate`] checked.
+    pub fn height(&self, rho: f64) -> Option<f64> {
+        let r = self.radius.unwrap_or(0.0);
+        match self.shape {
+            IndenterShape::Plane => Some(0.0),
+            IndenterShape::Paraboloid => Some(rho * rho / (2.0 * r)),
+            IndenterShape::Sphere | IndenterShape::Cylinder => {
+                (rho <= r).then(|| r - (r * r - rho * rho).max(0.0).sqrt())
+            }
+            IndenterShape::Cone => Some(rho / self.half_angle.unwrap_or(45.0).to_radians().tan()),
+            IndenterShape::Punch => (rho <= r).then_some(0.0),
+            IndenterShape::Profile => {
+                let table = self.profile.as_deref().unwrap_or_default();
+                let k = table.windows(2).position(|w| rho <= w[1][0])?;
+                let ([r0, h0], [r1, h1]) = (table[k], table[k + 1]);
+                Some(h0 + (h1 - h0) * (rho - r0) / (r1 - r0))
+            }
+        }
+    }
 }
 
 /// Normal compliance: the foundation's pressure `λ_n = k [u_n - g]₊^m` at the penetration
@@ -904,7 +1034,39 @@ impl ContactSpec {
             electric: None,
             foundation_potential: None,
             conductance: None,
+            indenter: None,
         }
+    }
+
+    /// The radius of the curved body of Hertz's solution: `1 / gap_curvature`, or an
+    /// indenter's sphere or paraboloid radius; `None` for a flat or another shape.
+    pub fn hertz_radius(&self) -> Option<f64> {
+        match &self.indenter {
+            Some(i) if matches!(i.shape, IndenterShape::Sphere | IndenterShape::Paraboloid) => i.radius,
+            Some(_) => None,
+            None => (self.gap_curvature > 0.0).then(|| 1.0 / self.gap_curvature),
+        }
+    }
+
+    /// The uniform part of the gap a load path's `gap` factor scales: `contact.gap` less an
+    /// indenter's depth.
+    pub fn uniform_gap(&self) -> f64 {
+        self.gap - self.indenter.as_ref().map_or(0.0, |i| i.depth)
+    }
+
+    /// The gap at the face point `x` along the unit outward normal `n`; `None` where an
+    /// indenter's shape does not reach. Without an indenter: `gap + |x - c|²_t / (2R)` (the
+    /// parabola of `gap_curvature` about `gap_center`).
+    pub fn gap_at(&self, x: &[f64; 3], n: &[f64; 3]) -> Option<f64> {
+        let Some(ind) = &self.indenter else {
+            let c = self.gap_center.as_deref().unwrap_or_default();
+            let d: Vec<f64> = (0..3).map(|k| x[k] - c.get(k).copied().unwrap_or(0.0)).collect();
+            let along: f64 = (0..3).map(|k| d[k] * n[k]).sum();
+            let dist2 = (0..3).map(|k| d[k] * d[k]).sum::<f64>() - along * along;
+            return Some(self.gap + 0.5 * self.gap_curvature * dist2.max(0.0));
+        };
+        let (along, rho) = ind.local(x, n);
+        Some(self.gap - along + ind.height(rho)? - ind.depth)
     }
 
     /// The electric law of a conductive or conducting foundation, with its potential `φ_F`;

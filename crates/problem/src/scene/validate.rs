@@ -5,8 +5,8 @@
 //! mesh is read ([`Scene::check_dimension`]).
 
 use super::{
-    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, MaterialModel, MaterialSpec, MeshKind, MeshSpec,
-    PathSpec, Rule, Scene, SolverSpec, Strategy,
+    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, IndenterShape, IndenterSpec, MaterialModel,
+    MaterialSpec, MeshKind, MeshSpec, PathSpec, Rule, Scene, SolverSpec, Strategy,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -169,6 +169,7 @@ impl Scene {
             validate_contact(c)?;
         }
         validate_solver(&self.solver)?;
+        refuse_axisymmetric(self)?;
         refuse_compliance(self)?;
         refuse_weakening(self)?;
         refuse_electric(self)?;
@@ -192,6 +193,12 @@ impl Scene {
     /// # Errors
     /// A [`SceneError`] naming the key and the length it needs.
     pub fn check_dimension(&self, dim: usize) -> Result<(), SceneError> {
+        if self.mesh.axisymmetric && dim != 2 {
+            return Err(SceneError::new(
+                "mesh.axisymmetric",
+                format!("mesh.axisymmetric: a body of revolution is meshed in its 2D meridian plane, and the mesh is {dim}D"),
+            ));
+        }
         let len = |key: &str, v: &[f64], n: usize| {
             if v.len() == n {
                 Ok(())
@@ -225,6 +232,27 @@ impl Scene {
             len("contact.normal", &c.normal, dim)?;
             if let Some(g) = &c.gap_center {
                 len("contact.gap_center", g, dim)?;
+            }
+            if let Some(i) = &c.indenter {
+                if let Some(tip) = &i.tip {
+                    len("contact.indenter.tip", tip, dim)?;
+                }
+                if let Some(axis) = &i.axis {
+                    len("contact.indenter.axis", axis, dim)?;
+                    refuse_if(
+                        dim != 3,
+                        "contact.indenter.axis",
+                        "a 3D cylinder's axis, and the mesh is 2D (the plane-strain cylinder needs none)",
+                    )?;
+                }
+            }
+        }
+        if let Some(g) = self.mesh.grading.as_ref().map(|g| g.ratios()) {
+            if g.len() != 1 && g.len() != dim {
+                return Err(SceneError::new(
+                    "mesh.grading",
+                    format!("mesh.grading needs one ratio, or one per axis ({dim}), not {}", g.len()),
+                ));
             }
         }
         for r in &self.mesh.regions {
@@ -330,6 +358,20 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
     ] {
         if v == Some(0) {
             return Err(SceneError::new(key, format!("{key} must be at least 1")));
+        }
+    }
+    if let Some(g) = m.grading.as_ref().map(|g| g.ratios()) {
+        refuse_if(
+            m.dim().is_none(),
+            "mesh.grading",
+            "a generated mesh's grading, and a Gmsh or given mesh fixes its own",
+        )?;
+        all_finite("mesh.grading", &g)?;
+        if let Some(q) = g.iter().find(|q| !(**q >= 0.5 && **q <= 2.0)) {
+            return Err(SceneError::new(
+                "mesh.grading",
+                format!("mesh.grading = {q}: the ratio of neighbouring cells must lie in [0.5, 2] (1 is uniform)"),
+            ));
         }
     }
     match m.dim() {
@@ -582,7 +624,128 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
         c.gap_center.is_some() && c.gap_curvature == 0.0,
         "contact.gap_center",
         "the centre of a curved gap, and contact.gap_curvature is 0",
-    )
+    )?;
+    match &c.indenter {
+        Some(i) => validate_indenter(i, c),
+        None => Ok(()),
+    }
+}
+
+/// An indenter's keys: those of its shape, given and in range, and no others; not beside a
+/// curved gap (the indenter is the obstacle's shape).
+fn validate_indenter(i: &IndenterSpec, c: &ContactSpec) -> Result<(), SceneError> {
+    use IndenterShape as S;
+    let why = "the obstacle's shape, and contact.indenter gives it";
+    refuse_if(c.gap_curvature != 0.0, "contact.gap_curvature", why)?;
+    refuse_if(c.gap_center.is_some(), "contact.gap_center", why)?;
+    finite("contact.indenter.depth", i.depth)?;
+    all_finite("contact.indenter.tip", i.tip.as_deref().unwrap_or_default())?;
+    all_finite("contact.indenter.axis", i.axis.as_deref().unwrap_or_default())?;
+    let shape = i.shape;
+    let needs_radius = matches!(shape, S::Sphere | S::Paraboloid | S::Cylinder | S::Punch);
+    let not_for = |key: &str| format!("{key}, and contact.indenter.shape = \"{shape}\" does not take it");
+    refuse_if(
+        !needs_radius && i.radius.is_some(),
+        "contact.indenter.radius",
+        &not_for("a radius"),
+    )?;
+    refuse_if(
+        shape != S::Cone && i.half_angle.is_some(),
+        "contact.indenter.half_angle",
+        &not_for("a cone's angle"),
+    )?;
+    refuse_if(
+        shape != S::Profile && i.profile.is_some(),
+        "contact.indenter.profile",
+        &not_for("a profile"),
+    )?;
+    refuse_if(
+        shape != S::Cylinder && i.axis.is_some(),
+        "contact.indenter.axis",
+        &not_for("a cylinder's axis"),
+    )?;
+    if needs_radius {
+        let r = i.radius.ok_or_else(|| {
+            SceneError::new(
+                "contact.indenter.radius",
+                format!("contact.indenter.shape = \"{shape}\" needs contact.indenter.radius"),
+            )
+        })?;
+        if !(r > 0.0 && r.is_finite()) {
+            return Err(SceneError::new(
+                "contact.indenter.radius",
+                format!("contact.indenter.radius = {r} must be positive and finite"),
+            ));
+        }
+    }
+    if shape == S::Cone {
+        let a = i.half_angle.ok_or_else(|| {
+            SceneError::new(
+                "contact.indenter.half_angle",
+                "contact.indenter.shape = \"cone\" needs contact.indenter.half_angle (degrees)",
+            )
+        })?;
+        if !(a > 0.0 && a < 90.0) {
+            return Err(SceneError::new(
+                "contact.indenter.half_angle",
+                format!("contact.indenter.half_angle = {a} must lie strictly between 0 and 90 degrees"),
+            ));
+        }
+    }
+    if let Some(axis) = &i.axis {
+        if !(mesh::scaled_norm(axis) > 0.0) {
+            return Err(SceneError::new(
+                "contact.indenter.axis",
+                "contact.indenter.axis is the zero vector",
+            ));
+        }
+    }
+    if shape == S::Profile {
+        let table = i.profile.as_deref().unwrap_or_default();
+        let flat: Vec<f64> = table.iter().flatten().copied().collect();
+        all_finite("contact.indenter.profile", &flat)?;
+        if table.len() < 2 || table[0] != [0.0, 0.0] || table.windows(2).any(|w| !(w[0][0] < w[1][0])) {
+            return Err(SceneError::new(
+                "contact.indenter.profile",
+                "contact.indenter.profile needs at least two points [ρ, h], the first [0, 0] (the tip), ρ strictly increasing",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A body of revolution: what it cannot carry (a tangential load path's exact solution in plane
+/// strain, the PETSc backend's assembly), and a material symmetric about its axis (checked when
+/// the material is built).
+fn refuse_axisymmetric(s: &Scene) -> Result<(), SceneError> {
+    if !s.mesh.axisymmetric {
+        return Ok(());
+    }
+    refuse_if(
+        s.solver.backend == BackendChoice::Petsc,
+        "mesh.axisymmetric",
+        "a body of revolution, and the PETSc backend assembles plane and 3D bodies only; use the default backend",
+    )?;
+    if let Some(x) = &s.exact {
+        refuse_if(
+            x.kind != ExactKind::Hertz,
+            "exact.kind",
+            &format!("exact.kind `{}`, a plane or 3D solution, and the body is one of revolution (mesh.axisymmetric; `hertz` is the sphere's there)", x.kind),
+        )?;
+    }
+    if let Some(i) = s.contact.as_ref().and_then(|c| c.indenter.as_ref()) {
+        refuse_if(
+            i.shape == IndenterShape::Cylinder,
+            "contact.indenter.shape",
+            "a cylinder lying on the face, and a body of revolution is indented along its axis (sphere, paraboloid, cone, punch, profile)",
+        )?;
+        refuse_if(
+            i.tip.as_ref().is_some_and(|t| t.first().is_some_and(|&r| r != 0.0)),
+            "contact.indenter.tip",
+            "a tip off the axis, and a body of revolution is indented on its axis (tip = [0, z])",
+        )?;
+    }
+    Ok(())
 }
 
 /// What the PETSc backend does not take: a contact normal that is not a coordinate axis (its
@@ -964,13 +1127,15 @@ fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError>
     if s.mesh.kind != MeshKind::Rectangle {
         return Err(SceneError::new(
             "exact.kind",
-            format!("exact.kind `{kind}` is a plane-strain solution: it needs mesh.kind = \"rectangle\""),
+            format!(
+                "exact.kind `{kind}` is a plane-strain or axisymmetric solution: it needs mesh.kind = \"rectangle\""
+            ),
         ));
     }
-    let Some(c) = s.contact.as_ref().filter(|c| c.gap_curvature > 0.0) else {
+    let Some(c) = s.contact.as_ref().filter(|c| c.hertz_radius().is_some()) else {
         return Err(SceneError::new(
             "exact.kind",
-            format!("exact.kind `{kind}` needs contact with a curved gap (contact.gap_curvature > 0)"),
+            format!("exact.kind `{kind}` needs contact with a curved gap (contact.gap_curvature > 0, or a sphere's or paraboloid's contact.indenter)"),
         ));
     };
     if kind == ExactKind::Hertz && law != ContactLaw::Signorini {
