@@ -193,7 +193,8 @@ class Result:
         """Nodal electric potentials, (n_points,)."""
     @property
     def stress(self) -> npt.NDArray[np.float64]:
-        """Stress per cell, Voigt order: (n_cells, 3) in 2D, (n_cells, 6) in 3D."""
+        """Stress per cell, Voigt order: (n_cells, 3) in plane strain, (n_cells, 4) on a body of
+        revolution ([rr, zz, rz, θθ]), (n_cells, 6) in 3D."""
     @property
     def strain(self) -> npt.NDArray[np.float64]:
         """Strain per cell, Voigt order with engineering shears, shaped as `stress`."""

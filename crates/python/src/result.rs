@@ -152,8 +152,8 @@ impl RunResult {
         lend(this.as_any(), ArrayView1::from(&this.get().solution.phi[..]))
     }
 
-    /// Stress per cell, Voigt order, (n_cells, 3) in 2D (xx, yy, xy), (n_cells, 6) in 3D (xx,
-    /// yy, zz, yz, xz, xy).
+    /// Stress per cell, Voigt order, (n_cells, 3) in plane strain (xx, yy, xy), (n_cells, 4) on
+    /// a body of revolution (rr, zz, rz, θθ), (n_cells, 6) in 3D (xx, yy, zz, yz, xz, xy).
     #[getter]
     fn stress<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let r = this.get();

@@ -1,0 +1,28 @@
+"""Indentation from Python: a body of revolution under a rigid sphere (the shipped
+hertz-sphere scene) with its indenter's figures in the report, its four stress components per
+cell ([rr, zz, rz, θθ]), and another shape set from Python."""
+
+import math
+
+import piezocontact as pc
+
+
+def test_hertz_sphere_from_python():
+    r = pc.run(pc.Scene.load("hertz-sphere"))
+    report = r.report
+    assert report["exact"]["force_error"] < 0.01
+    ind = report["indenter"]
+    assert ind["shape"] == "paraboloid" and ind["depth"] == 0.01
+    assert abs(ind["force"] - report["exact"]["load_p"]) == 0.0
+    assert r.stress.shape[1] == 4
+
+
+def test_a_cone_set_from_python_follows_sneddon():
+    scene = pc.Scene.load("hertz-sphere")
+    scene.set("exact", None)
+    scene.set("contact.indenter", {"shape": "cone", "half_angle": 70.0, "depth": 0.01})
+    r = pc.run(scene)
+    e_star = 100.0 / (1.0 - 0.3**2)
+    closed = 2.0 / math.pi * e_star * 0.01**2 * math.tan(math.radians(70.0))
+    # measured +1.2 % at the scene's mesh
+    assert abs(r.report["indenter"]["force"] - closed) / closed < 0.025
