@@ -55,7 +55,7 @@ pub use dofs::{Constraint, Dof, DofMap, Field};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
 pub use held::Unheld;
 pub use loads::{facet_measure, Load, RhsParts};
-pub use material::{voigt, Crystal, Material, MaterialError};
+pub use material::{voigt, voigt_len, Crystal, Material, MaterialError};
 pub use recovery::{CellFields, ChargeFunctional};
 
 use std::sync::Arc;

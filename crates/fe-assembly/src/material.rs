@@ -153,6 +153,16 @@ pub enum MaterialError {
     },
 }
 
+/// Number of Voigt strain components in dimension `dim`: 3 in plane strain, 4 on a body of
+/// revolution (`[rr, zz, rz, θθ]`), 6 in 3D.
+pub fn voigt_len(dim: usize, axisymmetric: bool) -> usize {
+    match (dim, axisymmetric) {
+        (2, false) => 3,
+        (2, true) => 4,
+        _ => 6,
+    }
+}
+
 /// Voigt index of the symmetric pair `(i, j)` in dimension `dim`: `[xx, yy, xy]` in 2D,
 /// `[xx, yy, zz, yz, xz, xy]` (= `[11, 22, 33, 23, 13, 12]`) in 3D.
 pub fn voigt(dim: usize, i: usize, j: usize) -> usize {
@@ -210,12 +220,7 @@ impl Material {
         poling: [f64; 3],
         dim: usize,
     ) -> Result<Material, MaterialError> {
-        let q = crystal_frame(poling).ok_or_else(|| MaterialError::BadPoling {
-            material: name.into(),
-            dir: poling,
-        })?;
-        finite(name, crystal)?;
-        let (c3, e3, b3) = rotated(crystal, &q);
+        let (c3, e3, b3) = poled(name, crystal, poling)?;
         let (rows, fields): (Vec<usize>, Vec<usize>) = match dim {
             2 => (vec![0, 1, 5], vec![0, 1]),
             _ => ((0..6).collect(), (0..3).collect()),
@@ -246,12 +251,7 @@ impl Material {
         crystal: &Crystal,
         poling: [f64; 3],
     ) -> Result<Material, MaterialError> {
-        let q = crystal_frame(poling).ok_or_else(|| MaterialError::BadPoling {
-            material: name.into(),
-            dir: poling,
-        })?;
-        finite(name, crystal)?;
-        let (c3, e3, b3) = rotated(crystal, &q);
+        let (c3, e3, b3) = poled(name, crystal, poling)?;
         // symmetric about y: the same tensors after a rotation by 1 rad about y (to the 1 % of
         // tabulated data: PZT-5A's c66 is 22.6 beside (c11 - c12) / 2 = 22.8)
         let (s, c) = 1f64.sin_cos();
@@ -280,11 +280,7 @@ impl Material {
 
     /// Number of Voigt strain components (3 in plane strain, 4 axisymmetric, 6 in 3D).
     pub fn nv(&self) -> usize {
-        match (self.dim, self.axisymmetric) {
-            (2, false) => 3,
-            (2, true) => 4,
-            _ => 6,
-        }
+        voigt_len(self.dim, self.axisymmetric)
     }
 
     /// A copy with `e` multiplied by `factor` (the `material.coupling_scale` of the scenes).
@@ -319,6 +315,17 @@ impl Material {
         }
         Ok(())
     }
+}
+
+/// The crystal's tensors in the global frame, its 3-axis along `poling`, its constants checked
+/// finite.
+fn poled(name: &str, crystal: &Crystal, poling: [f64; 3]) -> Result<Tensors3, MaterialError> {
+    let q = crystal_frame(poling).ok_or_else(|| MaterialError::BadPoling {
+        material: name.into(),
+        dir: poling,
+    })?;
+    finite(name, crystal)?;
+    Ok(rotated(crystal, &q))
 }
 
 /// Checks that every constant of the crystal is finite.

@@ -63,11 +63,7 @@ impl Discretization<'_> {
     /// Voigt strain components: 3 in plane strain, 4 on a body of revolution (`[rr, zz, rz,
     /// θθ]`), 6 in 3D.
     pub fn nv(&self) -> usize {
-        match (self.mesh.dim, self.axisymmetric) {
-            (2, false) => 3,
-            (2, true) => 4,
-            _ => 6,
-        }
+        crate::voigt_len(self.mesh.dim, self.axisymmetric)
     }
 
     /// The charge through each of `groups` (boundary groups where the potential is
@@ -118,15 +114,19 @@ impl Discretization<'_> {
                 }
                 q(&x[..dim]) / cell.len() as f64
             });
+            // D at each point of the cell's quadrature, once for all its nodes
             let (points, n_points) = g.points();
+            let flux_at: Vec<(f64, [f64; 3])> = points[..n_points]
+                .iter()
+                .map(|p| (p.weight, displacement(m, &strain_at(dim, g, &p.hoop, &ul), &grad)))
+                .collect();
             for (a, &v) in cell.iter().enumerate() {
                 if owner[v] == usize::MAX {
                     continue;
                 }
-                for p in &points[..n_points] {
-                    let d = displacement(m, &strain_at(dim, g, &p.hoop, &ul), &grad);
+                for (weight, d) in &flux_at {
                     let flux: f64 = (0..dim).map(|k| d[k] * g.grads[a][k]).sum();
-                    out[owner[v]] += p.weight * flux;
+                    out[owner[v]] += weight * flux;
                 }
                 out[owner[v]] += g.volume() * source;
             }
