@@ -21,6 +21,7 @@ __all__ = [
     "Result",
     "Contact",
     "run",
+    "capacitance",
     "STICK",
     "SLIP",
     "SEPARATED",
@@ -222,6 +223,14 @@ class Result:
         `directory`, as one set (`OutputError`; nothing half-written)."""
     def to_meshio(self) -> Any:
         """The solution as a `meshio.Mesh` (needs meshio)."""
+
+def capacitance(scene: Scene) -> dict[str, Any]:
+    """The capacitance matrix between the terminals of `scene` (its electrode and the groups
+    at a prescribed potential; the displacements it prescribes held at 0, no load, the contact
+    face free): `terminals` (names; groups joined by a node as one, `a+b`), `matrix`
+    (`C[i, j]`: the charge on terminal i per unit potential of terminal j, an ndarray),
+    `asymmetry` and `column_sum` (reciprocity and Gauss's law, relative: round-off).
+    Raises InputError, MeshError, SolverError."""
 
 def run(
     scene: Scene,

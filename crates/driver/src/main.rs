@@ -43,6 +43,19 @@ enum Command {
     },
     /// List the shipped scenes.
     Scenes,
+    /// The capacitance matrix between a scene's terminals (its electrode and the groups at a
+    /// prescribed potential; the displacements it prescribes held at 0, no load, the contact
+    /// face free); prints it and writes capacitance.csv and capacitance.json.
+    Capacitance {
+        /// Scene name or file (default: actuator).
+        scene: Option<String>,
+        /// Override a scene key (repeatable; `--set ~KEY` removes a key).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Output directory (default: out/SCENE-capacitance/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Run a scene along one parameter; writes sweep.csv and sweep.svg/png.
     Sweep {
         /// Scene name or file.
@@ -279,6 +292,7 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             petsc,
         } => run(scene, overrides(set, unset), out, petsc),
         Command::Scenes => scenes(),
+        Command::Capacitance { scene, set, out } => capacitance(scene, &set, out),
         Command::Fclib {
             files,
             solver,
@@ -430,6 +444,51 @@ fn run_petsc(
 }
 
 /// `piezocontact scenes`: one line per shipped scene.
+/// `piezocontact capacitance`: the matrix printed, and written as CSV and JSON.
+fn capacitance(scene: Option<String>, set: &[String], out: Option<PathBuf>) -> Result<(), DriverError> {
+    let name = scene.unwrap_or_else(|| "actuator".into());
+    let (scene, source) = scene_file::load(&name, set)?;
+    let c = files::run::capacitance(&scene, &source, None)?;
+    let mut csv = format!("terminal,{}\n", c.terminals.join(","));
+    for (t, row) in c.terminals.iter().zip(&c.matrix) {
+        let cells: Vec<String> = row.iter().map(|x| format!("{x:e}")).collect();
+        csv.push_str(&format!("{t},{}\n", cells.join(",")));
+    }
+    let width = c.terminals.iter().map(|t| t.len()).max().unwrap_or(0).max(8);
+    println!(
+        "capacitance of `{}` (Q_i = sum_j C_ij V_j, the scene's units):",
+        scene.name
+    );
+    println!(
+        "{:width$} {}",
+        "",
+        c.terminals.iter().map(|t| format!("{t:>14}")).collect::<String>()
+    );
+    for (t, row) in c.terminals.iter().zip(&c.matrix) {
+        println!(
+            "{t:width$} {}",
+            row.iter().map(|x| format!("{x:>14.6e}")).collect::<String>()
+        );
+    }
+    say(&format!(
+        "reciprocity max|C - Cᵀ|/max|C| = {:.1e}; Gauss max|column sum|/max|C| = {:.1e}",
+        c.asymmetry, c.column_sum
+    ));
+    let dir = out.unwrap_or_else(|| output::default_dir(&format!("{}-capacitance", scene.name)));
+    let mut o = output::Outputs::documents(&dir);
+    o.add("capacitance.csv", csv.into_bytes());
+    o.add(
+        "capacitance.json",
+        serde_json::to_vec_pretty(&c).map_err(|e| DriverError::Unexpected {
+            what: "capacitance.json",
+            items: vec![e.to_string()],
+        })?,
+    );
+    o.commit()?;
+    say(&format!("wrote capacitance.csv, capacitance.json in {}", dir.display()));
+    Ok(())
+}
+
 fn scenes() -> Result<(), DriverError> {
     let mut out = std::io::stdout().lock();
     for (name, text) in scene_file::SHIPPED {

@@ -23,6 +23,34 @@ pub fn memory_limits(ranks: u64) -> (Option<u64>, Option<&'static str>) {
     }
 }
 
+/// The mesh of `scene`: its Gmsh file read (relative to the scene's `source`), or the one
+/// `given` (a `given` scene's), or none (a generated mesh, made by the problem).
+fn mesh_of(scene: &Scene, source: &Source, given: Option<mesh::Mesh>) -> Result<Option<mesh::Mesh>, Error> {
+    Ok(match (scene.mesh.kind, &scene.mesh.file, given) {
+        (MeshKind::Gmsh, Some(file), None) => Some(mesh::read_msh(source.dir.join(file))?),
+        (_, _, given) => given,
+    })
+}
+
+/// The limits of one run in this process: the memory available, and `interrupt`.
+fn limits(interrupt: contact::Interrupt) -> problem::Limits {
+    let (memory_bytes, memory_limit) = memory_limits(1);
+    problem::Limits {
+        memory_bytes,
+        memory_limit,
+        interrupt,
+    }
+}
+
+/// The capacitance matrix between the terminals of `scene` (from `source`: its Gmsh file
+/// read; `given` the mesh of a `given` scene), [`problem::capacitance`].
+///
+/// # Errors
+/// [`Error::Mesh`] for a Gmsh file that does not read, [`Error::Problem`] for the problem's.
+pub fn capacitance(scene: &Scene, source: &Source, given: Option<mesh::Mesh>) -> Result<problem::Capacitance, Error> {
+    Ok(problem::capacitance(scene, mesh_of(scene, source, given)?)?)
+}
+
 /// Solves `scene` (from `source`) within the memory this machine has available, reporting to
 /// `reporter`; writes nothing.
 ///
@@ -46,16 +74,8 @@ pub fn solve_with(
     interrupt: contact::Interrupt,
     reporter: &mut dyn Reporter,
 ) -> Result<Solution, Error> {
-    let mesh = match (scene.mesh.kind, &scene.mesh.file, given) {
-        (MeshKind::Gmsh, Some(file), None) => Some(mesh::read_msh(source.dir.join(file))?),
-        (_, _, given) => given,
-    };
-    let (memory_bytes, memory_limit) = memory_limits(1);
-    let limits = problem::Limits {
-        memory_bytes,
-        memory_limit,
-        interrupt,
-    };
+    let mesh = mesh_of(scene, source, given)?;
+    let limits = limits(interrupt);
     let mut solution = problem::solve_within(scene, mesh, limits, reporter)?;
     solution.report.scene.source = source.label.clone();
     solution.report.memory.peak_bytes = peak_memory_bytes();
@@ -77,16 +97,8 @@ pub fn solve_path_with(
     reporter: &mut dyn Reporter,
     each: &mut dyn FnMut(problem::Step<'_>) -> Result<(), Error>,
 ) -> Result<Solution, Error> {
-    let mesh = match (scene.mesh.kind, &scene.mesh.file, given) {
-        (MeshKind::Gmsh, Some(file), None) => Some(mesh::read_msh(source.dir.join(file))?),
-        (_, _, given) => given,
-    };
-    let (memory_bytes, memory_limit) = memory_limits(1);
-    let limits = problem::Limits {
-        memory_bytes,
-        memory_limit,
-        interrupt,
-    };
+    let mesh = mesh_of(scene, source, given)?;
+    let limits = limits(interrupt);
     // the caller's error, carried past the problem's
     let mut failed = None;
     let solved = problem::solve_path(scene, mesh, limits, reporter, with_fields, &mut |step| {

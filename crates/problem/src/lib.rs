@@ -58,6 +58,7 @@
 mod analytical;
 pub mod backend;
 mod boundary;
+mod capacitance;
 mod estimate;
 mod exact;
 mod faer_backend;
@@ -71,6 +72,7 @@ mod setup;
 
 pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindlin_deresiewicz_traction};
 pub use backend::Limits;
+pub use capacitance::{capacitance, Capacitance};
 pub use exact::ExactReport;
 pub use faer_backend::Faer;
 pub use fe_assembly::CellFields;

@@ -25,6 +25,7 @@ fn piezocontact(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<result::RunResult>()?;
     m.add_class::<result::Contact>()?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(run::capacitance, m)?)?;
     m.add("STICK", result::STICK)?;
     m.add("SLIP", result::SLIP)?;
     m.add("SEPARATED", result::SEPARATED)?;

@@ -193,3 +193,23 @@ pub fn run(
         .map(|(solution, series)| RunResult { solution, series })
         .map_err(to_py)
 }
+
+/// The capacitance matrix between the terminals of `scene` (its electrode and the groups at a
+/// prescribed potential; the displacements it prescribes held at 0, no load, the contact face
+/// free): a dict with `terminals` (names; groups joined by a node as one, `a+b`), `matrix`
+/// (`C[i, j]`: the charge on terminal i per unit potential of terminal j), `asymmetry` and
+/// `column_sum` (reciprocity and Gauss's law, relative: round-off). Errors: `InputError`,
+/// `MeshError`, `SolverError`.
+#[pyfunction]
+pub fn capacitance<'py>(py: Python<'py>, scene: &Scene) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let given = scene.mesh.as_deref().cloned();
+    let c = files::run::capacitance(&scene.scene, &scene.source, given).map_err(to_py)?;
+    let n = c.terminals.len();
+    let matrix = numpy::ndarray::Array2::from_shape_fn((n, n), |(i, j)| c.matrix[i][j]);
+    let out = pyo3::types::PyDict::new(py);
+    out.set_item("terminals", c.terminals)?;
+    out.set_item("matrix", crate::arrays::owned(py, matrix))?;
+    out.set_item("asymmetry", c.asymmetry)?;
+    out.set_item("column_sum", c.column_sum)?;
+    Ok(out)
+}

@@ -1,6 +1,6 @@
-"""Indentation from Python: a body of revolution under a rigid sphere (the shipped
+"""Indentation and terminals from Python: a body of revolution under a rigid sphere (the shipped
 hertz-sphere scene) with its indenter's figures in the report, its four stress components per
-cell ([rr, zz, rz, θθ]), and another shape set from Python."""
+cell ([rr, zz, rz, θθ]), another shape set from Python, and the capacitance matrix."""
 
 import math
 
@@ -26,3 +26,14 @@ def test_a_cone_set_from_python_follows_sneddon():
     closed = 2.0 / math.pi * e_star * 0.01**2 * math.tan(math.radians(70.0))
     # measured +1.2 % at the scene's mesh
     assert abs(r.report["indenter"]["force"] - closed) / closed < 0.025
+
+
+def test_the_capacitance_matrix_from_python():
+    # the actuator's three terminals: reciprocal, each column's charges summing to zero
+    c = pc.capacitance(pc.Scene.load("actuator", {"mesh.n": 16}))
+    assert c["terminals"] == ["left", "right", "electrode"]
+    m = c["matrix"]
+    assert m.shape == (3, 3)
+    assert abs(m - m.T).max() < 1e-10 * abs(m).max()
+    assert abs(m.sum(axis=0)).max() < 1e-10 * abs(m).max()
+    assert c["asymmetry"] < 1e-10 and c["column_sum"] < 1e-10

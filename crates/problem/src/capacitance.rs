@@ -1,0 +1,161 @@
+//! The capacitance matrix between a scene's terminals (the boundary groups at a prescribed
+//! potential: its `[electrode]` and `dirichlet.phi` groups; groups that share a node are one
+//! conductor, named `a+b`): `Q_i = Σ_j C_ij V_j`, `Q_i` the charge on terminal i (the negative
+//! of the flux `∫ D·ν ds` out of the body through it), `V_j` the terminals' potentials.
+//!
+//! Column j is the charges of the state with terminal j at unit potential, every other
+//! terminal at 0, the scene's prescribed displacements at 0 and no load: the small-signal
+//! capacitance of the body as its mechanical conditions hold it (clamped where they clamp it,
+//! free where it is free; the contact face free). One factorisation of `K` serves every
+//! column. Reciprocity (`C = Cᵀ`) and Gauss's law (each column's charges sum to 0 where the
+//! terminals enclose every flux) are identities of the discrete problem, reported as checks.
+
+use crate::run::terminal_groups;
+use crate::scene::{Scene, SceneError};
+use crate::setup::setup;
+use crate::ProblemError;
+use fe_assembly::{AssemblyError, Discretization, Dof, Parallelism};
+use linalg::{CoupledSolver, DirectLdlt, Ordering};
+use serde::{Deserialize, Serialize};
+
+/// The capacitance matrix of a scene's terminals, in the scene's units (charge per unit
+/// potential: nF in the scaled scenes' nF/m times m, per metre of depth in plane strain, the
+/// whole body's on a body of revolution).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Capacitance {
+    /// The terminals, in the order of the scene's conditions (groups joined by a node as one,
+    /// `a+b`).
+    pub terminals: Vec<String>,
+    /// `matrix[i][j] = C_ij`.
+    pub matrix: Vec<Vec<f64>>,
+    /// `max |C_ij - C_ji| / max |C_ij|`: reciprocity, round-off.
+    pub asymmetry: f64,
+    /// `max_j |Σ_i C_ij| / max |C_ij|`: Gauss's law where the terminals take every flux (a
+    /// charge may leave through a face with a surface charge or through the contact face of
+    /// a conductive foundation, which the matrix leaves out).
+    pub column_sum: f64,
+}
+
+/// The capacitance matrix of `scene` (validated here; `mesh` the mesh of a `gmsh` or `given`
+/// scene, read by the caller).
+///
+/// # Errors
+/// The scene's and set-up's errors, as a run's; a scene without electric unknowns or without
+/// a terminal (key `dirichlet`); a body its mechanical conditions do not hold.
+pub fn capacitance(scene: &Scene, mesh: Option<mesh::Mesh>) -> Result<Capacitance, ProblemError> {
+    let valid = scene.validate()?;
+    let setup = setup(valid, mesh)?;
+    if !setup.plan.electric {
+        return Err(SceneError::new(
+            "material",
+            "the scene has no electric unknowns (no permittivity): no capacitance",
+        )
+        .into());
+    }
+    let groups = terminal_groups(&setup);
+    if groups.is_empty() {
+        return Err(SceneError::new(
+            "dirichlet",
+            "the scene has no terminal (no [electrode], no dirichlet.phi)",
+        )
+        .into());
+    }
+    let mut disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
+    disc.check_held().map_err(AssemblyError::from)?;
+    let (conductor, names) = conductors(&setup.mesh, &groups)?;
+    let mut member = vec![None; setup.mesh.n_nodes()];
+    for (g, group) in groups.iter().enumerate() {
+        for v in setup.mesh.boundary(group)?.nodes() {
+            member[v] = Some(conductor[g]);
+        }
+    }
+    let blocks = disc.assemble(Parallelism::Rayon);
+    let mut solver = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq)?;
+    let base = disc.dofs.clone();
+    let n = names.len();
+    let mut matrix = vec![vec![0.0; n]; n];
+    for j in 0..n {
+        // terminal j at 1, the others and the prescribed displacements at 0
+        let mut dofs = base.clone();
+        dofs.u.iter_mut().for_each(|d| {
+            if let Dof::Fixed(v) = d {
+                *v = 0.0;
+            }
+        });
+        for (v, d) in dofs.phi.iter_mut().enumerate() {
+            if let Dof::Fixed(x) = d {
+                *x = if member[v] == Some(j) { 1.0 } else { 0.0 };
+            }
+        }
+        disc.dofs = dofs;
+        let (b_u, b_phi) = disc.rhs(&[])?;
+        let (mut u, mut phi) = (vec![0.0; disc.dofs.n_u], vec![0.0; disc.dofs.n_phi]);
+        solver.solve(&b_u, &b_phi, &mut u, &mut phi)?;
+        let (u, phi) = (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&phi));
+        // a node of several groups counts for the first: a conductor's charge is its groups'
+        for (g, flux) in disc.charges(&u, &phi, &groups, &[])?.into_iter().enumerate() {
+            matrix[conductor[g]][j] -= flux;
+        }
+    }
+    let big = matrix
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, c| m.max(c.abs()))
+        .max(f64::MIN_POSITIVE);
+    let asymmetry = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| (matrix[i][j] - matrix[j][i]).abs())
+        .fold(0.0, f64::max)
+        / big;
+    let column_sum = (0..n)
+        .map(|j| (0..n).map(|i| matrix[i][j]).sum::<f64>().abs())
+        .fold(0.0, f64::max)
+        / big;
+    Ok(Capacitance {
+        terminals: names,
+        matrix,
+        asymmetry,
+        column_sum,
+    })
+}
+
+/// The conductor of each group (groups that share a node joined, in the order of their first
+/// group) and each conductor's name (its groups joined by `+`).
+fn conductors(mesh: &mesh::Mesh, groups: &[&str]) -> Result<(Vec<usize>, Vec<String>), ProblemError> {
+    // union-find over the groups, joined through their shared nodes
+    let mut parent: Vec<usize> = (0..groups.len()).collect();
+    fn root(parent: &mut [usize], mut g: usize) -> usize {
+        while parent[g] != g {
+            parent[g] = parent[parent[g]];
+            g = parent[g];
+        }
+        g
+    }
+    let mut first = vec![usize::MAX; mesh.n_nodes()];
+    for (g, group) in groups.iter().enumerate() {
+        for v in mesh.boundary(group)?.nodes() {
+            if first[v] == usize::MAX {
+                first[v] = g;
+            } else {
+                let (a, b) = (root(&mut parent, first[v]), root(&mut parent, g));
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let (mut conductor, mut names, mut index) = (
+        vec![0; groups.len()],
+        Vec::<String>::new(),
+        vec![usize::MAX; groups.len()],
+    );
+    for g in 0..groups.len() {
+        let r = root(&mut parent, g);
+        if index[r] == usize::MAX {
+            index[r] = names.len();
+            names.push(groups[g].to_string());
+        } else {
+            names[index[r]] = format!("{}+{}", names[index[r]], groups[g]);
+        }
+        conductor[g] = index[r];
+    }
+    Ok((conductor, names))
+}

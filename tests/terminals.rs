@@ -1,0 +1,123 @@
+//! The capacitance matrix between terminals (`problem::capacitance`) against the parallel-plate
+//! capacitor's closed forms, for a poled PZT-5A plate between electrodes on its faces:
+//!
+//! - clamped (no displacement can occur: rollers on every face), `C = ε33 A / h`;
+//! - free to thicken (its top free), uniaxial strain `ε_zz = e33 E_z / c33` stiffens the
+//!   permittivity, `C = (ε33 + e33² / c33) A / h` (IEEE Std 176-1987's clamped and
+//!   "stiffened" permittivities);
+//!
+//! in plane strain (A the width, per unit depth) and on a disc of revolution (A = π R²); P1
+//! holds these uniform fields, so the matrix is the closed form to round-off. And the
+//! identities of any matrix: reciprocity `C = Cᵀ`, Gauss's law (each column sums to 0),
+//! groups joined by a node counted as one conductor.
+
+use problem::{DirichletSpec, MaterialSpec, MeshSpec, Scene};
+
+const C33: f64 = 111.0;
+const E33: f64 = 15.8;
+const EPS33: f64 = 7.35;
+
+fn plate(axisymmetric: bool, top_free: bool) -> Scene {
+    let roller = |group: &str, ux: bool| DirichletSpec {
+        group: group.into(),
+        ux: ux.then_some(0.0),
+        uy: (!ux).then_some(0.0),
+        ..Default::default()
+    };
+    let mut dirichlet = vec![roller("left", true), roller("right", true)];
+    let mut bottom = roller("bottom", false);
+    bottom.phi = Some(0.0);
+    dirichlet.push(bottom);
+    let mut top = if top_free {
+        DirichletSpec {
+            group: "top".into(),
+            ..Default::default()
+        }
+    } else {
+        roller("top", false)
+    };
+    top.phi = Some(1.0);
+    dirichlet.push(top);
+    let mut mesh = MeshSpec::rectangle([0.0, 0.0], [2.0, 0.5], 4);
+    mesh.axisymmetric = axisymmetric;
+    Scene {
+        name: "plate".into(),
+        description: String::new(),
+        mesh,
+        material: vec![MaterialSpec::crystal_6mm(
+            "body",
+            [121.0, 75.4, 75.2, C33, 21.1, 22.6],
+            [-5.4, E33, 12.3],
+            [8.11, EPS33],
+            [0.0, 1.0, 0.0],
+        )],
+        dirichlet,
+        load: None,
+        electrode: None,
+        contact: None,
+        solver: Default::default(),
+        exact: None,
+        path: None,
+    }
+}
+
+#[test]
+fn a_plate_between_electrodes_is_the_parallel_plate_capacitor() {
+    let h = 0.5;
+    for axisymmetric in [false, true] {
+        // the area: the width per unit depth, or the disc of radius 2
+        let area = if axisymmetric { std::f64::consts::PI * 4.0 } else { 2.0 };
+        for (top_free, permittivity) in [(false, EPS33), (true, EPS33 + E33 * E33 / C33)] {
+            let c = problem::capacitance(&plate(axisymmetric, top_free), None).unwrap();
+            assert_eq!(c.terminals, ["bottom", "top"]);
+            let expected = permittivity * area / h;
+            for (i, j, sign) in [(0, 0, 1.0), (1, 1, 1.0), (0, 1, -1.0), (1, 0, -1.0)] {
+                let got = c.matrix[i][j];
+                assert!(
+                    (got - sign * expected).abs() < 1e-10 * expected,
+                    "axisymmetric {axisymmetric}, top free {top_free}: C[{i}][{j}] = {got} against {}",
+                    sign * expected
+                );
+            }
+            assert!(c.asymmetry < 1e-12 && c.column_sum < 1e-12, "{c:?}");
+        }
+    }
+}
+
+#[test]
+fn three_terminals_are_reciprocal_and_joined_groups_are_one_conductor() {
+    // the paper's actuator: two grounded sides and an electrode on part of the top
+    let (scene, _) = files::scene_file::load("actuator", &["mesh.n=16".into()]).unwrap();
+    let c = problem::capacitance(&scene, None).unwrap();
+    assert_eq!(c.terminals.len(), 3, "{:?}", c.terminals);
+    assert!(c.asymmetry < 1e-10, "reciprocity: {c:?}");
+    assert!(c.column_sum < 1e-10, "Gauss: {c:?}");
+    for i in 0..3 {
+        assert!(c.matrix[i][i] > 0.0, "{c:?}");
+    }
+    // its bottom grounded too: it joins both grounded sides at the corners, one conductor
+    let (mut scene, _) = files::scene_file::load("actuator", &["mesh.n=16".into()]).unwrap();
+    scene.dirichlet.push(DirichletSpec {
+        group: "bottom".into(),
+        phi: Some(0.0),
+        ..Default::default()
+    });
+    let joined = problem::capacitance(&scene, None).unwrap();
+    assert_eq!(joined.terminals, ["left+right+bottom", "electrode"], "{joined:?}");
+    assert!(joined.asymmetry < 1e-10 && joined.column_sum < 1e-10, "{joined:?}");
+    // a grounded bottom under the electrode takes more of its field: a larger capacitance
+    assert!(joined.matrix[1][1] > c.matrix[2][2], "{joined:?} {c:?}");
+}
+
+#[test]
+fn a_scene_without_terminals_or_permittivity_is_refused_by_name() {
+    let mut scene = plate(false, false);
+    for d in &mut scene.dirichlet {
+        d.phi = None;
+    }
+    let e = problem::capacitance(&scene, None).unwrap_err();
+    assert!(e.to_string().contains("no terminal"), "{e}");
+    let (elastic, _) = files::scene_file::load("hertz-sphere", &[]).unwrap();
+    let e = problem::capacitance(&elastic, None).unwrap_err();
+    assert!(e.to_string().contains("no electric unknowns"), "{e}");
+}
