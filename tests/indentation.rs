@@ -24,15 +24,7 @@ fn e_star() -> f64 {
 }
 
 fn indenter(shape: IndenterShape, depth: f64) -> IndenterSpec {
-    IndenterSpec {
-        shape,
-        radius: None,
-        half_angle: None,
-        profile: None,
-        tip: None,
-        axis: None,
-        depth,
-    }
+    IndenterSpec::new(shape, depth)
 }
 
 /// The shipped hertz-sphere scene with its indenter replaced.
@@ -60,6 +52,38 @@ fn the_hertz_sphere_scene_is_within_one_percent_of_johnson() {
     let ind = solution.report.indenter.as_ref().unwrap();
     assert_eq!(ind.shape, "paraboloid");
     assert!((ind.depth - 0.01).abs() < 1e-15 && ind.force == f("load_p"));
+}
+
+#[test]
+fn force_control_finds_the_depth_that_carries_the_force() {
+    // the depth-controlled run's force, given back: its depth found again, from a start
+    // below (the body clear of the sphere) and from one above
+    let (scene, _) = files::scene_file::load("hertz-sphere", &["mesh.n=64".into(), "~exact".into()]).unwrap();
+    let by_depth = problem::solve(&scene, None, &mut Silent).unwrap();
+    let force = by_depth.report.indenter.as_ref().unwrap().force;
+    for start in [0.0, 0.03] {
+        let mut controlled = scene.clone();
+        let ind = controlled.contact.as_mut().unwrap().indenter.as_mut().unwrap();
+        ind.force = Some(force);
+        ind.depth = start;
+        let found = problem::solve(&controlled, None, &mut Silent).unwrap();
+        let r = found.report.indenter.as_ref().unwrap();
+        assert!(
+            (r.force - force).abs() <= 1e-9 * force,
+            "start {start}: force {} against {force}",
+            r.force
+        );
+        assert!((r.depth - 0.01).abs() <= 1e-8, "start {start}: depth {}", r.depth);
+        let (a, b) = (
+            &by_depth.contact.as_ref().unwrap().solution.lambda.normal,
+            &found.contact.as_ref().unwrap().solution.lambda.normal,
+        );
+        let scale = a.iter().cloned().fold(0.0, f64::max);
+        assert!(
+            a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-7 * scale),
+            "start {start}: pressures differ"
+        );
+    }
 }
 
 #[test]
@@ -257,6 +281,19 @@ fn keys_that_cannot_apply_are_refused_by_name() {
     refused(&["contact.gap_curvature=0.1"], "contact.gap_curvature");
     refused(&["contact.indenter.radius=-1.0"], "contact.indenter.radius");
     refused(&["mesh.grading=3.0"], "mesh.grading");
+    refused(&["contact.indenter.force=-1.0"], "contact.indenter.force");
+    refused(
+        &["contact.indenter.force=0.4", "solver.strategy=\"uzawa-direct\""],
+        "contact.indenter.force",
+    );
+    refused(
+        &[
+            "contact.indenter.force=0.4",
+            "~exact",
+            "path={t=[0.0,1.0],gap=[0.0,1.0],steps=2}",
+        ],
+        "contact.indenter.force",
+    );
     refused(&["mesh.grading=[1.0, 1.0, 1.0]"], "mesh.grading");
     refused(&["solver.backend=\"petsc\""], "mesh.axisymmetric");
     refused(&["exact.kind=\"cattaneo-mindlin\""], "exact.kind");

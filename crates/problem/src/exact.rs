@@ -305,7 +305,7 @@ pub fn contact_errors(
     };
     // pushed in by d = -(the uniform gap): Hertz's force and radius at that depth (Johnson
     // (4.23): d = a²/R, P = (4/3) E* R^(1/2) d^(3/2))
-    let depth = -c.uniform_gap();
+    let depth = c.depth_at(points);
     let e_star = young / (1.0 - poisson * poisson);
     let at_depth = (sphere && depth > 0.0).then(|| {
         (

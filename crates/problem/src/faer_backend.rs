@@ -388,12 +388,115 @@ impl ContactSolve<'_> {
     }
 }
 
+/// Relative tolerance on the force of a force-controlled indenter.
+const FORCE_TOL: f64 = 1e-10;
+
+/// Force control: the depth at which the body carries `force` from the indenter, one more
+/// unknown with its equation `Σ w_i λ_n,i = force`. The force is a continuous, nondecreasing
+/// function of how far the gaps are lowered (`s`), 0 while the body is clear of the indenter:
+/// `s` is bracketed by steps growing fourfold from a millionth of the face's size, then found
+/// by the Illinois variant of regula falsi, each evaluation a contact solve on the same
+/// condensed compliance warm-started from the last. Leaves the boundary with the gaps of the
+/// depth found, and returns its solution.
+fn force_controlled(
+    how: &ContactSolve<'_>,
+    dense: &mut DenseContactProblem,
+    boundary: &mut ContactBoundary,
+    force: f64,
+    reporter: &mut dyn Reporter,
+) -> Result<ContactSolution, ProblemError> {
+    let base = boundary.points.gap.clone();
+    let weight = boundary.points.weight.clone();
+    let size = face_size(&boundary.points);
+    let mut last: Option<PointValues> = None;
+    let mut eval = |s: f64, boundary: &mut ContactBoundary| -> Result<(f64, ContactSolution), ProblemError> {
+        for (g, b) in boundary.points.gap.iter_mut().zip(&base) {
+            *g = b - s;
+        }
+        let sol = how.run(Operator::Condensed(dense), &boundary.points, last.take(), reporter)?;
+        last = Some(sol.lambda.clone());
+        let f = sol.lambda.normal.iter().zip(&weight).map(|(l, w)| l * w).sum::<f64>();
+        Ok((f - force, sol))
+    };
+    let close = |r: f64| r.abs() <= FORCE_TOL * force;
+    let (mut a, (mut fa, mut sol)) = (0.0, eval(0.0, boundary)?);
+    if close(fa) {
+        return Ok(sol);
+    }
+    // bracket: step away from s = 0 until the residual changes sign
+    let direction = if fa < 0.0 { 1.0 } else { -1.0 };
+    // the body clear of the indenter: the first step reaches the nearest point
+    let clear = base.iter().cloned().fold(f64::INFINITY, f64::min).max(0.0);
+    let mut step = size * 1e-6;
+    let (mut b, mut fb);
+    loop {
+        b = if direction > 0.0 { clear + step } else { -step };
+        (fb, sol) = eval(b, boundary)?;
+        if close(fb) {
+            return Ok(sol);
+        }
+        if fb.signum() != fa.signum() {
+            break;
+        }
+        (a, fa) = (b, fb);
+        step *= 4.0;
+        if step > 1e6 * size {
+            return Err(SceneError::new(
+                "contact.indenter.force",
+                format!("no depth within a million face sizes carries contact.indenter.force = {force:e} (the body carries {:e} at most there)", fb + force),
+            )
+            .into());
+        }
+    }
+    // Illinois: regula falsi with the stale end's residual halved
+    let mut side = 0;
+    for _ in 0..200 {
+        let c = b - fb * (b - a) / (fb - fa);
+        let (fc, sc) = eval(c, boundary)?;
+        sol = sc;
+        if close(fc) || (b - a).abs() <= 4.0 * f64::EPSILON * c.abs().max(size * 1e-12) {
+            return Ok(sol);
+        }
+        if fc.signum() == fb.signum() {
+            (b, fb) = (c, fc);
+            if side == -1 {
+                fa /= 2.0;
+            }
+            side = -1;
+        } else {
+            (a, fa) = (b, fb);
+            (b, fb) = (c, fc);
+            side = 1;
+        }
+    }
+    Err(SceneError::new(
+        "contact.indenter.force",
+        format!("the depth that carries contact.indenter.force = {force:e} was not found in 200 contact solves"),
+    )
+    .into())
+}
+
+/// The largest extent of the contact points along any axis.
+fn face_size(points: &ContactPoints) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (lo, hi) = points
+                .position
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x[k]), hi.max(x[k]))
+                });
+            hi - lo
+        })
+        .fold(f64::MIN_POSITIVE, f64::max)
+}
+
 /// The contact solve: on the condensed compliance (Newton, or a first-order method), or with
 /// one full primal solve per first-order step; then `(u, φ)` under the contact forces found.
 fn solve_contact(
     how: &ContactSolve<'_>,
     system: &mut Factored,
-    boundary: ContactBoundary,
+    mut boundary: ContactBoundary,
     posed: &Posed<'_>,
     reporter: &mut dyn Reporter,
 ) -> Result<Solved<Fields>, ProblemError> {
@@ -420,7 +523,16 @@ fn solve_contact(
                 seconds: condense.1,
             });
             system.condense = Some(condense);
-            let sol = how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?;
+            let force = posed
+                .scene
+                .contact
+                .as_ref()
+                .and_then(|c| c.indenter.as_ref())
+                .and_then(|i| i.force);
+            let sol = match force {
+                Some(force) => force_controlled(how, &mut dense, &mut boundary, force, reporter)?,
+                None => how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?,
+            };
             let (mut u, mut phi) = boundary.recover(direct, condensed, &sol.lambda, &loads.b_u, &loads.b_phi)?;
             let mut on = Refining {
                 direct,

@@ -396,11 +396,7 @@ impl Walk<'_> {
             check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
             check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
             let pair = Some((&boundary, &sol));
-            let mut recovered = recover(scene, setup, disc, (&u, &phi), pair, equilibrium, reporter)?;
-            if let Some(ind) = &mut recovered.indenter {
-                // the depth at this instant: the uniform gap's factor scales it
-                ind.depth *= f.gap;
-            }
+            let recovered = recover(scene, setup, disc, (&u, &phi), pair, equilibrium, reporter)?;
             (sol, Some((recovered, equilibrium, posed.loads, u)))
         } else {
             check_solved(scene, (&[], &[]), Some(&sol), 0.0)?;

@@ -388,7 +388,7 @@ pub(crate) fn recover(
     ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
     ProblemError::check_finite(&fields.stress, "the stress", scene)?;
     let terminals = terminals(setup, disc, &u, &phi)?;
-    let indenter = contact.and_then(|(b, sol)| indenter_report(scene, &b.points, sol, counts.normal_force, 1.0));
+    let indenter = contact.and_then(|(b, sol)| indenter_report(scene, &b.points, sol, counts.normal_force));
     Ok(Recovered {
         u,
         phi,
@@ -400,15 +400,13 @@ pub(crate) fn recover(
     })
 }
 
-/// A rigid indenter's figures at the solution `sol` on `points`, the body carrying
-/// `normal_force`, the uniform gap scaled by `gap_factor` (a load path's); `None` without
-/// `contact.indenter`.
+/// A rigid indenter's figures at the solution `sol` on `points` (the depth read off their
+/// gaps), the body carrying `normal_force`; `None` without `contact.indenter`.
 pub(crate) fn indenter_report(
     scene: &Scene,
     points: &contact::ContactPoints,
     sol: &ContactSolution,
     normal_force: f64,
-    gap_factor: f64,
 ) -> Option<crate::report::IndenterReport> {
     let c = scene.contact.as_ref()?;
     let ind = c.indenter.as_ref()?;
@@ -421,7 +419,7 @@ pub(crate) fn indenter_report(
     }
     Some(crate::report::IndenterReport {
         shape: ind.shape.to_string(),
-        depth: -c.uniform_gap() * gap_factor,
+        depth: c.depth_at(points),
         force: normal_force,
         contact_radius: radius,
         points_in_contact: count,

@@ -950,12 +950,32 @@ pub struct IndenterSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis: Option<Vec<f64>>,
     /// How far the tip is pushed into the body along `-n` (depth control; a load path's `gap`
-    /// factor scales it with `contact.gap`).
+    /// factor scales it with `contact.gap`); under force control, where the search for the
+    /// depth starts.
     #[serde(default)]
     pub depth: f64,
+    /// Force control: the total normal force the indenter carries (> 0); its depth is then an
+    /// unknown, found with the contact solution.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force: Option<f64>,
 }
 
 impl IndenterSpec {
+    /// An indenter of `shape` pushed in by `depth`, its tip at the origin, no other key (a
+    /// shape's radius, angle or profile to be set).
+    pub fn new(shape: IndenterShape, depth: f64) -> Self {
+        IndenterSpec {
+            shape,
+            radius: None,
+            half_angle: None,
+            profile: None,
+            tip: None,
+            axis: None,
+            depth,
+            force: None,
+        }
+    }
+
     /// The point `x` in the indenter's frame: its distance along the normal `n` from the tip,
     /// and its distance `ρ` from the indenter's axis (across a cylinder's axis).
     pub fn local(&self, x: &[f64; 3], n: &[f64; 3]) -> (f64, f64) {
@@ -1046,6 +1066,17 @@ impl ContactSpec {
             Some(_) => None,
             None => (self.gap_curvature > 0.0).then(|| 1.0 / self.gap_curvature),
         }
+    }
+
+    /// How far an indenter's tip is pushed in, read off the gaps of `points` as solved (a
+    /// depth found under force control, or scaled along a path): `-(contact.gap - depth)`
+    /// plus how far the points' gaps lie below the shape's.
+    pub fn depth_at(&self, points: &contact::ContactPoints) -> f64 {
+        let below = match points.position.first() {
+            Some(x) => self.gap_at(x, &points.normal[0]).map_or(0.0, |g| g - points.gap[0]),
+            None => 0.0,
+        };
+        -self.uniform_gap() + below
     }
 
     /// The uniform part of the gap a load path's `gap` factor scales: `contact.gap` less an

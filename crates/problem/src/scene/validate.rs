@@ -170,6 +170,7 @@ impl Scene {
         }
         validate_solver(&self.solver)?;
         refuse_axisymmetric(self)?;
+        refuse_force_control(self)?;
         refuse_compliance(self)?;
         refuse_weakening(self)?;
         refuse_electric(self)?;
@@ -639,6 +640,16 @@ fn validate_indenter(i: &IndenterSpec, c: &ContactSpec) -> Result<(), SceneError
     refuse_if(c.gap_curvature != 0.0, "contact.gap_curvature", why)?;
     refuse_if(c.gap_center.is_some(), "contact.gap_center", why)?;
     finite("contact.indenter.depth", i.depth)?;
+    if let Some(f) = i.force {
+        if !(f > 0.0 && f.is_finite()) {
+            return Err(SceneError::new(
+                "contact.indenter.force",
+                format!(
+                    "contact.indenter.force = {f} must be positive and finite (the force the indenter presses with)"
+                ),
+            ));
+        }
+    }
     all_finite("contact.indenter.tip", i.tip.as_deref().unwrap_or_default())?;
     all_finite("contact.indenter.axis", i.axis.as_deref().unwrap_or_default())?;
     let shape = i.shape;
@@ -712,6 +723,39 @@ fn validate_indenter(i: &IndenterSpec, c: &ContactSpec) -> Result<(), SceneError
         }
     }
     Ok(())
+}
+
+/// Force control (`contact.indenter.force`): found on the condensed compliance of the default
+/// backend, for an insulating contact at one instant.
+fn refuse_force_control(s: &Scene) -> Result<(), SceneError> {
+    let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
+        return Ok(());
+    };
+    if c.indenter.as_ref().is_none_or(|i| i.force.is_none()) {
+        return Ok(());
+    }
+    let key = "contact.indenter.force";
+    refuse_if(
+        s.solver.backend == BackendChoice::Petsc,
+        key,
+        "force control, and the PETSc backend's active sets take a given depth only; use the default backend",
+    )?;
+    refuse_if(
+        !s.solver.strategy.is_condensed(),
+        key,
+        &format!("force control, and solver.strategy = \"{}\" does not condense: the depth is found on the condensed compliance (newton-condensed)", s.solver.strategy),
+    )?;
+    refuse_if(
+        c.electric
+            .is_some_and(|e| e != crate::scene::ElectricCondition::Insulated),
+        key,
+        "force control, and an electrical contact's depth is given (contact.indenter.depth), not yet found",
+    )?;
+    refuse_if(
+        s.path.is_some(),
+        key,
+        "force control, and a load path drives the depth (its gap factor), not the force",
+    )
 }
 
 /// A body of revolution: what it cannot carry (a tangential load path's exact solution in plane
