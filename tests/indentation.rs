@@ -87,6 +87,32 @@ fn force_control_finds_the_depth_that_carries_the_force() {
 }
 
 #[test]
+fn a_piezoelectric_body_under_a_sphere_is_self_similar() {
+    // a homogeneous half-space under a paraboloid: the force and the charge a grounded
+    // conducting tip draws grow as d^(3/2) (the problem scales with a = √(R d)); measured at
+    // n = 160: exponents 1.5006 (insulating force), 1.5005 (conducting force and charge)
+    let run = |electric: &str, depth: f64| {
+        let sets = [format!("contact.electric=\"{electric}\""), format!("contact.indenter.depth={depth}")];
+        let (scene, _) = files::scene_file::load("indent-sphere", &sets).unwrap();
+        let s = problem::solve(&scene, None, &mut Silent).unwrap();
+        let top = s.report.terminals.iter().find(|t| t.group == "top").unwrap().charge;
+        (s.report.indenter.unwrap().force, top)
+    };
+    let exponent = |a: f64, b: f64| (b / a).ln() / 2f64.ln();
+    let (f1, q1) = run("insulated", 0.005);
+    let (f2, q2) = run("insulated", 0.01);
+    assert!((exponent(f1, f2) - 1.5).abs() < 0.005, "insulating force: {f1} {f2}");
+    // no charge enters through an insulating tip: the grounded face draws none (Gauss)
+    assert!(q1.abs() < 1e-9 * f1 && q2.abs() < 1e-9 * f2, "{q1} {q2}");
+    let (g1, c1) = run("conducting", 0.005);
+    let (g2, c2) = run("conducting", 0.01);
+    assert!((exponent(g1, g2) - 1.5).abs() < 0.005, "conducting force: {g1} {g2}");
+    assert!((exponent(c1, c2) - 1.5).abs() < 0.005, "conducting charge: {c1} {c2}");
+    // the two electric conditions pose different problems
+    assert!((g2 - f2).abs() > 0.1 * f2, "{f2} {g2}");
+}
+
+#[test]
 fn sneddon_cone_and_flat_punch() {
     // cone of semi-angle 70°: a = 2 d tan α / π = 0.0175 at d = 0.01
     let alpha = 70f64.to_radians();
