@@ -93,7 +93,10 @@ fn a_piezoelectric_body_under_a_sphere_is_self_similar() {
     // conducting tip draws grow as d^(3/2) (the problem scales with a = √(R d)); measured at
     // n = 160: exponents 1.5006 (insulating force), 1.5005 (conducting force and charge)
     let run = |electric: &str, depth: f64| {
-        let sets = [format!("contact.electric=\"{electric}\""), format!("contact.indenter.depth={depth}")];
+        let sets = [
+            format!("contact.electric=\"{electric}\""),
+            format!("contact.indenter.depth={depth}"),
+        ];
         let (scene, _) = files::scene_file::load("indent-sphere", &sets).unwrap();
         let s = problem::solve(&scene, None, &mut Silent).unwrap();
         let top = s.report.terminals.iter().find(|t| t.group == "top").unwrap().charge;
@@ -121,7 +124,12 @@ fn a_sphere_is_not_a_paraboloid_as_sneddon_says() {
     let force = |shape| {
         let mut ind = indenter(shape, d);
         ind.radius = Some(r);
-        problem::solve(&hertz_body(ind), None, &mut Silent).unwrap().report.indenter.unwrap().force
+        problem::solve(&hertz_body(ind), None, &mut Silent)
+            .unwrap()
+            .report
+            .indenter
+            .unwrap()
+            .force
     };
     let (sphere, paraboloid) = (force(IndenterShape::Sphere), force(IndenterShape::Paraboloid));
     let (mut lo, mut hi) = (0.0, r * (1.0 - 1e-12));
@@ -138,10 +146,42 @@ fn a_sphere_is_not_a_paraboloid_as_sneddon_says() {
     let hertz = 4.0 / 3.0 * e_star() * r.sqrt() * d.powf(1.5);
     // measured: the sphere +0.78 % of Sneddon's, the paraboloid +0.82 % of Hertz's; their
     // ratio 0.96947 against the closed forms' 0.96991 (the body's bias cancels)
-    assert!((sphere - sneddon).abs() < 0.012 * sneddon, "sphere {sphere} against {sneddon}");
-    assert!((paraboloid - hertz).abs() < 0.012 * hertz, "paraboloid {paraboloid} against {hertz}");
+    assert!(
+        (sphere - sneddon).abs() < 0.012 * sneddon,
+        "sphere {sphere} against {sneddon}"
+    );
+    assert!(
+        (paraboloid - hertz).abs() < 0.012 * hertz,
+        "paraboloid {paraboloid} against {hertz}"
+    );
     let ratio = (sphere / paraboloid) / (sneddon / hertz);
     assert!((ratio - 1.0).abs() < 0.002, "ratio off by {}", ratio - 1.0);
+}
+
+#[test]
+fn a_small_force_is_met_not_passed_at_zero() {
+    // 1e-3 of the sphere's force at d = 0.01: the contact solve's floor was the whole face's
+    // gaps (up to 200 here), and λ = 0 passed as converged (1.33 times the force came back)
+    let force = 4.6e-4;
+    let sets = [
+        "~exact".into(),
+        "contact.indenter.depth=0.0".into(),
+        format!("contact.indenter.force={force}"),
+    ];
+    let (scene, _) = files::scene_file::load("hertz-sphere", &sets).unwrap();
+    let r = problem::solve(&scene, None, &mut Silent)
+        .unwrap()
+        .report
+        .indenter
+        .unwrap();
+    assert!((r.force - force).abs() <= 1e-9 * force, "{} against {force}", r.force);
+    // Hertz's depth, (3P / (4 E* √R))^(2/3) = 9.95e-5; measured 9.908e-5 (11 points in contact)
+    let hertz = (3.0 * force / (4.0 * e_star() * 10f64.sqrt())).powf(2.0 / 3.0);
+    assert!(
+        (r.depth - hertz).abs() < 0.01 * hertz,
+        "depth {} against {hertz}",
+        r.depth
+    );
 }
 
 #[test]

@@ -545,8 +545,8 @@ impl Preamble {
 }
 
 /// The multiplier scale of the problem (the floor of the residual's denominator, see
-/// [`complementarity_residual`]): on a rigid foundation `c ‖u(0) - g‖_W`, the multipliers that
-/// push the free motion back by its own size; on a compliant one the smaller of that and the
+/// [`complementarity_residual`]): on a rigid foundation `c ‖([u_n(0) - g]₊, u_t(0))‖_W`, the
+/// multipliers that push the free motion's penetration back by its own size; on a compliant one the smaller of that and the
 /// bed's pressure at the free penetration, `‖k [u(0)_n - g]₊^m‖_W` (a soft bed under a small
 /// load carries pressures many decades below `c ‖u(0) - g‖`, and a floor at the rigid scale
 /// would accept their round-off as the answer: 1e-7 of a pressure of 1e-6 on `k = 3e-3`,
@@ -556,7 +556,15 @@ pub fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64
     for (u, g) in free.normal.iter_mut().zip(&points.gap) {
         *u -= g;
     }
-    let rigid = c * free.weighted_norm(&points.weight);
+    // the free motion's penetrations: a point the free motion leaves clear by its gap needs no
+    // multiplier, and a large gap far from the contact (a body under a sphere: gaps of
+    // r²/2R) must not set the scale (it did: 1e-10 of it was 1e-4 of a small indenter's force)
+    let mut penetration = free.clone();
+    penetration
+        .normal
+        .iter_mut()
+        .for_each(|p| *p = crate::project_nonnegative(*p));
+    let rigid = c * penetration.weighted_norm(&points.weight);
     if points.foundation == Foundation::Rigid {
         return rigid;
     }
