@@ -10,6 +10,10 @@
 //! holds these uniform fields, so the matrix is the closed form to round-off. And the
 //! identities of any matrix: reciprocity `C = Cᵀ`, Gauss's law (each column sums to 0),
 //! groups joined by a node counted as one conductor.
+//!
+//! Floating terminals (`dirichlet.charge`): the same plate pressed by `p` with its top
+//! electrode open (no charge) reads `V = -p e33 h / (c33 ε33 + e33²)` (uniaxial strain with
+//! `D_z = 0`), and a charge `Q` on it adds `Q / C` with the stiffened `C`.
 
 use problem::{DirichletSpec, MaterialSpec, MeshSpec, Scene};
 
@@ -120,4 +124,74 @@ fn a_scene_without_terminals_or_permittivity_is_refused_by_name() {
     let (elastic, _) = files::scene_file::load("hertz-sphere", &[]).unwrap();
     let e = problem::capacitance(&elastic, None).unwrap_err();
     assert!(e.to_string().contains("no electric unknowns"), "{e}");
+}
+
+/// The plate pressed by `p` on its top, its top electrode floating with `charge` on it.
+fn sensor(axisymmetric: bool, p: f64, charge: f64) -> Scene {
+    let mut scene = plate(axisymmetric, true);
+    let top = scene.dirichlet.iter_mut().find(|d| d.group == "top").unwrap();
+    top.phi = None;
+    top.charge = Some(charge);
+    scene.load = Some(problem::LoadSpec {
+        group: "top".into(),
+        p,
+        direction: vec![0.0, -1.0],
+    });
+    scene
+}
+
+#[test]
+fn an_open_electrode_on_a_pressed_plate_reads_its_closed_form_voltage() {
+    let (h, p) = (0.5, 0.01);
+    let open = -p * E33 * h / (C33 * EPS33 + E33 * E33);
+    for axisymmetric in [false, true] {
+        let area = if axisymmetric { std::f64::consts::PI * 4.0 } else { 2.0 };
+        let c_free = (EPS33 + E33 * E33 / C33) * area / h;
+        for q in [0.0, 1e-3] {
+            let s = problem::solve(&sensor(axisymmetric, p, q), None, &mut problem::Silent).unwrap();
+            let top = s.report.terminals.iter().find(|t| t.group == "top").unwrap();
+            assert!(top.floating);
+            let expected = open + q / c_free;
+            assert!(
+                (top.potential - expected).abs() < 1e-10 * open.abs(),
+                "axisymmetric {axisymmetric}, Q = {q}: V = {} against {expected}",
+                top.potential
+            );
+            // the charge asked for, as the final run's reaction
+            assert!(
+                (-top.charge - q).abs() < 1e-10 * (q.abs() + c_free * open.abs()),
+                "charge {}",
+                -top.charge
+            );
+            // the whole top at that potential
+            let nodes = s.mesh.boundary("top").unwrap().nodes();
+            assert!(nodes
+                .iter()
+                .all(|&v| (s.phi[v] - top.potential).abs() < 1e-14 * open.abs()));
+        }
+    }
+}
+
+#[test]
+fn what_a_floating_terminal_cannot_carry_is_refused_by_name() {
+    let mut with_phi = sensor(false, 0.01, 0.0);
+    with_phi.dirichlet.iter_mut().find(|d| d.group == "top").unwrap().phi = Some(1.0);
+    let e = problem::solve(&with_phi, None, &mut problem::Silent).err().unwrap();
+    assert!(e.to_string().contains("dirichlet.charge"), "{e}");
+    let (mut contact, _) = files::scene_file::load("actuator", &["mesh.n=8".into()]).unwrap();
+    contact.dirichlet[0].phi = None;
+    contact.dirichlet[0].charge = Some(0.0);
+    let e = problem::solve(&contact, None, &mut problem::Silent).err().unwrap();
+    assert!(e.to_string().contains("contact"), "{e}");
+    // one run of a backend does not take it: problem::solve does
+    let e = problem::run(
+        &mut problem::Faer,
+        &sensor(false, 0.01, 0.0),
+        None,
+        Default::default(),
+        &mut problem::Silent,
+    )
+    .err()
+    .unwrap();
+    assert!(e.to_string().contains("problem::solve"), "{e}");
 }

@@ -50,6 +50,7 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ("paper-elastic", include_str!("../../../scenes/paper-elastic.toml")),
     ("hertz-sphere", include_str!("../../../scenes/hertz-sphere.toml")),
     ("indent-sphere", include_str!("../../../scenes/indent-sphere.toml")),
+    ("sensor", include_str!("../../../scenes/sensor.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),
     ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),

@@ -43,6 +43,12 @@ pub struct Capacitance {
 /// The scene's and set-up's errors, as a run's; a scene without electric unknowns or without
 /// a terminal (key `dirichlet`); a body its mechanical conditions do not hold.
 pub fn capacitance(scene: &Scene, mesh: Option<mesh::Mesh>) -> Result<Capacitance, ProblemError> {
+    // a floating terminal is a terminal like the others here (its potential a column's)
+    let mut scene = scene.clone();
+    for d in scene.dirichlet.iter_mut().filter(|d| d.charge.is_some()) {
+        d.phi = Some(0.0);
+        d.charge = None;
+    }
     let valid = scene.validate()?;
     let setup = setup(valid, mesh)?;
     if !setup.plan.electric {

@@ -75,6 +75,9 @@ pub struct TerminalReport {
     /// The charge through it, `∫ D·ν ds` (`ν` out of the body; the electrode's own charge is
     /// its negative), as the electric equation's reaction at its nodes.
     pub charge: f64,
+    /// A floating terminal (`dirichlet.charge`): its potential found, its charge given.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub floating: bool,
 }
 
 /// A load path's figures (`run.json`'s `path`): its steps, one row each, and what was reused.

@@ -71,6 +71,10 @@ pub fn run<B: Backend>(
         let why = "a load path is solved by problem::solve or problem::solve_path (its steps share one factorisation), not one instant of a backend";
         return Err(ProblemError::from(crate::SceneError::new("path", why)).into());
     }
+    if scene.scene().dirichlet.iter().any(|d| d.charge.is_some()) {
+        let why = "a floating terminal is solved by problem::solve (its potential by superposition over runs), not one run of a backend";
+        return Err(ProblemError::from(crate::SceneError::new("dirichlet.charge", why)).into());
+    }
     backend.refuse(&scene)?;
     let t_total = Instant::now();
     let setup = begin(scene, mesh, backend.estimate(&scene), &limits, reporter)?;
@@ -469,6 +473,7 @@ fn terminals(
             group: group.to_string(),
             potential: first.first().map_or(0.0, |&v| phi[v]),
             charge,
+            floating: false,
         });
     }
     Ok(out)

@@ -37,3 +37,12 @@ def test_the_capacitance_matrix_from_python():
     assert abs(m - m.T).max() < 1e-10 * abs(m).max()
     assert abs(m.sum(axis=0)).max() < 1e-10 * abs(m).max()
     assert c["asymmetry"] < 1e-10 and c["column_sum"] < 1e-10
+
+
+def test_an_open_electrode_from_python():
+    # the shipped sensor: the open-circuit voltage of a pressed, laterally confined PZT-4 disc
+    r = pc.run(pc.Scene.load("sensor"))
+    top = next(t for t in r.report["terminals"] if t["group"] == "top")
+    assert top["floating"]
+    expected = -0.01 * 15.1 * 0.5 / (115.0 * 5.62 + 15.1**2)
+    assert abs(top["potential"] - expected) < 1e-10 * abs(expected)

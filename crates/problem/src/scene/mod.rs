@@ -834,6 +834,11 @@ pub struct DirichletSpec {
     /// Prescribed potential, if any.
     #[serde(default)]
     pub phi: Option<f64>,
+    /// A floating terminal: the group's potential is unknown (one value over the group) and
+    /// the charge on it is this (the negative of the flux `∫ D·ν ds` out of the body through
+    /// it; 0 for an open circuit). Instead of `phi`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charge: Option<f64>,
 }
 
 /// A uniform traction `p * direction` on a group.

@@ -131,18 +131,28 @@ impl Scene {
                     .chain(&d.ux)
                     .chain(&d.uy)
                     .chain(&d.uz)
-                    .chain(&d.phi);
+                    .chain(&d.phi)
+                    .chain(&d.charge);
             values.clone().try_for_each(|&v| finite("dirichlet", v))?;
             if values.count() == 0 {
                 return Err(SceneError::new(
                     "dirichlet",
                     format!(
-                        "the dirichlet entry on `{}` prescribes nothing (give u, ux, uy, uz or phi)",
+                        "the dirichlet entry on `{}` prescribes nothing (give u, ux, uy, uz, phi or charge)",
                         d.group
                     ),
                 ));
             }
+            refuse_if(
+                d.charge.is_some() && d.phi.is_some(),
+                "dirichlet.charge",
+                &format!(
+                    "a floating terminal's charge on `{}`, and dirichlet.phi prescribes its potential",
+                    d.group
+                ),
+            )?;
         }
+        refuse_floating(self)?;
         if let Some(l) = &self.load {
             finite("load.p", l.p)?;
             all_finite("load.direction", &l.direction)?;
@@ -723,6 +733,31 @@ fn validate_indenter(i: &IndenterSpec, c: &ContactSpec) -> Result<(), SceneError
         }
     }
     Ok(())
+}
+
+/// Floating terminals (`dirichlet.charge`): solved by superposition (the grounded run, the
+/// capacitance matrix, the final run), so on a linear problem (no contact, one instant), by the
+/// default backend.
+fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
+    if !s.dirichlet.iter().any(|d| d.charge.is_some()) {
+        return Ok(());
+    }
+    let key = "dirichlet.charge";
+    refuse_if(
+        s.contact_law() != ContactLaw::None,
+        key,
+        "a floating terminal, and contact makes the problem nonlinear: its potential is found by superposition, which needs contact.law = \"none\" (not yet with contact)",
+    )?;
+    refuse_if(
+        s.path.is_some(),
+        key,
+        "a floating terminal, and a load path (not yet: a floating terminal's potential is found at one instant)",
+    )?;
+    refuse_if(
+        s.solver.backend == BackendChoice::Petsc,
+        key,
+        "a floating terminal, and the PETSc backend takes prescribed potentials only; use the default backend",
+    )
 }
 
 /// Force control (`contact.indenter.force`): found on the condensed compliance of the default
