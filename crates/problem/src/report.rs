@@ -63,6 +63,14 @@ pub struct IndenterReport {
     pub contact_radius: f64,
     /// Contact points carrying pressure.
     pub points_in_contact: usize,
+    /// A conducting indenter (`contact.electric = "conducting"` or `"conductive"`): its
+    /// potential (`contact.foundation_potential`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub potential: Option<f64>,
+    /// A conducting indenter: the charge it carries, the negative of the flux `Σ w D·ν`
+    /// through the contact zone out of the body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charge: Option<f64>,
 }
 
 /// A boundary group at a prescribed potential (`run.json`'s `terminals`).

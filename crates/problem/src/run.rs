@@ -427,6 +427,8 @@ pub(crate) fn indenter_report(
         force: normal_force,
         contact_radius: radius,
         points_in_contact: count,
+        potential: c.electric_law().map(|(_, potential)| potential),
+        charge: sol.electric.as_ref().map(|e| -e.charge(&points.weight)),
     })
 }
 
