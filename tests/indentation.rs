@@ -390,7 +390,8 @@ fn keys_that_cannot_apply_are_refused_by_name() {
     refused(&["contact.indenter.half_angle=30.0"], "contact.indenter.half_angle");
     refused(&["contact.gap_curvature=0.1"], "contact.gap_curvature");
     refused(&["contact.indenter.radius=-1.0"], "contact.indenter.radius");
-    refused(&["mesh.grading=3.0"], "mesh.grading");
+    refused(&["mesh.grading=1e9"], "mesh.grading");
+    refused(&["mesh.grading=0.0"], "mesh.grading");
     refused(&["contact.indenter.force=-1.0"], "contact.indenter.force");
     refused(
         &["contact.indenter.force=0.4", "solver.strategy=\"uzawa-direct\""],

@@ -227,13 +227,15 @@ fn axis_group(mesh: &mut mesh::Mesh) -> Result<(), ProblemError> {
     Ok(())
 }
 
-/// Grades a generated mesh towards `lo`: along axis k the cells' sizes grow by the ratio
-/// `grading[k]` (or the one ratio given) from one cell to the next, the nodes keeping their
-/// places in the structured grid.
+/// Grades a generated mesh towards `lo`: along axis k the cells' sizes grow geometrically from
+/// the first to the last, `grading[k]` (or the one stretch given) times the first, the nodes
+/// keeping their places in the structured grid.
 fn grade(mesh: &mut mesh::Mesh, m: &crate::scene::MeshSpec, grading: &[f64]) {
     let n = m.cells_per_axis();
     for (k, &cells) in n.iter().enumerate().take(mesh.dim) {
-        let q = grading.get(k).or(grading.first()).copied().unwrap_or(1.0);
+        let stretch = grading.get(k).or(grading.first()).copied().unwrap_or(1.0);
+        // the ratio of neighbouring cells that stretches the first to the last
+        let q = stretch.powf(1.0 / cells.saturating_sub(1).max(1) as f64);
         // cell widths q^i, scaled by the largest so that no power overflows
         let top = if q >= 1.0 { (cells - 1) as f64 } else { 0.0 };
         let widths: Vec<f64> = (0..cells).map(|i| q.powf(i as f64 - top)).collect();

@@ -629,14 +629,16 @@ pub struct MeshSpec {
     /// (the radial displacement held on the axis; forces and charges are the whole body's).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub axisymmetric: bool,
-    /// A generated mesh graded towards `lo`: along each axis, each cell `grading` times the
-    /// size of the one before it (one ratio per axis, or one for all; 1 is uniform), as for a
-    /// contact zone at a corner of a large body.
+    /// A generated mesh graded towards `lo`: along each axis, the last cell `grading` times the
+    /// size of the first, the sizes growing geometrically between (one stretch per axis, or one
+    /// for all; 1 is uniform), as for a contact zone at a corner of a large body. The stretch
+    /// does not depend on the number of cells, so that `mesh.n` refines the same grading
+    /// (every cell halves when `n` doubles).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grading: Option<Grading>,
 }
 
-/// `mesh.grading`: one ratio for every axis, or one per axis.
+/// `mesh.grading`: one stretch (last cell over first) for every axis, or one per axis.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Grading {
@@ -647,7 +649,7 @@ pub enum Grading {
 }
 
 impl Grading {
-    /// The ratios given (one, or one per axis).
+    /// The stretches given (one, or one per axis).
     pub fn ratios(&self) -> Vec<f64> {
         match self {
             Grading::One(q) => vec![*q],

@@ -262,7 +262,10 @@ impl Scene {
             if g.len() != 1 && g.len() != dim {
                 return Err(SceneError::new(
                     "mesh.grading",
-                    format!("mesh.grading needs one ratio, or one per axis ({dim}), not {}", g.len()),
+                    format!(
+                        "mesh.grading needs one stretch, or one per axis ({dim}), not {}",
+                        g.len()
+                    ),
                 ));
             }
         }
@@ -378,10 +381,10 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
             "a generated mesh's grading, and a Gmsh or given mesh fixes its own",
         )?;
         all_finite("mesh.grading", &g)?;
-        if let Some(q) = g.iter().find(|q| !(**q >= 0.5 && **q <= 2.0)) {
+        if let Some(q) = g.iter().find(|q| !(**q >= 1e-6 && **q <= 1e6)) {
             return Err(SceneError::new(
                 "mesh.grading",
-                format!("mesh.grading = {q}: the ratio of neighbouring cells must lie in [0.5, 2] (1 is uniform)"),
+                format!("mesh.grading = {q}: the last cell over the first must lie in [1e-6, 1e6] (1 is uniform; above 1 the cells grow away from lo)"),
             ));
         }
     }
