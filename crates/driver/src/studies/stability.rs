@@ -373,7 +373,7 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "heavy force",
-        why: "force control with 1e4 times the sphere's Hertz force (a depth of 4.6 R): the bracket grown far",
+        why: "force control with 1e4 times the sphere's Hertz force (a depth of about 4.4 R): the bracket grown far",
         scene: "hertz-sphere",
         sets: &["mesh.n=160", "~exact", "contact.indenter.depth=0.0", "contact.indenter.force=4.6e3"],
         paper_sets: None,
