@@ -196,6 +196,36 @@ fn a_small_force_is_met_not_passed_at_zero() {
     );
 }
 
+/// The force and (for a conducting tip) the charge of a shipped indentation scene at `depth`.
+fn indent(scene: &str, electric: &str, depth: f64) -> (f64, Option<f64>) {
+    let sets = [format!("contact.electric={electric}"), format!("contact.indenter.depth={depth}")];
+    let (scene, _) = files::scene_file::load(scene, &sets).unwrap();
+    let ind = problem::solve(&scene, None, &mut Silent).unwrap().report.indenter.unwrap();
+    (ind.force, ind.charge)
+}
+
+#[test]
+fn a_piezoelectric_body_under_a_cone_and_a_punch_scales_as_they_must() {
+    // a cone is self-similar: force and charge as d²; measured exponents 1.9865 (insulating),
+    // 1.989 and 1.991 (conducting force and charge), 7 and 12 points in contact
+    let exponent = |a: f64, b: f64| (b / a).ln() / 2f64.ln();
+    for electric in ["insulated", "conducting"] {
+        let (f1, q1) = indent("indent-cone", electric, 0.01);
+        let (f2, q2) = indent("indent-cone", electric, 0.02);
+        assert!((exponent(f1, f2) - 2.0).abs() < 0.03, "{electric} cone: {f1} {f2}");
+        if let (Some(q1), Some(q2)) = (q1, q2) {
+            assert!((exponent(q1, q2) - 2.0).abs() < 0.03, "cone's charge: {q1} {q2}");
+        }
+        // a punch's face is in contact whole at any depth: the problem is linear in it
+        let (f1, q1) = indent("indent-punch", electric, 0.001);
+        let (f2, q2) = indent("indent-punch", electric, 0.002);
+        assert!((f2 - 2.0 * f1).abs() < 1e-9 * f2, "{electric} punch: {f1} {f2}");
+        if let (Some(q1), Some(q2)) = (q1, q2) {
+            assert!((q2 - 2.0 * q1).abs() < 1e-9 * q2.abs(), "punch's charge: {q1} {q2}");
+        }
+    }
+}
+
 #[test]
 fn sneddon_cone_and_flat_punch() {
     // cone of semi-angle 70°: a = 2 d tan α / π = 0.0175 at d = 0.01
