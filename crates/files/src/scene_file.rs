@@ -52,7 +52,11 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ("indent-sphere", include_str!("../../../scenes/indent-sphere.toml")),
     ("indent-cone", include_str!("../../../scenes/indent-cone.toml")),
     ("indent-punch", include_str!("../../../scenes/indent-punch.toml")),
-    ("indent-sphere-3d", include_str!("../../../scenes/indent-sphere-3d.toml")),
+    (
+        "indent-sphere-3d",
+        include_str!("../../../scenes/indent-sphere-3d.toml"),
+    ),
+    ("pfm", include_str!("../../../scenes/pfm.toml")),
     ("sensor", include_str!("../../../scenes/sensor.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),

@@ -395,31 +395,34 @@ const FORCE_TOL: f64 = 1e-10;
 /// unknown with its equation `Σ w_i λ_n,i = force`. The force is a continuous, nondecreasing
 /// function of how far the gaps are lowered (`s`), 0 while the body is clear of the indenter:
 /// `s` is bracketed by steps growing fourfold from a millionth of the face's size, then found
-/// by the Illinois variant of regula falsi, each evaluation a contact solve on the same
-/// condensed compliance warm-started from the last. Leaves the boundary with the gaps of the
-/// depth found, and returns its solution.
+/// by the Illinois variant of regula falsi, each evaluation a contact solve (`solve`, on the
+/// points with their gaps lowered, from the last multipliers) on the same condensed
+/// compliance. Leaves the points with the gaps of the depth found, and returns its solution.
 fn force_controlled(
-    how: &ContactSolve<'_>,
-    dense: &mut DenseContactProblem,
-    boundary: &mut ContactBoundary,
+    points: &mut ContactPoints,
     force: f64,
-    reporter: &mut dyn Reporter,
+    mut solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, ProblemError>,
 ) -> Result<ContactSolution, ProblemError> {
-    let base = boundary.points.gap.clone();
-    let weight = boundary.points.weight.clone();
-    let size = face_size(&boundary.points);
+    let base = points.gap.clone();
+    let size = face_size(points);
     let mut last: Option<PointValues> = None;
-    let mut eval = |s: f64, boundary: &mut ContactBoundary| -> Result<(f64, ContactSolution), ProblemError> {
-        for (g, b) in boundary.points.gap.iter_mut().zip(&base) {
+    let mut eval = |s: f64, points: &mut ContactPoints| -> Result<(f64, ContactSolution), ProblemError> {
+        for (g, b) in points.gap.iter_mut().zip(&base) {
             *g = b - s;
         }
-        let sol = how.run(Operator::Condensed(dense), &boundary.points, last.take(), reporter)?;
+        let sol = solve(points, last.take())?;
         last = Some(sol.lambda.clone());
-        let f = sol.lambda.normal.iter().zip(&weight).map(|(l, w)| l * w).sum::<f64>();
+        let f = sol
+            .lambda
+            .normal
+            .iter()
+            .zip(&points.weight)
+            .map(|(l, w)| l * w)
+            .sum::<f64>();
         Ok((f - force, sol))
     };
     let close = |r: f64| r.abs() <= FORCE_TOL * force;
-    let (mut a, (mut fa, mut sol)) = (0.0, eval(0.0, boundary)?);
+    let (mut a, (mut fa, mut sol)) = (0.0, eval(0.0, points)?);
     if close(fa) {
         return Ok(sol);
     }
@@ -431,7 +434,7 @@ fn force_controlled(
     let (mut b, mut fb);
     loop {
         b = if direction > 0.0 { clear + step } else { -step };
-        (fb, sol) = eval(b, boundary)?;
+        (fb, sol) = eval(b, points)?;
         if close(fb) {
             return Ok(sol);
         }
@@ -452,7 +455,7 @@ fn force_controlled(
     let mut side = 0;
     for _ in 0..200 {
         let c = b - fb * (b - a) / (fb - fa);
-        let (fc, sc) = eval(c, boundary)?;
+        let (fc, sc) = eval(c, points)?;
         sol = sc;
         if close(fc) || (b - a).abs() <= 4.0 * f64::EPSILON * c.abs().max(size * 1e-12) {
             return Ok(sol);
@@ -474,6 +477,16 @@ fn force_controlled(
         format!("the depth that carries contact.indenter.force = {force:e} was not found in 200 contact solves"),
     )
     .into())
+}
+
+/// The force of a force-controlled indenter in `posed`'s scene.
+fn indenter_force(posed: &Posed<'_>) -> Option<f64> {
+    posed
+        .scene
+        .contact
+        .as_ref()
+        .and_then(|c| c.indenter.as_ref())
+        .and_then(|i| i.force)
 }
 
 /// The largest extent of the contact points along any axis.
@@ -503,11 +516,12 @@ fn solve_contact(
     let t = Instant::now();
     let nt = how.plan.n_tangential();
     let condensed = how.plan.linear_strategy.is_condensed();
-    let electric = boundary.electric.as_ref().map(|(e, _)| e);
+    // electrical contact: its law, owned (force control lowers the boundary's gaps)
+    let electric = boundary.electric.as_ref().map(|(e, _)| e.clone());
     let (sol, (u, phi)) = match (&mut system.solver, electric) {
         (LinearSolver::Direct(direct), Some(electric)) if condensed => {
             let (sol, fields, condense, refinement) =
-                electric_contact(how, electric, direct, &system.blocks, &boundary, posed, reporter)?;
+                electric_contact(how, &electric, direct, &system.blocks, &mut boundary, posed, reporter)?;
             system.condense = Some(condense);
             system.refinement = refinement;
             (sol, fields)
@@ -523,14 +537,10 @@ fn solve_contact(
                 seconds: condense.1,
             });
             system.condense = Some(condense);
-            let force = posed
-                .scene
-                .contact
-                .as_ref()
-                .and_then(|c| c.indenter.as_ref())
-                .and_then(|i| i.force);
-            let sol = match force {
-                Some(force) => force_controlled(how, &mut dense, &mut boundary, force, reporter)?,
+            let sol = match indenter_force(posed) {
+                Some(force) => force_controlled(&mut boundary.points, force, |points, start| {
+                    how.run(Operator::Condensed(&mut dense), points, start, reporter)
+                })?,
                 None => how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?,
             };
             let (mut u, mut phi) = boundary.recover(direct, condensed, &sol.lambda, &loads.b_u, &loads.b_phi)?;
@@ -580,7 +590,7 @@ fn electric_contact(
     electric: &contact::ElectricContact,
     direct: &mut DirectLdlt,
     blocks: &Blocks,
-    boundary: &ContactBoundary,
+    boundary: &mut ContactBoundary,
     posed: &Posed<'_>,
     reporter: &mut dyn Reporter,
 ) -> Result<(ContactSolution, Fields, (CondenseRoute, f64), usize), ProblemError> {
@@ -596,14 +606,14 @@ fn electric_contact(
     });
     let tol = how.tol;
     let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-    let mut sol = contact::solve_newton_electric(
-        &problem,
-        &boundary.points,
-        &how.law,
-        &how.newton_params(),
-        &mut progress,
-    )
-    .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))?;
+    let mut solve = |points: &ContactPoints, _: Option<PointValues>| {
+        contact::solve_newton_electric(&problem, points, &how.law, &how.newton_params(), &mut progress)
+            .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))
+    };
+    let mut sol = match indenter_force(posed) {
+        Some(force) => force_controlled(&mut boundary.points, force, &mut solve)?,
+        None => solve(&boundary.points, None)?,
+    };
     let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
     let (b_u, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
     let refinement = refine(direct, blocks, &b_u, &b_phi, scale, &mut u, &mut phi, REFINE_TOL)?.steps;

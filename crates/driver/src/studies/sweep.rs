@@ -29,6 +29,9 @@ pub struct SweepRow {
     pub fixed_point: usize,
     /// Wall time of the run (s).
     pub seconds: f64,
+    /// A rigid indenter's depth and (a conducting one's) charge, where the scene has one (a
+    /// force-controlled indenter's depth against a voltage: piezoresponse).
+    pub indenter: Option<(f64, Option<f64>)>,
 }
 
 /// The parameter a sweep varies: `steps` values from `from` to `to`, inclusive.
@@ -91,6 +94,7 @@ pub fn sweep(
             uzawa: r.iterations.uzawa,
             fixed_point: r.iterations.fixed_point,
             seconds: t.elapsed().as_secs_f64(),
+            indenter: r.indenter.as_ref().map(|i| (i.depth, i.charge)),
         };
         progress(&format!(
             "[{}/{steps}] {param} = {value:.6e}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}",
@@ -113,12 +117,22 @@ pub fn sweep(
     Ok(rows)
 }
 
-/// The rows as CSV.
+/// The rows as CSV (with `indenter_depth,indenter_charge` where the scene has an indenter;
+/// `nan` for an insulating one's charge).
 pub fn csv(param: &str, rows: &[SweepRow]) -> String {
-    let mut csv = format!("{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds\n");
+    let indenter = rows.iter().any(|r| r.indenter.is_some());
+    let mut csv = format!(
+        "{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds{}\n",
+        if indenter { ",indenter_depth,indenter_charge" } else { "" }
+    );
     for r in rows {
+        let extra = match (indenter, r.indenter) {
+            (false, _) => String::new(),
+            (true, Some((depth, charge))) => format!(",{depth:e},{:e}", charge.unwrap_or(f64::NAN)),
+            (true, None) => ",nan,nan".into(),
+        };
         csv.push_str(&format!(
-            "{:e},{},{},{},{:e},{:e},{:.3e},{:.3e},{},{},{:.4}\n",
+            "{:e},{},{},{},{:e},{:e},{:.3e},{:.3e},{},{},{:.4}{extra}\n",
             r.value,
             r.counts.0,
             r.counts.1,

@@ -764,7 +764,7 @@ fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
 }
 
 /// Force control (`contact.indenter.force`): found on the condensed compliance of the default
-/// backend, for an insulating contact at one instant.
+/// backend, at one instant.
 fn refuse_force_control(s: &Scene) -> Result<(), SceneError> {
     let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
         return Ok(());
@@ -782,12 +782,6 @@ fn refuse_force_control(s: &Scene) -> Result<(), SceneError> {
         !s.solver.strategy.is_condensed(),
         key,
         &format!("force control, and solver.strategy = \"{}\" does not condense: the depth is found on the condensed compliance (newton-condensed)", s.solver.strategy),
-    )?;
-    refuse_if(
-        c.electric
-            .is_some_and(|e| e != crate::scene::ElectricCondition::Insulated),
-        key,
-        "force control, and an electrical contact's depth is given (contact.indenter.depth), not yet found",
     )?;
     refuse_if(
         s.path.is_some(),
