@@ -118,11 +118,14 @@ fn block(dim: usize, law: ContactLaw, gap: f64, half: bool) -> Scene {
             poling,
         )],
         dirichlet,
-        load: Some(LoadSpec {
-            group: "top".into(),
-            p: -2.0,
-            direction: up,
-        }),
+        load: Some(
+            LoadSpec {
+                group: "top".into(),
+                p: -2.0,
+                direction: up,
+            }
+            .into(),
+        ),
         electrode: None,
         contact: Some(contact),
         solver: Default::default(),

@@ -132,11 +132,14 @@ fn sensor(axisymmetric: bool, p: f64, charge: f64) -> Scene {
     let top = scene.dirichlet.iter_mut().find(|d| d.group == "top").unwrap();
     top.phi = None;
     top.charge = Some(charge);
-    scene.load = Some(problem::LoadSpec {
-        group: "top".into(),
-        p,
-        direction: vec![0.0, -1.0],
-    });
+    scene.load = Some(
+        problem::LoadSpec {
+            group: "top".into(),
+            p,
+            direction: vec![0.0, -1.0],
+        }
+        .into(),
+    );
     scene
 }
 
@@ -194,4 +197,54 @@ fn what_a_floating_terminal_cannot_carry_is_refused_by_name() {
     .err()
     .unwrap();
     assert!(e.to_string().contains("problem::solve"), "{e}");
+}
+
+#[test]
+fn several_loads_add_up() {
+    // the sensor's pressure as two [[load]] entries of half each: the same open-circuit voltage
+    let one = problem::solve(&sensor(false, 0.01, 0.0), None, &mut problem::Silent).unwrap();
+    let mut two = sensor(false, 0.01, 0.0);
+    let half = problem::LoadSpec {
+        group: "top".into(),
+        p: 0.005,
+        direction: vec![0.0, -1.0],
+    };
+    two.load = Some(problem::Loads::Many(vec![half.clone(), half]));
+    let two = problem::solve(&two, None, &mut problem::Silent).unwrap();
+    let v = |s: &problem::Solution| s.report.terminals.iter().find(|t| t.group == "top").unwrap().potential;
+    assert!(
+        (v(&one) - v(&two)).abs() < 1e-12 * v(&one).abs(),
+        "{} {}",
+        v(&one),
+        v(&two)
+    );
+    // and from a scene file's [[load]] array
+    let text = r#"
+name = "two-loads"
+description = "two tractions"
+[mesh]
+kind = "rectangle"
+lo = [0.0, 0.0]
+hi = [2.0, 1.0]
+n = 4
+[[material]]
+region = "body"
+model = "isotropic"
+young = 100.0
+poisson = 0.3
+[[dirichlet]]
+group = "bottom"
+u = [0.0, 0.0]
+[[load]]
+group = "top"
+p = 1.0
+direction = [1.0, 0.0]
+[[load]]
+group = "right"
+p = 2.0
+direction = [0.0, 1.0]
+"#;
+    let scene = files::scene_file::parse(text, "two-loads", &[]).unwrap();
+    assert_eq!(scene.loads().len(), 2);
+    assert!(problem::solve(&scene, None, &mut problem::Silent).is_ok());
 }

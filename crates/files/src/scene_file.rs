@@ -410,7 +410,7 @@ mod tests {
             assert!(e.contains(says) && !e.contains("invalid type: string"), "{set}: {e}");
         }
         let (s, _) = load("paper", &["load.p=-2.5E0".into()]).unwrap();
-        assert_eq!(s.load.unwrap().p, -2.5);
+        assert_eq!(s.loads()[0].p, -2.5);
     }
 
     #[test]

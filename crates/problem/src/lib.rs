@@ -34,7 +34,7 @@
 //!     mesh: MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 8),
 //!     material: vec![MaterialSpec::crystal_6mm("body", pzt5a, [-5.4, 15.8, 12.3], [8.11, 7.35], [0.0, 1.0, 0.0])],
 //!     dirichlet: vec![clamped("left"), clamped("right")],
-//!     load: Some(LoadSpec { group: "top".into(), p: -2.0, direction: vec![0.0, 1.0] }),
+//!     load: Some(LoadSpec { group: "top".into(), p: -2.0, direction: vec![0.0, 1.0] }.into()),
 //!     electrode: None,
 //!     contact: Some(contact),
 //!     solver: Default::default(),
@@ -84,7 +84,7 @@ pub use report::{PetscReport, RunReport};
 pub use run::{run, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectricCondition,
-    ElectrodeSpec, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, MaterialModel,
+    ElectrodeSpec, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, Loads, MaterialModel,
     MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy, Valid,
 };
 

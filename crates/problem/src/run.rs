@@ -565,11 +565,14 @@ mod tests {
                 [0.0, 1.0, 0.0],
             )],
             dirichlet: vec![clamped("left"), clamped("right")],
-            load: Some(LoadSpec {
-                group: "top".into(),
-                p: -2.0,
-                direction: vec![0.0, 1.0],
-            }),
+            load: Some(
+                LoadSpec {
+                    group: "top".into(),
+                    p: -2.0,
+                    direction: vec![0.0, 1.0],
+                }
+                .into(),
+            ),
             electrode: None,
             contact: Some(contact),
             solver: Default::default(),

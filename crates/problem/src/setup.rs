@@ -144,7 +144,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         coincident_nodes: quality.coincident_nodes,
         unused_nodes: quality.unused_nodes,
     };
-    if let Some(l) = &scene.load {
+    for l in scene.loads() {
         crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;
     }
     for r in &m.regions {
@@ -315,19 +315,23 @@ fn constraints(scene: &Scene, plan: &Plan) -> Vec<Constraint> {
     out
 }
 
-/// The loads of a validated scene.
+/// The loads of a validated scene: each a uniform traction on its group (several on one group
+/// add up).
 fn loads(scene: &Scene, dim: usize) -> Vec<Load> {
-    let Some(l) = &scene.load else {
-        return vec![];
-    };
-    // a direction: normalised (the magnitude is load.p), robustly for tiny or huge entries
-    let len = mesh::scaled_norm(&l.direction);
-    let mut t = [0.0; 3];
-    for k in 0..dim {
-        t[k] = l.p * (l.direction[k] / len);
-    }
-    vec![Load::Traction {
-        group: l.group.clone(),
-        value: Arc::new(move |_| t),
-    }]
+    scene
+        .loads()
+        .iter()
+        .map(|l| {
+            // a direction: normalised (the magnitude is load.p), robustly for tiny or huge entries
+            let len = mesh::scaled_norm(&l.direction);
+            let mut t = [0.0; 3];
+            for k in 0..dim {
+                t[k] = l.p * (l.direction[k] / len);
+            }
+            Load::Traction {
+                group: l.group.clone(),
+                value: Arc::new(move |_| t),
+            }
+        })
+        .collect()
 }

@@ -308,9 +308,9 @@ pub struct Scene {
     /// Clamped / grounded groups.
     #[serde(default)]
     pub dirichlet: Vec<DirichletSpec>,
-    /// The mechanical load.
+    /// The mechanical loads: one `[load]`, or several `[[load]]`.
     #[serde(default)]
-    pub load: Option<LoadSpec>,
+    pub load: Option<Loads>,
     /// A voltage electrode.
     #[serde(default)]
     pub electrode: Option<ElectrodeSpec>,
@@ -497,7 +497,7 @@ impl Scene {
             add("dirichlet.uz", d.uz.as_slice());
             add("dirichlet.phi", d.phi.as_slice());
         }
-        if let Some(l) = &self.load {
+        for l in self.loads() {
             add("load.p", &[l.p]);
         }
         if let Some(e) = &self.electrode {
@@ -841,6 +841,39 @@ pub struct DirichletSpec {
     /// it; 0 for an open circuit). Instead of `phi`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub charge: Option<f64>,
+}
+
+/// The scene's tractions: one table `[load]`, or an array `[[load]]`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Loads {
+    /// `[load]`.
+    One(LoadSpec),
+    /// `[[load]]`.
+    Many(Vec<LoadSpec>),
+}
+
+impl Loads {
+    /// Every load.
+    pub fn all(&self) -> &[LoadSpec] {
+        match self {
+            Loads::One(l) => std::slice::from_ref(l),
+            Loads::Many(v) => v,
+        }
+    }
+}
+
+impl From<LoadSpec> for Loads {
+    fn from(l: LoadSpec) -> Self {
+        Loads::One(l)
+    }
+}
+
+impl Scene {
+    /// The scene's tractions (none, one or several).
+    pub fn loads(&self) -> &[LoadSpec] {
+        self.load.as_ref().map_or(&[], Loads::all)
+    }
 }
 
 /// A uniform traction `p * direction` on a group.

@@ -153,7 +153,7 @@ impl Scene {
             )?;
         }
         refuse_floating(self)?;
-        if let Some(l) = &self.load {
+        for l in self.loads() {
             finite("load.p", l.p)?;
             all_finite("load.direction", &l.direction)?;
             if !(mesh::scaled_norm(&l.direction) > 0.0) {
@@ -236,7 +236,7 @@ impl Scene {
                 }
             }
         }
-        if let Some(l) = &self.load {
+        for l in self.loads() {
             len("load.direction", &l.direction, dim)?;
         }
         if let Some(c) = &self.contact {
@@ -331,7 +331,7 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "path",
         "a path carries friction's history from step to step, and the scene has no contact (contact.law = \"none\"): without it each instant is the static answer scaled",
     )?;
-    applies(scene.load.is_none(), "path.load", "the scene has no [load]")?;
+    applies(scene.loads().is_empty(), "path.load", "the scene has no [load]")?;
     applies(scene.active_contact().is_none(), "path.gap", "the scene has no contact")?;
     refuse_if(
         scene.exact.is_some(),
