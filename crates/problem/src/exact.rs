@@ -132,6 +132,8 @@ pub enum ExactReport {
     Field(FieldErrors),
     /// Against Hertz or Cattaneo-Mindlin.
     Contact(ContactErrors),
+    /// Against the half-space's closed form of an axisymmetric indenter (`half-space`).
+    HalfSpace(Box<crate::report::HalfSpaceReport>),
 }
 
 impl ExactReport {
@@ -140,6 +142,7 @@ impl ExactReport {
         match self {
             ExactReport::Field(f) => f.kind,
             ExactReport::Contact(c) => c.kind,
+            ExactReport::HalfSpace(_) => ExactKind::HalfSpace,
         }
     }
 
@@ -148,6 +151,7 @@ impl ExactReport {
         match self {
             ExactReport::Field(f) => f.error,
             ExactReport::Contact(c) => c.error,
+            ExactReport::HalfSpace(h) => h.error,
         }
     }
 
@@ -156,6 +160,7 @@ impl ExactReport {
         match self {
             ExactReport::Field(f) => &f.error_name,
             ExactReport::Contact(c) => &c.error_name,
+            ExactReport::HalfSpace(h) => &h.error_name,
         }
     }
 }
@@ -277,7 +282,10 @@ pub fn contact_errors(
     p: f64,
     q: f64,
 ) -> Option<ExactReport> {
-    let x = scene.exact.as_ref().filter(|x| !x.kind.is_field())?;
+    let x = scene
+        .exact
+        .as_ref()
+        .filter(|x| !x.kind.is_field() && x.kind != ExactKind::HalfSpace)?;
     let c = scene.contact.as_ref()?;
     let m = scene.material.first()?;
     let (young, poisson) = (m.young?, m.poisson?);
@@ -350,4 +358,153 @@ pub fn contact_errors(
         out.stick_offset = Some(stick_centre / a);
     }
     Some(ExactReport::Contact(out))
+}
+
+/// The half-space problem of the scene's indenter: the body's [`HalfSpace`], the indenter's
+/// [`Profile`] and its electric [`Tip`]; `Err` (why, in words) where no closed form applies: a
+/// plane body, friction, a compliant bed, a conductive (finite-conductance) tip, several
+/// materials, a crystal not poled along the axis, an indenter off the axis or without an
+/// axisymmetric profile. `electric`: whether the run has electric unknowns.
+///
+/// [`HalfSpace`]: crate::halfspace::HalfSpace
+/// [`Profile`]: crate::halfspace::Profile
+/// [`Tip`]: crate::halfspace::Tip
+pub(crate) fn half_space_problem(
+    scene: &Scene,
+    electric: bool,
+) -> Result<
+    (
+        crate::halfspace::HalfSpace,
+        crate::halfspace::Profile,
+        crate::halfspace::Tip,
+    ),
+    String,
+> {
+    use crate::halfspace::{HalfSpace, Profile, Tip};
+    use crate::scene::{ContactLaw, ElectricCondition, IndenterShape, MaterialModel};
+    let c = scene.contact.as_ref().ok_or("it needs [contact]")?;
+    let ind = c.indenter.as_ref().ok_or("it needs a [contact.indenter]")?;
+    let [m] = &scene.material[..] else {
+        return Err("it needs one material".into());
+    };
+    if !scene.mesh.axisymmetric {
+        return Err("it needs a body of revolution (mesh.axisymmetric = true)".into());
+    }
+    if c.law != ContactLaw::Signorini || c.compliance.is_some() {
+        return Err(
+            "it is frictionless on a rigid indenter: contact.law = \"signorini\", no contact.compliance".into(),
+        );
+    }
+    if !ind.tip.as_deref().and_then(|t| t.first()).is_none_or(|x| *x == 0.0) {
+        return Err("the indenter's tip must lie on the axis (contact.indenter.tip = [0, z])".into());
+    }
+    let need = |v: Option<f64>| v.ok_or_else(|| "the indenter's radius or angle is missing".to_string());
+    let profile = match ind.shape {
+        IndenterShape::Paraboloid => Profile::Paraboloid {
+            radius: need(ind.radius)?,
+        },
+        IndenterShape::Sphere => Profile::Sphere {
+            radius: need(ind.radius)?,
+        },
+        IndenterShape::Cone => Profile::Cone {
+            half_angle: need(ind.half_angle)?,
+        },
+        IndenterShape::Punch => Profile::Punch {
+            radius: need(ind.radius)?,
+        },
+        IndenterShape::Profile => Profile::Tabulated(ind.profile.clone().ok_or("the profile is missing")?),
+        IndenterShape::Plane | IndenterShape::Cylinder => {
+            return Err(format!("a {} is no axisymmetric indenter", ind.shape));
+        }
+    };
+    let mut crystal = crate::setup::crystal(m);
+    let scale = m.coupling_scale.unwrap_or(1.0);
+    crystal
+        .e
+        .iter_mut()
+        .flatten()
+        .for_each(|x| *x *= if electric { scale } else { 0.0 });
+    if !electric {
+        crystal.permittivity = [[0.0; 3]; 3];
+    }
+    // the half-space's inward normal is -n (the axis, y); a crystal poled along it, either way
+    let inward = -c.normal.get(1).copied().unwrap_or(0.0);
+    let along = match m.model {
+        MaterialModel::Isotropic => 1.0,
+        MaterialModel::Crystal6mm => {
+            let p = &m.poling;
+            let len = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if p.len() != 3 || (p[0].abs() + p[2].abs()) > 1e-12 * len {
+                return Err("the crystal must be poled along the axis (material.poling = [0, ±1, 0])".into());
+            }
+            p[1].signum() * inward.signum()
+        }
+    };
+    let body = HalfSpace::from_crystal(&crystal).map_err(|e| e.to_string())?;
+    let body = if along < 0.0 { body.reversed() } else { body };
+    let tip = match (electric, c.electric.unwrap_or(ElectricCondition::Insulated)) {
+        (false, _) | (true, ElectricCondition::Insulated) => Tip::Insulating,
+        (true, ElectricCondition::Conducting) => match c.charge {
+            Some(charge) => Tip::Floating { charge },
+            None => Tip::Conducting {
+                potential: c.foundation_potential.unwrap_or(0.0),
+            },
+        },
+        (true, ElectricCondition::Conductive) => {
+            return Err(
+                "a conductive tip (finite conductance) has no closed form; use \"insulated\" or \"conducting\"".into(),
+            );
+        }
+    };
+    Ok((body, profile, tip))
+}
+
+/// The half-space closed form of `problem::halfspace` for the scene's indenter, and the run's
+/// errors against it (`indenter.half_space`); `None` where [`half_space_problem`] refuses.
+pub(crate) fn half_space(
+    scene: &Scene,
+    electric: bool,
+    run: &crate::report::IndenterReport,
+) -> Option<crate::report::HalfSpaceReport> {
+    use crate::halfspace::Tip;
+    let (body, profile, tip) = half_space_problem(scene, electric).ok()?;
+    let force = scene.contact.as_ref()?.indenter.as_ref()?.force;
+    let form = match force {
+        Some(f) => body.at_force(&profile, f, tip),
+        None => body.at_depth(&profile, run.depth, tip),
+    };
+    let rel = |h: f64, exact: f64| (h - exact).abs() / exact.abs();
+    let (error, error_name) = match force {
+        Some(_) => (
+            rel(run.depth, form.depth),
+            "relative error of the depth against the half-space's closed form at the same force",
+        ),
+        None => (
+            rel(run.force, form.force),
+            "relative error of the force against the half-space's closed form at the same depth",
+        ),
+    };
+    // the quantity found: a conductor's charge at a given potential, an insulator's or a
+    // floating conductor's potential
+    let electric_error = match tip {
+        Tip::Conducting { .. } => run.charge.zip(form.charge).map(|(h, q)| rel(h, q)),
+        Tip::Insulating => run.tip_potential.zip(form.potential).map(|(h, p)| rel(h, p)),
+        Tip::Floating { .. } => run.potential.zip(form.potential).map(|(h, p)| rel(h, p)),
+    };
+    Some(crate::report::HalfSpaceReport {
+        depth: form.depth,
+        force: form.force,
+        contact_radius: form.contact_radius,
+        potential: form.potential,
+        charge: form.charge.filter(|_| !matches!(tip, Tip::Insulating)),
+        modulus: match tip {
+            Tip::Insulating => Some(body.insulating_modulus()),
+            Tip::Conducting { .. } => Some(body.conducting_modulus()),
+            Tip::Floating { .. } => None,
+        },
+        error,
+        error_name: error_name.into(),
+        radius_error: rel(run.contact_radius, form.contact_radius),
+        electric_error,
+    })
 }

@@ -63,6 +63,7 @@ mod estimate;
 mod exact;
 mod faer_backend;
 mod floating;
+pub mod halfspace;
 mod path;
 mod plan;
 mod progress;

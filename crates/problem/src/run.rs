@@ -392,7 +392,38 @@ pub(crate) fn recover(
     ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
     ProblemError::check_finite(&fields.stress, "the stress", scene)?;
     let terminals = terminals(setup, disc, &u, &phi)?;
-    let indenter = contact.and_then(|(b, sol)| indenter_report(scene, &b.points, sol, counts.normal_force));
+    let indenter = contact.and_then(|(b, sol)| {
+        let mut r = indenter_report(scene, &b.points, sol, counts.normal_force)?;
+        if setup.plan.electric {
+            // the contact node nearest the indenter's axis
+            let ind = scene.contact.as_ref()?.indenter.as_ref()?;
+            let nearest = (0..b.points.len()).min_by(|&i, &j| {
+                let ri = ind.local(&b.points.position[i], &b.points.normal[i]).1;
+                let rj = ind.local(&b.points.position[j], &b.points.normal[j]).1;
+                ri.total_cmp(&rj)
+            });
+            r.tip_potential = nearest.map(|i| phi[b.nodes[i]]);
+        }
+        r.half_space = crate::exact::half_space(scene, setup.plan.electric, &r);
+        Some(r)
+    });
+    let exact = match (&scene.exact, &indenter) {
+        (Some(x), Some(i)) if x.kind == crate::scene::ExactKind::HalfSpace => {
+            let h = i.half_space.clone().ok_or_else(|| {
+                ProblemError::Scene(crate::scene::SceneError::new(
+                    "exact.kind",
+                    "exact.kind `half-space`: the run's indenter has no closed form",
+                ))
+            })?;
+            reporter.event(&Event::Exact {
+                kind: crate::scene::ExactKind::HalfSpace,
+                what: &h.error_name,
+                error: h.error,
+            });
+            Some(crate::exact::ExactReport::HalfSpace(Box::new(h)))
+        }
+        _ => exact,
+    };
     Ok(Recovered {
         u,
         phi,
@@ -427,8 +458,20 @@ pub(crate) fn indenter_report(
         force: normal_force,
         contact_radius: radius,
         points_in_contact: count,
-        potential: c.electric_law().map(|(_, potential)| potential),
+        // a floating tip's potential is found: that of a point it presses
+        potential: match (c.charge, sol.electric.as_ref()) {
+            (Some(_), Some(e)) => e
+                .points
+                .iter()
+                .zip(&e.potential)
+                .filter(|&(&i, _)| sol.lambda.normal[i] > 0.0)
+                .map(|(_, &v)| v)
+                .next(),
+            _ => c.electric_law().map(|(_, potential)| potential),
+        },
         charge: sol.electric.as_ref().map(|e| -e.charge(&points.weight)),
+        tip_potential: None,
+        half_space: None,
     })
 }
 

@@ -114,6 +114,23 @@ pub const ENTRIES: &[Entry] = &[
         },
     },
     Entry {
+        scene: "indent-sphere",
+        sizes: (&[96, 128, 160], &[96, 128, 160, 224]),
+        reference: (None, None),
+        strategies: &[NewtonCondensed, ApgCondensed],
+        tols: &[1e-6, 1e-10],
+        claim: "a PZT-4 body of revolution under an insulating sphere carries the half-space's force (problem::halfspace's closed form): error falling with h, below 1 % on the finest mesh (the body's finite size leaves about 0.5 %, halving as the body doubles: docs/theory.md)",
+        check: |s| {
+            let falls = s.tight.windows(2).all(|w| w[1].1 < w[0].1);
+            let e = finest(s);
+            if falls && e < 0.01 {
+                Ok(())
+            } else {
+                Err(format!("finest error {e:.3e}, falling with h: {falls}"))
+            }
+        },
+    },
+    Entry {
         scene: "cattaneo-mindlin",
         sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
         reference: (None, None),

@@ -208,6 +208,9 @@ choice! {
         Hertz = "hertz",
         /// Cattaneo-Mindlin's partial slip under a tangential force.
         CattaneoMindlin = "cattaneo-mindlin",
+        /// A rigid axisymmetric indenter on a transversely isotropic piezoelectric (or
+        /// isotropic) half-space: `problem::halfspace`'s closed form.
+        HalfSpace = "half-space",
     }
 }
 
@@ -279,6 +282,9 @@ impl ExactKind {
             ExactKind::Hertz => "relative l2 error of the nodal contact pressure against Hertz's, over |x| ≤ 1.5 a",
             ExactKind::CattaneoMindlin => {
                 "relative l2 error of the nodal tangential traction against Cattaneo-Mindlin's, over |x| ≤ 1.5 a"
+            }
+            ExactKind::HalfSpace => {
+                "relative error of the indenter's force (its depth under force control) against the half-space's closed form"
             }
         }
     }
@@ -959,6 +965,13 @@ pub struct ContactSpec {
     /// pressure, or unit penetration under normal compliance).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub conductance: Option<f64>,
+    /// A floating conducting foundation or indenter (`electric = "conducting"` or
+    /// `"conductive"`): the charge
+    /// it carries (as run.json's `indenter.charge`; 0 for an open circuit), its potential one
+    /// more unknown, found with the contact solution (`foundation_potential` is where the
+    /// search starts).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charge: Option<f64>,
     /// A rigid indenter of a given shape (the obstacle), instead of a flat or parabolic gap.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub indenter: Option<IndenterSpec>,
@@ -1094,6 +1107,7 @@ impl ContactSpec {
             electric: None,
             foundation_potential: None,
             conductance: None,
+            charge: None,
             indenter: None,
         }
     }
