@@ -556,7 +556,7 @@ fn indenter_of(scene: &str, sets: &[String]) -> problem::report::IndenterReport 
 
 #[test]
 fn piezoelectric_indentation_meets_the_half_space_closed_forms() {
-    // problem::halfspace: Barnett-Lothe's surface compliance of the crystal and Sneddon's
+    // problem::HalfSpace: Barnett-Lothe's surface compliance of the crystal and Sneddon's
     // integrals through the correspondence principle (docs/theory.md). Measured at the
     // shipped n = 160 (force, contact radius, tip potential or charge, relative):
     // PZT-4 sphere 0.58/0.21/0.27 % insulating, 0.48/0.21/0.42 % conducting (the body's
@@ -615,7 +615,7 @@ fn the_half_space_error_falls_with_the_mesh_and_the_body_size() {
 fn the_pfm_response_is_the_half_spaces() {
     // the depth at constant force moves by -(K₁₂/K₁₁) ψ on a half-space (K = G⁻¹): 0.2501 m/GV
     // on PZT-4; the shipped pfm (a conductive contact, conductance 1e4) measured 0.248
-    use problem::halfspace::{HalfSpace, Profile, Tip};
+    use problem::{HalfSpace, Profile, Tip};
     let pzt4 =
         fe_assembly::Crystal::hexagonal_6mm([139.0, 77.8, 74.3, 115.0, 25.6, 30.6], [-5.2, 15.1, 12.7], [6.46, 5.62]);
     let body = HalfSpace::from_crystal(&pzt4).unwrap();

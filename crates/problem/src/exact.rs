@@ -133,7 +133,7 @@ pub enum ExactReport {
     /// Against Hertz or Cattaneo-Mindlin.
     Contact(ContactErrors),
     /// Against the half-space's closed form of an axisymmetric indenter (`half-space`).
-    HalfSpace(Box<crate::report::HalfSpaceReport>),
+    HalfSpace(Box<HalfSpaceReport>),
 }
 
 impl ExactReport {
@@ -360,114 +360,11 @@ pub fn contact_errors(
     Some(ExactReport::Contact(out))
 }
 
-/// The half-space problem of the scene's indenter: the body's [`HalfSpace`], the indenter's
-/// [`Profile`] and its electric [`Tip`]; `Err` (why, in words) where no closed form applies: a
-/// plane body, friction, a compliant bed, a conductive (finite-conductance) tip, several
-/// materials, a crystal not poled along the axis, an indenter off the axis or without an
-/// axisymmetric profile. `electric`: whether the run has electric unknowns.
-///
-/// [`HalfSpace`]: crate::halfspace::HalfSpace
-/// [`Profile`]: crate::halfspace::Profile
-/// [`Tip`]: crate::halfspace::Tip
-pub(crate) fn half_space_problem(
-    scene: &Scene,
-    electric: bool,
-) -> Result<
-    (
-        crate::halfspace::HalfSpace,
-        crate::halfspace::Profile,
-        crate::halfspace::Tip,
-    ),
-    String,
-> {
-    use crate::halfspace::{HalfSpace, Profile, Tip};
-    use crate::scene::{ContactLaw, ElectricCondition, IndenterShape, MaterialModel};
-    let c = scene.contact.as_ref().ok_or("it needs [contact]")?;
-    let ind = c.indenter.as_ref().ok_or("it needs a [contact.indenter]")?;
-    let [m] = &scene.material[..] else {
-        return Err("it needs one material".into());
-    };
-    if !scene.mesh.axisymmetric {
-        return Err("it needs a body of revolution (mesh.axisymmetric = true)".into());
-    }
-    if c.law != ContactLaw::Signorini || c.compliance.is_some() {
-        return Err(
-            "it is frictionless on a rigid indenter: contact.law = \"signorini\", no contact.compliance".into(),
-        );
-    }
-    if !ind.tip.as_deref().and_then(|t| t.first()).is_none_or(|x| *x == 0.0) {
-        return Err("the indenter's tip must lie on the axis (contact.indenter.tip = [0, z])".into());
-    }
-    let need = |v: Option<f64>| v.ok_or_else(|| "the indenter's radius or angle is missing".to_string());
-    let profile = match ind.shape {
-        IndenterShape::Paraboloid => Profile::Paraboloid {
-            radius: need(ind.radius)?,
-        },
-        IndenterShape::Sphere => Profile::Sphere {
-            radius: need(ind.radius)?,
-        },
-        IndenterShape::Cone => Profile::Cone {
-            half_angle: need(ind.half_angle)?,
-        },
-        IndenterShape::Punch => Profile::Punch {
-            radius: need(ind.radius)?,
-        },
-        IndenterShape::Profile => Profile::Tabulated(ind.profile.clone().ok_or("the profile is missing")?),
-        IndenterShape::Plane | IndenterShape::Cylinder => {
-            return Err(format!("a {} is no axisymmetric indenter", ind.shape));
-        }
-    };
-    let mut crystal = crate::setup::crystal(m);
-    let scale = m.coupling_scale.unwrap_or(1.0);
-    crystal
-        .e
-        .iter_mut()
-        .flatten()
-        .for_each(|x| *x *= if electric { scale } else { 0.0 });
-    if !electric {
-        crystal.permittivity = [[0.0; 3]; 3];
-    }
-    // the half-space's inward normal is -n (the axis, y); a crystal poled along it, either way
-    let inward = -c.normal.get(1).copied().unwrap_or(0.0);
-    let along = match m.model {
-        MaterialModel::Isotropic => 1.0,
-        MaterialModel::Crystal6mm => {
-            let p = &m.poling;
-            let len = p.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if p.len() != 3 || (p[0].abs() + p[2].abs()) > 1e-12 * len {
-                return Err("the crystal must be poled along the axis (material.poling = [0, ±1, 0])".into());
-            }
-            p[1].signum() * inward.signum()
-        }
-    };
-    let body = HalfSpace::from_crystal(&crystal).map_err(|e| e.to_string())?;
-    let body = if along < 0.0 { body.reversed() } else { body };
-    let tip = match (electric, c.electric.unwrap_or(ElectricCondition::Insulated)) {
-        (false, _) | (true, ElectricCondition::Insulated) => Tip::Insulating,
-        (true, ElectricCondition::Conducting) => match c.charge {
-            Some(charge) => Tip::Floating { charge },
-            None => Tip::Conducting {
-                potential: c.foundation_potential.unwrap_or(0.0),
-            },
-        },
-        (true, ElectricCondition::Conductive) => {
-            return Err(
-                "a conductive tip (finite conductance) has no closed form; use \"insulated\" or \"conducting\"".into(),
-            );
-        }
-    };
-    Ok((body, profile, tip))
-}
-
-/// The half-space closed form of `problem::halfspace` for the scene's indenter, and the run's
-/// errors against it (`indenter.half_space`); `None` where [`half_space_problem`] refuses.
-pub(crate) fn half_space(
-    scene: &Scene,
-    electric: bool,
-    run: &crate::report::IndenterReport,
-) -> Option<crate::report::HalfSpaceReport> {
+/// The half-space closed form of `problem::HalfSpace` for the scene's indenter, and the run's
+/// errors against it (`indenter.half_space`); `None` where [`Scene::half_space_problem`] refuses.
+pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Option<HalfSpaceReport> {
     use crate::halfspace::Tip;
-    let (body, profile, tip) = half_space_problem(scene, electric).ok()?;
+    let (body, profile, tip) = scene.half_space_problem(electric).ok()?;
     let force = scene.contact.as_ref()?.indenter.as_ref()?.force;
     let form = match force {
         Some(f) => body.at_force(&profile, f, tip),
@@ -491,7 +388,7 @@ pub(crate) fn half_space(
         Tip::Insulating => run.tip_potential.zip(form.potential).map(|(h, p)| rel(h, p)),
         Tip::Floating { .. } => run.potential.zip(form.potential).map(|(h, p)| rel(h, p)),
     };
-    Some(crate::report::HalfSpaceReport {
+    Some(HalfSpaceReport {
         depth: form.depth,
         force: form.force,
         contact_radius: form.contact_radius,
@@ -507,4 +404,51 @@ pub(crate) fn half_space(
         radius_error: rel(run.contact_radius, form.contact_radius),
         electric_error,
     })
+}
+
+/// What a run measured of its indenter, for [`half_space`] (run.json's `indenter`).
+pub(crate) struct Measured {
+    /// The depth.
+    pub depth: f64,
+    /// The force.
+    pub force: f64,
+    /// The contact radius.
+    pub contact_radius: f64,
+    /// The tip's potential (a conductor's).
+    pub potential: Option<f64>,
+    /// The tip's charge (a conductor's).
+    pub charge: Option<f64>,
+    /// The surface's potential under the tip.
+    pub tip_potential: Option<f64>,
+}
+
+/// The closed form of a half-space under the scene's indenter (`run.json`'s
+/// `indenter.half_space`), and the run's relative errors against it.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct HalfSpaceReport {
+    /// The depth (the run's under depth control; the closed form's under force control).
+    pub depth: f64,
+    /// The force (the closed form's under depth control; the run's under force control).
+    pub force: f64,
+    /// The contact radius.
+    pub contact_radius: f64,
+    /// The tip's potential: a conductor's own; under an insulator, the surface's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub potential: Option<f64>,
+    /// A conducting tip's charge (the same sign convention as `indenter.charge`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charge: Option<f64>,
+    /// The indentation modulus the tip sees (`P = (4/3) E* √R d^(3/2)` for a paraboloid):
+    /// `2/G₁₁` insulating, `2 (G⁻¹)₁₁` conducting at a given potential; none floating.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modulus: Option<f64>,
+    /// Depth control: `|P_h - P| / P`; force control: `|d_h - d| / d`.
+    pub error: f64,
+    /// What `error` measures, in words (the force's error, or the depth's under force control).
+    pub error_name: String,
+    /// `|a_h - a| / a`.
+    pub radius_error: f64,
+    /// `|Q_h - Q| / |Q|` (conducting) or `|φ_h - φ| / |φ|` at the tip (insulating).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub electric_error: Option<f64>,
 }

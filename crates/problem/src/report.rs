@@ -4,6 +4,7 @@
 //! residuals, timings, memory, and the solver's own parameters.
 
 use crate::exact::ExactReport;
+pub use crate::exact::HalfSpaceReport;
 use crate::plan::Plan;
 use crate::scene::{Rule, Scene, Strategy};
 use serde::{Deserialize, Serialize};
@@ -78,41 +79,10 @@ pub struct IndenterReport {
     /// On a body of revolution under a frictionless axisymmetric indenter (one isotropic or
     /// 6mm material poled along the axis, an insulating or conducting tip): the closed form
     /// of a half-space of the same material at the same depth (force control: the same
-    /// force), and the run's errors against it (`problem::halfspace`; a finite body differs
+    /// force), and the run's errors against it (`problem::HalfSpace`; a finite body differs
     /// by its size effect).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub half_space: Option<HalfSpaceReport>,
-}
-
-/// The closed form of a half-space under the scene's indenter (`run.json`'s
-/// `indenter.half_space`), and the run's relative errors against it.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct HalfSpaceReport {
-    /// The depth (the run's under depth control; the closed form's under force control).
-    pub depth: f64,
-    /// The force (the closed form's under depth control; the run's under force control).
-    pub force: f64,
-    /// The contact radius.
-    pub contact_radius: f64,
-    /// The tip's potential: a conductor's own; under an insulator, the surface's.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub potential: Option<f64>,
-    /// A conducting tip's charge (the same sign convention as `indenter.charge`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub charge: Option<f64>,
-    /// The indentation modulus the tip sees (`P = (4/3) E* √R d^(3/2)` for a paraboloid):
-    /// `2/G₁₁` insulating, `2 (G⁻¹)₁₁` conducting at a given potential; none floating.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub modulus: Option<f64>,
-    /// Depth control: `|P_h - P| / P`; force control: `|d_h - d| / d`.
-    pub error: f64,
-    /// What `error` measures, in words (the force's error, or the depth's under force control).
-    pub error_name: String,
-    /// `|a_h - a| / a`.
-    pub radius_error: f64,
-    /// `|Q_h - Q| / |Q|` (conducting) or `|φ_h - φ| / |φ|` at the tip (insulating).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub electric_error: Option<f64>,
 }
 
 /// A boundary group at a prescribed potential (`run.json`'s `terminals`).

@@ -404,7 +404,15 @@ pub(crate) fn recover(
             });
             r.tip_potential = nearest.map(|i| phi[b.nodes[i]]);
         }
-        r.half_space = crate::exact::half_space(scene, setup.plan.electric, &r);
+        let measured = crate::exact::Measured {
+            depth: r.depth,
+            force: r.force,
+            contact_radius: r.contact_radius,
+            potential: r.potential,
+            charge: r.charge,
+            tip_potential: r.tip_potential,
+        };
+        r.half_space = crate::exact::half_space(scene, setup.plan.electric, &measured);
         Some(r)
     });
     let exact = match (&scene.exact, &indenter) {

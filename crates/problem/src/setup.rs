@@ -4,9 +4,9 @@
 
 use crate::exact::FieldSolution;
 use crate::plan::{electric_data, Plan};
-use crate::scene::{MaterialModel, MaterialSpec, MeshKind, Scene, SceneError, Valid};
+use crate::scene::{MaterialSpec, MeshKind, Scene, SceneError, Valid};
 use crate::ProblemError;
-use fe_assembly::{Constraint, Crystal, Field, Load, Material};
+use fe_assembly::{Constraint, Field, Load, Material};
 use std::sync::Arc;
 
 /// Everything a scene sets up before assembly.
@@ -256,7 +256,7 @@ fn grade(mesh: &mut mesh::Mesh, m: &crate::scene::MeshSpec, grading: &[f64]) {
 /// The material of a validated spec in dimension `dim`, in the global frame (of a body of
 /// revolution about y where `axisymmetric`).
 fn material(spec: &MaterialSpec, dim: usize, axisymmetric: bool) -> Result<Material, ProblemError> {
-    let crystal = crystal(spec);
+    let crystal = spec.crystal();
     // an isotropic material has no poling; the validated crystal has 3 components
     let poling = match spec.poling[..] {
         [a, b, c] => [a, b, c],
@@ -270,21 +270,6 @@ fn material(spec: &MaterialSpec, dim: usize, axisymmetric: bool) -> Result<Mater
         Material::from_crystal(&spec.region, &crystal, poling, dim)?
     };
     Ok(material.with_coupling_scale(scale))
-}
-
-/// The constants of a validated spec in its crystal frame (the coupling not yet scaled).
-pub(crate) fn crystal(spec: &MaterialSpec) -> Crystal {
-    match spec.model {
-        MaterialModel::Crystal6mm => {
-            let (c, e, p) = (&spec.c, &spec.e, &spec.permittivity);
-            Crystal::hexagonal_6mm([c[0], c[1], c[2], c[3], c[4], c[5]], [e[0], e[1], e[2]], [p[0], p[1]])
-        }
-        MaterialModel::Isotropic => Crystal::isotropic(
-            spec.young.unwrap_or_default(),
-            spec.poisson.unwrap_or_default(),
-            spec.permittivity.first().copied().unwrap_or(0.0),
-        ),
-    }
 }
 
 /// The materials of the scene by region, in the global frame.

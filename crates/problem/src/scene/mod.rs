@@ -209,7 +209,7 @@ choice! {
         /// Cattaneo-Mindlin's partial slip under a tangential force.
         CattaneoMindlin = "cattaneo-mindlin",
         /// A rigid axisymmetric indenter on a transversely isotropic piezoelectric (or
-        /// isotropic) half-space: `problem::halfspace`'s closed form.
+        /// isotropic) half-space: `problem::HalfSpace`'s closed form.
         HalfSpace = "half-space",
     }
 }
@@ -784,6 +784,22 @@ pub struct MaterialSpec {
 }
 
 impl MaterialSpec {
+    /// The constants of a validated spec in its crystal frame (the coupling not yet scaled).
+    pub(crate) fn crystal(&self) -> fe_assembly::Crystal {
+        use fe_assembly::Crystal;
+        match self.model {
+            MaterialModel::Crystal6mm => {
+                let (c, e, p) = (&self.c, &self.e, &self.permittivity);
+                Crystal::hexagonal_6mm([c[0], c[1], c[2], c[3], c[4], c[5]], [e[0], e[1], e[2]], [p[0], p[1]])
+            }
+            MaterialModel::Isotropic => Crystal::isotropic(
+                self.young.unwrap_or_default(),
+                self.poisson.unwrap_or_default(),
+                self.permittivity.first().copied().unwrap_or(0.0),
+            ),
+        }
+    }
+
     /// A poled 6mm crystal on `region`: `c = [c11, c12, c13, c33, c44, c66]`,
     /// `e = [e31, e33, e15]`, `permittivity = [eps11, eps33]`, poled along `poling`.
     pub fn crystal_6mm(region: &str, c: [f64; 6], e: [f64; 3], permittivity: [f64; 2], poling: [f64; 3]) -> Self {
@@ -1011,6 +1027,107 @@ pub struct IndenterSpec {
     /// unknown, found with the contact solution.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force: Option<f64>,
+}
+
+impl Scene {
+    /// The half-space problem of the scene's indenter: the body's [`HalfSpace`], the indenter's
+    /// [`Profile`] and its electric [`Tip`]; `Err` (why, in words) where no closed form applies: a
+    /// plane body, friction, a compliant bed, a conductive (finite-conductance) tip, several
+    /// materials, a crystal not poled along the axis, an indenter off the axis or without an
+    /// axisymmetric profile. `electric`: whether the run has electric unknowns.
+    ///
+    /// [`HalfSpace`]: crate::halfspace::HalfSpace
+    /// [`Profile`]: crate::halfspace::Profile
+    /// [`Tip`]: crate::halfspace::Tip
+    pub(crate) fn half_space_problem(
+        &self,
+        electric: bool,
+    ) -> Result<
+        (
+            crate::halfspace::HalfSpace,
+            crate::halfspace::Profile,
+            crate::halfspace::Tip,
+        ),
+        String,
+    > {
+        use crate::halfspace::{HalfSpace, Profile, Tip};
+        let c = self.contact.as_ref().ok_or("it needs [contact]")?;
+        let ind = c.indenter.as_ref().ok_or("it needs a [contact.indenter]")?;
+        let [m] = &self.material[..] else {
+            return Err("it needs one material".into());
+        };
+        if !self.mesh.axisymmetric {
+            return Err("it needs a body of revolution (mesh.axisymmetric = true)".into());
+        }
+        if c.law != ContactLaw::Signorini || c.compliance.is_some() {
+            return Err(
+                "it is frictionless on a rigid indenter: contact.law = \"signorini\", no contact.compliance".into(),
+            );
+        }
+        if !ind.tip.as_deref().and_then(|t| t.first()).is_none_or(|x| *x == 0.0) {
+            return Err("the indenter's tip must lie on the axis (contact.indenter.tip = [0, z])".into());
+        }
+        let need = |v: Option<f64>| v.ok_or_else(|| "the indenter's radius or angle is missing".to_string());
+        let profile = match ind.shape {
+            IndenterShape::Paraboloid => Profile::Paraboloid {
+                radius: need(ind.radius)?,
+            },
+            IndenterShape::Sphere => Profile::Sphere {
+                radius: need(ind.radius)?,
+            },
+            IndenterShape::Cone => Profile::Cone {
+                half_angle: need(ind.half_angle)?,
+            },
+            IndenterShape::Punch => Profile::Punch {
+                radius: need(ind.radius)?,
+            },
+            IndenterShape::Profile => Profile::Tabulated(ind.profile.clone().ok_or("the profile is missing")?),
+            IndenterShape::Plane | IndenterShape::Cylinder => {
+                return Err(format!("a {} is no axisymmetric indenter", ind.shape));
+            }
+        };
+        let mut crystal = m.crystal();
+        let scale = m.coupling_scale.unwrap_or(1.0);
+        crystal
+            .e
+            .iter_mut()
+            .flatten()
+            .for_each(|x| *x *= if electric { scale } else { 0.0 });
+        if !electric {
+            crystal.permittivity = [[0.0; 3]; 3];
+        }
+        // the half-space's inward normal is -n (the axis, y); a crystal poled along it, either way
+        let inward = -c.normal.get(1).copied().unwrap_or(0.0);
+        let along = match m.model {
+            MaterialModel::Isotropic => 1.0,
+            MaterialModel::Crystal6mm => {
+                let p = &m.poling;
+                let len = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+                if p.len() != 3 || (p[0].abs() + p[2].abs()) > 1e-12 * len {
+                    return Err("the crystal must be poled along the axis (material.poling = [0, ±1, 0])".into());
+                }
+                p[1].signum() * inward.signum()
+            }
+        };
+        let body = HalfSpace::from_crystal(&crystal).map_err(|e| e.to_string())?;
+        let body = if along < 0.0 { body.reversed() } else { body };
+        let tip = match (electric, c.electric.unwrap_or(ElectricCondition::Insulated)) {
+            (false, _) | (true, ElectricCondition::Insulated) => Tip::Insulating,
+            (true, ElectricCondition::Conducting) => match c.charge {
+                Some(charge) => Tip::Floating { charge },
+                None => Tip::Conducting {
+                    potential: c.foundation_potential.unwrap_or(0.0),
+                },
+            },
+            (true, ElectricCondition::Conductive) => {
+                return Err(
+                    "a conductive tip (finite conductance) has no closed form; use \"insulated\" or \"conducting\""
+                        .into(),
+                );
+            }
+        };
+        Ok((body, profile, tip))
+    }
 }
 
 impl IndenterSpec {

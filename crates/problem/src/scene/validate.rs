@@ -1091,14 +1091,12 @@ fn validate_exact(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
         refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
         refuse_if(x.slip.is_some(), "exact.slip", why)?;
         let electric = s.material.iter().any(|m| m.permittivity.iter().any(|&e| e != 0.0));
-        return crate::exact::half_space_problem(s, electric)
-            .map(|_| ())
-            .map_err(|why| {
-                SceneError::new(
-                    "exact.kind",
-                    format!("exact.kind `half-space`: {why} (or remove [exact]: `--set ~exact`)"),
-                )
-            });
+        return s.half_space_problem(electric).map(|_| ()).map_err(|why| {
+            SceneError::new(
+                "exact.kind",
+                format!("exact.kind `half-space`: {why} (or remove [exact]: `--set ~exact`)"),
+            )
+        });
     }
     if x.kind.is_field() {
         validate_field_solution(x, s)
