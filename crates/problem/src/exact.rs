@@ -282,10 +282,7 @@ pub fn contact_errors(
     p: f64,
     q: f64,
 ) -> Option<ExactReport> {
-    let x = scene
-        .exact
-        .as_ref()
-        .filter(|x| !x.kind.is_field() && x.kind != ExactKind::HalfSpace)?;
+    let x = scene.exact.as_ref().filter(|x| !x.kind.is_field())?;
     let c = scene.contact.as_ref()?;
     let m = scene.material.first()?;
     let (young, poisson) = (m.young?, m.poisson?);

@@ -371,27 +371,6 @@ pub(crate) fn recover(
         held_inside: b.held_inside,
         ..ContactReport::of(&b.points, sol)
     });
-    let exact = match (&setup.exact, contact) {
-        (Some(ex), _) => Some(ex.errors(disc, &u, &phi, setup.plan.electric)),
-        (None, Some((b, sol))) => contact_errors(scene, &b.points, sol, counts.normal_force, counts.tangential_force),
-        (None, None) => None,
-    };
-    if let Some(e) = &exact {
-        reporter.event(&Event::Exact {
-            kind: e.kind(),
-            what: e.error_name(),
-            error: e.error(),
-        });
-    }
-    let reported = [
-        equilibrium,
-        counts.normal_force,
-        counts.tangential_force,
-        exact.as_ref().map_or(0.0, |e| e.error()),
-    ];
-    ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
-    ProblemError::check_finite(&fields.stress, "the stress", scene)?;
-    let terminals = terminals(setup, disc, &u, &phi)?;
     let indenter = contact.and_then(|(b, sol)| {
         let mut r = indenter_report(scene, &b.points, sol, counts.normal_force)?;
         if setup.plan.electric {
@@ -415,23 +394,41 @@ pub(crate) fn recover(
         r.half_space = crate::exact::half_space(scene, setup.plan.electric, &measured);
         Some(r)
     });
-    let exact = match (&scene.exact, &indenter) {
-        (Some(x), Some(i)) if x.kind == crate::scene::ExactKind::HalfSpace => {
-            let h = i.half_space.clone().ok_or_else(|| {
+    let half_space = scene
+        .exact
+        .as_ref()
+        .is_some_and(|x| x.kind == crate::scene::ExactKind::HalfSpace);
+    let exact = match (&setup.exact, contact) {
+        (Some(ex), _) => Some(ex.errors(disc, &u, &phi, setup.plan.electric)),
+        // the half-space's closed form, reported with the indenter's figures
+        (None, Some(_)) if half_space => {
+            let h = indenter.as_ref().and_then(|i| i.half_space.clone()).ok_or_else(|| {
                 ProblemError::Scene(crate::scene::SceneError::new(
                     "exact.kind",
                     "exact.kind `half-space`: the run's indenter has no closed form",
                 ))
             })?;
-            reporter.event(&Event::Exact {
-                kind: crate::scene::ExactKind::HalfSpace,
-                what: &h.error_name,
-                error: h.error,
-            });
             Some(crate::exact::ExactReport::HalfSpace(Box::new(h)))
         }
-        _ => exact,
+        (None, Some((b, sol))) => contact_errors(scene, &b.points, sol, counts.normal_force, counts.tangential_force),
+        (None, None) => None,
     };
+    if let Some(e) = &exact {
+        reporter.event(&Event::Exact {
+            kind: e.kind(),
+            what: e.error_name(),
+            error: e.error(),
+        });
+    }
+    let reported = [
+        equilibrium,
+        counts.normal_force,
+        counts.tangential_force,
+        exact.as_ref().map_or(0.0, |e| e.error()),
+    ];
+    ProblemError::check_finite(&reported, "a reported number (residual, force or error)", scene)?;
+    ProblemError::check_finite(&fields.stress, "the stress", scene)?;
+    let terminals = terminals(setup, disc, &u, &phi)?;
     Ok(Recovered {
         u,
         phi,

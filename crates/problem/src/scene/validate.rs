@@ -1079,17 +1079,23 @@ fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// A contact solution (Hertz, Cattaneo-Mindlin, the half-space) takes none of a field
+/// solution's data.
+fn refuse_field_data(x: &ExactSpec) -> Result<(), SceneError> {
+    let why = "a field solution's data, and exact.kind is a contact solution";
+    refuse_if(!x.groups.is_empty(), "exact.groups", why)?;
+    refuse_if(
+        !(x.u0.is_empty() && x.grad_u.is_empty() && x.grad_phi.is_empty()),
+        "exact.u0",
+        why,
+    )?;
+    refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
+    refuse_if(x.slip.is_some(), "exact.slip", why)
+}
+
 fn validate_exact(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
     if x.kind == ExactKind::HalfSpace {
-        let why = "a field solution's data, and exact.kind is a contact solution";
-        refuse_if(!x.groups.is_empty(), "exact.groups", why)?;
-        refuse_if(
-            !(x.u0.is_empty() && x.grad_u.is_empty() && x.grad_phi.is_empty()),
-            "exact.u0",
-            why,
-        )?;
-        refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
-        refuse_if(x.slip.is_some(), "exact.slip", why)?;
+        refuse_field_data(x)?;
         let electric = s.material.iter().any(|m| m.permittivity.iter().any(|&e| e != 0.0));
         return s.half_space_problem(electric).map(|_| ()).map_err(|why| {
             SceneError::new(
@@ -1227,15 +1233,7 @@ fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError>
             &why,
         )?;
     }
-    let why = "a field solution's data, and exact.kind is a contact solution";
-    refuse_if(!x.groups.is_empty(), "exact.groups", why)?;
-    refuse_if(
-        !(x.u0.is_empty() && x.grad_u.is_empty() && x.grad_phi.is_empty()),
-        "exact.u0",
-        why,
-    )?;
-    refuse_if(x.phi0.is_some(), "exact.phi0", why)?;
-    refuse_if(x.slip.is_some(), "exact.slip", why)?;
+    refuse_field_data(x)?;
     if s.mesh.kind != MeshKind::Rectangle {
         return Err(SceneError::new(
             "exact.kind",
