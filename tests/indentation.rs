@@ -88,6 +88,74 @@ fn force_control_finds_the_depth_that_carries_the_force() {
 }
 
 #[test]
+fn force_control_follows_a_load_path_on_hertz_curve() {
+    // the sphere's force ramped in 20 steps by the path's load factor: at each instant the depth
+    // found is Hertz's for that force, d = (3 F / (4 E* √R))^(2/3), within the mesh's error
+    // (the force's 0.5 % at a given depth: a third less in depth), the contact radius √(R d)'s,
+    // and the last instant is the one-instant force-controlled run's
+    let force = 0.46;
+    let sets = |path: bool| {
+        let mut v = vec![
+            "mesh.n=96".to_string(),
+            "~exact".into(),
+            format!("contact.indenter.force={force}"),
+        ];
+        if path {
+            v.push("path={t=[0.0,1.0],steps=20,load=[0.0,1.0],output_every=0}".into());
+        }
+        v
+    };
+    let (scene, _) = files::scene_file::load("hertz-sphere", &sets(true)).unwrap();
+    let s = problem::solve(&scene, None, &mut Silent).unwrap();
+    let rows = &s.report.path.as_ref().unwrap().rows;
+    assert_eq!(rows.len(), 21);
+    // at no force the sphere just touches
+    assert_eq!(
+        (rows[0].normal_force, rows[0].depth, rows[0].contact_radius),
+        (0.0, Some(0.0), Some(0.0))
+    );
+    // the pressed nodes' spacing: the largest jump of the contact radius between instants
+    let radii: Vec<f64> = rows.iter().map(|r| r.contact_radius.unwrap()).collect();
+    let cell = radii.windows(2).map(|w| w[1] - w[0]).fold(0.0f64, f64::max);
+    assert!(
+        radii.windows(2).all(|w| w[1] >= w[0]),
+        "the zone grows with the force: {radii:?}"
+    );
+    for row in &rows[1..] {
+        let f = force * row.t;
+        assert!(
+            (row.normal_force - f).abs() <= 1e-9 * f,
+            "t = {}: force {} against {f}",
+            row.t,
+            row.normal_force
+        );
+        let depth = (3.0 * f / (4.0 * e_star() * 10f64.sqrt())).powf(2.0 / 3.0);
+        let d = row.depth.unwrap();
+        assert!(
+            (d - depth).abs() < 0.01 * depth,
+            "t = {}: depth {d} against Hertz's {depth}",
+            row.t
+        );
+        // the radius is the farthest pressed node's: Hertz's within the cell beyond it
+        let (a, radius) = (row.contact_radius.unwrap(), (10.0 * depth).sqrt());
+        assert!(
+            a <= 1.02 * radius && a > radius - cell,
+            "t = {}: radius {a} against {radius}",
+            row.t
+        );
+    }
+    let (once, _) = files::scene_file::load("hertz-sphere", &sets(false)).unwrap();
+    let once = problem::solve(&once, None, &mut Silent).unwrap();
+    let last = rows.last().unwrap();
+    let depth = once.report.indenter.as_ref().unwrap().depth;
+    assert!(
+        (last.depth.unwrap() - depth).abs() < 1e-8 * depth,
+        "{} against {depth}",
+        last.depth.unwrap()
+    );
+}
+
+#[test]
 fn a_piezoelectric_body_under_a_sphere_is_self_similar() {
     // a homogeneous half-space under a paraboloid: the force and the charge a grounded
     // conducting tip draws grow as d^(3/2) (the problem scales with a = √(R d)); measured at
@@ -678,5 +746,52 @@ fn a_floating_tip_finds_the_potential_that_carries_its_charge() {
     ] {
         let e = files::scene_file::load("indent-sphere", &sets).unwrap_err().to_string();
         assert!(e.contains("contact.charge"), "{e}");
+    }
+}
+
+/// `indent-sphere` on the body of revolution R = H = 8 (graded as `indent-sphere-3d`), and the
+/// same body in 3D: `indent-sphere-3d` on the quarter cylinder (`mesh.cylinder`), its force
+/// times 4. Returns (force, contact radius, tip potential) of each.
+fn revolved_and_3d(n: usize) -> ([f64; 3], [f64; 3]) {
+    let grid = [format!("mesh.n={n}"), "mesh.grading=13.55".into()];
+    let mut axi = vec!["mesh.hi=[8.0,8.0]".to_string(), "~exact".into()];
+    axi.extend(grid.iter().cloned());
+    let mut solid = vec!["mesh.cylinder=true".to_string()];
+    solid.extend(grid.iter().cloned());
+    let figures = |scene: &str, sets: &[String], share: f64| {
+        let r = indenter_of(scene, sets);
+        [share * r.force, r.contact_radius, r.tip_potential.unwrap()]
+    };
+    (
+        figures("indent-sphere", &axi, 1.0),
+        figures("indent-sphere-3d", &solid, 4.0),
+    )
+}
+
+#[test]
+fn the_body_of_revolution_is_the_3d_cylinder() {
+    // measured (force, tip potential; 3D against axisymmetric at the same meridian grid):
+    // n = 8 +1.2 %, +5.2 %; 12 +1.25 %, +5.3 %; 16 +0.95 %, +5.3 %; 24 +0.68 %, +4.5 %;
+    // 32 +0.40 %, +3.6 %; against the converged axisymmetric force (n = 320: 0.49162) the
+    // errors at n = 16 are +7.6 % (axisymmetric) and +8.6 % (3D)
+    let converged = 0.49162;
+    let mut last = f64::INFINITY;
+    for n in [12, 16] {
+        let (axi, solid) = revolved_and_3d(n);
+        let gap = |k: usize| (solid[k] / axi[k] - 1.0).abs();
+        assert!(
+            gap(0) < 0.015 && gap(0) < last,
+            "n = {n}: force {} against {}",
+            solid[0],
+            axi[0]
+        );
+        assert!(
+            gap(0) < 0.25 * (axi[0] / converged - 1.0).abs(),
+            "n = {n}: the gap is not below the mesh's error"
+        );
+        // the same nodes of the contact face, the same last pressed one
+        assert!(gap(1) < 1e-12, "n = {n}: radius {} against {}", solid[1], axi[1]);
+        assert!(gap(2) < 0.06, "n = {n}: tip potential {} against {}", solid[2], axi[2]);
+        last = gap(0);
     }
 }

@@ -181,22 +181,244 @@ fn what_a_floating_terminal_cannot_carry_is_refused_by_name() {
     with_phi.dirichlet.iter_mut().find(|d| d.group == "top").unwrap().phi = Some(1.0);
     let e = problem::solve(&with_phi, None, &mut problem::Silent).err().unwrap();
     assert!(e.to_string().contains("dirichlet.charge"), "{e}");
-    let (mut contact, _) = files::scene_file::load("actuator", &["mesh.n=8".into()]).unwrap();
-    contact.dirichlet[0].phi = None;
-    contact.dirichlet[0].charge = Some(0.0);
-    let e = problem::solve(&contact, None, &mut problem::Silent).err().unwrap();
-    assert!(e.to_string().contains("contact"), "{e}");
-    // one run of a backend does not take it: problem::solve does
-    let e = problem::run(
-        &mut problem::Faer,
-        &sensor(false, 0.01, 0.0),
-        None,
-        Default::default(),
-        &mut problem::Silent,
-    )
-    .err()
-    .unwrap();
-    assert!(e.to_string().contains("problem::solve"), "{e}");
+    // a floating terminal touching a grounded one: one conductor, by name
+    let mut touching = sensor(false, 0.01, 0.0);
+    touching.dirichlet.push(DirichletSpec {
+        group: "left".into(),
+        phi: Some(0.0),
+        ..Default::default()
+    });
+    let e = problem::solve(&touching, None, &mut problem::Silent).err().unwrap();
+    assert!(
+        e.to_string().contains("one conductor") && e.to_string().contains("`top`"),
+        "{e}"
+    );
+    // an electrical contact on the floating terminal's face
+    let mut conducting = pressed_onto_a_foundation(2, 1e-3, 0.0);
+    conducting.dirichlet.retain(|d| d.group != "top");
+    conducting.dirichlet.push(DirichletSpec {
+        group: "top".into(),
+        uy: Some(-1e-3),
+        ..Default::default()
+    });
+    conducting
+        .dirichlet
+        .iter_mut()
+        .find(|d| d.group == "bottom")
+        .unwrap()
+        .phi = None;
+    conducting
+        .dirichlet
+        .iter_mut()
+        .find(|d| d.group == "bottom")
+        .unwrap()
+        .charge = Some(0.0);
+    conducting.dirichlet.push(DirichletSpec {
+        group: "top".into(),
+        phi: Some(0.0),
+        ..Default::default()
+    });
+    conducting.contact.as_mut().unwrap().electric = Some(problem::ElectricCondition::Conducting);
+    let e = problem::solve(&conducting, None, &mut problem::Silent).err().unwrap();
+    assert!(
+        e.to_string().contains("contact.electric") && e.to_string().contains("floating terminal"),
+        "{e}"
+    );
+    // a charge without electric unknowns
+    let mut elastic = sensor(false, 0.01, 1e-3);
+    elastic.material[0] = MaterialSpec::isotropic("body", 100.0, 0.3);
+    let e = problem::solve(&elastic, None, &mut problem::Silent).err().unwrap();
+    assert!(e.to_string().contains("dirichlet.charge"), "{e}");
+}
+
+/// A plate (2D: plane strain, or a box in 3D) poled across its thickness `h = 0.5`, laterally
+/// confined by rollers, its top pushed down by `d` and carrying a floating electrode with
+/// `charge` on it, its grounded bottom resting on a rigid foundation (frictionless contact).
+/// Uniaxial strain `ε = -d/h` with `D_z = -Q/A`: the top reads `V = (e33 ε h + Q h / A) / ε33`
+/// (the clamped capacitance: the strain is given), and the foundation carries the pressure
+/// `p = -σ_zz = -(c33 ε + e33 (e33 ε + Q/A) / ε33)`.
+fn pressed_onto_a_foundation(dim: usize, d: f64, charge: f64) -> Scene {
+    let mut scene = plate(false, true);
+    let (up, normal) = if dim == 2 {
+        (1, vec![0.0, -1.0])
+    } else {
+        (2, vec![0.0, 0.0, -1.0])
+    };
+    let mut dirichlet = vec![];
+    let sides: &[(&str, usize)] = if dim == 2 {
+        &[("left", 0), ("right", 0)]
+    } else {
+        &[("left", 0), ("right", 0), ("front", 1), ("back", 1)]
+    };
+    for &(group, k) in sides {
+        let mut roller = DirichletSpec {
+            group: group.into(),
+            ..Default::default()
+        };
+        match k {
+            0 => roller.ux = Some(0.0),
+            _ => roller.uy = Some(0.0),
+        }
+        dirichlet.push(roller);
+    }
+    let mut top = DirichletSpec {
+        group: "top".into(),
+        charge: Some(charge),
+        ..Default::default()
+    };
+    if up == 1 {
+        top.uy = Some(-d);
+    } else {
+        top.uz = Some(-d);
+    }
+    dirichlet.push(top);
+    dirichlet.push(DirichletSpec {
+        group: "bottom".into(),
+        phi: Some(0.0),
+        ..Default::default()
+    });
+    scene.dirichlet = dirichlet;
+    if dim == 3 {
+        scene.mesh = MeshSpec::cuboid([0.0; 3], [2.0, 1.0, 0.5], 4);
+        scene.material[0].poling = vec![0.0, 0.0, 1.0];
+    }
+    scene.contact = Some(problem::ContactSpec::new(
+        "bottom",
+        problem::ContactLaw::Signorini,
+        &normal,
+    ));
+    scene
+}
+
+#[test]
+fn a_floating_electrode_pressed_onto_a_foundation_reads_its_closed_form() {
+    let (h, d) = (0.5, 1e-3);
+    let strain = -d / h;
+    for dim in [2, 3] {
+        // the top: 2 x 1 per unit depth in plane strain, 2 x 1 in 3D
+        let area = 2.0;
+        for q in [0.0, 0.05] {
+            let s = problem::solve(&pressed_onto_a_foundation(dim, d, q), None, &mut problem::Silent).unwrap();
+            let top = s.report.terminals.iter().find(|t| t.group == "top").unwrap();
+            assert!(top.floating);
+            let v = (E33 * strain * h + q * h / area) / EPS33;
+            assert!(
+                (top.potential - v).abs() < 1e-9 * v.abs(),
+                "{dim}D, Q = {q}: V = {} against {v}",
+                top.potential
+            );
+            assert!(
+                (-top.charge - q).abs() < 1e-9 * (q.abs() + EPS33 * area / h * v.abs()),
+                "{dim}D charge {}",
+                top.charge
+            );
+            let pressure = -(C33 * strain + E33 * (E33 * strain + q / area) / EPS33);
+            let force = s.report.contact.normal_force;
+            assert!(
+                (force - pressure * area).abs() < 1e-9 * pressure * area,
+                "{dim}D, Q = {q}: force {force} against {}",
+                pressure * area
+            );
+        }
+    }
+}
+
+/// The paper's block with its sides clamped, its bottom grounded and pressed by Coulomb friction
+/// onto the foundation, its top loaded and carrying a floating electrode with `charge`: a
+/// contact zone that sticks and slips, and a terminal whose potential moves it.
+fn floating_on_friction(dim: usize, charge: f64) -> Scene {
+    let (mut scene, _) =
+        files::scene_file::load(if dim == 2 { "actuator" } else { "paper-3d" }, &["mesh.n=8".into()]).unwrap();
+    scene.electrode = None;
+    for d in &mut scene.dirichlet {
+        d.phi = None;
+    }
+    scene
+        .dirichlet
+        .retain(|d| d.u.is_some() || d.ux.is_some() || d.uy.is_some() || d.uz.is_some());
+    scene.dirichlet.push(DirichletSpec {
+        group: "bottom".into(),
+        phi: Some(0.0),
+        ..Default::default()
+    });
+    scene.dirichlet.push(DirichletSpec {
+        group: "top".into(),
+        charge: Some(charge),
+        ..Default::default()
+    });
+    let contact = scene.contact.as_mut().unwrap();
+    contact.law = problem::ContactLaw::Coulomb;
+    contact.friction = Some(if dim == 2 { 0.05 } else { 0.2 });
+    scene
+}
+
+#[test]
+fn a_floating_terminal_under_friction_is_the_prescribed_potential_that_carries_its_charge() {
+    // the floating run's potential, prescribed: the same solution, with the charge asked for
+    for dim in [2, 3] {
+        let charge = if dim == 2 { 0.05 } else { 0.02 };
+        let floating = problem::solve(&floating_on_friction(dim, charge), None, &mut problem::Silent).unwrap();
+        let top = floating.report.terminals.iter().find(|t| t.group == "top").unwrap();
+        let contact = &floating.report.contact;
+        assert!(contact.n_stick > 0 && contact.n_slip > 0, "{dim}D: {contact:?}");
+        let mut prescribed = floating_on_friction(dim, charge);
+        let spec = prescribed.dirichlet.iter_mut().find(|d| d.group == "top").unwrap();
+        spec.charge = None;
+        spec.phi = Some(top.potential);
+        let fixed = problem::solve(&prescribed, None, &mut problem::Silent).unwrap();
+        let fixed_top = fixed.report.terminals.iter().find(|t| t.group == "top").unwrap();
+        assert!(!fixed_top.floating);
+        assert!(
+            (-fixed_top.charge - charge).abs() < 1e-8 * charge,
+            "{dim}D: the potential {} carries {} against {charge}",
+            top.potential,
+            -fixed_top.charge
+        );
+        let scale = fixed.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let gap = floating
+            .u
+            .iter()
+            .zip(&fixed.u)
+            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+            .fold(0.0f64, f64::max);
+        assert!(
+            gap < 1e-8 * scale,
+            "{dim}D: displacements differ by {gap:e} of {scale:e}"
+        );
+    }
+}
+
+#[test]
+fn a_floating_terminal_follows_a_load_path() {
+    // the plate pushed onto its foundation in five steps (the displacement factor) with a
+    // charge ramped by the voltage factor: frictionless, so each instant is the static answer
+    let (h, d, q) = (0.5, 1e-3, 0.05);
+    let mut scene = pressed_onto_a_foundation(2, d, q);
+    scene.path = Some(problem::PathSpec {
+        t: vec![0.0, 1.0],
+        steps: Some(5),
+        displacement: Some(vec![0.0, 1.0]),
+        voltage: Some(vec![0.0, 1.0]),
+        ..Default::default()
+    });
+    let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+    let path = s.report.path.as_ref().unwrap();
+    let top = s.report.terminals.iter().position(|t| t.group == "top").unwrap();
+    assert_eq!(path.rows.len(), 6);
+    for row in &path.rows {
+        let f = row.t;
+        let v = (E33 * (-f * d / h) * h + f * q * h / 2.0) / EPS33;
+        let got = row.potentials[top];
+        assert!(
+            (got - v).abs() < 1e-9 * (d * E33 / EPS33),
+            "t = {f}: V = {got} against {v}"
+        );
+        assert!(
+            (-row.charges[top] - f * q).abs() < 1e-9 * q,
+            "t = {f}: charge {}",
+            row.charges[top]
+        );
+    }
 }
 
 #[test]

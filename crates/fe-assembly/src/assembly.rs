@@ -171,10 +171,12 @@ impl<'m> Discretization<'m> {
         &self.materials[self.cell_material[c]]
     }
 
-    /// Assembles `A`, `G` and `B`.
+    /// Assembles `A`, `G` and `B`. A floating terminal's rows and columns are its nodes'
+    /// summed (assembled on the untied map, [`DofMap::untied`], then folded).
     pub fn assemble(&self, par: Parallelism) -> Blocks {
         let mesh = self.mesh;
-        let d = &self.dofs;
+        let untied = self.dofs.untied();
+        let d = untied.as_ref().map_or(&self.dofs, |(m, _)| m);
         let node_cells = mesh.node_cells();
         let graph_all = mesh.node_graph_from(&node_cells, |_| true);
         // the electric cells' graph is the whole graph when every cell is electric
@@ -197,19 +199,28 @@ impl<'m> Discretization<'m> {
         );
         let (mut av, mut gv, mut bv) = (a.zeros(), g.zeros(), b.zeros());
         match par {
-            Parallelism::Rayon => self.assemble_node_owned(&node_cells, &a, &g, &b, &mut av, &mut gv, &mut bv),
-            Parallelism::Serial => self.assemble_cell_loop(&a, &g, &b, &mut av, &mut gv, &mut bv),
+            Parallelism::Rayon => self.assemble_node_owned(d, &node_cells, &a, &g, &b, &mut av, &mut gv, &mut bv),
+            Parallelism::Serial => self.assemble_cell_loop(d, &a, &g, &b, &mut av, &mut gv, &mut bv),
         }
+        let (g, b) = (g.into_matrix(gv), b.into_matrix(bv));
+        let (g, b) = match &untied {
+            Some((_, fold)) => {
+                let (n, to) = (self.dofs.n_phi, |j: usize| fold[j]);
+                (fold_rows(&g, n, &to), fold_cols(&fold_rows(&b, n, &to), n, &to))
+            }
+            None => (g, b),
+        };
         Blocks {
             a: a.into_matrix(av),
-            g: g.into_matrix(gv),
-            b: b.into_matrix(bv),
+            g,
+            b,
         }
     }
 
     #[allow(clippy::too_many_arguments)]
     fn assemble_node_owned(
         &self,
+        d: &DofMap,
         node_cells: &(Vec<usize>, Vec<usize>),
         pa: &Pattern,
         pg: &Pattern,
@@ -222,7 +233,6 @@ impl<'m> Discretization<'m> {
         let dim = mesh.dim;
         let nl = dim + 1;
         let (off, node_cells) = (&node_cells.0, &node_cells.1);
-        let d = &self.dofs;
         // per node: its slice of each block's values (its columns are contiguous)
         let n_nodes = mesh.n_nodes();
         let a_slices = pa.split_by_node(av, n_nodes, |i| u_cols(d, i));
@@ -308,8 +318,10 @@ impl<'m> Discretization<'m> {
             });
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn assemble_cell_loop(
         &self,
+        d: &DofMap,
         pa: &Pattern,
         pg: &Pattern,
         pb: &Pattern,
@@ -320,7 +332,6 @@ impl<'m> Discretization<'m> {
         let mesh = self.mesh;
         let dim = mesh.dim;
         let nl = dim + 1;
-        let d = &self.dofs;
         for (c, cell) in mesh.iter_cells().enumerate() {
             let (m, geo) = (self.material(c), &self.geometry[c]);
             for (a, &va) in cell.iter().enumerate() {
@@ -411,6 +422,55 @@ impl ColDofs<'_> {
                     out.push(j);
                 }
             }
+        }
+    }
+}
+
+/// `m` with its row `i` moved to row `to(i)` (rows that meet summed), `nrows` rows.
+fn fold_rows(m: &SparseColMat<usize, f64>, nrows: usize, to: &dyn Fn(usize) -> usize) -> SparseColMat<usize, f64> {
+    let (mut col_ptr, mut row_idx, mut values) = (vec![0], vec![], vec![]);
+    let mut entries: Vec<(usize, f64)> = vec![];
+    for j in 0..m.ncols() {
+        entries.clear();
+        entries.extend(m.row_idx_of_col(j).zip(m.val_of_col(j)).map(|(i, &v)| (to(i), v)));
+        push_merged(&mut entries, &mut row_idx, &mut values);
+        col_ptr.push(row_idx.len());
+    }
+    let sym = SymbolicSparseColMat::new_checked(nrows, m.ncols(), col_ptr, None, row_idx);
+    SparseColMat::new(sym, values)
+}
+
+/// `m` with its column `j` moved to column `to(j)` (columns that meet summed), `ncols`
+/// columns.
+fn fold_cols(m: &SparseColMat<usize, f64>, ncols: usize, to: &dyn Fn(usize) -> usize) -> SparseColMat<usize, f64> {
+    let mut sources: Vec<Vec<usize>> = vec![vec![]; ncols];
+    for j in 0..m.ncols() {
+        sources[to(j)].push(j);
+    }
+    let (mut col_ptr, mut row_idx, mut values) = (vec![0], vec![], vec![]);
+    let mut entries: Vec<(usize, f64)> = vec![];
+    for from in &sources {
+        entries.clear();
+        for &j in from {
+            entries.extend(m.row_idx_of_col(j).zip(m.val_of_col(j)).map(|(i, &v)| (i, v)));
+        }
+        push_merged(&mut entries, &mut row_idx, &mut values);
+        col_ptr.push(row_idx.len());
+    }
+    let sym = SymbolicSparseColMat::new_checked(m.nrows(), ncols, col_ptr, None, row_idx);
+    SparseColMat::new(sym, values)
+}
+
+/// One column's `(row, value)` entries, sorted by row with equal rows summed, appended.
+fn push_merged(entries: &mut [(usize, f64)], row_idx: &mut Vec<usize>, values: &mut Vec<f64>) {
+    entries.sort_unstable_by_key(|e| e.0);
+    let start = row_idx.len();
+    for &(i, v) in entries.iter() {
+        if row_idx.len() > start && row_idx.last() == Some(&i) {
+            *values.last_mut().expect("an entry was pushed") += v;
+        } else {
+            row_idx.push(i);
+            values.push(v);
         }
     }
 }

@@ -3,6 +3,11 @@
 //! Free dofs are numbered node by node (node-major), displacements and potentials
 //! separately, so that the columns of one node are contiguous in every block. A node carries a
 //! potential only if an electric cell (a material with a permittivity) holds it.
+//!
+//! A floating terminal ([`Field::Floating`]) ties the potentials of its group's nodes to one
+//! free dof (an equipotential conductor whose potential is unknown): the group's nodes share
+//! that index, numbered after every other potential. Its equation is the conductor's charge
+//! balance (the rows of the group summed), and its right-hand side the charge put on it.
 
 use crate::InputError;
 use crate::{AssemblyError, ScalarFn};
@@ -26,6 +31,10 @@ pub enum Field {
     Displacement(usize),
     /// The electric potential.
     Potential,
+    /// The potential of a floating terminal: one unknown shared by every node of the group
+    /// (the condition's value is not used; the charge on the terminal is a load,
+    /// [`crate::Load::TerminalCharge`]).
+    Floating,
 }
 
 /// A Dirichlet condition `field = value(x)` on the nodes of a boundary group.
@@ -50,6 +59,13 @@ impl Constraint {
     }
 }
 
+impl Constraint {
+    /// A floating terminal on `group` ([`Field::Floating`]).
+    pub fn floating(group: &str) -> Self {
+        Constraint::constant(group, Field::Floating, 0.0)
+    }
+}
+
 impl std::fmt::Debug for Constraint {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "Constraint({:?} on `{}`)", self.field, self.group)
@@ -67,8 +83,11 @@ pub struct DofMap {
     pub phi: Vec<Dof>,
     /// Number of free displacement dofs.
     pub n_u: usize,
-    /// Number of free potential dofs.
+    /// Number of free potential dofs (a floating terminal's counted once).
     pub n_phi: usize,
+    /// The floating terminals: each group and its potential's free index (the last ones,
+    /// `n_phi - floating.len()..n_phi`, in the order of their conditions).
+    pub floating: Vec<(String, usize)>,
 }
 
 impl DofMap {
@@ -88,55 +107,25 @@ impl DofMap {
     }
 
     /// Builds the map: `has_phi[node]` says which nodes carry a potential; `constraints` are
-    /// applied in order; a node that no cell uses has its displacement held at 0 (no unknown). A node constrained twice to values that differ by more than 1e-12
-    /// (relative) is an error, and so is a condition that reaches no dof.
+    /// applied in order; a node that no cell uses has its displacement held at 0 (no unknown).
+    /// A node constrained twice to values that differ by more than 1e-12 (relative) is an
+    /// error, and so are a condition that reaches no dof and a floating terminal that touches
+    /// another terminal.
     pub fn new(mesh: &Mesh, has_phi: &[bool], constraints: &[Constraint]) -> Result<DofMap, AssemblyError> {
-        let (n, dim) = (mesh.n_nodes(), mesh.dim);
-        let mut u: Vec<Option<(f64, usize)>> = vec![None; n * dim];
-        let mut phi: Vec<Option<(f64, usize)>> = vec![None; n];
+        let mut held = Held {
+            mesh,
+            has_phi,
+            constraints,
+            u: vec![None; mesh.n_nodes() * mesh.dim],
+            phi: vec![None; mesh.n_nodes()],
+            tie: vec![None; mesh.n_nodes()],
+            floating: vec![],
+        };
         for (ci, c) in constraints.iter().enumerate() {
-            let group = mesh.boundary(&c.group)?;
-            let mut reached = 0usize;
-            for node in group.nodes() {
-                let slot = match c.field {
-                    Field::Displacement(k) if k < dim => &mut u[node * dim + k],
-                    Field::Displacement(k) => {
-                        return Err(InputError::Component {
-                            group: c.group.clone(),
-                            component: k,
-                            dim,
-                        }
-                        .into())
-                    }
-                    Field::Potential if has_phi[node] => &mut phi[node],
-                    Field::Potential => continue,
-                };
-                let v = (c.value)(mesh.point(node));
-                if !v.is_finite() {
-                    return Err(InputError::NotFiniteCondition {
-                        group: c.group.clone(),
-                        value: v,
-                        node,
-                    }
-                    .into());
-                }
-                if let Some((old, from)) = *slot {
-                    if (old - v).abs() > 1e-12 * old.abs().max(v.abs()) {
-                        return Err(InputError::Conflicting {
-                            node,
-                            at: mesh.point(node).to_vec(),
-                            field: c.field,
-                            first: constraints[from].group.clone(),
-                            first_value: old,
-                            second: c.group.clone(),
-                            second_value: v,
-                        }
-                        .into());
-                    }
-                }
-                *slot = Some((v, ci));
-                reached += 1;
-            }
+            let reached = match c.field {
+                Field::Floating => held.tie(ci)?,
+                _ => held.prescribe(ci)?,
+            };
             if reached == 0 {
                 return Err(InputError::ReachesNothing {
                     field: c.field,
@@ -145,62 +134,52 @@ impl DofMap {
                 .into());
             }
         }
-        // a node that no cell uses (the centre of a Gmsh arc) has no stiffness: its displacement
-        // is no unknown (held at 0, as the mesh reports)
-        let mut used = vec![false; n];
-        for &v in &mesh.cells {
-            used[v] = true;
-        }
-        let mut n_u = 0;
-        let u = u
-            .into_iter()
-            .enumerate()
-            .map(|(i, s)| match s {
-                Some((v, _)) => Dof::Fixed(v),
-                None if !used[i / dim] => Dof::Fixed(0.0),
-                None => {
-                    n_u += 1;
-                    Dof::Free(n_u - 1)
-                }
-            })
-            .collect();
-        let mut n_phi = 0;
-        let phi = phi
-            .into_iter()
-            .zip(has_phi)
-            .map(|(s, &has)| match (s, has) {
-                (_, false) => Dof::Absent,
-                (Some((v, _)), true) => Dof::Fixed(v),
-                (None, true) => {
-                    n_phi += 1;
-                    Dof::Free(n_phi - 1)
-                }
-            })
-            .collect();
-        Ok(DofMap {
-            dim,
-            u,
-            phi,
-            n_u,
-            n_phi,
-        })
+        Ok(held.number())
     }
 
     /// Expands a node order (`order[new] = old node`) to the free dofs of `K`'s `[u; φ]`
     /// layout: each node's displacement components, then its potential (index `n_u + j`).
+    ///
+    /// A floating terminal's potential, coupled to every node of its group, comes last (as a
+    /// dense row would: eliminated early it would fill the whole group's neighbourhood).
     pub fn expand_node_order(&self, order: &[usize]) -> Vec<usize> {
         let mut out = Vec::with_capacity(self.n_u + self.n_phi);
+        let first_floating = self.n_phi - self.floating.len();
         for &node in order {
             for k in 0..self.dim {
                 if let Dof::Free(j) = self.u[node * self.dim + k] {
                     out.push(j);
                 }
             }
-            if let Dof::Free(j) = self.phi[node] {
-                out.push(self.n_u + j);
+            match self.phi[node] {
+                Dof::Free(j) if j < first_floating => out.push(self.n_u + j),
+                _ => {}
             }
         }
+        out.extend((first_floating..self.n_phi).map(|j| self.n_u + j));
         out
+    }
+
+    /// The same map with each node of a floating terminal given a potential of its own (the
+    /// potentials numbered node by node again, as without the terminals), and the fold that
+    /// takes each of its potentials to the tied map's (`fold[j]`): the element-by-element
+    /// assembly works on the untied map, whose unknowns belong to one node each, in node
+    /// order. `None` without floating terminals.
+    pub fn untied(&self) -> Option<(DofMap, Vec<usize>)> {
+        if self.floating.is_empty() {
+            return None;
+        }
+        let mut out = self.clone();
+        let mut fold = vec![];
+        for d in &mut out.phi {
+            if let Dof::Free(j) = *d {
+                *d = Dof::Free(fold.len());
+                fold.push(j);
+            }
+        }
+        out.n_phi = fold.len();
+        out.floating.clear();
+        Some((out, fold))
     }
 
     /// Nodal displacements `[x, y, z]` from the free values (prescribed values filled in).
@@ -251,5 +230,173 @@ fn value(d: Dof, free: &[f64]) -> f64 {
         Dof::Free(j) => free[j],
         Dof::Fixed(v) => v,
         Dof::Absent => 0.0,
+    }
+}
+
+/// The conditions met so far while a [`DofMap`] is built: each dof's prescribed value and the
+/// condition that set it, and each node's floating terminal.
+struct Held<'a> {
+    mesh: &'a Mesh,
+    has_phi: &'a [bool],
+    constraints: &'a [Constraint],
+    u: Vec<Option<(f64, usize)>>,
+    phi: Vec<Option<(f64, usize)>>,
+    /// The floating terminal (an index into `floating`) that ties a node's potential.
+    tie: Vec<Option<usize>>,
+    /// Each floating terminal's group and its first condition.
+    floating: Vec<(String, usize)>,
+}
+
+impl Held<'_> {
+    fn joined(&self, node: usize, floating: &str, other: usize) -> AssemblyError {
+        InputError::JoinedTerminals {
+            node,
+            at: self.mesh.point(node).to_vec(),
+            floating: floating.to_string(),
+            other: self.constraints[other].group.clone(),
+        }
+        .into()
+    }
+
+    /// Condition `ci`, a floating terminal: ties the potentials of its group's nodes. Returns
+    /// how many it reached.
+    fn tie(&mut self, ci: usize) -> Result<usize, AssemblyError> {
+        let c = &self.constraints[ci];
+        let group = self.mesh.boundary(&c.group)?;
+        let t = match self.floating.iter().position(|(g, _)| g == &c.group) {
+            Some(t) => t,
+            None => {
+                self.floating.push((c.group.clone(), ci));
+                self.floating.len() - 1
+            }
+        };
+        let mut reached = 0;
+        for node in group.nodes().into_iter().filter(|&v| self.has_phi[v]) {
+            let other = match (self.phi[node], self.tie[node]) {
+                (Some((_, from)), _) => Some(from),
+                (None, Some(s)) if s != t => Some(self.floating[s].1),
+                _ => None,
+            };
+            if let Some(from) = other {
+                return Err(self.joined(node, &c.group, from));
+            }
+            self.tie[node] = Some(t);
+            reached += 1;
+        }
+        Ok(reached)
+    }
+
+    /// Condition `ci`, a prescribed value: sets it on its group's dofs. Returns how many it
+    /// reached.
+    fn prescribe(&mut self, ci: usize) -> Result<usize, AssemblyError> {
+        let (c, mesh, dim) = (&self.constraints[ci], self.mesh, self.mesh.dim);
+        let mut reached = 0;
+        for node in mesh.boundary(&c.group)?.nodes() {
+            if let (Field::Potential, Some(t)) = (c.field, self.tie[node]) {
+                let floating = self.floating[t].1;
+                return Err(self.joined(node, &self.constraints[floating].group, ci));
+            }
+            let slot = match c.field {
+                Field::Displacement(k) if k < dim => &mut self.u[node * dim + k],
+                Field::Displacement(k) => {
+                    return Err(InputError::Component {
+                        group: c.group.clone(),
+                        component: k,
+                        dim,
+                    }
+                    .into())
+                }
+                Field::Potential if self.has_phi[node] => &mut self.phi[node],
+                Field::Potential | Field::Floating => continue,
+            };
+            let v = (c.value)(mesh.point(node));
+            if !v.is_finite() {
+                return Err(InputError::NotFiniteCondition {
+                    group: c.group.clone(),
+                    value: v,
+                    node,
+                }
+                .into());
+            }
+            if let Some((old, from)) = *slot {
+                if (old - v).abs() > 1e-12 * old.abs().max(v.abs()) {
+                    return Err(InputError::Conflicting {
+                        node,
+                        at: mesh.point(node).to_vec(),
+                        field: c.field,
+                        first: self.constraints[from].group.clone(),
+                        first_value: old,
+                        second: c.group.clone(),
+                        second_value: v,
+                    }
+                    .into());
+                }
+            }
+            *slot = Some((v, ci));
+            reached += 1;
+        }
+        Ok(reached)
+    }
+
+    /// The map: the free dofs numbered node by node, each floating terminal's potential after
+    /// the other potentials.
+    fn number(self) -> DofMap {
+        let (mesh, dim) = (self.mesh, self.mesh.dim);
+        // a node that no cell uses (the centre of a Gmsh arc) has no stiffness: its displacement
+        // is no unknown (held at 0, as the mesh reports)
+        let mut used = vec![false; mesh.n_nodes()];
+        for &v in &mesh.cells {
+            used[v] = true;
+        }
+        let mut n_u = 0;
+        let u = self
+            .u
+            .into_iter()
+            .enumerate()
+            .map(|(i, s)| match s {
+                Some((v, _)) => Dof::Fixed(v),
+                None if !used[i / dim] => Dof::Fixed(0.0),
+                None => {
+                    n_u += 1;
+                    Dof::Free(n_u - 1)
+                }
+            })
+            .collect();
+        let mut n_phi = 0;
+        let mut phi: Vec<Dof> = self
+            .phi
+            .into_iter()
+            .zip(self.has_phi)
+            .zip(&self.tie)
+            .map(|((s, &has), t)| match (s, has, t) {
+                (_, false, _) => Dof::Absent,
+                (Some((v, _)), true, _) => Dof::Fixed(v),
+                (None, true, Some(_)) => Dof::Absent, // numbered below, after the others
+                (None, true, None) => {
+                    n_phi += 1;
+                    Dof::Free(n_phi - 1)
+                }
+            })
+            .collect();
+        for (node, t) in self.tie.iter().enumerate() {
+            if let Some(t) = t {
+                phi[node] = Dof::Free(n_phi + t);
+            }
+        }
+        let floating: Vec<(String, usize)> = self
+            .floating
+            .into_iter()
+            .enumerate()
+            .map(|(t, (group, _))| (group, n_phi + t))
+            .collect();
+        n_phi += floating.len();
+        DofMap {
+            dim,
+            u,
+            phi,
+            n_u,
+            n_phi,
+            floating,
+        }
     }
 }

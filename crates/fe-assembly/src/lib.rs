@@ -140,8 +140,26 @@ pub enum InputError {
         /// The second value.
         second_value: f64,
     },
+    /// A charge put on a group that is no floating terminal.
+    #[error("a charge is put on `{group}`, which is no floating terminal (no Field::Floating condition on it)")]
+    NotFloating {
+        /// The group.
+        group: String,
+    },
+    /// A floating terminal that shares a node with another terminal (one conductor).
+    #[error("node {node} at {at:?} lies on the floating terminal `{floating}` and on the terminal `{other}`: they touch, so they are one conductor (give them one condition)")]
+    JoinedTerminals {
+        /// The node.
+        node: usize,
+        /// Its coordinates.
+        at: Vec<f64>,
+        /// The floating terminal's group.
+        floating: String,
+        /// The other terminal's group.
+        other: String,
+    },
     /// A condition that reaches no unknown.
-    #[error("condition {field:?} on `{group}` reaches no degree of freedom{}", if *.field == Field::Potential { " (no node of it carries a potential)" } else { "" })]
+    #[error("condition {field:?} on `{group}` reaches no degree of freedom{}", if matches!(*.field, Field::Potential | Field::Floating) { " (no node of it carries a potential)" } else { "" })]
     ReachesNothing {
         /// The field.
         field: Field,

@@ -31,6 +31,16 @@ pub enum Load {
         /// The charge density at a point.
         value: ScalarFn,
     },
+    /// The total charge on a floating terminal ([`crate::Field::Floating`]): the negative of
+    /// the flux `∫ D·n ds` out of the body through its group, the right-hand side of its one
+    /// potential's equation. A load path scales it with the terminals' potentials (it goes to
+    /// [`RhsParts::potentials`]).
+    TerminalCharge {
+        /// The floating terminal's group.
+        group: String,
+        /// The charge.
+        charge: f64,
+    },
 }
 
 impl std::fmt::Debug for Load {
@@ -40,6 +50,7 @@ impl std::fmt::Debug for Load {
             Load::BodyCharge(_) => write!(f, "BodyCharge"),
             Load::Traction { group, .. } => write!(f, "Traction on `{group}`"),
             Load::SurfaceCharge { group, .. } => write!(f, "SurfaceCharge on `{group}`"),
+            Load::TerminalCharge { group, charge } => write!(f, "TerminalCharge {charge} on `{group}`"),
         }
     }
 }
@@ -118,10 +129,17 @@ impl Discretization<'_> {
             self.lift(&mut bu, &mut bphi, which);
             (bu, bphi)
         };
+        let terminal = |l: &&Load| matches!(l, Load::TerminalCharge { .. });
+        let (charges, others): (Vec<Load>, Vec<Load>) = loads.iter().cloned().partition(|l| terminal(&l));
+        let mut potentials = lifted(Lifted::Potentials);
+        let (_, on_terminals) = self.load_vectors(&charges)?;
+        for (b, q) in potentials.1.iter_mut().zip(on_terminals) {
+            *b += q;
+        }
         Ok(RhsParts {
-            loads: self.load_vectors(loads)?,
+            loads: self.load_vectors(&others)?,
             displacements: (0..self.mesh.dim).map(|k| lifted(Lifted::Component(k))).collect(),
-            potentials: lifted(Lifted::Potentials),
+            potentials,
         })
     }
 
@@ -209,6 +227,13 @@ impl Discretization<'_> {
                             }
                         }
                     }
+                }
+                Load::TerminalCharge { group, charge } => {
+                    let Some(&(_, j)) = d.floating.iter().find(|(g, _)| g == group) else {
+                        return Err(InputError::NotFloating { group: group.clone() }.into());
+                    };
+                    // the flux out of the body is -Q, and b_φ carries +∫ q2 ψ
+                    bphi[j] -= check("the terminal's charge", *charge)?;
                 }
             }
         }

@@ -277,3 +277,55 @@ mod tests {
         }
     }
 }
+
+/// Makes the section `[0, r]²` of a 3D mesh (its x and y, any `r`) a quarter of the disc of
+/// radius `r` about the z axis: each point moves along its ray from the axis, from distance `ρ` to
+/// `ρ max(|cos θ|, |sin θ|)` (the squares `max(x, y) = s` become the circles of radius `s`).
+/// The faces x = 0 and y = 0 stay in place, x = r and y = r become the cylinder's face. The
+/// map keeps the polar angle and stretches the radius by a factor in `[1/√2, 1]` with positive
+/// Jacobian `max(|cos θ|, |sin θ|)²` on each side of the diagonal, so no cell turns over.
+pub fn round_quarter_section(mesh: &mut Mesh) {
+    for p in &mut mesh.points {
+        let (x, y) = (p[0], p[1]);
+        let rho = x.hypot(y);
+        if rho > 0.0 {
+            let f = x.abs().max(y.abs()) / rho;
+            p[0] = x * f;
+            p[1] = y * f;
+        }
+    }
+}
+
+#[cfg(test)]
+mod round_tests {
+    use super::*;
+
+    #[test]
+    fn a_rounded_box_is_a_quarter_cylinder_with_no_cell_turned() {
+        let mut m = box_tet([0.0; 3], [2.0, 2.0, 1.0], 6, 6, 3);
+        let before: Vec<f64> = (0..m.n_cells()).map(|c| signed_volume(&m.points, m.cell(c))).collect();
+        round_quarter_section(&mut m);
+        for face in ["right", "back"] {
+            for v in m.boundary(face).unwrap().nodes() {
+                let p = m.points[v];
+                assert!((p[0].hypot(p[1]) - 2.0).abs() < 1e-14, "{face}: {p:?}");
+            }
+        }
+        for v in m.boundary("left").unwrap().nodes() {
+            assert_eq!(m.points[v][0], 0.0);
+        }
+        // every cell keeps its orientation, and the volume is the quarter cylinder's (its
+        // polygonal section a little short of the disc)
+        let after: Vec<f64> = (0..m.n_cells()).map(|c| signed_volume(&m.points, m.cell(c))).collect();
+        assert!(before
+            .iter()
+            .zip(&after)
+            .all(|(b, a)| b.signum() == a.signum() && a.abs() > 0.0));
+        let volume: f64 = after.iter().map(|v| v.abs()).sum();
+        let quarter = std::f64::consts::PI;
+        assert!(
+            volume < quarter && volume > 0.98 * quarter,
+            "{volume} against {quarter}"
+        );
+    }
+}

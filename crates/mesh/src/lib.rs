@@ -34,7 +34,7 @@ mod parts;
 mod quality;
 mod topology;
 
-pub use generate::{box_tet, rectangle_quad, rectangle_tri};
+pub use generate::{box_tet, rectangle_quad, rectangle_tri, round_quarter_section};
 pub use gmsh::{read_msh, read_msh_bytes};
 pub use ordering::nested_dissection;
 pub use parts::MeshParts;

@@ -625,6 +625,13 @@ fn electric_points(
     }
     let (mut points, mut phi) = (vec![], vec![]);
     for (i, &node) in nodes.iter().enumerate() {
+        if let Some((group, _)) = dofs.floating.iter().find(|(_, j)| dofs.phi[node] == Dof::Free(*j)) {
+            return Err(SceneError::new(
+                "contact.electric",
+                format!("the contact face touches the floating terminal `{group}`, and an electrical contact there would join the foundation and the terminal into one conductor: keep contact.electric = \"insulated\", or make the foundation the floating conductor (contact.charge)"),
+            )
+            .into());
+        }
         if let Dof::Free(j) = dofs.phi[node] {
             points.push(i);
             phi.push(dofs.n_u + j);

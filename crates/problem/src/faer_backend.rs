@@ -396,16 +396,19 @@ const FORCE_TOL: f64 = 1e-10;
 /// function of how far the gaps are lowered (`s`), 0 while the body is clear of the indenter:
 /// `s` is bracketed by steps growing fourfold from a millionth of the face's size, then found
 /// by the Illinois variant of regula falsi, each evaluation a contact solve (`solve`, on the
-/// points with their gaps lowered, from the last multipliers) on the same condensed
-/// compliance. Leaves the points with the gaps of the depth found, and returns its solution.
-fn force_controlled(
+/// points with their gaps lowered, from the last multipliers, the first from `start`) on the
+/// same condensed compliance. A zero force (a path's load factor at 0) is met with the
+/// indenter just touching (every shallower depth carries none too). Leaves the points with the
+/// gaps of the depth found, and returns its solution.
+pub(crate) fn force_controlled(
     points: &mut ContactPoints,
     force: f64,
+    start: Option<PointValues>,
     mut solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, ProblemError>,
 ) -> Result<ContactSolution, ProblemError> {
     let base = points.gap.clone();
     let size = face_size(points);
-    let mut last: Option<PointValues> = None;
+    let mut last: Option<PointValues> = start;
     let mut eval = |s: f64, points: &mut ContactPoints| -> Result<(f64, ContactSolution), ProblemError> {
         for (g, b) in points.gap.iter_mut().zip(&base) {
             *g = b - s;
@@ -422,14 +425,19 @@ fn force_controlled(
         Ok((f - force, sol))
     };
     let close = |r: f64| r.abs() <= FORCE_TOL * force;
+    // the body clear of the indenter: the first step reaches the nearest point
+    let clear = base.iter().cloned().fold(f64::INFINITY, f64::min).max(0.0);
+    if force == 0.0 {
+        // every depth short of first touch carries no force: the indenter just touching
+        let touch = base.iter().cloned().fold(f64::INFINITY, f64::min);
+        return Ok(eval(touch, points)?.1);
+    }
     let (mut a, (mut fa, mut sol)) = (0.0, eval(0.0, points)?);
     if close(fa) {
         return Ok(sol);
     }
     // bracket: step away from s = 0 until the residual changes sign
     let direction = if fa < 0.0 { 1.0 } else { -1.0 };
-    // the body clear of the indenter: the first step reaches the nearest point
-    let clear = base.iter().cloned().fold(f64::INFINITY, f64::min).max(0.0);
     let mut step = size * 1e-6;
     let (mut b, mut fb);
     loop {
@@ -625,7 +633,7 @@ fn solve_contact(
             });
             system.condense = Some(condense);
             let sol = match indenter_force(posed) {
-                Some(force) => force_controlled(&mut boundary.points, force, |points, start| {
+                Some(force) => force_controlled(&mut boundary.points, force, None, |points, start| {
                     how.run(Operator::Condensed(&mut dense), points, start, reporter)
                 })?,
                 None => how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?,
@@ -704,7 +712,7 @@ fn electric_contact(
         None => newton(&problem, points),
     };
     let mut sol = match indenter_force(posed) {
-        Some(force) => force_controlled(&mut boundary.points, force, &mut solve)?,
+        Some(force) => force_controlled(&mut boundary.points, force, None, &mut solve)?,
         None => solve(&boundary.points, None)?,
     };
     let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
@@ -958,6 +966,13 @@ impl PathSystem {
         start: Option<PointValues>,
         reporter: &mut dyn Reporter,
     ) -> Result<ContactSolution, ProblemError> {
+        self.prime(boundary, factors, shift);
+        self.solve_at(how, &boundary.points, start, reporter)
+    }
+
+    /// The contact problem's `u⁰` at a step of `factors`, in the frame `shift`: the loads'
+    /// displacement at the points, before any contact force.
+    pub(crate) fn prime(&mut self, boundary: &ContactBoundary, factors: &[f64], shift: &PointValues) {
         let mut x0 = vec![0.0; self.parts[0].len()];
         for (part, f) in self.parts.iter().zip(factors) {
             if *f != 0.0 {
@@ -968,7 +983,18 @@ impl PathSystem {
         }
         let nt = self.dense.nt;
         self.dense.u0 = in_frame(fields_at_points(boundary, &x0, nt), Some(shift));
-        how.run(Operator::Condensed(&mut self.dense), &boundary.points, start, reporter)
+    }
+
+    /// The contact solve of the primed step ([`PathSystem::prime`]) on `points` (their gaps
+    /// the step's, or a force search's).
+    pub(crate) fn solve_at(
+        &mut self,
+        how: &ContactSolve<'_>,
+        points: &ContactPoints,
+        start: Option<PointValues>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        how.run(Operator::Condensed(&mut self.dense), points, start, reporter)
     }
 
     /// The fields of a step under the loads of `posed` and the contact forces of `sol` (in

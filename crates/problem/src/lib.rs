@@ -62,7 +62,6 @@ mod capacitance;
 mod estimate;
 mod exact;
 mod faer_backend;
-mod floating;
 mod halfspace;
 mod path;
 mod plan;
@@ -116,9 +115,6 @@ pub fn solve_within(
     if scene.path.is_some() {
         // a path's instants, each step's files unwritten: the last instant, with the rows
         return Ok(path::solve_path(scene, mesh, limits, reporter, false, &mut |_| Ok(()))?.last);
-    }
-    if !floating::floating(scene).is_empty() {
-        return floating::solve_floating(scene, mesh, limits, reporter);
     }
     let solution = run::run(&mut Faer, scene, mesh, limits, reporter)?;
     Ok(solution.expect("the default backend runs in one process, which holds the solution"))

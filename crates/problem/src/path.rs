@@ -20,8 +20,8 @@ use crate::faer_backend::{Factored, Faer, Fields, PathSystem};
 use crate::progress::{Event, Reporter};
 use crate::report::{PathReport, RunReport, StepRow, Timings};
 use crate::run::{
-    begin, check_accurate, check_solved, contact_result, recover, report, stop_if_interrupted, terminal_groups,
-    ContactResult, Measured, Recovered,
+    begin, check_accurate, check_solved, contact_result, indenter_report, recover, report, stop_if_interrupted,
+    terminal_groups, ContactResult, Measured, Recovered,
 };
 use crate::scene::{Factors, PathSpec, Scene, SceneError};
 use crate::setup::Setup;
@@ -166,19 +166,46 @@ struct Walk<'a> {
     terminals: Terminals,
 }
 
-/// The charges through the terminals (the groups at a prescribed potential) at any step from
-/// its factors and multipliers: `Σ_q f_q Q_q - Σ_i w_i λ_i · z_i`.
+/// The charges through the terminals and their potentials at any step from its factors and
+/// multipliers, each a linear functional of the solution: `Σ_q f_q Q_q - Σ_i w_i λ_i · z_i`.
 #[derive(Default)]
 struct Terminals {
-    /// Per terminal, the charge of each part's solution `Q_q` (its prescribed values lifted).
-    of_parts: Vec<Vec<f64>>,
-    /// Per terminal, `z = K⁻¹ a` at the points (`a` its functional on the free unknowns).
-    at_points: Vec<PointValues>,
+    /// Per terminal, the charge through it.
+    charges: Vec<Functional>,
+    /// Per terminal, its potential (a prescribed one's is its parts' alone; a floating one's
+    /// responds to the multipliers).
+    potentials: Vec<Functional>,
+}
+
+/// A linear functional `a` of the solution along a path: its value on each part's solution
+/// `Q_q` (the part's prescribed values lifted), and `z = K⁻¹ a` at the points where it responds
+/// to the multipliers.
+struct Functional {
+    of_parts: Vec<f64>,
+    at_points: Option<PointValues>,
+}
+
+impl Functional {
+    /// The value at a step of `factors` (in the order of the parts) and multipliers.
+    fn at(&self, factors: &[f64], lambda: &PointValues, weight: &[f64]) -> f64 {
+        let loads: f64 = self.of_parts.iter().zip(factors).map(|(q, f)| q * f).sum();
+        let Some(z) = &self.at_points else { return loads };
+        let nt = lambda.n_tangential();
+        let contact: f64 = (0..weight.len())
+            .map(|i| {
+                let t: f64 = (0..nt.min(z.n_tangential()))
+                    .map(|k| lambda.tangential_of(i)[k] * z.tangential_of(i)[k])
+                    .sum();
+                weight[i] * (lambda.normal[i] * z.normal[i] + t)
+            })
+            .sum();
+        loads - contact
+    }
 }
 
 impl Terminals {
-    /// The functionals of the setup's terminals: each part's charge, from its solution's
-    /// fields, and the response of each functional at the points (one solve each).
+    /// The functionals of the setup's terminals: each part's charge and potential, from its
+    /// solution's fields, and the response of each functional at the points (one solve each).
     fn new(
         walk: &Walk<'_>,
         disc: &Discretization<'_>,
@@ -192,7 +219,13 @@ impl Terminals {
             return Ok(Terminals::default());
         }
         let dim = setup.mesh.dim;
-        let mut of_parts = vec![vec![]; groups.len()];
+        let first_node = |g: &str| -> Result<Option<usize>, ProblemError> {
+            let group = setup.mesh.boundary(g).map_err(fe_assembly::AssemblyError::from)?;
+            Ok(group.nodes().first().copied())
+        };
+        let firsts: Vec<Option<usize>> = groups.iter().map(|g| first_node(g)).collect::<Result<_, _>>()?;
+        let mut charges = vec![vec![]; groups.len()];
+        let mut potentials = vec![vec![]; groups.len()];
         for (q, (u, phi)) in solved.iter().enumerate() {
             // the part's own prescribed values: part q's factor 1, every other 0
             let unit = |k: usize| if q == k + 1 { 1.0 } else { 0.0 };
@@ -202,39 +235,45 @@ impl Terminals {
             let (u, phi) = (dofs.expand_u(u), dofs.expand_phi(phi));
             let loads: &[fe_assembly::Load] = if q == 0 { &setup.loads } else { &[] };
             for (g, charge) in disc.charges(&u, &phi, &groups, loads)?.into_iter().enumerate() {
-                of_parts[g].push(charge);
+                charges[g].push(charge);
+                potentials[g].push(firsts[g].map_or(0.0, |v| phi[v]));
             }
         }
-        let mut at_points = vec![];
-        for (a_u, a_phi) in disc.charge_functionals(&groups)? {
-            let (z, _) = PathSystem::solve(system, &a_u, &a_phi)?;
-            let points = &boundary.points;
+        let points = &boundary.points;
+        let mut respond = |a_u: &[f64], a_phi: &[f64]| -> Result<PointValues, ProblemError> {
+            let (z, _) = PathSystem::solve(system, a_u, a_phi)?;
             let mut out = PointValues::zeros(points.len(), points.n_tangential());
             boundary.extract_free(&z, &mut out);
-            at_points.push(out);
+            Ok(out)
+        };
+        let mut out = Terminals::default();
+        for ((a_u, a_phi), of_parts) in disc.charge_functionals(&groups)?.into_iter().zip(charges) {
+            out.charges.push(Functional {
+                of_parts,
+                at_points: Some(respond(&a_u, &a_phi)?),
+            });
         }
-        Ok(Terminals { of_parts, at_points })
+        let dofs = &disc.dofs;
+        for (first, of_parts) in firsts.into_iter().zip(potentials) {
+            // a floating terminal's potential is a free unknown: e_j's response
+            let at_points = match first.map(|v| dofs.phi[v]) {
+                Some(fe_assembly::Dof::Free(j)) => {
+                    let mut a_phi = vec![0.0; dofs.n_phi];
+                    a_phi[j] = 1.0;
+                    Some(respond(&vec![0.0; dofs.n_u], &a_phi)?)
+                }
+                _ => None,
+            };
+            out.potentials.push(Functional { of_parts, at_points });
+        }
+        Ok(out)
     }
 
-    /// The charges at a step of `factors` (in the order of the parts) and multipliers.
-    fn charges(&self, factors: &[f64], lambda: &PointValues, weight: &[f64]) -> Vec<f64> {
-        let nt = lambda.n_tangential();
-        self.of_parts
-            .iter()
-            .zip(&self.at_points)
-            .map(|(parts, z)| {
-                let loads: f64 = parts.iter().zip(factors).map(|(q, f)| q * f).sum();
-                let contact: f64 = (0..weight.len())
-                    .map(|i| {
-                        let t: f64 = (0..nt.min(z.n_tangential()))
-                            .map(|k| lambda.tangential_of(i)[k] * z.tangential_of(i)[k])
-                            .sum();
-                        weight[i] * (lambda.normal[i] * z.normal[i] + t)
-                    })
-                    .sum();
-                loads - contact
-            })
-            .collect()
+    /// The charges and the potentials at a step of `factors` (in the order of the parts) and
+    /// multipliers.
+    fn at(&self, factors: &[f64], lambda: &PointValues, weight: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let values = |of: &[Functional]| of.iter().map(|f| f.at(factors, lambda, weight)).collect();
+        (values(&self.charges), values(&self.potentials))
     }
 }
 
@@ -379,7 +418,18 @@ impl Walk<'_> {
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
         factors.push(f.voltage);
-        let sol = path.contact(how, &boundary, &factors, &state.shift, state.start.take(), reporter)?;
+        // force control: the depth found at each step for the indenter's force times the load
+        // factor, from the step before's multipliers
+        let sol = match self.contact.indenter.as_ref().and_then(|i| i.force) {
+            Some(force) => {
+                path.prime(&boundary, &factors, &state.shift);
+                let start = state.start.take();
+                crate::faer_backend::force_controlled(&mut boundary.points, force * f.load, start, |points, warm| {
+                    path.solve_at(how, points, warm, reporter)
+                })?
+            }
+            None => path.contact(how, &boundary, &factors, &state.shift, state.start.take(), reporter)?,
+        };
         if let Some(contraction) = sol.info.contraction.filter(|c| *c >= 1.0) {
             reporter.event(&Event::NotContractive { contraction });
         }
@@ -416,11 +466,14 @@ impl Walk<'_> {
             None => sol.u.clone(),
         };
         let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift);
+        if let Some(indenter) = indenter_report(scene, &boundary.points, &sol, row.normal_force) {
+            (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
+        }
         // the charges of the fields where they are computed, else of the functionals (equal to
         // the condensed solve's accuracy: tests/path.rs)
-        row.charges = match &fields {
-            Some((recovered, _, _, _)) => recovered.terminals.iter().map(|x| x.charge).collect(),
-            None => self.terminals.charges(&factors, &sol.lambda, &boundary.points.weight),
+        (row.charges, row.potentials) = match &fields {
+            Some((recovered, _, _, _)) => recovered.terminals.iter().map(|x| (x.charge, x.potential)).unzip(),
+            None => self.terminals.at(&factors, &sol.lambda, &boundary.points.weight),
         };
         row.equilibrium = fields.as_ref().map(|(_, e, _, _)| *e);
         state.advance(&now, &sol);
@@ -558,7 +611,10 @@ fn step_row(
         n_slip: counts.n_slip,
         n_separated: counts.n_separated,
         iterations: sol.info.newton_iters + sol.info.uzawa_iters,
+        depth: None,
+        contact_radius: None,
         charges: vec![],
+        potentials: vec![],
         complementarity: sol.info.complementarity,
         equilibrium: None,
     }

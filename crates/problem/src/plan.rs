@@ -23,6 +23,9 @@ choice! {
         Deformed = "deformed.svg/png",
         /// Contours of the potential (SVG and PNG).
         Potential = "potential.svg/png",
+        /// A body of revolution's solution swept round its axis, a 3D view for ParaView
+        /// (`mesh.revolve`).
+        RevolvedVtu = "revolved.vtu",
     }
 }
 
@@ -78,6 +81,9 @@ impl Plan {
         });
         let strategy = scene.solver.strategy;
         let mut outputs = vec![Output::RunJson, Output::SolutionVtu];
+        if scene.mesh.revolve.is_some() {
+            outputs.push(Output::RevolvedVtu);
+        }
         if law != ContactLaw::None {
             outputs.extend([Output::ContactCsv, Output::Multipliers]);
         }
@@ -144,10 +150,14 @@ impl Plan {
 }
 
 /// Whether the scene prescribes a non-zero potential (an electrode's voltage or a Dirichlet
-/// potential): electric data that needs electric unknowns even without coupling.
+/// potential) or a non-zero charge on a floating terminal: electric data that needs electric
+/// unknowns even without coupling.
 pub fn electric_data(scene: &Scene) -> bool {
     scene.electrode.as_ref().is_some_and(|e| e.v != 0.0)
-        || scene.dirichlet.iter().any(|d| d.phi.is_some_and(|p| p != 0.0))
+        || scene
+            .dirichlet
+            .iter()
+            .any(|d| d.phi.is_some_and(|p| p != 0.0) || d.charge.is_some_and(|q| q != 0.0))
 }
 
 impl fmt::Display for Plan {

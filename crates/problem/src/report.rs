@@ -141,9 +141,20 @@ pub struct StepRow {
     pub n_separated: usize,
     /// Newton (or first-order) iterations of the step.
     pub iterations: usize,
+    /// A rigid indenter's depth at the step (under force control: the depth found).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depth: Option<f64>,
+    /// A rigid indenter's contact radius at the step (the farthest pressed point from its
+    /// axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_radius: Option<f64>,
     /// The charge through each terminal, in the order of [`RunReport::terminals`].
     #[serde(default)]
     pub charges: Vec<f64>,
+    /// The potential of each terminal, in the order of [`RunReport::terminals`] (a floating
+    /// terminal's found, a prescribed one's scaled by the voltage factor).
+    #[serde(default)]
+    pub potentials: Vec<f64>,
     /// The complementarity residual of the step.
     pub complementarity: f64,
     /// The equilibrium residual of the step, where its fields were computed (the instants

@@ -71,10 +71,6 @@ pub fn run<B: Backend>(
         let why = "a load path is solved by problem::solve or problem::solve_path (its steps share one factorisation), not one instant of a backend";
         return Err(ProblemError::from(crate::SceneError::new("path", why)).into());
     }
-    if scene.scene().dirichlet.iter().any(|d| d.charge.is_some()) {
-        let why = "a floating terminal is solved by problem::solve (its potential by superposition over runs), not one run of a backend";
-        return Err(ProblemError::from(crate::SceneError::new("dirichlet.charge", why)).into());
-    }
     backend.refuse(&scene)?;
     let t_total = Instant::now();
     let setup = begin(scene, mesh, backend.estimate(&scene), &limits, reporter)?;
@@ -480,8 +476,8 @@ pub(crate) fn indenter_report(
     })
 }
 
-/// The groups where the potential is prescribed (none without electric unknowns), each once,
-/// in the order of the conditions.
+/// The terminals: the groups where the potential is prescribed or floats (none without
+/// electric unknowns), each once, in the order of the conditions.
 pub(crate) fn terminal_groups(setup: &Setup) -> Vec<&str> {
     let mut groups: Vec<&str> = vec![];
     if !setup.plan.electric {
@@ -490,7 +486,7 @@ pub(crate) fn terminal_groups(setup: &Setup) -> Vec<&str> {
     for c in setup
         .constraints
         .iter()
-        .filter(|c| c.field == fe_assembly::Field::Potential)
+        .filter(|c| matches!(c.field, fe_assembly::Field::Potential | fe_assembly::Field::Floating))
     {
         if !groups.contains(&c.group.as_str()) {
             groups.push(&c.group);
@@ -499,8 +495,8 @@ pub(crate) fn terminal_groups(setup: &Setup) -> Vec<&str> {
     groups
 }
 
-/// The groups where the potential is prescribed, each with its potential and the charge
-/// through it (none without electric unknowns).
+/// The terminals (the groups where the potential is prescribed or floats), each with its
+/// potential and the charge through it (none without electric unknowns).
 fn terminals(
     setup: &Setup,
     disc: &Discretization<'_>,
@@ -523,7 +519,7 @@ fn terminals(
             group: group.to_string(),
             potential: first.first().map_or(0.0, |&v| phi[v]),
             charge,
-            floating: false,
+            floating: disc.dofs.floating.iter().any(|(g, _)| g == group),
         });
     }
     Ok(out)

@@ -52,14 +52,16 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
     scene.check_dimension(dim)?;
     let materials = materials(scene, dim)?;
     if electric_data(scene) && !materials.iter().any(|(_, m)| m.electric) {
-        let key = if scene.electrode.as_ref().is_some_and(|e| e.v != 0.0) {
-            "electrode.v"
+        let (key, what) = if scene.electrode.as_ref().is_some_and(|e| e.v != 0.0) {
+            ("electrode.v", "a potential")
+        } else if scene.dirichlet.iter().any(|d| d.phi.is_some_and(|p| p != 0.0)) {
+            ("dirichlet.phi", "a potential")
         } else {
-            "dirichlet.phi"
+            ("dirichlet.charge", "a charge")
         };
         return Err(SceneError::new(
             key,
-            format!("{key} prescribes a potential, but no material has a permittivity (no electric unknowns): it would be ignored"),
+            format!("{key} prescribes {what}, but no material has a permittivity (no electric unknowns): it would be ignored"),
         )
         .into());
     }
@@ -74,7 +76,7 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         // the axis of a body of revolution: no radial displacement
         constraints.push(Constraint::constant("axis", Field::Displacement(0), 0.0));
     }
-    let mut loads = loads(scene, dim);
+    let mut loads = loads(scene, dim, plan.electric);
     let exact = FieldSolution::of(scene, dim);
     if let Some(ex) = &exact {
         let groups: Vec<&str> = ex.groups.iter().map(String::as_str).collect();
@@ -137,6 +139,9 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     };
     if let Some(g) = &m.grading {
         grade(&mut mesh, m, &g.ratios());
+    }
+    if m.cylinder {
+        mesh::round_quarter_section(&mut mesh);
     }
     let quality = mesh.check()?;
     let notes = MeshNotes {
@@ -298,6 +303,9 @@ fn constraints(scene: &Scene, plan: &Plan) -> Vec<Constraint> {
         if let (Some(phi), true) = (d.phi, plan.electric) {
             out.push(Constraint::constant(&d.group, Field::Potential, phi));
         }
+        if let (Some(_), true) = (d.charge, plan.electric) {
+            out.push(Constraint::floating(&d.group));
+        }
     }
     if let (Some(e), true) = (&scene.electrode, plan.electric) {
         out.push(Constraint::constant("electrode", Field::Potential, e.v));
@@ -306,8 +314,14 @@ fn constraints(scene: &Scene, plan: &Plan) -> Vec<Constraint> {
 }
 
 /// The loads of a validated scene: each a uniform traction on its group (several on one group
-/// add up).
-fn loads(scene: &Scene, dim: usize) -> Vec<Load> {
+/// add up), and the charges on the floating terminals.
+fn loads(scene: &Scene, dim: usize, electric: bool) -> Vec<Load> {
+    let charges = scene.dirichlet.iter().filter(|_| electric).filter_map(|d| {
+        d.charge.map(|charge| Load::TerminalCharge {
+            group: d.group.clone(),
+            charge,
+        })
+    });
     scene
         .loads()
         .iter()
@@ -323,5 +337,6 @@ fn loads(scene: &Scene, dim: usize) -> Vec<Load> {
                 value: Arc::new(move |_| t),
             }
         })
+        .chain(charges)
         .collect()
 }

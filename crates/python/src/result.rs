@@ -193,8 +193,9 @@ impl RunResult {
     /// instants: the `path.csv` columns (`step`, `t`, the factors `load`, `voltage`, `ux`, `uy`,
     /// `uz`, `gap`, `normal_force`, `tangential_force`, `max_slip`, `max_slip_increment`,
     /// `n_stick`, `n_slip`, `n_separated`, `iterations`, `complementarity`, `equilibrium` (NaN
-    /// where the instant's fields were not computed)), `charges` (n_instants, n_terminals) with
-    /// `terminals` their groups; and with `run(..., series=True)` the contact values of every
+    /// where the instant's fields were not computed), and under an indenter `depth` and
+    /// `contact_radius`), `charges` and `potentials` (n_instants,
+    /// n_terminals) with `terminals` their groups; and with `run(..., series=True)` the contact values of every
     /// point at every instant, (n_instants, n_points): `lambda_n`, `lambda_t`, `u_n`, `u_t`
     /// (along the first tangent) and `status`.
     #[getter]
@@ -222,6 +223,10 @@ impl RunResult {
         out.set_item("iterations", column(&|r| r.iterations as f64))?;
         out.set_item("complementarity", column(&|r| r.complementarity))?;
         out.set_item("equilibrium", column(&|r| r.equilibrium.unwrap_or(f64::NAN)))?;
+        if rows.iter().any(|r| r.depth.is_some()) {
+            out.set_item("depth", column(&|r| r.depth.unwrap_or(f64::NAN)))?;
+            out.set_item("contact_radius", column(&|r| r.contact_radius.unwrap_or(f64::NAN)))?;
+        }
         let terminals: Vec<&str> = self
             .solution
             .report
@@ -229,11 +234,13 @@ impl RunResult {
             .iter()
             .map(|t| t.group.as_str())
             .collect();
-        let charges: Vec<f64> = rows.iter().flat_map(|r| r.charges.iter().copied()).collect();
         let shape = (rows.len(), terminals.len());
-        let charges =
-            numpy::ndarray::Array2::from_shape_vec(shape, charges).map_err(|e| Kind::Base.err(e.to_string()))?;
-        out.set_item("charges", owned(py, charges))?;
+        let per_terminal = |of: &dyn Fn(&problem::report::StepRow) -> &[f64]| {
+            let values: Vec<f64> = rows.iter().flat_map(|r| of(r).iter().copied()).collect();
+            numpy::ndarray::Array2::from_shape_vec(shape, values).map_err(|e| Kind::Base.err(e.to_string()))
+        };
+        out.set_item("charges", owned(py, per_terminal(&|r| &r.charges)?))?;
+        out.set_item("potentials", owned(py, per_terminal(&|r| &r.potentials)?))?;
         out.set_item("terminals", terminals)?;
         if let Some(series) = &self.series {
             let shape = (rows.len(), series.n_points);

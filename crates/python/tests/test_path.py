@@ -28,6 +28,8 @@ def test_the_series_are_the_programs_path_csv(binary, tmp_path):
     assert p["charges"].shape == (13, 3)
     charges = np.array([[float(row[f"charge_{t}"]) for t in p["terminals"]] for row in rows])
     assert np.allclose(p["charges"], charges, rtol=1e-12, atol=1e-15)
+    potentials = np.array([[float(row[f"potential_{t}"]) for t in p["terminals"]] for row in rows])
+    assert np.allclose(p["potentials"], potentials, rtol=1e-12, atol=1e-15)
     # the fields of the instants the library did not need are not computed: no equilibrium
     assert np.isnan(p["equilibrium"][:-1]).all() and p["equilibrium"][-1] < 1e-8
     assert "lambda_n" not in p
@@ -46,3 +48,48 @@ def test_every_instants_contact_values_on_request():
     assert np.allclose(p["lambda_n"] @ w, p["normal_force"], rtol=1e-12)
     assert np.allclose(p["lambda_t"] @ w, p["tangential_force"], rtol=1e-12, atol=1e-14)
     assert pc.run(pc.Scene.load("paper", {"mesh.n": 8})).path is None
+
+
+def test_a_floating_electrode_pushed_onto_a_foundation_along_a_path():
+    """The sensor disc pushed down by d at its top onto a frictionless rigid foundation (its
+    grounded bottom in contact instead of on a support), its top electrode open: uniaxial strain
+    eps = -d / h with D_z = 0 reads V = e33 eps h / eps33 at every instant of the ramp."""
+    data = pc.Scene.load("sensor").to_dict()
+    d = 1e-3
+    for c in data["dirichlet"]:
+        if c["group"] == "bottom":
+            del c["uy"]
+        if c["group"] == "top":
+            c["uy"] = -d
+    del data["load"]
+    data["contact"] = {"group": "bottom", "law": "signorini", "normal": [0.0, -1.0]}
+    data["path"] = {"t": [0.0, 1.0], "steps": 4, "displacement": [0.0, 1.0]}
+    r = pc.run(pc.Scene.from_dict(data))
+    p = r.path
+    top = p["terminals"].index("top")
+    e33, eps33 = 15.1, 5.62
+    expected = e33 * (-d * p["t"]) / eps33
+    assert np.allclose(p["potentials"][:, top], expected, rtol=1e-9, atol=1e-15)
+    assert np.allclose(p["charges"][:, top], 0.0, atol=1e-12)
+    assert [t["floating"] for t in r.report["terminals"] if t["group"] == "top"] == [True]
+
+
+def test_a_force_depth_curve_under_force_control():
+    """hertz-sphere's force ramped along a path: the depth found at each instant is Hertz's,
+    d = (3 F / (4 E* sqrt(R)))^(2/3), within the mesh's 1 %."""
+    scene = pc.Scene.load(
+        "hertz-sphere",
+        {
+            "mesh.n": 96,
+            "exact": None,
+            "contact.indenter.force": 0.46,
+            "path": {"t": [0.0, 1.0], "steps": 10, "load": [0.0, 1.0], "output_every": 0},
+        },
+    )
+    p = pc.run(scene).path
+    force = 0.46 * p["t"]
+    assert np.allclose(p["normal_force"], force, rtol=1e-9, atol=1e-15)
+    e_star = 100.0 / (1.0 - 0.3**2)
+    hertz = (3.0 * force / (4.0 * e_star * np.sqrt(10.0))) ** (2.0 / 3.0)
+    assert np.all(np.abs(p["depth"][1:] / hertz[1:] - 1.0) < 0.01)
+    assert p["depth"][0] == 0.0

@@ -69,6 +69,26 @@ impl Case {
     }
 }
 
+/// The actuator with its electrodes replaced by a grounded bottom and a floating top carrying
+/// `charge` (the last entry), under Coulomb friction with F = 0.05.
+macro_rules! floating_top {
+    ($charge:literal) => {
+        [
+            "mesh.n=64",
+            "~electrode",
+            "~dirichlet.0.phi",
+            "~dirichlet.1.phi",
+            "dirichlet.2.group=\"bottom\"",
+            "dirichlet.2.phi=0.0",
+            "dirichlet.3.group=\"top\"",
+            "contact.friction=0.05",
+            concat!("dirichlet.3.charge=", $charge),
+        ]
+    };
+}
+const FLOATING_TOP_SETS: [&str; 9] = floating_top!("0.05");
+const FLOODED_TOP_SETS: [&str; 9] = floating_top!("1e6");
+
 /// The cases of SCENES.md section 5 (bad input has its own corpus, `tests/bad-input`).
 pub const CASES: &[Case] = &[
     Case {
@@ -378,6 +398,24 @@ pub const CASES: &[Case] = &[
         sets: &["mesh.n=160", "contact.electric=\"conducting\"", "contact.charge=-1.0"],
         paper_sets: None,
         expect: Expect::Refused("lifts the body off"),
+        fine: false,
+    },
+    Case {
+        name: "floating electrode",
+        why: "the actuator's top a floating terminal (charge 0.05) over a grounded bottom under Coulomb friction (F = 0.05): its potential found with a zone that sticks and slips",
+        scene: "actuator",
+        sets: &FLOATING_TOP_SETS,
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "flooded electrode",
+        why: "the same floating top given a charge of 1e6 (about 3e7 times the first): its potential of 5e4 lifts the whole face off the foundation",
+        scene: "actuator",
+        sets: &FLOODED_TOP_SETS,
+        paper_sets: None,
+        expect: Expect::Converged,
         fine: false,
     },
     Case {

@@ -1,4 +1,5 @@
-//! The files of a run, exactly those its plan lists (`run.json`, `solution.vtu`,
+//! The files of a run, exactly those its plan lists (`run.json`, `solution.vtu`, a body of
+//! revolution's `revolved.vtu`,
 //! `contact.csv`, the pictures), written as one set ([`Outputs`], in `set`): the new set
 //! appears all at once, in place of the previous one, or not at all.
 
@@ -48,6 +49,21 @@ pub fn files(solution: &Solution) -> Result<Outputs, Error> {
                     (&solution.u, &solution.phi),
                     &solution.fields,
                     solution.contact.as_ref(),
+                )?,
+            ),
+            Output::RevolvedVtu => out.add(
+                "revolved.vtu",
+                revolved_vtu(
+                    &solution.mesh,
+                    (&solution.u, &solution.phi),
+                    &solution.fields,
+                    solution
+                        .report
+                        .scene
+                        .settings
+                        .mesh
+                        .revolve
+                        .ok_or_else(|| missing("revolved.vtu"))?,
                 )?,
             ),
             Output::ContactCsv => {
@@ -142,6 +158,88 @@ fn vtu(
     vtk.write_xml(&mut buf).map_err(|e| Error::Picture {
         name: "solution.vtu".into(),
         message: e.to_string(),
+    })?;
+    Ok(buf)
+}
+
+/// A body of revolution's solution swept round its axis (y) in `segments` steps: each meridian
+/// triangle `(r, z)` a ring of wedges, the point `(r, z)` at the angle θ at `(r cos θ, z, r sin θ)`
+/// (points on the axis repeated at every angle). Point data `u` (Cartesian: `u_r` turned by θ),
+/// `phi`; cell data `stress` and `strain` in the body's own components `[rr, zz, rz, θθ]`,
+/// `electric_displacement` and `electric_field` Cartesian (turned by the wedge's mid-angle).
+fn revolved_vtu(
+    mesh: &mesh::Mesh,
+    (u, phi): (&[[f64; 3]], &[f64]),
+    fields: &problem::CellFields,
+    segments: usize,
+) -> Result<Vec<u8>, Error> {
+    let (n, cells) = (mesh.n_nodes(), mesh.n_cells());
+    let angle = |k: usize| 2.0 * std::f64::consts::PI * (k % segments) as f64 / segments as f64;
+    let (mut points, mut uu, mut pp) = (vec![], vec![], vec![]);
+    for k in 0..segments {
+        let (c, s) = (angle(k).cos(), angle(k).sin());
+        for v in 0..n {
+            let [r, z, _] = mesh.points[v];
+            points.extend([r * c, z, r * s]);
+            uu.extend([u[v][0] * c, u[v][1], u[v][0] * s]);
+            pp.push(phi[v]);
+        }
+    }
+    let (mut connectivity, mut offsets) = (vec![], vec![]);
+    let nv = fields.stress.len() / cells.max(1);
+    let (mut stress, mut strain, mut d, mut e) = (vec![], vec![], vec![], vec![]);
+    for k in 0..segments {
+        let (lo, hi) = ((k * n) as u64, (((k + 1) % segments) * n) as u64);
+        let mid = 0.5 * (angle(k) + angle(k) + 2.0 * std::f64::consts::PI / segments as f64);
+        let (c, s) = (mid.cos(), mid.sin());
+        for cell in 0..cells {
+            let t = mesh.cell(cell);
+            // VTK's wedge: the base (0, 1, 2) turns about its outward normal, away from the
+            // top (3, 4, 5); a counterclockwise meridian triangle faces the growing angle, so
+            // the base is the later angle's
+            connectivity.extend(t.iter().map(|&v| hi + v as u64));
+            connectivity.extend(t.iter().map(|&v| lo + v as u64));
+            offsets.push(connectivity.len() as u64);
+            stress.extend_from_slice(&fields.stress[cell * nv..(cell + 1) * nv]);
+            strain.extend_from_slice(&fields.strain[cell * nv..(cell + 1) * nv]);
+            for (out, of) in [
+                (&mut d, &fields.electric_displacement),
+                (&mut e, &fields.electric_field),
+            ] {
+                let (vr, vz) = (of[2 * cell], of[2 * cell + 1]);
+                out.extend([vr * c, vz, vr * s]);
+            }
+        }
+    }
+    let vtk = Vtk {
+        version: Version::new((1, 0)),
+        title: "piezocontact solution, revolved".into(),
+        byte_order: ByteOrder::LittleEndian,
+        file_path: None,
+        data: DataSet::inline(UnstructuredGridPiece {
+            points: points.into(),
+            cells: Cells {
+                cell_verts: VertexNumbers::XML { connectivity, offsets },
+                types: vec![CellType::Wedge; cells * segments],
+            },
+            data: Attributes {
+                point: vec![
+                    Attribute::generic("u", 3).with_data(uu),
+                    Attribute::scalars("phi", 1).with_data(pp),
+                ],
+                cell: vec![
+                    Attribute::generic("stress", nv as u32).with_data(stress),
+                    Attribute::generic("strain", nv as u32).with_data(strain),
+                    Attribute::generic("electric_displacement", 3).with_data(d),
+                    Attribute::generic("electric_field", 3).with_data(e),
+                ],
+            },
+        }),
+    };
+    let mut buf = Vec::new();
+    vtk.write_xml(&mut buf).map_err(|err| Error::Picture {
+        name: "revolved.vtu".into(),
+        message: err.to_string(),
     })?;
     Ok(buf)
 }
@@ -333,13 +431,17 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     Ok(out)
 }
 
-/// `path.csv`: one row per instant, with the charge through each terminal (`charge_GROUP`).
+/// `path.csv`: one row per instant, with the charge through each terminal (`charge_GROUP`) and
+/// its potential (`potential_GROUP`).
 fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
     let mut s = String::from(
-        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium",
+        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius",
     );
     for t in terminals {
         s.push_str(&format!(",charge_{t}"));
+    }
+    for t in terminals {
+        s.push_str(&format!(",potential_{t}"));
     }
     s.push('\n');
     for r in rows {
@@ -357,7 +459,10 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         );
         row.push(format!("{:e}", r.complementarity));
         row.push(r.equilibrium.map_or(String::new(), |e| format!("{e:e}")));
+        row.push(r.depth.map_or(String::new(), |e| format!("{e:e}")));
+        row.push(r.contact_radius.map_or(String::new(), |e| format!("{e:e}")));
         row.extend(r.charges.iter().map(|q| format!("{q:e}")));
+        row.extend(r.potentials.iter().map(|v| format!("{v:e}")));
         s.push_str(&row.join(","));
         s.push('\n');
     }
@@ -380,7 +485,8 @@ fn pvd(series: &[(f64, String)]) -> Vec<u8> {
 
 /// The path's global curves: the contact forces against time; the forces against the factor
 /// that drives the path (the one that varies most: a load, a voltage, a displacement), whose
-/// loop is friction's hysteresis; and the charges through the terminals against time.
+/// loop is friction's hysteresis; an indenter's force against its depth; and the charges
+/// through the terminals and their potentials against time.
 fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result<plots::Files, Error> {
     let over = |f: &dyn Fn(&problem::report::StepRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
     const FACTORS: [&str; 6] = ["load", "voltage", "ux", "uy", "uz", "gap"];
@@ -414,6 +520,16 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
             )],
         },
     ];
+    if rows.iter().any(|r| r.depth.is_some()) {
+        panels.push(Panel {
+            title: "Indenter force against depth".into(),
+            labels: ("depth".into(), "force".into()),
+            series: vec![Series::line(
+                "normal force",
+                over(&|r| (r.depth.unwrap_or(f64::NAN), r.normal_force)),
+            )],
+        });
+    }
     if !terminals.is_empty() {
         panels.push(Panel {
             title: "Charge through each terminal".into(),
@@ -422,6 +538,15 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
                 .iter()
                 .enumerate()
                 .map(|(g, name)| Series::line(name, over(&|r| (r.t, r.charges.get(g).copied().unwrap_or(f64::NAN)))))
+                .collect(),
+        });
+        panels.push(Panel {
+            title: "Potential of each terminal".into(),
+            labels: ("t".into(), "potential".into()),
+            series: terminals
+                .iter()
+                .enumerate()
+                .map(|(g, name)| Series::line(name, over(&|r| (r.t, r.potentials.get(g).copied().unwrap_or(f64::NAN)))))
                 .collect(),
         });
     }
@@ -455,6 +580,65 @@ pub fn safe_file_name(name: &str, fallback: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_body_of_revolution_is_swept_into_wedges_that_face_out() {
+        let mesh = mesh::rectangle_tri([0.0, 0.0], [1.0, 2.0], 2, 4);
+        mesh.check().unwrap();
+        let n = mesh.n_nodes();
+        let u: Vec<[f64; 3]> = mesh.points.iter().map(|p| [0.1 * p[0], -0.2 * p[1], 0.0]).collect();
+        let phi: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
+        let cells = mesh.n_cells();
+        let fields = problem::CellFields {
+            stress: vec![1.0; 4 * cells],
+            strain: vec![0.5; 4 * cells],
+            electric_displacement: [1.0, 0.0].repeat(cells),
+            electric_field: [0.0, 1.0].repeat(cells),
+        };
+        let bytes = revolved_vtu(&mesh, (&u, &phi), &fields, 12).unwrap();
+        let vtk = Vtk::parse_xml(&bytes[..]).unwrap();
+        let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+            panic!("not a grid")
+        };
+        let vtkio::model::Piece::Inline(piece) = &pieces[0] else {
+            panic!("not inline")
+        };
+        let points: Vec<f64> = piece.points.clone().cast_into().unwrap();
+        assert_eq!(points.len(), 3 * 12 * n);
+        let VertexNumbers::XML { connectivity, .. } = &piece.cells.cell_verts else {
+            panic!("legacy")
+        };
+        assert_eq!(connectivity.len(), 6 * 12 * cells);
+        // every wedge's base turns about a normal pointing away from its top
+        let at = |i: u64| {
+            [
+                points[3 * i as usize],
+                points[3 * i as usize + 1],
+                points[3 * i as usize + 2],
+            ]
+        };
+        for w in connectivity.chunks(6) {
+            let (a, b, c) = (at(w[0]), at(w[1]), at(w[2]));
+            let (ab, ac) = (
+                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+            );
+            let normal = [
+                ab[1] * ac[2] - ab[2] * ac[1],
+                ab[2] * ac[0] - ab[0] * ac[2],
+                ab[0] * ac[1] - ab[1] * ac[0],
+            ];
+            let top: Vec<[f64; 3]> = w[3..].iter().map(|&i| at(i)).collect();
+            let centre: [f64; 3] = std::array::from_fn(|k| top.iter().map(|p| p[k]).sum::<f64>() / 3.0 - a[k]);
+            let side: f64 = (0..3).map(|k| normal[k] * centre[k]).sum();
+            assert!(side < 0.0, "wedge {w:?}: the base faces its top");
+        }
+        // the radius of each point is its meridian r, the axis its y
+        for (k, p) in points.chunks(3).enumerate() {
+            let m = mesh.points[k % n];
+            assert!((p[0].hypot(p[2]) - m[0]).abs() < 1e-14 && p[1] == m[1]);
+        }
+    }
 
     #[test]
     fn the_default_directory_stays_under_out() {

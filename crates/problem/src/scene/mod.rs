@@ -347,10 +347,12 @@ pub struct PathSpec {
     /// Steps after `t[0]` (default: one per later instant of `t`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub steps: Option<usize>,
-    /// The factor on the load (`load.p`).
+    /// The factor on the load (`load.p`, every `[[load]]`, and an indenter's force under force
+    /// control, `contact.indenter.force`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load: Option<Vec<f64>>,
-    /// The factor on every prescribed potential (`electrode.v`, `dirichlet.phi`).
+    /// The factor on every prescribed potential (`electrode.v`, `dirichlet.phi`) and on the
+    /// charges of the floating terminals (`dirichlet.charge`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub voltage: Option<Vec<f64>>,
     /// The factor on every prescribed displacement component (where `ux`, `uy`, `uz` give
@@ -642,6 +644,16 @@ pub struct MeshSpec {
     /// (every cell halves when `n` doubles).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grading: Option<Grading>,
+    /// A box whose section is a quarter of a disc: the box `[0, R]² x [z₀, z₁]` made a quarter
+    /// of the cylinder of radius R about the z axis (`mesh::round_quarter_section`, after any
+    /// grading), its faces `left` (x = 0) and `front` (y = 0) the symmetry planes, `right` and
+    /// `back` together its curved face: the 3D twin of a body of revolution.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub cylinder: bool,
+    /// A body of revolution's 3D view: `revolved.vtu`, the solution swept round the axis in
+    /// this many segments (its cells are `revolve` times the meridian's; absent: not written).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub revolve: Option<usize>,
 }
 
 /// `mesh.grading`: one stretch (last cell over first) for every axis, or one per axis.
@@ -703,6 +715,8 @@ impl MeshSpec {
             regions: vec![],
             axisymmetric: false,
             grading: None,
+            cylinder: false,
+            revolve: None,
         }
     }
 

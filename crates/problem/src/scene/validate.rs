@@ -331,7 +331,15 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "path",
         "a path carries friction's history from step to step, and the scene has no contact (contact.law = \"none\"): without it each instant is the static answer scaled",
     )?;
-    applies(scene.loads().is_empty(), "path.load", "the scene has no [load]")?;
+    let force_control = scene
+        .active_contact()
+        .and_then(|c| c.indenter.as_ref())
+        .is_some_and(|i| i.force.is_some());
+    applies(
+        scene.loads().is_empty() && !force_control,
+        "path.load",
+        "the scene has no [load] (nor an indenter under force control, contact.indenter.force)",
+    )?;
     applies(scene.active_contact().is_none(), "path.gap", "the scene has no contact")?;
     refuse_if(
         scene.exact.is_some(),
@@ -387,6 +395,34 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
                 format!("mesh.grading = {q}: the last cell over the first must lie in [1e-6, 1e6] (1 is uniform; above 1 the cells grow away from lo)"),
             ));
         }
+    }
+    if let Some(k) = m.revolve {
+        refuse_if(
+            !m.axisymmetric,
+            "mesh.revolve",
+            "mesh.revolve sweeps a body of revolution round its axis, and mesh.axisymmetric is not set",
+        )?;
+        refuse_if(
+            !(3..=360).contains(&k),
+            "mesh.revolve",
+            &format!("mesh.revolve = {k}: the segments of the revolved view must number 3 to 360"),
+        )?;
+    }
+    if m.cylinder {
+        refuse_if(
+            m.kind != MeshKind::Box,
+            "mesh.cylinder",
+            &format!(
+                "mesh.cylinder rounds a generated box's section, and mesh.kind = \"{}\"",
+                m.kind
+            ),
+        )?;
+        let square = m.lo.len() == 3 && m.hi.len() == 3 && m.lo[0] == 0.0 && m.lo[1] == 0.0 && m.hi[0] == m.hi[1];
+        refuse_if(
+            !square,
+            "mesh.cylinder",
+            "mesh.cylinder makes the section [0, R]² a quarter disc of radius R: give mesh.lo = [0, 0, z0] and mesh.hi = [R, R, z1]",
+        )?;
     }
     match m.dim() {
         None => validate_read(m),
@@ -738,24 +774,13 @@ fn validate_indenter(i: &IndenterSpec, c: &ContactSpec) -> Result<(), SceneError
     Ok(())
 }
 
-/// Floating terminals (`dirichlet.charge`): solved by superposition (the grounded run, the
-/// capacitance matrix, the final run), so on a linear problem (no contact, one instant), by the
-/// default backend.
+/// Floating terminals (`dirichlet.charge`): one potential tied over the group, in the
+/// default backend's assembly.
 fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
     if !s.dirichlet.iter().any(|d| d.charge.is_some()) {
         return Ok(());
     }
     let key = "dirichlet.charge";
-    refuse_if(
-        s.contact_law() != ContactLaw::None,
-        key,
-        "a floating terminal, and contact makes the problem nonlinear: its potential is found by superposition, which needs contact.law = \"none\" (not yet with contact)",
-    )?;
-    refuse_if(
-        s.path.is_some(),
-        key,
-        "a floating terminal, and a load path (not yet: a floating terminal's potential is found at one instant)",
-    )?;
     refuse_if(
         s.solver.backend == BackendChoice::Petsc,
         key,
@@ -764,7 +789,7 @@ fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
 }
 
 /// Force control (`contact.indenter.force`): found on the condensed compliance of the default
-/// backend, at one instant.
+/// backend, at one instant or at each instant of a path (the force scaled by its load factor).
 fn refuse_force_control(s: &Scene) -> Result<(), SceneError> {
     let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
         return Ok(());
@@ -784,9 +809,9 @@ fn refuse_force_control(s: &Scene) -> Result<(), SceneError> {
         &format!("force control, and solver.strategy = \"{}\" does not condense: the depth is found on the condensed compliance (newton-condensed)", s.solver.strategy),
     )?;
     refuse_if(
-        s.path.is_some(),
+        s.path.as_ref().is_some_and(|p| p.gap.is_some()),
         key,
-        "force control, and a load path drives the depth (its gap factor), not the force",
+        "force control, and path.gap drives the depth: under force control the depth is found at each instant for the force times the load factor (path.load); remove path.gap",
     )
 }
 
