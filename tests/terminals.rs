@@ -470,3 +470,107 @@ direction = [0.0, 1.0]
     assert_eq!(scene.loads().len(), 2);
     assert!(problem::solve(&scene, None, &mut problem::Silent).is_ok());
 }
+
+#[test]
+fn electrodes_split_in_two_are_the_one_they_cover() {
+    // the actuator's electrode (0.25 <= x <= 1.75 of the top, 0.05) as two [[electrode]]
+    // halves at the same voltage: the same solution, and their charges add up to its charge
+    let (one, _) = files::scene_file::load("actuator", &["mesh.n=16".into()]).unwrap();
+    let mut two = one.clone();
+    let half = |lo: f64, hi: f64, name: &str| problem::ElectrodeSpec {
+        x_range: Some(vec![lo, hi]),
+        name: Some(name.into()),
+        ..problem::ElectrodeSpec::at("top", 0.05)
+    };
+    two.electrode = Some(problem::Electrodes::Many(vec![
+        half(0.25, 1.0, "west"),
+        half(1.0, 1.75, "east"),
+    ]));
+    let (a, b) = (
+        problem::solve(&one, None, &mut problem::Silent).unwrap(),
+        problem::solve(&two, None, &mut problem::Silent).unwrap(),
+    );
+    let scale = a.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let gap =
+        a.u.iter()
+            .zip(&b.u)
+            .flat_map(|(x, y)| x.iter().zip(y).map(|(p, q)| (p - q).abs()))
+            .fold(0.0, f64::max);
+    assert!(gap < 1e-10 * scale, "displacements differ by {gap:e}");
+    let charge = |s: &problem::Solution, g: &str| s.report.terminals.iter().find(|t| t.group == g).unwrap().charge;
+    let names: Vec<&str> = b.report.terminals.iter().map(|t| t.group.as_str()).collect();
+    assert_eq!(names, ["left", "right", "west", "east"]);
+    let whole = charge(&a, "electrode");
+    let sum = charge(&b, "west") + charge(&b, "east");
+    assert!((sum - whole).abs() < 1e-10 * whole.abs(), "{sum} against {whole}");
+    // the capacitance matrix: the halves share the node at x = 1, one conductor
+    let c = problem::capacitance(&two, None).unwrap();
+    assert_eq!(c.terminals, ["left", "right", "west+east"]);
+}
+
+#[test]
+fn a_floating_electrode_table_reads_the_open_circuit_voltage() {
+    // the sensor's open top as an [[electrode]] with charge = 0 instead of a dirichlet group
+    let (h, p) = (0.5, 0.01);
+    let open = -p * E33 * h / (C33 * EPS33 + E33 * E33);
+    let mut scene = sensor(true, p, 0.0);
+    scene.dirichlet.retain(|d| d.group != "top");
+    scene.electrode = Some(
+        problem::ElectrodeSpec {
+            group: "top".into(),
+            charge: Some(0.0),
+            name: Some("sense".into()),
+            ..Default::default()
+        }
+        .into(),
+    );
+    let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+    let sense = s.report.terminals.iter().find(|t| t.group == "sense").unwrap();
+    assert!(sense.floating);
+    assert!(
+        (sense.potential - open).abs() < 1e-10 * open.abs(),
+        "{} against {open}",
+        sense.potential
+    );
+}
+
+#[test]
+fn electrodes_that_cannot_be_are_refused_by_name() {
+    let (base, _) = files::scene_file::load("actuator", &["mesh.n=8".into()]).unwrap();
+    let with = |e: Vec<problem::ElectrodeSpec>| {
+        let mut s = base.clone();
+        s.electrode = Some(problem::Electrodes::Many(e));
+        problem::solve(&s, None, &mut problem::Silent)
+            .err()
+            .unwrap()
+            .to_string()
+    };
+    let both = problem::ElectrodeSpec {
+        charge: Some(0.0),
+        ..problem::ElectrodeSpec::at("top", 1.0)
+    };
+    assert!(with(vec![both]).contains("a voltage (electrode.v) and a charge"));
+    let neither = problem::ElectrodeSpec {
+        group: "top".into(),
+        ..Default::default()
+    };
+    assert!(with(vec![neither]).contains("neither a voltage"));
+    let e = with(vec![
+        problem::ElectrodeSpec::at("top", 1.0),
+        problem::ElectrodeSpec::at("top", 2.0),
+    ]);
+    assert!(e.contains("electrode.v") || e.contains("gets"), "{e}");
+    let named = |n: &str| problem::ElectrodeSpec {
+        name: Some(n.into()),
+        ..problem::ElectrodeSpec::at("top", 1.0)
+    };
+    assert!(with(vec![named("a"), named("a")]).contains("two electrodes make the group `a`"));
+    assert!(with(vec![named("bottom")]).contains("would replace the mesh's own group"));
+    // a floating electrode touching a grounded side: one conductor
+    let floating_top = problem::ElectrodeSpec {
+        group: "top".into(),
+        charge: Some(0.0),
+        ..Default::default()
+    };
+    assert!(with(vec![floating_top]).contains("one conductor"));
+}

@@ -85,8 +85,9 @@ pub use report::{PetscReport, RunReport};
 pub use run::{run, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectricCondition,
-    ElectrodeSpec, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, Loads, MaterialModel,
-    MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec, Strategy, Valid,
+    ElectrodeSpec, Electrodes, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, Loads,
+    MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec,
+    Strategy, Valid,
 };
 
 use contact::ContactError;

@@ -153,7 +153,10 @@ impl Plan {
 /// potential) or a non-zero charge on a floating terminal: electric data that needs electric
 /// unknowns even without coupling.
 pub fn electric_data(scene: &Scene) -> bool {
-    scene.electrode.as_ref().is_some_and(|e| e.v != 0.0)
+    scene
+        .electrodes()
+        .iter()
+        .any(|e| e.v.is_some_and(|v| v != 0.0) || e.charge.is_some_and(|q| q != 0.0))
         || scene
             .dirichlet
             .iter()

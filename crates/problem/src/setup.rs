@@ -52,8 +52,10 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
     scene.check_dimension(dim)?;
     let materials = materials(scene, dim)?;
     if electric_data(scene) && !materials.iter().any(|(_, m)| m.electric) {
-        let (key, what) = if scene.electrode.as_ref().is_some_and(|e| e.v != 0.0) {
+        let (key, what) = if scene.electrodes().iter().any(|e| e.v.is_some_and(|v| v != 0.0)) {
             ("electrode.v", "a potential")
+        } else if scene.electrodes().iter().any(|e| e.charge.is_some_and(|q| q != 0.0)) {
+            ("electrode.charge", "a charge")
         } else if scene.dirichlet.iter().any(|d| d.phi.is_some_and(|p| p != 0.0)) {
             ("dirichlet.phi", "a potential")
         } else {
@@ -167,24 +169,32 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         }
         mesh.regions.insert(r.name.clone(), cells);
     }
-    if let Some(e) = &scene.electrode {
+    for (k, e) in scene.electrodes().iter().enumerate() {
         let range = e
             .x_range
             .clone()
             .unwrap_or_else(|| vec![f64::NEG_INFINITY, f64::INFINITY]);
         let tol = 1e-12 * (1.0 + range[0].abs().max(range[1].abs()));
         let g = mesh.select_facets(&e.group, |x| x[0] >= range[0] - tol && x[0] <= range[1] + tol)?;
+        let name = e.group_name(k);
         if g.n_facets() == 0 {
             return Err(SceneError::new(
                 "electrode.x_range",
                 format!(
-                    "the electrode covers no facet of `{}` in x in [{}, {}]",
+                    "the electrode `{name}` covers no facet of `{}` in x in [{}, {}]",
                     e.group, range[0], range[1]
                 ),
             )
             .into());
         }
-        mesh.boundaries.insert("electrode".into(), g);
+        if mesh.boundaries.contains_key(&name) {
+            return Err(SceneError::new(
+                "electrode.name",
+                format!("the electrode `{name}` would replace the mesh's own group of that name: name it otherwise (electrode.name)"),
+            )
+            .into());
+        }
+        mesh.boundaries.insert(name, g);
     }
     if m.axisymmetric {
         axis_group(&mut mesh)?;
@@ -307,8 +317,12 @@ fn constraints(scene: &Scene, plan: &Plan) -> Vec<Constraint> {
             out.push(Constraint::floating(&d.group));
         }
     }
-    if let (Some(e), true) = (&scene.electrode, plan.electric) {
-        out.push(Constraint::constant("electrode", Field::Potential, e.v));
+    for (k, e) in scene.electrodes().iter().enumerate().filter(|_| plan.electric) {
+        match (e.v, e.charge) {
+            (Some(v), _) => out.push(Constraint::constant(&e.group_name(k), Field::Potential, v)),
+            (None, Some(_)) => out.push(Constraint::floating(&e.group_name(k))),
+            (None, None) => {}
+        }
     }
     out
 }
@@ -316,12 +330,16 @@ fn constraints(scene: &Scene, plan: &Plan) -> Vec<Constraint> {
 /// The loads of a validated scene: each a uniform traction on its group (several on one group
 /// add up), and the charges on the floating terminals.
 fn loads(scene: &Scene, dim: usize, electric: bool) -> Vec<Load> {
-    let charges = scene.dirichlet.iter().filter(|_| electric).filter_map(|d| {
-        d.charge.map(|charge| Load::TerminalCharge {
-            group: d.group.clone(),
-            charge,
-        })
-    });
+    let on_groups = scene
+        .dirichlet
+        .iter()
+        .filter_map(|d| d.charge.map(|q| (d.group.clone(), q)));
+    let on_electrodes = (scene.electrodes().iter().enumerate())
+        .filter_map(|(k, e)| e.charge.filter(|_| e.v.is_none()).map(|q| (e.group_name(k), q)));
+    let charges = on_groups
+        .chain(on_electrodes)
+        .filter(|_| electric)
+        .map(|(group, charge)| Load::TerminalCharge { group, charge });
     scene
         .loads()
         .iter()

@@ -46,6 +46,20 @@ def test_an_open_electrode_from_python():
     assert top["floating"]
     expected = -0.01 * 15.1 * 0.5 / (115.0 * 5.62 + 15.1**2)
     assert abs(top["potential"] - expected) < 1e-10 * abs(expected)
+    # the same open top as a floating [[electrode]] half of two, the other half grounded:
+    # several electrodes, each its own terminal, from a list of dicts
+    scene = pc.Scene.load("sensor")
+    data = scene.to_dict()
+    data["dirichlet"] = [d for d in data["dirichlet"] if d["group"] != "top"]
+    data["electrode"] = [
+        {"group": "top", "x_range": [0.0, 0.5], "charge": 0.0, "name": "sense"},
+        {"group": "top", "x_range": [0.75, 1.0], "v": 0.0, "name": "guard"},
+    ]
+    r = pc.run(pc.Scene.from_dict(data))
+    groups = {t["group"]: t for t in r.report["terminals"]}
+    assert groups["sense"]["floating"] and not groups["guard"].get("floating", False)
+    # the grounded guard draws part of the field: the open sense reads less than the whole top
+    assert 0.0 < groups["sense"]["potential"] / expected < 1.0
 
 
 def test_the_piezoelectric_half_space_closed_form_from_python():

@@ -317,9 +317,10 @@ pub struct Scene {
     /// The mechanical loads: one `[load]`, or several `[[load]]`.
     #[serde(default)]
     pub load: Option<Loads>,
-    /// A voltage electrode.
+    /// Electrodes on parts of boundary groups: one table `[electrode]`, or an array
+    /// `[[electrode]]`, each at a voltage or floating.
     #[serde(default)]
-    pub electrode: Option<ElectrodeSpec>,
+    pub electrode: Option<Electrodes>,
     /// Contact with a rigid foundation.
     #[serde(default)]
     pub contact: Option<ContactSpec>,
@@ -508,8 +509,9 @@ impl Scene {
         for l in self.loads() {
             add("load.p", &[l.p]);
         }
-        if let Some(e) = &self.electrode {
-            add("electrode.v", &[e.v]);
+        for e in self.electrodes() {
+            add("electrode.v", e.v.as_slice());
+            add("electrode.charge", e.charge.as_slice());
         }
         if let Some(c) = &self.contact {
             add("contact.friction", c.friction.as_slice());
@@ -924,17 +926,81 @@ pub struct LoadSpec {
     pub direction: Vec<f64>,
 }
 
-/// A voltage on the part of a group inside a range of x.
+/// The scene's electrodes: one table `[electrode]`, or an array `[[electrode]]`.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Electrodes {
+    /// `[electrode]`.
+    One(ElectrodeSpec),
+    /// `[[electrode]]`.
+    Many(Vec<ElectrodeSpec>),
+}
+
+impl Electrodes {
+    /// Every electrode.
+    pub fn all(&self) -> &[ElectrodeSpec] {
+        match self {
+            Electrodes::One(e) => std::slice::from_ref(e),
+            Electrodes::Many(v) => v,
+        }
+    }
+}
+
+impl From<ElectrodeSpec> for Electrodes {
+    fn from(e: ElectrodeSpec) -> Self {
+        Electrodes::One(e)
+    }
+}
+
+impl Scene {
+    /// The scene's electrodes (none, one or several).
+    pub fn electrodes(&self) -> &[ElectrodeSpec] {
+        self.electrode.as_ref().map_or(&[], Electrodes::all)
+    }
+}
+
+/// An electrode: the part of a boundary group inside a range of x, at a voltage or floating,
+/// made a boundary group of its own (its `name`: the scene's terminal).
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ElectrodeSpec {
     /// Boundary group the electrode lies on.
     pub group: String,
-    /// Voltage (`electrode.v`).
-    pub v: f64,
+    /// Voltage (`electrode.v`); or `charge`, not both.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v: Option<f64>,
+    /// A floating electrode: its potential unknown (one value over it), the charge on it this
+    /// (0 for an open circuit), as a floating `dirichlet.charge`. Instead of `v`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charge: Option<f64>,
     /// Only facets whose nodes have `x_range[0] <= x <= x_range[1]`.
     #[serde(default)]
     pub x_range: Option<Vec<f64>>,
+    /// The group the electrode makes, its name as a terminal (default: `electrode` for the
+    /// first, `electrode-2`, `electrode-3`, ... for the others).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+}
+
+impl ElectrodeSpec {
+    /// An electrode on the whole of `group` at the voltage `v`.
+    pub fn at(group: &str, v: f64) -> Self {
+        ElectrodeSpec {
+            group: group.into(),
+            v: Some(v),
+            ..Default::default()
+        }
+    }
+
+    /// The group the `k`-th electrode of a scene makes (0-based): its `name`, or `electrode`,
+    /// `electrode-2`, ...
+    pub fn group_name(&self, k: usize) -> String {
+        match (&self.name, k) {
+            (Some(n), _) => n.clone(),
+            (None, 0) => "electrode".into(),
+            (None, k) => format!("electrode-{}", k + 1),
+        }
+    }
 }
 
 /// Contact with a rigid, non-conductive foundation.

@@ -163,8 +163,32 @@ impl Scene {
                 ));
             }
         }
-        if let Some(e) = &self.electrode {
-            finite("electrode.v", e.v)?;
+        let mut names: Vec<String> = vec![];
+        for (k, e) in self.electrodes().iter().enumerate() {
+            let name = e.group_name(k);
+            match (e.v, e.charge) {
+                (Some(v), None) => finite("electrode.v", v)?,
+                (None, Some(q)) => finite("electrode.charge", q)?,
+                (Some(_), Some(_)) => {
+                    return Err(SceneError::new(
+                        "electrode.charge",
+                        format!("the electrode `{name}` has a voltage (electrode.v) and a charge (electrode.charge): a floating electrode's potential is found, give one of them"),
+                    ))
+                }
+                (None, None) => {
+                    return Err(SceneError::new(
+                        "electrode.v",
+                        format!("the electrode `{name}` has neither a voltage (electrode.v) nor a charge (electrode.charge, floating)"),
+                    ))
+                }
+            }
+            if names.contains(&name) {
+                return Err(SceneError::new(
+                    "electrode.name",
+                    format!("two electrodes make the group `{name}`: give each its own electrode.name"),
+                ));
+            }
+            names.push(name);
             if let Some(r) = &e.x_range {
                 all_finite("electrode.x_range", r)?;
                 if r.len() != 2 || !(r[0] <= r[1]) {
@@ -774,13 +798,16 @@ fn validate_indenter(i: &IndenterSpec, c: &ContactSpec) -> Result<(), SceneError
     Ok(())
 }
 
-/// Floating terminals (`dirichlet.charge`): one potential tied over the group, in the
-/// default backend's assembly.
+/// Floating terminals (`dirichlet.charge`, `electrode.charge`): one potential tied over the
+/// group, in the default backend's assembly.
 fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
-    if !s.dirichlet.iter().any(|d| d.charge.is_some()) {
+    let key = if s.dirichlet.iter().any(|d| d.charge.is_some()) {
+        "dirichlet.charge"
+    } else if s.electrodes().iter().any(|e| e.charge.is_some()) {
+        "electrode.charge"
+    } else {
         return Ok(());
-    }
-    let key = "dirichlet.charge";
+    };
     refuse_if(
         s.solver.backend == BackendChoice::Petsc,
         key,
