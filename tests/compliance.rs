@@ -69,7 +69,7 @@ fn block(dim: usize, compliance: Option<ComplianceSpec>, friction: bool) -> Scen
         dirichlet,
         load: None,
         electrode: None,
-        contact: Some(contact),
+        contact: Some(contact.into()),
         solver: Default::default(),
         exact: None,
         path: None,
@@ -188,7 +188,7 @@ fn compliance_is_refused_where_it_is_not_solved() {
     assert_eq!(s.validate().unwrap_err().key, "contact.compliance");
     // Hertz's closed form is a rigid foundation's: not compared against a compliant one
     let (mut hertz, _) = files::scene_file::load("hertz", &[]).unwrap();
-    hertz.contact.as_mut().unwrap().compliance = Some(spec);
+    hertz.first_contact_mut().unwrap().compliance = Some(spec);
     assert_eq!(hertz.validate().unwrap_err().key, "contact.compliance");
     let bad = ComplianceSpec {
         stiffness: 1.0,

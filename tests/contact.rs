@@ -513,3 +513,149 @@ fn newton_steps_do_not_grow_with_the_mesh() {
         assert!(steps.iter().all(|&s| s <= 7), "{scene}: {steps:?}");
     }
 }
+
+/// A unit square (cube) on symmetry rollers (`left`, `bottom`, and `front` in 3D) pressed into
+/// a corner: every other face against its own rigid wall (`[[contact]]`, frictionless) placed
+/// `delta` inside it. The walls squeeze the body uniformly, `u = -delta x`, so each wall carries
+/// the pressure `p = (dim λ + 2μ) delta` over its unit face; the corner nodes are points of two
+/// (three) groups.
+fn squeezed_into_a_corner(dim: usize, delta: f64) -> problem::Scene {
+    let toml = if dim == 2 {
+        r#"
+name = "corner"
+description = "a square squeezed by two walls"
+[mesh]
+kind = "rectangle"
+lo = [0.0, 0.0]
+hi = [1.0, 1.0]
+n = 4
+[[material]]
+region = "body"
+model = "isotropic"
+young = 100.0
+poisson = 0.3
+[[dirichlet]]
+group = "left"
+ux = 0.0
+[[dirichlet]]
+group = "bottom"
+uy = 0.0
+[[contact]]
+group = "right"
+law = "signorini"
+normal = [1.0, 0.0]
+gap = -DELTA
+[[contact]]
+group = "top"
+law = "signorini"
+normal = [0.0, 1.0]
+gap = -DELTA
+"#
+    } else {
+        r#"
+name = "corner-3d"
+description = "a cube squeezed by three walls"
+[mesh]
+kind = "box"
+lo = [0.0, 0.0, 0.0]
+hi = [1.0, 1.0, 1.0]
+n = 3
+[[material]]
+region = "body"
+model = "isotropic"
+young = 100.0
+poisson = 0.3
+[[dirichlet]]
+group = "left"
+ux = 0.0
+[[dirichlet]]
+group = "front"
+uy = 0.0
+[[dirichlet]]
+group = "bottom"
+uz = 0.0
+[[contact]]
+group = "right"
+law = "signorini"
+normal = [1.0, 0.0, 0.0]
+gap = -DELTA
+[[contact]]
+group = "back"
+law = "signorini"
+normal = [0.0, 1.0, 0.0]
+gap = -DELTA
+[[contact]]
+group = "top"
+law = "signorini"
+normal = [0.0, 0.0, 1.0]
+gap = -DELTA
+"#
+    };
+    files::scene_file::parse(&toml.replace("DELTA", &delta.to_string()), "corner", &[]).unwrap()
+}
+
+#[test]
+fn several_contact_groups_squeeze_a_body_into_a_corner_as_the_closed_form_says() {
+    let (young, poisson, delta) = (100.0, 0.3, 1e-3);
+    let (lambda, mu) = (
+        young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson)),
+        young / (2.0 * (1.0 + poisson)),
+    );
+    for dim in [2, 3] {
+        let scene = squeezed_into_a_corner(dim, delta);
+        let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+        let p = (dim as f64 * lambda + 2.0 * mu) * delta;
+        let groups = &s.report.contact.groups;
+        assert_eq!(groups.len(), dim, "{dim}D: {groups:?}");
+        for g in groups {
+            assert!(
+                (g.normal_force - p).abs() < 1e-9 * p,
+                "{dim}D `{}`: force {} against {p}",
+                g.group,
+                g.normal_force
+            );
+            assert_eq!(g.n_separated, 0, "{dim}D `{}`", g.group);
+        }
+        for (x, u) in s.mesh.points.iter().zip(&s.u) {
+            for k in 0..dim {
+                assert!((u[k] + delta * x[k]).abs() < 1e-12, "{dim}D at {x:?}: {u:?}");
+            }
+        }
+        // the corner's node is a point of each wall
+        let n = s.report.contact.n_points;
+        let faces: usize = groups.iter().map(|g| g.n_points).sum();
+        assert_eq!(n, faces);
+    }
+}
+
+#[test]
+fn what_several_contact_groups_cannot_share_is_refused_by_name() {
+    let base = squeezed_into_a_corner(2, 1e-3);
+    let refused = |change: &dyn Fn(&mut problem::Scene)| {
+        let mut s = base.clone();
+        change(&mut s);
+        s.validate().unwrap_err().key
+    };
+    let Some(problem::Contacts::Many(_)) = &base.contact else {
+        panic!("an array")
+    };
+    fn group(s: &mut problem::Scene, k: usize) -> &mut problem::ContactSpec {
+        match s.contact.as_mut().unwrap() {
+            problem::Contacts::Many(v) => &mut v[k],
+            problem::Contacts::One(c) => c,
+        }
+    }
+    assert_eq!(
+        refused(&|s| group(s, 1).law = problem::ContactLaw::Coulomb),
+        "contact.law"
+    );
+    assert_eq!(refused(&|s| group(s, 1).group = "right".into()), "contact.group");
+    assert_eq!(
+        refused(&|s| group(s, 0).electric = Some(problem::ElectricCondition::Conducting)),
+        "contact.electric"
+    );
+    assert_eq!(
+        refused(&|s| s.solver.backend = problem::BackendChoice::Petsc),
+        "contact"
+    );
+}

@@ -78,7 +78,7 @@ fn block(dim: usize, condition: ElectricCondition, conductance: Option<f64>) -> 
         dirichlet,
         load: None,
         electrode: None,
-        contact: Some(contact),
+        contact: Some(contact.into()),
         solver: Default::default(),
         exact: None,
         path: None,

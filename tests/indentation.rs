@@ -32,7 +32,7 @@ fn indenter(shape: IndenterShape, depth: f64) -> IndenterSpec {
 fn hertz_body(ind: IndenterSpec) -> Scene {
     let (mut scene, _) = files::scene_file::load("hertz-sphere", &[]).unwrap();
     scene.exact = None;
-    scene.contact.as_mut().unwrap().indenter = Some(ind);
+    scene.first_contact_mut().unwrap().indenter = Some(ind);
     scene
 }
 
@@ -64,7 +64,7 @@ fn force_control_finds_the_depth_that_carries_the_force() {
     let force = by_depth.report.indenter.as_ref().unwrap().force;
     for start in [0.0, 0.03] {
         let mut controlled = scene.clone();
-        let ind = controlled.contact.as_mut().unwrap().indenter.as_mut().unwrap();
+        let ind = controlled.first_contact_mut().unwrap().indenter.as_mut().unwrap();
         ind.force = Some(force);
         ind.depth = start;
         let found = problem::solve(&controlled, None, &mut Silent).unwrap();
@@ -398,7 +398,7 @@ fn block(kind: &str, depth: f64) -> Scene {
         dirichlet,
         load: None,
         electrode: None,
-        contact: Some(contact),
+        contact: Some(contact.into()),
         solver: Default::default(),
         exact: None,
         path: None,
@@ -794,4 +794,41 @@ fn the_body_of_revolution_is_the_3d_cylinder() {
         assert!(gap(2) < 0.06, "n = {n}: tip potential {} against {}", solid[2], axi[2]);
         last = gap(0);
     }
+}
+
+#[test]
+fn an_indenter_among_several_contact_groups_reports_its_own_zone() {
+    // hertz-sphere with a second group: its rim against a wall it never reaches (gap 1). The
+    // indenter's depth, force and radius are the one-group run's; the wall carries nothing.
+    let sets = ["mesh.n=64".to_string(), "~exact".into()];
+    let (one, _) = files::scene_file::load("hertz-sphere", &sets).unwrap();
+    let mut two = one.clone();
+    let mut wall = problem::ContactSpec::new("right", ContactLaw::Signorini, &[1.0, 0.0]);
+    wall.gap = 1.0;
+    two.contact = Some(problem::Contacts::Many(vec![
+        wall,
+        one.first_contact().unwrap().clone(),
+    ]));
+    let (a, b) = (
+        problem::solve(&one, None, &mut Silent).unwrap(),
+        problem::solve(&two, None, &mut Silent).unwrap(),
+    );
+    let (x, y) = (a.report.indenter.as_ref().unwrap(), b.report.indenter.as_ref().unwrap());
+    assert!(
+        (x.force - y.force).abs() < 1e-10 * x.force,
+        "{} against {}",
+        y.force,
+        x.force
+    );
+    assert_eq!(
+        (x.depth, x.contact_radius, x.points_in_contact),
+        (y.depth, y.contact_radius, y.points_in_contact)
+    );
+    let groups = &b.report.contact.groups;
+    assert_eq!(groups[0].group, "right");
+    assert_eq!(
+        (groups[0].normal_force, groups[0].n_separated),
+        (0.0, groups[0].n_points)
+    );
+    assert!((groups[1].normal_force - x.force).abs() < 1e-10 * x.force);
 }

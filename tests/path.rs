@@ -24,7 +24,7 @@ fn stick_half_width(a: f64, f: f64, p: f64, reversals: &[f64], q: f64) -> f64 {
 fn cycle(n: usize) -> Vec<(f64, f64, f64, f64, f64)> {
     let sets = [format!("mesh.n={n}")];
     let (scene, _) = scene_file::load("cattaneo-mindlin-cycle", &sets).unwrap();
-    let c = scene.contact.clone().unwrap();
+    let c = scene.first_contact().cloned().unwrap();
     let f = c.friction();
     let radius = 1.0 / c.gap_curvature;
     let m = &scene.material[0];
@@ -343,7 +343,7 @@ fn sphere_loop(n: usize) -> (f64, f64) {
     let (scene, _) = scene_file::load("mindlin-sphere-cycle", &[format!("mesh.n={n}")]).unwrap();
     let m = &scene.material[0];
     let (young, poisson) = (m.young.unwrap(), m.poisson.unwrap());
-    let c = scene.contact.clone().unwrap();
+    let c = scene.first_contact().cloned().unwrap();
     let amplitude = scene.dirichlet[0].u.as_ref().unwrap()[0];
     let p = problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())).unwrap();
     let rows = p.last.report.path.unwrap().rows;

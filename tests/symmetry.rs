@@ -127,7 +127,7 @@ fn block(dim: usize, law: ContactLaw, gap: f64, half: bool) -> Scene {
             .into(),
         ),
         electrode: None,
-        contact: Some(contact),
+        contact: Some(contact.into()),
         solver: Default::default(),
         exact: None,
         path: None,
@@ -287,7 +287,7 @@ fn the_other_combinations_are_solved_or_refused_with_their_reason() {
     }
     // a roller across an oblique normal
     let mut s = block(2, ContactLaw::Coulomb, 0.0, false);
-    s.contact.as_mut().unwrap().normal = vec![0.3, -1.0];
+    s.first_contact_mut().unwrap().normal = vec![0.3, -1.0];
     s.dirichlet.push(DirichletSpec {
         group: "bottom".into(),
         ux: Some(0.0),
@@ -310,7 +310,7 @@ fn the_other_combinations_are_solved_or_refused_with_their_reason() {
     // its answer is the frictionless answer with ux = 0 on the face: a body glued sideways
     // and free to lift off, solved with Signorini alone
     let mut signorini = s.clone();
-    signorini.contact = Some(ContactSpec::new("bottom", ContactLaw::Signorini, &[0.0, -1.0]));
+    signorini.contact = Some(ContactSpec::new("bottom", ContactLaw::Signorini, &[0.0, -1.0]).into());
     let other = solve(&signorini, m);
     for (a, b) in held.u.iter().zip(&other.u) {
         assert!((a[1] - b[1]).abs() <= 1e-12 * (1.0 + a[1].abs()));

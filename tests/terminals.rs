@@ -218,7 +218,7 @@ fn what_a_floating_terminal_cannot_carry_is_refused_by_name() {
         phi: Some(0.0),
         ..Default::default()
     });
-    conducting.contact.as_mut().unwrap().electric = Some(problem::ElectricCondition::Conducting);
+    conducting.first_contact_mut().unwrap().electric = Some(problem::ElectricCondition::Conducting);
     let e = problem::solve(&conducting, None, &mut problem::Silent).err().unwrap();
     assert!(
         e.to_string().contains("contact.electric") && e.to_string().contains("floating terminal"),
@@ -282,11 +282,7 @@ fn pressed_onto_a_foundation(dim: usize, d: f64, charge: f64) -> Scene {
         scene.mesh = MeshSpec::cuboid([0.0; 3], [2.0, 1.0, 0.5], 4);
         scene.material[0].poling = vec![0.0, 0.0, 1.0];
     }
-    scene.contact = Some(problem::ContactSpec::new(
-        "bottom",
-        problem::ContactLaw::Signorini,
-        &normal,
-    ));
+    scene.contact = Some(problem::ContactSpec::new("bottom", problem::ContactLaw::Signorini, &normal).into());
     scene
 }
 
@@ -346,7 +342,7 @@ fn floating_on_friction(dim: usize, charge: f64) -> Scene {
         charge: Some(charge),
         ..Default::default()
     });
-    let contact = scene.contact.as_mut().unwrap();
+    let contact = scene.first_contact_mut().unwrap();
     contact.law = problem::ContactLaw::Coulomb;
     contact.friction = Some(if dim == 2 { 0.05 } else { 0.2 });
     scene

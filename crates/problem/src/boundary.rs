@@ -35,6 +35,13 @@ pub struct ContactBoundary {
     /// Electrical contact: the law and the points with a free potential, and those potentials'
     /// dofs (indices into `[u; φ]`), condensed after `dofs`.
     pub electric: Option<(contact::ElectricContact, Vec<usize>)>,
+    /// The contact group of each point (an index into `groups`).
+    pub group_of: Vec<usize>,
+    /// The contact groups, in the scene's order.
+    pub groups: Vec<String>,
+    /// The uniform part of each point's gap (its group's `contact.gap` less an indenter's
+    /// depth), which a load path's `gap` factor scales.
+    uniform: Vec<f64>,
 }
 
 /// One displacement component of a contact point.
@@ -188,6 +195,66 @@ impl ContactBoundary {
     /// normal or a tangent (neither along nor orthogonal to it); a group with no contact point
     /// left.
     pub fn new(disc: &Discretization<'_>, spec: &ContactSpec) -> Result<Self, ProblemError> {
+        Self::of_groups(disc, std::slice::from_ref(spec))
+    }
+
+    /// The contact points of several groups (`[[contact]]`), each as [`ContactBoundary::new`]
+    /// makes them with its own normal, gap and friction, in the order of the groups. A node
+    /// of two groups (a corner against two faces) is a point of each, its displacement dofs
+    /// condensed once.
+    ///
+    /// # Errors
+    /// As [`ContactBoundary::new`], for each group.
+    pub fn of_groups(disc: &Discretization<'_>, specs: &[ContactSpec]) -> Result<Self, ProblemError> {
+        let dim = disc.mesh.dim;
+        let mut b = ContactBoundary {
+            points: ContactPoints {
+                dim,
+                position: vec![],
+                normal: vec![],
+                tangent: vec![],
+                weight: vec![],
+                gap: vec![],
+                friction: vec![],
+                held: vec![],
+                foundation: match specs.first().and_then(|s| s.compliance) {
+                    Some(k) => contact::Foundation::Compliant {
+                        stiffness: k.stiffness,
+                        exponent: k.exponent,
+                    },
+                    None => contact::Foundation::Rigid,
+                },
+                slipped: vec![],
+            },
+            nodes: vec![],
+            dofs: vec![],
+            slots: vec![],
+            held_nodes: 0,
+            held_inside: 0,
+            electric: None,
+            group_of: vec![],
+            groups: specs.iter().map(|s| s.group.clone()).collect(),
+            uniform: vec![],
+        };
+        let mut place: std::collections::HashMap<usize, usize> = Default::default();
+        for (k, spec) in specs.iter().enumerate() {
+            b.add_group(disc, k, spec, &mut place)?;
+        }
+        if let [spec] = specs {
+            b.electric = electric_points(spec, &disc.dofs, &b.nodes)?;
+        }
+        Ok(b)
+    }
+
+    /// Adds the points of group `k` (`spec`); `place` holds each condensed dof's place in
+    /// `dofs`, shared by the points of one node.
+    fn add_group(
+        &mut self,
+        disc: &Discretization<'_>,
+        k: usize,
+        spec: &ContactSpec,
+        place: &mut std::collections::HashMap<usize, usize>,
+    ) -> Result<(), ProblemError> {
         let (mesh, dofs) = (disc.mesh, &disc.dofs);
         let dim = mesh.dim;
         let nv = unit_normal(spec, dim)?;
@@ -197,26 +264,7 @@ impl ContactBoundary {
         let group = mesh.boundary(&spec.group)?;
         let weight = lumped_weights(mesh, group, disc.axisymmetric);
         let friction = spec.friction();
-        let mut points = ContactPoints {
-            dim,
-            position: vec![],
-            normal: vec![],
-            tangent: vec![],
-            weight: vec![],
-            gap: vec![],
-            friction: vec![],
-            held: vec![],
-            foundation: match spec.compliance {
-                Some(k) => contact::Foundation::Compliant {
-                    stiffness: k.stiffness,
-                    exponent: k.exponent,
-                },
-                None => contact::Foundation::Rigid,
-            },
-            slipped: vec![],
-        };
-        let (mut nodes, mut point_dofs, mut slots) = (vec![], vec![], vec![]);
-        let (mut held_nodes, mut held_inside, mut out_of_reach) = (0, 0, 0);
+        let (mut added, mut held_nodes, mut out_of_reach) = (0, 0, 0);
         for node in group.nodes() {
             let x = mesh.points[node];
             let Some(gap) = spec.gap_at(&x, &nv) else {
@@ -231,32 +279,37 @@ impl ContactBoundary {
                     // Dirichlet condition wins, even where it holds the node past the gap)
                     held_nodes += 1;
                     if u_n > gap + 1e-12 * (u_n.abs() + gap.abs()) {
-                        held_inside += 1;
+                        self.held_inside += 1;
                     }
                     continue;
                 }
                 Held::Tangents(held) => held,
             };
             for c in &comps {
-                slots.push(match *c {
-                    Dof::Free(j) => {
-                        point_dofs.push(j);
-                        Slot::Free(point_dofs.len() - 1)
-                    }
+                self.slots.push(match *c {
+                    Dof::Free(j) => Slot::Free(*place.entry(j).or_insert_with(|| {
+                        self.dofs.push(j);
+                        self.dofs.len() - 1
+                    })),
                     Dof::Fixed(v) => Slot::Fixed(v),
                     Dof::Absent => Slot::Fixed(0.0),
                 });
             }
-            nodes.push(node);
-            points.position.push(x);
-            points.normal.push(nv);
-            points.tangent.push(tangents);
-            points.weight.push(weight[node]);
-            points.gap.push(gap);
-            points.friction.push(friction);
-            points.held.push(held);
+            self.nodes.push(node);
+            let p = &mut self.points;
+            p.position.push(x);
+            p.normal.push(nv);
+            p.tangent.push(tangents);
+            p.weight.push(weight[node]);
+            p.gap.push(gap);
+            p.friction.push(friction);
+            p.held.push(held);
+            self.group_of.push(k);
+            self.uniform.push(spec.uniform_gap());
+            added += 1;
         }
-        if nodes.is_empty() && out_of_reach > 0 {
+        self.held_nodes += held_nodes;
+        if added == 0 && out_of_reach > 0 {
             return Err(SceneError::new(
                 "contact.indenter",
                 format!(
@@ -266,7 +319,7 @@ impl ContactBoundary {
             )
             .into());
         }
-        if nodes.is_empty() {
+        if added == 0 {
             return Err(SceneError::new(
                 "contact.group",
                 format!(
@@ -276,22 +329,14 @@ impl ContactBoundary {
             )
             .into());
         }
-        let electric = electric_points(spec, dofs, &nodes)?;
-        Ok(ContactBoundary {
-            points,
-            nodes,
-            dofs: point_dofs,
-            slots,
-            held_nodes,
-            held_inside,
-            electric,
-        })
+        Ok(())
     }
 
-    /// The boundary at an instant of a load path: the uniform part `g0` of every gap
-    /// (`contact.gap`) scaled by `gap`, and each prescribed displacement component `k` of a
-    /// point by `displacement[k]` (the points, their dofs and weights are the same).
-    pub fn at_factors(&self, g0: f64, gap: f64, displacement: [f64; 3]) -> ContactBoundary {
+    /// The boundary at an instant of a load path: the uniform part of every gap (its group's
+    /// `contact.gap` less an indenter's depth) scaled by `gap`, and each prescribed
+    /// displacement component `k` of a point by `displacement[k]` (the points, their dofs and
+    /// weights are the same).
+    pub fn at_factors(&self, gap: f64, displacement: [f64; 3]) -> ContactBoundary {
         let dim = self.points.dim;
         let mut b = ContactBoundary {
             points: self.points.clone(),
@@ -301,8 +346,13 @@ impl ContactBoundary {
             held_nodes: self.held_nodes,
             held_inside: self.held_inside,
             electric: self.electric.clone(),
+            group_of: self.group_of.clone(),
+            groups: self.groups.clone(),
+            uniform: self.uniform.clone(),
         };
-        b.points.gap.iter_mut().for_each(|g| *g += (gap - 1.0) * g0);
+        for (g, g0) in b.points.gap.iter_mut().zip(&self.uniform) {
+            *g += (gap - 1.0) * g0;
+        }
         for (j, slot) in b.slots.iter_mut().enumerate() {
             if let Slot::Fixed(v) = slot {
                 *v *= displacement[j % dim];
@@ -372,7 +422,7 @@ impl ContactBoundary {
                 for q in 0..nt {
                     f += lambda.tangential[i * nt + q] * p.tangent[i][q][k];
                 }
-                out[j] = -p.weight[i] * f;
+                out[j] -= p.weight[i] * f;
             }
         }
         out

@@ -40,7 +40,7 @@ impl FieldSolution {
         } else if x.kind == ExactKind::ManufacturedContact {
             // validated: a box or rectangle, contact on its bottom face; a bed or an electric
             // face other than the conducting one under one 6mm crystal poled along the normal
-            let c = scene.contact.as_ref()?;
+            let c = scene.first_contact()?;
             let center = pad(c.gap_center.as_deref().unwrap_or_default(), 3);
             let s0 = scene.mesh.lo.get(dim - 1).copied().unwrap_or(0.0);
             let m = &scene.material[0];
@@ -283,7 +283,7 @@ pub fn contact_errors(
     q: f64,
 ) -> Option<ExactReport> {
     let x = scene.exact.as_ref().filter(|x| !x.kind.is_field())?;
-    let c = scene.contact.as_ref()?;
+    let c = scene.first_contact()?;
     let m = scene.material.first()?;
     let (young, poisson) = (m.young?, m.poisson?);
     let radius = c.hertz_radius()?;
@@ -362,7 +362,7 @@ pub fn contact_errors(
 pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Option<HalfSpaceReport> {
     use crate::halfspace::Tip;
     let (body, profile, tip) = scene.half_space_problem(electric).ok()?;
-    let force = scene.contact.as_ref()?.indenter.as_ref()?.force;
+    let force = scene.first_contact()?.indenter.as_ref()?.force;
     let form = match force {
         Some(f) => body.at_force(&profile, f, tip),
         None => body.at_depth(&profile, run.depth, tip),

@@ -578,8 +578,7 @@ fn floating_tip(
 fn indenter_force(posed: &Posed<'_>) -> Option<f64> {
     posed
         .scene
-        .contact
-        .as_ref()
+        .first_contact()
         .and_then(|c| c.indenter.as_ref())
         .and_then(|i| i.force)
 }
@@ -706,7 +705,7 @@ fn electric_contact(
             .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))
     };
     let mut problem = problem;
-    let floating = posed.scene.contact.as_ref().and_then(|c| c.charge);
+    let floating = posed.scene.first_contact().and_then(|c| c.charge);
     let mut solve = |points: &ContactPoints, _: Option<PointValues>| match floating {
         Some(charge) => floating_tip(&mut problem, points, charge, &mut newton),
         None => newton(&problem, points),

@@ -36,7 +36,7 @@
 //!     dirichlet: vec![clamped("left"), clamped("right")],
 //!     load: Some(LoadSpec { group: "top".into(), p: -2.0, direction: vec![0.0, 1.0] }.into()),
 //!     electrode: None,
-//!     contact: Some(contact),
+//!     contact: Some(contact.into()),
 //!     solver: Default::default(),
 //!     exact: None,
 //!     path: None,
@@ -84,7 +84,7 @@ pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
 pub use run::{run, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
-    BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, DirichletSpec, ElectricCondition,
+    BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, Contacts, DirichletSpec, ElectricCondition,
     ElectrodeSpec, Electrodes, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, Loads,
     MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec,
     Strategy, Valid,
@@ -341,11 +341,7 @@ impl ProblemError {
             }
         }
         let newton = strategy == Strategy::NewtonCondensed;
-        let electric = scene
-            .contact
-            .as_ref()
-            .and_then(|c| c.electric_law())
-            .map(|(law, _)| law);
+        let electric = scene.first_contact().and_then(|c| c.electric_law()).map(|(law, _)| law);
         let hint = match (&source, electric) {
             (ContactError::Stalled { .. }, Some(contact::ElectricLaw::Conducting)) => {
                 "; semismooth Newton and its proximal stage stalled on the coupled rows (electrical contact has no first-order stage): an ideally conducting foundation whose potential lifts the body off where it touches may have no solution (contact gives the potential that lifts, lift-off takes it away); contact.electric = \"conductive\" with a finite contact.conductance is the regularised law, solved there"

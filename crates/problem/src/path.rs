@@ -349,7 +349,7 @@ impl Walk<'_> {
         let assembled = Faer.assemble(&posed)?;
         let t_assembly = t.elapsed().as_secs_f64();
         reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
-        let boundary = ContactBoundary::new(disc, self.contact)?;
+        let boundary = ContactBoundary::of_groups(disc, self.scene.contacts())?;
         boundary.report_held(&self.contact.group, reporter);
         let system = Faer.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
         stop_if_interrupted(limits, "factorisation")?;
@@ -411,7 +411,7 @@ impl Walk<'_> {
         let (scene, setup) = (self.scene, self.setup);
         let f = self.spec.factors(t);
         disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
-        let mut boundary = base.at_factors(self.contact.uniform_gap(), f.gap, f.displacement);
+        let mut boundary = base.at_factors(f.gap, f.displacement);
         if how.weakening.is_some() {
             boundary.points.slipped.clone_from(&state.slipped);
         }
@@ -466,7 +466,7 @@ impl Walk<'_> {
             None => sol.u.clone(),
         };
         let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift);
-        if let Some(indenter) = indenter_report(scene, &boundary.points, &sol, row.normal_force) {
+        if let Some(indenter) = indenter_report(scene, &boundary, &sol) {
             (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
         }
         // the charges of the fields where they are computed, else of the functionals (equal to

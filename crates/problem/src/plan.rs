@@ -74,7 +74,7 @@ impl Plan {
         let coupling = materials.iter().any(|(_, m)| m.e.iter().any(|&x| x != 0.0));
         let electric = (coupling || electric_data(scene)) && materials.iter().any(|(_, m)| m.electric);
         let law = scene.contact_law();
-        let friction = scene.contact.as_ref().is_some_and(|c| match law {
+        let friction = scene.first_contact().is_some_and(|c| match law {
             ContactLaw::Coulomb => c.friction() > 0.0,
             ContactLaw::Tresca => c.slip_bound() > 0.0,
             _ => false,
@@ -106,13 +106,11 @@ impl Plan {
             rule: scene.solver.rule,
             outputs,
             compliance: scene
-                .contact
-                .as_ref()
+                .first_contact()
                 .filter(|_| law != ContactLaw::None)
                 .and_then(|c| c.compliance),
             weakening: scene
-                .contact
-                .as_ref()
+                .first_contact()
                 .filter(|_| law == ContactLaw::Coulomb)
                 .and_then(|c| c.slip_weakening()),
             tol: scene.solver.tol,
@@ -120,7 +118,7 @@ impl Plan {
                 Rule::Paper => 1e-2,
                 Rule::Tight => 1e-12,
             }),
-            slip_bound: scene.contact.as_ref().map_or(0.0, |c| c.slip_bound()),
+            slip_bound: scene.first_contact().map_or(0.0, |c| c.slip_bound()),
         }
     }
 

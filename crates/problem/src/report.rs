@@ -305,22 +305,90 @@ pub struct ContactReport {
     /// electrode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub electric_points: Option<usize>,
+    /// Several contact groups (`[[contact]]`): each one's own counts and forces.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<ContactGroupReport>,
+}
+
+/// One contact group's share of a contact solution (several `[[contact]]` groups).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct ContactGroupReport {
+    /// The group.
+    pub group: String,
+    /// Its contact points.
+    pub n_points: usize,
+    /// Its points in contact and sticking.
+    pub n_stick: usize,
+    /// Its points in contact and sliding.
+    pub n_slip: usize,
+    /// Its points with no contact force.
+    pub n_separated: usize,
+    /// `Σ w λ_n` over its points (along its own normal).
+    pub normal_force: f64,
+    /// `|Σ w λ_t t|` over its points.
+    pub tangential_force: f64,
+}
+
+/// The counts (stick, slip, separated), the normal force and the tangential force vector of
+/// the points `of` a contact solution.
+fn tally(
+    points: &contact::ContactPoints,
+    sol: &contact::ContactSolution,
+    of: impl Iterator<Item = usize>,
+) -> ([usize; 3], f64, [f64; 3]) {
+    let nt = sol.lambda.n_tangential();
+    let (mut counts, mut normal, mut t) = ([0; 3], 0.0, [0.0; 3]);
+    for i in of {
+        counts[match sol.status[i] {
+            contact::Status::Stick => 0,
+            contact::Status::Slip => 1,
+            contact::Status::Separated => 2,
+        }] += 1;
+        normal += points.weight[i] * sol.lambda.normal[i];
+        for q in 0..nt {
+            for k in 0..3 {
+                t[k] += points.weight[i] * sol.lambda.tangential[i * nt + q] * points.tangent[i][q][k];
+            }
+        }
+    }
+    (counts, normal, t)
 }
 
 impl ContactReport {
+    /// The summary of a contact solution on its points; with several groups (`groups[k]` the
+    /// name of group k, `group_of[i]` point i's), each group's share too.
+    pub fn of_groups(
+        points: &contact::ContactPoints,
+        sol: &contact::ContactSolution,
+        groups: &[String],
+        group_of: &[usize],
+    ) -> Self {
+        let mut out = Self::of(points, sol);
+        if groups.len() > 1 {
+            out.groups = groups
+                .iter()
+                .enumerate()
+                .map(|(k, group)| {
+                    let mine = || (0..points.len()).filter(move |&i| group_of[i] == k);
+                    let ([n_stick, n_slip, n_separated], normal_force, t) = tally(points, sol, mine());
+                    ContactGroupReport {
+                        group: group.clone(),
+                        n_points: mine().count(),
+                        n_stick,
+                        n_slip,
+                        n_separated,
+                        normal_force,
+                        tangential_force: linalg::norm(&t),
+                    }
+                })
+                .collect();
+        }
+        out
+    }
+
     /// The summary of a contact solution on its points.
     pub fn of(points: &contact::ContactPoints, sol: &contact::ContactSolution) -> Self {
-        let (n_stick, n_slip, n_separated) = sol.counts();
-        let normal_force: f64 = points.weight.iter().zip(&sol.lambda.normal).map(|(w, l)| w * l).sum();
-        let nt = sol.lambda.n_tangential();
-        let mut t = [0.0; 3];
-        for i in 0..points.len() {
-            for q in 0..nt {
-                for k in 0..3 {
-                    t[k] += points.weight[i] * sol.lambda.tangential[i * nt + q] * points.tangent[i][q][k];
-                }
-            }
-        }
+        let ([n_stick, n_slip, n_separated], normal_force, t) = tally(points, sol, 0..points.len());
         ContactReport {
             n_points: points.len(),
             n_stick,
@@ -336,6 +404,7 @@ impl ContactReport {
             held_inside: 0,
             charge: sol.electric.as_ref().map(|e| e.charge(&points.weight)),
             electric_points: sol.electric.as_ref().map(|e| e.points.len()),
+            groups: vec![],
         }
     }
 }

@@ -48,6 +48,10 @@ pub struct ContactResult {
     /// `u_n` and all `dim - 1` components of `u_t` of the final displacement, whatever the law
     /// (a frictionless body slides too).
     pub displacement: PointValues,
+    /// The contact groups, in the scene's order.
+    pub groups: Vec<String>,
+    /// The group of each point (an index into `groups`).
+    pub group_of: Vec<usize>,
 }
 
 /// Solves `scene` on `backend`, within `limits`: validate, refuse what the backend does not
@@ -212,16 +216,12 @@ fn pose<'a>(scene: Valid<'a>, setup: &'a Setup, disc: &'a Discretization<'a>) ->
 /// The contact boundary, where the plan has contact; its nodes that the Dirichlet conditions
 /// hold reported.
 fn contact_boundary(posed: &Posed<'_>, reporter: &mut dyn Reporter) -> Result<Option<ContactBoundary>, ProblemError> {
-    let Some(spec) = posed
-        .scene
-        .contact
-        .as_ref()
-        .filter(|_| posed.plan().contact_law != ContactLaw::None)
-    else {
+    let specs = posed.scene.contacts();
+    if specs.is_empty() || posed.plan().contact_law == ContactLaw::None {
         return Ok(None);
-    };
-    let boundary = ContactBoundary::new(posed.disc, spec)?;
-    boundary.report_held(&spec.group, reporter);
+    }
+    let boundary = ContactBoundary::of_groups(posed.disc, specs)?;
+    boundary.report_held(&boundary.groups.join(", "), reporter);
     Ok(Some(boundary))
 }
 
@@ -240,6 +240,8 @@ impl ContactResult {
             points: b.points,
             solution,
             displacement,
+            groups: b.groups,
+            group_of: b.group_of,
         }
     }
 }
@@ -254,6 +256,8 @@ pub(crate) fn contact_result(b: ContactBoundary, solution: ContactSolution, u: &
         nodes: b.nodes,
         solution,
         displacement,
+        groups: b.groups,
+        group_of: b.group_of,
     }
 }
 
@@ -365,14 +369,15 @@ pub(crate) fn recover(
     let counts = contact.map_or_else(ContactReport::default, |(b, sol)| ContactReport {
         held_nodes: b.held_nodes,
         held_inside: b.held_inside,
-        ..ContactReport::of(&b.points, sol)
+        ..ContactReport::of_groups(&b.points, sol, &b.groups, &b.group_of)
     });
     let indenter = contact.and_then(|(b, sol)| {
-        let mut r = indenter_report(scene, &b.points, sol, counts.normal_force)?;
+        let mut r = indenter_report(scene, b, sol)?;
         if setup.plan.electric {
             // the contact node nearest the indenter's axis
-            let ind = scene.contact.as_ref()?.indenter.as_ref()?;
-            let nearest = (0..b.points.len()).min_by(|&i, &j| {
+            let (k, c) = scene.indenter_contact()?;
+            let ind = c.indenter.as_ref()?;
+            let nearest = (0..b.points.len()).filter(|&i| b.group_of[i] == k).min_by(|&i, &j| {
                 let ri = ind.local(&b.points.position[i], &b.points.normal[i]).1;
                 let rj = ind.local(&b.points.position[j], &b.points.normal[j]).1;
                 ri.total_cmp(&rj)
@@ -440,23 +445,27 @@ pub(crate) fn recover(
 /// gaps), the body carrying `normal_force`; `None` without `contact.indenter`.
 pub(crate) fn indenter_report(
     scene: &Scene,
-    points: &contact::ContactPoints,
+    b: &ContactBoundary,
     sol: &ContactSolution,
-    normal_force: f64,
 ) -> Option<crate::report::IndenterReport> {
-    let c = scene.contact.as_ref()?;
+    let (k, c) = scene.indenter_contact()?;
     let ind = c.indenter.as_ref()?;
-    let (mut radius, mut count) = (0.0f64, 0);
-    for (i, x) in points.position.iter().enumerate() {
+    let points = &b.points;
+    // the indenter's own points (the other groups rest on foundations)
+    let mine: Vec<usize> = (0..points.len()).filter(|&i| b.group_of[i] == k).collect();
+    let (mut radius, mut count, mut force) = (0.0f64, 0, 0.0);
+    for &i in &mine {
         if sol.lambda.normal[i] > 0.0 {
-            radius = radius.max(ind.local(x, &points.normal[i]).1);
+            radius = radius.max(ind.local(&points.position[i], &points.normal[i]).1);
             count += 1;
         }
+        force += points.weight[i] * sol.lambda.normal[i];
     }
+    let first = *mine.first()?;
     Some(crate::report::IndenterReport {
         shape: ind.shape.to_string(),
-        depth: c.depth_at(points),
-        force: normal_force,
+        depth: c.depth_at_point(&points.position[first], &points.normal[first], points.gap[first]),
+        force,
         contact_radius: radius,
         points_in_contact: count,
         // a floating tip's potential is found: that of a point it presses
@@ -618,7 +627,7 @@ mod tests {
                 .into(),
             ),
             electrode: None,
-            contact: Some(contact),
+            contact: Some(contact.into()),
             solver: Default::default(),
             exact: None,
             path: None,

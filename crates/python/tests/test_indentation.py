@@ -76,3 +76,30 @@ def test_the_piezoelectric_half_space_closed_form_from_python():
     ind = pc.run(scene).report["indenter"]
     assert abs(ind["charge"]) < 1e-9 * ind["force"]
     assert ind["potential"] > 0.0 and ind["half_space"]["potential"] > 0.0
+
+
+def test_several_contact_groups_from_python():
+    # a unit square on symmetry rollers squeezed by two walls 1e-3 inside it ([[contact]] as a
+    # list of dicts): each wall carries (2 lambda + 2 mu) delta, the corner node a point of both
+    young, nu, delta = 100.0, 0.3, 1e-3
+    scene = pc.Scene.from_dict(
+        {
+            "name": "corner",
+            "description": "a square squeezed by two walls",
+            "mesh": {"kind": "rectangle", "lo": [0.0, 0.0], "hi": [1.0, 1.0], "n": 4},
+            "material": [{"region": "body", "model": "isotropic", "young": young, "poisson": nu}],
+            "dirichlet": [{"group": "left", "ux": 0.0}, {"group": "bottom", "uy": 0.0}],
+            "contact": [
+                {"group": "right", "law": "signorini", "normal": [1.0, 0.0], "gap": -delta},
+                {"group": "top", "law": "signorini", "normal": [0.0, 1.0], "gap": -delta},
+            ],
+        }
+    )
+    r = pc.run(scene)
+    lam = young * nu / ((1 + nu) * (1 - 2 * nu))
+    mu = young / (2 * (1 + nu))
+    p = (2 * lam + 2 * mu) * delta
+    groups = r.report["contact"]["groups"]
+    assert [g["group"] for g in groups] == ["right", "top"]
+    for g in groups:
+        assert abs(g["normal_force"] - p) < 1e-9 * p

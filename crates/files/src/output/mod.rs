@@ -245,7 +245,8 @@ fn revolved_vtu(
 }
 
 /// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
-/// and, with electrical contact, `flux,potential` (`nan` where an electrode holds the point);
+/// and, with electrical contact, `flux,potential` (`nan` where an electrode holds the point),
+/// with several contact groups `group`;
 /// the displacements are those of the final solution (a frictionless body slides: its `u_t`
 /// is written too), the tangential multipliers 0 where the law carries none.
 fn contact_csv(c: &ContactResult) -> Vec<u8> {
@@ -266,7 +267,10 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
         }
         at
     });
-    s.push_str(if electric.is_some() { ",flux,potential\n" } else { "\n" });
+    s.push_str(if electric.is_some() { ",flux,potential" } else { "" });
+    // several contact groups: each point's
+    let several = c.groups.len() > 1;
+    s.push_str(if several { ",group\n" } else { "\n" });
     for i in 0..points.len() {
         // `{:e}`: the shortest digits that read back to the same double
         let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| format!("{x:e}")).collect();
@@ -286,6 +290,9 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
         if let Some(at) = &electric {
             row.push(format!("{:e}", at[i].0));
             row.push(format!("{:e}", at[i].1));
+        }
+        if several {
+            row.push(c.groups[c.group_of[i]].clone());
         }
         s.push_str(&row.join(","));
         s.push('\n');

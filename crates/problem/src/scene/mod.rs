@@ -321,9 +321,10 @@ pub struct Scene {
     /// `[[electrode]]`, each at a voltage or floating.
     #[serde(default)]
     pub electrode: Option<Electrodes>,
-    /// Contact with a rigid foundation.
+    /// Contact with a rigid foundation or indenter: one table `[contact]`, or an array
+    /// `[[contact]]` of groups (each its own face, normal, gap, friction or indenter).
     #[serde(default)]
-    pub contact: Option<ContactSpec>,
+    pub contact: Option<Contacts>,
     /// Solver choices.
     #[serde(default)]
     pub solver: SolverSpec,
@@ -476,12 +477,36 @@ fn interpolate(t: &[f64], f: &[f64], x: f64) -> f64 {
 impl Scene {
     /// The contact law, `none` where the scene has no contact section.
     pub fn contact_law(&self) -> ContactLaw {
-        self.contact.as_ref().map_or(ContactLaw::None, |c| c.law)
+        self.first_contact().map_or(ContactLaw::None, |c| c.law)
     }
 
-    /// The contact section when its law is not `none`.
+    /// The contact section when its law is not `none` (the first of several).
     pub fn active_contact(&self) -> Option<&ContactSpec> {
-        self.contact.as_ref().filter(|c| c.law != ContactLaw::None)
+        self.first_contact().filter(|c| c.law != ContactLaw::None)
+    }
+
+    /// Every contact group (none, one `[contact]`, or the `[[contact]]` array).
+    pub fn contacts(&self) -> &[ContactSpec] {
+        self.contact.as_ref().map_or(&[], Contacts::all)
+    }
+
+    /// The contact section, or the first of several.
+    pub fn first_contact(&self) -> Option<&ContactSpec> {
+        self.contacts().first()
+    }
+
+    /// The contact section, or the first of several, to change.
+    pub fn first_contact_mut(&mut self) -> Option<&mut ContactSpec> {
+        match self.contact.as_mut()? {
+            Contacts::One(c) => Some(c),
+            Contacts::Many(v) => v.first_mut(),
+        }
+    }
+
+    /// The contact group whose face a rigid indenter presses (at most one: validated), with
+    /// its index among [`Scene::contacts`].
+    pub fn indenter_contact(&self) -> Option<(usize, &ContactSpec)> {
+        self.contacts().iter().enumerate().find(|(_, c)| c.indenter.is_some())
     }
 
     /// Every number of the scene with its key (`load.p`, `material.c`, ...).
@@ -513,7 +538,7 @@ impl Scene {
             add("electrode.v", e.v.as_slice());
             add("electrode.charge", e.charge.as_slice());
         }
-        if let Some(c) = &self.contact {
+        for c in self.contacts() {
             add("contact.friction", c.friction.as_slice());
             add("contact.slip_bound", c.slip_bound.as_slice());
             add("contact.gap", &[c.gap]);
@@ -882,7 +907,7 @@ pub struct DirichletSpec {
 }
 
 /// The scene's tractions: one table `[load]`, or an array `[[load]]`.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Loads {
     /// `[load]`.
@@ -927,7 +952,7 @@ pub struct LoadSpec {
 }
 
 /// The scene's electrodes: one table `[electrode]`, or an array `[[electrode]]`.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Electrodes {
     /// `[electrode]`.
@@ -1000,6 +1025,34 @@ impl ElectrodeSpec {
             (None, 0) => "electrode".into(),
             (None, k) => format!("electrode-{}", k + 1),
         }
+    }
+}
+
+/// The scene's contact groups: one table `[contact]`, or an array `[[contact]]`.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(untagged)]
+// a scene holds one of these, read once: its size is no matter, a box would only obscure it
+#[allow(clippy::large_enum_variant)]
+pub enum Contacts {
+    /// `[contact]`.
+    One(ContactSpec),
+    /// `[[contact]]`.
+    Many(Vec<ContactSpec>),
+}
+
+impl Contacts {
+    /// Every contact group.
+    pub fn all(&self) -> &[ContactSpec] {
+        match self {
+            Contacts::One(c) => std::slice::from_ref(c),
+            Contacts::Many(v) => v,
+        }
+    }
+}
+
+impl From<ContactSpec> for Contacts {
+    fn from(c: ContactSpec) -> Self {
+        Contacts::One(c)
     }
 }
 
@@ -1131,7 +1184,7 @@ impl Scene {
         String,
     > {
         use crate::halfspace::{HalfSpace, Profile, Tip};
-        let c = self.contact.as_ref().ok_or("it needs [contact]")?;
+        let c = self.first_contact().ok_or("it needs [contact]")?;
         let ind = c.indenter.as_ref().ok_or("it needs a [contact.indenter]")?;
         let [m] = &self.material[..] else {
             return Err("it needs one material".into());
@@ -1323,11 +1376,16 @@ impl ContactSpec {
     /// depth found under force control, or scaled along a path): `-(contact.gap - depth)`
     /// plus how far the points' gaps lie below the shape's.
     pub fn depth_at(&self, points: &contact::ContactPoints) -> f64 {
-        let below = match points.position.first() {
-            Some(x) => self.gap_at(x, &points.normal[0]).map_or(0.0, |g| g - points.gap[0]),
-            None => 0.0,
-        };
-        -self.uniform_gap() + below
+        match points.position.first() {
+            Some(x) => self.depth_at_point(x, &points.normal[0], points.gap[0]),
+            None => -self.uniform_gap(),
+        }
+    }
+
+    /// The depth, as [`ContactSpec::depth_at`], from one of this group's points `x` (normal
+    /// `n`) and its gap now.
+    pub fn depth_at_point(&self, x: &[f64; 3], n: &[f64; 3], gap: f64) -> f64 {
+        -self.uniform_gap() + self.gap_at(x, n).map_or(0.0, |g| g - gap)
     }
 
     /// The uniform part of the gap a load path's `gap` factor scales: `contact.gap` less an
@@ -1535,4 +1593,46 @@ impl ExactSpec {
 /// every number of the scene).
 fn zero_when_absent<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_f64(v.unwrap_or(0.0))
+}
+
+/// A table or an array of tables (`[x]` or `[[x]]`), read as the one or the many: by the
+/// value's shape, so that a bad entry's own error (an unknown law, a string for a number)
+/// reaches the user, where serde's untagged enums say only that no variant matched.
+fn one_or_many<'de, D, T, O>(deserializer: D, one: fn(T) -> O, many: fn(Vec<T>) -> O) -> Result<O, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    struct Shape<T, O>(fn(T) -> O, fn(Vec<T>) -> O);
+    impl<'de, T: Deserialize<'de>, O> serde::de::Visitor<'de> for Shape<T, O> {
+        type Value = O;
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str("a table, or an array of tables")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<O, A::Error> {
+            T::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(self.0)
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<O, A::Error> {
+            Vec::<T>::deserialize(serde::de::value::SeqAccessDeserializer::new(seq)).map(self.1)
+        }
+    }
+    deserializer.deserialize_any(Shape(one, many))
+}
+
+impl<'de> Deserialize<'de> for Loads {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        one_or_many(d, Loads::One, Loads::Many)
+    }
+}
+
+impl<'de> Deserialize<'de> for Electrodes {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        one_or_many(d, Electrodes::One, Electrodes::Many)
+    }
+}
+
+impl<'de> Deserialize<'de> for Contacts {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        one_or_many(d, Contacts::One, Contacts::Many)
+    }
 }

@@ -163,45 +163,11 @@ impl Scene {
                 ));
             }
         }
-        let mut names: Vec<String> = vec![];
-        for (k, e) in self.electrodes().iter().enumerate() {
-            let name = e.group_name(k);
-            match (e.v, e.charge) {
-                (Some(v), None) => finite("electrode.v", v)?,
-                (None, Some(q)) => finite("electrode.charge", q)?,
-                (Some(_), Some(_)) => {
-                    return Err(SceneError::new(
-                        "electrode.charge",
-                        format!("the electrode `{name}` has a voltage (electrode.v) and a charge (electrode.charge): a floating electrode's potential is found, give one of them"),
-                    ))
-                }
-                (None, None) => {
-                    return Err(SceneError::new(
-                        "electrode.v",
-                        format!("the electrode `{name}` has neither a voltage (electrode.v) nor a charge (electrode.charge, floating)"),
-                    ))
-                }
-            }
-            if names.contains(&name) {
-                return Err(SceneError::new(
-                    "electrode.name",
-                    format!("two electrodes make the group `{name}`: give each its own electrode.name"),
-                ));
-            }
-            names.push(name);
-            if let Some(r) = &e.x_range {
-                all_finite("electrode.x_range", r)?;
-                if r.len() != 2 || !(r[0] <= r[1]) {
-                    return Err(SceneError::new(
-                        "electrode.x_range",
-                        "electrode.x_range needs two numbers, the first not above the second",
-                    ));
-                }
-            }
-        }
-        if let Some(c) = &self.contact {
+        validate_electrodes(self)?;
+        for c in self.contacts() {
             validate_contact(c)?;
         }
+        refuse_several_contacts(self)?;
         validate_solver(&self.solver)?;
         refuse_axisymmetric(self)?;
         refuse_force_control(self)?;
@@ -263,7 +229,7 @@ impl Scene {
         for l in self.loads() {
             len("load.direction", &l.direction, dim)?;
         }
-        if let Some(c) = &self.contact {
+        for c in self.contacts() {
             len("contact.normal", &c.normal, dim)?;
             if let Some(g) = &c.gap_center {
                 len("contact.gap_center", g, dim)?;
@@ -798,6 +764,130 @@ fn validate_indenter(i: &IndenterSpec, c: &ContactSpec) -> Result<(), SceneError
     Ok(())
 }
 
+/// Each electrode at a voltage or floating (not both), under a name of its own, its x range
+/// two ordered numbers.
+fn validate_electrodes(s: &Scene) -> Result<(), SceneError> {
+    let mut names: Vec<String> = vec![];
+    for (k, e) in s.electrodes().iter().enumerate() {
+        let name = e.group_name(k);
+        match (e.v, e.charge) {
+            (Some(v), None) => finite("electrode.v", v)?,
+            (None, Some(q)) => finite("electrode.charge", q)?,
+            (Some(_), Some(_)) => {
+                return Err(SceneError::new(
+                    "electrode.charge",
+                    format!("the electrode `{name}` has a voltage (electrode.v) and a charge (electrode.charge): a floating electrode's potential is found, give one of them"),
+                ))
+            }
+            (None, None) => {
+                return Err(SceneError::new(
+                    "electrode.v",
+                    format!("the electrode `{name}` has neither a voltage (electrode.v) nor a charge (electrode.charge, floating)"),
+                ))
+            }
+        }
+        if names.contains(&name) {
+            return Err(SceneError::new(
+                "electrode.name",
+                format!("two electrodes make the group `{name}`: give each its own electrode.name"),
+            ));
+        }
+        names.push(name);
+        if let Some(r) = &e.x_range {
+            all_finite("electrode.x_range", r)?;
+            if r.len() != 2 || !(r[0] <= r[1]) {
+                return Err(SceneError::new(
+                    "electrode.x_range",
+                    "electrode.x_range needs two numbers, the first not above the second",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
+/// coefficient and (one of them) a depth-controlled indenter; what they share (the law, the
+/// foundation's compliance, Tresca's bound) the same for all; what is posed for one zone
+/// (electrical contact, a floating tip, force control, slip weakening, an exact solution) and
+/// the PETSc backend refused by key.
+fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
+    let contacts = s.contacts();
+    let [first, rest @ ..] = contacts else { return Ok(()) };
+    if rest.is_empty() {
+        return Ok(());
+    }
+    for (k, c) in contacts.iter().enumerate() {
+        if let Some(other) = contacts[..k].iter().find(|o| o.group == c.group) {
+            return Err(SceneError::new(
+                "contact.group",
+                format!(
+                    "two [[contact]] entries on the group `{}`: one entry per face",
+                    other.group
+                ),
+            ));
+        }
+        let same = |key: &str, differs: bool, what: &str| {
+            refuse_if(
+                differs,
+                key,
+                &format!(
+                    "the [[contact]] groups `{}` and `{}` differ in {what}, which all share: give them the same",
+                    first.group, c.group
+                ),
+            )
+        };
+        same("contact.law", c.law != first.law, "their law")?;
+        same(
+            "contact.compliance",
+            c.compliance != first.compliance,
+            "the foundation's compliance",
+        )?;
+        same(
+            "contact.slip_bound",
+            c.slip_bound != first.slip_bound,
+            "Tresca's slip bound",
+        )?;
+        let one = |key: &str, given: bool, what: &str| {
+            refuse_if(
+                given,
+                key,
+                &format!(
+                    "{what} on one of several [[contact]] groups (`{}`): not yet; pose it with one [contact]",
+                    c.group
+                ),
+            )
+        };
+        one("contact.electric", c.electric_law().is_some(), "electrical contact")?;
+        one("contact.charge", c.charge.is_some(), "a floating tip")?;
+        one(
+            "contact.friction_law",
+            c.slip_weakening().is_some(),
+            "slip-weakening friction",
+        )?;
+        one(
+            "contact.indenter.force",
+            c.indenter.as_ref().is_some_and(|i| i.force.is_some()),
+            "force control",
+        )?;
+    }
+    refuse_if(
+        contacts.iter().filter(|c| c.indenter.is_some()).count() > 1,
+        "contact.indenter",
+        "two [[contact]] groups with an indenter: one indenter per scene (the others are foundations)",
+    )?;
+    refuse_if(
+        s.exact.is_some(),
+        "exact",
+        "an exact solution, and several [[contact]] groups: the known solutions have one contact zone",
+    )?;
+    refuse_if(
+        s.solver.backend == BackendChoice::Petsc,
+        "contact",
+        "several [[contact]] groups, and the PETSc backend takes one: use the default backend",
+    )
+}
+
 /// Floating terminals (`dirichlet.charge`, `electrode.charge`): one potential tied over the
 /// group, in the default backend's assembly.
 fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
@@ -818,7 +908,7 @@ fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
 /// Force control (`contact.indenter.force`): found on the condensed compliance of the default
 /// backend, at one instant or at each instant of a path (the force scaled by its load factor).
 fn refuse_force_control(s: &Scene) -> Result<(), SceneError> {
-    let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
+    let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) else {
         return Ok(());
     };
     if c.indenter.as_ref().is_none_or(|i| i.force.is_none()) {
@@ -861,7 +951,7 @@ fn refuse_axisymmetric(s: &Scene) -> Result<(), SceneError> {
             &format!("exact.kind `{}`, a plane or 3D solution, and the body is one of revolution (mesh.axisymmetric; `hertz` is the sphere's there)", x.kind),
         )?;
     }
-    if let Some(i) = s.contact.as_ref().and_then(|c| c.indenter.as_ref()) {
+    if let Some(i) = s.first_contact().and_then(|c| c.indenter.as_ref()) {
         refuse_if(
             i.shape == IndenterShape::Cylinder,
             "contact.indenter.shape",
@@ -883,8 +973,7 @@ fn refuse_axisymmetric(s: &Scene) -> Result<(), SceneError> {
 /// Gauss-Seidel as its last stage) solves it, and the PETSc backend's active sets do not.
 fn refuse_compliance(s: &Scene) -> Result<(), SceneError> {
     if !s
-        .contact
-        .as_ref()
+        .first_contact()
         .is_some_and(|c| c.compliance.is_some() && c.law != ContactLaw::None)
     {
         return Ok(());
@@ -920,7 +1009,7 @@ fn newton_on_the_default_backend(
 /// `newton-condensed` on the default backend. Elsewhere its keys do not apply.
 fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
     // contact switched off: the section is kept as it is, unused
-    let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
+    let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) else {
         return Ok(());
     };
     let keys = [
@@ -985,7 +1074,7 @@ fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
 /// refused once the plan knows it.)
 fn refuse_electric(s: &Scene) -> Result<(), SceneError> {
     use crate::scene::ElectricCondition as E;
-    let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) else {
+    let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) else {
         return Ok(());
     };
     let condition = c.electric.unwrap_or(E::Insulated);
@@ -1064,7 +1153,7 @@ fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
         "solver.rule",
         "the PETSc backend stops on the complementarity residual (the paper's rule is for its Uzawa)",
     )?;
-    if let Some(c) = s.contact.as_ref().filter(|c| c.law != ContactLaw::None) {
+    if let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) {
         let nonzero = c.normal.iter().filter(|&&x| x != 0.0).count();
         if nonzero != 1 {
             return Err(SceneError::new(
@@ -1225,7 +1314,7 @@ fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
 /// bed only where the bed is linear (the closed form).
 fn validate_manufactured_contact(s: &Scene) -> Result<(), SceneError> {
     let why = "exact.kind = \"manufactured-contact\" is a solution in sticking contact with the foundation under the bottom face";
-    let Some(c) = s.contact.as_ref().filter(|c| c.law == ContactLaw::Coulomb) else {
+    let Some(c) = s.first_contact().filter(|c| c.law == ContactLaw::Coulomb) else {
         return Err(SceneError::new(
             "contact.law",
             format!("{why}: it needs contact.law = \"coulomb\""),
@@ -1274,7 +1363,7 @@ fn validate_manufactured_contact(s: &Scene) -> Result<(), SceneError> {
 /// material.
 fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
     let (law, kind) = (s.contact_law(), x.kind);
-    if let Some(c) = s.contact.as_ref().filter(|_| law != ContactLaw::None) {
+    if let Some(c) = s.first_contact().filter(|_| law != ContactLaw::None) {
         // the closed forms are a rigid foundation's, with a constant coefficient
         let why = format!("exact.kind = \"{kind}\" is the closed form of a rigid foundation with a constant friction coefficient: remove [exact], or the key");
         refuse_if(c.compliance.is_some(), "contact.compliance", &why)?;
@@ -1294,7 +1383,7 @@ fn validate_contact_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError>
             ),
         ));
     }
-    let Some(c) = s.contact.as_ref().filter(|c| c.hertz_radius().is_some()) else {
+    let Some(c) = s.first_contact().filter(|c| c.hertz_radius().is_some()) else {
         return Err(SceneError::new(
             "exact.kind",
             format!("exact.kind `{kind}` needs contact with a curved gap (contact.gap_curvature > 0, or a sphere's or paraboloid's contact.indenter)"),
