@@ -659,3 +659,32 @@ fn what_several_contact_groups_cannot_share_is_refused_by_name() {
         "contact"
     );
 }
+
+#[test]
+fn the_shipped_corner_meets_its_closed_form() {
+    // scenes/corner.toml: a PZT-5A square squeezed into a corner by two walls, its top an open
+    // electrode: uniform strain -delta, the open top's field (e31 + e33)(-delta)/eps33
+    let (c11, c13, c33, e31, e33, eps33, delta) = (121.0, 75.2, 111.0, -5.4, 15.8, 7.35, 1e-3);
+    let (scene, _) = files::scene_file::load("corner", &[]).unwrap();
+    let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+    let field = (e31 + e33) * (-delta) / eps33;
+    let sense = s.report.terminals.iter().find(|t| t.group == "sense").unwrap();
+    assert!(sense.floating);
+    assert!(
+        (sense.potential - field).abs() < 1e-9 * field.abs(),
+        "V = {} against {field}",
+        sense.potential
+    );
+    let p = [
+        -((c11 + c13) * (-delta) + e31 * field),
+        -((c13 + c33) * (-delta) + e33 * field),
+    ];
+    for (g, p) in s.report.contact.groups.iter().zip(p) {
+        assert!(
+            (g.normal_force - p).abs() < 1e-9 * p,
+            "`{}`: {} against {p}",
+            g.group,
+            g.normal_force
+        );
+    }
+}

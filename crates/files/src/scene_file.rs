@@ -58,6 +58,7 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ),
     ("pfm", include_str!("../../../scenes/pfm.toml")),
     ("sensor", include_str!("../../../scenes/sensor.toml")),
+    ("corner", include_str!("../../../scenes/corner.toml")),
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),
     ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),

@@ -419,6 +419,21 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "walls with friction",
+        why: "the corner's two [[contact]] walls with Coulomb friction (F = 0.3) at n = 128: a node of both walls, each wall sticking and slipping",
+        scene: "corner",
+        sets: &[
+            "mesh.n=128",
+            "contact.0.law=\"coulomb\"",
+            "contact.0.friction=0.3",
+            "contact.1.law=\"coulomb\"",
+            "contact.1.friction=0.3",
+        ],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "feather force",
         why: "force control with 1e-9 of the sphere's Hertz force: the depth found a millionth of the face's size from first touch",
         scene: "hertz-sphere",

@@ -126,6 +126,15 @@ pub const ENTRIES: &[Entry] = &[
         check: |s| falls_to_below(s, 0.01),
     },
     Entry {
+        scene: "indent-cone",
+        sizes: (&[96, 128, 160], &[96, 128, 160, 224]),
+        reference: (None, None),
+        strategies: &[NewtonCondensed, ApgCondensed],
+        tols: &[1e-6, 1e-10],
+        claim: "a PZT-4 body of revolution under an insulating 70° cone carries the half-space's force (problem::halfspace, Sneddon's cone through the correspondence principle): error falling with h, below 1 % on the finest mesh (the tip's pressure singular, the body's size effect as the sphere's)",
+        check: |s| falls_to_below(s, 0.01),
+    },
+    Entry {
         scene: "cattaneo-mindlin",
         sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
         reference: (None, None),
