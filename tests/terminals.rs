@@ -407,9 +407,20 @@ fn a_floating_terminal_follows_a_load_path() {
         let f = row.t;
         let v = (E33 * (-f * d / h) * h + f * q * h / 2.0) / EPS33;
         let got = row.potentials[top];
-        assert!((got - v).abs() < 1e-9 * (d * E33 / EPS33), "t = {f}: V = {got} against {v}");
-        assert!((-row.charges[top] - f * q).abs() < 1e-9 * q, "t = {f}: charge {}", row.charges[top]);
-        assert_eq!(row.equilibrium.is_some(), f == 1.0, "t = {f}: fields where not asked for");
+        assert!(
+            (got - v).abs() < 1e-9 * (d * E33 / EPS33),
+            "t = {f}: V = {got} against {v}"
+        );
+        assert!(
+            (-row.charges[top] - f * q).abs() < 1e-9 * q,
+            "t = {f}: charge {}",
+            row.charges[top]
+        );
+        assert_eq!(
+            row.equilibrium.is_some(),
+            f == 1.0,
+            "t = {f}: fields where not asked for"
+        );
     }
 }
 

@@ -1,6 +1,6 @@
 //! A fill-reducing node ordering by geometric nested dissection: split the nodes at the median
-//! of their longest bounding-box axis, take as separator the nodes of one half that touch the
-//! other, order the two halves recursively and the separator last. On meshes of planar or
+//! of each axis they extend along, keep the split with the fewest separator nodes (the nodes of
+//! one half that touch the other), order the two halves recursively and the separator last. On meshes of planar or
 //! solid bodies this gives the O(n log n) fill of nested dissection (George, 1973), less than
 //! minimum degree on 2D grids.
 
@@ -45,7 +45,6 @@ fn split(
     part: &[usize],
     side: &mut [u8],
 ) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    let (off, nbr) = graph;
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for &v in part {
@@ -54,9 +53,28 @@ fn split(
             hi[k] = hi[k].max(points[v][k]);
         }
     }
-    let axis = (0..3)
-        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
-        .unwrap_or(0);
+    // the median split along each axis the part extends in, the smallest separator kept: on
+    // a graded mesh the longest axis in space may cut across the most nodes
+    let mut best: Option<(Vec<usize>, Vec<usize>, Vec<usize>)> = None;
+    for axis in (0..3).filter(|&k| hi[k] > lo[k]) {
+        let cut = split_along(points, graph, part, side, axis);
+        if best.as_ref().is_none_or(|b| cut.2.len() < b.2.len()) {
+            best = Some(cut);
+        }
+    }
+    best.unwrap_or_else(|| (part.to_vec(), vec![], vec![]))
+}
+
+/// The median split of `part` along `axis`: (left, right, separator), the separator the
+/// right-half nodes with a left-half neighbour, each sorted.
+fn split_along(
+    points: &[[f64; 3]],
+    graph: &(Vec<usize>, Vec<usize>),
+    part: &[usize],
+    side: &mut [u8],
+    axis: usize,
+) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let (off, nbr) = graph;
     let mut sorted: Vec<usize> = part.to_vec();
     let mid = sorted.len() / 2;
     sorted.select_nth_unstable_by(mid, |&a, &b| {
@@ -69,7 +87,6 @@ fn split(
     for &v in right_half {
         side[v] = 2;
     }
-    // separator: the right-half nodes with a left-half neighbour
     let mut left = left_half.to_vec();
     let mut right = Vec::with_capacity(right_half.len());
     let mut sep = vec![];
@@ -92,6 +109,28 @@ fn split(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_split_cuts_across_the_fewest_nodes_not_the_longest_side() {
+        // 10 long in x with 5 node columns, 1 tall with 41 node rows (a graded mesh's
+        // stretched cells): a cut across x would take a column of 41 nodes, across y a row of 5
+        let m = crate::rectangle_tri([0.0, 0.0], [10.0, 1.0], 4, 40);
+        let g = m.node_graph();
+        let (left, right, sep) = split(
+            &m.points,
+            &g,
+            &(0..m.n_nodes()).collect::<Vec<_>>(),
+            &mut vec![0; m.n_nodes()],
+        );
+        // (the median falls inside a row: a row and a node of the next)
+        assert!(sep.len() <= 6, "separator {sep:?}");
+        assert_eq!(left.len() + right.len() + sep.len(), m.n_nodes());
+        let ys: Vec<f64> = sep.iter().map(|&v| m.points[v][1]).collect();
+        assert!(
+            ys.iter().all(|&y| (y - ys[0]).abs() <= 1.0 / 40.0 + 1e-12),
+            "across y: {ys:?}"
+        );
+    }
 
     #[test]
     fn is_a_permutation_and_separates() {

@@ -40,8 +40,9 @@ pub struct RunReport {
     /// A load path's figures (absent from a run of one instant).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<PathReport>,
-    /// The boundary groups where the potential is prescribed (the electrode, grounded sides),
-    /// each with its potential and the charge through it (absent without electric unknowns).
+    /// The terminals: the boundary groups where the potential is prescribed (the electrodes,
+    /// grounded sides) or floats (`dirichlet.charge`, `electrode.charge`), each with its
+    /// potential and the charge through it (absent without electric unknowns).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub terminals: Vec<TerminalReport>,
     /// A rigid indenter's figures (absent without `contact.indenter`).
@@ -592,6 +593,10 @@ pub struct SolverReport {
     /// several solutions, and this one is the branch from the stick start); absent elsewhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction_map_contraction: Option<f64>,
+    /// The threads of rayon's pool the run had (`RAYON_NUM_THREADS`, else the cores): the
+    /// assembly's; the factorisation runs on one (docs/performance.md).
+    #[serde(default)]
+    pub threads: usize,
 }
 
 impl SolverReport {
@@ -612,6 +617,7 @@ impl SolverReport {
             smallest_pivot_ratio: None,
             refinement_steps: 0,
             friction_map_contraction: info.and_then(|i| i.contraction),
+            threads: rayon::current_num_threads(),
         }
     }
 }
