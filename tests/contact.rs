@@ -688,3 +688,23 @@ fn the_shipped_corner_meets_its_closed_form() {
         );
     }
 }
+
+#[test]
+fn friction_on_a_later_contact_group_is_not_lost() {
+    // the corner's walls under Coulomb's law, the first frictionless, the second F = 0.3: the
+    // plan has friction (it once looked at the first group alone, and the second wall's
+    // friction was dropped), the second wall carries a tangential force, the first none
+    let mut scene = squeezed_into_a_corner(2, 1e-3);
+    let Some(problem::Contacts::Many(walls)) = scene.contact.as_mut() else {
+        panic!("an array")
+    };
+    for (w, f) in walls.iter_mut().zip([0.0, 0.3]) {
+        w.law = problem::ContactLaw::Coulomb;
+        w.friction = Some(f);
+    }
+    let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+    assert!(s.report.plan.friction);
+    let groups = &s.report.contact.groups;
+    assert_eq!(groups[0].tangential_force, 0.0, "{groups:?}");
+    assert!(groups[1].tangential_force > 1e-6 * groups[1].normal_force, "{groups:?}");
+}

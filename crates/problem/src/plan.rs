@@ -74,7 +74,9 @@ impl Plan {
         let coupling = materials.iter().any(|(_, m)| m.e.iter().any(|&x| x != 0.0));
         let electric = (coupling || electric_data(scene)) && materials.iter().any(|(_, m)| m.electric);
         let law = scene.contact_law();
-        let friction = scene.first_contact().is_some_and(|c| match law {
+        // friction on any contact group gives every point its tangential multipliers (a
+        // frictionless group's coefficient is 0)
+        let friction = scene.contacts().iter().any(|c| match law {
             ContactLaw::Coulomb => c.friction() > 0.0,
             ContactLaw::Tresca => c.slip_bound() > 0.0,
             _ => false,
