@@ -520,78 +520,35 @@ fn newton_steps_do_not_grow_with_the_mesh() {
 /// the pressure `p = (dim λ + 2μ) delta` over its unit face; the corner nodes are points of two
 /// (three) groups.
 fn squeezed_into_a_corner(dim: usize, delta: f64) -> problem::Scene {
-    let toml = if dim == 2 {
-        r#"
-name = "corner"
-description = "a square squeezed by two walls"
-[mesh]
-kind = "rectangle"
-lo = [0.0, 0.0]
-hi = [1.0, 1.0]
-n = 4
-[[material]]
-region = "body"
-model = "isotropic"
-young = 100.0
-poisson = 0.3
-[[dirichlet]]
-group = "left"
-ux = 0.0
-[[dirichlet]]
-group = "bottom"
-uy = 0.0
-[[contact]]
-group = "right"
-law = "signorini"
-normal = [1.0, 0.0]
-gap = -DELTA
-[[contact]]
-group = "top"
-law = "signorini"
-normal = [0.0, 1.0]
-gap = -DELTA
-"#
+    let (kind, hi, n) = if dim == 2 {
+        ("rectangle", "[1.0, 1.0]", 4)
     } else {
-        r#"
-name = "corner-3d"
-description = "a cube squeezed by three walls"
-[mesh]
-kind = "box"
-lo = [0.0, 0.0, 0.0]
-hi = [1.0, 1.0, 1.0]
-n = 3
-[[material]]
-region = "body"
-model = "isotropic"
-young = 100.0
-poisson = 0.3
-[[dirichlet]]
-group = "left"
-ux = 0.0
-[[dirichlet]]
-group = "front"
-uy = 0.0
-[[dirichlet]]
-group = "bottom"
-uz = 0.0
-[[contact]]
-group = "right"
-law = "signorini"
-normal = [1.0, 0.0, 0.0]
-gap = -DELTA
-[[contact]]
-group = "back"
-law = "signorini"
-normal = [0.0, 1.0, 0.0]
-gap = -DELTA
-[[contact]]
-group = "top"
-law = "signorini"
-normal = [0.0, 0.0, 1.0]
-gap = -DELTA
-"#
+        ("box", "[1.0, 1.0, 1.0]", 3)
     };
-    files::scene_file::parse(&toml.replace("DELTA", &delta.to_string()), "corner", &[]).unwrap()
+    let mut toml = format!(
+        "name = \"corner-{dim}d\"\ndescription = \"a unit square or cube squeezed by its walls\"\n\
+         [mesh]\nkind = \"{kind}\"\nlo = {}\nhi = {hi}\nn = {n}\n\
+         [[material]]\nregion = \"body\"\nmodel = \"isotropic\"\nyoung = 100.0\npoisson = 0.3\n",
+        hi.replace('1', "0")
+    );
+    // per axis: the symmetry face (a roller) and the face against its wall
+    let faces = if dim == 2 {
+        &[("left", "right"), ("bottom", "top")][..]
+    } else {
+        &[("left", "right"), ("front", "back"), ("bottom", "top")][..]
+    };
+    for (k, (roller, wall)) in faces.iter().enumerate() {
+        let normal: Vec<String> = (0..dim)
+            .map(|q| if q == k { "1.0" } else { "0.0" }.to_string())
+            .collect();
+        toml += &format!("[[dirichlet]]\ngroup = \"{roller}\"\nu{} = 0.0\n", ["x", "y", "z"][k]);
+        toml += &format!(
+            "[[contact]]\ngroup = \"{wall}\"\nlaw = \"signorini\"\nnormal = [{}]\ngap = {}\n",
+            normal.join(", "),
+            -delta
+        );
+    }
+    files::scene_file::parse(&toml, "corner", &[]).unwrap()
 }
 
 #[test]

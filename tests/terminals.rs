@@ -319,6 +319,16 @@ fn a_floating_electrode_pressed_onto_a_foundation_reads_its_closed_form() {
     }
 }
 
+/// The largest difference between two solutions' nodal displacements, and the largest
+/// displacement of the second (the scale it is judged against).
+fn displacement_gap(a: &problem::Solution, b: &problem::Solution) -> (f64, f64) {
+    let scale = b.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let gap = (a.u.iter().zip(&b.u))
+        .flat_map(|(x, y)| x.iter().zip(y).map(|(p, q)| (p - q).abs()))
+        .fold(0.0f64, f64::max);
+    (gap, scale)
+}
+
 /// The paper's block with its sides clamped, its bottom grounded and pressed by Coulomb friction
 /// onto the foundation, its top loaded and carrying a floating electrode with `charge`: a
 /// contact zone that sticks and slips, and a terminal whose potential moves it.
@@ -370,13 +380,7 @@ fn a_floating_terminal_under_friction_is_the_prescribed_potential_that_carries_i
             top.potential,
             -fixed_top.charge
         );
-        let scale = fixed.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-        let gap = floating
-            .u
-            .iter()
-            .zip(&fixed.u)
-            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
-            .fold(0.0f64, f64::max);
+        let (gap, scale) = displacement_gap(&floating, &fixed);
         assert!(
             gap < 1e-8 * scale,
             "{dim}D: displacements differ by {gap:e} of {scale:e}"
@@ -493,12 +497,7 @@ fn electrodes_split_in_two_are_the_one_they_cover() {
         problem::solve(&one, None, &mut problem::Silent).unwrap(),
         problem::solve(&two, None, &mut problem::Silent).unwrap(),
     );
-    let scale = a.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    let gap =
-        a.u.iter()
-            .zip(&b.u)
-            .flat_map(|(x, y)| x.iter().zip(y).map(|(p, q)| (p - q).abs()))
-            .fold(0.0, f64::max);
+    let (gap, scale) = displacement_gap(&b, &a);
     assert!(gap < 1e-10 * scale, "displacements differ by {gap:e}");
     let charge = |s: &problem::Solution, g: &str| s.report.terminals.iter().find(|t| t.group == g).unwrap().charge;
     let names: Vec<&str> = b.report.terminals.iter().map(|t| t.group.as_str()).collect();

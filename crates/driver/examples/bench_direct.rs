@@ -7,6 +7,8 @@
 //!
 //!   cargo run --release -p driver --example bench_direct -- 256 paper out/bench-direct [repeats]
 
+mod common;
+
 use fe_assembly::{Discretization, Parallelism};
 use linalg::{FactorKind, Ordering, SparseFactor};
 use std::io::Write;
@@ -18,17 +20,12 @@ fn main() {
     let name = args.get(2).cloned().unwrap_or_else(|| "paper".into());
     let dir = std::path::PathBuf::from(args.get(3).cloned().unwrap_or_else(|| "out/bench-direct".into()));
     let repeats: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(3);
-    let sets = [format!("mesh.n={n}"), "contact.law=none".into()];
-    let without = [sets[0].clone(), sets[1].clone(), "~exact".into()];
-    let (scene, _) = files::scene_file::load(&name, &without)
-        .or_else(|_| files::scene_file::load(&name, &sets))
-        .expect("scene");
     let problem::backend::Setup {
         mesh,
         materials,
         constraints,
         ..
-    } = problem::backend::setup(scene.validate().expect("a valid scene"), None).expect("setup");
+    } = common::setup_without_contact(&name, n);
     let disc = Discretization::new(&mesh, &materials, &constraints).expect("discretisation");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());

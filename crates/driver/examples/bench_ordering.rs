@@ -4,6 +4,8 @@
 //!
 //!   cargo run --release -p driver --example bench_ordering -- 256
 
+mod common;
+
 use fe_assembly::{Discretization, Parallelism};
 use linalg::{FactorKind, Ordering, SparseFactor};
 use std::time::Instant;
@@ -16,18 +18,12 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(128);
     let name = std::env::args().nth(2).unwrap_or_else(|| "paper".into());
-    // the matrix without contact (a known solution needs its contact: removed where there is one)
-    let sets = [format!("mesh.n={n}"), "contact.law=none".into()];
-    let without = [sets[0].clone(), sets[1].clone(), "~exact".into()];
-    let (scene, _) = files::scene_file::load(&name, &without)
-        .or_else(|_| files::scene_file::load(&name, &sets))
-        .expect("scene");
     let problem::backend::Setup {
         mesh,
         materials: mats,
         constraints: bcs,
         ..
-    } = problem::backend::setup(scene.validate().expect("a valid scene"), None).expect("setup");
+    } = common::setup_without_contact(&name, n);
     let disc = Discretization::new(&mesh, &mats, &bcs).expect("setup");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());

@@ -1,36 +1,17 @@
 //! The charges through the groups at a prescribed potential (`Discretization::charges`, from the
 //! recovered fields) against their functionals on the free unknowns
 //! (`Discretization::charge_functionals`): with the prescribed values zero and no body charge,
-//! `charge = a_u · u + a_φ · φ` for any `(u, φ)`, on a jittered mesh with a piezoelectric and an
-//! elastic region, in 2D, 3D and on a body of revolution.
+//! `charge = a_u · u + a_φ · φ` for any `(u, φ)`, on a jittered mesh of PZT-5A, in 2D, 3D and
+//! on a body of revolution.
 
-use fe_assembly::{Constraint, Crystal, Discretization, Field, Material};
+mod common;
+
+use fe_assembly::{Constraint, Discretization, Field};
 
 fn check(dim: usize, axisymmetric: bool) {
-    let mut mesh = if dim == 2 {
-        mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 6, 4)
-    } else {
-        mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2)
-    };
-    let (lo, hi) = mesh.bounding_box();
-    let mut seed = 99u64;
-    let mut random = move || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    for p in &mut mesh.points {
-        if (0..dim).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
-            for k in 0..dim {
-                p[k] += 0.08 * random();
-            }
-        }
-    }
-    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
-    let mat = if axisymmetric {
-        Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), poling).unwrap()
-    } else {
-        Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap()
-    };
+    let mut random = common::random_source(99);
+    let mesh = common::jittered_block(dim, &mut random);
+    let mat = common::pzt5a(dim, axisymmetric);
     let materials = vec![("body".to_string(), mat)];
     let constraints = vec![
         Constraint::constant("left", Field::Displacement(0), 0.0),

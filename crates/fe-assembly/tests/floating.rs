@@ -2,20 +2,13 @@
 //! tied system must be the free one restricted to fields constant on the group: with `P` the
 //! map from the tied unknowns to the free ones (the group's nodes all taking the terminal's
 //! value), `K_tied = Pᵀ K_free P` and `b_tied = Pᵀ b_free`. Checked on random vectors, on a
-//! jittered mesh with a piezoelectric and an elastic region, in 2D, 3D and on a body of
-//! revolution, for both assembly loops; and the charge put on the terminal is the right-hand
-//! side of its one equation.
+//! jittered mesh of PZT-5A, in 2D, 3D and on a body of revolution, for both assembly loops; and
+//! the charge put on the terminal is the right-hand side of its one equation.
+
+mod common;
 
 use faer::sparse::SparseColMat;
 use fe_assembly::{Constraint, Crystal, Discretization, Dof, Field, Load, Material, Parallelism};
-
-fn random_source(seed: u64) -> impl FnMut() -> f64 {
-    let mut seed = seed;
-    move || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-}
 
 fn mat_vec(m: &SparseColMat<usize, f64>, x: &[f64]) -> Vec<f64> {
     let mut out = vec![0.0; m.nrows()];
@@ -32,26 +25,9 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 fn check(dim: usize, axisymmetric: bool) {
-    let mut mesh = if dim == 2 {
-        mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 6, 4)
-    } else {
-        mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2)
-    };
-    let (lo, hi) = mesh.bounding_box();
-    let mut random = random_source(7);
-    for p in &mut mesh.points {
-        if (0..dim).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
-            for k in 0..dim {
-                p[k] += 0.08 * random();
-            }
-        }
-    }
-    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
-    let mat = if axisymmetric {
-        Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), poling).unwrap()
-    } else {
-        Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap()
-    };
+    let mut random = common::random_source(7);
+    let mesh = common::jittered_block(dim, &mut random);
+    let mat = common::pzt5a(dim, axisymmetric);
     let materials = vec![("body".to_string(), mat)];
     let held = vec![
         Constraint::constant("left", Field::Displacement(0), 0.0),

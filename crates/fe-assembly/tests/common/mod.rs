@@ -1,5 +1,5 @@
-//! Helpers shared by the integration tests: solving the assembled system both ways, and full
-//! tensors from Voigt arrays.
+//! Helpers shared by the integration tests: solving the assembled system both ways, full
+//! tensors from Voigt arrays, and a jittered PZT-5A block with its random numbers.
 #![allow(dead_code)]
 
 use fe_assembly::{Blocks, Discretization, Load, Parallelism};
@@ -62,4 +62,46 @@ pub fn stress_and_d(m: &fe_assembly::Material, gu: &[[f64; 3]; 3], gp: &[f64; 3]
 /// Largest absolute difference.
 pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+/// Uniform numbers in `[-0.5, 0.5)` from a linear congruential generator seeded with `seed`
+/// (reproducible, and independent of any crate's generator).
+pub fn random_source(seed: u64) -> impl FnMut() -> f64 {
+    let mut seed = seed;
+    move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+}
+
+/// The block `[0, 2] x [0, 1]` (x `[0, 1]` in 3D) of 6 x 4 triangles or 4 x 2 x 2 boxes of
+/// tetrahedra, its interior nodes moved by up to 0.04 in each coordinate (`random`'s numbers,
+/// drawn node by node).
+pub fn jittered_block(dim: usize, random: &mut impl FnMut() -> f64) -> mesh::Mesh {
+    let mut mesh = if dim == 2 {
+        mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 6, 4)
+    } else {
+        mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2)
+    };
+    let (lo, hi) = mesh.bounding_box();
+    for p in &mut mesh.points {
+        if (0..dim).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
+            for k in 0..dim {
+                p[k] += 0.08 * random();
+            }
+        }
+    }
+    mesh
+}
+
+/// PZT-5A poled along the last axis (y in 2D, z in 3D), in plane strain or 3D, or on a body
+/// of revolution about y.
+pub fn pzt5a(dim: usize, axisymmetric: bool) -> fe_assembly::Material {
+    use fe_assembly::{Crystal, Material};
+    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
+    if axisymmetric {
+        Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), poling).unwrap()
+    } else {
+        Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap()
+    }
 }

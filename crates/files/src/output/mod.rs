@@ -140,23 +140,35 @@ fn vtu(
         Attribute::generic("electric_displacement", dim as u32).with_data(fields.electric_displacement.clone()),
         Attribute::generic("electric_field", dim as u32).with_data(fields.electric_field.clone()),
     ];
+    let cells = Cells {
+        cell_verts: VertexNumbers::XML { connectivity, offsets },
+        types: vec![ct; mesh.n_cells()],
+    };
+    grid_xml(
+        "solution.vtu",
+        "piezocontact solution",
+        points,
+        cells,
+        Attributes { point, cell },
+    )
+}
+
+/// An unstructured grid as VTK XML, the file `name` (for its error).
+fn grid_xml(name: &str, title: &str, points: Vec<f64>, cells: Cells, data: Attributes) -> Result<Vec<u8>, Error> {
     let vtk = Vtk {
         version: Version::new((1, 0)),
-        title: "piezocontact solution".into(),
+        title: title.into(),
         byte_order: ByteOrder::LittleEndian,
         file_path: None,
         data: DataSet::inline(UnstructuredGridPiece {
             points: points.into(),
-            cells: Cells {
-                cell_verts: VertexNumbers::XML { connectivity, offsets },
-                types: vec![ct; mesh.n_cells()],
-            },
-            data: Attributes { point, cell },
+            cells,
+            data,
         }),
     };
     let mut buf = Vec::new();
     vtk.write_xml(&mut buf).map_err(|e| Error::Picture {
-        name: "solution.vtu".into(),
+        name: name.into(),
         message: e.to_string(),
     })?;
     Ok(buf)
@@ -211,37 +223,23 @@ fn revolved_vtu(
             }
         }
     }
-    let vtk = Vtk {
-        version: Version::new((1, 0)),
-        title: "piezocontact solution, revolved".into(),
-        byte_order: ByteOrder::LittleEndian,
-        file_path: None,
-        data: DataSet::inline(UnstructuredGridPiece {
-            points: points.into(),
-            cells: Cells {
-                cell_verts: VertexNumbers::XML { connectivity, offsets },
-                types: vec![CellType::Wedge; cells * segments],
-            },
-            data: Attributes {
-                point: vec![
-                    Attribute::generic("u", 3).with_data(uu),
-                    Attribute::scalars("phi", 1).with_data(pp),
-                ],
-                cell: vec![
-                    Attribute::generic("stress", nv as u32).with_data(stress),
-                    Attribute::generic("strain", nv as u32).with_data(strain),
-                    Attribute::generic("electric_displacement", 3).with_data(d),
-                    Attribute::generic("electric_field", 3).with_data(e),
-                ],
-            },
-        }),
+    let grid = Cells {
+        cell_verts: VertexNumbers::XML { connectivity, offsets },
+        types: vec![CellType::Wedge; cells * segments],
     };
-    let mut buf = Vec::new();
-    vtk.write_xml(&mut buf).map_err(|err| Error::Picture {
-        name: "revolved.vtu".into(),
-        message: err.to_string(),
-    })?;
-    Ok(buf)
+    let data = Attributes {
+        point: vec![
+            Attribute::generic("u", 3).with_data(uu),
+            Attribute::scalars("phi", 1).with_data(pp),
+        ],
+        cell: vec![
+            Attribute::generic("stress", nv as u32).with_data(stress),
+            Attribute::generic("strain", nv as u32).with_data(strain),
+            Attribute::generic("electric_displacement", 3).with_data(d),
+            Attribute::generic("electric_field", 3).with_data(e),
+        ],
+    };
+    grid_xml("revolved.vtu", "piezocontact solution, revolved", points, grid, data)
 }
 
 /// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
