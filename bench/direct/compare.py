@@ -1,14 +1,15 @@
 """The direct solvers side by side on one matrix (issue 25, item 3): the scene's `K` without
 contact (the linear floor: analysis, numeric factorisation, one solve), factored by
 
-- faer, as the default backend does it (`bench_direct`, one core for the factor),
+- faer, as the default backend does it (`bench_direct`), on 1 and 2 threads of rayon's pool
+  (`RAYON_NUM_THREADS`: on 2, the factor's elimination tree on both cores),
 - PARDISO (Intel MKL, through `pypardiso` from PyPI) on 1 and 2 threads,
 - MUMPS through PETSc on 1 and 2 MPI ranks (the optional backend's build,
   `target/petsc/release/piezocontact`, with `-ksp_type preonly -pc_type lu
   -pc_factor_mat_solver_type mumps`; its run.json's factorisation and solve), where that build
   exists,
 
-in interleaved rounds (faer, PARDISO 1, PARDISO 2, MUMPS 1, MUMPS 2, then again), so that the
+in interleaved rounds (faer 1, faer 2, PARDISO 1, PARDISO 2, MUMPS 1, MUMPS 2, then again), so that the
 machine's drift falls on all alike; prints each one's median over the rounds and its ratio to
 faer's.
 
@@ -57,8 +58,10 @@ def parse(line):
     return {w[i]: float(w[i + 1]) for i in range(1, len(w) - 1, 2)}
 
 
-def faer(n, scene, d):
-    out = subprocess.run([str(EXAMPLE), str(n), scene, d, "1"], check=True, capture_output=True, text=True).stdout
+def faer(n, scene, d, threads=1):
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
+    out = subprocess.run([str(EXAMPLE), str(n), scene, d, "1"], check=True, capture_output=True, text=True,
+                         env=env).stdout
     return parse([l for l in out.splitlines() if l.startswith("faer")][-1])
 
 
@@ -86,7 +89,8 @@ def main():
     scene = sys.argv[2] if len(sys.argv) > 2 else "paper"
     rounds = int(sys.argv[3]) if len(sys.argv) > 3 else 3
     d = str(REPO / "out" / "bench-direct" / f"{scene}-{n}")
-    runs = {"faer (1 core)": lambda: faer(n, scene, d),
+    runs = {"faer 1 thread": lambda: faer(n, scene, d, 1),
+            "faer 2 threads": lambda: faer(n, scene, d, 2),
             "PARDISO 1 thread": lambda: pardiso(1, d),
             "PARDISO 2 threads": lambda: pardiso(2, d)}
     if PETSC.exists():

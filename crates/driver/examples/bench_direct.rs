@@ -1,7 +1,7 @@
 //! The linear floor of a scene's matrix without contact (`K` of `[u; φ]`, symmetric
 //! quasi-definite): analysis (the nested-dissection order and the symbolic factorisation),
 //! numeric `L D Lᵀ` and one solve with faer, as the default backend does them, on rayon's pool
-//! for the order and one core for the factor. Writes the matrix (its lower triangle, Matrix
+//! (`RAYON_NUM_THREADS`): the order, and the factor's elimination tree. Writes the matrix (its lower triangle, Matrix
 //! Market, 1-based) and a right-hand side for the comparators of `bench/direct/compare.py`, and
 //! prints one line `faer analysis A factor F solve S residual R` per repeat.
 //!
@@ -48,8 +48,13 @@ fn main() {
         let order = disc
             .dofs
             .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
-        let mut factor =
-            SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &Ordering::Given(order), faer::Par::Seq).expect("ldlt");
+        let mut factor = SparseFactor::new(
+            k.as_ref(),
+            FactorKind::Ldlt,
+            &Ordering::Given(order),
+            linalg::pool_par(),
+        )
+        .expect("ldlt");
         let both = t.elapsed().as_secs_f64();
         let t = Instant::now();
         factor.refactor(k.as_ref()).expect("refactor");

@@ -4,7 +4,7 @@
 
 use crate::LinalgError;
 use crate::ShapeError;
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
@@ -22,6 +22,17 @@ use faer::{Conj, MatMut, Par, Side};
 /// Below this `|pivot| / |diagonal entry|` a factorisation reports the matrix singular to
 /// working precision ([`LinalgError::NearlySingular`]).
 pub const SINGULAR_PIVOT_RATIO: f64 = 1e-13;
+
+/// The parallelism of rayon's current pool for a factorisation: [`Par::Seq`] on one thread,
+/// else `Par::rayon` over all of the pool's threads (`RAYON_NUM_THREADS`, else the cores). An
+/// `L D Lᵀ` given it factors independent subtrees of its elimination tree on different
+/// threads ([`SparseFactor::parallel_tree`]).
+pub fn pool_par() -> Par {
+    match rayon::current_num_threads() {
+        0 | 1 => Par::Seq,
+        t => Par::rayon(t),
+    }
+}
 
 /// Which factorisation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -65,6 +76,8 @@ pub struct SparseFactor {
     solve_mem: MemBuffer,
     solve_mem_ncols: usize,
     par: Par,
+    /// The supernodes' tree, where the numeric `L D Lᵀ` runs on several cores.
+    tree: Option<crate::tree::Tree>,
     /// The smallest `|pivot| / |diagonal entry|` of the last numeric factorisation.
     pivot_ratio: f64,
 }
@@ -84,8 +97,11 @@ impl std::fmt::Debug for SparseFactor {
 impl SparseFactor {
     /// Analyses and factors `a` (square; the lower triangle is read).
     ///
-    /// `par` is passed to faer's dense kernels inside the supernodes. On this project's
-    /// 2-core target `Par::Seq` was measured faster (see `docs/performance.md`).
+    /// `par`: with `Par::rayon(t)`, `t > 1`, an `L D Lᵀ` walks its elimination tree on rayon's
+    /// current pool (independent subtrees at the same time, the large supernodes above them
+    /// with faer's parallel dense kernels; [`pool_par`] picks it from the pool); otherwise the
+    /// factorisation is faer's, whose dense kernels get `par` (on this project's 2-core target
+    /// a loss: see `docs/performance.md`).
     ///
     /// # Errors
     /// A non-square or non-finite matrix, an ordering that is not a permutation, a failed
@@ -125,25 +141,39 @@ impl SparseFactor {
                 what: format!("matrix entry {i}"),
             });
         }
-        let (fwd, inv);
-        let ord = match ordering {
-            Ordering::Amd => SymmetricOrdering::Amd,
+        let wants_tree = matches!((kind, par), (FactorKind::Ldlt, Par::Rayon(t)) if t.get() > 1);
+        let (fwd, inv, kept) = match ordering {
+            Ordering::Amd => (vec![], vec![], 0),
             Ordering::AmdThenLast(last) => {
-                (fwd, inv) = amd_then_last(a, last)?;
-                SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
+                let (f, i) = amd_then_last(a, last)?;
+                (f, i, last.len())
             }
-            Ordering::Given(given) => {
-                (fwd, inv) = (given.clone(), inverse_permutation(given)?);
-                SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
-            }
+            Ordering::Given(given) => (given.clone(), inverse_permutation(given)?, 0),
             Ordering::GivenThenLast { order, last } => {
                 let is_last = mark(n, last)?;
                 let mut f: Vec<usize> = order.iter().copied().filter(|&i| i >= n || !is_last[i]).collect();
                 f.extend_from_slice(last);
                 let i = inverse_permutation(&f)?;
-                (fwd, inv) = (f, i);
-                SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n))
+                (f, i, last.len())
             }
+        };
+        // the parallel tree walks subtrees that are contiguous: the order made a postorder of
+        // its elimination tree first (the same fill), where that keeps the chosen last dofs last
+        let post = if wants_tree {
+            crate::tree::postordered(a, &fwd, &inv)
+        } else {
+            None
+        };
+        let (fwd, inv) = match post {
+            Some(post) if post[n - kept..] == fwd[n - kept..] => {
+                let post_inv = inverse_permutation(&post)?;
+                (post, post_inv)
+            }
+            _ => (fwd, inv),
+        };
+        let ord = match ordering {
+            Ordering::Amd => SymmetricOrdering::Amd,
+            _ => SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n)),
         };
         // chosen dofs last are there to be read off the last supernode: force supernodal
         let params = match ordering {
@@ -153,8 +183,15 @@ impl SparseFactor {
             },
             _ => CholeskySymbolicParams::default(),
         };
-        let symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
+        let mut symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
             .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+        let tree = if wants_tree {
+            let tree;
+            (symbolic, tree) = parallel_tree(a, symbolic, params, kept)?;
+            tree
+        } else {
+            None
+        };
         let factor_req = match kind {
             FactorKind::Cholesky => symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
             FactorKind::Ldlt => symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
@@ -169,10 +206,11 @@ impl SparseFactor {
             kind,
             values: vec![0.0; symbolic.len_val()],
             symbolic,
-            factor_mem: MemBuffer::new(factor_req),
+            factor_mem: MemBuffer::new(if tree.is_some() { StackReq::EMPTY } else { factor_req }),
             solve_mem,
             solve_mem_ncols: 1,
             par,
+            tree,
             pivot_ratio: f64::NAN,
         };
         f.refactor(a)?;
@@ -196,27 +234,39 @@ impl SparseFactor {
                     )
                     .map_err(|e| match e {
                         faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
-                            LinalgError::NotPositiveDefinite { pivot: index }
+                            LinalgError::NotPositiveDefinite {
+                                pivot: original(&self.symbolic, index),
+                            }
                         }
                     })?;
             }
-            FactorKind::Ldlt => {
-                self.symbolic
-                    .factorize_numeric_ldlt(
-                        &mut self.values,
-                        a,
-                        Side::Lower,
-                        LdltRegularization::default(),
-                        self.par,
-                        stack,
-                        Default::default(),
-                    )
-                    .map_err(|e| match e {
-                        faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
-                            LinalgError::ZeroPivot { pivot: index }
-                        }
-                    })?;
-            }
+            FactorKind::Ldlt => match (self.tree.as_mut(), self.symbolic.raw()) {
+                (Some(tree), SymbolicCholeskyRaw::Supernodal(sym)) => {
+                    tree.factor(sym, a, &mut self.values, self.par)
+                        .map_err(|index| LinalgError::ZeroPivot {
+                            pivot: original(&self.symbolic, index),
+                        })?;
+                }
+                _ => {
+                    self.symbolic
+                        .factorize_numeric_ldlt(
+                            &mut self.values,
+                            a,
+                            Side::Lower,
+                            LdltRegularization::default(),
+                            self.par,
+                            stack,
+                            Default::default(),
+                        )
+                        .map_err(|e| match e {
+                            faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
+                                LinalgError::ZeroPivot {
+                                    pivot: original(&self.symbolic, index),
+                                }
+                            }
+                        })?;
+                }
+            },
         }
         if let Some(i) = self.values.iter().position(|x| !x.is_finite()) {
             return Err(LinalgError::NonFinite {
@@ -263,6 +313,14 @@ impl SparseFactor {
             }
         }
         best
+    }
+
+    /// Whether the numeric factorisation walks the supernodes' elimination tree on several
+    /// threads (a supernodal `L D Lᵀ` given `Par::rayon` with more than one thread; then
+    /// independent subtrees are factored at the same time, on rayon's current pool), rather
+    /// than faer's sequential walk with parallel dense kernels.
+    pub fn parallel_tree(&self) -> bool {
+        self.tree.is_some()
     }
 
     /// Dimension.
@@ -392,7 +450,7 @@ impl SparseFactor {
         let wrong_sign = |j: usize, x: f64| if negative(j) { !(x < 0.0) } else { !(x > 0.0) };
         if let Some(j) = (0..k).find(|&j| wrong_sign(j, d[j])) {
             return Err(LinalgError::NotPositiveDefinite {
-                pivot: self.n() - k + j,
+                pivot: original(&self.symbolic, self.n() - k + j),
             });
         }
         let mut x = faer::Mat::<f64>::zeros(k, k);
@@ -580,6 +638,53 @@ impl SparseFactor {
             None => (0..self.n()).collect(),
         }
     }
+}
+
+/// The tree of a supernodal symbolic factor for the parallel numeric `L D Lᵀ`, the analysis
+/// redone once in postorder where its supernodes were not (AMD's order, or relaxed supernodes
+/// that merged across a subtree); `None` (and the analysis unchanged) for a simplicial factor,
+/// or where the postorder would move the `kept` dofs ordered last.
+fn parallel_tree(
+    a: SparseColMatRef<'_, usize, f64>,
+    symbolic: SymbolicCholesky<usize>,
+    params: CholeskySymbolicParams<'_>,
+    kept: usize,
+) -> Result<(SymbolicCholesky<usize>, Option<crate::tree::Tree>), LinalgError> {
+    let SymbolicCholeskyRaw::Supernodal(s) = symbolic.raw() else {
+        return Ok((symbolic, None));
+    };
+    let inv = |sym: &SymbolicCholesky<usize>| sym.perm().map(|p| p.arrays().1.to_vec());
+    if let Some(tree) = crate::tree::Tree::new(s, a, inv(&symbolic).as_deref()) {
+        return Ok((symbolic, Some(tree)));
+    }
+    let fwd = match symbolic.perm() {
+        Some(p) => p.arrays().0.to_vec(),
+        None => (0..a.nrows()).collect(),
+    };
+    let post: Vec<usize> = crate::tree::postorder(s).into_iter().map(|k| fwd[k]).collect();
+    let n = a.nrows();
+    if post[n - kept..] != fwd[n - kept..] {
+        // the chosen last dofs would move: faer's sequential walk keeps them
+        return Ok((symbolic, None));
+    }
+    let post_inv = inverse_permutation(&post)?;
+    let ord = SymmetricOrdering::Custom(PermRef::new_checked(&post, &post_inv, a.nrows()));
+    let again = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
+        .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+    let tree = match again.raw() {
+        SymbolicCholeskyRaw::Supernodal(s) => crate::tree::Tree::new(s, a, inv(&again).as_deref()),
+        SymbolicCholeskyRaw::Simplicial(_) => None,
+    };
+    Ok((again, tree))
+}
+
+/// The matrix's index at position `new` of the factor's order (`new` itself where it is out
+/// of range).
+fn original(symbolic: &SymbolicCholesky<usize>, new: usize) -> usize {
+    symbolic
+        .perm()
+        .and_then(|p| p.arrays().0.get(new).copied())
+        .unwrap_or(new)
 }
 
 /// The inverse of a permutation, or an error if `fwd` is not one.

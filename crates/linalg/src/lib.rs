@@ -40,13 +40,14 @@ mod coupled;
 mod factor;
 mod pcg;
 pub mod sparse;
+mod tree;
 
 pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{
     equilibrium_residual, refine, CoupledBlocks, CoupledSolver, DirectLdlt, FactorPreconditioner, Refined,
     SchurOperator, SchurPcg, SolveInfo,
 };
-pub use factor::{FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
+pub use factor::{pool_par, FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};
 
 /// What can go wrong in the linear algebra.
@@ -56,13 +57,13 @@ pub enum LinalgError {
     /// body that is not held against rigid motions).
     #[error("the matrix is not positive definite (pivot {pivot})")]
     NotPositiveDefinite {
-        /// The pivot's index in the factor's order.
+        /// The matrix's index (row and column) whose pivot it was.
         pivot: usize,
     },
     /// An `L D Lᵀ` factorisation met an exactly zero pivot.
     #[error("zero pivot {pivot} in the L D Lᵀ factorisation")]
     ZeroPivot {
-        /// The pivot's index in the factor's order.
+        /// The matrix's index (row and column) whose pivot it was.
         pivot: usize,
     },
     /// A pivot lost all but a few digits of its diagonal entry to cancellation: the matrix is

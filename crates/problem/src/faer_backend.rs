@@ -175,7 +175,8 @@ impl Factored {
 /// Factors the linear solver: the Schur PCG's Cholesky factors, or the `L D Lᵀ` of `K` in
 /// geometric nested dissection (measured no slower than AMD in 2D and 1.6x faster in 3D,
 /// docs/performance.md), with the contact dofs of `boundary` last for the condensed
-/// strategies, to read the contact block off the factor.
+/// strategies, to read the contact block off the factor; its elimination tree on all of
+/// rayon's threads ([`linalg::pool_par`]).
 fn factor(
     posed: &Posed<'_>,
     blocks: Blocks,
@@ -196,6 +197,8 @@ fn factor(
         },
         ..Default::default()
     };
+    // the Schur route's Cholesky factors with faer's sequential walk (its parallel dense kernels
+    // lose on 2 cores); the L D Lᵀ of K walks its elimination tree on rayon's pool
     let par = faer::Par::Seq;
     let budget = factor_budget(posed, &blocks, boundary, limits)?;
     let too_large = |e: linalg::LinalgError| too_large(e, limits, scene);
@@ -217,7 +220,8 @@ fn factor(
             _ => Ordering::Given(order),
         };
         LinearSolver::Direct(
-            DirectLdlt::new_within(&blocks.a, &blocks.g, &blocks.b, &ordering, par, budget).map_err(too_large)?,
+            DirectLdlt::new_within(&blocks.a, &blocks.g, &blocks.b, &ordering, linalg::pool_par(), budget)
+                .map_err(too_large)?,
         )
     };
     let seconds = t.elapsed().as_secs_f64();

@@ -594,7 +594,8 @@ pub struct SolverReport {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction_map_contraction: Option<f64>,
     /// The threads of rayon's pool the run had (`RAYON_NUM_THREADS`, else the cores): the
-    /// assembly's; the factorisation runs on one (docs/performance.md).
+    /// assembly's, and the `L D Lᵀ`'s (independent subtrees of its elimination tree factored
+    /// at the same time; docs/performance.md). The Schur route's Cholesky factors run on one.
     #[serde(default)]
     pub threads: usize,
 }

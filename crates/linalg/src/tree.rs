@@ -1,0 +1,558 @@
+//! The numeric `L D Lᵀ` of a supernodal symbolic factor on every core of rayon's pool: the
+//! supernodes' elimination tree is walked from the leaves, and subtrees that share no
+//! supernode are factored at the same time (they read only their own descendants and write
+//! only their own values), the supernodes above them with faer's parallel dense kernels.
+//!
+//! Each supernode is the left-looking step of faer's sequential
+//! `factorize_supernodal_numeric_ldlt` (faer 0.24): gather the matrix's columns, subtract
+//! `L_d D_d L_dᵀ` of every descendant `d` whose row pattern meets the supernode, factor the
+//! diagonal block densely (`L D Lᵀ`, no pivoting) and solve for the rows below it. The values
+//! are laid out as faer lays them, so every solve and every view of the factor (the trailing
+//! block of the contact dofs) reads them unchanged. faer parallelises only inside a supernode,
+//! which on a 2D mesh's many small supernodes costs more than it gains
+//! (docs/performance.md); here the tree gives the second core its own half of the work.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::{cholesky_in_place, cholesky_in_place_scratch, LdltRegularization};
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use faer::sparse::SparseColMatRef;
+use faer::{Accum, MatMut, MatRef, Par};
+
+/// Subtrees with fewer floating-point operations than this are factored on one core, in
+/// order (a task of this size takes about 2 ms; below it the cost of a task's scratch and of
+/// stealing it shows).
+const SEQUENTIAL_FLOPS: f64 = 2e7;
+
+/// What the parallel numeric factorisation needs beyond faer's symbolic factor, computed once
+/// per pattern: the supernodes' tree, the descendants that update each supernode, the work of
+/// each subtree, and the matrix's lower triangle in the factor's order (its pattern, and where
+/// each value comes from).
+#[derive(Debug)]
+pub(crate) struct Tree {
+    /// `parent[s]`: the supernode holding the first row of `s`'s pattern (`usize::MAX` for a
+    /// root).
+    parent: Vec<usize>,
+    /// `first[s]`: the first supernode of `s`'s subtree, which is `first[s]..=s` (postorder).
+    first: Vec<usize>,
+    /// `updaters[upd_ptr[s]..upd_ptr[s + 1]]`: the supernodes whose pattern meets `s`'s columns.
+    upd_ptr: Vec<usize>,
+    updaters: Vec<usize>,
+    /// Floating-point operations of each supernode's subtree.
+    work: Vec<f64>,
+    /// The lower triangle in the factor's order: column pointers, rows, and the index of each
+    /// value in the input matrix's values.
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    src: Vec<usize>,
+    /// The permuted values, gathered again by each factorisation.
+    vals: Vec<f64>,
+}
+
+impl Tree {
+    /// The tree of `sym`'s supernodes, and `a`'s lower triangle in the order `inv`
+    /// (`inv[old] = new`). `None` where the supernodes are not in postorder (each subtree
+    /// contiguous), which the schedule needs.
+    pub(crate) fn new(
+        sym: &SymbolicSupernodalCholesky<usize>,
+        a: SparseColMatRef<'_, usize, f64>,
+        inv: Option<&[usize]>,
+    ) -> Option<Tree> {
+        let (shape, (col_ptr, rows, src)) = rayon::join(|| Tree::shape(sym), || permuted_lower(a, inv));
+        let (parent, first, upd_ptr, updaters, work) = shape?;
+        Some(Tree {
+            parent,
+            first,
+            upd_ptr,
+            updaters,
+            work,
+            col_ptr,
+            vals: vec![0.0; rows.len()],
+            row_idx: rows,
+            src,
+        })
+    }
+
+    /// The supernodes' parents, first descendants, updaters (pointers and list) and subtree
+    /// work; `None` where they are not in postorder.
+    #[allow(clippy::type_complexity)]
+    fn shape(
+        sym: &SymbolicSupernodalCholesky<usize>,
+    ) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>, Vec<usize>, Vec<f64>)> {
+        let ns = sym.n_supernodes();
+        let n = sym.nrows();
+        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+        let (cp_row, row_idx) = (sym.col_ptr_for_row_idx(), sym.row_idx());
+        let mut of_col = vec![0usize; n];
+        for s in 0..ns {
+            of_col[begin[s]..end[s]].fill(s);
+        }
+        let mut parent = vec![usize::MAX; ns];
+        let mut size = vec![1usize; ns];
+        let mut work = vec![0.0; ns];
+        let mut lists: Vec<Vec<usize>> = vec![Vec::new(); ns];
+        for d in 0..ns {
+            let pattern = &row_idx[cp_row[d]..cp_row[d + 1]];
+            if let Some(&r) = pattern.first() {
+                parent[d] = of_col[r];
+            }
+            let mut last = usize::MAX;
+            for &r in pattern {
+                let s = of_col[r];
+                if s != last {
+                    lists[s].push(d);
+                    last = s;
+                }
+            }
+            let w = end[d] - begin[d];
+            work[d] += (0..w)
+                .map(|j| {
+                    let c = (w - 1 - j + pattern.len()) as f64;
+                    c * (c + 3.0)
+                })
+                .sum::<f64>();
+        }
+        for s in 0..ns {
+            if parent[s] != usize::MAX {
+                if parent[s] <= s {
+                    return None;
+                }
+                size[parent[s]] += size[s];
+                work[parent[s]] += work[s];
+            }
+        }
+        let first: Vec<usize> = (0..ns).map(|s| s + 1 - size[s]).collect();
+        // postorder: every supernode's subtree is the range of its size ending at it
+        for s in 0..ns {
+            let p = parent[s];
+            if p != usize::MAX && !(first[p] <= first[s] && s < p) {
+                return None;
+            }
+        }
+        let mut upd_ptr = Vec::with_capacity(ns + 1);
+        upd_ptr.push(0);
+        let mut updaters = Vec::new();
+        for l in lists {
+            updaters.extend(l);
+            upd_ptr.push(updaters.len());
+        }
+        Some((parent, first, upd_ptr, updaters, work))
+    }
+
+    /// Factors `a` (the pattern the tree was built for) into `values`, faer's supernodal
+    /// layout, on rayon's pool. The error is the (permuted) index of a zero pivot.
+    pub(crate) fn factor(
+        &mut self,
+        sym: &SymbolicSupernodalCholesky<usize>,
+        a: SparseColMatRef<'_, usize, f64>,
+        values: &mut [f64],
+        par: Par,
+    ) -> Result<(), usize> {
+        let av = a.val();
+        for (v, &k) in self.vals.iter_mut().zip(&self.src) {
+            *v = av[k];
+        }
+        let ctx = Ctx { sym, tree: self, par };
+        let ns = sym.n_supernodes();
+        ctx.forest(0, ns, values, 0)
+    }
+}
+
+/// The order `fwd` (`inv` its inverse; both empty: no order given) made a postorder of its
+/// elimination tree: children before their parent, every subtree contiguous, roots and
+/// children kept in their order. The tree by Liu's algorithm with path compression (Liu, ACM
+/// TOMS 12 (1986)) on the pattern of `a` in the order `fwd`. `None` where no order was given.
+pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv: &[usize]) -> Option<Vec<usize>> {
+    let n = a.nrows();
+    if fwd.len() != n || inv.len() != n {
+        return None;
+    }
+    // for each new column k, the new rows i < k of its upper part
+    let sym = a.symbolic();
+    let mut ptr = vec![0usize; n + 1];
+    for j in 0..n {
+        for &i in sym.row_idx_of_col_raw(j) {
+            let (pi, pj) = (inv[i], inv[j]);
+            if pi != pj {
+                ptr[pi.max(pj) + 1] += 1;
+            }
+        }
+    }
+    for k in 0..n {
+        ptr[k + 1] += ptr[k];
+    }
+    let mut next = ptr.clone();
+    let mut upper = vec![0usize; ptr[n]];
+    for j in 0..n {
+        for &i in sym.row_idx_of_col_raw(j) {
+            let (pi, pj) = (inv[i], inv[j]);
+            if pi != pj {
+                let k = pi.max(pj);
+                upper[next[k]] = pi.min(pj);
+                next[k] += 1;
+            }
+        }
+    }
+    let mut parent = vec![usize::MAX; n];
+    let mut ancestor = vec![usize::MAX; n];
+    for k in 0..n {
+        for &i0 in &upper[ptr[k]..ptr[k + 1]] {
+            let mut i = i0;
+            while i != usize::MAX && i < k {
+                let up = ancestor[i];
+                ancestor[i] = k;
+                if up == usize::MAX {
+                    parent[i] = k;
+                }
+                i = up;
+            }
+        }
+    }
+    let mut child_ptr = vec![0usize; n + 1];
+    for &p in &parent {
+        if p != usize::MAX {
+            child_ptr[p + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        child_ptr[k + 1] += child_ptr[k];
+    }
+    let mut at = child_ptr.clone();
+    let mut children = vec![0usize; child_ptr[n]];
+    for (c, &p) in parent.iter().enumerate() {
+        if p != usize::MAX {
+            children[at[p]] = c;
+            at[p] += 1;
+        }
+    }
+    let mut out = Vec::with_capacity(n);
+    let roots = (0..n).filter(|&k| parent[k] == usize::MAX);
+    let mut stack: Vec<(usize, usize)> = Vec::new();
+    for r in roots {
+        stack.push((r, child_ptr[r]));
+        while let Some((v, c)) = stack.pop() {
+            if c < child_ptr[v + 1] {
+                stack.push((v, c + 1));
+                let w = children[c];
+                stack.push((w, child_ptr[w]));
+            } else {
+                out.push(fwd[v]);
+            }
+        }
+    }
+    Some(out)
+}
+
+/// The columns of `sym` (in its order) reordered so that its supernodes come in postorder,
+/// every subtree contiguous and ending at its root (roots and children in their order, so a
+/// connected factor's last supernode stays last): `order[new] = old` in `sym`'s order. A
+/// postorder is an equivalent ordering (the same elimination tree, the same fill; Liu, SIAM
+/// J. Matrix Anal. Appl. 11 (1990)), so the symbolic analysis of the reordered matrix finds
+/// the same supernodes.
+pub(crate) fn postorder(sym: &SymbolicSupernodalCholesky<usize>) -> Vec<usize> {
+    let ns = sym.n_supernodes();
+    let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+    let (cp_row, row_idx) = (sym.col_ptr_for_row_idx(), sym.row_idx());
+    let mut of_col = vec![0usize; sym.nrows()];
+    for s in 0..ns {
+        of_col[begin[s]..end[s]].fill(s);
+    }
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); ns];
+    let mut roots = vec![];
+    for d in 0..ns {
+        match row_idx[cp_row[d]..cp_row[d + 1]].first() {
+            Some(&r) => children[of_col[r]].push(d),
+            None => roots.push(d),
+        }
+    }
+    let mut order = Vec::with_capacity(sym.nrows());
+    // depth first, children before their parent
+    let mut stack: Vec<(usize, usize)> = roots.iter().rev().map(|&r| (r, 0)).collect();
+    while let Some((s, next)) = stack.pop() {
+        if let Some(&c) = children[s].get(next) {
+            stack.push((s, next + 1));
+            stack.push((c, 0));
+        } else {
+            order.extend(begin[s]..end[s]);
+        }
+    }
+    order
+}
+
+/// The lower triangle of `a` (whose lower triangle is read) in the order `inv`, as column
+/// pointers, rows (in no particular order within a column) and the source of each value: two
+/// counting passes, no sort.
+fn permuted_lower(a: SparseColMatRef<'_, usize, f64>, inv: Option<&[usize]>) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let n = a.nrows();
+    let p = |i: usize| inv.map_or(i, |v| v[i]);
+    let sym = a.symbolic();
+    // the (row, column) in the new order of each lower entry, column the smaller
+    let place = |i: usize, j: usize| {
+        let (pi, pj) = (p(i), p(j));
+        if pi >= pj {
+            (pi, pj)
+        } else {
+            (pj, pi)
+        }
+    };
+    let mut col_ptr = vec![0usize; n + 1];
+    for j in 0..n {
+        for &i in sym.row_idx_of_col_raw(j) {
+            if i >= j {
+                col_ptr[place(i, j).1 + 1] += 1;
+            }
+        }
+    }
+    for c in 0..n {
+        col_ptr[c + 1] += col_ptr[c];
+    }
+    let nnz = col_ptr[n];
+    let mut next = col_ptr.clone();
+    let (mut rows, mut src) = (vec![0usize; nnz], vec![0usize; nnz]);
+    let all_rows = sym.row_idx();
+    for j in 0..n {
+        for k in sym.col_range(j) {
+            let i = all_rows[k];
+            if i >= j {
+                let (r, c) = place(i, j);
+                rows[next[c]] = r;
+                src[next[c]] = k;
+                next[c] += 1;
+            }
+        }
+    }
+    (col_ptr, rows, src)
+}
+
+/// One factorisation's shared, read-only state.
+struct Ctx<'a> {
+    sym: &'a SymbolicSupernodalCholesky<usize>,
+    tree: &'a Tree,
+    par: Par,
+}
+
+/// A task's workspace: the map from a row to its place in the current supernode, and the
+/// buffers of the descendants' updates.
+struct Scratch {
+    local: Vec<usize>,
+    rows: Vec<usize>,
+    scaled: Vec<f64>,
+    update: Vec<f64>,
+    dense: MemBuffer,
+}
+
+impl Scratch {
+    fn new(n: usize, max_cols: usize, par: Par) -> Scratch {
+        Scratch {
+            local: vec![usize::MAX; n],
+            rows: vec![],
+            scaled: vec![],
+            update: vec![],
+            dense: MemBuffer::new(cholesky_in_place_scratch::<f64>(max_cols, par, Default::default())),
+        }
+    }
+}
+
+impl Ctx<'_> {
+    /// Factors the supernodes `lo..hi`, a union of whole subtrees, into `values` (theirs,
+    /// starting at value `off` of the factor).
+    fn forest(&self, lo: usize, hi: usize, values: &mut [f64], off: usize) -> Result<(), usize> {
+        if lo == hi {
+            return Ok(());
+        }
+        let t = self.tree;
+        let roots: Vec<usize> = (lo..hi).filter(|&s| t.parent[s] >= hi).collect();
+        let total: f64 = roots.iter().map(|&r| t.work[r]).sum();
+        if total < SEQUENTIAL_FLOPS || rayon::current_num_threads() < 2 {
+            return self.in_order(lo, hi, values, off, Par::Seq);
+        }
+        if let [root] = roots[..] {
+            let cpv = self.sym.col_ptr_for_val();
+            let (below, mine) = values.split_at_mut(cpv[root] - off);
+            self.forest(lo, root, below, off)?;
+            let mut scratch = self.scratch(root, root + 1, self.par);
+            return self.node(root, (below, mine), off, &mut scratch, self.par);
+        }
+        // two groups of whole subtrees with about half the work each
+        let mut acc = 0.0;
+        let mut cut = roots[roots.len() - 1];
+        for &r in &roots {
+            acc += t.work[r];
+            if acc >= total / 2.0 {
+                cut = r;
+                break;
+            }
+        }
+        // the last root ends the range: cut before its subtree instead of after it
+        let mid = if cut == hi - 1 { t.first[cut] } else { cut + 1 };
+        let cpv = self.sym.col_ptr_for_val();
+        let (left, right) = values.split_at_mut(cpv[mid] - off);
+        let (a, b) = rayon::join(
+            || self.forest(lo, mid, left, off),
+            || self.forest(mid, hi, right, cpv[mid]),
+        );
+        a.and(b)
+    }
+
+    fn scratch(&self, lo: usize, hi: usize, par: Par) -> Scratch {
+        let (begin, end) = (self.sym.supernode_begin(), self.sym.supernode_end());
+        let max_cols = (lo..hi).map(|s| end[s] - begin[s]).max().unwrap_or(0);
+        Scratch::new(self.sym.nrows(), max_cols, par)
+    }
+
+    /// Factors the supernodes `lo..hi` one after another on this thread.
+    fn in_order(&self, lo: usize, hi: usize, values: &mut [f64], off: usize, par: Par) -> Result<(), usize> {
+        let mut scratch = self.scratch(lo, hi, par);
+        let cpv = self.sym.col_ptr_for_val();
+        for s in lo..hi {
+            let (below, mine) = values.split_at_mut(cpv[s] - off);
+            self.node(s, (below, mine), off, &mut scratch, par)?;
+        }
+        Ok(())
+    }
+
+    /// The left-looking step of supernode `s`: its columns of the matrix, less the updates of
+    /// its descendants (in `parts.0`, the factor's values from `off` to `s`'s), factored into
+    /// `parts.1` (starting with `s`'s values).
+    fn node(
+        &self,
+        s: usize,
+        parts: (&[f64], &mut [f64]),
+        off: usize,
+        scratch: &mut Scratch,
+        par: Par,
+    ) -> Result<(), usize> {
+        let (head, tail) = parts;
+        let sym = self.sym;
+        let t = self.tree;
+        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+        let (cp_row, cpv, rows) = (sym.col_ptr_for_row_idx(), sym.col_ptr_for_val(), sym.row_idx());
+        let (s_start, s_end) = (begin[s], end[s]);
+        let pattern = &rows[cp_row[s]..cp_row[s + 1]];
+        let ncols = s_end - s_start;
+        let nrows = ncols + pattern.len();
+        let local = &mut scratch.local;
+        for (i, &r) in pattern.iter().enumerate() {
+            local[r] = i + ncols;
+        }
+        // column-major, nrows x ncols
+        let ls = &mut tail[..cpv[s + 1] - cpv[s]];
+        ls.fill(0.0);
+        for j in s_start..s_end {
+            let col = &mut ls[(j - s_start) * nrows..(j - s_start + 1) * nrows];
+            for k in t.col_ptr[j]..t.col_ptr[j + 1] {
+                let i = t.row_idx[k];
+                let at = if i >= s_end { local[i] } else { i - s_start };
+                col[at] += t.vals[k];
+            }
+        }
+        for &d in &t.updaters[t.upd_ptr[s]..t.upd_ptr[s + 1]] {
+            let d_pattern = &rows[cp_row[d]..cp_row[d + 1]];
+            let d_ncols = end[d] - begin[d];
+            let ld = MatRef::from_column_major_slice(
+                &head[cpv[d] - off..cpv[d + 1] - off],
+                d_ncols + d_pattern.len(),
+                d_ncols,
+            );
+            let start = d_pattern.partition_point(|&r| r < s_start);
+            let mid = d_pattern[start..].partition_point(|&r| r < s_end);
+            let hit = &d_pattern[start..];
+            let below = ld.subrows(d_ncols + start, hit.len());
+            // each row's place in the supernode: its columns' rows first, then its pattern
+            scratch.rows.clear();
+            scratch
+                .rows
+                .extend(hit.iter().map(|&r| if r < s_end { r - s_start } else { local[r] }));
+            subtract_update(
+                (&mut *ls, nrows),
+                ld,
+                below,
+                mid,
+                (&mut scratch.scaled, &mut scratch.update),
+                par,
+                &scratch.rows,
+            );
+        }
+        for &r in pattern {
+            local[r] = usize::MAX;
+        }
+        let ls = MatMut::from_column_major_slice_mut(ls, nrows, ncols);
+        let (mut top, mut bot) = ls.split_at_row_mut(ncols);
+        cholesky_in_place(
+            top.rb_mut(),
+            LdltRegularization::default(),
+            par,
+            MemStack::new(&mut scratch.dense),
+            Default::default(),
+        )
+        .map_err(|e| match e {
+            faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => index + s_start,
+        })?;
+        for j in 0..ncols {
+            for i in 0..j {
+                top[(i, j)] = 0.0;
+            }
+        }
+        faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place(
+            top.rb(),
+            bot.rb_mut().transpose_mut(),
+            par,
+        );
+        for j in 0..ncols {
+            let d = top[(j, j)].recip();
+            for i in 0..bot.nrows() {
+                bot[(i, j)] *= d;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `L_s -= W` (`ls`: the supernode's values, column-major, and its number of rows),
+/// `W = B D Mᵀ` with `B` the rows of descendant `ld` from the supernode's first
+/// column on (`below`), `M` its first `mid` rows and `D` the descendant's pivots; `W`'s row `i`
+/// goes to row `rows[i]` of `L_s`, its column `j` to column `rows[j]` (only `i ≥ j`: the
+/// factor is lower triangular). One dense product (the top square's upper half is computed
+/// and dropped: one call costs less than two on the small blocks of a 2D mesh), then the
+/// scatter.
+fn subtract_update(
+    ls: (&mut [f64], usize),
+    ld: MatRef<'_, f64>,
+    below: MatRef<'_, f64>,
+    mid: usize,
+    bufs: (&mut Vec<f64>, &mut Vec<f64>),
+    par: Par,
+    rows: &[usize],
+) {
+    let (scaled, update) = bufs;
+    let (m, w) = (below.nrows(), below.ncols());
+    if mid == 0 || m == 0 {
+        return;
+    }
+    // M D, mid x w (the buffers only grow: their old contents are overwritten)
+    if scaled.len() < mid * w {
+        scaled.resize(mid * w, 0.0);
+    }
+    let mut md = MatMut::from_column_major_slice_mut(&mut scaled[..mid * w], mid, w);
+    for k in 0..w {
+        let d = ld[(k, k)];
+        let src = below.col(k);
+        for i in 0..mid {
+            md[(i, k)] = src[i] * d;
+        }
+    }
+    if update.len() < m * mid {
+        update.resize(m * mid, 0.0);
+    }
+    let mut wm = MatMut::from_column_major_slice_mut(&mut update[..m * mid], m, mid);
+    faer::linalg::matmul::matmul(wm.rb_mut(), Accum::Replace, below, md.rb().transpose(), 1.0, par);
+    let wv = &update[..m * mid];
+    let (ls, nrows) = ls;
+    for j in 0..mid {
+        let dst = &mut ls[rows[j] * nrows..(rows[j] + 1) * nrows];
+        let src = &wv[j * m..(j + 1) * m];
+        for i in j..m {
+            dst[rows[i]] -= src[i];
+        }
+    }
+}

@@ -1,0 +1,251 @@
+//! The numeric `L D Lᵀ` on several cores (the supernodes' elimination tree walked in parallel)
+//! against faer's own sequential factorisation of the same matrix in the same order: the
+//! same pivots, the same solution, the same condensation onto dofs ordered last, on a
+//! quasi-definite `K = [[A, Gᵀ], [G, -B]]` of a grid (two displacements and one potential per
+//! node) in a nested-dissection order, whose tree has independent subtrees at every level.
+
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Par;
+use linalg::{DirectLdlt, FactorKind, Ordering, SparseFactor};
+
+/// `K` of an `m x m` grid: `A = L ⊗ I₂ + I`, `B = L + I` (`L` the graph Laplacian with random
+/// positive edge weights), `G` coupling each potential to its node's and its neighbours'
+/// displacements; `(A, G, B)` and the lower triangle of `K`. Dofs: `u` node-major, then `φ`.
+type Blocks = (
+    SparseColMat<usize, f64>,
+    SparseColMat<usize, f64>,
+    SparseColMat<usize, f64>,
+);
+
+fn grid(m: usize, seed: u64) -> Blocks {
+    let mut state = seed;
+    let mut rnd = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64) / ((1u64 << 53) as f64)
+    };
+    let n = m * m;
+    let (mut a, mut g, mut b) = (vec![], vec![], vec![]);
+    let node = |i: usize, j: usize| i * m + j;
+    for i in 0..m {
+        for j in 0..m {
+            let p = node(i, j);
+            for k in 0..2 {
+                a.push(Triplet::new(2 * p + k, 2 * p + k, 1.0));
+            }
+            b.push(Triplet::new(p, p, 1.0));
+            g.push(Triplet::new(p, 2 * p, rnd() - 0.5));
+            let mut link = |q: usize| {
+                let w = 1.0 + rnd();
+                for (lo, hi) in [(p, q), (q, p)] {
+                    for k in 0..2 {
+                        a.push(Triplet::new(2 * lo + k, 2 * lo + k, w));
+                        a.push(Triplet::new(2 * lo + k, 2 * hi + k, -w));
+                    }
+                    b.push(Triplet::new(lo, lo, w));
+                    b.push(Triplet::new(lo, hi, -w));
+                }
+                g.push(Triplet::new(p, 2 * q + 1, rnd() - 0.5));
+                g.push(Triplet::new(q, 2 * p, rnd() - 0.5));
+            };
+            if i + 1 < m {
+                link(node(i + 1, j));
+            }
+            if j + 1 < m {
+                link(node(i, j + 1));
+            }
+        }
+    }
+    (
+        SparseColMat::try_new_from_triplets(2 * n, 2 * n, &a).unwrap(),
+        SparseColMat::try_new_from_triplets(n, 2 * n, &g).unwrap(),
+        SparseColMat::try_new_from_triplets(n, n, &b).unwrap(),
+    )
+}
+
+/// Nested dissection of the grid's nodes (split the longer side in the middle, the middle
+/// line last), expanded to each node's dofs (`u`, then `φ`).
+fn dissection(m: usize) -> Vec<usize> {
+    fn rec(i0: usize, i1: usize, j0: usize, j1: usize, m: usize, out: &mut Vec<usize>) {
+        if (i1 - i0) * (j1 - j0) <= 16 {
+            for i in i0..i1 {
+                for j in j0..j1 {
+                    out.push(i * m + j);
+                }
+            }
+            return;
+        }
+        if i1 - i0 >= j1 - j0 {
+            let c = (i0 + i1) / 2;
+            rec(i0, c, j0, j1, m, out);
+            rec(c + 1, i1, j0, j1, m, out);
+            rec(c, c + 1, j0, j1, m, out);
+        } else {
+            let c = (j0 + j1) / 2;
+            rec(i0, i1, j0, c, m, out);
+            rec(i0, i1, c + 1, j1, m, out);
+            rec(i0, i1, c, c + 1, m, out);
+        }
+    }
+    let mut nodes = vec![];
+    rec(0, m, 0, m, m, &mut nodes);
+    let n = m * m;
+    nodes.iter().flat_map(|&p| [2 * p, 2 * p + 1, 2 * n + p]).collect()
+}
+
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+fn relative_gap(a: &[f64], b: &[f64]) -> f64 {
+    let num = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+    num / b.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+#[test]
+fn the_tree_on_two_cores_factors_as_faer_does_on_one() {
+    for (m, seed) in [(90, 1), (61, 2)] {
+        let (a, g, b) = grid(m, seed);
+        let k = linalg::sparse::lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref());
+        let n = k.nrows();
+        let ord = Ordering::Given(dissection(m));
+        let mut seq = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::Seq).unwrap();
+        // a pool of one thread walks the tree in order
+        for threads in [1, 2, 3] {
+            let mut par = on_threads(threads, || {
+                SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::rayon(2))
+            })
+            .unwrap();
+            assert!(par.parallel_tree() && !seq.parallel_tree());
+            // the order made a postorder of its elimination tree: an equivalent order, with
+            // the same fill (the stored values differ by the supernodes' padding) and, index
+            // by index, the same pivots
+            let (lp, ls) = (par.factor_len() as f64, seq.factor_len() as f64);
+            assert!((lp / ls - 1.0).abs() < 0.05, "{lp} values against {ls}");
+            let by_index = |f: &SparseFactor| {
+                let (mut d, pivots) = (vec![0.0; n], f.pivots());
+                for (new, old) in f.permutation().into_iter().enumerate() {
+                    d[old] = pivots[new];
+                }
+                d
+            };
+            let gap = relative_gap(&by_index(&par), &by_index(&seq));
+            assert!(gap < 1e-13, "m = {m}, {threads} threads: pivots differ by {gap:e}");
+            assert_eq!(par.inertia(), (2 * m * m, m * m, 0));
+            let rhs: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+            let (mut x, mut y) = (rhs.clone(), rhs.clone());
+            seq.solve_in_place(&mut x);
+            par.solve_in_place(&mut y);
+            let gap = relative_gap(&y, &x);
+            assert!(gap < 1e-12, "m = {m}, {threads} threads: solutions differ by {gap:e}");
+            // and again after a refactorisation with new values on the same pattern
+            let k2 = linalg::sparse::lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref());
+            on_threads(threads, || par.refactor(k2.as_ref())).unwrap();
+            let mut z = rhs.clone();
+            par.solve_in_place(&mut z);
+            assert!(relative_gap(&z, &x) < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn the_condensation_reads_the_same_trailing_block_off_the_parallel_factor() {
+    let m = 70;
+    let (a, g, b) = grid(m, 3);
+    let (n_u, n_phi) = (a.nrows(), b.nrows());
+    // the displacements of the grid's first row, as contact dofs would be
+    let last: Vec<usize> = (0..2 * m).collect();
+    let ordering = Ordering::GivenThenLast {
+        order: dissection(m),
+        last: last.clone(),
+    };
+    let b_u: Vec<f64> = (0..n_u).map(|i| ((i * 13) % 7) as f64 - 3.0).collect();
+    let b_phi: Vec<f64> = (0..n_phi).map(|i| ((i * 5) % 3) as f64).collect();
+    let mut seq = DirectLdlt::new(&a, &g, &b, &ordering, Par::Seq).unwrap();
+    let mut par = on_threads(2, || DirectLdlt::new(&a, &g, &b, &ordering, Par::rayon(2))).unwrap();
+    let cs = seq.condense(&b_u, &b_phi, &last).unwrap();
+    let cp = par.condense(&b_u, &b_phi, &last).unwrap();
+    assert_eq!(cp.loads.route, linalg::CondenseRoute::TrailingBlock);
+    assert!(relative_gap(&cp.inverse, &cs.inverse) < 1e-12);
+    assert!(relative_gap(&cp.loads.solution, &cs.loads.solution) < 1e-12);
+    let d: Vec<f64> = (0..last.len()).map(|i| (i % 5) as f64 * 0.1).collect();
+    let (us, ps) = seq.solve_with_update(cs.loads, &b_u, &b_phi, &d).unwrap();
+    let (up, pp) = par.solve_with_update(cp.loads, &b_u, &b_phi, &d).unwrap();
+    assert!(relative_gap(&up, &us) < 1e-12);
+    assert!(relative_gap(&pp, &ps) < 1e-12);
+}
+
+#[test]
+fn a_singular_matrix_is_refused_on_the_parallel_route_too() {
+    // the grid with one node's potential cut off from everything and its diagonal zero
+    let m = 60;
+    let (a, g, b) = grid(m, 4);
+    let mut t = vec![];
+    let dead = m * m / 2;
+    for j in 0..b.ncols() {
+        for (i, v) in b.row_idx_of_col(j).zip(b.val_of_col(j)) {
+            if i != dead && j != dead {
+                t.push(Triplet::new(i, j, *v));
+            }
+        }
+    }
+    let b0 = SparseColMat::try_new_from_triplets(b.nrows(), b.ncols(), &t).unwrap();
+    let mut tg = vec![];
+    for j in 0..g.ncols() {
+        for (i, v) in g.row_idx_of_col(j).zip(g.val_of_col(j)) {
+            if i != dead {
+                tg.push(Triplet::new(i, j, *v));
+            }
+        }
+    }
+    let g0 = SparseColMat::try_new_from_triplets(g.nrows(), g.ncols(), &tg).unwrap();
+    let k = linalg::sparse::lower_quasi_definite(a.as_ref(), g0.as_ref(), b0.as_ref());
+    let ord = Ordering::Given(dissection(m));
+    let seq = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::Seq).unwrap_err();
+    let par = on_threads(2, || {
+        SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::rayon(2))
+    })
+    .unwrap_err();
+    assert_eq!(format!("{par}"), format!("{seq}"));
+}
+
+#[test]
+fn a_matrix_of_two_unconnected_blocks_has_two_roots_and_factors_alike() {
+    let k1 = {
+        let (a, g, b) = grid(50, 5);
+        linalg::sparse::lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref())
+    };
+    let k2 = {
+        let (a, g, b) = grid(40, 6);
+        linalg::sparse::lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref())
+    };
+    let (n1, n2) = (k1.nrows(), k2.nrows());
+    let mut t = vec![];
+    for (k, off) in [(&k1, 0), (&k2, n1)] {
+        for j in 0..k.ncols() {
+            for (i, v) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
+                t.push(Triplet::new(i + off, j + off, *v));
+            }
+        }
+    }
+    let k = SparseColMat::try_new_from_triplets(n1 + n2, n1 + n2, &t).unwrap();
+    let mut order = dissection(50);
+    order.extend(dissection(40).into_iter().map(|i| i + n1));
+    let ord = Ordering::Given(order);
+    let mut seq = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::Seq).unwrap();
+    let mut par = on_threads(2, || {
+        SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::rayon(2))
+    })
+    .unwrap();
+    assert!(par.parallel_tree());
+    let rhs: Vec<f64> = (0..n1 + n2).map(|i| (i % 9) as f64 - 4.0).collect();
+    let (mut x, mut y) = (rhs.clone(), rhs.clone());
+    seq.solve_in_place(&mut x);
+    par.solve_in_place(&mut y);
+    assert!(relative_gap(&y, &x) < 1e-12);
+}
