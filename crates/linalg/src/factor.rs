@@ -240,7 +240,7 @@ impl SparseFactor {
                         }
                     })?;
             }
-            FactorKind::Ldlt => match (self.tree.as_mut(), self.symbolic.raw()) {
+            FactorKind::Ldlt => match (self.tree.as_ref(), self.symbolic.raw()) {
                 (Some(tree), SymbolicCholeskyRaw::Supernodal(sym)) => {
                     tree.factor(sym, a, &mut self.values, self.par)
                         .map_err(|index| LinalgError::ZeroPivot {

@@ -45,8 +45,6 @@ pub(crate) struct Tree {
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     src: Vec<usize>,
-    /// The permuted values, gathered again by each factorisation.
-    vals: Vec<f64>,
 }
 
 impl Tree {
@@ -67,7 +65,6 @@ impl Tree {
             updaters,
             work,
             col_ptr,
-            vals: vec![0.0; rows.len()],
             row_idx: rows,
             src,
         })
@@ -80,13 +77,9 @@ impl Tree {
         sym: &SymbolicSupernodalCholesky<usize>,
     ) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>, Vec<usize>, Vec<f64>)> {
         let ns = sym.n_supernodes();
-        let n = sym.nrows();
         let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
         let (cp_row, row_idx) = (sym.col_ptr_for_row_idx(), sym.row_idx());
-        let mut of_col = vec![0usize; n];
-        for s in 0..ns {
-            of_col[begin[s]..end[s]].fill(s);
-        }
+        let of_col = supernode_of_column(sym);
         let mut parent = vec![usize::MAX; ns];
         let mut size = vec![1usize; ns];
         let mut work = vec![0.0; ns];
@@ -142,17 +135,18 @@ impl Tree {
     /// Factors `a` (the pattern the tree was built for) into `values`, faer's supernodal
     /// layout, on rayon's pool. The error is the (permuted) index of a zero pivot.
     pub(crate) fn factor(
-        &mut self,
+        &self,
         sym: &SymbolicSupernodalCholesky<usize>,
         a: SparseColMatRef<'_, usize, f64>,
         values: &mut [f64],
         par: Par,
     ) -> Result<(), usize> {
-        let av = a.val();
-        for (v, &k) in self.vals.iter_mut().zip(&self.src) {
-            *v = av[k];
-        }
-        let ctx = Ctx { sym, tree: self, par };
+        let ctx = Ctx {
+            sym,
+            tree: self,
+            values: a.val(),
+            par,
+        };
         let ns = sym.n_supernodes();
         ctx.forest(0, ns, values, 0)
     }
@@ -249,14 +243,21 @@ pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv
 /// postorder is an equivalent ordering (the same elimination tree, the same fill; Liu, SIAM
 /// J. Matrix Anal. Appl. 11 (1990)), so the symbolic analysis of the reordered matrix finds
 /// the same supernodes.
+/// The supernode each column belongs to.
+fn supernode_of_column(sym: &SymbolicSupernodalCholesky<usize>) -> Vec<usize> {
+    let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+    let mut of_col = vec![0usize; sym.nrows()];
+    for s in 0..sym.n_supernodes() {
+        of_col[begin[s]..end[s]].fill(s);
+    }
+    of_col
+}
+
 pub(crate) fn postorder(sym: &SymbolicSupernodalCholesky<usize>) -> Vec<usize> {
     let ns = sym.n_supernodes();
     let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
     let (cp_row, row_idx) = (sym.col_ptr_for_row_idx(), sym.row_idx());
-    let mut of_col = vec![0usize; sym.nrows()];
-    for s in 0..ns {
-        of_col[begin[s]..end[s]].fill(s);
-    }
+    let of_col = supernode_of_column(sym);
     let mut children: Vec<Vec<usize>> = vec![Vec::new(); ns];
     let mut roots = vec![];
     for d in 0..ns {
@@ -328,6 +329,8 @@ fn permuted_lower(a: SparseColMatRef<'_, usize, f64>, inv: Option<&[usize]>) -> 
 struct Ctx<'a> {
     sym: &'a SymbolicSupernodalCholesky<usize>,
     tree: &'a Tree,
+    /// The input matrix's values, read through `tree.src`.
+    values: &'a [f64],
     par: Par,
 }
 
@@ -443,7 +446,7 @@ impl Ctx<'_> {
             for k in t.col_ptr[j]..t.col_ptr[j + 1] {
                 let i = t.row_idx[k];
                 let at = if i >= s_end { local[i] } else { i - s_start };
-                col[at] += t.vals[k];
+                col[at] += self.values[t.src[k]];
             }
         }
         for &d in &t.updaters[t.upd_ptr[s]..t.upd_ptr[s + 1]] {
