@@ -6,11 +6,13 @@
 //! semidefinite (rigid multibody problems), where Newton's matrices are singular; it converges
 //! linearly, so it is the last stage of [`crate::solve_newton`] for Coulomb's law.
 
-use crate::local::{Point, PointLaw};
-use crate::operator::{AffineProblem, Compliance};
+use crate::local::{inverse, Point, PointLaw};
+use crate::operator::{dot8, AffineProblem, Compliance};
 use crate::points::{ContactPoints, Flat, PointValues};
 use crate::solution::{classify, counts, slip_bound, Best, Counter, Preamble};
-use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law, Measure, Progress, Stage, Stall};
+use crate::{
+    ContactError, ContactInfo, ContactSolution, Interrupt, Interruption, Iterate, Law, Measure, Progress, Stage, Stall,
+};
 
 /// Parameters of [`solve_gauss_seidel`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,10 +46,14 @@ impl Default for GaussSeidelParams {
 
 /// Sweeps without a 1 % gain on the best residual before the method is declared stalled.
 const STALL_SWEEPS: usize = 2_000;
+/// The full residual is evaluated at least every this many sweeps (it costs about one sweep:
+/// one product with `D`), and whenever the sweeps' own change says the tolerance may be met.
+const FULL_EVERY: usize = 10;
 
 /// Solves the affine contact problem `problem` for `law` by block Gauss–Seidel sweeps over
 /// the points, from `lambda0` (zeros when `None`). The answer is the best iterate (by the
-/// measure asked for); [`ContactInfo::uzawa_iters`] counts the sweeps.
+/// measure asked for, evaluated at least every ten sweeps and wherever the sweeps' change
+/// falls below its threshold); [`ContactInfo::uzawa_iters`] counts the sweeps.
 ///
 /// # Errors
 /// [`ContactError::Input`] for inconsistent data; [`ContactError::Stalled`] or
@@ -62,157 +68,386 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
     let pre = Preamble::new(&mut Counter::new(problem), points, law, params.power_iters, None)?;
-    let mut lambda = pre.start(lambda0)?;
-    let Preamble {
-        n,
-        nt,
-        mu_max,
-        u0,
-        reference,
-    } = pre;
-    let sweeper = Sweeper::new(problem, Flat { n, nt });
+    let lambda = pre.start(lambda0)?;
+    let (mu_max, reference) = (pre.mu_max, pre.reference);
     let mut info = ContactInfo::new(mu_max);
-    let mut best = Best::new(0.99);
-    let mut residual = f64::NAN;
-    for sweep in 1..=params.max_sweeps {
-        sweeper.sweep(points, law, &u0, &mut lambda);
-        info.uzawa_iters = sweep;
-        let u = sweeper.displacement(&u0, &lambda);
-        residual = params
-            .measure
-            .of(points, law, &lambda, &u, &u0, 1.0 / mu_max, reference);
-        best.offer(&lambda, &u, residual);
-        if params.report_every > 0 && sweep % params.report_every == 0 {
-            progress(&Progress {
-                stage: Stage::GaussSeidel,
-                iter: sweep,
-                residual,
-                counts: counts(&classify(&lambda, &slip_bound(points, law, &lambda.normal))),
-            });
-        }
-        if residual <= params.tol {
-            break;
-        }
-        if !residual.is_finite() {
-            return Err(stopped(Stall::NonFinite, sweep, residual, best.take()));
-        }
-        if let Some(why) = params.interrupt.check() {
+    let run = Sweeps {
+        problem: &*problem,
+        points,
+        law,
+        measure: params.measure,
+        tol: params.tol,
+        mu_max,
+        reference,
+    }
+    .run(
+        &lambda,
+        params.max_sweeps,
+        None,
+        params.report_every,
+        &params.interrupt,
+        progress,
+    );
+    info.uzawa_iters = run.sweeps;
+    match run.end {
+        SweepEnd::Converged => {}
+        SweepEnd::Interrupted(why) => {
             return Err(ContactError::Interrupted {
                 why,
-                n_iters: sweep,
-                residual,
-                best: best.boxed(),
-            });
-        }
-        if best.since() >= STALL_SWEEPS {
-            return Err(stopped(Stall::NoProgress, sweep, residual, best.take()));
-        }
-    }
-    let best = match best.take() {
-        Some(b) if b.residual <= params.tol => b,
-        best => {
-            return Err(ContactError::NoConvergence {
-                n_iters: info.uzawa_iters,
-                residual,
-                best: best.map(Box::new),
+                n_iters: run.sweeps,
+                residual: run.residual,
+                best: run.best.map(Box::new),
             })
         }
-    };
+        SweepEnd::Stalled(reason) => return Err(stopped(reason, run.sweeps, run.residual, run.best)),
+        SweepEnd::Limit | SweepEnd::Abandoned => {
+            return Err(ContactError::NoConvergence {
+                n_iters: run.sweeps,
+                residual: run.residual,
+                best: run.best.map(Box::new),
+            })
+        }
+    }
+    let best = run.best.expect("a converged run judged an iterate");
+    Ok(solution(best, points, law, info, mu_max, reference))
+}
+
+/// The solution of the converged iterate `best`, with the counts `info`.
+pub(crate) fn solution(
+    best: Iterate,
+    points: &ContactPoints,
+    law: &Law,
+    mut info: ContactInfo,
+    mu_max: f64,
+    reference: f64,
+) -> ContactSolution {
     let radius = slip_bound(points, law, &best.lambda.normal);
     info.residual = best.residual;
     info.complementarity =
         crate::complementarity_residual(points, &radius, &best.lambda, &best.u, 1.0 / mu_max, reference);
-    Ok(ContactSolution {
+    ContactSolution {
         status: classify(&best.lambda, &radius),
         lambda: best.lambda,
         u: best.u,
         info,
         electric: None,
-    })
+    }
 }
 
-/// The sweeps' data: the compliance `D` (its rows in the flat layout), the weights `W`, and
-/// each point's own block of `D W`, which its local problem inverts.
+/// How a run of sweeps ended.
+pub(crate) enum SweepEnd {
+    /// The residual met the tolerance.
+    Converged,
+    /// The sweep limit.
+    Limit,
+    /// The measured rate promised no answer within the budget ([`Sweeps::run`]).
+    Abandoned,
+    Stalled(Stall),
+    Interrupted(Interruption),
+}
+
+/// A run of sweeps: the best iterate judged, the sweeps, the last residual, how it ended.
+pub(crate) struct SweepRun {
+    pub best: Option<Iterate>,
+    pub sweeps: usize,
+    pub residual: f64,
+    pub end: SweepEnd,
+}
+
+/// The sweeps' problem, law and measure, with the preamble's `μ_max` and multiplier scale.
+pub(crate) struct Sweeps<'a, P> {
+    pub problem: &'a P,
+    pub points: &'a ContactPoints,
+    pub law: &'a Law,
+    pub measure: Measure,
+    pub tol: f64,
+    pub mu_max: f64,
+    pub reference: f64,
+}
+
+impl<P: AffineProblem> Sweeps<'_, P> {
+    /// Sweeps from `lambda`, at most `max_sweeps`. The full residual is evaluated at least
+    /// every [`FULL_EVERY`] sweeps and where the sweep's relative change of the multipliers
+    /// falls below a threshold (Siconos' "light" error, the threshold lowered in proportion
+    /// where the full residual then misses the tolerance, as Siconos' NSGS does). With a
+    /// `budget`, the run is abandoned as soon as the rate measured between two evaluations
+    /// (from the second window on) predicts more sweeps in all than the budget.
+    pub(crate) fn run(
+        &self,
+        lambda: &PointValues,
+        max_sweeps: usize,
+        budget: Option<f64>,
+        report_every: usize,
+        interrupt: &Interrupt,
+        progress: &mut dyn FnMut(&Progress),
+    ) -> SweepRun {
+        let (points, law) = (self.points, self.law);
+        let (n, nt) = (lambda.n_points(), lambda.n_tangential());
+        let sweeper = Sweeper::new(self.problem, Flat { n, nt });
+        let u0 = self.problem.loads();
+        let mut x: Vec<f64> = lambda.normal.iter().chain(&lambda.tangential).copied().collect();
+        let u0_flat: Vec<f64> = u0.normal.iter().chain(&u0.tangential).copied().collect();
+        let laws: Vec<PointLaw> = (0..n).map(|i| point_law(law, points, i)).collect();
+        let mut best = Best::new();
+        let mut residual = f64::NAN;
+        let mut light_tol = self.tol;
+        let mut last_gain = 0;
+        // the last evaluation before this one: (sweep, residual)
+        let mut previous: Option<(usize, f64)> = None;
+        let end = 'sweeps: {
+            for sweep in 1..=max_sweeps {
+                let light = sweeper.sweep(points, &laws, &u0_flat, &mut x);
+                let report = report_every > 0 && sweep % report_every == 0;
+                let evaluate = light <= light_tol || report || sweep % FULL_EVERY == 0 || sweep == max_sweeps;
+                if !light.is_finite() {
+                    break 'sweeps (sweep, SweepEnd::Stalled(Stall::NonFinite));
+                }
+                if evaluate {
+                    let before = best.residual();
+                    let lambda;
+                    (lambda, residual) = self.judge(&sweeper, &x, &u0_flat, &mut best);
+                    if !residual.is_finite() {
+                        break 'sweeps (sweep, SweepEnd::Stalled(Stall::NonFinite));
+                    }
+                    if before.is_none_or(|b| residual < 0.99 * b) {
+                        last_gain = sweep;
+                    }
+                    if report {
+                        progress(&Progress {
+                            stage: Stage::GaussSeidel,
+                            iter: sweep,
+                            residual,
+                            counts: counts(&classify(&lambda, &slip_bound(points, law, &lambda.normal))),
+                        });
+                    }
+                    if residual <= self.tol {
+                        break 'sweeps (sweep, SweepEnd::Converged);
+                    }
+                    if light == 0.0 {
+                        // a sweep that moved nothing: every later one is the same
+                        break 'sweeps (sweep, SweepEnd::Stalled(Stall::NoProgress));
+                    }
+                    if light <= light_tol {
+                        light_tol = light * self.tol / residual;
+                    }
+                    if let (Some(budget), Some((at, before))) = (budget, previous) {
+                        if !(predicted(sweep, residual, at, before, self.tol) <= budget) {
+                            break 'sweeps (sweep, SweepEnd::Abandoned);
+                        }
+                    }
+                    previous = Some((sweep, residual));
+                }
+                if let Some(why) = interrupt.check() {
+                    break 'sweeps (sweep, SweepEnd::Interrupted(why));
+                }
+                if sweep - last_gain >= STALL_SWEEPS {
+                    break 'sweeps (sweep, SweepEnd::Stalled(Stall::NoProgress));
+                }
+            }
+            (max_sweeps, SweepEnd::Limit)
+        };
+        let (sweeps, end) = end;
+        if matches!(end, SweepEnd::Interrupted(_)) && best.residual().is_none() {
+            // interrupted before the first evaluation: the caller gets the iterate it stopped at
+            residual = self.judge(&sweeper, &x, &u0_flat, &mut best).1;
+        }
+        SweepRun {
+            best: best.take(),
+            sweeps,
+            residual,
+            end,
+        }
+    }
+
+    /// The residual of the multipliers `x` (flat layout), offered to `best`: the multipliers
+    /// as point values, and the residual.
+    fn judge(&self, sweeper: &Sweeper<'_>, x: &[f64], u0: &[f64], best: &mut Best) -> (PointValues, f64) {
+        let (n, nt) = (sweeper.flat.n, sweeper.flat.nt);
+        let lambda = PointValues::from_flat(x, n, nt);
+        let u = sweeper.displacement(u0, x);
+        let residual = self.measure.of(
+            self.points,
+            self.law,
+            &lambda,
+            &u,
+            self.problem.loads(),
+            1.0 / self.mu_max,
+            self.reference,
+        );
+        best.offer(&lambda, &u, residual);
+        (lambda, residual)
+    }
+}
+
+/// The sweeps in all that a linear rate measured between `(at, before)` and `(sweep, now)`
+/// predicts to reach `tol` (infinite where the residual did not fall).
+fn predicted(sweep: usize, now: f64, at: usize, before: f64, tol: f64) -> f64 {
+    let rate = (now / before).ln() / (sweep - at) as f64;
+    if !(rate < 0.0) {
+        return f64::INFINITY;
+    }
+    sweep as f64 + (tol / now).ln() / rate
+}
+
+/// Point `i`'s law.
+fn point_law(law: &Law, points: &ContactPoints, i: usize) -> PointLaw {
+    match law {
+        Law::Frictionless => PointLaw::Frictionless,
+        Law::Tresca(s) => PointLaw::Tresca(s[i]),
+        Law::Coulomb => PointLaw::Coulomb(points.friction[i]),
+    }
+}
+
+/// The rows of `D W` with each point's own block left out, which a sweep multiplies by the
+/// latest multipliers.
+enum Coupling<'p> {
+    /// A dense `D` (row-major) and the weights in the flat layout: a row's product skips the
+    /// point's own columns, `i` and `n + i nt ..`, by summing the three stretches between them.
+    Dense { d: &'p [f64], w: Vec<f64> },
+    /// A sparse `D W` without the own blocks, compressed rows.
+    Sparse {
+        ptr: Vec<usize>,
+        col: Vec<u32>,
+        val: Vec<f64>,
+    },
+}
+
+/// The sweeps' data: the compliance's rows without the own blocks, the weights, and each
+/// point's own block of `D W`, which its local problem inverts.
 struct Sweeper<'p> {
     d: Compliance<'p>,
+    coupling: Coupling<'p>,
+    /// The weights in the flat layout.
     w: Vec<f64>,
     flat: Flat,
     blocks: Vec<[[f64; 3]; 3]>,
+    /// The blocks' inverses in 3D (`None` where singular), for the sticking case.
+    inverses: Vec<Option<[[f64; 3]; 3]>>,
 }
 
 impl<'p> Sweeper<'p> {
     fn new<P: AffineProblem>(problem: &'p P, flat: Flat) -> Self {
         let d = problem.compliance();
-        let w = problem.weights().to_vec();
+        let weights = problem.weights();
+        let w: Vec<f64> = (0..flat.len()).map(|r| weights[flat.owner(r).0]).collect();
         let mut blocks = vec![[[0.0; 3]; 3]; flat.n];
-        for r in 0..flat.len() {
-            let (i, kr) = flat.owner(r);
-            for (col, v) in d.row(r) {
-                let (j, kc) = flat.owner(col);
-                if j == i {
-                    blocks[i][kr][kc] = v * w[i];
-                }
-            }
-        }
-        Sweeper { d, w, flat, blocks }
-    }
-
-    /// One sweep: each point in turn solves its own law exactly against
-    /// `b = u0_i - Σ_{j ≠ i} D_ij w_j λ_j`, from the latest multipliers.
-    fn sweep(&self, points: &ContactPoints, law: &Law, u0: &PointValues, lambda: &mut PointValues) {
-        let nt = self.flat.nt;
-        for i in 0..self.flat.n {
-            let mut b = [0.0; 3];
-            for (k, bk) in b.iter_mut().enumerate().take(1 + nt) {
-                let mut acc = 0.0;
-                for (col, v) in self.d.row(self.flat.index(i, k)) {
-                    let (j, kc) = self.flat.owner(col);
-                    if j != i {
-                        acc += v * self.w[j] * lambda.component(j, kc);
+        let coupling = match d {
+            Compliance::Dense(dense) => {
+                let m = flat.len();
+                for r in 0..m {
+                    let (i, kr) = flat.owner(r);
+                    for (kc, b) in blocks[i][kr].iter_mut().enumerate().take(1 + flat.nt) {
+                        *b = dense[r * m + flat.index(i, kc)] * w[r];
                     }
                 }
-                *bk = u0.component(i, k) - acc;
+                Coupling::Dense { d: dense, w: w.clone() }
+            }
+            Compliance::Sparse(s) => {
+                let (mut ptr, mut col, mut val) = (vec![0], vec![], vec![]);
+                for r in 0..flat.len() {
+                    let (i, kr) = flat.owner(r);
+                    for (c, v) in s.col_idx_of_row(r).zip(s.val_of_row(r)) {
+                        let (j, kc) = flat.owner(c);
+                        if j == i {
+                            blocks[i][kr][kc] = v * w[c];
+                        } else {
+                            col.push(c as u32);
+                            val.push(v * w[c]);
+                        }
+                    }
+                    ptr.push(col.len());
+                }
+                Coupling::Sparse { ptr, col, val }
+            }
+        };
+        let inverses = blocks
+            .iter()
+            .map(|b| if flat.nt == 2 { inverse(*b, 3) } else { None })
+            .collect();
+        Sweeper {
+            d,
+            coupling,
+            w,
+            flat,
+            blocks,
+            inverses,
+        }
+    }
+
+    /// `Σ_{j ≠ i} (D W)_{r j} λ_j` for row `r` of point `i`, with `xw = W λ` (dense) or `x = λ`
+    /// (sparse).
+    fn coupled(&self, r: usize, i: usize, x: &[f64], xw: &[f64]) -> f64 {
+        match &self.coupling {
+            Coupling::Dense { d, .. } => {
+                let (m, n, nt) = (self.flat.len(), self.flat.n, self.flat.nt);
+                let row = &d[r * m..(r + 1) * m];
+                let (t0, t1) = (n + i * nt, n + (i + 1) * nt);
+                dot8(&row[..i], &xw[..i]) + dot8(&row[i + 1..t0], &xw[i + 1..t0]) + dot8(&row[t1..], &xw[t1..])
+            }
+            Coupling::Sparse { ptr, col, val } => {
+                let range = ptr[r]..ptr[r + 1];
+                col[range.clone()]
+                    .iter()
+                    .zip(&val[range])
+                    .map(|(&c, v)| v * x[c as usize])
+                    .sum()
+            }
+        }
+    }
+
+    /// One sweep over `x = λ` (flat layout): each point in turn solves its own law exactly
+    /// against `b = u0_i - Σ_{j ≠ i} D_ij w_j λ_j`, from the latest multipliers. Returns the
+    /// sweep's relative change `‖Δλ‖ / ‖λ‖` (0 where λ stays 0).
+    fn sweep(&self, points: &ContactPoints, laws: &[PointLaw], u0: &[f64], x: &mut [f64]) -> f64 {
+        let (n, k) = (self.flat.n, 1 + self.flat.nt);
+        let mut xw: Vec<f64> = match &self.coupling {
+            Coupling::Dense { w, .. } => x.iter().zip(w).map(|(a, b)| a * b).collect(),
+            Coupling::Sparse { .. } => Vec::new(),
+        };
+        let (mut change, mut size) = (0.0, 0.0);
+        for i in 0..n {
+            let mut b = [0.0; 3];
+            let mut x0 = [0.0; 3];
+            for c in 0..k {
+                let r = self.flat.index(i, c);
+                b[c] = u0[r] - self.coupled(r, i, x, &xw);
+                x0[c] = x[r];
             }
             let point = Point {
                 a: self.blocks[i],
                 b,
                 g: points.gap[i],
-                k: 1 + nt,
-                law: match law {
-                    Law::Frictionless => PointLaw::Frictionless,
-                    Law::Tresca(s) => PointLaw::Tresca(s[i]),
-                    Law::Coulomb => PointLaw::Coulomb(points.friction[i]),
-                },
+                k,
+                law: laws[i],
                 held: points.held[i],
                 foundation: points.foundation,
+                inverse: self.inverses[i],
             };
-            let mut x0 = [0.0; 3];
-            for (k, x) in x0.iter_mut().enumerate().take(1 + nt) {
-                *x = lambda.component(i, k);
+            let new = point.solve(x0);
+            for c in 0..k {
+                let r = self.flat.index(i, c);
+                change += (new[c] - x0[c]) * (new[c] - x0[c]);
+                size += new[c] * new[c];
+                x[r] = new[c];
+                if !xw.is_empty() {
+                    xw[r] = new[c] * self.w[r];
+                }
             }
-            let x = point.solve(x0);
-            for (k, &xk) in x.iter().enumerate().take(1 + nt) {
-                *lambda.component_mut(i, k) = xk;
-            }
+        }
+        if size > 0.0 {
+            (change / size).sqrt()
+        } else {
+            change.sqrt()
         }
     }
 
     /// The contact displacement `u = u0 - D W λ`.
-    fn displacement(&self, u0: &PointValues, lambda: &PointValues) -> PointValues {
-        let flat: Vec<f64> = (0..self.flat.len())
-            .map(|r| {
-                let (i, k) = self.flat.owner(r);
-                self.w[i] * lambda.component(i, k)
-            })
-            .collect();
+    fn displacement(&self, u0: &[f64], x: &[f64]) -> PointValues {
+        let xw: Vec<f64> = x.iter().zip(&self.w).map(|(a, b)| a * b).collect();
         let mut dw = vec![0.0; self.flat.len()];
-        self.d.apply(&flat, &mut dw);
-        let mut u = u0.clone();
-        for (r, v) in dw.iter().enumerate() {
-            let (i, k) = self.flat.owner(r);
-            *u.component_mut(i, k) -= v;
-        }
-        u
+        self.d.apply(&xw, &mut dw);
+        let u: Vec<f64> = u0.iter().zip(&dw).map(|(a, b)| a - b).collect();
+        PointValues::from_flat(&u, self.flat.n, self.flat.nt)
     }
 }
 /// A Gauss–Seidel stall, with the best iterate.

@@ -35,6 +35,9 @@ pub(crate) struct Point {
     pub(crate) held: [bool; 2],
     /// The foundation, which gives the normal law.
     pub(crate) foundation: Foundation,
+    /// `A⁻¹` where the caller keeps it (a sweep's blocks do not change): the sticking case's
+    /// multipliers in nine products.
+    pub(crate) inverse: Option<[[f64; 3]; 3]>,
 }
 
 /// Newton steps before the fixed point takes over.
@@ -149,12 +152,26 @@ impl Point {
 
     /// Solves the point's law from `x0`; returns the multipliers.
     pub(crate) fn solve(&self, x0: [f64; 3]) -> [f64; 3] {
-        let k = self.k;
-        let size: f64 = self.a.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+        let size = self.size();
         if !(size > 0.0 && size.is_finite()) {
             return x0;
         }
-        let mut c = 1.0 / size;
+        // on a rigid foundation the law's cases have closed forms (in 3D all but sliding)
+        self.cases_2d()
+            .or_else(|| self.cases_3d())
+            .unwrap_or_else(|| self.iterate(x0))
+    }
+
+    /// `‖A‖_F`.
+    fn size(&self) -> f64 {
+        self.a.iter().flatten().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
+    /// The law solved by Newton's method from `x0`, then the projected fixed point should it
+    /// stall.
+    fn iterate(&self, x0: [f64; 3]) -> [f64; 3] {
+        let k = self.k;
+        let mut c = 1.0 / self.size();
         let two = |v: &[f64; 3]| norm(&v[..k]);
         // round-off of the multipliers: the rigid scale (c times the free motion), or a soft
         // bed's pressure at the free penetration where that is smaller
@@ -219,6 +236,105 @@ impl Point {
         }
         best.1
     }
+
+    /// A 3D point under Coulomb's law on a rigid foundation with no held direction: the cases
+    /// that have closed forms, separated (`x = 0` where `e_n ≤ 0`) and in contact and sticking
+    /// (`A x = e` with `x_n ≥ 0`, `|x_t| ≤ F x_n`), in the notation of [`Point::cases_2d`];
+    /// `None` where neither holds (the point slides: Newton finds its direction).
+    fn cases_3d(&self) -> Option<[f64; 3]> {
+        let PointLaw::Coulomb(mu) = self.law else {
+            return None;
+        };
+        if self.k != 3 || self.foundation != Foundation::Rigid || self.held != [false; 2] {
+            return None;
+        }
+        let e = [self.b[0] - self.g, self.b[1], self.b[2]];
+        if e[0] <= 0.0 {
+            return Some([0.0; 3]);
+        }
+        let x = match &self.inverse {
+            Some(inv) => inv.map(|row| row[0] * e[0] + row[1] * e[1] + row[2] * e[2]),
+            None => solve_small(self.a, e, 3)?,
+        };
+        (x[0] >= 0.0 && norm(&x[1..]) <= mu * x[0]).then_some(x)
+    }
+
+    /// A 2D point on a rigid foundation with no held direction: the law's cases in closed
+    /// form, `e = b - g e_n` the free penetration and `v = e - A x` the penetration at `x`
+    /// (`v_n ≤ 0`, `x_n ≥ 0`, `x_n v_n = 0`; `x_t = P_R(x_t + c v_t)`). Separated (`x = 0`,
+    /// `e_n ≤ 0`; for Tresca the tangent's own cases at `x_n = 0`), in contact and sticking
+    /// (`A x = e`, `|x_t| ≤ R`), in contact and sliding either way (`x_t = ±R`, `±v_t ≥ 0`:
+    /// Coulomb's `x_n = e_n / (A_nn ± F A_nt)`, Tresca's `x_n = (e_n ∓ A_nt S) / A_nn`). Returns
+    /// the first case whose conditions hold, or `None` where none does (a case on the edge
+    /// between two, lost to round-off) or the point is not of this kind.
+    fn cases_2d(&self) -> Option<[f64; 3]> {
+        if self.k != 2 || self.foundation != Foundation::Rigid || self.held[0] {
+            return None;
+        }
+        let a = &self.a;
+        let e = [self.b[0] - self.g, self.b[1]];
+        let v = |xn: f64, xt: f64| [e[0] - a[0][0] * xn - a[0][1] * xt, e[1] - a[1][0] * xn - a[1][1] * xt];
+        let finite = |xn: f64, xt: f64| xn.is_finite() && xt.is_finite();
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        let stick = [
+            (e[0] * a[1][1] - a[0][1] * e[1]) / det,
+            (a[0][0] * e[1] - a[1][0] * e[0]) / det,
+        ];
+        let sticks = |radius: f64| finite(stick[0], stick[1]) && stick[0] >= 0.0 && stick[1].abs() <= radius;
+        match self.law {
+            PointLaw::Frictionless => {
+                let xn = e[0] / a[0][0];
+                (e[0] <= 0.0)
+                    .then_some([0.0; 3])
+                    .or((xn >= 0.0).then_some([xn, 0.0, 0.0]))
+            }
+            PointLaw::Coulomb(mu) => {
+                if e[0] <= 0.0 {
+                    return Some([0.0; 3]);
+                }
+                if sticks(mu * stick[0]) {
+                    return Some([stick[0], stick[1], 0.0]);
+                }
+                [1.0, -1.0].into_iter().find_map(|s| {
+                    let xn = e[0] / (a[0][0] + s * mu * a[0][1]);
+                    let xt = s * mu * xn;
+                    (finite(xn, xt) && xn >= 0.0 && s * v(xn, xt)[1] >= 0.0).then_some([xn, xt, 0.0])
+                })
+            }
+            PointLaw::Tresca(bound) => {
+                if sticks(bound) {
+                    return Some([stick[0], stick[1], 0.0]);
+                }
+                // separated: the tangent alone, sticking or sliding
+                let xt = e[1] / a[1][1];
+                if finite(0.0, xt) && xt.abs() <= bound && v(0.0, xt)[0] <= 0.0 {
+                    return Some([0.0, xt, 0.0]);
+                }
+                [1.0, -1.0].into_iter().find_map(|s| {
+                    let xt = s * bound;
+                    if v(0.0, xt)[0] <= 0.0 && s * v(0.0, xt)[1] >= 0.0 {
+                        return Some([0.0, xt, 0.0]);
+                    }
+                    let xn = (e[0] - s * a[0][1] * bound) / a[0][0];
+                    (finite(xn, xt) && xn >= 0.0 && s * v(xn, xt)[1] >= 0.0).then_some([xn, xt, 0.0])
+                })
+            }
+        }
+    }
+}
+
+/// The inverse of the leading `k x k` block of `a`, `None` where it is singular.
+pub(crate) fn inverse(a: [[f64; 3]; 3], k: usize) -> Option<[[f64; 3]; 3]> {
+    let mut inv = [[0.0; 3]; 3];
+    for col in 0..k {
+        let mut unit = [0.0; 3];
+        unit[col] = 1.0;
+        let x = solve_small(a, unit, k)?;
+        for r in 0..k {
+            inv[r][col] = x[r];
+        }
+    }
+    Some(inv)
 }
 
 /// `J d = f` for `k ≤ 3` by Gaussian elimination with partial pivoting; `None` if singular.
@@ -263,6 +379,7 @@ mod tests {
             law: PointLaw::Coulomb(0.3),
             held: [false; 2],
             foundation: Foundation::Rigid,
+            inverse: None,
         };
         let x = p.solve([0.0; 3]);
         assert!(
@@ -303,6 +420,7 @@ mod tests {
                     stiffness: 4.0,
                     exponent,
                 },
+                inverse: None,
             }
             .solve([0.0; 3])
         };
@@ -313,5 +431,54 @@ mod tests {
         let xn = (17.0 - 33f64.sqrt()) / 32.0;
         assert!((x[0] - xn).abs() < 1e-14, "{x:?} {xn}");
         assert!((x[1] + 0.3 * xn).abs() < 1e-14, "{x:?}");
+    }
+
+    proptest::proptest! {
+        /// The closed forms of the 2D cases (Coulomb, Tresca) and of the 3D separated and
+        /// sticking cases against Newton's iteration on the same point: both meet the natural
+        /// map's equations, and where the law has one solution (the block symmetric positive
+        /// definite and `F` small enough: Hild's condition for one point) they agree.
+        #[test]
+        fn closed_forms_meet_the_law(
+            k in 2usize..=3,
+            entries in proptest::collection::vec(-1.0f64..1.0, 9),
+            b in proptest::collection::vec(-2.0f64..2.0, 3),
+            gap in -0.5f64..0.5,
+            friction in 0.0f64..0.8,
+            tresca in proptest::bool::ANY,
+        ) {
+            // A = G Gᵀ + I/2 on the leading k x k block: symmetric positive definite
+            let mut a = [[0.0; 3]; 3];
+            for r in 0..k {
+                for c in 0..k {
+                    a[r][c] = (0..k).map(|l| entries[3 * r + l] * entries[3 * c + l]).sum::<f64>()
+                        + if r == c { 0.5 } else { 0.0 };
+                }
+            }
+            let law = if tresca && k == 2 { PointLaw::Tresca(friction) } else { PointLaw::Coulomb(friction) };
+            let point = Point {
+                a,
+                b: [b[0], b[1], if k == 3 { b[2] } else { 0.0 }],
+                g: gap,
+                k,
+                law,
+                held: [false; 2],
+                foundation: Foundation::Rigid,
+                inverse: if k == 3 { inverse(a, 3) } else { None },
+            };
+            let scale = 1.0 + point.b.iter().map(|v| v.abs()).sum::<f64>();
+            let c = 1.0 / point.size();
+            let Some(closed) = point.cases_2d().or_else(|| point.cases_3d()) else {
+                // only a 3D slide has no closed form
+                proptest::prop_assert!(k == 3);
+                return Ok(());
+            };
+            let (_, f) = point.equations(&closed, c);
+            proptest::prop_assert!(norm(&f[..k]) <= 1e-12 * scale, "{closed:?}: {f:?}");
+            let iterated = point.iterate([0.0; 3]);
+            for r in 0..k {
+                proptest::prop_assert!((closed[r] - iterated[r]).abs() <= 1e-9 * scale, "{closed:?} vs {iterated:?}");
+            }
+        }
     }
 }

@@ -14,6 +14,8 @@ pub fn norm(x: &[f64]) -> f64 {
     let s: f64 = x.iter().map(|v| v * v).sum();
     if trusted(s) {
         s.sqrt()
+    } else if s == 0.0 && x.iter().all(|v| *v == 0.0) {
+        0.0
     } else {
         x.iter().fold(0.0, |a, &v| a.hypot(v))
     }

@@ -25,7 +25,8 @@ pub enum Law {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactInfo {
     /// First-order steps (Uzawa or the accelerated gradient), summed over the fixed point; or
-    /// the block Gauss–Seidel method's sweeps.
+    /// block Gauss–Seidel sweeps (the method's own, or those [`crate::solve_newton`] runs
+    /// first, its stage 0).
     pub uzawa_iters: usize,
     /// Semismooth Newton steps ([`crate::solve_newton`]).
     pub newton_iters: usize,
@@ -663,41 +664,26 @@ fn estimate_mu_max(
     Ok((mu, u0))
 }
 
-/// The best iterate of a loop by its residual, and how many steps ago the residual last fell
-/// by a gain (a fraction, 0.99 for 1 %) below the best: the bookkeeping of every solver's
-/// best-iterate answer and stall test. `T` is the solver's iterate ([`Iterate`], or Newton's
-/// own state). A kept residual that is not a number is replaced by any other.
+/// The best iterate of a loop by its residual: the bookkeeping of every solver's best-iterate
+/// answer. `T` is the solver's iterate ([`Iterate`], or Newton's own state). A kept residual
+/// that is not a number is replaced by any other.
 #[derive(Clone, Debug)]
 pub(crate) struct Best<T = Iterate> {
     kept: Option<(T, f64)>,
-    gain: f64,
-    since: usize,
 }
 
 impl<T: Clone> Best<T> {
-    /// No iterate yet; a step improves when its residual is below `gain` times the best.
-    pub fn new(gain: f64) -> Self {
-        Best {
-            kept: None,
-            gain,
-            since: 0,
-        }
+    /// No iterate yet.
+    pub fn new() -> Self {
+        Best { kept: None }
     }
 
     /// Keeps the iterate `make` gives where `residual` is the lowest yet (or the kept one's is
-    /// NaN), and counts the steps without gain.
+    /// NaN).
     pub fn offer_with(&mut self, residual: f64, make: impl FnOnce() -> T) {
-        let best = self.residual();
-        let improved = best.is_none_or(|b| residual < self.gain * b || b.is_nan());
-        if best.is_none_or(|b| residual < b || b.is_nan()) {
+        if self.residual().is_none_or(|b| residual < b || b.is_nan()) {
             self.kept = Some((make(), residual));
         }
-        self.since = if improved { 0 } else { self.since + 1 };
-    }
-
-    /// Steps since the last gain.
-    pub fn since(&self) -> usize {
-        self.since
     }
 
     /// The best residual, where an iterate was offered.
@@ -717,7 +703,7 @@ impl<T: Clone> Best<T> {
 }
 
 impl Best<Iterate> {
-    /// Keeps `(λ, u)` where its residual is the lowest yet, and counts the steps without gain.
+    /// Keeps `(λ, u)` where its residual is the lowest yet.
     pub fn offer(&mut self, lambda: &crate::PointValues, u: &crate::PointValues, residual: f64) {
         self.offer_with(residual, || Iterate {
             lambda: lambda.clone(),

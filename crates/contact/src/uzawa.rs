@@ -228,7 +228,7 @@ pub fn solve(
         info: ContactInfo::new(mu_max),
         inner_tol: None,
         u0,
-        best: Best::new(1.0),
+        best: Best::new(),
     };
     let mut u = PointValues::zeros(n, nt);
     let outcome = match law {

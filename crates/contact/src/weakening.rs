@@ -330,7 +330,7 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
     let scale = law.static_coefficient.max(f64::MIN_POSITIVE);
     let (mut start, mut newton_iters) = (None, 0);
     let mut contraction: Option<f64> = None;
-    let mut best = Best::new(1.0);
+    let mut best = Best::new();
     let mut anderson = Anderson::new(ANDERSON_DEPTH);
     let mut previous: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut newton = params.newton;

@@ -186,7 +186,7 @@ impl<'a> Judge<'a> {
             measure: params.measure,
             reference,
             tol: params.tol,
-            best: Best::new(1.0),
+            best: Best::new(),
             seed: None,
         }
     }
