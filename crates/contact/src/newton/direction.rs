@@ -6,10 +6,12 @@
 
 use super::equations::{Flat, RowForm, State};
 use crate::operator::{dot8, Compliance};
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::Mat;
+use faer::{Conj, Mat, Par};
+use std::sync::{Arc, Mutex};
 
 /// Largest relative asymmetry of a dense compliance that is solved through its symmetric part
 /// (a condensed finite-element compliance is symmetric to round-off; Siconos' printed files
@@ -29,20 +31,23 @@ pub(super) enum Directions {
         symmetric: bool,
     },
     /// Sparse: one sparse LU of `J` per step, on a pattern (and its symbolic factorisation)
-    /// fixed for the problem.
-    SparseLu(Box<SparsePattern>),
+    /// fixed for the problem and shared by its proximal problems (`σ` moves only the values
+    /// of the points' own columns, which the pattern holds whatever the branch).
+    SparseLu(Arc<SparsePattern>),
 }
 
 /// The pattern of every Jacobian of a sparse problem, row by row: row `r` of point `i` may hold
 /// the columns of every row of `D` that belongs to point `i`, and the point's own columns
 /// (whatever the branch); and the symbolic LU of `Jᵀ`, whose columns are `J`'s rows.
-#[derive(Clone)]
 pub(super) struct SparsePattern {
     /// Row pointers of `J` (= column pointers of `Jᵀ`).
     ptr: Vec<usize>,
     /// Column indices of `J`'s rows, sorted.
     idx: Vec<usize>,
     symbolic: SymbolicLu<usize>,
+    /// The numeric factor's storage and the workspace, kept from one step to the next (a
+    /// fresh factor's pages cost as much as its arithmetic).
+    numeric: Mutex<(NumericLu<usize, f64>, MemBuffer)>,
 }
 
 impl SparsePattern {
@@ -69,8 +74,17 @@ impl SparsePattern {
             ptr.push(idx.len());
         }
         let pattern = SymbolicSparseColMatRef::new_checked(m, m, &ptr, None, &idx);
-        let symbolic = SymbolicLu::try_new(pattern).ok()?;
-        Some(SparsePattern { ptr, idx, symbolic })
+        let symbolic = factorize_symbolic_lu(pattern, Default::default()).ok()?;
+        let scratch = symbolic
+            .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_transpose_in_place_scratch::<f64>(1, Par::Seq));
+        let numeric = Mutex::new((NumericLu::new(), MemBuffer::try_new(scratch).ok()?));
+        Some(SparsePattern {
+            ptr,
+            idx,
+            symbolic,
+            numeric,
+        })
     }
 }
 
@@ -81,7 +95,7 @@ impl Directions {
         let d = match flat.d {
             Compliance::Sparse(_) => {
                 return match SparsePattern::new(flat) {
-                    Some(p) => Directions::SparseLu(Box::new(p)),
+                    Some(p) => Directions::SparseLu(Arc::new(p)),
                     None => Directions::DenseLu { symmetric: false },
                 }
             }
@@ -112,6 +126,15 @@ impl Directions {
                 Directions::Reduced((0..m * m).map(|k| inv[(k / m, k % m)]).collect())
             }
             Err(_) => Directions::DenseLu { symmetric: true },
+        }
+    }
+
+    /// The way for `problem`, a proximal problem of the problem these directions are for:
+    /// the same sparse pattern, or made anew (a dense stiffness depends on `σ`).
+    pub(super) fn for_proximal(&self, problem: &Flat<'_>) -> Self {
+        match self {
+            Directions::SparseLu(pattern) => Directions::SparseLu(Arc::clone(pattern)),
+            _ => Directions::new(problem),
         }
     }
 
@@ -228,9 +251,22 @@ fn sparse_lu(flat: &Flat<'_>, s: &State, rows: &[RowForm], pattern: &SparsePatte
         }
     }
     let structure = SymbolicSparseColMatRef::new_checked(m, m, &pattern.ptr, None, &pattern.idx);
-    let lu = Lu::try_new_with_symbolic(pattern.symbolic.clone(), SparseColMatRef::new(structure, &values)).ok()?;
+    // sequential: these matrices are small (a thread pool's start costs more than it saves)
+    let (symbolic, par) = (&pattern.symbolic, Par::Seq);
+    let mut kept = pattern.numeric.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let (numeric, buffer) = &mut *kept;
+    let stack = MemStack::new(buffer);
+    let lu = symbolic
+        .factorize_numeric_lu(
+            numeric,
+            SparseColMatRef::new(structure, &values),
+            par,
+            stack,
+            Default::default(),
+        )
+        .ok()?;
     let mut rhs = Mat::<f64>::from_fn(m, 1, |r, _| -s.f[r]);
-    lu.solve_transpose_in_place(rhs.as_mut());
+    lu.solve_transpose_in_place_with_conj(Conj::No, rhs.as_mut(), par, stack);
     let delta: Vec<f64> = (0..m).map(|r| rhs[(r, 0)]).collect();
     delta.iter().all(|v| v.is_finite()).then_some(delta)
 }

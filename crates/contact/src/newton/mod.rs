@@ -434,9 +434,11 @@ fn judged_steps(
     end
 }
 
-/// The proximal stage from the best iterate: returns how it ended.
+/// The proximal stage from the best iterate, its directions made from `base` (the problem's
+/// own): returns how it ended.
 fn proximal_stage(
     judge: &mut Judge<'_>,
+    base: &Directions,
     params: &NewtonParams,
     info: &mut ContactInfo,
     progress: &mut dyn FnMut(&Progress),
@@ -458,7 +460,7 @@ fn proximal_stage(
         }
         let sigma = (boost * residual).clamp(SIGMA_MIN, SIGMA_MAX);
         let problem = judge.flat.proximal(sigma * unit, &center);
-        let directions = Directions::new(&problem);
+        let directions = base.for_proximal(&problem);
         let s0 = problem.state(center.clone());
         // an inexact inner solve, in the measure asked for: a tenth of the outer residual
         let inner_tol = (INNER_RATIO * residual).max(0.5 * params.tol);
@@ -923,7 +925,7 @@ fn newton_stages(
     };
     let mut end = judged_steps(judge, &directions, s, strict, params, info, progress);
     if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
-        end = proximal_stage(judge, params, info, progress);
+        end = proximal_stage(judge, &directions, params, info, progress);
     }
     if matches!(end, End::Stalled(_)) && !directions.symmetric_dense() {
         if let Some((start, _)) = judge.best.get().cloned() {
