@@ -3,11 +3,18 @@
 `bench/siconos/solve.py ... --json FILE`, per file: our time and outcome, Siconos' best solver
 (the fastest that solved it) and its time, the ratio, and the counts.
 
-    python3 bench/siconos/compare.py DIR/summary.json siconos.json
+    python3 bench/siconos/compare.py DIR/summary.json siconos.json [DIR2/summary.json ...]
+
+With more runs of ours (further summaries after Siconos'), our time per file is their median.
 """
-import json, math, sys
+import json, math, statistics, sys
 
 ours = {r["file"]: r for r in json.load(open(sys.argv[1]))}
+for extra in sys.argv[3:]:
+    for r in json.load(open(extra)):
+        ours[r["file"]].setdefault("times", [ours[r["file"]]["time_s"]]).append(r["time_s"])
+for r in ours.values():
+    r["time_s"] = statistics.median(r.get("times", [r["time_s"]]))
 theirs = {}
 for r in json.load(open(sys.argv[2])):
     theirs.setdefault(r["file"], []).append(r)

@@ -1047,6 +1047,8 @@ proptest! {
         let (nested, zero) = (solve_with(true), solve_with(false));
         prop_assert!(nested.info.coarse_newton_iters > 0);
         prop_assert_eq!(zero.info.coarse_newton_iters, 0);
+        // a dense symmetric compliance (a condensed finite-element one): no sweeps first
+        prop_assert_eq!(nested.info.uzawa_iters + zero.info.uzawa_iters, 0);
         let scale = zero.lambda.norm().max(1e-12);
         prop_assert!(nested.lambda.minus(&zero.lambda).norm() <= 1e-9 * scale, "{:?}\n{:?}", nested.info, zero.info);
         prop_assert!(nested.info.complementarity <= 1e-12);
