@@ -175,6 +175,12 @@ fn violation(p: &FrictionProblem, r: &[f64]) -> f64 {
     worst
 }
 
+/// `λ` solves `p` to Siconos' error 1e-8, and the laws hold to 1e-6 ([`violation`]).
+fn assert_solves(p: &FrictionProblem, name: &str, lambda: &PointValues) {
+    let r = p.reaction(lambda);
+    assert!(p.error(&r) <= 1e-8 && violation(p, &r) <= 1e-6, "{name}");
+}
+
 /// Every one of the twelve, by the default solver, to Siconos' error 1e-8: the tolerance at
 /// which Siconos' own test suite runs its Newton solvers on these files is 1e-3 to 1e-8 (1e-3
 /// for BoxesStack1 in `test_nsn_3.c`), so this is at least as tight.
@@ -268,8 +274,7 @@ fn gauss_seidel_solves_the_well_conditioned_ones() {
             &mut |_| {},
         )
         .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let r = p.reaction(&sol.lambda);
-        assert!(p.error(&r) <= 1e-8 && violation(&p, &r) <= 1e-6, "{name}");
+        assert_solves(&p, name, &sol.lambda);
     }
 }
 
@@ -297,8 +302,7 @@ fn sweeps_run_first_where_they_win() {
             &mut |_| {},
         )
         .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let r = p.reaction(&sol.lambda);
-        assert!(p.error(&r) <= 1e-8 && violation(&p, &r) <= 1e-6, "{name}");
+        assert_solves(&p, name, &sol.lambda);
         sol.info
     };
     let granular = solve("FrictionContactProblem00727.dat", true);
