@@ -700,7 +700,12 @@ fn sweeps_first<P: AffineProblem>(
     match run.end {
         SweepEnd::Converged => {
             let best = run.best.expect("a converged run judged an iterate");
-            let solution = gauss_seidel::solution(best, points, law, info.clone(), mu_max, reference);
+            // no Newton step ran: no natural-map constant to report
+            let info = ContactInfo {
+                augmentation: None,
+                ..info.clone()
+            };
+            let solution = gauss_seidel::solution(best, points, law, info, mu_max, reference);
             Ok(First::Solved(Box::new(solution)))
         }
         SweepEnd::Interrupted(why) => Err(ContactError::Interrupted {
