@@ -11,12 +11,79 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Largest relative asymmetry of a dense compliance that is solved through its symmetric part
 /// (a condensed finite-element compliance is symmetric to round-off; Siconos' printed files
 /// are not, by up to 1e-3).
 const SYMMETRIC: f64 = 1e-8;
+
+/// The stiffness `K = (D + σ W⁻¹)⁻¹` of the reduced directions: on a symmetric `D` its
+/// Cholesky factor (`m³/3` flops), with `K`'s rows by solves while a direction needs few of
+/// them and its explicit inverse (`m³` more) made once one needs many; on a positive-real `D`
+/// (electric rows) the inverse from one LU.
+pub(super) struct Stiffness {
+    llt: Option<faer::linalg::solvers::Llt<f64>>,
+    /// `K`, row-major, once made.
+    inverse: OnceLock<Vec<f64>>,
+}
+
+impl Stiffness {
+    /// A stiffness given as its inverse, row-major.
+    fn inverse(k: Vec<f64>) -> Self {
+        Stiffness {
+            llt: None,
+            inverse: OnceLock::from(k),
+        }
+    }
+
+    /// `K`, row-major, made from the factor where it is not yet.
+    fn explicit(&self, m: usize) -> &[f64] {
+        self.inverse.get_or_init(|| {
+            let llt = self
+                .llt
+                .as_ref()
+                .expect("a stiffness without its inverse has its factor");
+            let inv = faer::linalg::solvers::DenseSolveCore::inverse(llt);
+            (0..m * m).map(|k| inv[(k / m, k % m)]).collect()
+        })
+    }
+
+    /// Rows `js` of `K` (`K` symmetric where it is factored: row `j` is `K e_j`), row-major,
+    /// `js.len() x m`: by solves while they are fewer than `m / 8` and the inverse is not made.
+    fn rows(&self, js: &[usize], m: usize) -> Vec<f64> {
+        match (&self.llt, self.inverse.get()) {
+            (Some(llt), None) if 8 * js.len() < m => {
+                let mut rhs = Mat::<f64>::zeros(m, js.len());
+                for (k, &j) in js.iter().enumerate() {
+                    rhs[(j, k)] = 1.0;
+                }
+                llt.solve_in_place(rhs.as_mut());
+                (0..js.len() * m).map(|i| rhs[(i % m, i / m)]).collect()
+            }
+            _ => {
+                let k = self.explicit(m);
+                js.iter().flat_map(|&j| k[j * m..(j + 1) * m].iter().copied()).collect()
+            }
+        }
+    }
+
+    /// `K v`.
+    fn apply(&self, v: &[f64]) -> Vec<f64> {
+        let m = v.len();
+        match (&self.llt, self.inverse.get()) {
+            (Some(llt), None) => {
+                let mut rhs = Mat::<f64>::from_fn(m, 1, |i, _| v[i]);
+                llt.solve_in_place(rhs.as_mut());
+                (0..m).map(|i| rhs[(i, 0)]).collect()
+            }
+            _ => {
+                let k = self.explicit(m);
+                (0..m).map(|r| dot8(&k[r * m..(r + 1) * m], v)).collect()
+            }
+        }
+    }
+}
 
 /// A Newton step on a sparse compliance, in block Gauss–Seidel sweeps: 14 to 50 measured on
 /// Siconos' test problems (docs/fclib.md), with 52 to 2020 contacts.
@@ -26,8 +93,8 @@ const SPARSE_STEP_SWEEPS: f64 = 30.0;
 #[derive(Clone)]
 pub(super) enum Directions {
     /// Dense SPD, or positive real with electric rows: the reduced system, with the stiffness
-    /// `(D + σ W⁻¹)⁻¹` (row-major).
-    Reduced(Vec<f64>),
+    /// `(D + σ W⁻¹)⁻¹`.
+    Reduced(Arc<Stiffness>),
     /// Dense, not SPD or not symmetric: one LU of `J` per step.
     DenseLu {
         /// Whether `D` is symmetric (to [`SYMMETRIC`]), or a condensed finite-element
@@ -116,7 +183,7 @@ impl Directions {
             let inv = faer::linalg::solvers::DenseSolveCore::inverse(&shifted.partial_piv_lu());
             let inv: Vec<f64> = (0..m * m).map(|k| inv[(k / m, k % m)]).collect();
             return if inv.iter().all(|v| v.is_finite()) {
-                Directions::Reduced(inv)
+                Directions::Reduced(Arc::new(Stiffness::inverse(inv)))
             } else {
                 Directions::DenseLu { symmetric: true }
             };
@@ -125,10 +192,10 @@ impl Directions {
             return Directions::DenseLu { symmetric: false };
         }
         match shifted.llt(faer::Side::Lower) {
-            Ok(llt) => {
-                let inv = faer::linalg::solvers::DenseSolveCore::inverse(&llt);
-                Directions::Reduced((0..m * m).map(|k| inv[(k / m, k % m)]).collect())
-            }
+            Ok(llt) => Directions::Reduced(Arc::new(Stiffness {
+                llt: Some(llt),
+                inverse: OnceLock::new(),
+            })),
             Err(_) => Directions::DenseLu { symmetric: true },
         }
     }
@@ -293,7 +360,7 @@ fn sparse_lu(flat: &Flat<'_>, s: &State, rows: &[RowForm], pattern: &SparsePatte
 /// dense system (`N x N`, often far smaller than `m x m`, and empty when every point sticks);
 /// then `δ = C⁻¹ y`, with `C⁻¹ = W⁻¹ K diag(1/c)` and `K = (D + σ W⁻¹)⁻¹` (row-major). `None`
 /// where the reduced system is singular.
-fn reduced(flat: &Flat<'_>, s: &State, rows: &[RowForm], stiffness: &[f64]) -> Option<Vec<f64>> {
+fn reduced(flat: &Flat<'_>, s: &State, rows: &[RowForm], stiffness: &Stiffness) -> Option<Vec<f64>> {
     let m = flat.m;
     let inv_c: Vec<f64> = flat.c.iter().map(|c| 1.0 / c).collect();
     let mut slot = vec![usize::MAX; m];
@@ -301,6 +368,18 @@ fn reduced(flat: &Flat<'_>, s: &State, rows: &[RowForm], stiffness: &[f64]) -> O
     for (k, &r) in others.iter().enumerate() {
         slot[r] = k;
     }
+    // the rows of K the reduced system reads, each once
+    let mut wanted = vec![usize::MAX; m];
+    let mut js = vec![];
+    for &r in &others {
+        for &(j, _) in &rows[r].e {
+            if wanted[j] == usize::MAX {
+                wanted[j] = js.len();
+                js.push(j);
+            }
+        }
+    }
+    let k_rows = stiffness.rows(&js, m);
     // y on the identity rows is -f there
     let mut y: Vec<f64> = (0..m)
         .map(|r| if slot[r] == usize::MAX { -s.f[r] } else { 0.0 })
@@ -314,7 +393,8 @@ fn reduced(flat: &Flat<'_>, s: &State, rows: &[RowForm], stiffness: &[f64]) -> O
             row.iter_mut().for_each(|v| *v = 0.0);
             for &(j, v) in &rows[r].e {
                 let scale = v / flat.w[j];
-                for ((x, kj), ic) in row.iter_mut().zip(&stiffness[j * m..(j + 1) * m]).zip(&inv_c) {
+                let kj = &k_rows[wanted[j] * m..(wanted[j] + 1) * m];
+                for ((x, kj), ic) in row.iter_mut().zip(kj).zip(&inv_c) {
                     *x += scale * kj * ic;
                 }
             }
@@ -340,12 +420,13 @@ fn reduced(flat: &Flat<'_>, s: &State, rows: &[RowForm], stiffness: &[f64]) -> O
     // δ = C⁻¹ y; on a row that is the identity in J (a separated point) δ_r = -f_r exactly,
     // which sets its multiplier to exactly zero, not to round-off
     let y_c: Vec<f64> = y.iter().zip(&inv_c).map(|(y, ic)| y * ic).collect();
+    let k_y = stiffness.apply(&y_c);
     let delta: Vec<f64> = (0..m)
         .map(|r| {
             if rows[r].is_identity(r) {
                 -s.f[r]
             } else {
-                dot8(&stiffness[r * m..(r + 1) * m], &y_c) / flat.w[r]
+                k_y[r] / flat.w[r]
             }
         })
         .collect();
