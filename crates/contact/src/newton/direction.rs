@@ -521,6 +521,40 @@ mod tests {
         }
     }
 
+    /// The stiffness read through its Cholesky factor (rows by solves, `K v` by a solve)
+    /// equals the one read from its explicit inverse, and once the inverse is made (many rows
+    /// asked for) both reads go through it.
+    #[test]
+    fn the_stiffness_by_solves_is_the_inverse() {
+        let m = 40;
+        let g = |i: usize, j: usize| ((i * 7 + j * 3) % 11) as f64 * 0.1 - 0.5;
+        let a = Mat::<f64>::from_fn(m, m, |i, j| {
+            (0..m).map(|l| g(i, l) * g(j, l)).sum::<f64>() + if i == j { 1.0 } else { 0.0 }
+        });
+        let factored = Stiffness {
+            llt: Some(a.llt(faer::Side::Lower).unwrap()),
+            inverse: OnceLock::new(),
+        };
+        let inv = faer::linalg::solvers::DenseSolveCore::inverse(&a.partial_piv_lu());
+        let explicit = Stiffness::inverse((0..m * m).map(|k| inv[(k / m, k % m)]).collect());
+        let v: Vec<f64> = (0..m).map(|i| (i as f64 * 0.7).sin()).collect();
+        let close = |x: &[f64], y: &[f64]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= 1e-12 * (1.0 + q.abs()));
+        let few = [3, 17, 39];
+        assert!(close(&factored.rows(&few, m), &explicit.rows(&few, m)));
+        assert!(close(&factored.apply(&v), &explicit.apply(&v)));
+        assert!(
+            factored.inverse.get().is_none(),
+            "three rows of forty are read by solves"
+        );
+        let many: Vec<usize> = (0..m).step_by(2).collect();
+        assert!(close(&factored.rows(&many, m), &explicit.rows(&many, m)));
+        assert!(
+            factored.inverse.get().is_some(),
+            "twenty rows of forty make the inverse"
+        );
+        assert!(close(&factored.apply(&v), &explicit.apply(&v)));
+    }
+
     /// The rows of the Jacobian with electric rows are the derivative of the equations: a
     /// difference quotient along random directions, away from the kinks, on a positive-real
     /// compliance (rigid and compliant foundations, both electric laws).
