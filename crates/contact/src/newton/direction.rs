@@ -209,16 +209,19 @@ impl Directions {
         }
     }
 
-    /// A Newton step's cost in block Gauss–Seidel sweeps, where sweeps may be tried first: a
-    /// sparse LU of the Jacobian about [`SPARSE_STEP_SWEEPS`] sweeps, a dense one (`2N³/3`
-    /// flops, `N` about `m/2` rows in contact, against a sweep's `m²`) `m/12` at least that;
-    /// `None` for a dense symmetric `D` (a condensed finite-element compliance, on which sweeps
-    /// converge slowly and Newton's reduced steps are cheap).
-    pub(super) fn step_in_sweeps(&self, m: usize) -> Option<f64> {
-        match self {
-            Directions::Reduced(_) | Directions::DenseLu { symmetric: true } => None,
-            Directions::DenseLu { symmetric: false } => Some((m as f64 / 12.0).max(SPARSE_STEP_SWEEPS)),
-            Directions::SparseLu(_) => Some(SPARSE_STEP_SWEEPS),
+    /// A Newton step's cost in block Gauss–Seidel sweeps on `flat`, where sweeps may be tried
+    /// first (read from the compliance, before any factorisation): a sparse LU of the Jacobian
+    /// about [`SPARSE_STEP_SWEEPS`] sweeps, a dense one (`2N³/3` flops, `N` about `m/2` rows
+    /// in contact, against a sweep's `m²`) `m/12` at least that; `None` for a dense symmetric
+    /// `D` (a condensed finite-element compliance, on which sweeps converge slowly and Newton's
+    /// reduced steps are cheap) and for electric rows.
+    pub(super) fn step_in_sweeps(flat: &Flat<'_>) -> Option<f64> {
+        match flat.d {
+            Compliance::Sparse(_) => Some(SPARSE_STEP_SWEEPS),
+            Compliance::Dense(_) if flat.electric.is_none() && flat.d.asymmetry() > SYMMETRIC => {
+                Some((flat.m as f64 / 12.0).max(SPARSE_STEP_SWEEPS))
+            }
+            Compliance::Dense(_) => None,
         }
     }
 

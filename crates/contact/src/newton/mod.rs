@@ -606,7 +606,6 @@ pub fn solve_newton_cached<P: AffineProblem>(
     let mut flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
     flat.weakening = params.weakening;
     info.augmentation = Some(1.0 / mu_max);
-    let directions = cache.directions.get_or_insert_with(|| Directions::new(&flat));
     let x0 = match sweeps_first(
         problem,
         points,
@@ -614,7 +613,7 @@ pub fn solve_newton_cached<P: AffineProblem>(
         params,
         (mu_max, reference),
         &start,
-        directions,
+        Directions::step_in_sweeps(&flat),
         &mut info,
         progress,
     )? {
@@ -659,8 +658,8 @@ enum First {
 /// they stall (rigid capsules and boxes).
 const FIRST_SWEEPS_STEPS: f64 = 25.0;
 
-/// Stage 0: block Gauss–Seidel sweeps from `start` ([`crate::gauss_seidel`]), where the
-/// compliance is not a condensed finite-element one (a multibody Delassus operator, sparse or
+/// Stage 0: block Gauss–Seidel sweeps from `start` ([`crate::gauss_seidel`]), where `step`
+/// (a Newton step's cost in sweeps) says the compliance is not a condensed finite-element one (a multibody Delassus operator, sparse or
 /// asymmetric) and the law holds constant coefficients. The sweeps run while the rate they
 /// measure promises the tolerance within [`FIRST_SWEEPS_STEPS`] Newton steps' cost
 /// ([`Directions::step_in_sweeps`]); where it does not, Newton starts as it would have. The
@@ -674,12 +673,11 @@ fn sweeps_first<P: AffineProblem>(
     params: &NewtonParams,
     (mu_max, reference): (f64, f64),
     start: &PointValues,
-    directions: &Directions,
+    step: Option<f64>,
     info: &mut ContactInfo,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<First, ContactError> {
-    let m = start.n_points() * (1 + start.n_tangential());
-    let Some(step) = directions.step_in_sweeps(m) else {
+    let Some(step) = step else {
         return Ok(First::Skipped);
     };
     if !params.sweeps_first || params.weakening.is_some() {
