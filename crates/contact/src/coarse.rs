@@ -230,7 +230,7 @@ impl Coarsening {
             }
         }
         // u₀,c = W_c⁻¹ Pᵀ W u₀
-        let flat: Vec<f64> = u0.normal.iter().chain(&u0.tangential).copied().collect();
+        let flat = u0.to_flat();
         let mut uc = vec![0.0; mc];
         for (r, entries) in p.iter().enumerate() {
             for &(a, pv) in entries {
@@ -250,7 +250,7 @@ impl Coarsening {
     /// The coarse multipliers interpolated to every point, `λ = P λ_c`.
     pub(crate) fn prolong(&self, coarse: &PointValues, points: &ContactPoints) -> PointValues {
         let (n, nt) = (points.len(), coarse.n_tangential());
-        let flat: Vec<f64> = coarse.normal.iter().chain(&coarse.tangential).copied().collect();
+        let flat = coarse.to_flat();
         let values: Vec<f64> = self
             .flat_interpolation(points, nt)
             .iter()
@@ -356,8 +356,7 @@ mod tests {
         )
         .unwrap();
         let l = c.prolong(&lc, &pts);
-        let flat = |v: &PointValues| v.normal.iter().chain(&v.tangential).copied().collect::<Vec<f64>>();
-        let (lf, lcf) = (flat(&l), flat(&lc));
+        let (lf, lcf) = (l.to_flat(), lc.to_flat());
         let w = |r: usize| pts.weight[if r < n { r } else { (r - n) / nt }];
         let fine_u: Vec<f64> = (0..m)
             .map(|r| (0..m).map(|s| d[r * m + s] * w(s) * lf[s]).sum())

@@ -290,7 +290,7 @@ impl ContactOperator for ElectricContactProblem {
     }
     fn forces_alone(&mut self, lambda: &PointValues, out: &mut PointValues) -> Result<usize, OperatorError> {
         let (m, o) = (self.m(), self.order());
-        let mut x: Vec<f64> = lambda.normal.iter().chain(&lambda.tangential).copied().collect();
+        let mut x = lambda.to_flat();
         x.resize(o, 0.0);
         let w = self.flat_weights();
         for r in 0..m {

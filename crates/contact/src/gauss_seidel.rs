@@ -185,8 +185,8 @@ impl<P: AffineProblem> Sweeps<'_, P> {
         let (n, nt) = (lambda.n_points(), lambda.n_tangential());
         let sweeper = Sweeper::new(self.problem, Flat { n, nt });
         let u0 = self.problem.loads();
-        let mut x: Vec<f64> = lambda.normal.iter().chain(&lambda.tangential).copied().collect();
-        let u0_flat: Vec<f64> = u0.normal.iter().chain(&u0.tangential).copied().collect();
+        let mut x = lambda.to_flat();
+        let u0_flat = u0.to_flat();
         let laws: Vec<PointLaw> = (0..n).map(|i| point_law(law, points, i)).collect();
         let mut best = Best::new();
         let mut residual = f64::NAN;
@@ -301,9 +301,9 @@ fn point_law(law: &Law, points: &ContactPoints, i: usize) -> PointLaw {
 /// The rows of `D W` with each point's own block left out, which a sweep multiplies by the
 /// latest multipliers.
 enum Coupling<'p> {
-    /// A dense `D` (row-major) and the weights in the flat layout: a row's product skips the
-    /// point's own columns, `i` and `n + i nt ..`, by summing the three stretches between them.
-    Dense { d: &'p [f64], w: Vec<f64> },
+    /// A dense `D` (row-major), multiplied by `W λ`: a row's product skips the point's own
+    /// columns, `i` and `n + i nt ..`, by summing the three stretches between them.
+    Dense(&'p [f64]),
     /// A sparse `D W` without the own blocks, compressed rows.
     Sparse {
         ptr: Vec<usize>,
@@ -340,7 +340,7 @@ impl<'p> Sweeper<'p> {
                         *b = dense[r * m + flat.index(i, kc)] * w[r];
                     }
                 }
-                Coupling::Dense { d: dense, w: w.clone() }
+                Coupling::Dense(dense)
             }
             Compliance::Sparse(s) => {
                 let (mut ptr, mut col, mut val) = (vec![0], vec![], vec![]);
@@ -378,7 +378,7 @@ impl<'p> Sweeper<'p> {
     /// (sparse).
     fn coupled(&self, r: usize, i: usize, x: &[f64], xw: &[f64]) -> f64 {
         match &self.coupling {
-            Coupling::Dense { d, .. } => {
+            Coupling::Dense(d) => {
                 let (m, n, nt) = (self.flat.len(), self.flat.n, self.flat.nt);
                 let row = &d[r * m..(r + 1) * m];
                 let (t0, t1) = (n + i * nt, n + (i + 1) * nt);
@@ -401,7 +401,7 @@ impl<'p> Sweeper<'p> {
     fn sweep(&self, points: &ContactPoints, laws: &[PointLaw], u0: &[f64], x: &mut [f64]) -> f64 {
         let (n, k) = (self.flat.n, 1 + self.flat.nt);
         let mut xw: Vec<f64> = match &self.coupling {
-            Coupling::Dense { w, .. } => x.iter().zip(w).map(|(a, b)| a * b).collect(),
+            Coupling::Dense(_) => x.iter().zip(&self.w).map(|(a, b)| a * b).collect(),
             Coupling::Sparse { .. } => Vec::new(),
         };
         let (mut change, mut size) = (0.0, 0.0);
@@ -450,6 +450,7 @@ impl<'p> Sweeper<'p> {
         PointValues::from_flat(&u, self.flat.n, self.flat.nt)
     }
 }
+
 /// A Gauss–Seidel stall, with the best iterate.
 fn stopped(reason: Stall, sweeps: usize, residual: f64, best: Option<Iterate>) -> ContactError {
     ContactError::Stalled {

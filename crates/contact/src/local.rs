@@ -282,12 +282,8 @@ impl Point {
         ];
         let sticks = |radius: f64| finite(stick[0], stick[1]) && stick[0] >= 0.0 && stick[1].abs() <= radius;
         match self.law {
-            PointLaw::Frictionless => {
-                let xn = e[0] / a[0][0];
-                (e[0] <= 0.0)
-                    .then_some([0.0; 3])
-                    .or((xn >= 0.0).then_some([xn, 0.0, 0.0]))
-            }
+            // frictionless points have no tangent (k = 1): never here
+            PointLaw::Frictionless => None,
             PointLaw::Coulomb(mu) => {
                 if e[0] <= 0.0 {
                     return Some([0.0; 3]);

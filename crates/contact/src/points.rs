@@ -282,6 +282,12 @@ impl PointValues {
         }
     }
 
+    /// The values as a flat vector in the layout `[normal (n); tangential (n·nt)]`, the
+    /// inverse of [`PointValues::from_flat`].
+    pub(crate) fn to_flat(&self) -> Vec<f64> {
+        self.normal.iter().chain(&self.tangential).copied().collect()
+    }
+
     /// Number of points.
     pub fn n_points(&self) -> usize {
         self.normal.len()

@@ -133,7 +133,7 @@ impl<'a> Flat<'a> {
             w: (0..m)
                 .map(|j| points.weight[if j < n { j } else { (j - n) / nt }])
                 .collect(),
-            u0: u0.normal.iter().chain(&u0.tangential).copied().collect(),
+            u0: u0.to_flat(),
             sigma: 0.0,
             weakening: None,
             electric: None,

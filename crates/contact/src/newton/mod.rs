@@ -601,7 +601,7 @@ pub fn solve_newton_cached<P: AffineProblem>(
             None => pre.start(None)?,
         },
     };
-    let x0: Vec<f64> = start.normal.iter().chain(&start.tangential).copied().collect();
+    let x0 = start.to_flat();
     let u0 = problem.loads().clone();
     let mut flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
     flat.weakening = params.weakening;
