@@ -1,7 +1,9 @@
 //! The numeric `L D Lᵀ` of a supernodal symbolic factor on every core of rayon's pool: the
 //! supernodes' elimination tree is walked from the leaves, and subtrees that share no
 //! supernode are factored at the same time (they read only their own descendants and write
-//! only their own values), the supernodes above them with faer's parallel dense kernels.
+//! only their own values), the supernodes above them with faer's parallel dense kernels and
+//! their columns assembled in pieces on different threads (each piece reads every descendant's
+//! update of its columns, and writes only its own columns).
 //!
 //! Each supernode is the left-looking step of faer's sequential
 //! `factorize_supernodal_numeric_ldlt` (faer 0.24): gather the matrix's columns, subtract
@@ -18,11 +20,16 @@ use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::SparseColMatRef;
 use faer::{Accum, MatMut, MatRef, Par};
+use rayon::prelude::*;
 
 /// Subtrees with fewer floating-point operations than this are factored on one core, in
 /// order (a task of this size takes about 2 ms; below it the cost of a task's scratch and of
 /// stealing it shows).
 const SEQUENTIAL_FLOPS: f64 = 2e7;
+
+/// The narrowest piece of a supernode's columns assembled on a thread of its own (wide
+/// supernodes, above the independent subtrees, are cut into pieces: [`column_pieces`]).
+const PIECE_COLS: usize = 32;
 
 /// What the parallel numeric factorisation needs beyond faer's symbolic factor, computed once
 /// per pattern: the supernodes' tree, the descendants that update each supernode, the work of
@@ -334,26 +341,57 @@ struct Ctx<'a> {
     par: Par,
 }
 
-/// A task's workspace: the map from a row to its place in the current supernode, and the
-/// buffers of the descendants' updates.
+/// A task's workspace: the map from a row to its place in the current supernode, the
+/// buffers of the descendants' updates, and the dense factorisation's.
 struct Scratch {
     local: Vec<usize>,
+    bufs: Bufs,
+    dense: MemBuffer,
+}
+
+/// The buffers of one descendant's update: its rows' places in the supernode, `M D` and the
+/// product `W` (they only grow: their old contents are overwritten).
+#[derive(Default)]
+struct Bufs {
     rows: Vec<usize>,
     scaled: Vec<f64>,
     update: Vec<f64>,
-    dense: MemBuffer,
 }
 
 impl Scratch {
     fn new(n: usize, max_cols: usize, par: Par) -> Scratch {
         Scratch {
             local: vec![usize::MAX; n],
-            rows: vec![],
-            scaled: vec![],
-            update: vec![],
+            bufs: Bufs::default(),
             dense: MemBuffer::new(cholesky_in_place_scratch::<f64>(max_cols, par, Default::default())),
         }
     }
+}
+
+/// Where a supernode of `ncols` columns and `nrows` rows is cut into pieces of columns
+/// assembled on different threads (their boundaries, from 0 to `ncols`): about the same part
+/// of the lower trapezoid each, four pieces per thread for the balance, none narrower than
+/// [`PIECE_COLS`]; one piece where `par` is sequential.
+fn column_pieces(ncols: usize, nrows: usize, par: Par) -> Vec<usize> {
+    let threads = match par {
+        Par::Seq => 1,
+        Par::Rayon(t) => t.get(),
+    };
+    let pieces = (4 * threads).min(ncols / PIECE_COLS).max(1);
+    if threads < 2 || pieces < 2 {
+        return vec![0, ncols];
+    }
+    // column j holds nrows - j values of the lower trapezoid
+    let area = |j: usize| (j * (2 * nrows - j + 1) / 2) as f64;
+    let share = area(ncols) / pieces as f64;
+    let mut cuts = vec![0];
+    for j in 1..ncols {
+        if area(j) >= share * cuts.len() as f64 && j - cuts[cuts.len() - 1] >= PIECE_COLS {
+            cuts.push(j);
+        }
+    }
+    cuts.push(ncols);
+    cuts
 }
 
 impl Ctx<'_> {
@@ -414,6 +452,57 @@ impl Ctx<'_> {
         Ok(())
     }
 
+    /// The columns `cols` of supernode `s` (its local indices) into `piece` (column-major,
+    /// the supernode's rows): the matrix's entries, less the updates `L_d D_d L_dᵀ` of its
+    /// descendants (in `head`, the factor's values from value `off` on) that meet these columns.
+    /// `local` maps a row of the supernode's pattern to its place.
+    #[allow(clippy::too_many_arguments)]
+    fn assemble(
+        &self,
+        s: usize,
+        cols: std::ops::Range<usize>,
+        piece: &mut [f64],
+        (head, off): (&[f64], usize),
+        local: &[usize],
+        bufs: &mut Bufs,
+        par: Par,
+    ) {
+        let sym = self.sym;
+        let t = self.tree;
+        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+        let (cp_row, cpv, rows) = (sym.col_ptr_for_row_idx(), sym.col_ptr_for_val(), sym.row_idx());
+        let (s_start, s_end) = (begin[s], end[s]);
+        let nrows = s_end - s_start + cp_row[s + 1] - cp_row[s];
+        let place = |r: usize| if r < s_end { r - s_start } else { local[r] };
+        piece.fill(0.0);
+        for j in cols.clone() {
+            let col = &mut piece[(j - cols.start) * nrows..(j - cols.start + 1) * nrows];
+            let g = s_start + j;
+            for k in t.col_ptr[g]..t.col_ptr[g + 1] {
+                col[place(t.row_idx[k])] += self.values[t.src[k]];
+            }
+        }
+        let (c0, c1) = (s_start + cols.start, s_start + cols.end);
+        for &d in &t.updaters[t.upd_ptr[s]..t.upd_ptr[s + 1]] {
+            let d_pattern = &rows[cp_row[d]..cp_row[d + 1]];
+            let d_ncols = end[d] - begin[d];
+            let ld = MatRef::from_column_major_slice(
+                &head[cpv[d] - off..cpv[d + 1] - off],
+                d_ncols + d_pattern.len(),
+                d_ncols,
+            );
+            // the descendant's rows from the piece's first column on; the first `mid` of them
+            // are the piece's columns
+            let start = d_pattern.partition_point(|&r| r < c0);
+            let mid = d_pattern[start..].partition_point(|&r| r < c1);
+            let hit = &d_pattern[start..];
+            let below = ld.subrows(d_ncols + start, hit.len());
+            bufs.rows.clear();
+            bufs.rows.extend(hit.iter().map(|&r| place(r)));
+            subtract_update((&mut *piece, nrows, cols.start), ld, below, mid, bufs, par);
+        }
+    }
+
     /// The left-looking step of supernode `s`: its columns of the matrix, less the updates of
     /// its descendants (in `parts.0`, the factor's values from `off` to `s`'s), factored into
     /// `parts.1` (starting with `s`'s values).
@@ -427,57 +516,39 @@ impl Ctx<'_> {
     ) -> Result<(), usize> {
         let (head, tail) = parts;
         let sym = self.sym;
-        let t = self.tree;
         let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
         let (cp_row, cpv, rows) = (sym.col_ptr_for_row_idx(), sym.col_ptr_for_val(), sym.row_idx());
         let (s_start, s_end) = (begin[s], end[s]);
         let pattern = &rows[cp_row[s]..cp_row[s + 1]];
         let ncols = s_end - s_start;
         let nrows = ncols + pattern.len();
-        let local = &mut scratch.local;
         for (i, &r) in pattern.iter().enumerate() {
-            local[r] = i + ncols;
+            scratch.local[r] = i + ncols;
         }
         // column-major, nrows x ncols
         let ls = &mut tail[..cpv[s + 1] - cpv[s]];
-        ls.fill(0.0);
-        for j in s_start..s_end {
-            let col = &mut ls[(j - s_start) * nrows..(j - s_start + 1) * nrows];
-            for k in t.col_ptr[j]..t.col_ptr[j + 1] {
-                let i = t.row_idx[k];
-                let at = if i >= s_end { local[i] } else { i - s_start };
-                col[at] += self.values[t.src[k]];
+        let cuts = column_pieces(ncols, nrows, par);
+        let local = &scratch.local;
+        if let [0, all] = cuts[..] {
+            self.assemble(s, 0..all, ls, (head, off), local, &mut scratch.bufs, par);
+        } else {
+            // pieces of columns on different threads: each reads every descendant and writes
+            // only its own columns
+            let mut pieces = Vec::with_capacity(cuts.len() - 1);
+            let mut rest = &mut *ls;
+            for w in cuts.windows(2) {
+                let (piece, after) = rest.split_at_mut((w[1] - w[0]) * nrows);
+                pieces.push((w[0]..w[1], piece));
+                rest = after;
             }
-        }
-        for &d in &t.updaters[t.upd_ptr[s]..t.upd_ptr[s + 1]] {
-            let d_pattern = &rows[cp_row[d]..cp_row[d + 1]];
-            let d_ncols = end[d] - begin[d];
-            let ld = MatRef::from_column_major_slice(
-                &head[cpv[d] - off..cpv[d + 1] - off],
-                d_ncols + d_pattern.len(),
-                d_ncols,
-            );
-            let start = d_pattern.partition_point(|&r| r < s_start);
-            let mid = d_pattern[start..].partition_point(|&r| r < s_end);
-            let hit = &d_pattern[start..];
-            let below = ld.subrows(d_ncols + start, hit.len());
-            // each row's place in the supernode: its columns' rows first, then its pattern
-            scratch.rows.clear();
-            scratch
-                .rows
-                .extend(hit.iter().map(|&r| if r < s_end { r - s_start } else { local[r] }));
-            subtract_update(
-                (&mut *ls, nrows),
-                ld,
-                below,
-                mid,
-                (&mut scratch.scaled, &mut scratch.update),
-                par,
-                &scratch.rows,
-            );
+            pieces
+                .into_par_iter()
+                .for_each_init(Bufs::default, |bufs, (cols, piece)| {
+                    self.assemble(s, cols, piece, (head, off), local, bufs, Par::Seq)
+                });
         }
         for &r in pattern {
-            local[r] = usize::MAX;
+            scratch.local[r] = usize::MAX;
         }
         let ls = MatMut::from_column_major_slice_mut(ls, nrows, ncols);
         let (mut top, mut bot) = ls.split_at_row_mut(ncols);
@@ -511,23 +582,22 @@ impl Ctx<'_> {
     }
 }
 
-/// `L_s -= W` (`ls`: the supernode's values, column-major, and its number of rows),
-/// `W = B D Mᵀ` with `B` the rows of descendant `ld` from the supernode's first
-/// column on (`below`), `M` its first `mid` rows and `D` the descendant's pivots; `W`'s row `i`
-/// goes to row `rows[i]` of `L_s`, its column `j` to column `rows[j]` (only `i ≥ j`: the
-/// factor is lower triangular). One dense product (the top square's upper half is computed
-/// and dropped: one call costs less than two on the small blocks of a 2D mesh), then the
-/// scatter.
+/// `L_s -= W` (`ls`: columns of the supernode's values from column `col0` on, column-major,
+/// with the supernode's number of rows), `W = B D Mᵀ` with `B` the rows of descendant `ld`
+/// from the first of these columns on (`below`), `M` its first `mid` rows and `D` the
+/// descendant's pivots; `W`'s row `i` goes to row `bufs.rows[i]` of `L_s`, its column `j` to
+/// column `bufs.rows[j]` (only `i ≥ j`: the factor is lower triangular). One dense product
+/// (the top square's upper half is computed and dropped: one call costs less than two on the
+/// small blocks of a 2D mesh), then the scatter.
 fn subtract_update(
-    ls: (&mut [f64], usize),
+    ls: (&mut [f64], usize, usize),
     ld: MatRef<'_, f64>,
     below: MatRef<'_, f64>,
     mid: usize,
-    bufs: (&mut Vec<f64>, &mut Vec<f64>),
+    bufs: &mut Bufs,
     par: Par,
-    rows: &[usize],
 ) {
-    let (scaled, update) = bufs;
+    let Bufs { rows, scaled, update } = bufs;
     let (m, w) = (below.nrows(), below.ncols());
     if mid == 0 || m == 0 {
         return;
@@ -550,12 +620,50 @@ fn subtract_update(
     let mut wm = MatMut::from_column_major_slice_mut(&mut update[..m * mid], m, mid);
     faer::linalg::matmul::matmul(wm.rb_mut(), Accum::Replace, below, md.rb().transpose(), 1.0, par);
     let wv = &update[..m * mid];
-    let (ls, nrows) = ls;
+    let (ls, nrows, col0) = ls;
     for j in 0..mid {
-        let dst = &mut ls[rows[j] * nrows..(rows[j] + 1) * nrows];
+        let c = rows[j] - col0;
+        let dst = &mut ls[c * nrows..(c + 1) * nrows];
         let src = &wv[j * m..(j + 1) * m];
         for i in j..m {
             dst[rows[i]] -= src[i];
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pieces_cover_the_columns_with_about_equal_work() {
+        let area = |nrows: usize, a: usize, b: usize| (a..b).map(|j| (nrows - j) as f64).sum::<f64>();
+        for (ncols, nrows, threads) in [
+            (4896, 4896, 2),
+            (2420, 5024, 2),
+            (300, 900, 3),
+            (70, 70, 2),
+            (1000, 1000, 1),
+        ] {
+            let cuts = column_pieces(ncols, nrows, Par::rayon(threads));
+            assert_eq!((cuts[0], cuts[cuts.len() - 1]), (0, ncols));
+            assert!(cuts.len() - 1 <= 4 * threads, "{cuts:?}");
+            if threads == 1 || ncols < 2 * PIECE_COLS {
+                assert_eq!(cuts, vec![0, ncols]);
+                continue;
+            }
+            assert!(cuts.len() > 2, "{ncols} columns on {threads} threads: one piece");
+            let share = area(nrows, 0, ncols) / (cuts.len() - 1) as f64;
+            for w in cuts.windows(2) {
+                assert!(w[1] > w[0]);
+                let got = area(nrows, w[0], w[1]);
+                // every piece but the last is at least PIECE_COLS wide and near its share
+                if w[1] < ncols {
+                    assert!(w[1] - w[0] >= PIECE_COLS);
+                    assert!(got <= 1.5 * share && got >= 0.5 * share, "{w:?}: {got} against {share}");
+                }
+            }
+        }
+        assert_eq!(column_pieces(500, 600, Par::Seq), vec![0, 500]);
     }
 }
