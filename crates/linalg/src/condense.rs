@@ -150,7 +150,7 @@ impl DirectLdlt {
         }
         self.factor.solve_in_place(&mut b);
         Ok(Condensed {
-            inverse: crate::factor::symmetric_row_major(&inv),
+            inverse: crate::dense::symmetric_row_major(&inv),
             loads: CondensedLoads {
                 solution: dofs.iter().map(|&d| b[d]).collect(),
                 route: CondenseRoute::BlockSolves,

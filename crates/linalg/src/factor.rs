@@ -432,8 +432,9 @@ impl SparseFactor {
     /// The inverse of the Schur complement onto the last `k` indices of the factor's order,
     /// `S_c⁻¹ = L_cc⁻ᵀ D_c⁻¹ L_cc⁻¹` (dense, row-major `k x k`): the block of the matrix's
     /// inverse on the last `k` indices, with no further factorisation (one unit-triangular
-    /// inverse and one triangular product, `2k³/3` flops). `None` unless the factor is a
-    /// supernodal `L D Lᵀ` whose last supernode holds all `k` columns;
+    /// inverse and one product of the two triangles by dense row blocks, `2k³/3` flops).
+    /// `None` unless the factor is a supernodal `L D Lᵀ` whose last supernode holds all `k`
+    /// columns;
     /// [`LinalgError::NotPositiveDefinite`] where a pivot of the block has not the sign of its
     /// kind: the pivots of a quasi-definite matrix, in any order, are positive on its
     /// positive-definite dofs and negative on the others (Vanderbei, SIAM J. Optim. 5 (1995));
@@ -455,29 +456,12 @@ impl SparseFactor {
         }
         let mut x = faer::Mat::<f64>::zeros(k, k);
         faer::linalg::triangular_inverse::invert_unit_lower_triangular(x.as_mut(), l, self.par);
-        // the unit diagonal is implied, not necessarily written
+        // the unit diagonal is implied, not necessarily written; the strict upper part is zero
         for j in 0..k {
+            x.col_mut(j).subrows_mut(0, j).fill(0.0);
             x[(j, j)] = 1.0;
         }
-        let mut y = x.clone();
-        for j in 0..k {
-            for i in j..k {
-                y[(i, j)] /= d[i];
-            }
-        }
-        let mut prod = faer::Mat::<f64>::zeros(k, k);
-        faer::linalg::matmul::triangular::matmul(
-            prod.as_mut(),
-            faer::linalg::matmul::triangular::BlockStructure::Rectangular,
-            faer::Accum::Replace,
-            x.transpose(),
-            faer::linalg::matmul::triangular::BlockStructure::TriangularUpper,
-            y.as_ref(),
-            faer::linalg::matmul::triangular::BlockStructure::TriangularLower,
-            1.0,
-            self.par,
-        );
-        Ok(Some(symmetric_row_major(&prod)))
+        Ok(Some(crate::dense::unit_lower_gram(x.as_ref(), &d)))
     }
 
     /// The trailing `k x k` corner of the factor, `D_c` on its diagonal and `L_cc` below it (a
@@ -702,21 +686,6 @@ fn inverse_permutation(fwd: &[usize]) -> Result<Vec<usize>, LinalgError> {
         inv[old] = new;
     }
     Ok(inv)
-}
-
-/// `(M + Mᵀ)/2` of a square matrix, row-major: a product that is symmetric in exact arithmetic,
-/// with its round-off asymmetry removed.
-pub(crate) fn symmetric_row_major(m: &faer::Mat<f64>) -> Vec<f64> {
-    let k = m.nrows();
-    let mut out = vec![0.0; k * k];
-    for i in 0..k {
-        for j in 0..=i {
-            let v = 0.5 * (m[(i, j)] + m[(j, i)]);
-            out[i * k + j] = v;
-            out[j * k + i] = v;
-        }
-    }
-    out
 }
 
 /// A mask of `last` among `0..n`; an error names an index out of range or repeated.

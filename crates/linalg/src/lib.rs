@@ -37,6 +37,7 @@
 
 mod condense;
 mod coupled;
+mod dense;
 mod factor;
 mod pcg;
 pub mod sparse;
@@ -47,6 +48,7 @@ pub use coupled::{
     equilibrium_residual, refine, CoupledBlocks, CoupledSolver, DirectLdlt, FactorPreconditioner, Refined,
     SchurOperator, SchurPcg, SolveInfo,
 };
+pub use dense::mirror_lower;
 pub use factor::{pool_par, FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};
 
