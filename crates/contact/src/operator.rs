@@ -5,6 +5,7 @@
 use crate::points::PointValues;
 use crate::OperatorError;
 use faer::sparse::{SparseRowMat, SparseRowMatRef};
+use rayon::prelude::*;
 
 /// The contact problem seen from the multipliers.
 pub trait ContactOperator {
@@ -102,6 +103,10 @@ pub struct SparseContactProblem {
     pub nt: usize,
 }
 
+/// The order from which a dense compliance's product runs on rayon's pool (below it, a
+/// product takes less than the tasks cost).
+const PARALLEL_ROWS: usize = 512;
+
 /// The compliance of an affine problem, as the solvers read it.
 #[derive(Clone, Copy, Debug)]
 pub enum Compliance<'a> {
@@ -125,8 +130,12 @@ impl Compliance<'_> {
         match self {
             Compliance::Dense(d) => {
                 let m = x.len();
-                for (r, o) in out.iter_mut().enumerate() {
-                    *o = dot8(&d[r * m..(r + 1) * m], x);
+                let row = |(r, o): (usize, &mut f64)| *o = dot8(&d[r * m..(r + 1) * m], x);
+                if m >= PARALLEL_ROWS {
+                    // memory-bound: a second core adds bandwidth; each row's sum is the same
+                    out.par_iter_mut().enumerate().for_each(row);
+                } else {
+                    out.iter_mut().enumerate().for_each(row);
                 }
             }
             Compliance::Sparse(s) => {

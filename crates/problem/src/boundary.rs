@@ -13,6 +13,7 @@ use contact::{
 };
 use fe_assembly::{facet_measure, Discretization, Dof, DofMap};
 use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
+use rayon::prelude::*;
 
 /// The contact points of a boundary group and the u dofs of their nodes.
 pub struct ContactBoundary {
@@ -600,9 +601,10 @@ impl ContactBoundary {
         let (n, m) = (p.len(), p.len() * (1 + nt));
         let free = self.free_slots();
         let mut d = vec![0.0; m * m];
-        for r in 0..m {
+        // the lower triangle by rows on rayon's pool, then mirrored
+        d.par_chunks_mut(m.max(1)).enumerate().for_each(|(r, row)| {
             let (i, a) = self.direction_of(r, nt);
-            for c in 0..=r {
+            for (c, out) in row.iter_mut().enumerate().take(r + 1) {
                 let (j, b) = self.direction_of(c, nt);
                 let mut v = 0.0;
                 for &(x, jx) in &free[i] {
@@ -610,10 +612,10 @@ impl ContactBoundary {
                         v += a[x] * inv[jx * stride + jy] * b[y];
                     }
                 }
-                d[r * m + c] = v;
-                d[c * m + r] = v;
+                *out = v;
             }
-        }
+        });
+        linalg::mirror_lower(&mut d, m);
         hold_rows(&mut d, m, n, nt, p);
         d
     }

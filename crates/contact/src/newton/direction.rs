@@ -10,7 +10,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Mat, Par};
+use faer::{Conj, Mat, MatRef, Par};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Largest relative asymmetry of a dense compliance that is solved through its symmetric part
@@ -173,15 +173,20 @@ impl Directions {
             Compliance::Dense(d) => d,
         };
         let m = flat.m;
-        let shifted = Mat::<f64>::from_fn(m, m, |i, j| {
-            d[i * m + j] + if i == j { flat.sigma / flat.w[i] } else { 0.0 }
-        });
+        // `(D + σW⁻¹)ᵀ`, read column by column (a contiguous copy): the Cholesky factorisation
+        // reads its lower triangle, `D`'s upper one (the same within [`SYMMETRIC`])
+        let mut transposed = MatRef::from_column_major_slice(d, m, m).to_owned();
+        for i in 0..m {
+            transposed[(i, i)] += flat.sigma / flat.w[i];
+        }
         if flat.electric.is_some() {
             // positive real, not symmetric (the electric couplings are opposite): the reduced
             // system with the stiffness from one LU; a condensed finite-element compliance
             // all the same, under its rules
-            let inv = faer::linalg::solvers::DenseSolveCore::inverse(&shifted.partial_piv_lu());
-            let inv: Vec<f64> = (0..m * m).map(|k| inv[(k / m, k % m)]).collect();
+            // the inverse of the transpose is the transposed inverse: row-major `(D + σW⁻¹)⁻¹`
+            // is its column-major storage
+            let inv = faer::linalg::solvers::DenseSolveCore::inverse(&transposed.partial_piv_lu());
+            let inv: Vec<f64> = (0..m * m).map(|k| inv[(k % m, k / m)]).collect();
             return if inv.iter().all(|v| v.is_finite()) {
                 Directions::Reduced(Arc::new(Stiffness::inverse(inv)))
             } else {
@@ -191,7 +196,7 @@ impl Directions {
         if flat.d.asymmetry() > SYMMETRIC {
             return Directions::DenseLu { symmetric: false };
         }
-        match shifted.llt(faer::Side::Lower) {
+        match transposed.llt(faer::Side::Lower) {
             Ok(llt) => Directions::Reduced(Arc::new(Stiffness {
                 llt: Some(llt),
                 inverse: OnceLock::new(),
