@@ -315,6 +315,22 @@ impl SparseFactor {
         best
     }
 
+    /// The tree, the supernodal symbolic factor and the values, where the factorisation walked
+    /// the tree (for the tree's own tests).
+    #[cfg(test)]
+    pub(crate) fn tree_parts(
+        &self,
+    ) -> Option<(
+        &crate::tree::Tree,
+        &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>,
+        &[f64],
+    )> {
+        match (self.tree.as_ref(), self.symbolic.raw()) {
+            (Some(tree), SymbolicCholeskyRaw::Supernodal(sym)) => Some((tree, sym, &self.values)),
+            _ => None,
+        }
+    }
+
     /// Whether the numeric factorisation walks the supernodes' elimination tree on several
     /// threads (a supernodal `L D Lᵀ` given `Par::rayon` with more than one thread; then
     /// independent subtrees are factored at the same time, on rayon's current pool), rather
@@ -383,8 +399,24 @@ impl SparseFactor {
         self.solve_mat(rhs);
     }
 
-    fn solve_mat(&mut self, rhs: MatMut<'_, f64>) {
+    fn solve_mat(&mut self, mut rhs: MatMut<'_, f64>) {
         let k = rhs.ncols();
+        if let (Some(tree), SymbolicCholeskyRaw::Supernodal(sym)) = (self.tree.as_ref(), self.symbolic.raw()) {
+            // the tree's sweeps, on the right-hand sides permuted into the factor's order,
+            // index by index
+            let fwd = self.permutation();
+            let mut x = Vec::with_capacity(fwd.len() * k);
+            for &old in &fwd {
+                x.extend((0..k).map(|j| rhs[(old, j)]));
+            }
+            tree.solve(sym, &self.values, &mut x, k);
+            for (new, &old) in fwd.iter().enumerate() {
+                for j in 0..k {
+                    rhs[(old, j)] = x[new * k + j];
+                }
+            }
+            return;
+        }
         if k > self.solve_mem_ncols {
             self.solve_mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(k, self.par));
             self.solve_mem_ncols = k;

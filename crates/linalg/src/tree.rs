@@ -22,6 +22,8 @@ use faer::sparse::SparseColMatRef;
 use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
+mod solve;
+
 /// Subtrees with fewer floating-point operations than this are factored on one core, in
 /// order (a task of this size takes about 2 ms; below it the cost of a task's scratch and of
 /// stealing it shows).
