@@ -71,7 +71,7 @@ pub enum Ordering {
 pub struct SparseFactor {
     kind: FactorKind,
     symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
+    values: crate::values::Values,
     factor_mem: MemBuffer,
     solve_mem: MemBuffer,
     solve_mem_ncols: usize,
@@ -142,35 +142,7 @@ impl SparseFactor {
             });
         }
         let wants_tree = matches!((kind, par), (FactorKind::Ldlt, Par::Rayon(t)) if t.get() > 1);
-        let (fwd, inv, kept) = match ordering {
-            Ordering::Amd => (vec![], vec![], 0),
-            Ordering::AmdThenLast(last) => {
-                let (f, i) = amd_then_last(a, last)?;
-                (f, i, last.len())
-            }
-            Ordering::Given(given) => (given.clone(), inverse_permutation(given)?, 0),
-            Ordering::GivenThenLast { order, last } => {
-                let is_last = mark(n, last)?;
-                let mut f: Vec<usize> = order.iter().copied().filter(|&i| i >= n || !is_last[i]).collect();
-                f.extend_from_slice(last);
-                let i = inverse_permutation(&f)?;
-                (f, i, last.len())
-            }
-        };
-        // the parallel tree walks subtrees that are contiguous: the order made a postorder of
-        // its elimination tree first (the same fill), where that keeps the chosen last dofs last
-        let post = if wants_tree {
-            crate::tree::postordered(a, &fwd, &inv)
-        } else {
-            None
-        };
-        let (fwd, inv) = match post {
-            Some(post) if post[n - kept..] == fwd[n - kept..] => {
-                let post_inv = inverse_permutation(&post)?;
-                (post, post_inv)
-            }
-            _ => (fwd, inv),
-        };
+        let (fwd, inv, kept) = resolve_order(a, ordering, wants_tree)?;
         let ord = match ordering {
             Ordering::Amd => SymmetricOrdering::Amd,
             _ => SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n)),
@@ -183,11 +155,21 @@ impl SparseFactor {
             },
             _ => CholeskySymbolicParams::default(),
         };
-        let mut symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
-            .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+        let analyse = || {
+            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
+                .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))
+        };
+        // the tree's copy of the lower triangle needs only a given order: made meanwhile
+        let (symbolic, lower) = if wants_tree && *ordering != Ordering::Amd {
+            let (symbolic, lower) = rayon::join(analyse, || crate::tree::Lower::new(a, Some(&inv)));
+            (symbolic, Some(lower))
+        } else {
+            (analyse(), None)
+        };
+        let mut symbolic = symbolic?;
         let tree = if wants_tree {
             let tree;
-            (symbolic, tree) = parallel_tree(a, symbolic, params, kept)?;
+            (symbolic, tree) = parallel_tree(a, symbolic, params, kept, lower)?;
             tree
         } else {
             None
@@ -204,7 +186,7 @@ impl SparseFactor {
         let solve_mem = MemBuffer::new(solve_req);
         let mut f = SparseFactor {
             kind,
-            values: vec![0.0; symbolic.len_val()],
+            values: crate::values::Values::zeros(symbolic.len_val()),
             symbolic,
             factor_mem: MemBuffer::new(if tree.is_some() { StackReq::EMPTY } else { factor_req }),
             solve_mem,
@@ -656,21 +638,63 @@ impl SparseFactor {
     }
 }
 
+/// The order `ordering` asks for as `(fwd, inv, kept)` (`fwd[new] = old`, `inv` its inverse,
+/// both empty for faer's own AMD; `kept` indices ordered last), made a postorder of its
+/// elimination tree where `postorder` (the tree's schedule) and that keeps the last ones last.
+fn resolve_order(
+    a: SparseColMatRef<'_, usize, f64>,
+    ordering: &Ordering,
+    postorder: bool,
+) -> Result<(Vec<usize>, Vec<usize>, usize), LinalgError> {
+    let n = a.nrows();
+    let (fwd, inv, kept) = match ordering {
+        Ordering::Amd => (vec![], vec![], 0),
+        Ordering::AmdThenLast(last) => {
+            let (f, i) = amd_then_last(a, last)?;
+            (f, i, last.len())
+        }
+        Ordering::Given(given) => (given.clone(), inverse_permutation(given)?, 0),
+        Ordering::GivenThenLast { order, last } => {
+            let is_last = mark(n, last)?;
+            let mut f: Vec<usize> = order.iter().copied().filter(|&i| i >= n || !is_last[i]).collect();
+            f.extend_from_slice(last);
+            let i = inverse_permutation(&f)?;
+            (f, i, last.len())
+        }
+    };
+    // the parallel tree walks subtrees that are contiguous: the order made a postorder of
+    // its elimination tree first (the same fill), where that keeps the chosen last dofs last
+    let post = if postorder {
+        crate::tree::postordered(a, &fwd, &inv)
+    } else {
+        None
+    };
+    Ok(match post {
+        Some(post) if post[n - kept..] == fwd[n - kept..] => {
+            let post_inv = inverse_permutation(&post)?;
+            (post, post_inv, kept)
+        }
+        _ => (fwd, inv, kept),
+    })
+}
+
 /// The tree of a supernodal symbolic factor for the parallel numeric `L D Lᵀ`, the analysis
 /// redone once in postorder where its supernodes were not (AMD's order, or relaxed supernodes
 /// that merged across a subtree); `None` (and the analysis unchanged) for a simplicial factor,
-/// or where the postorder would move the `kept` dofs ordered last.
+/// or where the postorder would move the `kept` dofs ordered last. `lower`: the matrix's lower
+/// triangle in `symbolic`'s order, where it was built already.
 fn parallel_tree(
     a: SparseColMatRef<'_, usize, f64>,
     symbolic: SymbolicCholesky<usize>,
     params: CholeskySymbolicParams<'_>,
     kept: usize,
+    lower: Option<crate::tree::Lower>,
 ) -> Result<(SymbolicCholesky<usize>, Option<crate::tree::Tree>), LinalgError> {
     let SymbolicCholeskyRaw::Supernodal(s) = symbolic.raw() else {
         return Ok((symbolic, None));
     };
     let inv = |sym: &SymbolicCholesky<usize>| sym.perm().map(|p| p.arrays().1.to_vec());
-    if let Some(tree) = crate::tree::Tree::new(s, a, inv(&symbolic).as_deref()) {
+    if let Some(tree) = crate::tree::Tree::new(s, a, inv(&symbolic).as_deref(), lower) {
         return Ok((symbolic, Some(tree)));
     }
     let fwd = match symbolic.perm() {
@@ -688,7 +712,7 @@ fn parallel_tree(
     let again = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
         .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
     let tree = match again.raw() {
-        SymbolicCholeskyRaw::Supernodal(s) => crate::tree::Tree::new(s, a, inv(&again).as_deref()),
+        SymbolicCholeskyRaw::Supernodal(s) => crate::tree::Tree::new(s, a, inv(&again).as_deref(), None),
         SymbolicCholeskyRaw::Simplicial(_) => None,
     };
     Ok((again, tree))

@@ -42,6 +42,7 @@ mod factor;
 mod pcg;
 pub mod sparse;
 mod tree;
+mod values;
 
 pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{

@@ -58,15 +58,21 @@ pub(crate) struct Tree {
 
 impl Tree {
     /// The tree of `sym`'s supernodes, and `a`'s lower triangle in the order `inv`
-    /// (`inv[old] = new`). `None` where the supernodes are not in postorder (each subtree
-    /// contiguous), which the schedule needs.
+    /// (`inv[old] = new`): `lower` where it was built already ([`Lower::new`], while the
+    /// symbolic factorisation ran), else now, beside the tree's shape. `None` where the
+    /// supernodes are not in postorder (each subtree contiguous), which the schedule needs.
     pub(crate) fn new(
         sym: &SymbolicSupernodalCholesky<usize>,
         a: SparseColMatRef<'_, usize, f64>,
         inv: Option<&[usize]>,
+        lower: Option<Lower>,
     ) -> Option<Tree> {
-        let (shape, (col_ptr, rows, src)) = rayon::join(|| Tree::shape(sym), || permuted_lower(a, inv));
+        let (shape, lower) = match lower {
+            Some(lower) => (Tree::shape(sym), lower),
+            None => rayon::join(|| Tree::shape(sym), || Lower::new(a, inv)),
+        };
         let (parent, first, upd_ptr, updaters, work) = shape?;
+        let Lower { col_ptr, rows, src } = lower;
         Some(Tree {
             parent,
             first,
@@ -289,49 +295,60 @@ pub(crate) fn postorder(sym: &SymbolicSupernodalCholesky<usize>) -> Vec<usize> {
     order
 }
 
-/// The lower triangle of `a` (whose lower triangle is read) in the order `inv`, as column
-/// pointers, rows (in no particular order within a column) and the source of each value: two
-/// counting passes, no sort.
-fn permuted_lower(a: SparseColMatRef<'_, usize, f64>, inv: Option<&[usize]>) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    let n = a.nrows();
-    let p = |i: usize| inv.map_or(i, |v| v[i]);
-    let sym = a.symbolic();
-    // the (row, column) in the new order of each lower entry, column the smaller
-    let place = |i: usize, j: usize| {
-        let (pi, pj) = (p(i), p(j));
-        if pi >= pj {
-            (pi, pj)
-        } else {
-            (pj, pi)
-        }
-    };
-    let mut col_ptr = vec![0usize; n + 1];
-    for j in 0..n {
-        for &i in sym.row_idx_of_col_raw(j) {
-            if i >= j {
-                col_ptr[place(i, j).1 + 1] += 1;
+/// A matrix's lower triangle in a factor's order: column pointers, rows (in no particular
+/// order within a column) and the index of each value in the matrix's values.
+#[derive(Debug)]
+pub(crate) struct Lower {
+    col_ptr: Vec<usize>,
+    rows: Vec<usize>,
+    src: Vec<usize>,
+}
+
+impl Lower {
+    /// The lower triangle of `a` (whose lower triangle is read) in the order `inv`
+    /// (`inv[old] = new`; `None`: the identity): two counting passes, no sort. It needs only
+    /// the order, so it is built while the symbolic factorisation runs.
+    pub(crate) fn new(a: SparseColMatRef<'_, usize, f64>, inv: Option<&[usize]>) -> Lower {
+        let n = a.nrows();
+        let p = |i: usize| inv.map_or(i, |v| v[i]);
+        let sym = a.symbolic();
+        // the (row, column) in the new order of each lower entry, column the smaller
+        let place = |i: usize, j: usize| {
+            let (pi, pj) = (p(i), p(j));
+            if pi >= pj {
+                (pi, pj)
+            } else {
+                (pj, pi)
+            }
+        };
+        let mut col_ptr = vec![0usize; n + 1];
+        for j in 0..n {
+            for &i in sym.row_idx_of_col_raw(j) {
+                if i >= j {
+                    col_ptr[place(i, j).1 + 1] += 1;
+                }
             }
         }
-    }
-    for c in 0..n {
-        col_ptr[c + 1] += col_ptr[c];
-    }
-    let nnz = col_ptr[n];
-    let mut next = col_ptr.clone();
-    let (mut rows, mut src) = (vec![0usize; nnz], vec![0usize; nnz]);
-    let all_rows = sym.row_idx();
-    for j in 0..n {
-        for k in sym.col_range(j) {
-            let i = all_rows[k];
-            if i >= j {
-                let (r, c) = place(i, j);
-                rows[next[c]] = r;
-                src[next[c]] = k;
-                next[c] += 1;
+        for c in 0..n {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        let nnz = col_ptr[n];
+        let mut next = col_ptr.clone();
+        let (mut rows, mut src) = (vec![0usize; nnz], vec![0usize; nnz]);
+        let all_rows = sym.row_idx();
+        for j in 0..n {
+            for k in sym.col_range(j) {
+                let i = all_rows[k];
+                if i >= j {
+                    let (r, c) = place(i, j);
+                    rows[next[c]] = r;
+                    src[next[c]] = k;
+                    next[c] += 1;
+                }
             }
         }
+        Lower { col_ptr, rows, src }
     }
-    (col_ptr, rows, src)
 }
 
 /// One factorisation's shared, read-only state.

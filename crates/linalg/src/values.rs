@@ -1,0 +1,79 @@
+//! A large factor's values in memory advised to use transparent huge pages.
+//!
+//! A fresh factor's values are touched first by the numeric factorisation: at 4 KB pages that
+//! is one page fault per 512 values, 147 000 for the 576 MB of `paper` at n = 256, measured at
+//! 0.36 s on this project's machine; at 2 MB pages, 0.05 s. Where the kernel offers transparent huge
+//! pages on request (`/sys/kernel/mm/transparent_hugepage/enabled` = `madvise`, Debian's
+//! default) an anonymous mapping so advised gets them; where it does not (or the advice is
+//! refused, or not Linux), the mapping behaves as any zeroed memory. Small factors keep a `Vec`.
+
+use memmap2::{MmapMut, MmapOptions};
+
+/// Values from which a factor's storage is mapped and advised (64 MB: 32 huge pages).
+const MAPPED_FROM: usize = 8 << 20;
+
+/// Zero-initialised `f64` storage of a fixed length.
+pub(crate) enum Values {
+    /// A `Vec`, for small factors.
+    Heap(Vec<f64>),
+    /// An anonymous mapping (page-aligned, zeroed by the kernel) of `len` values.
+    Mapped { map: MmapMut, len: usize },
+}
+
+impl Values {
+    /// `len` zeros.
+    pub(crate) fn zeros(len: usize) -> Values {
+        if len >= MAPPED_FROM {
+            if let Ok(map) = MmapOptions::new().len(len * std::mem::size_of::<f64>()).map_anon() {
+                #[cfg(target_os = "linux")]
+                {
+                    // a hint: refused or unavailable, the pages are small ones
+                    let _ = map.advise(memmap2::Advice::HugePage);
+                }
+                return Values::Mapped { map, len };
+            }
+        }
+        Values::Heap(vec![0.0; len])
+    }
+}
+
+impl std::ops::Deref for Values {
+    type Target = [f64];
+
+    fn deref(&self) -> &[f64] {
+        match self {
+            Values::Heap(v) => v,
+            Values::Mapped { map, len } => &bytemuck::cast_slice(&map[..])[..*len],
+        }
+    }
+}
+
+impl std::ops::DerefMut for Values {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        match self {
+            Values::Heap(v) => v,
+            Values::Mapped { map, len } => &mut bytemuck::cast_slice_mut(&mut map[..])[..*len],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_storage_is_zeros_of_its_length_mapped_or_not() {
+        for len in [0, 1, 1000, MAPPED_FROM, MAPPED_FROM + 3] {
+            let mut v = Values::zeros(len);
+            assert_eq!(v.len(), len);
+            assert!(matches!(v, Values::Mapped { .. }) == (len >= MAPPED_FROM));
+            assert!(v.iter().all(|&x| x == 0.0));
+            if len > 0 {
+                v[len - 1] = 2.5;
+                v[0] += 1.0;
+                let first: f64 = if len == 1 { 3.5 } else { 1.0 };
+                assert_eq!((v[0], v[len - 1]), (first, first.max(2.5)));
+            }
+        }
+    }
+}
