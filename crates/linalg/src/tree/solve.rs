@@ -106,8 +106,9 @@ impl Solve<'_> {
     }
 
     /// Whether the range `lo..hi` (whole subtrees) is solved on this thread, in order; else
-    /// where it splits: `Some(root)` for a range of one root (its subtree below it first),
-    /// `None` with the cut between two groups of subtrees of about half the values each.
+    /// where it splits: [`Split::Root`] for a range of one root (the subtree below it apart
+    /// from it), [`Split::Between`] with the cut between two groups of whole subtrees of about
+    /// half the values each.
     fn split(&self, lo: usize, hi: usize) -> Split {
         let cpv = self.sym.col_ptr_for_val();
         if cpv[hi] - cpv[lo] < self.sequential || rayon::current_num_threads() < 2 {
@@ -274,8 +275,11 @@ fn dense_par(w: usize) -> Par {
 
 /// How a range of supernodes is solved: see [`Solve::split`].
 enum Split {
+    /// On this thread, in order.
     InOrder,
+    /// The range's one root, its subtree below it first (forward) or after it (backward).
     Root(usize),
+    /// Two groups of whole subtrees, `lo..mid` and `mid..hi`, at the same time.
     Between(usize),
 }
 
