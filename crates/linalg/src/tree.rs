@@ -167,6 +167,45 @@ impl Tree {
     }
 }
 
+/// How a range of supernodes, a union of whole subtrees, is walked ([`Tree::split`]).
+pub(crate) enum Split {
+    /// On this thread, in order.
+    InOrder,
+    /// The range's one root: the subtree below it apart from it (before it when factoring or
+    /// sweeping forward, after it when sweeping back).
+    Root(usize),
+    /// Two groups of whole subtrees, `lo..mid` and `mid..hi`, at the same time.
+    Between(usize),
+}
+
+impl Tree {
+    /// How the supernodes `lo..hi` (whole subtrees) are walked, given the `size` of each
+    /// subtree by its root: in order on this thread where they are smaller than `sequential`
+    /// in all (or the pool has one thread); the one root apart where there is one; else cut
+    /// between two groups of whole subtrees of about half the size each.
+    pub(crate) fn split(&self, lo: usize, hi: usize, size: impl Fn(usize) -> f64, sequential: f64) -> Split {
+        let roots: Vec<usize> = (lo..hi).filter(|&s| self.parent[s] >= hi).collect();
+        let total: f64 = roots.iter().map(|&r| size(r)).sum();
+        if total < sequential || rayon::current_num_threads() < 2 {
+            return Split::InOrder;
+        }
+        if let [root] = roots[..] {
+            return Split::Root(root);
+        }
+        let mut acc = 0.0;
+        let mut cut = roots[roots.len() - 1];
+        for &r in &roots {
+            acc += size(r);
+            if acc >= total / 2.0 {
+                cut = r;
+                break;
+            }
+        }
+        // the last root ends the range: cut before its subtree instead of after it
+        Split::Between(if cut == hi - 1 { self.first[cut] } else { cut + 1 })
+    }
+}
+
 /// The order `fwd` (`inv` its inverse; both empty: no order given) made a postorder of its
 /// elimination tree: children before their parent, every subtree contiguous, roots and
 /// children kept in their order. The tree by Liu's algorithm with path compression (Liu, ACM
@@ -421,30 +460,17 @@ impl Ctx<'_> {
             return Ok(());
         }
         let t = self.tree;
-        let roots: Vec<usize> = (lo..hi).filter(|&s| t.parent[s] >= hi).collect();
-        let total: f64 = roots.iter().map(|&r| t.work[r]).sum();
-        if total < SEQUENTIAL_FLOPS || rayon::current_num_threads() < 2 {
-            return self.in_order(lo, hi, values, off, Par::Seq);
-        }
-        if let [root] = roots[..] {
-            let cpv = self.sym.col_ptr_for_val();
-            let (below, mine) = values.split_at_mut(cpv[root] - off);
-            self.forest(lo, root, below, off)?;
-            let mut scratch = self.scratch(root, root + 1, self.par);
-            return self.node(root, (below, mine), off, &mut scratch, self.par);
-        }
-        // two groups of whole subtrees with about half the work each
-        let mut acc = 0.0;
-        let mut cut = roots[roots.len() - 1];
-        for &r in &roots {
-            acc += t.work[r];
-            if acc >= total / 2.0 {
-                cut = r;
-                break;
+        let mid = match t.split(lo, hi, |r| t.work[r], SEQUENTIAL_FLOPS) {
+            Split::InOrder => return self.in_order(lo, hi, values, off, Par::Seq),
+            Split::Root(root) => {
+                let cpv = self.sym.col_ptr_for_val();
+                let (below, mine) = values.split_at_mut(cpv[root] - off);
+                self.forest(lo, root, below, off)?;
+                let mut scratch = self.scratch(root, root + 1, self.par);
+                return self.node(root, (below, mine), off, &mut scratch, self.par);
             }
-        }
-        // the last root ends the range: cut before its subtree instead of after it
-        let mid = if cut == hi - 1 { t.first[cut] } else { cut + 1 };
+            Split::Between(mid) => mid,
+        };
         let cpv = self.sym.col_ptr_for_val();
         let (left, right) = values.split_at_mut(cpv[mid] - off);
         let (a, b) = rayon::join(

@@ -13,7 +13,7 @@
 //! the rows of a range of supernodes are one contiguous slice, split between the tasks as the
 //! factor's values are.
 
-use super::Tree;
+use super::{Split, Tree};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::{Accum, MatMut, MatRef, Par};
 
@@ -105,28 +105,16 @@ impl Solve<'_> {
         MatRef::from_column_major_slice(&self.values[cpv[s]..cpv[s + 1]], rows, w)
     }
 
-    /// Whether the range `lo..hi` (whole subtrees) is solved on this thread, in order; else
-    /// where it splits: [`Split::Root`] for a range of one root (the subtree below it apart
-    /// from it), [`Split::Between`] with the cut between two groups of whole subtrees of about
-    /// half the values each.
+    /// How the range `lo..hi` (whole subtrees) is solved: [`Tree::split`] by the factor's
+    /// values, which a sweep reads once.
     fn split(&self, lo: usize, hi: usize) -> Split {
-        let cpv = self.sym.col_ptr_for_val();
-        if cpv[hi] - cpv[lo] < self.sequential || rayon::current_num_threads() < 2 {
-            return Split::InOrder;
-        }
-        let t = self.tree;
-        let roots: Vec<usize> = (lo..hi).filter(|&s| t.parent[s] >= hi).collect();
-        if let [root] = roots[..] {
-            return Split::Root(root);
-        }
-        let half = (cpv[hi] - cpv[lo]) / 2;
-        let cut = roots
-            .iter()
-            .copied()
-            .find(|&r| cpv[r + 1] - cpv[lo] >= half)
-            .unwrap_or(roots[roots.len() - 1]);
-        // the last root ends the range: cut before its subtree instead of after it
-        Split::Between(if cut == hi - 1 { t.first[cut] } else { cut + 1 })
+        let (cpv, t) = (self.sym.col_ptr_for_val(), self.tree);
+        t.split(
+            lo,
+            hi,
+            |r| (cpv[r + 1] - cpv[t.first[r]]) as f64,
+            self.sequential as f64,
+        )
     }
 
     /// The forward sweep over the supernodes `lo..hi` (whole subtrees), whose rows are `x`
@@ -271,16 +259,6 @@ fn dense_par(w: usize) -> Par {
     } else {
         Par::Seq
     }
-}
-
-/// How a range of supernodes is solved: see [`Solve::split`].
-enum Split {
-    /// On this thread, in order.
-    InOrder,
-    /// The range's one root, its subtree below it first (forward) or after it (backward).
-    Root(usize),
-    /// Two groups of whole subtrees, `lo..mid` and `mid..hi`, at the same time.
-    Between(usize),
 }
 
 #[cfg(test)]
