@@ -44,8 +44,10 @@ impl Stiffness {
                 .llt
                 .as_ref()
                 .expect("a stiffness without its inverse has its factor");
+            // faer mirrors the inverse's lower half onto its upper one: symmetric exactly, so
+            // its column-major storage, read contiguously, is the row-major `K`
             let inv = faer::linalg::solvers::DenseSolveCore::inverse(llt);
-            (0..m * m).map(|k| inv[(k / m, k % m)]).collect()
+            (0..m * m).map(|k| inv[(k % m, k / m)]).collect()
         })
     }
 
@@ -193,7 +195,7 @@ impl Directions {
                 Directions::DenseLu { symmetric: true }
             };
         }
-        if flat.d.asymmetry() > SYMMETRIC {
+        if flat.asymmetry() > SYMMETRIC {
             return Directions::DenseLu { symmetric: false };
         }
         match transposed.llt(faer::Side::Lower) {
@@ -223,7 +225,7 @@ impl Directions {
     pub(super) fn step_in_sweeps(flat: &Flat<'_>) -> Option<f64> {
         match flat.d {
             Compliance::Sparse(_) => Some(SPARSE_STEP_SWEEPS),
-            Compliance::Dense(_) if flat.electric.is_none() && flat.d.asymmetry() > SYMMETRIC => {
+            Compliance::Dense(_) if flat.electric.is_none() && flat.asymmetry() > SYMMETRIC => {
                 Some((flat.m as f64 / 12.0).max(SPARSE_STEP_SWEEPS))
             }
             Compliance::Dense(_) => None,

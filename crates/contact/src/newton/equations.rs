@@ -69,6 +69,9 @@ pub(super) struct Flat<'a> {
     pub(super) weakening: Option<crate::SlipWeakening>,
     /// Electrical contact: the rows after the mechanical ones.
     pub(super) electric: Option<ElectricRows<'a>>,
+    /// `d`'s relative asymmetry, read once ([`Flat::asymmetry`]; a proximal problem, a clone
+    /// with the same `d`, keeps it).
+    asymmetry: std::sync::OnceLock<f64>,
 }
 
 /// The electric rows of a problem with electrical contact: one per electric point, from
@@ -137,6 +140,7 @@ impl<'a> Flat<'a> {
             sigma: 0.0,
             weakening: None,
             electric: None,
+            asymmetry: std::sync::OnceLock::new(),
         };
         flat.c = vec![1.0 / mu_max; m];
         flat
@@ -148,6 +152,7 @@ impl<'a> Flat<'a> {
     pub(super) fn with_electric(mut self, d: Compliance<'a>, contact: &'a ElectricContact, phi0: &[f64]) -> Self {
         let start = self.m;
         self.d = d;
+        self.asymmetry = std::sync::OnceLock::new();
         self.m = start + contact.points.len();
         self.w.extend(contact.points.iter().map(|&i| self.points.weight[i]));
         self.u0.extend_from_slice(phi0);
@@ -169,6 +174,12 @@ impl<'a> Flat<'a> {
             reference,
         });
         self
+    }
+
+    /// The compliance's largest relative asymmetry ([`Compliance::asymmetry`], an `m²` pass),
+    /// computed on the first call.
+    pub(super) fn asymmetry(&self) -> f64 {
+        *self.asymmetry.get_or_init(|| self.d.asymmetry())
     }
 
     /// The natural map's constant of a row whose own compliance is `own`: its inverse, within
