@@ -18,14 +18,16 @@
 //! 2. **Proximal point** where Newton stalls (a singular Jacobian where `D` is only
 //!    semidefinite, as for rigid multibody problems; a line search that fails; a cycle): a
 //!    sequence of regularised problems `u_σ(λ) = u(λ) - σ (λ - λ_k)`, each solved by Newton
-//!    to a tenth of the current residual, whose solutions converge to a solution of the
+//!    to a tenth of the current residual (an inner solve that stalls, by stage 1's patience
+//!    rule, has failed), whose solutions converge to a solution of the
 //!    problem itself (Rockafellar's proximal point algorithm; Siconos' PROX solver is this
 //!    method around its Alart–Curnier Newton). `D + σ W⁻¹` is definite for any `σ > 0`; `σ`
 //!    follows the residual (in units of the points' mean compliance), ten times more after an
 //!    inner solve that failed, coming back down by halves.
 //!
-//!    Then, where `D` is sparse or asymmetric and both stages stalled, Newton again under the
-//!    rules of a dense symmetric `D` (damped steps against the history, no patience rule),
+//!    Then, where `D` is sparse or asymmetric and both stages stalled, Newton again from
+//!    stage 1's best iterate under the rules of a dense symmetric `D` (damped steps against
+//!    the history, no patience rule),
 //!    for at most ten times `max_iters` steps: stage 1's stricter rules keep it cheap on the
 //!    problems it solves, and can stop it short of an active set a longer search finds.
 //! 3. **Fallback**, capped: for Coulomb's law the block Gauss–Seidel method
@@ -62,7 +64,8 @@ pub struct NewtonParams {
     pub measure: Measure,
     /// Newton steps on the problem itself before the proximal stage takes over.
     pub max_iters: usize,
-    /// Outer steps of the proximal stage (0: no proximal stage).
+    /// Outer steps of the proximal stage (0: no proximal stage). Its inner Newton steps are
+    /// capped too, at 20 000 in all.
     pub max_proximal: usize,
     /// Power iterations for `μ_max`.
     pub power_iters: usize,
@@ -100,7 +103,7 @@ impl Default for NewtonParams {
             tol: 1e-10,
             measure: Measure::Complementarity,
             max_iters: 100,
-            max_proximal: 200,
+            max_proximal: 1000,
             power_iters: 30,
             mu_max: None,
             weakening: None,
@@ -126,9 +129,15 @@ const MAX_HALVINGS: usize = 30;
 const PATIENCE: usize = 15;
 /// The lenient Newton stage's steps, in units of `max_iters`.
 const LENIENT_STEPS: usize = 10;
-/// Newton steps of one proximal problem (no patience rule there: a failed inner solve is
-/// what raises `σ`).
+/// Newton steps of one proximal problem. Its solve also ends, failed, after [`PATIENCE`]
+/// steps without a 10 % gain (as stage 1 does): a failed inner solve is what raises `σ`, and
+/// one that has stalled at this `σ` seldom recovers (on Siconos' rigid multibody problems the
+/// inner solves that spent all 100 steps had made no 10 % gain in any of them).
 const INNER_STEPS: usize = 100;
+/// Newton steps the proximal stage may take in all its inner solves: the stage's worst case
+/// of 200 outer steps of [`INNER_STEPS`] each, from before the inner solves had a patience
+/// rule (the outer steps that rule saves go to more outer steps, up to `max_proximal`).
+const PROXIMAL_STEPS: usize = 200 * INNER_STEPS;
 /// The tolerance of one proximal problem's solve, relative to the outer residual.
 const INNER_RATIO: f64 = 0.1;
 /// The proximal shift's bounds, relative to the points' mean compliance.
@@ -460,9 +469,13 @@ fn proximal_stage(
     // compliance after an inner solve that converged, ten times more after one that failed
     let mut boost = 1.0;
     let mut last = End::Stalled(Stall::IterationLimit);
+    let first_step = info.newton_iters;
     for outer in 1..=params.max_proximal {
         if let Some(why) = params.interrupt.check() {
             return End::Interrupted(why);
+        }
+        if info.newton_iters - first_step >= PROXIMAL_STEPS {
+            return last;
         }
         let sigma = (boost * residual).clamp(SIGMA_MIN, SIGMA_MAX);
         let problem = judge.flat.proximal(sigma * unit, &center);
@@ -476,7 +489,7 @@ fn proximal_stage(
             s0,
             INNER_STEPS,
             MEMORY,
-            INNER_STEPS,
+            PATIENCE,
             false,
             None,
             &params.interrupt,
@@ -990,7 +1003,7 @@ fn stall_error(info: &ContactInfo, residual: f64, reason: Stall, best: Option<It
 }
 
 /// Newton's stages from `x0` (docs/theory.md, "Semismooth Newton"), each from the best iterate
-/// of those before, each run only where the ones before stalled:
+/// of those before (stage 2b from stage 1's), each run only where the ones before stalled:
 ///
 /// | stage | what | where |
 /// |---|---|---|
@@ -1021,11 +1034,15 @@ fn newton_stages(
         seed: judge.seed,
     };
     let mut end = judged_steps(judge, &directions, s, strict, params, info, progress);
+    // stage 2b goes on with stage 1's search: from stage 1's best, not from where the
+    // proximal iterates wandered (on a problem past uniqueness they can end near a point
+    // Newton does not leave: measured on a multibody problem, fclib.rs)
+    let stage_1 = judge.best.get().map(|(start, _)| start.clone());
     if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
         end = proximal_stage(judge, &directions, params, info, progress);
     }
     if matches!(end, End::Stalled(_)) && !directions.symmetric_dense() {
-        if let Some((start, _)) = judge.best.get().cloned() {
+        if let Some(start) = stage_1 {
             let steps = LENIENT_STEPS * params.max_iters;
             let lenient = Rules {
                 steps,
