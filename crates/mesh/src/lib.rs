@@ -40,6 +40,7 @@ pub use ordering::nested_dissection;
 pub use parts::MeshParts;
 pub use quality::QualityReport;
 
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// The kind of every cell of a mesh (meshes hold one kind).
@@ -352,36 +353,55 @@ impl Mesh {
 
     /// As [`Mesh::node_graph`], counting only the cells `c` with `keep(c)`; a node in no kept
     /// cell is its own only neighbour.
-    pub fn node_graph_where(&self, keep: impl Fn(usize) -> bool) -> (Vec<usize>, Vec<usize>) {
+    pub fn node_graph_where(&self, keep: impl Fn(usize) -> bool + Sync) -> (Vec<usize>, Vec<usize>) {
         self.node_graph_from(&self.node_cells(), keep)
     }
 
     /// As [`Mesh::node_graph_where`], from the cells of each node already computed by
-    /// [`Mesh::node_cells`] (so that several graphs share one pass over the cells).
+    /// [`Mesh::node_cells`] (so that several graphs share one pass over the cells). Blocks of
+    /// nodes are gathered on rayon's pool, then joined in order.
     pub fn node_graph_from(
         &self,
         node_cells: &(Vec<usize>, Vec<usize>),
-        keep: impl Fn(usize) -> bool,
+        keep: impl Fn(usize) -> bool + Sync,
     ) -> (Vec<usize>, Vec<usize>) {
+        /// Nodes gathered by one task.
+        const BLOCK: usize = 4096;
         let n = self.n_nodes();
         let k = self.kind.n_nodes();
         let (count, node_cells) = (&node_cells.0, &node_cells.1);
+        // each block: the neighbour count of each of its nodes, and the neighbours in order
+        let blocks: Vec<(Vec<usize>, Vec<usize>)> = (0..n.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let nodes = b * BLOCK..((b + 1) * BLOCK).min(n);
+                let mut lens = Vec::with_capacity(nodes.len());
+                let mut nbrs = Vec::with_capacity(nodes.len() * 8);
+                let mut scratch = Vec::with_capacity(64);
+                for i in nodes {
+                    scratch.clear();
+                    for &c in node_cells[count[i]..count[i + 1]].iter().filter(|&&c| keep(c)) {
+                        scratch.extend_from_slice(&self.cells[c * k..(c + 1) * k]);
+                    }
+                    if scratch.is_empty() {
+                        scratch.push(i);
+                    }
+                    scratch.sort_unstable();
+                    scratch.dedup();
+                    nbrs.extend_from_slice(&scratch);
+                    lens.push(scratch.len());
+                }
+                (lens, nbrs)
+            })
+            .collect();
         let mut offsets = Vec::with_capacity(n + 1);
         offsets.push(0);
-        let mut nbrs = Vec::with_capacity(n * 8);
-        let mut scratch = Vec::with_capacity(64);
-        for i in 0..n {
-            scratch.clear();
-            for &c in node_cells[count[i]..count[i + 1]].iter().filter(|&&c| keep(c)) {
-                scratch.extend_from_slice(&self.cells[c * k..(c + 1) * k]);
+        let mut nbrs = Vec::with_capacity(blocks.iter().map(|b| b.1.len()).sum());
+        for (lens, block) in blocks {
+            for len in lens {
+                offsets.push(offsets[offsets.len() - 1] + len);
             }
-            if scratch.is_empty() {
-                scratch.push(i);
-            }
-            scratch.sort_unstable();
-            scratch.dedup();
-            nbrs.extend_from_slice(&scratch);
-            offsets.push(nbrs.len());
+            nbrs.extend_from_slice(&block);
         }
         (offsets, nbrs)
     }

@@ -2,40 +2,76 @@
 //! of each axis they extend along, keep the split with the fewest separator nodes (the nodes of
 //! one half that touch the other), order the two halves recursively and the separator last. On meshes of planar or
 //! solid bodies this gives the O(n log n) fill of nested dissection (George, 1973), less than
-//! minimum degree on 2D grids.
+//! minimum degree on 2D grids. The two halves of a large part are ordered at the same time on
+//! rayon's pool; the order does not depend on the number of threads.
+
+use rayon::join;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Parts smaller than this are ordered as they come (the factorisation's own supernodes and
 /// their dense kernels handle small blocks best).
 const LEAF: usize = 64;
 
+/// Parts with at least this many nodes have their two halves ordered on two threads (below it,
+/// a task costs more than it saves).
+const PARALLEL: usize = 2048;
+
+/// Marks of the nodes for the splits under way, one array per axis (a part's splits along its
+/// axes run at the same time): each median split marks its left half with a tag of its own,
+/// so that splits of disjoint parts on different threads never read each other's marks as
+/// theirs (a node outside the part carries another split's tag, or none).
+struct Marks {
+    side: [Vec<AtomicU32>; 3],
+    next: AtomicU32,
+}
+
+impl Marks {
+    fn new(n: usize) -> Marks {
+        Marks {
+            side: std::array::from_fn(|_| (0..n).map(|_| AtomicU32::new(0)).collect()),
+            next: AtomicU32::new(1),
+        }
+    }
+
+    /// A tag no split has used.
+    fn fresh(&self) -> u32 {
+        self.next.fetch_add(1, Relaxed)
+    }
+}
+
 /// The nested-dissection order of the nodes (`order[new] = old`), from node coordinates and the
 /// node adjacency in compressed form (as [`crate::Mesh::node_graph`] returns it).
 pub fn nested_dissection(points: &[[f64; 3]], graph: &(Vec<usize>, Vec<usize>)) -> Vec<usize> {
     let n = points.len();
-    let mut order = Vec::with_capacity(n);
-    let mut side = vec![0u8; n]; // scratch: 1 = left, 2 = right of the current split
-    let mut stack: Vec<(Vec<usize>, bool)> = vec![((0..n).collect(), false)];
-    let mut out_stack: Vec<Vec<usize>> = vec![];
-    while let Some((part, done)) = stack.pop() {
-        if done || part.len() <= LEAF {
-            out_stack.push(part);
-            continue;
-        }
-        let (left, right, sep) = split(points, graph, &part, &mut side);
-        if left.is_empty() || right.is_empty() {
-            out_stack.push(part);
-            continue;
-        }
-        // LIFO: the left part is processed first, then the right, then the separator
-        stack.push((sep, true));
-        stack.push((right, false));
-        stack.push((left, false));
-    }
-    // leaves come out as left subtree, right subtree, separator, recursively
-    for leaf in out_stack {
-        order.extend(leaf);
-    }
+    let marks = Marks::new(n);
+    let order = dissect(points, graph, (0..n).collect(), &marks);
     debug_assert_eq!(order.len(), n);
+    order
+}
+
+/// The order of `part`: its left half's, its right half's, then the separator.
+fn dissect(points: &[[f64; 3]], graph: &(Vec<usize>, Vec<usize>), part: Vec<usize>, marks: &Marks) -> Vec<usize> {
+    if part.len() <= LEAF {
+        return part;
+    }
+    let (left, right, sep) = split(points, graph, &part, marks);
+    if left.is_empty() || right.is_empty() {
+        return part;
+    }
+    let (mut order, right) = if part.len() >= PARALLEL {
+        join(
+            || dissect(points, graph, left, marks),
+            || dissect(points, graph, right, marks),
+        )
+    } else {
+        (
+            dissect(points, graph, left, marks),
+            dissect(points, graph, right, marks),
+        )
+    };
+    order.extend(right);
+    order.extend(sep);
     order
 }
 
@@ -43,7 +79,7 @@ fn split(
     points: &[[f64; 3]],
     graph: &(Vec<usize>, Vec<usize>),
     part: &[usize],
-    side: &mut [u8],
+    marks: &Marks,
 ) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -53,11 +89,18 @@ fn split(
             hi[k] = hi[k].max(points[v][k]);
         }
     }
-    // the median split along each axis the part extends in, the smallest separator kept: on
-    // a graded mesh the longest axis in space may cut across the most nodes
+    // the median split along each axis the part extends in, the smallest separator kept (the
+    // first axis of those): on a graded mesh the longest axis in space may cut across the most
+    // nodes. Large parts try their axes at the same time (each axis has its own marks).
+    let axes: Vec<usize> = (0..3).filter(|&k| hi[k] > lo[k]).collect();
+    let cut = |&axis: &usize| split_along(points, graph, part, marks, axis);
+    let cuts: Vec<_> = if part.len() >= PARALLEL {
+        axes.par_iter().map(cut).collect()
+    } else {
+        axes.iter().map(cut).collect()
+    };
     let mut best: Option<(Vec<usize>, Vec<usize>, Vec<usize>)> = None;
-    for axis in (0..3).filter(|&k| hi[k] > lo[k]) {
-        let cut = split_along(points, graph, part, side, axis);
+    for cut in cuts {
         if best.as_ref().is_none_or(|b| cut.2.len() < b.2.len()) {
             best = Some(cut);
         }
@@ -71,7 +114,7 @@ fn split_along(
     points: &[[f64; 3]],
     graph: &(Vec<usize>, Vec<usize>),
     part: &[usize],
-    side: &mut [u8],
+    marks: &Marks,
     axis: usize,
 ) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
     let (off, nbr) = graph;
@@ -81,24 +124,19 @@ fn split_along(
         points[a][axis].total_cmp(&points[b][axis]).then(a.cmp(&b))
     });
     let (left_half, right_half) = sorted.split_at(mid);
+    let (tag, side) = (marks.fresh(), &marks.side[axis]);
     for &v in left_half {
-        side[v] = 1;
-    }
-    for &v in right_half {
-        side[v] = 2;
+        side[v].store(tag, Relaxed);
     }
     let mut left = left_half.to_vec();
     let mut right = Vec::with_capacity(right_half.len());
     let mut sep = vec![];
     for &v in right_half {
-        if nbr[off[v]..off[v + 1]].iter().any(|&w| side[w] == 1) {
+        if nbr[off[v]..off[v + 1]].iter().any(|&w| side[w].load(Relaxed) == tag) {
             sep.push(v);
         } else {
             right.push(v);
         }
-    }
-    for &v in part {
-        side[v] = 0;
     }
     left.sort_unstable();
     right.sort_unstable();
@@ -120,7 +158,7 @@ mod tests {
             &m.points,
             &g,
             &(0..m.n_nodes()).collect::<Vec<_>>(),
-            &mut vec![0; m.n_nodes()],
+            &Marks::new(m.n_nodes()),
         );
         // (the median falls inside a row: a row and a node of the next)
         assert!(sep.len() <= 6, "separator {sep:?}");
@@ -155,6 +193,32 @@ mod tests {
                     in_sep(w) || m.points[w][0] <= 1.0 + 1e-12,
                     "edge {v}-{w} crosses the separator"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn the_order_does_not_depend_on_the_threads() {
+        // above PARALLEL nodes: halves and axes on different threads, marks shared
+        for m in [
+            crate::box_tet([0.0; 3], [2.0, 1.4, 1.0], 24, 16, 12),
+            crate::rectangle_tri([0.0, 0.0], [3.0, 1.0], 150, 50),
+        ] {
+            let g = m.node_graph();
+            let on = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| (nested_dissection(&m.points, &g), m.node_graph()))
+            };
+            let (one, graph) = on(1);
+            assert!(m.n_nodes() > 2 * PARALLEL);
+            assert_eq!(graph, g);
+            let mut seen = one.clone();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..m.n_nodes()).collect::<Vec<_>>());
+            for threads in [2, 3] {
+                for _ in 0..3 {
+                    assert_eq!(on(threads), (one.clone(), g.clone()), "{threads} threads");
+                }
             }
         }
     }
