@@ -8,9 +8,10 @@
 //! anonymous mapping so advised gets them; where it does not (or the advice is refused, or not
 //! Linux), the mapping behaves as any zeroed memory. Small factors keep a `Vec`.
 //!
-//! The mapping's pages are faulted in at once on every thread of rayon's pool, one write per
-//! page, rather than one by one by the factorisation: the kernel's work per fault (zeroing a
-//! page, finding a huge one) then runs on all cores. Measured on `paper` at n = 256 (541 MB),
+//! Where rayon's pool has several threads, the mapping's pages are faulted in at once on all
+//! of them, one write per page, rather than one by one by the factorisation: the kernel's work
+//! per fault (zeroing a page, finding a huge one) then runs on all cores. (On one thread there
+//! is nothing to gain: the same faults, one after another, sooner.) Measured on `paper` at n = 256 (541 MB),
 //! two threads, first factorisations in fresh processes: analysis, factorisation and solve
 //! 1.53 s without, 1.41 s with (medians of 6); the touch alone, sequential 0.07-0.67 s (the
 //! kernel's huge pages come fast or slow), on two threads 0.035-0.32 s.
@@ -39,7 +40,9 @@ impl Values {
                     // a hint: refused or unavailable, the pages are small ones
                     let _ = map.advise(memmap2::Advice::HugePage);
                 }
-                fault_in(&mut map);
+                if rayon::current_num_threads() > 1 {
+                    fault_in(&mut map);
+                }
                 return Values::Mapped { map, len };
             }
         }
