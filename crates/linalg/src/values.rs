@@ -10,11 +10,11 @@
 //!
 //! Where rayon's pool has several threads, the mapping's pages are faulted in at once on all
 //! of them, one write per page, rather than one by one by the factorisation: the kernel's work
-//! per fault (zeroing a page, finding a huge one) then runs on all cores. (On one thread there
-//! is nothing to gain: the same faults, one after another, sooner.) Measured on `paper` at n = 256 (541 MB),
-//! two threads, first factorisations in fresh processes: analysis, factorisation and solve
-//! 1.53 s without, 1.41 s with (medians of 6); the touch alone, sequential 0.07-0.67 s (the
-//! kernel's huge pages come fast or slow), on two threads 0.035-0.32 s.
+//! per fault (zeroing a page, finding a huge one) then runs on all cores. On one thread there
+//! is nothing to gain (the same faults, one after another, sooner). Measured on `paper` at
+//! n = 256 (541 MB of values), two threads, first factorisations in fresh processes: analysis,
+//! factorisation and solve 1.45 s without, 1.32 s with (medians of 6); the touch alone took
+//! 0.07-0.67 s on one thread (the kernel's huge pages come fast or slow), 0.035-0.32 s on two.
 
 use memmap2::{MmapMut, MmapOptions};
 use rayon::prelude::*;
