@@ -1,10 +1,10 @@
 //! A large factor's values in memory advised to use transparent huge pages.
 //!
-//! A fresh factor's values are touched first by the numeric factorisation: at 4 KB pages that
-//! is one page fault per 512 values, 147 000 for the 576 MB of `paper` at n = 256, measured at
-//! 0.36 s on this project's machine; at 2 MB pages, 0.05 s, and the dense kernels of a 3D
-//! factor miss the TLB less. Where the kernel offers transparent huge pages on request
-//! (`/sys/kernel/mm/transparent_hugepage/enabled` = `madvise`, as on that machine) an
+//! The first touch of a fresh factor's values faults its pages in: at 4 KB pages that is one
+//! fault per 512 values, 147 000 for a 576 MB factor (what `paper` at n = 256 held when this
+//! was measured), 0.36 s on this project's machine; at 2 MB pages, 0.05 s, and the dense
+//! kernels of a 3D factor miss the TLB less. Where the kernel offers transparent huge pages on
+//! request (`/sys/kernel/mm/transparent_hugepage/enabled` = `madvise`, as on that machine) an
 //! anonymous mapping so advised gets them; where it does not (or the advice is refused, or not
 //! Linux), the mapping behaves as any zeroed memory. Small factors keep a `Vec`.
 //!

@@ -1036,8 +1036,12 @@ fn newton_stages(
     let mut end = judged_steps(judge, &directions, s, strict, params, info, progress);
     // stage 2b goes on with stage 1's search: from stage 1's best, not from where the
     // proximal iterates wandered (on a problem past uniqueness they can end near a point
-    // Newton does not leave: measured on a multibody problem, fclib.rs)
-    let stage_1 = judge.best.get().map(|(start, _)| start.clone());
+    // Newton does not leave: measured on a multibody problem, fclib.rs); kept only where
+    // stage 2b may run
+    let lenient_may_run = matches!(end, End::Stalled(_)) && !directions.symmetric_dense();
+    let stage_1 = lenient_may_run
+        .then(|| judge.best.get().map(|(start, _)| start.clone()))
+        .flatten();
     if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
         end = proximal_stage(judge, &directions, params, info, progress);
     }
