@@ -166,6 +166,9 @@ pub enum Stall {
     NonFinite,
     /// Steps that no longer lowered the residual, even with a smaller step size.
     NoProgress,
+    /// Steps that came back to the branches (the active set) of an earlier iterate without a
+    /// gain: a cycle.
+    Cycle,
 }
 
 impl std::fmt::Display for Stall {
@@ -176,6 +179,7 @@ impl std::fmt::Display for Stall {
             Stall::LineSearch => "a failed line search",
             Stall::NonFinite => "a non-finite residual",
             Stall::NoProgress => "no progress",
+            Stall::Cycle => "a cycle of active sets",
         })
     }
 }

@@ -32,6 +32,21 @@ impl RowForm {
     }
 }
 
+/// The pattern of a generalised Jacobian: which entries each row holds (so the branch of every
+/// point: in contact or separated, sticking or slipping), hashed. Iterates of one pattern take
+/// their Newton steps on the same piece of the equations.
+pub(super) fn pattern(rows: &[RowForm]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    for row in rows {
+        (row.e.len(), row.b.len()).hash(&mut hasher);
+        for &(j, _) in row.e.iter().chain(&row.b) {
+            j.hash(&mut hasher);
+        }
+    }
+    hasher.finish()
+}
+
 /// The floor of the electric residual's denominator, relative to the ideal conductor's flux
 /// scale ([`Flat::electric_residual`]).
 const ELECTRIC_FLOOR: f64 = 1e-6;
