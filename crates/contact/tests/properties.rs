@@ -1090,6 +1090,62 @@ fn a_cycle_of_active_sets_is_left() {
     }
 }
 
+/// A warm start that meets the tolerance on changed data is the answer as it is, or, with
+/// `refine_start`, the start of Newton steps whose answer follows the change: force control's
+/// search for a depth needs the force of each depth, not of the one before.
+#[test]
+fn a_refined_warm_start_follows_the_data_below_the_tolerance() {
+    let (op, mut pts) = chain(80, 1, 0.1, 0.02, 0.3);
+    let law = Law::Coulomb;
+    let params = NewtonParams {
+        tol: 1e-10,
+        ..Default::default()
+    };
+    let first = solve_newton(&mut op.clone(), &pts, &law, &params, None, &mut |_| {}).unwrap();
+    // the gaps lowered by far less than the tolerance can see in the multipliers
+    pts.gap.iter_mut().for_each(|g| *g -= 1e-11);
+    let again = |refine_start: bool| {
+        let params = NewtonParams { refine_start, ..params };
+        solve_newton(
+            &mut op.clone(),
+            &pts,
+            &law,
+            &params,
+            Some(first.lambda.clone()),
+            &mut |_| {},
+        )
+        .unwrap()
+    };
+    let (kept, refined) = (again(false), again(true));
+    let exact = solve_newton(
+        &mut op.clone(),
+        &pts,
+        &law,
+        &NewtonParams { tol: 1e-14, ..params },
+        None,
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(kept.info.newton_iters, 0);
+    assert_eq!(kept.lambda, first.lambda);
+    assert!(refined.info.newton_iters >= 1);
+    let force = |l: &PointValues| l.normal.iter().zip(&pts.weight).map(|(a, w)| a * w).sum::<f64>();
+    let f = force(&exact.lambda);
+    assert!(
+        (force(&refined.lambda) - f).abs() <= 1e-14 * f,
+        "{} {}",
+        force(&refined.lambda),
+        f
+    );
+    // the start itself is off by more than that
+    assert!(
+        (force(&first.lambda) - f).abs() > 1e3 * 1e-14 * f,
+        "{} {}",
+        force(&first.lambda),
+        f
+    );
+}
+
 /// The nested start over many chains of the property test's kind, drawn from a fixed seed:
 /// the same answers, each from a coarser problem, in far fewer Newton steps in all.
 #[test]

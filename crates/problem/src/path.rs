@@ -425,7 +425,7 @@ impl Walk<'_> {
                 path.prime(&boundary, &factors, &state.shift);
                 let start = state.start.take();
                 crate::faer_backend::force_controlled(&mut boundary.points, force * f.load, start, |points, warm| {
-                    path.solve_at(how, points, warm, reporter)
+                    path.force_search_at(how, points, warm, reporter)
                 })?
             }
             None => path.contact(how, &boundary, &factors, &state.shift, state.start.take(), reporter)?,

@@ -93,6 +93,12 @@ pub struct NewtonParams {
     /// compliance, constant friction coefficients), for as long as their measured rate
     /// promises the tolerance within the cost of some Newton steps.
     pub sweeps_first: bool,
+    /// Whether a start that already meets the tolerance still takes Newton steps, until one
+    /// meets it (the answer is then a Newton iterate, not the start; the start where they
+    /// stall). For a warm start on changed data whose answer must follow the data more closely
+    /// than the tolerance: force control's search for a depth evaluates the force at each
+    /// depth, and a start taken as it is carries the force of the depth before.
+    pub refine_start: bool,
     /// A deadline or a cancel flag.
     pub interrupt: Interrupt,
 }
@@ -111,6 +117,7 @@ impl Default for NewtonParams {
             max_fallback_iters: 200_000,
             nested_start: true,
             sweeps_first: true,
+            refine_start: false,
             interrupt: Interrupt::NONE,
         }
     }
@@ -1085,8 +1092,10 @@ fn newton_stages(
     cache: &mut Option<Directions>,
 ) -> End {
     let s = judge.flat.state(x0);
-    let (_, done) = judge.offer(&s);
-    if done {
+    // a start that meets the tolerance is the answer, or, where asked, kept aside for the
+    // Newton iterates that follow it (offered only if they stall)
+    let refined = (params.refine_start && judge.residual(&s) <= judge.tol).then(|| s.clone());
+    if refined.is_none() && judge.offer(&s).1 {
         return End::Converged;
     }
     let directions = cache.get_or_insert_with(|| Directions::new(&judge.flat)).clone();
@@ -1100,6 +1109,10 @@ fn newton_stages(
         cycles: params.max_proximal > 0,
     };
     let mut end = judged_steps(judge, &directions, s, strict, params, info, progress);
+    if let (Some(start), End::Stalled(_)) = (refined, &end) {
+        judge.offer(&start);
+        return End::Converged;
+    }
     // stage 2b goes on with stage 1's search: from stage 1's best, not from where the
     // proximal iterates wandered (on a problem past uniqueness they can end near a point
     // Newton does not leave: measured on a multibody problem, fclib.rs); kept only where
