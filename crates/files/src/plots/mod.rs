@@ -9,6 +9,7 @@
 pub mod mesh_view;
 
 use crate::Error;
+use plotters::coord::combinators::WithKeyPoints;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::Once;
@@ -300,7 +301,7 @@ fn draw_loglog<DB: DrawingBackend>(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .build_cartesian_2d(log_axis(x0, x1), log_axis(y0, y1))
         .map_err(e)?;
     chart
         .configure_mesh()
@@ -345,6 +346,41 @@ fn draw_loglog<DB: DrawingBackend>(
     Ok(())
 }
 
+/// A log axis over `lo..hi` with its marks: labelled at 1, 2 and 5 times the powers of ten
+/// where it spans at most 2 decades, at the powers of ten (every few where there are more than
+/// 8) beyond, and fine lines at each integer multiple up to 8 decades. Plotters' own marks start
+/// at the first power of ten in the range (a range from 0.04 to 1.5 had none below 0.1) and
+/// crowd their labels at the top of a decade ("8e-19e-11e0").
+fn log_axis(lo: f64, hi: f64) -> WithKeyPoints<LogCoord<f64>> {
+    let (bold, light) = log_marks(lo, hi);
+    (lo..hi).log_scale().with_key_points(bold).with_light_points(light)
+}
+
+/// The labelled and the fine marks of [`log_axis`].
+fn log_marks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let decades = (hi / lo).log10();
+    let inside = |v: &f64| (lo..=hi).contains(v);
+    let multiples = |ms: &[f64], step: i32| -> Vec<f64> {
+        (first..=last)
+            .filter(|k| k.rem_euclid(step) == 0)
+            .flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(inside)
+            .collect()
+    };
+    let bold = if decades <= 2.0 {
+        multiples(&[1.0, 2.0, 5.0], 1)
+    } else {
+        multiples(&[1.0], (decades / 8.0).ceil().max(1.0) as i32)
+    };
+    let light = if decades <= 8.0 {
+        multiples(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], 1)
+    } else {
+        multiples(&[1.0], 1)
+    };
+    (bold, light)
+}
+
 /// A log-log chart as SVG and PNG, named `name`. Points with a non-positive or non-finite x
 /// are left out; y is clamped to the axis.
 ///
@@ -380,5 +416,22 @@ mod tests {
             series: vec![],
         };
         assert_eq!(panels("empty", &[empty]).unwrap().len(), 2);
+    }
+
+    /// A log axis is labelled inside its range, below its first power of ten too, at 1, 2
+    /// and 5 times the powers over a short range and at some powers over a long one.
+    #[test]
+    fn log_axes_are_labelled_across_their_range() {
+        let close =
+            |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * y);
+        let (bold, light) = log_marks(0.035, 1.5);
+        assert!(close(&bold, &[0.05, 0.1, 0.2, 0.5, 1.0]), "{bold:?}");
+        assert_eq!(light.len(), 6 + 9 + 1, "{light:?}");
+        // 20 decades: every third power of ten
+        let (bold, light) = log_marks(1e-17, 1e3);
+        assert!(close(&bold, &[1e-15, 1e-12, 1e-9, 1e-6, 1e-3, 1.0, 1e3]), "{bold:?}");
+        assert_eq!(light.len(), 21);
+        let (bold, _) = log_marks(2e-3, 5e2);
+        assert!(close(&bold, &[1e-2, 1e-1, 1.0, 1e1, 1e2]), "{bold:?}");
     }
 }
