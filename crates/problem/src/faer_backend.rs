@@ -348,22 +348,12 @@ impl ContactSolve<'_> {
         self.run_with(problem, points, start, false, reporter)
     }
 
-    /// [`ContactSolve::run`] for one depth of force control's search ([`force_controlled`]):
-    /// Newton takes steps from a warm start that already meets the tolerance
-    /// ([`NewtonParams::refine_start`]), so that the force found is this depth's. Taken as it
+    /// [`ContactSolve::run`], where `refine_start` asks Newton to take steps from a warm start
+    /// that already meets the tolerance ([`NewtonParams::refine_start`]): one depth of force
+    /// control's search ([`force_controlled`]), whose force must be this depth's. Taken as it
     /// was, the start of the depth before carried its force: the search's residual stood still
     /// while the depth moved, and it ended on a force 3e-8 off (`hertz-sphere` n = 96 on a
     /// 20-step path, at t = 0.3).
-    fn run_refined(
-        &self,
-        problem: Operator<'_>,
-        points: &ContactPoints,
-        start: Option<PointValues>,
-        reporter: &mut dyn Reporter,
-    ) -> Result<ContactSolution, ProblemError> {
-        self.run_with(problem, points, start, true, reporter)
-    }
-
     fn run_with(
         &self,
         problem: Operator<'_>,
@@ -432,7 +422,7 @@ const FORCE_TOL: f64 = 1e-10;
 /// by the Illinois variant of regula falsi, each evaluation a contact solve (`solve`, on the
 /// points with their gaps lowered, from the last multipliers, the first from `start`) on the
 /// same condensed compliance, which must take Newton steps from a start that already meets its
-/// tolerance ([`ContactSolve::run_refined`]). A zero force (a path's load factor at 0) is met with the
+/// tolerance ([`ContactSolve::run_with`]). A zero force (a path's load factor at 0) is met with the
 /// indenter just touching (every shallower depth carries none too). Leaves the points with the
 /// gaps of the depth found, and returns its solution.
 pub(crate) fn force_controlled(
@@ -668,7 +658,7 @@ fn solve_contact(
             system.condense = Some(condense);
             let sol = match indenter_force(posed) {
                 Some(force) => force_controlled(&mut boundary.points, force, None, |points, start| {
-                    how.run_refined(Operator::Condensed(&mut dense), points, start, reporter)
+                    how.run_with(Operator::Condensed(&mut dense), points, start, true, reporter)
                 })?,
                 None => how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?,
             };
@@ -1020,7 +1010,7 @@ impl PathSystem {
     }
 
     /// The contact solve of the primed step ([`PathSystem::prime`]) at one depth of a force
-    /// search: `points` with that depth's gaps ([`ContactSolve::run_refined`]).
+    /// search: `points` with that depth's gaps, refined ([`ContactSolve::run_with`]).
     pub(crate) fn force_search_at(
         &mut self,
         how: &ContactSolve<'_>,
@@ -1028,7 +1018,7 @@ impl PathSystem {
         start: Option<PointValues>,
         reporter: &mut dyn Reporter,
     ) -> Result<ContactSolution, ProblemError> {
-        how.run_refined(Operator::Condensed(&mut self.dense), points, start, reporter)
+        how.run_with(Operator::Condensed(&mut self.dense), points, start, true, reporter)
     }
 
     /// The fields of a step under the loads of `posed` and the contact forces of `sol` (in
