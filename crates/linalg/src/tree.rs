@@ -215,36 +215,18 @@ pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv
     if fwd.len() != n || inv.len() != n {
         return None;
     }
-    // for each new column k, the new rows i < k of its upper part
-    let sym = a.symbolic();
-    let mut ptr = vec![0usize; n + 1];
-    for j in 0..n {
-        for &i in sym.row_idx_of_col_raw(j) {
-            let (pi, pj) = (inv[i], inv[j]);
-            if pi != pj {
-                ptr[pi.max(pj) + 1] += 1;
-            }
-        }
-    }
-    for k in 0..n {
-        ptr[k + 1] += ptr[k];
-    }
-    let mut next = ptr.clone();
-    let mut upper = vec![0usize; ptr[n]];
-    for j in 0..n {
-        for &i in sym.row_idx_of_col_raw(j) {
-            let (pi, pj) = (inv[i], inv[j]);
-            if pi != pj {
-                let k = pi.max(pj);
-                upper[next[k]] = pi.min(pj);
-                next[k] += 1;
-            }
-        }
-    }
+    // for each new column k, the new rows i < k of its upper part: gathered by ranges of the
+    // input's columns at the same time, each range's own lists (the tree is the same whatever
+    // the ranges; the lists' page faults and the scattered reads of `inv` shared out)
+    let chunks: Vec<(Vec<usize>, Vec<usize>)> = column_ranges(a, rayon::current_num_threads())
+        .into_par_iter()
+        .map(|cols| upper_lists(a, inv, cols))
+        .collect();
     let mut parent = vec![usize::MAX; n];
     let mut ancestor = vec![usize::MAX; n];
     for k in 0..n {
-        for &i0 in &upper[ptr[k]..ptr[k + 1]] {
+        let rows = chunks.iter().flat_map(|(ptr, upper)| &upper[ptr[k]..ptr[k + 1]]);
+        for &i0 in rows {
             let mut i = i0;
             while i != usize::MAX && i < k {
                 let up = ancestor[i];
@@ -289,6 +271,62 @@ pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv
         }
     }
     Some(out)
+}
+
+/// `0..n` cut into at most `parts` ranges of the columns of `a` with about as many entries
+/// each.
+fn column_ranges(a: SparseColMatRef<'_, usize, f64>, parts: usize) -> Vec<std::ops::Range<usize>> {
+    let n = a.ncols();
+    let sym = a.symbolic();
+    let total: usize = (0..n).map(|j| sym.row_idx_of_col_raw(j).len()).sum();
+    let share = total.div_ceil(parts.max(1)).max(1);
+    let (mut ranges, mut start, mut acc) = (Vec::new(), 0, 0);
+    for j in 0..n {
+        acc += sym.row_idx_of_col_raw(j).len();
+        if acc >= share * (ranges.len() + 1) && ranges.len() + 1 < parts {
+            ranges.push(start..j + 1);
+            start = j + 1;
+        }
+    }
+    ranges.push(start..n);
+    ranges
+}
+
+/// The entries of the columns `cols` of `a` (its lower triangle) in the order `inv`, as lists
+/// by new column `k` of the new rows `i < k` (the upper part of the reordered matrix):
+/// `upper[ptr[k]..ptr[k + 1]]`.
+fn upper_lists(
+    a: SparseColMatRef<'_, usize, f64>,
+    inv: &[usize],
+    cols: std::ops::Range<usize>,
+) -> (Vec<usize>, Vec<usize>) {
+    let n = a.nrows();
+    let sym = a.symbolic();
+    let mut ptr = vec![0usize; n + 1];
+    for j in cols.clone() {
+        for &i in sym.row_idx_of_col_raw(j) {
+            let (pi, pj) = (inv[i], inv[j]);
+            if pi != pj {
+                ptr[pi.max(pj) + 1] += 1;
+            }
+        }
+    }
+    for k in 0..n {
+        ptr[k + 1] += ptr[k];
+    }
+    let mut next = ptr.clone();
+    let mut upper = vec![0usize; ptr[n]];
+    for j in cols {
+        for &i in sym.row_idx_of_col_raw(j) {
+            let (pi, pj) = (inv[i], inv[j]);
+            if pi != pj {
+                let k = pi.max(pj);
+                upper[next[k]] = pi.min(pj);
+                next[k] += 1;
+            }
+        }
+    }
+    (ptr, upper)
 }
 
 /// The columns of `sym` (in its order) reordered so that its supernodes come in postorder,
@@ -710,5 +748,83 @@ mod tests {
             }
         }
         assert_eq!(column_pieces(500, 600, Par::Seq), vec![0, 500]);
+    }
+
+    /// The postorder of a grid Laplacian's elimination tree in a scrambled order is one (every
+    /// column's parent after it, every subtree contiguous), and the same on pools of 1 to 3
+    /// threads, whose ranges of columns gather the pattern in 1 to 3 parts.
+    #[test]
+    fn the_postorder_is_one_and_does_not_depend_on_the_threads() {
+        use faer::sparse::{SparseColMat, Triplet};
+        let side = 23;
+        let n = side * side;
+        let mut t = vec![];
+        for i in 0..n {
+            t.push(Triplet::new(i, i, 4.0));
+            for j in [i + 1, i + side] {
+                if j < n && (j != i + 1 || j % side != 0) {
+                    t.push(Triplet::new(j, i, -1.0));
+                }
+            }
+        }
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
+        // a scrambled order: i * 7 mod n (7 and 529 are coprime)
+        let fwd: Vec<usize> = (0..n).map(|i| i * 7 % n).collect();
+        let mut inv = vec![0; n];
+        for (new, &old) in fwd.iter().enumerate() {
+            inv[old] = new;
+        }
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                (
+                    column_ranges(a.as_ref(), threads),
+                    postordered(a.as_ref(), &fwd, &inv).unwrap(),
+                )
+            })
+        };
+        let (ranges, post) = on(1);
+        assert_eq!(ranges, vec![0..n]);
+        for threads in [2, 3] {
+            let (ranges, again) = on(threads);
+            assert_eq!(ranges.len(), threads);
+            assert!(ranges.windows(2).all(|w| w[0].end == w[1].start) && ranges[threads - 1].end == n);
+            assert_eq!(again, post, "{threads} threads");
+        }
+        // the tree in the postorder: parents after their children, subtrees contiguous
+        let mut post_inv = vec![0; n];
+        for (new, &old) in post.iter().enumerate() {
+            post_inv[old] = new;
+        }
+        let chunks = vec![upper_lists(a.as_ref(), &post_inv, 0..n)];
+        let mut parent = vec![usize::MAX; n];
+        let mut ancestor = vec![usize::MAX; n];
+        for k in 0..n {
+            for &i0 in chunks.iter().flat_map(|(ptr, upper)| &upper[ptr[k]..ptr[k + 1]]) {
+                let mut i = i0;
+                while i != usize::MAX && i < k {
+                    let up = ancestor[i];
+                    ancestor[i] = k;
+                    if up == usize::MAX {
+                        parent[i] = k;
+                    }
+                    i = up;
+                }
+            }
+        }
+        let mut size = vec![1usize; n];
+        for k in 0..n {
+            if parent[k] != usize::MAX {
+                assert!(parent[k] > k);
+                size[parent[k]] += size[k];
+            }
+        }
+        for k in 0..n {
+            let p = parent[k];
+            // k's subtree is the range of its size ending at k, inside its parent's
+            assert!(p == usize::MAX || p + 1 - size[p] <= k + 1 - size[k], "column {k}");
+        }
+        // and postordering it again changes nothing
+        assert_eq!(postordered(a.as_ref(), &post, &post_inv).unwrap(), post);
     }
 }
