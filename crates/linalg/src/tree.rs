@@ -222,22 +222,7 @@ pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv
         .into_par_iter()
         .map(|cols| upper_lists(a, inv, cols))
         .collect();
-    let mut parent = vec![usize::MAX; n];
-    let mut ancestor = vec![usize::MAX; n];
-    for k in 0..n {
-        let rows = chunks.iter().flat_map(|(ptr, upper)| &upper[ptr[k]..ptr[k + 1]]);
-        for &i0 in rows {
-            let mut i = i0;
-            while i != usize::MAX && i < k {
-                let up = ancestor[i];
-                ancestor[i] = k;
-                if up == usize::MAX {
-                    parent[i] = k;
-                }
-                i = up;
-            }
-        }
-    }
+    let parent = elimination_tree(n, &chunks);
     let mut child_ptr = vec![0usize; n + 1];
     for &p in &parent {
         if p != usize::MAX {
@@ -271,6 +256,28 @@ pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv
         }
     }
     Some(out)
+}
+
+/// The parent of each of the `n` columns in the elimination tree (`usize::MAX` for a root), by
+/// Liu's algorithm with path compression, from lists by column `k` of the rows `i < k` of its
+/// upper part (from several ranges of the input's columns: [`upper_lists`]).
+fn elimination_tree(n: usize, lists: &[(Vec<usize>, Vec<usize>)]) -> Vec<usize> {
+    let mut parent = vec![usize::MAX; n];
+    let mut ancestor = vec![usize::MAX; n];
+    for k in 0..n {
+        for &i0 in lists.iter().flat_map(|(ptr, upper)| &upper[ptr[k]..ptr[k + 1]]) {
+            let mut i = i0;
+            while i != usize::MAX && i < k {
+                let up = ancestor[i];
+                ancestor[i] = k;
+                if up == usize::MAX {
+                    parent[i] = k;
+                }
+                i = up;
+            }
+        }
+    }
+    parent
 }
 
 /// `0..n` cut into at most `parts` ranges of the columns of `a` with about as many entries
@@ -796,22 +803,7 @@ mod tests {
         for (new, &old) in post.iter().enumerate() {
             post_inv[old] = new;
         }
-        let chunks = vec![upper_lists(a.as_ref(), &post_inv, 0..n)];
-        let mut parent = vec![usize::MAX; n];
-        let mut ancestor = vec![usize::MAX; n];
-        for k in 0..n {
-            for &i0 in chunks.iter().flat_map(|(ptr, upper)| &upper[ptr[k]..ptr[k + 1]]) {
-                let mut i = i0;
-                while i != usize::MAX && i < k {
-                    let up = ancestor[i];
-                    ancestor[i] = k;
-                    if up == usize::MAX {
-                        parent[i] = k;
-                    }
-                    i = up;
-                }
-            }
-        }
+        let parent = elimination_tree(n, &[upper_lists(a.as_ref(), &post_inv, 0..n)]);
         let mut size = vec![1usize; n];
         for k in 0..n {
             if parent[k] != usize::MAX {
