@@ -19,7 +19,7 @@
 //!    semidefinite, as for rigid multibody problems; a line search that fails; a cycle): a
 //!    sequence of regularised problems `u_σ(λ) = u(λ) - σ (λ - λ_k)`, each solved by Newton
 //!    to a tenth of the current residual (an inner solve that stalls, by stage 1's patience
-//!    rule, has failed), whose solutions converge to a solution of the
+//!    or cycle rule, has failed), whose solutions converge to a solution of the
 //!    problem itself (Rockafellar's proximal point algorithm; Siconos' PROX solver is this
 //!    method around its Alart–Curnier Newton). `D + σ W⁻¹` is definite for any `σ > 0`; `σ`
 //!    follows the residual (in units of the points' mean compliance), ten times more after an
@@ -152,10 +152,12 @@ const REVISITS: usize = 4;
 const COARSE_PROXIMAL: usize = 20;
 /// The lenient Newton stage's steps, in units of `max_iters`.
 const LENIENT_STEPS: usize = 10;
-/// Newton steps of one proximal problem. Its solve also ends, failed, after [`PATIENCE`]
-/// steps without a 10 % gain (as stage 1 does): a failed inner solve is what raises `σ`, and
-/// one that has stalled at this `σ` seldom recovers (on Siconos' rigid multibody problems the
-/// inner solves that spent all 100 steps had made no 10 % gain in any of them).
+/// Newton steps of one proximal problem. Its solve also ends, failed, as stage 1's does: after
+/// [`PATIENCE`] steps without a 10 % gain where `D` is sparse or asymmetric, on a cycle of
+/// active sets ([`REVISITS`]) where it is dense and symmetric. A failed inner solve is what
+/// raises `σ`, and one that has stalled at this `σ` seldom recovers (on Siconos' rigid
+/// multibody problems the inner solves that spent all 100 steps had made no 10 % gain in any
+/// of them).
 const INNER_STEPS: usize = 100;
 /// Newton steps the proximal stage may take in all its inner solves: the stage's worst case
 /// of 200 outer steps of [`INNER_STEPS`] each, from before the inner solves had a patience
