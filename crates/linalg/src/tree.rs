@@ -16,6 +16,7 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{cholesky_in_place, cholesky_in_place_scratch, LdltRegularization};
+use faer::linalg::matmul::triangular::BlockStructure;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::SparseColMatRef;
@@ -672,13 +673,20 @@ impl Ctx<'_> {
     }
 }
 
+/// From this many columns on, an update's top square is computed as its lower half alone
+/// (`triangular::matmul`) and the rows below it by a second product; below, one product of
+/// the whole block costs less than two.
+const TRIANGLE_SPLIT: usize = 32;
+
 /// `L_s -= W` (`ls`: columns of the supernode's values from column `col0` on, column-major,
 /// with the supernode's number of rows), `W = B D Mᵀ` with `B` the rows of descendant `ld`
 /// from the first of these columns on (`below`), `M` its first `mid` rows and `D` the
 /// descendant's pivots; `W`'s row `i` goes to row `bufs.rows[i]` of `L_s`, its column `j` to
-/// column `bufs.rows[j]` (only `i ≥ j`: the factor is lower triangular). One dense product
-/// (the top square's upper half is computed and dropped: one call costs less than two on the
-/// small blocks of a 2D mesh), then the scatter.
+/// column `bufs.rows[j]` (only `i ≥ j`: the factor is lower triangular). Below
+/// [`TRIANGLE_SPLIT`] columns one dense product (the top square's upper half computed and
+/// dropped: one call costs less than two on the small blocks of a 2D mesh), from it on the top
+/// square's lower half and the rows below it apart (the wide supernodes of a 3D mesh, where
+/// `mid` is most of `m`: up to half the flops saved); then the scatter.
 fn subtract_update(
     ls: (&mut [f64], usize, usize),
     ld: MatRef<'_, f64>,
@@ -708,7 +716,27 @@ fn subtract_update(
         update.resize(m * mid, 0.0);
     }
     let mut wm = MatMut::from_column_major_slice_mut(&mut update[..m * mid], m, mid);
-    faer::linalg::matmul::matmul(wm.rb_mut(), Accum::Replace, below, md.rb().transpose(), 1.0, par);
+    if mid >= TRIANGLE_SPLIT {
+        // the top square's lower half alone, then the rows below it
+        let (top, rest) = wm.split_at_row_mut(mid);
+        let (b_top, b_rest) = below.split_at_row(mid);
+        faer::linalg::matmul::triangular::matmul(
+            top,
+            BlockStructure::TriangularLower,
+            Accum::Replace,
+            b_top,
+            BlockStructure::Rectangular,
+            md.rb().transpose(),
+            BlockStructure::Rectangular,
+            1.0,
+            par,
+        );
+        if m > mid {
+            faer::linalg::matmul::matmul(rest, Accum::Replace, b_rest, md.rb().transpose(), 1.0, par);
+        }
+    } else {
+        faer::linalg::matmul::matmul(wm.rb_mut(), Accum::Replace, below, md.rb().transpose(), 1.0, par);
+    }
     let wv = &update[..m * mid];
     let (ls, nrows, col0) = ls;
     for j in 0..mid {
