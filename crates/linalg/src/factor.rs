@@ -10,7 +10,8 @@ use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::amd;
-use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
+use faer::sparse::linalg::cholesky::simplicial::SymbolicSimplicialCholesky;
+use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
@@ -23,15 +24,13 @@ use faer::{Conj, MatMut, Par, Side};
 /// working precision ([`LinalgError::NearlySingular`]).
 pub const SINGULAR_PIVOT_RATIO: f64 = 1e-13;
 
-/// The parallelism of rayon's current pool for a factorisation: [`Par::Seq`] on one thread,
-/// else `Par::rayon` over all of the pool's threads (`RAYON_NUM_THREADS`, else the cores). An
-/// `L D Lᵀ` given it factors independent subtrees of its elimination tree on different
-/// threads ([`SparseFactor::parallel_tree`]).
+/// The parallelism of rayon's current pool for a factorisation: `Par::rayon` over all of the
+/// pool's threads (`RAYON_NUM_THREADS`, else the cores; one included). An `L D Lᵀ` given it
+/// walks its elimination tree on the pool, independent subtrees on different threads where
+/// there are several ([`SparseFactor::parallel_tree`]); given [`Par::Seq`] it is faer's
+/// sequential walk.
 pub fn pool_par() -> Par {
-    match rayon::current_num_threads() {
-        0 | 1 => Par::Seq,
-        t => Par::rayon(t),
-    }
+    Par::rayon(rayon::current_num_threads().max(1))
 }
 
 /// Which factorisation.
@@ -70,7 +69,7 @@ pub enum Ordering {
 /// is read.
 pub struct SparseFactor {
     kind: FactorKind,
-    symbolic: SymbolicCholesky<usize>,
+    symbolic: Analysis,
     values: crate::values::Values,
     factor_mem: MemBuffer,
     solve_mem: MemBuffer,
@@ -97,11 +96,12 @@ impl std::fmt::Debug for SparseFactor {
 impl SparseFactor {
     /// Analyses and factors `a` (square; the lower triangle is read).
     ///
-    /// `par`: with `Par::rayon(t)`, `t > 1`, an `L D Lᵀ` walks its elimination tree on rayon's
-    /// current pool (independent subtrees at the same time, the large supernodes above them
-    /// with faer's parallel dense kernels; [`pool_par`] picks it from the pool); otherwise the
-    /// factorisation is faer's, whose dense kernels get `par` (on this project's 2-core target
-    /// a loss: see `docs/performance.md`).
+    /// `par`: with `Par::rayon(t)` an `L D Lᵀ` walks its elimination tree on rayon's current
+    /// pool (independent subtrees at the same time, the large supernodes above them with
+    /// faer's parallel dense kernels; [`pool_par`] picks it from the pool), and a given order
+    /// is analysed here (made a postorder of its elimination tree, the column counts in time
+    /// about proportional to the matrix's entries: `docs/theory.md`); otherwise (`Par::Seq`,
+    /// `L Lᵀ`) the analysis and the factorisation are faer's.
     ///
     /// # Errors
     /// A non-square or non-finite matrix, an ordering that is not a permutation, a failed
@@ -141,44 +141,26 @@ impl SparseFactor {
                 what: format!("matrix entry {i}"),
             });
         }
-        let wants_tree = matches!((kind, par), (FactorKind::Ldlt, Par::Rayon(t)) if t.get() > 1);
-        let (fwd, inv, kept) = resolve_order(a, ordering, wants_tree)?;
-        let ord = match ordering {
-            Ordering::Amd => SymmetricOrdering::Amd,
-            _ => SymmetricOrdering::Custom(PermRef::new_checked(&fwd, &inv, n)),
+        let wants_tree = kind == FactorKind::Ldlt && matches!(par, Par::Rayon(_));
+        let (fwd, inv, kept, etree) = resolve_order(a, ordering, wants_tree)?;
+        let (symbolic, tree) = match etree.and_then(|parent| own_analysis(a, fwd.clone(), &inv, &parent).transpose()) {
+            Some(own) => {
+                let (symbolic, tree) = own?;
+                (symbolic, Some(tree))
+            }
+            None => faer_analysis(a, ordering, (&fwd, &inv, kept), wants_tree)?,
         };
-        // chosen dofs last are there to be read off the last supernode: force supernodal
-        let params = match ordering {
-            Ordering::AmdThenLast(_) | Ordering::GivenThenLast { .. } => CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-            _ => CholeskySymbolicParams::default(),
+        let (factor_req, solve_req) = match (&symbolic, kind) {
+            (Analysis::Own { sym, .. }, _) => (StackReq::EMPTY, sym.solve_in_place_scratch::<f64>(1, Par::Seq)),
+            (Analysis::Faer(s), FactorKind::Cholesky) => (
+                s.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+                s.solve_in_place_scratch::<f64>(1, par),
+            ),
+            (Analysis::Faer(s), FactorKind::Ldlt) => (
+                s.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
+                s.solve_in_place_scratch::<f64>(1, par),
+            ),
         };
-        let analyse = || {
-            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
-                .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))
-        };
-        // the tree's copy of the lower triangle needs only a given order: made meanwhile
-        let (symbolic, lower) = if wants_tree && *ordering != Ordering::Amd {
-            let (symbolic, lower) = rayon::join(analyse, || crate::tree::Lower::new(a, Some(&inv)));
-            (symbolic, Some(lower))
-        } else {
-            (analyse(), None)
-        };
-        let mut symbolic = symbolic?;
-        let tree = if wants_tree {
-            let tree;
-            (symbolic, tree) = parallel_tree(a, symbolic, params, kept, lower)?;
-            tree
-        } else {
-            None
-        };
-        let factor_req = match kind {
-            FactorKind::Cholesky => symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
-            FactorKind::Ldlt => symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
-        };
-        let solve_req = symbolic.solve_in_place_scratch::<f64>(1, par);
         let needed = 8 * symbolic.len_val() + factor_req.size_bytes() + solve_req.size_bytes();
         if let Some(budget) = budget.filter(|&b| needed > b) {
             return Err(LinalgError::TooLarge { needed, budget });
@@ -204,7 +186,10 @@ impl SparseFactor {
         let stack = MemStack::new(&mut self.factor_mem);
         match self.kind {
             FactorKind::Cholesky => {
-                self.symbolic
+                let Analysis::Faer(symbolic) = &self.symbolic else {
+                    unreachable!("an L Lᵀ stands on faer's analysis");
+                };
+                symbolic
                     .factorize_numeric_llt(
                         &mut self.values,
                         a,
@@ -222,15 +207,16 @@ impl SparseFactor {
                         }
                     })?;
             }
-            FactorKind::Ldlt => match (self.tree.as_ref(), self.symbolic.raw()) {
-                (Some(tree), SymbolicCholeskyRaw::Supernodal(sym)) => {
+            FactorKind::Ldlt => match (self.tree.as_ref(), self.symbolic.supernodal(), &self.symbolic) {
+                (Some(tree), Some(sym), _) => {
                     tree.factor(sym, a, &mut self.values, self.par)
                         .map_err(|index| LinalgError::ZeroPivot {
                             pivot: original(&self.symbolic, index),
                         })?;
                 }
-                _ => {
-                    self.symbolic
+                (_, _, Analysis::Own { .. }) => unreachable!("this crate's analysis comes with its tree"),
+                (_, _, Analysis::Faer(symbolic)) => {
+                    symbolic
                         .factorize_numeric_ldlt(
                             &mut self.values,
                             a,
@@ -307,16 +293,12 @@ impl SparseFactor {
         &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>,
         &[f64],
     )> {
-        match (self.tree.as_ref(), self.symbolic.raw()) {
-            (Some(tree), SymbolicCholeskyRaw::Supernodal(sym)) => Some((tree, sym, &self.values)),
-            _ => None,
-        }
+        Some((self.tree.as_ref()?, self.symbolic.supernodal()?, &self.values))
     }
 
-    /// Whether the numeric factorisation walks the supernodes' elimination tree on several
-    /// threads (a supernodal `L D Lᵀ` given `Par::rayon` with more than one thread; then
-    /// independent subtrees are factored at the same time, on rayon's current pool), rather
-    /// than faer's sequential walk with parallel dense kernels.
+    /// Whether the numeric factorisation walks the supernodes' elimination tree on rayon's
+    /// pool (a supernodal `L D Lᵀ` given `Par::rayon`; on several threads independent subtrees
+    /// are factored at the same time), rather than faer's sequential walk.
     pub fn parallel_tree(&self) -> bool {
         self.tree.is_some()
     }
@@ -337,7 +319,7 @@ impl SparseFactor {
     /// of [`SparseFactor::refactor`] it gives the achieved rate.
     pub fn factor_flops(&self) -> f64 {
         match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => (0..s.n_supernodes())
+            Raw::Supernodal(s) => (0..s.n_supernodes())
                 .map(|k| {
                     let w = s.supernode_end()[k] - s.supernode_begin()[k];
                     let p = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
@@ -349,7 +331,7 @@ impl SparseFactor {
                         .sum::<f64>()
                 })
                 .sum(),
-            SymbolicCholeskyRaw::Simplicial(s) => {
+            Raw::Simplicial(s) => {
                 let cp = s.col_ptr();
                 (0..cp.len() - 1)
                     .map(|j| {
@@ -383,7 +365,38 @@ impl SparseFactor {
 
     fn solve_mat(&mut self, mut rhs: MatMut<'_, f64>) {
         let k = rhs.ncols();
-        if let (Some(tree), SymbolicCholeskyRaw::Supernodal(sym)) = (self.tree.as_ref(), self.symbolic.raw()) {
+        let n = self.n();
+        if let Analysis::Own { sym, fwd } = &self.symbolic {
+            if rayon::current_num_threads() == 1 {
+                // one thread: faer's sequential sweeps, which read the factor in order (the
+                // tree's forward sweep gathers from each supernode's descendants), on the
+                // right-hand sides permuted into the factor's order
+                let mut x = vec![0.0; n * k];
+                for j in 0..k {
+                    for (new, &old) in fwd.iter().enumerate() {
+                        x[j * n + new] = rhs[(old, j)];
+                    }
+                }
+                if k > self.solve_mem_ncols {
+                    self.solve_mem = MemBuffer::new(sym.solve_in_place_scratch::<f64>(k, Par::Seq));
+                    self.solve_mem_ncols = k;
+                }
+                let xm = MatMut::from_column_major_slice_mut(&mut x, n, k);
+                SupernodalLdltRef::new(sym, &self.values).solve_in_place_with_conj(
+                    Conj::No,
+                    xm,
+                    Par::Seq,
+                    MemStack::new(&mut self.solve_mem),
+                );
+                for j in 0..k {
+                    for (new, &old) in fwd.iter().enumerate() {
+                        rhs[(old, j)] = x[j * n + new];
+                    }
+                }
+                return;
+            }
+        }
+        if let (Some(tree), Some(sym)) = (self.tree.as_ref(), self.symbolic.supernodal()) {
             // the tree's sweeps, on the right-hand sides permuted into the factor's order,
             // index by index
             let fwd = self.permutation();
@@ -399,17 +412,20 @@ impl SparseFactor {
             }
             return;
         }
+        let Analysis::Faer(symbolic) = &self.symbolic else {
+            unreachable!("this crate's analysis comes with its tree");
+        };
         if k > self.solve_mem_ncols {
-            self.solve_mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(k, self.par));
+            self.solve_mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(k, self.par));
             self.solve_mem_ncols = k;
         }
         let stack = MemStack::new(&mut self.solve_mem);
         match self.kind {
             FactorKind::Cholesky => {
-                LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, stack)
+                LltRef::new(symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, stack)
             }
             FactorKind::Ldlt => {
-                LdltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, stack)
+                LdltRef::new(symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, stack)
             }
         }
     }
@@ -419,7 +435,7 @@ impl SparseFactor {
     pub fn pivots(&self) -> Vec<f64> {
         let mut d = Vec::with_capacity(self.n());
         match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => {
+            Raw::Simplicial(s) => {
                 let (cp, ri) = (s.col_ptr(), s.row_idx());
                 for j in 0..self.n() {
                     // the diagonal is stored first in each column
@@ -427,7 +443,7 @@ impl SparseFactor {
                     d.push(self.values[cp[j]]);
                 }
             }
-            SymbolicCholeskyRaw::Supernodal(s) => {
+            Raw::Supernodal(s) => {
                 let (begin, end) = (s.supernode_begin(), s.supernode_end());
                 let (cp_row, cp_val) = (s.col_ptr_for_row_idx(), s.col_ptr_for_val());
                 for k in 0..s.n_supernodes() {
@@ -485,9 +501,7 @@ impl SparseFactor {
         if self.kind != FactorKind::Ldlt || k == 0 || k > self.n() {
             return None;
         }
-        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
-            return None;
-        };
+        let s = self.symbolic.supernodal()?;
         let last = s.n_supernodes().checked_sub(1)?;
         let (begin, end) = (s.supernode_begin()[last], s.supernode_end()[last]);
         if end != self.n() || begin > self.n() - k {
@@ -612,10 +626,7 @@ impl SparseFactor {
         if self.kind != FactorKind::Ldlt {
             return None;
         }
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => Some((s, self.permutation())),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
-        }
+        Some((self.symbolic.supernodal()?, self.permutation()))
     }
 
     /// `(positive, negative, zero)` pivot counts of an `L D Lᵀ` factor: by Sylvester's law the
@@ -631,8 +642,8 @@ impl SparseFactor {
 
     /// The fill-reducing permutation, `fwd[new] = old`.
     pub fn permutation(&self) -> Vec<usize> {
-        match self.symbolic.perm() {
-            Some(p) => p.arrays().0.to_vec(),
+        match self.symbolic.fwd() {
+            Some(fwd) => fwd.to_vec(),
             None => (0..self.n()).collect(),
         }
     }
@@ -640,12 +651,14 @@ impl SparseFactor {
 
 /// The order `ordering` asks for as `(fwd, inv, kept)` (`fwd[new] = old`, `inv` its inverse,
 /// both empty for faer's own AMD; `kept` indices ordered last), made a postorder of its
-/// elimination tree where `postorder` (the tree's schedule) and that keeps the last ones last.
+/// elimination tree where `postorder` (the tree's schedule) and that keeps the last ones last;
+/// then with the tree in that order (`parent[k]`, `usize::MAX` for a root).
+#[allow(clippy::type_complexity)]
 fn resolve_order(
     a: SparseColMatRef<'_, usize, f64>,
     ordering: &Ordering,
     postorder: bool,
-) -> Result<(Vec<usize>, Vec<usize>, usize), LinalgError> {
+) -> Result<(Vec<usize>, Vec<usize>, usize, Option<Vec<usize>>), LinalgError> {
     let n = a.nrows();
     let (fwd, inv, kept) = match ordering {
         Ordering::Amd => (vec![], vec![], 0),
@@ -670,31 +683,135 @@ fn resolve_order(
         None
     };
     Ok(match post {
-        Some(post) if post[n - kept..] == fwd[n - kept..] => {
+        Some((post, parent)) if post[n - kept..] == fwd[n - kept..] => {
             let post_inv = inverse_permutation(&post)?;
-            (post, post_inv, kept)
+            (post, post_inv, kept, Some(parent))
         }
-        _ => (fwd, inv, kept),
+        _ => (fwd, inv, kept, None),
     })
+}
+
+/// This crate's analysis for the tree's walk (`fwd`, `inv`: an order that is a postorder of
+/// its elimination tree `parent`): the column counts and supernodes, with the matrix's lower
+/// triangle in that order ([`crate::tree::supernodal`]), and the tree. `None` where the
+/// supernodes are not in postorder (not expected of a postordered tree; faer's analysis then
+/// takes over).
+fn own_analysis(
+    a: SparseColMatRef<'_, usize, f64>,
+    fwd: Vec<usize>,
+    inv: &[usize],
+    parent: &[usize],
+) -> Result<Option<(Analysis, crate::tree::Tree)>, LinalgError> {
+    let (sym, lower) = crate::tree::supernodal(a, inv, parent)?;
+    Ok(crate::tree::Tree::new(&sym, a, Some(inv), Some(lower)).map(|tree| (Analysis::Own { sym, fwd }, tree)))
+}
+
+/// faer's analysis of `a` in the order `(fwd, inv)` (faer's AMD where `ordering` is
+/// [`Ordering::Amd`]), with the tree for the parallel walk where `wants_tree`
+/// ([`parallel_tree`]); `kept`: the number of indices ordered last.
+fn faer_analysis(
+    a: SparseColMatRef<'_, usize, f64>,
+    ordering: &Ordering,
+    (fwd, inv, kept): (&[usize], &[usize], usize),
+    wants_tree: bool,
+) -> Result<(Analysis, Option<crate::tree::Tree>), LinalgError> {
+    let n = a.nrows();
+    let ord = match ordering {
+        Ordering::Amd => SymmetricOrdering::Amd,
+        _ => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
+    };
+    // chosen dofs last are there to be read off the last supernode: force supernodal
+    let params = match ordering {
+        Ordering::AmdThenLast(_) | Ordering::GivenThenLast { .. } => CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        },
+        _ => CholeskySymbolicParams::default(),
+    };
+    let symbolic = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ord, params)
+        .map_err(|e| LinalgError::Symbolic(format!("{e:?}")))?;
+    if !wants_tree {
+        return Ok((Analysis::Faer(symbolic), None));
+    }
+    let (symbolic, tree) = parallel_tree(a, symbolic, params, kept)?;
+    Ok((Analysis::Faer(symbolic), tree))
+}
+
+/// The symbolic analysis a factor stands on.
+enum Analysis {
+    /// faer's whole analysis: its AMD, `L Lᵀ`, a simplicial factor, faer's sequential walk
+    /// (`Par::Seq`), or an order whose postorder would move the indices asked last.
+    Faer(SymbolicCholesky<usize>),
+    /// This crate's, for the tree's walk: a supernodal `L D Lᵀ` in a given order made a
+    /// postorder of its elimination tree (`fwd[new] = old`).
+    Own {
+        sym: SymbolicSupernodalCholesky<usize>,
+        fwd: Vec<usize>,
+    },
+}
+
+/// A symbolic factor's structure: supernodal or simplicial.
+enum Raw<'a> {
+    Supernodal(&'a SymbolicSupernodalCholesky<usize>),
+    Simplicial(&'a SymbolicSimplicialCholesky<usize>),
+}
+
+impl Analysis {
+    fn nrows(&self) -> usize {
+        match self {
+            Analysis::Faer(s) => s.nrows(),
+            Analysis::Own { sym, .. } => sym.nrows(),
+        }
+    }
+
+    fn len_val(&self) -> usize {
+        match self {
+            Analysis::Faer(s) => s.len_val(),
+            Analysis::Own { sym, .. } => sym.len_val(),
+        }
+    }
+
+    fn raw(&self) -> Raw<'_> {
+        match self {
+            Analysis::Faer(s) => match s.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => Raw::Supernodal(s),
+                SymbolicCholeskyRaw::Simplicial(s) => Raw::Simplicial(s),
+            },
+            Analysis::Own { sym, .. } => Raw::Supernodal(sym),
+        }
+    }
+
+    fn supernodal(&self) -> Option<&SymbolicSupernodalCholesky<usize>> {
+        match self.raw() {
+            Raw::Supernodal(s) => Some(s),
+            Raw::Simplicial(_) => None,
+        }
+    }
+
+    /// The order, `fwd[new] = old` (`None`: the identity).
+    fn fwd(&self) -> Option<&[usize]> {
+        match self {
+            Analysis::Faer(s) => s.perm().map(|p| p.arrays().0),
+            Analysis::Own { fwd, .. } => Some(fwd),
+        }
+    }
 }
 
 /// The tree of a supernodal symbolic factor for the parallel numeric `L D Lᵀ`, the analysis
 /// redone once in postorder where its supernodes were not (AMD's order, or relaxed supernodes
 /// that merged across a subtree); `None` (and the analysis unchanged) for a simplicial factor,
-/// or where the postorder would move the `kept` dofs ordered last. `lower`: the matrix's lower
-/// triangle in `symbolic`'s order, where it was built already.
+/// or where the postorder would move the `kept` dofs ordered last.
 fn parallel_tree(
     a: SparseColMatRef<'_, usize, f64>,
     symbolic: SymbolicCholesky<usize>,
     params: CholeskySymbolicParams<'_>,
     kept: usize,
-    lower: Option<crate::tree::Lower>,
 ) -> Result<(SymbolicCholesky<usize>, Option<crate::tree::Tree>), LinalgError> {
     let SymbolicCholeskyRaw::Supernodal(s) = symbolic.raw() else {
         return Ok((symbolic, None));
     };
     let inv = |sym: &SymbolicCholesky<usize>| sym.perm().map(|p| p.arrays().1.to_vec());
-    if let Some(tree) = crate::tree::Tree::new(s, a, inv(&symbolic).as_deref(), lower) {
+    if let Some(tree) = crate::tree::Tree::new(s, a, inv(&symbolic).as_deref(), None) {
         return Ok((symbolic, Some(tree)));
     }
     let fwd = match symbolic.perm() {
@@ -720,11 +837,8 @@ fn parallel_tree(
 
 /// The matrix's index at position `new` of the factor's order (`new` itself where it is out
 /// of range).
-fn original(symbolic: &SymbolicCholesky<usize>, new: usize) -> usize {
-    symbolic
-        .perm()
-        .and_then(|p| p.arrays().0.get(new).copied())
-        .unwrap_or(new)
+fn original(symbolic: &Analysis, new: usize) -> usize {
+    symbolic.fwd().and_then(|fwd| fwd.get(new).copied()).unwrap_or(new)
 }
 
 /// The inverse of a permutation, or an error if `fwd` is not one.

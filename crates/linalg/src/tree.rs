@@ -23,7 +23,10 @@ use faer::sparse::SparseColMatRef;
 use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
+mod analysis;
 mod solve;
+
+pub(crate) use analysis::supernodal;
 
 /// Subtrees with fewer floating-point operations than this are factored on one core, in
 /// order (a task of this size takes about 2 ms; below it the cost of a task's scratch and of
@@ -210,8 +213,13 @@ impl Tree {
 /// The order `fwd` (`inv` its inverse; both empty: no order given) made a postorder of its
 /// elimination tree: children before their parent, every subtree contiguous, roots and
 /// children kept in their order. The tree by Liu's algorithm with path compression (Liu, ACM
-/// TOMS 12 (1986)) on the pattern of `a` in the order `fwd`. `None` where no order was given.
-pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv: &[usize]) -> Option<Vec<usize>> {
+/// TOMS 12 (1986)) on the pattern of `a` in the order `fwd`. With it, the tree in the new
+/// order (`parent[k]`, `usize::MAX` for a root). `None` where no order was given.
+pub(crate) fn postordered(
+    a: SparseColMatRef<'_, usize, f64>,
+    fwd: &[usize],
+    inv: &[usize],
+) -> Option<(Vec<usize>, Vec<usize>)> {
     let n = a.nrows();
     if fwd.len() != n || inv.len() != n {
         return None;
@@ -242,6 +250,8 @@ pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv
         }
     }
     let mut out = Vec::with_capacity(n);
+    // the new place of each column, to carry the tree over
+    let mut place = vec![0usize; n];
     let roots = (0..n).filter(|&k| parent[k] == usize::MAX);
     let mut stack: Vec<(usize, usize)> = Vec::new();
     for r in roots {
@@ -252,11 +262,18 @@ pub(crate) fn postordered(a: SparseColMatRef<'_, usize, f64>, fwd: &[usize], inv
                 let w = children[c];
                 stack.push((w, child_ptr[w]));
             } else {
+                place[v] = out.len();
                 out.push(fwd[v]);
             }
         }
     }
-    Some(out)
+    let mut new_parent = vec![usize::MAX; n];
+    for (v, &p) in parent.iter().enumerate() {
+        if p != usize::MAX {
+            new_parent[place[v]] = place[p];
+        }
+    }
+    Some((out, new_parent))
 }
 
 /// The parent of each of the `n` columns in the elimination tree (`usize::MAX` for a root), by
@@ -337,12 +354,6 @@ fn upper_lists(
     (ptr, upper)
 }
 
-/// The columns of `sym` (in its order) reordered so that its supernodes come in postorder,
-/// every subtree contiguous and ending at its root (roots and children in their order, so a
-/// connected factor's last supernode stays last): `order[new] = old` in `sym`'s order. A
-/// postorder is an equivalent ordering (the same elimination tree, the same fill; Liu, SIAM
-/// J. Matrix Anal. Appl. 11 (1990)), so the symbolic analysis of the reordered matrix finds
-/// the same supernodes.
 /// The supernode each column belongs to.
 fn supernode_of_column(sym: &SymbolicSupernodalCholesky<usize>) -> Vec<usize> {
     let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
@@ -353,6 +364,12 @@ fn supernode_of_column(sym: &SymbolicSupernodalCholesky<usize>) -> Vec<usize> {
     of_col
 }
 
+/// The columns of `sym` (in its order) reordered so that its supernodes come in postorder,
+/// every subtree contiguous and ending at its root (roots and children in their order, so a
+/// connected factor's last supernode stays last): `order[new] = old` in `sym`'s order. A
+/// postorder is an equivalent ordering (the same elimination tree, the same fill; Liu, SIAM
+/// J. Matrix Anal. Appl. 11 (1990)), so the symbolic analysis of the reordered matrix finds
+/// the same supernodes.
 pub(crate) fn postorder(sym: &SymbolicSupernodalCholesky<usize>) -> Vec<usize> {
     let ns = sym.n_supernodes();
     let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
@@ -818,13 +835,13 @@ mod tests {
                 )
             })
         };
-        let (ranges, post) = on(1);
+        let (ranges, (post, post_parent)) = on(1);
         assert_eq!(ranges, vec![0..n]);
         for threads in [2, 3] {
             let (ranges, again) = on(threads);
             assert_eq!(ranges.len(), threads);
             assert!(ranges.windows(2).all(|w| w[0].end == w[1].start) && ranges[threads - 1].end == n);
-            assert_eq!(again, post, "{threads} threads");
+            assert_eq!(again.0, post, "{threads} threads");
         }
         // the tree in the postorder: parents after their children, subtrees contiguous
         let mut post_inv = vec![0; n];
@@ -832,6 +849,7 @@ mod tests {
             post_inv[old] = new;
         }
         let parent = elimination_tree(n, &[upper_lists(a.as_ref(), &post_inv, 0..n)]);
+        assert_eq!(post_parent, parent, "the tree carried over to the new order");
         let mut size = vec![1usize; n];
         for k in 0..n {
             if parent[k] != usize::MAX {
@@ -845,6 +863,6 @@ mod tests {
             assert!(p == usize::MAX || p + 1 - size[p] <= k + 1 - size[k], "column {k}");
         }
         // and postordering it again changes nothing
-        assert_eq!(postordered(a.as_ref(), &post, &post_inv).unwrap(), post);
+        assert_eq!(postordered(a.as_ref(), &post, &post_inv).unwrap().0, post);
     }
 }

@@ -8,13 +8,17 @@
 //! anonymous mapping so advised gets them; where it does not (or the advice is refused, or not
 //! Linux), the mapping behaves as any zeroed memory. Small factors keep a `Vec`.
 //!
-//! Where rayon's pool has several threads, the mapping's pages are faulted in at once on all
-//! of them, one write per page, rather than one by one by the factorisation: the kernel's work
-//! per fault (zeroing a page, finding a huge one) then runs on all cores. On one thread there
-//! is nothing to gain (the same faults, one after another, sooner). Measured on `paper` at
-//! n = 256 (541 MB of values), two threads, first factorisations in fresh processes: analysis,
-//! factorisation and solve 1.45 s without, 1.32 s with (medians of 6); the touch alone took
-//! 0.07-0.67 s on one thread (the kernel's huge pages come fast or slow), 0.035-0.32 s on two.
+//! The mapping's pages are faulted in at once on all of rayon's threads, one write per page,
+//! rather than one by one by the factorisation: the kernel's work per fault (zeroing a page,
+//! finding a huge one) then runs on all cores. Measured on `paper` at n = 256 (541 MB of
+//! values), two threads, first factorisations in fresh processes: analysis, factorisation and
+//! solve 1.45 s without, 1.32 s with (medians of 6); the touch alone took 0.07-0.67 s on one
+//! thread (the kernel's huge pages come fast or slow), 0.035-0.32 s on two. On one thread it
+//! was left to the factorisation while that was faer's walk (nothing measurable to gain
+//! then); the tree's walk, on one thread too since, touches its pages supernode by supernode,
+//! and at `paper-3d` n = 24 (1.6 GB of values) the first factorisation took 1.4-2.9 s longer
+//! than a refactorisation without the touch, 0-0.45 s with it (8 fresh processes each, one
+//! thread, this VM; the 2D floor: no difference within the noise).
 
 use memmap2::{MmapMut, MmapOptions};
 use rayon::prelude::*;
@@ -40,9 +44,7 @@ impl Values {
                     // a hint: refused or unavailable, the pages are small ones
                     let _ = map.advise(memmap2::Advice::HugePage);
                 }
-                if rayon::current_num_threads() > 1 {
-                    fault_in(&mut map);
-                }
+                fault_in(&mut map);
                 return Values::Mapped { map, len };
             }
         }
