@@ -232,23 +232,7 @@ pub(crate) fn postordered(
         .map(|cols| upper_lists(a, inv, cols))
         .collect();
     let parent = elimination_tree(n, &chunks);
-    let mut child_ptr = vec![0usize; n + 1];
-    for &p in &parent {
-        if p != usize::MAX {
-            child_ptr[p + 1] += 1;
-        }
-    }
-    for k in 0..n {
-        child_ptr[k + 1] += child_ptr[k];
-    }
-    let mut at = child_ptr.clone();
-    let mut children = vec![0usize; child_ptr[n]];
-    for (c, &p) in parent.iter().enumerate() {
-        if p != usize::MAX {
-            children[at[p]] = c;
-            at[p] += 1;
-        }
-    }
+    let (child_ptr, children) = children_of(&parent);
     let mut out = Vec::with_capacity(n);
     // the new place of each column, to carry the tree over
     let mut place = vec![0usize; n];
@@ -274,6 +258,30 @@ pub(crate) fn postordered(
         }
     }
     Some((out, new_parent))
+}
+
+/// The children of each node of the forest `parent` (`usize::MAX` for a root), in increasing
+/// order: `children[ptr[k]..ptr[k + 1]]`.
+fn children_of(parent: &[usize]) -> (Vec<usize>, Vec<usize>) {
+    let n = parent.len();
+    let mut ptr = vec![0usize; n + 1];
+    for &p in parent {
+        if p != usize::MAX {
+            ptr[p + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        ptr[k + 1] += ptr[k];
+    }
+    let mut at = ptr.clone();
+    let mut children = vec![0usize; ptr[n]];
+    for (c, &p) in parent.iter().enumerate() {
+        if p != usize::MAX {
+            children[at[p]] = c;
+            at[p] += 1;
+        }
+    }
+    (ptr, children)
 }
 
 /// The parent of each of the `n` columns in the elimination tree (`usize::MAX` for a root), by

@@ -43,26 +43,15 @@ pub(crate) fn supernodal(
     // own pattern (column j: the diagonal and `parent[j]`), whose elimination tree is the tree
     // itself, costs one step per column (its counts, those of a factor with no fill, are not
     // used)
-    let mut tree_ptr = vec![0usize; n + 1];
-    for (k, &p) in parent.iter().enumerate() {
-        tree_ptr[k + 1] += 1;
-        if p != ROOT {
-            tree_ptr[p + 1] += 1;
-        }
-    }
+    let (child_ptr, children) = super::children_of(parent);
+    let mut tree_ptr = Vec::with_capacity(n + 1);
+    let mut tree_rows = Vec::with_capacity(children.len() + n);
+    tree_ptr.push(0);
     for k in 0..n {
-        tree_ptr[k + 1] += tree_ptr[k];
-    }
-    // the children in increasing order, then the diagonal (the largest row of its column)
-    let mut next = tree_ptr.clone();
-    let mut tree_rows = vec![0usize; tree_ptr[n]];
-    for (j, &p) in parent.iter().enumerate() {
-        if p != ROOT {
-            tree_rows[next[p]] = j;
-            next[p] += 1;
-        }
-        tree_rows[next[j]] = j;
-        next[j] += 1;
+        // the children in increasing order, then the diagonal (the largest row of its column)
+        tree_rows.extend_from_slice(&children[child_ptr[k]..child_ptr[k + 1]]);
+        tree_rows.push(k);
+        tree_ptr.push(tree_rows.len());
     }
     let tree = SymbolicSparseColMatRef::new_checked(n, n, &tree_ptr, None, &tree_rows);
     let mut etree = vec![0isize; n];
