@@ -396,9 +396,10 @@ impl SparseFactor {
                 return;
             }
         }
-        if let (Some(tree), Some(sym)) = (self.tree.as_ref(), self.symbolic.supernodal()) {
+        let several = rayon::current_num_threads() > 1;
+        if let (Some(tree), Some(sym), true) = (self.tree.as_ref(), self.symbolic.supernodal(), several) {
             // the tree's sweeps, on the right-hand sides permuted into the factor's order,
-            // index by index
+            // index by index (on one thread faer's sweeps, above or below)
             let fwd = self.permutation();
             let mut x = Vec::with_capacity(fwd.len() * k);
             for &old in &fwd {

@@ -140,7 +140,8 @@ fn the_tree_on_two_cores_factors_as_faer_does_on_one() {
             let rhs: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
             let (mut x, mut y) = (rhs.clone(), rhs.clone());
             seq.solve_in_place(&mut x);
-            par.solve_in_place(&mut y);
+            // the solve on the same pool (one thread: faer's sweeps on the tree's factor)
+            on_threads(threads, || par.solve_in_place(&mut y));
             let gap = relative_gap(&y, &x);
             assert!(gap < 1e-12, "m = {m}, {threads} threads: solutions differ by {gap:e}");
             // and again after a refactorisation with new values on the same pattern
@@ -149,6 +150,15 @@ fn the_tree_on_two_cores_factors_as_faer_does_on_one() {
             let mut z = rhs.clone();
             par.solve_in_place(&mut z);
             assert!(relative_gap(&z, &x) < 1e-12);
+            // faer's analysis with the tree (its AMD, the analysis redone in postorder)
+            let mut amd = on_threads(threads, || {
+                SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &Ordering::Amd, Par::rayon(2))
+            })
+            .unwrap();
+            assert!(amd.parallel_tree());
+            let mut w = rhs.clone();
+            on_threads(threads, || amd.solve_in_place(&mut w));
+            assert!(relative_gap(&w, &x) < 1e-12, "AMD, {threads} threads");
         }
     }
 }
