@@ -325,10 +325,10 @@ fn column_ranges(a: SparseColMatRef<'_, usize, f64>, parts: usize) -> Vec<std::o
     ranges
 }
 
-/// The entries of the columns `cols` of `a` (its lower triangle) in the order `inv`, as lists
-/// by new column `k` of the new rows `i < k` (the upper part of the reordered matrix):
-/// `upper[ptr[k]..ptr[k + 1]]`.
-fn upper_lists(
+/// The entries of the columns `cols` of `a`'s lower triangle (entries above the diagonal are
+/// not read) in the order `inv`, as lists by new column `k` of the new rows `i < k` (the upper
+/// part of the reordered matrix, no diagonal): `upper[ptr[k]..ptr[k + 1]]`.
+pub(super) fn upper_lists(
     a: SparseColMatRef<'_, usize, f64>,
     inv: &[usize],
     cols: std::ops::Range<usize>,
@@ -339,7 +339,7 @@ fn upper_lists(
     for j in cols.clone() {
         for &i in sym.row_idx_of_col_raw(j) {
             let (pi, pj) = (inv[i], inv[j]);
-            if pi != pj {
+            if i > j {
                 ptr[pi.max(pj) + 1] += 1;
             }
         }
@@ -352,7 +352,7 @@ fn upper_lists(
     for j in cols {
         for &i in sym.row_idx_of_col_raw(j) {
             let (pi, pj) = (inv[i], inv[j]);
-            if pi != pj {
+            if i > j {
                 let k = pi.max(pj);
                 upper[next[k]] = pi.min(pj);
                 next[k] += 1;

@@ -36,7 +36,7 @@ pub(crate) fn supernodal(
     parent: &[usize],
 ) -> Result<(SymbolicSupernodalCholesky<usize>, Lower), LinalgError> {
     let n = parent.len();
-    let (lower, (col_ptr, rows)) = rayon::join(|| Lower::new(a, Some(inv)), || upper(a, inv));
+    let (lower, (col_ptr, rows)) = rayon::join(|| Lower::new(a, Some(inv)), || super::upper_lists(a, inv, 0..n));
     let counts = column_counts(&lower, parent);
     let upper = SymbolicSparseColMatRef::new_unsorted_checked(n, n, &col_ptr, None, &rows);
     // faer takes the tree only as computed by its own analysis of a matrix: that of the tree's
@@ -129,37 +129,6 @@ pub(crate) fn column_counts(lower: &Lower, parent: &[usize]) -> Vec<usize> {
     delta.into_iter().map(|d| d as usize).collect()
 }
 
-/// The pattern of the upper triangle of `a` (whose lower triangle is read) in the order `inv`:
-/// column `k`, the new rows `i ≤ k` (in no particular order), by one counting pass.
-fn upper(a: SparseColMatRef<'_, usize, f64>, inv: &[usize]) -> (Vec<usize>, Vec<usize>) {
-    let n = a.nrows();
-    let sym = a.symbolic();
-    let mut col_ptr = vec![0usize; n + 1];
-    for j in 0..n {
-        for &i in sym.row_idx_of_col_raw(j) {
-            if i >= j {
-                col_ptr[inv[i].max(inv[j]) + 1] += 1;
-            }
-        }
-    }
-    for k in 0..n {
-        col_ptr[k + 1] += col_ptr[k];
-    }
-    let mut next = col_ptr.clone();
-    let mut rows = vec![0usize; col_ptr[n]];
-    for j in 0..n {
-        for &i in sym.row_idx_of_col_raw(j) {
-            if i >= j {
-                let (pi, pj) = (inv[i], inv[j]);
-                let k = pi.max(pj);
-                rows[next[k]] = pi.min(pj);
-                next[k] += 1;
-            }
-        }
-    }
-    (col_ptr, rows)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,8 +142,15 @@ mod tests {
     use proptest::prelude::*;
 
     /// A symmetric pattern's lower triangle: a grid of `side²` nodes with `dofs` unknowns each,
-    /// coupled to their neighbours, plus `extra` long-range pairs (`pairs`, folded into range).
-    fn matrix(side: usize, dofs: usize, pairs: &[(usize, usize)]) -> SparseColMat<usize, f64> {
+    /// coupled to their neighbours, plus `extra` long-range pairs (`pairs`, folded into range);
+    /// and entries above the diagonal (`above`, unknowns folded into range), which an analysis
+    /// of the lower triangle must not read.
+    fn matrix(
+        side: usize,
+        dofs: usize,
+        pairs: &[(usize, usize)],
+        above: &[(usize, usize)],
+    ) -> SparseColMat<usize, f64> {
         let nodes = side * side;
         let n = nodes * dofs;
         let mut t = vec![];
@@ -201,6 +177,12 @@ mod tests {
             let (p, q) = (p % nodes, q % nodes);
             if p != q {
                 couple(p.max(q), p.min(q));
+            }
+        }
+        for &(i, j) in above {
+            let (i, j) = (i % n, j % n);
+            if i != j {
+                t.push(Triplet::new(i.min(j), i.max(j), 1.0));
             }
         }
         for i in 0..n {
@@ -240,20 +222,21 @@ mod tests {
             side in 2usize..14,
             dofs in 1usize..4,
             pairs in proptest::collection::vec((0usize..200, 0usize..200), 0..12),
+            above in proptest::collection::vec((0usize..600, 0usize..600), 0..8),
             stride in 1usize..50,
         ) {
-            let a = matrix(side, dofs, &pairs);
+            let a = matrix(side, dofs, &pairs, &above);
             let n = a.nrows();
             // a scrambled order: i * s mod n with s coprime to n
             let s = (stride..stride + n + 1).find(|s| gcd(*s, n) == 1).unwrap();
             let fwd: Vec<usize> = (0..n).map(|i| i * s % n).collect();
             let (post, post_inv, ours, counts) = both(&a, &fwd);
 
-            // faer's counts, on the upper triangle in the same order
+            // faer's counts, on the lower triangle's pattern made upper in the same order
             let perm = PermRef::new_checked(&post, &post_inv, n);
             let mut t = vec![];
             for j in 0..n {
-                for &i in a.symbolic().row_idx_of_col_raw(j) {
+                for &i in a.symbolic().row_idx_of_col_raw(j).iter().filter(|&&i| i >= j) {
                     let (pi, pj) = (post_inv[i], post_inv[j]);
                     t.push(Triplet::new(pi.min(pj), pi.max(pj), 1.0));
                 }
