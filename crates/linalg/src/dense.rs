@@ -18,16 +18,18 @@ const TILE: usize = 64;
 /// dense kernels; the row blocks run as rayon tasks, and the upper part is mirrored.
 pub(crate) fn unit_lower_gram(x: MatRef<'_, f64>, d: &[f64]) -> Vec<f64> {
     let k = x.nrows();
-    let mut y = x.to_owned();
-    for j in 0..k {
-        for (i, &di) in d.iter().enumerate().skip(j) {
-            y[(i, j)] /= di;
-        }
-    }
     let mut out = vec![0.0; k * k];
     if k == 0 {
         return out;
     }
+    // `Y`'s lower part, column by column on the pool (fresh zero pages: the upper part zero)
+    let mut y_values = vec![0.0; k * k];
+    y_values.par_chunks_mut(k).enumerate().for_each(|(j, col)| {
+        for i in j..k {
+            col[i] = x[(i, j)] / d[i];
+        }
+    });
+    let y = MatRef::from_column_major_slice(&y_values, k, k);
     out.par_chunks_mut(GRAM_ROWS * k).enumerate().for_each(|(b, rows)| {
         let (i0, nb) = (b * GRAM_ROWS, rows.len() / k);
         let i1 = i0 + nb;

@@ -2,6 +2,7 @@
 //! low-level API: the symbolic analysis is done once, the numeric factorisation can be redone
 //! in place when the values change, and solves reuse their workspace (no allocation).
 
+use crate::tree::Breakdown;
 use crate::LinalgError;
 use crate::ShapeError;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -209,10 +210,13 @@ impl SparseFactor {
             }
             FactorKind::Ldlt => match (self.tree.as_ref(), self.symbolic.supernodal(), &self.symbolic) {
                 (Some(tree), Some(sym), _) => {
-                    tree.factor(sym, a, &mut self.values, self.par)
-                        .map_err(|index| LinalgError::ZeroPivot {
+                    // the tree checks each supernode's values as it factors it
+                    tree.factor(sym, a, &mut self.values, self.par).map_err(|b| match b {
+                        Breakdown::ZeroPivot(index) => LinalgError::ZeroPivot {
                             pivot: original(&self.symbolic, index),
-                        })?;
+                        },
+                        Breakdown::NonFinite(i) => non_finite_entry(i),
+                    })?;
                 }
                 (_, _, Analysis::Own { .. }) => unreachable!("this crate's analysis comes with its tree"),
                 (_, _, Analysis::Faer(symbolic)) => {
@@ -236,10 +240,10 @@ impl SparseFactor {
                 }
             },
         }
-        if let Some(i) = self.values.iter().position(|x| !x.is_finite()) {
-            return Err(LinalgError::NonFinite {
-                what: format!("factor entry {i} (overflow)"),
-            });
+        if self.tree.is_none() {
+            if let Some(i) = self.values.iter().position(|x| !x.is_finite()) {
+                return Err(non_finite_entry(i));
+            }
         }
         // a pivot that kept fewer than 3 significant digits of its diagonal entry (the rest
         // cancelled): the matrix is singular to working precision. The ratio is free of the
@@ -396,8 +400,7 @@ impl SparseFactor {
                 return;
             }
         }
-        let several = rayon::current_num_threads() > 1;
-        if let (Some(tree), Some(sym), true) = (self.tree.as_ref(), self.symbolic.supernodal(), several) {
+        if let (Some(tree), Some(sym)) = (self.tree_sweeps(), self.symbolic.supernodal()) {
             // the tree's sweeps, on the right-hand sides permuted into the factor's order,
             // index by index (on one thread faer's sweeps, above or below)
             let fwd = self.permutation();
@@ -485,14 +488,15 @@ impl SparseFactor {
                 pivot: original(&self.symbolic, self.n() - k + j),
             });
         }
-        let mut x = faer::Mat::<f64>::zeros(k, k);
-        faer::linalg::triangular_inverse::invert_unit_lower_triangular(x.as_mut(), l, self.par);
-        // the unit diagonal is implied, not necessarily written; the strict upper part is zero
+        // fresh zero pages (the strict upper part stays zero), touched first by faer's kernels
+        let mut x = vec![0.0; k * k];
+        let mut xm = MatMut::from_column_major_slice_mut(&mut x, k, k);
+        faer::linalg::triangular_inverse::invert_unit_lower_triangular(xm.rb_mut(), l, self.par);
+        // the unit diagonal is implied, not necessarily written
         for j in 0..k {
-            x.col_mut(j).subrows_mut(0, j).fill(0.0);
-            x[(j, j)] = 1.0;
+            xm[(j, j)] = 1.0;
         }
-        Ok(Some(crate::dense::unit_lower_gram(x.as_ref(), &d)))
+        Ok(Some(crate::dense::unit_lower_gram(xm.rb(), &d)))
     }
 
     /// The trailing `k x k` corner of the factor, `D_c` on its diagonal and `L_cc` below it (a
@@ -528,6 +532,10 @@ impl SparseFactor {
     pub(crate) fn forward(&self, x: &[f64]) -> Option<Vec<f64>> {
         let (sym, fwd) = self.supernodal_ldlt()?;
         let mut y: Vec<f64> = fwd.iter().map(|&old| x[old]).collect();
+        if let Some(tree) = self.tree_sweeps() {
+            tree.forward(sym, &self.values, &mut y, 1);
+            return Some(y);
+        }
         let f = SupernodalLdltRef::new(sym, &self.values);
         let mut ym = MatMut::from_column_major_slice_mut(&mut y, self.n(), 1);
         let mut tmp = vec![];
@@ -586,8 +594,16 @@ impl SparseFactor {
     /// (consumed). `None` unless the factor is a supernodal `L D Lᵀ`.
     pub(crate) fn backward(&self, mut y: Vec<f64>) -> Option<Vec<f64>> {
         let (sym, fwd) = self.supernodal_ldlt()?;
-        let f = SupernodalLdltRef::new(sym, &self.values);
         let n = self.n();
+        if let Some(tree) = self.tree_sweeps() {
+            tree.backward(sym, &self.values, &mut y, 1);
+            let mut x = vec![0.0; n];
+            for (new, &old) in fwd.iter().enumerate() {
+                x[old] = y[new];
+            }
+            return Some(x);
+        }
+        let f = SupernodalLdltRef::new(sym, &self.values);
         let mut ym = MatMut::from_column_major_slice_mut(&mut y, n, 1);
         for s in 0..sym.n_supernodes() {
             let node = f.supernode(s);
@@ -615,6 +631,12 @@ impl SparseFactor {
             x[old] = y[new];
         }
         Some(x)
+    }
+
+    /// The tree, where its sweeps solve: a factor made on it, solved on a pool of several
+    /// threads (on one, faer's sequential sweeps read the factor in order, and are faster).
+    fn tree_sweeps(&self) -> Option<&crate::tree::Tree> {
+        self.tree.as_ref().filter(|_| rayon::current_num_threads() > 1)
     }
 
     /// The supernodal symbolic factor and the permutation, for an `L D Lᵀ`.
@@ -647,6 +669,13 @@ impl SparseFactor {
             Some(fwd) => fwd.to_vec(),
             None => (0..self.n()).collect(),
         }
+    }
+}
+
+/// A NaN or an infinity at entry `i` of the factor's values: an overflow.
+fn non_finite_entry(i: usize) -> LinalgError {
+    LinalgError::NonFinite {
+        what: format!("factor entry {i} (overflow)"),
     }
 }
 

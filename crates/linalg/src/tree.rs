@@ -37,6 +37,17 @@ const SEQUENTIAL_FLOPS: f64 = 2e7;
 /// supernodes, above the independent subtrees, are cut into pieces: [`column_pieces`]).
 const PIECE_COLS: usize = 32;
 
+/// Why the numeric factorisation of a supernode stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Breakdown {
+    /// A zero pivot at this (permuted) index.
+    ZeroPivot(usize),
+    /// A NaN or an infinity (an overflow) at this index of the factor's values: each
+    /// supernode's values are checked right after it is factored, while they are in cache,
+    /// rather than all of them in one pass after (a 5 GB factor read again on one core).
+    NonFinite(usize),
+}
+
 /// What the parallel numeric factorisation needs beyond faer's symbolic factor, computed once
 /// per pattern: the supernodes' tree, the descendants that update each supernode, the work of
 /// each subtree, and the matrix's lower triangle in the factor's order (its pattern, and where
@@ -152,14 +163,14 @@ impl Tree {
     }
 
     /// Factors `a` (the pattern the tree was built for) into `values`, faer's supernodal
-    /// layout, on rayon's pool. The error is the (permuted) index of a zero pivot.
+    /// layout, on rayon's pool, every value checked finite.
     pub(crate) fn factor(
         &self,
         sym: &SymbolicSupernodalCholesky<usize>,
         a: SparseColMatRef<'_, usize, f64>,
         values: &mut [f64],
         par: Par,
-    ) -> Result<(), usize> {
+    ) -> Result<(), Breakdown> {
         let ctx = Ctx {
             sym,
             tree: self,
@@ -526,7 +537,7 @@ fn column_pieces(ncols: usize, nrows: usize, par: Par) -> Vec<usize> {
 impl Ctx<'_> {
     /// Factors the supernodes `lo..hi`, a union of whole subtrees, into `values` (theirs,
     /// starting at value `off` of the factor).
-    fn forest(&self, lo: usize, hi: usize, values: &mut [f64], off: usize) -> Result<(), usize> {
+    fn forest(&self, lo: usize, hi: usize, values: &mut [f64], off: usize) -> Result<(), Breakdown> {
         if lo == hi {
             return Ok(());
         }
@@ -558,7 +569,7 @@ impl Ctx<'_> {
     }
 
     /// Factors the supernodes `lo..hi` one after another on this thread.
-    fn in_order(&self, lo: usize, hi: usize, values: &mut [f64], off: usize, par: Par) -> Result<(), usize> {
+    fn in_order(&self, lo: usize, hi: usize, values: &mut [f64], off: usize, par: Par) -> Result<(), Breakdown> {
         let mut scratch = self.scratch(lo, hi, par);
         let cpv = self.sym.col_ptr_for_val();
         for s in lo..hi {
@@ -629,7 +640,7 @@ impl Ctx<'_> {
         off: usize,
         scratch: &mut Scratch,
         par: Par,
-    ) -> Result<(), usize> {
+    ) -> Result<(), Breakdown> {
         let (head, tail) = parts;
         let sym = self.sym;
         let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
@@ -676,7 +687,9 @@ impl Ctx<'_> {
             Default::default(),
         )
         .map_err(|e| match e {
-            faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => index + s_start,
+            faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
+                Breakdown::ZeroPivot(index + s_start)
+            }
         })?;
         for j in 0..ncols {
             for i in 0..j {
@@ -694,7 +707,24 @@ impl Ctx<'_> {
                 bot[(i, j)] *= d;
             }
         }
-        Ok(())
+        match first_non_finite(&tail[..cpv[s + 1] - cpv[s]], par) {
+            Some(i) => Err(Breakdown::NonFinite(cpv[s] + i)),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The first NaN or infinity of `v`, read on rayon's pool where `par` is (a wide supernode's
+/// millions of values, where no other task runs).
+fn first_non_finite(v: &[f64], par: Par) -> Option<usize> {
+    const CHUNK: usize = 1 << 16;
+    let bad = |x: &f64| !x.is_finite();
+    match par {
+        Par::Rayon(_) if v.len() > CHUNK => {
+            let c = v.par_chunks(CHUNK).position_first(|c| c.iter().any(bad))?;
+            Some(c * CHUNK + v[c * CHUNK..].iter().position(bad)?)
+        }
+        _ => v.iter().position(bad),
     }
 }
 

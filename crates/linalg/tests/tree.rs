@@ -179,13 +179,14 @@ fn the_condensation_reads_the_same_trailing_block_off_the_parallel_factor() {
     let mut seq = DirectLdlt::new(&a, &g, &b, &ordering, Par::Seq).unwrap();
     let mut par = on_threads(2, || DirectLdlt::new(&a, &g, &b, &ordering, Par::rayon(2))).unwrap();
     let cs = seq.condense(&b_u, &b_phi, &last).unwrap();
-    let cp = par.condense(&b_u, &b_phi, &last).unwrap();
+    // on two threads the condensation's forward sweep and the final backward one walk the tree
+    let cp = on_threads(2, || par.condense(&b_u, &b_phi, &last)).unwrap();
     assert_eq!(cp.loads.route, linalg::CondenseRoute::TrailingBlock);
     assert!(relative_gap(&cp.inverse, &cs.inverse) < 1e-12);
     assert!(relative_gap(&cp.loads.solution, &cs.loads.solution) < 1e-12);
     let d: Vec<f64> = (0..last.len()).map(|i| (i % 5) as f64 * 0.1).collect();
     let (us, ps) = seq.solve_with_update(cs.loads, &b_u, &b_phi, &d).unwrap();
-    let (up, pp) = par.solve_with_update(cp.loads, &b_u, &b_phi, &d).unwrap();
+    let (up, pp) = on_threads(2, || par.solve_with_update(cp.loads, &b_u, &b_phi, &d)).unwrap();
     assert!(relative_gap(&up, &us) < 1e-12);
     assert!(relative_gap(&pp, &ps) < 1e-12);
 }
@@ -222,6 +223,44 @@ fn a_singular_matrix_is_refused_on_the_parallel_route_too() {
     })
     .unwrap_err();
     assert_eq!(format!("{par}"), format!("{seq}"));
+}
+
+/// The tree checks each supernode's values as it factors it (the whole factor is not read
+/// again after). The first node's potential, uncoupled from the displacements and given the
+/// subnormal diagonal `1e-310`, is the last pivot of its supernode, `-1e-310`: the entries
+/// below it, `b_i0 / 1e-310`, are infinities under finite pivots. The tree names them an
+/// overflow of the factor where they appear; faer's sequential walk stops on the pivot they
+/// make infinite next (faer calls a non-finite pivot a zero one). Both refuse the matrix.
+#[test]
+fn an_overflow_is_refused_on_the_parallel_route_too() {
+    let m = 40;
+    let (a, g, b) = grid(m, 6);
+    let keep = |m: &SparseColMat<usize, f64>, f: &dyn Fn(usize, usize, f64) -> Option<f64>| {
+        let mut t = vec![];
+        for j in 0..m.ncols() {
+            for (i, v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                if let Some(x) = f(i, j, *v) {
+                    t.push(Triplet::new(i, j, x));
+                }
+            }
+        }
+        SparseColMat::try_new_from_triplets(m.nrows(), m.ncols(), &t).unwrap()
+    };
+    let b = keep(&b, &|i, j, v| Some(if (i, j) == (0, 0) { 1e-310 } else { v }));
+    let g = keep(&g, &|i, _, v| (i != 0).then_some(v));
+    let k = linalg::sparse::lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref());
+    let ord = Ordering::Given(dissection(m));
+    assert!(SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::Seq).is_err());
+    for threads in [1, 2] {
+        let e = on_threads(threads, || {
+            SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::rayon(2))
+        })
+        .unwrap_err();
+        assert!(
+            matches!(&e, linalg::LinalgError::NonFinite { what } if what.contains("overflow")),
+            "{threads} threads: {e}"
+        );
+    }
 }
 
 #[test]

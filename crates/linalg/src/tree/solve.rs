@@ -61,13 +61,36 @@ impl Tree {
         self.solve_splitting(sym, values, (x, k), SEQUENTIAL_VALUES);
     }
 
+    /// The forward half of [`Tree::solve`], `y = L⁻¹ b`, in place.
+    pub(crate) fn forward(&self, sym: &SymbolicSupernodalCholesky<usize>, values: &[f64], x: &mut [f64], k: usize) {
+        self.sweeps(sym, values, (x, k), SEQUENTIAL_VALUES, (true, false));
+    }
+
+    /// The backward half of [`Tree::solve`], `x = L⁻ᵀ D⁻¹ y`, in place.
+    pub(crate) fn backward(&self, sym: &SymbolicSupernodalCholesky<usize>, values: &[f64], x: &mut [f64], k: usize) {
+        self.sweeps(sym, values, (x, k), SEQUENTIAL_VALUES, (false, true));
+    }
+
     /// [`Tree::solve`], ranges of fewer than `sequential` factor values solved in order.
     fn solve_splitting(
         &self,
         sym: &SymbolicSupernodalCholesky<usize>,
         values: &[f64],
+        x: (&mut [f64], usize),
+        sequential: usize,
+    ) {
+        self.sweeps(sym, values, x, sequential, (true, true));
+    }
+
+    /// The forward sweep, the backward sweep or both (`which`), ranges of fewer than
+    /// `sequential` factor values in order.
+    fn sweeps(
+        &self,
+        sym: &SymbolicSupernodalCholesky<usize>,
+        values: &[f64],
         (x, k): (&mut [f64], usize),
         sequential: usize,
+        (forward, backward): (bool, bool),
     ) {
         let ns = sym.n_supernodes();
         if ns == 0 || k == 0 {
@@ -80,8 +103,12 @@ impl Tree {
             k,
             sequential,
         };
-        s.forward(0, ns, x, 0);
-        s.backward(0, ns, x, 0, &Above { runs: vec![] });
+        if forward {
+            s.forward(0, ns, x, 0);
+        }
+        if backward {
+            s.backward(0, ns, x, 0, &Above { runs: vec![] });
+        }
     }
 }
 
