@@ -33,6 +33,7 @@
 use crate::operator::{Compliance, DenseContactProblem};
 use crate::points::{ContactPoints, PointValues};
 use crate::solution::Law;
+use rayon::prelude::*;
 
 /// Points below which no coarser problem is made: its solve would cost as much as the steps it
 /// saves.
@@ -205,29 +206,40 @@ impl Coarsening {
         let p = self.flat_interpolation(points, nt);
         let w = |r: usize| points.weight[if r < n { r } else { (r - n) / nt }];
         let wc = |a: usize| self.weight[if a < nc { a } else { (a - nc) / nt }];
-        // T = D W P (m x mc), then D_c = W_c⁻¹ Pᵀ W T W_c⁻¹
+        // T = D W P (m x mc), then D_c = W_c⁻¹ Pᵀ W T W_c⁻¹, both by rows on rayon's pool (`D`
+        // is read once, `m²` values)
         let mut t = vec![0.0; m * mc];
-        for r in 0..m {
-            let (row, out) = (&d[r * m..(r + 1) * m], &mut t[r * mc..(r + 1) * mc]);
-            for (c, entries) in p.iter().enumerate() {
-                let v = row[c] * w(c);
-                for &(a, pv) in entries {
-                    out[a] += v * pv;
+        if mc > 0 {
+            t.par_chunks_mut(mc).enumerate().for_each(|(r, out)| {
+                let row = &d[r * m..(r + 1) * m];
+                for (c, entries) in p.iter().enumerate() {
+                    let v = row[c] * w(c);
+                    for &(a, pv) in entries {
+                        out[a] += v * pv;
+                    }
                 }
+            });
+        }
+        // Pᵀ by its rows: the fine rows of each coarse one, in increasing order
+        let mut pt: Vec<Vec<(usize, f64)>> = vec![vec![]; mc];
+        for (r, entries) in p.iter().enumerate() {
+            for &(a, pv) in entries {
+                pt[a].push((r, pv));
             }
         }
         let mut dc = vec![0.0; mc * mc];
-        for (r, entries) in p.iter().enumerate() {
-            for &(a, pv) in entries {
-                let s = pv * w(r);
-                let (src, dst) = (&t[r * mc..(r + 1) * mc], &mut dc[a * mc..(a + 1) * mc]);
-                dst.iter_mut().zip(src).for_each(|(x, y)| *x += s * y);
-            }
-        }
-        for a in 0..mc {
-            for b in 0..mc {
-                dc[a * mc + b] /= wc(a) * wc(b);
-            }
+        if mc > 0 {
+            dc.par_chunks_mut(mc).zip(&pt).enumerate().for_each(|(a, (dst, fine))| {
+                for &(r, pv) in fine {
+                    let s = pv * w(r);
+                    dst.iter_mut()
+                        .zip(&t[r * mc..(r + 1) * mc])
+                        .for_each(|(x, y)| *x += s * y);
+                }
+                for (b, x) in dst.iter_mut().enumerate() {
+                    *x /= wc(a) * wc(b);
+                }
+            });
         }
         // u₀,c = W_c⁻¹ Pᵀ W u₀
         let flat = u0.to_flat();

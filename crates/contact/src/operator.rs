@@ -163,19 +163,26 @@ impl Compliance<'_> {
         let (mut diff, mut size) = (0.0f64, 0.0f64);
         match self {
             Compliance::Dense(d) => {
-                // by tiles, so that the transposed reads stay in cache
+                // by tiles, so that the transposed reads stay in cache; the rows of tiles on
+                // rayon's pool
                 const TILE: usize = 64;
-                for i0 in (0..m).step_by(TILE) {
-                    for j0 in (0..=i0).step_by(TILE) {
-                        for i in i0..(i0 + TILE).min(m) {
-                            for j in j0..(j0 + TILE).min(i + 1) {
-                                let (a, b) = (d[i * m + j], d[j * m + i]);
-                                size = size.max(a.abs()).max(b.abs());
-                                diff = diff.max((a - b).abs());
+                (diff, size) = (0..m.div_ceil(TILE))
+                    .into_par_iter()
+                    .map(|t| {
+                        let (mut diff, mut size) = (0.0f64, 0.0f64);
+                        let i0 = t * TILE;
+                        for j0 in (0..=i0).step_by(TILE) {
+                            for i in i0..(i0 + TILE).min(m) {
+                                for j in j0..(j0 + TILE).min(i + 1) {
+                                    let (a, b) = (d[i * m + j], d[j * m + i]);
+                                    size = size.max(a.abs()).max(b.abs());
+                                    diff = diff.max((a - b).abs());
+                                }
                             }
                         }
-                    }
-                }
+                        (diff, size)
+                    })
+                    .reduce(|| (0.0, 0.0), |x, y| (x.0.max(y.0), x.1.max(y.1)));
             }
             Compliance::Sparse(s) => {
                 let at = |i: usize, j: usize| {

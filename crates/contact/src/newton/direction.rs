@@ -7,10 +7,12 @@
 use super::equations::{Flat, RowForm, State};
 use crate::operator::{dot8, Compliance};
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Mat, MatRef, Par};
+use faer::{Conj, Mat, MatMut, MatRef, Par};
+use rayon::prelude::*;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Largest relative asymmetry of a dense compliance that is solved through its symmetric part
@@ -23,7 +25,9 @@ const SYMMETRIC: f64 = 1e-8;
 /// them and its explicit inverse (`m³` more) made once one needs many; on a positive-real `D`
 /// (electric rows) the inverse from one LU.
 pub(super) struct Stiffness {
-    llt: Option<faer::linalg::solvers::Llt<f64>>,
+    /// The Cholesky factor `L` of `K⁻¹`, column-major `m x m` (its lower triangle; the upper
+    /// one is not read), where `K` is factored.
+    factor: Option<Vec<f64>>,
     /// `K`, row-major, once made.
     inverse: OnceLock<Vec<f64>>,
 }
@@ -32,35 +36,76 @@ impl Stiffness {
     /// A stiffness given as its inverse, row-major.
     fn inverse(k: Vec<f64>) -> Self {
         Stiffness {
-            llt: None,
+            factor: None,
             inverse: OnceLock::from(k),
         }
+    }
+
+    /// The stiffness of the row-major `m x m` compliance `d` (its upper triangle, symmetric
+    /// within [`SYMMETRIC`]) with `shift[i]` added to its diagonal, by its Cholesky factor;
+    /// `None` where that fails (not positive definite). The factor's columns are copied from
+    /// `d`'s rows (contiguous reads) on rayon's pool, into fresh pages that each task touches
+    /// first, and factored in place with faer's parallel kernels: an `m²` matrix is written
+    /// once (faer's `Llt` zeroes, copies and clears it on one core, three passes).
+    fn factored(d: &[f64], m: usize, shift: impl Fn(usize) -> f64 + Sync) -> Option<Self> {
+        let mut l = vec![0.0; m * m];
+        if m > 0 {
+            l.par_chunks_mut(m).enumerate().for_each(|(j, col)| {
+                col[j..].copy_from_slice(&d[j * m + j..(j + 1) * m]);
+                col[j] += shift(j);
+            });
+        }
+        let par = faer::get_global_parallelism();
+        let mut mem = MemBuffer::try_new(cholesky_in_place_scratch::<f64>(m, par, Default::default())).ok()?;
+        let lm = MatMut::from_column_major_slice_mut(&mut l, m, m);
+        cholesky_in_place(lm, Default::default(), par, MemStack::new(&mut mem), Default::default()).ok()?;
+        Some(Stiffness {
+            factor: Some(l),
+            inverse: OnceLock::new(),
+        })
+    }
+
+    /// `X ← K X`: solves with the factor, in place.
+    fn solve(l: &[f64], x: MatMut<'_, f64>) {
+        let m = x.nrows();
+        let lm = MatRef::from_column_major_slice(l, m, m);
+        let par = faer::get_global_parallelism();
+        faer::linalg::cholesky::llt::solve::solve_in_place_with_conj(lm, Conj::No, x, par, MemStack::new(&mut []));
     }
 
     /// `K`, row-major, made from the factor where it is not yet.
     fn explicit(&self, m: usize) -> &[f64] {
         self.inverse.get_or_init(|| {
-            let llt = self
-                .llt
+            let l = self
+                .factor
                 .as_ref()
                 .expect("a stiffness without its inverse has its factor");
-            // faer mirrors the inverse's lower half onto its upper one: symmetric exactly, so
-            // its column-major storage, read contiguously, is the row-major `K`
-            let inv = faer::linalg::solvers::DenseSolveCore::inverse(llt);
-            (0..m * m).map(|k| inv[(k % m, k / m)]).collect()
+            let par = faer::get_global_parallelism();
+            let mut mem = MemBuffer::new(faer::linalg::cholesky::llt::inverse::inverse_scratch::<f64>(m, par));
+            // the inverse's lower half, column-major: row-major, `K`'s upper half
+            let mut k = vec![0.0; m * m];
+            let lm = MatRef::from_column_major_slice(l, m, m);
+            let out = MatMut::from_column_major_slice_mut(&mut k, m, m);
+            faer::linalg::cholesky::llt::inverse::inverse(out, lm, par, MemStack::new(&mut mem));
+            for r in 0..m {
+                for c in 0..r {
+                    k[r * m + c] = k[c * m + r];
+                }
+            }
+            k
         })
     }
 
     /// Rows `js` of `K` (`K` symmetric where it is factored: row `j` is `K e_j`), row-major,
     /// `js.len() x m`: by solves while they are fewer than `m / 8` and the inverse is not made.
     fn rows(&self, js: &[usize], m: usize) -> Vec<f64> {
-        match (&self.llt, self.inverse.get()) {
-            (Some(llt), None) if 8 * js.len() < m => {
+        match (&self.factor, self.inverse.get()) {
+            (Some(l), None) if 8 * js.len() < m => {
                 let mut rhs = Mat::<f64>::zeros(m, js.len());
                 for (k, &j) in js.iter().enumerate() {
                     rhs[(j, k)] = 1.0;
                 }
-                llt.solve_in_place(rhs.as_mut());
+                Stiffness::solve(l, rhs.as_mut());
                 (0..js.len() * m).map(|i| rhs[(i % m, i / m)]).collect()
             }
             _ => {
@@ -73,11 +118,11 @@ impl Stiffness {
     /// `K v`.
     fn apply(&self, v: &[f64]) -> Vec<f64> {
         let m = v.len();
-        match (&self.llt, self.inverse.get()) {
-            (Some(llt), None) => {
-                let mut rhs = Mat::<f64>::from_fn(m, 1, |i, _| v[i]);
-                llt.solve_in_place(rhs.as_mut());
-                (0..m).map(|i| rhs[(i, 0)]).collect()
+        match (&self.factor, self.inverse.get()) {
+            (Some(l), None) => {
+                let mut x = v.to_vec();
+                Stiffness::solve(l, MatMut::from_column_major_slice_mut(&mut x, m, 1));
+                x
             }
             _ => {
                 let k = self.explicit(m);
@@ -175,13 +220,12 @@ impl Directions {
             Compliance::Dense(d) => d,
         };
         let m = flat.m;
-        // `(D + σW⁻¹)ᵀ`, read column by column (a contiguous copy): the Cholesky factorisation
-        // reads its lower triangle, `D`'s upper one (the same within [`SYMMETRIC`])
-        let mut transposed = MatRef::from_column_major_slice(d, m, m).to_owned();
-        for i in 0..m {
-            transposed[(i, i)] += flat.sigma / flat.w[i];
-        }
         if flat.electric.is_some() {
+            // `(D + σW⁻¹)ᵀ`, read column by column (a contiguous copy)
+            let mut transposed = MatRef::from_column_major_slice(d, m, m).to_owned();
+            for i in 0..m {
+                transposed[(i, i)] += flat.sigma / flat.w[i];
+            }
             // positive real, not symmetric (the electric couplings are opposite): the reduced
             // system with the stiffness from one LU; a condensed finite-element compliance
             // all the same, under its rules
@@ -198,12 +242,11 @@ impl Directions {
         if flat.asymmetry() > SYMMETRIC {
             return Directions::DenseLu { symmetric: false };
         }
-        match transposed.llt(faer::Side::Lower) {
-            Ok(llt) => Directions::Reduced(Arc::new(Stiffness {
-                llt: Some(llt),
-                inverse: OnceLock::new(),
-            })),
-            Err(_) => Directions::DenseLu { symmetric: true },
+        // the Cholesky factorisation reads the lower triangle of `(D + σW⁻¹)ᵀ`, `D`'s upper one
+        // (the same within [`SYMMETRIC`])
+        match Stiffness::factored(d, m, |i| flat.sigma / flat.w[i]) {
+            Some(stiffness) => Directions::Reduced(Arc::new(stiffness)),
+            None => Directions::DenseLu { symmetric: true },
         }
     }
 
@@ -541,10 +584,9 @@ mod tests {
         let a = Mat::<f64>::from_fn(m, m, |i, j| {
             (0..m).map(|l| g(i, l) * g(j, l)).sum::<f64>() + if i == j { 1.0 } else { 0.0 }
         });
-        let factored = Stiffness {
-            llt: Some(a.llt(faer::Side::Lower).unwrap()),
-            inverse: OnceLock::new(),
-        };
+        let row_major: Vec<f64> = (0..m * m).map(|k| a[(k / m, k % m)]).collect();
+        let factored = Stiffness::factored(&row_major, m, |_| 0.0).unwrap();
+        let shifted = Stiffness::factored(&row_major, m, |i| 0.5 + 0.01 * i as f64).unwrap();
         let inv = faer::linalg::solvers::DenseSolveCore::inverse(&a.partial_piv_lu());
         let explicit = Stiffness::inverse((0..m * m).map(|k| inv[(k / m, k % m)]).collect());
         let v: Vec<f64> = (0..m).map(|i| (i as f64 * 0.7).sin()).collect();
@@ -563,6 +605,15 @@ mod tests {
             "twenty rows of forty make the inverse"
         );
         assert!(close(&factored.apply(&v), &explicit.apply(&v)));
+        // the shift is added to the diagonal; a shift that leaves the matrix indefinite is
+        // refused
+        let a_shifted = Mat::<f64>::from_fn(m, m, |i, j| {
+            a[(i, j)] + if i == j { 0.5 + 0.01 * i as f64 } else { 0.0 }
+        });
+        let inv = faer::linalg::solvers::DenseSolveCore::inverse(&a_shifted.partial_piv_lu());
+        let by_lu: Vec<f64> = (0..m).map(|i| (0..m).map(|j| inv[(i, j)] * v[j]).sum()).collect();
+        assert!(close(&shifted.apply(&v), &by_lu));
+        assert!(Stiffness::factored(&row_major, m, |_| -100.0).is_none());
     }
 
     /// The rows of the Jacobian with electric rows are the derivative of the equations: a
