@@ -9,6 +9,7 @@
 //! from parts that were not merged) are allowed and counted.
 
 use crate::{CellKind, Mesh, MeshError};
+use rayon::prelude::*;
 
 /// A facet as its sorted nodes (unused slots `usize::MAX`), so equal facets compare equal.
 type Key = [usize; 4];
@@ -45,7 +46,7 @@ impl Mesh {
                 all.push((key(&buf[..f.len()]), c));
             }
         }
-        all.sort_unstable();
+        all.par_sort_unstable();
         all
     }
 
@@ -177,16 +178,37 @@ impl Mesh {
     /// [`MeshError::MissingBoundary`].
     pub fn interior_facets(&self, group: &str) -> Result<Vec<usize>, MeshError> {
         let g = self.boundary(group)?;
-        let facets = self.cell_facets();
+        let around = self.node_cells();
         Ok(g.iter()
             .enumerate()
-            .filter(|(_, f)| {
-                let k = key(f);
-                let at = facets.partition_point(|x| x.0 < k);
-                facets[at..].iter().take_while(|x| x.0 == k).count() > 1
-            })
+            .filter(|(_, f)| self.cells_of_facet(&around, f).nth(1).is_some())
             .map(|(i, _)| i)
             .collect())
+    }
+
+    /// The cells that have `facet` (its nodes, in any order) as one of theirs, found among the
+    /// cells around its first node (`around`: [`Mesh::node_cells`]); none for a facet whose
+    /// nodes are not the mesh's.
+    fn cells_of_facet<'a>(
+        &'a self,
+        (offsets, node_cells): &'a (Vec<usize>, Vec<usize>),
+        facet: &'a [usize],
+    ) -> impl Iterator<Item = usize> + 'a {
+        let k = key(facet);
+        let near = match facet.first() {
+            Some(&v) if v + 1 < offsets.len() => &node_cells[offsets[v]..offsets[v + 1]],
+            _ => &[],
+        };
+        near.iter().copied().filter(move |&c| {
+            let cell = self.cell(c);
+            self.kind.facets().iter().any(|f| {
+                let mut nodes = [0usize; 3];
+                for (q, &l) in f.iter().enumerate() {
+                    nodes[q] = cell[l];
+                }
+                f.len() == facet.len() && key(&nodes[..f.len()]) == k
+            })
+        })
     }
 
     /// The nodes that no cell uses, sorted.
@@ -219,7 +241,16 @@ impl Mesh {
     /// holds, or that two cells hold (inside the mesh, it has no outward side).
     pub fn outward_normals(&self, group: &str) -> Result<Vec<[f64; 3]>, MeshError> {
         let g = self.boundary(group)?;
-        if let Some(&f) = self.interior_facets(group)?.first() {
+        let around = self.node_cells();
+        // each facet's cells: its owner, and whether another shares it
+        let owners: Vec<(Option<usize>, bool)> = g
+            .iter()
+            .map(|facet| {
+                let mut cells = self.cells_of_facet(&around, facet);
+                (cells.next(), cells.next().is_some())
+            })
+            .collect();
+        if let Some(f) = owners.iter().position(|o| o.1) {
             return Err(MeshError::BadBoundaryFacet {
                 group: group.into(),
                 facet: f,
@@ -227,19 +258,14 @@ impl Mesh {
                 problem: "lies inside the mesh (two cells share it): it has no outward normal",
             });
         }
-        let (offsets, node_cells) = self.node_cells();
         let mut out = Vec::with_capacity(g.n_facets());
         for (f, facet) in g.iter().enumerate() {
-            let owner = node_cells[offsets[facet[0]]..offsets[facet[0] + 1]]
-                .iter()
-                .copied()
-                .find(|&c| facet.iter().all(|v| self.cell(c).contains(v)))
-                .ok_or_else(|| MeshError::BadBoundaryFacet {
-                    group: group.into(),
-                    facet: f,
-                    nodes: facet.to_vec(),
-                    problem: "is not a facet of any cell",
-                })?;
+            let owner = owners[f].0.ok_or_else(|| MeshError::BadBoundaryFacet {
+                group: group.into(),
+                facet: f,
+                nodes: facet.to_vec(),
+                problem: "is not a facet of any cell",
+            })?;
             let p = |v: usize| self.points[v];
             let n = if self.dim == 2 {
                 let (a, b) = (p(facet[0]), p(facet[1]));
