@@ -337,6 +337,22 @@ mod tests {
         }
     }
 
+    /// A facet's cells are those with one of their own facets on its nodes: two across an
+    /// interior edge of quads, none for a quad's diagonal (whose two nodes the quad holds).
+    #[test]
+    fn a_quads_diagonal_is_no_facet_of_it() {
+        let m = crate::rectangle_quad([0.0, 0.0], [2.0, 1.0], 2, 1);
+        let around = m.node_cells();
+        let (a, b) = (m.cell(0).to_vec(), m.cell(1).to_vec());
+        let shared: Vec<usize> = a.iter().copied().filter(|v| b.contains(v)).collect();
+        assert_eq!(m.cells_of_facet(&around, &shared).count(), 2);
+        let diagonal = [a[0], a[2]];
+        assert_eq!(m.cells_of_facet(&around, &diagonal).count(), 0);
+        assert_eq!(m.cells_of_facet(&around, &[a[0], a[1]]).collect::<Vec<_>>(), vec![0]);
+        // nodes the mesh does not have
+        assert_eq!(m.cells_of_facet(&around, &[m.n_nodes() + 5, 0]).count(), 0);
+    }
+
     #[test]
     fn broken_topology_is_named() {
         // a cell listed twice
