@@ -4,16 +4,16 @@
 //! appears all at once, in place of the previous one, or not at all.
 
 mod set;
+mod vtu;
 
 pub use set::{Outputs, SetWriter};
 
 use crate::plots::{self, Mark, Panel, Series};
 use crate::Error;
 use problem::{ContactResult, Output, RunReport, Solution};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use vtkio::model::{
-    Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, UnstructuredGridPiece, Version, VertexNumbers, Vtk,
-};
+use vtu::{Array, CellType, Grid, Values};
 
 /// `run.json`: the report, pretty, its keys in sorted order.
 ///
@@ -29,64 +29,79 @@ pub fn run_json(report: &RunReport) -> Result<Vec<u8>, Error> {
 }
 
 /// The files of a solution, those its plan lists (and, for the last instant of a load path,
-/// `path.csv` and its pictures).
+/// `path.csv` and its pictures), each made on rayon's pool at the same time as the others (the
+/// grid's encoding and the pictures' rendering do not depend on each other), in the plan's
+/// order.
 ///
 /// # Errors
-/// [`Error::Picture`] where a file cannot be made.
+/// [`Error::Picture`] where a file cannot be made (the first in the plan's order).
 pub fn files(solution: &Solution) -> Result<Outputs, Error> {
+    let made: Vec<Result<plots::Files, Error>> = solution
+        .report
+        .plan
+        .outputs
+        .par_iter()
+        .map(|&output| output_files(solution, output))
+        .collect();
     let mut out = Outputs::new(Path::new(""));
-    let missing = |what: &str| Error::Picture {
-        name: what.into(),
-        message: "the plan lists it, but the run has nothing to draw it from".into(),
-    };
-    for &output in &solution.report.plan.outputs {
-        match output {
-            Output::RunJson => out.add("run.json", run_json(&solution.report)?),
-            Output::SolutionVtu => out.add(
-                "solution.vtu",
-                vtu(
-                    &solution.mesh,
-                    (&solution.u, &solution.phi),
-                    &solution.fields,
-                    solution.contact.as_ref(),
-                )?,
-            ),
-            Output::RevolvedVtu => out.add(
-                "revolved.vtu",
-                revolved_vtu(
-                    &solution.mesh,
-                    (&solution.u, &solution.phi),
-                    &solution.fields,
-                    solution
-                        .report
-                        .scene
-                        .settings
-                        .mesh
-                        .revolve
-                        .ok_or_else(|| missing("revolved.vtu"))?,
-                )?,
-            ),
-            Output::ContactCsv => {
-                let c = solution.contact.as_ref().ok_or_else(|| missing("contact.csv"))?;
-                out.add("contact.csv", contact_csv(c));
-            }
-            Output::Multipliers => {
-                let c = solution.contact.as_ref().ok_or_else(|| missing("multipliers"))?;
-                out.extend(multipliers_picture(c)?);
-            }
-            Output::Deformed => {
-                let pic = plots::mesh_view::deformed_picture(&solution.mesh, &solution.u)?;
-                out.extend(pic.ok_or_else(|| missing("deformed"))?);
-            }
-            Output::Potential => {
-                let pic = plots::mesh_view::potential_picture(&solution.mesh, &solution.u, &solution.phi)?;
-                out.extend(pic.ok_or_else(|| missing("potential"))?);
-            }
-        }
+    for files in made {
+        out.extend(files?);
     }
     // a load path's rows and curves
     out.extend(path_files(solution)?);
     Ok(out)
+}
+
+/// The files of one output of the plan.
+fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Error> {
+    let missing = |what: &str| Error::Picture {
+        name: what.into(),
+        message: "the plan lists it, but the run has nothing to draw it from".into(),
+    };
+    let one = |name: &str, bytes: Vec<u8>| vec![(name.to_string(), bytes)];
+    Ok(match output {
+        Output::RunJson => one("run.json", run_json(&solution.report)?),
+        Output::SolutionVtu => one(
+            "solution.vtu",
+            vtu(
+                &solution.mesh,
+                (&solution.u, &solution.phi),
+                &solution.fields,
+                solution.contact.as_ref(),
+            )?,
+        ),
+        Output::RevolvedVtu => one(
+            "revolved.vtu",
+            revolved_vtu(
+                &solution.mesh,
+                (&solution.u, &solution.phi),
+                &solution.fields,
+                solution
+                    .report
+                    .scene
+                    .settings
+                    .mesh
+                    .revolve
+                    .ok_or_else(|| missing("revolved.vtu"))?,
+            )?,
+        ),
+        Output::ContactCsv => {
+            let c = solution.contact.as_ref().ok_or_else(|| missing("contact.csv"))?;
+            one("contact.csv", contact_csv(c))
+        }
+        Output::Multipliers => {
+            let c = solution.contact.as_ref().ok_or_else(|| missing("multipliers"))?;
+            multipliers_picture(c)?
+        }
+        Output::Deformed => {
+            let pic = plots::mesh_view::deformed_picture(&solution.mesh, &solution.u)?;
+            pic.ok_or_else(|| missing("deformed"))?
+        }
+        Output::Potential => {
+            let pic = plots::mesh_view::potential_picture(&solution.mesh, &solution.u, &solution.phi)?;
+            pic.ok_or_else(|| missing("potential"))?
+        }
+    })
 }
 
 /// Writes the files of a solution into `dir`, as one set.
@@ -110,7 +125,7 @@ fn vtu(
     let k = mesh.kind.n_nodes();
     let connectivity: Vec<u64> = mesh.cells.iter().map(|&v| v as u64).collect();
     let offsets: Vec<u64> = (1..=mesh.n_cells()).map(|c| (c * k) as u64).collect();
-    let ct = match mesh.kind {
+    let cell_type = match mesh.kind {
         mesh::CellKind::Tri3 => CellType::Triangle,
         mesh::CellKind::Quad4 => CellType::Quad,
         mesh::CellKind::Tet4 => CellType::Tetra,
@@ -119,11 +134,8 @@ fn vtu(
     // Voigt components per cell: 3 in plane strain, 4 on a body of revolution ([rr, zz, rz,
     // θθ]), 6 in 3D
     let nv = fields.stress.len() / mesh.n_cells().max(1);
-    let mut point = vec![
-        Attribute::generic("u", 3).with_data(u.iter().flatten().copied().collect::<Vec<f64>>()),
-        Attribute::scalars("phi", 1).with_data(phi.to_vec()),
-    ];
-    if let Some(c) = contact {
+    let u: Vec<f64> = u.iter().flatten().copied().collect();
+    let status = contact.map(|c| {
         let mut status = vec![0.0; mesh.n_nodes()];
         for (i, &node) in c.nodes.iter().enumerate() {
             status[node] = match c.solution.status[i] {
@@ -132,46 +144,31 @@ fn vtu(
                 contact::Status::Separated => 3.0,
             };
         }
-        point.push(Attribute::scalars("contact_status", 1).with_data(status));
+        status
+    });
+    let array = |name, components, values| Array {
+        name,
+        components,
+        values: Values::F64(values),
+    };
+    let mut point = vec![array("u", 3, &u), array("phi", 1, phi)];
+    if let Some(status) = &status {
+        point.push(array("contact_status", 1, status));
     }
     let cell = vec![
-        Attribute::generic("stress", nv as u32).with_data(fields.stress.clone()),
-        Attribute::generic("strain", nv as u32).with_data(fields.strain.clone()),
-        Attribute::generic("electric_displacement", dim as u32).with_data(fields.electric_displacement.clone()),
-        Attribute::generic("electric_field", dim as u32).with_data(fields.electric_field.clone()),
+        array("stress", nv, &fields.stress),
+        array("strain", nv, &fields.strain),
+        array("electric_displacement", dim, &fields.electric_displacement),
+        array("electric_field", dim, &fields.electric_field),
     ];
-    let cells = Cells {
-        cell_verts: VertexNumbers::XML { connectivity, offsets },
-        types: vec![ct; mesh.n_cells()],
-    };
-    grid_xml(
-        "solution.vtu",
-        "piezocontact solution",
-        points,
-        cells,
-        Attributes { point, cell },
-    )
-}
-
-/// An unstructured grid as VTK XML, the file `name` (for its error).
-fn grid_xml(name: &str, title: &str, points: Vec<f64>, cells: Cells, data: Attributes) -> Result<Vec<u8>, Error> {
-    let vtk = Vtk {
-        version: Version::new((1, 0)),
-        title: title.into(),
-        byte_order: ByteOrder::LittleEndian,
-        file_path: None,
-        data: DataSet::inline(UnstructuredGridPiece {
-            points: points.into(),
-            cells,
-            data,
-        }),
-    };
-    let mut buf = Vec::new();
-    vtk.write_xml(&mut buf).map_err(|e| Error::Picture {
-        name: name.into(),
-        message: e.to_string(),
-    })?;
-    Ok(buf)
+    Ok(vtu::write(&Grid {
+        points: &points,
+        connectivity: &connectivity,
+        offsets: &offsets,
+        cell_type,
+        point,
+        cell,
+    }))
 }
 
 /// A body of revolution's solution swept round its axis (y) in `segments` steps: each meridian
@@ -223,23 +220,24 @@ fn revolved_vtu(
             }
         }
     }
-    let grid = Cells {
-        cell_verts: VertexNumbers::XML { connectivity, offsets },
-        types: vec![CellType::Wedge; cells * segments],
+    let array = |name, components, values| Array {
+        name,
+        components,
+        values: Values::F64(values),
     };
-    let data = Attributes {
-        point: vec![
-            Attribute::generic("u", 3).with_data(uu),
-            Attribute::scalars("phi", 1).with_data(pp),
-        ],
+    Ok(vtu::write(&Grid {
+        points: &points,
+        connectivity: &connectivity,
+        offsets: &offsets,
+        cell_type: CellType::Wedge,
+        point: vec![array("u", 3, &uu), array("phi", 1, &pp)],
         cell: vec![
-            Attribute::generic("stress", nv as u32).with_data(stress),
-            Attribute::generic("strain", nv as u32).with_data(strain),
-            Attribute::generic("electric_displacement", 3).with_data(d),
-            Attribute::generic("electric_field", 3).with_data(e),
+            array("stress", nv, &stress),
+            array("strain", nv, &strain),
+            array("electric_displacement", 3, &d),
+            array("electric_field", 3, &e),
         ],
-    };
-    grid_xml("revolved.vtu", "piezocontact solution, revolved", points, grid, data)
+    }))
 }
 
 /// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
@@ -585,6 +583,7 @@ pub fn safe_file_name(name: &str, fallback: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use vtkio::model::{DataSet, VertexNumbers, Vtk};
 
     #[test]
     fn a_body_of_revolution_is_swept_into_wedges_that_face_out() {
