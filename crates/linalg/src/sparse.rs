@@ -11,8 +11,9 @@ const PARALLEL_ENTRIES: usize = 1 << 18;
 /// partial sums are added in this fixed order: the result does not depend on the pool's size.
 const PARTS: usize = 8;
 
-/// `y += alpha M x`: by columns (each scatters into `y`); a large `M` in [`PARTS`] ranges of
-/// columns on rayon's pool, each into a vector of its own, added in order.
+/// `y += alpha M x`: by columns (each scatters into `y`); a large `M` in 8 ranges of
+/// columns of about equal entries on rayon's pool, each into a vector of its own, added in
+/// order (the same result on any pool).
 pub fn mul_add(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alpha: f64) {
     let ncols = m.ncols().min(x.len());
     if m.val().len() < PARALLEL_ENTRIES {
