@@ -59,32 +59,18 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
         message: "the plan lists it, but the run has nothing to draw it from".into(),
     };
     let one = |name: &str, bytes: Vec<u8>| vec![(name.to_string(), bytes)];
+    let (mesh, fields) = (&solution.mesh, (&solution.u[..], &solution.phi[..]));
     Ok(match output {
         Output::RunJson => one("run.json", run_json(&solution.report)?),
         Output::SolutionVtu => one(
             "solution.vtu",
-            vtu(
-                &solution.mesh,
-                (&solution.u, &solution.phi),
-                &solution.fields,
-                solution.contact.as_ref(),
-            )?,
+            vtu(mesh, fields, &solution.fields, solution.contact.as_ref())?,
         ),
-        Output::RevolvedVtu => one(
-            "revolved.vtu",
-            revolved_vtu(
-                &solution.mesh,
-                (&solution.u, &solution.phi),
-                &solution.fields,
-                solution
-                    .report
-                    .scene
-                    .settings
-                    .mesh
-                    .revolve
-                    .ok_or_else(|| missing("revolved.vtu"))?,
-            )?,
-        ),
+        Output::RevolvedVtu => {
+            let segments = solution.report.scene.settings.mesh.revolve;
+            let segments = segments.ok_or_else(|| missing("revolved.vtu"))?;
+            one("revolved.vtu", revolved_vtu(mesh, fields, &solution.fields, segments)?)
+        }
         Output::ContactCsv => {
             let c = solution.contact.as_ref().ok_or_else(|| missing("contact.csv"))?;
             one("contact.csv", contact_csv(c))
