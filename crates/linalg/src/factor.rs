@@ -241,7 +241,7 @@ impl SparseFactor {
             },
         }
         if self.tree.is_none() {
-            if let Some(i) = self.values.iter().position(|x| !x.is_finite()) {
+            if let Some(i) = crate::tree::first_non_finite(&self.values, self.par) {
                 return Err(non_finite_entry(i));
             }
         }
@@ -595,36 +595,37 @@ impl SparseFactor {
     pub(crate) fn backward(&self, mut y: Vec<f64>) -> Option<Vec<f64>> {
         let (sym, fwd) = self.supernodal_ldlt()?;
         let n = self.n();
-        if let Some(tree) = self.tree_sweeps() {
-            tree.backward(sym, &self.values, &mut y, 1);
-            let mut x = vec![0.0; n];
-            for (new, &old) in fwd.iter().enumerate() {
-                x[old] = y[new];
+        match self.tree_sweeps() {
+            Some(tree) => tree.backward(sym, &self.values, &mut y, 1),
+            None => {
+                let f = SupernodalLdltRef::new(sym, &self.values);
+                let mut ym = MatMut::from_column_major_slice_mut(&mut y, n, 1);
+                for s in 0..sym.n_supernodes() {
+                    let node = f.supernode(s);
+                    let ls = node.val();
+                    for j in 0..ls.ncols() {
+                        ym[(node.start() + j, 0)] /= ls[(j, j)];
+                    }
+                }
+                let mut tmp = vec![];
+                for s in (0..sym.n_supernodes()).rev() {
+                    let node = f.supernode(s);
+                    let ls = node.val();
+                    let w = ls.ncols();
+                    let (top, bot) = ls.split_at_row(w);
+                    let pattern = node.pattern();
+                    tmp.clear();
+                    tmp.extend(pattern.iter().map(|&i| ym[(i, 0)]));
+                    let t = faer::MatRef::from_column_major_slice(&tmp, pattern.len(), 1);
+                    let mut x_top = ym.rb_mut().subrows_mut(node.start(), w);
+                    faer::linalg::matmul::matmul(x_top.rb_mut(), faer::Accum::Add, bot.transpose(), t, -1.0, Par::Seq);
+                    faer::linalg::triangular_solve::solve_unit_upper_triangular_in_place(
+                        top.transpose(),
+                        x_top,
+                        Par::Seq,
+                    );
+                }
             }
-            return Some(x);
-        }
-        let f = SupernodalLdltRef::new(sym, &self.values);
-        let mut ym = MatMut::from_column_major_slice_mut(&mut y, n, 1);
-        for s in 0..sym.n_supernodes() {
-            let node = f.supernode(s);
-            let ls = node.val();
-            for j in 0..ls.ncols() {
-                ym[(node.start() + j, 0)] /= ls[(j, j)];
-            }
-        }
-        let mut tmp = vec![];
-        for s in (0..sym.n_supernodes()).rev() {
-            let node = f.supernode(s);
-            let ls = node.val();
-            let w = ls.ncols();
-            let (top, bot) = ls.split_at_row(w);
-            let pattern = node.pattern();
-            tmp.clear();
-            tmp.extend(pattern.iter().map(|&i| ym[(i, 0)]));
-            let t = faer::MatRef::from_column_major_slice(&tmp, pattern.len(), 1);
-            let mut x_top = ym.rb_mut().subrows_mut(node.start(), w);
-            faer::linalg::matmul::matmul(x_top.rb_mut(), faer::Accum::Add, bot.transpose(), t, -1.0, Par::Seq);
-            faer::linalg::triangular_solve::solve_unit_upper_triangular_in_place(top.transpose(), x_top, Par::Seq);
         }
         let mut x = vec![0.0; n];
         for (new, &old) in fwd.iter().enumerate() {

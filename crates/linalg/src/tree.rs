@@ -715,8 +715,8 @@ impl Ctx<'_> {
 }
 
 /// The first NaN or infinity of `v`, read on rayon's pool where `par` is (a wide supernode's
-/// millions of values, where no other task runs).
-fn first_non_finite(v: &[f64], par: Par) -> Option<usize> {
+/// millions of values, where no other task runs; a whole factor faer walked).
+pub(crate) fn first_non_finite(v: &[f64], par: Par) -> Option<usize> {
     const CHUNK: usize = 1 << 16;
     let bad = |x: &f64| !x.is_finite();
     match par {

@@ -58,7 +58,7 @@ impl Tree {
     /// order, stored index by index: `x[i k + j]` is index `i` of right-hand side `j`), with
     /// `values` the factor this tree's [`Tree::factor`] wrote.
     pub(crate) fn solve(&self, sym: &SymbolicSupernodalCholesky<usize>, values: &[f64], x: &mut [f64], k: usize) {
-        self.solve_splitting(sym, values, (x, k), SEQUENTIAL_VALUES);
+        self.sweeps(sym, values, (x, k), SEQUENTIAL_VALUES, (true, true));
     }
 
     /// The forward half of [`Tree::solve`], `y = L⁻¹ b`, in place.
@@ -71,19 +71,8 @@ impl Tree {
         self.sweeps(sym, values, (x, k), SEQUENTIAL_VALUES, (false, true));
     }
 
-    /// [`Tree::solve`], ranges of fewer than `sequential` factor values solved in order.
-    fn solve_splitting(
-        &self,
-        sym: &SymbolicSupernodalCholesky<usize>,
-        values: &[f64],
-        x: (&mut [f64], usize),
-        sequential: usize,
-    ) {
-        self.sweeps(sym, values, x, sequential, (true, true));
-    }
-
-    /// The forward sweep, the backward sweep or both (`which`), ranges of fewer than
-    /// `sequential` factor values in order.
+    /// The forward sweep, the backward sweep or both (`(forward, backward)`), ranges of fewer
+    /// than `sequential` factor values solved in order.
     fn sweeps(
         &self,
         sym: &SymbolicSupernodalCholesky<usize>,
@@ -355,7 +344,7 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| tree.solve_splitting(sym, values, (&mut x, ncols), sequential));
+                .install(|| tree.sweeps(sym, values, (&mut x, ncols), sequential, (true, true)));
             let gap = (0..n * ncols)
                 .map(|i| (x[i] - want[(i % ncols) * n + i / ncols]).abs())
                 .fold(0.0, f64::max);
