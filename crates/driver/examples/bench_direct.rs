@@ -3,9 +3,12 @@
 //! numeric `L D Lᵀ` and one solve with faer, as the default backend does them, on rayon's pool
 //! (`RAYON_NUM_THREADS`): the order, and the factor's elimination tree. Writes the matrix (its lower triangle, Matrix
 //! Market, 1-based) and a right-hand side for the comparators of `bench/direct/compare.py`, and
-//! prints one line `faer analysis A factor F solve S residual R` per repeat.
+//! prints one line `faer analysis A factor F solve S residual R` per repeat. With a fifth
+//! argument `last=GROUP`, the free displacements of that boundary group's nodes are ordered
+//! last, as a condensed contact strategy orders its contact dofs (the run's own factorisation:
+//! a root supernode as wide as the contact surface and the separator above it).
 //!
-//!   cargo run --release -p driver --example bench_direct -- 256 paper out/bench-direct [repeats]
+//!   cargo run --release -p driver --example bench_direct -- 256 paper out/bench-direct [repeats] [last=GROUP]
 
 mod common;
 
@@ -20,6 +23,7 @@ fn main() {
     let name = args.get(2).cloned().unwrap_or_else(|| "paper".into());
     let dir = std::path::PathBuf::from(args.get(3).cloned().unwrap_or_else(|| "out/bench-direct".into()));
     let repeats: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(3);
+    let last_group = args.get(5).and_then(|s| s.strip_prefix("last="));
     let problem::backend::Setup {
         mesh,
         materials,
@@ -29,6 +33,7 @@ fn main() {
     let disc = Discretization::new(&mesh, &materials, &constraints).expect("discretisation");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());
+    let last = last_group.map(|group| group_displacements(&mesh, &disc.dofs, group));
     let rhs: Vec<f64> = (0..k.nrows()).map(|i| 1.0 + (i % 7) as f64 * 0.1).collect();
     std::fs::create_dir_all(&dir).expect("the output directory");
     write_market(&dir.join("K.mtx"), &k).expect("K.mtx");
@@ -48,13 +53,14 @@ fn main() {
         let order = disc
             .dofs
             .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
-        let mut factor = SparseFactor::new(
-            k.as_ref(),
-            FactorKind::Ldlt,
-            &Ordering::Given(order),
-            linalg::pool_par(),
-        )
-        .expect("ldlt");
+        let ordering = match &last {
+            Some(last) => Ordering::GivenThenLast {
+                order,
+                last: last.clone(),
+            },
+            None => Ordering::Given(order),
+        };
+        let mut factor = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ordering, linalg::pool_par()).expect("ldlt");
         let both = t.elapsed().as_secs_f64();
         let t = Instant::now();
         factor.refactor(k.as_ref()).expect("refactor");
@@ -71,6 +77,23 @@ fn main() {
             residual(&k, &x, &rhs)
         );
     }
+}
+
+/// The free displacement dofs of the nodes of boundary group `group`, in node order.
+fn group_displacements(mesh: &mesh::Mesh, dofs: &fe_assembly::DofMap, group: &str) -> Vec<usize> {
+    let facets = mesh.boundaries.get(group).unwrap_or_else(|| {
+        let names: Vec<&String> = mesh.boundaries.keys().collect();
+        panic!("no boundary group {group:?}; the mesh has {names:?}")
+    });
+    facets
+        .nodes()
+        .into_iter()
+        .flat_map(|p| (0..dofs.dim).map(move |k| p * dofs.dim + k))
+        .filter_map(|i| match dofs.u[i] {
+            fe_assembly::Dof::Free(d) => Some(d),
+            _ => None,
+        })
+        .collect()
 }
 
 /// `|K x - b| / |b|` with `K` given by its lower triangle.

@@ -15,7 +15,9 @@
 //! (docs/performance.md); here the tree gives the second core its own half of the work.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::ldlt::factor::{cholesky_in_place, cholesky_in_place_scratch, LdltRegularization};
+use faer::linalg::cholesky::ldlt::factor::{
+    cholesky_in_place, cholesky_in_place_scratch, LdltParams, LdltRegularization,
+};
 use faer::linalg::matmul::triangular::BlockStructure;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
@@ -36,6 +38,15 @@ const SEQUENTIAL_FLOPS: f64 = 2e7;
 /// The narrowest piece of a supernode's columns assembled on a thread of its own (wide
 /// supernodes, above the independent subtrees, are cut into pieces: [`column_pieces`]).
 const PIECE_COLS: usize = 32;
+
+/// From this many columns on, a supernode's dense `L D Lᵀ` updates its trailing block
+/// [`WIDE_PANEL`] columns at a time rather than faer's default 128: each panel's update reads
+/// and writes the whole trailing triangle, and on the root of a 3D mesh (10 630 columns at
+/// `paper-3d` n = 32) 128-column panels make that traffic what two cores wait on.
+const WIDE_FROM: usize = 4096;
+
+/// The panel of a wide supernode's dense `L D Lᵀ` ([`WIDE_FROM`]).
+const WIDE_PANEL: usize = 512;
 
 /// Why the numeric factorisation of a supernode stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -503,7 +514,7 @@ impl Scratch {
         Scratch {
             local: vec![usize::MAX; n],
             bufs: Bufs::default(),
-            dense: MemBuffer::new(cholesky_in_place_scratch::<f64>(max_cols, par, Default::default())),
+            dense: MemBuffer::new(cholesky_in_place_scratch::<f64>(max_cols, par, dense_params(max_cols))),
         }
     }
 }
@@ -684,7 +695,7 @@ impl Ctx<'_> {
             LdltRegularization::default(),
             par,
             MemStack::new(&mut scratch.dense),
-            Default::default(),
+            dense_params(ncols),
         )
         .map_err(|e| match e {
             faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
@@ -712,6 +723,16 @@ impl Ctx<'_> {
             None => Ok(()),
         }
     }
+}
+
+/// faer's parameters for the dense `L D Lᵀ` of a supernode of `ncols` columns: its defaults,
+/// with [`WIDE_PANEL`] columns per panel from [`WIDE_FROM`] columns on.
+fn dense_params(ncols: usize) -> faer::Spec<LdltParams, f64> {
+    let mut params = faer::Spec::<LdltParams, f64>::default();
+    if ncols >= WIDE_FROM {
+        params.block_size = WIDE_PANEL;
+    }
+    params
 }
 
 /// The first NaN or infinity of `v`, read on rayon's pool where `par` is (a wide supernode's

@@ -191,6 +191,37 @@ fn the_condensation_reads_the_same_trailing_block_off_the_parallel_factor() {
     assert!(relative_gap(&pp, &ps) < 1e-12);
 }
 
+/// A root supernode wider than 4096 columns (the displacements of the grid's first 30 rows
+/// ordered last: 4200 dofs coupled through the whole grid), whose dense `L D Lᵀ` the tree
+/// makes with 512-column panels (faer's default is 128): the same pivots and solution as
+/// faer's sequential walk.
+#[test]
+fn a_wide_root_factors_as_faer_does_on_one_core() {
+    let m = 70;
+    let (a, g, b) = grid(m, 5);
+    let k = linalg::sparse::lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref());
+    let n = k.nrows();
+    let last: Vec<usize> = (0..2 * m * 30).collect();
+    let ord = Ordering::GivenThenLast {
+        order: dissection(m),
+        last,
+    };
+    let mut seq = SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::Seq).unwrap();
+    let mut par = on_threads(2, || {
+        SparseFactor::new(k.as_ref(), FactorKind::Ldlt, &ord, Par::rayon(2))
+    })
+    .unwrap();
+    assert!(par.parallel_tree());
+    assert!(relative_gap(&par.pivots(), &seq.pivots()) < 1e-12);
+    assert_eq!(par.inertia(), (2 * m * m, m * m, 0));
+    let rhs: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+    let (mut x, mut y) = (rhs.clone(), rhs);
+    seq.solve_in_place(&mut x);
+    on_threads(2, || par.solve_in_place(&mut y));
+    let gap = relative_gap(&y, &x);
+    assert!(gap < 1e-12, "solutions differ by {gap:e}");
+}
+
 #[test]
 fn a_singular_matrix_is_refused_on_the_parallel_route_too() {
     // the grid with one node's potential cut off from everything and its diagonal zero
