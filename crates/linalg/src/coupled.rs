@@ -270,12 +270,15 @@ pub struct Refined {
     pub residual: f64,
 }
 
-/// Iterative refinement of `(u, φ)` for `K x = b` with the factors of `solver`: while the
-/// equilibrium residual (relative to `scale`, as [`equilibrium_residual`]) is above `tol` and
-/// falls, `x ← x + K⁻¹ (b - K x)`, at most `max_steps` times; a correction that does not lower
-/// the residual is not kept. In double precision with a backward-stable factorisation, each
-/// step gains the factor's accuracy again, up to `ε κ(K)`: it recovers the digits that a large
-/// growth of the pivots (a strongly coupled material, a stiffness contrast) lost.
+/// Iterative refinement of `(u, φ)` for `K x = b` with the factors of `solver`:
+/// `x ← x + K⁻¹ (b - K x)` while the equilibrium residual (relative to `scale`, as
+/// [`equilibrium_residual`]) is above `tol` and the step before at least halved it, at most
+/// `max_steps` times; a correction that does not lower the residual is not kept. In double
+/// precision with a backward-stable factorisation, each step gains the factor's accuracy
+/// again, up to `ε κ(K)`: it recovers the digits that a large growth of the pivots (a strongly
+/// coupled material, a stiffness contrast) lost. A step that gained less than a factor 2 has
+/// reached that floor, and the next ones would only stir its round-off (the test of LAPACK's
+/// `xGERFS`; a step is a solve with the factors, the cost of the run's solve).
 ///
 /// # Errors
 /// The solver's error.
@@ -306,8 +309,12 @@ pub fn refine(
         }
         u.copy_from_slice(&nu);
         phi.copy_from_slice(&np);
+        let halved = 2.0 * after <= residual;
         residual = after;
         steps += 1;
+        if !halved {
+            break;
+        }
     }
     Ok(Refined { steps, residual })
 }

@@ -300,3 +300,71 @@ fn check_trailing_block(
         );
     }
 }
+
+/// The exact solve of `K` with its answer scaled by `1 - rho`: each refinement step then
+/// leaves exactly the fraction `rho` of the error (and of the residual).
+struct Damped {
+    exact: DirectLdlt,
+    rho: f64,
+}
+
+impl CoupledSolver for Damped {
+    fn solve(
+        &mut self,
+        b_u: &[f64],
+        b_phi: &[f64],
+        u: &mut [f64],
+        phi: &mut [f64],
+    ) -> Result<linalg::SolveInfo, linalg::LinalgError> {
+        let info = self.exact.solve(b_u, b_phi, u, phi)?;
+        for x in u.iter_mut().chain(phi.iter_mut()) {
+            *x *= 1.0 - self.rho;
+        }
+        Ok(info)
+    }
+
+    fn factor_bytes(&self) -> usize {
+        self.exact.factor_bytes()
+    }
+}
+
+/// Refinement goes on while each step at least halves the residual (LAPACK's `xGERFS` test):
+/// a solver that leaves a tenth of the error takes every step allowed, one that leaves 70 %
+/// stops after its first step (which is kept: it lowered the residual), and the exact one
+/// stops once its residual is round-off.
+#[test]
+fn refinement_stops_where_a_step_no_longer_halves_the_residual() {
+    let (nu, np) = (12, 5);
+    let vals: Vec<f64> = (0..40).map(|k| ((k * 37) % 11) as f64 / 11.0 - 0.4).collect();
+    let a = spd(nu, &vals, 1.0);
+    let b = spd(np, &vals[..15], 0.5);
+    let mut gd = DMatrix::<f64>::zeros(np, nu);
+    for k in 0..20 {
+        gd[((k * 5) % np, (k * 3 + k / np) % nu)] += vals[k];
+    }
+    let g = dense_to_sparse(&gd);
+    let k = linalg::CoupledBlocks { a: &a, g: &g, b: &b };
+    let b_u: Vec<f64> = (0..nu).map(|i| 1.0 + i as f64).collect();
+    let b_phi: Vec<f64> = (0..np).map(|i| (i % 2) as f64 - 0.5).collect();
+    let refine = |rho: f64| {
+        let exact = DirectLdlt::new(&a, &g, &b, &Ordering::Amd, Par::Seq).unwrap();
+        let mut solver = Damped { exact, rho };
+        let (mut u, mut phi) = (vec![0.0; nu], vec![0.0; np]);
+        let start = linalg::equilibrium_residual(&a, &g, &b, &u, &phi, &b_u, &b_phi, 0.0);
+        let out = linalg::refine(&mut solver, k, &b_u, &b_phi, &mut u, &mut phi, 0.0, 1e-300, 3).unwrap();
+        (start, out)
+    };
+    let (start, tenth) = refine(0.1);
+    assert_eq!(tenth.steps, 3);
+    assert!(
+        (tenth.residual / start / 1e-3 - 1.0).abs() < 1e-6,
+        "{}",
+        tenth.residual / start
+    );
+    let (start, most) = refine(0.7);
+    assert_eq!(most.steps, 1);
+    assert!((most.residual / start / 0.7 - 1.0).abs() < 1e-9);
+    let (start, exact) = refine(0.0);
+    assert!((1..=2).contains(&exact.steps), "{} steps", exact.steps);
+    assert!(exact.residual < 1e-14 * start);
+}
