@@ -272,8 +272,8 @@ pub struct Refined {
 
 /// Iterative refinement of `(u, φ)` for `K x = b` with the factors of `solver`:
 /// `x ← x + K⁻¹ (b - K x)` while the equilibrium residual (relative to `scale`, as
-/// [`equilibrium_residual`]) is above `tol` and the step before at least halved it, at most
-/// `max_steps` times; a correction that does not lower the residual is not kept. In double
+/// [`equilibrium_residual`]) is above `tol` and every step so far at least halved it, at
+/// most `max_steps` times; a correction that does not lower the residual is not kept. In double
 /// precision with a backward-stable factorisation, each step gains the factor's accuracy
 /// again, up to `ε κ(K)`: it recovers the digits that a large growth of the pivots (a strongly
 /// coupled material, a stiffness contrast) lost. A step that gained less than a factor 2 has

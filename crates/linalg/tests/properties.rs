@@ -4,7 +4,8 @@
 //! - the direct `L D Lᵀ` and the Schur PCG give the same solution of `K x = b`;
 //! - an ordering that puts chosen dofs last gives the same solution as AMD, and `K` has
 //!   exactly `n_φ` negative pivots;
-//! - the condensation onto chosen dofs is the block of `K⁻¹`, by both of its routes.
+//! - the condensation onto chosen dofs is the block of `K⁻¹`, by both of its routes;
+//! - iterative refinement goes on only while each step at least halves the residual.
 
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Par;
