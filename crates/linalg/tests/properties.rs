@@ -28,6 +28,15 @@ fn spd(n: usize, vals: &[f64], shift: f64) -> SparseColMat<usize, f64> {
     dense_to_sparse(&a)
 }
 
+/// A random `np x nu` coupling block: the values `vals` summed into scattered entries.
+fn coupling(np: usize, nu: usize, vals: &[f64]) -> DMatrix<f64> {
+    let mut gd = DMatrix::<f64>::zeros(np, nu);
+    for (k, &v) in vals.iter().enumerate() {
+        gd[((k * 5) % np, (k * 3 + k / np) % nu)] += v;
+    }
+    gd
+}
+
 fn dense_to_sparse(a: &DMatrix<f64>) -> SparseColMat<usize, f64> {
     let mut t = vec![];
     for j in 0..a.ncols() {
@@ -107,10 +116,7 @@ proptest! {
     ) {
         let a = spd(nu, &va, 0.1);
         let b = spd(np, &vb, 0.1);
-        let mut gd = DMatrix::<f64>::zeros(np, nu);
-        for (k, &v) in vg.iter().enumerate() {
-            gd[((k * 5) % np, (k * 3 + k / np) % nu)] += v;
-        }
+        let gd = coupling(np, nu, &vg);
         let g = dense_to_sparse(&gd);
         let (ad, bd) = (dense(&a), dense(&b));
         let s_dense = &ad + gd.transpose() * bd.clone().try_inverse().unwrap() * &gd;
@@ -339,10 +345,7 @@ fn refinement_stops_where_a_step_no_longer_halves_the_residual() {
     let vals: Vec<f64> = (0..40).map(|k| ((k * 37) % 11) as f64 / 11.0 - 0.4).collect();
     let a = spd(nu, &vals, 1.0);
     let b = spd(np, &vals[..15], 0.5);
-    let mut gd = DMatrix::<f64>::zeros(np, nu);
-    for k in 0..20 {
-        gd[((k * 5) % np, (k * 3 + k / np) % nu)] += vals[k];
-    }
+    let gd = coupling(np, nu, &vals[..20]);
     let g = dense_to_sparse(&gd);
     let k = linalg::CoupledBlocks { a: &a, g: &g, b: &b };
     let b_u: Vec<f64> = (0..nu).map(|i| 1.0 + i as f64).collect();
