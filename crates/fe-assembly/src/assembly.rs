@@ -244,7 +244,13 @@ impl<'m> Discretization<'m> {
             .zip(b_slices)
             .enumerate()
             .with_min_len(256)
-            .for_each(|(i, ((a_node, g_node), b_node))| {
+            .for_each(|(i, ((mut a_node, mut g_node), mut b_node))| {
+                // the node's values written before they are added to: fresh pages read first
+                // fault twice, the second time with an interrupt to every other core
+                // (docs/performance.md, "The zero page")
+                for values in [&mut a_node.1, &mut g_node.1, &mut b_node.1] {
+                    values.fill(0.0);
+                }
                 // the free u columns of node i: (component k, column offset q within the node)
                 let mut ucols = [(0usize, 0usize); 3];
                 let mut nq = 0;
