@@ -207,10 +207,14 @@ impl Coarsening {
         let w = |r: usize| points.weight[if r < n { r } else { (r - n) / nt }];
         let wc = |a: usize| self.weight[if a < nc { a } else { (a - nc) / nt }];
         // T = D W P (m x mc), then D_c = W_c⁻¹ Pᵀ W T W_c⁻¹, both by rows on rayon's pool (`D`
-        // is read once, `m²` values)
+        // is read once, `m²` values). Each task writes its fresh rows before it adds to them: a
+        // fresh page read first maps the shared zero page, and the write after it faults again
+        // and flushes the page from the other cores' TLBs, an interrupt to each (docs/
+        // performance.md: 80 MB so filled on 2 threads, 0.11 s read first, 0.024 s written first)
         let mut t = vec![0.0; m * mc];
         if mc > 0 {
             t.par_chunks_mut(mc).enumerate().for_each(|(r, out)| {
+                out.fill(0.0);
                 let row = &d[r * m..(r + 1) * m];
                 for (c, entries) in p.iter().enumerate() {
                     let v = row[c] * w(c);
@@ -230,6 +234,7 @@ impl Coarsening {
         let mut dc = vec![0.0; mc * mc];
         if mc > 0 {
             dc.par_chunks_mut(mc).zip(&pt).enumerate().for_each(|(a, (dst, fine))| {
+                dst.fill(0.0);
                 for &(r, pv) in fine {
                     let s = pv * w(r);
                     dst.iter_mut()
