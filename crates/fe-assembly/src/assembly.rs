@@ -251,15 +251,7 @@ impl<'m> Discretization<'m> {
                 for values in [&mut a_node.1, &mut g_node.1, &mut b_node.1] {
                     values.fill(0.0);
                 }
-                // the free u columns of node i: (component k, column offset q within the node)
-                let mut ucols = [(0usize, 0usize); 3];
-                let mut nq = 0;
-                for k in 0..dim {
-                    if let Dof::Free(_) = d.u[i * dim + k] {
-                        ucols[nq] = (k, nq);
-                        nq += 1;
-                    }
-                }
+                let (ucols, nq) = free_components(d, i, dim);
                 let ucols = &ucols[..nq];
                 let (first_u, _) = u_cols(d, i);
                 let a_rows = if nq > 0 { pa.rows_of(first_u) } else { &[][..] };
@@ -373,6 +365,20 @@ impl<'m> Discretization<'m> {
             }
         }
     }
+}
+
+/// The free u columns of node `i`: (component `k`, column offset `q` within the node), the
+/// first `nq` of the array.
+fn free_components(d: &DofMap, i: usize, dim: usize) -> ([(usize, usize); 3], usize) {
+    let mut ucols = [(0usize, 0usize); 3];
+    let mut nq = 0;
+    for k in 0..dim {
+        if let Dof::Free(_) = d.u[i * dim + k] {
+            ucols[nq] = (k, nq);
+            nq += 1;
+        }
+    }
+    (ucols, nq)
 }
 
 /// Index of `row` in the sorted `rows` (present by construction of the pattern).
