@@ -210,7 +210,8 @@ impl Coarsening {
         // is read once, `m²` values). Each task writes its fresh rows before it adds to them: a
         // fresh page read first maps the shared zero page, and the write after it faults again
         // and flushes the page from the other cores' TLBs, an interrupt to each (docs/
-        // performance.md: 80 MB so filled on 2 threads, 0.11 s read first, 0.024 s written first)
+        // performance.md, "The zero page": 80 MB on 2 threads, 0.12 s read first, 0.025 s
+        // written first)
         let mut t = vec![0.0; m * mc];
         if mc > 0 {
             t.par_chunks_mut(mc).enumerate().for_each(|(r, out)| {
