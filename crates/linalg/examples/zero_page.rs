@@ -40,7 +40,7 @@ fn main() {
         let (read, write) = (fill(len, row, false), fill(len, row, true));
         println!(
             "{} MB on a pool of {}: read first {read:.3} s, written first {write:.3} s",
-            len * 8 >> 20,
+            (len * 8) >> 20,
             rayon::current_num_threads()
         );
     }
