@@ -176,19 +176,24 @@ mod tests {
     use super::*;
     use faer::sparse::Triplet;
 
+    /// Uniform numbers in `[0, 1)` from a linear congruential generator started at `seed`.
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// `K`'s lower triangle, built by ranges of columns on the pool, is entry for entry the
     /// blocks' (`A` and `-B` below their diagonals, `G` below `A`), whatever the pool, with
     /// columns of every kind: empty, `A` or `B` without entries above the diagonal, `G` empty.
     #[test]
     fn the_lower_triangle_of_k_is_the_blocks_on_any_pool() {
         let (n_u, n_phi) = (3 * COLUMNS_PER_TASK / 2 + 7, COLUMNS_PER_TASK + 3);
-        let mut state = 11u64;
-        let mut rnd = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(11);
         let mut sym = |n: usize, skip: usize| {
             let mut t = vec![];
             for j in (0..n).filter(|j| j % skip != 0) {
@@ -252,13 +257,7 @@ mod tests {
     #[test]
     fn the_parallel_products_are_the_sequential_ones() {
         let (rows, cols) = (3000, 2500);
-        let mut state = 7u64;
-        let mut rnd = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(7);
         let mut t = vec![];
         for j in 0..cols {
             // 120 entries per column: 300 000 in all, above PARALLEL_ENTRIES; the last columns empty
