@@ -81,11 +81,8 @@ fn main() {
 
 /// The free displacement dofs of the nodes of boundary group `group`, in node order.
 fn group_displacements(mesh: &mesh::Mesh, dofs: &fe_assembly::DofMap, group: &str) -> Vec<usize> {
-    let facets = mesh.boundaries.get(group).unwrap_or_else(|| {
-        let names: Vec<&String> = mesh.boundaries.keys().collect();
-        panic!("no boundary group {group:?}; the mesh has {names:?}")
-    });
-    facets
+    mesh.boundary(group)
+        .unwrap_or_else(|e| panic!("last={group}: {e}"))
         .nodes()
         .into_iter()
         .flat_map(|p| (0..dofs.dim).map(move |k| p * dofs.dim + k))
