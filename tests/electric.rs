@@ -130,15 +130,16 @@ fn errors(dim: usize, condition: ElectricCondition, sigma: Option<f64>) -> (f64,
     let a = bottom_potential(condition, sigma.unwrap_or(0.0));
     let (lambda, q) = at(a);
     assert!(lambda > 0.0, "the block is in contact: λ = {lambda}");
-    // the top terminal carries the flux out through the top, `D·e_n = -q`, over its area (the
-    // electric equation's reaction at its nodes)
+    // the flux out through the top is `D·e_n = -q`, so the top electrode carries the charge
+    // `q` times its area (the charge on the conductor: the negative of the flux; the electric
+    // equation's reaction at its nodes)
     let area = if dim == 2 { 2.0 } else { 1.0 };
     let top = solution.report.terminals.iter().find(|t| t.group == "top").unwrap();
     assert!(
-        (top.charge + q * area).abs() <= 1e-9 * (q * area).abs().max(E33 * DELTA),
+        (top.charge - q * area).abs() <= 1e-9 * (q * area).abs().max(E33 * DELTA),
         "{dim}D {condition:?}: top charge {} vs {}",
         top.charge,
-        -q * area
+        q * area
     );
     assert!((top.potential - V).abs() < 1e-15);
     let rel = |x: f64, y: f64, scale: f64| (x - y).abs() / scale;
@@ -156,12 +157,18 @@ fn errors(dim: usize, condition: ElectricCondition, sigma: Option<f64>) -> (f64,
     let q_scale = q.abs().max(1e-300);
     let e_q = e.flux.iter().map(|f| rel(*f, q, q_scale)).fold(0.0, f64::max);
     let e_phi = e.potential.iter().map(|p| rel(*p, a, PHI_F)).fold(0.0, f64::max);
-    // the charge through the zone reported: q times the face's area
+    // the charge on the foundation across the zone: -q times the face's area (the flux q
+    // leaves the body into it), opposite to the top electrode's (Gauss)
     let charge = solution.report.contact.charge.unwrap();
     assert!(
-        (charge - q * area).abs() <= 1e-9 * (q * area).abs().max(1e-12),
+        (charge + q * area).abs() <= 1e-9 * (q * area).abs().max(1e-12),
         "{charge} vs {}",
-        q * area
+        -q * area
+    );
+    assert!(
+        (charge + top.charge).abs() <= 1e-9 * (q * area).abs().max(E33 * DELTA),
+        "Gauss: foundation {charge} + top {}",
+        top.charge
     );
     (e_lambda, e_q, e_phi)
 }

@@ -35,7 +35,7 @@ fn cycle(n: usize) -> Vec<(f64, f64, f64, f64, f64)> {
     let mut rising = true;
     problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |step| {
         let r = step.contact;
-        let (p, q) = (step.row.normal_force, step.row.tangential_force);
+        let (p, q) = (step.row.normal_force, step.row.tangential_resultant[0]);
         if let Some(lq) = last_q {
             let now_rising = q > lq;
             if now_rising != rising && step.row.step > 1 {
@@ -295,7 +295,7 @@ fn weakening_cycle(n: usize, static_coefficient: f64, dynamic: f64) -> Vec<StepR
     rows.iter()
         .map(|r| StepRowLite {
             t: r.t,
-            q: r.tangential_force,
+            q: r.tangential_resultant[0],
         })
         .collect()
 }
@@ -320,7 +320,7 @@ fn slip_weakening_along_a_path_weakens_where_it_slid() {
     let equal = weakening_cycle(24, 0.5, 0.5);
     for (a, b) in equal.iter().zip(&coulomb) {
         assert!(
-            (a.q - b.tangential_force).abs() <= 1e-10 * b.tangential_force.abs().max(1e-3),
+            (a.q - b.tangential_resultant[0]).abs() <= 1e-10 * b.tangential_resultant[0].abs().max(1e-3),
             "t = {}",
             a.t
         );
@@ -351,12 +351,14 @@ fn sphere_loop(n: usize) -> (f64, f64) {
     let area: f64 = cycle
         .windows(2)
         .map(|w| {
-            0.5 * (w[0].tangential_force + w[1].tangential_force) * (w[1].factors[2] - w[0].factors[2]) * amplitude
+            0.5 * (w[0].tangential_resultant[0] + w[1].tangential_resultant[0])
+                * (w[1].factors[2] - w[0].factors[2])
+                * amplitude
         })
         .sum();
     let load = cycle.iter().map(|r| r.normal_force).sum::<f64>() / cycle.len() as f64;
     let turn = cycle.iter().position(|r| (r.t - 2.0).abs() < 1e-9).unwrap();
-    let q_star = 0.5 * (cycle[0].tangential_force - cycle[turn].tangential_force);
+    let q_star = 0.5 * (cycle[0].tangential_resultant[0] - cycle[turn].tangential_resultant[0]);
     let a = problem::hertz_sphere(load, 1.0 / c.gap_curvature, young, poisson);
     let w = problem::mindlin_deresiewicz_dissipation(load, q_star, c.friction(), a, young, poisson);
     (area, w)

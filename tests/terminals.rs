@@ -162,9 +162,9 @@ fn an_open_electrode_on_a_pressed_plate_reads_its_closed_form_voltage() {
             );
             // the charge asked for, as the final run's reaction
             assert!(
-                (-top.charge - q).abs() < 1e-10 * (q.abs() + c_free * open.abs()),
+                (top.charge - q).abs() < 1e-10 * (q.abs() + c_free * open.abs()),
                 "charge {}",
-                -top.charge
+                top.charge
             );
             // the whole top at that potential
             let nodes = s.mesh.boundary("top").unwrap().nodes();
@@ -304,7 +304,7 @@ fn a_floating_electrode_pressed_onto_a_foundation_reads_its_closed_form() {
                 top.potential
             );
             assert!(
-                (-top.charge - q).abs() < 1e-9 * (q.abs() + EPS33 * area / h * v.abs()),
+                (top.charge - q).abs() < 1e-9 * (q.abs() + EPS33 * area / h * v.abs()),
                 "{dim}D charge {}",
                 top.charge
             );
@@ -375,10 +375,10 @@ fn a_floating_terminal_under_friction_is_the_prescribed_potential_that_carries_i
         let fixed_top = fixed.report.terminals.iter().find(|t| t.group == "top").unwrap();
         assert!(!fixed_top.floating);
         assert!(
-            (-fixed_top.charge - charge).abs() < 1e-8 * charge,
+            (fixed_top.charge - charge).abs() < 1e-8 * charge,
             "{dim}D: the potential {} carries {} against {charge}",
             top.potential,
-            -fixed_top.charge
+            fixed_top.charge
         );
         let (gap, scale) = displacement_gap(&floating, &fixed);
         assert!(
@@ -416,7 +416,7 @@ fn a_floating_terminal_follows_a_load_path() {
             "t = {f}: V = {got} against {v}"
         );
         assert!(
-            (-row.charges[top] - f * q).abs() < 1e-9 * q,
+            (row.charges[top] - f * q).abs() < 1e-9 * q,
             "t = {f}: charge {}",
             row.charges[top]
         );
@@ -575,4 +575,108 @@ fn electrodes_that_cannot_be_are_refused_by_name() {
         ..Default::default()
     };
     assert!(with(vec![floating_top]).contains("one conductor"));
+}
+
+/// The one convention for charge (docs/theory.md, "Signs that every output shares"): on every
+/// shipped scene with terminals, at its smoke size, the charges on all the conductors around
+/// the body (its terminals, a conducting foundation or tip) sum to 0 (Gauss: the flux is
+/// divergence-free; skipped where an exact solution adds a body or surface charge); and a
+/// charge reported reads back as the same input: a terminal at a prescribed potential made
+/// floating with its reported charge floats at that potential, and a conducting tip or
+/// foundation given its reported charge (`contact.charge`) finds its potential again.
+#[test]
+fn charges_read_back_and_sum_to_zero() {
+    use problem::ExactKind;
+    let solve = |name: &str, sets: &[String]| {
+        let (scene, _) = files::scene_file::load(name, sets).unwrap();
+        (problem::solve(&scene, None, &mut problem::Silent).unwrap(), scene)
+    };
+    let mut checked = 0;
+    for (name, text) in files::scene_file::SHIPPED {
+        let scene = files::scene_file::parse(text, name, &[]).unwrap();
+        let sized = vec![format!("mesh.n={}", scene.mesh.smoke_n.unwrap())];
+        let (s, scene) = solve(name, &sized);
+        let r = &s.report;
+        if r.terminals.is_empty() {
+            continue;
+        }
+        let charges: Vec<f64> = r.terminals.iter().map(|t| t.charge).chain(r.contact.charge).collect();
+        let scale = charges.iter().fold(0.0f64, |m, q| m.max(q.abs()));
+        let added = matches!(
+            scene.exact.as_ref().map(|e| e.kind),
+            Some(ExactKind::Manufactured | ExactKind::ManufacturedContact | ExactKind::Affine)
+        );
+        if !added {
+            // a lone conductor carries no charge: round-off against the scenes' charges (1e-3..1)
+            let sum: f64 = charges.iter().sum();
+            assert!(
+                sum.abs() <= 1e-9 * scale.max(1e-4),
+                "{name}: the charges {charges:?} sum to {sum}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 5, "Gauss checked on {checked} scenes");
+
+    // the actuator's electrode (at 0.05) made floating with the charge it carried
+    let (at_v, _) = solve("actuator", &["mesh.n=16".into()]);
+    let q = at_v
+        .report
+        .terminals
+        .iter()
+        .find(|t| t.group == "electrode")
+        .unwrap()
+        .charge;
+    assert!(
+        q > 0.0,
+        "an electrode at the higher potential carries positive charge: {q}"
+    );
+    let (floated, _) = solve(
+        "actuator",
+        &[
+            "mesh.n=16".into(),
+            format!("electrode.charge={q:e}"),
+            "~electrode.v".into(),
+        ],
+    );
+    let t = floated
+        .report
+        .terminals
+        .iter()
+        .find(|t| t.group == "electrode")
+        .unwrap();
+    assert!(t.floating);
+    assert!((t.potential - 0.05).abs() <= 1e-9 * 0.05, "floats at {}", t.potential);
+    assert!(
+        (t.charge - q).abs() <= 1e-12 * q.abs(),
+        "reads back {} against {q}",
+        t.charge
+    );
+
+    // a grounded conducting tip's charge given back to the tip: it floats at 0 again
+    let tip = |sets: &[String]| {
+        let (s, _) = solve("indent-sphere", sets);
+        let ind = s.report.indenter.unwrap();
+        (
+            ind.potential.unwrap(),
+            ind.charge.unwrap(),
+            s.report.contact.charge.unwrap(),
+        )
+    };
+    let base = ["mesh.n=40".to_string(), "contact.electric=\"conducting\"".into()];
+    let (v0, q0, zone) = tip(&base);
+    assert_eq!(v0, 0.0);
+    assert!((zone - q0).abs() <= 1e-12 * q0.abs(), "the zone's charge is the tip's");
+    let mut given = base.to_vec();
+    given.push(format!("contact.charge={q0:e}"));
+    let (v1, q1, _) = tip(&given);
+    assert!((q1 - q0).abs() <= 1e-9 * q0.abs(), "{q1} against {q0}");
+    // the potential that carries q0: 0, within what a relative 1e-6 of the charge moves it
+    let mut lifted = base.to_vec();
+    lifted.push("contact.foundation_potential=1e-3".into());
+    let slope = (tip(&lifted).1 - q0) / 1e-3;
+    assert!(
+        v1.abs() <= 1e-6 * (q0 / slope).abs(),
+        "floats at {v1} (dQ/dψ = {slope})"
+    );
 }

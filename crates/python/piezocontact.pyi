@@ -164,7 +164,8 @@ class Contact:
     @property
     def flux(self) -> Optional[npt.NDArray[np.float64]]:
         """Electrical contact: the outward flux D.nu through each point, (m,); NaN where an
-        electrode prescribes the potential; None on an insulating foundation."""
+        electrode prescribes the potential; None on an insulating foundation. The charge on
+        the foundation across the zone is -nansum(weight * flux)."""
     @property
     def status(self) -> npt.NDArray[np.int8]:
         """STICK (1), SLIP (2) or SEPARATED (3), (m,)."""
@@ -211,10 +212,12 @@ class Result:
     @property
     def path(self) -> Optional[dict[str, Any]]:
         """A load path's series (None for one instant): NumPy arrays over its instants, the
-        path.csv columns (`t`, the factors, `normal_force`, `tangential_force`, `max_slip`, ...,
-        `equilibrium` NaN where the fields were not computed), `charges` (n_instants,
-        n_terminals) with `terminals` their groups; with `run(..., series=True)` also
-        `lambda_n`, `lambda_t`, `u_n`, `u_t`, `status`, (n_instants, n_points)."""
+        path.csv columns (`t`, the factors, `normal_force`, `tangential_force` (the magnitude),
+        `tangential_force_x`, `_y` (`_z` in 3D), `max_slip`, ..., `equilibrium` NaN where the
+        fields were not computed), `charges` (n_instants, n_terminals: the charge on each
+        conductor) with `terminals` their groups; with `run(..., series=True)` also
+        `lambda_n`, `u_n`, `status` (n_instants, n_points) and `lambda_t`, `u_t` (n_instants,
+        n_points, dim - 1)."""
     @property
     def report(self) -> dict[str, Any]:
         """run.json as a dict."""

@@ -156,9 +156,17 @@ pub struct ElectricValues {
 }
 
 impl ElectricValues {
-    /// The charge through the contact zone, `Σ w_i q_i` (leaving the body where positive).
+    /// The charge on the conductor across the contact zone (the foundation, or the tip), the
+    /// negative of the flux out of the body, `-Σ w_i q_i`: the project's one convention for
+    /// a charge (the charge on the conductor, positive where the conductor is at the higher
+    /// potential of a capacitor).
     pub fn charge(&self, weight: &[f64]) -> f64 {
-        self.points.iter().zip(&self.flux).map(|(&i, q)| weight[i] * q).sum()
+        -self
+            .points
+            .iter()
+            .zip(&self.flux)
+            .map(|(&i, q)| weight[i] * q)
+            .sum::<f64>()
     }
 }
 

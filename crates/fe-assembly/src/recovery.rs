@@ -66,9 +66,11 @@ impl Discretization<'_> {
         crate::voigt_len(self.mesh.dim, self.axisymmetric)
     }
 
-    /// The charge through each of `groups` (boundary groups where the potential is
-    /// prescribed: electrodes, grounded sides), `∫ D·ν ds` with `ν` the body's outward normal,
-    /// as the reaction of the electric equation at the group's nodes: with `div D = q0`, the
+    /// The charge on each of `groups` (boundary groups where the potential is prescribed or
+    /// floats: electrodes, grounded sides), in the project's one convention: the charge on the
+    /// conductor, `Q = -∫ D·ν ds` with `ν` the body's outward normal (a positive electrode
+    /// draws positive charge; the body's charges on all its terminals sum to 0, Gauss).
+    /// It is the reaction of the electric equation at the group's nodes: with `div D = q0`, the
     /// weak form gives `∫_Γ (D·ν) ψ_i = ∫_Ω D·∇ψ_i + ∫_Ω q0 ψ_i` for each hat function `ψ_i`,
     /// and the hats of a group's nodes sum to 1 on it (P1: `D` constant per cell, so each
     /// cell adds `|T| D_T·∇ψ_i`, or its quadrature on a body of revolution, where `D` varies
@@ -124,11 +126,12 @@ impl Discretization<'_> {
                 if owner[v] == usize::MAX {
                     continue;
                 }
+                // the conductor's charge is the negative of the flux out of the body
                 for (weight, d) in &flux_at {
                     let flux: f64 = (0..dim).map(|k| d[k] * g.grads[a][k]).sum();
-                    out[owner[v]] += weight * flux;
+                    out[owner[v]] -= weight * flux;
                 }
-                out[owner[v]] += g.volume() * source;
+                out[owner[v]] -= g.volume() * source;
             }
         }
         Ok(out)
@@ -150,7 +153,7 @@ impl Discretization<'_> {
     /// The part of [`Discretization::charges`] that the free unknowns make: for each group,
     /// the coefficients `(a_u, a_φ)` on the free displacements and potentials with
     /// `charge = a_u · u + a_φ · φ` plus what the prescribed values and the body charge add
-    /// (`|T| (e B_b)ᵀ ∇ψ_a` on `u_b`, `-|T| ∇ψ_aᵀ β ∇ψ_b` on `φ_b`, for each node `a` of the group
+    /// (`-|T| (e B_b)ᵀ ∇ψ_a` on `u_b`, `|T| ∇ψ_aᵀ β ∇ψ_b` on `φ_b`, for each node `a` of the group
     /// in a cell `T` and each node `b` of `T`). A load path's charges at every step come from
     /// them without the fields.
     ///
@@ -181,7 +184,7 @@ impl Discretization<'_> {
                                 let d: f64 = (0..dim)
                                     .map(|l| grad_a[l] * (0..nv).map(|v| m.e[l * nv + v] * column[v]).sum::<f64>())
                                     .sum();
-                                a_u[j] += p.weight * d;
+                                a_u[j] -= p.weight * d;
                             }
                         }
                     }
@@ -189,7 +192,7 @@ impl Discretization<'_> {
                         let d: f64 = (0..dim)
                             .map(|l| grad_a[l] * (0..dim).map(|q| m.beta[l * dim + q] * g.grads[b][q]).sum::<f64>())
                             .sum();
-                        a_phi[j] -= g.volume() * d;
+                        a_phi[j] += g.volume() * d;
                     }
                 }
             }

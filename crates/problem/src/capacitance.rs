@@ -99,8 +99,8 @@ pub fn capacitance(scene: &Scene, mesh: Option<mesh::Mesh>) -> Result<Capacitanc
         solver.solve(&b_u, &b_phi, &mut u, &mut phi)?;
         let (u, phi) = (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&phi));
         // a node of several groups counts for the first: a conductor's charge is its groups'
-        for (g, flux) in disc.charges(&u, &phi, &groups, &[])?.into_iter().enumerate() {
-            matrix[conductor[g]][j] -= flux;
+        for (g, charge) in disc.charges(&u, &phi, &groups, &[])?.into_iter().enumerate() {
+            matrix[conductor[g]][j] += charge;
         }
     }
     let big = matrix

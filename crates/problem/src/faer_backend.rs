@@ -541,7 +541,7 @@ fn floating_tip(
             .electric
             .as_ref()
             .ok_or_else(|| refuse("the run has no electrical contact".into()))?;
-        let q = -e.charge(&points.weight);
+        let q = e.charge(&points.weight);
         scale = scale.max(q.abs());
         if (q - charge).abs() <= CHARGE_TOL * scale.max(f64::MIN_POSITIVE) {
             return Ok(sol);

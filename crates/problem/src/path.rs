@@ -573,13 +573,6 @@ fn step_row(
     let points = &boundary.points;
     let counts = crate::report::ContactReport::of(points, sol);
     let nt = sol.lambda.n_tangential();
-    let tangential_force = if nt > 0 {
-        (0..points.len())
-            .map(|i| points.weight[i] * sol.lambda.tangential_of(i)[0])
-            .sum()
-    } else {
-        0.0
-    };
     let mut max_slip = 0.0f64;
     let mut max_inc = 0.0f64;
     // the slips of the points in contact (a separated point moves freely)
@@ -604,7 +597,8 @@ fn step_row(
             f.gap,
         ],
         normal_force: counts.normal_force,
-        tangential_force,
+        tangential_force: counts.tangential_force,
+        tangential_resultant: counts.tangential_resultant,
         max_slip,
         max_slip_increment: max_inc,
         n_stick: counts.n_stick,

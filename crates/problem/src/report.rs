@@ -70,7 +70,7 @@ pub struct IndenterReport {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub potential: Option<f64>,
     /// A conducting indenter: the charge it carries, the negative of the flux `Σ w D·ν`
-    /// through the contact zone out of the body.
+    /// through the contact zone out of the body (the charge on the conductor).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub charge: Option<f64>,
     /// With electric unknowns: the surface's potential at the contact point nearest the
@@ -93,8 +93,10 @@ pub struct TerminalReport {
     pub group: String,
     /// Its potential (at its first node, where the prescribed value varies).
     pub potential: f64,
-    /// The charge through it, `∫ D·ν ds` (`ν` out of the body; the electrode's own charge is
-    /// its negative), as the electric equation's reaction at its nodes.
+    /// The charge on it, `-∫ D·ν ds` (`ν` out of the body): the charge on the conductor, the
+    /// program's one convention (a floating terminal's reads back its `charge`; the charges
+    /// of all terminals and contact conductors sum to 0 where they enclose every flux), as the
+    /// electric equation's reaction at its nodes.
     pub charge: f64,
     /// A floating terminal (`dirichlet.charge`): its potential found, its charge given.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -127,9 +129,13 @@ pub struct StepRow {
     pub factors: [f64; 6],
     /// The total normal contact force (the pressures integrated).
     pub normal_force: f64,
-    /// The total tangential contact force, signed along the first tangent (2D), or its
-    /// magnitude's vector sum along the first tangent (3D: the first component).
+    /// The magnitude of the total tangential contact force, `|Σ w λ_t t|` (as run.json's
+    /// `contact.tangential_force`).
     pub tangential_force: f64,
+    /// The total tangential contact force as a vector, `Σ w λ_t t` in the global frame (one
+    /// component per dimension): a friction loop plots its component along the drive.
+    #[serde(default)]
+    pub tangential_resultant: Vec<f64>,
     /// The largest tangential displacement of a point in contact (the slip from rest).
     pub max_slip: f64,
     /// The largest slip of a point in contact in this step (the increment's).
@@ -149,7 +155,8 @@ pub struct StepRow {
     /// axis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_radius: Option<f64>,
-    /// The charge through each terminal, in the order of [`RunReport::terminals`].
+    /// The charge on each terminal (the charge on the conductor), in the order of
+    /// [`RunReport::terminals`].
     #[serde(default)]
     pub charges: Vec<f64>,
     /// The potential of each terminal, in the order of [`RunReport::terminals`] (a floating
@@ -282,8 +289,12 @@ pub struct ContactReport {
     pub n_separated: usize,
     /// `Σ w λ_n`.
     pub normal_force: f64,
-    /// `|Σ w λ_t t|`.
+    /// `|Σ w λ_t t|`: the magnitude of [`ContactReport::tangential_resultant`].
     pub tangential_force: f64,
+    /// The tangential force as a vector, `Σ w λ_t t` in the global frame (`x, y[, z]`: one
+    /// component per dimension; the force the foundation exerts on the body, against the slip).
+    #[serde(default)]
+    pub tangential_resultant: Vec<f64>,
     /// The largest contact pressure (absent without contact).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_lambda_n: Option<f64>,
@@ -298,10 +309,17 @@ pub struct ContactReport {
     /// Those of them held past the gap, inside the foundation (the condition wins).
     #[serde(default)]
     pub held_inside: usize,
-    /// Electrical contact: the charge through the contact zone, `Σ w q` with `q = D·ν` the
-    /// outward flux (C, or C/m in plane strain: the scene's units; positive leaving the body).
+    /// Electrical contact: the charge on the foundation (or the tip) across the contact zone,
+    /// `-Σ w q` with `q = D·ν` the flux out of the body (C, or C/m in plane strain: the
+    /// scene's units); the charge on the conductor, as every charge the program reports or
+    /// reads (`contact.charge` of a floating tip takes this value back).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub charge: Option<f64>,
+    /// A conducting foundation (or tip): its potential, prescribed
+    /// (`contact.foundation_potential`) or, floating with a given `contact.charge`, found (the
+    /// potential of the points it presses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub potential: Option<f64>,
     /// Electrical contact: the points whose potential is free (the others sit on an
     /// electrode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -328,6 +346,9 @@ pub struct ContactGroupReport {
     pub normal_force: f64,
     /// `|Σ w λ_t t|` over its points.
     pub tangential_force: f64,
+    /// `Σ w λ_t t` over its points, in the global frame (one component per dimension).
+    #[serde(default)]
+    pub tangential_resultant: Vec<f64>,
 }
 
 /// The counts (stick, slip, separated), the normal force and the tangential force vector of
@@ -380,6 +401,7 @@ impl ContactReport {
                         n_separated,
                         normal_force,
                         tangential_force: linalg::norm(&t),
+                        tangential_resultant: t[..points.dim].to_vec(),
                     }
                 })
                 .collect();
@@ -397,6 +419,7 @@ impl ContactReport {
             n_separated,
             normal_force,
             tangential_force: linalg::norm(&t),
+            tangential_resultant: t[..points.dim].to_vec(),
             max_lambda_n: Some(sol.lambda.normal.iter().cloned().fold(0.0f64, f64::max)),
             held_tangent_points: (0..points.len())
                 .filter(|&i| points.held[i][..points.n_tangential()].iter().any(|&h| h))
@@ -404,6 +427,7 @@ impl ContactReport {
             held_nodes: 0,
             held_inside: 0,
             charge: sol.electric.as_ref().map(|e| e.charge(&points.weight)),
+            potential: None,
             electric_points: sol.electric.as_ref().map(|e| e.points.len()),
             groups: vec![],
         }

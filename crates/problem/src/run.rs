@@ -369,6 +369,11 @@ pub(crate) fn recover(
     let counts = contact.map_or_else(ContactReport::default, |(b, sol)| ContactReport {
         held_nodes: b.held_nodes,
         held_inside: b.held_inside,
+        potential: scene
+            .contacts()
+            .iter()
+            .find(|c| c.electric_law().is_some())
+            .and_then(|c| conductor_potential(c, sol)),
         ..ContactReport::of_groups(&b.points, sol, &b.groups, &b.group_of)
     });
     let indenter = contact.and_then(|(b, sol)| {
@@ -468,21 +473,26 @@ pub(crate) fn indenter_report(
         force,
         contact_radius: radius,
         points_in_contact: count,
-        // a floating tip's potential is found: that of a point it presses
-        potential: match (c.charge, sol.electric.as_ref()) {
-            (Some(_), Some(e)) => e
-                .points
-                .iter()
-                .zip(&e.potential)
-                .filter(|&(&i, _)| sol.lambda.normal[i] > 0.0)
-                .map(|(_, &v)| v)
-                .next(),
-            _ => c.electric_law().map(|(_, potential)| potential),
-        },
-        charge: sol.electric.as_ref().map(|e| -e.charge(&points.weight)),
+        potential: conductor_potential(c, sol),
+        charge: sol.electric.as_ref().map(|e| e.charge(&points.weight)),
         tip_potential: None,
         half_space: None,
     })
+}
+
+/// The potential of a conducting foundation or tip (`None` on an insulating one): prescribed,
+/// or, floating with a given charge, found: that of a point it presses.
+fn conductor_potential(c: &crate::ContactSpec, sol: &ContactSolution) -> Option<f64> {
+    match (c.charge, sol.electric.as_ref()) {
+        (Some(_), Some(e)) => e
+            .points
+            .iter()
+            .zip(&e.potential)
+            .filter(|&(&i, _)| sol.lambda.normal[i] > 0.0)
+            .map(|(_, &v)| v)
+            .next(),
+        _ => c.electric_law().map(|(_, potential)| potential),
+    }
 }
 
 /// The terminals: the groups where the potential is prescribed or floats (none without

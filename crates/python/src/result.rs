@@ -33,13 +33,15 @@ pub struct RunResult {
 pub struct Series {
     /// Points per instant.
     pub n_points: usize,
+    /// Tangential components per point (`dim - 1`).
+    pub n_tangential: usize,
     /// `λ_n`.
     pub lambda_n: Vec<f64>,
-    /// `λ_t` along the first tangent.
+    /// `λ_t`, every tangential component of each point.
     pub lambda_t: Vec<f64>,
     /// `u_n`.
     pub u_n: Vec<f64>,
-    /// `u_t` along the first tangent.
+    /// `u_t`, every tangential component of each point.
     pub u_t: Vec<f64>,
     /// Contact status codes.
     pub status: Vec<i8>,
@@ -50,13 +52,18 @@ impl Series {
     pub fn push(&mut self, c: &problem::ContactResult) {
         let n = c.points.len();
         self.n_points = n;
+        self.n_tangential = c.points.dim - 1;
         let (lambda, u) = (&c.solution.lambda, &c.displacement);
-        let first = |v: &contact::PointValues, i: usize| v.tangential_of(i).first().copied().unwrap_or(0.0);
+        // every tangential component (zeros where the solution carries none: frictionless)
+        let all = |v: &contact::PointValues, i: usize, out: &mut Vec<f64>| {
+            let t = v.tangential_of(i);
+            out.extend((0..c.points.dim - 1).map(|k| t.get(k).copied().unwrap_or(0.0)));
+        };
         for i in 0..n {
             self.lambda_n.push(lambda.normal[i]);
-            self.lambda_t.push(first(lambda, i));
+            all(lambda, i, &mut self.lambda_t);
             self.u_n.push(u.normal[i]);
-            self.u_t.push(first(u, i));
+            all(u, i, &mut self.u_t);
             self.status.push(status_code(c.solution.status[i]));
         }
     }
@@ -194,10 +201,12 @@ impl RunResult {
     /// `uz`, `gap`, `normal_force`, `tangential_force`, `max_slip`, `max_slip_increment`,
     /// `n_stick`, `n_slip`, `n_separated`, `iterations`, `complementarity`, `equilibrium` (NaN
     /// where the instant's fields were not computed), and under an indenter `depth` and
-    /// `contact_radius`), `charges` and `potentials` (n_instants,
-    /// n_terminals) with `terminals` their groups; and with `run(..., series=True)` the contact values of every
-    /// point at every instant, (n_instants, n_points): `lambda_n`, `lambda_t`, `u_n`, `u_t`
-    /// (along the first tangent) and `status`.
+    /// `contact_radius`), the tangential force's components `tangential_force_x`, `_y`
+    /// (`_z` in 3D) beside its magnitude `tangential_force`, `charges` and `potentials`
+    /// (n_instants, n_terminals: the charge on each conductor) with `terminals` their groups;
+    /// and with `run(..., series=True)` the contact values of every point at every instant:
+    /// `lambda_n`, `u_n` and `status` (n_instants, n_points), `lambda_t` and `u_t` (n_instants,
+    /// n_points, dim - 1: every tangential component, as `contact.lambda_t`).
     #[getter]
     fn path<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let Some(path) = &self.solution.report.path else {
@@ -215,6 +224,10 @@ impl RunResult {
         }
         out.set_item("normal_force", column(&|r| r.normal_force))?;
         out.set_item("tangential_force", column(&|r| r.tangential_force))?;
+        for (k, axis) in ["x", "y", "z"].iter().enumerate().take(self.solution.mesh.dim) {
+            let component = column(&|r| r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN));
+            out.set_item(format!("tangential_force_{axis}"), component)?;
+        }
         out.set_item("max_slip", column(&|r| r.max_slip))?;
         out.set_item("max_slip_increment", column(&|r| r.max_slip_increment))?;
         out.set_item("n_stick", column(&|r| r.n_stick as f64))?;
@@ -248,9 +261,13 @@ impl RunResult {
                 numpy::ndarray::Array2::from_shape_vec(shape, v.to_vec()).map_err(|e| Kind::Base.err(e.to_string()))
             };
             out.set_item("lambda_n", owned(py, table(&series.lambda_n)?))?;
-            out.set_item("lambda_t", owned(py, table(&series.lambda_t)?))?;
+            let tangential = |v: &[f64]| {
+                numpy::ndarray::Array3::from_shape_vec((rows.len(), series.n_points, series.n_tangential), v.to_vec())
+                    .map_err(|e| Kind::Base.err(e.to_string()))
+            };
+            out.set_item("lambda_t", owned(py, tangential(&series.lambda_t)?))?;
             out.set_item("u_n", owned(py, table(&series.u_n)?))?;
-            out.set_item("u_t", owned(py, table(&series.u_t)?))?;
+            out.set_item("u_t", owned(py, tangential(&series.u_t)?))?;
             let status = numpy::ndarray::Array2::from_shape_vec(shape, series.status.clone())
                 .map_err(|e| Kind::Base.err(e.to_string()))?;
             out.set_item("status", owned(py, status))?;
@@ -424,8 +441,8 @@ impl Contact {
 
     /// Electrical contact (`contact.electric` conductive or conducting): the outward flux
     /// `D·nu` through each point, (m,) (charge per unit area; NaN where an electrode
-    /// prescribes the point's potential); None on an insulating foundation. The charge through
-    /// the zone is `nansum(weight * flux)` (`report["contact"]["charge"]`).
+    /// prescribes the point's potential); None on an insulating foundation. The charge on the
+    /// conductor across the zone is `-nansum(weight * flux)` (`report["contact"]["charge"]`).
     #[getter]
     fn flux<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
         self.with(py, |_, c| {

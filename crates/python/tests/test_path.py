@@ -40,13 +40,18 @@ def test_every_instants_contact_values_on_request():
     r = pc.run(scene, series=True)
     p = r.path
     n = len(r.contact.lambda_n)
-    for key in ["lambda_n", "lambda_t", "u_n", "u_t", "status"]:
+    for key in ["lambda_n", "u_n", "status"]:
         assert p[key].shape == (7, n), key
+    for key in ["lambda_t", "u_t"]:
+        assert p[key].shape == (7, n, 1), key
     # the last instant's values are the result's own; the forces are the weighted sums
     assert np.allclose(p["lambda_n"][-1], r.contact.lambda_n, rtol=1e-12, atol=0)
     w = r.contact.weight
     assert np.allclose(p["lambda_n"] @ w, p["normal_force"], rtol=1e-12)
-    assert np.allclose(p["lambda_t"] @ w, p["tangential_force"], rtol=1e-12, atol=1e-14)
+    # the tangent is x: the resultant's x component is the signed sum, its magnitude the norm
+    assert np.allclose(p["lambda_t"][:, :, 0] @ w, p["tangential_force_x"], rtol=1e-12, atol=1e-14)
+    assert np.allclose(np.abs(p["tangential_force_x"]), p["tangential_force"], rtol=1e-12, atol=1e-14)
+    assert np.allclose(p["tangential_force_y"], 0.0, atol=1e-14)
     assert pc.run(pc.Scene.load("paper", {"mesh.n": 8})).path is None
 
 

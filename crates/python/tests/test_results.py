@@ -212,7 +212,8 @@ def test_slip_weakening_friction_from_python():
 
 def test_electrical_contact_from_python():
     """`contact.electric`: a conducting foundation holds the potential of the points in contact
-    at its own, the flux sums to the reported charge, no conductance is the insulated answer,
+    at its own, the flux sums to the negative of the reported charge (the charge on the
+    foundation), no conductance is the insulated answer,
     and the PETSc backend is refused by key."""
     phi_f = 0.02
     r = pc.run(pc.Scene.load("paper-conducting", {"mesh.n": 8, "contact.foundation_potential": phi_f}))
@@ -220,7 +221,7 @@ def test_electrical_contact_from_python():
     touching = c.lambda_n > 0
     assert touching.any()
     assert np.allclose(r.phi[c.node[touching]], phi_f, rtol=0, atol=1e-12)
-    charge = np.nansum(c.weight * c.flux)
+    charge = -np.nansum(c.weight * c.flux)
     assert np.isclose(charge, r.report["contact"]["charge"], rtol=1e-12)
     bare = {"contact.electric": "insulated", "contact.conductance": None, "contact.foundation_potential": None}
     insulated = pc.run(pc.Scene.load("paper-conductive", {"mesh.n": 8, **bare})).contact

@@ -420,12 +420,18 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     Ok(out)
 }
 
-/// `path.csv`: one row per instant, with the charge through each terminal (`charge_GROUP`) and
-/// its potential (`potential_GROUP`).
+/// `path.csv`: one row per instant, with the tangential force's magnitude (`tangential_force`)
+/// and its components in the global frame (`tangential_force_x`, `_y`, `_z` in 3D), the charge
+/// on each terminal (`charge_GROUP`, the charge on the conductor) and its potential
+/// (`potential_GROUP`).
 fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
     let mut s = String::from(
         "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius",
     );
+    let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
+    for axis in ["x", "y", "z"].iter().take(dim) {
+        s.push_str(&format!(",tangential_force_{axis}"));
+    }
     for t in terminals {
         s.push_str(&format!(",charge_{t}"));
     }
@@ -450,6 +456,7 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         row.push(r.equilibrium.map_or(String::new(), |e| format!("{e:e}")));
         row.push(r.depth.map_or(String::new(), |e| format!("{e:e}")));
         row.push(r.contact_radius.map_or(String::new(), |e| format!("{e:e}")));
+        row.extend((0..dim).map(|k| format!("{:e}", r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN))));
         row.extend(r.charges.iter().map(|q| format!("{q:e}")));
         row.extend(r.potentials.iter().map(|v| format!("{v:e}")));
         s.push_str(&row.join(","));
@@ -488,6 +495,16 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
     let driver = (0..FACTORS.len())
         .max_by(|&a, &b| range(a).total_cmp(&range(b)))
         .unwrap_or(0);
+    // the loop's force: the component along a driving displacement (ux, uy, uz), else the
+    // magnitude
+    let along = |r: &problem::report::StepRow| match driver {
+        2..=4 => r.tangential_resultant.get(driver - 2).copied().unwrap_or(f64::NAN),
+        _ => r.tangential_force,
+    };
+    let loop_label = match driver {
+        2..=4 => format!("tangential force along {}", &FACTORS[driver][1..]),
+        _ => "tangential force (magnitude)".to_string(),
+    };
     let mut panels = vec![
         Panel {
             title: "Contact forces along the path".into(),
@@ -502,11 +519,8 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
                 "Tangential force against the {} factor (friction's loop)",
                 FACTORS[driver]
             ),
-            labels: (format!("{} factor", FACTORS[driver]), "tangential force".into()),
-            series: vec![Series::line(
-                "tangential force",
-                over(&|r| (r.factors[driver], r.tangential_force)),
-            )],
+            labels: (format!("{} factor", FACTORS[driver]), loop_label.clone()),
+            series: vec![Series::line(&loop_label, over(&|r| (r.factors[driver], along(r))))],
         },
     ];
     if rows.iter().any(|r| r.depth.is_some()) {
@@ -521,7 +535,7 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
     }
     if !terminals.is_empty() {
         panels.push(Panel {
-            title: "Charge through each terminal".into(),
+            title: "Charge on each terminal".into(),
             labels: ("t".into(), "charge".into()),
             series: terminals
                 .iter()
