@@ -449,8 +449,10 @@ fn capacitance(scene: Option<String>, set: &[String], out: Option<PathBuf>) -> R
     let name = scene.unwrap_or_else(|| "actuator".into());
     let (scene, source) = scene_file::load(&name, set)?;
     let c = files::run::capacitance(&scene, &source, None)?;
-    let mut csv = format!("terminal,{}\n", c.terminals.join(","));
-    for (t, row) in c.terminals.iter().zip(&c.matrix) {
+    let field = files::output::csv_field;
+    let names: Vec<_> = c.terminals.iter().map(|t| field(t)).collect();
+    let mut csv = format!("terminal,{}\n", names.join(","));
+    for (t, row) in names.iter().zip(&c.matrix) {
         let cells: Vec<String> = row.iter().map(|x| format!("{x:e}")).collect();
         csv.push_str(&format!("{t},{}\n", cells.join(",")));
     }

@@ -125,7 +125,10 @@ impl Profile {
     fn slope(&self, rho: f64) -> Option<f64> {
         match self {
             Profile::Paraboloid { radius } => Some(rho / radius),
-            Profile::Sphere { radius } => (rho < *radius).then(|| rho / (radius * radius - rho * rho).sqrt()),
+            // `√(R² - ρ²)` as `√(R - ρ) √(R + ρ)`: no overflow of R²
+            Profile::Sphere { radius } => {
+                (rho < *radius).then(|| rho / ((radius - rho).sqrt() * (radius + rho).sqrt()))
+            }
             Profile::Cone { half_angle } => Some(1.0 / half_angle.to_radians().tan()),
             Profile::Punch { .. } => Some(0.0),
             Profile::Tabulated(t) => {

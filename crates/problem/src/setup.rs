@@ -40,6 +40,29 @@ pub struct MeshNotes {
     pub unused_nodes: usize,
 }
 
+/// Without electric unknowns (no coupling and no potential or charge that is not 0), what acts
+/// on them only would be ignored: a floating terminal (even an open one), a path's voltage.
+fn refuse_electric_keys_without_unknowns(scene: &Scene, plan: &Plan) -> Result<(), ProblemError> {
+    if plan.electric {
+        return Ok(());
+    }
+    let why = "the body has no electric unknowns (no piezoelectric coupling, no potential or charge that is not 0), so it would be ignored";
+    let key = if scene.dirichlet.iter().any(|d| d.charge.is_some()) {
+        "dirichlet.charge"
+    } else if scene.electrodes().iter().any(|e| e.charge.is_some()) {
+        "electrode.charge"
+    } else if scene.path.as_ref().is_some_and(|p| p.voltage.is_some()) {
+        "path.voltage"
+    } else {
+        return Ok(());
+    };
+    Err(SceneError::new(
+        key,
+        format!("{key} does not apply: {why} (remove it, or `--set ~{key}`)"),
+    )
+    .into())
+}
+
 /// Makes the [`Setup`] of a validated scene ([`Scene::validate`]). `given` is the mesh of a
 /// `gmsh` scene, read by the caller (this crate does no IO); a generated mesh is made here.
 ///
@@ -68,6 +91,7 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         .into());
     }
     let plan = Plan::new(scene, dim, &materials);
+    refuse_electric_keys_without_unknowns(scene, &plan)?;
     let materials = if plan.electric {
         materials
     } else {

@@ -68,19 +68,26 @@ pub fn sweep(
             return Err(DriverError::Usage(format!("sweep {name} {v} is not a finite number")));
         }
     }
+    let integer = integer_key(scene, sets, param, [*from, *to]);
     let mut rows = vec![];
     for k in 0..*steps {
         // a weighted mean of the bounds: finite for any finite bounds (their difference may
         // overflow), and the bounds themselves at the ends
         let t = k as f64 / (steps - 1) as f64;
-        let value = if k + 1 == *steps {
+        let mut value = if k + 1 == *steps {
             *to
         } else {
             from * (1.0 - t) + to * t
         };
         let mut s = sets.to_vec();
-        // the shortest digits that read back to the value (`{:?}`: 1e300, not 301 digits)
-        s.push(format!("{param}={value:?}"));
+        if integer {
+            // an integer key (`mesh.n`, `path.steps`) takes the nearest integer, written as one
+            value = value.round();
+            s.push(format!("{param}={}", value as i64));
+        } else {
+            // the shortest digits that read back to the value (`{:?}`: 1e300, not 301 digits)
+            s.push(format!("{param}={value:?}"));
+        }
         let t = Instant::now();
         let r = solve(scene, &s)?.report;
         let c = &r.contact;
@@ -115,6 +122,28 @@ pub fn sweep(
         progress(&format!("wrote sweep.csv, sweep.svg, sweep.png in {}", dir.display()));
     }
     Ok(rows)
+}
+
+/// Whether `param` is an integer key of the scene: its value in the scene (with `sets`) is a
+/// TOML integer; where the scene leaves it out, whether both bounds are whole numbers within
+/// the integers a double holds exactly.
+fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> bool {
+    let found = files::scene_file::load(scene, sets)
+        .ok()
+        .and_then(|(s, _)| toml::Value::try_from(&s).ok())
+        .and_then(|tree| {
+            param
+                .split('.')
+                .try_fold(tree, |node, part| match (node, part.parse::<usize>()) {
+                    (toml::Value::Array(mut items), Ok(i)) if i < items.len() => Some(items.swap_remove(i)),
+                    (toml::Value::Table(mut table), _) => table.remove(part),
+                    _ => None,
+                })
+        });
+    match found {
+        Some(v) => v.is_integer(),
+        None => bounds.iter().all(|b| b.fract() == 0.0 && b.abs() < 2f64.powi(53)),
+    }
 }
 
 /// The rows as CSV (with `indenter_depth,indenter_charge` where the scene has an indenter;
@@ -173,4 +202,20 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
         ],
     };
     Ok(plots::panels("sweep", &[states, forces])?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::integer_key;
+
+    #[test]
+    fn a_sweep_knows_an_integer_key_from_the_scene() {
+        assert!(integer_key("paper", &[], "mesh.n", [8.0, 9.5]));
+        assert!(!integer_key("paper", &[], "load.p", [-4.0, -2.0]));
+        assert!(integer_key("cattaneo-mindlin-cycle", &[], "path.steps", [3.0, 7.0]));
+        assert!(!integer_key("corner", &[], "contact.1.gap", [-1.0, 0.0]));
+        // a key the scene leaves out: whole bounds read as integers
+        assert!(integer_key("paper", &[], "mesh.nx", [8.0, 16.0]));
+        assert!(!integer_key("paper", &[], "mesh.nx", [8.0, 16.5]));
+    }
 }

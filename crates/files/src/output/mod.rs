@@ -231,6 +231,17 @@ fn revolved_vtu(
 /// with several contact groups `group`;
 /// the displacements are those of the final solution (a frictionless body slides: its `u_t`
 /// is written too), the tangential multipliers 0 where the law carries none.
+/// A CSV field as RFC 4180 writes it: quoted (its quotes doubled) where it holds a comma, a
+/// quote or a line break, as it is elsewhere. Every name that becomes a column or a cell (a
+/// Gmsh group's physical name, a terminal) goes through it, so no name can shift a column.
+pub fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\"")).into()
+    } else {
+        text.into()
+    }
+}
+
 fn contact_csv(c: &ContactResult) -> Vec<u8> {
     let (points, sol, u) = (&c.points, &c.solution, &c.displacement);
     let dim = points.dim;
@@ -274,7 +285,7 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
             row.push(format!("{:e}", at[i].1));
         }
         if several {
-            row.push(c.groups[c.group_of[i]].clone());
+            row.push(csv_field(&c.groups[c.group_of[i]]).into_owned());
         }
         s.push_str(&row.join(","));
         s.push('\n');
@@ -433,10 +444,10 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         s.push_str(&format!(",tangential_force_{axis}"));
     }
     for t in terminals {
-        s.push_str(&format!(",charge_{t}"));
+        s.push_str(&format!(",{}", csv_field(&format!("charge_{t}"))));
     }
     for t in terminals {
-        s.push_str(&format!(",potential_{t}"));
+        s.push_str(&format!(",{}", csv_field(&format!("potential_{t}"))));
     }
     s.push('\n');
     for r in rows {
@@ -584,6 +595,30 @@ pub fn safe_file_name(name: &str, fallback: &str) -> String {
 mod tests {
     use super::*;
     use vtkio::model::{DataSet, VertexNumbers, Vtk};
+
+    /// RFC 4180: a field with a comma, a quote or a line break is quoted, its quotes doubled;
+    /// read back by splitting on the commas outside quotes, every field is what was written.
+    #[test]
+    fn a_name_with_commas_or_quotes_stays_one_csv_field() {
+        let names = ["plain", "a,b", "say \"x\"", "two\nlines", "", "-_+."];
+        let line: Vec<String> = names.iter().map(|n| csv_field(n).into_owned()).collect();
+        let line = line.join(",");
+        let (mut fields, mut field, mut quoted, mut chars) = (vec![], String::new(), false, line.chars().peekable());
+        while let Some(c) = chars.next() {
+            match (c, quoted) {
+                ('"', true) if chars.peek() == Some(&'"') => {
+                    chars.next();
+                    field.push('"');
+                }
+                ('"', _) => quoted = !quoted,
+                (',', false) => fields.push(std::mem::take(&mut field)),
+                (c, _) => field.push(c),
+            }
+        }
+        fields.push(field);
+        assert_eq!(fields, names);
+        assert_eq!(csv_field("plain"), "plain");
+    }
 
     #[test]
     fn a_body_of_revolution_is_swept_into_wedges_that_face_out() {

@@ -164,16 +164,17 @@ impl Scene {
             }
         }
         validate_electrodes(self)?;
-        for c in self.contacts() {
-            validate_contact(c)?;
-        }
+        // every entry of `[[contact]]` is read as the first one is: its own keys, each
+        // refused by name where it does not apply
+        each_contact(self, |_, c| validate_contact(c))?;
         refuse_several_contacts(self)?;
         validate_solver(&self.solver)?;
         refuse_axisymmetric(self)?;
-        refuse_force_control(self)?;
-        refuse_compliance(self)?;
-        refuse_weakening(self)?;
-        refuse_electric(self)?;
+        each_contact(self, refuse_force_control)?;
+        each_contact(self, refuse_compliance)?;
+        each_contact(self, refuse_weakening)?;
+        each_contact(self, refuse_electric)?;
+        each_contact(self, refuse_backend_contact)?;
         refuse_backend(self)?;
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
@@ -229,6 +230,11 @@ impl Scene {
         for l in self.loads() {
             len("load.direction", &l.direction, dim)?;
         }
+        refuse_if(
+            dim == 2 && self.path.as_ref().is_some_and(|p| p.uz.is_some()),
+            "path.uz",
+            "a displacement along z, and the mesh is 2D (plane strain: u = (ux, uy))",
+        )?;
         for c in self.contacts() {
             len("contact.normal", &c.normal, dim)?;
             if let Some(g) = &c.gap_center {
@@ -245,6 +251,25 @@ impl Scene {
                         "contact.indenter.axis",
                         "a 3D cylinder's axis, and the mesh is 2D (the plane-strain cylinder needs none)",
                     )?;
+                    // a cylinder lies on the face: its axis in the face's plane (an axis along
+                    // the normal would leave the distance across it that of a sphere)
+                    let (a, n) = (mesh::scaled_norm(axis), mesh::scaled_norm(&c.normal));
+                    let cos: f64 = axis.iter().zip(&c.normal).map(|(x, y)| (x / a) * (y / n)).sum();
+                    if cos.abs() > 1e-9 {
+                        return Err(SceneError::new(
+                            "contact.indenter.axis",
+                            format!(
+                                "contact.indenter.axis = {axis:?} is not in the contact face's plane (its angle with contact.normal = {:?} is {:.6}°): a cylinder lies on the face, its axis perpendicular to the normal",
+                                c.normal,
+                                cos.clamp(-1.0, 1.0).acos().to_degrees()
+                            ),
+                        ));
+                    }
+                } else if i.shape == IndenterShape::Cylinder && dim == 3 {
+                    return Err(SceneError::new(
+                        "contact.indenter.axis",
+                        "contact.indenter.shape = \"cylinder\" in 3D needs contact.indenter.axis (a direction in the contact face's plane)",
+                    ));
                 }
             }
         }
@@ -353,6 +378,31 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "path",
         "the PETSc backend solves one instant; a path reuses one factorisation, which the faer backend has (solver.backend = \"faer\")",
     )?;
+    Ok(())
+}
+
+/// Runs `check` on every contact entry that is switched on (`contact.law` other than `none`:
+/// the section is then kept as it is, unused, and the plan says so); with several
+/// `[[contact]]` entries, an error names the entry as `--set` reaches it (`contact.1.KEY`)
+/// and its group.
+fn each_contact(s: &Scene, check: impl Fn(&Scene, &ContactSpec) -> Result<(), SceneError>) -> Result<(), SceneError> {
+    let contacts = s.contacts();
+    let several = contacts.len() > 1;
+    for (k, c) in contacts.iter().enumerate() {
+        // validate_contact reads a switched-off section's numbers too (finite, in range)
+        check(s, c).map_err(|e| match (several, e.key.strip_prefix("contact.")) {
+            // the entry's own keys in the message too (`--set ~contact.1.conductance`)
+            (true, Some(rest)) => SceneError::new(
+                &format!("contact.{k}.{rest}"),
+                format!(
+                    "[[contact]] {k} on `{}`: {}",
+                    c.group,
+                    e.message.replace("contact.", &format!("contact.{k}."))
+                ),
+            ),
+            _ => e,
+        })?;
+    }
     Ok(())
 }
 
@@ -770,6 +820,9 @@ fn validate_electrodes(s: &Scene) -> Result<(), SceneError> {
     let mut names: Vec<String> = vec![];
     for (k, e) in s.electrodes().iter().enumerate() {
         let name = e.group_name(k);
+        if let Some(given) = &e.name {
+            check_name("electrode.name", given)?;
+        }
         match (e.v, e.charge) {
             (Some(v), None) => finite("electrode.v", v)?,
             (None, Some(q)) => finite("electrode.charge", q)?,
@@ -804,6 +857,30 @@ fn validate_electrodes(s: &Scene) -> Result<(), SceneError> {
         }
     }
     Ok(())
+}
+
+/// A name the scene gives to something the outputs name (a group, a terminal: a column of
+/// path.csv and capacitance.csv, a ParaView array): not empty, no control characters (a line
+/// break would end a CSV row), no blanks at either end (they would not survive a spreadsheet).
+pub(crate) fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
+    let problem = if name.is_empty() {
+        Some("is empty")
+    } else if name.chars().any(char::is_control) {
+        Some("holds a control character (a line break, a tab)")
+    } else if name.trim() != name {
+        Some("begins or ends with a blank")
+    } else {
+        None
+    };
+    match problem {
+        Some(what) => Err(SceneError::new(
+            key,
+            format!(
+                "{key} = {name:?} {what}: a name becomes a column of the CSV outputs; use letters, digits, `-`, `_`"
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
@@ -907,10 +984,10 @@ fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
 
 /// Force control (`contact.indenter.force`): found on the condensed compliance of the default
 /// backend, at one instant or at each instant of a path (the force scaled by its load factor).
-fn refuse_force_control(s: &Scene) -> Result<(), SceneError> {
-    let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) else {
+fn refuse_force_control(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
+    if c.law == ContactLaw::None {
         return Ok(());
-    };
+    }
     if c.indenter.as_ref().is_none_or(|i| i.force.is_none()) {
         return Ok(());
     }
@@ -971,11 +1048,8 @@ fn refuse_axisymmetric(s: &Scene) -> Result<(), SceneError> {
 /// a strategy or rule of the default backend's contact solvers (it runs its own).
 /// A compliant foundation's law is no projection: only semismooth Newton (with block
 /// Gauss-Seidel as its last stage) solves it, and the PETSc backend's active sets do not.
-fn refuse_compliance(s: &Scene) -> Result<(), SceneError> {
-    if !s
-        .first_contact()
-        .is_some_and(|c| c.compliance.is_some() && c.law != ContactLaw::None)
-    {
+fn refuse_compliance(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
+    if !(c.compliance.is_some() && c.law != ContactLaw::None) {
         return Ok(());
     }
     newton_on_the_default_backend(
@@ -1007,11 +1081,11 @@ fn newton_on_the_default_backend(
 /// Slip-weakening friction's keys, where `contact.friction_law = "slip-weakening"`: the three
 /// numbers given and in range, Coulomb's law, no constant coefficient; solved by
 /// `newton-condensed` on the default backend. Elsewhere its keys do not apply.
-fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
+fn refuse_weakening(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
     // contact switched off: the section is kept as it is, unused
-    let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) else {
+    if c.law == ContactLaw::None {
         return Ok(());
-    };
+    }
     let keys = [
         ("contact.friction_static", c.friction_static),
         ("contact.friction_dynamic", c.friction_dynamic),
@@ -1072,11 +1146,11 @@ fn refuse_weakening(s: &Scene) -> Result<(), SceneError> {
 /// `conductance` where it is conductive (given, finite, `>= 0`); solved by `newton-condensed`
 /// on the default backend, not with slip weakening. (A body without electric unknowns is
 /// refused once the plan knows it.)
-fn refuse_electric(s: &Scene) -> Result<(), SceneError> {
+fn refuse_electric(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
     use crate::scene::ElectricCondition as E;
-    let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) else {
+    if c.law == ContactLaw::None {
         return Ok(());
-    };
+    }
     let condition = c.electric.unwrap_or(E::Insulated);
     if let Some(v) = c.foundation_potential {
         finite("contact.foundation_potential", v)?;
@@ -1153,19 +1227,23 @@ fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
         "solver.rule",
         "the PETSc backend stops on the complementarity residual (the paper's rule is for its Uzawa)",
     )?;
-    if let Some(c) = s.first_contact().filter(|c| c.law != ContactLaw::None) {
-        let nonzero = c.normal.iter().filter(|&&x| x != 0.0).count();
-        if nonzero != 1 {
-            return Err(SceneError::new(
-                "contact.normal",
-                format!(
-                    "contact.normal = {:?}: the PETSc backend needs a normal along a coordinate axis (its contact iteration holds displacement components); use the default backend for an oblique contact face",
-                    c.normal
-                ),
-            ));
-        }
-    }
     Ok(())
+}
+
+/// The PETSc backend's contact normal: along a coordinate axis.
+fn refuse_backend_contact(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
+    if s.solver.backend != BackendChoice::Petsc || c.law == ContactLaw::None {
+        return Ok(());
+    }
+    let nonzero = c.normal.iter().filter(|&&x| x != 0.0).count();
+    refuse_if(
+        nonzero != 1,
+        "contact.normal",
+        &format!(
+            "contact.normal = {:?}: the PETSc backend needs a normal along a coordinate axis (its contact iteration holds displacement components); use the default backend for an oblique contact face",
+            c.normal
+        ),
+    )
 }
 
 fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
