@@ -1,4 +1,4 @@
-//! End-to-end contact tests on whole scenes (SCENES.md sections 1-4).
+//! End-to-end contact tests on whole scenes (docs/scenes.md sections 1-4).
 //!
 //! ```text
 //!            p (traction on top)
@@ -9,9 +9,9 @@
 //!      ///// rigid foundation, Coulomb F ///////
 //! ```
 //!
-//! Expected numbers: `paper-slip` has 69 of 127 points slipping at n = 64 (SCENES.md);
+//! Expected numbers: `paper-slip` has 69 of 127 points slipping at n = 64 (docs/scenes.md);
 //! `paper` sticks everywhere; the answer is proportional to p (g = 0); `pzt5a-si` is `paper`
-//! under the change of units of SCENES.md section 4; the strategies agree to 1e-8.
+//! under the change of units of docs/scenes.md section 4; the strategies agree to 1e-8.
 
 use problem::Solution;
 
@@ -102,7 +102,7 @@ fn strategies_agree() {
 fn si_units_give_the_paper_answer_mapped() {
     let paper = run("paper", &["mesh.n=16"]);
     let si = run("pzt5a-si", &["mesh.n=16"]);
-    // lambda_SI = 1e6 lambda, u_SI = 1e-5 u, phi_SI = 1e4 phi (SCENES.md section 4)
+    // lambda_SI = 1e6 lambda, u_SI = 1e-5 u, phi_SI = 1e4 phi (docs/scenes.md section 4)
     assert!(rel_diff(&lambdas(&paper), &lambdas(&si), 1e6) < 1e-11);
     let up: Vec<f64> = paper.u.iter().flatten().copied().collect();
     let us: Vec<f64> = si.u.iter().flatten().copied().collect();

@@ -2,7 +2,7 @@
 //! poled along the contact normal, held laterally by rollers, pushed down by `δ` at its top
 //! with the top's potential `V` given, on a foundation at `φ_F`, is in uniaxial strain and a
 //! uniform field along the normal (P1 elements hold it exactly). With the 6mm constants along
-//! the poling, `σ = c33 ε + e33 φ'` and `D = e33 ε - ε33 φ'` (DESIGN.md's signs), `ε = -δ/H`:
+//! the poling, `σ = c33 ε + e33 φ'` and `D = e33 ε - ε33 φ'` (docs/theory.md's signs), `ε = -δ/H`:
 //! - conducting: `φ(0) = φ_F`, so `φ' = (V - φ_F)/H`; the pressure `λ = -σ`, the flux through
 //!   the contact face `q = D·ν = -D`;
 //! - conductive: `q = σ_c λ (φ(0) - φ_F)` with `λ` and `q` affine in `a = φ(0)`: a quadratic in

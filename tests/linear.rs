@@ -1,6 +1,6 @@
 //! End-to-end tests of the linear solve on whole scenes (no contact).
 //!
-//! Source: SCENES.md sections 1-2. Goal: the shipped scenes run through the driver; the two
+//! Source: docs/scenes.md sections 1-2. Goal: the shipped scenes run through the driver; the two
 //! linear strategies agree; the plan leaves out what a scene does not need; the factor of `K`
 //! at a size where faer goes supernodal has exactly `n_φ` negative pivots.
 
@@ -102,7 +102,7 @@ fn outputs_are_written_and_bad_input_writes_nothing() {
 
 /// The `patch` scene.
 ///
-/// - Source: the patch test of Irons (Irons and Razzaque, 1972; SCENES.md section 6): an
+/// - Source: the patch test of Irons (Irons and Razzaque, 1972; docs/scenes.md section 6): an
 ///   element that is to converge must reproduce any field its space contains exactly.
 /// - Goal: assembly, Dirichlet lifting (of u and of a non-zero φ) and both linear strategies,
 ///   through the whole driver, return an affine (u, φ) unchanged.

@@ -95,7 +95,8 @@ class Scene:
         """Changes keys: `set("mesh.n", 128)`, `set({"contact.law": "signorini",
         "contact.friction": None})`, or keywords: a key with `__` for its dots
         (`set(mesh__n=128)`) or a section merged key by key (`set(mesh={"n": 128})`). None
-        removes a key."""
+        removes a key. A key named twice in one call (a dict and a keyword, a table and one of
+        its keys) is an InputError."""
     def get(self, key: str, default: Any = None) -> Any:
         """The value of a dotted key (`scene.get("mesh.n")`), or `default`."""
     def set_mesh(
@@ -109,7 +110,9 @@ class Scene:
         (n, 3); `cells` (m, 3) triangles or (m, 4) quadrilaterals in 2D, (m, 4) tetrahedra in
         3D, 0-based; `boundary` named facet arrays ((k, 2) in 2D, (k, 3) in 3D); `regions`
         named cell-index arrays (default: all cells in "body"). Checked as a file's mesh is
-        (`MeshError`)."""
+        (`MeshError`). The arrays replace only how the mesh was made: the `[mesh]` keys that
+        describe the body (`axisymmetric`, `revolve`) stay. A mesh too large for the memory
+        left is refused before it is copied (`SolverError`, naming the limit)."""
     def to_dict(self) -> dict[str, Any]:
         """The scene as a dict of its sections."""
     def to_toml(self) -> str:

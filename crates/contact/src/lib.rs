@@ -8,7 +8,7 @@
 //! block Gauss–Seidel ([`solve_gauss_seidel`]). [`siconos`] reads the frictional contact
 //! problems of the Siconos project, on which the solvers are judged against Siconos' own.
 //!
-//! # Glossary (signs fixed by DESIGN.md)
+//! # Glossary (signs fixed by docs/theory.md)
 //! - `n`: outward normal of the body; `u_n = u·n`, `u_t = (u·t_k)_k`; gap `g`: `u_n ≤ g`.
 //! - `λ_n = -σ_n ≥ 0`: the contact pressure; `λ_t = -(σn)·t`, so at a sliding point `λ_t`
 //!   points along `u_t`. Equilibrium: `A u + Gᵀ φ = f - Nᵀ W λ_n - Tᵀ W λ_t`, `W` the weights.

@@ -1,6 +1,6 @@
 //! What a contact solve returns and how it is judged, the same for every solver: the law, the
 //! solution with its counts ([`ContactInfo`]), progress lines, the slip bound, the
-//! scale-free complementarity residual and the stick/slip status of DESIGN.md.
+//! scale-free complementarity residual and the stick/slip status of docs/theory.md.
 
 use crate::operator::ContactOperator;
 use crate::points::{ContactPoints, Foundation, PointValues, Status};
@@ -311,7 +311,7 @@ pub fn coulomb_radius(friction: f64, z_n: f64) -> f64 {
     friction * crate::project_nonnegative(z_n)
 }
 
-/// The natural-map residual of DESIGN.md with step `c`:
+/// The natural-map residual of docs/theory.md with step `c`:
 /// `‖(λ_n - max(0, λ_n + c (u_n - g)), λ_t - P_S(λ_t + c u_t))‖_W / max(‖λ‖_W, reference)`.
 ///
 /// `reference` is the multiplier scale of the problem, `c ‖(u_n(0) - g, u_t(0))‖_W` with `u(0)`
@@ -438,7 +438,7 @@ impl Measure {
     }
 }
 
-/// Status of each point (DESIGN.md): separated if `λ_n ≤ 1e-9 max λ_n`; otherwise slip if the
+/// Status of each point (docs/theory.md): separated if `λ_n ≤ 1e-9 max λ_n`; otherwise slip if the
 /// radius is 0 or `|λ_t| ≥ (1 - 1e-9) S`; otherwise stick.
 pub fn classify(lambda: &PointValues, radius: &[f64]) -> Vec<Status> {
     let max_n = lambda.normal.iter().cloned().fold(0.0f64, f64::max);

@@ -1,4 +1,4 @@
-//! Uzawa's algorithm with projections (the paper's Algorithm 2, signs of DESIGN.md), its
+//! Uzawa's algorithm with projections (the paper's Algorithm 2, signs of docs/theory.md), its
 //! accelerated version, and the fixed point on the slip bound for Coulomb friction
 //! (Algorithm 4), with the step from the dual operator's largest eigenvalue.
 
@@ -14,7 +14,7 @@ use crate::{ContactError, ContactInfo, ContactSolution, Interrupt, Iterate, Law,
 /// When the loops stop.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum StopRule {
-    /// The complementarity residual (DESIGN.md) at most `tol`; for Coulomb the residual with
+    /// The complementarity residual (docs/theory.md) at most `tol`; for Coulomb the residual with
     /// the Coulomb radius `F λ_n`, so that the fixed point stops only at a Coulomb solution.
     Tight {
         /// Tolerance.

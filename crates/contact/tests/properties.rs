@@ -255,7 +255,7 @@ proptest! {
             prop_assert!(l.normal[i] >= 0.0);
             prop_assert!(u.normal[i] <= 1e-7 * scale_u);
             prop_assert!((l.normal[i] * u.normal[i]).abs() <= 1e-7 * scale_l * scale_u);
-            // a point whose pressure is round-off (DESIGN.md: λ_n ≤ 1e-9 max λ_n) is separated:
+            // a point whose pressure is round-off (docs/theory.md: λ_n ≤ 1e-9 max λ_n) is separated:
             // it may slide freely
             if l.normal[i] <= 1e-9 * l.normal.iter().cloned().fold(0.0, f64::max) {
                 continue;

@@ -5,7 +5,7 @@
 //! [[A, Gᵀ], [-G, B]] [u; φ] = [b_u; -b_φ]
 //! ```
 //!
-//! is DESIGN.md's `K [u; φ] = [b_u; b_φ]`, `K = [[A, Gᵀ], [G, -B]]`, with the potential's rows
+//! is docs/theory.md's `K [u; φ] = [b_u; b_φ]`, `K = [[A, Gᵀ], [G, -B]]`, with the potential's rows
 //! negated: the same solution, and a Schur complement of the potentials, `B + G A⁻¹ Gᵀ`, that
 //! is positive definite, as algebraic multigrid wants. The element matrices are those of
 //! `fe_assembly::kernels` (one column at a time), the loads those of

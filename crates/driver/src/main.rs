@@ -154,7 +154,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Run the stiff and extreme cases (SCENES.md section 5), each in its own process, and
+    /// Run the stiff and extreme cases (docs/scenes.md section 5), each in its own process, and
     /// write their table to docs/stability.md.
     Stability {
         /// Leave out the fine cases (2D n = 512 and 1024, 3D n = 32).

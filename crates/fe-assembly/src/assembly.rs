@@ -1,4 +1,4 @@
-//! Global assembly of the blocks `A` (u-u), `G` (φ-u) and `B` (φ-φ) of DESIGN.md into sparse
+//! Global assembly of the blocks `A` (u-u), `G` (φ-u) and `B` (φ-φ) of docs/theory.md into sparse
 //! patterns built from the mesh graph, and of the right-hand sides of the symmetric system
 //!
 //! ```text

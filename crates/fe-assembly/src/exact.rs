@@ -3,7 +3,7 @@
 //! (manufactured solutions, Roache 2002), the Dirichlet data it prescribes, and the errors of a
 //! discrete solution against it in the L2 and energy norms.
 //!
-//! The equations (signs of DESIGN.md): `-div σ = f0`, `div D = q0`, with
+//! The equations (signs of docs/theory.md): `-div σ = f0`, `div D = q0`, with
 //! `σ = C ε(u) + eᵀ ∇φ` and `D = e ε(u) - β ∇φ`. So, in index form,
 //! `f0_i = -Σ_jkl C_ijkl ∂_jl u_k - Σ_jk e_kij ∂_jk φ` and
 //! `q0 = Σ_ikl e_ikl ∂_il u_k - Σ_ik β_ik ∂_ik φ`.

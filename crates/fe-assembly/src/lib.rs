@@ -2,7 +2,7 @@
 //! parallel assembly of the blocks `A`, `G`, `B`, loads, and recovery of stress and electric
 //! displacement.
 //!
-//! # Glossary (signs fixed by DESIGN.md)
+//! # Glossary (signs fixed by docs/theory.md)
 //! - `u`: displacement; `φ` (`phi`): electric potential; `E = -∇φ`.
 //! - Law: `σ = C ε(u) + eᵀ ∇φ`, `D = e ε(u) - β ∇φ` (`C`: elasticity, `e`: piezoelectric
 //!   stress constants, `β` (`beta`): permittivity). Voigt order `[xx, yy, xy]` (2D, plane

@@ -1,4 +1,4 @@
-//! Right-hand sides of `K [u; φ] = [f; -q]` (DESIGN.md):
+//! Right-hand sides of `K [u; φ] = [f; -q]` (docs/theory.md):
 //!
 //! - `f_v = ∫_Ω f0 · v dx + ∫_Γ2 f2 · v ds`           (body force, traction),
 //! - `q_ψ = ∫_Ω q0 ψ dx - ∫_Γb q2 ψ ds`              (the paper's (3) `div D = q0`, and `D·n = q2`),

@@ -18,7 +18,7 @@ pub struct Crystal {
 }
 
 impl Crystal {
-    /// PZT-5A as tabulated in SCENES.md (GPa, C/m^2, nF/m): c11 = 121, c12 = 75.4,
+    /// PZT-5A as tabulated in docs/scenes.md (GPa, C/m^2, nF/m): c11 = 121, c12 = 75.4,
     /// c13 = 75.2, c33 = 111, c44 = 21.1, c66 = 22.6; e31 = -5.4, e33 = 15.8, e15 = 12.3;
     /// eps11 = 8.11, eps33 = 7.35.
     pub fn pzt5a() -> Self {
@@ -210,7 +210,7 @@ impl Material {
     ///
     /// ```
     /// use fe_assembly::{Crystal, Material};
-    /// // PZT-5A poled along y in plane strain: SCENES.md's 2D values.
+    /// // PZT-5A poled along y in plane strain: docs/scenes.md's 2D values.
     /// let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
     /// assert_eq!(m.c, vec![121.0, 75.2, 0.0, 75.2, 111.0, 0.0, 0.0, 0.0, 21.1]);
     /// ```
@@ -489,7 +489,7 @@ fn check_spd(name: &str, what: &'static str, m: &[f64], n: usize) -> Result<(), 
 mod tests {
     use super::*;
 
-    /// SCENES.md section 1: the plane-strain reduction of PZT-5A poled along y.
+    /// docs/scenes.md section 1: the plane-strain reduction of PZT-5A poled along y.
     #[test]
     fn pzt5a_plane_strain_matches_scenes() {
         let m = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();

@@ -1,5 +1,5 @@
 //! Recovery of the stress `σ = C ε(u) + eᵀ ∇φ` and the electric displacement
-//! `D = e ε(u) - β ∇φ` (DESIGN.md's law; `E = -∇φ`), constant on each P1 cell.
+//! `D = e ε(u) - β ∇φ` (docs/theory.md's law; `E = -∇φ`), constant on each P1 cell.
 
 use crate::kernels::{cell_gradient, cell_strain, strain_at};
 use crate::Discretization;

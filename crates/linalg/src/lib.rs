@@ -2,7 +2,7 @@
 //! `L D Lᵀ`), preconditioned conjugate gradients, the Schur-complement operator, and the two
 //! strategies for the coupled system. It knows no finite elements: it sees matrices.
 //!
-//! # Glossary (signs fixed by DESIGN.md)
+//! # Glossary (signs fixed by docs/theory.md)
 //! - `A` (n_u x n_u, SPD), `G` (n_φ x n_u), `B` (n_φ x n_φ, SPD): the blocks of
 //!   `K = [[A, Gᵀ], [G, -B]]`, symmetric quasi-definite, with exactly `n_φ` negative pivots.
 //! - `S = A + Gᵀ B⁻¹ G`: the Schur complement of `K` onto `u` (SPD), applied by

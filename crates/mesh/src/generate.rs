@@ -5,7 +5,7 @@ use crate::{CellKind, FacetGroup, Mesh};
 use std::collections::BTreeMap;
 
 /// The rectangle `[lo, hi]` cut into `nx x ny` squares, each split along its SW-NE diagonal
-/// into the P1 triangles `(n00, n10, n11)` and `(n00, n11, n01)` (SCENES.md, `paper`).
+/// into the P1 triangles `(n00, n10, n11)` and `(n00, n11, n01)` (docs/scenes.md, `paper`).
 ///
 /// Node `(i, j)` has index `j (nx + 1) + i`. Boundary groups `left`, `right`, `bottom`, `top`
 /// hold segments ordered counter-clockwise around the rectangle; the region `body` holds every
@@ -82,7 +82,7 @@ fn rectangle(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize, kind: CellKind, c
 
 /// The box `[lo, hi]` cut into `nx x ny x nz` cubes, each split into the six Kuhn tetrahedra
 /// `(v000, v000 + e_p1, v000 + e_p1 + e_p2, v111)`, one per order `(p1, p2, p3)` of the axes
-/// (SCENES.md, `paper-3d`), stored positively oriented. The split is conforming, and every
+/// (docs/scenes.md, `paper-3d`), stored positively oriented. The split is conforming, and every
 /// face is cut along the diagonal joining its lowest and highest corners (SW-NE).
 ///
 /// Node `(i, j, k)` has index `(k (ny + 1) + j)(nx + 1) + i`. Boundary groups: `left`/`right`

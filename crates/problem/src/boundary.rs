@@ -86,7 +86,7 @@ fn direction(d: &[f64; 3], fixed: &[bool], dim: usize) -> Direction {
 }
 
 /// `t1` = the first axis made orthogonal to `n`; in 3D `t2 = t1 x n` (so that n = -z gives
-/// t1 = x, t2 = y, as SCENES.md fixes).
+/// t1 = x, t2 = y, as docs/scenes.md fixes).
 fn tangent_basis(dim: usize, n: [f64; 3]) -> [[f64; 3]; 2] {
     if dim == 2 {
         return [[-n[1], n[0], 0.0], [0.0; 3]];

@@ -1,4 +1,4 @@
-//! A scene's known solution (its `[exact]` section; SCENES.md section 6) and the errors a run
+//! A scene's known solution (its `[exact]` section; docs/scenes.md section 6) and the errors a run
 //! reports against it: the fields of a manufactured or affine solution (energy and L2 norms),
 //! and the contact tractions of Hertz and Cattaneo-Mindlin (profile errors, the contact and
 //! stick zones). The formulas of the contact solutions are in [`crate::analytical`].

@@ -5,7 +5,7 @@
 //! and every choice in it is an enum. The `piezocontact` application (`driver`) reads scene
 //! files, writes outputs and draws pictures on top of it.
 //!
-//! # Glossary (signs fixed by DESIGN.md)
+//! # Glossary (signs fixed by docs/theory.md)
 //! - scene ([`Scene`]): what to solve (mesh, materials, Dirichlet data, load, electrode,
 //!   contact, solver, exact solution); checked by [`Scene::validate`].
 //! - plan ([`Plan`]): what a run computes, decided before computing (electric unknowns or

@@ -1,6 +1,6 @@
 //! The report of a run as a typed value ([`RunReport`]): what `run.json` holds, field for
 //! field (serde writes it; the application writes the file). Its sections are the ones
-//! DESIGN.md lists: the scene, the plan, sizes, contact counts and forces, iterations,
+//! docs/theory.md lists: the scene, the plan, sizes, contact counts and forces, iterations,
 //! residuals, timings, memory, and the solver's own parameters.
 
 use crate::exact::ExactReport;
@@ -549,7 +549,7 @@ impl Iterations {
 pub struct Residuals {
     /// `‖K x - b‖ / ‖b‖` with the contact forces in `b`.
     pub equilibrium: f64,
-    /// The natural-map residual of DESIGN.md (0 without contact).
+    /// The natural-map residual of docs/theory.md (0 without contact).
     pub complementarity: f64,
     /// Whether the run stopped on its tolerance (the tight rule), not on the paper's loose rule.
     pub converged_to_tolerance: bool,

@@ -26,6 +26,99 @@ pub struct Scene {
     pub(crate) mesh: Option<Arc<mesh::Mesh>>,
 }
 
+/// The nodes of `set_mesh`'s `points` as `[x, y, z]` rows and the mesh's dimension (after the
+/// memory check, which reads the size of `cells` too).
+fn points_of(py: Python<'_>, points: &Bound<'_, PyAny>, cells: &Bound<'_, PyAny>) -> PyResult<(Vec<[f64; 3]>, usize)> {
+    let np = py.import("numpy")?;
+    let raw = np
+        .call_method1("asarray", (points,))
+        .map_err(|e| Kind::Mesh.err(format!("mesh arrays: points are not an array of numbers ({e})")))?;
+    let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "f" | "i" | "u") && raw.getattr("size")?.extract::<usize>()? > 0 {
+        // a complex array would lose its imaginary parts to the cast with a mere warning
+        return Err(Kind::Mesh.err(format!(
+            "mesh arrays: points must hold real numbers, not {}",
+            raw.getattr("dtype")?.str()?
+        )));
+    }
+    let points = np
+        .call_method1("ascontiguousarray", (raw, "float64"))
+        .map_err(|e| Kind::Mesh.err(format!("mesh arrays: points are not an array of numbers ({e})")))?;
+    let points: PyReadonlyArray2<'_, f64> = points
+        .extract()
+        .map_err(|_| Kind::Mesh.err("mesh arrays: points must be a 2-D array, (n, 2) or (n, 3)"))?;
+    let columns = points.shape()[1];
+    if !(columns == 2 || columns == 3) {
+        return Err(Kind::Mesh.err(format!(
+            "mesh arrays: points have {columns} columns: (n, 2) in 2D, (n, 3) in 3D"
+        )));
+    }
+    // the cells' size, from NumPy's own shape, before any array is copied
+    let cell_array = np.call_method1("asarray", (cells,))?;
+    let shape: Vec<usize> = cell_array.getattr("shape")?.extract().unwrap_or_default();
+    if let [rows, width] = shape[..] {
+        check_mesh_memory(points.shape()[0], rows.saturating_mul(width), width, columns)?;
+    }
+    let mut xyz = vec![[0.0; 3]; points.shape()[0]];
+    for (p, row) in xyz.iter_mut().zip(points.as_array().rows()) {
+        for (k, x) in row.iter().enumerate() {
+            p[k] = *x;
+        }
+    }
+    // (n, 3) points in one plane z = const are a 2D mesh, as meshio gives a 2D Gmsh mesh
+    // (the Gmsh reader's rule); the plane is put at z = 0
+    let planar = columns == 3 && xyz.windows(2).all(|w| w[0][2] == w[1][2]);
+    let dim = if planar { 2 } else { columns };
+    if planar {
+        xyz.iter_mut().for_each(|p| p[2] = 0.0);
+    }
+    Ok((xyz, dim))
+}
+
+/// The scene's tree with its `[mesh]` table made `kind = "given"`: the arrays replace how the
+/// mesh was made, and only that; what the table says of the body (`axisymmetric`, `revolve`)
+/// stays.
+fn given_mesh_table(mut tree: toml::Table) -> toml::Table {
+    let mut spec = match tree.remove("mesh") {
+        Some(toml::Value::Table(t)) => t,
+        _ => toml::Table::new(),
+    };
+    for key in MAKING_KEYS {
+        spec.remove(key);
+    }
+    spec.insert("kind".into(), toml::Value::String("given".into()));
+    tree.insert("mesh".into(), toml::Value::Table(spec));
+    tree
+}
+
+/// The `[mesh]` keys that say how a mesh is made (a generator's box and sizes, a file): the
+/// ones a mesh given as arrays replaces.
+const MAKING_KEYS: [&str; 13] = [
+    "kind", "lo", "hi", "n", "nx", "ny", "nz", "h", "file", "smoke_n", "region", "grading", "cylinder",
+];
+
+/// Refuses a mesh whose arrays this process cannot hold and check, before any of them is
+/// copied: the nodes (3 doubles each, twice: the copy and the mesh), the cells' indices
+/// (`entries`, 8 bytes each, twice) and the topology check's facets (each cell's facets, their
+/// sorted nodes and owner: `(dim + 2)` words per facet, `dim + 1` facets per simplex), against
+/// what `files::memory::available` finds (the machine, `ulimit`, a cgroup). A mesh of 1e8
+/// points aborted at an allocation.
+fn check_mesh_memory(n_points: usize, entries: usize, nodes_per_cell: usize, dim: usize) -> PyResult<()> {
+    let cells = entries.checked_div(nodes_per_cell).unwrap_or(0) as f64;
+    let need = 2.0 * 24.0 * n_points as f64
+        + 2.0 * 8.0 * entries as f64
+        + cells * nodes_per_cell as f64 * (dim + 2) as f64 * 8.0;
+    match files::memory::available() {
+        Some(a) if need > a.bytes as f64 => Err(Kind::Solver.err(format!(
+            "mesh arrays: a mesh of {n_points} points and {cells} cells needs about {:.1} GB to hold and check, and {} leaves {:.1} GB",
+            need / 1e9,
+            a.limit,
+            a.bytes as f64 / 1e9
+        ))),
+        _ => Ok(()),
+    }
+}
+
 fn here() -> PathBuf {
     std::env::current_dir().unwrap_or_default()
 }
@@ -62,7 +155,30 @@ fn changes(
             flatten(&name.extract::<String>()?.replace("__", "."), &v, &mut out)?;
         }
     }
+    refuse_overlaps(&out)?;
     Ok(out)
+}
+
+/// One call names each key once: a key given twice (by a dict and by a keyword, `mesh.n` and
+/// `mesh__n`), or a key and a table that holds it (`mesh` and `mesh.n`), would keep one of
+/// them silently.
+fn refuse_overlaps(changes: &[(String, Option<toml::Value>)]) -> PyResult<()> {
+    for (k, (a, _)) in changes.iter().enumerate() {
+        for (b, _) in &changes[..k] {
+            let within = |outer: &str, inner: &str| inner.strip_prefix(outer).is_some_and(|rest| rest.starts_with('.'));
+            if a == b || within(a, b) || within(b, a) {
+                let what = if a == b {
+                    format!("`{a}` is given twice")
+                } else {
+                    format!("`{b}` and `{a}` both change `{}`", if within(a, b) { a } else { b })
+                };
+                return Err(Kind::Input.err(format!(
+                    "set(): {what} in one call (a dict and a keyword, or a table and one of its keys); give each key once"
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A keyword section: a dict is merged key by key (nested dicts too), anything else set whole.
@@ -238,7 +354,9 @@ impl Scene {
     /// triangles in 3D) for the conditions' groups; `regions` a dict of named cell-index
     /// arrays for the materials (default: all cells in `"body"`). Cells numbered clockwise
     /// (2D) or negatively (3D) throughout are turned round. The mesh is checked as a file's
-    /// is (`MeshError`).
+    /// is (`MeshError`). The arrays replace only how the mesh was made: the `[mesh]` keys that
+    /// describe the body (`axisymmetric`, `revolve`) stay. A mesh too large for the memory
+    /// left is refused before it is copied (`SolverError`, naming the limit).
     #[pyo3(signature = (points, cells, boundary, regions = None))]
     fn set_mesh(
         &mut self,
@@ -248,43 +366,7 @@ impl Scene {
         boundary: &Bound<'_, PyAny>,
         regions: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let np = py.import("numpy")?;
-        let raw = np
-            .call_method1("asarray", (points,))
-            .map_err(|e| Kind::Mesh.err(format!("mesh arrays: points are not an array of numbers ({e})")))?;
-        let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
-        if !matches!(kind.as_str(), "f" | "i" | "u") && raw.getattr("size")?.extract::<usize>()? > 0 {
-            // a complex array would lose its imaginary parts to the cast with a mere warning
-            return Err(Kind::Mesh.err(format!(
-                "mesh arrays: points must hold real numbers, not {}",
-                raw.getattr("dtype")?.str()?
-            )));
-        }
-        let points = np
-            .call_method1("ascontiguousarray", (raw, "float64"))
-            .map_err(|e| Kind::Mesh.err(format!("mesh arrays: points are not an array of numbers ({e})")))?;
-        let points: PyReadonlyArray2<'_, f64> = points
-            .extract()
-            .map_err(|_| Kind::Mesh.err("mesh arrays: points must be a 2-D array, (n, 2) or (n, 3)"))?;
-        let columns = points.shape()[1];
-        if !(columns == 2 || columns == 3) {
-            return Err(Kind::Mesh.err(format!(
-                "mesh arrays: points have {columns} columns: (n, 2) in 2D, (n, 3) in 3D"
-            )));
-        }
-        let mut xyz = vec![[0.0; 3]; points.shape()[0]];
-        for (p, row) in xyz.iter_mut().zip(points.as_array().rows()) {
-            for (k, x) in row.iter().enumerate() {
-                p[k] = *x;
-            }
-        }
-        // (n, 3) points in one plane z = const are a 2D mesh, as meshio gives a 2D Gmsh mesh
-        // (the Gmsh reader's rule); the plane is put at z = 0
-        let planar = columns == 3 && xyz.windows(2).all(|w| w[0][2] == w[1][2]);
-        let dim = if planar { 2 } else { columns };
-        if planar {
-            xyz.iter_mut().for_each(|p| p[2] = 0.0);
-        }
+        let (xyz, dim) = points_of(py, points, cells)?;
         let (flat, nodes_per_cell) = indices(py, cells, "cells")?;
         let mut boundaries = BTreeMap::new();
         let boundary = boundary
@@ -331,10 +413,7 @@ impl Scene {
             regions: region_map,
         };
         let mesh = py.detach(|| mesh::Mesh::from_parts(parts)).map_err(mesh_err)?;
-        let mut tree = self.tree.clone();
-        let mut spec = toml::Table::new();
-        spec.insert("kind".into(), toml::Value::String("given".into()));
-        tree.insert("mesh".into(), toml::Value::Table(spec));
+        let tree = given_mesh_table(self.tree.clone());
         *self = Self::of(tree, self.source.clone(), vec![], Some(Arc::new(mesh)))?;
         Ok(())
     }

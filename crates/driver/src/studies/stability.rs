@@ -1,4 +1,4 @@
-//! The stability study (`piezocontact stability`): the stiff and extreme cases of SCENES.md
+//! The stability study (`piezocontact stability`): the stiff and extreme cases of docs/scenes.md
 //! section 5, each run in its own process (so that its peak memory is its own, and a failure
 //! cannot take the study down), with the default strategy and, on the cases up to n = 128, the
 //! paper's Uzawa + Schur PCG. Every case either converges (the residuals of its `run.json`
@@ -89,7 +89,7 @@ macro_rules! floating_top {
 const FLOATING_TOP_SETS: [&str; 9] = floating_top!("0.05");
 const FLOODED_TOP_SETS: [&str; 9] = floating_top!("1e6");
 
-/// The cases of SCENES.md section 5 (bad input has its own corpus, `tests/bad-input`).
+/// The cases of docs/scenes.md section 5 (bad input has its own corpus, `tests/bad-input`).
 pub const CASES: &[Case] = &[
     Case {
         name: "coupling x10",

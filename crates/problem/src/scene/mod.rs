@@ -1511,7 +1511,7 @@ impl Default for SolverSpec {
     }
 }
 
-/// The exact solution a scene can be checked against (SCENES.md section 6).
+/// The exact solution a scene can be checked against (docs/scenes.md section 6).
 ///
 /// - `manufactured`: the smooth coupled solution of `fe_assembly::Exact::manufactured`,
 ///   prescribed on `groups` (default: every side of the generated mesh), with the body force

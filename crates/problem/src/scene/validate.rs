@@ -201,16 +201,6 @@ impl Scene {
                 format!("mesh.axisymmetric: a body of revolution is meshed in its 2D meridian plane, and the mesh is {dim}D"),
             ));
         }
-        let len = |key: &str, v: &[f64], n: usize| {
-            if v.len() == n {
-                Ok(())
-            } else {
-                Err(SceneError::new(
-                    key,
-                    format!("{key} needs {n} components, not {}", v.len()),
-                ))
-            }
-        };
         for d in &self.dirichlet {
             if let Some(u) = &d.u {
                 len("dirichlet.u", u, dim).map_err(|e| on_group(e, &d.group))?;
@@ -236,42 +226,7 @@ impl Scene {
             "a displacement along z, and the mesh is 2D (plane strain: u = (ux, uy))",
         )?;
         for c in self.contacts() {
-            len("contact.normal", &c.normal, dim)?;
-            if let Some(g) = &c.gap_center {
-                len("contact.gap_center", g, dim)?;
-            }
-            if let Some(i) = &c.indenter {
-                if let Some(tip) = &i.tip {
-                    len("contact.indenter.tip", tip, dim)?;
-                }
-                if let Some(axis) = &i.axis {
-                    len("contact.indenter.axis", axis, dim)?;
-                    refuse_if(
-                        dim != 3,
-                        "contact.indenter.axis",
-                        "a 3D cylinder's axis, and the mesh is 2D (the plane-strain cylinder needs none)",
-                    )?;
-                    // a cylinder lies on the face: its axis in the face's plane (an axis along
-                    // the normal would leave the distance across it that of a sphere)
-                    let (a, n) = (mesh::scaled_norm(axis), mesh::scaled_norm(&c.normal));
-                    let cos: f64 = axis.iter().zip(&c.normal).map(|(x, y)| (x / a) * (y / n)).sum();
-                    if cos.abs() > 1e-9 {
-                        return Err(SceneError::new(
-                            "contact.indenter.axis",
-                            format!(
-                                "contact.indenter.axis = {axis:?} is not in the contact face's plane (its angle with contact.normal = {:?} is {:.6}°): a cylinder lies on the face, its axis perpendicular to the normal",
-                                c.normal,
-                                cos.clamp(-1.0, 1.0).acos().to_degrees()
-                            ),
-                        ));
-                    }
-                } else if i.shape == IndenterShape::Cylinder && dim == 3 {
-                    return Err(SceneError::new(
-                        "contact.indenter.axis",
-                        "contact.indenter.shape = \"cylinder\" in 3D needs contact.indenter.axis (a direction in the contact face's plane)",
-                    ));
-                }
-            }
+            check_contact_dimension(c, dim)?;
         }
         if let Some(g) = self.mesh.grading.as_ref().map(|g| g.ratios()) {
             if g.len() != 1 && g.len() != dim {
@@ -297,6 +252,60 @@ impl Scene {
             None => Ok(()),
         }
     }
+}
+
+/// `key`'s vector `v` has `n` components.
+fn len(key: &str, v: &[f64], n: usize) -> Result<(), SceneError> {
+    if v.len() == n {
+        Ok(())
+    } else {
+        Err(SceneError::new(
+            key,
+            format!("{key} needs {n} components, not {}", v.len()),
+        ))
+    }
+}
+
+/// The lengths of a contact entry's vectors in dimension `dim`, and a cylinder's axis: in 3D,
+/// given and in the contact face's plane.
+fn check_contact_dimension(c: &ContactSpec, dim: usize) -> Result<(), SceneError> {
+    len("contact.normal", &c.normal, dim)?;
+    if let Some(g) = &c.gap_center {
+        len("contact.gap_center", g, dim)?;
+    }
+    if let Some(i) = &c.indenter {
+        if let Some(tip) = &i.tip {
+            len("contact.indenter.tip", tip, dim)?;
+        }
+        if let Some(axis) = &i.axis {
+            len("contact.indenter.axis", axis, dim)?;
+            refuse_if(
+                dim != 3,
+                "contact.indenter.axis",
+                "a 3D cylinder's axis, and the mesh is 2D (the plane-strain cylinder needs none)",
+            )?;
+            // a cylinder lies on the face: its axis in the face's plane (an axis along
+            // the normal would leave the distance across it that of a sphere)
+            let (a, n) = (mesh::scaled_norm(axis), mesh::scaled_norm(&c.normal));
+            let cos: f64 = axis.iter().zip(&c.normal).map(|(x, y)| (x / a) * (y / n)).sum();
+            if cos.abs() > 1e-9 {
+                return Err(SceneError::new(
+                        "contact.indenter.axis",
+                        format!(
+                            "contact.indenter.axis = {axis:?} is not in the contact face's plane (its angle with contact.normal = {:?} is {:.6}°): a cylinder lies on the face, its axis perpendicular to the normal",
+                            c.normal,
+                            cos.clamp(-1.0, 1.0).acos().to_degrees()
+                        ),
+                    ));
+            }
+        } else if i.shape == IndenterShape::Cylinder && dim == 3 {
+            return Err(SceneError::new(
+                    "contact.indenter.axis",
+                    "contact.indenter.shape = \"cylinder\" in 3D needs contact.indenter.axis (a direction in the contact face's plane)",
+                ));
+        }
+    }
+    Ok(())
 }
 
 /// Most steps a path may take.
