@@ -54,8 +54,11 @@ fn points_of(py: Python<'_>, points: &Bound<'_, PyAny>, cells: &Bound<'_, PyAny>
         )));
     }
     // the cells' size, from NumPy's own shape, before any array is copied
-    let cell_array = np.call_method1("asarray", (cells,))?;
-    let shape: Vec<usize> = cell_array.getattr("shape")?.extract().unwrap_or_default();
+    // (cells that are no array are refused with their own message when they are read)
+    let shape: Vec<usize> = np
+        .call_method1("shape", (cells,))
+        .and_then(|s| s.extract())
+        .unwrap_or_default();
     if let [rows, width] = shape[..] {
         check_mesh_memory(points.shape()[0], rows.saturating_mul(width), width, columns)?;
     }

@@ -12,11 +12,12 @@ from test_mesh_arrays import rectangle_groups
 
 
 def test_a_mesh_given_as_arrays_keeps_the_body_of_revolution():
-    generated = pc.run(pc.Scene.load("hertz-sphere", {"mesh.n": 16}))
+    # (Hertz's exact solution is checked on the generated rectangle only)
+    generated = pc.run(pc.Scene.load("hertz-sphere", {"mesh.n": 16, "exact": None}))
     points, cells = np.array(generated.points), np.array(generated.cells)
     groups = rectangle_groups(points, cells)
     groups["axis"] = groups["left"]
-    scene = pc.Scene.load("hertz-sphere")
+    scene = pc.Scene.load("hertz-sphere", {"exact": None})
     assert scene.get("mesh.axisymmetric") is True
     scene.set_mesh(points, cells, groups)
     # what the [mesh] table says of the body stays; how the mesh was made goes
