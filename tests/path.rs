@@ -188,6 +188,47 @@ fn what_a_path_cannot_carry_is_refused_by_key() {
     }
 }
 
+/// Every instant is judged at its own scale: after an excursion of the load to 1e30 the
+/// history leaves the next instant at load 1 round-off, and the path stops there with a typed
+/// error naming the instant (it reported a force of 768 where the static answer is 2.635 with
+/// exit 0); after an excursion to 1e4 the instant back at load 1 is the answer of the same
+/// path without it, up to the slip the excursion left (every point sticks, so none: equal).
+#[test]
+fn an_instant_after_an_excursion_is_judged_at_its_own_scale() {
+    let run = |peak: &str| {
+        let sets: Vec<String> = [
+            "mesh.n=16",
+            "path.t=[0.0, 1.0, 2.0, 3.0]",
+            &format!("path.load=[1.0, 1.0, {peak}, 1.0]"),
+            "~path.steps",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let (scene, _) = scene_file::load("paper-cycle", &sets).unwrap();
+        problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(()))
+    };
+    match run("1e30") {
+        Err(problem::ProblemError::AtStep { step: 3, source, .. }) => match *source {
+            problem::ProblemError::IllConditioned { what, .. } => {
+                assert!(what.contains("friction's history"), "{what}")
+            }
+            other => panic!("another error at step 3: {other}"),
+        },
+        Err(other) => panic!("another error: {other}"),
+        Ok(_) => panic!("the instant after the excursion was reported"),
+    }
+    let rows = run("1e4").unwrap().last.report.path.unwrap().rows;
+    let (first, last) = (&rows[1], &rows[3]);
+    assert_eq!(last.factors[0], 1.0);
+    assert!(
+        (last.normal_force - first.normal_force).abs() <= 1e-9 * first.normal_force,
+        "{} against {}",
+        last.normal_force,
+        first.normal_force
+    );
+}
+
 /// The multipliers of a path's instant `k` (every instant kept).
 fn path_lambdas(name: &str, sets: &[&str]) -> Vec<contact::PointValues> {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();

@@ -996,6 +996,18 @@ impl PathSystem {
 
     /// The contact problem's `u⁰` at a step of `factors`, in the frame `shift`: the loads'
     /// displacement at the points, before any contact force.
+    /// The largest displacement of the boundary's dofs that the instant's own data make
+    /// (`Σ_q f_q x_q` at `factors`, no contact force): the scale of the instant's answer.
+    pub(crate) fn own_scale(&self, factors: &[f64]) -> f64 {
+        let mut x0 = vec![0.0; self.parts[0].len()];
+        for (part, f) in self.parts.iter().zip(factors) {
+            for (x, p) in x0.iter_mut().zip(part) {
+                *x += f * p;
+            }
+        }
+        x0.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
     pub(crate) fn prime(&mut self, boundary: &ContactBoundary, factors: &[f64], shift: &PointValues) {
         let mut x0 = vec![0.0; self.parts[0].len()];
         for (part, f) in self.parts.iter().zip(factors) {

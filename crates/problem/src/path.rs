@@ -433,6 +433,10 @@ impl Walk<'_> {
         if let Some(contraction) = sol.info.contraction.filter(|c| *c >= 1.0) {
             reporter.event(&Event::NotContractive { contraction });
         }
+        // the instant's own displacement scale: its loads' and prescribed values', and how far
+        // its gaps press in
+        let pressed = boundary.points.gap.iter().fold(0.0f64, |m, g| m.max(-g));
+        check_history(&state.shift, path.own_scale(&factors).max(pressed), &setup.plan)?;
         let (mut sol, fields) = if with_fields {
             let posed = Posed {
                 scene: self.valid,
@@ -557,6 +561,32 @@ fn step_loads(parts: &RhsParts, f: &Factors, scene: &Scene) -> Result<Loads, Pro
     ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
     Ok(Loads { b_u, b_phi })
+}
+
+/// Whether an instant can be resolved at its own scale `own` (the displacement its
+/// own data make): friction acts on the increment `u_t - shift`, so the step's slip, and the
+/// multipliers it sets, are known to `ε |shift|` at best; where that is more than the
+/// tolerance times the instant's own displacements (after an excursion: a load factor of 1e30
+/// leaves tangential displacements of 1e12 behind, and a later instant at load 1 is round-off
+/// in them) the instant cannot meet it, however well its solve converged on its own numbers.
+/// An instant whose own data make nothing (zero load) has nothing to resolve. Under the tight
+/// rule the path stops there with [`ProblemError::IllConditioned`].
+fn check_history(shift: &PointValues, own: f64, plan: &crate::plan::Plan) -> Result<(), ProblemError> {
+    let history = shift.tangential.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if plan.rule != crate::Rule::Tight || history == 0.0 || own == 0.0 {
+        return Ok(());
+    }
+    let floor = f64::EPSILON * history / own;
+    if floor <= plan.tol {
+        return Ok(());
+    }
+    Err(ProblemError::IllConditioned {
+        what: format!(
+            "friction's history carries tangential displacements up to {history:.2e}, this instant's own data displace the contact face by {own:.2e}, so double precision resolves it to {floor:.1e} of itself at best, above solver.tol = {:e}",
+            plan.tol
+        ),
+        factors: "an earlier instant's factors far larger than this one's (an excursion of the load, voltage or displacement along the path): scale the path's factors nearer each other, or start a new path after the excursion".into(),
+    })
 }
 
 /// The row of a step: its forces (the multipliers weighted), slips and counts; its charges

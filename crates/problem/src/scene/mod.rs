@@ -460,15 +460,21 @@ impl PathSpec {
     }
 }
 
-/// The piecewise-linear interpolant of `(t, f)` at `x`, constant beyond the ends.
+/// The piecewise-linear interpolant of `(t, f)` at `x`, constant beyond the ends: the weighted
+/// mean `(1 - s) f₀ + s f₁`, exact at the instants (the form `f₀ + s (f₁ - f₀)` gave 0 for
+/// `f₁ = 1` after `f₀ = 1e30`: the difference had lost `f₁`) and finite for any finite factors.
 fn interpolate(t: &[f64], f: &[f64], x: f64) -> f64 {
     if x <= t[0] {
         return f[0];
     }
     for k in 1..t.len() {
         if x <= t[k] {
+            // an instant's own factor exactly, whatever its neighbour's magnitude
+            if x == t[k] {
+                return f[k];
+            }
             let s = (x - t[k - 1]) / (t[k] - t[k - 1]);
-            return f[k - 1] + s * (f[k] - f[k - 1]);
+            return (1.0 - s) * f[k - 1] + s * f[k];
         }
     }
     f[f.len() - 1]
@@ -1680,5 +1686,22 @@ mod tests {
         sphere.radius = Some(1e6);
         assert_eq!(sphere.height(1.0), Some(sphere_height(1e6, 1.0)));
         assert_eq!(sphere.height(2e6), None);
+    }
+
+    /// A path's factor at its instants is the factor given, whatever its neighbours (the
+    /// form `f₀ + s (f₁ - f₀)` gave 0 at the instant after 1e30), and between them finite and
+    /// between its ends.
+    #[test]
+    fn a_paths_factor_is_exact_at_its_instants() {
+        let (t, f) = ([0.0, 1.0, 2.0, 3.0], [1.0, 1.0, 1e30, 1.0]);
+        for (x, y) in t.iter().zip(&f) {
+            assert_eq!(interpolate(&t, &f, *x), *y);
+        }
+        let mid = interpolate(&t, &f, 2.5);
+        assert!((mid - 5e29).abs() <= 1e-15 * 5e29, "{mid:e}");
+        let huge = [f64::MAX, -f64::MAX];
+        assert!(interpolate(&[0.0, 1.0], &huge, 0.5).is_finite());
+        assert_eq!(interpolate(&t, &f, -1.0), 1.0);
+        assert_eq!(interpolate(&t, &f, 9.0), 1.0);
     }
 }
