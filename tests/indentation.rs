@@ -831,3 +831,41 @@ fn an_indenter_among_several_contact_groups_reports_its_own_zone() {
     );
     assert!((groups[1].normal_force - x.force).abs() < 1e-10 * x.force);
 }
+
+/// The half-space's closed form only inside its domain: where nothing touches (a depth of 0
+/// or less) the run solves (no force) and run.json says why the closed form is absent, and
+/// `[exact]` there is refused by key; where the closed form does not evaluate to a contact (a
+/// radius of 1e-300 gave a force of -4.6e210) it is absent with the reason, not reported.
+#[test]
+fn the_half_spaces_closed_form_is_reported_only_inside_its_domain() {
+    let run = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let (scene, _) = files::scene_file::load("indent-sphere", &sets)?;
+        problem::solve(&scene, None, &mut Silent).map_err(files::Error::from)
+    };
+    for (depth, electric) in [("-0.01", "insulated"), ("0.0", "insulated"), ("-0.01", "conducting")] {
+        let s = run(&[
+            "mesh.n=40",
+            "~exact",
+            &format!("contact.indenter.depth={depth}"),
+            &format!("contact.electric=\"{electric}\""),
+        ])
+        .unwrap();
+        let ind = s.report.indenter.unwrap();
+        assert_eq!((ind.force, ind.points_in_contact), (0.0, 0), "depth {depth}");
+        assert!(ind.half_space.is_none(), "depth {depth}");
+        assert!(ind.half_space_absent.unwrap().contains("nothing touches"));
+    }
+    let Err(e) = run(&["mesh.n=40", "contact.indenter.depth=-0.01"]) else {
+        panic!("[exact] where nothing touches ran")
+    };
+    let e = e.to_string();
+    assert!(e.contains("exact.kind") && e.contains("nothing touches"), "{e}");
+    let s = run(&["mesh.n=40", "~exact", "contact.indenter.radius=1e-300"]).unwrap();
+    let ind = s.report.indenter.unwrap();
+    assert!(ind.half_space.is_none());
+    assert!(ind.half_space_absent.unwrap().contains("does not evaluate"));
+    // inside the domain it is there, and nothing says it is absent
+    let ind = run(&["mesh.n=40"]).unwrap().report.indenter.unwrap();
+    assert!(ind.half_space.is_some() && ind.half_space_absent.is_none());
+}

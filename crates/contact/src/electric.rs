@@ -167,6 +167,8 @@ impl ElectricValues {
             .zip(&self.flux)
             .map(|(&i, q)| weight[i] * q)
             .sum::<f64>()
+            // no charge reads 0, not -0
+            + 0.0
     }
 }
 

@@ -358,15 +358,39 @@ pub fn contact_errors(
 }
 
 /// The half-space closed form of `problem::HalfSpace` for the scene's indenter, and the run's
-/// errors against it (`indenter.half_space`); `None` where [`Scene::half_space_problem`] refuses.
-pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Option<HalfSpaceReport> {
+/// errors against it (`indenter.half_space`); `Err` with the reason where it does not apply
+/// ([`Scene::half_space_problem`] refuses the scene) or lies outside its domain: nothing
+/// touches (the run's or the closed form's force 0: no relative error exists), or the closed
+/// form does not evaluate to a finite contact at these data (a radius of 1e-300 gave a force of
+/// -4.6e210).
+pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Result<HalfSpaceReport, String> {
     use crate::halfspace::Tip;
-    let (body, profile, tip) = scene.half_space_problem(electric).ok()?;
-    let force = scene.first_contact()?.indenter.as_ref()?.force;
+    let (body, profile, tip) = scene.half_space_problem(electric)?;
+    let force = scene
+        .first_contact()
+        .and_then(|c| c.indenter.as_ref())
+        .ok_or("the scene has no indenter")?
+        .force;
+    if !(run.force > 0.0) {
+        return Err("nothing touches: the indenter carries no force".into());
+    }
     let form = match force {
         Some(f) => body.at_force(&profile, f, tip),
         None => body.at_depth(&profile, run.depth, tip),
     };
+    let numbers = [form.depth, form.force, form.contact_radius];
+    if !numbers
+        .iter()
+        .chain(&form.potential)
+        .chain(&form.charge)
+        .all(|v| v.is_finite())
+        || !(form.force > 0.0 && form.contact_radius > 0.0)
+    {
+        return Err(format!(
+            "the closed form does not evaluate to a contact at these data (depth {:e}, force {:e}, contact radius {:e}): the indenter's dimensions are outside what double precision resolves",
+            form.depth, form.force, form.contact_radius
+        ));
+    }
     let rel = |h: f64, exact: f64| (h - exact).abs() / exact.abs();
     let (error, error_name) = match force {
         Some(_) => (
@@ -385,7 +409,7 @@ pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Optio
         Tip::Insulating => run.tip_potential.zip(form.potential).map(|(h, p)| rel(h, p)),
         Tip::Floating { .. } => run.potential.zip(form.potential).map(|(h, p)| rel(h, p)),
     };
-    Some(HalfSpaceReport {
+    Ok(HalfSpaceReport {
         depth: form.depth,
         force: form.force,
         contact_radius: form.contact_radius,

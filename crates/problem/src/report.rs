@@ -84,6 +84,10 @@ pub struct IndenterReport {
     /// by its size effect).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub half_space: Option<HalfSpaceReport>,
+    /// Where the half-space's closed form applies to the scene but not to this run's data
+    /// (nothing touches; dimensions double precision does not resolve): why it is absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_space_absent: Option<String>,
 }
 
 /// A boundary group at a prescribed potential (`run.json`'s `terminals`).

@@ -397,7 +397,12 @@ pub(crate) fn recover(
             charge: r.charge,
             tip_potential: r.tip_potential,
         };
-        r.half_space = crate::exact::half_space(scene, setup.plan.electric, &measured);
+        match crate::exact::half_space(scene, setup.plan.electric, &measured) {
+            Ok(h) => r.half_space = Some(h),
+            // said where the closed form would be; a scene it does not apply to says nothing
+            Err(why) if scene.half_space_problem(setup.plan.electric).is_ok() => r.half_space_absent = Some(why),
+            Err(_) => {}
+        }
         Some(r)
     });
     let half_space = scene
@@ -409,9 +414,13 @@ pub(crate) fn recover(
         // the half-space's closed form, reported with the indenter's figures
         (None, Some(_)) if half_space => {
             let h = indenter.as_ref().and_then(|i| i.half_space.clone()).ok_or_else(|| {
+                let why = indenter.as_ref().and_then(|i| i.half_space_absent.clone());
                 ProblemError::Scene(crate::scene::SceneError::new(
                     "exact.kind",
-                    "exact.kind `half-space`: the run's indenter has no closed form",
+                    format!(
+                        "exact.kind `half-space`: the run's indenter has no closed form: {}",
+                        why.unwrap_or_else(|| "it does not apply".into())
+                    ),
                 ))
             })?;
             Some(crate::exact::ExactReport::HalfSpace(Box::new(h)))
@@ -477,6 +486,7 @@ pub(crate) fn indenter_report(
         charge: sol.electric.as_ref().map(|e| e.charge(&points.weight)),
         tip_potential: None,
         half_space: None,
+        half_space_absent: None,
     })
 }
 
