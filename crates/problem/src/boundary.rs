@@ -684,9 +684,27 @@ fn electric_points(
             )
             .into());
         }
-        if let Dof::Free(j) = dofs.phi[node] {
-            points.push(i);
-            phi.push(dofs.n_u + j);
+        match dofs.phi[node] {
+            Dof::Free(j) => {
+                points.push(i);
+                phi.push(dofs.n_u + j);
+            }
+            // an ideal conductor touching a terminal at another potential: a short circuit
+            // between two prescribed potentials, which no contact state satisfies
+            Dof::Fixed(v)
+                if matches!(law, contact::ElectricLaw::Conducting) && (spec.charge.is_some() || v != potential) =>
+            {
+                let foundation = match spec.charge {
+                    Some(_) => "a floating foundation (contact.charge), which would take it".to_string(),
+                    None => format!("the foundation at contact.foundation_potential = {potential:e}"),
+                };
+                return Err(SceneError::new(
+                    "contact.electric",
+                    format!("a contact point of `{}` lies on a terminal at the potential {v:e}, and contact.electric = \"conducting\" joins it to {foundation}: two conductors at two potentials would touch; give them one potential, use contact.electric = \"conductive\" (a finite conductance), or keep the terminal off the contact face", spec.group),
+                )
+                .into());
+            }
+            _ => {}
         }
     }
     let contact = contact::ElectricContact { law, potential, points };

@@ -434,6 +434,8 @@ pub(crate) fn force_controlled(
     let base = points.gap.clone();
     let size = face_size(points);
     let mut last: Option<PointValues> = start;
+    // the largest force carried so far (`f - force` loses `f` when the force asked is huge)
+    let most = std::cell::Cell::new(0.0f64);
     let mut eval = |s: f64, points: &mut ContactPoints| -> Result<(f64, ContactSolution), ProblemError> {
         for (g, b) in points.gap.iter_mut().zip(&base) {
             *g = b - s;
@@ -447,6 +449,7 @@ pub(crate) fn force_controlled(
             .zip(&points.weight)
             .map(|(l, w)| l * w)
             .sum::<f64>();
+        most.set(most.get().max(f));
         Ok((f - force, sol))
     };
     let close = |r: f64| r.abs() <= FORCE_TOL * force;
@@ -479,7 +482,10 @@ pub(crate) fn force_controlled(
         if step > 1e6 * size {
             return Err(SceneError::new(
                 "contact.indenter.force",
-                format!("no depth within a million face sizes carries contact.indenter.force = {force:e} (the body carries {:e} at most there)", fb + force),
+                format!(
+                    "no depth within a million face sizes carries contact.indenter.force = {force:e} (the body carries {:e} at most there)",
+                    most.get()
+                ),
             )
             .into());
         }

@@ -111,9 +111,11 @@ impl Plan {
                 .first_contact()
                 .filter(|_| law != ContactLaw::None)
                 .and_then(|c| c.compliance),
+            // a weakening law from a static coefficient of 0 is frictionless (its dynamic one,
+            // at most the static, is 0 too): no tangential multipliers for it to act on
             weakening: scene
                 .first_contact()
-                .filter(|_| law == ContactLaw::Coulomb)
+                .filter(|_| law == ContactLaw::Coulomb && friction)
                 .and_then(|c| c.slip_weakening()),
             tol: scene.solver.tol,
             pcg_tol: scene.solver.pcg_tol.unwrap_or(match scene.solver.rule {

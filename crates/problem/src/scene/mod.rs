@@ -417,10 +417,12 @@ impl PathSpec {
         }
         (0..=n)
             .map(|k| {
+                // the weighted mean: finite for any finite ends (their difference may overflow)
+                let s = k as f64 / n as f64;
                 if k == n {
                     t1
                 } else {
-                    t0 + (t1 - t0) * k as f64 / n as f64
+                    (1.0 - s) * t0 + s * t1
                 }
             })
             .collect()
@@ -473,7 +475,8 @@ fn interpolate(t: &[f64], f: &[f64], x: f64) -> f64 {
             if x == t[k] {
                 return f[k];
             }
-            let s = (x - t[k - 1]) / (t[k] - t[k - 1]);
+            // halves: the differences of instants near the largest double would overflow
+            let s = (x / 2.0 - t[k - 1] / 2.0) / (t[k] / 2.0 - t[k - 1] / 2.0);
             return (1.0 - s) * f[k - 1] + s * f[k];
         }
     }
@@ -1703,5 +1706,22 @@ mod tests {
         assert!(interpolate(&[0.0, 1.0], &huge, 0.5).is_finite());
         assert_eq!(interpolate(&t, &f, -1.0), 1.0);
         assert_eq!(interpolate(&t, &f, 9.0), 1.0);
+        // instants near the largest double: their difference overflows, the mean does not
+        let wide = [-1.7e308, 1.7e308];
+        assert_eq!(interpolate(&wide, &[0.0, 1.0], 0.0), 0.5);
+        let path = PathSpec {
+            t: wide.to_vec(),
+            load: Some(vec![0.0, 1.0]),
+            steps: Some(4),
+            ..Default::default()
+        };
+        let instants = path.instants();
+        for (x, y) in instants.iter().zip([-1.7e308, -0.85e308, 0.0, 0.85e308, 1.7e308]) {
+            assert!((x - y).abs() <= 1e-15 * 1.7e308, "{x:e} against {y:e}");
+        }
+        for (x, y) in instants.iter().zip([0.0, 0.25, 0.5, 0.75, 1.0]) {
+            let load = path.factors(*x).load;
+            assert!((load - y).abs() <= 1e-15, "{load} against {y}");
+        }
     }
 }
