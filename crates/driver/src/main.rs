@@ -260,6 +260,7 @@ fn contact_bar() -> indicatif::ProgressBar {
 
 fn main() -> ExitCode {
     files::memory::bound_heaps_under_an_address_space_limit();
+    on_signals();
     let cli = Cli::parse();
     let command = cli.command.unwrap_or(Command::Run {
         scene: None,
@@ -273,6 +274,34 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+/// What a signal does to a run. SIGINT, SIGTERM and SIGHUP end it at once (their usual exit
+/// status, 128 + the signal), the output sets it was writing removed (the directory keeps its
+/// previous set); SIGXFSZ is not left to kill it (exit 153 with no word): a write past the
+/// file-size limit (`ulimit -f`) fails, and the run stops with an output error naming the limit.
+fn on_signals() {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM, SIGXFSZ};
+        let ignored = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        if let Err(e) = signal_hook::flag::register(SIGXFSZ, ignored) {
+            eprintln!("warning: SIGXFSZ keeps its default action ({e}): a file past `ulimit -f` ends the run");
+        }
+        match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+            Ok(mut signals) => {
+                std::thread::spawn(move || {
+                    if let Some(signal) = signals.forever().next() {
+                        eprintln!("\nstopped by signal {signal}: the partial output set is removed");
+                        files::output::abandon_and_exit(128 + signal);
+                    }
+                });
+            }
+            Err(e) => {
+                eprintln!("warning: no handler for SIGINT and SIGTERM ({e}): a stopped run may leave a partial set")
+            }
         }
     }
 }

@@ -6,7 +6,7 @@
 mod set;
 mod vtu;
 
-pub use set::{Outputs, SetWriter};
+pub use set::{abandon_and_exit, Outputs, SetWriter};
 
 use crate::plots::{self, Mark, Panel, Series};
 use crate::Error;

@@ -273,10 +273,35 @@ fn check_name(dir: &Path, name: &str) -> Result<(), Error> {
 }
 
 fn io(what: &str, p: &Path, e: std::io::Error) -> Error {
+    // EFBIG: a write past the file-size limit (the driver ignores SIGXFSZ, so it fails here)
+    let limit = if e.kind() == std::io::ErrorKind::FileTooLarge {
+        " (the file-size limit, ulimit -f, is smaller than the file: raise it, or write fewer or smaller files, e.g. path.output_every)"
+    } else {
+        ""
+    };
     Error::Output {
-        what: format!("{what} {}", p.display()),
+        what: format!("{what} {}{limit}", p.display()),
         source: e,
     }
+}
+
+/// The sets being written in this process (their directories under `.piezocontact/`), so that
+/// a run stopped by a signal removes them on its way out.
+static STAGING: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn staging() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    STAGING.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Removes the sets this process was writing and ends it with `code`, the registry held to
+/// the end so that no set is begun after it (the driver calls it on SIGINT, SIGTERM, SIGHUP: a
+/// stopped run leaves no partial set behind, and the previous set stays the directory's).
+pub fn abandon_and_exit(code: i32) -> ! {
+    let mut sets = staging();
+    for set in sets.drain(..) {
+        let _ = std::fs::remove_dir_all(set);
+    }
+    std::process::exit(code)
 }
 
 fn conflict(p: &Path, why: &str) -> Error {
@@ -288,7 +313,7 @@ fn conflict(p: &Path, why: &str) -> Error {
 
 #[cfg(unix)]
 mod unix {
-    use super::{conflict, io, CURRENT, HIDDEN, LEGACY_MANIFEST, LOCK, README, README_TEXT};
+    use super::{conflict, io, staging, CURRENT, HIDDEN, LEGACY_MANIFEST, LOCK, README, README_TEXT};
     use crate::Error;
     use std::os::unix::fs::symlink;
     use std::path::{Path, PathBuf};
@@ -486,7 +511,15 @@ mod unix {
             write_readme(&hidden).map_err(undo)?;
             adopt_legacy(dir, &hidden).map_err(undo)?;
             let set = fresh(&hidden, "set");
-            std::fs::create_dir(&set).map_err(|e| undo(io("cannot create", &set, e)))?;
+            {
+                // registered before it exists, under the registry's lock (see abandon_and_exit)
+                let mut sets = staging();
+                sets.push(set.clone());
+                std::fs::create_dir(&set).map_err(|e| {
+                    sets.retain(|s| s != &set);
+                    undo(io("cannot create", &set, e))
+                })?;
+            }
             Ok(Writer {
                 dir: dir.to_path_buf(),
                 hidden,
@@ -555,6 +588,7 @@ mod unix {
 
     impl Drop for Writer {
         fn drop(&mut self) {
+            staging().retain(|s| s != &self.set);
             if self.done {
                 return;
             }
