@@ -138,8 +138,15 @@ fn vtu(
         values: Values::F64(values),
     };
     let mut point = vec![array("u", 3, &u), array("phi", 1, phi)];
-    if let Some(status) = &status {
+    let on_face = contact.map(|c| contact_point_data(c, mesh.n_nodes()));
+    if let (Some(status), Some(data)) = (&status, &on_face) {
         point.push(array("contact_status", 1, status));
+        point.push(array("contact_pressure", 1, &data.pressure));
+        point.push(array("contact_traction", 3, &data.traction));
+        point.push(array("contact_gap", 1, &data.gap));
+        if let Some(flux) = &data.flux {
+            point.push(array("contact_flux", 1, flux));
+        }
     }
     let cell = vec![
         array("stress", nv, &fields.stress),
@@ -155,6 +162,42 @@ fn vtu(
         point,
         cell,
     }))
+}
+
+/// The contact values as point data of the mesh's nodes (0 off the contact face, where
+/// `contact_status` is 0): the pressure `λ_n`, the tangential traction `Σ_k λ_t,k t_k` in the
+/// global frame (3 components), the initial gap, and with electrical contact the flux `D·ν`.
+struct ContactPointData {
+    pressure: Vec<f64>,
+    traction: Vec<f64>,
+    gap: Vec<f64>,
+    flux: Option<Vec<f64>>,
+}
+
+fn contact_point_data(c: &ContactResult, n_nodes: usize) -> ContactPointData {
+    let (p, s) = (&c.points, &c.solution);
+    let nt = s.lambda.n_tangential();
+    let mut out = ContactPointData {
+        pressure: vec![0.0; n_nodes],
+        traction: vec![0.0; 3 * n_nodes],
+        gap: vec![0.0; n_nodes],
+        flux: s.electric.as_ref().map(|_| vec![0.0; n_nodes]),
+    };
+    for (i, &node) in c.nodes.iter().enumerate() {
+        out.pressure[node] = s.lambda.normal[i];
+        out.gap[node] = p.gap[i];
+        for q in 0..nt {
+            for k in 0..3 {
+                out.traction[3 * node + k] += s.lambda.tangential[i * nt + q] * p.tangent[i][q][k];
+            }
+        }
+    }
+    if let (Some(flux), Some(e)) = (&mut out.flux, &s.electric) {
+        for (&i, q) in e.points.iter().zip(&e.flux) {
+            flux[c.nodes[i]] = *q;
+        }
+    }
+    out
 }
 
 /// A body of revolution's solution swept round its axis (y) in `segments` steps: each meridian
@@ -618,6 +661,58 @@ mod tests {
         fields.push(field);
         assert_eq!(fields, names);
         assert_eq!(csv_field("plain"), "plain");
+    }
+
+    /// The contact values in every ParaView file (the solution's and a path's steps): the
+    /// pressure and the tangential traction of each contact node read back as the solution's
+    /// multipliers (the traction along the paper's tangent x), their weighted sum the normal
+    /// force, and 0 off the contact face.
+    #[test]
+    fn the_contact_values_are_point_data_of_the_solution() {
+        let (scene, _) = crate::scene_file::load("paper-slip", &["mesh.n=8".to_string()]).unwrap();
+        let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+        let c = s.contact.as_ref().unwrap();
+        let bytes = vtu(&s.mesh, (&s.u, &s.phi), &s.fields, Some(c)).unwrap();
+        let vtk = Vtk::parse_xml(&bytes[..]).unwrap();
+        let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+            panic!("not a grid")
+        };
+        let vtkio::model::Piece::Inline(piece) = &pieces[0] else {
+            panic!("not inline")
+        };
+        let array = |name: &str| -> Vec<f64> {
+            piece
+                .data
+                .point
+                .iter()
+                .find_map(|a| match a {
+                    vtkio::model::Attribute::DataArray(d) if d.name == name => d.data.clone().cast_into(),
+                    _ => None,
+                })
+                .unwrap_or_else(|| panic!("no point array {name}"))
+        };
+        let (pressure, traction, gap) = (
+            array("contact_pressure"),
+            array("contact_traction"),
+            array("contact_gap"),
+        );
+        let lambda = &c.solution.lambda;
+        let mut force = 0.0;
+        for (i, &node) in c.nodes.iter().enumerate() {
+            assert_eq!(pressure[node], lambda.normal[i]);
+            assert_eq!(traction[3 * node], lambda.tangential[i]);
+            assert_eq!(gap[node], c.points.gap[i]);
+            force += c.points.weight[i] * pressure[node];
+        }
+        let r = s.report.contact.normal_force;
+        assert!((force - r).abs() <= 1e-12 * r, "{force} against {r}");
+        let off: Vec<usize> = (0..s.mesh.n_nodes()).filter(|v| !c.nodes.contains(v)).collect();
+        assert!(
+            !off.is_empty()
+                && off
+                    .iter()
+                    .all(|&v| pressure[v] == 0.0 && traction[3 * v..3 * v + 3] == [0.0; 3])
+        );
     }
 
     #[test]
