@@ -377,38 +377,18 @@ fn slip_weakening_along_a_path_weakens_where_it_slid() {
     assert!(first <= at(&equal, 1.0) + 1e-12);
 }
 
-/// The friction loop of `mindlin-sphere-cycle` at `n` cells: its area (the energy dissipated in
-/// one cycle, the trapezoidal integral of Q over the prescribed displacement from t = 1 to 3)
-/// and Mindlin and Deresiewicz's at the computed P and Q* (Hertz's a of P).
+/// The friction loop of `mindlin-sphere-cycle` at `n` cells: its area and Mindlin and
+/// Deresiewicz's at the computed P and Q* (`driver::studies::loops`).
 fn sphere_loop(n: usize) -> (f64, f64) {
-    let (scene, _) = scene_file::load("mindlin-sphere-cycle", &[format!("mesh.n={n}")]).unwrap();
-    let m = &scene.material[0];
-    let (young, poisson) = (m.young.unwrap(), m.poisson.unwrap());
-    let c = scene.first_contact().cloned().unwrap();
-    let amplitude = scene.dirichlet[0].u.as_ref().unwrap()[0];
-    let p = problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())).unwrap();
-    let rows = p.last.report.path.unwrap().rows;
-    let cycle: Vec<_> = rows.iter().filter(|r| r.t >= 1.0 - 1e-9).collect();
-    let area: f64 = cycle
-        .windows(2)
-        .map(|w| {
-            0.5 * (w[0].tangential_resultant[0] + w[1].tangential_resultant[0])
-                * (w[1].factors[2] - w[0].factors[2])
-                * amplitude
-        })
-        .sum();
-    let load = cycle.iter().map(|r| r.normal_force).sum::<f64>() / cycle.len() as f64;
-    let turn = cycle.iter().position(|r| (r.t - 2.0).abs() < 1e-9).unwrap();
-    let q_star = 0.5 * (cycle[0].tangential_resultant[0] - cycle[turn].tangential_resultant[0]);
-    let a = problem::hertz_sphere(load, 1.0 / c.gap_curvature, young, poisson);
-    let w = problem::mindlin_deresiewicz_dissipation(load, q_star, c.friction(), a, young, poisson);
-    (area, w)
+    let f = driver::studies::loops::sphere_loop(n, None).unwrap();
+    (f.area, f.closed_form)
 }
 
 /// In 3D the sphere's loop of tangential force against displacement encloses the energy that
 /// Mindlin and Deresiewicz's closed form gives, to the discretisation's error, which falls
-/// under refinement (measured: 54 % at n = 8, 15 % at 12, 7 % at 16, 0.8 % at 20; the
-/// tests run the first two).
+/// under refinement (measured with the scene's 24 steps: +54 % at n = 8, +15 % at 12, +7 % at
+/// 16; converged in the steps about +2 % from n = 20 on, docs/theory.md; the tests run the
+/// first two).
 #[test]
 fn the_sphere_dissipates_mindlin_deresiewicz_energy() {
     let errors: Vec<f64> = [8, 12]

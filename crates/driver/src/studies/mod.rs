@@ -1,11 +1,13 @@
 //! The studies over many runs, each building its own table and series: a scene along one
 //! parameter ([`sweep`]), the paper's Table 1 ([`table1`]), error against h and run time
 //! ([`convergence`]), the verification report ([`verification`]), the stiff and extreme
-//! cases ([`stability`]) and the hostile inputs ([`inputs`]).
+//! cases ([`stability`]), the hostile inputs ([`inputs`]) and the sphere's friction loop
+//! against its closed form ([`loops`]).
 
 pub mod child;
 pub mod convergence;
 pub mod inputs;
+pub mod loops;
 pub mod stability;
 pub mod sweep;
 pub mod table1;

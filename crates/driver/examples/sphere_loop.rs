@@ -1,0 +1,37 @@
+//! The friction loop of `mindlin-sphere-cycle` against Mindlin and Deresiewicz's closed form,
+//! over mesh sizes and numbers of path steps: the table of docs/theory.md ("Load paths").
+//!
+//!   cargo run --release -p driver --example sphere_loop -- 8,12,16,20,24 24,96,192
+
+fn list(arg: Option<String>, default: &str) -> Vec<usize> {
+    arg.unwrap_or_else(|| default.into())
+        .split(',')
+        .map(|s| s.trim().parse().expect("a list of whole numbers, 8,12,16"))
+        .collect()
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let sizes = list(args.next(), "8,12,16,20,24");
+    let steps = list(args.next(), "24,96");
+    println!("| n | steps | loop area | Mindlin-Deresiewicz | error | P | Q* | Q at t = 0 | s |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for &n in &sizes {
+        for &s in &steps {
+            let t = std::time::Instant::now();
+            match driver::studies::loops::sphere_loop(n, Some(s)) {
+                Ok(f) => println!(
+                    "| {n} | {s} | {:.4e} | {:.4e} | {:+.2} % | {:.4e} | {:.4e} | {:.3e} | {:.1} |",
+                    f.area,
+                    f.closed_form,
+                    100.0 * (f.area - f.closed_form) / f.closed_form,
+                    f.normal_force,
+                    f.amplitude,
+                    f.offset,
+                    t.elapsed().as_secs_f64()
+                ),
+                Err(e) => println!("| {n} | {s} | error: {e} ||||||"),
+            }
+        }
+    }
+}
