@@ -646,6 +646,55 @@ fn the_shipped_corner_meets_its_closed_form() {
     }
 }
 
+/// The corner squeezed along a path (the walls' gap factor from 0 to 1): each instant's row
+/// carries each wall's forces, which sum to the row's total, and at the last instant each
+/// wall's pressure is the static closed form's (the problem is linear in the squeeze).
+#[test]
+fn a_path_reports_each_contact_groups_forces() {
+    let (c11, c13, c33, e31, e33, eps33, delta) = (121.0, 75.2, 111.0, -5.4, 15.8, 7.35, 1e-3);
+    let sets = [
+        "mesh.n=4".to_string(),
+        "path={t=[0.0,1.0],gap=[0.0,1.0],steps=4}".into(),
+    ];
+    let (scene, _) = files::scene_file::load("corner", &sets).unwrap();
+    let p = problem::solve_path(
+        &scene,
+        None,
+        Default::default(),
+        &mut problem::Silent,
+        false,
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    let rows = p.last.report.path.unwrap().rows;
+    let field = (e31 + e33) * (-delta) / eps33;
+    let closed = [
+        -((c11 + c13) * (-delta) + e31 * field),
+        -((c13 + c33) * (-delta) + e33 * field),
+    ];
+    for r in &rows {
+        let names: Vec<&str> = r.groups.iter().map(|g| g.group.as_str()).collect();
+        assert_eq!(names, ["right", "top"]);
+        let sum: f64 = r.groups.iter().map(|g| g.normal_force).sum();
+        assert!(
+            (sum - r.normal_force).abs() <= 1e-12 * r.normal_force.max(1e-300),
+            "t = {}",
+            r.t
+        );
+        let f = r.factors[5];
+        for (g, p) in r.groups.iter().zip(closed) {
+            assert!(
+                (g.normal_force - f * p).abs() <= 1e-9 * p,
+                "t = {}, `{}`: {}",
+                r.t,
+                g.group,
+                g.normal_force
+            );
+            assert_eq!(g.tangential_resultant, [0.0, 0.0], "frictionless walls");
+        }
+    }
+}
+
 #[test]
 fn friction_on_a_later_contact_group_is_not_lost() {
     // the corner's walls under Coulomb's law, the first frictionless, the second F = 0.3: the

@@ -216,7 +216,9 @@ class Result:
     def path(self) -> Optional[dict[str, Any]]:
         """A load path's series (None for one instant): NumPy arrays over its instants, the
         path.csv columns (`t`, the factors, `normal_force`, `tangential_force` (the magnitude),
-        `tangential_force_x`, `_y` (`_z` in 3D), `max_slip`, ..., `equilibrium` NaN where the
+        `tangential_force_x`, `_y` (`_z` in 3D), with several contact groups each one's
+        `normal_force_G`, `tangential_force_G`, `tangential_force_x_G`, ..., `max_slip`, ...,
+        `equilibrium` NaN where the
         fields were not computed), `charges` (n_instants, n_terminals: the charge on each
         conductor) with `terminals` their groups; with `run(..., series=True)` also
         `lambda_n`, `u_n`, `status` (n_instants, n_points) and `lambda_t`, `u_t` (n_instants,

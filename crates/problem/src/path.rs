@@ -601,7 +601,7 @@ fn step_row(
     before: &PointValues,
 ) -> StepRow {
     let points = &boundary.points;
-    let counts = crate::report::ContactReport::of(points, sol);
+    let counts = crate::report::ContactReport::of_groups(points, sol, &boundary.groups, &boundary.group_of);
     let nt = sol.lambda.n_tangential();
     let mut max_slip = 0.0f64;
     let mut max_inc = 0.0f64;
@@ -629,6 +629,7 @@ fn step_row(
         normal_force: counts.normal_force,
         tangential_force: counts.tangential_force,
         tangential_resultant: counts.tangential_resultant,
+        groups: counts.groups,
         max_slip,
         max_slip_increment: max_inc,
         n_stick: counts.n_stick,

@@ -140,6 +140,9 @@ pub struct StepRow {
     /// component per dimension): a friction loop plots its component along the drive.
     #[serde(default)]
     pub tangential_resultant: Vec<f64>,
+    /// Several contact groups (`[[contact]]`): each one's counts and forces at the step.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<ContactGroupReport>,
     /// The largest tangential displacement of a point in contact (the slip from rest).
     pub max_slip: f64,
     /// The largest slip of a point in contact in this step (the increment's).

@@ -228,6 +228,21 @@ impl RunResult {
             let component = column(&|r| r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN));
             out.set_item(format!("tangential_force_{axis}"), component)?;
         }
+        // several contact groups: each one's forces, as path.csv's columns
+        let groups: Vec<String> = rows
+            .first()
+            .map_or(vec![], |r| r.groups.iter().map(|g| g.group.clone()).collect());
+        for (k, g) in groups.iter().enumerate() {
+            let of = |f: &dyn Fn(&problem::report::ContactGroupReport) -> f64| {
+                column(&|r| r.groups.get(k).map_or(f64::NAN, f))
+            };
+            out.set_item(format!("normal_force_{g}"), of(&|g| g.normal_force))?;
+            out.set_item(format!("tangential_force_{g}"), of(&|g| g.tangential_force))?;
+            for (q, axis) in ["x", "y", "z"].iter().enumerate().take(self.solution.mesh.dim) {
+                let component = of(&|g| g.tangential_resultant.get(q).copied().unwrap_or(f64::NAN));
+                out.set_item(format!("tangential_force_{axis}_{g}"), component)?;
+            }
+        }
         out.set_item("max_slip", column(&|r| r.max_slip))?;
         out.set_item("max_slip_increment", column(&|r| r.max_slip_increment))?;
         out.set_item("n_stick", column(&|r| r.n_stick as f64))?;

@@ -98,3 +98,15 @@ def test_a_force_depth_curve_under_force_control():
     hertz = (3.0 * force / (4.0 * e_star * np.sqrt(10.0))) ** (2.0 / 3.0)
     assert np.all(np.abs(p["depth"][1:] / hertz[1:] - 1.0) < 0.01)
     assert p["depth"][0] == 0.0
+
+
+def test_each_contact_groups_forces_along_a_path():
+    """Several [[contact]] groups: path.csv's per-group columns, in the path dict too; the
+    groups' normal forces sum to the total at every instant."""
+    scene = pc.Scene.load("corner", {"mesh.n": 4, "path": {"t": [0.0, 1.0], "gap": [0.0, 1.0], "steps": 4}})
+    p = pc.run(scene).path
+    total = p["normal_force_right"] + p["normal_force_top"]
+    assert np.allclose(total, p["normal_force"], rtol=1e-12, atol=0)
+    for g in ["right", "top"]:
+        for key in [f"tangential_force_{g}", f"tangential_force_x_{g}", f"tangential_force_y_{g}"]:
+            assert np.all(p[key] == 0.0), key

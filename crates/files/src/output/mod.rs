@@ -475,7 +475,9 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
 }
 
 /// `path.csv`: one row per instant, with the tangential force's magnitude (`tangential_force`)
-/// and its components in the global frame (`tangential_force_x`, `_y`, `_z` in 3D), the charge
+/// and its components in the global frame (`tangential_force_x`, `_y`, `_z` in 3D), with
+/// several contact groups each one's forces (`normal_force_G`, `tangential_force_G`,
+/// `tangential_force_x_G`, ...), the charge
 /// on each terminal (`charge_GROUP`, the charge on the conductor) and its potential
 /// (`potential_GROUP`).
 fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
@@ -483,8 +485,21 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius",
     );
     let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
-    for axis in ["x", "y", "z"].iter().take(dim) {
+    let axes = ["x", "y", "z"];
+    for axis in axes.iter().take(dim) {
         s.push_str(&format!(",tangential_force_{axis}"));
+    }
+    // several contact groups: each one's normal force and tangential force (magnitude, then
+    // components), named after the group
+    let groups: Vec<&str> = rows
+        .first()
+        .map_or(vec![], |r| r.groups.iter().map(|g| g.group.as_str()).collect());
+    for g in &groups {
+        let mut names = vec![format!("normal_force_{g}"), format!("tangential_force_{g}")];
+        names.extend(axes.iter().take(dim).map(|axis| format!("tangential_force_{axis}_{g}")));
+        for name in names {
+            s.push_str(&format!(",{}", csv_field(&name)));
+        }
     }
     for t in terminals {
         s.push_str(&format!(",{}", csv_field(&format!("charge_{t}"))));
@@ -511,6 +526,17 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         row.push(r.depth.map_or(String::new(), |e| format!("{e:e}")));
         row.push(r.contact_radius.map_or(String::new(), |e| format!("{e:e}")));
         row.extend((0..dim).map(|k| format!("{:e}", r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN))));
+        for k in 0..groups.len() {
+            let g = r.groups.get(k);
+            row.push(format!("{:e}", g.map_or(f64::NAN, |g| g.normal_force)));
+            row.push(format!("{:e}", g.map_or(f64::NAN, |g| g.tangential_force)));
+            let at = |q: usize| {
+                g.and_then(|g| g.tangential_resultant.get(q))
+                    .copied()
+                    .unwrap_or(f64::NAN)
+            };
+            row.extend((0..dim).map(|q| format!("{:e}", at(q))));
+        }
         row.extend(r.charges.iter().map(|q| format!("{q:e}")));
         row.extend(r.potentials.iter().map(|v| format!("{v:e}")));
         s.push_str(&row.join(","));
