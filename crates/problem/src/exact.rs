@@ -379,13 +379,12 @@ pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Resul
         None => body.at_depth(&profile, run.depth, tip),
     };
     let numbers = [form.depth, form.force, form.contact_radius];
-    if !numbers
+    let finite = numbers
         .iter()
         .chain(&form.potential)
         .chain(&form.charge)
-        .all(|v| v.is_finite())
-        || !(form.force > 0.0 && form.contact_radius > 0.0)
-    {
+        .all(|v| v.is_finite());
+    if !(finite && form.force > 0.0 && form.contact_radius > 0.0) {
         return Err(format!(
             "the closed form does not evaluate to a contact at these data (depth {:e}, force {:e}, contact radius {:e}): the indenter's dimensions are outside what double precision resolves",
             form.depth, form.force, form.contact_radius
