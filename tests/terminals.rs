@@ -680,3 +680,81 @@ fn charges_read_back_and_sum_to_zero() {
         "floats at {v1} (dQ/dψ = {slope})"
     );
 }
+
+/// The round trip on every shipped scene with terminals (smoke size): each terminal held at a
+/// potential by a Dirichlet condition or an electrode, made floating with the charge the run
+/// reported on it, floats at that potential and reads that charge back. Skipped where the
+/// floating terminal would be refused (it touches another terminal: one conductor) or where
+/// no other potential would remain to fix the potentials' level.
+#[test]
+fn every_terminal_floated_with_its_charge_keeps_its_potential() {
+    use problem::{Electrodes, Silent};
+    let mut checked = 0;
+    for (name, text) in files::scene_file::SHIPPED {
+        let base = files::scene_file::parse(text, name, &[]).unwrap();
+        let n = base.mesh.smoke_n.unwrap();
+        let (scene, _) = files::scene_file::load(name, &[format!("mesh.n={n}")]).unwrap();
+        let Ok(solved) = problem::solve(&scene, None, &mut Silent) else {
+            continue;
+        };
+        let terminals = &solved.report.terminals;
+        let scale = terminals.iter().fold(0.0f64, |m, t| m.max(t.potential.abs()));
+        let fixed = terminals.iter().filter(|t| !t.floating).count();
+        if fixed < 2 || scale == 0.0 {
+            continue;
+        }
+        // each terminal's own condition, made floating at its reported charge
+        let mut variants: Vec<(String, problem::Scene)> = vec![];
+        for (k, d) in scene.dirichlet.iter().enumerate() {
+            let Some(t) = terminals.iter().find(|t| t.group == d.group && !t.floating) else {
+                continue;
+            };
+            let mut s = scene.clone();
+            s.dirichlet[k].phi = None;
+            s.dirichlet[k].charge = Some(t.charge);
+            variants.push((t.group.clone(), s));
+        }
+        for (k, e) in scene.electrodes().iter().enumerate() {
+            let group = e.group_name(k);
+            let Some(t) = terminals.iter().find(|t| t.group == group && !t.floating) else {
+                continue;
+            };
+            let mut s = scene.clone();
+            let spec = match s.electrode.as_mut().unwrap() {
+                Electrodes::One(one) => one,
+                Electrodes::Many(many) => &mut many[k],
+            };
+            spec.v = None;
+            spec.charge = Some(t.charge);
+            variants.push((group, s));
+        }
+        for (group, s) in variants {
+            let floated = match problem::solve(&s, None, &mut Silent) {
+                Ok(r) => r,
+                // a terminal that touches another is one conductor with it: refused by key
+                Err(e) if e.to_string().contains("one conductor") => continue,
+                Err(e) => panic!("{name}, `{group}` floated: {e}"),
+            };
+            let (before, after) = (
+                terminals.iter().find(|t| t.group == group).unwrap(),
+                floated.report.terminals.iter().find(|t| t.group == group).unwrap(),
+            );
+            assert!(after.floating);
+            assert!(
+                (after.potential - before.potential).abs() <= 1e-8 * scale,
+                "{name}, `{group}`: floats at {} against {}",
+                after.potential,
+                before.potential
+            );
+            assert!(
+                (after.charge - before.charge).abs() <= 1e-10 * before.charge.abs().max(1e-300),
+                "{name}, `{group}`: reads back {} against {}",
+                after.charge,
+                before.charge
+            );
+            checked += 1;
+        }
+    }
+    eprintln!("the round trip ran on {checked} terminals");
+    assert!(checked >= 3, "the round trip ran on {checked} terminals");
+}
