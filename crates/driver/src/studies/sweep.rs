@@ -32,6 +32,9 @@ pub struct SweepRow {
     /// A rigid indenter's depth and (a conducting one's) charge, where the scene has one (a
     /// force-controlled indenter's depth against a voltage: piezoresponse).
     pub indenter: Option<(f64, Option<f64>)>,
+    /// The run's error where this point failed (its numbers then NaN): the other points are
+    /// kept.
+    pub error: Option<String>,
 }
 
 /// The parameter a sweep varies: `steps` values from `from` to `to`, inclusive.
@@ -48,10 +51,13 @@ pub struct SweepSpec {
 }
 
 /// Runs `scene` along `spec`, with the other overrides `sets`; writes `sweep.csv` and
-/// `sweep.svg/png` into `out` when given.
+/// `sweep.svg/png` into `out` when given. Each point is its own run: one that fails is a row
+/// with its error (and NaN numbers), the others are kept and written.
 ///
 /// # Errors
-/// [`DriverError::Usage`] for fewer than 2 steps; a run's error.
+/// [`DriverError::Usage`] for fewer than 2 steps; the first point's error where every point
+/// failed (nothing is written); [`DriverError::Unexpected`] naming the failed points where
+/// some did (after the rest is written).
 pub fn sweep(
     scene: &str,
     sets: &[String],
@@ -70,6 +76,7 @@ pub fn sweep(
     }
     let integer = integer_key(scene, sets, param, [*from, *to]);
     let mut rows = vec![];
+    let mut first_error: Option<files::Error> = None;
     for k in 0..*steps {
         // a weighted mean of the bounds: finite for any finite bounds (their difference may
         // overflow), and the bounds themselves at the ends
@@ -89,7 +96,15 @@ pub fn sweep(
             s.push(format!("{param}={value:?}"));
         }
         let t = Instant::now();
-        let r = solve(scene, &s)?.report;
+        let r = match solve(scene, &s) {
+            Ok(solved) => solved.report,
+            Err(e) => {
+                progress(&format!("[{}/{steps}] {param} = {value:.6e}: failed: {e}", k + 1));
+                rows.push(SweepRow::failed(value, t.elapsed().as_secs_f64(), e.to_string()));
+                first_error.get_or_insert(e);
+                continue;
+            }
+        };
         let c = &r.contact;
         let row = SweepRow {
             value,
@@ -102,6 +117,7 @@ pub fn sweep(
             fixed_point: r.iterations.fixed_point,
             seconds: t.elapsed().as_secs_f64(),
             indenter: r.indenter.as_ref().map(|i| (i.depth, i.charge)),
+            error: None,
         };
         progress(&format!(
             "[{}/{steps}] {param} = {value:.6e}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}",
@@ -114,6 +130,14 @@ pub fn sweep(
         ));
         rows.push(row);
     }
+    let failed: Vec<String> = rows
+        .iter()
+        .filter_map(|r| r.error.as_ref().map(|e| format!("{param} = {:e}: {e}", r.value)))
+        .collect();
+    if let (Some(e), true) = (first_error, failed.len() == rows.len()) {
+        // nothing found: the first point's error, nothing written
+        return Err(e.into());
+    }
     if let Some(dir) = out {
         let mut outs = Outputs::new(dir);
         outs.add("sweep.csv", csv(param, &rows).into_bytes());
@@ -121,7 +145,32 @@ pub fn sweep(
         outs.commit()?;
         progress(&format!("wrote sweep.csv, sweep.svg, sweep.png in {}", dir.display()));
     }
+    if !failed.is_empty() {
+        return Err(DriverError::Unexpected {
+            what: "sweep points that failed (the others are in sweep.csv)",
+            items: failed,
+        });
+    }
     Ok(rows)
+}
+
+impl SweepRow {
+    /// A point whose run failed with `error`: its numbers NaN, its error kept.
+    fn failed(value: f64, seconds: f64, error: String) -> Self {
+        SweepRow {
+            value,
+            counts: (0, 0, 0),
+            normal_force: f64::NAN,
+            tangential_force: f64::NAN,
+            complementarity: f64::NAN,
+            equilibrium: f64::NAN,
+            uzawa: 0,
+            fixed_point: 0,
+            seconds,
+            indenter: None,
+            error: Some(error),
+        }
+    }
 }
 
 /// Whether `param` is an integer key of the scene: its value in the scene (with `sets`) is a
@@ -150,9 +199,11 @@ fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> b
 /// `nan` for an insulating one's charge).
 pub fn csv(param: &str, rows: &[SweepRow]) -> String {
     let indenter = rows.iter().any(|r| r.indenter.is_some());
+    let errors = rows.iter().any(|r| r.error.is_some());
     let mut csv = format!(
-        "{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds{}\n",
-        if indenter { ",indenter_depth,indenter_charge" } else { "" }
+        "{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds{}{}\n",
+        if indenter { ",indenter_depth,indenter_charge" } else { "" },
+        if errors { ",error" } else { "" }
     );
     for r in rows {
         let extra = match (indenter, r.indenter) {
@@ -160,8 +211,12 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
             (true, Some((depth, charge))) => format!(",{depth:e},{:e}", charge.unwrap_or(f64::NAN)),
             (true, None) => ",nan,nan".into(),
         };
+        let error = match (errors, &r.error) {
+            (false, _) => String::new(),
+            (true, e) => format!(",{}", files::output::csv_field(e.as_deref().unwrap_or(""))),
+        };
         csv.push_str(&format!(
-            "{:e},{},{},{},{:e},{:e},{:.3e},{:.3e},{},{},{:.4}{extra}\n",
+            "{:e},{},{},{},{:e},{:e},{:.3e},{:.3e},{},{},{:.4}{extra}{error}\n",
             r.value,
             r.counts.0,
             r.counts.1,
@@ -206,7 +261,47 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
 
 #[cfg(test)]
 mod tests {
-    use super::integer_key;
+    use super::{integer_key, sweep, SweepSpec};
+    use crate::DriverError;
+
+    /// A sweep whose first points fail (nothing touches, and [exact] is refused there) keeps
+    /// the point that solves: sweep.csv holds all three rows, the failed ones with their error,
+    /// and the sweep ends with an error naming them; where every point fails, the first
+    /// point's own error and nothing written.
+    #[test]
+    fn a_sweep_keeps_the_points_that_solve() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join("sweep");
+        let spec = |from: f64, to: f64, steps: usize| SweepSpec {
+            param: "contact.indenter.depth".into(),
+            from,
+            to,
+            steps,
+        };
+        let sets = ["mesh.n=40".to_string()];
+        let e = sweep("indent-sphere", &sets, &spec(-0.01, 0.01, 3), Some(&dir), &mut |_| {}).unwrap_err();
+        assert!(
+            matches!(&e, DriverError::Unexpected { items, .. } if items.len() == 2),
+            "{e}"
+        );
+        let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4, "{text}");
+        assert!(lines[0].ends_with(",error"));
+        assert!(lines[1].contains("nothing touches") && lines[2].contains("nothing touches"));
+        assert!(lines[3].starts_with("1e-2,") && lines[3].ends_with(','), "{}", lines[3]);
+        let none = tmp.path().join("none");
+        let e = sweep(
+            "indent-sphere",
+            &sets,
+            &spec(-0.01, -0.005, 2),
+            Some(&none),
+            &mut |_| {},
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("exact.kind"), "{e}");
+        assert!(!none.exists());
+    }
 
     #[test]
     fn a_sweep_knows_an_integer_key_from_the_scene() {
