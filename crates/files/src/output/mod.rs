@@ -285,6 +285,12 @@ pub fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
     }
 }
 
+/// A number of a CSV output: the shortest digits that read back to the same double (`{:e}`),
+/// and 0 for a zero of either sign (round-off's -0 reads as 0).
+fn num(x: f64) -> String {
+    format!("{:e}", x + 0.0)
+}
+
 fn contact_csv(c: &ContactResult) -> Vec<u8> {
     let (points, sol, u) = (&c.points, &c.solution, &c.displacement);
     let dim = points.dim;
@@ -309,23 +315,20 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
     s.push_str(if several { ",group\n" } else { "\n" });
     for i in 0..points.len() {
         // `{:e}`: the shortest digits that read back to the same double
-        let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| format!("{x:e}")).collect();
-        row.push(format!("{:e}", points.gap[i]));
-        row.push(format!("{:e}", u.normal[i]));
+        let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| num(*x)).collect();
+        row.push(num(points.gap[i]));
+        row.push(num(u.normal[i]));
         for &ut in u.tangential_of(i) {
-            row.push(format!("{ut:e}"));
+            row.push(num(ut));
         }
-        row.push(format!("{:e}", sol.lambda.normal[i]));
+        row.push(num(sol.lambda.normal[i]));
         for q in 0..dim - 1 {
-            row.push(format!(
-                "{:e}",
-                if nt > 0 { sol.lambda.tangential[i * nt + q] } else { 0.0 }
-            ));
+            row.push(num(if nt > 0 { sol.lambda.tangential[i * nt + q] } else { 0.0 }));
         }
         row.push(sol.status[i].name().to_string());
         if let Some(at) = &electric {
-            row.push(format!("{:e}", at[i].0));
-            row.push(format!("{:e}", at[i].1));
+            row.push(num(at[i].0));
+            row.push(num(at[i].1));
         }
         if several {
             row.push(csv_field(&c.groups[c.group_of[i]]).into_owned());
@@ -509,36 +512,36 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
     }
     s.push('\n');
     for r in rows {
-        let mut row = vec![r.step.to_string(), format!("{:e}", r.t)];
-        row.extend(r.factors.iter().map(|f| format!("{f:e}")));
+        let mut row = vec![r.step.to_string(), num(r.t)];
+        row.extend(r.factors.iter().map(|f| num(*f)));
         row.extend(
             [r.normal_force, r.tangential_force, r.max_slip, r.max_slip_increment]
                 .iter()
-                .map(|v| format!("{v:e}")),
+                .map(|v| num(*v)),
         );
         row.extend(
             [r.n_stick, r.n_slip, r.n_separated, r.iterations]
                 .iter()
                 .map(|v| v.to_string()),
         );
-        row.push(format!("{:e}", r.complementarity));
-        row.push(r.equilibrium.map_or(String::new(), |e| format!("{e:e}")));
-        row.push(r.depth.map_or(String::new(), |e| format!("{e:e}")));
-        row.push(r.contact_radius.map_or(String::new(), |e| format!("{e:e}")));
-        row.extend((0..dim).map(|k| format!("{:e}", r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN))));
+        row.push(num(r.complementarity));
+        row.push(r.equilibrium.map_or(String::new(), |e| num(e)));
+        row.push(r.depth.map_or(String::new(), |e| num(e)));
+        row.push(r.contact_radius.map_or(String::new(), |e| num(e)));
+        row.extend((0..dim).map(|k| num(r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN))));
         for k in 0..groups.len() {
             let g = r.groups.get(k);
-            row.push(format!("{:e}", g.map_or(f64::NAN, |g| g.normal_force)));
-            row.push(format!("{:e}", g.map_or(f64::NAN, |g| g.tangential_force)));
+            row.push(num(g.map_or(f64::NAN, |g| g.normal_force)));
+            row.push(num(g.map_or(f64::NAN, |g| g.tangential_force)));
             let at = |q: usize| {
                 g.and_then(|g| g.tangential_resultant.get(q))
                     .copied()
                     .unwrap_or(f64::NAN)
             };
-            row.extend((0..dim).map(|q| format!("{:e}", at(q))));
+            row.extend((0..dim).map(|q| num(at(q))));
         }
-        row.extend(r.charges.iter().map(|q| format!("{q:e}")));
-        row.extend(r.potentials.iter().map(|v| format!("{v:e}")));
+        row.extend(r.charges.iter().map(|q| num(*q)));
+        row.extend(r.potentials.iter().map(|v| num(*v)));
         s.push_str(&row.join(","));
         s.push('\n');
     }
