@@ -525,9 +525,9 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
                 .map(|v| v.to_string()),
         );
         row.push(num(r.complementarity));
-        row.push(r.equilibrium.map_or(String::new(), |e| num(e)));
-        row.push(r.depth.map_or(String::new(), |e| num(e)));
-        row.push(r.contact_radius.map_or(String::new(), |e| num(e)));
+        row.push(r.equilibrium.map_or(String::new(), num));
+        row.push(r.depth.map_or(String::new(), num));
+        row.push(r.contact_radius.map_or(String::new(), num));
         row.extend((0..dim).map(|k| num(r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN))));
         for k in 0..groups.len() {
             let g = r.groups.get(k);
