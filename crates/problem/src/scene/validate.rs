@@ -390,15 +390,13 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// Runs `check` on every contact entry that is switched on (`contact.law` other than `none`:
-/// the section is then kept as it is, unused, and the plan says so); with several
-/// `[[contact]]` entries, an error names the entry as `--set` reaches it (`contact.1.KEY`)
-/// and its group.
+/// Runs `check` on every contact entry (each check passes over a section switched off,
+/// `contact.law = "none"`, where it must); with several `[[contact]]` entries, an error names
+/// the entry as `--set` reaches it (`contact.1.KEY`) and its group.
 fn each_contact(s: &Scene, check: impl Fn(&Scene, &ContactSpec) -> Result<(), SceneError>) -> Result<(), SceneError> {
     let contacts = s.contacts();
     let several = contacts.len() > 1;
     for (k, c) in contacts.iter().enumerate() {
-        // validate_contact reads a switched-off section's numbers too (finite, in range)
         check(s, c).map_err(|e| match (several, e.key.strip_prefix("contact.")) {
             // the entry's own keys in the message too (`--set ~contact.1.conductance`)
             (true, Some(rest)) => SceneError::new(
