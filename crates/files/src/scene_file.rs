@@ -303,6 +303,21 @@ fn set_table(a: &mut Vec<toml::Value>, i: usize, value: Option<toml::Value>, key
     }
 }
 
+/// Whether two dotted keys of one change would overwrite each other: the same key
+/// (`dirichlet[1].phi` is `dirichlet.1.phi`), one a table that holds the other (`mesh` and
+/// `mesh.n`), or two ways to give one quantity (`mesh.n` and `mesh.h`). A key that is no
+/// dotted key overlaps nothing (its own error comes when it is set).
+pub fn keys_overlap(a: &str, b: &str) -> bool {
+    let (Ok(a), Ok(b)) = (key_path(a), key_path(b)) else {
+        return false;
+    };
+    let within = |outer: &[String], inner: &[String]| inner.starts_with(outer);
+    let alternative_of = |p: &[String], q: &[String]| {
+        p.len() == q.len() && p[..p.len() - 1] == q[..q.len() - 1] && alternative(p) == q.last().map(String::as_str)
+    };
+    within(&a, &b) || within(&b, &a) || alternative_of(&a, &b)
+}
+
 /// The key that gives the same quantity as the dotted `path` another way (`mesh.h` and
 /// `mesh.n`), which a change of `path` replaces.
 fn alternative(path: &[String]) -> Option<&'static str> {
@@ -371,6 +386,27 @@ fn parse_value(raw: &str) -> Result<toml::Value, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn keys_that_overwrite_each_other_overlap() {
+        for (a, b) in [
+            ("mesh.n", "mesh.n"),
+            ("mesh", "mesh.n"),
+            ("mesh.n", "mesh.h"),
+            ("dirichlet[1].phi", "dirichlet.1.phi"),
+            ("contact", "contact.1.gap"),
+        ] {
+            assert!(keys_overlap(a, b) && keys_overlap(b, a), "{a} {b}");
+        }
+        for (a, b) in [
+            ("mesh.n", "mesh.nx"),
+            ("mesh.n", "load.p"),
+            ("dirichlet.0.phi", "dirichlet.1.phi"),
+            ("mesh.", "mesh.n"),
+        ] {
+            assert!(!keys_overlap(a, b), "{a} {b}");
+        }
+    }
 
     #[test]
     fn overrides_set_and_remove_keys_and_name_what_does_not_apply() {

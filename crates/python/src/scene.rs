@@ -163,22 +163,20 @@ fn changes(
 }
 
 /// One call names each key once: a key given twice (by a dict and by a keyword, `mesh.n` and
-/// `mesh__n`), or a key and a table that holds it (`mesh` and `mesh.n`), would keep one of
-/// them silently.
+/// `mesh__n`), a key and a table that holds it (`mesh` and `mesh.n`), or two keys of one
+/// quantity (`mesh.n` and `mesh.h`) would keep one of them silently
+/// (`scene_file::keys_overlap`).
 fn refuse_overlaps(changes: &[(String, Option<toml::Value>)]) -> PyResult<()> {
     for (k, (a, _)) in changes.iter().enumerate() {
-        for (b, _) in &changes[..k] {
-            let within = |outer: &str, inner: &str| inner.strip_prefix(outer).is_some_and(|rest| rest.starts_with('.'));
-            if a == b || within(a, b) || within(b, a) {
-                let what = if a == b {
-                    format!("`{a}` is given twice")
-                } else {
-                    format!("`{b}` and `{a}` both change `{}`", if within(a, b) { a } else { b })
-                };
-                return Err(Kind::Input.err(format!(
-                    "set(): {what} in one call (a dict and a keyword, or a table and one of its keys); give each key once"
-                )));
-            }
+        if let Some((b, _)) = changes[..k].iter().find(|(b, _)| scene_file::keys_overlap(a, b)) {
+            let what = if a == b {
+                format!("`{a}` is given twice")
+            } else {
+                format!("`{b}` and `{a}` both change one value")
+            };
+            return Err(Kind::Input.err(format!(
+                "set(): {what} in one call (a dict and a keyword, a table and one of its keys, or mesh.n and mesh.h); give each once"
+            )));
         }
     }
     Ok(())

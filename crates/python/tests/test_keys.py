@@ -37,6 +37,8 @@ def test_a_mesh_given_as_arrays_keeps_the_body_of_revolution():
         lambda s: s.set({"mesh.n": 8}, mesh={"n": 16}),
         lambda s: s.set({"mesh": {"kind": "rectangle", "lo": [0, 0], "hi": [2, 1], "n": 4}, "mesh.n": 8}),
         lambda s: s.set(contact={"friction": 0.3}, contact__friction=0.2),
+        lambda s: s.set({"mesh.n": 8}, mesh__h=0.125),
+        lambda s: s.set({"dirichlet[0].phi": 0.0, "dirichlet.0.phi": 0.1}),
     ],
 )
 def test_one_key_twice_in_one_call_is_refused(call):
