@@ -1000,21 +1000,9 @@ impl PathSystem {
         how.run(Operator::Condensed(&mut self.dense), &boundary.points, start, reporter)
     }
 
-    /// The contact problem's `u⁰` at a step of `factors`, in the frame `shift`: the loads'
-    /// displacement at the points, before any contact force.
-    /// The largest displacement of the boundary's dofs that the instant's own data make
-    /// (`Σ_q f_q x_q` at `factors`, no contact force): the scale of the instant's answer.
-    pub(crate) fn own_scale(&self, factors: &[f64]) -> f64 {
-        let mut x0 = vec![0.0; self.parts[0].len()];
-        for (part, f) in self.parts.iter().zip(factors) {
-            for (x, p) in x0.iter_mut().zip(part) {
-                *x += f * p;
-            }
-        }
-        x0.iter().fold(0.0f64, |m, v| m.max(v.abs()))
-    }
-
-    pub(crate) fn prime(&mut self, boundary: &ContactBoundary, factors: &[f64], shift: &PointValues) {
+    /// The displacement of the boundary's dofs that a step's own data make, `Σ_q f_q x_q` at
+    /// `factors` (no contact force).
+    fn own_data(&self, factors: &[f64]) -> Vec<f64> {
         let mut x0 = vec![0.0; self.parts[0].len()];
         for (part, f) in self.parts.iter().zip(factors) {
             if *f != 0.0 {
@@ -1023,6 +1011,19 @@ impl PathSystem {
                 }
             }
         }
+        x0
+    }
+
+    /// The largest displacement of the boundary's dofs that the instant's own data make
+    /// ([`PathSystem::own_data`]): the scale of the instant's answer.
+    pub(crate) fn own_scale(&self, factors: &[f64]) -> f64 {
+        self.own_data(factors).iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    /// The contact problem's `u⁰` at a step of `factors`, in the frame `shift`: the loads'
+    /// displacement at the points, before any contact force.
+    pub(crate) fn prime(&mut self, boundary: &ContactBoundary, factors: &[f64], shift: &PointValues) {
+        let x0 = self.own_data(factors);
         let nt = self.dense.nt;
         self.dense.u0 = in_frame(fields_at_points(boundary, &x0, nt), Some(shift));
     }
