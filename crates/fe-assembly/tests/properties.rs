@@ -1,4 +1,5 @@
-//! Property tests of the assembled coupled form (docs/theory.md, "Tests"):
+//! Property tests of the assembled coupled form (docs/theory.md, "The bilinear form and the
+//! blocks"):
 //! - coercivity: `xᵀ [[A, Gᵀ], [-G, B]] x = uᵀ A u + φᵀ B φ` to round-off, both parts
 //!   positive, on random admissible materials and randomly perturbed meshes;
 //! - the symmetric `K` has exactly `n_φ` negative pivots;

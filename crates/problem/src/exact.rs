@@ -358,25 +358,33 @@ pub fn contact_errors(
 }
 
 /// The half-space closed form of `problem::HalfSpace` for the scene's indenter, and the run's
-/// errors against it (`indenter.half_space`); `Err` with the reason where it does not apply
-/// ([`Scene::half_space_problem`] refuses the scene) or lies outside its domain: nothing
-/// touches (the run's or the closed form's force 0: no relative error exists), or the closed
-/// form does not evaluate to a finite contact at these data (a radius of 1e-300 gave a force of
-/// -4.6e210).
-pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Result<HalfSpaceReport, String> {
+/// errors against it (`indenter.half_space`): `None` where it does not apply to the scene
+/// ([`Scene::half_space_problem`] refuses it), `Some(Err)` with the reason where the run lies
+/// outside its domain: nothing touches (the run's or the closed form's force 0: no relative
+/// error exists), or the closed form does not evaluate to a finite contact at these data (a
+/// radius of 1e-300 gave a force of -4.6e210).
+pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Option<Result<HalfSpaceReport, String>> {
+    let (body, profile, tip) = scene.half_space_problem(electric).ok()?;
+    let force = scene.first_contact()?.indenter.as_ref()?.force;
+    Some(half_space_in_domain(&body, &profile, tip, force, run))
+}
+
+/// [`half_space`] for a scene it applies to: the closed form at the run's depth (or at the
+/// force under force control), or why the run lies outside its domain.
+fn half_space_in_domain(
+    body: &crate::halfspace::HalfSpace,
+    profile: &crate::halfspace::Profile,
+    tip: crate::halfspace::Tip,
+    force: Option<f64>,
+    run: &Measured,
+) -> Result<HalfSpaceReport, String> {
     use crate::halfspace::Tip;
-    let (body, profile, tip) = scene.half_space_problem(electric)?;
-    let force = scene
-        .first_contact()
-        .and_then(|c| c.indenter.as_ref())
-        .ok_or("the scene has no indenter")?
-        .force;
     if !(run.force > 0.0) {
         return Err("nothing touches: the indenter carries no force".into());
     }
     let form = match force {
-        Some(f) => body.at_force(&profile, f, tip),
-        None => body.at_depth(&profile, run.depth, tip),
+        Some(f) => body.at_force(profile, f, tip),
+        None => body.at_depth(profile, run.depth, tip),
     };
     let numbers = [form.depth, form.force, form.contact_radius];
     let finite = numbers

@@ -1,6 +1,6 @@
 //! The report of a run as a typed value ([`RunReport`]): what `run.json` holds, field for
 //! field (serde writes it; the application writes the file). Its sections are the ones
-//! docs/theory.md lists: the scene, the plan, sizes, contact counts and forces, iterations,
+//! the README lists: the scene, the plan, sizes, contact counts and forces, iterations,
 //! residuals, timings, memory, and the solver's own parameters.
 
 use crate::exact::ExactReport;

@@ -397,11 +397,11 @@ pub(crate) fn recover(
             charge: r.charge,
             tip_potential: r.tip_potential,
         };
+        // outside its domain it is absent and why is said (not applying, it is not said)
         match crate::exact::half_space(scene, setup.plan.electric, &measured) {
-            Ok(h) => r.half_space = Some(h),
-            // said where the closed form would be; a scene it does not apply to says nothing
-            Err(why) if scene.half_space_problem(setup.plan.electric).is_ok() => r.half_space_absent = Some(why),
-            Err(_) => {}
+            Some(Ok(h)) => r.half_space = Some(h),
+            Some(Err(why)) => r.half_space_absent = Some(why),
+            None => {}
         }
         Some(r)
     });

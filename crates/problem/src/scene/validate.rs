@@ -170,11 +170,13 @@ impl Scene {
         refuse_several_contacts(self)?;
         validate_solver(&self.solver)?;
         refuse_axisymmetric(self)?;
-        each_contact(self, refuse_force_control)?;
-        each_contact(self, refuse_compliance)?;
-        each_contact(self, refuse_weakening)?;
-        each_contact(self, refuse_electric)?;
-        each_contact(self, refuse_backend_contact)?;
+        each_contact(self, |s, c| {
+            refuse_force_control(s, c)?;
+            refuse_compliance(s, c)?;
+            refuse_weakening(s, c)?;
+            refuse_electric(s, c)?;
+            refuse_backend_contact(s, c)
+        })?;
         refuse_backend(self)?;
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
@@ -225,9 +227,7 @@ impl Scene {
             "path.uz",
             "a displacement along z, and the mesh is 2D (plane strain: u = (ux, uy))",
         )?;
-        for c in self.contacts() {
-            check_contact_dimension(c, dim)?;
-        }
+        each_contact(self, |_, c| check_contact_dimension(c, dim))?;
         if let Some(g) = self.mesh.grading.as_ref().map(|g| g.ratios()) {
             if g.len() != 1 && g.len() != dim {
                 return Err(SceneError::new(
@@ -869,7 +869,7 @@ fn validate_electrodes(s: &Scene) -> Result<(), SceneError> {
 /// A name the scene gives to something the outputs name (a group, a terminal: a column of
 /// path.csv and capacitance.csv, a ParaView array): not empty, no control characters (a line
 /// break would end a CSV row), no blanks at either end (they would not survive a spreadsheet).
-pub(crate) fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
+fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
     let problem = if name.is_empty() {
         Some("is empty")
     } else if name.chars().any(char::is_control) {
