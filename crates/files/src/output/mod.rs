@@ -269,11 +269,6 @@ fn revolved_vtu(
     }))
 }
 
-/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
-/// and, with electrical contact, `flux,potential` (`nan` where an electrode holds the point),
-/// with several contact groups `group`;
-/// the displacements are those of the final solution (a frictionless body slides: its `u_t`
-/// is written too), the tangential multipliers 0 where the law carries none.
 /// A CSV field as RFC 4180 writes it: quoted (its quotes doubled) where it holds a comma, a
 /// quote or a line break, as it is elsewhere. Every name that becomes a column or a cell (a
 /// Gmsh group's physical name, a terminal) goes through it, so no name can shift a column.
@@ -291,6 +286,11 @@ fn num(x: f64) -> String {
     format!("{:e}", x + 0.0)
 }
 
+/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
+/// and, with electrical contact, `flux,potential` (`nan` where an electrode holds the point),
+/// with several contact groups `group`;
+/// the displacements are those of the final solution (a frictionless body slides: its `u_t`
+/// is written too), the tangential multipliers 0 where the law carries none.
 fn contact_csv(c: &ContactResult) -> Vec<u8> {
     let (points, sol, u) = (&c.points, &c.solution, &c.displacement);
     let dim = points.dim;
@@ -314,7 +314,6 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
     let several = c.groups.len() > 1;
     s.push_str(if several { ",group\n" } else { "\n" });
     for i in 0..points.len() {
-        // `{:e}`: the shortest digits that read back to the same double
         let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| num(*x)).collect();
         row.push(num(points.gap[i]));
         row.push(num(u.normal[i]));
