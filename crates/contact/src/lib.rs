@@ -41,6 +41,7 @@
 
 mod coarse;
 mod electric;
+mod floating;
 mod gauss_seidel;
 mod local;
 mod newton;
@@ -54,6 +55,7 @@ mod uzawa;
 mod weakening;
 
 pub use electric::{ElectricContact, ElectricContactProblem, ElectricLaw, ElectricValues};
+pub use floating::{solve_floating, FloatingError, CHARGE_TOL};
 pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
 pub use newton::{solve_newton, solve_newton_cached, solve_newton_electric, NewtonCache, NewtonParams};
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};

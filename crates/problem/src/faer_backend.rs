@@ -518,91 +518,18 @@ pub(crate) fn force_controlled(
     .into())
 }
 
-/// Relative tolerance on the charge of a floating conducting tip.
-const CHARGE_TOL: f64 = 1e-10;
-
-/// A floating conducting tip (`contact.charge`): the potential `ψ` at which the electrical
-/// contact solution carries `charge` (`-Σ w_i q_i`, as run.json's `indenter.charge`), one more
-/// unknown with its equation. Newton on `ψ`: each step a contact solve (`newton`) at the
-/// current `ψ`, then `ψ += (charge - Q) / (dQ/dψ)` with the derivative of the contact zone as
-/// found (its normal rows at their gaps, its electric rows at `ψ`: `dQ/dψ = 1ᵀ S⁻¹ e` from
-/// the compliance's block `S` on those rows), exact while the zone does not change, and
-/// bisection inside the bracket the steps have found where a step leaves it; the starting
-/// `ψ` is `contact.foundation_potential`. Leaves `problem`'s potential at the `ψ`
-/// found.
+/// A floating conducting tip (`contact.charge`): [`contact::solve_floating`] around the
+/// contact solve `newton`, its refusals keyed `contact.charge`.
 fn floating_tip(
     problem: &mut contact::ElectricContactProblem,
     points: &ContactPoints,
     charge: f64,
     newton: &mut impl FnMut(&contact::ElectricContactProblem, &ContactPoints) -> Result<ContactSolution, ProblemError>,
 ) -> Result<ContactSolution, ProblemError> {
-    let refuse = |why: String| -> ProblemError { SceneError::new("contact.charge", why).into() };
-    let mut scale = charge.abs();
-    // the charge grows with the potential: once a step passes the root, keep it bracketed
-    // and bisect where Newton's step leaves the bracket (the zone changed on the way)
-    let (mut below, mut above) = (f64::NEG_INFINITY, f64::INFINITY);
-    for _ in 0..100 {
-        let sol = newton(problem, points)?;
-        let e = sol
-            .electric
-            .as_ref()
-            .ok_or_else(|| refuse("the run has no electrical contact".into()))?;
-        let q = e.charge(&points.weight);
-        scale = scale.max(q.abs());
-        if (q - charge).abs() <= CHARGE_TOL * scale.max(f64::MIN_POSITIVE) {
-            return Ok(sol);
-        }
-        // the rows of the zone in contact: normal rows of the points pressed, electric rows
-        // of the electric points among them
-        let (n, m, o) = (problem.weight.len(), problem.m(), problem.order());
-        let mut rows: Vec<usize> = (0..n).filter(|&i| sol.lambda.normal[i] > 0.0).collect();
-        let first_electric = rows.len();
-        rows.extend(
-            e.points
-                .iter()
-                .enumerate()
-                .filter(|&(_, &i)| sol.lambda.normal[i] > 0.0)
-                .map(|(k, _)| m + k),
-        );
-        if rows.len() == first_electric {
-            return Err(refuse(format!(
-                "the floating tip touches the body nowhere, so it carries no charge, and contact.charge = {charge:e}"
-            )));
-        }
-        let k = rows.len();
-        let s = nalgebra::DMatrix::from_fn(k, k, |a, b| problem.compliance[rows[a] * o + rows[b]]);
-        let rhs = nalgebra::DVector::from_fn(k, |a, _| if a >= first_electric { 1.0 } else { 0.0 });
-        let slope = s
-            .lu()
-            .solve(&rhs)
-            .map(|y| y.rows(first_electric, k - first_electric).sum())
-            .filter(|d: &f64| d.is_finite() && *d > 0.0)
-            .ok_or_else(|| {
-                refuse("the contact zone's compliance is singular: its charge does not follow its potential".into())
-            })?;
-        let psi = problem.electric.potential;
-        if q < charge {
-            below = below.max(psi);
-        } else {
-            above = above.min(psi);
-        }
-        if above - below <= 1e-12 * psi.abs().max(f64::MIN_POSITIVE) {
-            // the charge jumps here: a point entering contact brings its potential condition
-            // (the discrete trace of an ideal conductor's pinned edge)
-            return Err(refuse(format!(
-                "no potential of the ideally conducting tip carries contact.charge = {charge:e}: its charge jumps past it at ψ = {psi:e}, where a point enters contact; the regularised contact.electric = \"conductive\" (a large contact.conductance) has a charge continuous in ψ"
-            )));
-        }
-        let next = psi + (charge - q) / slope;
-        problem.electric.potential = if next > below && next < above {
-            next
-        } else {
-            0.5 * (below + above)
-        };
-    }
-    Err(refuse(format!(
-        "the potential of the floating tip carrying contact.charge = {charge:e} was not found in 100 contact solves"
-    )))
+    contact::solve_floating(problem, points, charge, newton).map_err(|e| match e {
+        contact::FloatingError::Solve(e) => e,
+        other => SceneError::new("contact.charge", other.to_string()).into(),
+    })
 }
 
 /// The force of a force-controlled indenter in `posed`'s scene.

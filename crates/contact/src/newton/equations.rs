@@ -84,6 +84,10 @@ pub(super) struct Flat<'a> {
     pub(super) weakening: Option<crate::SlipWeakening>,
     /// Electrical contact: the rows after the mechanical ones.
     pub(super) electric: Option<ElectricRows<'a>>,
+    /// Points held in contact whatever their multiplier (their normal row `u_n = g`, an ideal
+    /// conductor's electric row `φ = φ_F`): the trial zones of [`super::member`]; empty for
+    /// the problem itself.
+    pub(super) forced: Vec<bool>,
     /// `d`'s relative asymmetry, read once ([`Flat::asymmetry`]; a proximal problem, a clone
     /// with the same `d`, keeps it).
     asymmetry: std::sync::OnceLock<f64>,
@@ -155,6 +159,7 @@ impl<'a> Flat<'a> {
             sigma: 0.0,
             weakening: None,
             electric: None,
+            forced: vec![],
             asymmetry: std::sync::OnceLock::new(),
         };
         flat.c = vec![1.0 / mu_max; m];
@@ -273,12 +278,17 @@ impl<'a> Flat<'a> {
     /// it), on a compliant one the penetration.
     fn contact_of(&self, i: usize, s_u: &[f64], s_z: &[f64]) -> (f64, bool) {
         match self.points.foundation {
-            Foundation::Rigid => (s_z[i], s_z[i] > 0.0),
+            Foundation::Rigid => (s_z[i], s_z[i] > 0.0 || self.is_forced(i)),
             Foundation::Compliant { .. } => {
                 let pen = s_u[i] - self.points.gap[i];
                 (pen, pen > 0.0)
             }
         }
+    }
+
+    /// Whether point `i` is held in contact ([`Flat::forced`]).
+    fn is_forced(&self, i: usize) -> bool {
+        self.forced.get(i).copied().unwrap_or(false)
     }
 
     /// The flat indices of point `i`'s components.
@@ -397,10 +407,14 @@ impl<'a> Flat<'a> {
         let mut f = vec![0.0; m];
         let mut buf = [0.0; 2];
         for i in 0..self.n {
-            f[i] = self
-                .points
-                .foundation
-                .normal_residual(x[i], u[i] - self.points.gap[i], self.c[i]);
+            f[i] = if self.is_forced(i) {
+                // held in contact: u_n = g, in the natural map's units
+                -self.c[i] * (u[i] - self.points.gap[i])
+            } else {
+                self.points
+                    .foundation
+                    .normal_residual(x[i], u[i] - self.points.gap[i], self.c[i])
+            };
             if self.nt > 0 {
                 let t = self.layout().index(i, 1);
                 buf[..self.nt].copy_from_slice(&z[t..t + self.nt]);
@@ -431,7 +445,7 @@ impl<'a> Flat<'a> {
             let penetration = s.u[i] - self.points.gap[i];
             match self.points.foundation.equation(s.x[i], penetration, self.c[i]) {
                 // normal: [z_n]₊ has derivative 1 (contact: J = C) or 0 (separated: J = I)
-                None if s.z[i] > 0.0 => rows[i].b.push((i, 1.0)),
+                None if s.z[i] > 0.0 || self.is_forced(i) => rows[i].b.push((i, 1.0)),
                 None => rows[i].e.push((i, 1.0)),
                 // (λ_n - k [u_n - g]₊^m) / s, with ∂u/∂λ = -(D W + σ I) = -C / c and the scale
                 // s held: J = (I + (k'/c) C) / s

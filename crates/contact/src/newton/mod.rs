@@ -39,6 +39,7 @@
 
 mod direction;
 mod equations;
+mod member;
 
 use crate::coarse;
 use crate::electric::{ElectricContactProblem, ElectricValues};
@@ -481,6 +482,7 @@ impl Watch {
 }
 
 /// The rules of a run of Newton steps on the problem itself.
+#[derive(Clone, Copy)]
 struct Rules {
     /// Steps at most.
     steps: usize,
@@ -909,6 +911,13 @@ fn solve_electric(
         let best = judge.iterate(&best, best_residual);
         return Err(stall_error(&info, best_residual, reason, Some(best)));
     }
+    // the ideal conductor on a rigid foundation: the widest member of its family
+    let (best, best_residual) = match (problem.electric.law, &points.foundation) {
+        (crate::ElectricLaw::Conducting, crate::Foundation::Rigid) => {
+            member::widest(&judge, best, best_residual, params, &mut info, &mut cache.directions)
+        }
+        _ => (best, best_residual),
+    };
     let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
     info.complementarity = judge.complementarity(&best);
     info.residual = best_residual;
