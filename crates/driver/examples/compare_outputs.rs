@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Keys whose values are measurements of this run, not of the answer.
-const VOLATILE: &[&str] = &["timings_s", "memory.peak_bytes"];
+const VOLATILE: &[&str] = &["timings_s", "path.steps_s", "memory.peak_bytes"];
 
 fn flatten(prefix: &str, v: &Value, out: &mut BTreeMap<String, Value>) {
     match v {
