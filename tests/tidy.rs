@@ -110,6 +110,22 @@ fn the_core_crate_has_two_public_modules() {
     assert_eq!(public, ["backend", "report"], "problem's public modules");
 }
 
+/// The scene's validation knows no backend: what a backend does not solve is its own
+/// `Backend::supports` (the PETSc backend's in `distributed::supports`), so that a scene is
+/// valid or not whatever solves it.
+#[test]
+fn the_validation_names_no_backend() {
+    let path = root().join("crates/problem/src/scene/validate.rs");
+    let text = std::fs::read_to_string(&path).unwrap().to_lowercase();
+    for name in ["petsc", "faer", "backend"] {
+        assert!(
+            !text.contains(name),
+            "{} names `{name}`: a backend's limits are its Backend::supports",
+            path.display()
+        );
+    }
+}
+
 #[test]
 fn no_printing_outside_the_driver() {
     let mut files = vec![];

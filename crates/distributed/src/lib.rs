@@ -27,9 +27,14 @@
 //! one Krylov solve: no dense compliance, whose size grows like the square of the contact
 //! boundary's.
 //!
-//! With the feature `petsc` off the crate is empty.
+//! With the feature `petsc` off the crate holds only [`supports`]: what the backend solves,
+//! told from the scene.
 // Without the feature the items the docs link to do not exist.
 #![cfg_attr(not(feature = "petsc"), allow(rustdoc::broken_intra_doc_links))]
+
+mod supports;
+
+pub use supports::supports;
 
 #[cfg(feature = "petsc")]
 pub mod contact;

@@ -8,7 +8,7 @@ use crate::layout::Layout;
 use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError, Vector};
-use problem::backend::{Backend, ContactBoundary, ContactSolve, Figures, Finished, Posed, Setup, Solved};
+use problem::backend::{Backend, ContactBoundary, ContactSolve, Figures, Finished, Posed, Setup, Solved, Unsupported};
 use problem::{BackendChoice, ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, SceneError, Solution};
 use std::time::Instant;
 
@@ -109,18 +109,8 @@ impl<'p> Backend for PetscBackend<'p> {
     type Error = DistributedError;
     const HELD_TO_TOLERANCE: bool = false;
 
-    fn refuse(&self, scene: &Scene) -> Result<(), DistributedError> {
-        if scene.solver.backend == BackendChoice::Petsc {
-            return Ok(());
-        }
-        Err(ProblemError::from(SceneError::new(
-            "solver.backend",
-            format!(
-                "solver.backend = \"{}\" is the default backend's (problem::solve); this is the PETSc backend's run: set solver.backend = \"petsc\"",
-                scene.solver.backend
-            ),
-        ))
-        .into())
+    fn supports(&self, scene: &Scene) -> Result<(), Unsupported> {
+        crate::supports(scene)
     }
 
     fn estimate(&self, scene: &Scene) -> Option<(f64, String)> {

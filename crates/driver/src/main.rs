@@ -459,14 +459,16 @@ fn run_petsc(
     driver::petsc_run::run_distributed(scene, source, dir, terminal)
 }
 
-/// Without the feature, a run of the PETSc backend is refused by name.
+/// Without the feature, a run of the PETSc backend is refused by name: first what the backend
+/// would not solve in the scene (so that nobody builds PETSc to learn it), then the build.
 #[cfg(not(feature = "petsc"))]
 fn run_petsc(
-    _: &problem::Scene,
+    scene: &problem::Scene,
     _: &scene_file::Source,
     _: &std::path::Path,
     _: &mut Terminal,
 ) -> Result<Option<problem::Solution>, DriverError> {
+    distributed::supports(scene).map_err(problem::ProblemError::from)?;
     Err(DriverError::Usage(
         "solver.backend = \"petsc\" needs a build with PETSc: cargo build --release --features petsc (with petsc-dev, libclang-dev and pkg-config installed; see the README), then mpirun -np N target/release/piezocontact run ...".into(),
     ))

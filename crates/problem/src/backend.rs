@@ -21,6 +21,40 @@ pub use crate::boundary::{ContactBoundary, MAX_NORMAL_ANGLE_DEG};
 pub use crate::plan::Plan;
 pub use crate::setup::{setup, MeshNotes, Setup};
 
+/// A scene a backend does not solve: the backend, the scene key that asks for what it lacks,
+/// and what that is. Raised by [`Backend::supports`] before anything is built; the scene is
+/// valid (another backend may solve it).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{key}: {feature}; the {backend} backend does not solve it{}", advice.as_deref().map_or(String::new(), |a| format!(" ({a})")))]
+pub struct Unsupported {
+    /// The backend's name, as `solver.backend` takes it.
+    pub backend: &'static str,
+    /// The scene key that asks for it, dotted as `--set` takes it.
+    pub key: String,
+    /// What the scene asks for, in words.
+    pub feature: String,
+    /// What to do instead, where there is a way.
+    pub advice: Option<String>,
+}
+
+impl Unsupported {
+    /// `backend` does not solve `feature`, asked for by `key`.
+    pub fn new(backend: &'static str, key: &str, feature: impl Into<String>) -> Self {
+        Unsupported {
+            backend,
+            key: key.into(),
+            feature: feature.into(),
+            advice: None,
+        }
+    }
+
+    /// With what to do instead.
+    pub fn advise(mut self, advice: impl Into<String>) -> Self {
+        self.advice = Some(advice.into());
+        self
+    }
+}
+
 /// What a run may use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Limits {
@@ -42,7 +76,7 @@ impl Limits {
 }
 
 /// A backend: how the discrete problem of a run is assembled and solved. Every method is
-/// called once per run, in the order of the run: [`refuse`](Backend::refuse),
+/// called once per run, in the order of the run: [`supports`](Backend::supports),
 /// [`estimate`](Backend::estimate), [`assemble`](Backend::assemble),
 /// [`prepare`](Backend::prepare), one of [`solve_linear`](Backend::solve_linear) and
 /// [`solve_contact`](Backend::solve_contact), [`equilibrium`](Backend::equilibrium),
@@ -65,12 +99,13 @@ pub trait Backend {
     /// says whether it met them.
     const HELD_TO_TOLERANCE: bool;
 
-    /// Refuses, before anything is built, a scene this backend does not solve (its
-    /// `solver.backend`, a law or condition it does not support), naming the key.
+    /// Whether this backend solves the (valid) scene: its `solver.backend`, and every law,
+    /// condition and process it asks for. Called before anything is built. What a backend
+    /// lacks lives here, not in the scene's validation, which knows no backend.
     ///
     /// # Errors
-    /// The refusal.
-    fn refuse(&self, scene: &Scene) -> Result<(), Self::Error>;
+    /// [`Unsupported`], naming the key.
+    fn supports(&self, scene: &Scene) -> Result<(), Unsupported>;
 
     /// The lower estimate of the run's peak memory in bytes (per process), with what it
     /// counts, before the mesh is made; `None` where it cannot be told (a mesh read from a

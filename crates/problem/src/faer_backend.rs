@@ -4,6 +4,7 @@
 //! the dense contact problem by semismooth Newton or a first-order method, or (the paper's
 //! Uzawa) solves the primal problem once per first-order step.
 
+use crate::backend::Unsupported;
 use crate::backend::{Backend, ContactSolve, Figures, Finished, Limits, Posed, Solved};
 use crate::boundary::{ContactBoundary, FullSolve};
 use crate::progress::{Event, Reporter};
@@ -29,19 +30,23 @@ impl Backend for Faer {
     type Error = ProblemError;
     const HELD_TO_TOLERANCE: bool = true;
 
-    fn refuse(&self, scene: &Scene) -> Result<(), ProblemError> {
-        if scene.solver.backend == BackendChoice::Faer {
-            return Ok(());
-        }
+    fn supports(&self, scene: &Scene) -> Result<(), Unsupported> {
         // the scene asks for another backend: solving it here would ignore that silently
-        Err(SceneError::new(
-            "solver.backend",
-            format!(
-                "solver.backend = \"{}\" is solved by the distributed backend (the program built with the `petsc` feature, under mpirun; distributed::solve); this is the default backend's solve: remove solver.backend, or set it to \"faer\"",
-                scene.solver.backend
-            ),
-        )
-        .into())
+        if scene.solver.backend != BackendChoice::Faer {
+            return Err(Unsupported::new(
+                "faer",
+                "solver.backend",
+                format!("solver.backend = \"{}\" asks for the distributed backend (the program built with the `petsc` feature, under mpirun; distributed::solve)", scene.solver.backend),
+            )
+            .advise("remove solver.backend, or set it to \"faer\""));
+        }
+        if scene.solver.petsc_options.is_some() {
+            return Err(
+                Unsupported::new("faer", "solver.petsc_options", "options for PETSc's database")
+                    .advise("remove them, or set solver.backend = \"petsc\""),
+            );
+        }
+        Ok(())
     }
 
     fn estimate(&self, scene: &Scene) -> Option<(f64, String)> {

@@ -213,6 +213,9 @@ pub enum ProblemError {
     /// A scene value that cannot be used (named by its key).
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// A valid scene the backend does not solve (another backend may).
+    #[error(transparent)]
+    Unsupported(#[from] backend::Unsupported),
     /// A mesh problem (a missing group, a bad cell).
     #[error("mesh: {0}")]
     Mesh(#[from] mesh::MeshError),

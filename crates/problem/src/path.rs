@@ -90,7 +90,7 @@ pub fn solve_path(
         vec![1.0]
     };
     let valid = scene.validate()?;
-    Faer.refuse(&valid)?;
+    Faer.supports(&valid)?;
     let Some(spec_contact) = scene.active_contact().cloned() else {
         return Err(SceneError::new("path", "a path carries friction's history: the scene has no contact").into());
     };

@@ -75,7 +75,7 @@ pub fn run<B: Backend>(
         let why = "a load path is solved by problem::solve or problem::solve_path (its steps share one factorisation), not one instant of a backend";
         return Err(ProblemError::from(crate::SceneError::new("path", why)).into());
     }
-    backend.refuse(&scene)?;
+    backend.supports(&scene).map_err(ProblemError::from)?;
     let t_total = Instant::now();
     let setup = begin(scene, mesh, backend.estimate(&scene), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();

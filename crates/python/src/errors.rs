@@ -133,7 +133,11 @@ pub fn kind_of_problem(e: &ProblemError) -> Kind {
         ProblemError::AtStep { source, .. } => kind_of_problem(source),
         // a group the scene names and the mesh lacks is the mesh's error, wherever it is found
         ProblemError::Mesh(_) | ProblemError::Assembly(fe_assembly::AssemblyError::Mesh(_)) => Kind::Mesh,
-        ProblemError::Scene(_) | ProblemError::Assembly(_) | ProblemError::Material(_) => Kind::Input,
+        // a backend that does not solve the scene: the scene asks for another (a ValueError, by key)
+        ProblemError::Scene(_)
+        | ProblemError::Unsupported(_)
+        | ProblemError::Assembly(_)
+        | ProblemError::Material(_) => Kind::Input,
         ProblemError::Linalg(_)
         | ProblemError::NotFinite { .. }
         | ProblemError::TooLarge { .. }
@@ -181,6 +185,7 @@ pub fn scene_key(e: &Error) -> Option<String> {
             ..
         }
         | Error::Problem(ProblemError::Scene(s)) => Some(s.key.clone()),
+        Error::Problem(ProblemError::Unsupported(u)) => Some(u.key.clone()),
         Error::Scene {
             source: files::SceneFileError::Override { key, .. },
             ..

@@ -85,7 +85,7 @@ pub(super) struct Flat<'a> {
     /// Electrical contact: the rows after the mechanical ones.
     pub(super) electric: Option<ElectricRows<'a>>,
     /// Points held in contact whatever their multiplier (their normal row `u_n = g`, an ideal
-    /// conductor's electric row `φ = φ_F`): the trial zones of [`super::member`]; empty for
+    /// conductor's electric row `φ = φ_F`): the trial zones of the widest member's search; empty for
     /// the problem itself.
     pub(super) forced: Vec<bool>,
     /// `d`'s relative asymmetry, read once ([`Flat::asymmetry`]; a proximal problem, a clone

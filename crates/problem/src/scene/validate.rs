@@ -5,8 +5,8 @@
 //! mesh is read ([`Scene::check_dimension`]).
 
 use super::{
-    BackendChoice, ContactLaw, ContactSpec, ExactKind, ExactSpec, IndenterShape, IndenterSpec, MaterialModel,
-    MaterialSpec, MeshKind, MeshSpec, PathSpec, Rule, Scene, SolverSpec, Strategy,
+    ContactLaw, ContactSpec, ExactKind, ExactSpec, IndenterShape, IndenterSpec, MaterialModel, MaterialSpec, MeshKind,
+    MeshSpec, PathSpec, Rule, Scene, SolverSpec, Strategy,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -152,7 +152,6 @@ impl Scene {
                 ),
             )?;
         }
-        refuse_floating(self)?;
         for l in self.loads() {
             finite("load.p", l.p)?;
             all_finite("load.direction", &l.direction)?;
@@ -174,10 +173,8 @@ impl Scene {
             refuse_force_control(s, c)?;
             refuse_compliance(s, c)?;
             refuse_weakening(s, c)?;
-            refuse_electric(s, c)?;
-            refuse_backend_contact(s, c)
+            refuse_electric(s, c)
         })?;
-        refuse_backend(self)?;
         if let Some(x) = &self.exact {
             validate_exact(x, self)?;
         }
@@ -382,11 +379,6 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
             "a path carries friction's history on the condensed compliance: use solver.strategy = \"newton-condensed\", \"apg-condensed\" or \"uzawa-condensed\"",
         )?;
     }
-    refuse_if(
-        scene.solver.backend != BackendChoice::Faer,
-        "path",
-        "the PETSc backend solves one instant; a path reuses one factorisation, which the faer backend has (solver.backend = \"faer\")",
-    )?;
     Ok(())
 }
 
@@ -893,8 +885,8 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 /// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
 /// coefficient and (one of them) a depth-controlled indenter; what they share (the law, the
 /// foundation's compliance, Tresca's bound) the same for all; what is posed for one zone
-/// (electrical contact, a floating tip, force control, slip weakening, an exact solution) and
-/// the PETSc backend refused by key.
+/// (electrical contact, a floating tip, force control, slip weakening, an exact solution)
+/// refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
     let contacts = s.contacts();
     let [first, rest @ ..] = contacts else { return Ok(()) };
@@ -964,33 +956,10 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
         s.exact.is_some(),
         "exact",
         "an exact solution, and several [[contact]] groups: the known solutions have one contact zone",
-    )?;
-    refuse_if(
-        s.solver.backend == BackendChoice::Petsc,
-        "contact",
-        "several [[contact]] groups, and the PETSc backend takes one: use the default backend",
     )
 }
 
-/// Floating terminals (`dirichlet.charge`, `electrode.charge`): one potential tied over the
-/// group, in the default backend's assembly.
-fn refuse_floating(s: &Scene) -> Result<(), SceneError> {
-    let key = if s.dirichlet.iter().any(|d| d.charge.is_some()) {
-        "dirichlet.charge"
-    } else if s.electrodes().iter().any(|e| e.charge.is_some()) {
-        "electrode.charge"
-    } else {
-        return Ok(());
-    };
-    refuse_if(
-        s.solver.backend == BackendChoice::Petsc,
-        key,
-        "a floating terminal, and the PETSc backend takes prescribed potentials only; use the default backend",
-    )
-}
-
-/// Force control (`contact.indenter.force`): found on the condensed compliance of the default
-/// backend, at one instant or at each instant of a path (the force scaled by its load factor).
+/// Force control (`contact.indenter.force`): found on the condensed compliance, at one instant or at each instant of a path (the force scaled by its load factor).
 fn refuse_force_control(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
     if c.law == ContactLaw::None {
         return Ok(());
@@ -999,11 +968,6 @@ fn refuse_force_control(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
         return Ok(());
     }
     let key = "contact.indenter.force";
-    refuse_if(
-        s.solver.backend == BackendChoice::Petsc,
-        key,
-        "force control, and the PETSc backend's active sets take a given depth only; use the default backend",
-    )?;
     refuse_if(
         !s.solver.strategy.is_condensed(),
         key,
@@ -1016,18 +980,13 @@ fn refuse_force_control(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
     )
 }
 
-/// A body of revolution: what it cannot carry (a tangential load path's exact solution in plane
-/// strain, the PETSc backend's assembly), and a material symmetric about its axis (checked when
+/// A body of revolution: what it cannot carry (a plane or 3D exact solution, a cylinder lying
+/// on the face, a tip off the axis), and a material symmetric about its axis (checked when
 /// the material is built).
 fn refuse_axisymmetric(s: &Scene) -> Result<(), SceneError> {
     if !s.mesh.axisymmetric {
         return Ok(());
     }
-    refuse_if(
-        s.solver.backend == BackendChoice::Petsc,
-        "mesh.axisymmetric",
-        "a body of revolution, and the PETSc backend assembles plane and 3D bodies only; use the default backend",
-    )?;
     if let Some(x) = &s.exact {
         refuse_if(
             !matches!(x.kind, ExactKind::Hertz | ExactKind::HalfSpace),
@@ -1050,34 +1009,20 @@ fn refuse_axisymmetric(s: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// What the PETSc backend does not take: a contact normal that is not a coordinate axis (its
-/// active-set iteration holds the normal and tangential components as unknowns of the system),
-/// a strategy or rule of the default backend's contact solvers (it runs its own).
 /// A compliant foundation's law is no projection: only semismooth Newton (with block
-/// Gauss-Seidel as its last stage) solves it, and the PETSc backend's active sets do not.
+/// Gauss-Seidel as its last stage) solves it.
 fn refuse_compliance(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
     if !(c.compliance.is_some() && c.law != ContactLaw::None) {
         return Ok(());
     }
-    newton_on_the_default_backend(
-        s,
-        "contact.compliance",
-        "contact.compliance (a deformable foundation): the PETSc backend's active sets hold Signorini's conditions only; use the default backend",
-        |strategy| format!("a deformable foundation, and solver.strategy = \"{strategy}\" projects onto Signorini's conditions: normal compliance is solved by newton-condensed"),
-    )
+    newton_condensed_only(s, "contact.compliance", |strategy| {
+        format!("a deformable foundation, and solver.strategy = \"{strategy}\" projects onto Signorini's conditions: normal compliance is solved by newton-condensed")
+    })
 }
 
-/// A law only `newton-condensed` on the default backend solves: refused by `key` with
-/// `petsc` for the PETSc backend, with the reason `strategy` gives for another strategy.
-fn newton_on_the_default_backend(
-    s: &Scene,
-    key: &str,
-    petsc: &str,
-    strategy: impl FnOnce(Strategy) -> String,
-) -> Result<(), SceneError> {
-    if s.solver.backend == BackendChoice::Petsc {
-        return Err(SceneError::new(key, petsc));
-    }
+/// A law only `newton-condensed` solves: refused by `key` with the reason `strategy` gives
+/// for another strategy.
+fn newton_condensed_only(s: &Scene, key: &str, strategy: impl FnOnce(Strategy) -> String) -> Result<(), SceneError> {
     refuse_if(
         s.solver.strategy != Strategy::NewtonCondensed,
         key,
@@ -1087,7 +1032,7 @@ fn newton_on_the_default_backend(
 
 /// Slip-weakening friction's keys, where `contact.friction_law = "slip-weakening"`: the three
 /// numbers given and in range, Coulomb's law, no constant coefficient; solved by
-/// `newton-condensed` on the default backend. Elsewhere its keys do not apply.
+/// `newton-condensed`. Elsewhere its keys do not apply.
 fn refuse_weakening(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
     // contact switched off: the section is kept as it is, unused
     if c.law == ContactLaw::None {
@@ -1141,17 +1086,14 @@ fn refuse_weakening(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
             format!("contact.slip_length = {l} must be positive"),
         ));
     }
-    newton_on_the_default_backend(
-        s,
-        "contact.friction_law",
-        "contact.friction_law = \"slip-weakening\": the PETSc backend's active sets hold a constant coefficient only; use the default backend",
-        |strategy| format!("slip weakening, and solver.strategy = \"{strategy}\": its fixed point on the coefficients runs semismooth Newton (newton-condensed)"),
-    )
+    newton_condensed_only(s, "contact.friction_law", |strategy| {
+        format!("slip weakening, and solver.strategy = \"{strategy}\": its fixed point on the coefficients runs semismooth Newton (newton-condensed)")
+    })
 }
 
 /// Electrical contact's keys: `foundation_potential` where the foundation conducts,
-/// `conductance` where it is conductive (given, finite, `>= 0`); solved by `newton-condensed`
-/// on the default backend, not with slip weakening. (A body without electric unknowns is
+/// `conductance` where it is conductive (given, finite, `>= 0`); solved by `newton-condensed`,
+/// not with slip weakening. (A body without electric unknowns is
 /// refused once the plan knows it.)
 fn refuse_electric(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
     use crate::scene::ElectricCondition as E;
@@ -1212,45 +1154,9 @@ fn refuse_electric(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
         "contact.electric",
         "electrical contact with slip-weakening friction: the two are not solved together (use contact.friction_law = \"coulomb\", or an insulating foundation)",
     )?;
-    newton_on_the_default_backend(
-        s,
-        "contact.electric",
-        &format!("contact.electric = \"{condition}\": the PETSc backend's active sets hold an insulating foundation only; use the default backend"),
-        |strategy| format!("electrical contact, and solver.strategy = \"{strategy}\": the potentials of the contact points join the condensed unknowns of semismooth Newton (newton-condensed)"),
-    )
-}
-
-fn refuse_backend(s: &Scene) -> Result<(), SceneError> {
-    if s.solver.backend != BackendChoice::Petsc {
-        return Ok(());
-    }
-    refuse_if(
-        s.solver.strategy != Strategy::NewtonCondensed,
-        "solver.strategy",
-        "the PETSc backend runs its own contact solver (a primal-dual active set on the full system, Krylov solves)",
-    )?;
-    refuse_if(
-        s.solver.rule != Rule::Tight,
-        "solver.rule",
-        "the PETSc backend stops on the complementarity residual (the paper's rule is for its Uzawa)",
-    )?;
-    Ok(())
-}
-
-/// The PETSc backend's contact normal: along a coordinate axis.
-fn refuse_backend_contact(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
-    if s.solver.backend != BackendChoice::Petsc || c.law == ContactLaw::None {
-        return Ok(());
-    }
-    let nonzero = c.normal.iter().filter(|&&x| x != 0.0).count();
-    refuse_if(
-        nonzero != 1,
-        "contact.normal",
-        &format!(
-            "contact.normal = {:?}: the PETSc backend needs a normal along a coordinate axis (its contact iteration holds displacement components); use the default backend for an oblique contact face",
-            c.normal
-        ),
-    )
+    newton_condensed_only(s, "contact.electric", |strategy| {
+        format!("electrical contact, and solver.strategy = \"{strategy}\": the potentials of the contact points join the condensed unknowns of semismooth Newton (newton-condensed)")
+    })
 }
 
 fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
@@ -1263,11 +1169,6 @@ fn validate_solver(s: &SolverSpec) -> Result<(), SceneError> {
             ),
         ));
     }
-    refuse_if(
-        s.petsc_options.is_some() && s.backend != BackendChoice::Petsc,
-        "solver.petsc_options",
-        "options for PETSc's database, and solver.backend is not `petsc`",
-    )?;
     refuse_if(
         s.pcg_tol.is_some() && !s.strategy.runs_pcg(),
         "solver.pcg_tol",

@@ -1,0 +1,126 @@
+//! What the PETSc backend solves, told from the scene alone (no PETSc needed: the program built
+//! without the feature tells a user what the backend would refuse before they build it).
+//!
+//! Its contact iteration is a primal-dual active set on the full system, each step one Krylov
+//! solve: it holds Signorini's conditions with Coulomb or Tresca friction on one insulating,
+//! rigid, flat or indenting zone whose normal is a coordinate axis, at one instant, with a
+//! given depth and prescribed potentials, on plane and 3D bodies. Every other law, condition
+//! and process of the model family is the default backend's for now; each is refused here by
+//! the key that asks for it.
+
+use problem::backend::Unsupported;
+use problem::{BackendChoice, ContactLaw, ContactSpec, Rule, Scene, Strategy};
+
+const BACKEND: &str = "petsc";
+
+/// What to do instead of a feature the PETSc backend lacks.
+const DEFAULT: &str = "use the default backend: remove solver.backend";
+
+/// Whether the PETSc backend solves `scene` (a valid scene): the first thing it lacks, by key.
+///
+/// # Errors
+/// [`Unsupported`] naming the key.
+pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
+    let lacks = |key: &str, feature: &str| Err(Unsupported::new(BACKEND, key, feature).advise(DEFAULT));
+    if scene.solver.backend != BackendChoice::Petsc {
+        return Err(Unsupported::new(
+            BACKEND,
+            "solver.backend",
+            format!(
+                "solver.backend = \"{}\" is the default backend's (problem::solve)",
+                scene.solver.backend
+            ),
+        )
+        .advise("set solver.backend = \"petsc\""));
+    }
+    let active: Vec<&ContactSpec> = scene.contacts().iter().filter(|c| c.law != ContactLaw::None).collect();
+    if active.len() > 1 {
+        return lacks("contact", "several [[contact]] zones (its active sets hold one)");
+    }
+    if scene.mesh.axisymmetric {
+        return lacks(
+            "mesh.axisymmetric",
+            "a body of revolution (it assembles plane and 3D bodies)",
+        );
+    }
+    if scene.dirichlet.iter().any(|d| d.charge.is_some()) {
+        return lacks(
+            "dirichlet.charge",
+            "a floating terminal (it takes prescribed potentials)",
+        );
+    }
+    if scene.electrodes().iter().any(|e| e.charge.is_some()) {
+        return lacks(
+            "electrode.charge",
+            "a floating terminal (it takes prescribed potentials)",
+        );
+    }
+    for c in active {
+        contact_zone(c)?;
+    }
+    if scene.solver.strategy != Strategy::NewtonCondensed {
+        return Err(Unsupported::new(
+            BACKEND,
+            "solver.strategy",
+            format!(
+                "solver.strategy = \"{}\" (it runs its own contact solver: a primal-dual active set on the full system, Krylov solves)",
+                scene.solver.strategy
+            ),
+        )
+        .advise("remove solver.strategy"));
+    }
+    if scene.solver.rule != Rule::Tight {
+        return Err(Unsupported::new(
+            BACKEND,
+            "solver.rule",
+            "the paper's stopping rule (it stops on the complementarity residual; the paper's rule is Uzawa's)",
+        )
+        .advise("remove solver.rule"));
+    }
+    if scene.path.is_some() {
+        return lacks(
+            "path",
+            "a load path (it solves one instant; a path reuses one factorisation)",
+        );
+    }
+    Ok(())
+}
+
+/// What one contact zone asks for that the PETSc backend's active sets do not hold.
+fn contact_zone(c: &ContactSpec) -> Result<(), Unsupported> {
+    let lacks = |key: &str, feature: String| Err(Unsupported::new(BACKEND, key, feature).advise(DEFAULT));
+    if c.indenter.as_ref().is_some_and(|i| i.force.is_some()) {
+        return lacks(
+            "contact.indenter.force",
+            "force control (its active sets take a given depth)".into(),
+        );
+    }
+    if c.compliance.is_some() {
+        return lacks(
+            "contact.compliance",
+            "a deformable foundation (its active sets hold Signorini's conditions)".into(),
+        );
+    }
+    if c.slip_weakening().is_some() {
+        return lacks(
+            "contact.friction_law",
+            "slip-weakening friction (its active sets hold a constant coefficient)".into(),
+        );
+    }
+    if let Some(condition) = c.electric.filter(|_| c.electric_law().is_some()) {
+        return lacks(
+            "contact.electric",
+            format!("contact.electric = \"{condition}\" (its active sets hold an insulating foundation)"),
+        );
+    }
+    if c.normal.iter().filter(|&&x| x != 0.0).count() != 1 {
+        return lacks(
+            "contact.normal",
+            format!(
+                "contact.normal = {:?}, an oblique face (its contact iteration holds displacement components: a normal along a coordinate axis)",
+                c.normal
+            ),
+        );
+    }
+    Ok(())
+}
