@@ -9,7 +9,7 @@ use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError, Vector};
 use problem::backend::{Backend, ContactBoundary, ContactSolve, Figures, Finished, Posed, Setup, Solved, Unsupported};
-use problem::{BackendChoice, ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, SceneError, Solution};
+use problem::{ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, SceneError, Solution};
 use std::time::Instant;
 
 /// Steps of the active-set iteration at most.

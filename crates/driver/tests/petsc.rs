@@ -167,7 +167,11 @@ fn bad_options_and_oblique_normals_are_refused_by_name() {
         let sets = ["mesh.n=8".to_string(), "solver.backend=\"petsc\"".to_string()];
         let mut oblique = sets.to_vec();
         oblique.push("contact.normal=[0.3, -1.0]".into());
-        let e = scene_file::parse(text, "paper", &oblique).map(|_| ()).unwrap_err();
+        // a valid scene, which the backend does not solve: refused before anything is built
+        let scene = scene_file::parse(text, "paper", &oblique).expect("a valid scene");
+        let e = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .map(|_| ())
+            .unwrap_err();
         assert!(e.to_string().contains("coordinate axis"), "{e}");
         let mut sets = sets.to_vec();
         sets.push("solver.petsc_options=\"-ksp_type nonsense\"".into());

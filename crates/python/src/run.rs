@@ -87,6 +87,28 @@ impl<'py> Progress<'py> {
     }
 }
 
+/// A scene for the PETSc backend: what that backend would not solve, first (as the program
+/// built without it says); the default backend then refuses another's scene.
+fn petsc_supports(scene: &problem::Scene) -> PyResult<()> {
+    if scene.solver.backend != problem::BackendChoice::Petsc {
+        return Ok(());
+    }
+    distributed::supports(scene).map_err(|e| to_py(problem::ProblemError::from(e).into()))
+}
+
+/// The instant a run given `timeout` seconds stops at: none for no timeout, for `inf` and for
+/// a limit beyond the clock's end; at the first check for 0.
+fn deadline(timeout: Option<f64>) -> PyResult<Option<std::time::Instant>> {
+    let now = std::time::Instant::now();
+    Ok(match timeout {
+        Some(0.0) => Some(now),
+        Some(t) => files::limits::seconds(t, "timeout =")
+            .map_err(to_py)?
+            .and_then(|d| now.checked_add(d)),
+        None => None,
+    })
+}
+
 /// Solves `scene` and returns its `Result`. `progress`: False (nothing), True (a line per step
 /// and per outer contact iteration on `sys.stderr`), or a callable that takes each line.
 /// `series`: for a scene with a `[path]`, keep the contact values of every point at every
@@ -103,16 +125,8 @@ pub fn run(
     timeout: Option<f64>,
     series: bool,
 ) -> PyResult<RunResult> {
-    let now = std::time::Instant::now();
-    let deadline = match timeout {
-        // 0: stop at the first check
-        Some(0.0) => Some(now),
-        // a positive number of seconds, or inf (and a limit beyond the clock's end): no limit
-        Some(t) => files::limits::seconds(t, "timeout =")
-            .map_err(to_py)?
-            .and_then(|d| now.checked_add(d)),
-        None => None,
-    };
+    petsc_supports(&scene.scene)?;
+    let deadline = deadline(timeout)?;
     let progress = match progress {
         Some(p) => Progress::of(py, p)?,
         None => Progress::Quiet,

@@ -63,7 +63,7 @@ def test_scene_errors_name_the_key_and_leave_the_scene_unchanged():
 
 def test_a_scene_for_the_petsc_backend_is_refused_not_solved_by_the_default_one():
     s = pc.Scene.load("paper", {"mesh.n": 4, "solver.backend": "petsc"})
-    with pytest.raises(pc.InputError, match='solver.backend = "petsc" is solved by the distributed backend') as info:
+    with pytest.raises(pc.InputError, match='solver.backend = "petsc" asks for the distributed backend') as info:
         pc.run(s)
     assert info.value.key == "solver.backend"
 
