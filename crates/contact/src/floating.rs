@@ -10,6 +10,7 @@
 //! fraction of its flux (docs/theory.md, "A floating conducting indenter"). Its defect, the
 //! entering node's flux while it is not yet pressed, shrinks with the mesh as the jump does.
 
+use crate::outer::{bracketed_root, Evaluation, Found, Search, SearchError};
 use crate::{ContactPoints, ContactSolution, ElectricContactProblem, ElectricValues, PointValues};
 
 /// Relative tolerance on the charge.
@@ -41,15 +42,13 @@ pub enum FloatingError<E> {
     },
 }
 
-/// The potential `ψ` at which `solve`'s contact solution carries `charge`: Newton on `ψ`,
-/// each step a contact solve at the current `ψ` (`problem.electric.potential`), then
-/// `ψ += (Q - Q(ψ)) / (dQ/dψ)` with the derivative of the contact zone as found (its normal
-/// rows at their gaps, its electric rows at `ψ`: `dQ/dψ = 1ᵀ S⁻¹ e` from the compliance's
-/// block `S` on those rows), exact while the zone does not change, and bisection inside the
-/// bracket the steps have found where a step leaves it. The start is the `ψ` `problem`
-/// carries. Where the bracket closes on a jump of the charge, the mixture of its two ends that
-/// carries `charge` (the module's documentation). Leaves `problem`'s potential at the `ψ`
-/// found.
+/// The potential `ψ` at which `solve`'s contact solution carries `charge`: the bracketed
+/// search of [`crate::outer`] on `ψ` (`problem.electric.potential`), each evaluation a contact
+/// solve, with the derivative of the contact zone as found (its normal rows at their gaps, its
+/// electric rows at `ψ`: `dQ/dψ = 1ᵀ S⁻¹ e` from the compliance's block `S` on those rows),
+/// exact while the zone does not change. The start is the `ψ` `problem` carries. Where the
+/// bracket closes on a jump of the charge, the mixture of its two ends that carries `charge`
+/// (the module's documentation). Leaves `problem`'s potential at the `ψ` found.
 ///
 /// # Errors
 /// [`FloatingError`]: a solve's own error, a zone that touches nowhere or whose compliance is
@@ -60,42 +59,47 @@ pub fn solve_floating<E>(
     charge: f64,
     mut solve: impl FnMut(&ElectricContactProblem, &ContactPoints) -> Result<ContactSolution, E>,
 ) -> Result<ContactSolution, FloatingError<E>> {
+    let search = Search {
+        start: problem.electric.potential,
+        up_from: problem.electric.potential,
+        first_step: 0.0,
+        max_step: 0.0,
+        closed: 1e-12,
+        floor: f64::MIN_POSITIVE,
+        max_evals: MAX_SOLVES,
+    };
+    // the tolerance's scale: the charge asked, or the largest charge met on the way
     let mut scale = charge.abs();
-    // the charge grows with the potential: once a step passes the root, keep it bracketed
-    // (with the solutions at its ends) and bisect where Newton's step leaves the bracket
-    let mut below: (f64, Option<(ContactSolution, f64)>) = (f64::NEG_INFINITY, None);
-    let mut above: (f64, Option<(ContactSolution, f64)>) = (f64::INFINITY, None);
-    for _ in 0..MAX_SOLVES {
+    let found = bracketed_root(&search, |psi| {
+        problem.electric.potential = psi;
         let sol = solve(problem, points).map_err(FloatingError::Solve)?;
         let Some(e) = sol.electric.as_ref() else {
             return Err(FloatingError::Untouched { charge });
         };
         let q = e.charge(&points.weight);
         scale = scale.max(q.abs());
-        if (q - charge).abs() <= CHARGE_TOL * scale.max(f64::MIN_POSITIVE) {
-            return Ok(sol);
-        }
-        let slope = charge_slope(problem, &sol, e, charge)?;
-        let psi = problem.electric.potential;
-        if q < charge {
-            below = (psi, Some((sol, q)));
+        let met = (q - charge).abs() <= CHARGE_TOL * scale.max(f64::MIN_POSITIVE);
+        let slope = if met {
+            None
         } else {
-            above = (psi, Some((sol, q)));
-        }
-        if above.0 - below.0 <= 1e-12 * psi.abs().max(f64::MIN_POSITIVE) {
-            if let ((lo, Some(b)), (hi, Some(a))) = (below, above) {
-                return Ok(mixture(problem, (lo, b), (hi, a), charge));
-            }
-            return Err(FloatingError::NotFound { charge });
-        }
-        let next = psi + (charge - q) / slope;
-        problem.electric.potential = if next > below.0 && next < above.0 {
-            next
-        } else {
-            0.5 * (below.0 + above.0)
+            Some(charge_slope(problem, &sol, e, charge)?)
         };
+        Ok(Evaluation {
+            residual: q - charge,
+            slope,
+            met,
+            value: sol,
+        })
+    });
+    match found {
+        Ok(Found::Root { s, at }) => {
+            problem.electric.potential = s;
+            Ok(at.value)
+        }
+        Ok(Found::Jump { below, above }) => Ok(mixture(problem, below, above, charge)),
+        Err(SearchError::Eval(e)) => Err(e),
+        Err(SearchError::NoBracket { .. } | SearchError::NotFound) => Err(FloatingError::NotFound { charge }),
     }
-    Err(FloatingError::NotFound { charge })
 }
 
 /// `dQ/dψ` of the zone of `sol`: its normal rows at their gaps and its electric rows at `ψ`,
@@ -130,14 +134,16 @@ fn charge_slope<E>(
 }
 
 /// The mixture `(1 - θ) b + θ a` of the members at the two ends of a closed bracket (`b`
-/// below the charge, `a` above, each with its potential and charge) that carries `charge`;
+/// below the charge, `a` above, each with its potential and evaluation) that carries `charge`;
 /// `problem`'s potential set to the mixture's.
 fn mixture(
     problem: &mut ElectricContactProblem,
-    (psi_b, (b, q_b)): (f64, (ContactSolution, f64)),
-    (psi_a, (a, q_a)): (f64, (ContactSolution, f64)),
+    (psi_b, b): (f64, Evaluation<ContactSolution>),
+    (psi_a, a): (f64, Evaluation<ContactSolution>),
     charge: f64,
 ) -> ContactSolution {
+    let (q_b, q_a) = (b.residual + charge, a.residual + charge);
+    let (b, a) = (b.value, a.value);
     let theta = ((charge - q_b) / (q_a - q_b)).clamp(0.0, 1.0);
     let mix = |x: &[f64], y: &[f64]| -> Vec<f64> { x.iter().zip(y).map(|(x, y)| x + theta * (y - x)).collect() };
     let values = |x: &PointValues, y: &PointValues| {

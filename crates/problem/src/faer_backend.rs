@@ -417,114 +417,27 @@ impl ContactSolve<'_> {
     }
 }
 
-/// Relative tolerance on the force of a force-controlled indenter.
-const FORCE_TOL: f64 = 1e-10;
-
-/// Force control: the depth at which the body carries `force` from the indenter, one more
-/// unknown with its equation `Σ w_i λ_n,i = force`. The force is a continuous, nondecreasing
-/// function of how far the gaps are lowered (`s`), 0 while the body is clear of the indenter:
-/// `s` is bracketed by steps growing fourfold from a millionth of the face's size, then found
-/// by the Illinois variant of regula falsi, each evaluation a contact solve (`solve`, on the
-/// points with their gaps lowered, from the last multipliers, the first from `start`) on the
-/// same condensed compliance, which must take Newton steps from a start that already meets its
-/// tolerance ([`ContactSolve::run_with`]). A zero force (a path's load factor at 0) is met with the
-/// indenter just touching (every shallower depth carries none too). Leaves the points with the
-/// gaps of the depth found, and returns its solution.
+/// Force control (`contact.indenter.force`): [`contact::solve_force_controlled`] around the
+/// contact solve `solve`; where no depth carries the force, no solution keyed
+/// `contact.indenter.force`.
 pub(crate) fn force_controlled(
     points: &mut ContactPoints,
     force: f64,
     start: Option<PointValues>,
-    mut solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, ProblemError>,
+    solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, ProblemError>,
 ) -> Result<ContactSolution, ProblemError> {
-    let base = points.gap.clone();
-    let size = face_size(points);
-    let mut last: Option<PointValues> = start;
-    // the largest force carried so far (`f - force` loses `f` when the force asked is huge)
-    let most = std::cell::Cell::new(0.0f64);
-    let mut eval = |s: f64, points: &mut ContactPoints| -> Result<(f64, ContactSolution), ProblemError> {
-        for (g, b) in points.gap.iter_mut().zip(&base) {
-            *g = b - s;
-        }
-        let sol = solve(points, last.take())?;
-        last = Some(sol.lambda.clone());
-        let f = sol
-            .lambda
-            .normal
-            .iter()
-            .zip(&points.weight)
-            .map(|(l, w)| l * w)
-            .sum::<f64>();
-        most.set(most.get().max(f));
-        Ok((f - force, sol))
-    };
-    let close = |r: f64| r.abs() <= FORCE_TOL * force;
-    // the body clear of the indenter: the first step reaches the nearest point
-    let clear = base.iter().cloned().fold(f64::INFINITY, f64::min).max(0.0);
-    if force == 0.0 {
-        // every depth short of first touch carries no force: the indenter just touching
-        let touch = base.iter().cloned().fold(f64::INFINITY, f64::min);
-        return Ok(eval(touch, points)?.1);
-    }
-    let (mut a, (mut fa, mut sol)) = (0.0, eval(0.0, points)?);
-    if close(fa) {
-        return Ok(sol);
-    }
-    // bracket: step away from s = 0 until the residual changes sign
-    let direction = if fa < 0.0 { 1.0 } else { -1.0 };
-    let mut step = size * 1e-6;
-    let (mut b, mut fb);
-    loop {
-        b = if direction > 0.0 { clear + step } else { -step };
-        (fb, sol) = eval(b, points)?;
-        if close(fb) {
-            return Ok(sol);
-        }
-        if fb.signum() != fa.signum() {
-            break;
-        }
-        (a, fa) = (b, fb);
-        step *= 4.0;
-        if step > 1e6 * size {
-            return Err(SceneError::new(
-                "contact.indenter.force",
-                format!(
-                    "no depth within a million face sizes carries contact.indenter.force = {force:e} (the body carries {:e} at most there)",
-                    most.get()
-                ),
-            )
-            .into());
-        }
-    }
-    // Illinois: regula falsi with the stale end's residual halved
-    let mut side = 0;
-    for _ in 0..200 {
-        let c = b - fb * (b - a) / (fb - fa);
-        let (fc, sc) = eval(c, points)?;
-        sol = sc;
-        if close(fc) || (b - a).abs() <= 4.0 * f64::EPSILON * c.abs().max(size * 1e-12) {
-            return Ok(sol);
-        }
-        if fc.signum() == fb.signum() {
-            (b, fb) = (c, fc);
-            if side == -1 {
-                fa /= 2.0;
-            }
-            side = -1;
-        } else {
-            (a, fa) = (b, fb);
-            (b, fb) = (c, fc);
-            side = 1;
-        }
-    }
-    Err(SceneError::new(
-        "contact.indenter.force",
-        format!("the depth that carries contact.indenter.force = {force:e} was not found in 200 contact solves"),
-    )
-    .into())
+    contact::solve_force_controlled(points, force, start, solve).map_err(|e| match e {
+        contact::ForceError::Solve(e) => e,
+        other => ProblemError::NoSolution {
+            sought: "contact.indenter.force",
+            why: other.to_string(),
+        },
+    })
 }
 
 /// A floating conducting tip (`contact.charge`): [`contact::solve_floating`] around the
-/// contact solve `newton`, its refusals keyed `contact.charge`.
+/// contact solve `newton`; where no potential carries the charge, no solution keyed
+/// `contact.charge`.
 fn floating_tip(
     problem: &mut contact::ElectricContactProblem,
     points: &ContactPoints,
@@ -533,7 +446,10 @@ fn floating_tip(
 ) -> Result<ContactSolution, ProblemError> {
     contact::solve_floating(problem, points, charge, newton).map_err(|e| match e {
         contact::FloatingError::Solve(e) => e,
-        other => SceneError::new("contact.charge", other.to_string()).into(),
+        other => ProblemError::NoSolution {
+            sought: "contact.charge",
+            why: other.to_string(),
+        },
     })
 }
 
@@ -544,21 +460,6 @@ fn indenter_force(posed: &Posed<'_>) -> Option<f64> {
         .first_contact()
         .and_then(|c| c.indenter.as_ref())
         .and_then(|i| i.force)
-}
-
-/// The largest extent of the contact points along any axis.
-fn face_size(points: &ContactPoints) -> f64 {
-    (0..3)
-        .map(|k| {
-            let (lo, hi) = points
-                .position
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                    (lo.min(x[k]), hi.max(x[k]))
-                });
-            hi - lo
-        })
-        .fold(f64::MIN_POSITIVE, f64::max)
 }
 
 /// The contact solve: on the condensed compliance (Newton, or a first-order method), or with

@@ -216,6 +216,15 @@ pub enum ProblemError {
     /// A valid scene the backend does not solve (another backend may).
     #[error(transparent)]
     Unsupported(#[from] backend::Unsupported),
+    /// No solution found for one more unknown of the scene (an indenter's depth under force
+    /// control, a floating tip's potential): what was sought, by its key, and why not.
+    #[error("{sought}: {why}")]
+    NoSolution {
+        /// The key of what was sought.
+        sought: &'static str,
+        /// Why it was not found.
+        why: String,
+    },
     /// A mesh problem (a missing group, a bad cell).
     #[error("mesh: {0}")]
     Mesh(#[from] mesh::MeshError),

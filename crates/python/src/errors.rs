@@ -144,8 +144,9 @@ pub fn kind_of_problem(e: &ProblemError) -> Kind {
         | ProblemError::IllConditioned { .. } => Kind::Solver,
         // a residual that is not a number: the data overflowed, the solve did not fail to converge
         ProblemError::Contact { source, .. } if source.residual().is_some_and(|r| !r.is_finite()) => Kind::Solver,
-        // not converged: within its iterations, or within the time `run` was given
-        ProblemError::Contact { .. } => Kind::Convergence,
+        // not converged: within its iterations, or within the time `run` was given; one more
+        // unknown (a depth, a potential) not found
+        ProblemError::Contact { .. } | ProblemError::NoSolution { .. } => Kind::Convergence,
         ProblemError::Interrupted {
             why: contact::Interruption::Deadline,
             ..
@@ -186,6 +187,7 @@ pub fn scene_key(e: &Error) -> Option<String> {
         }
         | Error::Problem(ProblemError::Scene(s)) => Some(s.key.clone()),
         Error::Problem(ProblemError::Unsupported(u)) => Some(u.key.clone()),
+        Error::Problem(ProblemError::NoSolution { sought, .. }) => Some(sought.to_string()),
         Error::Scene {
             source: files::SceneFileError::Override { key, .. },
             ..

@@ -1,0 +1,132 @@
+//! Force control: an indenter pressed with a given force, its depth the unknown. The force is a
+//! continuous, nondecreasing function of how far the gaps are lowered (`s`), 0 while the body
+//! is clear of the indenter; [`solve_force_controlled`] finds the `s` that carries the force
+//! by the bracketed search of [`crate::outer`] around any contact solve.
+
+use crate::outer::{bracketed_root, Evaluation, Found, Search, SearchError};
+use crate::{ContactPoints, ContactSolution, PointValues};
+
+/// Relative tolerance on the force.
+pub const FORCE_TOL: f64 = 1e-10;
+
+/// The contact solves the search may take.
+const MAX_SOLVES: usize = 200;
+
+/// Why the depth was not found.
+#[derive(Debug, thiserror::Error)]
+pub enum ForceError<E> {
+    /// A contact solve at some depth failed.
+    #[error(transparent)]
+    Solve(E),
+    /// No depth within reach carries the force.
+    #[error(
+        "no depth within a million face sizes carries the force {force:e} (the body carries {most:e} at most there)"
+    )]
+    Unreachable {
+        /// The force asked for.
+        force: f64,
+        /// The largest force carried at the depths tried.
+        most: f64,
+    },
+    /// The search did not close in [`MAX_SOLVES`] solves.
+    #[error("the depth that carries the force {force:e} was not found in {MAX_SOLVES} contact solves")]
+    NotFound {
+        /// The force asked for.
+        force: f64,
+    },
+}
+
+/// The depth at which the body carries `force` (`Σ w_i λ_n,i`) from the indenter: each
+/// evaluation a contact solve (`solve`, on the points with their gaps lowered by `s`, from the
+/// last multipliers, the first from `start`); the search's steps up start at first touch and
+/// grow fourfold from a millionth of the face's size, then regula falsi (Illinois) closes on the
+/// depth. A zero force (a path's load factor at 0) is met with the indenter just touching
+/// (every shallower depth carries none too). The caller's solve must take Newton steps from a
+/// start that already meets its tolerance (its force must be this depth's). Leaves the points
+/// with the gaps of the depth found, and returns its solution.
+///
+/// # Errors
+/// [`ForceError`]: a solve's own error, no depth within a million face sizes, or no depth in
+/// [`MAX_SOLVES`] solves.
+pub fn solve_force_controlled<E>(
+    points: &mut ContactPoints,
+    force: f64,
+    start: Option<PointValues>,
+    mut solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, E>,
+) -> Result<ContactSolution, ForceError<E>> {
+    let base = points.gap.clone();
+    let size = face_size(points);
+    let mut last = start;
+    // the largest force carried so far (`f - force` loses `f` when the force asked is huge)
+    let mut most = 0.0f64;
+    let mut eval = |s: f64, points: &mut ContactPoints| -> Result<Evaluation<ContactSolution>, E> {
+        for (g, b) in points.gap.iter_mut().zip(&base) {
+            *g = b - s;
+        }
+        let sol = solve(points, last.take())?;
+        last = Some(sol.lambda.clone());
+        let f = sol
+            .lambda
+            .normal
+            .iter()
+            .zip(&points.weight)
+            .map(|(l, w)| l * w)
+            .sum::<f64>();
+        most = most.max(f);
+        Ok(Evaluation {
+            residual: f - force,
+            slope: None,
+            met: (f - force).abs() <= FORCE_TOL * force,
+            value: sol,
+        })
+    };
+    let touch = base.iter().cloned().fold(f64::INFINITY, f64::min);
+    if force == 0.0 {
+        // every depth short of first touch carries no force: the indenter just touching
+        return eval(touch, points).map(|e| e.value).map_err(ForceError::Solve);
+    }
+    let search = Search {
+        start: 0.0,
+        // the body clear of the indenter: the first step up reaches the nearest point
+        up_from: touch.max(0.0),
+        first_step: size * 1e-6,
+        max_step: 1e6 * size,
+        closed: 4.0 * f64::EPSILON,
+        floor: size * 1e-12 * 4.0 * f64::EPSILON,
+        max_evals: MAX_SOLVES,
+    };
+    let found = bracketed_root(&search, |s| eval(s, points));
+    let (s, sol) = match found {
+        Ok(Found::Root { s, at }) => (s, at.value),
+        // a continuous force: the bracket closes at the depth to round-off; the nearer end
+        Ok(Found::Jump { below, above }) => {
+            if below.1.residual.abs() < above.1.residual.abs() {
+                (below.0, below.1.value)
+            } else {
+                (above.0, above.1.value)
+            }
+        }
+        Err(SearchError::Eval(e)) => return Err(ForceError::Solve(e)),
+        Err(SearchError::NoBracket { .. }) => return Err(ForceError::Unreachable { force, most }),
+        Err(SearchError::NotFound) => return Err(ForceError::NotFound { force }),
+    };
+    for (g, b) in points.gap.iter_mut().zip(&base) {
+        *g = b - s;
+    }
+    Ok(sol)
+}
+
+/// The largest extent of the contact points along any axis.
+fn face_size(points: &ContactPoints) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (lo, hi) = points
+                .position
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x[k]), hi.max(x[k]))
+                });
+            hi - lo
+        })
+        .fold(f64::MIN_POSITIVE, f64::max)
+}
