@@ -1,0 +1,458 @@
+//! The contact solve of the default backend: on the condensed compliance (semismooth Newton or
+//! a first-order method, the electric rows an optional block, force control and a floating
+//! tip around it), or one full primal solve per first-order step; then the fields under the
+//! forces found, refined with the factors of `K`, and the law judged on them.
+
+use super::{Factored, Fields, LinearSolver};
+use crate::backend::{ContactSolve, Posed, Solved};
+use crate::boundary::{ContactBoundary, FullSolve};
+use crate::progress::{Event, Reporter};
+use crate::scene::{ContactSolver, Rule};
+use crate::ProblemError;
+use contact::{
+    ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, NewtonParams, PointValues,
+    StopRule, UzawaParams,
+};
+use fe_assembly::Blocks;
+use linalg::{CondenseRoute, CoupledSolver, DirectLdlt};
+use std::time::Instant;
+
+/// The contact problem as its solvers see it.
+pub(super) enum Operator<'a> {
+    /// The condensed compliance (Newton, or a first-order method).
+    Condensed(&'a mut DenseContactProblem),
+    /// One full primal solve per call (first-order methods).
+    FullSolves(&'a mut dyn ContactOperator),
+}
+
+impl ContactSolve<'_> {
+    /// Semismooth Newton's parameters for this solve: its tolerance and interrupt.
+    fn newton_params(&self) -> NewtonParams {
+        NewtonParams {
+            tol: self.tol,
+            interrupt: self.interrupt,
+            ..Default::default()
+        }
+    }
+
+    /// Runs the strategy's contact solver on `problem`, reporting each outer iteration.
+    pub(super) fn run(
+        &self,
+        problem: Operator<'_>,
+        points: &ContactPoints,
+        start: Option<PointValues>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        self.run_with(problem, points, start, false, reporter)
+    }
+
+    /// [`ContactSolve::run`], where `refine_start` asks Newton to take steps from a warm start
+    /// that already meets the tolerance ([`NewtonParams::refine_start`]): one depth of force
+    /// control's search ([`force_controlled`]), whose force must be this depth's. Taken as it
+    /// was, the start of the depth before carried its force: the search's residual stood still
+    /// while the depth moved, and it ended on a force 3e-8 off (`hertz-sphere` n = 96 on a
+    /// 20-step path, at t = 0.3).
+    pub(super) fn run_with(
+        &self,
+        problem: Operator<'_>,
+        points: &ContactPoints,
+        start: Option<PointValues>,
+        refine_start: bool,
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        let tol = self.tol;
+        let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+        let solved = match (self.plan.linear_strategy.contact_solver(), problem) {
+            (ContactSolver::Newton, Operator::Condensed(dense)) => {
+                let params = NewtonParams {
+                    refine_start,
+                    ..self.newton_params()
+                };
+                match &self.weakening {
+                    // the branch from the stick start, whatever the warm start
+                    Some(w) => {
+                        let params = contact::WeakeningParams {
+                            newton: params,
+                            tol,
+                            ..Default::default()
+                        };
+                        let cache = &mut self.cache.borrow_mut();
+                        contact::solve_slip_weakening_cached(dense, points, w, &params, &mut progress, cache)
+                    }
+                    None => {
+                        let cache = &mut self.cache.borrow_mut();
+                        contact::solve_newton_cached(dense, points, &self.law, &params, start, &mut progress, cache)
+                    }
+                }
+            }
+            (ContactSolver::FirstOrder { accelerate }, problem) => {
+                let op: &mut dyn ContactOperator = match problem {
+                    Operator::Condensed(dense) => dense,
+                    Operator::FullSolves(op) => op,
+                };
+                let params = UzawaParams {
+                    rule: match self.plan.rule {
+                        Rule::Paper => StopRule::Paper,
+                        Rule::Tight => StopRule::Tight { tol },
+                    },
+                    report_every: 50,
+                    accelerate,
+                    interrupt: self.interrupt,
+                    ..Default::default()
+                };
+                contact::solve(op, points, &self.law, &params, start, &mut progress)
+            }
+            (ContactSolver::Newton, Operator::FullSolves(_)) => Err(ContactError::Input(
+                contact::InputError::Unsupported("semismooth Newton needs the condensed compliance"),
+            )),
+        };
+        solved.map_err(|e| ProblemError::contact(e, self.plan.linear_strategy, self.scene))
+    }
+}
+
+/// Force control (`contact.indenter.force`): [`contact::solve_force_controlled`] around the
+/// contact solve `solve`; where no depth carries the force, no solution keyed
+/// `contact.indenter.force`.
+pub(crate) fn force_controlled(
+    points: &mut ContactPoints,
+    force: f64,
+    start: Option<PointValues>,
+    solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, ProblemError>,
+) -> Result<ContactSolution, ProblemError> {
+    contact::solve_force_controlled(points, force, start, solve).map_err(|e| match e {
+        contact::ForceError::Solve(e) => e,
+        other => ProblemError::NoSolution {
+            sought: "contact.indenter.force",
+            why: other.to_string(),
+        },
+    })
+}
+
+/// A floating conducting tip (`contact.charge`): [`contact::solve_floating`] around the
+/// contact solve `newton`; where no potential carries the charge, no solution keyed
+/// `contact.charge`.
+fn floating_tip(
+    problem: &mut contact::ElectricContactProblem,
+    points: &ContactPoints,
+    charge: f64,
+    newton: &mut impl FnMut(&contact::ElectricContactProblem, &ContactPoints) -> Result<ContactSolution, ProblemError>,
+) -> Result<ContactSolution, ProblemError> {
+    contact::solve_floating(problem, points, charge, newton).map_err(|e| match e {
+        contact::FloatingError::Solve(e) => e,
+        other => ProblemError::NoSolution {
+            sought: "contact.charge",
+            why: other.to_string(),
+        },
+    })
+}
+
+/// The force of a force-controlled indenter in `posed`'s scene.
+fn indenter_force(posed: &Posed<'_>) -> Option<f64> {
+    posed
+        .scene
+        .first_contact()
+        .and_then(|c| c.indenter.as_ref())
+        .and_then(|i| i.force)
+}
+
+/// The contact solve: on the condensed compliance (Newton, or a first-order method), or with
+/// one full primal solve per first-order step; then `(u, φ)` under the contact forces found.
+pub(super) fn solve_contact(
+    how: &ContactSolve<'_>,
+    system: &mut Factored,
+    mut boundary: ContactBoundary,
+    posed: &Posed<'_>,
+    reporter: &mut dyn Reporter,
+) -> Result<Solved<Fields>, ProblemError> {
+    let t = Instant::now();
+    let nt = how.plan.n_tangential();
+    let condensed = how.plan.linear_strategy.is_condensed();
+    // electrical contact: its law, owned (force control lowers the boundary's gaps)
+    let electric = boundary.electric.as_ref().map(|(e, _)| e.clone());
+    let (sol, (u, phi)) = match (&mut system.solver, electric) {
+        (LinearSolver::Direct(direct), Some(electric)) if condensed => {
+            let (sol, fields, condense, refinement) =
+                electric_contact(how, &electric, direct, &system.blocks, &mut boundary, posed, reporter)?;
+            system.condense = Some(condense);
+            system.refinement = refinement;
+            (sol, fields)
+        }
+        (LinearSolver::Direct(direct), None) if condensed => {
+            let t_condense = Instant::now();
+            let loads = &posed.loads;
+            let (mut dense, condensed) = boundary.condense(direct, &loads.b_u, &loads.b_phi, nt)?;
+            let condense = (condensed.route, t_condense.elapsed().as_secs_f64());
+            reporter.event(&Event::Condensed {
+                m: dense.m(),
+                route: condense.0,
+                seconds: condense.1,
+            });
+            system.condense = Some(condense);
+            let sol = match indenter_force(posed) {
+                Some(force) => force_controlled(&mut boundary.points, force, None, |points, start| {
+                    how.run_with(Operator::Condensed(&mut dense), points, start, true, reporter)
+                })?,
+                None => how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?,
+            };
+            let (mut u, mut phi) = boundary.recover(direct, condensed, &sol.lambda, &loads.b_u, &loads.b_phi)?;
+            let mut on = Refining {
+                direct,
+                blocks: &system.blocks,
+                posed,
+                boundary: &boundary,
+                refinement: 0,
+                shift: None,
+                refine_tol: REFINE_TOL,
+            };
+            let sol = on.correct(how, &mut dense, sol, (&mut u, &mut phi), reporter)?;
+            system.refinement = on.refinement;
+            (sol, (u, phi))
+        }
+        (other, _) => {
+            let mut op = FullSolve {
+                boundary: &boundary,
+                solver: other.coupled(),
+                b_u: &posed.loads.b_u,
+                b_phi: &posed.loads.b_phi,
+                nt,
+                u: vec![0.0; posed.disc.dofs.n_u],
+                phi: vec![0.0; posed.disc.dofs.n_phi],
+            };
+            let sol = how.run(Operator::FullSolves(&mut op), &boundary.points, None, reporter)?;
+            (sol, (op.u, op.phi))
+        }
+    };
+    Ok(Solved {
+        x: (u, phi),
+        pcg_iters: sol.info.inner_iters,
+        contact: Some((boundary, sol)),
+        seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+/// The contact solve with electrical contact: the condensation onto the points'
+/// displacements and free potentials, semismooth Newton on all their rows, the fields under
+/// the forces and the flux found, refined; the law judged on the refined fields. Returns the
+/// solution, the fields, how the condensation was formed and in how long, and the refinement
+/// steps.
+#[allow(clippy::too_many_arguments)]
+fn electric_contact(
+    how: &ContactSolve<'_>,
+    electric: &contact::ElectricContact,
+    direct: &mut DirectLdlt,
+    blocks: &Blocks,
+    boundary: &mut ContactBoundary,
+    posed: &Posed<'_>,
+    reporter: &mut dyn Reporter,
+) -> Result<(ContactSolution, Fields, (CondenseRoute, f64), usize), ProblemError> {
+    let t = Instant::now();
+    let loads = &posed.loads;
+    let nt = how.plan.n_tangential();
+    let (problem, condensed) = boundary.condense_electric(electric, direct, &loads.b_u, &loads.b_phi, nt)?;
+    let condense = (condensed.route, t.elapsed().as_secs_f64());
+    reporter.event(&Event::Condensed {
+        m: problem.order(),
+        route: condense.0,
+        seconds: condense.1,
+    });
+    let tol = how.tol;
+    let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+    let mut newton = |problem: &contact::ElectricContactProblem, points: &ContactPoints| {
+        contact::solve_newton_electric(problem, points, &how.law, &how.newton_params(), &mut progress)
+            .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))
+    };
+    let mut problem = problem;
+    let floating = posed.scene.first_contact().and_then(|c| c.charge);
+    let mut solve = |points: &ContactPoints, _: Option<PointValues>| match floating {
+        Some(charge) => floating_tip(&mut problem, points, charge, &mut newton),
+        None => newton(&problem, points),
+    };
+    let mut sol = match indenter_force(posed) {
+        Some(force) => force_controlled(&mut boundary.points, force, None, &mut solve)?,
+        None => solve(&boundary.points, None)?,
+    };
+    let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
+    let (b_u, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
+    let refinement = refine(direct, blocks, &b_u, &b_phi, scale, &mut u, &mut phi, REFINE_TOL)?.steps;
+    // the potentials reported are the refined fields'
+    if let (Some(e), Some((_, dofs))) = (&mut sol.electric, &boundary.electric) {
+        let n_u = loads.b_u.len();
+        for (v, &d) in e.potential.iter_mut().zip(dofs) {
+            *v = phi[d - n_u];
+        }
+    }
+    sol.info.complementarity = law_residual(boundary, how, &sol, &problem.u0, &u, None);
+    sol.info.residual = sol.info.residual.max(sol.info.complementarity);
+    Ok((sol, (u, phi), condense, refinement))
+}
+
+/// The fields of a condensed contact solve, refined with the factors of `K`.
+pub(super) struct Refining<'a> {
+    pub(super) direct: &'a mut DirectLdlt,
+    pub(super) blocks: &'a Blocks,
+    pub(super) posed: &'a Posed<'a>,
+    pub(super) boundary: &'a ContactBoundary,
+    /// Steps of iterative refinement of the last solve.
+    pub(super) refinement: usize,
+    /// A path's step: the tangential displacement of the points at the step before, which
+    /// the friction law's slip is measured from (the contact problem's frame).
+    pub(super) shift: Option<&'a PointValues>,
+    /// The equilibrium residual above which the fields are refined ([`REFINE_TOL`] for one
+    /// instant; a path's steps refine only what a direct solve did not reach,
+    /// [`PATH_REFINE_TOL`]).
+    pub(super) refine_tol: f64,
+}
+
+/// The equilibrium residual a run's fields are refined to.
+pub(super) const REFINE_TOL: f64 = 1e-14;
+
+/// The equilibrium residual above which a path's step refines its fields: a direct solve
+/// reaches 1e-13 to 1e-15 on the shipped scenes, and a refinement step costs a solve, the
+/// step's own cost (measured on `paper-cycle`, n = 128: 1 to 3 refinement steps tripled it).
+pub(super) const PATH_REFINE_TOL: f64 = 1e-12;
+
+impl Refining<'_> {
+    /// The fields are those of the last solve: refined, and the contact law judged on them
+    /// (not on the condensed problem's own displacement); where the compliance lost digits to
+    /// an ill-conditioned system, its defect at the points is corrected, at most
+    /// [`MAX_CORRECTIONS`] times (each a warm contact solve and one solve with the factors).
+    pub(super) fn correct(
+        &mut self,
+        how: &ContactSolve<'_>,
+        dense: &mut DenseContactProblem,
+        mut sol: ContactSolution,
+        (u, phi): (&mut Vec<f64>, &mut Vec<f64>),
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        let (boundary, posed) = (self.boundary, self.posed);
+        let u0 = dense.u0.clone();
+        let mut corrections = 0;
+        loop {
+            let (b_full, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
+            self.refinement += refine(
+                self.direct,
+                self.blocks,
+                &b_full,
+                &b_phi,
+                scale,
+                u,
+                phi,
+                self.refine_tol,
+            )?
+            .steps;
+            sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u, self.shift);
+            if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
+                break;
+            }
+            let actual = in_frame(fields_at_points(boundary, u, sol.lambda.n_tangential()), self.shift);
+            for (d, (x, model)) in dense.u0.normal.iter_mut().chain(dense.u0.tangential.iter_mut()).zip(
+                actual
+                    .normal
+                    .iter()
+                    .chain(&actual.tangential)
+                    .zip(sol.u.normal.iter().chain(&sol.u.tangential)),
+            ) {
+                *d += x - model;
+            }
+            let start = sol.lambda.clone();
+            sol = how.run(Operator::Condensed(dense), &boundary.points, Some(start), reporter)?;
+            let (b_full, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
+            self.direct.solve(&b_full, &b_phi, u, phi)?;
+            corrections += 1;
+        }
+        sol.info.residual = sol.info.residual.max(sol.info.complementarity);
+        Ok(sol)
+    }
+}
+
+/// The right-hand sides with the contact forces of `contact` (and the electric flux, with
+/// electrical contact), and the size of their parts (the loads, the contact forces: they may
+/// cancel in the sum).
+pub(crate) fn rhs_with_contact(
+    posed: &Posed<'_>,
+    contact: Option<(&ContactBoundary, &ContactSolution)>,
+) -> (Vec<f64>, Vec<f64>, f64) {
+    let loads = &posed.loads;
+    let (mut b_full, mut b_phi) = (loads.b_u.clone(), loads.b_phi.clone());
+    let mut scale = linalg::norm(&loads.b_u).hypot(linalg::norm(&loads.b_phi));
+    if let Some((cb, sol)) = contact {
+        let forces = cb.forces(&sol.lambda);
+        scale = scale.max(linalg::norm(&forces));
+        for (&j, f) in cb.dofs.iter().zip(&forces) {
+            b_full[j] += f;
+        }
+        let charges = cb.electric_charges(sol, loads.b_u.len());
+        let charge_norm = charges.iter().map(|(_, q)| q * q).sum::<f64>().sqrt();
+        scale = scale.max(charge_norm);
+        for (j, q) in charges {
+            b_phi[j] += q;
+        }
+    }
+    (b_full, b_phi, scale)
+}
+
+/// Iterative refinement of the last solve (with `K`'s factors), to the equilibrium residual
+/// `tol`: at most 3 corrections, each kept only where it lowers the residual.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn refine(
+    direct: &mut DirectLdlt,
+    b: &Blocks,
+    b_u: &[f64],
+    b_phi: &[f64],
+    scale: f64,
+    u: &mut [f64],
+    phi: &mut [f64],
+    tol: f64,
+) -> Result<linalg::Refined, ProblemError> {
+    let k = linalg::CoupledBlocks {
+        a: &b.a,
+        g: &b.g,
+        b: &b.b,
+    };
+    Ok(linalg::refine(direct, k, b_u, b_phi, u, phi, scale, tol, 3)?)
+}
+
+/// Corrections of the condensed problem by its defect at the points, at most (each a warm
+/// Newton solve and one solve with the factors): where the compliance is accurate to a
+/// fraction, each gains that fraction's digits.
+const MAX_CORRECTIONS: usize = 4;
+
+/// The displacement of the points in the free vector `u`, in the contact problem's layout
+/// (`nt` tangential components: none without friction).
+pub(super) fn fields_at_points(boundary: &ContactBoundary, u: &[f64], nt: usize) -> PointValues {
+    let points = &boundary.points;
+    let mut all = PointValues::zeros(points.len(), points.n_tangential());
+    boundary.extract(u, &mut all);
+    let tangential = if nt > 0 { all.tangential } else { vec![] };
+    PointValues::from_parts(all.normal, tangential, nt).unwrap_or_else(|_| PointValues::zeros(points.len(), nt))
+}
+
+/// The points' displacement `at` in the frame of a path's step: its tangential part less
+/// `shift` (the step before's), the slip increment the friction law reads.
+pub(super) fn in_frame(mut at: PointValues, shift: Option<&PointValues>) -> PointValues {
+    if let Some(s) = shift {
+        for (v, s) in at.tangential.iter_mut().zip(&s.tangential) {
+            *v -= s;
+        }
+    }
+    at
+}
+
+/// The complementarity residual of the law on the final fields: the multipliers of `sol` with
+/// the displacement of the points in `u` (the last, refined solve), against the loads' `u0`.
+fn law_residual(
+    boundary: &ContactBoundary,
+    how: &ContactSolve<'_>,
+    sol: &ContactSolution,
+    u0: &PointValues,
+    u: &[f64],
+    shift: Option<&PointValues>,
+) -> f64 {
+    let law = &how.law;
+    let points = &how.points_at(&boundary.points, sol);
+    let at = in_frame(fields_at_points(boundary, u, sol.lambda.n_tangential()), shift);
+    let c = 1.0 / sol.info.mu_max;
+    let reference = contact::multiplier_scale(points, u0, c);
+    let radius = contact::slip_bound(points, law, &sol.lambda.normal);
+    contact::complementarity_residual(points, &radius, &sol.lambda, &at, c, reference)
+}

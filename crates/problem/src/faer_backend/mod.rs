@@ -1,0 +1,328 @@
+//! The default backend: faer's sparse factorisations on one machine. A run without contact
+//! is one solve with the factors, refined; a run with contact condenses `K` onto the contact
+//! dofs (ordered last, so that the contact block comes off the one factorisation) and solves
+//! the dense contact problem by semismooth Newton or a first-order method, or (the paper's
+//! Uzawa) solves the primal problem once per first-order step.
+
+mod condensed;
+mod path_system;
+
+pub(crate) use condensed::{force_controlled, rhs_with_contact};
+use condensed::{refine, solve_contact, REFINE_TOL};
+pub(crate) use path_system::PathSystem;
+
+use crate::backend::Unsupported;
+use crate::backend::{Backend, ContactSolve, Figures, Finished, Limits, Posed, Solved};
+use crate::boundary::ContactBoundary;
+use crate::progress::{Event, Reporter};
+use crate::scene::{BackendChoice, Rule, Scene};
+use crate::ProblemError;
+use fe_assembly::{Blocks, Parallelism};
+use linalg::{CondenseRoute, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
+use std::time::Instant;
+
+/// The default backend (`solver.backend = "faer"`): faer's sparse direct factorisations on
+/// one machine.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Faer;
+
+impl Backend for Faer {
+    type Assembled = Blocks;
+    type System = Factored;
+    type Solution = Fields;
+    type Error = ProblemError;
+    const HELD_TO_TOLERANCE: bool = true;
+
+    fn supports(&self, scene: &Scene) -> Result<(), Unsupported> {
+        // the scene asks for another backend: solving it here would ignore that silently
+        if scene.solver.backend != BackendChoice::Faer {
+            return Err(Unsupported::new(
+                "faer",
+                "solver.backend",
+                format!("solver.backend = \"{}\" asks for the distributed backend (the program built with the `petsc` feature, under mpirun; distributed::solve)", scene.solver.backend),
+            )
+            .advise("remove solver.backend, or set it to \"faer\""));
+        }
+        if scene.solver.petsc_options.is_some() {
+            return Err(
+                Unsupported::new("faer", "solver.petsc_options", "options for PETSc's database")
+                    .advise("remove them, or set solver.backend = \"petsc\""),
+            );
+        }
+        Ok(())
+    }
+
+    fn estimate(&self, scene: &Scene) -> Option<(f64, String)> {
+        crate::estimate::before_mesh(scene)
+    }
+
+    /// Assembles `A`, `G`, `B` over the free dofs (on rayon's threads), checked finite.
+    fn assemble(&mut self, posed: &Posed<'_>) -> Result<Blocks, ProblemError> {
+        let blocks = posed.disc.assemble(Parallelism::Rayon);
+        let scene = posed.scene.scene();
+        ProblemError::check_finite(blocks.a.val(), "the stiffness matrix A", scene)?;
+        ProblemError::check_finite(blocks.g.val(), "the coupling matrix G", scene)?;
+        ProblemError::check_finite(blocks.b.val(), "the dielectric matrix B", scene)?;
+        Ok(blocks)
+    }
+
+    fn prepare(
+        &mut self,
+        posed: &Posed<'_>,
+        blocks: Blocks,
+        boundary: Option<&ContactBoundary>,
+        limits: Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Factored, ProblemError> {
+        factor(posed, blocks, boundary, limits, reporter)
+    }
+
+    fn solve_linear(
+        &mut self,
+        posed: &Posed<'_>,
+        system: &mut Factored,
+        _: &mut dyn Reporter,
+    ) -> Result<Solved<Self::Solution>, ProblemError> {
+        solve_linear(system, posed).map_err(|e| e.on_scene(&posed.scene))
+    }
+
+    fn solve_contact(
+        &mut self,
+        posed: &Posed<'_>,
+        system: &mut Factored,
+        boundary: ContactBoundary,
+        how: &ContactSolve<'_>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Solved<Self::Solution>, ProblemError> {
+        solve_contact(how, system, boundary, posed, reporter).map_err(|e| e.on_scene(&posed.scene))
+    }
+
+    fn equilibrium(
+        &mut self,
+        posed: &Posed<'_>,
+        system: &Factored,
+        solved: &Solved<Self::Solution>,
+    ) -> Result<f64, ProblemError> {
+        let (b_full, b_phi, scale) = rhs_with_contact(posed, solved.contact.as_ref().map(|(b, sol)| (b, sol)));
+        let (b, (u, phi)) = (&system.blocks, &solved.x);
+        Ok(linalg::equilibrium_residual(
+            &b.a, &b.g, &b.b, u, phi, &b_full, &b_phi, scale,
+        ))
+    }
+
+    fn finish(
+        &mut self,
+        _: &Posed<'_>,
+        system: Factored,
+        (u, phi): Self::Solution,
+    ) -> Result<Option<Finished>, ProblemError> {
+        let figures = system.figures();
+        Ok(Some(Finished { u, phi, figures }))
+    }
+}
+
+/// The free unknowns `(u, φ)`.
+pub(crate) type Fields = (Vec<f64>, Vec<f64>);
+
+/// The linear solver the plan asks for, factored once.
+#[allow(clippy::large_enum_variant)] // one per run, moved never
+enum LinearSolver {
+    /// One `L D Lᵀ` of `K`.
+    Direct(DirectLdlt),
+    /// The paper's Schur-complement PCG (Cholesky factors of `A` and `B`).
+    SchurPcg(SchurPcg),
+}
+
+impl LinearSolver {
+    fn coupled(&mut self) -> &mut dyn CoupledSolver {
+        match self {
+            LinearSolver::Direct(d) => d,
+            LinearSolver::SchurPcg(p) => p,
+        }
+    }
+}
+
+/// The assembled blocks and the factored solver, with what the solves measured on it.
+pub struct Factored {
+    blocks: Blocks,
+    solver: LinearSolver,
+    pcg_params: PcgParams,
+    /// Wall time of the factorisation.
+    seconds: f64,
+    /// Steps of iterative refinement of the last solve.
+    refinement: usize,
+    /// How the contact compliance was formed, and in how long (condensed strategies).
+    condense: Option<(CondenseRoute, f64)>,
+}
+
+impl Factored {
+    /// What the factorisation and the solves on it measured, for the report.
+    pub(crate) fn figures(&self) -> Figures {
+        let (smallest_pivot_ratio, factor_bytes) = match &self.solver {
+            LinearSolver::Direct(d) => (Some(d.factor().pivot_ratio()), d.factor_bytes()),
+            LinearSolver::SchurPcg(p) => (None, p.factor_bytes()),
+        };
+        Figures {
+            factor_seconds: self.seconds,
+            condense: self.condense,
+            pcg_rel_tol: self.pcg_params.rel_tol,
+            smallest_pivot_ratio,
+            refinement_steps: self.refinement,
+            factor_bytes,
+            petsc: None,
+        }
+    }
+
+    /// The equilibrium residual of `(u, φ)` against the right-hand sides (their size `scale`).
+    pub(crate) fn equilibrium_of(&self, u: &[f64], phi: &[f64], b_u: &[f64], b_phi: &[f64], scale: f64) -> f64 {
+        let b = &self.blocks;
+        linalg::equilibrium_residual(&b.a, &b.g, &b.b, u, phi, b_u, b_phi, scale)
+    }
+}
+
+/// Factors the linear solver: the Schur PCG's Cholesky factors, or the `L D Lᵀ` of `K` in
+/// geometric nested dissection (measured no slower than AMD in 2D and 1.6x faster in 3D,
+/// docs/performance.md), with the contact dofs of `boundary` last for the condensed
+/// strategies, to read the contact block off the factor; its elimination tree on all of
+/// rayon's threads ([`linalg::pool_par`]).
+fn factor(
+    posed: &Posed<'_>,
+    blocks: Blocks,
+    boundary: Option<&ContactBoundary>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<Factored, ProblemError> {
+    let t = Instant::now();
+    let (scene, plan) = (posed.scene.scene(), posed.plan());
+    let paper = plan.rule == Rule::Paper;
+    let pcg_params = PcgParams {
+        rel_tol: plan.pcg_tol,
+        max_iters: 10_000,
+        stop: if paper {
+            PcgStop::PaperRz
+        } else {
+            PcgStop::RelativeResidual
+        },
+        ..Default::default()
+    };
+    // the Schur route's Cholesky factors with faer's sequential walk (its parallel dense kernels
+    // lose on 2 cores); the L D Lᵀ of K walks its elimination tree on rayon's pool
+    let par = faer::Par::Seq;
+    let budget = factor_budget(posed, &blocks, boundary, limits)?;
+    let too_large = |e: linalg::LinalgError| too_large(e, limits, scene);
+    let solver = if plan.linear_strategy.runs_pcg() {
+        let pcg = SchurPcg::new_within(blocks.a.clone(), blocks.g.clone(), &blocks.b, pcg_params, par, budget)
+            .map_err(too_large)?;
+        LinearSolver::SchurPcg(pcg)
+    } else {
+        let mesh = &posed.setup.mesh;
+        let order = posed
+            .disc
+            .dofs
+            .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
+        let ordering = match (boundary, plan.linear_strategy.is_condensed()) {
+            (Some(cb), true) => Ordering::GivenThenLast {
+                order,
+                last: cb.condensed_dofs(),
+            },
+            _ => Ordering::Given(order),
+        };
+        LinearSolver::Direct(
+            DirectLdlt::new_within(&blocks.a, &blocks.g, &blocks.b, &ordering, linalg::pool_par(), budget)
+                .map_err(too_large)?,
+        )
+    };
+    let seconds = t.elapsed().as_secs_f64();
+    reporter.event(&Event::Factored { seconds });
+    Ok(Factored {
+        blocks,
+        solver,
+        pcg_params,
+        seconds,
+        refinement: 0,
+        condense: None,
+    })
+}
+
+/// The bytes left for the factor within `limits`, once the assembled blocks and (condensed
+/// strategies) the dense contact problem are counted; an error where those alone do not fit.
+fn factor_budget(
+    posed: &Posed<'_>,
+    b: &Blocks,
+    boundary: Option<&ContactBoundary>,
+    limits: Limits,
+) -> Result<Option<usize>, ProblemError> {
+    let Some(available) = limits.memory_bytes else {
+        return Ok(None);
+    };
+    let (plan, dofs) = (posed.plan(), &posed.disc.dofs);
+    let nnz = b.a.val().len() + b.g.val().len() + b.b.val().len();
+    let held = crate::estimate::assembled(nnz, posed.setup.mesh.n_nodes(), dofs.n_u + dofs.n_phi);
+    let dense = match boundary {
+        Some(cb) if plan.linear_strategy.is_condensed() => {
+            let k = cb.condensed_dofs().len();
+            let m = cb.points.len() * (1 + plan.n_tangential()) + (k - cb.dofs.len());
+            crate::estimate::dense_contact(k, m)
+        }
+        _ => 0.0,
+    };
+    // the peak of a run is the assembled system and the factor together, times PEAK_RATIO, and
+    // BASE_BYTES beside (the factorisation's workspace, the recovery; measured on paper and
+    // paper-3d at several sizes): the factor's budget leaves that margin
+    let available_f = ((available as f64) - crate::estimate::BASE_BYTES).max(0.0) / crate::estimate::PEAK_RATIO;
+    if held + dense > available_f {
+        return Err(ProblemError::TooLarge {
+            what: format!(
+                "the assembled system and the dense contact compliance of a condensed strategy ({:.1} GiB)",
+                dense / crate::estimate::GIB
+            ),
+            needed: ((held + dense) * crate::estimate::PEAK_RATIO + crate::estimate::BASE_BYTES) as u64,
+            available,
+            limit: limits.limit(),
+        });
+    }
+    Ok(Some((available_f - held - dense) as usize))
+}
+
+/// A linear-algebra error, made [`ProblemError::TooLarge`] where the factor did not fit, and
+/// [`ProblemError::IllConditioned`] where it broke down on an ill-conditioned scene.
+fn too_large(e: linalg::LinalgError, limits: Limits, scene: &Scene) -> ProblemError {
+    let inner = match &e {
+        linalg::LinalgError::In { source, .. } => source.as_ref(),
+        other => other,
+    };
+    match (inner, limits.memory_bytes) {
+        (linalg::LinalgError::TooLarge { needed, budget }, Some(available)) => ProblemError::TooLarge {
+            what: format!(
+                "a sparse factor of {:.1} GiB, counted by its symbolic analysis, beside the assembled system",
+                *needed as f64 / crate::estimate::GIB
+            ),
+            // the rest of the run takes what the factor's budget left out
+            needed: (*needed + (available as usize).saturating_sub(*budget)) as u64,
+            available,
+            limit: limits.limit(),
+        },
+        _ => ProblemError::linear(e, scene),
+    }
+}
+
+/// The one linear solve of a run without contact, refined with the factors of `K`.
+fn solve_linear(system: &mut Factored, posed: &Posed<'_>) -> Result<Solved<Fields>, ProblemError> {
+    let t = Instant::now();
+    let (dofs, loads) = (&posed.disc.dofs, &posed.loads);
+    let (mut u, mut phi) = (vec![0.0; dofs.n_u], vec![0.0; dofs.n_phi]);
+    let info = system
+        .solver
+        .coupled()
+        .solve(&loads.b_u, &loads.b_phi, &mut u, &mut phi)?;
+    if let LinearSolver::Direct(direct) = &mut system.solver {
+        let (b, b_phi, scale) = rhs_with_contact(posed, None);
+        system.refinement = refine(direct, &system.blocks, &b, &b_phi, scale, &mut u, &mut phi, REFINE_TOL)?.steps;
+    }
+    Ok(Solved {
+        x: (u, phi),
+        contact: None,
+        pcg_iters: info.pcg_iters,
+        seconds: t.elapsed().as_secs_f64(),
+    })
+}

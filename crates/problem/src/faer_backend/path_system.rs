@@ -1,0 +1,166 @@
+//! What a load path keeps on the default backend's one factorisation: the condensed
+//! compliance and the solutions of each part of the right-hand side, from which every step's
+//! loads are a sum.
+
+use super::condensed::{fields_at_points, in_frame, rhs_with_contact, Operator, Refining, PATH_REFINE_TOL};
+use super::{Factored, Fields, LinearSolver};
+use crate::backend::{ContactSolve, Posed};
+use crate::boundary::ContactBoundary;
+use crate::progress::{Event, Reporter};
+use crate::scene::SceneError;
+use crate::ProblemError;
+use contact::{ContactPoints, ContactSolution, DenseContactProblem, PointValues};
+use linalg::CoupledSolver;
+use std::time::Instant;
+
+/// What stays from step to step of a load path on one factorisation: the condensed compliance
+/// and the solutions of `K x = b_q` for each part `q` of the right-hand side (the loads, each
+/// displacement component's lifting, the potentials' lifting), whose sum with the step's
+/// factors is the loads' solution of the step.
+pub(crate) struct PathSystem {
+    dense: DenseContactProblem,
+    /// `x_q`'s displacement part, per part, in the order of the parts.
+    parts: Vec<Vec<f64>>,
+}
+
+impl PathSystem {
+    /// The condensation of `K` on the boundary's dofs (once) and the parts' solutions (one
+    /// solve each), returned whole. `parts` are the right-hand side's parts in the order loads,
+    /// x, y, z displacements (as many as the dimension), potentials.
+    pub(crate) fn new(
+        system: &mut Factored,
+        boundary: &ContactBoundary,
+        parts: &[(Vec<f64>, Vec<f64>)],
+        nt: usize,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(PathSystem, Vec<Fields>), ProblemError> {
+        let LinearSolver::Direct(direct) = &mut system.solver else {
+            return Err(not_direct());
+        };
+        let t = Instant::now();
+        let (b_u, b_phi) = &parts[0];
+        let (dense, condensed) = boundary.condense(direct, b_u, b_phi, nt)?;
+        let condense = (condensed.route, t.elapsed().as_secs_f64());
+        reporter.event(&Event::Condensed {
+            m: dense.m(),
+            route: condense.0,
+            seconds: condense.1,
+        });
+        system.condense = Some(condense);
+        let mut solved = Vec::with_capacity(parts.len());
+        for (b_u, b_phi) in parts {
+            solved.push(Self::solve(system, b_u, b_phi)?);
+        }
+        let parts = solved.iter().map(|(u, _)| u.clone()).collect();
+        Ok((PathSystem { dense, parts }, solved))
+    }
+
+    /// `K⁻¹ [b_u; b_φ]` with the factors of `K`.
+    pub(crate) fn solve(system: &mut Factored, b_u: &[f64], b_phi: &[f64]) -> Result<Fields, ProblemError> {
+        let LinearSolver::Direct(direct) = &mut system.solver else {
+            return Err(not_direct());
+        };
+        let (mut u, mut phi) = (vec![0.0; b_u.len()], vec![0.0; b_phi.len()]);
+        direct.solve(b_u, b_phi, &mut u, &mut phi)?;
+        Ok((u, phi))
+    }
+
+    /// The contact problem of a step: the loads' displacement at the points for the step's
+    /// `factors` (the parts summed), in the frame of the step before's tangential displacement
+    /// `shift` (friction on the slip increment), warm-started from `start`. Its displacements
+    /// are in that frame.
+    pub(crate) fn contact(
+        &mut self,
+        how: &ContactSolve<'_>,
+        boundary: &ContactBoundary,
+        factors: &[f64],
+        shift: &PointValues,
+        start: Option<PointValues>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        self.prime(boundary, factors, shift);
+        how.run(Operator::Condensed(&mut self.dense), &boundary.points, start, reporter)
+    }
+
+    /// The displacement of the boundary's dofs that a step's own data make, `Σ_q f_q x_q` at
+    /// `factors` (no contact force).
+    fn own_data(&self, factors: &[f64]) -> Vec<f64> {
+        let mut x0 = vec![0.0; self.parts[0].len()];
+        for (part, f) in self.parts.iter().zip(factors) {
+            if *f != 0.0 {
+                for (x, p) in x0.iter_mut().zip(part) {
+                    *x += f * p;
+                }
+            }
+        }
+        x0
+    }
+
+    /// The largest displacement of the boundary's dofs that the instant's own data make
+    /// ([`PathSystem::own_data`]): the scale of the instant's answer.
+    pub(crate) fn own_scale(&self, factors: &[f64]) -> f64 {
+        self.own_data(factors).iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    /// The contact problem's `u⁰` at a step of `factors`, in the frame `shift`: the loads'
+    /// displacement at the points, before any contact force.
+    pub(crate) fn prime(&mut self, boundary: &ContactBoundary, factors: &[f64], shift: &PointValues) {
+        let x0 = self.own_data(factors);
+        let nt = self.dense.nt;
+        self.dense.u0 = in_frame(fields_at_points(boundary, &x0, nt), Some(shift));
+    }
+
+    /// The contact solve of the primed step ([`PathSystem::prime`]) at one depth of a force
+    /// search: `points` with that depth's gaps, refined ([`ContactSolve::run_with`]).
+    pub(crate) fn force_search_at(
+        &mut self,
+        how: &ContactSolve<'_>,
+        points: &ContactPoints,
+        start: Option<PointValues>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        how.run_with(Operator::Condensed(&mut self.dense), points, start, true, reporter)
+    }
+
+    /// The fields of a step under the loads of `posed` and the contact forces of `sol` (in
+    /// the frame `shift`), refined, the law judged on them (and the contact solve corrected
+    /// where they miss it).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn fields(
+        &mut self,
+        how: &ContactSolve<'_>,
+        system: &mut Factored,
+        boundary: &ContactBoundary,
+        posed: &Posed<'_>,
+        shift: &PointValues,
+        sol: ContactSolution,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(ContactSolution, Fields), ProblemError> {
+        let (b_u, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
+        let (mut u, mut phi) = Self::solve(system, &b_u, &b_phi)?;
+        let LinearSolver::Direct(direct) = &mut system.solver else {
+            return Err(not_direct());
+        };
+        let mut on = Refining {
+            direct,
+            blocks: &system.blocks,
+            posed,
+            boundary,
+            refinement: 0,
+            shift: Some(shift),
+            refine_tol: PATH_REFINE_TOL,
+        };
+        let sol = on.correct(how, &mut self.dense, sol, (&mut u, &mut phi), reporter)?;
+        system.refinement = on.refinement;
+        Ok((sol, (u, phi)))
+    }
+}
+
+/// A path on a strategy without the `L D Lᵀ` of `K` (the scene's checks refuse it first).
+fn not_direct() -> ProblemError {
+    SceneError::new(
+        "path",
+        "a path carries friction's history on the condensed compliance of the L D Lᵀ of K: use a condensed strategy",
+    )
+    .into()
+}
