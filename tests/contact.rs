@@ -714,3 +714,117 @@ fn friction_on_a_later_contact_group_is_not_lost() {
     assert_eq!(groups[0].tangential_force, 0.0, "{groups:?}");
     assert!(groups[1].tangential_force > 1e-6 * groups[1].normal_force, "{groups:?}");
 }
+
+/// Tresca's bound along the zone (`contact.slip_bound_profile`): a profile of one value is the
+/// uniform bound to the bit; a bound rising along x holds every slipping point at its own bound
+/// and every sticking point under it (2D, and 3D with the bound along y); the profile's data
+/// are refused by key where they cannot be read.
+#[test]
+fn a_tresca_bound_along_the_zone_holds_each_point_at_its_own() {
+    let profile = |along: &str, at: &str, value: &str| {
+        format!("contact.slip_bound_profile={{along={along},at={at},value={value}}}")
+    };
+    let uniform = run("paper-tresca", &["mesh.n=16"]);
+    let one = profile("[1.0,0.0]", "[0.0]", "[0.05]");
+    let flat = run("paper-tresca", &["mesh.n=16", "~contact.slip_bound", &one]);
+    assert_eq!(lambdas(&uniform), lambdas(&flat));
+    let cases = [
+        (
+            "paper-tresca",
+            vec!["mesh.n=32".to_string(), "~contact.slip_bound".into()],
+            profile("[1.0,0.0]", "[0.0,2.0]", "[0.01,0.1]"),
+        ),
+        (
+            "paper-3d",
+            vec![
+                "mesh.n=8".into(),
+                "contact.law=\"tresca\"".into(),
+                "~contact.friction".into(),
+            ],
+            profile("[0.0,1.0,0.0]", "[0.0,1.0]", "[0.02,0.2]"),
+        ),
+    ];
+    for (scene, mut sets, p) in cases {
+        sets.push(p);
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let r = run(scene, &sets);
+        let c = r.contact.as_ref().unwrap();
+        let (sol, nt) = (&c.solution, c.solution.lambda.n_tangential());
+        let (mut slipping, mut bounds) = (0, vec![]);
+        for (i, x) in c.points.position.iter().enumerate() {
+            // the bound the profile gives here, piecewise linear along its direction
+            let (s, (lo, hi), (v0, v1)) = if nt == 1 {
+                (x[0], (0.0, 2.0), (0.01, 0.1))
+            } else {
+                (x[1], (0.0, 1.0), (0.02, 0.2))
+            };
+            let bound = v0 + (v1 - v0) * ((s - lo) / (hi - lo)).clamp(0.0, 1.0);
+            bounds.push(bound);
+            let t: f64 = (0..nt)
+                .map(|k| sol.lambda.component(i, 1 + k).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!(
+                t <= bound * (1.0 + 1e-9) + 1e-14,
+                "{scene} point {i}: |λ_t| = {t} above {bound}"
+            );
+            if sol.status[i] == contact::Status::Slip {
+                slipping += 1;
+                assert!(
+                    (t - bound).abs() <= 1e-9 * bound,
+                    "{scene} point {i} slips: |λ_t| = {t}, bound {bound}"
+                );
+            }
+        }
+        assert!(slipping > 0, "{scene}: some points slip");
+        let spread =
+            bounds.iter().cloned().fold(0.0f64, f64::max) / bounds.iter().cloned().fold(f64::INFINITY, f64::min);
+        assert!(spread > 5.0, "{scene}: the bound varies along the zone ({spread})");
+    }
+    // read or refused by key
+    for (sets, key) in [
+        (vec![one.clone()], "contact.slip_bound"),
+        (
+            vec![
+                "~contact.slip_bound".into(),
+                profile("[1.0,0.0]", "[1.0,0.0]", "[0.1,0.1]"),
+            ],
+            "contact.slip_bound_profile.at",
+        ),
+        (
+            vec!["~contact.slip_bound".into(), profile("[1.0,0.0]", "[0.0,1.0]", "[0.1]")],
+            "contact.slip_bound_profile.value",
+        ),
+        (
+            vec!["~contact.slip_bound".into(), profile("[1.0,0.0]", "[0.0]", "[-0.1]")],
+            "contact.slip_bound_profile.value",
+        ),
+        (
+            vec!["~contact.slip_bound".into(), profile("[0.0,0.0]", "[0.0]", "[0.1]")],
+            "contact.slip_bound_profile.along",
+        ),
+        (
+            vec!["~contact.slip_bound".into(), profile("[1.0]", "[0.0]", "[0.1]")],
+            "contact.slip_bound_profile.along",
+        ),
+        (
+            vec![
+                "contact.law=\"coulomb\"".into(),
+                "contact.friction=0.3".into(),
+                "~contact.slip_bound".into(),
+                one.clone(),
+            ],
+            "contact.slip_bound_profile",
+        ),
+    ] {
+        let e = files::scene_file::load("paper-tresca", &sets).unwrap_err();
+        let files::Error::Scene {
+            source: files::SceneFileError::Invalid(e),
+            ..
+        } = e
+        else {
+            panic!("{sets:?}: {e}")
+        };
+        assert_eq!(e.key, key, "{sets:?}: {e}");
+    }
+}

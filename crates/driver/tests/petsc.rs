@@ -53,6 +53,15 @@ const CONTACT_CASES: &[(&str, &[&str])] = &[
     ("paper", &["mesh.n=32"]),
     ("paper-slip", &["mesh.n=32"]),
     ("paper-tresca", &["mesh.n=32"]),
+    // Tresca's bound along the zone: the active sets take a bound per point
+    (
+        "paper-tresca",
+        &[
+            "mesh.n=32",
+            "~contact.slip_bound",
+            "contact.slip_bound_profile={along=[1.0,0.0],at=[0.0,2.0],value=[0.01,0.1]}",
+        ],
+    ),
     ("paper-frictionless", &["mesh.n=32"]),
     ("paper-3d", &["mesh.n=6"]),
     ("paper-3d", &["mesh.n=6", "contact.friction=0.1"]),

@@ -289,10 +289,15 @@ impl<'p> ContactSolve<'p> {
         }
     }
 
-    /// The plan's contact law on `n` points: frictionless without tangential multipliers,
-    /// Tresca with the scene's bound, else Coulomb.
-    pub fn new(plan: &'p Plan, scene: &'p Scene, n: usize, interrupt: contact::Interrupt) -> Self {
-        let law = plan.law(n);
+    /// The plan's contact law on `points`: frictionless without tangential multipliers,
+    /// Tresca with the scene's bound at each point, else Coulomb.
+    pub fn new(
+        plan: &'p Plan,
+        scene: &'p Scene,
+        points: &contact::ContactPoints,
+        interrupt: contact::Interrupt,
+    ) -> Self {
+        let law = plan.law(points);
         // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
         debug_assert_eq!(
             plan.fixed_point,

@@ -86,8 +86,8 @@ pub use run::{run, ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, Contacts, DirichletSpec, ElectricCondition,
     ElectrodeSpec, Electrodes, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, Loads,
-    MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SolverSpec,
-    Strategy, Valid,
+    MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SlipBoundProfile,
+    SolverSpec, Strategy, Valid,
 };
 
 use contact::ContactError;

@@ -66,6 +66,10 @@ pub struct Plan {
     /// Tresca's slip bound `S` (`contact.slip_bound`; 0 where the law is not Tresca's).
     #[serde(skip)]
     pub slip_bound: f64,
+    /// Tresca's slip bound along the zone (`contact.slip_bound_profile`), in place of
+    /// `slip_bound`.
+    #[serde(skip)]
+    pub slip_bound_profile: Option<crate::scene::SlipBoundProfile>,
 }
 
 impl Plan {
@@ -78,7 +82,12 @@ impl Plan {
         // frictionless group's coefficient is 0)
         let friction = scene.contacts().iter().any(|c| match law {
             ContactLaw::Coulomb => c.friction() > 0.0,
-            ContactLaw::Tresca => c.slip_bound() > 0.0,
+            ContactLaw::Tresca => {
+                c.slip_bound() > 0.0
+                    || c.slip_bound_profile
+                        .as_ref()
+                        .is_some_and(|p| p.value.iter().any(|&v| v > 0.0))
+            }
             _ => false,
         });
         let strategy = scene.solver.strategy;
@@ -123,15 +132,20 @@ impl Plan {
                 Rule::Tight => 1e-12,
             }),
             slip_bound: scene.first_contact().map_or(0.0, |c| c.slip_bound()),
+            slip_bound_profile: scene.first_contact().and_then(|c| c.slip_bound_profile.clone()),
         }
     }
 
-    /// The plan's contact law on `n` points, as the contact crate takes it: frictionless
-    /// without tangential multipliers, Tresca with the scene's bound, else Coulomb.
-    pub fn law(&self, n: usize) -> contact::Law {
+    /// The plan's contact law on `points`, as the contact crate takes it: frictionless
+    /// without tangential multipliers, Tresca with the scene's bound (uniform, or its profile
+    /// at each point), else Coulomb.
+    pub fn law(&self, points: &contact::ContactPoints) -> contact::Law {
         match (self.contact_law, self.friction) {
             (_, false) => contact::Law::Frictionless,
-            (ContactLaw::Tresca, true) => contact::Law::Tresca(vec![self.slip_bound; n]),
+            (ContactLaw::Tresca, true) => contact::Law::Tresca(match &self.slip_bound_profile {
+                Some(p) => points.position.iter().map(|&x| p.at_point(x)).collect(),
+                None => vec![self.slip_bound; points.len()],
+            }),
             _ => contact::Law::Coulomb,
         }
     }

@@ -235,3 +235,20 @@ def test_electrical_contact_from_python():
     with pytest.raises(pc.InputError, match="the petsc backend does not solve it") as info:
         pc.run(s)
     assert info.value.key == "contact.electric"
+
+
+def test_a_tresca_bound_along_the_zone_from_python():
+    """`contact.slip_bound_profile` given as a dict: every point's tangential multiplier within
+    its own bound (piecewise linear along x), the slipping points on it."""
+    profile = {"along": [1.0, 0.0], "at": [0.0, 2.0], "value": [0.01, 0.1]}
+    s = pc.Scene.load("paper-tresca", {"mesh.n": 32, "contact.slip_bound": None, "contact.slip_bound_profile": profile})
+    c = pc.run(s).contact
+    bound = np.interp(c.x[:, 0], profile["at"], profile["value"])
+    t = np.abs(c.lambda_t[:, 0])
+    assert np.all(t <= bound * (1 + 1e-9) + 1e-14)
+    slip = c.status == pc.SLIP
+    assert slip.any()
+    assert np.allclose(t[slip], bound[slip], rtol=1e-9, atol=0)
+    with pytest.raises(pc.InputError) as info:
+        s.set("contact.slip_bound_profile.at", [2.0, 0.0])
+    assert info.value.key == "contact.slip_bound_profile.at"

@@ -383,6 +383,19 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "Tresca step",
+        why: "Tresca's bound along the zone jumping from 0 (free slip) to 1 (every point held) across 0.002 at the middle of the face: two laws side by side on one face",
+        scene: "paper-tresca",
+        sets: &[
+            "mesh.n=128",
+            "~contact.slip_bound",
+            "contact.slip_bound_profile={along=[1.0,0.0],at=[0.999,1.001],value=[0.0,1.0]}",
+        ],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "huge sphere",
         why: "a rigid sphere of radius 1e6 pushed 1e-7 into PZT-4 (contact radius 0.32, as the shipped R = 10 at 0.01): its height R - sqrt(R² - ρ²) evaluated without cancellation",
         scene: "indent-sphere",

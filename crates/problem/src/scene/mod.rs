@@ -550,6 +550,9 @@ impl Scene {
         for c in self.contacts() {
             add("contact.friction", c.friction.as_slice());
             add("contact.slip_bound", c.slip_bound.as_slice());
+            if let Some(p) = &c.slip_bound_profile {
+                add("contact.slip_bound_profile.value", &p.value);
+            }
             add("contact.gap", &[c.gap]);
             add("contact.gap_curvature", &[c.gap_curvature]);
             add(
@@ -1079,6 +1082,9 @@ pub struct ContactSpec {
     /// Tresca slip bound S (Tresca only).
     #[serde(default, serialize_with = "zero_when_absent")]
     pub slip_bound: Option<f64>,
+    /// Tresca's slip bound varying along the zone (Tresca only; in place of `slip_bound`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slip_bound_profile: Option<SlipBoundProfile>,
     /// Initial gap g (uniform part).
     #[serde(default)]
     pub gap: f64,
@@ -1336,6 +1342,38 @@ pub fn sphere_height(r: f64, rho: f64) -> f64 {
     rho * (x / (1.0 + (1.0 - x).sqrt() * (1.0 + x).sqrt()))
 }
 
+/// Tresca's slip bound varying along the contact zone (`contact.slip_bound_profile`): piecewise
+/// linear in the point's coordinate `s = x · along` (`along` a direction, not normalised:
+/// `[1, 0]` reads `x`), through `value[k]` at `at[k]` (increasing), constant beyond the ends.
+/// A wear track, a lubricated patch, a bound that follows the pressure of a known solution.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SlipBoundProfile {
+    /// The direction along which the bound varies (the mesh's dimension).
+    pub along: Vec<f64>,
+    /// The coordinates of the profile's points, increasing.
+    pub at: Vec<f64>,
+    /// The bound at each (`>= 0`).
+    pub value: Vec<f64>,
+}
+
+impl SlipBoundProfile {
+    /// The bound at the point `x`.
+    pub fn at_point(&self, x: [f64; 3]) -> f64 {
+        let s: f64 = self.along.iter().zip(x).map(|(a, x)| a * x).sum();
+        let k = self.at.partition_point(|&t| t <= s);
+        match k {
+            0 => self.value[0],
+            k if k == self.at.len() => self.value[k - 1],
+            k => {
+                let (t0, t1) = (self.at[k - 1], self.at[k]);
+                let (v0, v1) = (self.value[k - 1], self.value[k]);
+                v0 + (v1 - v0) * ((s - t0) / (t1 - t0))
+            }
+        }
+    }
+}
+
 /// Normal compliance: the foundation's pressure `λ_n = k [u_n - g]₊^m` at the penetration
 /// `u_n - g` (Oden and Martins 1985; docs/theory.md).
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
@@ -1361,6 +1399,7 @@ impl ContactSpec {
             law,
             friction: None,
             slip_bound: None,
+            slip_bound_profile: None,
             gap: 0.0,
             gap_curvature: 0.0,
             gap_center: None,

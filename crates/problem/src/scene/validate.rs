@@ -6,7 +6,7 @@
 
 use super::{
     ContactLaw, ContactSpec, ExactKind, ExactSpec, IndenterShape, IndenterSpec, MaterialModel, MaterialSpec, MeshKind,
-    MeshSpec, PathSpec, Rule, Scene, SolverSpec, Strategy,
+    MeshSpec, PathSpec, Rule, Scene, SlipBoundProfile, SolverSpec, Strategy,
 };
 
 /// A scene value that cannot be used: the key at fault (dotted, as `--set` takes it) and what
@@ -267,6 +267,9 @@ fn len(key: &str, v: &[f64], n: usize) -> Result<(), SceneError> {
 /// given and in the contact face's plane.
 fn check_contact_dimension(c: &ContactSpec, dim: usize) -> Result<(), SceneError> {
     len("contact.normal", &c.normal, dim)?;
+    if let Some(p) = &c.slip_bound_profile {
+        len("contact.slip_bound_profile.along", &p.along, dim)?;
+    }
     if let Some(g) = &c.gap_center {
         len("contact.gap_center", g, dim)?;
     }
@@ -656,6 +659,47 @@ fn validate_material(m: &MaterialSpec) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// Tresca's bound along the zone: in place of the uniform one; a direction, increasing
+/// coordinates and as many non-negative values, all finite.
+fn validate_slip_bound_profile(p: &SlipBoundProfile, uniform: bool) -> Result<(), SceneError> {
+    let key = "contact.slip_bound_profile";
+    refuse_if(
+        uniform,
+        "contact.slip_bound",
+        "a uniform bound, and contact.slip_bound_profile gives the bound along the zone: give one",
+    )?;
+    all_finite(&format!("{key}.along"), &p.along)?;
+    all_finite(&format!("{key}.at"), &p.at)?;
+    all_finite(&format!("{key}.value"), &p.value)?;
+    refuse_if(
+        p.along.iter().all(|&a| a == 0.0),
+        &format!("{key}.along"),
+        "contact.slip_bound_profile.along is the zero vector: give the direction the bound varies along",
+    )?;
+    if p.at.is_empty() || p.at.len() != p.value.len() {
+        return Err(SceneError::new(
+            &format!("{key}.value"),
+            format!(
+                "contact.slip_bound_profile has {} coordinates (at) and {} values: give one value per coordinate, at least one",
+                p.at.len(),
+                p.value.len()
+            ),
+        ));
+    }
+    refuse_if(
+        p.at.windows(2).any(|w| w[0] >= w[1]),
+        &format!("{key}.at"),
+        "contact.slip_bound_profile.at must increase strictly",
+    )?;
+    if let Some(v) = p.value.iter().find(|&&v| v < 0.0) {
+        return Err(SceneError::new(
+            &format!("{key}.value"),
+            format!("contact.slip_bound_profile.value holds {v}: a slip bound is non-negative"),
+        ));
+    }
+    Ok(())
+}
+
 fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
     finite("contact.gap", c.gap)?;
     finite("contact.gap_curvature", c.gap_curvature)?;
@@ -667,6 +711,9 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
         if v < 0.0 {
             return Err(SceneError::new(key, format!("{key} = {v} must be non-negative")));
         }
+    }
+    if let Some(p) = &c.slip_bound_profile {
+        validate_slip_bound_profile(p, c.slip_bound.is_some())?;
     }
     all_finite("contact.gap_center", c.gap_center.as_deref().unwrap_or_default())?;
     all_finite("contact.normal", &c.normal)?;
@@ -695,17 +742,18 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
             let why = "friction, and contact.law = \"signorini\" is frictionless";
             refuse_if(c.friction.is_some(), "contact.friction", why)?;
             refuse_if(c.slip_bound.is_some(), "contact.slip_bound", why)?;
+            refuse_if(c.slip_bound_profile.is_some(), "contact.slip_bound_profile", why)?;
         }
         ContactLaw::Tresca => refuse_if(
             c.friction.is_some(),
             "contact.friction",
             "Coulomb's coefficient, and contact.law = \"tresca\" takes contact.slip_bound",
         )?,
-        ContactLaw::Coulomb => refuse_if(
-            c.slip_bound.is_some(),
-            "contact.slip_bound",
-            "Tresca's bound, and contact.law = \"coulomb\" takes contact.friction",
-        )?,
+        ContactLaw::Coulomb => {
+            let why = "Tresca's bound, and contact.law = \"coulomb\" takes contact.friction";
+            refuse_if(c.slip_bound.is_some(), "contact.slip_bound", why)?;
+            refuse_if(c.slip_bound_profile.is_some(), "contact.slip_bound_profile", why)?;
+        }
         // contact switched off: the section is kept as it is, unused (the plan says so)
         ContactLaw::None => {}
     }
@@ -921,7 +969,7 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
         )?;
         same(
             "contact.slip_bound",
-            c.slip_bound != first.slip_bound,
+            c.slip_bound != first.slip_bound || c.slip_bound_profile != first.slip_bound_profile,
             "Tresca's slip bound",
         )?;
         let one = |key: &str, given: bool, what: &str| {
