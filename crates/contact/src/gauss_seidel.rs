@@ -265,15 +265,13 @@ impl<P: AffineProblem> Sweeps<'_, P> {
         let (n, nt) = (sweeper.flat.n, sweeper.flat.nt);
         let lambda = PointValues::from_flat(x, n, nt);
         let u = sweeper.displacement(u0, x);
-        let residual = self.measure.of(
-            self.points,
-            self.law,
-            &lambda,
-            &u,
-            self.problem.loads(),
-            1.0 / self.mu_max,
-            self.reference,
-        );
+        let scales = crate::solution::Scales {
+            c: 1.0 / self.mu_max,
+            reference: self.reference,
+        };
+        let residual = self
+            .measure
+            .of(self.points, self.law, &lambda, &u, self.problem.loads(), scales);
         best.offer(&lambda, &u, residual);
         (lambda, residual)
     }

@@ -411,10 +411,18 @@ pub fn desaxce_residual(
     }
 }
 
+/// What the complementarity residual is measured with: the natural map's constant `c` and
+/// the multipliers' scale `reference` ([`complementarity_residual`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Scales {
+    pub(crate) c: f64,
+    pub(crate) reference: f64,
+}
+
 impl Measure {
-    /// The residual of `(lambda, u)` by this measure; `c` and `reference` are those of
-    /// [`complementarity_residual`], `u0` the displacement under the loads alone.
-    #[allow(clippy::too_many_arguments)]
+    /// The residual of `(lambda, u)` by this measure; `scales` are the natural map's constant
+    /// and the multipliers' scale of [`complementarity_residual`], `u0` the displacement under
+    /// the loads alone.
     pub(crate) fn of(
         self,
         points: &ContactPoints,
@@ -422,18 +430,17 @@ impl Measure {
         lambda: &PointValues,
         u: &PointValues,
         u0: &PointValues,
-        c: f64,
-        reference: f64,
+        scales: Scales,
     ) -> f64 {
         match self {
             Measure::Complementarity => {
                 let radius = slip_bound(points, law, &lambda.normal);
-                complementarity_residual(points, &radius, lambda, u, c, reference)
+                complementarity_residual(points, &radius, lambda, u, scales.c, scales.reference)
             }
             Measure::DeSaxce => desaxce_residual(points, law, lambda, u, u0),
             Measure::Both => Measure::Complementarity
-                .of(points, law, lambda, u, u0, c, reference)
-                .max(Measure::DeSaxce.of(points, law, lambda, u, u0, c, reference)),
+                .of(points, law, lambda, u, u0, scales)
+                .max(Measure::DeSaxce.of(points, law, lambda, u, u0, scales)),
         }
     }
 }

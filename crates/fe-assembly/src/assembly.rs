@@ -199,8 +199,8 @@ impl<'m> Discretization<'m> {
         );
         let (mut av, mut gv, mut bv) = (a.zeros(), g.zeros(), b.zeros());
         match par {
-            Parallelism::Rayon => self.assemble_node_owned(d, &node_cells, &a, &g, &b, &mut av, &mut gv, &mut bv),
-            Parallelism::Serial => self.assemble_cell_loop(d, &a, &g, &b, &mut av, &mut gv, &mut bv),
+            Parallelism::Rayon => self.assemble_node_owned(d, &node_cells, [&a, &g, &b], [&mut av, &mut gv, &mut bv]),
+            Parallelism::Serial => self.assemble_cell_loop(d, [&a, &g, &b], [&mut av, &mut gv, &mut bv]),
         }
         let (g, b) = (g.into_matrix(gv), b.into_matrix(bv));
         let (g, b) = match &untied {
@@ -217,17 +217,14 @@ impl<'m> Discretization<'m> {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// The blocks' values (`[A, G, B]` on their patterns), each node's columns filled by
+    /// one task from the cells around it.
     fn assemble_node_owned(
         &self,
         d: &DofMap,
         node_cells: &(Vec<usize>, Vec<usize>),
-        pa: &Pattern,
-        pg: &Pattern,
-        pb: &Pattern,
-        av: &mut [f64],
-        gv: &mut [f64],
-        bv: &mut [f64],
+        [pa, pg, pb]: [&Pattern; 3],
+        [av, gv, bv]: [&mut [f64]; 3],
     ) {
         let mesh = self.mesh;
         let dim = mesh.dim;
@@ -316,17 +313,8 @@ impl<'m> Discretization<'m> {
             });
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn assemble_cell_loop(
-        &self,
-        d: &DofMap,
-        pa: &Pattern,
-        pg: &Pattern,
-        pb: &Pattern,
-        av: &mut [f64],
-        gv: &mut [f64],
-        bv: &mut [f64],
-    ) {
+    /// The blocks' values (`[A, G, B]` on their patterns), cell after cell.
+    fn assemble_cell_loop(&self, d: &DofMap, [pa, pg, pb]: [&Pattern; 3], [av, gv, bv]: [&mut [f64]; 3]) {
         let mesh = self.mesh;
         let dim = mesh.dim;
         let nl = dim + 1;

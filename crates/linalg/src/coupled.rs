@@ -250,6 +250,19 @@ pub struct CoupledBlocks<'a> {
     pub b: &'a SparseColMat<usize, f64>,
 }
 
+/// A right-hand side `b = [b_u; b_φ]`, with `scale` the size of the parts it is made of (for a
+/// `b` whose parts cancel: loads balanced by contact forces), what a residual is measured
+/// against ([`equilibrium_residual`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Rhs<'a> {
+    /// `b_u`.
+    pub u: &'a [f64],
+    /// `b_φ`.
+    pub phi: &'a [f64],
+    /// The size of `b`'s parts (0: `‖b‖` itself).
+    pub scale: f64,
+}
+
 /// `b - K x` by blocks: `(b_u - A u - Gᵀ φ, b_φ - G u + B φ)`.
 fn minus_k_x(k: CoupledBlocks<'_>, u: &[f64], phi: &[f64], b_u: &[f64], b_phi: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let mut ru = b_u.to_vec();
@@ -282,19 +295,17 @@ pub struct Refined {
 ///
 /// # Errors
 /// The solver's error.
-#[allow(clippy::too_many_arguments)]
 pub fn refine(
     solver: &mut dyn CoupledSolver,
     k: CoupledBlocks<'_>,
-    b_u: &[f64],
-    b_phi: &[f64],
+    rhs: Rhs<'_>,
     u: &mut [f64],
     phi: &mut [f64],
-    scale: f64,
     tol: f64,
     max_steps: usize,
 ) -> Result<Refined, LinalgError> {
-    let measure = |u: &[f64], phi: &[f64]| equilibrium_residual(k.a, k.g, k.b, u, phi, b_u, b_phi, scale);
+    let Rhs { u: b_u, phi: b_phi, .. } = rhs;
+    let measure = |u: &[f64], phi: &[f64]| equilibrium_residual(k, u, phi, rhs);
     let mut residual = measure(u, phi);
     let mut steps = 0;
     while steps < max_steps && residual > tol && residual.is_finite() {
@@ -323,17 +334,13 @@ pub fn refine(
 /// is the size of the parts `b` is made of, for a `b` whose parts cancel (loads balanced by
 /// contact forces: `‖b‖` then says nothing of the error's size). The norms are scaled, so the
 /// residual is the same for data of any magnitude.
-#[allow(clippy::too_many_arguments)]
-pub fn equilibrium_residual(
-    a: &SparseColMat<usize, f64>,
-    g: &SparseColMat<usize, f64>,
-    b: &SparseColMat<usize, f64>,
-    u: &[f64],
-    phi: &[f64],
-    b_u: &[f64],
-    b_phi: &[f64],
-    scale: f64,
-) -> f64 {
+pub fn equilibrium_residual(k: CoupledBlocks<'_>, u: &[f64], phi: &[f64], rhs: Rhs<'_>) -> f64 {
+    let CoupledBlocks { a, g, b } = k;
+    let Rhs {
+        u: b_u,
+        phi: b_phi,
+        scale,
+    } = rhs;
     let mut ru: Vec<f64> = b_u.iter().map(|x| -x).collect();
     mul_add(a.as_ref(), u, &mut ru, 1.0);
     mul_t_add(g.as_ref(), phi, &mut ru, 1.0);

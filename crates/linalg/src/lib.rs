@@ -46,7 +46,7 @@ mod values;
 
 pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{
-    equilibrium_residual, refine, CoupledBlocks, CoupledSolver, DirectLdlt, FactorPreconditioner, Refined,
+    equilibrium_residual, refine, CoupledBlocks, CoupledSolver, DirectLdlt, FactorPreconditioner, Refined, Rhs,
     SchurOperator, SchurPcg, SolveInfo,
 };
 pub use dense::mirror_lower;

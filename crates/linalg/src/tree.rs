@@ -500,6 +500,21 @@ struct Scratch {
     dense: MemBuffer,
 }
 
+/// Columns of a supernode being assembled: the supernode `s`, its columns `cols` (local
+/// indices), and their values (column-major, the supernode's rows).
+struct Piece<'a> {
+    s: usize,
+    cols: std::ops::Range<usize>,
+    piece: &'a mut [f64],
+}
+
+/// The factor's values computed so far: `values[k]` is the factor's value `from + k`.
+#[derive(Clone, Copy)]
+struct Done<'a> {
+    values: &'a [f64],
+    from: usize,
+}
+
 /// The buffers of one descendant's update: its rows' places in the supernode, `M D` and the
 /// product `W` (they only grow: their old contents are overwritten).
 #[derive(Default)]
@@ -592,19 +607,14 @@ impl Ctx<'_> {
 
     /// The columns `cols` of supernode `s` (its local indices) into `piece` (column-major,
     /// the supernode's rows): the matrix's entries, less the updates `L_d D_d L_dᵀ` of its
-    /// descendants (in `head`, the factor's values from value `off` on) that meet these columns.
+    /// descendants (in `done`, the factor's values computed so far) that meet these columns.
     /// `local` maps a row of the supernode's pattern to its place.
-    #[allow(clippy::too_many_arguments)]
-    fn assemble(
-        &self,
-        s: usize,
-        cols: std::ops::Range<usize>,
-        piece: &mut [f64],
-        (head, off): (&[f64], usize),
-        local: &[usize],
-        bufs: &mut Bufs,
-        par: Par,
-    ) {
+    fn assemble(&self, target: Piece<'_>, done: Done<'_>, local: &[usize], bufs: &mut Bufs, par: Par) {
+        let Piece { s, cols, piece } = target;
+        let Done {
+            values: head,
+            from: off,
+        } = done;
         let sym = self.sym;
         let t = self.tree;
         let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
@@ -668,7 +678,21 @@ impl Ctx<'_> {
         let cuts = column_pieces(ncols, nrows, par);
         let local = &scratch.local;
         if let [0, all] = cuts[..] {
-            self.assemble(s, 0..all, ls, (head, off), local, &mut scratch.bufs, par);
+            let target = Piece {
+                s,
+                cols: 0..all,
+                piece: ls,
+            };
+            self.assemble(
+                target,
+                Done {
+                    values: head,
+                    from: off,
+                },
+                local,
+                &mut scratch.bufs,
+                par,
+            );
         } else {
             // pieces of columns on different threads: each reads every descendant and writes
             // only its own columns
@@ -682,7 +706,11 @@ impl Ctx<'_> {
             pieces
                 .into_par_iter()
                 .for_each_init(Bufs::default, |bufs, (cols, piece)| {
-                    self.assemble(s, cols, piece, (head, off), local, bufs, Par::Seq)
+                    let done = Done {
+                        values: head,
+                        from: off,
+                    };
+                    self.assemble(Piece { s, cols, piece }, done, local, bufs, Par::Seq)
                 });
         }
         for &r in pattern {

@@ -354,8 +354,13 @@ fn refinement_stops_where_a_step_no_longer_halves_the_residual() {
         let exact = DirectLdlt::new(&a, &g, &b, &Ordering::Amd, Par::Seq).unwrap();
         let mut solver = Damped { exact, rho };
         let (mut u, mut phi) = (vec![0.0; nu], vec![0.0; np]);
-        let start = linalg::equilibrium_residual(&a, &g, &b, &u, &phi, &b_u, &b_phi, 0.0);
-        let out = linalg::refine(&mut solver, k, &b_u, &b_phi, &mut u, &mut phi, 0.0, 1e-300, 3).unwrap();
+        let rhs = linalg::Rhs {
+            u: &b_u,
+            phi: &b_phi,
+            scale: 0.0,
+        };
+        let start = linalg::equilibrium_residual(k, &u, &phi, rhs);
+        let out = linalg::refine(&mut solver, k, rhs, &mut u, &mut phi, 1e-300, 3).unwrap();
         (start, out)
     };
     let (start, tenth) = refine(0.1);

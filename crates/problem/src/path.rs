@@ -16,7 +16,7 @@
 
 use crate::backend::{ContactSolve, Limits, Loads, Posed};
 use crate::boundary::ContactBoundary;
-use crate::faer_backend::{Factored, Faer, Fields, PathSystem};
+use crate::faer_backend::{Factored, Faer, Fields, Framed, PathSystem};
 use crate::progress::{Event, Reporter};
 use crate::report::{PathReport, RunReport, StepRow, Timings};
 use crate::run::{
@@ -123,15 +123,15 @@ pub fn solve_path(
     drop(solved);
     let t_steps = Instant::now();
     let mut state = History::new(boundary.points.len(), setup.plan.n_tangential(), instants.len());
-    walk.all_steps(
-        (&instants, &boundary),
-        &mut disc,
-        (&mut system, &mut path),
-        &how,
-        &mut state,
-        reporter,
-        each,
-    )?;
+    let mut on = On {
+        base: &boundary,
+        disc: &mut disc,
+        system: &mut system,
+        path: &mut path,
+        how: &how,
+        state: &mut state,
+    };
+    walk.all_steps(&instants, &mut on, reporter, each)?;
     let steps_s = t_steps.elapsed().as_secs_f64();
     let timings = (t_setup, t_assembly, steps_s, t_total);
     let (report, done) = walk.finish(&disc, &system, state, timings);
@@ -147,6 +147,18 @@ pub fn solve_path(
             fields: recovered.fields,
         },
     })
+}
+
+/// What a path's steps work on: the boundary at the scene's own factors, the discretisation
+/// (its prescribed values scaled at each step), the factors of `K` and the path's condensed
+/// system on them, the contact solve, and friction's history.
+struct On<'a, 'd> {
+    base: &'a ContactBoundary,
+    disc: &'a mut Discretization<'d>,
+    system: &'a mut Factored,
+    path: &'a mut PathSystem,
+    how: &'a ContactSolve<'a>,
+    state: &'a mut History,
 }
 
 /// What stays the same along a path: the scene, its set-up, the parts of the right-hand side.
@@ -323,6 +335,9 @@ impl History {
 
 /// One instant solved: its row, its contact solution, and where computed its fields (with the
 /// equilibrium residual and the step's loads).
+/// An instant's fields: recovered, their equilibrium residual, the loads, the displacement.
+type InstantFields = (Recovered, f64, Loads, Vec<f64>);
+
 struct Done {
     row: StepRow,
     result: ContactResult,
@@ -357,14 +372,10 @@ impl Walk<'_> {
     }
 
     /// Every instant in order, each handed to `each` and its row kept; the last kept whole.
-    #[allow(clippy::too_many_arguments)]
     fn all_steps(
         &self,
-        (instants, base): (&[f64], &ContactBoundary),
-        disc: &mut Discretization<'_>,
-        (system, path): (&mut Factored, &mut PathSystem),
-        how: &ContactSolve<'_>,
-        state: &mut History,
+        instants: &[f64],
+        on: &mut On<'_, '_>,
         reporter: &mut dyn Reporter,
         each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
     ) -> Result<(), ProblemError> {
@@ -373,9 +384,7 @@ impl Walk<'_> {
             reporter.event(&Event::PathStep { step: k, of, t });
             let at = |e: ProblemError| e.at_step(k, t);
             let fields = k == of || (self.with_fields && self.spec.has_fields(k, of + 1));
-            let done = self
-                .step((k, t), (fields, base), disc, (system, path), how, state, reporter)
-                .map_err(at)?;
+            let done = self.step(on, k, t, fields, reporter).map_err(at)?;
             reporter.event(&Event::PathStepDone { row: &done.row, of });
             each(Step {
                 row: &done.row,
@@ -387,39 +396,38 @@ impl Walk<'_> {
                     fields: &r.fields,
                 }),
             })?;
-            state.rows.push(done.row.clone());
+            on.state.rows.push(done.row.clone());
             if k == of {
-                state.last = Some(done);
+                on.state.last = Some(done);
             }
         }
         Ok(())
     }
 
-    /// The instant `(k, t)`: its prescribed values, gap and loads scaled, the contact problem
-    /// in the frame of the step before; where `with_fields`, the fields recovered and checked.
-    #[allow(clippy::too_many_arguments)]
+    /// The instant `t` (the path's `k`-th): its prescribed values, gap and loads scaled, the
+    /// contact problem in the frame of the step before; where `with_fields`, the fields
+    /// recovered and checked.
     fn step(
         &self,
-        (k, t): (usize, f64),
-        (with_fields, base): (bool, &ContactBoundary),
-        disc: &mut Discretization<'_>,
-        (system, path): (&mut Factored, &mut PathSystem),
-        how: &ContactSolve<'_>,
-        state: &mut History,
+        on: &mut On<'_, '_>,
+        k: usize,
+        t: f64,
+        with_fields: bool,
         reporter: &mut dyn Reporter,
     ) -> Result<Done, ProblemError> {
         let (scene, setup) = (self.scene, self.setup);
         let f = self.spec.factors(t);
-        disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
-        let mut boundary = base.at_factors(f.gap, f.displacement);
-        if how.weakening.is_some() {
-            boundary.points.slipped.clone_from(&state.slipped);
+        on.disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
+        let mut boundary = on.base.at_factors(f.gap, f.displacement);
+        if on.how.weakening.is_some() {
+            boundary.points.slipped.clone_from(&on.state.slipped);
         }
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
         factors.push(f.voltage);
         // force control: the depth found at each step for the indenter's force times the load
         // factor, from the step before's multipliers
+        let (path, how, state) = (&mut *on.path, on.how, &mut *on.state);
         let sol = match self.contact.indenter.as_ref().and_then(|i| i.force) {
             Some(force) => {
                 path.prime(&boundary, &factors, &state.shift);
@@ -438,25 +446,13 @@ impl Walk<'_> {
         let pressed = boundary.points.gap.iter().fold(0.0f64, |m, g| m.max(-g));
         check_history(&state.shift, path.own_scale(&factors).max(pressed), &setup.plan)?;
         let (mut sol, fields) = if with_fields {
-            let posed = Posed {
-                scene: self.valid,
-                setup,
-                disc,
-                loads: step_loads(self.parts, &f, scene)?,
-            };
-            let (sol, (u, phi)) = path.fields(how, system, &boundary, &posed, &state.shift, sol, reporter)?;
-            let (b_full, b_phi, scale) = crate::faer_backend::rhs_with_contact(&posed, Some((&boundary, &sol)));
-            let equilibrium = system.equilibrium_of(&u, &phi, &b_full, &b_phi, scale);
-            check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
-            check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
-            let pair = Some((&boundary, &sol));
-            let recovered = recover(scene, setup, disc, (&u, &phi), pair, equilibrium, reporter)?;
-            (sol, Some((recovered, equilibrium, posed.loads, u)))
+            self.fields_at(on, &boundary, &f, sol, reporter)?
         } else {
             check_solved(scene, (&[], &[]), Some(&sol), 0.0)?;
             check_accurate(scene, &setup.plan, Some(&sol), 0.0)?;
             (sol, None)
         };
+        let state = &mut *on.state;
         // the multipliers and displacements of the step in the body's frame
         for (v, s) in sol.u.tangential.iter_mut().zip(&state.shift.tangential) {
             *v += s;
@@ -490,6 +486,38 @@ impl Walk<'_> {
             result,
             fields: fields.map(|(r, e, l, _)| (r, e, l)),
         })
+    }
+
+    /// The fields of an instant (factors `f`) under the contact forces of `sol`: refined, the
+    /// law judged on them, checked and recovered; with the equilibrium residual, the loads and
+    /// the displacement.
+    fn fields_at(
+        &self,
+        on: &mut On<'_, '_>,
+        boundary: &ContactBoundary,
+        f: &Factors,
+        sol: ContactSolution,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(ContactSolution, Option<InstantFields>), ProblemError> {
+        let (scene, setup) = (self.scene, self.setup);
+        let posed = Posed {
+            scene: self.valid,
+            setup,
+            disc: on.disc,
+            loads: step_loads(self.parts, f, scene)?,
+        };
+        let framed = Framed {
+            boundary,
+            shift: &on.state.shift,
+        };
+        let (sol, (u, phi)) = on.path.fields(on.how, on.system, framed, &posed, sol, reporter)?;
+        let (b_full, b_phi, scale) = crate::faer_backend::rhs_with_contact(&posed, Some((boundary, &sol)));
+        let equilibrium = on.system.equilibrium_of(&u, &phi, &b_full, &b_phi, scale);
+        check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
+        check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
+        let pair = Some((boundary, &sol));
+        let recovered = recover(scene, setup, on.disc, (&u, &phi), pair, equilibrium, reporter)?;
+        Ok((sol, Some((recovered, equilibrium, posed.loads, u))))
     }
 
     /// The report of the last instant with the path's section, and the last instant.

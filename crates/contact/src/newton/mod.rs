@@ -47,7 +47,7 @@ use crate::gauss_seidel::{self, SweepEnd};
 use crate::operator::AffineProblem;
 use crate::operator::Compliance;
 use crate::points::{ContactPoints, PointValues};
-use crate::solution::{classify, counts, slip_bound, Best, Counter, Preamble};
+use crate::solution::{classify, counts, slip_bound, Best, Counter, Preamble, Scales};
 use crate::InputError;
 use crate::{
     ContactError, ContactInfo, ContactSolution, GaussSeidelParams, Interrupt, Interruption, Iterate, Law, Measure,
@@ -186,6 +186,14 @@ impl NanMax for f64 {
     }
 }
 
+/// What a solve is asked: its points, its law and Newton's parameters.
+#[derive(Clone, Copy)]
+struct Asked<'a> {
+    points: &'a ContactPoints,
+    law: &'a Law,
+    params: &'a NewtonParams,
+}
+
 /// How a run of Newton steps ended.
 enum End {
     Converged,
@@ -278,6 +286,15 @@ impl Judge<'_> {
         }
     }
 
+    /// The complementarity residual's scales: the problem's own constant `1/μ_max` and the
+    /// preamble's multiplier scale.
+    fn scales(&self) -> Scales {
+        Scales {
+            c: 1.0 / self.flat.mu_max,
+            reference: self.reference,
+        }
+    }
+
     /// The residual of a state of the problem itself.
     fn residual(&self, s: &State) -> f64 {
         self.residual_of(&self.flat, s)
@@ -290,15 +307,7 @@ impl Judge<'_> {
         let u = problem.values(&s.u);
         let u0 = problem.values(&problem.u0);
         self.measure
-            .of(
-                &self.points_at(&u),
-                self.law,
-                &lambda,
-                &u,
-                &u0,
-                1.0 / self.flat.mu_max,
-                self.reference,
-            )
+            .of(&self.points_at(&u), self.law, &lambda, &u, &u0, self.scales())
             .nan_max(problem.electric_residual(s))
     }
 
@@ -312,8 +321,7 @@ impl Judge<'_> {
                 &self.flat.values(&s.x),
                 &u,
                 self.u0,
-                1.0 / self.flat.mu_max,
-                self.reference,
+                self.scales(),
             )
             .nan_max(self.flat.electric_residual(s))
     }
@@ -692,11 +700,10 @@ pub fn solve_newton_cached<P: AffineProblem>(
     let mut flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
     flat.weakening = params.weakening;
     info.augmentation = Some(1.0 / mu_max);
+    let asked = Asked { points, law, params };
     let x0 = match sweeps_first(
         problem,
-        points,
-        law,
-        params,
+        asked,
         (mu_max, reference),
         &start,
         Directions::step_in_sweeps(&flat),
@@ -725,7 +732,7 @@ pub fn solve_newton_cached<P: AffineProblem>(
         });
     };
     let stalled = judge.iterate(&best, best_residual);
-    after_stall(problem, points, law, params, stalled, reason, info, progress)
+    after_stall(problem, asked, stalled, reason, info, progress)
 }
 
 /// How stage 0 ended.
@@ -751,12 +758,9 @@ const FIRST_SWEEPS_STEPS: f64 = 25.0;
 /// ([`Directions::step_in_sweeps`]); where it does not, Newton starts as it would have. The
 /// choice is the problem's: where a point's own block dominates its coupling to
 /// the others, sweeps converge fast and need no factorisation.
-#[allow(clippy::too_many_arguments)]
 fn sweeps_first<P: AffineProblem>(
     problem: &P,
-    points: &ContactPoints,
-    law: &Law,
-    params: &NewtonParams,
+    Asked { points, law, params }: Asked<'_>,
     (mu_max, reference): (f64, f64),
     start: &PointValues,
     step: Option<f64>,
@@ -1000,24 +1004,20 @@ fn electric_start(
 
 /// After Newton's stages stalled at the iterate `stalled`: stage 3 (the fallback, where the
 /// parameters ask for it), and then whose failure it is ([`whose_failure`]).
-#[allow(clippy::too_many_arguments)]
 fn after_stall<P: AffineProblem>(
     problem: &mut P,
-    points: &ContactPoints,
-    law: &Law,
-    params: &NewtonParams,
+    asked: Asked<'_>,
     stalled: Iterate,
     reason: Stall,
     info: ContactInfo,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
+    let Asked { points, law, params } = asked;
     let best_residual = stalled.residual;
     let failure = if params.fallback && params.weakening.is_none() {
         match fallback(
             problem,
-            points,
-            law,
-            params,
+            asked,
             stalled.lambda.clone(),
             best_residual,
             info.clone(),
@@ -1181,12 +1181,9 @@ fn whose_failure<P: AffineProblem>(
 
 /// Stage 3, from the best multipliers projected onto the sets: block Gauss–Seidel for
 /// Coulomb's law, the accelerated projected gradient for the convex laws.
-#[allow(clippy::too_many_arguments)]
 fn fallback<P: AffineProblem>(
     problem: &mut P,
-    points: &ContactPoints,
-    law: &Law,
-    params: &NewtonParams,
+    Asked { points, law, params }: Asked<'_>,
     lambda: PointValues,
     residual: f64,
     info: ContactInfo,

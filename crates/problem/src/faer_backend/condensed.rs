@@ -272,8 +272,8 @@ fn electric_contact(
         None => solve(&boundary.points, None)?,
     };
     let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
-    let (b_u, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
-    let refinement = refine(direct, blocks, &b_u, &b_phi, scale, &mut u, &mut phi, REFINE_TOL)?.steps;
+    let b = rhs_with_contact(posed, Some((boundary, &sol)));
+    let refinement = refine(direct, blocks, rhs(&b), &mut u, &mut phi, REFINE_TOL)?.steps;
     // the potentials reported are the refined fields'
     if let (Some(e), Some((_, dofs))) = (&mut sol.electric, &boundary.electric) {
         let n_u = loads.b_u.len();
@@ -328,18 +328,8 @@ impl Refining<'_> {
         let u0 = dense.u0.clone();
         let mut corrections = 0;
         loop {
-            let (b_full, b_phi, scale) = rhs_with_contact(posed, Some((boundary, &sol)));
-            self.refinement += refine(
-                self.direct,
-                self.blocks,
-                &b_full,
-                &b_phi,
-                scale,
-                u,
-                phi,
-                self.refine_tol,
-            )?
-            .steps;
+            let b = rhs_with_contact(posed, Some((boundary, &sol)));
+            self.refinement += refine(self.direct, self.blocks, rhs(&b), u, phi, self.refine_tol)?.steps;
             sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u, self.shift);
             if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
                 break;
@@ -393,23 +383,33 @@ pub(crate) fn rhs_with_contact(
 
 /// Iterative refinement of the last solve (with `K`'s factors), to the equilibrium residual
 /// `tol`: at most 3 corrections, each kept only where it lowers the residual.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn refine(
     direct: &mut DirectLdlt,
     b: &Blocks,
-    b_u: &[f64],
-    b_phi: &[f64],
-    scale: f64,
+    rhs: linalg::Rhs<'_>,
     u: &mut [f64],
     phi: &mut [f64],
     tol: f64,
 ) -> Result<linalg::Refined, ProblemError> {
-    let k = linalg::CoupledBlocks {
+    Ok(linalg::refine(direct, coupled(b), rhs, u, phi, tol, 3)?)
+}
+
+/// `K`'s blocks as linalg takes them.
+pub(super) fn coupled(b: &Blocks) -> linalg::CoupledBlocks<'_> {
+    linalg::CoupledBlocks {
         a: &b.a,
         g: &b.g,
         b: &b.b,
-    };
-    Ok(linalg::refine(direct, k, b_u, b_phi, u, phi, scale, tol, 3)?)
+    }
+}
+
+/// The right-hand side `(b_u, b_φ)` of size `scale`, as linalg takes it.
+pub(super) fn rhs<'a>((b_u, b_phi, scale): &'a (Vec<f64>, Vec<f64>, f64)) -> linalg::Rhs<'a> {
+    linalg::Rhs {
+        u: b_u,
+        phi: b_phi,
+        scale: *scale,
+    }
 }
 
 /// Corrections of the condensed problem by its defect at the points, at most (each a warm

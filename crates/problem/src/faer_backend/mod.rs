@@ -7,9 +7,9 @@
 mod condensed;
 mod path_system;
 
+use condensed::{coupled, refine, rhs, solve_contact, REFINE_TOL};
 pub(crate) use condensed::{force_controlled, rhs_with_contact};
-use condensed::{refine, solve_contact, REFINE_TOL};
-pub(crate) use path_system::PathSystem;
+pub(crate) use path_system::{Framed, PathSystem};
 
 use crate::backend::Unsupported;
 use crate::backend::{Backend, ContactSolve, Figures, Finished, Limits, Posed, Solved};
@@ -103,11 +103,9 @@ impl Backend for Faer {
         system: &Factored,
         solved: &Solved<Self::Solution>,
     ) -> Result<f64, ProblemError> {
-        let (b_full, b_phi, scale) = rhs_with_contact(posed, solved.contact.as_ref().map(|(b, sol)| (b, sol)));
-        let (b, (u, phi)) = (&system.blocks, &solved.x);
-        Ok(linalg::equilibrium_residual(
-            &b.a, &b.g, &b.b, u, phi, &b_full, &b_phi, scale,
-        ))
+        let b = rhs_with_contact(posed, solved.contact.as_ref().map(|(b, sol)| (b, sol)));
+        let (u, phi) = &solved.x;
+        Ok(linalg::equilibrium_residual(coupled(&system.blocks), u, phi, rhs(&b)))
     }
 
     fn finish(
@@ -175,8 +173,12 @@ impl Factored {
 
     /// The equilibrium residual of `(u, φ)` against the right-hand sides (their size `scale`).
     pub(crate) fn equilibrium_of(&self, u: &[f64], phi: &[f64], b_u: &[f64], b_phi: &[f64], scale: f64) -> f64 {
-        let b = &self.blocks;
-        linalg::equilibrium_residual(&b.a, &b.g, &b.b, u, phi, b_u, b_phi, scale)
+        let b = linalg::Rhs {
+            u: b_u,
+            phi: b_phi,
+            scale,
+        };
+        linalg::equilibrium_residual(coupled(&self.blocks), u, phi, b)
     }
 }
 
@@ -316,8 +318,8 @@ fn solve_linear(system: &mut Factored, posed: &Posed<'_>) -> Result<Solved<Field
         .coupled()
         .solve(&loads.b_u, &loads.b_phi, &mut u, &mut phi)?;
     if let LinearSolver::Direct(direct) = &mut system.solver {
-        let (b, b_phi, scale) = rhs_with_contact(posed, None);
-        system.refinement = refine(direct, &system.blocks, &b, &b_phi, scale, &mut u, &mut phi, REFINE_TOL)?.steps;
+        let b = rhs_with_contact(posed, None);
+        system.refinement = refine(direct, &system.blocks, rhs(&b), &mut u, &mut phi, REFINE_TOL)?.steps;
     }
     Ok(Solved {
         x: (u, phi),

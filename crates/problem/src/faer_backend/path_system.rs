@@ -125,14 +125,12 @@ impl PathSystem {
     /// The fields of a step under the loads of `posed` and the contact forces of `sol` (in
     /// the frame `shift`), refined, the law judged on them (and the contact solve corrected
     /// where they miss it).
-    #[allow(clippy::too_many_arguments)]
     pub(crate) fn fields(
         &mut self,
         how: &ContactSolve<'_>,
         system: &mut Factored,
-        boundary: &ContactBoundary,
+        Framed { boundary, shift }: Framed<'_>,
         posed: &Posed<'_>,
-        shift: &PointValues,
         sol: ContactSolution,
         reporter: &mut dyn Reporter,
     ) -> Result<(ContactSolution, Fields), ProblemError> {
@@ -154,6 +152,14 @@ impl PathSystem {
         system.refinement = on.refinement;
         Ok((sol, (u, phi)))
     }
+}
+
+/// A step's contact boundary (its gaps and prescribed values at the step's factors) and the
+/// frame its contact problem is posed in: the tangential displacements of the step before.
+#[derive(Clone, Copy)]
+pub(crate) struct Framed<'a> {
+    pub(crate) boundary: &'a ContactBoundary,
+    pub(crate) shift: &'a PointValues,
 }
 
 /// A path on a strategy without the `L D Lᵀ` of `K` (the scene's checks refuse it first).
