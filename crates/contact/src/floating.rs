@@ -21,6 +21,7 @@ const MAX_SOLVES: usize = 100;
 
 /// Why the floating conductor's potential was not found.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum FloatingError<E> {
     /// A contact solve at some `ψ` failed.
     #[error(transparent)]

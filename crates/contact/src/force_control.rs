@@ -14,6 +14,7 @@ const MAX_SOLVES: usize = 200;
 
 /// Why the depth was not found.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ForceError<E> {
     /// A contact solve at some depth failed.
     #[error(transparent)]

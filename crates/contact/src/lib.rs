@@ -98,6 +98,7 @@ impl OperatorError {
 /// A loop never reports an error at a residual that meets its tolerance. The messages name no
 /// solver option: the application that chose the solver knows what else to try.
 #[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
 pub enum ContactError {
     /// A first-order iteration reached its iteration limit while still making progress.
     #[error("Uzawa did not converge in {n_iters} iterations (residual {residual:.3e})")]
@@ -213,6 +214,7 @@ pub enum ContactError {
 
 /// What is wrong with the input of a contact solve: the first bad item, by name.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum InputError {
     /// The arrays of the contact points do not all have one entry per point.
     #[error("contact points: arrays of different lengths")]

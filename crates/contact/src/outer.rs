@@ -67,6 +67,7 @@ pub enum Found<T> {
 
 /// Why [`bracketed_root`] stopped without an answer.
 #[derive(Debug)]
+#[non_exhaustive]
 pub enum SearchError<E> {
     /// An evaluation failed.
     Eval(E),

@@ -57,6 +57,7 @@ pub struct FrictionProblem {
 
 /// What is wrong with a file that does not hold a problem.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum FormatError {
     /// A token that is not what the format has at that place.
     #[error("line {line}: expected {expected}, found `{found}`")]

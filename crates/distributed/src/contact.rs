@@ -327,6 +327,7 @@ impl<'p> Context<'_, 'p> {
 
 /// Why the active-set iteration stopped without an answer.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ActiveSetError {
     /// PETSc or MPI failed.
     #[error(transparent)]

@@ -9,7 +9,7 @@ use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError, Vector};
 use problem::backend::{Backend, ContactBoundary, ContactSolve, Figures, Finished, Posed, Setup, Solved, Unsupported};
-use problem::{ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, SceneError, Solution};
+use problem::{ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, Solution};
 use std::time::Instant;
 
 /// Steps of the active-set iteration at most.
@@ -17,6 +17,7 @@ pub const MAX_ACTIVE_SET_STEPS: usize = 60;
 
 /// What can stop a run of the PETSc backend.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum DistributedError {
     /// The scene, its mesh or its data (as the default backend reports them).
     #[error(transparent)]
@@ -295,13 +296,16 @@ fn refuse_held_tangent(scene: &Scene, boundary: &ContactBoundary) -> Result<(), 
     let (Some(node), Some(spec)) = (boundary.first_held_tangent(), scene.first_contact()) else {
         return Ok(());
     };
-    Err(SceneError::new(
+    // found once the mesh is read (the scene alone does not tell it): the backend's refusal
+    Err(Unsupported::new(
+        "petsc",
         "contact.group",
         format!(
-            "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face): the PETSc backend's active sets do not hold a tangent of a contact point; the default backend does",
+            "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face), and its active sets do not hold a tangent of a contact point",
             spec.group
         ),
     )
+    .advise("the default backend does: remove solver.backend")
     .into())
 }
 

@@ -11,6 +11,7 @@ pub mod studies;
 
 /// What can go wrong in the application; each variant names the file or item at fault.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum DriverError {
     /// A scene, mesh or input file, the run, or an output (as the library reports them).
     #[error(transparent)]
@@ -23,6 +24,10 @@ pub enum DriverError {
     #[cfg(feature = "petsc")]
     #[error("contact: {0}")]
     ActiveSet(distributed::contact::ActiveSetError),
+    /// Another failure of the PETSc backend's run.
+    #[cfg(feature = "petsc")]
+    #[error(transparent)]
+    Distributed(distributed::DistributedError),
     /// Command-line arguments (or a library caller's) that do not fit together, or are out of
     /// their range.
     #[error("{0}")]

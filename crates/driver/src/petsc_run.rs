@@ -39,6 +39,7 @@ pub fn run_distributed(
         distributed::DistributedError::Problem(p) => DriverError::from(p),
         distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
         distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),
+        other => DriverError::Distributed(other),
     })?;
     let peaks = petsc.all_gather(peak_memory_bytes())?;
     let Some(mut solution) = solved else {

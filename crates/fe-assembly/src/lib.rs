@@ -67,6 +67,7 @@ pub type VectorFn = Arc<dyn Fn(&[f64]) -> [f64; 3] + Send + Sync>;
 
 /// Inconsistent input of a discretisation: the first bad item, by name.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum InputError {
     /// The mesh's cells are not P1 simplices.
     #[error("{kind} cells are not supported: the kernels are P1 simplices")]
@@ -195,6 +196,7 @@ pub enum InputError {
 
 /// What can go wrong while setting up or assembling.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum AssemblyError {
     /// A mesh problem (a missing group, a bad cell).
     #[error(transparent)]

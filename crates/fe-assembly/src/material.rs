@@ -101,6 +101,7 @@ pub struct Material {
 
 /// A material that cannot be used.
 #[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
 pub enum MaterialError {
     /// A constant is NaN or infinite.
     #[error("material `{material}`: {what} has a non-finite entry")]

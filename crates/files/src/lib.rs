@@ -27,6 +27,7 @@ pub mod scene_file;
 
 /// What can go wrong with the files of a run; each variant names the file or item at fault.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A scene that does not read, or holds an invalid value.
     #[error("scene {file}: {source}")]
@@ -84,6 +85,7 @@ pub enum Error {
 
 /// Why a scene file does not become a scene.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SceneFileError {
     /// No shipped scene has the name, and no file the path.
     #[error("no shipped scene of that name and no such file (shipped: {})", .shipped.join(", "))]

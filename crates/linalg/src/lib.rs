@@ -55,6 +55,7 @@ pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgS
 
 /// What can go wrong in the linear algebra.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
+#[non_exhaustive]
 pub enum LinalgError {
     /// A Cholesky factorisation met a non-positive pivot: the matrix is not SPD (for example a
     /// body that is not held against rigid motions).
@@ -127,6 +128,7 @@ pub enum LinalgError {
 
 /// Sizes that do not fit, by what they are.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ShapeError {
     /// A matrix that is not square.
     #[error("a {rows}x{cols} matrix is not square")]

@@ -140,6 +140,7 @@ pub struct Mesh {
 
 /// What can go wrong with a mesh: reading it, checking it, or asking it for a group.
 #[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
 pub enum MeshError {
     /// A boundary group was asked for that the mesh does not have.
     #[error("boundary group `{name}` is missing (the mesh has: {available})")]

@@ -14,6 +14,7 @@ pub type Result<T> = std::result::Result<T, PetscError>;
 
 /// What went wrong in a call into PETSc, or in the layer's own checks around it.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum PetscError {
     /// A PETSc routine returned an error code.
     #[error("PETSc: {call} failed (error {code}): {message}")]

@@ -31,6 +31,7 @@ use std::f64::consts::PI;
 
 /// Why the half-space's constants cannot be formed.
 #[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
 pub enum HalfSpaceError {
     /// `T(ω)` (the (u, φ) stiffness along one direction) is singular: no admissible material.
     #[error("the material's stiffness along the direction at {angle_deg:.1} degrees is singular")]

@@ -209,6 +209,7 @@ pub struct ReadmeDoctests;
 
 /// What can go wrong in a run; each variant names the input or the step at fault.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ProblemError {
     /// A scene value that cannot be used (named by its key).
     #[error(transparent)]

@@ -152,6 +152,9 @@ pub fn kind_of_problem(e: &ProblemError) -> Kind {
             ..
         } => Kind::Convergence,
         ProblemError::Interrupted { .. } => Kind::Base,
+        // a kind the core adds later (its errors are non-exhaustive): the base class until it
+        // is given its own
+        _ => Kind::Base,
     }
 }
 
@@ -162,6 +165,7 @@ pub fn kind_of(e: &Error) -> Kind {
         Error::Mesh(_) => Kind::Mesh,
         Error::Problem(p) => kind_of_problem(p),
         Error::Output { .. } | Error::OutputConflict { .. } | Error::Picture { .. } => Kind::Output,
+        _ => Kind::Base,
     }
 }
 
