@@ -1368,7 +1368,9 @@ impl SlipBoundProfile {
             k => {
                 let (t0, t1) = (self.at[k - 1], self.at[k]);
                 let (v0, v1) = (self.value[k - 1], self.value[k]);
-                v0 + (v1 - v0) * ((s - t0) / (t1 - t0))
+                // halved: the differences of coordinates near the largest numbers stay finite
+                let w = (s / 2.0 - t0 / 2.0) / (t1 / 2.0 - t0 / 2.0);
+                v0 * (1.0 - w) + v1 * w
             }
         }
     }
@@ -1702,6 +1704,37 @@ mod tests {
     /// the largest double, finite and monotone, `R` at the rim; and, where the direct form
     /// `R - √(R² - ρ²)` keeps its digits, equal to it. The direct form at R = 1e6 was off the
     /// paraboloid by 1.7e-5 (relative), and -inf past R = 1e154.
+    #[test]
+    fn a_slip_bound_profile_is_piecewise_linear_and_finite_at_the_ends_of_the_numbers() {
+        let p = SlipBoundProfile {
+            along: vec![1.0, 0.0],
+            at: vec![0.0, 1.0, 3.0],
+            value: vec![0.0, 1.0, 0.5],
+        };
+        for (x, want) in [
+            (-1.0, 0.0),
+            (0.0, 0.0),
+            (0.25, 0.25),
+            (1.0, 1.0),
+            (2.0, 0.75),
+            (3.0, 0.5),
+            (9.0, 0.5),
+        ] {
+            assert!((p.at_point([x, 7.0, 0.0]) - want).abs() < 1e-15, "{x}");
+        }
+        // coordinates and directions near the largest numbers: no overflow to NaN
+        let wide = SlipBoundProfile {
+            along: vec![1e300, 0.0],
+            at: vec![-1.7e308, 1.7e308],
+            value: vec![0.0, 2.0],
+        };
+        for x in [-1e8, 0.0, 1.0, 1e8, f64::MAX] {
+            let v = wide.at_point([x, 0.0, 0.0]);
+            assert!((0.0..=2.0).contains(&v), "{x}: {v}");
+        }
+        assert!((wide.at_point([0.0, 0.0, 0.0]) - 1.0).abs() < 1e-12);
+    }
+
     #[test]
     fn a_spheres_height_keeps_its_digits_for_any_radius() {
         for r in [1e-300, 1e-10, 1.0, 1e6, 1e154, 1e200, 1e300, f64::MAX] {
