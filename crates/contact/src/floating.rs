@@ -35,7 +35,7 @@ pub enum FloatingError<E> {
     /// The zone's compliance does not let the charge follow the potential.
     #[error("the contact zone's compliance is singular: its charge does not follow its potential")]
     Singular,
-    /// The search did not find the potential in [`MAX_SOLVES`] solves.
+    /// The search did not find the potential in 100 contact solves.
     #[error("the potential of the floating conductor carrying the charge {charge:e} was not found in {MAX_SOLVES} contact solves")]
     NotFound {
         /// The charge asked for.
@@ -53,7 +53,7 @@ pub enum FloatingError<E> {
 ///
 /// # Errors
 /// [`FloatingError`]: a solve's own error, a zone that touches nowhere or whose compliance is
-/// singular, or no potential found in [`MAX_SOLVES`] solves.
+/// singular, or no potential found in 100 contact solves.
 pub fn solve_floating<E>(
     problem: &mut ElectricContactProblem,
     points: &ContactPoints,

@@ -29,7 +29,7 @@ pub enum ForceError<E> {
         /// The largest force carried at the depths tried.
         most: f64,
     },
-    /// The search did not close in [`MAX_SOLVES`] solves.
+    /// The search did not close in 200 contact solves.
     #[error("the depth that carries the force {force:e} was not found in {MAX_SOLVES} contact solves")]
     NotFound {
         /// The force asked for.
@@ -48,7 +48,7 @@ pub enum ForceError<E> {
 ///
 /// # Errors
 /// [`ForceError`]: a solve's own error, no depth within a million face sizes, or no depth in
-/// [`MAX_SOLVES`] solves.
+/// 200 contact solves.
 pub fn solve_force_controlled<E>(
     points: &mut ContactPoints,
     force: f64,
