@@ -828,3 +828,44 @@ fn a_tresca_bound_along_the_zone_holds_each_point_at_its_own() {
         assert_eq!(e.key, key, "{sets:?}: {e}");
     }
 }
+
+/// Each `[[contact]]` zone its own Tresca bound (zones once had to share it): the corner's two
+/// walls under Tresca, the right wall's bound a hundredth of the top's; every point within its
+/// own zone's bound, the slipping points on it, and the zones' bounds distinct in the law.
+#[test]
+fn each_contact_zone_keeps_its_own_tresca_bound() {
+    let bounds = [1e-4, 1e-2];
+    let sets: Vec<String> = vec![
+        "contact.0.law=\"tresca\"".into(),
+        format!("contact.0.slip_bound={}", bounds[0]),
+        "contact.1.law=\"tresca\"".into(),
+        format!("contact.1.slip_bound={}", bounds[1]),
+    ];
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let r = run("corner", &sets);
+    let c = r.contact.as_ref().unwrap();
+    let sol = &c.solution;
+    let mut slipping = [0usize; 2];
+    for (i, &g) in c.group_of.iter().enumerate() {
+        let bound = bounds[g];
+        let t = sol.lambda.component(i, 1).abs();
+        assert!(
+            t <= bound * (1.0 + 1e-9),
+            "point {i} of zone {g}: |λ_t| = {t} above {bound}"
+        );
+        if sol.status[i] == contact::Status::Slip {
+            slipping[g] += 1;
+            assert!(
+                (t - bound).abs() <= 1e-9 * bound,
+                "point {i} of zone {g} slips: |λ_t| = {t}, bound {bound}"
+            );
+        }
+    }
+    assert!(slipping[0] > 0, "the weak wall slips: {slipping:?}");
+    // the strong wall holds more than the weak wall's bound could: its own bound is in the law
+    let strongest = (0..c.group_of.len())
+        .filter(|&i| c.group_of[i] == 1)
+        .map(|i| sol.lambda.component(i, 1).abs())
+        .fold(0.0f64, f64::max);
+    assert!(strongest > 2.0 * bounds[0], "the top wall's largest |λ_t| = {strongest}");
+}

@@ -289,15 +289,10 @@ impl<'p> ContactSolve<'p> {
         }
     }
 
-    /// The plan's contact law on `points`: frictionless without tangential multipliers,
-    /// Tresca with the scene's bound at each point, else Coulomb.
-    pub fn new(
-        plan: &'p Plan,
-        scene: &'p Scene,
-        points: &contact::ContactPoints,
-        interrupt: contact::Interrupt,
-    ) -> Self {
-        let law = plan.law(points);
+    /// The plan's contact law on `boundary`'s points: frictionless without tangential
+    /// multipliers, Tresca with each zone's bound at each of its points, else Coulomb.
+    pub fn new(plan: &'p Plan, scene: &'p Scene, boundary: &ContactBoundary, interrupt: contact::Interrupt) -> Self {
+        let law = plan.law(&boundary.points, &boundary.group_of);
         // the first-order solvers meet Coulomb's law by the fixed point on S, Newton directly
         debug_assert_eq!(
             plan.fixed_point,

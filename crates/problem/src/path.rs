@@ -113,7 +113,7 @@ pub fn solve_path(
         terminals: Terminals::default(),
     };
     let (mut system, boundary, t_assembly) = walk.factor(&disc, &instants, &limits, reporter)?;
-    let how = ContactSolve::new(&setup.plan, scene, &boundary.points, limits.interrupt);
+    let how = ContactSolve::new(&setup.plan, scene, &boundary, limits.interrupt);
     let ordered: Vec<(Vec<f64>, Vec<f64>)> = std::iter::once(parts.loads.clone())
         .chain(parts.displacements.iter().cloned())
         .chain(std::iter::once(parts.potentials.clone()))

@@ -63,13 +63,29 @@ pub struct Plan {
     /// Table 1) and 1e-12 under the tight rule.
     #[serde(skip)]
     pub pcg_tol: f64,
-    /// Tresca's slip bound `S` (`contact.slip_bound`; 0 where the law is not Tresca's).
+    /// Tresca's slip bound of each contact zone, in the scene's order (`contact.slip_bound`, or
+    /// `contact.slip_bound_profile`; 0 where the law is not Tresca's).
     #[serde(skip)]
-    pub slip_bound: f64,
-    /// Tresca's slip bound along the zone (`contact.slip_bound_profile`), in place of
-    /// `slip_bound`.
-    #[serde(skip)]
-    pub slip_bound_profile: Option<crate::scene::SlipBoundProfile>,
+    pub slip_bounds: Vec<ZoneBound>,
+}
+
+/// Tresca's bound of one contact zone: uniform, or along the zone.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ZoneBound {
+    /// `contact.slip_bound`.
+    Uniform(f64),
+    /// `contact.slip_bound_profile`.
+    Profile(crate::scene::SlipBoundProfile),
+}
+
+impl ZoneBound {
+    /// The bound at the point `x`.
+    pub fn at(&self, x: [f64; 3]) -> f64 {
+        match self {
+            ZoneBound::Uniform(s) => *s,
+            ZoneBound::Profile(p) => p.at_point(x),
+        }
+    }
 }
 
 impl Plan {
@@ -131,21 +147,32 @@ impl Plan {
                 Rule::Paper => 1e-2,
                 Rule::Tight => 1e-12,
             }),
-            slip_bound: scene.first_contact().map_or(0.0, |c| c.slip_bound()),
-            slip_bound_profile: scene.first_contact().and_then(|c| c.slip_bound_profile.clone()),
+            slip_bounds: scene
+                .contacts()
+                .iter()
+                .map(|c| match &c.slip_bound_profile {
+                    Some(p) => ZoneBound::Profile(p.clone()),
+                    None => ZoneBound::Uniform(c.slip_bound()),
+                })
+                .collect(),
         }
     }
 
-    /// The plan's contact law on `points`, as the contact crate takes it: frictionless
-    /// without tangential multipliers, Tresca with the scene's bound (uniform, or its profile
-    /// at each point), else Coulomb.
-    pub fn law(&self, points: &contact::ContactPoints) -> contact::Law {
+    /// The plan's contact law on `points` (`group_of[i]`: point `i`'s contact zone, an index
+    /// into the scene's contacts), as the contact crate takes it: frictionless without
+    /// tangential multipliers, Tresca with each zone's bound at each of its points, else
+    /// Coulomb.
+    pub fn law(&self, points: &contact::ContactPoints, group_of: &[usize]) -> contact::Law {
         match (self.contact_law, self.friction) {
             (_, false) => contact::Law::Frictionless,
-            (ContactLaw::Tresca, true) => contact::Law::Tresca(match &self.slip_bound_profile {
-                Some(p) => points.position.iter().map(|&x| p.at_point(x)).collect(),
-                None => vec![self.slip_bound; points.len()],
-            }),
+            (ContactLaw::Tresca, true) => contact::Law::Tresca(
+                points
+                    .position
+                    .iter()
+                    .zip(group_of)
+                    .map(|(&x, &g)| self.slip_bounds.get(g).map_or(0.0, |b| b.at(x)))
+                    .collect(),
+            ),
             _ => contact::Law::Coulomb,
         }
     }

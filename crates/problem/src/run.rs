@@ -92,7 +92,7 @@ pub fn run<B: Backend>(
     stop_if_interrupted(&limits, "factorisation")?;
     let solved = match boundary {
         Some(b) => {
-            let how = ContactSolve::new(&setup.plan, &scene, &b.points, limits.interrupt);
+            let how = ContactSolve::new(&setup.plan, &scene, &b, limits.interrupt);
             backend.solve_contact(&posed, &mut system, b, &how, reporter)?
         }
         None => backend.solve_linear(&posed, &mut system, reporter)?,

@@ -931,8 +931,8 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 }
 
 /// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
-/// coefficient and (one of them) a depth-controlled indenter; what they share (the law, the
-/// foundation's compliance, Tresca's bound) the same for all; what is posed for one zone
+/// coefficient, Tresca bound and (one of them) a depth-controlled indenter; what they share
+/// (the law, the foundation's compliance) the same for all; what is posed for one zone
 /// (electrical contact, a floating tip, force control, slip weakening, an exact solution)
 /// refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
@@ -966,11 +966,6 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
             "contact.compliance",
             c.compliance != first.compliance,
             "the foundation's compliance",
-        )?;
-        same(
-            "contact.slip_bound",
-            c.slip_bound != first.slip_bound || c.slip_bound_profile != first.slip_bound_profile,
-            "Tresca's slip bound",
         )?;
         let one = |key: &str, given: bool, what: &str| {
             refuse_if(
