@@ -602,10 +602,19 @@ fn what_several_contact_groups_cannot_share_is_refused_by_name() {
             problem::Contacts::One(c) => c,
         }
     }
+    // Tresca's and Coulomb's laws do not mix (a frictionless zone joins either: below)
     assert_eq!(
-        refused(&|s| group(s, 1).law = problem::ContactLaw::Coulomb),
+        refused(&|s| {
+            let a = group(s, 0);
+            a.law = problem::ContactLaw::Tresca;
+            a.slip_bound = Some(0.1);
+            let c = group(s, 1);
+            c.law = problem::ContactLaw::Coulomb;
+            c.friction = Some(0.3);
+        }),
         "contact.law"
     );
+    assert_eq!(refused(&|s| group(s, 1).law = problem::ContactLaw::None), "contact.law");
     assert_eq!(refused(&|s| group(s, 1).group = "right".into()), "contact.group");
     assert_eq!(
         refused(&|s| group(s, 0).electric = Some(problem::ElectricCondition::Conducting)),
@@ -867,5 +876,37 @@ fn each_contact_zone_keeps_its_own_tresca_bound() {
         .filter(|&i| c.group_of[i] == 1)
         .map(|i| sol.lambda.component(i, 1).abs())
         .fold(0.0f64, f64::max);
-    assert!(strongest > 2.0 * bounds[0], "the top wall's largest |λ_t| = {strongest}");
+    assert!(
+        strongest > 2.0 * bounds[0],
+        "the top wall's largest |λ_t| = {strongest}"
+    );
+}
+
+/// A frictionless zone beside a frictional one (zones once had to share their law): the
+/// corner's right wall under Coulomb (F = 0.3), its top wall Signorini's; the top's tangential
+/// multipliers are zero, the right wall's within Coulomb's cone, some of its points sliding on it.
+#[test]
+fn a_frictionless_zone_joins_a_coulomb_zone() {
+    let r = run(
+        "corner",
+        &["contact.0.law=\"coulomb\"", "contact.0.friction=0.3", "mesh.n=16"],
+    );
+    let c = r.contact.as_ref().unwrap();
+    assert_eq!(r.report.plan.contact_law, problem::ContactLaw::Coulomb);
+    let sol = &c.solution;
+    let mut on_the_cone = 0;
+    for (i, &g) in c.group_of.iter().enumerate() {
+        let (n, t) = (sol.lambda.normal[i], sol.lambda.component(i, 1).abs());
+        if g == 1 {
+            assert_eq!(t, 0.0, "point {i} of the frictionless top");
+        } else {
+            assert!(
+                t <= 0.3 * n * (1.0 + 1e-9) + 1e-14,
+                "point {i}: |λ_t| = {t}, F λ_n = {}",
+                0.3 * n
+            );
+            on_the_cone += usize::from(n > 0.0 && (t - 0.3 * n).abs() <= 1e-9 * n);
+        }
+    }
+    assert!(on_the_cone > 0, "the right wall's points slide on Coulomb's cone");
 }

@@ -486,7 +486,16 @@ fn interpolate(t: &[f64], f: &[f64], x: f64) -> f64 {
 impl Scene {
     /// The contact law, `none` where the scene has no contact section.
     pub fn contact_law(&self) -> ContactLaw {
-        self.first_contact().map_or(ContactLaw::None, |c| c.law)
+        let first = self.first_contact().map_or(ContactLaw::None, |c| c.law);
+        // a frictionless zone among frictional ones takes their law with a zero coefficient or
+        // bound (exactly frictionless); Tresca's and Coulomb's together are refused by key
+        let any = |law: ContactLaw| self.contacts().iter().any(|c| c.law == law);
+        match first {
+            ContactLaw::None => ContactLaw::None,
+            _ if any(ContactLaw::Coulomb) => ContactLaw::Coulomb,
+            _ if any(ContactLaw::Tresca) => ContactLaw::Tresca,
+            law => law,
+        }
     }
 
     /// The contact section when its law is not `none` (the first of several).

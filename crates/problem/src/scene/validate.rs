@@ -932,7 +932,8 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 
 /// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
 /// coefficient, Tresca bound and (one of them) a depth-controlled indenter; what they share
-/// (the law, the foundation's compliance) the same for all; what is posed for one zone
+/// (the friction law, the foundation's compliance) the same for all, a frictionless zone
+/// joining either friction law; what is posed for one zone
 /// (electrical contact, a floating tip, force control, slip weakening, an exact solution)
 /// refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
@@ -961,7 +962,16 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
                 ),
             )
         };
-        same("contact.law", c.law != first.law, "their law")?;
+        // a frictionless zone joins frictional ones (its coefficient or bound 0); Tresca's and
+        // Coulomb's laws, and a zone switched off among active ones, do not mix
+        let off = |c: &ContactSpec| c.law == ContactLaw::None;
+        let frictional = |c: &ContactSpec| matches!(c.law, ContactLaw::Tresca | ContactLaw::Coulomb);
+        same(
+            "contact.law",
+            off(c) != off(first)
+                || contacts[..k].iter().any(|o| frictional(o) && frictional(c) && o.law != c.law),
+            "their law (a Signorini zone may join Tresca's or Coulomb's, but Tresca's and Coulomb's do not mix, nor a zone switched off with active ones)",
+        )?;
         same(
             "contact.compliance",
             c.compliance != first.compliance,
