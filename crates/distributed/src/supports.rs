@@ -16,12 +16,16 @@ const BACKEND: &str = "petsc";
 /// What to do instead of a feature the PETSc backend lacks.
 const DEFAULT: &str = "use the default backend: remove solver.backend";
 
+/// The backend lacks `feature`, asked for by `key`; the default backend has it.
+fn lacks(key: &str, feature: impl Into<String>) -> Result<(), Unsupported> {
+    Err(Unsupported::new(BACKEND, key, feature).advise(DEFAULT))
+}
+
 /// Whether the PETSc backend solves `scene` (a valid scene): the first thing it lacks, by key.
 ///
 /// # Errors
 /// [`Unsupported`] naming the key.
 pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
-    let lacks = |key: &str, feature: &str| Err(Unsupported::new(BACKEND, key, feature).advise(DEFAULT));
     if scene.solver.backend != BackendChoice::Petsc {
         return Err(Unsupported::new(
             BACKEND,
@@ -88,23 +92,22 @@ pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
 
 /// What one contact zone asks for that the PETSc backend's active sets do not hold.
 fn contact_zone(c: &ContactSpec) -> Result<(), Unsupported> {
-    let lacks = |key: &str, feature: String| Err(Unsupported::new(BACKEND, key, feature).advise(DEFAULT));
     if c.indenter.as_ref().is_some_and(|i| i.force.is_some()) {
         return lacks(
             "contact.indenter.force",
-            "force control (its active sets take a given depth)".into(),
+            "force control (its active sets take a given depth)",
         );
     }
     if c.compliance.is_some() {
         return lacks(
             "contact.compliance",
-            "a deformable foundation (its active sets hold Signorini's conditions)".into(),
+            "a deformable foundation (its active sets hold Signorini's conditions)",
         );
     }
     if c.slip_weakening().is_some() {
         return lacks(
             "contact.friction_law",
-            "slip-weakening friction (its active sets hold a constant coefficient)".into(),
+            "slip-weakening friction (its active sets hold a constant coefficient)",
         );
     }
     if let Some(condition) = c.electric.filter(|_| c.electric_law().is_some()) {
