@@ -99,7 +99,7 @@ pub fn solve_floating<E>(
         }
         Ok(Found::Jump { below, above }) => Ok(mixture(problem, below, above, charge)),
         Err(SearchError::Eval(e)) => Err(e),
-        Err(SearchError::NoBracket { .. } | SearchError::NotFound) => Err(FloatingError::NotFound { charge }),
+        Err(SearchError::NoBracket | SearchError::NotFound) => Err(FloatingError::NotFound { charge }),
     }
 }
 

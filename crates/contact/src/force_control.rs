@@ -108,7 +108,7 @@ pub fn solve_force_controlled<E>(
             }
         }
         Err(SearchError::Eval(e)) => return Err(ForceError::Solve(e)),
-        Err(SearchError::NoBracket { .. }) => return Err(ForceError::Unreachable { force, most }),
+        Err(SearchError::NoBracket) => return Err(ForceError::Unreachable { force, most }),
         Err(SearchError::NotFound) => return Err(ForceError::NotFound { force }),
     };
     for (g, b) in points.gap.iter_mut().zip(&base) {

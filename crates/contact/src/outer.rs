@@ -71,11 +71,8 @@ pub enum Found<T> {
 pub enum SearchError<E> {
     /// An evaluation failed.
     Eval(E),
-    /// No sign change of `r` within [`Search::max_step`] of the start; the `s` reached.
-    NoBracket {
-        /// The last `s` evaluated.
-        reached: f64,
-    },
+    /// No sign change of `r` within [`Search::max_step`] of the start.
+    NoBracket,
     /// No root in [`Search::max_evals`] evaluations.
     NotFound,
 }
@@ -144,7 +141,7 @@ pub fn bracketed_root<T, E>(
             // no bracket, no slope: a step away from the side the residual is on
             _ => {
                 if step > search.max_step {
-                    return Err(SearchError::NoBracket { reached: s });
+                    return Err(SearchError::NoBracket);
                 }
                 let next = if residual < 0.0 {
                     search.up_from.max(search.start) + step
@@ -231,6 +228,6 @@ mod tests {
             })
         })
         .unwrap_err();
-        assert!(matches!(e, SearchError::NoBracket { .. }), "{e:?}");
+        assert!(matches!(e, SearchError::NoBracket), "{e:?}");
     }
 }

@@ -47,17 +47,15 @@ pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
             "a body of revolution (it assembles plane and 3D bodies)",
         );
     }
-    if scene.dirichlet.iter().any(|d| d.charge.is_some()) {
-        return lacks(
-            "dirichlet.charge",
-            "a floating terminal (it takes prescribed potentials)",
-        );
-    }
-    if scene.electrodes().iter().any(|e| e.charge.is_some()) {
-        return lacks(
-            "electrode.charge",
-            "a floating terminal (it takes prescribed potentials)",
-        );
+    let floating = if scene.dirichlet.iter().any(|d| d.charge.is_some()) {
+        Some("dirichlet.charge")
+    } else if scene.electrodes().iter().any(|e| e.charge.is_some()) {
+        Some("electrode.charge")
+    } else {
+        None
+    };
+    if let Some(key) = floating {
+        return lacks(key, "a floating terminal (it takes prescribed potentials)");
     }
     for c in active {
         contact_zone(c)?;

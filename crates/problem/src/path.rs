@@ -511,8 +511,8 @@ impl Walk<'_> {
             shift: &on.state.shift,
         };
         let (sol, (u, phi)) = on.path.fields(on.how, on.system, framed, &posed, sol, reporter)?;
-        let (b_full, b_phi, scale) = crate::faer_backend::rhs_with_contact(&posed, Some((boundary, &sol)));
-        let equilibrium = on.system.equilibrium_of(&u, &phi, &b_full, &b_phi, scale);
+        let b = crate::faer_backend::rhs_with_contact(&posed, Some((boundary, &sol)));
+        let equilibrium = on.system.equilibrium_of(&u, &phi, &b);
         check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
         check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
         let pair = Some((boundary, &sol));

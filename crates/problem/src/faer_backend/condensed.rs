@@ -178,16 +178,15 @@ pub(super) fn solve_contact(
             (sol, fields)
         }
         (LinearSolver::Direct(direct), None) if condensed => {
-            let t_condense = Instant::now();
             let loads = &posed.loads;
-            let (mut dense, condensed) = boundary.condense(direct, &loads.b_u, &loads.b_phi, nt)?;
-            let condense = (condensed.route, t_condense.elapsed().as_secs_f64());
-            reporter.event(&Event::Condensed {
-                m: dense.m(),
-                route: condense.0,
-                seconds: condense.1,
-            });
-            system.condense = Some(condense);
+            let (mut dense, condensed) = condense_reported(
+                &boundary,
+                direct,
+                (&loads.b_u, &loads.b_phi),
+                nt,
+                &mut system.condense,
+                reporter,
+            )?;
             let sol = match indenter_force(posed) {
                 Some(force) => force_controlled(&mut boundary.points, force, None, |points, start| {
                     how.run_with(Operator::Condensed(&mut dense), points, start, true, reporter)
@@ -228,6 +227,28 @@ pub(super) fn solve_contact(
         contact: Some((boundary, sol)),
         seconds: t.elapsed().as_secs_f64(),
     })
+}
+
+/// `boundary.condense` with `direct` for the right-hand side `(b_u, b_φ)`, timed, reported
+/// (`Event::Condensed`) and its route and seconds kept in `condense`.
+pub(super) fn condense_reported(
+    boundary: &ContactBoundary,
+    direct: &mut DirectLdlt,
+    (b_u, b_phi): (&[f64], &[f64]),
+    nt: usize,
+    condense: &mut Option<(CondenseRoute, f64)>,
+    reporter: &mut dyn Reporter,
+) -> Result<(DenseContactProblem, linalg::CondensedLoads), ProblemError> {
+    let t = Instant::now();
+    let (dense, condensed) = boundary.condense(direct, b_u, b_phi, nt)?;
+    let (route, seconds) = (condensed.route, t.elapsed().as_secs_f64());
+    reporter.event(&Event::Condensed {
+        m: dense.m(),
+        route,
+        seconds,
+    });
+    *condense = Some((route, seconds));
+    Ok((dense, condensed))
 }
 
 /// The contact solve with electrical contact: the condensation onto the points'

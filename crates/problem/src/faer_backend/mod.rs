@@ -105,7 +105,7 @@ impl Backend for Faer {
     ) -> Result<f64, ProblemError> {
         let b = rhs_with_contact(posed, solved.contact.as_ref().map(|(b, sol)| (b, sol)));
         let (u, phi) = &solved.x;
-        Ok(linalg::equilibrium_residual(coupled(&system.blocks), u, phi, rhs(&b)))
+        Ok(system.equilibrium_of(u, phi, &b))
     }
 
     fn finish(
@@ -171,14 +171,10 @@ impl Factored {
         }
     }
 
-    /// The equilibrium residual of `(u, φ)` against the right-hand sides (their size `scale`).
-    pub(crate) fn equilibrium_of(&self, u: &[f64], phi: &[f64], b_u: &[f64], b_phi: &[f64], scale: f64) -> f64 {
-        let b = linalg::Rhs {
-            u: b_u,
-            phi: b_phi,
-            scale,
-        };
-        linalg::equilibrium_residual(coupled(&self.blocks), u, phi, b)
+    /// The equilibrium residual of `(u, φ)` against the right-hand side `b` (`(b_u, b_φ, scale)`,
+    /// as [`rhs_with_contact`] gives it).
+    pub(crate) fn equilibrium_of(&self, u: &[f64], phi: &[f64], b: &(Vec<f64>, Vec<f64>, f64)) -> f64 {
+        linalg::equilibrium_residual(coupled(&self.blocks), u, phi, rhs(b))
     }
 }
 

@@ -2,16 +2,17 @@
 //! compliance and the solutions of each part of the right-hand side, from which every step's
 //! loads are a sum.
 
-use super::condensed::{fields_at_points, in_frame, rhs_with_contact, Operator, Refining, PATH_REFINE_TOL};
+use super::condensed::{
+    condense_reported, fields_at_points, in_frame, rhs_with_contact, Operator, Refining, PATH_REFINE_TOL,
+};
 use super::{Factored, Fields, LinearSolver};
 use crate::backend::{ContactSolve, Posed};
 use crate::boundary::ContactBoundary;
-use crate::progress::{Event, Reporter};
+use crate::progress::Reporter;
 use crate::scene::SceneError;
 use crate::ProblemError;
 use contact::{ContactPoints, ContactSolution, DenseContactProblem, PointValues};
 use linalg::CoupledSolver;
-use std::time::Instant;
 
 /// What stays from step to step of a load path on one factorisation: the condensed compliance
 /// and the solutions of `K x = b_q` for each part `q` of the right-hand side (the loads, each
@@ -37,16 +38,8 @@ impl PathSystem {
         let LinearSolver::Direct(direct) = &mut system.solver else {
             return Err(not_direct());
         };
-        let t = Instant::now();
         let (b_u, b_phi) = &parts[0];
-        let (dense, condensed) = boundary.condense(direct, b_u, b_phi, nt)?;
-        let condense = (condensed.route, t.elapsed().as_secs_f64());
-        reporter.event(&Event::Condensed {
-            m: dense.m(),
-            route: condense.0,
-            seconds: condense.1,
-        });
-        system.condense = Some(condense);
+        let (dense, _) = condense_reported(boundary, direct, (b_u, b_phi), nt, &mut system.condense, reporter)?;
         let mut solved = Vec::with_capacity(parts.len());
         for (b_u, b_phi) in parts {
             solved.push(Self::solve(system, b_u, b_phi)?);
