@@ -209,3 +209,152 @@ fn compliance_is_refused_where_it_is_not_solved() {
         "contact.compliance.stiffness"
     );
 }
+
+/// The block of [`block`] with its top pressed by the traction `q` instead of held: only the
+/// bed holds its vertical translation (the rollers hold the rest). In uniaxial strain the
+/// pressure is `q` at every point and the penetration `(q / k)^(1/m)`; the run holds the body
+/// with springs it takes out again (`problem::bed`).
+fn on_its_bed(dim: usize, k: f64, m: f64, friction: bool, q: f64) -> Scene {
+    let spec = ComplianceSpec {
+        stiffness: k,
+        exponent: m,
+    };
+    let mut s = block(dim, Some(spec), friction);
+    s.dirichlet.retain(|d| d.group != "top");
+    let mut direction = vec![0.0; dim];
+    direction[dim - 1] = 1.0;
+    s.load = Some(
+        problem::LoadSpec {
+            group: "top".into(),
+            p: -q,
+            direction,
+        }
+        .into(),
+    );
+    s
+}
+
+#[test]
+fn a_block_only_its_bed_holds_is_the_closed_form_to_round_off() {
+    let q = c_modulus() * DELTA;
+    for dim in [2, 3] {
+        for m in [1.0, 2.0] {
+            for friction in [false, true] {
+                // from a soft bed (k C⁻¹ H = 1e-3) to a stiff one (1e6)
+                for k in [1e-3, 1.0, 1e3, 1e6].map(|f| f * c_modulus()) {
+                    let what = format!("{dim}D, k = {k:e}, m = {m}, friction {friction}");
+                    let s = problem::solve(&on_its_bed(dim, k, m, friction, q), None, &mut Silent)
+                        .unwrap_or_else(|e| panic!("{what}: {e}"));
+                    let contact = s.contact.as_ref().unwrap();
+                    let p = (q / k).powf(1.0 / m);
+                    let e_pressure = contact
+                        .solution
+                        .lambda
+                        .normal
+                        .iter()
+                        .map(|l| (l - q).abs() / q)
+                        .fold(0.0, f64::max);
+                    // against the displacement's scale: the body's own shortening is δ
+                    let e_penetration = contact
+                        .displacement
+                        .normal
+                        .iter()
+                        .map(|u| (u - p).abs() / p.max(DELTA))
+                        .fold(0.0, f64::max);
+                    assert!(
+                        e_pressure < 1e-9 && e_penetration < 1e-8,
+                        "{what}: {e_pressure:e} {e_penetration:e}"
+                    );
+                    assert!(s.report.residuals.converged_to_tolerance, "{what}");
+                    let steps = s.report.iterations.bed;
+                    assert!(
+                        (1..=12).contains(&steps),
+                        "{what}: {steps} steps of the bed's fixed point"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_body_the_conditions_hold_runs_without_the_beds_springs() {
+    let spec = ComplianceSpec {
+        stiffness: c_modulus(),
+        exponent: 1.0,
+    };
+    let s = problem::solve(&block(2, Some(spec), false), None, &mut Silent).unwrap();
+    assert_eq!(s.report.iterations.bed, 0);
+}
+
+/// The error of a run that must fail.
+fn fails(s: &Scene) -> problem::ProblemError {
+    match problem::solve(s, None, &mut Silent) {
+        Ok(_) => panic!("{} solved", s.name),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn what_the_bed_does_not_hold_is_named_and_a_bed_it_leaves_is_no_solution() {
+    let k = c_modulus();
+    let q = k * DELTA;
+    // no rollers: the bed holds the vertical translation and the tilts, not the slide
+    let mut s = on_its_bed(2, k, 1.0, true, q);
+    s.dirichlet.clear();
+    let e = fails(&s).to_string();
+    assert!(
+        e.contains("the Dirichlet conditions and the compliant bed leave 1 rigid motion of the body free (a translation along [1.000, 0.000])")
+            && e.contains("friction holds nothing"),
+        "{e}"
+    );
+    // 3D, rollers on the x faces only: the slide along y is free
+    let mut s = on_its_bed(3, k, 1.0, false, q);
+    s.dirichlet.retain(|d| d.group == "left" || d.group == "right");
+    let e = fails(&s).to_string();
+    let along_y = ["[0.000, 1.000, 0.000]", "[0.000, -1.000, 0.000]"]
+        .map(|d| format!("1 rigid motion of the body free (a translation along {d})"));
+    assert!(along_y.iter().any(|m| e.contains(m.as_str())), "{e}");
+    // a rigid foundation holds nothing: the message says what a bed would
+    let mut s = on_its_bed(2, k, 1.0, false, q);
+    s.first_contact_mut().unwrap().compliance = None;
+    let e = fails(&s).to_string();
+    assert!(
+        e.contains("the Dirichlet conditions leave 1 rigid motion") && e.contains("contact.compliance"),
+        "{e}"
+    );
+    // pulled off its bed: nothing holds it
+    for dim in [2, 3] {
+        let e = fails(&on_its_bed(dim, k, 1.0, false, -q));
+        assert!(
+            matches!(
+                e,
+                problem::ProblemError::NoSolution {
+                    sought: "contact.compliance",
+                    ..
+                }
+            ),
+            "{dim}D: {e}"
+        );
+    }
+    // no load at all: nothing presses it onto the bed
+    let mut s = on_its_bed(2, k, 1.0, false, q);
+    s.load = None;
+    let e = fails(&s);
+    assert!(matches!(e, problem::ProblemError::NoSolution { .. }), "{e}");
+}
+
+#[test]
+fn a_path_of_a_body_only_its_bed_holds_is_refused_by_name() {
+    let k = c_modulus();
+    let mut s = on_its_bed(2, k, 1.0, false, k * DELTA);
+    s.path = Some(problem::PathSpec {
+        t: vec![0.0, 1.0],
+        steps: Some(2),
+        ..Default::default()
+    });
+    match fails(&s) {
+        problem::ProblemError::Unsupported(u) => assert_eq!(u.key, "path", "{u}"),
+        e => panic!("{e}"),
+    }
+}

@@ -132,6 +132,11 @@ impl<'p> Backend for PetscBackend<'p> {
         _: problem::Limits,
         _: &mut dyn Reporter,
     ) -> Result<Prepared<'p>, DistributedError> {
+        if posed.bed.is_some() {
+            // a compliant bed is refused by supports(); a body only it holds is refused here too
+            let feature = "a body that only its compliant bed holds (the springs that hold it in K)";
+            return Err(ProblemError::from(Unsupported::new("petsc", "contact.compliance", feature)).into());
+        }
         let options = configure(self.petsc, &posed.scene, posed.setup, &layout)?;
         let fields = Fields::new(self.petsc, posed.setup, &layout);
         Ok(Prepared {

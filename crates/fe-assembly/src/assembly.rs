@@ -166,6 +166,13 @@ impl<'m> Discretization<'m> {
         crate::held::check(self.mesh, &self.dofs, &self.cell_electric, self.axisymmetric)
     }
 
+    /// [`Discretization::check_held`], counting `supports` (a compliant bed's points along
+    /// its normal) where the Dirichlet conditions alone leave a motion free
+    /// ([`crate::held::check_with`]).
+    pub fn check_held_with(&self, supports: &[crate::Support]) -> Result<crate::Held, Unheld> {
+        crate::held::check_with(self.mesh, &self.dofs, &self.cell_electric, self.axisymmetric, supports)
+    }
+
     /// The material of cell `c`.
     pub fn material(&self, c: usize) -> &Material {
         &self.materials[self.cell_material[c]]

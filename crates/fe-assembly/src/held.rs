@@ -15,6 +15,11 @@
 //! held when these conditions have full rank, judged on the eigenvalues of their Gram matrix
 //! (coordinates taken from the part's centroid and scaled by its size, so that the test is
 //! independent of units and position).
+//!
+//! A compliant bed holds a body too, along its normal only: [`check_with`] counts each bed
+//! point's normal component as a condition `r(x_node) · n = 0`, and says whether the body
+//! needs the bed ([`Held::WithSupports`]: the solver then holds it with springs it takes out
+//! again) and, where the bed too leaves a motion free, which.
 
 use crate::{Dof, DofMap};
 use mesh::Mesh;
@@ -25,12 +30,19 @@ use nalgebra::{DMatrix, SymmetricEigen};
 pub enum Unheld {
     /// Rigid motions of a part are free.
     #[error(
-        "the Dirichlet conditions leave {count} rigid motion{s} of the body free ({motions}) \
-         in its part with cell {cell} ({cells} cells): contact alone does not hold a body in \
-         this solver (the paper's Γ1 has positive measure: every solve needs the stiffness \
-         invertible); prescribe that motion on a boundary group, e.g. the component along it on \
-         a face that contact does not need",
-        s = if *count == 1 { "" } else { "s" }
+        "{by} leave {count} rigid motion{s} of the body free ({motions}) in its part with cell \
+         {cell} ({cells} cells): {why}; prescribe that motion on a boundary group, e.g. the \
+         component along it on a face that contact does not need",
+        s = if *count == 1 { "" } else { "s" },
+        by = if *with_supports { "the Dirichlet conditions and the compliant bed" } else { "the Dirichlet conditions" },
+        why = if *with_supports {
+            "a compliant bed holds a body along its normal only, and friction holds nothing in \
+             this solver (every solve needs the stiffness invertible)"
+        } else {
+            "a rigid foundation's contact does not hold a body in this solver (the paper's Γ1 has \
+             positive measure: every solve needs the stiffness invertible), a compliant bed \
+             (contact.compliance) along its normal only"
+        }
     )]
     Motion {
         /// How many independent motions are free.
@@ -41,6 +53,8 @@ pub enum Unheld {
         cell: usize,
         /// The part's number of cells.
         cells: usize,
+        /// Whether a compliant bed's supports were counted.
+        with_supports: bool,
     },
     /// The potential of an electric part is free (no condition on φ reaches it).
     #[error(
@@ -153,23 +167,69 @@ const FREE: f64 = 1e-12;
 /// A body of revolution (`axisymmetric`) has one rigid motion, the translation along its axis
 /// (a radial one strains the hoops).
 pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool], axisymmetric: bool) -> Result<(), Unheld> {
+    check_with(mesh, dofs, cell_electric, axisymmetric, &[]).map(|_| ())
+}
+
+/// A support along one direction at a node: a compliant bed's hold on its point, along the
+/// bed's normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Support {
+    /// The node.
+    pub node: usize,
+    /// The direction it holds (a unit vector).
+    pub direction: [f64; 3],
+}
+
+/// What holds the body's rigid motions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Held {
+    /// The Dirichlet conditions alone.
+    ByConditions,
+    /// The Dirichlet conditions with the supports: some motion the conditions leave free, the
+    /// supports hold.
+    WithSupports,
+}
+
+/// [`check`], the `supports` counted as holding their nodes along their directions where the
+/// Dirichlet conditions alone leave a motion free.
+///
+/// # Errors
+/// As [`check`]; [`Unheld::Motion`] names the motions that the conditions and the supports
+/// together leave free (`with_supports` where there are supports).
+pub fn check_with(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    cell_electric: &[bool],
+    axisymmetric: bool,
+    supports: &[Support],
+) -> Result<Held, Unheld> {
     let solids = Solids::new(mesh);
+    let mut held = Held::ByConditions;
     for i in 0..solids.first.len() {
-        let motions = if axisymmetric {
-            solids.free_axial_motion(dofs, i)
-        } else {
-            solids.free_motions(mesh, dofs, i)
+        let free = |with: &[Support]| {
+            if axisymmetric {
+                solids.free_axial_motion(dofs, i, with)
+            } else {
+                solids.free_motions(mesh, dofs, i, with)
+            }
         };
+        let mut motions = free(&[]);
+        if !motions.is_empty() && !supports.is_empty() {
+            motions = free(supports);
+            held = Held::WithSupports;
+        }
         if !motions.is_empty() {
             return Err(Unheld::Motion {
                 count: motions.len(),
                 motions: motions.join("; "),
                 cell: solids.first[i],
                 cells: solids.cells[i],
+                with_supports: !supports.is_empty(),
             });
         }
     }
-    floating_potential(mesh, dofs, cell_electric)
+    floating_potential(mesh, dofs, cell_electric)?;
+    Ok(held)
 }
 
 /// The solid parts of a mesh with their nodes, centroids and sizes.
@@ -187,6 +247,14 @@ struct Solids {
 }
 
 impl Solids {
+    /// The supports at nodes of part `i`.
+    fn supports_of<'s>(&self, i: usize, supports: &'s [Support]) -> impl Iterator<Item = &'s Support> + use<'s, '_> {
+        let members = &self.members[self.start[i]..self.start[i + 1]];
+        supports
+            .iter()
+            .filter(move |s| members.binary_search(&(i, s.node)).is_ok())
+    }
+
     fn new(mesh: &Mesh) -> Self {
         let dim = mesh.dim;
         let (cell_part, n_parts) = mesh.solid_parts();
@@ -253,10 +321,11 @@ impl Solids {
 
     /// The translation along the axis of part `i` of a body of revolution, in words, where no
     /// prescribed axial component holds it.
-    fn free_axial_motion(&self, dofs: &DofMap, i: usize) -> Vec<String> {
+    fn free_axial_motion(&self, dofs: &DofMap, i: usize, supports: &[Support]) -> Vec<String> {
         let held = self.members[self.start[i]..self.start[i + 1]]
             .iter()
-            .any(|&(_, v)| matches!(dofs.u[v * 2 + 1], Dof::Fixed(_)));
+            .any(|&(_, v)| matches!(dofs.u[v * 2 + 1], Dof::Fixed(_)))
+            || self.supports_of(i, supports).any(|s| s.direction[1].abs() > 1e-6);
         if held {
             vec![]
         } else {
@@ -266,19 +335,32 @@ impl Solids {
 
     /// The rigid motions of part `i` that its prescribed components leave free, in words:
     /// the null space of the Gram matrix of the conditions they put on its motions.
-    fn free_motions(&self, mesh: &Mesh, dofs: &DofMap, i: usize) -> Vec<String> {
+    fn free_motions(&self, mesh: &Mesh, dofs: &DofMap, i: usize, supports: &[Support]) -> Vec<String> {
         let dim = dofs.dim;
         let n_modes = if dim == 2 { 3 } else { 6 };
         let mut gram = DMatrix::<f64>::zeros(n_modes, n_modes);
+        let scaled = |v: usize| -> [f64; 3] {
+            std::array::from_fn(|k| {
+                if k < dim {
+                    (mesh.points[v][k] - self.centroid[i][k]) / self.size[i]
+                } else {
+                    0.0
+                }
+            })
+        };
         for &(_, v) in &self.members[self.start[i]..self.start[i + 1]] {
-            let mut y = [0.0; 3];
-            for k in 0..dim {
-                y[k] = (mesh.points[v][k] - self.centroid[i][k]) / self.size[i];
-            }
             for k in (0..dim).filter(|&k| matches!(dofs.u[v * dim + k], Dof::Fixed(_))) {
-                let row = nalgebra::DVector::from_vec(rigid_row(dim, k, y));
+                let row = nalgebra::DVector::from_vec(rigid_row(dim, k, scaled(v)));
                 gram += &row * row.transpose();
             }
+        }
+        // a support's condition: the motion's component along its direction, r(x) · n = 0
+        for s in self.supports_of(i, supports) {
+            let mut row = nalgebra::DVector::<f64>::zeros(n_modes);
+            for k in 0..dim {
+                row += nalgebra::DVector::from_vec(rigid_row(dim, k, scaled(s.node))) * s.direction[k];
+            }
+            gram += &row * row.transpose();
         }
         let eig = SymmetricEigen::new(gram);
         let largest = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
@@ -385,6 +467,64 @@ mod tests {
             )),
             0
         );
+    }
+
+    #[test]
+    fn a_bed_holds_a_body_along_its_normal_only() {
+        let m = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 8, 4);
+        let all = vec![true; m.n_cells()];
+        let left = |x: &[f64]| x[0] < 1e-12;
+        let sides = |x: &[f64]| x[0] < 1e-12 || x[0] > 2.0 - 1e-12;
+        let bed: Vec<Support> = (0..m.n_nodes())
+            .filter(|&v| m.point(v)[1] < 1e-12)
+            .map(|node| Support {
+                node,
+                direction: [0.0, -1.0, 0.0],
+            })
+            .collect();
+        // on rollers: the bed holds the vertical translation
+        let rollers = dofs(&m, |x, k| k == 0 && sides(x), left);
+        assert_eq!(check_with(&m, &rollers, &all, false, &bed), Ok(Held::WithSupports));
+        assert_eq!(free(check(&m, &rollers, &all, false)), 1);
+        // clamped: the conditions alone
+        let clamped = dofs(&m, |x, _| left(x), left);
+        assert_eq!(check_with(&m, &clamped, &all, false, &bed), Ok(Held::ByConditions));
+        // free: the bed holds the vertical translation and the rotation, not the slide
+        let e = check_with(&m, &dofs(&m, |_, _| false, left), &all, false, &bed).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Unheld::Motion {
+                    count: 1,
+                    with_supports: true,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("a translation along [1.000, 0.000]"), "{e}");
+        // rollers at the top corners and one point of the bed (the corner (0, 0)): the rotation
+        // about (0, 1) moves none of them
+        let e = check_with(
+            &m,
+            &dofs(&m, |x, k| k == 0 && sides(x) && x[1] > 0.99, left),
+            &all,
+            false,
+            &bed[..1],
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("a rotation about the point (0.0000e0, 1.0000e0)"),
+            "{e}"
+        );
+        // a body of revolution: a bed across the axis holds its axial translation
+        let r = mesh::rectangle_tri([0.0, 0.0], [1.0, 1.0], 4, 4);
+        let axis = dofs(&r, |x, k| k == 0 && x[0] < 1e-12, |x: &[f64]| x[1] > 0.99);
+        let under: Vec<Support> = bed.iter().filter(|s| r.point(s.node)[0] <= 1.0).copied().collect();
+        let all_r = vec![true; r.n_cells()];
+        assert_eq!(free(check(&r, &axis, &all_r, true)), 1);
+        assert_eq!(check_with(&r, &axis, &all_r, true, &under), Ok(Held::WithSupports));
     }
 
     #[test]

@@ -53,7 +53,7 @@ mod recovery;
 pub use assembly::{Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
-pub use held::Unheld;
+pub use held::{Held, Support, Unheld};
 pub use loads::{facet_measure, Load, RhsParts};
 pub use material::{voigt, voigt_len, Crystal, Material, MaterialError};
 pub use recovery::{CellFields, ChargeFunctional};

@@ -160,6 +160,33 @@ pub fn lower_quasi_definite(
 /// Columns per task where [`lower_quasi_definite`] counts and writes `K`'s columns.
 const COLUMNS_PER_TASK: usize = 4096;
 
+/// Adds each `(row, column, value)` of `entries` to the stored entry of `m` there (a sum where
+/// a position repeats), without changing its pattern; `Err((row, column))` at the first
+/// position `m` does not store, before any value is changed.
+pub fn add_to_pattern(m: &mut SparseColMat<usize, f64>, entries: &[(usize, usize, f64)]) -> Result<(), (usize, usize)> {
+    let mut at = Vec::with_capacity(entries.len());
+    {
+        let sym = m.symbolic();
+        for &(i, j, _) in entries {
+            let col_start = if j < sym.ncols() {
+                sym.col_ptr()[j]
+            } else {
+                return Err((i, j));
+            };
+            let rows = sym.row_idx_of_col_raw(j);
+            match rows.iter().position(|&r| r == i) {
+                Some(k) => at.push(col_start + k),
+                None => return Err((i, j)),
+            }
+        }
+    }
+    let vals = m.val_mut();
+    for (&k, &(_, _, v)) in at.iter().zip(entries) {
+        vals[k] += v;
+    }
+    Ok(())
+}
+
 /// `M` as a dense row-major array (for tests and small problems).
 pub fn to_dense(m: SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
     let mut d = vec![vec![0.0; m.ncols()]; m.nrows()];
@@ -190,6 +217,26 @@ mod tests {
     /// `K`'s lower triangle, built by ranges of columns on the pool, is entry for entry the
     /// blocks' (`A` and `-B` below their diagonals, `G` below `A`), whatever the pool, with
     /// columns of every kind: empty, `A` or `B` without entries above the diagonal, `G` empty.
+    /// Entries land on their stored positions (repeats summed); a position outside the
+    /// pattern is refused with nothing changed.
+    #[test]
+    fn entries_are_added_within_the_pattern_only() {
+        let t = [
+            Triplet::new(0, 0, 1.0),
+            Triplet::new(2, 0, 2.0),
+            Triplet::new(1, 1, 3.0),
+            Triplet::new(0, 2, 2.0),
+            Triplet::new(2, 2, 5.0),
+        ];
+        let mut m = SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &t).unwrap();
+        add_to_pattern(&mut m, &[(2, 0, 0.5), (0, 2, 0.5), (2, 2, 1.0), (2, 2, 1.0)]).unwrap();
+        let d = to_dense(m.as_ref());
+        assert_eq!(d, vec![vec![1.0, 0.0, 2.5], vec![0.0, 3.0, 0.0], vec![2.5, 0.0, 7.0]]);
+        assert_eq!(add_to_pattern(&mut m, &[(0, 0, 1.0), (1, 0, 1.0)]), Err((1, 0)));
+        assert_eq!(add_to_pattern(&mut m, &[(0, 3, 1.0)]), Err((0, 3)));
+        assert_eq!(to_dense(m.as_ref()), d);
+    }
+
     #[test]
     fn the_lower_triangle_of_k_is_the_blocks_on_any_pool() {
         let (n_u, n_phi) = (3 * COLUMNS_PER_TASK / 2 + 7, COLUMNS_PER_TASK + 3);

@@ -194,6 +194,26 @@ pub struct Posed<'a> {
     pub disc: &'a Discretization<'a>,
     /// The loads on the free dofs, checked finite.
     pub loads: Loads,
+    /// The springs that hold a body only its compliant bed holds, which the backend assembles
+    /// into `K` along the bed's normal ([`ContactBoundary::normal_springs`]) and the run takes
+    /// out again by a fixed point on the loads; `None` where the Dirichlet conditions hold the
+    /// body.
+    pub bed: Option<Bed>,
+}
+
+/// The springs that hold a body only its compliant bed holds (the Dirichlet conditions leave
+/// a motion free that the bed holds along its normal): `k_s w_i n_i n_iᵀ` at each bed point,
+/// assembled into `K` by the backend; the run takes them out again by a fixed point on the
+/// loads, `(K + S) u_{j+1} + contact = b + S u_j` (docs/theory.md, "A body only its bed
+/// holds").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bed {
+    /// `k_s`: the springs' stiffness, pressure per unit normal displacement.
+    pub stiffness: f64,
+    /// The bed's tangent stiffness at the loads' mean pressure (the same units).
+    pub tangent: f64,
+    /// The body's own stiffness at the bed, `c / h` (the same units).
+    pub body: f64,
 }
 
 impl Posed<'_> {

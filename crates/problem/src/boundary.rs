@@ -16,6 +16,7 @@ use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
 use rayon::prelude::*;
 
 /// The contact points of a boundary group and the u dofs of their nodes.
+#[derive(Clone)]
 pub struct ContactBoundary {
     /// The points.
     pub points: ContactPoints,
@@ -426,6 +427,61 @@ impl ContactBoundary {
                 out[j] -= p.weight[i] * f;
             }
         }
+        out
+    }
+
+    /// The points' holds along their normals, for the rigid motions a compliant bed holds
+    /// ([`fe_assembly::Discretization::check_held_with`]).
+    pub fn supports(&self) -> Vec<fe_assembly::Support> {
+        self.nodes
+            .iter()
+            .zip(&self.points.normal)
+            .map(|(&node, &direction)| fe_assembly::Support { node, direction })
+            .collect()
+    }
+
+    /// The springs `k w_i n_i n_iᵀ` at the points on their free components, as `(row, column,
+    /// value)` in the free u numbering (both triangles): a compliant bed's hold on a body only
+    /// it holds (the run's `Bed`).
+    pub fn normal_springs(&self, k: f64) -> Vec<(usize, usize, f64)> {
+        let p = &self.points;
+        let dim = p.dim;
+        let mut out = vec![];
+        for i in 0..p.len() {
+            for a in 0..dim {
+                let Slot::Free(ja) = self.slots[i * dim + a] else {
+                    continue;
+                };
+                for b in 0..dim {
+                    let Slot::Free(jb) = self.slots[i * dim + b] else {
+                        continue;
+                    };
+                    let v = k * p.weight[i] * p.normal[i][a] * p.normal[i][b];
+                    if v != 0.0 {
+                        out.push((self.dofs[ja], self.dofs[jb], v));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// `S u` for the springs of [`ContactBoundary::normal_springs`], on the `n_u` free
+    /// displacements, from the points' normal displacement `u_n` (their prescribed
+    /// components' part taken out: the springs act on the free ones).
+    pub fn spring_load(&self, k: f64, u_n: &[f64], n_u: usize) -> Vec<f64> {
+        let p = &self.points;
+        let dim = p.dim;
+        let zero = vec![0.0; self.dofs.len()];
+        let mut lambda = PointValues::zeros(p.len(), 0);
+        for i in 0..p.len() {
+            let prescribed = self.point_u(i, &zero);
+            let along: f64 = (0..dim).map(|a| prescribed[a] * p.normal[i][a]).sum();
+            // the force of a multiplier is -w λ n: the springs' is w k u_n
+            lambda.normal[i] = -k * (u_n[i] - along);
+        }
+        let mut out = vec![0.0; n_u];
+        self.add_forces(&lambda, &mut out);
         out
     }
 

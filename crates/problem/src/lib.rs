@@ -57,6 +57,7 @@
 
 mod analytical;
 pub mod backend;
+mod bed;
 mod boundary;
 mod capacitance;
 mod estimate;

@@ -99,7 +99,6 @@ pub fn solve_path(
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
     let mut disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
-    disc.check_held().map_err(fe_assembly::AssemblyError::from)?;
     let parts = disc.rhs_parts(&setup.loads)?;
     let mut walk = Walk {
         scene,
@@ -360,12 +359,19 @@ impl Walk<'_> {
             setup: self.setup,
             disc,
             loads: step_loads(self.parts, &self.spec.factors(instants[0]), self.scene)?,
+            bed: None,
         };
         let assembled = Faer.assemble(&posed)?;
         let t_assembly = t.elapsed().as_secs_f64();
         reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
         let boundary = ContactBoundary::of_groups(disc, self.scene.contacts())?;
         boundary.report_held(&self.contact.group, reporter);
+        if crate::backend::Bed::needed(&posed, Some(&boundary))?.is_some() {
+            let feature = "a load path of a body that only its compliant bed holds (the springs that hold it are taken out by a fixed point on each instant's loads, which the path's condensed steps do not run)";
+            return Err(crate::backend::Unsupported::new("faer", "path", feature)
+                .advise("prescribe the motion the bed holds on a boundary group, or solve each instant as a scene without [path]")
+                .into());
+        }
         let system = Faer.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
         stop_if_interrupted(limits, "factorisation")?;
         Ok((system, boundary, t_assembly))
@@ -505,6 +511,7 @@ impl Walk<'_> {
             setup,
             disc: on.disc,
             loads: step_loads(self.parts, f, scene)?,
+            bed: None,
         };
         let framed = Framed {
             boundary,
@@ -545,6 +552,7 @@ impl Walk<'_> {
             setup: self.setup,
             disc,
             loads: std::mem::take(loads),
+            bed: None,
         };
         let measured = Measured {
             info: Some(&done.result.solution.info),
@@ -552,6 +560,7 @@ impl Walk<'_> {
             equilibrium: *equilibrium,
             timings_s,
             figures,
+            bed_steps: 0,
         };
         let mut report: RunReport = report(&posed, measured, recovered);
         // the path's iterations are its steps' summed

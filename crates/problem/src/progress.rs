@@ -53,6 +53,17 @@ pub enum Event<'a> {
         /// Wall time (s).
         seconds: f64,
     },
+    /// A step of the fixed point that takes out the springs holding a body only its compliant
+    /// bed holds (the run's `Bed`): the change of the springs' forces, relative to the
+    /// loads.
+    BedStep {
+        /// The step, from 1.
+        step: usize,
+        /// The change.
+        change: f64,
+        /// The change below which the fixed point has settled.
+        settled: f64,
+    },
     /// An outer iteration of the contact solve, with the tolerance it aims at.
     Contact {
         /// The solver's progress line.
@@ -185,6 +196,10 @@ impl fmt::Display for Event<'_> {
                 row.step, row.t, row.normal_force, row.tangential_force, row.n_stick, row.n_slip, row.n_separated, row.iterations
             ),
             Event::PathStep { step, of, t } => write!(f, "path step {step}/{of}: t = {t}"),
+            Event::BedStep { step, change, settled } => write!(
+                f,
+                "the bed's springs, step {step}: their forces changed by {change:.3e} of the loads (settled below {settled:.0e})"
+            ),
             Event::Condensed { m, route, seconds } => write!(
                 f,
                 "condensed the contact compliance ({m} x {m}, {route:?}) in {seconds:.3} s"

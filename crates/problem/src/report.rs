@@ -468,6 +468,11 @@ pub struct Iterations {
     pub primal_solves: usize,
     /// PCG iterations spent estimating `μ_max`.
     pub pcg_in_step_estimate: usize,
+    /// Steps of the fixed point on the springs that hold a body only its compliant bed holds
+    /// (each a contact solve; the counts above are the last one's), 0 where the Dirichlet
+    /// conditions hold the body.
+    #[serde(default)]
+    pub bed: usize,
 }
 
 impl Iterations {
@@ -485,6 +490,7 @@ impl Iterations {
             pcg,
             primal_solves: info.map_or(1, |i| i.operator_calls),
             pcg_in_step_estimate: info.map_or(0, |i| i.estimate_inner_iters),
+            bed: 0,
         }
     }
 
@@ -500,6 +506,7 @@ impl Iterations {
         self.pcg += other.pcg;
         self.primal_solves += other.primal_solves;
         self.pcg_in_step_estimate += other.pcg_in_step_estimate;
+        self.bed += other.bed;
     }
 
     /// One line: the counts of the loops that ran (`4 Newton`, `39 Uzawa, 3 FP, 812 PCG`),
@@ -513,6 +520,7 @@ impl Iterations {
             (self.uzawa, "Uzawa"),
             (self.fixed_point, "FP"),
             (self.pcg, "PCG"),
+            (self.bed, "bed"),
         ] {
             if count > 0 {
                 parts.push(format!("{count} {name}"));

@@ -3,7 +3,8 @@
 //! system), check, recover the fields, report. [`run`] calls the steps in order on any
 //! [`Backend`] and builds the report once; [`solve`] runs the default backend.
 
-use crate::backend::{Backend, ContactSolve, Figures, Finished, Limits, Loads, Posed, Solved};
+use crate::backend::{Backend, Bed, ContactSolve, Figures, Finished, Limits, Loads, Posed, Solved};
+use crate::bed::Balanced;
 use crate::boundary::ContactBoundary;
 use crate::exact::contact_errors;
 use crate::plan::Plan;
@@ -16,7 +17,7 @@ use crate::scene::{ContactLaw, Rule, Scene, Valid};
 use crate::setup::{setup, MeshNotes, Setup};
 use crate::ProblemError;
 use contact::{ContactPoints, ContactSolution, PointValues};
-use fe_assembly::{AssemblyError, CellFields, Discretization};
+use fe_assembly::{CellFields, Discretization};
 use std::time::Instant;
 
 /// What a run produced: its report, the mesh, the nodal solution, the per-cell fields, and the
@@ -82,22 +83,20 @@ pub fn run<B: Backend>(
     stop_if_interrupted(&limits, "set-up")?;
     let t = Instant::now();
     let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints).map_err(ProblemError::from)?;
-    let posed = pose(scene, &setup, &disc)?;
+    let mut posed = pose(scene, &setup, &disc)?;
+    let boundary = contact_boundary(&posed, reporter)?;
+    posed.bed = Bed::needed(&posed, boundary.as_ref())?;
     let assembled = backend.assemble(&posed)?;
     let t_assembly = t.elapsed().as_secs_f64();
     reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
     stop_if_interrupted(&limits, "assembly")?;
-    let boundary = contact_boundary(&posed, reporter)?;
     let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
     stop_if_interrupted(&limits, "factorisation")?;
-    let solved = match boundary {
-        Some(b) => {
-            let how = ContactSolve::new(&setup.plan, &scene, &b, limits.interrupt);
-            backend.solve_contact(&posed, &mut system, b, &how, reporter)?
-        }
-        None => backend.solve_linear(&posed, &mut system, reporter)?,
-    };
-    let equilibrium = backend.equilibrium(&posed, &system, &solved)?;
+    let Balanced {
+        solved,
+        equilibrium,
+        steps: bed_steps,
+    } = solve(backend, &mut posed, &mut system, boundary, limits, reporter)?;
     if let Some(contraction) = solved.contact.as_ref().and_then(|(_, sol)| sol.info.contraction) {
         if contraction >= 1.0 {
             reporter.event(&Event::NotContractive { contraction });
@@ -108,6 +107,7 @@ pub fn run<B: Backend>(
         pcg_iters: solved.pcg_iters,
         equilibrium,
     });
+    let bed = posed.bed;
     let Solved {
         x,
         contact,
@@ -120,7 +120,14 @@ pub fn run<B: Backend>(
     let sol = contact.as_ref().map(|(_, sol)| sol);
     check_solved(&scene, (&u, &phi), sol, equilibrium)?;
     if B::HELD_TO_TOLERANCE {
-        check_accurate(&scene, &setup.plan, sol, equilibrium)?;
+        check_accurate(&scene, &setup.plan, sol, equilibrium).map_err(|e| match (e, bed) {
+            // a body only its bed holds: the bed's softness is the likely cause
+            (ProblemError::IllConditioned { what, .. }, Some(bed)) => ProblemError::IllConditioned {
+                what,
+                factors: bed.conditioning_in_words(),
+            },
+            (e, _) => e,
+        })?;
     }
     let contact_pair = contact.as_ref().map(|(b, sol)| (b, sol));
     let recovered = recover(&scene, &setup, &disc, (&u, &phi), contact_pair, equilibrium, reporter)?;
@@ -139,6 +146,7 @@ pub fn run<B: Backend>(
         equilibrium,
         timings_s,
         figures,
+        bed_steps,
     };
     let report = report(&posed, measured, &recovered);
     drop(posed);
@@ -150,6 +158,45 @@ pub fn run<B: Backend>(
         phi: recovered.phi,
         fields: recovered.fields,
     }))
+}
+
+/// The run's solve on the prepared `system`: the contact problem on `boundary` (through the
+/// bed's fixed point where only a compliant bed holds the body), or the one linear solve;
+/// with the equilibrium residual and the bed's steps.
+fn solve<B: Backend>(
+    backend: &mut B,
+    posed: &mut Posed<'_>,
+    system: &mut B::System,
+    boundary: Option<ContactBoundary>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<Balanced<B::Solution>, B::Error> {
+    let (scene, plan) = (posed.scene, &posed.setup.plan);
+    match (boundary, posed.bed) {
+        (Some(b), Some(bed)) => {
+            let how = ContactSolve::new(plan, scene.scene(), &b, limits.interrupt);
+            crate::bed::solve_held(backend, posed, system, &b, (&how, bed), reporter)
+        }
+        (Some(b), None) => {
+            let how = ContactSolve::new(plan, scene.scene(), &b, limits.interrupt);
+            let solved = backend.solve_contact(posed, system, b, &how, reporter)?;
+            let equilibrium = backend.equilibrium(posed, system, &solved)?;
+            Ok(Balanced {
+                solved,
+                equilibrium,
+                steps: 0,
+            })
+        }
+        (None, _) => {
+            let solved = backend.solve_linear(posed, system, reporter)?;
+            let equilibrium = backend.equilibrium(posed, system, &solved)?;
+            Ok(Balanced {
+                solved,
+                equilibrium,
+                steps: 0,
+            })
+        }
+    }
 }
 
 /// The start of a run: the memory `estimate` (bytes, and what it counts) checked against
@@ -198,10 +245,9 @@ pub(crate) fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Resul
     }
 }
 
-/// The discrete problem: the Dirichlet conditions checked to hold the body, the loads on the
-/// free dofs, checked finite.
+/// The discrete problem: the loads on the free dofs, checked finite (what holds the body is
+/// judged with the contact boundary, [`Bed::needed`]).
 fn pose<'a>(scene: Valid<'a>, setup: &'a Setup, disc: &'a Discretization<'a>) -> Result<Posed<'a>, ProblemError> {
-    disc.check_held().map_err(AssemblyError::from)?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     ProblemError::check_finite(&b_u, "the mechanical load vector", &scene)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", &scene)?;
@@ -210,6 +256,7 @@ fn pose<'a>(scene: Valid<'a>, setup: &'a Setup, disc: &'a Discretization<'a>) ->
         setup,
         disc,
         loads: Loads { b_u, b_phi },
+        bed: None,
     })
 }
 
@@ -561,6 +608,8 @@ pub(crate) struct Measured<'a> {
     pub(crate) equilibrium: f64,
     pub(crate) timings_s: Timings,
     pub(crate) figures: Figures,
+    /// Steps of the bed's fixed point ([`crate::bed`]).
+    pub(crate) bed_steps: usize,
 }
 
 /// The typed report of the run, whichever backend solved it.
@@ -577,7 +626,10 @@ pub(crate) fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunRe
         },
         contact: r.contact.clone(),
         exact: r.exact.clone(),
-        iterations: Iterations::of(info, m.pcg_iters),
+        iterations: Iterations {
+            bed: m.bed_steps,
+            ..Iterations::of(info, m.pcg_iters)
+        },
         residuals: Residuals {
             equilibrium,
             complementarity: info.map_or(0.0, |i| i.complementarity),

@@ -95,3 +95,19 @@ def test_every_form_the_installed_gmsh_writes_reads_as_the_same_mesh(tmp_path):
         check_stack(pc.run(pc.Scene.from_dict(stack(f))))
     with pytest.raises(pc.MeshError, match="second-order"):
         pc.run(pc.Scene.from_dict(stack(tmp_path / "2d-ascii-order2.msh")))
+
+
+def test_a_body_only_its_bed_holds_runs_and_what_it_leaves_free_is_named():
+    # the paper's block on its compliant bed, its sides on rollers: only the bed holds it
+    s = pc.Scene.load("paper-compliance", {"mesh.n": 8})
+    s.set({"dirichlet.0.u": None, "dirichlet.1.u": None})
+    s.set({"dirichlet.0.ux": 0.0, "dirichlet.1.ux": 0.0})
+    r = pc.run(s)
+    assert r.report["residuals"]["converged_to_tolerance"]
+    assert r.report["iterations"]["bed"] > 0
+    # the bed carries the whole load: 2 (pressure) x 2 (width)
+    assert abs(r.report["contact"]["normal_force"] - 4.0) < 1e-9
+    # nothing on the sides: the bed does not hold the slide
+    s.set({"dirichlet.0.ux": None, "dirichlet.1.ux": None})
+    with pytest.raises(pc.InputError, match=r"compliant bed leave 1 rigid motion of the body free \(a translation along \[1.000, 0.000\]\)"):
+        pc.run(s)

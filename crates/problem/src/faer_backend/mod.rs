@@ -185,12 +185,21 @@ impl Factored {
 /// rayon's threads ([`linalg::pool_par`]).
 fn factor(
     posed: &Posed<'_>,
-    blocks: Blocks,
+    mut blocks: Blocks,
     boundary: Option<&ContactBoundary>,
     limits: Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Factored, ProblemError> {
     let t = Instant::now();
+    if let (Some(bed), Some(cb)) = (posed.bed, boundary) {
+        // the springs that hold a body only its bed holds (crate::bed), on A's own pattern
+        linalg::sparse::add_to_pattern(&mut blocks.a, &cb.normal_springs(bed.stiffness)).map_err(|(i, j)| {
+            ProblemError::NoSolution {
+                sought: "contact.compliance",
+                why: format!("the stiffness matrix stores no entry ({i}, {j}) for the bed's springs at a contact node"),
+            }
+        })?;
+    }
     let (scene, plan) = (posed.scene.scene(), posed.plan());
     let paper = plan.rule == Rule::Paper;
     let pcg_params = PcgParams {

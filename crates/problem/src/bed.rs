@@ -1,0 +1,232 @@
+//! A body that only its compliant bed holds.
+//!
+//! Every solve needs the stiffness `K` invertible, and a compliant bed holds a body only where
+//! it presses: a block on rollers whose vertical translation nothing prescribes is held by the
+//! bed it rests on, but `K` alone is singular. The run holds such a body with springs
+//! `S = Σ_i k_s w_i n_i n_iᵀ` along the bed's normal at its points, assembled into `K`
+//! ([`ContactBoundary::normal_springs`]), and takes them out again by a fixed point on the
+//! loads (a proximal-point iteration in the springs' norm):
+//!
+//! `(K + S) u_{j+1} + contact(u_{j+1}) = b + S u_j`,
+//!
+//! whose fixed point solves `K u + contact(u) = b`. In a motion the bed holds the error falls
+//! by `k_s / (k_s + t)` per step, `t` the bed's tangent stiffness where it presses; where the
+//! bed lets a point go, by `k_s / (k_s + c / h)`, `c / h` the body's own stiffness there. The
+//! springs are taken at [`SPRING_FRACTION`] of the smaller of the two (the tangent at the mean
+//! pressure the loads put on the bed, the largest elastic constant over the bed's median
+//! spacing), so each step gains two digits or more, at the price of two decades of `K`'s
+//! conditioning in the motions the bed holds. Each step is a contact solve of the backend with its own
+//! loads; the run stops where a step changes the springs' forces by less than
+//! [`SETTLED`] of the loads, or where the change stops falling (its round-off floor) below
+//! half the equilibrium residual a run must reach; the change is added to the residual the
+//! run reports.
+//!
+//! A body that the bed holds nowhere (the loads lift it off) has no solution: a typed
+//! [`ProblemError::NoSolution`], as has a fixed point that does not settle.
+
+use crate::backend::{Backend, Bed, ContactSolve, Posed, Solved};
+use crate::boundary::ContactBoundary;
+use crate::progress::{Event, Reporter};
+use crate::ProblemError;
+use contact::Foundation;
+
+/// The springs' stiffness as a fraction of the bed's tangent stiffness at the loads' mean
+/// pressure: the fixed point's error falls by about this much per step where the bed presses
+/// everywhere (less where it presses part of the bed).
+pub const SPRING_FRACTION: f64 = 1e-2;
+
+/// The fixed point stops where a step changes the springs' forces by less than this fraction
+/// of the loads: a thousandth of the equilibrium residual a run must reach
+/// ([`crate::EQUILIBRIUM_TOL`]), which the change adds to.
+pub const SETTLED: f64 = 1e-11;
+
+/// At most this many steps of the fixed point.
+pub const MAX_STEPS: usize = 60;
+
+impl Bed {
+    /// The springs a run needs: `None` where the Dirichlet conditions hold the body (or there
+    /// is no compliant bed), the springs where only the bed holds some rigid motion.
+    ///
+    /// # Errors
+    /// [`fe_assembly::Unheld`] (as an assembly error) naming the motions that the conditions
+    /// and the bed together leave free; [`ProblemError::NoSolution`] where the loads press
+    /// nothing onto the bed.
+    pub(crate) fn needed(posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> Result<Option<Bed>, ProblemError> {
+        let supports = match boundary {
+            Some(b) if matches!(b.points.foundation, Foundation::Compliant { .. }) => b.supports(),
+            _ => vec![],
+        };
+        let held = posed
+            .disc
+            .check_held_with(&supports)
+            .map_err(fe_assembly::AssemblyError::from)?;
+        let (fe_assembly::Held::WithSupports, Some(boundary)) = (held, boundary) else {
+            return Ok(None);
+        };
+        let Foundation::Compliant { stiffness, exponent } = boundary.points.foundation else {
+            return Ok(None);
+        };
+        // the mean pressure the loads put on the bed: their resultant over its area (where they
+        // balance, a sum of their sizes)
+        let area: f64 = boundary.points.weight.iter().sum();
+        let b = &posed.loads.b_u;
+        let dim = posed.disc.dofs.dim;
+        let mut resultant = [0.0f64; 3];
+        for (v, d) in posed.disc.dofs.u.iter().enumerate() {
+            if let fe_assembly::Dof::Free(j) = d {
+                resultant[v % dim] += b[*j];
+            }
+        }
+        let mut force = resultant.iter().map(|f| f * f).sum::<f64>().sqrt();
+        if !(force > 0.0) {
+            force = b.iter().map(|x| x.abs()).sum();
+        }
+        let pressure = force / area;
+        if !(pressure > 0.0 && pressure.is_finite()) {
+            return Err(ProblemError::NoSolution {
+                sought: "contact.compliance",
+                why: "only the compliant bed holds the body, and no load presses it onto the bed".into(),
+            });
+        }
+        // k [p]^m at the pressure P: p = (P / k)^(1/m), tangent k m p^(m-1)
+        let penetration = (pressure / stiffness).powf(1.0 / exponent);
+        let tangent = stiffness * exponent * penetration.powf(exponent - 1.0);
+        // no stiffer than a fraction of the body's own stiffness at the bed, c / h: where the
+        // bed lets a point go, the spring alone holds it, and the fixed point's error there
+        // falls by k_s / (k_s + c / h)
+        let c = posed
+            .setup
+            .materials
+            .iter()
+            .flat_map(|(_, m)| (0..m.c.len().isqrt()).map(|k| m.c[k * m.c.len().isqrt() + k]))
+            .fold(0.0f64, f64::max);
+        let mut weights = boundary.points.weight.clone();
+        weights.sort_by(f64::total_cmp);
+        let h = weights[weights.len() / 2].powf(1.0 / (dim as f64 - 1.0));
+        let body = c / h;
+        let springs = SPRING_FRACTION * tangent.min(body);
+        if !(springs > 0.0 && springs.is_finite()) {
+            return Err(ProblemError::NoSolution {
+                sought: "contact.compliance",
+                why: format!(
+                    "the bed's tangent stiffness at the loads' mean pressure {pressure:.3e} is {tangent:.3e}: no spring of finite positive stiffness holds the body in its place"
+                ),
+            });
+        }
+        Ok(Some(Bed {
+            stiffness: springs,
+            tangent,
+            body,
+        }))
+    }
+
+    /// Why a run of a body only this bed holds is ill-conditioned, in words: a bed far softer
+    /// than the body sinks it by many times its own deformation, whose digits the
+    /// displacement's rigid part takes.
+    pub fn conditioning_in_words(&self) -> String {
+        format!(
+            "only its compliant bed holds the body, and the bed's tangent stiffness {:.3e} is {:.1e} of the body's own at the bed (c / h = {:.3e}): the body sinks about {:.0e} times as far as it deforms, and its rigid motion takes the digits of its deformation (hold that motion with a Dirichlet condition, or stiffen the bed)",
+            self.tangent,
+            self.tangent / self.body,
+            self.body,
+            self.body / self.tangent
+        )
+    }
+}
+
+/// A run's solve with its equilibrium residual on the body's own loads and the steps of the
+/// bed's fixed point (0 without it; with it, the last step's solution, whose residual is the
+/// step's own plus the springs' last change).
+pub(crate) struct Balanced<X> {
+    pub(crate) solved: Solved<X>,
+    pub(crate) equilibrium: f64,
+    pub(crate) steps: usize,
+}
+
+/// The contact problem of a body only its bed holds: contact solves of `backend` (whose `K`
+/// carries the springs of `bed`) with the loads `b + S u_j` until the springs' forces settle.
+/// `posed`'s loads are its own again on return.
+///
+/// # Errors
+/// The backend's; [`ProblemError::NoSolution`] where the loads lift the body off its bed (no
+/// point pressed) or the fixed point does not settle in [`MAX_STEPS`].
+pub(crate) fn solve_held<B: Backend>(
+    backend: &mut B,
+    posed: &mut Posed<'_>,
+    system: &mut B::System,
+    boundary: &ContactBoundary,
+    (how, bed): (&ContactSolve<'_>, Bed),
+    reporter: &mut dyn Reporter,
+) -> Result<Balanced<B::Solution>, B::Error> {
+    let loads = posed.loads.b_u.clone();
+    let result = fixed_point(backend, posed, system, boundary, (how, bed), &loads, reporter);
+    posed.loads.b_u = loads;
+    result
+}
+
+/// [`solve_held`]'s steps, from the body's own loads `loads`.
+fn fixed_point<B: Backend>(
+    backend: &mut B,
+    posed: &mut Posed<'_>,
+    system: &mut B::System,
+    boundary: &ContactBoundary,
+    (how, bed): (&ContactSolve<'_>, Bed),
+    loads: &[f64],
+    reporter: &mut dyn Reporter,
+) -> Result<Balanced<B::Solution>, B::Error> {
+    let mut springs = vec![0.0; loads.len()];
+    let (mut seconds, mut pcg_iters) = (0.0, 0);
+    let (mut change, mut last) = (f64::INFINITY, f64::INFINITY);
+    for step in 1..=MAX_STEPS {
+        let mut solved = backend.solve_contact(posed, system, boundary.clone(), how, reporter)?;
+        (seconds, pcg_iters) = (seconds + solved.seconds, pcg_iters + solved.pcg_iters);
+        let Some((cb, sol)) = solved.contact.as_ref() else {
+            return Ok(Balanced {
+                equilibrium: backend.equilibrium(posed, system, &solved)?,
+                solved,
+                steps: step,
+            });
+        };
+        if !sol.lambda.normal.iter().any(|&l| l > 0.0) {
+            let why =
+                "the loads lift the body off its compliant bed (no point presses on it), and only the bed holds it"
+                    .into();
+            return Err(ProblemError::NoSolution {
+                sought: "contact.compliance",
+                why,
+            }
+            .into());
+        }
+        let next = cb.spring_load(bed.stiffness, &sol.u.normal, loads.len());
+        let scale = linalg::norm(loads).max(linalg::norm(&cb.forces(&sol.lambda)));
+        change = linalg::norm(&next.iter().zip(&springs).map(|(a, b)| a - b).collect::<Vec<_>>()) / scale;
+        reporter.event(&Event::BedStep {
+            step,
+            change,
+            settled: SETTLED,
+        });
+        // settled, or at its round-off floor (no longer falling) within what a run must reach
+        let floor = change <= 0.5 * crate::EQUILIBRIUM_TOL && change > 0.5 * last;
+        last = change;
+        if change <= SETTLED || floor {
+            let equilibrium = backend.equilibrium(posed, system, &solved)? + change;
+            (solved.seconds, solved.pcg_iters) = (seconds, pcg_iters);
+            return Ok(Balanced {
+                solved,
+                equilibrium,
+                steps: step,
+            });
+        }
+        for ((b, l), s) in posed.loads.b_u.iter_mut().zip(loads).zip(&next) {
+            *b = l + s;
+        }
+        springs = next;
+    }
+    Err(ProblemError::NoSolution {
+        sought: "contact.compliance",
+        why: format!(
+            "the fixed point on the springs that hold the body in its bed's place did not settle in {MAX_STEPS} steps (last change {change:.1e} of the loads, {SETTLED:.0e} sought)"
+        ),
+    }
+    .into())
+}
