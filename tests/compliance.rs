@@ -345,16 +345,55 @@ fn what_the_bed_does_not_hold_is_named_and_a_bed_it_leaves_is_no_solution() {
 }
 
 #[test]
-fn a_path_of_a_body_only_its_bed_holds_is_refused_by_name() {
+fn a_path_of_a_body_only_its_bed_holds_meets_the_closed_form_at_each_instant() {
+    // the traction grows from 0 to q in 4 steps; Coulomb's law has nothing to do (uniaxial
+    // strain), so each instant is the closed form at its load, and the last the one-instant run
     let k = c_modulus();
-    let mut s = on_its_bed(2, k, 1.0, false, k * DELTA);
-    s.path = Some(problem::PathSpec {
-        t: vec![0.0, 1.0],
-        steps: Some(2),
-        ..Default::default()
-    });
-    match fails(&s) {
-        problem::ProblemError::Unsupported(u) => assert_eq!(u.key, "path", "{u}"),
-        e => panic!("{e}"),
+    let q = k * DELTA;
+    for dim in [2, 3] {
+        let mut s = on_its_bed(dim, k, 1.0, true, q);
+        s.path = Some(problem::PathSpec {
+            t: vec![0.0, 1.0],
+            steps: Some(4),
+            load: Some(vec![0.0, 1.0]),
+            ..Default::default()
+        });
+        let mut rows = vec![];
+        let path = problem::solve_path(&s, None, problem::Limits::default(), &mut Silent, false, &mut |step| {
+            rows.push((
+                step.row.t,
+                step.contact.solution.lambda.normal.clone(),
+                step.contact.solution.u.normal.clone(),
+            ));
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{dim}D: {e}"));
+        assert_eq!(rows.len(), 5);
+        for (t, lambda, u_n) in &rows {
+            let e_pressure = lambda.iter().map(|l| (l - t * q).abs() / q).fold(0.0, f64::max);
+            let e_penetration = u_n.iter().map(|u| (u - t * q / k).abs() / DELTA).fold(0.0, f64::max);
+            assert!(
+                e_pressure < 1e-9 && e_penetration < 1e-8,
+                "{dim}D t = {t}: {e_pressure:e} {e_penetration:e}"
+            );
+        }
+        let report = &path.last.report;
+        assert!(report.residuals.converged_to_tolerance, "{dim}D");
+        assert!(
+            report.iterations.bed >= 4,
+            "{dim}D: {} steps of the bed's fixed point",
+            report.iterations.bed
+        );
+        s.path = None;
+        let once = problem::solve(&s, None, &mut Silent).unwrap();
+        let (a, b) = (
+            &path.last.contact.as_ref().unwrap().solution.lambda.normal,
+            &once.contact.as_ref().unwrap().solution.lambda.normal,
+        );
+        let diff = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        assert!(
+            diff < 1e-10 * q,
+            "{dim}D: the path's last instant and the run differ by {diff:e}"
+        );
     }
 }

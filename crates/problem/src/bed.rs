@@ -28,7 +28,7 @@ use crate::backend::{Backend, Bed, ContactSolve, Posed, Solved};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
 use crate::ProblemError;
-use contact::Foundation;
+use contact::{ContactSolution, Foundation, PointValues};
 
 /// The springs' stiffness as a fraction of the bed's tangent stiffness at the loads' mean
 /// pressure: the fixed point's error falls by about this much per step where the bed presses
@@ -174,9 +174,9 @@ fn fixed_point<B: Backend>(
     loads: &[f64],
     reporter: &mut dyn Reporter,
 ) -> Result<Balanced<B::Solution>, B::Error> {
-    let mut springs = vec![0.0; loads.len()];
+    let mut springs = PointValues::zeros(boundary.points.len(), 0);
     let (mut seconds, mut pcg_iters) = (0.0, 0);
-    let (mut change, mut last) = (f64::INFINITY, f64::INFINITY);
+    let mut last = f64::INFINITY;
     for step in 1..=MAX_STEPS {
         let mut solved = backend.solve_contact(posed, system, boundary.clone(), how, reporter)?;
         (seconds, pcg_iters) = (seconds + solved.seconds, pcg_iters + solved.pcg_iters);
@@ -187,28 +187,13 @@ fn fixed_point<B: Backend>(
                 steps: step,
             });
         };
-        if !sol.lambda.normal.iter().any(|&l| l > 0.0) {
-            let why =
-                "the loads lift the body off its compliant bed (no point presses on it), and only the bed holds it"
-                    .into();
-            return Err(ProblemError::NoSolution {
-                sought: "contact.compliance",
-                why,
-            }
-            .into());
-        }
-        let next = cb.spring_load(bed.stiffness, &sol.u.normal, loads.len());
-        let scale = linalg::norm(loads).max(linalg::norm(&cb.forces(&sol.lambda)));
-        change = linalg::norm(&next.iter().zip(&springs).map(|(a, b)| a - b).collect::<Vec<_>>()) / scale;
+        let (next, change) = settle(cb, bed, sol, &springs, linalg::norm(loads))?;
         reporter.event(&Event::BedStep {
             step,
             change,
             settled: SETTLED,
         });
-        // settled, or at its round-off floor (no longer falling) within what a run must reach
-        let floor = change <= 0.5 * crate::EQUILIBRIUM_TOL && change > 0.5 * last;
-        last = change;
-        if change <= SETTLED || floor {
+        if settled(change, last) {
             let equilibrium = backend.equilibrium(posed, system, &solved)? + change;
             (solved.seconds, solved.pcg_iters) = (seconds, pcg_iters);
             return Ok(Balanced {
@@ -217,16 +202,58 @@ fn fixed_point<B: Backend>(
                 steps: step,
             });
         }
-        for ((b, l), s) in posed.loads.b_u.iter_mut().zip(loads).zip(&next) {
-            *b = l + s;
-        }
-        springs = next;
+        posed.loads.b_u.copy_from_slice(loads);
+        cb.add_forces(&next, &mut posed.loads.b_u);
+        (springs, last) = (next, change);
     }
-    Err(ProblemError::NoSolution {
+    Err(unsettled(last).into())
+}
+
+/// The springs' multipliers at the solution `sol` (a spring's force is a multiplier
+/// `-k_s (u_n - u_n,prescribed)` at its point: [`ContactBoundary::spring_multipliers`]), and
+/// their forces' change from `current`, relative to `scale` (the loads') or the contact
+/// forces, the larger.
+///
+/// # Errors
+/// [`ProblemError::NoSolution`] where the body moved off its bed (no point pressed).
+pub(crate) fn settle(
+    boundary: &ContactBoundary,
+    bed: Bed,
+    sol: &ContactSolution,
+    current: &PointValues,
+    scale: f64,
+) -> Result<(PointValues, f64), ProblemError> {
+    let next = boundary.spring_multipliers(bed.stiffness, &sol.u.normal, current.n_tangential());
+    let mut step = next.clone();
+    for (d, c) in step.normal.iter_mut().zip(&current.normal) {
+        *d -= c;
+    }
+    let moved = linalg::norm(&boundary.forces(&step));
+    if moved > 0.0 && !sol.lambda.normal.iter().any(|&l| l > 0.0) {
+        let why =
+            "the loads lift the body off its compliant bed (no point presses on it), and only the bed holds it".into();
+        return Err(ProblemError::NoSolution {
+            sought: "contact.compliance",
+            why,
+        });
+    }
+    let scale = scale.max(linalg::norm(&boundary.forces(&sol.lambda)));
+    Ok((next, if moved == 0.0 { 0.0 } else { moved / scale }))
+}
+
+/// Whether the fixed point has settled at a step that changed the springs' forces by
+/// `change` (`last` the step before's): below [`SETTLED`], or no longer falling (its round-off
+/// floor) below half the equilibrium residual a run must reach.
+pub(crate) fn settled(change: f64, last: f64) -> bool {
+    change <= SETTLED || (change <= 0.5 * crate::EQUILIBRIUM_TOL && change > 0.5 * last)
+}
+
+/// The fixed point that did not settle in [`MAX_STEPS`], its last change `change`.
+pub(crate) fn unsettled(change: f64) -> ProblemError {
+    ProblemError::NoSolution {
         sought: "contact.compliance",
         why: format!(
             "the fixed point on the springs that hold the body in its bed's place did not settle in {MAX_STEPS} steps (last change {change:.1e} of the loads, {SETTLED:.0e} sought)"
         ),
     }
-    .into())
 }

@@ -466,23 +466,22 @@ impl ContactBoundary {
         out
     }
 
-    /// `S u` for the springs of [`ContactBoundary::normal_springs`], on the `n_u` free
-    /// displacements, from the points' normal displacement `u_n` (their prescribed
-    /// components' part taken out: the springs act on the free ones).
-    pub fn spring_load(&self, k: f64, u_n: &[f64], n_u: usize) -> Vec<f64> {
+    /// The multipliers whose forces are those of the springs of
+    /// [`ContactBoundary::normal_springs`] at the points' normal displacement `u_n`:
+    /// `-k (u_n - u_n,p)`, `u_n,p` the prescribed components' part (the springs act on the free
+    /// ones), with `nt` tangential components at 0.
+    pub fn spring_multipliers(&self, k: f64, u_n: &[f64], nt: usize) -> PointValues {
         let p = &self.points;
         let dim = p.dim;
         let zero = vec![0.0; self.dofs.len()];
-        let mut lambda = PointValues::zeros(p.len(), 0);
+        let mut lambda = PointValues::zeros(p.len(), nt);
         for i in 0..p.len() {
             let prescribed = self.point_u(i, &zero);
             let along: f64 = (0..dim).map(|a| prescribed[a] * p.normal[i][a]).sum();
-            // the force of a multiplier is -w λ n: the springs' is w k u_n
+            // the force of a multiplier is -w λ n: the spring's is w k u_n
             lambda.normal[i] = -k * (u_n[i] - along);
         }
-        let mut out = vec![0.0; n_u];
-        self.add_forces(&lambda, &mut out);
-        out
+        lambda
     }
 
     /// Adds the contact forces of `lambda` to `b_u`.

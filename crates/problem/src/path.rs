@@ -111,7 +111,7 @@ pub fn solve_path(
         with_fields,
         terminals: Terminals::default(),
     };
-    let (mut system, boundary, t_assembly) = walk.factor(&disc, &instants, &limits, reporter)?;
+    let (mut system, boundary, t_assembly, bed) = walk.factor(&disc, &instants, &limits, reporter)?;
     let how = ContactSolve::new(&setup.plan, scene, &boundary, limits.interrupt);
     let ordered: Vec<(Vec<f64>, Vec<f64>)> = std::iter::once(parts.loads.clone())
         .chain(parts.displacements.iter().cloned())
@@ -129,6 +129,7 @@ pub fn solve_path(
         path: &mut path,
         how: &how,
         state: &mut state,
+        bed,
     };
     walk.all_steps(&instants, &mut on, reporter, each)?;
     let steps_s = t_steps.elapsed().as_secs_f64();
@@ -158,6 +159,8 @@ struct On<'a, 'd> {
     path: &'a mut PathSystem,
     how: &'a ContactSolve<'a>,
     state: &'a mut History,
+    /// The springs that hold a body only its compliant bed holds.
+    bed: Option<crate::backend::Bed>,
 }
 
 /// What stays the same along a path: the scene, its set-up, the parts of the right-hand side.
@@ -337,6 +340,25 @@ impl History {
 /// An instant's fields: recovered, their equilibrium residual, the loads, the displacement.
 type InstantFields = (Recovered, f64, Loads, Vec<f64>);
 
+/// The springs' multipliers of an instant of a body only its compliant bed holds (zeros
+/// otherwise), the bed's fixed-point steps, and its last change (relative to the forces).
+struct Springs {
+    lambda: PointValues,
+    steps: usize,
+    change: f64,
+}
+
+impl Springs {
+    /// The multipliers that act on the springs' `K`: the contact's `lambda` and the springs'.
+    fn applied(&self, lambda: &PointValues) -> PointValues {
+        let mut out = lambda.clone();
+        for (a, s) in out.normal.iter_mut().zip(&self.lambda.normal) {
+            *a += s;
+        }
+        out
+    }
+}
+
 struct Done {
     row: StepRow,
     result: ContactResult,
@@ -352,9 +374,9 @@ impl Walk<'_> {
         instants: &[f64],
         limits: &Limits,
         reporter: &mut dyn Reporter,
-    ) -> Result<(Factored, ContactBoundary, f64), ProblemError> {
+    ) -> Result<(Factored, ContactBoundary, f64, Option<crate::backend::Bed>), ProblemError> {
         let t = Instant::now();
-        let posed = Posed {
+        let mut posed = Posed {
             scene: self.valid,
             setup: self.setup,
             disc,
@@ -366,15 +388,35 @@ impl Walk<'_> {
         reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
         let boundary = ContactBoundary::of_groups(disc, self.scene.contacts())?;
         boundary.report_held(&self.contact.group, reporter);
-        if crate::backend::Bed::needed(&posed, Some(&boundary))?.is_some() {
-            let feature = "a load path of a body that only its compliant bed holds (the springs that hold it are taken out by a fixed point on each instant's loads, which the path's condensed steps do not run)";
-            return Err(crate::backend::Unsupported::new("faer", "path", feature)
-                .advise("prescribe the motion the bed holds on a boundary group, or solve each instant as a scene without [path]")
-                .into());
-        }
+        posed.bed = self.bed(disc, instants, &boundary)?;
         let system = Faer.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
         stop_if_interrupted(limits, "factorisation")?;
-        Ok((system, boundary, t_assembly))
+        Ok((system, boundary, t_assembly, posed.bed))
+    }
+
+    /// The springs that hold a body only its compliant bed holds (`None` where the conditions
+    /// hold it), sized by the loads of the path's strongest instant.
+    fn bed(
+        &self,
+        disc: &Discretization<'_>,
+        instants: &[f64],
+        boundary: &ContactBoundary,
+    ) -> Result<Option<crate::backend::Bed>, ProblemError> {
+        let mut strongest = step_loads(self.parts, &self.spec.factors(instants[0]), self.scene)?;
+        for &t in &instants[1..] {
+            let loads = step_loads(self.parts, &self.spec.factors(t), self.scene)?;
+            if linalg::norm(&loads.b_u) > linalg::norm(&strongest.b_u) {
+                strongest = loads;
+            }
+        }
+        let posed = Posed {
+            scene: self.valid,
+            setup: self.setup,
+            disc,
+            loads: strongest,
+            bed: None,
+        };
+        crate::backend::Bed::needed(&posed, Some(boundary))
     }
 
     /// Every instant in order, each handed to `each` and its row kept; the last kept whole.
@@ -431,28 +473,16 @@ impl Walk<'_> {
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
         factors.push(f.voltage);
-        // force control: the depth found at each step for the indenter's force times the load
-        // factor, from the step before's multipliers
-        let (path, how, state) = (&mut *on.path, on.how, &mut *on.state);
-        let sol = match self.contact.indenter.as_ref().and_then(|i| i.force) {
-            Some(force) => {
-                path.prime(&boundary, &factors, &state.shift);
-                let start = state.start.take();
-                crate::faer_backend::force_controlled(&mut boundary.points, force * f.load, start, |points, warm| {
-                    path.force_search_at(how, points, warm, reporter)
-                })?
-            }
-            None => path.contact(how, &boundary, &factors, &state.shift, state.start.take(), reporter)?,
-        };
+        let (sol, spring) = self.contact_at(on, &mut boundary, &factors, f.load, reporter)?;
         if let Some(contraction) = sol.info.contraction.filter(|c| *c >= 1.0) {
             reporter.event(&Event::NotContractive { contraction });
         }
         // the instant's own displacement scale: its loads' and prescribed values', and how far
         // its gaps press in
         let pressed = boundary.points.gap.iter().fold(0.0f64, |m, g| m.max(-g));
-        check_history(&state.shift, path.own_scale(&factors).max(pressed), &setup.plan)?;
+        check_history(&on.state.shift, on.path.own_scale(&factors).max(pressed), &setup.plan)?;
         let (mut sol, fields) = if with_fields {
-            self.fields_at(on, &boundary, &f, sol, reporter)?
+            self.fields_at(on, &boundary, &f, (sol, &spring), reporter)?
         } else {
             check_solved(scene, (&[], &[]), Some(&sol), 0.0)?;
             check_accurate(scene, &setup.plan, Some(&sol), 0.0)?;
@@ -479,10 +509,13 @@ impl Walk<'_> {
         // the condensed solve's accuracy: tests/path.rs)
         (row.charges, row.potentials) = match &fields {
             Some((recovered, _, _, _)) => recovered.terminals.iter().map(|x| (x.charge, x.potential)).unzip(),
-            None => self.terminals.at(&factors, &sol.lambda, &boundary.points.weight),
+            None => self
+                .terminals
+                .at(&factors, &spring.applied(&sol.lambda), &boundary.points.weight),
         };
         row.equilibrium = fields.as_ref().map(|(_, e, _, _)| *e);
         state.advance(&now, &sol);
+        state.iterations.bed += spring.steps;
         let result = match &fields {
             Some((_, _, _, u)) => contact_result(boundary, sol, u),
             None => ContactResult::condensed(boundary, sol),
@@ -502,15 +535,18 @@ impl Walk<'_> {
         on: &mut On<'_, '_>,
         boundary: &ContactBoundary,
         f: &Factors,
-        sol: ContactSolution,
+        (sol, spring): (ContactSolution, &Springs),
         reporter: &mut dyn Reporter,
     ) -> Result<(ContactSolution, Option<InstantFields>), ProblemError> {
         let (scene, setup) = (self.scene, self.setup);
+        let mut loads = step_loads(self.parts, f, scene)?;
+        // the springs' forces of a body only its bed holds are loads of the springs' K
+        boundary.add_forces(&spring.lambda, &mut loads.b_u);
         let posed = Posed {
             scene: self.valid,
             setup,
             disc: on.disc,
-            loads: step_loads(self.parts, f, scene)?,
+            loads,
             bed: None,
         };
         let framed = Framed {
@@ -519,12 +555,69 @@ impl Walk<'_> {
         };
         let (sol, (u, phi)) = on.path.fields(on.how, on.system, framed, &posed, sol, reporter)?;
         let b = crate::faer_backend::rhs_with_contact(&posed, Some((boundary, &sol)));
-        let equilibrium = on.system.equilibrium_of(&u, &phi, &b);
+        let equilibrium = on.system.equilibrium_of(&u, &phi, &b) + spring.change;
         check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
         check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
         let pair = Some((boundary, &sol));
         let recovered = recover(scene, setup, on.disc, (&u, &phi), pair, equilibrium, reporter)?;
         Ok((sol, Some((recovered, equilibrium, posed.loads, u))))
+    }
+
+    /// The contact solve of an instant at `factors` (force control: the depth found for the
+    /// indenter's force times the `load` factor, from the step before's multipliers); where
+    /// only a compliant bed holds the body, the bed's fixed point around it (the springs'
+    /// forces a multiplier of their own on the condensed problem, as in the run:
+    /// `crate::bed`), with the springs' multipliers and steps.
+    fn contact_at(
+        &self,
+        on: &mut On<'_, '_>,
+        boundary: &mut ContactBoundary,
+        factors: &[f64],
+        load: f64,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(ContactSolution, Springs), ProblemError> {
+        let (path, how, state) = (&mut *on.path, on.how, &mut *on.state);
+        let force = self.contact.indenter.as_ref().and_then(|i| i.force);
+        let base_gap = boundary.points.gap.clone();
+        let n = boundary.points.len();
+        let mut springs = Springs {
+            lambda: PointValues::zeros(n, path.n_tangential()),
+            steps: 0,
+            change: 0.0,
+        };
+        let mut start = state.start.take();
+        let mut last = f64::INFINITY;
+        loop {
+            path.prime(boundary, factors, &state.shift);
+            path.add_forces(&springs.lambda)?;
+            boundary.points.gap.clone_from(&base_gap);
+            let sol = match force {
+                Some(force) => {
+                    crate::faer_backend::force_controlled(&mut boundary.points, force * load, start, |points, warm| {
+                        path.force_search_at(how, points, warm, reporter)
+                    })?
+                }
+                None => path.solve_primed(how, &boundary.points, start, reporter)?,
+            };
+            let Some(bed) = on.bed else { return Ok((sol, springs)) };
+            springs.steps += 1;
+            let (next, change) = crate::bed::settle(boundary, bed, &sol, &springs.lambda, 0.0)?;
+            reporter.event(&Event::BedStep {
+                step: springs.steps,
+                change,
+                settled: crate::bed::SETTLED,
+            });
+            if crate::bed::settled(change, last) {
+                springs.change = change;
+                return Ok((sol, springs));
+            }
+            if springs.steps == crate::bed::MAX_STEPS {
+                return Err(crate::bed::unsettled(change));
+            }
+            last = change;
+            springs.lambda = next;
+            start = Some(sol.lambda);
+        }
     }
 
     /// The report of the last instant with the path's section, and the last instant.

@@ -58,23 +58,6 @@ impl PathSystem {
         Ok((u, phi))
     }
 
-    /// The contact problem of a step: the loads' displacement at the points for the step's
-    /// `factors` (the parts summed), in the frame of the step before's tangential displacement
-    /// `shift` (friction on the slip increment), warm-started from `start`. Its displacements
-    /// are in that frame.
-    pub(crate) fn contact(
-        &mut self,
-        how: &ContactSolve<'_>,
-        boundary: &ContactBoundary,
-        factors: &[f64],
-        shift: &PointValues,
-        start: Option<PointValues>,
-        reporter: &mut dyn Reporter,
-    ) -> Result<ContactSolution, ProblemError> {
-        self.prime(boundary, factors, shift);
-        how.run(Operator::Condensed(&mut self.dense), &boundary.points, start, reporter)
-    }
-
     /// The displacement of the boundary's dofs that a step's own data make, `Σ_q f_q x_q` at
     /// `factors` (no contact force).
     fn own_data(&self, factors: &[f64]) -> Vec<f64> {
@@ -101,6 +84,49 @@ impl PathSystem {
         let x0 = self.own_data(factors);
         let nt = self.dense.nt;
         self.dense.u0 = in_frame(fields_at_points(boundary, &x0, nt), Some(shift));
+    }
+
+    /// Tangential components per point of the condensed problem.
+    pub(crate) fn n_tangential(&self) -> usize {
+        self.dense.nt
+    }
+
+    /// Adds the displacement of the forces of the multipliers `lambda` to the primed step's
+    /// `u⁰` (the springs that hold a body only its bed holds, which act as multipliers).
+    ///
+    /// # Errors
+    /// The operator's (a dense one has none).
+    pub(crate) fn add_forces(&mut self, lambda: &PointValues) -> Result<(), ProblemError> {
+        if lambda.normal.iter().all(|&l| l == 0.0) {
+            return Ok(());
+        }
+        let mut moved = PointValues::zeros(lambda.n_points(), self.dense.nt);
+        let mut all = PointValues::zeros(lambda.n_points(), self.dense.nt);
+        all.normal.clone_from(&lambda.normal);
+        contact::ContactOperator::forces_alone(&mut self.dense, &all, &mut moved).map_err(|e| {
+            ProblemError::NoSolution {
+                sought: "contact.compliance",
+                why: format!("the springs' forces on the condensed problem: {e}"),
+            }
+        })?;
+        for (u, m) in self.dense.u0.normal.iter_mut().zip(&moved.normal) {
+            *u += m;
+        }
+        for (u, m) in self.dense.u0.tangential.iter_mut().zip(&moved.tangential) {
+            *u += m;
+        }
+        Ok(())
+    }
+
+    /// The contact solve of the primed step ([`PathSystem::prime`]).
+    pub(crate) fn solve_primed(
+        &mut self,
+        how: &ContactSolve<'_>,
+        points: &ContactPoints,
+        start: Option<PointValues>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError> {
+        how.run(Operator::Condensed(&mut self.dense), points, start, reporter)
     }
 
     /// The contact solve of the primed step ([`PathSystem::prime`]) at one depth of a force
