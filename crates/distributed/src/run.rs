@@ -104,6 +104,7 @@ pub struct Prepared<'p> {
 }
 
 impl<'p> Backend for PetscBackend<'p> {
+    const NAME: &'static str = "petsc";
     type Assembled = Assembled<'p>;
     type System = Prepared<'p>;
     type Solution = Vector<'p>;
@@ -219,6 +220,15 @@ impl<'p> Backend for PetscBackend<'p> {
     }
 
     /// Gathers the solution on rank 0 (collective), with the PETSc section of the report.
+    fn gather(
+        &mut self,
+        posed: &Posed<'_>,
+        s: &Prepared<'p>,
+        x: &Vector<'p>,
+    ) -> Result<Option<problem::backend::Fields>, DistributedError> {
+        Ok(x.gather()?.map(|x| unpermute(posed.disc, &s.layout, &x)))
+    }
+
     fn finish(
         &mut self,
         posed: &Posed<'_>,

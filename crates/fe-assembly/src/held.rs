@@ -40,8 +40,8 @@ pub enum Unheld {
              this solver (every solve needs the stiffness invertible)"
         } else {
             "a rigid foundation's contact does not hold a body in this solver (the paper's Γ1 has \
-             positive measure: every solve needs the stiffness invertible), a compliant bed \
-             (contact.compliance) along its normal only"
+             positive measure: every solve needs the stiffness invertible; a compliant bed, \
+             contact.compliance, would hold it along the bed's normal)"
         }
     )]
     Motion {

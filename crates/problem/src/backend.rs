@@ -12,8 +12,9 @@
 use crate::progress::Reporter;
 use crate::report::PetscReport;
 use crate::scene::{ContactSolver, Scene, Valid};
+use crate::solution::Solution;
 use crate::ProblemError;
-use contact::{ContactSolution, Law};
+use contact::{ContactPoints, ContactSolution, Law, PointValues};
 use fe_assembly::Discretization;
 use linalg::CondenseRoute;
 
@@ -84,6 +85,9 @@ impl Limits {
 /// collective on every rank; only [`finish`](Backend::finish) may return `None` (a rank that
 /// does not hold the gathered solution).
 pub trait Backend {
+    /// The backend's name, as `solver.backend` spells it (for its refusals).
+    const NAME: &'static str;
+
     /// The assembled system, before it is prepared.
     type Assembled;
     /// The system ready to be solved (factored, or its solvers configured).
@@ -181,6 +185,133 @@ pub trait Backend {
         system: Self::System,
         solution: Self::Solution,
     ) -> Result<Option<Finished>, Self::Error>;
+
+    /// The free unknowns `(u, φ)` of a solution, the system kept (for another solve on it);
+    /// `None` on a process that does not hold the gathered solution.
+    ///
+    /// # Errors
+    /// The backend's own.
+    fn gather(
+        &mut self,
+        posed: &Posed<'_>,
+        system: &Self::System,
+        solution: &Self::Solution,
+    ) -> Result<Option<Fields>, Self::Error>;
+
+    /// The scene's load path, its instants on one preparation of the system ([`PathBackend`]),
+    /// returning the last instant's solution (`None` on a process that does not hold it). A
+    /// backend that solves one instant only refuses it (the default).
+    ///
+    /// # Errors
+    /// [`Unsupported`] keyed `path` (the default); a path backend's errors.
+    fn run_path(
+        &mut self,
+        scene: &Scene,
+        mesh: Option<mesh::Mesh>,
+        limits: Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Option<Solution>, Self::Error> {
+        let _ = (scene, mesh, limits, reporter);
+        let feature = "a load path (it solves one instant)";
+        Err(ProblemError::from(Unsupported::new(Self::NAME, "path", feature)).into())
+    }
+}
+
+/// A backend that solves load paths: the instants on one preparation of the system, each a
+/// contact solve on what the path keeps ([`PathBackend::Path`]), the fields only where asked
+/// (`problem::solve_path` is the walk over the instants, written once for every such backend).
+pub trait PathBackend: Backend<Error = ProblemError> {
+    /// What a path keeps from instant to instant (the default backend: the condensed
+    /// compliance and the solutions of the parts of the right-hand side).
+    type Path;
+
+    /// Starts a path on the prepared `system` for the contact solve `how` on `boundary`: what
+    /// it keeps, built once, and the fields `K⁻¹ b_q` of each part `q` of the right-hand side
+    /// (`parts`: the loads, each displacement component's lifting, the potentials' lifting) in
+    /// that order.
+    ///
+    /// # Errors
+    /// A solve that failed; a system the backend cannot walk a path on.
+    fn begin_path(
+        &mut self,
+        system: &mut Self::System,
+        on: (&ContactBoundary, &ContactSolve<'_>),
+        parts: &[(Vec<f64>, Vec<f64>)],
+        reporter: &mut dyn Reporter,
+    ) -> Result<(Self::Path, Vec<Fields>), ProblemError>;
+
+    /// `K⁻¹ [a_u; a_φ]` (a functional's response).
+    ///
+    /// # Errors
+    /// A solve that failed.
+    fn respond(&mut self, system: &mut Self::System, a: (&[f64], &[f64]))
+        -> Result<(Vec<f64>, Vec<f64>), ProblemError>;
+
+    /// Poses an instant's contact problem: its data at `factors` (the parts' factors, in their
+    /// order), in the frame `shift` (the instant before's tangential displacement), with the
+    /// point forces of the multipliers `springs` among its loads (zeros but where only a
+    /// compliant bed holds the body): `frame_and_springs = (shift, springs)`.
+    ///
+    /// # Errors
+    /// The backend's own.
+    fn prime(
+        &mut self,
+        path: &mut Self::Path,
+        boundary: &ContactBoundary,
+        factors: &[f64],
+        frame_and_springs: (&PointValues, &PointValues),
+    ) -> Result<(), ProblemError>;
+
+    /// The contact solve of the posed instant at `at = (points, start, refine_start)`: on
+    /// `points` (their gaps an indenter's depth's under force control, where `refine_start`
+    /// asks Newton to take steps from a start that meets the tolerance), warm-started from
+    /// `start`; its displacements in the instant's frame.
+    ///
+    /// # Errors
+    /// A contact solve that did not converge.
+    fn solve_posed(
+        &mut self,
+        path: &mut Self::Path,
+        how: &ContactSolve<'_>,
+        at: (&ContactPoints, Option<PointValues>, bool),
+        reporter: &mut dyn Reporter,
+    ) -> Result<ContactSolution, ProblemError>;
+
+    /// The largest displacement of the contact dofs that an instant's own data make at
+    /// `factors`: the scale of its answer.
+    fn own_scale(&self, path: &Self::Path, factors: &[f64]) -> f64;
+
+    /// The fields of the posed instant (`instant = (framed, posed)`) under `posed`'s loads and
+    /// the contact forces of `sol` (in `framed`'s frame), on what the path `kept` (its state
+    /// and the system), refined, the law judged on them; with their equilibrium residual.
+    ///
+    /// # Errors
+    /// A solve that failed.
+    fn instant_fields(
+        &mut self,
+        kept: (&mut Self::Path, &mut Self::System),
+        how: &ContactSolve<'_>,
+        instant: (Framed<'_>, &Posed<'_>),
+        sol: ContactSolution,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(ContactSolution, Fields, f64), ProblemError>;
+
+    /// What the backend measured, for the path's report.
+    fn figures(&self, system: &Self::System) -> Figures;
+}
+
+/// The free unknowns `(u, φ)` of the discretisation.
+pub type Fields = (Vec<f64>, Vec<f64>);
+
+/// An instant's contact boundary (its gaps and prescribed values at the instant's factors)
+/// and the frame its contact problem is posed in: the tangential displacements of the
+/// instant before.
+#[derive(Clone, Copy)]
+pub struct Framed<'a> {
+    /// The boundary at the instant.
+    pub boundary: &'a ContactBoundary,
+    /// The instant before's tangential displacements.
+    pub shift: &'a PointValues,
 }
 
 /// The discrete problem a backend solves: the validated scene, its set-up, the discretisation

@@ -6,16 +6,17 @@
 //! Column j is the charges of the state with terminal j at unit potential, every other
 //! terminal at 0, the scene's prescribed displacements at 0 and no load: the small-signal
 //! capacitance of the body as its mechanical conditions hold it (clamped where they clamp it,
-//! free where it is free; the contact face free). One factorisation of `K` serves every
-//! column. Reciprocity (`C = Cᵀ`) and Gauss's law (each column's charges sum to 0 where the
+//! free where it is free; the contact face free). One preparation of `K` by the backend serves
+//! every column: a run over unit-potential instants (this module names no backend). Reciprocity (`C = Cᵀ`) and Gauss's law (each column's charges sum to 0 where the
 //! terminals enclose every flux) are identities of the discrete problem, reported as checks.
 
+use crate::backend::{Backend, Limits, Loads, Posed};
+use crate::progress::Silent;
 use crate::run::terminal_groups;
 use crate::scene::{Scene, SceneError};
 use crate::setup::setup;
 use crate::ProblemError;
-use fe_assembly::{AssemblyError, Discretization, Dof, Parallelism};
-use linalg::{CoupledSolver, DirectLdlt, Ordering};
+use fe_assembly::{AssemblyError, Discretization, Dof, DofMap};
 use serde::{Deserialize, Serialize};
 
 /// The capacitance matrix of a scene's terminals, in the scene's units (charge per unit
@@ -36,70 +37,78 @@ pub struct Capacitance {
     pub column_sum: f64,
 }
 
-/// The capacitance matrix of `scene` (validated here; `mesh` the mesh of a `gmsh` or `given`
-/// scene, read by the caller).
+/// The capacitance matrix of `scene` on `backend` (validated here; `mesh` the mesh of a
+/// `gmsh` or `given` scene, read by the caller); `None` on a process that does not hold the
+/// gathered solutions.
 ///
 /// # Errors
 /// The scene's and set-up's errors, as a run's; a scene without electric unknowns or without
-/// a terminal (key `dirichlet`); a body its mechanical conditions do not hold.
-pub fn capacitance(scene: &Scene, mesh: Option<mesh::Mesh>) -> Result<Capacitance, ProblemError> {
+/// a terminal (key `dirichlet`); a body its mechanical conditions do not hold; the backend's.
+pub(crate) fn capacitance<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+) -> Result<Option<Capacitance>, B::Error> {
     // a floating terminal is a terminal like the others here (its potential a column's)
     let mut scene = scene.clone();
     for d in scene.dirichlet.iter_mut().filter(|d| d.charge.is_some()) {
         d.phi = Some(0.0);
         d.charge = None;
     }
-    let valid = scene.validate()?;
+    let valid = scene.validate().map_err(ProblemError::from)?;
     let setup = setup(valid, mesh)?;
     if !setup.plan.electric {
-        return Err(SceneError::new(
-            "material",
-            "the scene has no electric unknowns (no permittivity): no capacitance",
-        )
-        .into());
+        let why = "the scene has no electric unknowns (no permittivity): no capacitance";
+        return Err(ProblemError::from(SceneError::new("material", why)).into());
     }
     let groups = terminal_groups(&setup);
     if groups.is_empty() {
-        return Err(SceneError::new(
-            "dirichlet",
-            "the scene has no terminal (no [electrode], no dirichlet.phi)",
-        )
-        .into());
+        let why = "the scene has no terminal (no [electrode], no dirichlet.phi)";
+        return Err(ProblemError::from(SceneError::new("dirichlet", why)).into());
     }
-    let mut disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
-    disc.check_held().map_err(AssemblyError::from)?;
+    let mut disc =
+        Discretization::new(&setup.mesh, &setup.materials, &setup.constraints).map_err(ProblemError::from)?;
+    disc.check_held()
+        .map_err(|e| ProblemError::from(AssemblyError::from(e)))?;
     let (conductor, names) = conductors(&setup.mesh, &groups)?;
     let mut member = vec![None; setup.mesh.n_nodes()];
     for (g, group) in groups.iter().enumerate() {
-        for v in setup.mesh.boundary(group)?.nodes() {
+        for v in setup.mesh.boundary(group).map_err(ProblemError::from)?.nodes() {
             member[v] = Some(conductor[g]);
         }
     }
-    let blocks = disc.assemble(Parallelism::Rayon);
-    let mut solver = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq)?;
     let base = disc.dofs.clone();
     let n = names.len();
     let mut matrix = vec![vec![0.0; n]; n];
+    let mut system = None;
     for j in 0..n {
-        // terminal j at 1, the others and the prescribed displacements at 0
-        let mut dofs = base.clone();
-        dofs.u.iter_mut().for_each(|d| {
-            if let Dof::Fixed(v) = d {
-                *v = 0.0;
-            }
-        });
-        for (v, d) in dofs.phi.iter_mut().enumerate() {
-            if let Dof::Fixed(x) = d {
-                *x = if member[v] == Some(j) { 1.0 } else { 0.0 };
-            }
+        disc.dofs = unit_potential(&base, &member, j);
+        let (b_u, b_phi) = disc.rhs(&[]).map_err(ProblemError::from)?;
+        let posed = Posed {
+            scene: valid,
+            setup: &setup,
+            disc: &disc,
+            loads: Loads { b_u, b_phi },
+            bed: None,
+        };
+        // one preparation for every column: the matrix does not change with the potentials
+        if system.is_none() {
+            let assembled = backend.assemble(&posed)?;
+            system = Some(backend.prepare(&posed, assembled, None, Limits::default(), &mut Silent)?);
         }
-        disc.dofs = dofs;
-        let (b_u, b_phi) = disc.rhs(&[])?;
-        let (mut u, mut phi) = (vec![0.0; disc.dofs.n_u], vec![0.0; disc.dofs.n_phi]);
-        solver.solve(&b_u, &b_phi, &mut u, &mut phi)?;
+        let Some(system) = system.as_mut() else { continue };
+        let solved = backend.solve_linear(&posed, system, &mut Silent)?;
+        let Some((u, phi)) = backend.gather(&posed, system, &solved.x)? else {
+            continue;
+        };
         let (u, phi) = (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&phi));
         // a node of several groups counts for the first: a conductor's charge is its groups'
-        for (g, charge) in disc.charges(&u, &phi, &groups, &[])?.into_iter().enumerate() {
+        for (g, charge) in disc
+            .charges(&u, &phi, &groups, &[])
+            .map_err(ProblemError::from)?
+            .into_iter()
+            .enumerate()
+        {
             matrix[conductor[g]][j] += charge;
         }
     }
@@ -117,12 +126,29 @@ pub fn capacitance(scene: &Scene, mesh: Option<mesh::Mesh>) -> Result<Capacitanc
         .map(|j| (0..n).map(|i| matrix[i][j]).sum::<f64>().abs())
         .fold(0.0, f64::max)
         / big;
-    Ok(Capacitance {
+    Ok(Some(Capacitance {
         terminals: names,
         matrix,
         asymmetry,
         column_sum,
-    })
+    }))
+}
+
+/// The dof map of column `j`: terminal `j` (the nodes whose `member` it is) at unit
+/// potential, the other terminals and the prescribed displacements of `base` at 0.
+fn unit_potential(base: &DofMap, member: &[Option<usize>], j: usize) -> DofMap {
+    let mut dofs = base.clone();
+    dofs.u.iter_mut().for_each(|d| {
+        if let Dof::Fixed(v) = d {
+            *v = 0.0;
+        }
+    });
+    for (v, d) in dofs.phi.iter_mut().enumerate() {
+        if let Dof::Fixed(x) = d {
+            *x = if member[v] == Some(j) { 1.0 } else { 0.0 };
+        }
+    }
+    dofs
 }
 
 /// The conductor of each group (groups that share a node joined, in the order of their first

@@ -64,6 +64,7 @@ mod estimate;
 mod exact;
 mod faer_backend;
 mod halfspace;
+mod outer;
 mod path;
 mod plan;
 mod progress;
@@ -71,15 +72,16 @@ pub mod report;
 mod run;
 mod scene;
 mod setup;
+mod solution;
 
 pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindlin_deresiewicz_traction};
 pub use backend::Limits;
-pub use capacitance::{capacitance, Capacitance};
+pub use capacitance::Capacitance;
 pub use exact::ExactReport;
 pub use faer_backend::Faer;
 pub use fe_assembly::CellFields;
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
-pub use path::{solve_path, PathSolution, Step};
+pub use path::{PathSolution, Step, StepFields};
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
@@ -114,12 +116,44 @@ pub fn solve_within(
     limits: Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Solution, ProblemError> {
-    if scene.path.is_some() {
-        // a path's instants, each step's files unwritten: the last instant, with the rows
-        return Ok(path::solve_path(scene, mesh, limits, reporter, false, &mut |_| Ok(()))?.last);
-    }
+    // a path's instants are the run's too (each step's files unwritten: the last instant,
+    // with the rows)
     let solution = run::run(&mut Faer, scene, mesh, limits, reporter)?;
     Ok(solution.expect("the default backend runs in one process, which holds the solution"))
+}
+
+/// The capacitance matrix between `scene`'s terminals on the default backend ([`Faer`]): one
+/// factorisation, a unit potential per column, the charges as reactions (`mesh` the mesh of a
+/// `gmsh` or `given` scene, read by the caller).
+///
+/// # Errors
+/// The scene's and set-up's errors, as a run's; a scene without electric unknowns or without
+/// a terminal (key `dirichlet`); a body its mechanical conditions do not hold.
+pub fn capacitance(scene: &Scene, mesh: Option<mesh::Mesh>) -> Result<Capacitance, ProblemError> {
+    let c = capacitance::capacitance(&mut Faer, scene, mesh)?;
+    Ok(c.expect("the default backend runs in one process, which holds the solution"))
+}
+
+/// Solves `scene`'s load path on the default backend ([`Faer`]): the instants of
+/// `scene.path` one after the other on one factorisation and one condensation, friction on
+/// the slip increment; `each` is called once per instant, in order, with the instant's row
+/// and contact solution, and, where `with_fields` asks for them, the fields of every
+/// `path.output_every`-th instant (and of the last, which the returned solution holds).
+/// Nothing of a step is kept after it but its row. A scene without a path is solved as the
+/// one instant it describes, which [`solve`] gives.
+///
+/// # Errors
+/// The errors of [`solve`], naming the step where one happened; `path` refused by the scene's
+/// checks where the run cannot carry friction's history; the error `each` returns.
+pub fn solve_path(
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+    with_fields: bool,
+    each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+) -> Result<PathSolution, ProblemError> {
+    path::walk(&mut Faer, scene, mesh, limits, reporter, with_fields, each)
 }
 
 /// "the most extreme inputs are ..." naming the scene's numbers far from 1 (each key once), or

@@ -14,9 +14,8 @@
 //! points, both computed once). The fields (a solve with `K`'s factors, refined, and the
 //! recovery) are computed only at the instants whose files are written, and at the last.
 
-use crate::backend::{ContactSolve, Limits, Loads, Posed};
+use crate::backend::{Bed, ContactSolve, Framed, Limits, Loads, PathBackend, Posed};
 use crate::boundary::ContactBoundary;
-use crate::faer_backend::{Factored, Faer, Fields, Framed, PathSystem};
 use crate::progress::{Event, Reporter};
 use crate::report::{PathReport, RunReport, StepRow, Timings};
 use crate::run::{
@@ -26,7 +25,7 @@ use crate::run::{
 use crate::scene::{Factors, PathSpec, Scene, SceneError};
 use crate::setup::Setup;
 use crate::ProblemError;
-use crate::{backend::Backend, Solution};
+use crate::Solution;
 use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization, RhsParts};
 use std::time::Instant;
@@ -61,17 +60,18 @@ pub struct PathSolution {
     pub last: Solution,
 }
 
-/// Solves `scene`'s path on the default backend: the instants of `scene.path` one after the
-/// other, friction on the slip increment; `each` is called once per instant, in order, with
-/// the instant's row and contact solution, and, where `with_fields` asks for them, the fields
-/// of every `path.output_every`-th instant (and of the last, which the returned solution
-/// holds). Nothing of a step is kept after it but its row. A scene without a path is solved
-/// as the one instant it describes, which [`crate::solve`] gives.
+/// Walks `scene`'s path on `backend`: the instants of `scene.path` one after the other,
+/// friction on the slip increment; `each` is called once per instant, in order, with the
+/// instant's row and contact solution, and, where `with_fields` asks for them, the fields of
+/// every `path.output_every`-th instant (and of the last, which the returned solution holds).
+/// Nothing of a step is kept after it but its row. A scene without a path is solved as the one
+/// instant it describes.
 ///
 /// # Errors
-/// The errors of [`crate::solve`], naming the step where one happened; `path` refused by the
-/// scene's checks where the run cannot carry friction's history; the error `each` returns.
-pub fn solve_path(
+/// The errors of a run, naming the step where one happened; `path` refused by the scene's
+/// checks where the run cannot carry friction's history; the error `each` returns.
+pub(crate) fn walk<B: PathBackend>(
+    backend: &mut B,
     scene: &Scene,
     mesh: Option<mesh::Mesh>,
     limits: Limits,
@@ -90,12 +90,12 @@ pub fn solve_path(
         vec![1.0]
     };
     let valid = scene.validate()?;
-    Faer.supports(&valid)?;
+    backend.supports(&valid)?;
     let Some(spec_contact) = scene.active_contact().cloned() else {
         return Err(SceneError::new("path", "a path carries friction's history: the scene has no contact").into());
     };
     let t_total = Instant::now();
-    let setup = begin(valid, mesh, Faer.estimate(&valid), &limits, reporter)?;
+    let setup = begin(valid, mesh, backend.estimate(&valid), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
     let mut disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
@@ -111,18 +111,19 @@ pub fn solve_path(
         with_fields,
         terminals: Terminals::default(),
     };
-    let (mut system, boundary, t_assembly, bed) = walk.factor(&disc, &instants, &limits, reporter)?;
+    let (mut system, boundary, t_assembly, bed) = walk.factor(backend, &disc, &instants, &limits, reporter)?;
     let how = ContactSolve::new(&setup.plan, scene, &boundary, limits.interrupt);
     let ordered: Vec<(Vec<f64>, Vec<f64>)> = std::iter::once(parts.loads.clone())
         .chain(parts.displacements.iter().cloned())
         .chain(std::iter::once(parts.potentials.clone()))
         .collect();
-    let (mut path, solved) = PathSystem::new(&mut system, &boundary, &ordered, setup.plan.n_tangential(), reporter)?;
-    walk.terminals = Terminals::new(&walk, &disc, &mut system, &boundary, &solved)?;
+    let (mut path, solved) = backend.begin_path(&mut system, (&boundary, &how), &ordered, reporter)?;
+    walk.terminals = Terminals::new(&walk, &disc, (&mut *backend, &mut system), &boundary, &solved)?;
     drop(solved);
     let t_steps = Instant::now();
     let mut state = History::new(boundary.points.len(), setup.plan.n_tangential(), instants.len());
     let mut on = On {
+        backend: &mut *backend,
         base: &boundary,
         disc: &mut disc,
         system: &mut system,
@@ -134,7 +135,8 @@ pub fn solve_path(
     walk.all_steps(&instants, &mut on, reporter, each)?;
     let steps_s = t_steps.elapsed().as_secs_f64();
     let timings = (t_setup, t_assembly, steps_s, t_total);
-    let (report, done) = walk.finish(&disc, &system, state, timings);
+    let figures = backend.figures(&system);
+    let (report, done) = walk.finish(&disc, figures, state, timings);
     drop(disc);
     let (recovered, _, _) = done.fields.expect("the last instant has its fields");
     Ok(PathSolution {
@@ -152,15 +154,16 @@ pub fn solve_path(
 /// What a path's steps work on: the boundary at the scene's own factors, the discretisation
 /// (its prescribed values scaled at each step), the factors of `K` and the path's condensed
 /// system on them, the contact solve, and friction's history.
-struct On<'a, 'd> {
+struct On<'a, 'd, B: PathBackend> {
+    backend: &'a mut B,
     base: &'a ContactBoundary,
     disc: &'a mut Discretization<'d>,
-    system: &'a mut Factored,
-    path: &'a mut PathSystem,
+    system: &'a mut B::System,
+    path: &'a mut B::Path,
     how: &'a ContactSolve<'a>,
     state: &'a mut History,
     /// The springs that hold a body only its compliant bed holds.
-    bed: Option<crate::backend::Bed>,
+    bed: Option<Bed>,
 }
 
 /// What stays the same along a path: the scene, its set-up, the parts of the right-hand side.
@@ -220,12 +223,12 @@ impl Functional {
 impl Terminals {
     /// The functionals of the setup's terminals: each part's charge and potential, from its
     /// solution's fields, and the response of each functional at the points (one solve each).
-    fn new(
+    fn new<B: PathBackend>(
         walk: &Walk<'_>,
         disc: &Discretization<'_>,
-        system: &mut Factored,
+        (backend, system): (&mut B, &mut B::System),
         boundary: &ContactBoundary,
-        solved: &[Fields],
+        solved: &[(Vec<f64>, Vec<f64>)],
     ) -> Result<Terminals, ProblemError> {
         let setup = walk.setup;
         let groups = terminal_groups(setup);
@@ -255,7 +258,7 @@ impl Terminals {
         }
         let points = &boundary.points;
         let mut respond = |a_u: &[f64], a_phi: &[f64]| -> Result<PointValues, ProblemError> {
-            let (z, _) = PathSystem::solve(system, a_u, a_phi)?;
+            let (z, _) = backend.respond(system, (a_u, a_phi))?;
             let mut out = PointValues::zeros(points.len(), points.n_tangential());
             boundary.extract_free(&z, &mut out);
             Ok(out)
@@ -368,13 +371,14 @@ struct Done {
 impl Walk<'_> {
     /// Assembles and factors `K` with the boundary's dofs last (at the first instant's
     /// factors); the boundary, and the assembly's time.
-    fn factor(
+    fn factor<B: PathBackend>(
         &self,
+        backend: &mut B,
         disc: &Discretization<'_>,
         instants: &[f64],
         limits: &Limits,
         reporter: &mut dyn Reporter,
-    ) -> Result<(Factored, ContactBoundary, f64, Option<crate::backend::Bed>), ProblemError> {
+    ) -> Result<(B::System, ContactBoundary, f64, Option<Bed>), ProblemError> {
         let t = Instant::now();
         let mut posed = Posed {
             scene: self.valid,
@@ -383,13 +387,13 @@ impl Walk<'_> {
             loads: step_loads(self.parts, &self.spec.factors(instants[0]), self.scene)?,
             bed: None,
         };
-        let assembled = Faer.assemble(&posed)?;
+        let assembled = backend.assemble(&posed)?;
         let t_assembly = t.elapsed().as_secs_f64();
         reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
         let boundary = ContactBoundary::of_groups(disc, self.scene.contacts())?;
         boundary.report_held(&self.contact.group, reporter);
         posed.bed = self.bed(disc, instants, &boundary)?;
-        let system = Faer.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
+        let system = backend.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
         stop_if_interrupted(limits, "factorisation")?;
         Ok((system, boundary, t_assembly, posed.bed))
     }
@@ -401,7 +405,7 @@ impl Walk<'_> {
         disc: &Discretization<'_>,
         instants: &[f64],
         boundary: &ContactBoundary,
-    ) -> Result<Option<crate::backend::Bed>, ProblemError> {
+    ) -> Result<Option<Bed>, ProblemError> {
         let mut strongest = step_loads(self.parts, &self.spec.factors(instants[0]), self.scene)?;
         for &t in &instants[1..] {
             let loads = step_loads(self.parts, &self.spec.factors(t), self.scene)?;
@@ -416,14 +420,14 @@ impl Walk<'_> {
             loads: strongest,
             bed: None,
         };
-        crate::backend::Bed::needed(&posed, Some(boundary))
+        Bed::needed(&posed, Some(boundary))
     }
 
     /// Every instant in order, each handed to `each` and its row kept; the last kept whole.
-    fn all_steps(
+    fn all_steps<B: PathBackend>(
         &self,
         instants: &[f64],
-        on: &mut On<'_, '_>,
+        on: &mut On<'_, '_, B>,
         reporter: &mut dyn Reporter,
         each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
     ) -> Result<(), ProblemError> {
@@ -455,9 +459,9 @@ impl Walk<'_> {
     /// The instant `t` (the path's `k`-th): its prescribed values, gap and loads scaled, the
     /// contact problem in the frame of the step before; where `with_fields`, the fields
     /// recovered and checked.
-    fn step(
+    fn step<B: PathBackend>(
         &self,
-        on: &mut On<'_, '_>,
+        on: &mut On<'_, '_, B>,
         k: usize,
         t: f64,
         with_fields: bool,
@@ -480,7 +484,11 @@ impl Walk<'_> {
         // the instant's own displacement scale: its loads' and prescribed values', and how far
         // its gaps press in
         let pressed = boundary.points.gap.iter().fold(0.0f64, |m, g| m.max(-g));
-        check_history(&on.state.shift, on.path.own_scale(&factors).max(pressed), &setup.plan)?;
+        check_history(
+            &on.state.shift,
+            on.backend.own_scale(on.path, &factors).max(pressed),
+            &setup.plan,
+        )?;
         let (mut sol, fields) = if with_fields {
             self.fields_at(on, &boundary, &f, (sol, &spring), reporter)?
         } else {
@@ -530,9 +538,9 @@ impl Walk<'_> {
     /// The fields of an instant (factors `f`) under the contact forces of `sol`: refined, the
     /// law judged on them, checked and recovered; with the equilibrium residual, the loads and
     /// the displacement.
-    fn fields_at(
+    fn fields_at<B: PathBackend>(
         &self,
-        on: &mut On<'_, '_>,
+        on: &mut On<'_, '_, B>,
         boundary: &ContactBoundary,
         f: &Factors,
         (sol, spring): (ContactSolution, &Springs),
@@ -553,9 +561,14 @@ impl Walk<'_> {
             boundary,
             shift: &on.state.shift,
         };
-        let (sol, (u, phi)) = on.path.fields(on.how, on.system, framed, &posed, sol, reporter)?;
-        let b = crate::faer_backend::rhs_with_contact(&posed, Some((boundary, &sol)));
-        let equilibrium = on.system.equilibrium_of(&u, &phi, &b) + spring.change;
+        let (sol, (u, phi), equilibrium) = on.backend.instant_fields(
+            (&mut *on.path, &mut *on.system),
+            on.how,
+            (framed, &posed),
+            sol,
+            reporter,
+        )?;
+        let equilibrium = equilibrium + spring.change;
         check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
         check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
         let pair = Some((boundary, &sol));
@@ -568,36 +581,35 @@ impl Walk<'_> {
     /// only a compliant bed holds the body, the bed's fixed point around it (the springs'
     /// forces a multiplier of their own on the condensed problem, as in the run:
     /// `crate::bed`), with the springs' multipliers and steps.
-    fn contact_at(
+    fn contact_at<B: PathBackend>(
         &self,
-        on: &mut On<'_, '_>,
+        on: &mut On<'_, '_, B>,
         boundary: &mut ContactBoundary,
         factors: &[f64],
         load: f64,
         reporter: &mut dyn Reporter,
     ) -> Result<(ContactSolution, Springs), ProblemError> {
-        let (path, how, state) = (&mut *on.path, on.how, &mut *on.state);
+        let (backend, path, how, state) = (&mut *on.backend, &mut *on.path, on.how, &mut *on.state);
         let force = self.contact.indenter.as_ref().and_then(|i| i.force);
         let base_gap = boundary.points.gap.clone();
         let n = boundary.points.len();
         let mut springs = Springs {
-            lambda: PointValues::zeros(n, path.n_tangential()),
+            lambda: PointValues::zeros(n, self.setup.plan.n_tangential()),
             steps: 0,
             change: 0.0,
         };
         let mut start = state.start.take();
         let mut last = f64::INFINITY;
         loop {
-            path.prime(boundary, factors, &state.shift);
-            path.add_forces(&springs.lambda)?;
+            backend.prime(path, boundary, factors, (&state.shift, &springs.lambda))?;
             boundary.points.gap.clone_from(&base_gap);
             let sol = match force {
                 Some(force) => {
-                    crate::faer_backend::force_controlled(&mut boundary.points, force * load, start, |points, warm| {
-                        path.force_search_at(how, points, warm, reporter)
+                    crate::outer::force_controlled(&mut boundary.points, force * load, start, |points, warm| {
+                        backend.solve_posed(path, how, (points, warm, true), reporter)
                     })?
                 }
-                None => path.solve_primed(how, &boundary.points, start, reporter)?,
+                None => backend.solve_posed(path, how, (&boundary.points, start, false), reporter)?,
             };
             let Some(bed) = on.bed else { return Ok((sol, springs)) };
             springs.steps += 1;
@@ -624,12 +636,11 @@ impl Walk<'_> {
     fn finish(
         self,
         disc: &Discretization<'_>,
-        system: &Factored,
+        figures: crate::backend::Figures,
         state: History,
         (t_setup, t_assembly, steps_s, t_total): (f64, f64, f64, Instant),
     ) -> (RunReport, Done) {
         let mut done = state.last.expect("a path has at least one instant");
-        let figures = system.figures();
         let timings_s = Timings {
             setup: t_setup,
             assembly: t_assembly,

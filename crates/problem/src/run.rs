@@ -15,45 +15,11 @@ use crate::report::{
 };
 use crate::scene::{ContactLaw, Rule, Scene, Valid};
 use crate::setup::{setup, MeshNotes, Setup};
+pub use crate::solution::{ContactResult, Solution};
 use crate::ProblemError;
-use contact::{ContactPoints, ContactSolution, PointValues};
+use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization};
 use std::time::Instant;
-
-/// What a run produced: its report, the mesh, the nodal solution, the per-cell fields, and the
-/// contact solution where the plan has contact.
-pub struct Solution {
-    /// What `run.json` holds.
-    pub report: RunReport,
-    /// The mesh (with the scene's regions and electrode group).
-    pub mesh: mesh::Mesh,
-    /// Nodal displacements (`z = 0` in 2D).
-    pub u: Vec<[f64; 3]>,
-    /// Nodal potentials (0 where a node has no electric unknown).
-    pub phi: Vec<f64>,
-    /// Per-cell stress, strain, electric displacement and field.
-    pub fields: CellFields,
-    /// The contact points and their solution.
-    pub contact: Option<ContactResult>,
-}
-
-/// The contact solution on its points.
-pub struct ContactResult {
-    /// The contact points.
-    pub points: ContactPoints,
-    /// The mesh node of each point.
-    pub nodes: Vec<usize>,
-    /// Multipliers, displacements and status, as the contact solver returned them (without
-    /// friction, the displacements have no tangential part).
-    pub solution: ContactSolution,
-    /// `u_n` and all `dim - 1` components of `u_t` of the final displacement, whatever the law
-    /// (a frictionless body slides too).
-    pub displacement: PointValues,
-    /// The contact groups, in the scene's order.
-    pub groups: Vec<String>,
-    /// The group of each point (an index into `groups`).
-    pub group_of: Vec<usize>,
-}
 
 /// Solves `scene` on `backend`, within `limits`: validate, refuse what the backend does not
 /// take, set up (the memory estimate checked first), discretise, assemble, build the contact
@@ -72,11 +38,11 @@ pub fn run<B: Backend>(
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, B::Error> {
     let scene = scene.validate().map_err(ProblemError::from)?;
-    if scene.scene().path.is_some() {
-        let why = "a load path is solved by problem::solve or problem::solve_path (its steps share one factorisation), not one instant of a backend";
-        return Err(ProblemError::from(crate::SceneError::new("path", why)).into());
-    }
     backend.supports(&scene).map_err(ProblemError::from)?;
+    if scene.scene().path.is_some() {
+        // the instants on one preparation of the system
+        return backend.run_path(scene.scene(), mesh, limits, reporter);
+    }
     let t_total = Instant::now();
     let setup = begin(scene, mesh, backend.estimate(&scene), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
@@ -724,6 +690,30 @@ mod tests {
             .unwrap()
             .to_string();
         assert!(e.contains("mesh.kind") && e.contains("none was given"), "{e}");
+    }
+
+    #[test]
+    fn a_path_is_a_run_of_the_backend_as_its_walk_is() {
+        let mut scene = block(MeshSpec::rectangle([0.0, 0.0], [2.0, 1.0], 8));
+        scene.path = Some(crate::PathSpec {
+            t: vec![0.0, 1.0],
+            steps: Some(3),
+            load: Some(vec![0.0, 1.0]),
+            ..Default::default()
+        });
+        let ran = run(&mut crate::Faer, &scene, None, Limits::default(), &mut Silent)
+            .unwrap()
+            .unwrap();
+        let walked = crate::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())).unwrap();
+        let rows = |s: &Solution| {
+            s.report
+                .path
+                .as_ref()
+                .map(|p| p.rows.iter().map(|r| r.normal_force).collect::<Vec<_>>())
+        };
+        assert_eq!(rows(&ran).map(|r| r.len()), Some(4));
+        assert_eq!(rows(&ran), rows(&walked.last));
+        assert_eq!(ran.u, walked.last.u);
     }
 
     #[test]

@@ -3,9 +3,11 @@
 //! tip around it), or one full primal solve per first-order step; then the fields under the
 //! forces found, refined with the factors of `K`, and the law judged on them.
 
-use super::{Factored, Fields, LinearSolver};
+use super::{Factored, LinearSolver};
+use crate::backend::Fields;
 use crate::backend::{ContactSolve, Posed, Solved};
 use crate::boundary::{ContactBoundary, FullSolve};
+use crate::outer::{floating_tip, force_controlled};
 use crate::progress::{Event, Reporter};
 use crate::scene::{ContactSolver, Rule};
 use crate::ProblemError;
@@ -48,7 +50,7 @@ impl ContactSolve<'_> {
 
     /// [`ContactSolve::run`], where `refine_start` asks Newton to take steps from a warm start
     /// that already meets the tolerance ([`NewtonParams::refine_start`]): one depth of force
-    /// control's search ([`force_controlled`]), whose force must be this depth's. Taken as it
+    /// control's search ([`crate::outer::force_controlled`]), whose force must be this depth's. Taken as it
     /// was, the start of the depth before carried its force: the search's residual stood still
     /// while the depth moved, and it ended on a force 3e-8 off (`hertz-sphere` n = 96 on a
     /// 20-step path, at t = 0.3).
@@ -108,42 +110,6 @@ impl ContactSolve<'_> {
         };
         solved.map_err(|e| ProblemError::contact(e, self.plan.linear_strategy, self.scene))
     }
-}
-
-/// Force control (`contact.indenter.force`): [`contact::solve_force_controlled`] around the
-/// contact solve `solve`; where no depth carries the force, no solution keyed
-/// `contact.indenter.force`.
-pub(crate) fn force_controlled(
-    points: &mut ContactPoints,
-    force: f64,
-    start: Option<PointValues>,
-    solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, ProblemError>,
-) -> Result<ContactSolution, ProblemError> {
-    contact::solve_force_controlled(points, force, start, solve).map_err(|e| match e {
-        contact::ForceError::Solve(e) => e,
-        other => ProblemError::NoSolution {
-            sought: "contact.indenter.force",
-            why: other.to_string(),
-        },
-    })
-}
-
-/// A floating conducting tip (`contact.charge`): [`contact::solve_floating`] around the
-/// contact solve `newton`; where no potential carries the charge, no solution keyed
-/// `contact.charge`.
-fn floating_tip(
-    problem: &mut contact::ElectricContactProblem,
-    points: &ContactPoints,
-    charge: f64,
-    newton: &mut impl FnMut(&contact::ElectricContactProblem, &ContactPoints) -> Result<ContactSolution, ProblemError>,
-) -> Result<ContactSolution, ProblemError> {
-    contact::solve_floating(problem, points, charge, newton).map_err(|e| match e {
-        contact::FloatingError::Solve(e) => e,
-        other => ProblemError::NoSolution {
-            sought: "contact.charge",
-            why: other.to_string(),
-        },
-    })
 }
 
 /// The force of a force-controlled indenter in `posed`'s scene.

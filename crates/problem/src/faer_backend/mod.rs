@@ -7,12 +7,10 @@
 mod condensed;
 mod path_system;
 
-use condensed::{coupled, refine, rhs, solve_contact, REFINE_TOL};
-pub(crate) use condensed::{force_controlled, rhs_with_contact};
-pub(crate) use path_system::{Framed, PathSystem};
+use condensed::{coupled, refine, rhs, rhs_with_contact, solve_contact, REFINE_TOL};
 
 use crate::backend::Unsupported;
-use crate::backend::{Backend, ContactSolve, Figures, Finished, Limits, Posed, Solved};
+use crate::backend::{Backend, ContactSolve, Fields, Figures, Finished, Limits, Posed, Solved};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
 use crate::scene::{BackendChoice, Rule, Scene};
@@ -27,6 +25,7 @@ use std::time::Instant;
 pub struct Faer;
 
 impl Backend for Faer {
+    const NAME: &'static str = "faer";
     type Assembled = Blocks;
     type System = Factored;
     type Solution = Fields;
@@ -117,10 +116,23 @@ impl Backend for Faer {
         let figures = system.figures();
         Ok(Some(Finished { u, phi, figures }))
     }
-}
 
-/// The free unknowns `(u, φ)`.
-pub(crate) type Fields = (Vec<f64>, Vec<f64>);
+    fn gather(&mut self, _: &Posed<'_>, _: &Factored, x: &Fields) -> Result<Option<Fields>, ProblemError> {
+        Ok(Some(x.clone()))
+    }
+
+    /// The path's instants on one factorisation and one condensation (`problem::solve_path`).
+    fn run_path(
+        &mut self,
+        scene: &Scene,
+        mesh: Option<mesh::Mesh>,
+        limits: Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Option<crate::Solution>, ProblemError> {
+        let path = crate::path::walk(self, scene, mesh, limits, reporter, false, &mut |_| Ok(()))?;
+        Ok(Some(path.last))
+    }
+}
 
 /// The linear solver the plan asks for, factored once.
 #[allow(clippy::large_enum_variant)] // one per run, moved never
