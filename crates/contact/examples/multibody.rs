@@ -55,6 +55,7 @@ fn main() {
         let params = NewtonParams {
             tol,
             measure,
+            schedule: contact::Schedule::of(contact::ProblemClass::Multibody),
             ..Default::default()
         };
         let start = Instant::now();
@@ -97,6 +98,7 @@ fn main() {
             let params = NewtonParams {
                 tol,
                 measure,
+                schedule: contact::Schedule::of(contact::ProblemClass::Multibody),
                 interrupt: Interrupt {
                     deadline: Some(Instant::now() + Duration::from_secs(60)),
                     cancel: None,

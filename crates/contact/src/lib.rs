@@ -50,6 +50,7 @@ mod operator;
 pub mod outer;
 mod points;
 mod projection;
+mod schedule;
 pub mod siconos;
 mod solution;
 mod uniqueness;
@@ -64,6 +65,7 @@ pub use newton::{solve_newton, solve_newton_cached, solve_newton_electric, Newto
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};
 pub use points::{ContactPoints, Foundation, PointValues, Status};
 pub use projection::{project_cone, project_disc, project_nonnegative};
+pub use schedule::{Phase, ProblemClass, Schedule};
 pub use solution::{
     classify, complementarity_residual, coulomb_radius, desaxce_residual, multiplier_scale, slip_bound, ContactInfo,
     ContactSolution, Interrupt, Interruption, Iterate, Law, Measure, Progress, Stage, Stall,

@@ -39,6 +39,8 @@ pub struct ContactInfo {
     pub line_search_cuts: usize,
     /// Whether Newton stalled and the accelerated gradient finished the solve.
     pub fallback: bool,
+    /// The stages of Newton's schedule that ran, in order (empty for the other solvers).
+    pub stages: Vec<crate::Phase>,
     /// Fixed-point iterations on the slip bound (0 when the solve has none).
     pub fixed_point_iters: usize,
     /// Inner iterations reported by the operator (PCG) in the first-order loops, summed.
@@ -82,6 +84,7 @@ impl ContactInfo {
             proximal_iters: 0,
             line_search_cuts: 0,
             fallback: false,
+            stages: vec![],
             fixed_point_iters: 0,
             inner_iters: 0,
             estimate_inner_iters: 0,

@@ -365,6 +365,7 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
             polished = true;
             let direct = NewtonParams {
                 weakening: Some(*law),
+                schedule: crate::Schedule::of(crate::ProblemClass::SlipWeakening),
                 ..newton
             };
             if let Ok(mut polish) = solve_newton_cached(

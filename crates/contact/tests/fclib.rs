@@ -8,7 +8,8 @@
 
 use contact::siconos::{FrictionProblem, Storage};
 use contact::{
-    solve_gauss_seidel, solve_newton, ContactError, GaussSeidelParams, Law, Measure, NewtonParams, PointValues,
+    solve_gauss_seidel, solve_newton, ContactError, GaussSeidelParams, Law, Measure, NewtonParams, Phase, PointValues,
+    ProblemClass, Schedule,
 };
 
 fn problem(name: &str) -> FrictionProblem {
@@ -290,7 +291,11 @@ fn sweeps_run_first_where_they_win() {
         let params = NewtonParams {
             tol: 1e-8,
             measure: Measure::Both,
-            sweeps_first,
+            schedule: if sweeps_first {
+                Schedule::of(ProblemClass::Multibody)
+            } else {
+                Schedule::of(ProblemClass::Multibody).without(Phase::Sweeps)
+            },
             ..Default::default()
         };
         let sol = solve_newton(
@@ -341,8 +346,7 @@ fn the_proximal_stage_finishes_rank_deficient_problems() {
     )
     .unwrap();
     assert!(sol.info.proximal_iters > 0 && !sol.info.fallback);
-    params.max_proximal = 0;
-    params.fallback = false;
+    params.schedule = params.schedule.without(Phase::Proximal).without(Phase::Fallback);
     let e = solve_newton(
         &mut p.sparse_problem(),
         &points,

@@ -4,8 +4,8 @@
 
 use contact::{
     complementarity_residual, project_cone, project_disc, project_nonnegative, solve, solve_gauss_seidel, solve_newton,
-    ContactError, ContactPoints, DenseContactProblem, GaussSeidelParams, Law, NewtonParams, PointValues, StopRule,
-    UzawaParams,
+    ContactError, ContactPoints, DenseContactProblem, GaussSeidelParams, Law, NewtonParams, Phase, PointValues,
+    ProblemClass, Schedule, StopRule, UzawaParams,
 };
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -307,7 +307,7 @@ proptest! {
         let mut op1 = problem(n, nt, &pts, &seed, &load);
         let mut op2 = op1.clone();
         let plain = solve(&mut op1, &pts, &law, &tight(1e-12), None, &mut |_| {}).unwrap();
-        let params = NewtonParams { tol: 1e-12, fallback: false, ..Default::default() };
+        let params = NewtonParams { tol: 1e-12, schedule: Schedule::all().without(Phase::Fallback), ..Default::default() };
         let newton = solve_newton(&mut op2, &pts, &law, &params, None, &mut |_| {}).unwrap();
         let scale = plain.lambda.norm().max(op1.u0.norm());
         let d = plain.lambda.minus(&newton.lambda).norm();
@@ -573,7 +573,7 @@ fn newton_falls_back_on_the_accelerated_gradient() {
         &pts,
         &Law::Coulomb,
         &NewtonParams {
-            fallback: false,
+            schedule: none.schedule.without(Phase::Fallback),
             ..none
         },
         None,
@@ -702,7 +702,7 @@ fn a_stall_past_uniqueness_is_diagnosed() {
             tol: 1e-12,
             max_iters: 0,
             max_proximal: 0,
-            fallback: false,
+            schedule: Schedule::all().without(Phase::Fallback),
             ..Default::default()
         };
         let e = solve_newton(&mut op, &pts, &Law::Coulomb, &params, None, &mut |_| {}).unwrap_err();
@@ -1046,7 +1046,11 @@ fn nested_and_zero(
     let solve_with = |nested_start: bool| {
         let params = NewtonParams {
             tol,
-            nested_start,
+            schedule: if nested_start {
+                Schedule::of(ProblemClass::CondensedFe)
+            } else {
+                Schedule::of(ProblemClass::CondensedFe).without(Phase::NestedStart)
+            },
             ..Default::default()
         };
         solve_newton(&mut op.clone(), pts, law, &params, None, &mut |_| {}).unwrap()

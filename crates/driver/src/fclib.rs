@@ -248,6 +248,7 @@ fn run_solver(
                 tol: options.tol,
                 measure: options.criterion.measure(),
                 interrupt,
+                schedule: contact::Schedule::of(contact::ProblemClass::Multibody),
                 ..Default::default()
             };
             contact::solve_newton(&mut sparse, &points, &Law::Coulomb, &params, None, progress)

@@ -473,6 +473,10 @@ pub struct Iterations {
     /// conditions hold the body.
     #[serde(default)]
     pub bed: usize,
+    /// The stages of Newton's schedule that ran (`nested-start`, `newton`, `proximal`,
+    /// `fallback`, ...: `contact::Phase`), in order; on a path, those that ran at any step.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<String>,
 }
 
 impl Iterations {
@@ -491,6 +495,7 @@ impl Iterations {
             primal_solves: info.map_or(1, |i| i.operator_calls),
             pcg_in_step_estimate: info.map_or(0, |i| i.estimate_inner_iters),
             bed: 0,
+            stages: info.map_or(vec![], |i| i.stages.iter().map(|p| p.name().to_string()).collect()),
         }
     }
 
@@ -507,6 +512,14 @@ impl Iterations {
         self.primal_solves += other.primal_solves;
         self.pcg_in_step_estimate += other.pcg_in_step_estimate;
         self.bed += other.bed;
+        // the stages that ran at any step, in the schedule's order
+        let ran = |name: &str, a: &[String], b: &[String]| a.iter().chain(b).any(|s| s == name);
+        self.stages = contact::Phase::ALL
+            .iter()
+            .map(|p| p.name())
+            .filter(|n| ran(n, &self.stages, &other.stages))
+            .map(String::from)
+            .collect();
     }
 
     /// One line: the counts of the loops that ran (`4 Newton`, `39 Uzawa, 3 FP, 812 PCG`),

@@ -53,6 +53,7 @@ use crate::{
     ContactError, ContactInfo, ContactSolution, GaussSeidelParams, Interrupt, Interruption, Iterate, Law, Measure,
     Progress, Stage, Stall, StopRule, UzawaParams,
 };
+use crate::{Phase, Schedule};
 use direction::Directions;
 use equations::{Flat, RowForm, State};
 
@@ -80,20 +81,15 @@ pub struct NewtonParams {
     /// coefficient): a stall is the caller's to handle ([`crate::solve_slip_weakening`] goes on
     /// with its fixed point).
     pub weakening: Option<crate::SlipWeakening>,
-    /// Whether to fall back on a last stage when both Newton stages stall: block Gauss–Seidel
-    /// for Coulomb's law, the accelerated projected gradient for the convex laws (when false,
-    /// a stall is a [`ContactError::Stalled`]).
-    pub fallback: bool,
+    /// The stages the solve may run ([`Schedule::of`] the problem's class): sweeps first
+    /// (stage 0), the nested start (a solve from zero multipliers starts from the answer of
+    /// the problem on a coarser set of its points: the step count then does not grow with the
+    /// number of points), Newton, the proximal stage, the lenient Newton, the fallback (block
+    /// Gauss–Seidel for Coulomb's law, the accelerated projected gradient for the convex laws;
+    /// without it, a stall is a [`ContactError::Stalled`]).
+    pub schedule: Schedule,
     /// Sweeps or steps the last stage may take.
     pub max_fallback_iters: usize,
-    /// Whether a solve from zero multipliers starts from the answer of the problem on a
-    /// coarser set of its points, solved first by this method ([`solve_newton`]'s nested
-    /// start): the step count then does not grow with the number of points.
-    pub nested_start: bool,
-    /// Whether block Gauss–Seidel sweeps may run first (stage 0: a sparse or asymmetric
-    /// compliance, constant friction coefficients), for as long as their measured rate
-    /// promises the tolerance within the cost of some Newton steps.
-    pub sweeps_first: bool,
     /// Whether a start that already meets the tolerance still takes Newton steps, until one
     /// meets it (the answer is then a Newton iterate, not the start; the start where they
     /// stall). For a warm start on changed data whose answer must follow the data more closely
@@ -114,10 +110,8 @@ impl Default for NewtonParams {
             power_iters: 30,
             mu_max: None,
             weakening: None,
-            fallback: true,
+            schedule: Schedule::all(),
             max_fallback_iters: 200_000,
-            nested_start: true,
-            sweeps_first: true,
             refine_start: false,
             interrupt: Interrupt::NONE,
         }
@@ -690,6 +684,7 @@ pub fn solve_newton_cached<P: AffineProblem>(
         None => match nested_start(problem, points, law, params) {
             Some((l, steps)) => {
                 info.coarse_newton_iters = steps;
+                info.stages.push(Phase::NestedStart);
                 l
             }
             None => pre.start(None)?,
@@ -770,7 +765,7 @@ fn sweeps_first<P: AffineProblem>(
     let Some(step) = step else {
         return Ok(First::Skipped);
     };
-    if !params.sweeps_first || params.weakening.is_some() {
+    if !params.schedule.has(Phase::Sweeps) || params.weakening.is_some() {
         return Ok(First::Skipped);
     }
     let budget = FIRST_SWEEPS_STEPS * step;
@@ -785,6 +780,7 @@ fn sweeps_first<P: AffineProblem>(
     }
     .run(start, budget as usize, Some(budget), 10, &params.interrupt, progress);
     info.uzawa_iters += run.sweeps;
+    info.stages.push(Phase::Sweeps);
     match run.end {
         SweepEnd::Converged => {
             let best = run.best.expect("a converged run judged an iterate");
@@ -820,13 +816,13 @@ fn nested_start<P: AffineProblem>(
     law: &Law,
     params: &NewtonParams,
 ) -> Option<(PointValues, usize)> {
-    if !params.nested_start {
+    if !params.schedule.has(Phase::NestedStart) {
         return None;
     }
     let coarsening = coarse::coarsen(points)?;
     let mut coarse = coarsening.problem(problem.compliance(), problem.loads(), points)?;
     let quiet = NewtonParams {
-        fallback: false,
+        schedule: params.schedule.without(Phase::Fallback),
         max_proximal: params.max_proximal.min(COARSE_PROXIMAL),
         mu_max: None,
         ..*params
@@ -962,7 +958,7 @@ fn electric_start(
     // have no solution where the potential lifts the body off: measured, its proximal stage
     // took 3300 steps and 25 s at n = 128 before it failed)
     let quiet = NewtonParams {
-        fallback: false,
+        schedule: params.schedule.without(Phase::Fallback).without(Phase::Proximal),
         max_proximal: 0,
         max_iters: params.max_iters.min(START_STEPS),
         ..*params
@@ -1014,7 +1010,7 @@ fn after_stall<P: AffineProblem>(
 ) -> Result<ContactSolution, ContactError> {
     let Asked { points, law, params } = asked;
     let best_residual = stalled.residual;
-    let failure = if params.fallback && params.weakening.is_none() {
+    let failure = if params.schedule.has(Phase::Fallback) && params.weakening.is_none() {
         match fallback(
             problem,
             asked,
@@ -1083,17 +1079,20 @@ fn stall_error(info: &ContactInfo, residual: f64, reason: Stall, best: Option<It
     }
 }
 
-/// Newton's stages from `x0` (docs/theory.md, "Semismooth Newton"), each from the best iterate
-/// of those before (stage 2b from stage 1's), each run only where the ones before stalled:
+/// Newton's stages from `x0` (docs/theory.md, "Semismooth Newton"), run by one loop over the
+/// schedule's Newton stages, each from the best iterate of those before (stage 2b from stage
+/// 1's), each run only where the ones before stalled:
 ///
 /// | stage | what | where |
 /// |---|---|---|
 /// | 1 | Newton on the problem itself, with a patience rule | always |
-/// | 2 | the proximal point method | `max_proximal > 0` |
-/// | 2b | Newton under its own lenient rules (non-monotone, no patience) | a sparse or asymmetric compliance, where stage 1 ran under stricter rules |
+/// | 2 | the proximal point method | [`Phase::Proximal`] in the schedule, `max_proximal > 0` |
+/// | 2b | Newton under its own lenient rules (non-monotone, no patience) | [`Phase::Lenient`], a sparse or asymmetric compliance, where stage 1 ran under stricter rules |
 ///
-/// (Stage 3, the first-order fallback, is [`fallback`].) The directions' factorisation is
-/// taken from `cache`, or made and left there (problems of one compliance share it).
+/// (Stage 0, the sweeps, and the nested start run before, [`sweeps_first`] and
+/// [`nested_start`]; stage 3, the first-order fallback, after, [`fallback`].) The stages that
+/// ran are added to `info.stages`. The directions' factorisation is taken from `cache`, or
+/// made and left there (problems of one compliance share it).
 fn newton_stages(
     judge: &mut Judge<'_>,
     x0: Vec<f64>,
@@ -1110,42 +1109,63 @@ fn newton_stages(
         return End::Converged;
     }
     let directions = cache.get_or_insert_with(|| Directions::new(&judge.flat)).clone();
-    let strict = Rules {
-        steps: params.max_iters,
-        patience: PATIENCE,
-        lenient: false,
-        seed: judge.seed,
-        // the proximal stage takes over from a cycle; without it (the nested start's coarser
-        // solves) Newton searches on
-        cycles: params.max_proximal > 0,
-    };
-    let mut end = judged_steps(judge, &directions, s, strict, params, info, progress);
-    if let (Some(start), End::Stalled(_)) = (refined, &end) {
-        judge.offer(&start);
-        return End::Converged;
-    }
-    // stage 2b goes on with stage 1's search: from stage 1's best, not from where the
-    // proximal iterates wandered (on a problem past uniqueness they can end near a point
-    // Newton does not leave: measured on a multibody problem, fclib.rs); kept only where
-    // stage 2b may run
-    let lenient_may_run = matches!(end, End::Stalled(_)) && !directions.symmetric_dense();
-    let stage_1 = lenient_may_run
-        .then(|| judge.best.get().map(|(start, _)| start.clone()))
-        .flatten();
-    if matches!(end, End::Stalled(_)) && params.max_proximal > 0 {
-        end = proximal_stage(judge, &directions, params, info, progress);
-    }
-    if matches!(end, End::Stalled(_)) && !directions.symmetric_dense() {
-        if let Some(start) = stage_1 {
-            let steps = LENIENT_STEPS * params.max_iters;
-            let lenient = Rules {
-                steps,
-                patience: steps,
-                lenient: true,
-                seed: None,
-                cycles: false,
-            };
-            end = judged_steps(judge, &directions, start, lenient, params, info, progress);
+    let proximal = params.schedule.has(Phase::Proximal) && params.max_proximal > 0;
+    let lenient = params.schedule.has(Phase::Lenient) && !directions.symmetric_dense();
+    let (mut end, mut stage_1, mut start) = (End::Stalled(Stall::IterationLimit), None, Some(s));
+    for phase in params.schedule.phases() {
+        let ran = match phase {
+            Phase::Newton => {
+                let strict = Rules {
+                    steps: params.max_iters,
+                    patience: PATIENCE,
+                    lenient: false,
+                    seed: judge.seed,
+                    // the proximal stage takes over from a cycle; without it (the nested
+                    // start's coarser solves) Newton searches on
+                    cycles: proximal,
+                };
+                let Some(s) = start.take() else { continue };
+                end = judged_steps(judge, &directions, s, strict, params, info, progress);
+                if let (Some(start), End::Stalled(_)) = (&refined, &end) {
+                    judge.offer(start);
+                    info.stages.push(Phase::Newton);
+                    return End::Converged;
+                }
+                // stage 2b goes on with stage 1's search: from stage 1's best, not from where
+                // the proximal iterates wandered (on a problem past uniqueness they can end
+                // near a point Newton does not leave: measured on a multibody problem,
+                // fclib.rs); kept only where stage 2b may run
+                if matches!(end, End::Stalled(_)) && lenient {
+                    stage_1 = judge.best.get().map(|(start, _)| start.clone());
+                }
+                true
+            }
+            Phase::Proximal if proximal => {
+                end = proximal_stage(judge, &directions, params, info, progress);
+                true
+            }
+            Phase::Lenient if lenient => match stage_1.take() {
+                Some(start) => {
+                    let steps = LENIENT_STEPS * params.max_iters;
+                    let rules = Rules {
+                        steps,
+                        patience: steps,
+                        lenient: true,
+                        seed: None,
+                        cycles: false,
+                    };
+                    end = judged_steps(judge, &directions, start, rules, params, info, progress);
+                    true
+                }
+                None => false,
+            },
+            _ => false,
+        };
+        if ran {
+            info.stages.push(phase);
+        }
+        if !matches!(end, End::Stalled(_)) {
+            break;
         }
     }
     end
@@ -1235,5 +1255,7 @@ fn fallback<P: AffineProblem>(
     sol.info.line_search_cuts = info.line_search_cuts;
     sol.info.augmentation = info.augmentation;
     sol.info.fallback = true;
+    sol.info.stages.clone_from(&info.stages);
+    sol.info.stages.push(Phase::Fallback);
     Ok(sol)
 }

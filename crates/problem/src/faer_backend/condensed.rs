@@ -13,7 +13,7 @@ use crate::scene::{ContactSolver, Rule};
 use crate::ProblemError;
 use contact::{
     ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, NewtonParams, PointValues,
-    StopRule, UzawaParams,
+    ProblemClass, Schedule, StopRule, UzawaParams,
 };
 use fe_assembly::Blocks;
 use linalg::{CondenseRoute, CoupledSolver, DirectLdlt};
@@ -33,6 +33,7 @@ impl ContactSolve<'_> {
         NewtonParams {
             tol: self.tol,
             interrupt: self.interrupt,
+            schedule: Schedule::of(ProblemClass::CondensedFe),
             ..Default::default()
         }
     }
@@ -244,8 +245,12 @@ fn electric_contact(
     });
     let tol = how.tol;
     let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+    let params = NewtonParams {
+        schedule: Schedule::of(ProblemClass::CoupledElectric),
+        ..how.newton_params()
+    };
     let mut newton = |problem: &contact::ElectricContactProblem, points: &ContactPoints| {
-        contact::solve_newton_electric(problem, points, &how.law, &how.newton_params(), &mut progress)
+        contact::solve_newton_electric(problem, points, &how.law, &params, &mut progress)
             .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))
     };
     let mut problem = problem;
