@@ -251,7 +251,7 @@ fn keys_that_do_not_fit_electrical_contact_are_refused_by_name() {
     // a body without electric unknowns: refused once the plan knows it
     let elastic = files::scene_file::load("paper-elastic", &["contact.electric=\"conducting\"".into()]).unwrap();
     match problem::solve(&elastic.0, None, &mut Silent) {
-        Err(problem::ProblemError::Scene(e)) => assert_eq!(e.key, "contact.electric"),
+        Err(problem::ProblemError::Setup(e)) => assert_eq!(e.key, "contact.electric"),
         Err(other) => panic!("{other}"),
         Ok(_) => panic!("an elastic body with electrical contact was solved"),
     }

@@ -129,6 +129,28 @@ fn the_validation_names_no_backend() {
     }
 }
 
+/// A scene error is the validation's verdict on the scene's own values: every other failure
+/// has its kind (`SetupError` for data that do not fit the mesh, `NoSolution`, `Unsupported`,
+/// ...), so a `SceneError` is built in `problem/src/scene/` alone.
+#[test]
+fn scene_errors_are_built_by_the_validation_only() {
+    let mut files = vec![];
+    for k in LIBRARIES.iter().chain(&["driver", "python"]) {
+        rust_files(&root().join("crates").join(k).join("src"), &mut files);
+    }
+    let scene = root().join("crates/problem/src/scene");
+    for f in files.iter().filter(|f| !f.starts_with(&scene)) {
+        let text = std::fs::read_to_string(f).unwrap();
+        for built in ["SceneError::new(", "SceneError {"] {
+            assert!(
+                !text.contains(built),
+                "{} builds a SceneError (`{built}`): only the scene's validation does",
+                f.display()
+            );
+        }
+    }
+}
+
 #[test]
 fn no_printing_outside_the_driver() {
     let mut files = vec![];

@@ -105,7 +105,7 @@ pub fn solve_path_with(
         each(step).map_err(|e| {
             let message = e.to_string();
             failed = Some(e);
-            problem::ProblemError::from(problem::SceneError::new("path", message))
+            problem::ProblemError::Stopped(message)
         })
     });
     if let Some(e) = failed {

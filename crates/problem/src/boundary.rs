@@ -6,8 +6,9 @@
 //! contact dofs onto each point's normal and tangents is this module's; the sparse work is
 //! linalg's.
 
-use crate::scene::{ContactSpec, SceneError};
+use crate::scene::ContactSpec;
 use crate::ProblemError;
+use crate::SetupError;
 use contact::{
     ContactOperator, ContactPoints, DenseContactProblem, ElectricContactProblem, OperatorError, PointValues,
 };
@@ -120,10 +121,10 @@ pub const MAX_NORMAL_ANGLE_DEG: f64 = 45.0;
 
 /// The unit normal of a validated spec in dimension `dim` (scaled, so that tiny or huge
 /// components neither underflow nor overflow).
-fn unit_normal(spec: &ContactSpec, dim: usize) -> Result<[f64; 3], SceneError> {
+fn unit_normal(spec: &ContactSpec, dim: usize) -> Result<[f64; 3], SetupError> {
     let len = mesh::scaled_norm(&spec.normal);
     if !(len > 0.0) || !len.is_finite() {
-        return Err(SceneError::new(
+        return Err(SetupError::new(
             "contact.normal",
             "contact.normal is not a non-zero vector",
         ));
@@ -144,7 +145,7 @@ fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(
         if angle > MAX_NORMAL_ANGLE_DEG {
             let at = mesh.points[g.facet(f)[0]];
             let shown: Vec<String> = out[..mesh.dim].iter().map(|x| format!("{x:.3}")).collect();
-            return Err(SceneError::new(
+            return Err(SetupError::new(
                 "contact.normal",
                 format!(
                     "contact.normal {:?} makes {angle:.0}° with the outward normal [{}] of facet {f} of `{}` (at {:?}); it must point out of the body, within {MAX_NORMAL_ANGLE_DEG}° of every facet's",
@@ -312,7 +313,7 @@ impl ContactBoundary {
         }
         self.held_nodes += held_nodes;
         if added == 0 && out_of_reach > 0 {
-            return Err(SceneError::new(
+            return Err(SetupError::new(
                 "contact.indenter",
                 format!(
                     "the indenter reaches no node of contact group `{}`: all its {out_of_reach} free nodes lie beyond the shape's reach (its radius, or its profile's last point)",
@@ -322,7 +323,7 @@ impl ContactBoundary {
             .into());
         }
         if added == 0 {
-            return Err(SceneError::new(
+            return Err(SetupError::new(
                 "contact.group",
                 format!(
                     "contact group `{}` has no contact point: Dirichlet conditions prescribe the normal displacement of all its {held_nodes} nodes, so the support holds them and contact never acts (remove the contact, or the condition on the normal component)",
@@ -724,7 +725,7 @@ fn electric_points(
         return Ok(None);
     };
     if dofs.n_phi == 0 {
-        return Err(SceneError::new(
+        return Err(SetupError::new(
             "contact.electric",
             "electrical contact needs electric unknowns, and no material has a permittivity (or the electrodes prescribe every potential): remove contact.electric",
         )
@@ -733,7 +734,7 @@ fn electric_points(
     let (mut points, mut phi) = (vec![], vec![]);
     for (i, &node) in nodes.iter().enumerate() {
         if let Some((group, _)) = dofs.floating.iter().find(|(_, j)| dofs.phi[node] == Dof::Free(*j)) {
-            return Err(SceneError::new(
+            return Err(SetupError::new(
                 "contact.electric",
                 format!("the contact face touches the floating terminal `{group}`, and an electrical contact there would join the foundation and the terminal into one conductor: keep contact.electric = \"insulated\", or make the foundation the floating conductor (contact.charge)"),
             )
@@ -753,7 +754,7 @@ fn electric_points(
                     Some(_) => "a floating foundation (contact.charge), which would take it".to_string(),
                     None => format!("the foundation at contact.foundation_potential = {potential:e}"),
                 };
-                return Err(SceneError::new(
+                return Err(SetupError::new(
                     "contact.electric",
                     format!("a contact point of `{}` lies on a terminal at the potential {v:e}, and contact.electric = \"conducting\" joins it to {foundation}: two conductors at two potentials would touch; give them one potential, use contact.electric = \"conductive\" (a finite conductance), or keep the terminal off the contact face", spec.group),
                 )
@@ -793,7 +794,7 @@ pub(crate) fn check_boundary(mesh: &mesh::Mesh, group: &str, key: &str, what: &s
     let inside = mesh.interior_facets(group)?;
     if let Some(&f) = inside.first() {
         let at = mesh.points[mesh.boundary(group)?.facet(f)[0]];
-        return Err(SceneError::new(
+        return Err(SetupError::new(
             key,
             format!(
                 "{key} `{group}` has {} facet(s) inside the mesh (shared by two cells, the first at {:?}): a {what} lies on the boundary (an interior group serves as an electrode or a Dirichlet condition)",
@@ -885,7 +886,7 @@ fn held_directions(
             .filter(|&k| fixed[k] && dir[k].abs() > ALIGNED)
             .map(|k| ["ux", "uy", "uz"][k])
             .collect();
-        SceneError::new(
+        SetupError::new(
             "contact.group",
             format!(
                 "node {node} of contact group `{}` (at {:?}): a Dirichlet condition prescribes {}, which lies across the contact {what} {:?} (neither along nor orthogonal to it): prescribe components along the normal or the tangents, or none",

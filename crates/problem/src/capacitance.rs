@@ -13,9 +13,10 @@
 use crate::backend::{Backend, Limits, Loads, Posed};
 use crate::progress::Silent;
 use crate::run::terminal_groups;
-use crate::scene::{Scene, SceneError};
+use crate::scene::Scene;
 use crate::setup::setup;
 use crate::ProblemError;
+use crate::SetupError;
 use fe_assembly::{AssemblyError, Discretization, Dof, DofMap};
 use serde::{Deserialize, Serialize};
 
@@ -59,12 +60,12 @@ pub(crate) fn capacitance<B: Backend>(
     let setup = setup(valid, mesh)?;
     if !setup.plan.electric {
         let why = "the scene has no electric unknowns (no permittivity): no capacitance";
-        return Err(ProblemError::from(SceneError::new("material", why)).into());
+        return Err(ProblemError::from(SetupError::new("material", why)).into());
     }
     let groups = terminal_groups(&setup);
     if groups.is_empty() {
         let why = "the scene has no terminal (no [electrode], no dirichlet.phi)";
-        return Err(ProblemError::from(SceneError::new("dirichlet", why)).into());
+        return Err(ProblemError::from(SetupError::new("dirichlet", why)).into());
     }
     let mut disc =
         Discretization::new(&setup.mesh, &setup.materials, &setup.constraints).map_err(ProblemError::from)?;

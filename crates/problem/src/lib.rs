@@ -242,13 +242,45 @@ fn extremes(scene: &Scene) -> Option<String> {
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
 
+/// A valid scene whose data do not fit its mesh, found while setting it up: the key at fault
+/// (dotted, as `--set` takes it) and what is wrong (a group or region the mesh lacks or leaves
+/// empty, a normal the contact face does not have, an indenter that reaches no node, a
+/// terminal a capacitance needs). The scene's own values are [`SceneError`]s, raised by
+/// [`Scene::validate`] only.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{message}")]
+pub struct SetupError {
+    /// The key at fault, e.g. `contact.normal`.
+    pub key: String,
+    /// What is wrong, naming the key.
+    pub message: String,
+}
+
+impl SetupError {
+    /// An error on `key`.
+    pub fn new(key: &str, message: impl Into<String>) -> Self {
+        SetupError {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}
+
 /// What can go wrong in a run; each variant names the input or the step at fault.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ProblemError {
-    /// A scene value that cannot be used (named by its key).
+    /// A scene value that cannot be used (named by its key): raised by the scene's
+    /// validation only.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// A valid scene whose data do not fit its mesh, found while setting it up (named by the
+    /// key at fault).
+    #[error(transparent)]
+    Setup(#[from] SetupError),
+    /// The caller's callback stopped the run (a path's `each`): its message.
+    #[error("stopped by the caller: {0}")]
+    Stopped(String),
     /// A valid scene the backend does not solve (another backend may).
     #[error(transparent)]
     Unsupported(#[from] backend::Unsupported),

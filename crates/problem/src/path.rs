@@ -22,9 +22,10 @@ use crate::run::{
     begin, check_accurate, check_solved, contact_result, indenter_report, recover, report, stop_if_interrupted,
     terminal_groups, ContactResult, Measured, Recovered,
 };
-use crate::scene::{Factors, PathSpec, Scene, SceneError};
+use crate::scene::{Factors, PathSpec, Scene};
 use crate::setup::Setup;
 use crate::ProblemError;
+use crate::SetupError;
 use crate::Solution;
 use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization, RhsParts};
@@ -39,7 +40,7 @@ pub struct Step<'a> {
     pub mesh: &'a mesh::Mesh,
     /// The contact solution of the step (its displacements the total ones).
     pub contact: &'a ContactResult,
-    /// The fields, at the instants that have them ([`solve_path`]).
+    /// The fields, at the instants that have them ([`crate::solve_path`]).
     pub fields: Option<StepFields<'a>>,
 }
 
@@ -92,7 +93,7 @@ pub(crate) fn walk<B: PathBackend>(
     let valid = scene.validate()?;
     backend.supports(&valid)?;
     let Some(spec_contact) = scene.active_contact().cloned() else {
-        return Err(SceneError::new("path", "a path carries friction's history: the scene has no contact").into());
+        return Err(SetupError::new("path", "a path carries friction's history: the scene has no contact").into());
     };
     let t_total = Instant::now();
     let setup = begin(valid, mesh, backend.estimate(&valid), &limits, reporter)?;

@@ -428,7 +428,7 @@ pub(crate) fn recover(
         (None, Some(_)) if half_space => {
             let h = indenter.as_ref().and_then(|i| i.half_space.clone()).ok_or_else(|| {
                 let why = indenter.as_ref().and_then(|i| i.half_space_absent.clone());
-                ProblemError::Scene(crate::scene::SceneError::new(
+                ProblemError::Setup(crate::SetupError::new(
                     "exact.kind",
                     format!(
                         "exact.kind `half-space`: the run's indenter has no closed form: {}",

@@ -4,8 +4,9 @@
 
 use crate::exact::FieldSolution;
 use crate::plan::{electric_data, Plan};
-use crate::scene::{MaterialSpec, MeshKind, Scene, SceneError, Valid};
+use crate::scene::{MaterialSpec, MeshKind, Scene, Valid};
 use crate::ProblemError;
+use crate::SetupError;
 use fe_assembly::{Constraint, Field, Load, Material};
 use std::sync::Arc;
 
@@ -56,7 +57,7 @@ fn refuse_electric_keys_without_unknowns(scene: &Scene, plan: &Plan) -> Result<(
     } else {
         return Ok(());
     };
-    Err(SceneError::new(
+    Err(SetupError::new(
         key,
         format!("{key} does not apply: {why} (remove it, or `--set ~{key}`)"),
     )
@@ -84,7 +85,7 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         } else {
             ("dirichlet.charge", "a charge")
         };
-        return Err(SceneError::new(
+        return Err(SetupError::new(
             key,
             format!("{key} prescribes {what}, but no material has a permittivity (no electric unknowns): it would be ignored"),
         )
@@ -133,7 +134,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     let mut mesh = match (m.kind, given) {
         // a mesh handed over to a scene that makes its own would be ignored
         (MeshKind::Rectangle | MeshKind::Box, Some(_)) => {
-            return Err(ProblemError::Scene(SceneError::new(
+            return Err(ProblemError::Setup(SetupError::new(
                 "mesh.kind",
                 format!(
                     "mesh.kind = \"{}\" makes its mesh, and a mesh was handed over too: mesh.kind = \"given\" uses the one handed over",
@@ -151,13 +152,13 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         ),
         (MeshKind::Gmsh | MeshKind::Given, Some(mesh)) => mesh,
         (MeshKind::Gmsh, None) => {
-            return Err(ProblemError::Scene(SceneError::new(
+            return Err(ProblemError::Setup(SetupError::new(
                 "mesh.file",
                 "mesh.kind = \"gmsh\": the caller reads the file and hands the mesh over",
             )))
         }
         (MeshKind::Given, None) => {
-            return Err(ProblemError::Scene(SceneError::new(
+            return Err(ProblemError::Setup(SetupError::new(
                 "mesh.kind",
                 "mesh.kind = \"given\": the caller hands the mesh over with the scene, and none was given",
             )))
@@ -189,7 +190,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
             })
             .collect();
         if cells.is_empty() {
-            return Err(SceneError::new("mesh.region", format!("mesh.region `{}` holds no cell", r.name)).into());
+            return Err(SetupError::new("mesh.region", format!("mesh.region `{}` holds no cell", r.name)).into());
         }
         mesh.regions.insert(r.name.clone(), cells);
     }
@@ -202,7 +203,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         let g = mesh.select_facets(&e.group, |x| x[0] >= range[0] - tol && x[0] <= range[1] + tol)?;
         let name = e.group_name(k);
         if g.n_facets() == 0 {
-            return Err(SceneError::new(
+            return Err(SetupError::new(
                 "electrode.x_range",
                 format!(
                     "the electrode `{name}` covers no facet of `{}` in x in [{}, {}]",
@@ -212,7 +213,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
             .into());
         }
         if mesh.boundaries.contains_key(&name) {
-            return Err(SceneError::new(
+            return Err(SetupError::new(
                 "electrode.name",
                 format!("the electrode `{name}` would replace the mesh's own group of that name: name it otherwise (electrode.name)"),
             )
@@ -234,7 +235,7 @@ fn axis_group(mesh: &mut mesh::Mesh) -> Result<(), ProblemError> {
     let tol = 1e-12 * (0..2).map(|k| hi[k] - lo[k]).fold(f64::MIN_POSITIVE, f64::max);
     if let Ok(g) = mesh.boundary("axis") {
         if let Some(&v) = g.nodes().iter().find(|&&v| mesh.points[v][0].abs() > tol) {
-            return Err(SceneError::new(
+            return Err(SetupError::new(
                 "mesh.axisymmetric",
                 format!(
                     "the mesh's group `axis` has node {v} at r = {:e}, off the axis x = 0 (where a body of revolution's radial displacement is held)",

@@ -135,6 +135,7 @@ pub fn kind_of_problem(e: &ProblemError) -> Kind {
         ProblemError::Mesh(_) | ProblemError::Assembly(fe_assembly::AssemblyError::Mesh(_)) => Kind::Mesh,
         // a backend that does not solve the scene: the scene asks for another (a ValueError, by key)
         ProblemError::Scene(_)
+        | ProblemError::Setup(_)
         | ProblemError::Unsupported(_)
         | ProblemError::Assembly(_)
         | ProblemError::Material(_) => Kind::Input,
@@ -190,6 +191,7 @@ pub fn scene_key(e: &Error) -> Option<String> {
             ..
         }
         | Error::Problem(ProblemError::Scene(s)) => Some(s.key.clone()),
+        Error::Problem(ProblemError::Setup(s)) => Some(s.key.clone()),
         Error::Problem(ProblemError::Unsupported(u)) => Some(u.key.clone()),
         Error::Problem(ProblemError::NoSolution { sought, .. }) => Some(sought.to_string()),
         Error::Scene {

@@ -10,7 +10,6 @@ use crate::backend::Fields;
 use crate::backend::{ContactSolve, Figures, Framed, PathBackend, Posed};
 use crate::boundary::ContactBoundary;
 use crate::progress::Reporter;
-use crate::scene::SceneError;
 use crate::ProblemError;
 use contact::{ContactPoints, ContactSolution, DenseContactProblem, PointValues};
 use linalg::CoupledSolver;
@@ -182,9 +181,9 @@ fn solve(system: &mut Factored, b_u: &[f64], b_phi: &[f64]) -> Result<Fields, Pr
 
 /// A path on a strategy without the `L D Lᵀ` of `K` (the scene's checks refuse it first).
 fn not_direct() -> ProblemError {
-    SceneError::new(
-        "path",
-        "a path carries friction's history on the condensed compliance of the L D Lᵀ of K: use a condensed strategy",
-    )
-    .into()
+    let feature =
+        "a path on a strategy without the L D Lᵀ of K (it carries friction's history on the condensed compliance)";
+    crate::backend::Unsupported::new("faer", "solver.strategy", feature)
+        .advise("use a condensed strategy")
+        .into()
 }
