@@ -235,8 +235,9 @@ pub trait PathBackend: Backend<Error = ProblemError> {
     fn begin_path(
         &mut self,
         system: &mut Self::System,
-        on: (&ContactBoundary, &ContactSolve<'_>),
-        parts: &[(Vec<f64>, Vec<f64>)],
+        boundary: &ContactBoundary,
+        how: &ContactSolve<'_>,
+        parts: &[Fields],
         reporter: &mut dyn Reporter,
     ) -> Result<(Self::Path, Vec<Fields>), ProblemError>;
 
@@ -244,28 +245,25 @@ pub trait PathBackend: Backend<Error = ProblemError> {
     ///
     /// # Errors
     /// A solve that failed.
-    fn respond(&mut self, system: &mut Self::System, a: (&[f64], &[f64]))
-        -> Result<(Vec<f64>, Vec<f64>), ProblemError>;
+    fn respond(&mut self, system: &mut Self::System, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError>;
 
     /// Poses an instant's contact problem: its data at `factors` (the parts' factors, in their
-    /// order), in the frame `shift` (the instant before's tangential displacement), with the
-    /// point forces of the multipliers `springs` among its loads (zeros but where only a
-    /// compliant bed holds the body): `frame_and_springs = (shift, springs)`.
+    /// order), on `framed`'s boundary in its frame (the instant before's tangential
+    /// displacement), with the point forces of the multipliers `springs` among its loads
+    /// (zeros but where only a compliant bed holds the body).
     ///
     /// # Errors
     /// The backend's own.
     fn prime(
         &mut self,
         path: &mut Self::Path,
-        boundary: &ContactBoundary,
+        framed: Framed<'_>,
         factors: &[f64],
-        frame_and_springs: (&PointValues, &PointValues),
+        springs: &PointValues,
     ) -> Result<(), ProblemError>;
 
-    /// The contact solve of the posed instant at `at = (points, start, refine_start)`: on
-    /// `points` (their gaps an indenter's depth's under force control, where `refine_start`
-    /// asks Newton to take steps from a start that meets the tolerance), warm-started from
-    /// `start`; its displacements in the instant's frame.
+    /// The contact solve of the posed instant `at` its points, warm start and rule; its
+    /// displacements in the instant's frame.
     ///
     /// # Errors
     /// A contact solve that did not converge.
@@ -273,7 +271,7 @@ pub trait PathBackend: Backend<Error = ProblemError> {
         &mut self,
         path: &mut Self::Path,
         how: &ContactSolve<'_>,
-        at: (&ContactPoints, Option<PointValues>, bool),
+        at: At<'_>,
         reporter: &mut dyn Reporter,
     ) -> Result<ContactSolution, ProblemError>;
 
@@ -281,17 +279,16 @@ pub trait PathBackend: Backend<Error = ProblemError> {
     /// `factors`: the scale of its answer.
     fn own_scale(&self, path: &Self::Path, factors: &[f64]) -> f64;
 
-    /// The fields of the posed instant (`instant = (framed, posed)`) under `posed`'s loads and
-    /// the contact forces of `sol` (in `framed`'s frame), on what the path `kept` (its state
-    /// and the system), refined, the law judged on them; with their equilibrium residual.
+    /// The fields of the posed `instant` under its loads and the contact forces of `sol` (in
+    /// its frame), refined, the law judged on them; with their equilibrium residual.
     ///
     /// # Errors
     /// A solve that failed.
     fn instant_fields(
         &mut self,
-        kept: (&mut Self::Path, &mut Self::System),
-        how: &ContactSolve<'_>,
-        instant: (Framed<'_>, &Posed<'_>),
+        path: &mut Self::Path,
+        system: &mut Self::System,
+        instant: InstantOf<'_>,
         sol: ContactSolution,
         reporter: &mut dyn Reporter,
     ) -> Result<(ContactSolution, Fields, f64), ProblemError>;
@@ -302,6 +299,28 @@ pub trait PathBackend: Backend<Error = ProblemError> {
 
 /// The free unknowns `(u, φ)` of the discretisation.
 pub type Fields = (Vec<f64>, Vec<f64>);
+
+/// Where a path's contact solve starts ([`PathBackend::solve_posed`]).
+pub struct At<'a> {
+    /// The points (their gaps an indenter's depth's under force control).
+    pub points: &'a ContactPoints,
+    /// The warm start.
+    pub start: Option<PointValues>,
+    /// Whether Newton steps from a start that already meets the tolerance (force control's
+    /// depths: the force must be the depth's own).
+    pub refine_start: bool,
+}
+
+/// An instant whose fields are computed ([`PathBackend::instant_fields`]): its contact solve,
+/// its boundary in its frame, its discrete problem with its loads.
+pub struct InstantOf<'a> {
+    /// The contact solve.
+    pub how: &'a ContactSolve<'a>,
+    /// The boundary at the instant, in the frame of the instant before.
+    pub framed: Framed<'a>,
+    /// The discrete problem with the instant's loads.
+    pub posed: &'a Posed<'a>,
+}
 
 /// An instant's contact boundary (its gaps and prescribed values at the instant's factors)
 /// and the frame its contact problem is posed in: the tangential displacements of the

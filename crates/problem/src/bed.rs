@@ -144,8 +144,8 @@ pub(crate) struct Balanced<X> {
 }
 
 /// The contact problem of a body only its bed holds: contact solves of `backend` (whose `K`
-/// carries the springs of `bed`) with the loads `b + S u_j` until the springs' forces settle.
-/// `posed`'s loads are its own again on return.
+/// carries the springs of `bed`) with the loads `b + S u_j` until the springs' forces settle,
+/// each by the contact solve `how`. `posed`'s loads are its own again on return.
 ///
 /// # Errors
 /// The backend's; [`ProblemError::NoSolution`] where the loads lift the body off its bed (no
@@ -155,58 +155,49 @@ pub(crate) fn solve_held<B: Backend>(
     posed: &mut Posed<'_>,
     system: &mut B::System,
     boundary: &ContactBoundary,
-    (how, bed): (&ContactSolve<'_>, Bed),
+    how: &ContactSolve<'_>,
+    bed: Bed,
     reporter: &mut dyn Reporter,
 ) -> Result<Balanced<B::Solution>, B::Error> {
     let loads = posed.loads.b_u.clone();
-    let result = fixed_point(backend, posed, system, boundary, (how, bed), &loads, reporter);
+    let mut steps = |posed: &mut Posed<'_>| -> Result<Balanced<B::Solution>, B::Error> {
+        let mut springs = PointValues::zeros(boundary.points.len(), 0);
+        let (mut seconds, mut pcg_iters) = (0.0, 0);
+        let mut last = f64::INFINITY;
+        for step in 1..=MAX_STEPS {
+            let mut solved = backend.solve_contact(posed, system, boundary.clone(), how, reporter)?;
+            (seconds, pcg_iters) = (seconds + solved.seconds, pcg_iters + solved.pcg_iters);
+            let Some((cb, sol)) = solved.contact.as_ref() else {
+                return Ok(Balanced {
+                    equilibrium: backend.equilibrium(posed, system, &solved)?,
+                    solved,
+                    steps: step,
+                });
+            };
+            let (next, change) = settle(cb, bed, sol, &springs, linalg::norm(&loads))?;
+            reporter.event(&Event::BedStep {
+                step,
+                change,
+                settled: SETTLED,
+            });
+            if settled(change, last) {
+                let equilibrium = backend.equilibrium(posed, system, &solved)? + change;
+                (solved.seconds, solved.pcg_iters) = (seconds, pcg_iters);
+                return Ok(Balanced {
+                    solved,
+                    equilibrium,
+                    steps: step,
+                });
+            }
+            posed.loads.b_u.copy_from_slice(&loads);
+            cb.add_forces(&next, &mut posed.loads.b_u);
+            (springs, last) = (next, change);
+        }
+        Err(unsettled(last).into())
+    };
+    let result = steps(posed);
     posed.loads.b_u = loads;
     result
-}
-
-/// [`solve_held`]'s steps, from the body's own loads `loads`.
-fn fixed_point<B: Backend>(
-    backend: &mut B,
-    posed: &mut Posed<'_>,
-    system: &mut B::System,
-    boundary: &ContactBoundary,
-    (how, bed): (&ContactSolve<'_>, Bed),
-    loads: &[f64],
-    reporter: &mut dyn Reporter,
-) -> Result<Balanced<B::Solution>, B::Error> {
-    let mut springs = PointValues::zeros(boundary.points.len(), 0);
-    let (mut seconds, mut pcg_iters) = (0.0, 0);
-    let mut last = f64::INFINITY;
-    for step in 1..=MAX_STEPS {
-        let mut solved = backend.solve_contact(posed, system, boundary.clone(), how, reporter)?;
-        (seconds, pcg_iters) = (seconds + solved.seconds, pcg_iters + solved.pcg_iters);
-        let Some((cb, sol)) = solved.contact.as_ref() else {
-            return Ok(Balanced {
-                equilibrium: backend.equilibrium(posed, system, &solved)?,
-                solved,
-                steps: step,
-            });
-        };
-        let (next, change) = settle(cb, bed, sol, &springs, linalg::norm(loads))?;
-        reporter.event(&Event::BedStep {
-            step,
-            change,
-            settled: SETTLED,
-        });
-        if settled(change, last) {
-            let equilibrium = backend.equilibrium(posed, system, &solved)? + change;
-            (solved.seconds, solved.pcg_iters) = (seconds, pcg_iters);
-            return Ok(Balanced {
-                solved,
-                equilibrium,
-                steps: step,
-            });
-        }
-        posed.loads.b_u.copy_from_slice(loads);
-        cb.add_forces(&next, &mut posed.loads.b_u);
-        (springs, last) = (next, change);
-    }
-    Err(unsettled(last).into())
 }
 
 /// The springs' multipliers at the solution `sol` (a spring's force is a multiplier

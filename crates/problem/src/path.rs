@@ -14,7 +14,7 @@
 //! points, both computed once). The fields (a solve with `K`'s factors, refined, and the
 //! recovery) are computed only at the instants whose files are written, and at the last.
 
-use crate::backend::{Bed, ContactSolve, Framed, Limits, Loads, PathBackend, Posed};
+use crate::backend::{At, Bed, ContactSolve, Framed, InstantOf, Limits, Loads, PathBackend, Posed};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
 use crate::report::{PathReport, RunReport, StepRow, Timings};
@@ -118,7 +118,7 @@ pub(crate) fn walk<B: PathBackend>(
         .chain(parts.displacements.iter().cloned())
         .chain(std::iter::once(parts.potentials.clone()))
         .collect();
-    let (mut path, solved) = backend.begin_path(&mut system, (&boundary, &how), &ordered, reporter)?;
+    let (mut path, solved) = backend.begin_path(&mut system, &boundary, &how, &ordered, reporter)?;
     walk.terminals = Terminals::new(&walk, &disc, (&mut *backend, &mut system), &boundary, &solved)?;
     drop(solved);
     let t_steps = Instant::now();
@@ -259,7 +259,7 @@ impl Terminals {
         }
         let points = &boundary.points;
         let mut respond = |a_u: &[f64], a_phi: &[f64]| -> Result<PointValues, ProblemError> {
-            let (z, _) = backend.respond(system, (a_u, a_phi))?;
+            let (z, _) = backend.respond(system, a_u, a_phi)?;
             let mut out = PointValues::zeros(points.len(), points.n_tangential());
             boundary.extract_free(&z, &mut out);
             Ok(out)
@@ -562,13 +562,12 @@ impl Walk<'_> {
             boundary,
             shift: &on.state.shift,
         };
-        let (sol, (u, phi), equilibrium) = on.backend.instant_fields(
-            (&mut *on.path, &mut *on.system),
-            on.how,
-            (framed, &posed),
-            sol,
-            reporter,
-        )?;
+        let instant = InstantOf {
+            how: on.how,
+            framed,
+            posed: &posed,
+        };
+        let (sol, (u, phi), equilibrium) = on.backend.instant_fields(on.path, on.system, instant, sol, reporter)?;
         let equilibrium = equilibrium + spring.change;
         check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
         check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
@@ -602,15 +601,31 @@ impl Walk<'_> {
         let mut start = state.start.take();
         let mut last = f64::INFINITY;
         loop {
-            backend.prime(path, boundary, factors, (&state.shift, &springs.lambda))?;
+            let framed = Framed {
+                boundary,
+                shift: &state.shift,
+            };
+            backend.prime(path, framed, factors, &springs.lambda)?;
             boundary.points.gap.clone_from(&base_gap);
             let sol = match force {
                 Some(force) => {
                     crate::outer::force_controlled(&mut boundary.points, force * load, start, |points, warm| {
-                        backend.solve_posed(path, how, (points, warm, true), reporter)
+                        let at = At {
+                            points,
+                            start: warm,
+                            refine_start: true,
+                        };
+                        backend.solve_posed(path, how, at, reporter)
                     })?
                 }
-                None => backend.solve_posed(path, how, (&boundary.points, start, false), reporter)?,
+                None => {
+                    let at = At {
+                        points: &boundary.points,
+                        start,
+                        refine_start: false,
+                    };
+                    backend.solve_posed(path, how, at, reporter)?
+                }
             };
             let Some(bed) = on.bed else { return Ok((sol, springs)) };
             springs.steps += 1;

@@ -141,7 +141,7 @@ fn solve<B: Backend>(
     match (boundary, posed.bed) {
         (Some(b), Some(bed)) => {
             let how = ContactSolve::new(plan, scene.scene(), &b, limits.interrupt);
-            crate::bed::solve_held(backend, posed, system, &b, (&how, bed), reporter)
+            crate::bed::solve_held(backend, posed, system, &b, &how, bed, reporter)
         }
         (Some(b), None) => {
             let how = ContactSolve::new(plan, scene.scene(), &b, limits.interrupt);

@@ -7,11 +7,11 @@ use super::condensed::{
 };
 use super::{Factored, Faer, LinearSolver};
 use crate::backend::Fields;
-use crate::backend::{ContactSolve, Figures, Framed, PathBackend, Posed};
+use crate::backend::{At, ContactSolve, Figures, Framed, InstantOf, PathBackend};
 use crate::boundary::ContactBoundary;
 use crate::progress::Reporter;
 use crate::ProblemError;
-use contact::{ContactPoints, ContactSolution, DenseContactProblem, PointValues};
+use contact::{ContactSolution, DenseContactProblem, PointValues};
 use linalg::CoupledSolver;
 
 /// What stays from step to step of a load path on one factorisation: the condensed compliance
@@ -32,8 +32,9 @@ impl PathBackend for Faer {
     fn begin_path(
         &mut self,
         system: &mut Factored,
-        (boundary, how): (&ContactBoundary, &ContactSolve<'_>),
-        parts: &[(Vec<f64>, Vec<f64>)],
+        boundary: &ContactBoundary,
+        how: &ContactSolve<'_>,
+        parts: &[Fields],
         reporter: &mut dyn Reporter,
     ) -> Result<(PathSystem, Vec<Fields>), ProblemError> {
         let LinearSolver::Direct(direct) = &mut system.solver else {
@@ -50,7 +51,7 @@ impl PathBackend for Faer {
         Ok((PathSystem { dense, parts }, solved))
     }
 
-    fn respond(&mut self, system: &mut Factored, (a_u, a_phi): (&[f64], &[f64])) -> Result<Fields, ProblemError> {
+    fn respond(&mut self, system: &mut Factored, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError> {
         solve(system, a_u, a_phi)
     }
 
@@ -59,9 +60,9 @@ impl PathBackend for Faer {
     fn prime(
         &mut self,
         path: &mut PathSystem,
-        boundary: &ContactBoundary,
+        Framed { boundary, shift }: Framed<'_>,
         factors: &[f64],
-        (shift, springs): (&PointValues, &PointValues),
+        springs: &PointValues,
     ) -> Result<(), ProblemError> {
         let x0 = path.own_data(factors);
         let nt = path.dense.nt;
@@ -73,7 +74,11 @@ impl PathBackend for Faer {
         &mut self,
         path: &mut PathSystem,
         how: &ContactSolve<'_>,
-        (points, start, refine_start): (&ContactPoints, Option<PointValues>, bool),
+        At {
+            points,
+            start,
+            refine_start,
+        }: At<'_>,
         reporter: &mut dyn Reporter,
     ) -> Result<ContactSolution, ProblemError> {
         how.run_with(
@@ -94,9 +99,13 @@ impl PathBackend for Faer {
     /// fields.
     fn instant_fields(
         &mut self,
-        (path, system): (&mut PathSystem, &mut Factored),
-        how: &ContactSolve<'_>,
-        (Framed { boundary, shift }, posed): (Framed<'_>, &Posed<'_>),
+        path: &mut PathSystem,
+        system: &mut Factored,
+        InstantOf {
+            how,
+            framed: Framed { boundary, shift },
+            posed,
+        }: InstantOf<'_>,
         sol: ContactSolution,
         reporter: &mut dyn Reporter,
     ) -> Result<(ContactSolution, Fields, f64), ProblemError> {
