@@ -585,6 +585,91 @@ fn several_contact_groups_squeeze_a_body_into_a_corner_as_the_closed_form_says()
     }
 }
 
+/// Two zones on two foundations: the unit square of [`squeezed_into_a_corner`] with its top
+/// wall a compliant bed (`λ_n = k p`) and its right wall rigid, each pressed in by `δ`. The
+/// strain is uniform (P1 holds it exactly): `ε_xx = -δ`, `ε_yy = -(δ - p)` with `p` the
+/// penetration into the bed, where the bed's pressure `k p` balances `-σ_yy`:
+/// `p = (λ δ + (λ + 2μ) δ) / (k + λ + 2μ)`; the right wall carries `(λ + 2μ) δ + λ (δ - p)`.
+/// On a path scaling the gaps (`path.gap`) each instant is that at its `δ` (frictionless: no
+/// history).
+#[test]
+fn a_compliant_bed_beside_a_rigid_wall_holds_each_zone_to_its_own_law() {
+    let (young, poisson, delta) = (100.0, 0.3, 1e-3);
+    let (lambda, mu) = (
+        young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson)),
+        young / (2.0 * (1.0 + poisson)),
+    );
+    let k = lambda + 2.0 * mu;
+    let mut scene = squeezed_into_a_corner(2, delta);
+    let Some(problem::Contacts::Many(zones)) = scene.contact.as_mut() else {
+        panic!("an array")
+    };
+    let top = zones.iter_mut().find(|z| z.group == "top").unwrap();
+    top.compliance = Some(problem::ComplianceSpec {
+        stiffness: k,
+        exponent: 1.0,
+    });
+    let expected = |d: f64| {
+        let p = (lambda * d + (lambda + 2.0 * mu) * d) / (k + lambda + 2.0 * mu);
+        (k * p, (lambda + 2.0 * mu) * d + lambda * (d - p))
+    };
+    let check = |s: &problem::Solution, d: f64, what: &str| {
+        let (bed, wall) = expected(d);
+        for g in &s.report.contact.groups {
+            // a face of length 1: the force is the pressure
+            let want = if g.group == "top" { bed } else { wall };
+            assert!(
+                (g.normal_force - want).abs() < 1e-9 * want,
+                "{what} `{}`: force {} against {want}",
+                g.group,
+                g.normal_force
+            );
+        }
+    };
+    let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+    check(&s, delta, "one instant");
+    assert!(s.report.plan.to_string().contains("in some zones"), "{}", s.report.plan);
+    // the same on a path of the gaps, 0 to δ in 4 steps
+    scene.path = Some(problem::PathSpec {
+        t: vec![0.0, 1.0],
+        steps: Some(4),
+        gap: Some(vec![0.0, 1.0]),
+        ..Default::default()
+    });
+    let mut forces = vec![];
+    let path = problem::solve_path(
+        &scene,
+        None,
+        problem::Limits::default(),
+        &mut problem::Silent,
+        false,
+        &mut |step| {
+            forces.push((
+                step.row.t,
+                step.row
+                    .groups
+                    .iter()
+                    .map(|g| (g.group.clone(), g.normal_force))
+                    .collect::<Vec<_>>(),
+            ));
+            Ok(())
+        },
+    )
+    .unwrap();
+    check(&path.last, delta, "the path's last instant");
+    assert_eq!(forces.len(), 5);
+    for (t, groups) in forces {
+        let (bed, wall) = expected(t * delta);
+        for (group, force) in groups {
+            let want = if group == "top" { bed } else { wall };
+            assert!(
+                (force - want).abs() <= 1e-9 * expected(delta).1,
+                "t = {t} `{group}`: {force} against {want}"
+            );
+        }
+    }
+}
+
 #[test]
 fn what_several_contact_groups_cannot_share_is_refused_by_name() {
     let base = squeezed_into_a_corner(2, 1e-3);

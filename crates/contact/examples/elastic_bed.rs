@@ -81,6 +81,7 @@ fn main() {
         friction: vec![friction; n],
         held: vec![[false; 2]; n],
         foundation: Default::default(),
+        foundations: vec![],
         slipped: vec![],
     };
     let mut problem = DenseContactProblem {

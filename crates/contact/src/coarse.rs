@@ -150,6 +150,11 @@ impl Coarsening {
             friction: self.mean(&points.friction, points),
             held: self.chosen.iter().map(|&i| points.held[i]).collect(),
             foundation: points.foundation,
+            foundations: if points.foundations.is_empty() {
+                vec![]
+            } else {
+                self.chosen.iter().map(|&i| points.foundation_of(i)).collect()
+            },
             slipped: if points.slipped.is_empty() {
                 vec![]
             } else {
@@ -304,6 +309,7 @@ mod tests {
             friction: vec![0.3; m],
             held: vec![[false; 2]; m],
             foundation: Default::default(),
+            foundations: vec![],
             slipped: vec![],
         }
     }

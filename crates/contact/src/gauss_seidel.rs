@@ -418,7 +418,7 @@ impl<'p> Sweeper<'p> {
                 k,
                 law: laws[i],
                 held: points.held[i],
-                foundation: points.foundation,
+                foundation: points.foundation_of(i),
                 inverse: self.inverses[i],
             };
             let new = point.solve(x0);

@@ -26,8 +26,12 @@ pub struct ContactPoints {
     /// in every direction; only the first `dim - 1` entries are read.
     pub held: Vec<[bool; 2]>,
     /// What the points press on: a rigid foundation (Signorini's conditions) or a deformable
-    /// one (normal compliance).
+    /// one (normal compliance); each point's own where [`ContactPoints::foundations`] gives
+    /// it.
     pub foundation: Foundation,
+    /// Each point's foundation where they differ (zones on different foundations: a compliant
+    /// bed beside a rigid wall). Empty: every point's is [`ContactPoints::foundation`].
+    pub foundations: Vec<Foundation>,
     /// The slip each point has accumulated before this problem (the earlier steps of a load
     /// path): slip-weakening friction takes its coefficient at this plus the problem's own
     /// slip `|u_t|`. Empty: none (zeros).
@@ -124,6 +128,18 @@ impl ContactPoints {
         self.weight.is_empty()
     }
 
+    /// What point `i` presses on ([`ContactPoints::foundations`], else
+    /// [`ContactPoints::foundation`]).
+    #[inline]
+    pub fn foundation_of(&self, i: usize) -> Foundation {
+        self.foundations.get(i).copied().unwrap_or(self.foundation)
+    }
+
+    /// Whether every point presses on a rigid foundation.
+    pub fn all_rigid(&self) -> bool {
+        (0..self.len()).all(|i| self.foundation_of(i) == Foundation::Rigid)
+    }
+
     /// The slip point `i` accumulated before this problem ([`ContactPoints::slipped`]).
     #[inline]
     pub fn slipped(&self, i: usize) -> f64 {
@@ -173,6 +189,7 @@ impl ContactPoints {
             || self.friction.len() != n
             || self.held.len() != n
             || !(self.slipped.is_empty() || self.slipped.len() == n)
+            || !(self.foundations.is_empty() || self.foundations.len() == n)
         {
             return Err(InputError::PointArrays);
         }
@@ -196,7 +213,10 @@ impl ContactPoints {
                 return Err(bad(i, "slipped", self.slipped(i), "must be finite and non-negative"));
             }
         }
-        if let Foundation::Compliant { stiffness, exponent } = self.foundation {
+        for f in self.foundations.iter().chain(std::iter::once(&self.foundation)) {
+            let Foundation::Compliant { stiffness, exponent } = *f else {
+                continue;
+            };
             if !(stiffness > 0.0 && stiffness.is_finite()) {
                 return Err(InputError::Foundation {
                     what: "stiffness",

@@ -325,6 +325,7 @@ impl FrictionProblem {
             friction: self.mu.clone(),
             held: vec![[false; 2]; nc],
             foundation: Default::default(),
+            foundations: vec![],
             slipped: vec![],
         }
     }

@@ -3,7 +3,7 @@
 //! scale-free complementarity residual and the stick/slip status of docs/theory.md.
 
 use crate::operator::ContactOperator;
-use crate::points::{ContactPoints, Foundation, PointValues, Status};
+use crate::points::{ContactPoints, PointValues, Status};
 use crate::projection::{norm, project_cone, project_disc, project_nonnegative};
 use crate::InputError;
 use crate::{ContactError, OperatorError};
@@ -337,7 +337,7 @@ pub fn complementarity_residual(
     let mut buf = [0.0; 2];
     for i in 0..n {
         r.normal[i] = points
-            .foundation
+            .foundation_of(i)
             .normal_residual(lambda.normal[i], u.normal[i] - points.gap[i], c);
         if nt > 0 {
             let (l, ut) = (lambda.tangential_of(i), u.tangential_of(i));
@@ -580,14 +580,14 @@ pub fn multiplier_scale(points: &ContactPoints, u0: &PointValues, c: f64) -> f64
         .iter_mut()
         .for_each(|p| *p = crate::project_nonnegative(*p));
     let rigid = c * penetration.weighted_norm(&points.weight);
-    if points.foundation == Foundation::Rigid {
+    if points.all_rigid() {
         return rigid;
     }
     // the bed's pressures at the free penetrations, weighted like the multipliers
     let mut bed = PointValues::zeros(free.n_points(), 0);
-    for (p, penetration) in bed.normal.iter_mut().zip(&free.normal) {
+    for (i, (p, penetration)) in bed.normal.iter_mut().zip(&free.normal).enumerate() {
         *p = points
-            .foundation
+            .foundation_of(i)
             .pressure(*penetration)
             .map_or(0.0, |(pressure, _)| pressure);
     }

@@ -184,7 +184,7 @@ pub fn solve(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    if points.foundation != crate::Foundation::Rigid {
+    if !points.all_rigid() {
         // its projections are onto Signorini's cone: a compliant foundation's law is no
         // projection
         return Err(InputError::Unsupported(

@@ -22,6 +22,7 @@ fn points(n: usize) -> ContactPoints {
         friction: vec![0.0; n],
         held: vec![[false; 2]; n],
         foundation: Foundation::Rigid,
+        foundations: vec![],
         slipped: vec![],
     }
 }

@@ -85,6 +85,7 @@ impl Chain {
             friction: vec![0.4; n],
             held: vec![[false; 2]; n],
             foundation,
+            foundations: vec![],
             slipped: vec![],
         }
     }

@@ -21,6 +21,7 @@ fn points(n: usize, dim: usize, w: &[f64], friction: f64) -> ContactPoints {
         friction: vec![friction; n],
         held: vec![[false; 2]; n],
         foundation: Default::default(),
+        foundations: vec![],
         slipped: vec![],
     }
 }

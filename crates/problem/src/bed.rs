@@ -52,9 +52,17 @@ impl Bed {
     /// and the bed together leave free; [`ProblemError::NoSolution`] where the loads press
     /// nothing onto the bed.
     pub(crate) fn needed(posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> Result<Option<Bed>, ProblemError> {
-        let supports = match boundary {
-            Some(b) if matches!(b.points.foundation, Foundation::Compliant { .. }) => b.supports(),
-            _ => vec![],
+        let compliant =
+            |b: &ContactBoundary, i: usize| matches!(b.points.foundation_of(i), Foundation::Compliant { .. });
+        let supports: Vec<fe_assembly::Support> = match boundary {
+            Some(b) => b
+                .supports()
+                .into_iter()
+                .enumerate()
+                .filter(|(i, _)| compliant(b, *i))
+                .map(|(_, s)| s)
+                .collect(),
+            None => vec![],
         };
         let held = posed
             .disc
@@ -63,12 +71,20 @@ impl Bed {
         let (fe_assembly::Held::WithSupports, Some(boundary)) = (held, boundary) else {
             return Ok(None);
         };
-        let Foundation::Compliant { stiffness, exponent } = boundary.points.foundation else {
-            return Ok(None);
-        };
+        // the compliant points' area and their zones' laws (each zone its own bed)
+        let points = &boundary.points;
+        let beds: Vec<usize> = (0..points.len()).filter(|&i| compliant(boundary, i)).collect();
+        let mut laws: Vec<(f64, f64)> = vec![];
+        for &i in &beds {
+            if let Foundation::Compliant { stiffness, exponent } = points.foundation_of(i) {
+                if !laws.contains(&(stiffness, exponent)) {
+                    laws.push((stiffness, exponent));
+                }
+            }
+        }
         // the mean pressure the loads put on the bed: their resultant over its area (where they
         // balance, a sum of their sizes)
-        let area: f64 = boundary.points.weight.iter().sum();
+        let area: f64 = beds.iter().map(|&i| points.weight[i]).sum();
         let b = &posed.loads.b_u;
         let dim = posed.disc.dofs.dim;
         let mut resultant = [0.0f64; 3];
@@ -88,9 +104,14 @@ impl Bed {
                 why: "only the compliant bed holds the body, and no load presses it onto the bed".into(),
             });
         }
-        // k [p]^m at the pressure P: p = (P / k)^(1/m), tangent k m p^(m-1)
-        let penetration = (pressure / stiffness).powf(1.0 / exponent);
-        let tangent = stiffness * exponent * penetration.powf(exponent - 1.0);
+        // k [p]^m at the pressure P: p = (P / k)^(1/m), tangent k m p^(m-1); the softest bed's
+        let tangent = laws
+            .iter()
+            .map(|&(stiffness, exponent)| {
+                let penetration = (pressure / stiffness).powf(1.0 / exponent);
+                stiffness * exponent * penetration.powf(exponent - 1.0)
+            })
+            .fold(f64::INFINITY, f64::min);
         // no stiffer than a fraction of the body's own stiffness at the bed, c / h: where the
         // bed lets a point go, the spring alone holds it, and the fixed point's error there
         // falls by k_s / (k_s + c / h)
@@ -100,7 +121,7 @@ impl Bed {
             .iter()
             .flat_map(|(_, m)| (0..m.c.len().isqrt()).map(|k| m.c[k * m.c.len().isqrt() + k]))
             .fold(0.0f64, f64::max);
-        let mut weights = boundary.points.weight.clone();
+        let mut weights: Vec<f64> = beds.iter().map(|&i| points.weight[i]).collect();
         weights.sort_by(f64::total_cmp);
         let h = weights[weights.len() / 2].powf(1.0 / (dim as f64 - 1.0));
         let body = c / h;

@@ -16,6 +16,17 @@ use fe_assembly::{facet_measure, Discretization, Dof, DofMap};
 use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
 use rayon::prelude::*;
 
+/// The foundation a contact zone presses on: its `contact.compliance`, or rigid.
+fn foundation_of(spec: &ContactSpec) -> contact::Foundation {
+    match spec.compliance {
+        Some(k) => contact::Foundation::Compliant {
+            stiffness: k.stiffness,
+            exponent: k.exponent,
+        },
+        None => contact::Foundation::Rigid,
+    }
+}
+
 /// The contact points of a boundary group and the u dofs of their nodes.
 #[derive(Clone)]
 pub struct ContactBoundary {
@@ -220,13 +231,8 @@ impl ContactBoundary {
                 gap: vec![],
                 friction: vec![],
                 held: vec![],
-                foundation: match specs.first().and_then(|s| s.compliance) {
-                    Some(k) => contact::Foundation::Compliant {
-                        stiffness: k.stiffness,
-                        exponent: k.exponent,
-                    },
-                    None => contact::Foundation::Rigid,
-                },
+                foundation: specs.first().map_or(contact::Foundation::Rigid, foundation_of),
+                foundations: vec![],
                 slipped: vec![],
             },
             nodes: vec![],
@@ -245,6 +251,11 @@ impl ContactBoundary {
         }
         if let [spec] = specs {
             b.electric = electric_points(spec, &disc.dofs, &b.nodes)?;
+        }
+        // zones on different foundations: each point its own zone's
+        let zones: Vec<contact::Foundation> = specs.iter().map(foundation_of).collect();
+        if zones.iter().any(|f| *f != b.points.foundation) {
+            b.points.foundations = b.group_of.iter().map(|&k| zones[k]).collect();
         }
         Ok(b)
     }
@@ -441,14 +452,15 @@ impl ContactBoundary {
             .collect()
     }
 
-    /// The springs `k w_i n_i n_iᵀ` at the points on their free components, as `(row, column,
-    /// value)` in the free u numbering (both triangles): a compliant bed's hold on a body only
+    /// The springs `k w_i n_i n_iᵀ` at the points on a compliant foundation, on their free
+    /// components, as `(row, column, value)` in the free u numbering (both triangles): a
+    /// compliant bed's hold on a body only
     /// it holds (the run's `Bed`).
     pub fn normal_springs(&self, k: f64) -> Vec<(usize, usize, f64)> {
         let p = &self.points;
         let dim = p.dim;
         let mut out = vec![];
-        for i in 0..p.len() {
+        for i in (0..p.len()).filter(|&i| p.foundation_of(i) != contact::Foundation::Rigid) {
             for a in 0..dim {
                 let Slot::Free(ja) = self.slots[i * dim + a] else {
                     continue;
@@ -470,13 +482,13 @@ impl ContactBoundary {
     /// The multipliers whose forces are those of the springs of
     /// [`ContactBoundary::normal_springs`] at the points' normal displacement `u_n`:
     /// `-k (u_n - u_n,p)`, `u_n,p` the prescribed components' part (the springs act on the free
-    /// ones), with `nt` tangential components at 0.
+    /// ones), with `nt` tangential components at 0; 0 at the points on a rigid foundation.
     pub fn spring_multipliers(&self, k: f64, u_n: &[f64], nt: usize) -> PointValues {
         let p = &self.points;
         let dim = p.dim;
         let zero = vec![0.0; self.dofs.len()];
         let mut lambda = PointValues::zeros(p.len(), nt);
-        for i in 0..p.len() {
+        for i in (0..p.len()).filter(|&i| p.foundation_of(i) != contact::Foundation::Rigid) {
             let prescribed = self.point_u(i, &zero);
             let along: f64 = (0..dim).map(|a| prescribed[a] * p.normal[i][a]).sum();
             // the force of a multiplier is -w λ n: the spring's is w k u_n

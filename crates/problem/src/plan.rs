@@ -49,10 +49,14 @@ pub struct Plan {
     pub rule: Rule,
     /// The files the run writes.
     pub outputs: Vec<Output>,
-    /// The foundation's normal compliance (absent: a rigid foundation, Signorini's
+    /// The foundation's normal compliance, the first compliant zone's (absent: a rigid foundation, Signorini's
     /// conditions).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compliance: Option<ComplianceSpec>,
+    /// Whether every contact zone presses on the same foundation (the compliance above, or a
+    /// rigid one); otherwise each zone on its own.
+    #[serde(default = "shared", skip_serializing_if = "is_shared")]
+    pub compliance_shared: bool,
     /// Slip-weakening friction's law (absent: a constant coefficient).
     #[serde(skip)]
     pub weakening: Option<contact::SlipWeakening>,
@@ -133,9 +137,15 @@ impl Plan {
             rule: scene.solver.rule,
             outputs,
             compliance: scene
-                .first_contact()
+                .contacts()
+                .iter()
                 .filter(|_| law != ContactLaw::None)
-                .and_then(|c| c.compliance),
+                .find_map(|c| c.compliance),
+            compliance_shared: law == ContactLaw::None
+                || scene
+                    .contacts()
+                    .iter()
+                    .all(|c| scene.contacts().first().is_some_and(|f| f.compliance == c.compliance)),
             // a weakening law from a static coefficient of 0 is frictionless (its dynamic one,
             // at most the static, is 0 too): no tangential multipliers for it to act on
             weakening: scene
@@ -215,9 +225,10 @@ impl fmt::Display for Plan {
             self.dim,
             if self.electric { "yes" } else { "left out" },
             self.contact_law,
-            match self.compliance {
-                Some(k) => format!(" on a compliant foundation (k = {:e}, m = {})", k.stiffness, k.exponent),
-                None => String::new(),
+            match (self.compliance, self.compliance_shared) {
+                (Some(k), true) => format!(" on a compliant foundation (k = {:e}, m = {})", k.stiffness, k.exponent),
+                (Some(_), false) => " on a compliant foundation in some zones (each zone its own)".into(),
+                (None, _) => String::new(),
             },
             match self.weakening {
                 Some(w) => format!(
@@ -233,4 +244,14 @@ impl fmt::Display for Plan {
             outputs.join(", ")
         )
     }
+}
+
+/// `true` (a report written before zones had foundations of their own had one).
+fn shared() -> bool {
+    true
+}
+
+/// Whether `shared` is `true` (left out of the report: the common case).
+fn is_shared(shared: &bool) -> bool {
+    *shared
 }

@@ -514,6 +514,7 @@ mod tests {
                     friction: vec![0.3; n],
                     held: vec![[false; 2]; n],
                     foundation: Default::default(),
+                    foundations: vec![],
                     slipped: vec![],
                 };
                 // an SPD compliance with zeros: a Gram matrix plus the identity
@@ -633,7 +634,13 @@ mod tests {
                 exponent: 1.5,
             },
         ];
-        for (law, foundation) in laws.iter().flat_map(|l| foundations.iter().map(move |f| (*l, *f))) {
+        // each law on each foundation, and on the foundation beside a rigid one (every other
+        // point's: zones on two foundations)
+        let cases = laws
+            .iter()
+            .flat_map(|l| foundations.iter().map(move |f| (*l, *f)))
+            .flat_map(|(l, f)| [(l, f, false), (l, f, true)]);
+        for (law, foundation, beside) in cases {
             let points = ContactPoints {
                 dim: 2,
                 position: vec![[0.0; 3]; n],
@@ -644,6 +651,13 @@ mod tests {
                 friction: vec![0.3; n],
                 held: vec![[false; 2]; n],
                 foundation,
+                foundations: if beside {
+                    (0..n)
+                        .map(|i| if i % 2 == 0 { foundation } else { Foundation::Rigid })
+                        .collect()
+                } else {
+                    vec![]
+                },
                 slipped: vec![],
             };
             let g = |i: usize, j: usize| ((i * 5 + j * 3) % 7) as f64 * 0.1 - 0.3;
@@ -698,7 +712,7 @@ mod tests {
                 let fd = (sp.f[r] - s.f[r]) / eps;
                 assert!(
                     (jv - fd).abs() <= 1e-5 * (1.0 + fd.abs()),
-                    "{law:?} {foundation:?} row {r}: {jv} vs {fd}"
+                    "{law:?} {foundation:?} (beside a rigid one: {beside}) row {r}: {jv} vs {fd}"
                 );
             }
         }

@@ -277,7 +277,7 @@ impl<'a> Flat<'a> {
     /// Coulomb's radius: from the start, a point pressed in conducts, and the derivative sees
     /// it), on a compliant one the penetration.
     fn contact_of(&self, i: usize, s_u: &[f64], s_z: &[f64]) -> (f64, bool) {
-        match self.points.foundation {
+        match self.points.foundation_of(i) {
             Foundation::Rigid => (s_z[i], s_z[i] > 0.0 || self.is_forced(i)),
             Foundation::Compliant { .. } => {
                 let pen = s_u[i] - self.points.gap[i];
@@ -373,7 +373,7 @@ impl<'a> Flat<'a> {
     /// The normal value Coulomb's radius is taken at: `z_n` on a rigid foundation, the
     /// pressure `x_n` on a compliant one.
     fn radius_normal(&self, i: usize, z: &[f64], x: &[f64]) -> f64 {
-        self.points.foundation.radius_normal(z[i], x[i])
+        self.points.foundation_of(i).radius_normal(z[i], x[i])
     }
 
     /// The slip `|u_t|` of point `i` in the flat `u`.
@@ -412,7 +412,7 @@ impl<'a> Flat<'a> {
                 -self.c[i] * (u[i] - self.points.gap[i])
             } else {
                 self.points
-                    .foundation
+                    .foundation_of(i)
                     .normal_residual(x[i], u[i] - self.points.gap[i], self.c[i])
             };
             if self.nt > 0 {
@@ -443,7 +443,7 @@ impl<'a> Flat<'a> {
         let mut rows = vec![RowForm::default(); self.m];
         for i in 0..n {
             let penetration = s.u[i] - self.points.gap[i];
-            match self.points.foundation.equation(s.x[i], penetration, self.c[i]) {
+            match self.points.foundation_of(i).equation(s.x[i], penetration, self.c[i]) {
                 // normal: [z_n]₊ has derivative 1 (contact: J = C) or 0 (separated: J = I)
                 None if s.z[i] > 0.0 || self.is_forced(i) => rows[i].b.push((i, 1.0)),
                 None => rows[i].e.push((i, 1.0)),
@@ -498,7 +498,7 @@ impl<'a> Flat<'a> {
                         // λ_t - S q/|q|: derivative I - (S/|q|)(I - q̂q̂ᵀ) M_t - q̂ dS, with
                         // dS = F M_n for Coulomb at a contact point
                         let ratio = radius / qn;
-                        let rigid = self.points.foundation == Foundation::Rigid;
+                        let rigid = self.points.foundation_of(i) == Foundation::Rigid;
                         // the normal value the radius is taken at, in contact where positive
                         let normal = crate::project_nonnegative(self.radius_normal(i, &s.z, &s.x));
                         let slope = match self.law {
@@ -556,7 +556,7 @@ impl<'a> Flat<'a> {
                 form.b.push((r, row.along_c));
             }
             if row.along_p != 0.0 {
-                match self.points.foundation {
+                match self.points.foundation_of(i) {
                     // p = [z_n]₊: ∂p = (I - C)_i
                     Foundation::Rigid => {
                         form.e.push((i, row.along_p));

@@ -912,8 +912,8 @@ fn solve_electric(
         return Err(stall_error(&info, best_residual, reason, Some(best)));
     }
     // the ideal conductor on a rigid foundation: the widest member of its family
-    let (best, best_residual) = match (problem.electric.law, &points.foundation) {
-        (crate::ElectricLaw::Conducting, crate::Foundation::Rigid) => {
+    let (best, best_residual) = match (problem.electric.law, points.all_rigid()) {
+        (crate::ElectricLaw::Conducting, true) => {
             member::widest(&judge, best, best_residual, params, &mut info, &mut cache.directions)
         }
         _ => (best, best_residual),
@@ -1225,7 +1225,7 @@ fn fallback<P: AffineProblem>(
     for i in 0..n {
         points.project_friction(i, start.tangential_of_mut(i), radius[i]);
     }
-    let mut sol = if *law == Law::Coulomb || points.foundation != crate::Foundation::Rigid {
+    let mut sol = if *law == Law::Coulomb || !points.all_rigid() {
         // Coulomb's law, or a compliant foundation's, directly, point by point
         let gs = GaussSeidelParams {
             tol: params.tol,

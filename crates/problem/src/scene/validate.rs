@@ -931,9 +931,9 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 }
 
 /// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
-/// coefficient, Tresca bound and (one of them) a depth-controlled indenter; what they share
-/// (the friction law, the foundation's compliance) the same for all, a frictionless zone
-/// joining either friction law; what is posed for one zone
+/// coefficient, Tresca bound, foundation (rigid, or its own compliance) and (one of them) a
+/// depth-controlled indenter; the friction law they share, a frictionless zone joining either
+/// friction law; what is posed for one zone
 /// (electrical contact, a floating tip, force control, slip weakening, an exact solution)
 /// refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
@@ -971,11 +971,6 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
             off(c) != off(first)
                 || contacts[..k].iter().any(|o| frictional(o) && frictional(c) && o.law != c.law),
             "their law (a Signorini zone may join Tresca's or Coulomb's, but Tresca's and Coulomb's do not mix, nor a zone switched off with active ones)",
-        )?;
-        same(
-            "contact.compliance",
-            c.compliance != first.compliance,
-            "the foundation's compliance",
         )?;
         let one = |key: &str, given: bool, what: &str| {
             refuse_if(
