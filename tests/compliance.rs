@@ -337,6 +337,23 @@ fn what_the_bed_does_not_hold_is_named_and_a_bed_it_leaves_is_no_solution() {
             "{dim}D: {e}"
         );
     }
+    // a load along the bed only (held by the rollers): nothing presses it onto the bed, and a
+    // body that floats has no position
+    let mut s = on_its_bed(2, k, 1.0, false, q);
+    if let Some(problem::Loads::One(l)) = s.load.as_mut() {
+        l.direction = vec![1.0, 0.0];
+    }
+    let e = fails(&s);
+    assert!(
+        matches!(
+            e,
+            problem::ProblemError::NoSolution {
+                sought: "contact.compliance",
+                ..
+            }
+        ) && e.to_string().contains("do not press it onto the bed"),
+        "{e}"
+    );
     // no load at all: nothing presses it onto the bed
     let mut s = on_its_bed(2, k, 1.0, false, q);
     s.load = None;

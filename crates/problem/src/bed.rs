@@ -82,8 +82,9 @@ impl Bed {
                 }
             }
         }
-        // the mean pressure the loads put on the bed: their resultant over its area (where they
-        // balance, a sum of their sizes)
+        // the mean pressure the loads put on the bed: their resultant along the bed's mean
+        // normal over its area; a resultant that does not press the body onto the bed leaves it
+        // nothing to hold it by (it floats, or lifts off)
         let area: f64 = beds.iter().map(|&i| points.weight[i]).sum();
         let b = &posed.loads.b_u;
         let dim = posed.disc.dofs.dim;
@@ -93,15 +94,22 @@ impl Bed {
                 resultant[v % dim] += b[*j];
             }
         }
-        let mut force = resultant.iter().map(|f| f * f).sum::<f64>().sqrt();
-        if !(force > 0.0) {
-            force = b.iter().map(|x| x.abs()).sum();
+        let mut normal = [0.0f64; 3];
+        for &i in &beds {
+            for (m, n) in normal.iter_mut().zip(points.normal[i]) {
+                *m += points.weight[i] * n;
+            }
         }
+        let length = normal.iter().map(|n| n * n).sum::<f64>().sqrt();
+        let force: f64 = resultant.iter().zip(&normal).map(|(f, n)| f * n).sum::<f64>() / length;
+        let size: f64 = b.iter().map(|x| x.abs()).sum();
         let pressure = force / area;
-        if !(pressure > 0.0 && pressure.is_finite()) {
+        if !(force > 1e-12 * size && pressure.is_finite()) {
             return Err(ProblemError::NoSolution {
                 sought: "contact.compliance",
-                why: "only the compliant bed holds the body, and no load presses it onto the bed".into(),
+                why: format!(
+                    "only the compliant bed holds the body, and the loads do not press it onto the bed (their resultant along the bed's normal is {force:.3e}, of loads of size {size:.3e}): the body floats or lifts off"
+                ),
             });
         }
         // k [p]^m at the pressure P: p = (P / k)^(1/m), tangent k m p^(m-1); the softest bed's
