@@ -8,7 +8,7 @@ use crate::layout::Layout;
 use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError, Vector};
-use problem::backend::{Backend, ContactBoundary, ContactSolve, Figures, Finished, Posed, Setup, Solved, Unsupported};
+use problem::backend::{Backend, ContactAt, ContactBoundary, Figures, Finished, Posed, Setup, Solved, Unsupported};
 use problem::{ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, Solution};
 use std::time::Instant;
 
@@ -151,31 +151,23 @@ impl<'p> Backend for PetscBackend<'p> {
         })
     }
 
-    /// One Krylov solve.
-    fn solve_linear(
-        &mut self,
-        _: &Posed<'_>,
-        s: &mut Prepared<'p>,
-        reporter: &mut dyn Reporter,
-    ) -> Result<Solved<Vector<'p>>, DistributedError> {
-        let t = Instant::now();
-        let mut x = s.system.rhs.duplicate()?;
-        (s.krylov, s.reason) =
-            krylov_solve(self.petsc, &s.fields, &mut s.t_pc)(&mut s.system.matrix, &s.system.rhs, &mut x)?;
-        Ok(s.solved(t, x, None, reporter))
-    }
-
-    /// The active-set iteration over the distributed system, each step one Krylov solve (a
-    /// tangent of a contact point held by a Dirichlet condition refused by name).
-    fn solve_contact(
+    /// One Krylov solve without contact; with contact, the active-set iteration over the
+    /// distributed system, each step one Krylov solve (a tangent of a contact point held by a
+    /// Dirichlet condition refused by name).
+    fn solve_instant(
         &mut self,
         posed: &Posed<'_>,
         s: &mut Prepared<'p>,
-        boundary: ContactBoundary,
-        how: &ContactSolve<'_>,
+        contact: Option<ContactAt<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<Solved<Vector<'p>>, DistributedError> {
         let t = Instant::now();
+        let Some(ContactAt { boundary, how }) = contact else {
+            let mut x = s.system.rhs.duplicate()?;
+            (s.krylov, s.reason) =
+                krylov_solve(self.petsc, &s.fields, &mut s.t_pc)(&mut s.system.matrix, &s.system.rhs, &mut x)?;
+            return Ok(s.solved(t, x, None, reporter));
+        };
         refuse_held_tangent(&posed.scene, &boundary)?;
         let rows = ContactRows::new(self.petsc, &boundary.points, &boundary.nodes, &s.layout, &s.system);
         let params = ActiveSetParams {

@@ -79,11 +79,12 @@ impl Limits {
 /// A backend: how the discrete problem of a run is assembled and solved. Every method is
 /// called once per run, in the order of the run: [`supports`](Backend::supports),
 /// [`estimate`](Backend::estimate), [`assemble`](Backend::assemble),
-/// [`prepare`](Backend::prepare), one of [`solve_linear`](Backend::solve_linear) and
-/// [`solve_contact`](Backend::solve_contact), [`equilibrium`](Backend::equilibrium),
-/// [`finish`](Backend::finish). A backend whose steps are collective (MPI) makes them
-/// collective on every rank; only [`finish`](Backend::finish) may return `None` (a rank that
-/// does not hold the gathered solution).
+/// [`prepare`](Backend::prepare), [`solve_instant`](Backend::solve_instant) (more than once
+/// on one preparation where the run asks: a body only its compliant bed holds, a
+/// capacitance's columns), [`equilibrium`](Backend::equilibrium), [`finish`](Backend::finish).
+/// A backend whose steps are collective (MPI) makes them collective on every rank; only
+/// [`finish`](Backend::finish) may return `None` (a rank that does not hold the gathered
+/// solution).
 pub trait Backend {
     /// The backend's name, as `solver.backend` spells it (for its refusals).
     const NAME: &'static str;
@@ -136,28 +137,17 @@ pub trait Backend {
         reporter: &mut dyn Reporter,
     ) -> Result<Self::System, Self::Error>;
 
-    /// The one linear solve of a run without contact.
-    ///
-    /// # Errors
-    /// A solve that failed.
-    fn solve_linear(
-        &mut self,
-        posed: &Posed<'_>,
-        system: &mut Self::System,
-        reporter: &mut dyn Reporter,
-    ) -> Result<Solved<Self::Solution>, Self::Error>;
-
-    /// The contact problem on `boundary`, solved as `how` says (the law, the tolerance, the
-    /// interrupt), each outer iteration reported.
+    /// The instant `posed` on the prepared `system`: the one linear solve without contact,
+    /// or the contact problem on its boundary, solved as its `how` says (the law, the
+    /// tolerance, the interrupt), each outer iteration reported.
     ///
     /// # Errors
     /// A contact solve that did not converge (with its best iterate), a solve that failed.
-    fn solve_contact(
+    fn solve_instant(
         &mut self,
         posed: &Posed<'_>,
         system: &mut Self::System,
-        boundary: ContactBoundary,
-        how: &ContactSolve<'_>,
+        contact: Option<ContactAt<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<Solved<Self::Solution>, Self::Error>;
 
@@ -299,6 +289,15 @@ pub trait PathBackend: Backend<Error = ProblemError> {
 
 /// The free unknowns `(u, φ)` of the discretisation.
 pub type Fields = (Vec<f64>, Vec<f64>);
+
+/// An instant's contact problem ([`Backend::solve_instant`]): its boundary, and how it is
+/// solved.
+pub struct ContactAt<'a> {
+    /// The contact boundary (its points, with the instant's gaps).
+    pub boundary: ContactBoundary,
+    /// The law, the tolerance, the interrupt.
+    pub how: &'a ContactSolve<'a>,
+}
 
 /// Where a path's contact solve starts ([`PathBackend::solve_posed`]).
 pub struct At<'a> {

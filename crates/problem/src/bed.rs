@@ -24,7 +24,7 @@
 //! A body that the bed holds nowhere (the loads lift it off) has no solution: a typed
 //! [`ProblemError::NoSolution`], as has a fixed point that does not settle.
 
-use crate::backend::{Backend, Bed, ContactSolve, Posed, Solved};
+use crate::backend::{Backend, Bed, ContactAt, ContactSolve, Posed, Solved};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
 use crate::ProblemError;
@@ -194,7 +194,11 @@ pub(crate) fn solve_held<B: Backend>(
         let (mut seconds, mut pcg_iters) = (0.0, 0);
         let mut last = f64::INFINITY;
         for step in 1..=MAX_STEPS {
-            let mut solved = backend.solve_contact(posed, system, boundary.clone(), how, reporter)?;
+            let contact = ContactAt {
+                boundary: boundary.clone(),
+                how,
+            };
+            let mut solved = backend.solve_instant(posed, system, Some(contact), reporter)?;
             (seconds, pcg_iters) = (seconds + solved.seconds, pcg_iters + solved.pcg_iters);
             let Some((cb, sol)) = solved.contact.as_ref() else {
                 return Ok(Balanced {

@@ -98,7 +98,7 @@ pub(crate) fn capacitance<B: Backend>(
             system = Some(backend.prepare(&posed, assembled, None, Limits::default(), &mut Silent)?);
         }
         let Some(system) = system.as_mut() else { continue };
-        let solved = backend.solve_linear(&posed, system, &mut Silent)?;
+        let solved = backend.solve_instant(&posed, system, None, &mut Silent)?;
         let Some((u, phi)) = backend.gather(&posed, system, &solved.x)? else {
             continue;
         };

@@ -3,7 +3,7 @@
 //! system), check, recover the fields, report. [`run`] calls the steps in order on any
 //! [`Backend`] and builds the report once; [`solve`] runs the default backend.
 
-use crate::backend::{Backend, Bed, ContactSolve, Figures, Finished, Limits, Loads, Posed, Solved};
+use crate::backend::{Backend, Bed, ContactAt, ContactSolve, Figures, Finished, Limits, Loads, Posed, Solved};
 use crate::bed::Balanced;
 use crate::boundary::ContactBoundary;
 use crate::exact::contact_errors;
@@ -145,7 +145,8 @@ fn solve<B: Backend>(
         }
         (Some(b), None) => {
             let how = ContactSolve::new(plan, scene.scene(), &b, limits.interrupt);
-            let solved = backend.solve_contact(posed, system, b, &how, reporter)?;
+            let contact = ContactAt { boundary: b, how: &how };
+            let solved = backend.solve_instant(posed, system, Some(contact), reporter)?;
             let equilibrium = backend.equilibrium(posed, system, &solved)?;
             Ok(Balanced {
                 solved,
@@ -154,7 +155,7 @@ fn solve<B: Backend>(
             })
         }
         (None, _) => {
-            let solved = backend.solve_linear(posed, system, reporter)?;
+            let solved = backend.solve_instant(posed, system, None, reporter)?;
             let equilibrium = backend.equilibrium(posed, system, &solved)?;
             Ok(Balanced {
                 solved,

@@ -10,7 +10,7 @@ mod path_system;
 use condensed::{coupled, refine, rhs, rhs_with_contact, solve_contact, REFINE_TOL};
 
 use crate::backend::Unsupported;
-use crate::backend::{Backend, ContactSolve, Fields, Figures, Finished, Limits, Posed, Solved};
+use crate::backend::{Backend, ContactAt, Fields, Figures, Finished, Limits, Posed, Solved};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
 use crate::scene::{BackendChoice, Rule, Scene};
@@ -76,24 +76,18 @@ impl Backend for Faer {
         factor(posed, blocks, boundary, limits, reporter)
     }
 
-    fn solve_linear(
+    fn solve_instant(
         &mut self,
         posed: &Posed<'_>,
         system: &mut Factored,
-        _: &mut dyn Reporter,
-    ) -> Result<Solved<Self::Solution>, ProblemError> {
-        solve_linear(system, posed).map_err(|e| e.on_scene(&posed.scene))
-    }
-
-    fn solve_contact(
-        &mut self,
-        posed: &Posed<'_>,
-        system: &mut Factored,
-        boundary: ContactBoundary,
-        how: &ContactSolve<'_>,
+        contact: Option<ContactAt<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<Solved<Self::Solution>, ProblemError> {
-        solve_contact(how, system, boundary, posed, reporter).map_err(|e| e.on_scene(&posed.scene))
+        match contact {
+            Some(ContactAt { boundary, how }) => solve_contact(how, system, boundary, posed, reporter),
+            None => solve_linear(system, posed),
+        }
+        .map_err(|e| e.on_scene(&posed.scene))
     }
 
     fn equilibrium(
