@@ -8,7 +8,7 @@
 //! F = 0.6: a central stick zone between two slip zones, as in Cattaneo-Mindlin). Prints the stick/slip pattern and the two solvers' agreement.
 
 use contact::{
-    solve, solve_newton, ContactPoints, DenseContactProblem, Law, NewtonParams, PointValues, Status, UzawaParams,
+    solve_newton, solve_uzawa, ContactPoints, DenseContactProblem, Law, NewtonParams, PointValues, Status, UzawaParams,
 };
 
 /// The compliance `D = (k_base I + k_spring L)⁻¹` of `n` points (L the 1D Laplacian with free
@@ -99,7 +99,7 @@ fn main() {
         &mut |_| {},
     )
     .expect("Newton converges on this problem");
-    let uzawa = solve(
+    let uzawa = solve_uzawa(
         &mut problem,
         &points,
         &Law::Coulomb,

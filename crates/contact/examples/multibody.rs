@@ -124,7 +124,10 @@ fn main() {
                     if s.info.fallback || t > 1.0 {
                         println!(
                             "{name}: {} Newton, {} proximal, fallback {} ({} sweeps), {t:.3} s",
-                            s.info.newton_iters, s.info.proximal_iters, s.info.fallback, s.info.uzawa_iters
+                            s.info.newton_iters,
+                            s.info.proximal_iters,
+                            s.info.fallback,
+                            s.info.uzawa_iters + s.info.sweeps
                         );
                     }
                 }

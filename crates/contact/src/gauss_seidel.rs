@@ -53,7 +53,7 @@ const FULL_EVERY: usize = 10;
 /// Solves the affine contact problem `problem` for `law` by block Gauss–Seidel sweeps over
 /// the points, from `lambda0` (zeros when `None`). The answer is the best iterate (by the
 /// measure asked for, evaluated at least every ten sweeps and wherever the sweeps' change
-/// falls below its threshold); [`ContactInfo::uzawa_iters`] counts the sweeps.
+/// falls below its threshold); [`ContactInfo::sweeps`] counts the sweeps.
 ///
 /// # Errors
 /// [`ContactError::Input`] for inconsistent data; [`ContactError::Stalled`] or
@@ -88,7 +88,7 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
         &params.interrupt,
         progress,
     );
-    info.uzawa_iters = run.sweeps;
+    info.sweeps = run.sweeps;
     match run.end {
         SweepEnd::Converged => {}
         SweepEnd::Interrupted(why) => {

@@ -21,7 +21,7 @@
 //!
 //! # Example
 //! ```
-//! use contact::{solve, ContactPoints, DenseContactProblem, Law, PointValues, Status, UzawaParams};
+//! use contact::{solve_uzawa, ContactPoints, DenseContactProblem, Law, PointValues, Status, UzawaParams};
 //! // one point pressed 1 unit into the foundation through a spring of compliance 1:
 //! // u_n = 1 - λ_n (w = 1), contact at g = 0 needs λ_n = 1.
 //! let points = ContactPoints {
@@ -34,7 +34,7 @@
 //!     u0: PointValues::from_parts(vec![1.0], vec![], 0).unwrap(),
 //!     compliance: vec![1.0], weight: vec![1.0], nt: 0,
 //! };
-//! let sol = solve(&mut op, &points, &Law::Frictionless, &UzawaParams::default(), None, &mut |_| {}).unwrap();
+//! let sol = solve_uzawa(&mut op, &points, &Law::Frictionless, &UzawaParams::default(), None, &mut |_| {}).unwrap();
 //! assert!((sol.lambda.normal[0] - 1.0).abs() < 1e-10);
 //! assert_eq!(sol.status[0], Status::Slip); // frictionless contact: slip
 //! ```
@@ -71,7 +71,7 @@ pub use solution::{
     ContactSolution, Interrupt, Interruption, Iterate, Law, Measure, Progress, Stage, Stall,
 };
 pub use uniqueness::slip_bound_expansion;
-pub use uzawa::{solve, StopRule, UzawaParams, FIXED_POINT_PATIENCE};
+pub use uzawa::{solve_uzawa, StopRule, UzawaParams, FIXED_POINT_PATIENCE};
 pub use weakening::{
     solve_slip_weakening, solve_slip_weakening_cached, Inner, SlipWeakening, Weakening, WeakeningParams,
 };

@@ -15,7 +15,7 @@ pub enum Law {
     Frictionless,
     /// Tresca friction with a given slip bound per point.
     Tresca(Vec<f64>),
-    /// Coulomb friction `S = F λ_n`: by the fixed point on `S` ([`crate::solve`]), or directly
+    /// Coulomb friction `S = F λ_n`: by the fixed point on `S` ([`crate::solve_uzawa`]), or directly
     /// ([`crate::solve_newton`]).
     Coulomb,
 }
@@ -24,10 +24,11 @@ pub enum Law {
 /// count is 0 (a step `None`) where its loop did not run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactInfo {
-    /// First-order steps (Uzawa or the accelerated gradient), summed over the fixed point; or
-    /// block Gauss–Seidel sweeps (the method's own, or those [`crate::solve_newton`] runs
-    /// first, its stage 0).
+    /// First-order steps (Uzawa or the accelerated gradient), summed over the fixed point.
     pub uzawa_iters: usize,
+    /// Block Gauss–Seidel sweeps: the method's own, those [`crate::solve_newton`] runs first
+    /// (its stage 0), or its fallback's for Coulomb's law.
+    pub sweeps: usize,
     /// Semismooth Newton steps ([`crate::solve_newton`]).
     pub newton_iters: usize,
     /// Newton steps on the coarser problems of Newton's nested start (each on a fraction of
@@ -79,6 +80,7 @@ impl ContactInfo {
     pub fn new(mu_max: f64) -> Self {
         ContactInfo {
             uzawa_iters: 0,
+            sweeps: 0,
             newton_iters: 0,
             coarse_newton_iters: 0,
             proximal_iters: 0,
@@ -318,7 +320,7 @@ pub fn coulomb_radius(friction: f64, z_n: f64) -> f64 {
 /// `‖(λ_n - max(0, λ_n + c (u_n - g)), λ_t - P_S(λ_t + c u_t))‖_W / max(‖λ‖_W, reference)`.
 ///
 /// `reference` is the multiplier scale of the problem, `c ‖(u_n(0) - g, u_t(0))‖_W` with `u(0)`
-/// the contact displacement under the loads alone ([`crate::solve`] computes it): without it, a
+/// the contact displacement under the loads alone ([`crate::solve_uzawa`] computes it): without it, a
 /// solution whose multipliers vanish at a grazing point would be approached with `‖r‖` and `‖λ‖`
 /// shrinking together and a relative residual that never falls. Both terms scale like λ, so
 /// the residual is free of units and of the solver's own step. A zero denominator gives the

@@ -26,7 +26,7 @@ pub enum StopRule {
     Paper,
 }
 
-/// Parameters of [`solve`].
+/// Parameters of [`solve_uzawa`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UzawaParams {
     /// The Uzawa step `r`; `None`: `safety / μ_max` from a power-iteration estimate.
@@ -176,7 +176,7 @@ struct Dual<'a, 'b> {
 /// [`ContactError::Input`] for inconsistent data, [`ContactError::NotLoaded`] when the
 /// multipliers do not move the points, the loops' own errors with their last residual, and
 /// [`ContactError::Operator`] when a primal solve fails.
-pub fn solve(
+pub fn solve_uzawa(
     op: &mut dyn ContactOperator,
     points: &ContactPoints,
     law: &Law,

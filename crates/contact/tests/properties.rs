@@ -3,9 +3,9 @@
 //! active-set enumeration and a KKT check, and homogeneity in the load.
 
 use contact::{
-    complementarity_residual, project_cone, project_disc, project_nonnegative, solve, solve_gauss_seidel, solve_newton,
-    ContactError, ContactPoints, DenseContactProblem, GaussSeidelParams, Law, NewtonParams, Phase, PointValues,
-    ProblemClass, Schedule, StopRule, UzawaParams,
+    complementarity_residual, project_cone, project_disc, project_nonnegative, solve_gauss_seidel, solve_newton,
+    solve_uzawa, ContactError, ContactPoints, DenseContactProblem, GaussSeidelParams, Law, NewtonParams, Phase,
+    PointValues, ProblemClass, Schedule, StopRule, UzawaParams,
 };
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -147,7 +147,7 @@ proptest! {
         }
         prop_assert!(newton.info.complementarity <= 1e-12);
         // Uzawa refuses a law that is no projection, by a typed error
-        let e = solve(&mut op.clone(), &pts, &law, &tight(1e-10), None, &mut |_| {}).unwrap_err();
+        let e = solve_uzawa(&mut op.clone(), &pts, &law, &tight(1e-10), None, &mut |_| {}).unwrap_err();
         prop_assert!(matches!(e, ContactError::Input(contact::InputError::Unsupported(_))), "{e}");
     }
 
@@ -204,7 +204,7 @@ proptest! {
     fn uzawa_matches_active_set_enumeration(n in 1usize..=4, seed in prop::collection::vec(-1.0f64..1.0, 40), w in prop::collection::vec(-1.0f64..1.0, 4), load in prop::collection::vec(-1.0f64..1.0, 12)) {
         let pts = points(n, 2, &w, 0.0);
         let mut op = problem(n, 0, &pts, &seed, &load);
-        let sol = solve(&mut op, &pts, &Law::Frictionless, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let sol = solve_uzawa(&mut op, &pts, &Law::Frictionless, &tight(1e-12), None, &mut |_| {}).unwrap();
         // enumeration: u = u0 - D W λ; on the active set u_n = g (= 0)
         let d = DMatrix::from_row_slice(n, n, &op.compliance);
         let mut found = None;
@@ -242,7 +242,7 @@ proptest! {
         let pts = points(n, dim, &w, f);
         let mut op = problem(n, nt, &pts, &seed, &load);
         let law = if coulomb { Law::Coulomb } else { Law::Tresca(vec![0.1; n]) };
-        let sol = solve(&mut op, &pts, &law, &tight(1e-11), None, &mut |_| {}).unwrap();
+        let sol = solve_uzawa(&mut op, &pts, &law, &tight(1e-11), None, &mut |_| {}).unwrap();
         let (l, u) = (&sol.lambda, &sol.u);
         // the residual's denominator: ‖λ‖, floored at the multipliers of the free motion
         // c ‖u(0) - g‖ (c = 1/μ_max), so that round-off of a small λ is no failure; a load
@@ -287,8 +287,8 @@ proptest! {
         let law = if coulomb { Law::Coulomb } else { Law::Tresca(vec![0.1; n]) };
         let mut op1 = problem(n, nt, &pts, &seed, &load);
         let mut op2 = op1.clone();
-        let plain = solve(&mut op1, &pts, &law, &tight(1e-12), None, &mut |_| {}).unwrap();
-        let fast = solve(&mut op2, &pts, &law, &UzawaParams { accelerate: true, ..tight(1e-12) }, None, &mut |_| {}).unwrap();
+        let plain = solve_uzawa(&mut op1, &pts, &law, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let fast = solve_uzawa(&mut op2, &pts, &law, &UzawaParams { accelerate: true, ..tight(1e-12) }, None, &mut |_| {}).unwrap();
         let scale = plain.lambda.norm().max(op1.u0.norm());
         let d = plain.lambda.minus(&fast.lambda).norm();
         prop_assert!(d <= 1e-8 * scale.max(1e-12), "difference {d} (scale {scale})");
@@ -307,7 +307,7 @@ proptest! {
         };
         let mut op1 = problem(n, nt, &pts, &seed, &load);
         let mut op2 = op1.clone();
-        let plain = solve(&mut op1, &pts, &law, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let plain = solve_uzawa(&mut op1, &pts, &law, &tight(1e-12), None, &mut |_| {}).unwrap();
         let params = NewtonParams { tol: 1e-12, schedule: Schedule::all().without(Phase::Fallback), ..Default::default() };
         let newton = solve_newton(&mut op2, &pts, &law, &params, None, &mut |_| {}).unwrap();
         let scale = plain.lambda.norm().max(op1.u0.norm());
@@ -341,7 +341,7 @@ proptest! {
         let mut s = vec![0.0; n];
         let mut diffs = vec![];
         for _ in 0..4 {
-            let sol = solve(&mut op, &pts, &Law::Tresca(s.clone()), &tight(1e-13), None, &mut |_| {}).unwrap();
+            let sol = solve_uzawa(&mut op, &pts, &Law::Tresca(s.clone()), &tight(1e-13), None, &mut |_| {}).unwrap();
             let s_new: Vec<f64> = sol.lambda.normal.iter().map(|l| f * l).collect();
             diffs.push(s_new.iter().zip(&s).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt());
             s = s_new;
@@ -361,8 +361,8 @@ proptest! {
         let mut op1 = problem(n, 1, &pts, &seed, &load);
         let scaled: Vec<f64> = load.iter().map(|x| alpha * x).collect();
         let mut op2 = problem(n, 1, &pts, &seed, &scaled);
-        let s1 = solve(&mut op1, &pts, &Law::Coulomb, &tight(1e-12), None, &mut |_| {}).unwrap();
-        let s2 = solve(&mut op2, &pts, &Law::Coulomb, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let s1 = solve_uzawa(&mut op1, &pts, &Law::Coulomb, &tight(1e-12), None, &mut |_| {}).unwrap();
+        let s2 = solve_uzawa(&mut op2, &pts, &Law::Coulomb, &tight(1e-12), None, &mut |_| {}).unwrap();
         let scale = s1.lambda.norm().max(1e-12);
         for (a, b) in s1.lambda.normal.iter().chain(&s1.lambda.tangential).zip(s2.lambda.normal.iter().chain(&s2.lambda.tangential)) {
             prop_assert!((alpha * a - b).abs() <= 1e-7 * alpha * scale);
@@ -393,7 +393,7 @@ fn non_convergence_is_a_typed_error_with_the_residual() {
         max_iters: 2,
         ..tight(1e-14)
     };
-    match solve(&mut op, &pts, &Law::Coulomb, &params, None, &mut |_| {}) {
+    match solve_uzawa(&mut op, &pts, &Law::Coulomb, &params, None, &mut |_| {}) {
         Err(contact::ContactError::NoConvergence { residual, .. }) => assert!(residual > 1e-14),
         other => panic!("{other:?}"),
     }
@@ -421,7 +421,7 @@ fn regression_power_iteration_sees_the_top_eigenvalue() {
         weight: w.clone(),
         nt: 0,
     };
-    let sol = solve(&mut op, &pts, &Law::Frictionless, &tight(1e-12), None, &mut |_| {}).unwrap();
+    let sol = solve_uzawa(&mut op, &pts, &Law::Frictionless, &tight(1e-12), None, &mut |_| {}).unwrap();
     let a = DMatrix::from_fn(2, 2, |i, j| d[i * 2 + j] * w[j]);
     let exact = a.lu().solve(&DVector::from_row_slice(&u0)).unwrap();
     for i in 0..2 {
@@ -524,7 +524,7 @@ fn regression_grazing_coulomb_point() {
     let f = 0.2439128030433884;
     let pts = points(4, 3, &[0.0; 4], f);
     let mut op = problem(4, 2, &pts, &seed, &load);
-    let sol = solve(&mut op, &pts, &Law::Coulomb, &tight(1e-11), None, &mut |_| {}).unwrap();
+    let sol = solve_uzawa(&mut op, &pts, &Law::Coulomb, &tight(1e-11), None, &mut |_| {}).unwrap();
     assert!(sol.info.complementarity <= 1e-11);
     // point 3: in contact with a small pressure, sliding along λ_t
     let (l, u) = (&sol.lambda, &sol.u);
@@ -565,7 +565,7 @@ fn newton_falls_back_on_the_accelerated_gradient() {
         ..Default::default()
     };
     let sol = solve_newton(&mut op, &pts, &Law::Coulomb, &none, None, &mut |_| {}).unwrap();
-    assert!(sol.info.fallback && sol.info.newton_iters == 0 && sol.info.uzawa_iters > 0);
+    assert!(sol.info.fallback && sol.info.newton_iters == 0 && sol.info.sweeps > 0);
     assert!(sol.info.complementarity <= 1e-12);
     let d = sol.lambda.minus(&reference.lambda).norm();
     assert!(d <= 1e-8 * reference.lambda.norm(), "{d}");
@@ -629,7 +629,7 @@ fn solutions_scale_with_the_data_over_the_whole_range() {
                 accelerate: true,
                 ..tight(1e-12)
             };
-            let first_order = solve(&mut p, &pts, &Law::Coulomb, &apg, None, &mut |_| {})
+            let first_order = solve_uzawa(&mut p, &pts, &Law::Coulomb, &apg, None, &mut |_| {})
                 .unwrap_or_else(|e| panic!("{dim}D, s = {s:e}: {e}"));
             for (what, sol) in [("Newton", &newton), ("APG", &first_order)] {
                 assert_eq!(sol.status, reference.status, "{what} {dim}D, s = {s:e}");
@@ -666,7 +666,7 @@ fn stalls_and_divergences_are_told_apart() {
             max_iters: 1_000_000,
             ..tight(1e-12)
         };
-        solve(&mut op.clone(), &pts, &Law::Frictionless, &params, None, &mut |_| {})
+        solve_uzawa(&mut op.clone(), &pts, &Law::Frictionless, &params, None, &mut |_| {})
     };
     let e = run(1e-14).unwrap_err();
     assert!(matches!(e, ContactError::Stalled { best: Some(_), .. }), "{e}");
@@ -776,7 +776,7 @@ proptest! {
         let scale = newton.lambda.norm().max(1e-300);
         prop_assert!(gs.lambda.minus(&newton.lambda).norm() <= 1e-8 * scale);
         let tresca_bound: Vec<f64> = newton.lambda.normal.iter().map(|l| f * l.max(0.0)).collect();
-        let uzawa = solve(&mut op.clone(), &pts, &Law::Tresca(tresca_bound), &tight(1e-12), None, &mut |_| {}).unwrap();
+        let uzawa = solve_uzawa(&mut op.clone(), &pts, &Law::Tresca(tresca_bound), &tight(1e-12), None, &mut |_| {}).unwrap();
         prop_assert!(uzawa.lambda.minus(&newton.lambda).norm() <= 1e-7 * scale, "Tresca at Newton's bound");
         for sol in [&newton, &gs, &uzawa] {
             for i in 0..n {
@@ -830,7 +830,7 @@ fn slow_failures_are_told_early() {
         max_iters: 200_000,
         ..tight(1e-12)
     };
-    let e = solve(&mut op, &pts, &Law::Frictionless, &params, None, &mut |_| {}).unwrap_err();
+    let e = solve_uzawa(&mut op, &pts, &Law::Frictionless, &params, None, &mut |_| {}).unwrap_err();
     match e {
         ContactError::TooSlow {
             n_iters, needed, limit, ..
@@ -1077,7 +1077,7 @@ proptest! {
         prop_assert!(nested.info.coarse_newton_iters > 0);
         prop_assert_eq!(zero.info.coarse_newton_iters, 0);
         // a dense symmetric compliance (a condensed finite-element one): no sweeps first
-        prop_assert_eq!(nested.info.uzawa_iters + zero.info.uzawa_iters, 0);
+        prop_assert_eq!(nested.info.uzawa_iters + zero.info.uzawa_iters + nested.info.sweeps + zero.info.sweeps, 0);
         let scale = zero.lambda.norm().max(1e-12);
         prop_assert!(nested.lambda.minus(&zero.lambda).norm() <= 1e-9 * scale, "{:?}\n{:?}", nested.info, zero.info);
         prop_assert!(nested.info.complementarity <= 1e-12);

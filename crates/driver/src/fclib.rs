@@ -196,7 +196,7 @@ pub fn solve(
         Ok(sol) => {
             let r = problem.reaction(&sol.lambda);
             let u = problem.velocity(&r);
-            row.iterations = sol.info.newton_iters + sol.info.uzawa_iters;
+            row.iterations = sol.info.newton_iters + sol.info.uzawa_iters + sol.info.sweeps;
             row.residual = sol.info.complementarity;
             row.siconos_error = problem.error(&r);
             let tol = options.tol;
@@ -271,7 +271,7 @@ fn run_solver(
                 interrupt,
                 ..Default::default()
             };
-            contact::solve(&mut sparse, &points, &Law::Coulomb, &params, None, progress)
+            contact::solve_uzawa(&mut sparse, &points, &Law::Coulomb, &params, None, progress)
         }
     }
 }

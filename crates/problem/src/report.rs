@@ -448,6 +448,9 @@ pub struct Iterations {
     pub fixed_point: usize,
     /// First-order steps (Uzawa, or the accelerated gradient's).
     pub uzawa: usize,
+    /// Block Gauss–Seidel sweeps (Newton's fallback for Coulomb's law).
+    #[serde(default)]
+    pub sweeps: usize,
     /// Semismooth Newton steps (those of the proximal stage's problems included).
     pub newton: usize,
     /// Newton steps on the coarser problems of Newton's nested start (each on a fraction of
@@ -460,7 +463,7 @@ pub struct Iterations {
     /// Halvings in Newton's line search.
     pub line_search_cuts: usize,
     /// Whether Newton stalled and its last stage finished (block Gauss–Seidel for Coulomb's
-    /// law, the accelerated gradient otherwise; its sweeps or steps are counted in `uzawa`).
+    /// law, the accelerated gradient otherwise; its sweeps are counted in `sweeps`, its steps in `uzawa`).
     pub newton_fallback: bool,
     /// PCG iterations in the contact loops (or the one linear solve).
     pub pcg: usize,
@@ -486,6 +489,7 @@ impl Iterations {
         Iterations {
             fixed_point: info.map_or(0, |i| i.fixed_point_iters),
             uzawa: info.map_or(0, |i| i.uzawa_iters),
+            sweeps: info.map_or(0, |i| i.sweeps),
             newton: info.map_or(0, |i| i.newton_iters),
             coarse_newton: info.map_or(0, |i| i.coarse_newton_iters),
             proximal: info.map_or(0, |i| i.proximal_iters),
@@ -503,6 +507,7 @@ impl Iterations {
     pub fn add(&mut self, other: &Iterations) {
         self.fixed_point += other.fixed_point;
         self.uzawa += other.uzawa;
+        self.sweeps += other.sweeps;
         self.newton += other.newton;
         self.coarse_newton += other.coarse_newton;
         self.proximal += other.proximal;
@@ -531,6 +536,7 @@ impl Iterations {
             (self.coarse_newton, "coarse Newton"),
             (self.proximal, "proximal"),
             (self.uzawa, "Uzawa"),
+            (self.sweeps, "sweeps"),
             (self.fixed_point, "FP"),
             (self.pcg, "PCG"),
             (self.bed, "bed"),

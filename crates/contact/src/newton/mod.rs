@@ -32,7 +32,7 @@
 //!    problems it solves, and can stop it short of an active set a longer search finds.
 //! 3. **Fallback**, capped: for Coulomb's law the block Gauss–Seidel method
 //!    ([`crate::solve_gauss_seidel`]), for the convex laws the accelerated projected gradient
-//!    ([`crate::solve`]).
+//!    ([`crate::solve_uzawa`]).
 //!
 //! Nothing is tuned to a problem: the constants are relative to the problem's own compliance
 //! and residual.
@@ -609,7 +609,7 @@ fn proximal_stage(
 ///
 /// The returned [`ContactInfo`] counts Newton steps in `newton_iters` (the proximal stage's
 /// inner steps included), proximal steps in `proximal_iters`, and gives Newton's constant `c`
-/// in `augmentation` (and the fallback's first-order steps, if any, in `uzawa_iters`, with
+/// in `augmentation` (and the fallback's first-order steps or sweeps, if any, in `uzawa_iters` or `sweeps`, with
 /// their step in `step`); `residual` is the residual of `params.measure`, at most
 /// `params.tol`, and `complementarity` the complementarity residual. The answer is the best
 /// iterate found.
@@ -779,7 +779,7 @@ fn sweeps_first<P: AffineProblem>(
         reference,
     }
     .run(start, budget as usize, Some(budget), 10, &params.interrupt, progress);
-    info.uzawa_iters += run.sweeps;
+    info.sweeps += run.sweeps;
     info.stages.push(Phase::Sweeps);
     match run.end {
         SweepEnd::Converged => {
@@ -1248,13 +1248,14 @@ fn fallback<P: AffineProblem>(
             interrupt: params.interrupt,
             ..Default::default()
         };
-        crate::solve(problem, points, law, &apg, Some(start), progress)?
+        crate::solve_uzawa(problem, points, law, &apg, Some(start), progress)?
     };
     sol.info.newton_iters = info.newton_iters;
     sol.info.proximal_iters = info.proximal_iters;
     sol.info.line_search_cuts = info.line_search_cuts;
     sol.info.augmentation = info.augmentation;
     sol.info.fallback = true;
+    sol.info.sweeps += info.sweeps;
     sol.info.stages.clone_from(&info.stages);
     sol.info.stages.push(Phase::Fallback);
     Ok(sol)

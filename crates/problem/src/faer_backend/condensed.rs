@@ -103,7 +103,7 @@ impl ContactSolve<'_> {
                     interrupt: self.interrupt,
                     ..Default::default()
                 };
-                contact::solve(op, points, &self.law, &params, start, &mut progress)
+                contact::solve_uzawa(op, points, &self.law, &params, start, &mut progress)
             }
             (ContactSolver::Newton, Operator::FullSolves(_)) => Err(ContactError::Input(
                 contact::InputError::Unsupported("semismooth Newton needs the condensed compliance"),

@@ -219,7 +219,7 @@ choice! {
 pub enum ContactSolver {
     /// Semismooth Newton (`contact::solve_newton`).
     Newton,
-    /// Uzawa's first-order iteration (`contact::solve`), accelerated or not.
+    /// Uzawa's first-order iteration (`contact::solve_uzawa`), accelerated or not.
     FirstOrder {
         /// Nesterov's acceleration (the APG strategy).
         accelerate: bool,
