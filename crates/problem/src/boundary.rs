@@ -18,13 +18,7 @@ use rayon::prelude::*;
 
 /// The foundation a contact zone presses on: its `contact.compliance`, or rigid.
 fn foundation_of(spec: &ContactSpec) -> contact::Foundation {
-    match spec.compliance {
-        Some(k) => contact::Foundation::Compliant {
-            stiffness: k.stiffness,
-            exponent: k.exponent,
-        },
-        None => contact::Foundation::Rigid,
-    }
+    spec.model().map_or(contact::Foundation::Rigid, |m| m.normal)
 }
 
 /// The contact points of a boundary group and the u dofs of their nodes.

@@ -92,6 +92,7 @@ pub use scene::{
     MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SlipBoundProfile,
     SolverSpec, Strategy, Valid,
 };
+pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
 
 use contact::ContactError;
 

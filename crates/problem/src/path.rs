@@ -590,7 +590,13 @@ impl Walk<'_> {
         reporter: &mut dyn Reporter,
     ) -> Result<(ContactSolution, Springs), ProblemError> {
         let (backend, path, how, state) = (&mut *on.backend, &mut *on.path, on.how, &mut *on.state);
-        let force = self.contact.indenter.as_ref().and_then(|i| i.force);
+        let force = match self.contact.model().map(|m| m.obstacle) {
+            Some(crate::scene::Obstacle::Indenter {
+                control: crate::scene::Control::Force(force),
+                ..
+            }) => Some(force),
+            _ => None,
+        };
         let base_gap = boundary.points.gap.clone();
         let n = boundary.points.len();
         let mut springs = Springs {

@@ -73,24 +73,7 @@ pub struct Plan {
     pub slip_bounds: Vec<ZoneBound>,
 }
 
-/// Tresca's bound of one contact zone: uniform, or along the zone.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ZoneBound {
-    /// `contact.slip_bound`.
-    Uniform(f64),
-    /// `contact.slip_bound_profile`.
-    Profile(crate::scene::SlipBoundProfile),
-}
-
-impl ZoneBound {
-    /// The bound at the point `x`.
-    pub fn at(&self, x: [f64; 3]) -> f64 {
-        match self {
-            ZoneBound::Uniform(s) => *s,
-            ZoneBound::Profile(p) => p.at_point(x),
-        }
-    }
-}
+pub use crate::scene::ZoneBound;
 
 impl Plan {
     /// Decides what the run of `scene` needs, on a mesh of dimension `dim` with `materials`.
@@ -157,12 +140,13 @@ impl Plan {
                 Rule::Paper => 1e-2,
                 Rule::Tight => 1e-12,
             }),
+            // each zone's Tresca bound; 0 where its law is not Tresca's (frictionless there)
             slip_bounds: scene
                 .contacts()
                 .iter()
-                .map(|c| match &c.slip_bound_profile {
-                    Some(p) => ZoneBound::Profile(p.clone()),
-                    None => ZoneBound::Uniform(c.slip_bound()),
+                .map(|c| match c.model().map(|m| m.friction) {
+                    Some(crate::scene::Friction::Tresca(bound)) => bound,
+                    _ => ZoneBound::Uniform(0.0),
                 })
                 .collect(),
         }

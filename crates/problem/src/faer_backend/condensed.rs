@@ -9,7 +9,7 @@ use crate::backend::{ContactSolve, Posed, Solved};
 use crate::boundary::{ContactBoundary, FullSolve};
 use crate::outer::{floating_tip, force_controlled};
 use crate::progress::{Event, Reporter};
-use crate::scene::{ContactSolver, Rule};
+use crate::scene::{ContactSolver, Control, Obstacle, Rule, ZoneElectric};
 use crate::ProblemError;
 use contact::{
     ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, NewtonParams, PointValues,
@@ -115,11 +115,13 @@ impl ContactSolve<'_> {
 
 /// The force of a force-controlled indenter in `posed`'s scene.
 fn indenter_force(posed: &Posed<'_>) -> Option<f64> {
-    posed
-        .scene
-        .first_contact()
-        .and_then(|c| c.indenter.as_ref())
-        .and_then(|i| i.force)
+    match posed.scene.first_contact()?.model()?.obstacle {
+        Obstacle::Indenter {
+            control: Control::Force(force),
+            ..
+        } => Some(force),
+        _ => None,
+    }
 }
 
 /// The contact solve: on the condensed compliance (Newton, or a first-order method), or with
@@ -254,7 +256,10 @@ fn electric_contact(
             .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))
     };
     let mut problem = problem;
-    let floating = posed.scene.first_contact().and_then(|c| c.charge);
+    let floating = match posed.scene.first_contact().and_then(|c| c.model()).map(|m| m.electric) {
+        Some(ZoneElectric::Floating { charge, .. }) => Some(charge),
+        _ => None,
+    };
     let mut solve = |points: &ContactPoints, _: Option<PointValues>| match floating {
         Some(charge) => floating_tip(&mut problem, points, charge, &mut newton),
         None => newton(&problem, points),

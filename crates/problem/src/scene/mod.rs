@@ -5,11 +5,13 @@
 //! anything is computed (`validate.rs`), and refuses keys that do not exist or do not apply.
 
 mod validate;
+mod zone;
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
 pub use validate::{SceneError, Valid};
+pub use zone::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
 
 /// An enum of named choices: serde reads and writes the names, `name()` gives them, `ALL` lists
 /// the variants, and `FromStr` parses a name (with a message that names the key and lists the
