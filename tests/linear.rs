@@ -56,7 +56,7 @@ fn supernodal_ldlt_has_the_inertia_of_k() {
         constraints: bcs,
         ..
     } = problem::backend::setup(scene.validate().expect("a valid scene"), None).expect("setup");
-    let disc = Discretization::new(&mesh, &mats, &bcs).unwrap();
+    let disc = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &mats, &bcs).unwrap();
     let b = disc.assemble(Parallelism::Rayon);
     let f = DirectLdlt::new(&b.a, &b.g, &b.b, &Ordering::Amd, faer::Par::Seq).unwrap();
     assert_eq!(f.factor().inertia(), (disc.dofs.n_u, disc.dofs.n_phi, 0));

@@ -30,7 +30,8 @@ fn main() {
         constraints,
         ..
     } = common::setup_without_contact(&name, n);
-    let disc = Discretization::new(&mesh, &materials, &constraints).expect("discretisation");
+    let disc = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &materials, &constraints)
+        .expect("discretisation");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());
     let last = last_group.map(|group| group_displacements(&mesh, &disc.dofs, group));

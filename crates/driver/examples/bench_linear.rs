@@ -36,7 +36,7 @@ fn main() {
     let mut dofs = (0, 0);
     for _ in 0..REPEATS {
         let t = Instant::now();
-        let disc = Discretization::new(&mesh, &mats, &bcs).expect("setup");
+        let disc = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &mats, &bcs).expect("setup");
         let blocks = disc.assemble(Parallelism::Rayon);
         let (bu, bp) = disc.rhs(&loads).expect("rhs");
         t_asm.push(t.elapsed().as_secs_f64());

@@ -24,7 +24,7 @@ fn main() {
         constraints: bcs,
         ..
     } = common::setup_without_contact(&name, n);
-    let disc = Discretization::new(&mesh, &mats, &bcs).expect("setup");
+    let disc = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &mats, &bcs).expect("setup");
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());
     let t = Instant::now();

@@ -13,7 +13,7 @@
 
 use crate::kernels::{coupling_column, dielectric_column, elasticity_column, SimplexGeometry};
 use crate::InputError;
-use crate::{AssemblyError, Constraint, Dof, DofMap, Material, Unheld};
+use crate::{AssemblyError, Constraint, Coordinates, Dof, DofMap, Material, Unheld};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use mesh::{CellKind, Mesh};
 use rayon::prelude::*;
@@ -42,9 +42,9 @@ pub struct Discretization<'m> {
     pub geometry: Vec<SimplexGeometry>,
     /// Whether each cell's material is electric.
     pub cell_electric: Vec<bool>,
-    /// A body of revolution about the y axis, meshed in its meridian plane (its materials'
-    /// [`Material::axisymmetric`]): every integral carries `2π r`.
-    pub axisymmetric: bool,
+    /// The body itself, or a body of revolution about the y axis meshed in its meridian plane
+    /// (every integral carries `2π r`).
+    pub coordinates: Coordinates,
 }
 
 /// The assembled blocks of the coupled system (free dofs only).
@@ -60,16 +60,22 @@ pub struct Blocks {
 impl<'m> Discretization<'m> {
     /// Sets up the discretisation: `materials` pairs a region name with its material; every
     /// cell must lie in exactly one of these regions. Only P1 simplices are supported.
-    /// Axisymmetric materials ([`Material::from_crystal_axisymmetric`]) make the 2D mesh the
-    /// meridian section of a body of revolution about the y axis (every node at `x >= 0`);
-    /// the caller holds the radial displacement of the nodes on the axis (`u_r = 0` there).
+    /// [`Coordinates::Axisymmetric`] makes the 2D mesh the meridian section of a body of
+    /// revolution about the y axis (every node at `x >= 0`), each material made for it
+    /// ([`Material::from_crystal_axisymmetric`]); the caller holds the radial displacement of
+    /// the nodes on the axis (`u_r = 0` there).
     pub fn new(
         mesh: &'m Mesh,
+        coordinates: Coordinates,
         materials: &[(String, Material)],
         constraints: &[Constraint],
     ) -> Result<Self, AssemblyError> {
         if !matches!(mesh.kind, CellKind::Tri3 | CellKind::Tet4) {
             return Err(InputError::CellKind { kind: mesh.kind.name() }.into());
+        }
+        let axisymmetric = coordinates == Coordinates::Axisymmetric;
+        if axisymmetric && mesh.dim != 2 {
+            return Err(InputError::AxisymmetricDimension { dim: mesh.dim }.into());
         }
         let n_cells = mesh.n_cells();
         let mut cell_material = vec![usize::MAX; n_cells];
@@ -101,11 +107,11 @@ impl<'m> Discretization<'m> {
             }
             .into());
         }
-        let axisymmetric = materials.first().is_some_and(|(_, m)| m.axisymmetric);
-        if let Some((region, m)) = materials.iter().find(|(_, m)| m.axisymmetric != axisymmetric) {
-            return Err(InputError::MixedKinematics {
+        if let Some((region, m)) = materials.iter().find(|(_, m)| m.coordinates() != coordinates) {
+            return Err(InputError::MaterialCoordinates {
                 region: region.clone(),
-                axisymmetric: m.axisymmetric,
+                material: m.coordinates(),
+                body: coordinates,
             }
             .into());
         }
@@ -156,21 +162,21 @@ impl<'m> Discretization<'m> {
             dofs,
             geometry,
             cell_electric,
-            axisymmetric,
+            coordinates,
         })
     }
 
     /// Checks that the Dirichlet conditions hold every rigid motion and every potential of
     /// each connected part of the mesh ([`crate::held::check`]): `K` is invertible only then.
     pub fn check_held(&self) -> Result<(), Unheld> {
-        crate::held::check(self.mesh, &self.dofs, &self.cell_electric, self.axisymmetric)
+        crate::held::check(self.mesh, &self.dofs, &self.cell_electric, self.coordinates)
     }
 
     /// [`Discretization::check_held`], counting `supports` (a compliant bed's points along
     /// its normal) where the Dirichlet conditions alone leave a motion free
     /// ([`crate::held::check_with`]).
     pub fn check_held_with(&self, supports: &[crate::Support]) -> Result<crate::Held, Unheld> {
-        crate::held::check_with(self.mesh, &self.dofs, &self.cell_electric, self.axisymmetric, supports)
+        crate::held::check_with(self.mesh, &self.dofs, &self.cell_electric, self.coordinates, supports)
     }
 
     /// The material of cell `c`.

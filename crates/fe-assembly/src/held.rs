@@ -21,7 +21,7 @@
 //! needs the bed ([`Held::WithSupports`]: the solver then holds it with springs it takes out
 //! again) and, where the bed too leaves a motion free, which.
 
-use crate::{Dof, DofMap};
+use crate::{Coordinates, Dof, DofMap};
 use mesh::Mesh;
 use nalgebra::{DMatrix, SymmetricEigen};
 
@@ -164,10 +164,10 @@ const FREE: f64 = 1e-12;
 /// [`Unheld::Motion`] with the free motions of the first part that has any, or
 /// [`Unheld::Potential`].
 ///
-/// A body of revolution (`axisymmetric`) has one rigid motion, the translation along its axis
+/// A body of revolution ([`Coordinates::Axisymmetric`]) has one rigid motion, the translation along its axis
 /// (a radial one strains the hoops).
-pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool], axisymmetric: bool) -> Result<(), Unheld> {
-    check_with(mesh, dofs, cell_electric, axisymmetric, &[]).map(|_| ())
+pub fn check(mesh: &Mesh, dofs: &DofMap, cell_electric: &[bool], coordinates: Coordinates) -> Result<(), Unheld> {
+    check_with(mesh, dofs, cell_electric, coordinates, &[]).map(|_| ())
 }
 
 /// A support along one direction at a node: a compliant bed's hold on its point, along the
@@ -200,14 +200,14 @@ pub fn check_with(
     mesh: &Mesh,
     dofs: &DofMap,
     cell_electric: &[bool],
-    axisymmetric: bool,
+    coordinates: Coordinates,
     supports: &[Support],
 ) -> Result<Held, Unheld> {
     let solids = Solids::new(mesh);
     let mut held = Held::ByConditions;
     for i in 0..solids.first.len() {
         let free = |with: &[Support]| {
-            if axisymmetric {
+            if coordinates == Coordinates::Axisymmetric {
                 solids.free_axial_motion(dofs, i, with)
             } else {
                 solids.free_motions(mesh, dofs, i, with)
@@ -439,11 +439,23 @@ mod tests {
         let left = |x: &[f64]| x[0] < 1e-12;
         let sides = |x: &[f64]| x[0] < 1e-12 || x[0] > 2.0 - 1e-12;
         // clamped on one side: held
-        assert_eq!(free(check(&m, &dofs(&m, |x, _| left(x), left), &all, false)), 0);
+        assert_eq!(
+            free(check(&m, &dofs(&m, |x, _| left(x), left), &all, Coordinates::Cartesian)),
+            0
+        );
         // nothing held: two translations and the rotation
-        assert_eq!(free(check(&m, &dofs(&m, |_, _| false, left), &all, false)), 3);
+        assert_eq!(
+            free(check(&m, &dofs(&m, |_, _| false, left), &all, Coordinates::Cartesian)),
+            3
+        );
         // both sides on rollers (ux = 0): the vertical translation
-        let e = check(&m, &dofs(&m, |x, k| k == 0 && sides(x), left), &all, false).unwrap_err();
+        let e = check(
+            &m,
+            &dofs(&m, |x, k| k == 0 && sides(x), left),
+            &all,
+            Coordinates::Cartesian,
+        )
+        .unwrap_err();
         assert!(
             e.to_string()
                 .contains("1 rigid motion of the body free (a translation along [0.000, 1.000])"),
@@ -451,7 +463,7 @@ mod tests {
         );
         // one node pinned: the rotation about it
         let pin = |x: &[f64]| x[0] < 1e-12 && x[1] < 1e-12;
-        let e = check(&m, &dofs(&m, |x, _| pin(x), left), &all, false).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| pin(x), left), &all, Coordinates::Cartesian).unwrap_err();
         assert!(
             e.to_string()
                 .contains("a rotation about the point (0.0000e0, 0.0000e0)"),
@@ -463,7 +475,7 @@ mod tests {
                 &m,
                 &dofs(&m, |x, k| pin(x) || (k == 1 && x[0] > 2.0 - 1e-12), left),
                 &all,
-                false
+                Coordinates::Cartesian
             )),
             0
         );
@@ -484,13 +496,19 @@ mod tests {
             .collect();
         // on rollers: the bed holds the vertical translation
         let rollers = dofs(&m, |x, k| k == 0 && sides(x), left);
-        assert_eq!(check_with(&m, &rollers, &all, false, &bed), Ok(Held::WithSupports));
-        assert_eq!(free(check(&m, &rollers, &all, false)), 1);
+        assert_eq!(
+            check_with(&m, &rollers, &all, Coordinates::Cartesian, &bed),
+            Ok(Held::WithSupports)
+        );
+        assert_eq!(free(check(&m, &rollers, &all, Coordinates::Cartesian)), 1);
         // clamped: the conditions alone
         let clamped = dofs(&m, |x, _| left(x), left);
-        assert_eq!(check_with(&m, &clamped, &all, false, &bed), Ok(Held::ByConditions));
+        assert_eq!(
+            check_with(&m, &clamped, &all, Coordinates::Cartesian, &bed),
+            Ok(Held::ByConditions)
+        );
         // free: the bed holds the vertical translation and the rotation, not the slide
-        let e = check_with(&m, &dofs(&m, |_, _| false, left), &all, false, &bed).unwrap_err();
+        let e = check_with(&m, &dofs(&m, |_, _| false, left), &all, Coordinates::Cartesian, &bed).unwrap_err();
         assert!(
             matches!(
                 e,
@@ -509,7 +527,7 @@ mod tests {
             &m,
             &dofs(&m, |x, k| k == 0 && sides(x) && x[1] > 0.99, left),
             &all,
-            false,
+            Coordinates::Cartesian,
             &bed[..1],
         )
         .unwrap_err();
@@ -523,8 +541,11 @@ mod tests {
         let axis = dofs(&r, |x, k| k == 0 && x[0] < 1e-12, |x: &[f64]| x[1] > 0.99);
         let under: Vec<Support> = bed.iter().filter(|s| r.point(s.node)[0] <= 1.0).copied().collect();
         let all_r = vec![true; r.n_cells()];
-        assert_eq!(free(check(&r, &axis, &all_r, true)), 1);
-        assert_eq!(check_with(&r, &axis, &all_r, true, &under), Ok(Held::WithSupports));
+        assert_eq!(free(check(&r, &axis, &all_r, Coordinates::Axisymmetric)), 1);
+        assert_eq!(
+            check_with(&r, &axis, &all_r, Coordinates::Axisymmetric, &under),
+            Ok(Held::WithSupports)
+        );
     }
 
     #[test]
@@ -532,7 +553,7 @@ mod tests {
         let m = mesh::box_tet([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], 3, 3, 3);
         let all = vec![true; m.n_cells()];
         let edge = |x: &[f64]| x[0] < 1e-12 && x[1] < 1e-12;
-        let e = check(&m, &dofs(&m, |x, _| edge(x), edge), &all, false).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| edge(x), edge), &all, Coordinates::Cartesian).unwrap_err();
         let s = e.to_string();
         assert!(
             s.contains("1 rigid motion") && s.contains("axis along [0.000, 0.000, 1.000]")
@@ -542,9 +563,22 @@ mod tests {
         assert!(s.contains("through (0.0000e0, 0.0000e0,"), "{s}");
         // a face clamped: held; a face on rollers (uz = 0 on z = 0): three motions free
         let bottom = |x: &[f64]| x[2] < 1e-12;
-        assert_eq!(free(check(&m, &dofs(&m, |x, _| bottom(x), edge), &all, false)), 0);
         assert_eq!(
-            free(check(&m, &dofs(&m, |x, k| k == 2 && bottom(x), edge), &all, false)),
+            free(check(
+                &m,
+                &dofs(&m, |x, _| bottom(x), edge),
+                &all,
+                Coordinates::Cartesian
+            )),
+            0
+        );
+        assert_eq!(
+            free(check(
+                &m,
+                &dofs(&m, |x, k| k == 2 && bottom(x), edge),
+                &all,
+                Coordinates::Cartesian
+            )),
             3
         );
     }
@@ -555,7 +589,7 @@ mod tests {
         let all = vec![true; m.n_cells()];
         let left = |x: &[f64]| x[0] < 1e-12;
         let both = |x: &[f64]| x[0] < 1e-12 || (x[0] - 3.0).abs() < 1e-12;
-        let e = check(&m, &dofs(&m, |x, _| left(x), both), &all, false).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| left(x), both), &all, Coordinates::Cartesian).unwrap_err();
         assert!(
             matches!(
                 e,
@@ -568,13 +602,19 @@ mod tests {
             ),
             "{e}"
         );
-        assert_eq!(free(check(&m, &dofs(&m, |x, _| both(x), both), &all, false)), 0);
+        assert_eq!(
+            free(check(&m, &dofs(&m, |x, _| both(x), both), &all, Coordinates::Cartesian)),
+            0
+        );
         // the second body's potential floats
-        let e = check(&m, &dofs(&m, |x, _| both(x), left), &all, false).unwrap_err();
+        let e = check(&m, &dofs(&m, |x, _| both(x), left), &all, Coordinates::Cartesian).unwrap_err();
         assert_eq!(e, Unheld::Potential { cell: 32, cells: 32 });
         // unless it is elastic only
         let first: Vec<bool> = (0..m.n_cells()).map(|c| c < 32).collect();
-        assert_eq!(check(&m, &dofs(&m, |x, _| both(x), left), &first, false), Ok(()));
+        assert_eq!(
+            check(&m, &dofs(&m, |x, _| both(x), left), &first, Coordinates::Cartesian),
+            Ok(())
+        );
     }
 
     #[test]
@@ -596,11 +636,14 @@ mod tests {
         let all = vec![true; m.n_cells()];
         // the first square clamped on its left, the hinge pinned: the second turns about it
         let held = |x: &[f64], _| x[0] == 0.0 || (x[0] == 1.0 && x[1] == 1.0);
-        let e = check(&m, &dofs(&m, held, |x| x[0] == 0.0), &all, false).unwrap_err();
+        let e = check(&m, &dofs(&m, held, |x| x[0] == 0.0), &all, Coordinates::Cartesian).unwrap_err();
         assert!(e.to_string().contains("1 rigid motion of the body free (a rotation about the point (1.0000e0, 1.0000e0)) in its part with cell 8 (8 cells)"), "{e}");
         // the potential is continuous through the node: one electric part
         let both = |x: &[f64], _| x[0] == 0.0 || x[0] == 2.0;
-        assert_eq!(check(&m, &dofs(&m, both, |x| x[0] == 0.0), &all, false), Ok(()));
+        assert_eq!(
+            check(&m, &dofs(&m, both, |x| x[0] == 0.0), &all, Coordinates::Cartesian),
+            Ok(())
+        );
     }
 
     #[test]
@@ -612,7 +655,7 @@ mod tests {
             Constraint::constant("left", Field::Potential, 0.0),
         ];
         let d = DofMap::new(&m, &vec![true; m.n_nodes()], &c).unwrap();
-        assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()], false)), 1);
+        assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()], Coordinates::Cartesian)), 1);
     }
 
     proptest! {
@@ -653,7 +696,7 @@ mod tests {
                 }
             }
             d.phi[0] = Dof::Fixed(0.0);
-            prop_assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()], false)), expected);
+            prop_assert_eq!(free(check(&m, &d, &vec![true; m.n_cells()], Coordinates::Cartesian)), expected);
         }
     }
 }

@@ -261,7 +261,11 @@ pub fn cell_strain(dim: usize, g: &SimplexGeometry, u_local: &[[f64; 3]]) -> [f6
 /// Voigt strain of a P1 displacement at a point where `N_a / r = hoop[a]`.
 pub fn strain_at(dim: usize, g: &SimplexGeometry, hoop: &[f64; 4], u_local: &[[f64; 3]]) -> [f64; 6] {
     let mut eps = [0.0; 6];
-    let nv = crate::voigt_len(dim, g.radii.is_some());
+    let coordinates = match g.radii {
+        Some(_) => crate::Coordinates::Axisymmetric,
+        None => crate::Coordinates::Cartesian,
+    };
+    let nv = crate::voigt_len(dim, coordinates);
     for (a, ua) in u_local.iter().enumerate() {
         let b = strain_columns_at(dim, &g.grads[a], hoop[a]);
         for k in 0..dim {

@@ -18,7 +18,7 @@
 //!
 //! # Example
 //! ```
-//! use fe_assembly::{Constraint, Crystal, Discretization, Field, Load, Material, Parallelism};
+//! use fe_assembly::{Constraint, Coordinates, Crystal, Discretization, Field, Load, Material, Parallelism};
 //! use std::sync::Arc;
 //! let mesh = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 8, 4);
 //! let pzt = Material::from_crystal("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0], 2).unwrap();
@@ -28,7 +28,7 @@
 //!     bcs.push(Constraint::constant(side, Field::Displacement(1), 0.0));
 //!     bcs.push(Constraint::constant(side, Field::Potential, 0.0));
 //! }
-//! let disc = Discretization::new(&mesh, &[("body".into(), pzt)], &bcs).unwrap();
+//! let disc = Discretization::new(&mesh, Coordinates::Cartesian, &[("body".into(), pzt)], &bcs).unwrap();
 //! let blocks = disc.assemble(Parallelism::Rayon);
 //! let load = Load::Traction { group: "top".into(), value: Arc::new(|_| [0.0, -2.0, 0.0]) };
 //! let (b_u, b_phi) = disc.rhs(&[load]).unwrap();
@@ -55,7 +55,7 @@ pub use dofs::{Constraint, Dof, DofMap, Field};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
 pub use held::{Held, Support, Unheld};
 pub use loads::{facet_measure, Load, RhsParts};
-pub use material::{voigt, voigt_len, Crystal, Material, MaterialError};
+pub use material::{voigt, voigt_len, Coordinates, Crystal, Material, MaterialError};
 pub use recovery::{CellFields, ChargeFunctional};
 
 use std::sync::Arc;
@@ -167,14 +167,22 @@ pub enum InputError {
         /// The condition's group.
         group: String,
     },
-    /// Materials of a body of revolution beside plane ones, or a body of revolution that is not
-    /// a 2D mesh.
-    #[error("region `{region}`'s material is {} and another's is not: a body is axisymmetric as a whole", if *.axisymmetric { "axisymmetric" } else { "plane" })]
-    MixedKinematics {
+    /// A material whose Voigt layout is not the body's coordinates' (a body of revolution's
+    /// material on a plane body, or the other way).
+    #[error("region `{region}`'s material is made for {} coordinates and the body's are {} (a body is of revolution as a whole, each material made for it)", .material.name(), .body.name())]
+    MaterialCoordinates {
         /// The region.
         region: String,
-        /// Whether its material is axisymmetric.
-        axisymmetric: bool,
+        /// Its material's coordinates.
+        material: Coordinates,
+        /// The body's.
+        body: Coordinates,
+    },
+    /// A body of revolution whose mesh is not its 2D meridian section.
+    #[error("a body of revolution is meshed in its 2D meridian plane, and the mesh is {dim}D")]
+    AxisymmetricDimension {
+        /// The mesh's dimension.
+        dim: usize,
     },
     /// A node of a body of revolution's meridian section on the negative side of the axis.
     #[error("node {node} at {at:?} has r = x < 0: a body of revolution is meshed in its meridian plane r >= 0 (the axis is x = 0)")]

@@ -254,7 +254,7 @@ impl Discretization<'_> {
     /// The measure's factor at `x`: `2π r` on a body of revolution (its integrals are over the
     /// whole body), 1 otherwise.
     fn ring(&self, x: &[f64; 3]) -> f64 {
-        if self.axisymmetric {
+        if self.coordinates == crate::Coordinates::Axisymmetric {
             std::f64::consts::TAU * x[0]
         } else {
             1.0

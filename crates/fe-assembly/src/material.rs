@@ -94,9 +94,6 @@ pub struct Material {
     pub beta: Vec<f64>,
     /// Whether the material carries electric unknowns (a non-zero permittivity).
     pub electric: bool,
-    /// A body of revolution about the y axis, meshed in its meridian plane `(r, z) = (x, y)`:
-    /// the Voigt order is `[rr, zz, rz, θθ]` (`nv = 4`), the hoop strain `u_r / r` last.
-    pub axisymmetric: bool,
 }
 
 /// A material that cannot be used.
@@ -144,6 +141,21 @@ pub enum MaterialError {
         /// The poling direction given.
         poling: [f64; 3],
     },
+    /// A constant whose number of entries fits no Voigt layout of the material's dimension.
+    #[error(
+        "material `{material}`: {what} has {len} entries, which fit no layout of a {dim}D material \
+         (C is 3 x 3 in plane strain, 4 x 4 on a body of revolution, 6 x 6 in 3D; e is dim x that)"
+    )]
+    Layout {
+        /// The material's name.
+        material: String,
+        /// Which constant.
+        what: &'static str,
+        /// Its number of entries.
+        len: usize,
+        /// The material's dimension.
+        dim: usize,
+    },
     /// The poling direction is zero or not finite.
     #[error("material `{material}`: the poling direction {dir:?} is not a non-zero vector")]
     BadPoling {
@@ -154,12 +166,37 @@ pub enum MaterialError {
     },
 }
 
+/// What the mesh is of: the body itself, or the meridian section of a body of revolution. An
+/// argument of the discretisation ([`crate::Discretization::new`]): the geometry decides the
+/// strains (the hoop strain of a body of revolution) and the measure of every integral (`2π r`
+/// there), and each material's Voigt layout must be the geometry's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Coordinates {
+    /// The mesh is the body: plane strain in 2D, the solid in 3D.
+    #[default]
+    Cartesian,
+    /// A body of revolution about the y axis, meshed in its meridian plane `(r, z) = (x, y)`
+    /// (2D, every node at `r >= 0`): the Voigt order is `[rr, zz, rz, θθ]`, the hoop strain
+    /// `u_r / r` last; a material for it is made by [`Material::from_crystal_axisymmetric`].
+    Axisymmetric,
+}
+
+impl Coordinates {
+    /// Their name in messages: `Cartesian` or `axisymmetric`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Coordinates::Cartesian => "Cartesian",
+            Coordinates::Axisymmetric => "axisymmetric",
+        }
+    }
+}
+
 /// Number of Voigt strain components in dimension `dim`: 3 in plane strain, 4 on a body of
 /// revolution (`[rr, zz, rz, θθ]`), 6 in 3D.
-pub fn voigt_len(dim: usize, axisymmetric: bool) -> usize {
-    match (dim, axisymmetric) {
-        (2, false) => 3,
-        (2, true) => 4,
+pub fn voigt_len(dim: usize, coordinates: Coordinates) -> usize {
+    match (dim, coordinates) {
+        (2, Coordinates::Cartesian) => 3,
+        (2, Coordinates::Axisymmetric) => 4,
         _ => 6,
     }
 }
@@ -226,7 +263,7 @@ impl Material {
             2 => (vec![0, 1, 5], vec![0, 1]),
             _ => ((0..6).collect(), (0..3).collect()),
         };
-        reduced(name, &(c3, e3, b3), &rows, &fields, dim, false)
+        reduced(name, &(c3, e3, b3), &rows, &fields, dim)
     }
 
     /// The crystal rotated so that its 3-axis points along `poling`, for a body of revolution
@@ -276,12 +313,23 @@ impl Material {
                 poling,
             });
         }
-        reduced(name, &(c3, e3, b3), &[0, 1, 5, 2], &[0, 1], 2, true)
+        reduced(name, &(c3, e3, b3), &[0, 1, 5, 2], &[0, 1], 2)
     }
 
-    /// Number of Voigt strain components (3 in plane strain, 4 axisymmetric, 6 in 3D).
+    /// Number of Voigt strain components (3 in plane strain, 4 axisymmetric, 6 in 3D): the
+    /// order of `c`.
     pub fn nv(&self) -> usize {
-        voigt_len(self.dim, self.axisymmetric)
+        self.c.len().isqrt()
+    }
+
+    /// The coordinates whose Voigt layout this material has: [`Coordinates::Axisymmetric`]
+    /// for the 4 strains of a body of revolution, else Cartesian.
+    pub fn coordinates(&self) -> Coordinates {
+        if self.dim == 2 && self.nv() == 4 {
+            Coordinates::Axisymmetric
+        } else {
+            Coordinates::Cartesian
+        }
     }
 
     /// A copy with `e` multiplied by `factor` (the `material.coupling_scale` of the scenes).
@@ -304,6 +352,21 @@ impl Material {
     /// Checks symmetry and positive definiteness of C and (for an electric material) beta.
     pub fn validate(&self, name: &str) -> Result<(), MaterialError> {
         let nv = self.nv();
+        let layouts: &[usize] = if self.dim == 2 { &[3, 4] } else { &[6] };
+        for (what, len, expected) in [
+            ("C", self.c.len(), nv * nv),
+            ("e", self.e.len(), self.dim * nv),
+            ("the permittivity", self.beta.len(), self.dim * self.dim),
+        ] {
+            if !layouts.contains(&nv) || len != expected || !matches!(self.dim, 2 | 3) {
+                return Err(MaterialError::Layout {
+                    material: name.into(),
+                    what,
+                    len,
+                    dim: self.dim,
+                });
+            }
+        }
         check_spd(name, "C", &self.c, nv)?;
         if self.electric {
             check_spd(name, "the permittivity", &self.beta, self.dim)?;
@@ -414,7 +477,6 @@ fn reduced(
     rows: &[usize],
     fields: &[usize],
     dim: usize,
-    axisymmetric: bool,
 ) -> Result<Material, MaterialError> {
     let c: Vec<f64> = rows.iter().flat_map(|&i| rows.iter().map(move |&j| c3[i][j])).collect();
     let e: Vec<f64> = fields
@@ -432,7 +494,6 @@ fn reduced(
         e,
         beta,
         electric,
-        axisymmetric,
     };
     m.validate(name)?;
     Ok(m)

@@ -63,7 +63,7 @@ impl Discretization<'_> {
     /// Voigt strain components: 3 in plane strain, 4 on a body of revolution (`[rr, zz, rz,
     /// θθ]`), 6 in 3D.
     pub fn nv(&self) -> usize {
-        crate::voigt_len(self.mesh.dim, self.axisymmetric)
+        crate::voigt_len(self.mesh.dim, self.coordinates)
     }
 
     /// The charge on each of `groups` (boundary groups where the potential is prescribed or

@@ -10,7 +10,7 @@
 //! - a cylinder pressed between sliding plates (uniaxial stress): its lateral expansion
 //!   `ν δ r / H` and its force `E (δ / H) π R²` through the cells' volumes of revolution.
 
-use fe_assembly::{Constraint, Crystal, Discretization, Field, Load, Material, Parallelism};
+use fe_assembly::{Constraint, Coordinates, Crystal, Discretization, Field, Load, Material, Parallelism};
 use linalg::{CoupledSolver, DirectLdlt, Ordering};
 use std::sync::Arc;
 
@@ -50,8 +50,8 @@ fn lame_cylinder_converges_at_second_order() {
             Constraint::constant("top", Field::Displacement(1), 0.0),
             Constraint::constant("bottom", Field::Displacement(1), 0.0),
         ];
-        let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
-        assert!(disc.axisymmetric);
+        let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat)], &bcs).unwrap();
+        assert_eq!(disc.coordinates, Coordinates::Axisymmetric);
         disc.check_held().unwrap();
         // the inner face pushed outwards: σ n = -p n with n = -e_r
         let load = Load::Traction {
@@ -87,7 +87,7 @@ fn a_disc_between_electrodes_is_reproduced_and_its_charge_is_the_whole_discs() {
         Constraint::constant("bottom", Field::Potential, 0.0),
         Constraint::constant("top", Field::Potential, volts),
     ];
-    let disc = Discretization::new(&mesh, &[("body".into(), mat.clone())], &bcs).unwrap();
+    let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat.clone())], &bcs).unwrap();
     let (u, phi) = solve(&disc, &[]);
     // the stress-free strain of the field: C ε = -eᵀ ∇φ on [rr, zz, rz, θθ]
     let grad = [0.0, volts / height];
@@ -140,7 +140,7 @@ fn a_pressed_cylinder_carries_e_eps_pi_r_squared() {
         Constraint::constant("bottom", Field::Displacement(1), 0.0),
         Constraint::constant("top", Field::Displacement(1), -delta),
     ];
-    let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
+    let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat)], &bcs).unwrap();
     let (u, _) = solve(&disc, &[]);
     for (x, u) in mesh.points.iter().zip(&u) {
         assert!(
@@ -174,7 +174,7 @@ fn a_pressed_cylinder_carries_e_eps_pi_r_squared() {
 fn bodies_of_revolution_are_refused_where_they_cannot_be() {
     let mesh = mesh::rectangle_tri([-1.0, 0.0], [1.0, 1.0], 4, 2);
     let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
-    let e = Discretization::new(&mesh, &[("body".into(), mat.clone())], &[])
+    let e = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat.clone())], &[])
         .err()
         .unwrap();
     assert!(e.to_string().contains("r = x < 0"), "{e}");
@@ -183,17 +183,57 @@ fn bodies_of_revolution_are_refused_where_they_cannot_be() {
     let n = mesh.n_cells();
     mesh.regions.insert("upper".into(), (0..n / 2).collect());
     mesh.regions.insert("lower".into(), (n / 2..n).collect());
-    let e = Discretization::new(&mesh, &[("upper".into(), mat), ("lower".into(), plane)], &[])
+    let e = Discretization::new(
+        &mesh,
+        Coordinates::Axisymmetric,
+        &[("upper".into(), mat.clone()), ("lower".into(), plane.clone())],
+        &[],
+    )
+    .err()
+    .unwrap();
+    assert!(
+        e.to_string()
+            .contains("region `lower`'s material is made for Cartesian coordinates and the body's are axisymmetric"),
+        "{e}"
+    );
+    // the geometry is the discretisation's argument: a body of revolution's material on a plane body, or a 3D mesh
+    let e = Discretization::new(
+        &mesh,
+        Coordinates::Cartesian,
+        &[("upper".into(), plane.clone()), ("lower".into(), mat.clone())],
+        &[],
+    )
+    .err()
+    .unwrap();
+    assert!(
+        e.to_string()
+            .contains("region `lower`'s material is made for axisymmetric coordinates"),
+        "{e}"
+    );
+    let cube = mesh::box_tet([0.0; 3], [1.0; 3], 1, 1, 1);
+    let e = Discretization::new(&cube, Coordinates::Axisymmetric, &[("body".into(), mat.clone())], &[])
         .err()
         .unwrap();
-    assert!(e.to_string().contains("axisymmetric as a whole"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("meshed in its 2D meridian plane, and the mesh is 3D"),
+        "{e}"
+    );
+    // a material's layout is the order of its C: one that fits none is refused by name
+    let mut odd = plane.clone();
+    odd.c.truncate(5);
+    let e = odd.validate("odd").unwrap_err();
+    assert!(e.to_string().contains("material `odd`: C has 5 entries"), "{e}");
+    let mut odd = plane;
+    odd.e.pop();
+    assert!(odd.validate("odd").unwrap_err().to_string().contains("e has 5 entries"));
     let e = Material::from_crystal_axisymmetric("tilted", &Crystal::pzt5a(), [1.0, 1.0, 0.0]).unwrap_err();
     assert!(e.to_string().contains("symmetric about its axis"), "{e}");
     // a body of revolution held only radially is free along its axis
     let mat = Material::from_crystal_axisymmetric("al", &Crystal::isotropic(70.0, 0.3, 0.0), [0.0, 1.0, 0.0]).unwrap();
     let mesh = mesh::rectangle_tri([0.0, 0.0], [1.0, 1.0], 4, 4);
     let bcs = vec![Constraint::constant("right", Field::Displacement(0), 0.0)];
-    let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
+    let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat)], &bcs).unwrap();
     let e = disc.check_held().unwrap_err();
     assert!(e.to_string().contains("translation along the axis"), "{e}");
 }

@@ -9,6 +9,11 @@ mod common;
 use fe_assembly::{Constraint, Discretization, Field};
 
 fn check(dim: usize, axisymmetric: bool) {
+    let coordinates = if axisymmetric {
+        fe_assembly::Coordinates::Axisymmetric
+    } else {
+        fe_assembly::Coordinates::Cartesian
+    };
     let mut random = common::random_source(99);
     let mesh = common::jittered_block(dim, &mut random);
     let mat = common::pzt5a(dim, axisymmetric);
@@ -19,7 +24,7 @@ fn check(dim: usize, axisymmetric: bool) {
         Constraint::constant("top", Field::Potential, 0.0),
         Constraint::constant("bottom", Field::Potential, 0.0),
     ];
-    let disc = Discretization::new(&mesh, &materials, &constraints).unwrap();
+    let disc = Discretization::new(&mesh, coordinates, &materials, &constraints).unwrap();
     let u_free: Vec<f64> = (0..disc.dofs.n_u).map(|_| 1e-3 * random()).collect();
     let phi_free: Vec<f64> = (0..disc.dofs.n_phi).map(|_| 1e-2 * random()).collect();
     let (u, phi) = (disc.dofs.expand_u(&u_free), disc.dofs.expand_phi(&phi_free));

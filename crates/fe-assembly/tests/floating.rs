@@ -25,6 +25,11 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 fn check(dim: usize, axisymmetric: bool) {
+    let coordinates = if axisymmetric {
+        fe_assembly::Coordinates::Axisymmetric
+    } else {
+        fe_assembly::Coordinates::Cartesian
+    };
     let mut random = common::random_source(7);
     let mesh = common::jittered_block(dim, &mut random);
     let mat = common::pzt5a(dim, axisymmetric);
@@ -36,8 +41,8 @@ fn check(dim: usize, axisymmetric: bool) {
     ];
     let mut tied_conditions = held.clone();
     tied_conditions.push(Constraint::floating("top"));
-    let free = Discretization::new(&mesh, &materials, &held).unwrap();
-    let tied = Discretization::new(&mesh, &materials, &tied_conditions).unwrap();
+    let free = Discretization::new(&mesh, coordinates, &materials, &held).unwrap();
+    let tied = Discretization::new(&mesh, coordinates, &materials, &tied_conditions).unwrap();
     let (df, dt) = (&free.dofs, &tied.dofs);
     assert_eq!(dt.floating, vec![("top".to_string(), dt.n_phi - 1)]);
     let top = mesh.boundary("top").unwrap().nodes();
@@ -129,12 +134,15 @@ fn a_floating_terminal_touching_another_terminal_is_one_conductor() {
         ],
         vec![Constraint::floating("top"), Constraint::floating("right")],
     ] {
-        let e = Discretization::new(&mesh, &materials, &conditions).err().unwrap();
+        let e = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &materials, &conditions)
+            .err()
+            .unwrap();
         assert!(e.to_string().contains("one conductor"), "{e}");
     }
     // a charge on a group that does not float
     let disc = Discretization::new(
         &mesh,
+        fe_assembly::Coordinates::Cartesian,
         &materials,
         &[Constraint::constant("left", Field::Potential, 0.0)],
     )

@@ -34,7 +34,13 @@ fn errors(dim: usize, n: usize) -> (f64, f64) {
     } else {
         &["left", "right", "bottom", "top", "front", "back"]
     };
-    let disc = Discretization::new(&mesh, &[("body".into(), m.clone())], &exact.constraints(groups)).unwrap();
+    let disc = Discretization::new(
+        &mesh,
+        fe_assembly::Coordinates::Cartesian,
+        &[("body".into(), m.clone())],
+        &exact.constraints(groups),
+    )
+    .unwrap();
     let loads = exact.loads(&m);
     let ((u1, p1), (u2, p2), _) = solve_both(&disc, &loads);
     // the two strategies agree to round-off

@@ -100,7 +100,13 @@ fn run_patch(dim: usize) {
             value: Arc::new(move |_| dn),
         });
     }
-    let disc = Discretization::new(&mesh, &[("body".into(), mat)], &bcs).unwrap();
+    let disc = Discretization::new(
+        &mesh,
+        fe_assembly::Coordinates::Cartesian,
+        &[("body".into(), mat)],
+        &bcs,
+    )
+    .unwrap();
     let ((u1, p1), (u2, p2), _) = solve_both(&disc, &loads);
     let nodal_u: Vec<[f64; 3]> = (0..mesh.n_nodes()).map(|i| u_exact(mesh.point(i))).collect();
     let nodal_p: Vec<f64> = (0..mesh.n_nodes()).map(|i| phi_exact(mesh.point(i))).collect();
@@ -161,7 +167,13 @@ fn the_right_hand_side_is_the_sum_of_its_parts() {
         let exact = fe_assembly::Exact::manufactured(dim);
         let groups: &[&str] = &["left", "right", "bottom"];
         let mats = [("body".to_string(), m.clone())];
-        let mut disc = Discretization::new(&mesh, &mats, &exact.constraints(groups)).unwrap();
+        let mut disc = Discretization::new(
+            &mesh,
+            fe_assembly::Coordinates::Cartesian,
+            &mats,
+            &exact.constraints(groups),
+        )
+        .unwrap();
         let loads = exact.loads(&m);
         let (bu, bphi) = disc.rhs(&loads).unwrap();
         let parts = disc.rhs_parts(&loads).unwrap();

@@ -82,7 +82,7 @@ proptest! {
         prop_assume!(mesh.check().is_ok());
         let pol = [poling[0], poling[1], poling[2] + 2.0];
         let mat = Material::from_crystal("random", &crystal(&seed), pol, dim).unwrap();
-        let disc = Discretization::new(&mesh, &[("body".into(), mat)], &clamped(dim)).unwrap();
+        let disc = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &[("body".into(), mat)], &clamped(dim)).unwrap();
         let bl = disc.assemble(Parallelism::Rayon);
         let (nu, np) = (disc.dofs.n_u, disc.dofs.n_phi);
         let (u, phi) = (&x[..nu], &x[nu..nu + np]);
@@ -117,7 +117,7 @@ proptest! {
         let mesh = perturbed_mesh(dim, n, &jitter);
         prop_assume!(mesh.check().is_ok());
         let mat = Material::from_crystal("random", &crystal(&seed), [0.0, 0.3, 1.0], dim).unwrap();
-        let disc = Discretization::new(&mesh, &[("body".into(), mat)], &clamped(dim)).unwrap();
+        let disc = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &[("body".into(), mat)], &clamped(dim)).unwrap();
         let (s, p) = (disc.assemble(Parallelism::Serial), disc.assemble(Parallelism::Rayon));
         for (x, y) in [(&s.a, &p.a), (&s.g, &p.g), (&s.b, &p.b)] {
             prop_assert_eq!(x.symbolic().col_ptr(), y.symbolic().col_ptr());
@@ -147,7 +147,7 @@ proptest! {
         prop_assume!(mesh.check().is_ok());
         let mat = Material::from_crystal("random", &crystal(&seed), [1.0, 0.0, 1.0], dim).unwrap();
         // no conditions: A is the full stiffness matrix, singular on rigid motions
-        let disc = Discretization::new(&mesh, &[("body".into(), mat)], &[]).unwrap();
+        let disc = Discretization::new(&mesh, fe_assembly::Coordinates::Cartesian, &[("body".into(), mat)], &[]).unwrap();
         let bl = disc.assemble(Parallelism::Rayon);
         let mut motions: Vec<Vec<[f64; 3]>> = vec![];
         for k in 0..dim {

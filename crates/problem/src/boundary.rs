@@ -12,7 +12,7 @@ use crate::SetupError;
 use contact::{
     ContactOperator, ContactPoints, DenseContactProblem, ElectricContactProblem, OperatorError, PointValues,
 };
-use fe_assembly::{facet_measure, Discretization, Dof, DofMap};
+use fe_assembly::{facet_measure, Coordinates, Discretization, Dof, DofMap};
 use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
 use rayon::prelude::*;
 
@@ -167,14 +167,14 @@ fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(
 }
 
 /// Lumped boundary mass of each node on `group`: each facet's measure shared equally among its
-/// nodes; on a body of revolution (`axisymmetric`), the ring's, `∫ N_a 2π r ds = 2π L (2 r_a +
+/// nodes; on a body of revolution ([`Coordinates::Axisymmetric`]), the ring's, `∫ N_a 2π r ds = 2π L (2 r_a +
 /// r_b) / 6` for the segment of length L from node a to node b.
-fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup, axisymmetric: bool) -> Vec<f64> {
+fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup, coordinates: Coordinates) -> Vec<f64> {
     let mut weight = vec![0.0; mesh.n_nodes()];
     for f in group.iter() {
         let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
         let len = facet_measure(&x);
-        if axisymmetric {
+        if coordinates == Coordinates::Axisymmetric {
             let (ra, rb) = (x[0][0], x[1][0]);
             weight[f[0]] += std::f64::consts::TAU * len * (2.0 * ra + rb) / 6.0;
             weight[f[1]] += std::f64::consts::TAU * len * (ra + 2.0 * rb) / 6.0;
@@ -270,7 +270,7 @@ impl ContactBoundary {
         check_normal(mesh, spec, nv)?;
         let tangents = tangent_basis(dim, nv);
         let group = mesh.boundary(&spec.group)?;
-        let weight = lumped_weights(mesh, group, disc.axisymmetric);
+        let weight = lumped_weights(mesh, group, disc.coordinates);
         let friction = spec.friction();
         let (mut added, mut held_nodes, mut out_of_reach) = (0, 0, 0);
         for node in group.nodes() {

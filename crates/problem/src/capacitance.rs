@@ -17,7 +17,7 @@ use crate::scene::Scene;
 use crate::setup::setup;
 use crate::ProblemError;
 use crate::SetupError;
-use fe_assembly::{AssemblyError, Discretization, Dof, DofMap};
+use fe_assembly::{AssemblyError, Dof, DofMap};
 use serde::{Deserialize, Serialize};
 
 /// The capacitance matrix of a scene's terminals, in the scene's units (charge per unit
@@ -67,8 +67,7 @@ pub(crate) fn capacitance<B: Backend>(
         let why = "the scene has no terminal (no [electrode], no dirichlet.phi)";
         return Err(ProblemError::from(SetupError::new("dirichlet", why)).into());
     }
-    let mut disc =
-        Discretization::new(&setup.mesh, &setup.materials, &setup.constraints).map_err(ProblemError::from)?;
+    let mut disc = setup.discretize().map_err(ProblemError::from)?;
     disc.check_held()
         .map_err(|e| ProblemError::from(AssemblyError::from(e)))?;
     let (conductor, names) = conductors(&setup.mesh, &groups)?;

@@ -99,7 +99,7 @@ pub(crate) fn walk<B: PathBackend>(
     let setup = begin(valid, mesh, backend.estimate(&valid), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
-    let mut disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints)?;
+    let mut disc = setup.discretize()?;
     let parts = disc.rhs_parts(&setup.loads)?;
     let mut walk = Walk {
         scene,

@@ -48,7 +48,7 @@ pub fn run<B: Backend>(
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
     let t = Instant::now();
-    let disc = Discretization::new(&setup.mesh, &setup.materials, &setup.constraints).map_err(ProblemError::from)?;
+    let disc = setup.discretize().map_err(ProblemError::from)?;
     let mut posed = pose(scene, &setup, &disc)?;
     let boundary = contact_boundary(&posed, reporter)?;
     posed.bed = Bed::needed(&posed, boundary.as_ref())?;

@@ -7,15 +7,18 @@ use crate::plan::{electric_data, Plan};
 use crate::scene::{MaterialSpec, MeshKind, Scene, Valid};
 use crate::ProblemError;
 use crate::SetupError;
-use fe_assembly::{Constraint, Field, Load, Material};
+use fe_assembly::{Constraint, Coordinates, Discretization, Field, Load, Material};
 use std::sync::Arc;
 
 /// Everything a scene sets up before assembly.
 pub struct Setup {
     /// The mesh (with an `electrode` group where the scene has one).
     pub mesh: mesh::Mesh,
-    /// Materials by region (without their electric part when the plan has no electric
-    /// unknowns).
+    /// What the mesh is of: the body, or a body of revolution's meridian section
+    /// (`mesh.axisymmetric`).
+    pub coordinates: Coordinates,
+    /// Materials by region, each made for the coordinates (without their electric part when
+    /// the plan has no electric unknowns).
     pub materials: Vec<(String, Material)>,
     /// What the run computes.
     pub plan: Plan,
@@ -115,8 +118,13 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         );
         loads.extend(ex.exact.loads(&materials[0].1));
     }
+    let coordinates = match scene.mesh.axisymmetric {
+        true => Coordinates::Axisymmetric,
+        false => Coordinates::Cartesian,
+    };
     Ok(Setup {
         mesh,
+        coordinates,
         materials,
         plan,
         constraints,
@@ -124,6 +132,17 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         exact,
         notes,
     })
+}
+
+impl Setup {
+    /// The discretisation of the set-up: its mesh in its coordinates, with its materials and
+    /// Dirichlet conditions.
+    ///
+    /// # Errors
+    /// What [`Discretization::new`] refuses.
+    pub fn discretize(&self) -> Result<Discretization<'_>, fe_assembly::AssemblyError> {
+        Discretization::new(&self.mesh, self.coordinates, &self.materials, &self.constraints)
+    }
 }
 
 /// The mesh of the scene, checked, with its regions by box and an `electrode` group where the
