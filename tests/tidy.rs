@@ -120,12 +120,35 @@ fn the_core_crate_has_two_public_modules() {
 fn the_validation_names_no_backend() {
     let path = root().join("crates/problem/src/scene/validate.rs");
     let text = std::fs::read_to_string(&path).unwrap().to_lowercase();
-    for name in ["petsc", "faer", "backend"] {
+    for name in BACKEND_NAMES.iter().chain(&["backend"]) {
         assert!(
             !text.contains(name),
             "{} names `{name}`: a backend's limits are its Backend::supports",
             path.display()
         );
+    }
+}
+
+/// The backends' names and their libraries', lower-cased.
+const BACKEND_NAMES: [&str; 5] = ["petsc", "faer", "sharedmemory", "shared_memory", "distributedmemory"];
+
+/// The run, the load path, the capacitance, the outer unknowns and the bed's fixed point are
+/// written once for every backend: outside their tests they call a `Backend` (or a
+/// `PathBackend`) and name none (a backend's own section of the report, `petsc`, is carried
+/// through as data).
+#[test]
+fn the_run_names_no_backend() {
+    for file in ["run.rs", "path.rs", "capacitance.rs", "outer.rs", "bed.rs"] {
+        let path = root().join("crates/problem/src").join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let code = text.split("#[cfg(test)]").next().unwrap().to_lowercase();
+        for name in ["faer", "sharedmemory", "shared_memory", "distributedmemory", "backendchoice::"] {
+            assert!(
+                !code.contains(name),
+                "{} names `{name}`: the run is written once for every backend",
+                path.display()
+            );
+        }
     }
 }
 

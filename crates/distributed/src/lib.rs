@@ -2,7 +2,7 @@
 //! "petsc"`): Krylov methods whose cost grows linearly with the mesh, and several processes
 //! (or machines), where the default backend factors one sparse matrix on one machine.
 //!
-//! The run is [`problem::run`]'s, with this crate's [`PetscBackend`] for what differs; on every
+//! The run is [`problem::run`]'s, with this crate's [`DistributedMemory`] for what differs; on every
 //! rank:
 //!
 //! 1. **set up**: the scene's mesh, materials, conditions and loads ([`problem::backend::setup`]),
@@ -49,5 +49,6 @@ pub mod system;
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
 pub use run::{
-    solve, Assembled, DistributedError, PetscBackend, Prepared, COUPLED_OPTIONS, ELASTIC_OPTIONS, MAX_ACTIVE_SET_STEPS,
+    solve, Assembled, DistributedError, DistributedMemory, Prepared, COUPLED_OPTIONS, ELASTIC_OPTIONS,
+    MAX_ACTIVE_SET_STEPS,
 };

@@ -74,11 +74,12 @@ pub fn solve(
     limits: problem::Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DistributedError> {
-    problem::run(&mut PetscBackend { petsc }, scene, mesh, limits, reporter)
+    problem::run(&mut DistributedMemory { petsc }, scene, mesh, limits, reporter)
 }
 
-/// The PETSc backend (`solver.backend = "petsc"`), on the ranks of `petsc`.
-pub struct PetscBackend<'p> {
+/// The backend named for its role: the ranks of an MPI run, each its own memory
+/// (`solver.backend = "petsc"`, after the library that runs it), on the ranks of `petsc`.
+pub struct DistributedMemory<'p> {
     /// PETSc, initialised on the ranks of the run.
     pub petsc: &'p Petsc,
 }
@@ -103,7 +104,7 @@ pub struct Prepared<'p> {
     reason: String,
 }
 
-impl<'p> Backend for PetscBackend<'p> {
+impl<'p> Backend for DistributedMemory<'p> {
     const NAME: &'static str = "petsc";
     type Assembled = Assembled<'p>;
     type System = Prepared<'p>;

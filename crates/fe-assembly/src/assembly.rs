@@ -78,35 +78,7 @@ impl<'m> Discretization<'m> {
             return Err(InputError::AxisymmetricDimension { dim: mesh.dim }.into());
         }
         let n_cells = mesh.n_cells();
-        let mut cell_material = vec![usize::MAX; n_cells];
-        for (mi, (region, m)) in materials.iter().enumerate() {
-            if m.dim != mesh.dim {
-                return Err(InputError::MaterialDimension {
-                    region: region.clone(),
-                    material: m.dim,
-                    mesh: mesh.dim,
-                }
-                .into());
-            }
-            for &c in mesh.region(region)? {
-                if cell_material[c] != usize::MAX {
-                    return Err(InputError::TwoMaterials {
-                        cell: c,
-                        first: region.clone(),
-                        second: materials[cell_material[c]].0.clone(),
-                    }
-                    .into());
-                }
-                cell_material[c] = mi;
-            }
-        }
-        if let Some(c) = cell_material.iter().position(|&m| m == usize::MAX) {
-            return Err(InputError::NoMaterial {
-                cell: c,
-                regions: materials.iter().map(|(r, _)| r.clone()).collect(),
-            }
-            .into());
-        }
+        let cell_material = cell_materials(mesh, materials)?;
         if let Some((region, m)) = materials.iter().find(|(_, m)| m.coordinates() != coordinates) {
             return Err(InputError::MaterialCoordinates {
                 region: region.clone(),
@@ -572,4 +544,38 @@ impl Pattern {
         let sym = SymbolicSparseColMat::new_checked(self.nrows, self.ncols, self.col_ptr, None, self.row_idx);
         SparseColMat::new(sym, values)
     }
+}
+
+/// The material of each cell: the index in `materials` of the one region holding it.
+fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<Vec<usize>, AssemblyError> {
+    let mut cell_material = vec![usize::MAX; mesh.n_cells()];
+    for (mi, (region, m)) in materials.iter().enumerate() {
+        if m.dim != mesh.dim {
+            return Err(InputError::MaterialDimension {
+                region: region.clone(),
+                material: m.dim,
+                mesh: mesh.dim,
+            }
+            .into());
+        }
+        for &c in mesh.region(region)? {
+            if cell_material[c] != usize::MAX {
+                return Err(InputError::TwoMaterials {
+                    cell: c,
+                    first: region.clone(),
+                    second: materials[cell_material[c]].0.clone(),
+                }
+                .into());
+            }
+            cell_material[c] = mi;
+        }
+    }
+    if let Some(c) = cell_material.iter().position(|&m| m == usize::MAX) {
+        return Err(InputError::NoMaterial {
+            cell: c,
+            regions: materials.iter().map(|(r, _)| r.clone()).collect(),
+        }
+        .into());
+    }
+    Ok(cell_material)
 }

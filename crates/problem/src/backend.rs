@@ -4,7 +4,7 @@
 //! its Krylov solvers), solves the linear or the contact problem on it, measures its
 //! equilibrium residual, and hands the free unknowns back.
 //!
-//! Two backends implement it: [`Faer`](crate::Faer) (this crate's default: faer's sparse factorisations on
+//! Two backends implement it: [`SharedMemory`](crate::SharedMemory) (this crate's default: faer's sparse factorisations on
 //! one machine, the condensed contact problem and its semismooth Newton) and the `distributed`
 //! crate's PETSc backend (Krylov solves with algebraic multigrid on the ranks of an MPI run).
 //! The run knows neither by name.

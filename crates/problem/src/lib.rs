@@ -62,7 +62,6 @@ mod boundary;
 mod capacitance;
 mod estimate;
 mod exact;
-mod faer_backend;
 mod halfspace;
 mod outer;
 mod path;
@@ -72,13 +71,13 @@ pub mod report;
 mod run;
 mod scene;
 mod setup;
+mod shared_memory;
 mod solution;
 
 pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindlin_deresiewicz_traction};
 pub use backend::Limits;
 pub use capacitance::Capacitance;
 pub use exact::ExactReport;
-pub use faer_backend::Faer;
 pub use fe_assembly::CellFields;
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
 pub use path::{PathSolution, Step, StepFields};
@@ -93,10 +92,11 @@ pub use scene::{
     SolverSpec, Strategy, Valid,
 };
 pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
+pub use shared_memory::SharedMemory;
 
 use contact::ContactError;
 
-/// Solves `scene` on the default backend ([`Faer`]). `mesh` is the mesh of a `gmsh` scene,
+/// Solves `scene` on the default backend ([`SharedMemory`]). `mesh` is the mesh of a `gmsh` scene,
 /// read by the caller (generated meshes are made here); `reporter` receives one event per
 /// step and per outer iteration.
 ///
@@ -119,11 +119,11 @@ pub fn solve_within(
 ) -> Result<Solution, ProblemError> {
     // a path's instants are the run's too (each step's files unwritten: the last instant,
     // with the rows)
-    let solution = run::run(&mut Faer, scene, mesh, limits, reporter)?;
+    let solution = run::run(&mut SharedMemory, scene, mesh, limits, reporter)?;
     Ok(solution.expect("the default backend runs in one process, which holds the solution"))
 }
 
-/// The capacitance matrix between `scene`'s terminals on the default backend ([`Faer`]): one
+/// The capacitance matrix between `scene`'s terminals on the default backend ([`SharedMemory`]): one
 /// factorisation, a unit potential per column, the charges as reactions (`mesh` the mesh of a
 /// `gmsh` or `given` scene, read by the caller).
 ///
@@ -131,11 +131,11 @@ pub fn solve_within(
 /// The scene's and set-up's errors, as a run's; a scene without electric unknowns or without
 /// a terminal (key `dirichlet`); a body its mechanical conditions do not hold.
 pub fn capacitance(scene: &Scene, mesh: Option<mesh::Mesh>) -> Result<Capacitance, ProblemError> {
-    let c = capacitance::capacitance(&mut Faer, scene, mesh)?;
+    let c = capacitance::capacitance(&mut SharedMemory, scene, mesh)?;
     Ok(c.expect("the default backend runs in one process, which holds the solution"))
 }
 
-/// Solves `scene`'s load path on the default backend ([`Faer`]): the instants of
+/// Solves `scene`'s load path on the default backend ([`SharedMemory`]): the instants of
 /// `scene.path` one after the other on one factorisation and one condensation, friction on
 /// the slip increment; `each` is called once per instant, in order, with the instant's row
 /// and contact solution, and, where `with_fields` asks for them, the fields of every
@@ -154,7 +154,7 @@ pub fn solve_path(
     with_fields: bool,
     each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
 ) -> Result<PathSolution, ProblemError> {
-    path::walk(&mut Faer, scene, mesh, limits, reporter, with_fields, each)
+    path::walk(&mut SharedMemory, scene, mesh, limits, reporter, with_fields, each)
 }
 
 /// "the most extreme inputs are ..." naming the scene's numbers far from 1 (each key once), or

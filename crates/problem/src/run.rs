@@ -702,7 +702,7 @@ mod tests {
             load: Some(vec![0.0, 1.0]),
             ..Default::default()
         });
-        let ran = run(&mut crate::Faer, &scene, None, Limits::default(), &mut Silent)
+        let ran = run(&mut crate::SharedMemory, &scene, None, Limits::default(), &mut Silent)
             .unwrap()
             .unwrap();
         let walked = crate::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())).unwrap();

@@ -19,12 +19,13 @@ use fe_assembly::{Blocks, Parallelism};
 use linalg::{CondenseRoute, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
 use std::time::Instant;
 
-/// The default backend (`solver.backend = "faer"`): faer's sparse direct factorisations on
-/// one machine.
+/// The default backend, named for its role: one process on one machine's shared memory, its
+/// threads (`solver.backend = "faer"`, after the library whose sparse factorisations it
+/// runs; also the Schur-complement PCG).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Faer;
+pub struct SharedMemory;
 
-impl Backend for Faer {
+impl Backend for SharedMemory {
     const NAME: &'static str = "faer";
     type Assembled = Blocks;
     type System = Factored;

@@ -1,11 +1,11 @@
 //! What a load path keeps on the default backend's one factorisation: the condensed
 //! compliance and the solutions of each part of the right-hand side, from which every step's
-//! loads are a sum ([`PathBackend`] for [`Faer`]).
+//! loads are a sum ([`PathBackend`] for [`SharedMemory`]).
 
 use super::condensed::{
     condense_reported, fields_at_points, in_frame, rhs_with_contact, Operator, Refining, PATH_REFINE_TOL,
 };
-use super::{Factored, Faer, LinearSolver};
+use super::{Factored, LinearSolver, SharedMemory};
 use crate::backend::Fields;
 use crate::backend::{At, ContactSolve, Figures, Framed, InstantOf, PathBackend};
 use crate::boundary::ContactBoundary;
@@ -24,7 +24,7 @@ pub struct PathSystem {
     parts: Vec<Vec<f64>>,
 }
 
-impl PathBackend for Faer {
+impl PathBackend for SharedMemory {
     type Path = PathSystem;
 
     /// The condensation of `K` on the boundary's dofs (once) and the parts' solutions (one
