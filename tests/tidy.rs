@@ -142,7 +142,13 @@ fn the_run_names_no_backend() {
         let path = root().join("crates/problem/src").join(file);
         let text = std::fs::read_to_string(&path).unwrap();
         let code = text.split("#[cfg(test)]").next().unwrap().to_lowercase();
-        for name in ["faer", "sharedmemory", "shared_memory", "distributedmemory", "backendchoice::"] {
+        for name in [
+            "faer",
+            "sharedmemory",
+            "shared_memory",
+            "distributedmemory",
+            "backendchoice::",
+        ] {
             assert!(
                 !code.contains(name),
                 "{} names `{name}`: the run is written once for every backend",

@@ -124,3 +124,76 @@ fn slip_weakening_in_three_dimensions_meets_its_law() {
     assert!(slipping > 0);
     assert!(weak.report.residuals.converged_to_tolerance);
 }
+
+/// Each `[[contact]]` zone its own friction law (zones once could not carry slip weakening):
+/// the corner's right wall weakens (0.3 -> 0.1 over 1e-5), its top wall keeps Coulomb's 0.3.
+/// Every slipping point carries its own zone's coefficient at its own slip, some point of the
+/// right wall below 0.3 (the law acts there), every point of the top at 0.3; with equal
+/// coefficients the two zones are Coulomb's law on both to round-off.
+#[test]
+fn each_contact_zone_keeps_its_own_friction_law() {
+    let (mu_s, mu_d, length, mu) = (0.3, 0.1, 1e-5, 0.3);
+    let zones = |dynamic: f64| {
+        let sets = [
+            "contact.0.law=\"coulomb\"".to_string(),
+            "contact.0.friction_law=\"slip-weakening\"".into(),
+            format!("contact.0.friction_static={mu_s}"),
+            format!("contact.0.friction_dynamic={dynamic}"),
+            format!("contact.0.slip_length={length}"),
+            "contact.1.law=\"coulomb\"".into(),
+            format!("contact.1.friction={mu}"),
+        ];
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        solve("corner", &sets)
+    };
+    let weak = zones(mu_d);
+    let c = weak.contact.as_ref().unwrap();
+    let sol = &c.solution;
+    let mut weakened = 0;
+    for (i, &g) in c.group_of.iter().enumerate() {
+        let (ln, lt) = (sol.lambda.normal[i], sol.lambda.tangential_norm(i));
+        let s = sol.u.tangential_norm(i);
+        let coefficient = if g == 0 {
+            mu_s - (mu_s - mu_d) * (s / length).min(1.0)
+        } else {
+            mu
+        };
+        assert!(
+            lt <= coefficient * ln * (1.0 + 1e-8) + 1e-14,
+            "point {i} of zone {g}: |λ_t| {lt} above {coefficient} λ_n"
+        );
+        if sol.status[i] == contact::Status::Slip {
+            assert!(
+                (lt - coefficient * ln).abs() <= 1e-8 * ln,
+                "point {i} of zone {g} slips: |λ_t| {lt}, μ λ_n {}",
+                coefficient * ln
+            );
+            weakened += usize::from(g == 0 && coefficient < mu_s * (1.0 - 1e-6));
+        }
+    }
+    assert!(
+        weakened > 0,
+        "no point of the weakening wall slid far enough for the law to act"
+    );
+    assert!(weak.report.residuals.converged_to_tolerance);
+    assert!(
+        weak.report.plan.to_string().contains("0.3 -> 0.1 over 1e-5 on `right`"),
+        "{}",
+        weak.report.plan
+    );
+    // equal coefficients: Coulomb's law on both walls, to round-off
+    let flat = zones(mu_s);
+    let coulomb = solve(
+        "corner",
+        &[
+            "contact.0.law=\"coulomb\"",
+            "contact.0.friction=0.3",
+            "contact.1.law=\"coulomb\"",
+            "contact.1.friction=0.3",
+        ],
+    );
+    assert_eq!(
+        flat.contact.unwrap().solution.lambda,
+        coulomb.contact.unwrap().solution.lambda
+    );
+}

@@ -83,6 +83,7 @@ fn main() {
         foundation: Default::default(),
         foundations: vec![],
         slipped: vec![],
+        weakening: vec![],
     };
     let mut problem = DenseContactProblem {
         u0,

@@ -160,6 +160,11 @@ impl Coarsening {
             } else {
                 self.mean(&points.slipped, points)
             },
+            weakening: if points.weakening.is_empty() {
+                vec![]
+            } else {
+                self.chosen.iter().map(|&i| points.weakening_of(i).copied()).collect()
+            },
         }
     }
 
@@ -311,6 +316,7 @@ mod tests {
             foundation: Default::default(),
             foundations: vec![],
             slipped: vec![],
+            weakening: vec![],
         }
     }
 

@@ -67,6 +67,7 @@ pub fn solve_gauss_seidel<P: AffineProblem>(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
+    points.refuse_weakening()?;
     let pre = Preamble::new(&mut Counter::new(problem), points, law, params.power_iters, None)?;
     let lambda = pre.start(lambda0)?;
     let (mu_max, reference) = (pre.mu_max, pre.reference);

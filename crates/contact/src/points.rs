@@ -36,6 +36,10 @@ pub struct ContactPoints {
     /// path): slip-weakening friction takes its coefficient at this plus the problem's own
     /// slip `|u_t|`. Empty: none (zeros).
     pub slipped: Vec<f64>,
+    /// Each point's slip-weakening law, where its coefficient falls with its slip
+    /// ([`crate::solve_slip_weakening`]; `None`: its `friction` is its constant coefficient).
+    /// Empty: no point weakens.
+    pub weakening: Vec<Option<crate::SlipWeakening>>,
 }
 
 /// The foundation under the contact points, which gives the normal law.
@@ -146,6 +150,58 @@ impl ContactPoints {
         self.slipped.get(i).copied().unwrap_or(0.0)
     }
 
+    /// Point `i`'s slip-weakening law ([`ContactPoints::weakening`]), if its coefficient
+    /// falls with its slip.
+    #[inline]
+    pub fn weakening_of(&self, i: usize) -> Option<&crate::SlipWeakening> {
+        self.weakening.get(i).and_then(Option::as_ref)
+    }
+
+    /// Whether a point's coefficient falls with its slip.
+    pub fn weakens(&self) -> bool {
+        self.weakening.iter().any(Option::is_some)
+    }
+
+    /// The points with `law` at every one of them ([`ContactPoints::weakening`]).
+    pub fn with_weakening(&self, law: crate::SlipWeakening) -> ContactPoints {
+        ContactPoints {
+            weakening: vec![Some(law); self.len()],
+            ..self.clone()
+        }
+    }
+
+    /// Refuses points that weaken, for a solver that holds each point's coefficient constant.
+    ///
+    /// # Errors
+    /// [`InputError::Unsupported`] where a point's coefficient falls with its slip.
+    pub(crate) fn refuse_weakening(&self) -> Result<(), InputError> {
+        if self.weakens() {
+            return Err(InputError::Unsupported(
+                "points whose coefficient falls with their slip: solve_slip_weakening solves them (this solver holds each point's coefficient)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Each point's Coulomb coefficient at its slip in `u` (and what it slipped before the
+    /// problem): its weakening law's there, or its constant one.
+    pub fn coefficients_at(&self, u: &crate::PointValues) -> Vec<f64> {
+        (0..self.len())
+            .map(|i| match self.weakening_of(i) {
+                Some(w) => w.coefficient(self.slipped(i) + u.tangential_norm(i)),
+                None => self.friction[i],
+            })
+            .collect()
+    }
+
+    /// The points with the coefficients at their slips in `u` ([`ContactPoints::coefficients_at`]).
+    pub fn at_slips(&self, u: &crate::PointValues) -> ContactPoints {
+        ContactPoints {
+            friction: self.coefficients_at(u),
+            ..self.clone()
+        }
+    }
+
     /// Tangential components per point.
     pub fn n_tangential(&self) -> usize {
         self.dim - 1
@@ -190,6 +246,7 @@ impl ContactPoints {
             || self.held.len() != n
             || !(self.slipped.is_empty() || self.slipped.len() == n)
             || !(self.foundations.is_empty() || self.foundations.len() == n)
+            || !(self.weakening.is_empty() || self.weakening.len() == n)
         {
             return Err(InputError::PointArrays);
         }
@@ -212,6 +269,9 @@ impl ContactPoints {
             if !(self.slipped(i) >= 0.0 && self.slipped(i).is_finite()) {
                 return Err(bad(i, "slipped", self.slipped(i), "must be finite and non-negative"));
             }
+        }
+        for w in self.weakening.iter().flatten() {
+            w.check()?;
         }
         for f in self.foundations.iter().chain(std::iter::once(&self.foundation)) {
             let Foundation::Compliant { stiffness, exponent } = *f else {

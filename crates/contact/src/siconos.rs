@@ -327,6 +327,7 @@ impl FrictionProblem {
             foundation: Default::default(),
             foundations: vec![],
             slipped: vec![],
+            weakening: vec![],
         }
     }
 

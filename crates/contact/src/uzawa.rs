@@ -184,6 +184,7 @@ pub fn solve_uzawa(
     lambda0: Option<PointValues>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
+    points.refuse_weakening()?;
     if !points.all_rigid() {
         // its projections are onto Signorini's cone: a compliant foundation's law is no
         // projection

@@ -183,24 +183,8 @@ impl SlipWeakening {
         }
     }
 
-    /// The coefficient of each point at its slip: what it slipped before the problem
-    /// ([`ContactPoints::slipped`]) and its slip `|u_t|` in `u`.
-    pub fn coefficients(&self, points: &ContactPoints, u: &crate::PointValues) -> Vec<f64> {
-        (0..u.n_points())
-            .map(|i| self.coefficient(points.slipped(i) + u.tangential_norm(i)))
-            .collect()
-    }
-
-    /// Points with the coefficients the law gives at their slips with `u`.
-    pub fn points_at(&self, points: &ContactPoints, u: &crate::PointValues) -> ContactPoints {
-        ContactPoints {
-            friction: self.coefficients(points, u),
-            ..points.clone()
-        }
-    }
-
     /// Checks the law's data.
-    fn check(&self) -> Result<(), InputError> {
+    pub(crate) fn check(&self) -> Result<(), InputError> {
         let (ms, md, l) = (self.static_coefficient, self.dynamic_coefficient, self.slip_length);
         let ok = md >= 0.0 && ms >= md && ms.is_finite() && l > 0.0 && l.is_finite();
         if ok {
@@ -288,8 +272,9 @@ fn secant_ratio(last: Option<&(Vec<f64>, Vec<f64>)>, (x, g): (&[f64], &[f64]), s
     (dx > NOISE * tol).then(|| max_difference(g, g0) / scale / dx)
 }
 
-/// Solves Coulomb's law with the slip-weakening coefficient `law` on `points` (their own
-/// coefficients are not read) by the fixed point on the coefficients, from the stick start.
+/// Solves Coulomb's law with each point's coefficient falling with its slip by its own law
+/// ([`ContactPoints::weakening`]; a point without one keeps its coefficient `friction`) by the
+/// fixed point on the coefficients, from the stick start.
 /// The returned solution's `info` counts the fixed-point steps (`fixed_point_iters`), Newton's
 /// steps summed (`newton_iters`), and the measured `contraction`; its `complementarity` is
 /// Coulomb's residual at the last coefficients, which the slips of the answer reproduce to
@@ -302,11 +287,10 @@ fn secant_ratio(last: Option<&(Vec<f64>, Vec<f64>)>, (x, g): (&[f64], &[f64]), s
 pub fn solve_slip_weakening<P: AffineProblem>(
     problem: &mut P,
     points: &ContactPoints,
-    law: &SlipWeakening,
     params: &WeakeningParams,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
-    solve_slip_weakening_cached(problem, points, law, params, progress, &mut NewtonCache::default())
+    solve_slip_weakening_cached(problem, points, params, progress, &mut NewtonCache::default())
 }
 
 /// [`solve_slip_weakening`], its Newton solves sharing what they may with the other solves of
@@ -317,17 +301,23 @@ pub fn solve_slip_weakening<P: AffineProblem>(
 pub fn solve_slip_weakening_cached<P: AffineProblem>(
     problem: &mut P,
     points: &ContactPoints,
-    law: &SlipWeakening,
     params: &WeakeningParams,
     progress: &mut dyn FnMut(&Progress),
     shared: &mut NewtonCache,
 ) -> Result<ContactSolution, ContactError> {
-    law.check()?;
-    let n = points.len();
-    let mut frozen = points.clone();
+    points.validate()?;
+    // each step's points: the coefficients frozen, none weakening within the step
+    let mut frozen = ContactPoints {
+        weakening: vec![],
+        ..points.clone()
+    };
     // the stick start: each point's coefficient at what it slipped before (μ_s where nothing)
-    frozen.friction = (0..n).map(|i| law.coefficient(points.slipped(i))).collect();
-    let scale = law.static_coefficient.max(f64::MIN_POSITIVE);
+    frozen.friction = points.coefficients_at(&crate::PointValues::zeros(points.len(), points.n_tangential()));
+    let scale = points
+        .weakening
+        .iter()
+        .flatten()
+        .fold(f64::MIN_POSITIVE, |m, w| m.max(w.static_coefficient));
     let (mut start, mut newton_iters) = (None, 0);
     let mut contraction: Option<f64> = None;
     let mut best = Best::new();
@@ -340,7 +330,7 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
         newton_iters += sol.info.newton_iters;
         // the operator is the same at every step: its μ_max once
         newton.mu_max = Some(sol.info.mu_max);
-        let next = law.coefficients(points, &sol.u);
+        let next = points.coefficients_at(&sol.u);
         let change = max_difference(&next, &frozen.friction) / scale;
         // the map's secant ratio |G(μ_k) - G(μ_j)| / |μ_k - μ_j| between successive iterates,
         // where the step stands above the round-off of the step's own solve
@@ -364,13 +354,17 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
         if change > params.tol && change <= POLISH && !polished && params.inner == Inner::Newton {
             polished = true;
             let direct = NewtonParams {
-                weakening: Some(*law),
+                weakening: true,
                 schedule: crate::Schedule::of(crate::ProblemClass::SlipWeakening),
                 ..newton
             };
+            let weakening = ContactPoints {
+                weakening: points.weakening.clone(),
+                ..frozen.clone()
+            };
             if let Ok(mut polish) = solve_newton_cached(
                 problem,
-                &frozen,
+                &weakening,
                 &Law::Coulomb,
                 &direct,
                 Some(sol.lambda.clone()),
@@ -391,13 +385,17 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
         }
         // Anderson's mixing of the last steps (the plain step `next` where it has no history),
         // kept within the law's range
-        let (lo, hi) = (law.dynamic_coefficient, law.static_coefficient);
         frozen.friction = if params.accelerate {
             anderson.step(&frozen.friction, &next)
         } else {
             next
         };
-        frozen.friction.iter_mut().for_each(|m| *m = m.clamp(lo, hi));
+        for (i, m) in frozen.friction.iter_mut().enumerate() {
+            *m = match points.weakening_of(i) {
+                Some(w) => m.clamp(w.dynamic_coefficient, w.static_coefficient),
+                None => points.friction[i],
+            };
+        }
         start = Some(sol.lambda);
     }
     Err(ContactError::FixedPointNoConvergence {

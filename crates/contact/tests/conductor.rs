@@ -24,6 +24,7 @@ fn points(n: usize) -> ContactPoints {
         foundation: Foundation::Rigid,
         foundations: vec![],
         slipped: vec![],
+        weakening: vec![],
     }
 }
 

@@ -87,6 +87,7 @@ impl Chain {
             foundation,
             foundations: vec![],
             slipped: vec![],
+            weakening: vec![],
         }
     }
 

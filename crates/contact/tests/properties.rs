@@ -23,6 +23,7 @@ fn points(n: usize, dim: usize, w: &[f64], friction: f64) -> ContactPoints {
         foundation: Default::default(),
         foundations: vec![],
         slipped: vec![],
+        weakening: vec![],
     }
 }
 
@@ -171,12 +172,12 @@ proptest! {
             form: if exponential { Weakening::Exponential } else { Weakening::Linear },
         };
         let by = |inner| WeakeningParams { tol: 1e-12, inner, newton: NewtonParams { tol: 1e-13, ..Default::default() }, ..Default::default() };
-        let newton = solve_slip_weakening(&mut op.clone(), &pts, &law, &by(Inner::Newton), &mut |_| {});
+        let newton = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(law), &by(Inner::Newton), &mut |_| {});
         prop_assume!(newton.is_ok()); // a map that does not settle: its own error, another test
         let newton = newton.unwrap();
         // Gauss-Seidel's steps have no Newton polish: a map contracting by 0.9 takes ~250 steps
         let slow = WeakeningParams { max_iters: 2000, ..by(Inner::GaussSeidel) };
-        let gs = solve_slip_weakening(&mut op.clone(), &pts, &law, &slow, &mut |_| {}).unwrap();
+        let gs = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(law), &slow, &mut |_| {}).unwrap();
         for sol in [&newton, &gs] {
             let scale = sol.lambda.norm().max(1e-12);
             for i in 0..n {
@@ -874,7 +875,7 @@ fn slip_weakening_on_one_point_is_its_hand_solution() {
         },
         ..Default::default()
     };
-    let sol = solve_slip_weakening(&mut op.clone(), &pts, &law, &params, &mut |_| {}).unwrap();
+    let sol = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(law), &params, &mut |_| {}).unwrap();
     let half_slope = 0.5 * (0.6 - 0.3) / 1.0;
     let mu = (0.6 - half_slope) / (1.0 - half_slope);
     assert!((sol.lambda.normal[0] - 0.5).abs() < 1e-14);
@@ -894,7 +895,7 @@ fn slip_weakening_on_one_point_is_its_hand_solution() {
         accelerate: true,
         ..params
     };
-    let mixed = solve_slip_weakening(&mut op.clone(), &pts, &law, &fast, &mut |_| {}).unwrap();
+    let mixed = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(law), &fast, &mut |_| {}).unwrap();
     assert!((mixed.lambda.tangential[0] - sol.lambda.tangential[0]).abs() < 1e-12);
     assert!(mixed.info.fixed_point_iters <= sol.info.fixed_point_iters);
     // equal coefficients: Coulomb's law itself, to round-off
@@ -902,7 +903,7 @@ fn slip_weakening_on_one_point_is_its_hand_solution() {
         dynamic_coefficient: 0.6,
         ..law
     };
-    let sw = solve_slip_weakening(&mut op.clone(), &pts, &flat, &params, &mut |_| {}).unwrap();
+    let sw = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(flat), &params, &mut |_| {}).unwrap();
     let coulomb = solve_newton(&mut op.clone(), &pts, &Law::Coulomb, &params.newton, None, &mut |_| {}).unwrap();
     assert_eq!(sw.lambda, coulomb.lambda);
     assert_eq!(sw.info.fixed_point_iters, 1);
@@ -911,17 +912,75 @@ fn slip_weakening_on_one_point_is_its_hand_solution() {
         dynamic_coefficient: 0.7,
         ..law
     };
-    let e = solve_slip_weakening(&mut op.clone(), &pts, &up, &params, &mut |_| {}).unwrap_err();
+    let e = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(up), &params, &mut |_| {}).unwrap_err();
     assert!(matches!(e, ContactError::Input(_)), "{e}");
     // the exponential form: μ(s) = μ_d + Δ exp(-s/L), its fixed point checked by its equation
     let exp = SlipWeakening {
         form: Weakening::Exponential,
         ..law
     };
-    let s = solve_slip_weakening(&mut op.clone(), &pts, &exp, &params, &mut |_| {}).unwrap();
+    let s = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(exp), &params, &mut |_| {}).unwrap();
     let slip = -s.u.tangential[0];
     let mu = -s.lambda.tangential[0] / 0.5;
     assert!((mu - exp.coefficient(slip)).abs() < 1e-12 && (slip - 0.5 * (1.0 - mu)).abs() < 1e-12);
+}
+
+/// Each point its own friction law: beside the weakening point of
+/// `slip_weakening_on_one_point_is_its_hand_solution`, an uncoupled point with a constant
+/// coefficient `μ = 0.4` (no law of its own) keeps it, and each meets its own hand solution; the
+/// solvers that hold coefficients constant refuse points that weaken.
+#[test]
+fn slip_weakening_acts_only_where_a_point_has_the_law() {
+    use contact::{solve_slip_weakening, SlipWeakening, Weakening, WeakeningParams};
+    let mut pts = ContactPoints {
+        weight: vec![1.0; 2],
+        ..points(2, 2, &[0.5, 0.5], 0.6)
+    };
+    pts.friction[1] = 0.4;
+    let law = SlipWeakening {
+        static_coefficient: 0.6,
+        dynamic_coefficient: 0.3,
+        slip_length: 1.0,
+        form: Weakening::Linear,
+    };
+    pts.weakening = vec![Some(law), None];
+    let op = DenseContactProblem {
+        u0: PointValues::from_parts(vec![1.0; 2], vec![-0.5; 2], 1).unwrap(),
+        compliance: (0..16)
+            .map(|k| [2.0, 2.0, 1.0, 1.0][k / 4] * f64::from(k % 5 == 0))
+            .collect(),
+        weight: vec![1.0; 2],
+        nt: 1,
+    };
+    let params = WeakeningParams {
+        tol: 1e-13,
+        newton: NewtonParams {
+            tol: 1e-14,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let sol = solve_slip_weakening(&mut op.clone(), &pts, &params, &mut |_| {}).unwrap();
+    let half_slope = 0.5 * (0.6 - 0.3) / 1.0;
+    let mu = (0.6 - half_slope) / (1.0 - half_slope);
+    for (i, mu) in [(0, mu), (1, 0.4)] {
+        assert!((sol.lambda.normal[i] - 0.5).abs() < 1e-14);
+        assert!(
+            (sol.lambda.tangential[i] + 0.5 * mu).abs() < 1e-12,
+            "point {i}: {:?} {mu}",
+            sol.lambda
+        );
+        assert!((sol.u.tangential[i] + 0.5 * (1.0 - mu)).abs() < 1e-12);
+    }
+    // Newton with constant coefficients, Gauss-Seidel and Uzawa do not take points that weaken
+    let e = solve_newton(&mut op.clone(), &pts, &Law::Coulomb, &params.newton, None, &mut |_| {}).unwrap_err();
+    assert!(e.to_string().contains("solve_slip_weakening solves them"), "{e}");
+    let gs = contact::GaussSeidelParams::default();
+    let e = contact::solve_gauss_seidel(&mut op.clone(), &pts, &Law::Coulomb, &gs, None, &mut |_| {}).unwrap_err();
+    assert!(e.to_string().contains("solve_slip_weakening solves them"), "{e}");
+    // the points' arrays must agree in length
+    pts.weakening.pop();
+    assert!(solve_slip_weakening(&mut op.clone(), &pts, &params, &mut |_| {}).is_err());
 }
 
 /// Found by the property test in CI: a soft bed (`k ≈ 3.4e-3`, `m ≈ 2.4`) under a tiny load,

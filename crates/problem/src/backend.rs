@@ -436,8 +436,6 @@ pub struct ContactSolve<'p> {
     pub tol: f64,
     /// A deadline or a cancel flag.
     pub interrupt: contact::Interrupt,
-    /// Slip-weakening friction (Coulomb's law with a coefficient that falls with the slip).
-    pub weakening: Option<contact::SlipWeakening>,
     /// What Newton's solves of the run's one condensed compliance share (a solve's
     /// corrections, a load path's steps): the factorisation of `D` for the directions, the
     /// estimate of `μ_max`.
@@ -452,9 +450,10 @@ impl<'p> ContactSolve<'p> {
         points: &'a contact::ContactPoints,
         sol: &ContactSolution,
     ) -> std::borrow::Cow<'a, contact::ContactPoints> {
-        match &self.weakening {
-            Some(w) => std::borrow::Cow::Owned(w.points_at(points, &sol.u)),
-            None => std::borrow::Cow::Borrowed(points),
+        if points.weakens() {
+            std::borrow::Cow::Owned(points.at_slips(&sol.u))
+        } else {
+            std::borrow::Cow::Borrowed(points)
         }
     }
 
@@ -473,7 +472,6 @@ impl<'p> ContactSolve<'p> {
             law,
             tol: plan.tol,
             interrupt,
-            weakening: plan.weakening,
             cache: Default::default(),
         }
     }

@@ -6,7 +6,7 @@
 //! contact dofs onto each point's normal and tangents is this module's; the sparse work is
 //! linalg's.
 
-use crate::scene::ContactSpec;
+use crate::scene::{ContactSpec, Friction};
 use crate::ProblemError;
 use crate::SetupError;
 use contact::{
@@ -228,6 +228,7 @@ impl ContactBoundary {
                 foundation: specs.first().map_or(contact::Foundation::Rigid, foundation_of),
                 foundations: vec![],
                 slipped: vec![],
+                weakening: vec![],
             },
             nodes: vec![],
             dofs: vec![],
@@ -245,6 +246,18 @@ impl ContactBoundary {
         }
         if let [spec] = specs {
             b.electric = electric_points(spec, &disc.dofs, &b.nodes)?;
+        }
+        // zones whose friction weakens with the slip: each point its zone's law (a law from a
+        // static coefficient of 0 is frictionless: its points keep the coefficient 0)
+        let weakening: Vec<Option<contact::SlipWeakening>> = specs
+            .iter()
+            .map(|s| match s.model().map(|m| m.friction) {
+                Some(Friction::SlipWeakening(w)) if w.static_coefficient > 0.0 => Some(w),
+                _ => None,
+            })
+            .collect();
+        if weakening.iter().any(Option::is_some) {
+            b.points.weakening = b.group_of.iter().map(|&k| weakening[k]).collect();
         }
         // zones on different foundations: each point its own zone's
         let zones: Vec<contact::Foundation> = specs.iter().map(foundation_of).collect();

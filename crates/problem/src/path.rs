@@ -472,7 +472,7 @@ impl Walk<'_> {
         let f = self.spec.factors(t);
         on.disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
         let mut boundary = on.base.at_factors(f.gap, f.displacement);
-        if on.how.weakening.is_some() {
+        if on.base.points.weakens() {
             boundary.points.slipped.clone_from(&on.state.slipped);
         }
         let mut factors = vec![f.load];

@@ -57,9 +57,10 @@ pub struct Plan {
     /// rigid one); otherwise each zone on its own.
     #[serde(default = "shared", skip_serializing_if = "is_shared")]
     pub compliance_shared: bool,
-    /// Slip-weakening friction's law (absent: a constant coefficient).
+    /// The zones whose friction weakens with the slip, each with its law (the others keep
+    /// a constant coefficient).
     #[serde(skip)]
-    pub weakening: Option<contact::SlipWeakening>,
+    pub weakening: Vec<(String, contact::SlipWeakening)>,
     /// The contact solve's complementarity tolerance (`solver.tol`).
     #[serde(skip)]
     pub tol: f64,
@@ -132,9 +133,11 @@ impl Plan {
             // a weakening law from a static coefficient of 0 is frictionless (its dynamic one,
             // at most the static, is 0 too): no tangential multipliers for it to act on
             weakening: scene
-                .first_contact()
+                .contacts()
+                .iter()
                 .filter(|_| law == ContactLaw::Coulomb && friction)
-                .and_then(|c| c.slip_weakening()),
+                .filter_map(|c| Some((c.group.clone(), c.slip_weakening()?)))
+                .collect(),
             tol: scene.solver.tol,
             pcg_tol: scene.solver.pcg_tol.unwrap_or(match scene.solver.rule {
                 Rule::Paper => 1e-2,
@@ -200,6 +203,32 @@ pub fn electric_data(scene: &Scene) -> bool {
             .any(|d| d.phi.is_some_and(|p| p != 0.0) || d.charge.is_some_and(|q| q != 0.0))
 }
 
+/// The plan's words for its slip-weakening zones: each law, and its zone where the scene has
+/// several.
+fn weakening_words(zones: &[(String, contact::SlipWeakening)], several: bool) -> String {
+    if zones.is_empty() {
+        return String::new();
+    }
+    let laws: Vec<String> = zones
+        .iter()
+        .map(|(group, w)| {
+            let law = format!(
+                "{} -> {} over {:e}",
+                w.static_coefficient, w.dynamic_coefficient, w.slip_length
+            );
+            if several {
+                format!("{law} on `{group}`")
+            } else {
+                law
+            }
+        })
+        .collect();
+    format!(
+        " with slip weakening ({}) by a fixed point on the coefficients",
+        laws.join("; ")
+    )
+}
+
 impl fmt::Display for Plan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let outputs: Vec<&str> = self.outputs.iter().map(|o| o.name()).collect();
@@ -214,13 +243,7 @@ impl fmt::Display for Plan {
                 (Some(_), false) => " on a compliant foundation in some zones (each zone its own)".into(),
                 (None, _) => String::new(),
             },
-            match self.weakening {
-                Some(w) => format!(
-                    " with slip weakening ({} -> {} over {:e}) by a fixed point on the coefficients",
-                    w.static_coefficient, w.dynamic_coefficient, w.slip_length
-                ),
-                None => String::new(),
-            },
+            weakening_words(&self.weakening, self.slip_bounds.len() > 1),
             if self.friction { " (tangential multipliers)" } else { "" },
             if self.fixed_point { " + fixed point on S" } else { "" },
             self.linear_strategy,

@@ -516,6 +516,7 @@ mod tests {
                     foundation: Default::default(),
                     foundations: vec![],
                     slipped: vec![],
+                    weakening: vec![],
                 };
                 // an SPD compliance with zeros: a Gram matrix plus the identity
                 let g = |i: usize, j: usize| ((i * 7 + j * 3 + case) % 5) as f64 * 0.1 - 0.2;
@@ -659,6 +660,7 @@ mod tests {
                     vec![]
                 },
                 slipped: vec![],
+                weakening: vec![],
             };
             let g = |i: usize, j: usize| ((i * 5 + j * 3) % 7) as f64 * 0.1 - 0.3;
             // symmetric SPD part plus an antisymmetric coupling between u and φ rows

@@ -79,9 +79,9 @@ pub(super) struct Flat<'a> {
     pub(super) u0: Vec<f64>,
     /// The proximal shift `σ` (0 for the problem itself).
     pub(super) sigma: f64,
-    /// Slip-weakening friction: Coulomb's radius with the coefficient `μ(|u_t|)` of each
-    /// point's own slip.
-    pub(super) weakening: Option<crate::SlipWeakening>,
+    /// Slip-weakening friction: at each point with a law of its own, Coulomb's radius with
+    /// the coefficient `μ(|u_t|)` of its own slip ([`crate::NewtonParams::weakening`]).
+    pub(super) weakening: bool,
     /// Electrical contact: the rows after the mechanical ones.
     pub(super) electric: Option<ElectricRows<'a>>,
     /// Points held in contact whatever their multiplier (their normal row `u_n = g`, an ideal
@@ -157,7 +157,7 @@ impl<'a> Flat<'a> {
                 .collect(),
             u0: u0.to_flat(),
             sigma: 0.0,
-            weakening: None,
+            weakening: false,
             electric: None,
             forced: vec![],
             asymmetry: std::sync::OnceLock::new(),
@@ -364,10 +364,15 @@ impl<'a> Flat<'a> {
     /// on a rigid foundation, `F [λ_n]₊` on a compliant one (whose `λ_n` is the pressure).
     pub(super) fn radius(&self, i: usize, z: &[f64], x: &[f64], u: &[f64]) -> f64 {
         let normal = self.radius_normal(i, z, x);
-        match &self.weakening {
+        match self.weakening_of(i) {
             Some(w) => crate::coulomb_radius(w.coefficient(self.points.slipped(i) + self.slip(i, u)), normal),
             None => self.law.radius(self.points, i, normal),
         }
+    }
+
+    /// Point `i`'s slip-weakening law where the problem solves it directly.
+    fn weakening_of(&self, i: usize) -> Option<&crate::SlipWeakening> {
+        self.points.weakening_of(i).filter(|_| self.weakening)
     }
 
     /// The normal value Coulomb's radius is taken at: `z_n` on a rigid foundation, the
@@ -471,7 +476,7 @@ impl<'a> Flat<'a> {
             // (at what it slipped before the problem and its slip in it)
             let slip = self.slip(i, &s.u);
             let total = self.points.slipped(i) + slip;
-            let (coefficient, weakens) = match &self.weakening {
+            let (coefficient, weakens) = match self.weakening_of(i) {
                 Some(w) => (w.coefficient(total), w.slope(total)),
                 None => (self.points.friction[i], 0.0),
             };

@@ -75,12 +75,13 @@ pub struct NewtonParams {
     /// the steps of a fixed point on the friction coefficients): the power iteration is
     /// skipped. `None`: estimated.
     pub mu_max: Option<f64>,
-    /// Slip-weakening friction solved directly (Coulomb's radius with the coefficient of each
-    /// point's own slip, differentiated through the slip), with `Law::Coulomb`; the points'
-    /// coefficients are not read. No last stage runs (its solvers hold a constant
-    /// coefficient): a stall is the caller's to handle ([`crate::solve_slip_weakening`] goes on
-    /// with its fixed point).
-    pub weakening: Option<crate::SlipWeakening>,
+    /// Slip-weakening friction solved directly: at each point with a law of its own
+    /// ([`ContactPoints::weakening`]), Coulomb's radius with the coefficient of its own slip,
+    /// differentiated through the slip (with `Law::Coulomb`; such a point's `friction` is not
+    /// read). No last stage runs (its solvers hold a constant coefficient): a stall is the
+    /// caller's to handle ([`crate::solve_slip_weakening`] goes on with its fixed point).
+    /// `false`: every point's coefficient is its `friction`, and points that weaken are refused.
+    pub weakening: bool,
     /// The stages the solve may run ([`Schedule::of`] the problem's class): sweeps first
     /// (stage 0), the nested start (a solve from zero multipliers starts from the answer of
     /// the problem on a coarser set of its points: the step count then does not grow with the
@@ -109,7 +110,7 @@ impl Default for NewtonParams {
             max_proximal: 1000,
             power_iters: 30,
             mu_max: None,
-            weakening: None,
+            weakening: false,
             schedule: Schedule::all(),
             max_fallback_iters: 200_000,
             refine_start: false,
@@ -274,9 +275,10 @@ impl Judge<'_> {
     /// The points with the coefficients of the law at the slips of `u` (slip weakening), or
     /// as they are.
     fn points_at(&self, u: &PointValues) -> std::borrow::Cow<'_, ContactPoints> {
-        match &self.flat.weakening {
-            Some(w) => std::borrow::Cow::Owned(w.points_at(self.points, u)),
-            None => std::borrow::Cow::Borrowed(self.points),
+        if self.flat.weakening {
+            std::borrow::Cow::Owned(self.points.at_slips(u))
+        } else {
+            std::borrow::Cow::Borrowed(self.points)
         }
     }
 
@@ -669,6 +671,9 @@ pub fn solve_newton_cached<P: AffineProblem>(
     cache: &mut NewtonCache,
 ) -> Result<ContactSolution, ContactError> {
     let nt = check_newton_input(problem, params)?;
+    if !params.weakening {
+        points.refuse_weakening()?;
+    }
     let pre = Preamble::new(
         &mut Counter::new(problem),
         points,
@@ -765,7 +770,7 @@ fn sweeps_first<P: AffineProblem>(
     let Some(step) = step else {
         return Ok(First::Skipped);
     };
-    if !params.schedule.has(Phase::Sweeps) || params.weakening.is_some() {
+    if !params.schedule.has(Phase::Sweeps) || params.weakening {
         return Ok(First::Skipped);
     }
     let budget = FIRST_SWEEPS_STEPS * step;
@@ -859,7 +864,7 @@ pub fn solve_newton_electric(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactSolution, ContactError> {
     problem.check(points)?;
-    if params.weakening.is_some() {
+    if params.weakening || points.weakens() {
         return Err(InputError::Unsupported("slip-weakening friction with electrical contact").into());
     }
     let (mut scaled, s) = problem.scaled();
@@ -1010,7 +1015,7 @@ fn after_stall<P: AffineProblem>(
 ) -> Result<ContactSolution, ContactError> {
     let Asked { points, law, params } = asked;
     let best_residual = stalled.residual;
-    let failure = if params.schedule.has(Phase::Fallback) && params.weakening.is_none() {
+    let failure = if params.schedule.has(Phase::Fallback) && !params.weakening {
         match fallback(
             problem,
             asked,

@@ -71,18 +71,18 @@ impl ContactSolve<'_> {
                     refine_start,
                     ..self.newton_params()
                 };
-                match &self.weakening {
+                match points.weakens() {
                     // the branch from the stick start, whatever the warm start
-                    Some(w) => {
+                    true => {
                         let params = contact::WeakeningParams {
                             newton: params,
                             tol,
                             ..Default::default()
                         };
                         let cache = &mut self.cache.borrow_mut();
-                        contact::solve_slip_weakening_cached(dense, points, w, &params, &mut progress, cache)
+                        contact::solve_slip_weakening_cached(dense, points, &params, &mut progress, cache)
                     }
-                    None => {
+                    false => {
                         let cache = &mut self.cache.borrow_mut();
                         contact::solve_newton_cached(dense, points, &self.law, &params, start, &mut progress, cache)
                     }
