@@ -849,6 +849,58 @@ fn an_indenter_among_several_contact_groups_reports_its_own_zone() {
     assert!((groups[1].normal_force - x.force).abs() < 1e-10 * x.force);
 }
 
+/// Force control on the indenter of several contact zones (zones once could not carry it):
+/// hertz-sphere's body of revolution with its rim squeezed by a wall (gap -1e-4, frictionless)
+/// beside the indenter. Pressed with the force the depth 0.01 carries, the indenter finds that
+/// depth, and the wall, its gaps as they are (the search drives the indenter's points alone),
+/// carries what it carried at that depth; its force is not counted in the indenter's.
+#[test]
+fn force_control_drives_the_indenter_among_several_contact_zones() {
+    let sets = ["mesh.n=48".to_string(), "~exact".into()];
+    let (one, _) = files::scene_file::load("hertz-sphere", &sets).unwrap();
+    let mut wall = problem::ContactSpec::new("right", ContactLaw::Signorini, &[1.0, 0.0]);
+    wall.gap = -1e-4;
+    let indenter = one.first_contact().unwrap().clone();
+    let with = |indenter: problem::ContactSpec| {
+        let mut two = one.clone();
+        two.contact = Some(problem::Contacts::Many(vec![wall.clone(), indenter]));
+        problem::solve(&two, None, &mut Silent).unwrap()
+    };
+    let at_depth = with(indenter.clone());
+    let x = at_depth.report.indenter.as_ref().unwrap();
+    let mut pressed = indenter;
+    let spec = pressed.indenter.as_mut().unwrap();
+    (spec.depth, spec.force) = (0.0, Some(x.force));
+    let by_force = with(pressed);
+    let y = by_force.report.indenter.as_ref().unwrap();
+    assert!(
+        (y.force - x.force).abs() <= 1e-8 * x.force,
+        "force {} against {}",
+        y.force,
+        x.force
+    );
+    assert!(
+        (y.depth - x.depth).abs() <= 1e-6 * x.depth,
+        "depth {} against {}",
+        y.depth,
+        x.depth
+    );
+    let (a, b) = (&at_depth.report.contact.groups, &by_force.report.contact.groups);
+    assert_eq!(a[0].group, "right");
+    assert!(
+        a[0].normal_force > 0.0,
+        "the wall carries nothing: {}",
+        a[0].normal_force
+    );
+    assert!(
+        (b[0].normal_force - a[0].normal_force).abs() <= 1e-6 * a[0].normal_force,
+        "the wall carries {} by force against {} at the depth",
+        b[0].normal_force,
+        a[0].normal_force
+    );
+    assert!((b[1].normal_force - y.force).abs() <= 1e-10 * y.force);
+}
+
 /// The half-space's closed form only inside its domain: where nothing touches (a depth of 0
 /// or less) the run solves (no force) and run.json says why the closed form is absent, and
 /// `[exact]` there is refused by key; where the closed form does not evaluate to a contact (a

@@ -37,9 +37,10 @@ pub enum ForceError<E> {
     },
 }
 
-/// The depth at which the body carries `force` (`Σ w_i λ_n,i`) from the indenter: each
-/// evaluation a contact solve (`solve`, on the points with their gaps lowered by `s`, from the
-/// last multipliers, the first from `start`); the search's steps up start at first touch and
+/// The depth at which the body carries `force` (`Σ w_i λ_n,i` over the indenter's points:
+/// `driven`, or every point where `None`) from the indenter: each evaluation a contact solve
+/// (`solve`, on the points with the indenter's gaps lowered by `s`, the others' as they are,
+/// from the last multipliers, the first from `start`); the search's steps up start at first touch and
 /// grow fourfold from a millionth of the face's size, then regula falsi (Illinois) closes on the
 /// depth. A zero force (a path's load factor at 0) is met with the indenter just touching
 /// (every shallower depth carries none too). The caller's solve must take Newton steps from a
@@ -51,19 +52,19 @@ pub enum ForceError<E> {
 /// 200 contact solves.
 pub fn solve_force_controlled<E>(
     points: &mut ContactPoints,
+    driven: Option<&[bool]>,
     force: f64,
     start: Option<PointValues>,
     mut solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, E>,
 ) -> Result<ContactSolution, ForceError<E>> {
     let base = points.gap.clone();
+    let drives = |i: usize| driven.is_none_or(|d| d.get(i).copied().unwrap_or(false));
     let size = face_size(points);
     let mut last = start;
     // the largest force carried so far (`f - force` loses `f` when the force asked is huge)
     let mut most = 0.0f64;
     let mut eval = |s: f64, points: &mut ContactPoints| -> Result<Evaluation<ContactSolution>, E> {
-        for (g, b) in points.gap.iter_mut().zip(&base) {
-            *g = b - s;
-        }
+        lower(points, &base, s, &drives);
         let sol = solve(points, last.take())?;
         last = Some(sol.lambda.clone());
         let f = sol
@@ -71,7 +72,9 @@ pub fn solve_force_controlled<E>(
             .normal
             .iter()
             .zip(&points.weight)
-            .map(|(l, w)| l * w)
+            .enumerate()
+            .filter(|&(i, _)| drives(i))
+            .map(|(_, (l, w))| l * w)
             .sum::<f64>();
         most = most.max(f);
         Ok(Evaluation {
@@ -81,7 +84,10 @@ pub fn solve_force_controlled<E>(
             value: sol,
         })
     };
-    let touch = base.iter().cloned().fold(f64::INFINITY, f64::min);
+    let touch = (0..base.len())
+        .filter(|&i| drives(i))
+        .map(|i| base[i])
+        .fold(f64::INFINITY, f64::min);
     if force == 0.0 {
         // every depth short of first touch carries no force: the indenter just touching
         return eval(touch, points).map(|e| e.value).map_err(ForceError::Solve);
@@ -111,13 +117,20 @@ pub fn solve_force_controlled<E>(
         Err(SearchError::NoBracket) => return Err(ForceError::Unreachable { force, most }),
         Err(SearchError::NotFound) => return Err(ForceError::NotFound { force }),
     };
-    for (g, b) in points.gap.iter_mut().zip(&base) {
-        *g = b - s;
-    }
+    lower(points, &base, s, &drives);
     Ok(sol)
 }
 
-/// The largest extent of the contact points along any axis.
+/// The gaps of the points the indenter drives lowered by the depth `s` from `base`.
+fn lower(points: &mut ContactPoints, base: &[f64], s: f64, drives: &dyn Fn(usize) -> bool) {
+    for (i, (g, b)) in points.gap.iter_mut().zip(base).enumerate() {
+        if drives(i) {
+            *g = b - s;
+        }
+    }
+}
+
+/// The largest extent of the contact points along any axis (the scale of the search's steps).
 fn face_size(points: &ContactPoints) -> f64 {
     (0..3)
         .map(|k| {

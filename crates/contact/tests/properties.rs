@@ -1259,3 +1259,48 @@ fn the_nested_start_saves_steps_on_many_chains() {
     // 87 495 before the cycle rule and the coarser problems' proximal stage)
     assert!(4 * steps_nested <= steps_zero, "{steps_nested} against {steps_zero}");
 }
+
+/// Force control drives the indenter's points alone: of two uncoupled frictionless points
+/// (`u = u₀ - λ`, `u₀ = (-1, -0.25)`, gaps 0), the first the indenter's, the second a wall's,
+/// the force 2 on the first is carried at the depth 3 (`λ₀ = s - 1`); the wall's gap stays, and
+/// its multiplier 0 is not counted. Driving both points, the wall would carry 2.75.
+#[test]
+fn force_control_drives_only_the_indenters_points() {
+    let pts = ContactPoints {
+        weight: vec![1.0; 2],
+        position: vec![[0.0; 3], [1.0, 0.0, 0.0]],
+        ..points(2, 2, &[0.5, 0.5], 0.0)
+    };
+    let op = DenseContactProblem {
+        u0: PointValues::from_parts(vec![-1.0, -0.25], vec![], 0).unwrap(),
+        compliance: vec![1.0, 0.0, 0.0, 1.0],
+        weight: vec![1.0; 2],
+        nt: 0,
+    };
+    let params = NewtonParams {
+        tol: 1e-14,
+        ..Default::default()
+    };
+    let solve = |p: &ContactPoints, start: Option<PointValues>| {
+        solve_newton(&mut op.clone(), p, &Law::Frictionless, &params, start, &mut |_| {})
+    };
+    let mut driven = pts.clone();
+    let sol = contact::solve_force_controlled(&mut driven, Some(&[true, false]), 2.0, None, solve).unwrap();
+    assert!((sol.lambda.normal[0] - 2.0).abs() < 1e-9 * 2.0, "{:?}", sol.lambda);
+    assert_eq!(sol.lambda.normal[1], 0.0);
+    assert!(
+        (driven.gap[0] + 3.0).abs() < 1e-8 && driven.gap[1] == 0.0,
+        "{:?}",
+        driven.gap
+    );
+    // every point driven: the force is shared, each lowered alike
+    let mut both = pts.clone();
+    let sol = contact::solve_force_controlled(&mut both, None, 2.0, None, solve).unwrap();
+    let total = sol.lambda.normal[0] + sol.lambda.normal[1];
+    assert!(
+        (total - 2.0).abs() < 1e-9 * 2.0 && both.gap[0] == both.gap[1],
+        "{:?} {:?}",
+        sol.lambda,
+        both.gap
+    );
+}

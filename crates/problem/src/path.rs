@@ -590,13 +590,7 @@ impl Walk<'_> {
         reporter: &mut dyn Reporter,
     ) -> Result<(ContactSolution, Springs), ProblemError> {
         let (backend, path, how, state) = (&mut *on.backend, &mut *on.path, on.how, &mut *on.state);
-        let force = match self.contact.model().map(|m| m.obstacle) {
-            Some(crate::scene::Obstacle::Indenter {
-                control: crate::scene::Control::Force(force),
-                ..
-            }) => Some(force),
-            _ => None,
-        };
+        let control = crate::outer::ForceControl::of(self.scene, boundary);
         let base_gap = boundary.points.gap.clone();
         let n = boundary.points.len();
         let mut springs = Springs {
@@ -613,9 +607,10 @@ impl Walk<'_> {
             };
             backend.prime(path, framed, factors, &springs.lambda)?;
             boundary.points.gap.clone_from(&base_gap);
-            let sol = match force {
-                Some(force) => {
-                    crate::outer::force_controlled(&mut boundary.points, force * load, start, |points, warm| {
+            let sol = match &control {
+                Some(control) => {
+                    let force = control.force * load;
+                    crate::outer::force_controlled(&mut boundary.points, control, force, start, |points, warm| {
                         let at = At {
                             points,
                             start: warm,

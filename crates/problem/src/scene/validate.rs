@@ -932,10 +932,11 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 
 /// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
 /// coefficient or slip-weakening law, Tresca bound, foundation (rigid, or its own compliance)
-/// and (one of them) a depth-controlled indenter; the friction law they share (Coulomb's with
-/// a constant or a weakening coefficient, or Tresca's), a frictionless zone joining either;
-/// what is posed for one zone (electrical contact, a floating tip, force control, an exact
-/// solution) refused by key.
+/// and (one of them) an indenter, at a depth or pressed with a force (its own points driven,
+/// the others resting on their foundations); the friction law they share (Coulomb's with a
+/// constant or a weakening coefficient, or Tresca's), a frictionless zone joining either; what
+/// is posed for one zone (electrical contact, a floating tip, an exact solution) refused by
+/// key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
     let contacts = s.contacts();
     let [first, rest @ ..] = contacts else { return Ok(()) };
@@ -984,11 +985,6 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
         };
         one("contact.electric", c.electric_law().is_some(), "electrical contact")?;
         one("contact.charge", c.charge.is_some(), "a floating tip")?;
-        one(
-            "contact.indenter.force",
-            c.indenter.as_ref().is_some_and(|i| i.force.is_some()),
-            "force control",
-        )?;
     }
     refuse_if(
         contacts.iter().filter(|c| c.indenter.is_some()).count() > 1,

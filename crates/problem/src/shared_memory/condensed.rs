@@ -7,9 +7,9 @@ use super::{Factored, LinearSolver};
 use crate::backend::Fields;
 use crate::backend::{ContactSolve, Posed, Solved};
 use crate::boundary::{ContactBoundary, FullSolve};
-use crate::outer::{floating_tip, force_controlled};
+use crate::outer::{floating_tip, force_controlled, ForceControl};
 use crate::progress::{Event, Reporter};
-use crate::scene::{ContactSolver, Control, Obstacle, Rule, ZoneElectric};
+use crate::scene::{ContactSolver, Rule, ZoneElectric};
 use crate::ProblemError;
 use contact::{
     ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, NewtonParams, PointValues,
@@ -113,17 +113,6 @@ impl ContactSolve<'_> {
     }
 }
 
-/// The force of a force-controlled indenter in `posed`'s scene.
-fn indenter_force(posed: &Posed<'_>) -> Option<f64> {
-    match posed.scene.first_contact()?.model()?.obstacle {
-        Obstacle::Indenter {
-            control: Control::Force(force),
-            ..
-        } => Some(force),
-        _ => None,
-    }
-}
-
 /// The contact solve: on the condensed compliance (Newton, or a first-order method), or with
 /// one full primal solve per first-order step; then `(u, φ)` under the contact forces found.
 pub(super) fn solve_contact(
@@ -156,10 +145,12 @@ pub(super) fn solve_contact(
                 &mut system.condense,
                 reporter,
             )?;
-            let sol = match indenter_force(posed) {
-                Some(force) => force_controlled(&mut boundary.points, force, None, |points, start| {
-                    how.run_with(Operator::Condensed(&mut dense), points, start, true, reporter)
-                })?,
+            let sol = match ForceControl::of(posed.scene.scene(), &boundary) {
+                Some(control) => {
+                    force_controlled(&mut boundary.points, &control, control.force, None, |points, start| {
+                        how.run_with(Operator::Condensed(&mut dense), points, start, true, reporter)
+                    })?
+                }
                 None => how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?,
             };
             let (mut u, mut phi) = boundary.recover(direct, condensed, &sol.lambda, &loads.b_u, &loads.b_phi)?;
@@ -264,8 +255,8 @@ fn electric_contact(
         Some(charge) => floating_tip(&mut problem, points, charge, &mut newton),
         None => newton(&problem, points),
     };
-    let mut sol = match indenter_force(posed) {
-        Some(force) => force_controlled(&mut boundary.points, force, None, &mut solve)?,
+    let mut sol = match ForceControl::of(posed.scene.scene(), boundary) {
+        Some(control) => force_controlled(&mut boundary.points, &control, control.force, None, &mut solve)?,
         None => solve(&boundary.points, None)?,
     };
     let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
