@@ -446,3 +446,80 @@ fn the_manufactured_sliding_solution_converges_at_order_one() {
         }
     }
 }
+
+/// One conducting zone among several (zones once could not carry electrical contact): the
+/// corner, its open top electrode removed, its right wall an ideal conductor at 0 and its top
+/// wall insulated. Where every point of the right wall touches, the conductor is the Dirichlet
+/// condition `φ = 0` on the face: the run with that condition in its place gives the same
+/// fields, and the wall's charge (the charge on the conductor) is the terminal's. Two zones
+/// conducting are refused by key.
+#[test]
+fn one_conducting_zone_among_several_is_a_terminal_where_it_touches() {
+    let (mut base, _) = files::scene_file::load("corner", &[]).unwrap();
+    base.electrode = None;
+    let mut conducting = base.clone();
+    {
+        let problem::Contacts::Many(zones) = conducting.contact.as_mut().unwrap() else {
+            panic!("the corner has two zones")
+        };
+        zones[0].electric = Some(ElectricCondition::Conducting);
+        zones[0].foundation_potential = Some(0.0);
+    }
+    let mut grounded = base.clone();
+    grounded.dirichlet.push(DirichletSpec {
+        group: "right".into(),
+        phi: Some(0.0),
+        ..Default::default()
+    });
+    let a = problem::solve(&conducting, None, &mut Silent).unwrap();
+    let b = problem::solve(&grounded, None, &mut Silent).unwrap();
+    let c = a.contact.as_ref().unwrap();
+    let on_wall: Vec<usize> = (0..c.group_of.len()).filter(|&i| c.group_of[i] == 0).collect();
+    assert!(
+        on_wall.iter().all(|&i| c.solution.lambda.normal[i] > 0.0),
+        "every point of the wall touches"
+    );
+    let e = c.solution.electric.as_ref().unwrap();
+    assert!(
+        e.points.iter().all(|&i| c.group_of[i] == 0),
+        "only the conducting zone's points carry a potential row"
+    );
+    let scale = b.phi.iter().fold(0.0f64, |m, p| m.max(p.abs()));
+    assert!(scale > 0.0);
+    let dphi = a.phi.iter().zip(&b.phi).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(dphi <= 1e-9 * scale, "potentials differ by {dphi:e} (scale {scale:e})");
+    let uscale = b.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let du =
+        a.u.iter()
+            .flatten()
+            .zip(b.u.iter().flatten())
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(du <= 1e-9 * uscale, "displacements differ by {du:e}");
+    let wall = a.report.contact.charge.unwrap();
+    let terminal = b.report.terminals.iter().find(|t| t.group == "right").unwrap().charge;
+    assert!(
+        (wall - terminal).abs() <= 1e-8 * terminal.abs(),
+        "the wall's charge {wall:e}, the terminal's {terminal:e}"
+    );
+    // two zones conducting: one conducts, the others are insulated
+    let mut both = conducting;
+    let problem::Contacts::Many(zones) = both.contact.as_mut().unwrap() else {
+        unreachable!()
+    };
+    zones[1].electric = Some(ElectricCondition::Conducting);
+    let e = both.validate().unwrap_err();
+    assert_eq!(e.key, "contact.electric", "{e}");
+    // along a path, electrical contact is refused on any zone, not the first's alone
+    let sets: Vec<String> = [
+        "~electrode",
+        "contact.1.electric=\"conducting\"",
+        "path={t=[0.0,1.0],steps=2,gap=[0.0,1.0]}",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let Err(e) = files::scene_file::load("corner", &sets) else {
+        panic!("a path with a conducting second zone was accepted")
+    };
+    assert!(e.to_string().contains("path does not apply: electrical contact along a path"), "{e}");
+}

@@ -244,8 +244,12 @@ impl ContactBoundary {
         for (k, spec) in specs.iter().enumerate() {
             b.add_group(disc, k, spec, &mut place)?;
         }
-        if let [spec] = specs {
-            b.electric = electric_points(spec, &disc.dofs, &b.nodes)?;
+        // the zone that conducts (at most one: validated), its points' potentials condensed
+        if let Some((k, spec)) = specs.iter().enumerate().find(|(_, s)| s.electric_law().is_some()) {
+            let members = (0..b.nodes.len())
+                .filter(|&i| b.group_of[i] == k)
+                .map(|i| (i, b.nodes[i]));
+            b.electric = electric_points(spec, &disc.dofs, members)?;
         }
         // zones whose friction weakens with the slip: each point its zone's law (a law from a
         // static coefficient of 0 is frictionless: its points keep the coefficient 0)
@@ -730,15 +734,16 @@ impl ContactBoundary {
     }
 }
 
-/// The electric points of a conductive or conducting foundation: the contact points whose
-/// potential is free (one on an electrode has it prescribed).
+/// The electric points of a conductive or conducting foundation: the contact points of its
+/// zone (`members`: each point's index among the boundary's and its node) whose potential is
+/// free (one on an electrode has it prescribed).
 ///
 /// # Errors
 /// `contact.electric` on a body without electric unknowns.
 fn electric_points(
     spec: &ContactSpec,
     dofs: &DofMap,
-    nodes: &[usize],
+    members: impl Iterator<Item = (usize, usize)>,
 ) -> Result<Option<(contact::ElectricContact, Vec<usize>)>, ProblemError> {
     let Some((law, potential)) = spec.electric_law() else {
         return Ok(None);
@@ -751,7 +756,7 @@ fn electric_points(
         .into());
     }
     let (mut points, mut phi) = (vec![], vec![]);
-    for (i, &node) in nodes.iter().enumerate() {
+    for (i, node) in members {
         if let Some((group, _)) = dofs.floating.iter().find(|(_, j)| dofs.phi[node] == Dof::Free(*j)) {
             return Err(SetupError::new(
                 "contact.electric",

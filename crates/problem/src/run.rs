@@ -497,7 +497,12 @@ pub(crate) fn indenter_report(
         contact_radius: radius,
         points_in_contact: count,
         potential: conductor_potential(c, sol),
-        charge: sol.electric.as_ref().map(|e| e.charge(&points.weight)),
+        // the charge across its own zone, where it conducts (another zone may)
+        charge: sol
+            .electric
+            .as_ref()
+            .filter(|_| c.electric_law().is_some())
+            .map(|e| e.charge(&points.weight)),
         tip_potential: None,
         half_space: None,
         half_space_absent: None,

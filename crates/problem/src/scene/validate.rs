@@ -355,9 +355,10 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "path",
         "a path carries friction's history from step to step, and the scene has no contact (contact.law = \"none\"): without it each instant is the static answer scaled",
     )?;
+    // the indenter's zone, whichever it is among several
     let force_control = scene
-        .active_contact()
-        .and_then(|c| c.indenter.as_ref())
+        .indenter_contact()
+        .and_then(|(_, c)| c.indenter.as_ref())
         .is_some_and(|i| i.force.is_some());
     applies(
         scene.loads().is_empty() && !force_control,
@@ -370,9 +371,10 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "path",
         "an exact solution is checked at one instant; a path solves many (remove [exact] or [path])",
     )?;
-    if let Some(c) = scene.active_contact() {
+    if scene.active_contact().is_some() {
+        // every zone's condition, not the first's alone
         refuse_if(
-            c.electric_law().is_some(),
+            scene.contacts().iter().any(|c| c.electric_law().is_some()),
             "path",
             "electrical contact along a path is not built yet: solve its instants one by one",
         )?;
@@ -934,9 +936,9 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 /// coefficient or slip-weakening law, Tresca bound, foundation (rigid, or its own compliance)
 /// and (one of them) an indenter, at a depth or pressed with a force (its own points driven,
 /// the others resting on their foundations); the friction law they share (Coulomb's with a
-/// constant or a weakening coefficient, or Tresca's), a frictionless zone joining either; what
-/// is posed for one zone (electrical contact, a floating tip, an exact solution) refused by
-/// key.
+/// constant or a weakening coefficient, or Tresca's), a frictionless zone joining either; one
+/// zone conducting (electrical contact), the others insulated; what is posed for one zone (a
+/// floating tip, an exact solution) refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
     let contacts = s.contacts();
     let [first, rest @ ..] = contacts else { return Ok(()) };
@@ -983,7 +985,16 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
                 ),
             )
         };
-        one("contact.electric", c.electric_law().is_some(), "electrical contact")?;
+        if let Some(other) = contacts[..k].iter().find(|o| o.electric_law().is_some()) {
+            refuse_if(
+                c.electric_law().is_some(),
+                "contact.electric",
+                &format!(
+                    "electrical contact on two [[contact]] groups (`{}` and `{}`): one zone conducts, the others are insulated",
+                    other.group, c.group
+                ),
+            )?;
+        }
         one("contact.charge", c.charge.is_some(), "a floating tip")?;
     }
     refuse_if(
