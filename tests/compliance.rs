@@ -414,3 +414,45 @@ fn a_path_of_a_body_only_its_bed_holds_meets_the_closed_form_at_each_instant() {
         );
     }
 }
+
+/// A body only its bed holds, pressed by an indenter: with a force (the springs that hold it
+/// sized by that force) it rests on its bed, which carries the indenter's force to round-off
+/// (the body is free along the bed's normal: contact alone balances it); at a depth (a force
+/// only the solve finds) it is refused, naming the indenter and what to give instead.
+#[test]
+fn a_body_only_its_bed_holds_is_pressed_by_a_force_controlled_indenter() {
+    let text = |control: &str| {
+        format!(
+            "name = \"bed-indenter\"\ndescription = \"a block on its bed, pressed\"\n\
+             [mesh]\nkind = \"rectangle\"\nlo = [0.0, 0.0]\nhi = [2.0, 1.0]\nn = 16\n\
+             [[material]]\nregion = \"body\"\nmodel = \"isotropic\"\nyoung = 100.0\npoisson = 0.3\n\
+             [[dirichlet]]\ngroup = \"left\"\nux = 0.0\n\
+             [[contact]]\ngroup = \"bottom\"\nlaw = \"signorini\"\nnormal = [0.0, -1.0]\ncompliance = {{ stiffness = 10.0, exponent = 1.0 }}\n\
+             [[contact]]\ngroup = \"top\"\nlaw = \"signorini\"\nnormal = [0.0, 1.0]\n\
+             [contact.indenter]\nshape = \"paraboloid\"\nradius = 1.0\n{control}\n"
+        )
+    };
+    let scene = files::scene_file::parse(&text("force = 0.1"), "bed-indenter", &[]).unwrap();
+    let s = problem::solve(&scene, None, &mut Silent).unwrap();
+    let groups = &s.report.contact.groups;
+    assert_eq!((groups[0].group.as_str(), groups[1].group.as_str()), ("bottom", "top"));
+    assert!(
+        (groups[1].normal_force - 0.1).abs() < 1e-9,
+        "the indenter's force {}",
+        groups[1].normal_force
+    );
+    assert!(
+        (groups[0].normal_force - groups[1].normal_force).abs() < 1e-10,
+        "the bed carries {} of the indenter's {}",
+        groups[0].normal_force,
+        groups[1].normal_force
+    );
+    assert!(s.report.iterations.bed > 0);
+    let scene = files::scene_file::parse(&text("depth = 0.01"), "bed-indenter", &[]).unwrap();
+    let e = fails(&scene);
+    let message = e.to_string();
+    assert!(
+        message.contains("the indenter at a depth on `top` presses it") && message.contains("contact.indenter.force"),
+        "{message}"
+    );
+}

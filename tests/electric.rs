@@ -521,5 +521,9 @@ fn one_conducting_zone_among_several_is_a_terminal_where_it_touches() {
     let Err(e) = files::scene_file::load("corner", &sets) else {
         panic!("a path with a conducting second zone was accepted")
     };
-    assert!(e.to_string().contains("path does not apply: electrical contact along a path"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("path does not apply: electrical contact along a path"),
+        "{e}"
+    );
 }

@@ -43,6 +43,48 @@ pub const SETTLED: f64 = 1e-11;
 /// At most this many steps of the fixed point.
 pub const MAX_STEPS: usize = 60;
 
+/// No solution where nothing the run knows of beforehand presses the body onto its bed: the
+/// loads (and a force-controlled indenter's force) float it or lift it off. Where another zone
+/// presses on a rigid obstacle (an indenter at a depth, a rigid foundation), its force is found
+/// only by the solve, and the springs that hold the body are sized by a force known before it:
+/// the message says so, and what to give instead.
+fn not_pressed(posed: &Posed<'_>, boundary: &ContactBoundary, force: f64, size: f64, pressed: bool) -> ProblemError {
+    let rigid: Vec<&str> = boundary
+        .groups
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| {
+            (0..boundary.points.len())
+                .any(|i| boundary.group_of[i] == k && boundary.points.foundation_of(i) == Foundation::Rigid)
+        })
+        .map(|(_, g)| g.as_str())
+        .collect();
+    let what = if pressed {
+        "the loads and the indenter's force"
+    } else {
+        "the loads"
+    };
+    let mut why = format!(
+        "only the compliant bed holds the body, and {what} do not press it onto the bed (their resultant along the bed's normal is {force:.3e}, of loads of size {size:.3e})"
+    );
+    match (rigid.is_empty(), posed.scene.scene().indenter_contact()) {
+        (true, _) => why.push_str(": the body floats or lifts off"),
+        (false, Some((_, c))) if c.indenter.as_ref().is_some_and(|i| i.force.is_none()) => why.push_str(&format!(
+            ": the indenter at a depth on `{}` presses it, with a force only the solve finds, and the springs that hold the body in the meantime are sized by a force known before it: press with a force (contact.indenter.force), add a load, or hold the body by a Dirichlet condition",
+            c.group
+        )),
+        (false, _) => why.push_str(&format!(
+            ": the rigid zone{} `{}` may press it, with a force only the solve finds, and the springs that hold the body in the meantime are sized by a force known before it: add a load that presses it onto the bed, or hold the body by a Dirichlet condition",
+            if rigid.len() > 1 { "s" } else { "" },
+            rigid.join("`, `")
+        )),
+    }
+    ProblemError::NoSolution {
+        sought: "contact.compliance",
+        why,
+    }
+}
+
 impl Bed {
     /// The springs a run needs: `None` where the Dirichlet conditions hold the body (or there
     /// is no compliant bed), the springs where only the bed holds some rigid motion.
@@ -100,17 +142,27 @@ impl Bed {
                 *m += points.weight[i] * n;
             }
         }
+        // a force-controlled indenter presses the body with its force, along its points'
+        // inward normal
+        let control = crate::outer::ForceControl::of(posed.scene.scene(), boundary);
+        let mut size: f64 = b.iter().map(|x| x.abs()).sum();
+        if let Some(control) = &control {
+            let driven: Vec<usize> = (0..points.len())
+                .filter(|&i| control.driven.as_ref().is_none_or(|d| d[i]))
+                .collect();
+            let area: f64 = driven.iter().map(|&i| points.weight[i]).sum();
+            for &i in &driven {
+                for (r, n) in resultant.iter_mut().zip(points.normal[i]) {
+                    *r -= control.force * points.weight[i] / area * n;
+                }
+            }
+            size += control.force;
+        }
         let length = normal.iter().map(|n| n * n).sum::<f64>().sqrt();
         let force: f64 = resultant.iter().zip(&normal).map(|(f, n)| f * n).sum::<f64>() / length;
-        let size: f64 = b.iter().map(|x| x.abs()).sum();
         let pressure = force / area;
         if !(force > 1e-12 * size && pressure.is_finite()) {
-            return Err(ProblemError::NoSolution {
-                sought: "contact.compliance",
-                why: format!(
-                    "only the compliant bed holds the body, and the loads do not press it onto the bed (their resultant along the bed's normal is {force:.3e}, of loads of size {size:.3e}): the body floats or lifts off"
-                ),
-            });
+            return Err(not_pressed(posed, boundary, force, size, control.is_some()));
         }
         // k [p]^m at the pressure P: p = (P / k)^(1/m), tangent k m p^(m-1); the softest bed's
         let tangent = laws
