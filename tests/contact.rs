@@ -701,8 +701,12 @@ fn what_several_contact_groups_cannot_share_is_refused_by_name() {
     );
     assert_eq!(refused(&|s| group(s, 1).law = problem::ContactLaw::None), "contact.law");
     assert_eq!(refused(&|s| group(s, 1).group = "right".into()), "contact.group");
+    // one zone conducts, the others are insulated
     assert_eq!(
-        refused(&|s| group(s, 0).electric = Some(problem::ElectricCondition::Conducting)),
+        refused(&|s| {
+            group(s, 0).electric = Some(problem::ElectricCondition::Conducting);
+            group(s, 1).electric = Some(problem::ElectricCondition::Conducting);
+        }),
         "contact.electric"
     );
     // several zones: the PETSc backend's own refusal (the scene is valid)

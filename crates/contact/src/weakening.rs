@@ -264,6 +264,41 @@ fn frozen_step<P: AffineProblem>(
     }
 }
 
+/// Newton on the law itself from an iterate of the fixed point: each weakening point's
+/// coefficient at its slip, differentiated through it ([`NewtonParams::weakening`]), from the
+/// iterate's coefficients and multipliers.
+struct Polish<'a> {
+    /// The points with their laws.
+    points: &'a ContactPoints,
+    /// The points with the iterate's coefficients.
+    frozen: &'a ContactPoints,
+    /// The fixed point's Newton parameters.
+    newton: &'a NewtonParams,
+    /// The iterate's multipliers.
+    start: &'a crate::PointValues,
+}
+
+impl Polish<'_> {
+    fn solve<P: AffineProblem>(
+        &self,
+        problem: &mut P,
+        progress: &mut dyn FnMut(&Progress),
+        shared: &mut NewtonCache,
+    ) -> Result<ContactSolution, ContactError> {
+        let direct = NewtonParams {
+            weakening: true,
+            schedule: crate::Schedule::of(crate::ProblemClass::SlipWeakening),
+            ..*self.newton
+        };
+        let weakening = ContactPoints {
+            weakening: self.points.weakening.clone(),
+            ..self.frozen.clone()
+        };
+        let start = Some(self.start.clone());
+        solve_newton_cached(problem, &weakening, &Law::Coulomb, &direct, start, progress, shared)
+    }
+}
+
 /// `|G(x) - G(x₀)|_∞ / |x - x₀|_∞` (relative to `scale`) between the last pair `(x₀, G(x₀))`
 /// and `(x, G(x))`, where the step stands above [`NOISE`] times `tol`.
 fn secant_ratio(last: Option<&(Vec<f64>, Vec<f64>)>, (x, g): (&[f64], &[f64]), scale: f64, tol: f64) -> Option<f64> {
@@ -353,24 +388,13 @@ pub fn solve_slip_weakening_cached<P: AffineProblem>(
         // goes on
         if change > params.tol && change <= POLISH && !polished && params.inner == Inner::Newton {
             polished = true;
-            let direct = NewtonParams {
-                weakening: true,
-                schedule: crate::Schedule::of(crate::ProblemClass::SlipWeakening),
-                ..newton
+            let at = Polish {
+                points,
+                frozen: &frozen,
+                newton: &newton,
+                start: &sol.lambda,
             };
-            let weakening = ContactPoints {
-                weakening: points.weakening.clone(),
-                ..frozen.clone()
-            };
-            if let Ok(mut polish) = solve_newton_cached(
-                problem,
-                &weakening,
-                &Law::Coulomb,
-                &direct,
-                Some(sol.lambda.clone()),
-                progress,
-                shared,
-            ) {
+            if let Ok(mut polish) = at.solve(problem, progress, shared) {
                 polish.info.fixed_point_iters = k;
                 polish.info.newton_iters += newton_iters;
                 polish.info.contraction = contraction;

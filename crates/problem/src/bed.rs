@@ -43,6 +43,26 @@ pub const SETTLED: f64 = 1e-11;
 /// At most this many steps of the fixed point.
 pub const MAX_STEPS: usize = 60;
 
+/// Adds a force-controlled indenter's force to the `resultant` of the loads (and to their
+/// `size`): each of its points' share along the point's inward normal. Whether there is one.
+fn indenter_presses(posed: &Posed<'_>, boundary: &ContactBoundary, resultant: &mut [f64; 3], size: &mut f64) -> bool {
+    let Some(control) = crate::outer::ForceControl::of(posed.scene.scene(), boundary) else {
+        return false;
+    };
+    let points = &boundary.points;
+    let driven: Vec<usize> = (0..points.len())
+        .filter(|&i| control.driven.as_ref().is_none_or(|d| d[i]))
+        .collect();
+    let area: f64 = driven.iter().map(|&i| points.weight[i]).sum();
+    for &i in &driven {
+        for (r, n) in resultant.iter_mut().zip(points.normal[i]) {
+            *r -= control.force * points.weight[i] / area * n;
+        }
+    }
+    *size += control.force;
+    true
+}
+
 /// No solution where nothing the run knows of beforehand presses the body onto its bed: the
 /// loads (and a force-controlled indenter's force) float it or lift it off. Where another zone
 /// presses on a rigid obstacle (an indenter at a depth, a rigid foundation), its force is found
@@ -142,27 +162,13 @@ impl Bed {
                 *m += points.weight[i] * n;
             }
         }
-        // a force-controlled indenter presses the body with its force, along its points'
-        // inward normal
-        let control = crate::outer::ForceControl::of(posed.scene.scene(), boundary);
         let mut size: f64 = b.iter().map(|x| x.abs()).sum();
-        if let Some(control) = &control {
-            let driven: Vec<usize> = (0..points.len())
-                .filter(|&i| control.driven.as_ref().is_none_or(|d| d[i]))
-                .collect();
-            let area: f64 = driven.iter().map(|&i| points.weight[i]).sum();
-            for &i in &driven {
-                for (r, n) in resultant.iter_mut().zip(points.normal[i]) {
-                    *r -= control.force * points.weight[i] / area * n;
-                }
-            }
-            size += control.force;
-        }
+        let pressed = indenter_presses(posed, boundary, &mut resultant, &mut size);
         let length = normal.iter().map(|n| n * n).sum::<f64>().sqrt();
         let force: f64 = resultant.iter().zip(&normal).map(|(f, n)| f * n).sum::<f64>() / length;
         let pressure = force / area;
         if !(force > 1e-12 * size && pressure.is_finite()) {
-            return Err(not_pressed(posed, boundary, force, size, control.is_some()));
+            return Err(not_pressed(posed, boundary, force, size, pressed));
         }
         // k [p]^m at the pressure P: p = (P / k)^(1/m), tangent k m p^(m-1); the softest bed's
         let tangent = laws
