@@ -527,3 +527,45 @@ fn one_conducting_zone_among_several_is_a_terminal_where_it_touches() {
         "{e}"
     );
 }
+
+/// A floating conducting zone among several (zones once could not float): the corner, its
+/// left face grounded instead of its bottom, its right wall an ideal conductor carrying the
+/// charge 1e-3. Where every point of the wall touches, the floating conductor is a floating
+/// terminal with that charge on the face: the same fields, the wall's potential the
+/// terminal's, and the grounded face carrying the opposite charge (Gauss).
+#[test]
+fn a_floating_conducting_zone_among_several_is_a_floating_terminal_where_it_touches() {
+    let run = |extra: &[&str]| {
+        let mut sets: Vec<String> = ["~electrode", "~dirichlet.1.phi", "dirichlet.0.phi=0.0"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        sets.extend(extra.iter().map(|s| s.to_string()));
+        let (scene, _) = files::scene_file::load("corner", &sets).unwrap();
+        problem::solve(&scene, None, &mut Silent).unwrap()
+    };
+    let q = 1e-3;
+    let a = run(&["contact.0.electric=\"conducting\"", &format!("contact.0.charge={q}")]);
+    let b = run(&[&format!("electrode={{group=\"right\",charge={q},name=\"wall\"}}")]);
+    let c = a.contact.as_ref().unwrap();
+    assert!((0..c.group_of.len())
+        .filter(|&i| c.group_of[i] == 0)
+        .all(|i| c.solution.lambda.normal[i] > 0.0));
+    let wall = b.report.terminals.iter().find(|t| t.group == "wall").unwrap();
+    let potential = a.report.contact.potential.unwrap();
+    assert!(
+        (potential - wall.potential).abs() <= 1e-9 * wall.potential.abs(),
+        "{potential:e} against {:e}",
+        wall.potential
+    );
+    assert!((a.report.contact.charge.unwrap() - q).abs() <= 1e-9 * q);
+    let left = a.report.terminals.iter().find(|t| t.group == "left").unwrap();
+    assert!(
+        (left.charge + q).abs() <= 1e-9 * q,
+        "Gauss: the grounded face carries {:e}",
+        left.charge
+    );
+    let scale = b.phi.iter().fold(0.0f64, |m, p| m.max(p.abs()));
+    let dphi = a.phi.iter().zip(&b.phi).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(dphi <= 1e-9 * scale, "potentials differ by {dphi:e} of {scale:e}");
+}

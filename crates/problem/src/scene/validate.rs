@@ -937,8 +937,8 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 /// and (one of them) an indenter, at a depth or pressed with a force (its own points driven,
 /// the others resting on their foundations); the friction law they share (Coulomb's with a
 /// constant or a weakening coefficient, or Tresca's), a frictionless zone joining either; one
-/// zone conducting (electrical contact), the others insulated; what is posed for one zone (a
-/// floating tip, an exact solution) refused by key.
+/// zone conducting (electrical contact, held at its potential or floating with its charge),
+/// the others insulated; an exact solution refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
     let contacts = s.contacts();
     let [first, rest @ ..] = contacts else { return Ok(()) };
@@ -975,16 +975,6 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
                 || contacts[..k].iter().any(|o| frictional(o) && frictional(c) && o.law != c.law),
             "their law (a Signorini zone may join Tresca's or Coulomb's, but Tresca's and Coulomb's do not mix, nor a zone switched off with active ones)",
         )?;
-        let one = |key: &str, given: bool, what: &str| {
-            refuse_if(
-                given,
-                key,
-                &format!(
-                    "{what} on one of several [[contact]] groups (`{}`): not yet; pose it with one [contact]",
-                    c.group
-                ),
-            )
-        };
         if let Some(other) = contacts[..k].iter().find(|o| o.electric_law().is_some()) {
             refuse_if(
                 c.electric_law().is_some(),
@@ -995,7 +985,6 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
                 ),
             )?;
         }
-        one("contact.charge", c.charge.is_some(), "a floating tip")?;
     }
     refuse_if(
         contacts.iter().filter(|c| c.indenter.is_some()).count() > 1,
@@ -1171,8 +1160,9 @@ fn refuse_electric(s: &Scene, c: &ContactSpec) -> Result<(), SceneError> {
             "contact.charge",
             "a floating conductor's charge, and contact.electric = \"insulated\" (a floating tip conducts: set contact.electric = \"conducting\" or \"conductive\")",
         )?;
+        // the indenter of any zone (the floating one or another)
         refuse_if(
-            c.indenter.as_ref().is_some_and(|i| i.force.is_some()),
+            s.indenter_contact().is_some_and(|(_, c)| c.indenter.as_ref().is_some_and(|i| i.force.is_some())),
             "contact.charge",
             "a floating tip under force control: not solved yet (the charge jumps as points enter the zone during the search for the depth); give the depth (contact.indenter.depth) instead of contact.indenter.force",
         )?;

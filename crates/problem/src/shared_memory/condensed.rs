@@ -247,10 +247,11 @@ fn electric_contact(
             .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))
     };
     let mut problem = problem;
-    let floating = match posed.scene.first_contact().and_then(|c| c.model()).map(|m| m.electric) {
-        Some(ZoneElectric::Floating { charge, .. }) => Some(charge),
+    // the conducting zone's charge where it floats (one zone conducts: validated)
+    let floating = posed.scene.contacts().iter().find_map(|c| match c.model()?.electric {
+        ZoneElectric::Floating { charge, .. } => Some(charge),
         _ => None,
-    };
+    });
     let mut solve = |points: &ContactPoints, _: Option<PointValues>| match floating {
         Some(charge) => floating_tip(&mut problem, points, charge, &mut newton),
         None => newton(&problem, points),
