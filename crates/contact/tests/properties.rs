@@ -867,14 +867,7 @@ fn slip_weakening_on_one_point_is_its_hand_solution() {
         slip_length: 1.0,
         form: Weakening::Linear,
     };
-    let params = WeakeningParams {
-        tol: 1e-13,
-        newton: NewtonParams {
-            tol: 1e-14,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let params = tight_weakening();
     let sol = solve_slip_weakening(&mut op.clone(), &pts.with_weakening(law), &params, &mut |_| {}).unwrap();
     let half_slope = 0.5 * (0.6 - 0.3) / 1.0;
     let mu = (0.6 - half_slope) / (1.0 - half_slope);
@@ -931,7 +924,7 @@ fn slip_weakening_on_one_point_is_its_hand_solution() {
 /// solvers that hold coefficients constant refuse points that weaken.
 #[test]
 fn slip_weakening_acts_only_where_a_point_has_the_law() {
-    use contact::{solve_slip_weakening, SlipWeakening, Weakening, WeakeningParams};
+    use contact::{solve_slip_weakening, SlipWeakening, Weakening};
     let mut pts = ContactPoints {
         weight: vec![1.0; 2],
         ..points(2, 2, &[0.5, 0.5], 0.6)
@@ -952,14 +945,7 @@ fn slip_weakening_acts_only_where_a_point_has_the_law() {
         weight: vec![1.0; 2],
         nt: 1,
     };
-    let params = WeakeningParams {
-        tol: 1e-13,
-        newton: NewtonParams {
-            tol: 1e-14,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let params = tight_weakening();
     let sol = solve_slip_weakening(&mut op.clone(), &pts, &params, &mut |_| {}).unwrap();
     let half_slope = 0.5 * (0.6 - 0.3) / 1.0;
     let mu = (0.6 - half_slope) / (1.0 - half_slope);
@@ -1303,4 +1289,17 @@ fn force_control_drives_only_the_indenters_points() {
         sol.lambda,
         both.gap
     );
+}
+
+/// The slip-weakening fixed point's parameters of the hand solutions: its tolerance 1e-13,
+/// Newton's 1e-14.
+fn tight_weakening() -> contact::WeakeningParams {
+    contact::WeakeningParams {
+        tol: 1e-13,
+        newton: NewtonParams {
+            tol: 1e-14,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
 }
