@@ -687,18 +687,6 @@ fn what_several_contact_groups_cannot_share_is_refused_by_name() {
             problem::Contacts::One(c) => c,
         }
     }
-    // Tresca's and Coulomb's laws do not mix (a frictionless zone joins either: below)
-    assert_eq!(
-        refused(&|s| {
-            let a = group(s, 0);
-            a.law = problem::ContactLaw::Tresca;
-            a.slip_bound = Some(0.1);
-            let c = group(s, 1);
-            c.law = problem::ContactLaw::Coulomb;
-            c.friction = Some(0.3);
-        }),
-        "contact.law"
-    );
     assert_eq!(refused(&|s| group(s, 1).law = problem::ContactLaw::None), "contact.law");
     assert_eq!(refused(&|s| group(s, 1).group = "right".into()), "contact.group");
     // one zone conducts, the others are insulated
@@ -969,6 +957,46 @@ fn each_contact_zone_keeps_its_own_tresca_bound() {
         strongest > 2.0 * bounds[0],
         "the top wall's largest |λ_t| = {strongest}"
     );
+}
+
+/// A Tresca zone beside a Coulomb zone (zones once could not mix the two): the corner's right
+/// wall under Tresca's bound 1e-3, its top wall under Coulomb's 0.3; every point within its own
+/// zone's radius (the bound, or `F λ_n`), the sliding points on it, some of each wall sliding.
+#[test]
+fn a_tresca_zone_beside_a_coulomb_zone_keeps_each_its_law() {
+    let (bound, mu) = (1e-3, 0.3);
+    let sets = [
+        "contact.0.law=\"tresca\"".to_string(),
+        format!("contact.0.slip_bound={bound}"),
+        "contact.1.law=\"coulomb\"".into(),
+        format!("contact.1.friction={mu}"),
+    ];
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let r = run("corner", &sets);
+    assert_eq!(r.report.plan.contact_law, problem::ContactLaw::Coulomb);
+    let c = r.contact.as_ref().unwrap();
+    let sol = &c.solution;
+    let mut sliding = [0usize; 2];
+    for (i, &g) in c.group_of.iter().enumerate() {
+        let (n, t) = (sol.lambda.normal[i], sol.lambda.component(i, 1).abs());
+        let radius = if g == 0 { bound } else { mu * n };
+        assert!(
+            t <= radius * (1.0 + 1e-9) + 1e-14,
+            "point {i} of zone {g}: |λ_t| = {t} above {radius}"
+        );
+        if sol.status[i] == contact::Status::Slip {
+            sliding[g] += 1;
+            assert!(
+                (t - radius).abs() <= 1e-8 * radius.max(1e-12),
+                "point {i} of zone {g} slides: |λ_t| = {t}, radius {radius}"
+            );
+        }
+    }
+    assert!(
+        sliding[0] > 0 && sliding[1] > 0,
+        "each wall has sliding points: {sliding:?}"
+    );
+    assert!(r.report.residuals.converged_to_tolerance);
 }
 
 /// A frictionless zone beside a frictional one (zones once had to share their law): the

@@ -84,6 +84,7 @@ fn main() {
         foundations: vec![],
         slipped: vec![],
         weakening: vec![],
+        tresca: vec![],
     };
     let mut problem = DenseContactProblem {
         u0,

@@ -165,6 +165,11 @@ impl Coarsening {
             } else {
                 self.chosen.iter().map(|&i| points.weakening_of(i).copied()).collect()
             },
+            tresca: if points.tresca.is_empty() {
+                vec![]
+            } else {
+                self.chosen.iter().map(|&i| points.tresca_of(i)).collect()
+            },
         }
     }
 
@@ -317,6 +322,7 @@ mod tests {
             foundations: vec![],
             slipped: vec![],
             weakening: vec![],
+            tresca: vec![],
         }
     }
 

@@ -293,7 +293,10 @@ fn point_law(law: &Law, points: &ContactPoints, i: usize) -> PointLaw {
     match law {
         Law::Frictionless => PointLaw::Frictionless,
         Law::Tresca(s) => PointLaw::Tresca(s[i]),
-        Law::Coulomb => PointLaw::Coulomb(points.friction[i]),
+        Law::Coulomb => match points.tresca_of(i) {
+            Some(s) => PointLaw::Tresca(s),
+            None => PointLaw::Coulomb(points.friction[i]),
+        },
     }
 }
 

@@ -28,7 +28,7 @@
 //!     dim: 2, position: vec![[0.0; 3]], normal: vec![[0.0, -1.0, 0.0]],
 //!     tangent: vec![[[1.0, 0.0, 0.0], [0.0; 3]]], weight: vec![1.0], gap: vec![0.0], friction: vec![0.0],
 //!     held: vec![[false; 2]],
-//!     foundation: Default::default(), foundations: vec![], slipped: vec![], weakening: vec![],
+//!     foundation: Default::default(), foundations: vec![], slipped: vec![], weakening: vec![], tresca: vec![],
 //! };
 //! let mut op = DenseContactProblem {
 //!     u0: PointValues::from_parts(vec![1.0], vec![], 0).unwrap(),

@@ -40,6 +40,10 @@ pub struct ContactPoints {
     /// ([`crate::solve_slip_weakening`]; `None`: its `friction` is its constant coefficient).
     /// Empty: no point weakens.
     pub weakening: Vec<Option<crate::SlipWeakening>>,
+    /// Each point's Tresca bound where its zone's law is Tresca's beside zones of Coulomb's
+    /// (the problem's law then Coulomb's): its slip radius is that constant whatever its normal
+    /// value, its coefficient `friction` not read (0). `None`: Coulomb's radius. Empty: none.
+    pub tresca: Vec<Option<f64>>,
 }
 
 /// The foundation under the contact points, which gives the normal law.
@@ -157,6 +161,13 @@ impl ContactPoints {
         self.weakening.get(i).and_then(Option::as_ref)
     }
 
+    /// Point `i`'s Tresca bound under Coulomb's law ([`ContactPoints::tresca`]), if its
+    /// radius is a constant.
+    #[inline]
+    pub fn tresca_of(&self, i: usize) -> Option<f64> {
+        self.tresca.get(i).copied().flatten()
+    }
+
     /// Whether a point's coefficient falls with its slip.
     pub fn weakens(&self) -> bool {
         self.weakening.iter().any(Option::is_some)
@@ -247,6 +258,7 @@ impl ContactPoints {
             || !(self.slipped.is_empty() || self.slipped.len() == n)
             || !(self.foundations.is_empty() || self.foundations.len() == n)
             || !(self.weakening.is_empty() || self.weakening.len() == n)
+            || !(self.tresca.is_empty() || self.tresca.len() == n)
         {
             return Err(InputError::PointArrays);
         }
@@ -265,6 +277,9 @@ impl ContactPoints {
             }
             if !(self.friction[i] >= 0.0 && self.friction[i].is_finite()) {
                 return Err(bad(i, "friction", self.friction[i], "must be finite and non-negative"));
+            }
+            if let Some(s) = self.tresca_of(i).filter(|s| !(*s >= 0.0 && s.is_finite())) {
+                return Err(bad(i, "tresca", s, "must be finite and non-negative"));
             }
             if !(self.slipped(i) >= 0.0 && self.slipped(i).is_finite()) {
                 return Err(bad(i, "slipped", self.slipped(i), "must be finite and non-negative"));

@@ -328,6 +328,7 @@ impl FrictionProblem {
             foundations: vec![],
             slipped: vec![],
             weakening: vec![],
+            tresca: vec![],
         }
     }
 

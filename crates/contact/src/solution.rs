@@ -300,13 +300,17 @@ pub fn slip_bound(points: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f6
 
 impl Law {
     /// The slip radius of point `i` at the normal value `z_n` (a multiplier, or Newton's
-    /// augmented `z_n`): Tresca's `S_i`, Coulomb's `F_i [z_n]₊` ([`coulomb_radius`]), 0
+    /// augmented `z_n`): Tresca's `S_i`, Coulomb's `F_i [z_n]₊` ([`coulomb_radius`]) or, at a
+    /// point of a Tresca zone beside Coulomb's ([`ContactPoints::tresca_of`]), its bound; 0
     /// without friction. The one place the radius is written.
     pub fn radius(&self, points: &ContactPoints, i: usize, z_n: f64) -> f64 {
         match self {
             Law::Frictionless => 0.0,
             Law::Tresca(s) => s[i],
-            Law::Coulomb => coulomb_radius(points.friction[i], z_n),
+            Law::Coulomb => match points.tresca_of(i) {
+                Some(s) => s,
+                None => coulomb_radius(points.friction[i], z_n),
+            },
         }
     }
 }
@@ -391,8 +395,12 @@ pub fn desaxce_residual(
         }
         // a held direction is no direction of the set: the projection is the subspace's first
         points.hold(i, &mut x[1..1 + nt]);
-        match law {
-            Law::Coulomb => {
+        match (law, points.tresca_of(i)) {
+            (Law::Coulomb, Some(s)) => {
+                x[0] = project_nonnegative(x[0]);
+                project_disc(&mut x[1..1 + nt], s);
+            }
+            (Law::Coulomb, None) => {
                 let f = points.friction[i];
                 let mut slip = [0.0; 2];
                 slip[..nt].copy_from_slice(ut);
@@ -400,11 +408,11 @@ pub fn desaxce_residual(
                 x[0] -= f * norm(&slip[..nt]);
                 project_cone(&mut x[..1 + nt], f);
             }
-            Law::Tresca(s) => {
+            (Law::Tresca(s), _) => {
                 x[0] = project_nonnegative(x[0]);
                 project_disc(&mut x[1..1 + nt], s[i]);
             }
-            Law::Frictionless => x[0] = project_nonnegative(x[0]),
+            (Law::Frictionless, _) => x[0] = project_nonnegative(x[0]),
         }
         e2 += (rn - x[0]).powi(2) + (0..nt).map(|k| (rt[k] - x[1 + k]).powi(2)).sum::<f64>();
     }

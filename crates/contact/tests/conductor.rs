@@ -25,6 +25,7 @@ fn points(n: usize) -> ContactPoints {
         foundations: vec![],
         slipped: vec![],
         weakening: vec![],
+        tresca: vec![],
     }
 }
 

@@ -88,6 +88,7 @@ impl Chain {
             foundations: vec![],
             slipped: vec![],
             weakening: vec![],
+            tresca: vec![],
         }
     }
 

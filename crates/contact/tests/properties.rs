@@ -24,6 +24,7 @@ fn points(n: usize, dim: usize, w: &[f64], friction: f64) -> ContactPoints {
         foundations: vec![],
         slipped: vec![],
         weakening: vec![],
+        tresca: vec![],
     }
 }
 
@@ -197,6 +198,46 @@ proptest! {
             let scale = newton.lambda.norm().max(1e-12);
             prop_assert!(gs.lambda.minus(&newton.lambda).norm() <= 1e-7 * scale, "{lipschitz}: {:?} {:?}", gs.lambda, newton.lambda);
         }
+    }
+
+    /// Each point its own friction law: Tresca's bound at some points (`ContactPoints::tresca`),
+    /// Coulomb's coefficient at the others, under Coulomb's law. Newton's answer meets each
+    /// point's law, and is the answer of Tresca's law (unique: a strictly convex problem) with
+    /// the bounds `S_i` of the Tresca points and `F_i λ_n,i` of the others, the fixed point's
+    /// identity; block Gauss-Seidel takes the mixed points too and meets the same laws.
+    #[test]
+    fn tresca_points_beside_coulomb_points_meet_each_their_law(n in 2usize..=5, dim in 2usize..=3, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 5), load in prop::collection::vec(-1.0f64..1.0, 15), mu in 0.05f64..0.5, bound in 0.0f64..0.2, mask in 1u32..31) {
+        let nt = dim - 1;
+        let mut pts = points(n, dim, &w, mu);
+        pts.tresca = (0..n).map(|i| (mask & (1 << i) != 0).then_some(bound)).collect();
+        for i in 0..n {
+            if pts.tresca[i].is_some() {
+                pts.friction[i] = 0.0;
+            }
+        }
+        let op = problem(n, nt, &pts, &seed, &load);
+        let params = NewtonParams { tol: 1e-13, ..Default::default() };
+        let newton = solve_newton(&mut op.clone(), &pts, &Law::Coulomb, &params, None, &mut |_| {});
+        prop_assume!(newton.is_ok()); // Coulomb's law may stall Newton: its own tests
+        let newton = newton.unwrap();
+        let gs = contact::GaussSeidelParams { tol: 1e-12, max_sweeps: 20000, ..Default::default() };
+        let sweeps = contact::solve_gauss_seidel(&mut op.clone(), &pts, &Law::Coulomb, &gs, None, &mut |_| {});
+        for sol in std::iter::once(&newton).chain(sweeps.as_ref().ok()) {
+            let scale = sol.lambda.norm().max(1e-12);
+            for i in 0..n {
+                let (lt, ln, s) = (sol.lambda.tangential_norm(i), sol.lambda.normal[i], sol.u.tangential_norm(i));
+                let radius = pts.tresca[i].unwrap_or(mu * ln.max(0.0));
+                prop_assert!(lt <= radius * (1.0 + 1e-8) + 1e-9 * scale, "point {i}: |λ_t| {lt} above {radius}");
+                if s > 1e-8 * (1.0 + sol.u.norm()) {
+                    prop_assert!((lt - radius).abs() <= 1e-7 * scale, "point {i} slides: |λ_t| {lt}, radius {radius}");
+                }
+            }
+        }
+        let radii: Vec<f64> = (0..n).map(|i| pts.tresca[i].unwrap_or(mu * newton.lambda.normal[i].max(0.0))).collect();
+        let plain = ContactPoints { tresca: vec![], ..pts.clone() };
+        let tresca = solve_newton(&mut op.clone(), &plain, &Law::Tresca(radii), &params, None, &mut |_| {}).unwrap();
+        let scale = newton.lambda.norm().max(1e-12);
+        prop_assert!(tresca.lambda.minus(&newton.lambda).norm() <= 1e-7 * scale, "{:?} against {:?}", tresca.lambda, newton.lambda);
     }
 
     /// Tiny frictionless problems: Uzawa's answer equals the one found by enumerating the

@@ -229,6 +229,7 @@ impl ContactBoundary {
                 foundations: vec![],
                 slipped: vec![],
                 weakening: vec![],
+                tresca: vec![],
             },
             nodes: vec![],
             dofs: vec![],
@@ -262,6 +263,21 @@ impl ContactBoundary {
             .collect();
         if weakening.iter().any(Option::is_some) {
             b.points.weakening = b.group_of.iter().map(|&k| weakening[k]).collect();
+        }
+        // Tresca zones beside Coulomb zones (the problem's law Coulomb's): each such point's
+        // radius its zone's bound there
+        let coulomb = specs.iter().any(|s| s.law == crate::ContactLaw::Coulomb);
+        let bounds: Vec<Option<crate::scene::ZoneBound>> = specs
+            .iter()
+            .map(|s| match s.model().map(|m| m.friction) {
+                Some(Friction::Tresca(bound)) if coulomb => Some(bound),
+                _ => None,
+            })
+            .collect();
+        if bounds.iter().any(Option::is_some) {
+            b.points.tresca = (0..b.points.len())
+                .map(|i| bounds[b.group_of[i]].as_ref().map(|z| z.at(b.points.position[i])))
+                .collect();
         }
         // zones on different foundations: each point its own zone's
         let zones: Vec<contact::Foundation> = specs.iter().map(foundation_of).collect();

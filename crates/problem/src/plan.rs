@@ -84,7 +84,9 @@ impl Plan {
         let law = scene.contact_law();
         // friction on any contact group gives every point its tangential multipliers (a
         // frictionless group's coefficient is 0)
-        let friction = scene.contacts().iter().any(|c| match law {
+        // each zone by its own law (a Tresca zone may stand beside Coulomb's)
+        let friction = scene.contacts().iter().any(|c| match c.law {
+            _ if law == ContactLaw::None => false,
             ContactLaw::Coulomb => c.friction() > 0.0,
             ContactLaw::Tresca => {
                 c.slip_bound() > 0.0

@@ -517,6 +517,7 @@ mod tests {
                     foundations: vec![],
                     slipped: vec![],
                     weakening: vec![],
+                    tresca: vec![],
                 };
                 // an SPD compliance with zeros: a Gram matrix plus the identity
                 let g = |i: usize, j: usize| ((i * 7 + j * 3 + case) % 5) as f64 * 0.1 - 0.2;
@@ -661,6 +662,7 @@ mod tests {
                 },
                 slipped: vec![],
                 weakening: vec![],
+                tresca: vec![],
             };
             let g = |i: usize, j: usize| ((i * 5 + j * 3) % 7) as f64 * 0.1 - 0.3;
             // symmetric SPD part plus an antisymmetric coupling between u and φ rows

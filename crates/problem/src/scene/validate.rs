@@ -935,8 +935,8 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 /// Several contact groups (`[[contact]]`): each its own face, normal, gap, friction
 /// coefficient or slip-weakening law, Tresca bound, foundation (rigid, or its own compliance)
 /// and (one of them) an indenter, at a depth or pressed with a force (its own points driven,
-/// the others resting on their foundations); the friction law they share (Coulomb's with a
-/// constant or a weakening coefficient, or Tresca's), a frictionless zone joining either; one
+/// the others resting on their foundations); each its own friction law (Signorini's,
+/// Tresca's, Coulomb's with a constant or a weakening coefficient); one
 /// zone conducting (electrical contact, held at its potential or floating with its charge),
 /// the others insulated; an exact solution refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
@@ -965,15 +965,14 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
                 ),
             )
         };
-        // a frictionless zone joins frictional ones (its coefficient or bound 0); Tresca's and
-        // Coulomb's laws, and a zone switched off among active ones, do not mix
+        // each zone its own law (a frictionless zone's coefficient or bound 0, a Tresca zone's
+        // radius its bound beside Coulomb's); a zone switched off among active ones does not
+        // mix
         let off = |c: &ContactSpec| c.law == ContactLaw::None;
-        let frictional = |c: &ContactSpec| matches!(c.law, ContactLaw::Tresca | ContactLaw::Coulomb);
         same(
             "contact.law",
-            off(c) != off(first)
-                || contacts[..k].iter().any(|o| frictional(o) && frictional(c) && o.law != c.law),
-            "their law (a Signorini zone may join Tresca's or Coulomb's, but Tresca's and Coulomb's do not mix, nor a zone switched off with active ones)",
+            off(c) != off(first),
+            "whether they are switched off (contact.law = \"none\" on one zone and not on another: remove the zone instead)",
         )?;
         if let Some(other) = contacts[..k].iter().find(|o| o.electric_law().is_some()) {
             refuse_if(
