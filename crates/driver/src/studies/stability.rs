@@ -387,6 +387,21 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "Tresca beside Coulomb",
+        why: "the corner's right wall under Tresca's bound 1e-6 (nearly frictionless) beside its top wall under Coulomb's 1.0: each zone its own friction law, far apart",
+        scene: "corner",
+        sets: &[
+            "mesh.n=64",
+            "contact.0.law=\"tresca\"",
+            "contact.0.slip_bound=1e-6",
+            "contact.1.law=\"coulomb\"",
+            "contact.1.friction=1.0",
+        ],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "pressed among walls",
         why: "a sphere pressed with a force on the corner's top beside its squeezing right wall: force control drives the indenter's points alone",
         scene: "corner",
