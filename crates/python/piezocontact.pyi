@@ -143,6 +143,13 @@ class Contact:
     def node(self) -> npt.NDArray[np.int64]:
         """The mesh node of each point, (m,)."""
     @property
+    def group(self) -> npt.NDArray[np.int64]:
+        """The contact group of each point, (m,): its index in `groups` (a node of two groups
+        is a point of each)."""
+    @property
+    def groups(self) -> list[str]:
+        """The contact groups, in the scene's order."""
+    @property
     def normal(self) -> npt.NDArray[np.float64]:
         """Outward unit normals of the body, (m, dim)."""
     @property

@@ -405,6 +405,22 @@ impl Contact {
         })
     }
 
+    /// The contact group of each point, (m,), int64: its index in `groups` (contact.csv's
+    /// `group`; a node of two groups is a point of each).
+    #[getter]
+    fn group<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        self.with(py, |_, c| {
+            let group: Vec<i64> = c.group_of.iter().map(|&g| g as i64).collect();
+            Ok(owned(py, group.into()))
+        })
+    }
+
+    /// The contact groups, in the scene's order (`[[contact]]`; one name for one `[contact]`).
+    #[getter]
+    fn groups(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        self.with(py, |_, c| Ok(c.groups.clone()))
+    }
+
     /// Outward unit normals of the body, (m, dim).
     #[getter]
     fn normal<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {

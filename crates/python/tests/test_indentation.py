@@ -103,3 +103,33 @@ def test_several_contact_groups_from_python():
     assert [g["group"] for g in groups] == ["right", "top"]
     for g in groups:
         assert abs(g["normal_force"] - p) < 1e-9 * p
+
+
+def test_each_contact_group_keeps_its_own_law_from_python():
+    # the corner's two walls from a list of dicts, each its own friction law: the right wall
+    # Tresca's bound 1e-3, the top wall Coulomb's 0.3 weakening to 0.1 over 1e-5; every point
+    # within its own zone's radius (the weakening one's at its own slip)
+    scene = pc.Scene.load("corner")
+    scene.set(
+        {
+            "contact.0.law": "tresca",
+            "contact.0.slip_bound": 1e-3,
+            "contact.1.law": "coulomb",
+            "contact.1.friction_law": "slip-weakening",
+            "contact.1.friction_static": 0.3,
+            "contact.1.friction_dynamic": 0.1,
+            "contact.1.slip_length": 1e-5,
+        }
+    )
+    r = pc.run(scene)
+    c = r.contact
+    assert c is not None
+    assert c.groups == ["right", "top"] == [g["group"] for g in r.report["contact"]["groups"]]
+    assert set(c.group.tolist()) == {0, 1}
+    weakened = 0
+    for i, g in enumerate(c.group):
+        ln, lt, ut = c.lambda_n[i], abs(c.lambda_t[i, 0]), abs(c.u_t[i, 0])
+        radius = 1e-3 if g == 0 else (0.3 - 0.2 * min(ut / 1e-5, 1.0)) * ln
+        assert lt <= radius * (1 + 1e-8) + 1e-14, (i, lt, radius)
+        weakened += g == 1 and c.status[i] == pc.SLIP and radius < 0.3 * ln * (1 - 1e-6)
+    assert weakened > 0
