@@ -216,7 +216,6 @@ pub(super) fn condense_reported(
 /// the forces and the flux found, refined; the law judged on the refined fields. Returns the
 /// solution, the fields, how the condensation was formed and in how long, and the refinement
 /// steps.
-#[allow(clippy::too_many_arguments)]
 fn electric_contact(
     how: &ContactSolve<'_>,
     electric: &contact::ElectricContact,
