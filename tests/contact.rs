@@ -687,7 +687,6 @@ fn what_several_contact_groups_cannot_share_is_refused_by_name() {
             problem::Contacts::One(c) => c,
         }
     }
-    assert_eq!(refused(&|s| group(s, 1).law = problem::ContactLaw::None), "contact.law");
     assert_eq!(refused(&|s| group(s, 1).group = "right".into()), "contact.group");
     // one zone conducts, the others are insulated
     assert_eq!(
@@ -957,6 +956,43 @@ fn each_contact_zone_keeps_its_own_tresca_bound() {
         strongest > 2.0 * bounds[0],
         "the top wall's largest |λ_t| = {strongest}"
     );
+}
+
+/// A zone switched off among others (`contact.1.law = "none"`; once refused) is not posed: the
+/// corner with its top wall switched off is the corner with its right wall alone, to the last
+/// bit, and reports the right wall alone; its keys are inert (a conducting condition on it
+/// changes nothing, as on one `[contact]` switched off).
+#[test]
+fn a_zone_switched_off_among_others_is_not_posed() {
+    let (corner, _) = files::scene_file::load("corner", &[]).unwrap();
+    let problem::Contacts::Many(zones) = corner.contact.clone().unwrap() else {
+        panic!("the corner has two zones")
+    };
+    let mut off = corner.clone();
+    let mut switched = zones.clone();
+    switched[1].law = problem::ContactLaw::None;
+    switched[1].electric = Some(problem::ElectricCondition::Conducting);
+    off.contact = Some(problem::Contacts::Many(switched));
+    let mut alone = corner.clone();
+    alone.contact = Some(problem::Contacts::Many(vec![zones[0].clone()]));
+    let (a, b) = (
+        problem::solve(&off, None, &mut problem::Silent).unwrap(),
+        problem::solve(&alone, None, &mut problem::Silent).unwrap(),
+    );
+    let (x, y) = (a.contact.as_ref().unwrap(), b.contact.as_ref().unwrap());
+    assert_eq!(x.groups, ["right"]);
+    assert_eq!(x.solution.lambda, y.solution.lambda);
+    assert_eq!(a.phi, b.phi);
+    assert_eq!(a.report.contact.groups.len(), b.report.contact.groups.len());
+    // every zone switched off: no contact at all
+    let mut none = off;
+    if let Some(problem::Contacts::Many(v)) = none.contact.as_mut() {
+        v[0].law = problem::ContactLaw::None;
+    }
+    assert!(problem::solve(&none, None, &mut problem::Silent)
+        .unwrap()
+        .contact
+        .is_none());
 }
 
 /// A Tresca zone beside a Coulomb zone (zones once could not mix the two): the corner's right

@@ -301,7 +301,7 @@ fn krylov_solve<'a, 'p: 'a>(
 /// The active sets hold the normal and tangential components of a contact point as unknowns
 /// of the system: a tangent prescribed by a Dirichlet condition is refused, naming its node.
 fn refuse_held_tangent(scene: &Scene, boundary: &ContactBoundary) -> Result<(), ProblemError> {
-    let (Some(node), Some(spec)) = (boundary.first_held_tangent(), scene.first_contact()) else {
+    let (Some(node), Some(spec)) = (boundary.first_held_tangent(), scene.active_contact()) else {
         return Ok(());
     };
     // found once the mesh is read (the scene alone does not tell it): the backend's refusal

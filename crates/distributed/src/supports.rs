@@ -9,7 +9,7 @@
 //! the key that asks for it.
 
 use problem::backend::Unsupported;
-use problem::{BackendChoice, ContactLaw, ContactSpec, Rule, Scene, Strategy};
+use problem::{BackendChoice, ContactSpec, Rule, Scene, Strategy};
 
 const BACKEND: &str = "petsc";
 
@@ -37,7 +37,7 @@ pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
         )
         .advise("set solver.backend = \"petsc\""));
     }
-    let active: Vec<&ContactSpec> = scene.contacts().iter().filter(|c| c.law != ContactLaw::None).collect();
+    let active = scene.zones();
     if active.len() > 1 {
         return lacks("contact", "several [[contact]] zones (its active sets hold one)");
     }

@@ -203,7 +203,7 @@ impl ContactBoundary {
     /// normal or a tangent (neither along nor orthogonal to it); a group with no contact point
     /// left.
     pub fn new(disc: &Discretization<'_>, spec: &ContactSpec) -> Result<Self, ProblemError> {
-        Self::of_groups(disc, std::slice::from_ref(spec))
+        Self::of_groups(disc, &[spec])
     }
 
     /// The contact points of several groups (`[[contact]]`), each as [`ContactBoundary::new`]
@@ -213,7 +213,7 @@ impl ContactBoundary {
     ///
     /// # Errors
     /// As [`ContactBoundary::new`], for each group.
-    pub fn of_groups(disc: &Discretization<'_>, specs: &[ContactSpec]) -> Result<Self, ProblemError> {
+    pub fn of_groups(disc: &Discretization<'_>, specs: &[&ContactSpec]) -> Result<Self, ProblemError> {
         let dim = disc.mesh.dim;
         let mut b = ContactBoundary {
             points: ContactPoints {
@@ -225,7 +225,7 @@ impl ContactBoundary {
                 gap: vec![],
                 friction: vec![],
                 held: vec![],
-                foundation: specs.first().map_or(contact::Foundation::Rigid, foundation_of),
+                foundation: specs.first().map_or(contact::Foundation::Rigid, |s| foundation_of(s)),
                 foundations: vec![],
                 slipped: vec![],
                 weakening: vec![],
@@ -280,7 +280,7 @@ impl ContactBoundary {
                 .collect();
         }
         // zones on different foundations: each point its own zone's
-        let zones: Vec<contact::Foundation> = specs.iter().map(foundation_of).collect();
+        let zones: Vec<contact::Foundation> = specs.iter().map(|s| foundation_of(s)).collect();
         if zones.iter().any(|f| *f != b.points.foundation) {
             b.points.foundations = b.group_of.iter().map(|&k| zones[k]).collect();
         }

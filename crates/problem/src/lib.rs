@@ -422,11 +422,7 @@ impl ProblemError {
             }
         }
         let newton = strategy == Strategy::NewtonCondensed;
-        let electric = scene
-            .contacts()
-            .iter()
-            .find_map(|c| c.electric_law())
-            .map(|(law, _)| law);
+        let electric = scene.zones().iter().find_map(|c| c.electric_law()).map(|(law, _)| law);
         let hint = match (&source, electric) {
             (ContactError::Stalled { .. }, Some(contact::ElectricLaw::Conducting)) => {
                 "; semismooth Newton and its proximal stage stalled on the coupled rows (electrical contact has no first-order stage): an ideally conducting foundation whose potential lifts the body off where it touches may have no solution (contact gives the potential that lifts, lift-off takes it away); contact.electric = \"conductive\" with a finite contact.conductance is the regularised law, solved there"

@@ -391,7 +391,7 @@ impl Walk<'_> {
         let assembled = backend.assemble(&posed)?;
         let t_assembly = t.elapsed().as_secs_f64();
         reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
-        let boundary = ContactBoundary::of_groups(disc, self.scene.contacts())?;
+        let boundary = ContactBoundary::of_groups(disc, &self.scene.zones())?;
         boundary.report_held(&self.contact.group, reporter);
         posed.bed = self.bed(disc, instants, &boundary)?;
         let system = backend.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;

@@ -85,7 +85,7 @@ impl Plan {
         // friction on any contact group gives every point its tangential multipliers (a
         // frictionless group's coefficient is 0)
         // each zone by its own law (a Tresca zone may stand beside Coulomb's)
-        let friction = scene.contacts().iter().any(|c| match c.law {
+        let friction = scene.zones().into_iter().any(|c| match c.law {
             _ if law == ContactLaw::None => false,
             ContactLaw::Coulomb => c.friction() > 0.0,
             ContactLaw::Tresca => {
@@ -123,20 +123,20 @@ impl Plan {
             rule: scene.solver.rule,
             outputs,
             compliance: scene
-                .contacts()
-                .iter()
+                .zones()
+                .into_iter()
                 .filter(|_| law != ContactLaw::None)
                 .find_map(|c| c.compliance),
             compliance_shared: law == ContactLaw::None
                 || scene
-                    .contacts()
-                    .iter()
-                    .all(|c| scene.contacts().first().is_some_and(|f| f.compliance == c.compliance)),
+                    .zones()
+                    .into_iter()
+                    .all(|c| scene.active_contact().is_some_and(|f| f.compliance == c.compliance)),
             // a weakening law from a static coefficient of 0 is frictionless (its dynamic one,
             // at most the static, is 0 too): no tangential multipliers for it to act on
             weakening: scene
-                .contacts()
-                .iter()
+                .zones()
+                .into_iter()
                 .filter(|_| law == ContactLaw::Coulomb && friction)
                 .filter_map(|c| Some((c.group.clone(), c.slip_weakening()?)))
                 .collect(),
@@ -147,8 +147,8 @@ impl Plan {
             }),
             // each zone's Tresca bound; 0 where its law is not Tresca's (frictionless there)
             slip_bounds: scene
-                .contacts()
-                .iter()
+                .zones()
+                .into_iter()
                 .map(|c| match c.model().map(|m| m.friction) {
                     Some(crate::scene::Friction::Tresca(bound)) => bound,
                     _ => ZoneBound::Uniform(0.0),

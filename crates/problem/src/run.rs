@@ -230,11 +230,11 @@ fn pose<'a>(scene: Valid<'a>, setup: &'a Setup, disc: &'a Discretization<'a>) ->
 /// The contact boundary, where the plan has contact; its nodes that the Dirichlet conditions
 /// hold reported.
 fn contact_boundary(posed: &Posed<'_>, reporter: &mut dyn Reporter) -> Result<Option<ContactBoundary>, ProblemError> {
-    let specs = posed.scene.contacts();
+    let specs = posed.scene.zones();
     if specs.is_empty() || posed.plan().contact_law == ContactLaw::None {
         return Ok(None);
     }
-    let boundary = ContactBoundary::of_groups(posed.disc, specs)?;
+    let boundary = ContactBoundary::of_groups(posed.disc, &specs)?;
     boundary.report_held(&boundary.groups.join(", "), reporter);
     Ok(Some(boundary))
 }
@@ -384,8 +384,8 @@ pub(crate) fn recover(
         held_nodes: b.held_nodes,
         held_inside: b.held_inside,
         potential: scene
-            .contacts()
-            .iter()
+            .zones()
+            .into_iter()
             .find(|c| c.electric_law().is_some())
             .and_then(|c| conductor_potential(c, sol)),
         ..ContactReport::of_groups(&b.points, sol, &b.groups, &b.group_of)

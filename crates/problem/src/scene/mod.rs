@@ -488,26 +488,34 @@ fn interpolate(t: &[f64], f: &[f64], x: f64) -> f64 {
 impl Scene {
     /// The contact law, `none` where the scene has no contact section.
     pub fn contact_law(&self) -> ContactLaw {
-        let first = self.first_contact().map_or(ContactLaw::None, |c| c.law);
-        // a frictionless zone among frictional ones takes their law with a zero coefficient or
-        // bound (exactly frictionless); Tresca's and Coulomb's together are refused by key
-        let any = |law: ContactLaw| self.contacts().iter().any(|c| c.law == law);
-        match first {
-            ContactLaw::None => ContactLaw::None,
-            _ if any(ContactLaw::Coulomb) => ContactLaw::Coulomb,
-            _ if any(ContactLaw::Tresca) => ContactLaw::Tresca,
-            law => law,
+        // the zones switched off aside; a frictionless zone among frictional ones takes their
+        // law with a zero coefficient or bound (exactly frictionless), a Tresca zone beside
+        // Coulomb's Coulomb's law with its bound as the radius of its points
+        let zones = self.zones();
+        let any = |law: ContactLaw| zones.iter().any(|c| c.law == law);
+        match zones.first() {
+            None => ContactLaw::None,
+            Some(_) if any(ContactLaw::Coulomb) => ContactLaw::Coulomb,
+            Some(_) if any(ContactLaw::Tresca) => ContactLaw::Tresca,
+            Some(c) => c.law,
         }
     }
 
-    /// The contact section when its law is not `none` (the first of several).
+    /// The first contact zone that is posed (`contact.law` not `none`).
     pub fn active_contact(&self) -> Option<&ContactSpec> {
-        self.first_contact().filter(|c| c.law != ContactLaw::None)
+        self.zones().first().copied()
     }
 
     /// Every contact group (none, one `[contact]`, or the `[[contact]]` array).
     pub fn contacts(&self) -> &[ContactSpec] {
         self.contact.as_ref().map_or(&[], Contacts::all)
+    }
+
+    /// The contact zones that are posed: every contact group but those switched off
+    /// (`contact.law = "none"`), in the scene's order. A zone's index here is its index in
+    /// the run (the contact boundary's groups, run.json's `contact.groups`).
+    pub fn zones(&self) -> Vec<&ContactSpec> {
+        self.contacts().iter().filter(|c| c.law != ContactLaw::None).collect()
     }
 
     /// The contact section, or the first of several.
@@ -523,10 +531,10 @@ impl Scene {
         }
     }
 
-    /// The contact group whose face a rigid indenter presses (at most one: validated), with
-    /// its index among [`Scene::contacts`].
+    /// The contact zone whose face a rigid indenter presses (at most one: validated), with
+    /// its index among [`Scene::zones`].
     pub fn indenter_contact(&self) -> Option<(usize, &ContactSpec)> {
-        self.contacts().iter().enumerate().find(|(_, c)| c.indenter.is_some())
+        self.zones().into_iter().enumerate().find(|(_, c)| c.indenter.is_some())
     }
 
     /// Every number of the scene with its key (`load.p`, `material.c`, ...).

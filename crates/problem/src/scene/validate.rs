@@ -374,7 +374,7 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
     if scene.active_contact().is_some() {
         // every zone's condition, not the first's alone
         refuse_if(
-            scene.contacts().iter().any(|c| c.electric_law().is_some()),
+            scene.zones().into_iter().any(|c| c.electric_law().is_some()),
             "path",
             "electrical contact along a path is not built yet: solve its instants one by one",
         )?;
@@ -938,11 +938,11 @@ fn check_name(key: &str, name: &str) -> Result<(), SceneError> {
 /// the others resting on their foundations); each its own friction law (Signorini's,
 /// Tresca's, Coulomb's with a constant or a weakening coefficient); one
 /// zone conducting (electrical contact, held at its potential or floating with its charge),
-/// the others insulated; an exact solution refused by key.
+/// the others insulated; a zone switched off (`contact.law = "none"`) not posed, its keys
+/// inert; an exact solution with several groups refused by key.
 fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
     let contacts = s.contacts();
-    let [first, rest @ ..] = contacts else { return Ok(()) };
-    if rest.is_empty() {
+    if contacts.len() < 2 {
         return Ok(());
     }
     for (k, c) in contacts.iter().enumerate() {
@@ -955,26 +955,13 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
                 ),
             ));
         }
-        let same = |key: &str, differs: bool, what: &str| {
-            refuse_if(
-                differs,
-                key,
-                &format!(
-                    "the [[contact]] groups `{}` and `{}` differ in {what}, which all share: give them the same",
-                    first.group, c.group
-                ),
-            )
-        };
-        // each zone its own law (a frictionless zone's coefficient or bound 0, a Tresca zone's
-        // radius its bound beside Coulomb's); a zone switched off among active ones does not
-        // mix
-        let off = |c: &ContactSpec| c.law == ContactLaw::None;
-        same(
-            "contact.law",
-            off(c) != off(first),
-            "whether they are switched off (contact.law = \"none\" on one zone and not on another: remove the zone instead)",
-        )?;
-        if let Some(other) = contacts[..k].iter().find(|o| o.electric_law().is_some()) {
+    }
+    // the zones that are posed (a zone switched off, contact.law = "none", keeps its keys
+    // inert, as one [contact] switched off does): each its own law (a frictionless zone's
+    // coefficient or bound 0, a Tresca zone's radius its bound beside Coulomb's)
+    let zones = s.zones();
+    for (k, c) in zones.iter().enumerate() {
+        if let Some(other) = zones[..k].iter().find(|o| o.electric_law().is_some()) {
             refuse_if(
                 c.electric_law().is_some(),
                 "contact.electric",
@@ -986,7 +973,7 @@ fn refuse_several_contacts(s: &Scene) -> Result<(), SceneError> {
         }
     }
     refuse_if(
-        contacts.iter().filter(|c| c.indenter.is_some()).count() > 1,
+        zones.iter().filter(|c| c.indenter.is_some()).count() > 1,
         "contact.indenter",
         "two [[contact]] groups with an indenter: one indenter per scene (the others are foundations)",
     )?;

@@ -247,7 +247,7 @@ fn electric_contact(
     };
     let mut problem = problem;
     // the conducting zone's charge where it floats (one zone conducts: validated)
-    let floating = posed.scene.contacts().iter().find_map(|c| match c.model()?.electric {
+    let floating = posed.scene.zones().into_iter().find_map(|c| match c.model()?.electric {
         ZoneElectric::Floating { charge, .. } => Some(charge),
         _ => None,
     });
