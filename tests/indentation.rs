@@ -847,6 +847,23 @@ fn an_indenter_among_several_contact_groups_reports_its_own_zone() {
         (0.0, groups[0].n_points)
     );
     assert!((groups[1].normal_force - x.force).abs() < 1e-10 * x.force);
+    // the half-space's closed form is one zone's: it does not apply beside a wall
+    assert!(x.half_space.is_some() && y.half_space.is_none());
+    // what a body of revolution refuses of an indenter, it refuses on the second zone too
+    for (key, change) in [("contact.indenter.shape", "cylinder"), ("contact.indenter.tip", "tip")] {
+        let mut bad = two.clone();
+        let Some(problem::Contacts::Many(zones)) = bad.contact.as_mut() else {
+            unreachable!()
+        };
+        let spec = zones[1].indenter.as_mut().unwrap();
+        if change == "cylinder" {
+            spec.shape = problem::IndenterShape::Cylinder;
+        } else {
+            spec.tip = Some(vec![1.0, 0.0]);
+        }
+        let e = bad.validate().unwrap_err();
+        assert_eq!(e.key, key, "{e}");
+    }
 }
 
 /// Force control on the indenter of several contact zones (zones once could not carry it):

@@ -365,7 +365,7 @@ pub fn contact_errors(
 /// radius of 1e-300 gave a force of -4.6e210).
 pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Option<Result<HalfSpaceReport, String>> {
     let (body, profile, tip) = scene.half_space_problem(electric).ok()?;
-    let force = scene.first_contact()?.indenter.as_ref()?.force;
+    let force = scene.active_contact()?.indenter.as_ref()?.force;
     Some(half_space_in_domain(&body, &profile, tip, force, run))
 }
 

@@ -1218,7 +1218,13 @@ impl Scene {
         String,
     > {
         use crate::halfspace::{HalfSpace, Profile, Tip};
-        let c = self.first_contact().ok_or("it needs [contact]")?;
+        let zones = self.zones();
+        let [c] = zones[..] else {
+            return Err(match zones.len() {
+                0 => "it needs [contact]".into(),
+                n => format!("the body has {n} contact zones, and the half-space's has one, its indenter's"),
+            });
+        };
         let ind = c.indenter.as_ref().ok_or("it needs a [contact.indenter]")?;
         let [m] = &self.material[..] else {
             return Err("it needs one material".into());

@@ -1019,7 +1019,8 @@ fn refuse_axisymmetric(s: &Scene) -> Result<(), SceneError> {
             &format!("exact.kind `{}`, a plane or 3D solution, and the body is one of revolution (mesh.axisymmetric; `hertz` is the sphere's there)", x.kind),
         )?;
     }
-    if let Some(i) = s.first_contact().and_then(|c| c.indenter.as_ref()) {
+    // the indenter of whichever zone carries it (not the first zone's alone)
+    if let Some(i) = s.indenter_contact().and_then(|(_, c)| c.indenter.as_ref()) {
         refuse_if(
             i.shape == IndenterShape::Cylinder,
             "contact.indenter.shape",
