@@ -61,16 +61,11 @@ pub struct PathSolution {
     pub last: Solution,
 }
 
-/// Walks `scene`'s path on `backend`: the instants of `scene.path` one after the other,
-/// friction on the slip increment; `each` is called once per instant, in order, with the
-/// instant's row and contact solution, and, where `with_fields` asks for them, the fields of
-/// every `path.output_every`-th instant (and of the last, which the returned solution holds).
-/// Nothing of a step is kept after it but its row. A scene without a path is solved as the one
-/// instant it describes.
+/// [`crate::solve_path`] on `backend`: the walk over the instants, written once for every
+/// [`PathBackend`].
 ///
 /// # Errors
-/// The errors of a run, naming the step where one happened; `path` refused by the scene's
-/// checks where the run cannot carry friction's history; the error `each` returns.
+/// As [`crate::solve_path`].
 pub(crate) fn walk<B: PathBackend>(
     backend: &mut B,
     scene: &Scene,

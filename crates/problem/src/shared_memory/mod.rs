@@ -37,7 +37,7 @@ impl Backend for SharedMemory {
         // the scene asks for another backend: solving it here would ignore that silently
         if scene.solver.backend != BackendChoice::Faer {
             return Err(Unsupported::new(
-                "faer",
+                Self::NAME,
                 "solver.backend",
                 format!("solver.backend = \"{}\" asks for the distributed backend (the program built with the `petsc` feature, under mpirun; distributed::solve)", scene.solver.backend),
             )
@@ -45,7 +45,7 @@ impl Backend for SharedMemory {
         }
         if scene.solver.petsc_options.is_some() {
             return Err(
-                Unsupported::new("faer", "solver.petsc_options", "options for PETSc's database")
+                Unsupported::new(Self::NAME, "solver.petsc_options", "options for PETSc's database")
                     .advise("remove them, or set solver.backend = \"petsc\""),
             );
         }

@@ -192,7 +192,11 @@ fn solve(system: &mut Factored, b_u: &[f64], b_phi: &[f64]) -> Result<Fields, Pr
 fn not_direct() -> ProblemError {
     let feature =
         "a path on a strategy without the L D Lᵀ of K (it carries friction's history on the condensed compliance)";
-    crate::backend::Unsupported::new("faer", "solver.strategy", feature)
-        .advise("use a condensed strategy")
-        .into()
+    crate::backend::Unsupported::new(
+        <SharedMemory as crate::backend::Backend>::NAME,
+        "solver.strategy",
+        feature,
+    )
+    .advise("use a condensed strategy")
+    .into()
 }
