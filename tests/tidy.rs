@@ -133,9 +133,27 @@ fn the_validation_names_no_backend() {
 const BACKEND_NAMES: [&str; 5] = ["petsc", "faer", "sharedmemory", "shared_memory", "distributedmemory"];
 
 /// The run, the load path, the capacitance, the outer unknowns and the bed's fixed point are
-/// written once for every backend: outside their tests they call a `Backend` (or a
-/// `PathBackend`) and name none (a backend's own section of the report, `petsc`, is carried
-/// through as data).
+/// written once for every backend: outside their tests they call a `Backend` and name none (a
+/// backend's own section of the report, `petsc`, is carried through as data).
+/// A static scene is a path of one instant: one trait a backend implements, whose per-instant
+/// steps every run takes, and no second run a backend could be handed (a `run_path`) or a
+/// second trait for paths.
+#[test]
+fn a_static_run_and_a_path_are_one_loop() {
+    let text = std::fs::read_to_string(root().join("crates/problem/src/backend.rs")).unwrap();
+    let traits = text.matches("pub trait ").count();
+    assert_eq!(
+        traits, 1,
+        "crates/problem/src/backend.rs defines {traits} traits: one Backend"
+    );
+    for second in ["fn run_path", "fn solve_instant", "PathBackend"] {
+        assert!(
+            !text.contains(second),
+            "crates/problem/src/backend.rs has `{second}`: a second way through the run"
+        );
+    }
+}
+
 #[test]
 fn the_run_names_no_backend() {
     for file in ["run.rs", "path.rs", "capacitance.rs", "outer.rs", "bed.rs"] {

@@ -37,6 +37,19 @@ pub enum ForceError<E> {
     },
 }
 
+impl<E> ForceError<E> {
+    /// The failed contact solve's own error (`Ok`), or the search's failure in words (`Err`):
+    /// for a caller whose solve's error is not [`std::fmt::Display`].
+    pub fn into_solve(self) -> Result<E, String> {
+        type Search = ForceError<std::convert::Infallible>;
+        match self {
+            ForceError::Solve(e) => Ok(e),
+            ForceError::Unreachable { force, most } => Err(Search::Unreachable { force, most }.to_string()),
+            ForceError::NotFound { force } => Err(Search::NotFound { force }.to_string()),
+        }
+    }
+}
+
 /// The depth at which the body carries `force` (`Σ w_i λ_n,i` over the indenter's points:
 /// `driven`, or every point where `None`) from the indenter: each evaluation a contact solve
 /// (`solve`, on the points with the indenter's gaps lowered by `s`, the others' as they are,

@@ -8,7 +8,11 @@ use crate::layout::Layout;
 use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError, Vector};
-use problem::backend::{Backend, ContactAt, ContactBoundary, Figures, Finished, Posed, Setup, Solved, Unsupported};
+use problem::backend::Fields as Free;
+use problem::backend::{
+    At, Backend, Contact, ContactBoundary, ContactSolve, Figures, InstantOf, InstantSolution, Posed, Primed, Setup,
+    Unsupported,
+};
 use problem::{ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, Solution};
 use std::time::Instant;
 
@@ -102,13 +106,16 @@ pub struct Prepared<'p> {
     /// Krylov iterations, and the last solve's reason.
     krylov: usize,
     reason: String,
+    /// The instant's contact boundary ([`Backend::prime`]).
+    boundary: Option<ContactBoundary>,
+    /// The last contact solve's solution, until its fields are taken.
+    x: Option<Vector<'p>>,
 }
 
 impl<'p> Backend for DistributedMemory<'p> {
     const NAME: &'static str = "petsc";
     type Assembled = Assembled<'p>;
     type System = Prepared<'p>;
-    type Solution = Vector<'p>;
     type Error = DistributedError;
     const HELD_TO_TOLERANCE: bool = false;
 
@@ -149,28 +156,53 @@ impl<'p> Backend for DistributedMemory<'p> {
             t_pc: 0.0,
             krylov: 0,
             reason: String::new(),
+            boundary: None,
+            x: None,
         })
     }
 
-    /// One Krylov solve without contact; with contact, the active-set iteration over the
-    /// distributed system, each step one Krylov solve (a tangent of a contact point held by a
-    /// Dirichlet condition refused by name).
-    fn solve_instant(
+    /// Nothing is kept from instant to instant: each solve is on the whole system (a path's
+    /// parts are refused, as `supports` refuses a path).
+    fn begin(
         &mut self,
-        posed: &Posed<'_>,
+        _: &mut Prepared<'p>,
+        _: &Posed<'_>,
+        _: Option<Contact<'_>>,
+        parts: &[Free],
+        _: &mut dyn Reporter,
+    ) -> Result<Vec<Free>, DistributedError> {
+        match parts.is_empty() {
+            true => Ok(vec![]),
+            false => Err(ProblemError::from(path_unsupported()).into()),
+        }
+    }
+
+    fn respond(&mut self, _: &mut Prepared<'p>, _: &[f64], _: &[f64]) -> Result<Free, DistributedError> {
+        Err(ProblemError::from(path_unsupported()).into())
+    }
+
+    /// The instant's boundary, kept for its active sets (its loads are the assembled ones: a
+    /// path's factors and a bed's springs are refused).
+    fn prime(&mut self, s: &mut Prepared<'p>, primed: Primed<'_>) -> Result<(), DistributedError> {
+        if primed.factors.is_some() {
+            return Err(ProblemError::from(path_unsupported()).into());
+        }
+        s.boundary = Some(primed.framed.boundary.clone());
+        Ok(())
+    }
+
+    /// The active-set iteration over the distributed system, each step one Krylov solve (a
+    /// tangent of a contact point held by a Dirichlet condition refused by name).
+    fn solve_posed(
+        &mut self,
         s: &mut Prepared<'p>,
-        contact: Option<ContactAt<'_>>,
+        how: &ContactSolve<'_>,
+        at: At<'_>,
         reporter: &mut dyn Reporter,
-    ) -> Result<Solved<Vector<'p>>, DistributedError> {
-        let t = Instant::now();
-        let Some(ContactAt { boundary, how }) = contact else {
-            let mut x = s.system.rhs.duplicate()?;
-            (s.krylov, s.reason) =
-                krylov_solve(self.petsc, &s.fields, &mut s.t_pc)(&mut s.system.matrix, &s.system.rhs, &mut x)?;
-            return Ok(s.solved(t, x, None, reporter));
-        };
-        refuse_held_tangent(&posed.scene, &boundary)?;
-        let rows = ContactRows::new(self.petsc, &boundary.points, &boundary.nodes, &s.layout, &s.system);
+    ) -> Result<contact::ContactSolution, DistributedError> {
+        let boundary = s.boundary.as_ref().ok_or_else(unprimed)?;
+        refuse_held_tangent(how.scene, boundary)?;
+        let rows = ContactRows::new(self.petsc, at.points, &boundary.nodes, &s.layout, &s.system);
         let params = ActiveSetParams {
             tol: how.tol,
             max_steps: MAX_ACTIVE_SET_STEPS,
@@ -194,49 +226,55 @@ impl<'p> Backend for DistributedMemory<'p> {
         })?;
         drop(solve_one);
         (s.krylov, s.reason) = (out.krylov_iterations, out.reason);
-        Ok(s.solved(t, out.x, Some((boundary, out.solution)), reporter))
+        s.report_krylov(reporter);
+        s.x = Some(out.x);
+        Ok(out.solution)
     }
 
-    fn equilibrium(
-        &mut self,
-        _: &Posed<'_>,
-        s: &Prepared<'p>,
-        solved: &Solved<Vector<'p>>,
-    ) -> Result<f64, DistributedError> {
-        Ok(residual(
-            &s.system,
-            &solved.x,
-            solved.contact.as_ref(),
-            &s.layout,
-            self.petsc,
-        )?)
+    fn own_scale(&self, _: &Prepared<'p>, _: &[f64]) -> f64 {
+        0.0
     }
 
-    /// Gathers the solution on rank 0 (collective), with the PETSc section of the report.
-    fn gather(
+    /// One Krylov solve without contact; with contact, the contact solve's solution. Its
+    /// equilibrium residual (collective), then the solution gathered on rank 0.
+    fn instant_fields(
         &mut self,
+        s: &mut Prepared<'p>,
         posed: &Posed<'_>,
-        s: &Prepared<'p>,
-        x: &Vector<'p>,
-    ) -> Result<Option<problem::backend::Fields>, DistributedError> {
-        Ok(x.gather()?.map(|x| unpermute(posed.disc, &s.layout, &x)))
+        contact: Option<InstantOf<'_>>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Option<InstantSolution>, DistributedError> {
+        let (x, contact) = match contact {
+            None => {
+                let mut x = s.system.rhs.duplicate()?;
+                (s.krylov, s.reason) =
+                    krylov_solve(self.petsc, &s.fields, &mut s.t_pc)(&mut s.system.matrix, &s.system.rhs, &mut x)?;
+                s.report_krylov(reporter);
+                (x, None)
+            }
+            Some(InstantOf { framed, sol, .. }) => {
+                let x = s.x.take().ok_or_else(unprimed)?;
+                (x, Some((framed.boundary.clone(), sol)))
+            }
+        };
+        let equilibrium = residual(&s.system, &x, contact.as_ref(), &s.layout, self.petsc)?;
+        let Some(gathered) = x.gather()? else {
+            return Ok(None);
+        };
+        Ok(Some(InstantSolution {
+            x: unpermute(posed.disc, &s.layout, &gathered),
+            contact: contact.map(|(_, sol)| sol),
+            equilibrium,
+            pcg_iters: 0,
+        }))
     }
 
-    fn finish(
-        &mut self,
-        posed: &Posed<'_>,
-        s: Prepared<'p>,
-        x: Vector<'p>,
-    ) -> Result<Option<Finished>, DistributedError> {
+    /// The PETSc section of the report (collective).
+    fn finish(&mut self, s: Prepared<'p>) -> Result<Figures, DistributedError> {
         let petsc = self.petsc;
         let (nonzeros, _) = s.system.matrix.local_info()?;
         let nonzeros = petsc.sum(&[nonzeros])?[0];
-        let gathered = x.gather()?;
         let cells_per_rank = per_rank(petsc, &s.layout)?;
-        let Some(x) = gathered else {
-            return Ok(None);
-        };
-        let (u, phi) = unpermute(posed.disc, &s.layout, &x);
         let report = PetscReport {
             ranks: petsc.size(),
             unknowns: s.layout.n_global(),
@@ -249,36 +287,41 @@ impl<'p> Backend for DistributedMemory<'p> {
             peak_bytes_per_rank: vec![],
             preconditioner_setup_s: s.t_pc,
         };
-        let figures = Figures {
+        Ok(Figures {
             factor_seconds: s.t_pc,
             petsc: Some(report),
             ..Figures::default()
-        };
-        Ok(Some(Finished { u, phi, figures }))
+        })
     }
 }
 
-impl<'p> Prepared<'p> {
-    /// The solve's result, timed from `t` without the preconditioners' set-up, its Krylov
-    /// figures reported.
-    fn solved(
-        &self,
-        t: Instant,
-        x: Vector<'p>,
-        contact: Option<(ContactBoundary, contact::ContactSolution)>,
-        reporter: &mut dyn Reporter,
-    ) -> Solved<Vector<'p>> {
+/// A load path: refused by [`crate::supports`] before anything is built; said again where a
+/// run would walk one.
+fn path_unsupported() -> Unsupported {
+    Unsupported::new(
+        "petsc",
+        "path",
+        "a load path (it solves one instant; a path reuses one factorisation)",
+    )
+}
+
+/// A step out of the run's order (a solve before the instant was posed).
+fn unprimed() -> DistributedError {
+    ProblemError::NoSolution {
+        sought: "the contact solve",
+        why: "the backend was asked for an instant it was not given (prime comes first)".into(),
+    }
+    .into()
+}
+
+impl Prepared<'_> {
+    /// Reports the last Krylov solve's figures.
+    fn report_krylov(&self, reporter: &mut dyn Reporter) {
         reporter.event(&Event::Krylov {
             iterations: self.krylov,
             reason: &self.reason,
             setup_seconds: self.t_pc,
         });
-        Solved {
-            x,
-            contact,
-            seconds: t.elapsed().as_secs_f64() - self.t_pc,
-            pcg_iters: 0,
-        }
     }
 }
 

@@ -12,7 +12,6 @@
 use crate::progress::Reporter;
 use crate::report::PetscReport;
 use crate::scene::{ContactSolver, Scene, Valid};
-use crate::solution::Solution;
 use crate::ProblemError;
 use contact::{ContactPoints, ContactSolution, Law, PointValues};
 use fe_assembly::Discretization;
@@ -76,25 +75,26 @@ impl Limits {
     }
 }
 
-/// A backend: how the discrete problem of a run is assembled and solved. Every method is
-/// called once per run, in the order of the run: [`supports`](Backend::supports),
-/// [`estimate`](Backend::estimate), [`assemble`](Backend::assemble),
-/// [`prepare`](Backend::prepare), [`solve_instant`](Backend::solve_instant) (more than once
-/// on one preparation where the run asks: a body only its compliant bed holds, a
-/// capacitance's columns), [`equilibrium`](Backend::equilibrium), [`finish`](Backend::finish).
-/// A backend whose steps are collective (MPI) makes them collective on every rank; only
-/// [`finish`](Backend::finish) may return `None` (a rank that does not hold the gathered
-/// solution).
+/// A backend: how the discrete problem of a run is assembled and solved. The run (the
+/// crate's `run`) calls [`supports`](Backend::supports), [`estimate`](Backend::estimate),
+/// [`assemble`](Backend::assemble) and [`prepare`](Backend::prepare) once, then
+/// [`begin`](Backend::begin) once, then for each instant of its path (a static scene is a
+/// path of one instant) [`prime`](Backend::prime) and [`solve_posed`](Backend::solve_posed)
+/// (more than once where an outer unknown is sought around the contact solve: force
+/// control's depth, a compliant bed's springs) and, at the instants whose fields it needs,
+/// [`instant_fields`](Backend::instant_fields); then [`finish`](Backend::finish). A backend
+/// whose steps are collective (MPI) makes them collective on every rank; only
+/// [`instant_fields`](Backend::instant_fields) may return `None` (a rank that does not hold
+/// the gathered fields).
 pub trait Backend {
     /// The backend's name, as `solver.backend` spells it (for its refusals).
     const NAME: &'static str;
 
     /// The assembled system, before it is prepared.
     type Assembled;
-    /// The system ready to be solved (factored, or its solvers configured).
+    /// The system ready to be solved (factored, or its solvers configured), with what the
+    /// run's instants keep on it.
     type System;
-    /// A solution `(u, φ)` in the backend's own layout.
-    type Solution;
     /// The backend's error: the problem's errors and its own.
     type Error: From<ProblemError>;
 
@@ -117,7 +117,7 @@ pub trait Backend {
     /// file, whose size the run checks once read).
     fn estimate(&self, scene: &Scene) -> Option<(f64, String)>;
 
-    /// Assembles the system of `posed`.
+    /// Assembles the system of `posed` (its loads the first instant's).
     ///
     /// # Errors
     /// Numbers that overflowed, the backend's own.
@@ -137,120 +137,38 @@ pub trait Backend {
         reporter: &mut dyn Reporter,
     ) -> Result<Self::System, Self::Error>;
 
-    /// The instant `posed` on the prepared `system`: the one linear solve without contact,
-    /// or the contact problem on its boundary, solved as its `how` says (the law, the
-    /// tolerance, the interrupt), each outer iteration reported.
-    ///
-    /// # Errors
-    /// A contact solve that did not converge (with its best iterate), a solve that failed.
-    fn solve_instant(
-        &mut self,
-        posed: &Posed<'_>,
-        system: &mut Self::System,
-        contact: Option<ContactAt<'_>>,
-        reporter: &mut dyn Reporter,
-    ) -> Result<Solved<Self::Solution>, Self::Error>;
-
-    /// `‖K x - b - f_c‖ / max(‖b‖, ‖f_c‖)` of the solution, with `f_c` the contact forces of
-    /// its multipliers (they may cancel the loads in the sum).
-    ///
-    /// # Errors
-    /// The backend's own.
-    fn equilibrium(
-        &mut self,
-        posed: &Posed<'_>,
-        system: &Self::System,
-        solved: &Solved<Self::Solution>,
-    ) -> Result<f64, Self::Error>;
-
-    /// The solution as the free unknowns of the discretisation, with what the backend
-    /// measured; the system is dropped (its memory freed before the recovery). `None` on a
-    /// process that does not hold the gathered solution.
-    ///
-    /// # Errors
-    /// The backend's own.
-    fn finish(
-        &mut self,
-        posed: &Posed<'_>,
-        system: Self::System,
-        solution: Self::Solution,
-    ) -> Result<Option<Finished>, Self::Error>;
-
-    /// The free unknowns `(u, φ)` of a solution, the system kept (for another solve on it);
-    /// `None` on a process that does not hold the gathered solution.
-    ///
-    /// # Errors
-    /// The backend's own.
-    fn gather(
-        &mut self,
-        posed: &Posed<'_>,
-        system: &Self::System,
-        solution: &Self::Solution,
-    ) -> Result<Option<Fields>, Self::Error>;
-
-    /// The scene's load path, its instants on one preparation of the system ([`PathBackend`]),
-    /// returning the last instant's solution (`None` on a process that does not hold it). A
-    /// backend that solves one instant only refuses it (the default).
-    ///
-    /// # Errors
-    /// [`Unsupported`] keyed `path` (the default); a path backend's errors.
-    fn run_path(
-        &mut self,
-        scene: &Scene,
-        mesh: Option<mesh::Mesh>,
-        limits: Limits,
-        reporter: &mut dyn Reporter,
-    ) -> Result<Option<Solution>, Self::Error> {
-        let _ = (scene, mesh, limits, reporter);
-        let feature = "a load path (it solves one instant)";
-        Err(ProblemError::from(Unsupported::new(Self::NAME, "path", feature)).into())
-    }
-}
-
-/// A backend that solves load paths: the instants on one preparation of the system, each a
-/// contact solve on what the path keeps ([`PathBackend::Path`]), the fields only where asked
-/// (`problem::solve_path` is the walk over the instants, written once for every such backend).
-pub trait PathBackend: Backend<Error = ProblemError> {
-    /// What a path keeps from instant to instant (the default backend: the condensed
-    /// compliance and the solutions of the parts of the right-hand side).
-    type Path;
-
-    /// Starts a path on the prepared `system` for the contact solve `how` on `boundary`: what
-    /// it keeps, built once, and the fields `K⁻¹ b_q` of each part `q` of the right-hand side
-    /// (`parts`: the loads, each displacement component's lifting, the potentials' lifting) in
-    /// that order.
+    /// Begins the run's instants on the prepared `system`: where the run has contact, what
+    /// its contact solves keep from instant to instant (the default backend: the contact
+    /// problem condensed for the loads of `posed`, the first instant's); and the fields
+    /// `K⁻¹ b_q` of each part `q` of a path's right-hand side (`parts`: the loads, each
+    /// displacement component's lifting, the potentials' lifting; a path's later instants are
+    /// sums of them), in their order. A run of one instant gives no parts.
     ///
     /// # Errors
     /// A solve that failed; a system the backend cannot walk a path on.
-    fn begin_path(
+    fn begin(
         &mut self,
         system: &mut Self::System,
-        boundary: &ContactBoundary,
-        how: &ContactSolve<'_>,
+        posed: &Posed<'_>,
+        contact: Option<Contact<'_>>,
         parts: &[Fields],
         reporter: &mut dyn Reporter,
-    ) -> Result<(Self::Path, Vec<Fields>), ProblemError>;
+    ) -> Result<Vec<Fields>, Self::Error>;
 
     /// `K⁻¹ [a_u; a_φ]` (a functional's response).
     ///
     /// # Errors
     /// A solve that failed.
-    fn respond(&mut self, system: &mut Self::System, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError>;
+    fn respond(&mut self, system: &mut Self::System, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, Self::Error>;
 
-    /// Poses an instant's contact problem: its data at `factors` (the parts' factors, in their
-    /// order), on `framed`'s boundary in its frame (the instant before's tangential
-    /// displacement), with the point forces of the multipliers `springs` among its loads
-    /// (zeros but where only a compliant bed holds the body).
+    /// Poses an instant's contact problem: its data (`primed.posed`'s loads and prescribed
+    /// values; on a path, the parts' `factors`), on its boundary in its frame (the instant
+    /// before's tangential displacement), with the point forces of the multipliers `springs`
+    /// among its loads (zeros but where only a compliant bed holds the body).
     ///
     /// # Errors
-    /// The backend's own.
-    fn prime(
-        &mut self,
-        path: &mut Self::Path,
-        framed: Framed<'_>,
-        factors: &[f64],
-        springs: &PointValues,
-    ) -> Result<(), ProblemError>;
+    /// A solve that failed; the backend's own.
+    fn prime(&mut self, system: &mut Self::System, primed: Primed<'_>) -> Result<(), Self::Error>;
 
     /// The contact solve of the posed instant `at` its points, warm start and rule; its
     /// displacements in the instant's frame.
@@ -259,47 +177,74 @@ pub trait PathBackend: Backend<Error = ProblemError> {
     /// A contact solve that did not converge.
     fn solve_posed(
         &mut self,
-        path: &mut Self::Path,
+        system: &mut Self::System,
         how: &ContactSolve<'_>,
         at: At<'_>,
         reporter: &mut dyn Reporter,
-    ) -> Result<ContactSolution, ProblemError>;
+    ) -> Result<ContactSolution, Self::Error>;
 
-    /// The largest displacement of the contact dofs that an instant's own data make at
-    /// `factors`: the scale of its answer.
-    fn own_scale(&self, path: &Self::Path, factors: &[f64]) -> f64;
+    /// The largest displacement of the contact dofs that a path's instant's own data make at
+    /// `factors`: the scale of its answer (0 where the backend keeps no parts).
+    fn own_scale(&self, system: &Self::System, factors: &[f64]) -> f64;
 
-    /// The fields of the posed `instant` under its loads and the contact forces of `sol` (in
-    /// its frame), refined, the law judged on them; with their equilibrium residual.
+    /// The fields of the posed instant: under its loads alone (no contact), or under the
+    /// contact forces of the contact solve `sol` (in its frame), refined, the law judged on
+    /// them; with their equilibrium residual `‖K x - b - f_c‖ / max(‖b‖, ‖f_c‖)`. `None` on a
+    /// process that does not hold the gathered fields.
     ///
     /// # Errors
     /// A solve that failed.
     fn instant_fields(
         &mut self,
-        path: &mut Self::Path,
         system: &mut Self::System,
-        instant: InstantOf<'_>,
-        sol: ContactSolution,
+        posed: &Posed<'_>,
+        contact: Option<InstantOf<'_>>,
         reporter: &mut dyn Reporter,
-    ) -> Result<(ContactSolution, Fields, f64), ProblemError>;
+    ) -> Result<Option<InstantSolution>, Self::Error>;
 
-    /// What the backend measured, for the path's report.
-    fn figures(&self, system: &Self::System) -> Figures;
+    /// What the backend measured, for the report; the system dropped (its memory freed
+    /// before the last instant's recovery).
+    ///
+    /// # Errors
+    /// The backend's own.
+    fn finish(&mut self, system: Self::System) -> Result<Figures, Self::Error>;
+
+    /// `e`, naming the path's step `k` at instant `t` where it happened.
+    fn at_step(e: Self::Error, k: usize, t: f64) -> Self::Error {
+        let _ = (k, t);
+        e
+    }
 }
 
 /// The free unknowns `(u, φ)` of the discretisation.
 pub type Fields = (Vec<f64>, Vec<f64>);
 
-/// An instant's contact problem ([`Backend::solve_instant`]): its boundary, and how it is
-/// solved.
-pub struct ContactAt<'a> {
-    /// The contact boundary (its points, with the instant's gaps).
-    pub boundary: ContactBoundary,
+/// The contact problem of a run's instants ([`Backend::begin`]): its boundary at the first
+/// instant's data, and how it is solved.
+#[derive(Clone, Copy)]
+pub struct Contact<'a> {
+    /// The contact boundary.
+    pub boundary: &'a ContactBoundary,
     /// The law, the tolerance, the interrupt.
     pub how: &'a ContactSolve<'a>,
 }
 
-/// Where a path's contact solve starts ([`PathBackend::solve_posed`]).
+/// An instant posed for its contact solves ([`Backend::prime`]).
+#[derive(Clone, Copy)]
+pub struct Primed<'a> {
+    /// The discrete problem with the instant's loads and prescribed values.
+    pub posed: &'a Posed<'a>,
+    /// The boundary at the instant, in the frame of the instant before.
+    pub framed: Framed<'a>,
+    /// A path's instant: the parts' factors, in their order ([`Backend::begin`]); `None` for
+    /// the one instant of a static run, whose loads the run began with.
+    pub factors: Option<&'a [f64]>,
+    /// The multipliers of the springs that hold a body only its compliant bed holds (zeros
+    /// otherwise), whose point forces are among the instant's loads.
+    pub springs: &'a PointValues,
+}
+
+/// Where an instant's contact solve starts ([`Backend::solve_posed`]).
 pub struct At<'a> {
     /// The points (their gaps an indenter's depth's under force control).
     pub points: &'a ContactPoints,
@@ -310,15 +255,15 @@ pub struct At<'a> {
     pub refine_start: bool,
 }
 
-/// An instant whose fields are computed ([`PathBackend::instant_fields`]): its contact solve,
-/// its boundary in its frame, its discrete problem with its loads.
+/// The contact of an instant whose fields are computed ([`Backend::instant_fields`]): its
+/// contact solve, its boundary in its frame, the solution found.
 pub struct InstantOf<'a> {
     /// The contact solve.
     pub how: &'a ContactSolve<'a>,
     /// The boundary at the instant, in the frame of the instant before.
     pub framed: Framed<'a>,
-    /// The discrete problem with the instant's loads.
-    pub posed: &'a Posed<'a>,
+    /// The contact solution found ([`Backend::solve_posed`]).
+    pub sol: ContactSolution,
 }
 
 /// An instant's contact boundary (its gaps and prescribed values at the instant's factors)
@@ -373,7 +318,7 @@ impl Posed<'_> {
 }
 
 /// The loads on the free dofs: `b_u` on the displacements, `b_φ` on the potentials.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub struct Loads {
     /// On the free displacements.
     pub b_u: Vec<f64>,
@@ -381,27 +326,17 @@ pub struct Loads {
     pub b_phi: Vec<f64>,
 }
 
-/// A backend's solution: `x` in its layout, and where the plan has contact, the boundary with
-/// its solution.
-pub struct Solved<X> {
-    /// The solution `(u, φ)`, in the backend's layout.
-    pub x: X,
-    /// The contact boundary and the contact solution.
-    pub contact: Option<(ContactBoundary, ContactSolution)>,
-    /// Wall time of the solve, contact included, without a preconditioner's set-up.
-    pub seconds: f64,
+/// The fields of an instant ([`Backend::instant_fields`]).
+pub struct InstantSolution {
+    /// The free unknowns `(u, φ)`.
+    pub x: Fields,
+    /// The contact solution, as the fields judged it (its complementarity residual the final
+    /// fields'), where the instant has contact.
+    pub contact: Option<ContactSolution>,
+    /// The equilibrium residual of the fields.
+    pub equilibrium: f64,
     /// PCG iterations (the Schur-complement strategy; 0 elsewhere).
     pub pcg_iters: usize,
-}
-
-/// The free unknowns `(u, φ)` of the discretisation, and what the backend measured.
-pub struct Finished {
-    /// The free displacements.
-    pub u: Vec<f64>,
-    /// The free potentials.
-    pub phi: Vec<f64>,
-    /// The backend's figures for the report.
-    pub figures: Figures,
 }
 
 /// What a backend measured, for the run's report.

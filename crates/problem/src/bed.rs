@@ -15,8 +15,8 @@
 //! springs are taken at [`SPRING_FRACTION`] of the smaller of the two (the tangent at the mean
 //! pressure the loads put on the bed, the largest elastic constant over the bed's median
 //! spacing), so each step gains two digits or more, at the price of two decades of `K`'s
-//! conditioning in the motions the bed holds. Each step is a contact solve of the backend with its own
-//! loads; the run stops where a step changes the springs' forces by less than
+//! conditioning in the motions the bed holds. Each step is a contact solve of the backend, the
+//! springs' forces among its loads (an instant of the run's walk); the run stops where a step changes the springs' forces by less than
 //! [`SETTLED`] of the loads, or where the change stops falling (its round-off floor) below
 //! half the equilibrium residual a run must reach; the change is added to the residual the
 //! run reports.
@@ -24,9 +24,8 @@
 //! A body that the bed holds nowhere (the loads lift it off) has no solution: a typed
 //! [`ProblemError::NoSolution`], as has a fixed point that does not settle.
 
-use crate::backend::{Backend, Bed, ContactAt, ContactSolve, Posed, Solved};
+use crate::backend::{Bed, Posed};
 use crate::boundary::ContactBoundary;
-use crate::progress::{Event, Reporter};
 use crate::ProblemError;
 use contact::{ContactSolution, Foundation, PointValues};
 
@@ -219,76 +218,6 @@ impl Bed {
             self.body / self.tangent
         )
     }
-}
-
-/// A run's solve with its equilibrium residual on the body's own loads and the steps of the
-/// bed's fixed point (0 without it; with it, the last step's solution, whose residual is the
-/// step's own plus the springs' last change).
-pub(crate) struct Balanced<X> {
-    pub(crate) solved: Solved<X>,
-    pub(crate) equilibrium: f64,
-    pub(crate) steps: usize,
-}
-
-/// The contact problem of a body only its bed holds: contact solves of `backend` (whose `K`
-/// carries the springs of `bed`) with the loads `b + S u_j` until the springs' forces settle,
-/// each by the contact solve `how`. `posed`'s loads are its own again on return.
-///
-/// # Errors
-/// The backend's; [`ProblemError::NoSolution`] where the loads lift the body off its bed (no
-/// point pressed) or the fixed point does not settle in [`MAX_STEPS`].
-pub(crate) fn solve_held<B: Backend>(
-    backend: &mut B,
-    posed: &mut Posed<'_>,
-    system: &mut B::System,
-    boundary: &ContactBoundary,
-    how: &ContactSolve<'_>,
-    bed: Bed,
-    reporter: &mut dyn Reporter,
-) -> Result<Balanced<B::Solution>, B::Error> {
-    let loads = posed.loads.b_u.clone();
-    let mut steps = |posed: &mut Posed<'_>| -> Result<Balanced<B::Solution>, B::Error> {
-        let mut springs = PointValues::zeros(boundary.points.len(), 0);
-        let (mut seconds, mut pcg_iters) = (0.0, 0);
-        let mut last = f64::INFINITY;
-        for step in 1..=MAX_STEPS {
-            let contact = ContactAt {
-                boundary: boundary.clone(),
-                how,
-            };
-            let mut solved = backend.solve_instant(posed, system, Some(contact), reporter)?;
-            (seconds, pcg_iters) = (seconds + solved.seconds, pcg_iters + solved.pcg_iters);
-            let Some((cb, sol)) = solved.contact.as_ref() else {
-                return Ok(Balanced {
-                    equilibrium: backend.equilibrium(posed, system, &solved)?,
-                    solved,
-                    steps: step,
-                });
-            };
-            let (next, change) = settle(cb, bed, sol, &springs, linalg::norm(&loads))?;
-            reporter.event(&Event::BedStep {
-                step,
-                change,
-                settled: SETTLED,
-            });
-            if settled(change, last) {
-                let equilibrium = backend.equilibrium(posed, system, &solved)? + change;
-                (solved.seconds, solved.pcg_iters) = (seconds, pcg_iters);
-                return Ok(Balanced {
-                    solved,
-                    equilibrium,
-                    steps: step,
-                });
-            }
-            posed.loads.b_u.copy_from_slice(&loads);
-            cb.add_forces(&next, &mut posed.loads.b_u);
-            (springs, last) = (next, change);
-        }
-        Err(unsettled(last).into())
-    };
-    let result = steps(posed);
-    posed.loads.b_u = loads;
-    result
 }
 
 /// The springs' multipliers at the solution `sol` (a spring's force is a multiplier

@@ -10,7 +10,7 @@
 //! every column: a run over unit-potential instants (this module names no backend). Reciprocity (`C = Cᵀ`) and Gauss's law (each column's charges sum to 0 where the
 //! terminals enclose every flux) are identities of the discrete problem, reported as checks.
 
-use crate::backend::{Backend, Limits, Loads, Posed};
+use crate::backend::{Backend, InstantSolution, Limits, Loads, Posed};
 use crate::progress::Silent;
 use crate::run::terminal_groups;
 use crate::scene::Scene;
@@ -94,11 +94,13 @@ pub(crate) fn capacitance<B: Backend>(
         // one preparation for every column: the matrix does not change with the potentials
         if system.is_none() {
             let assembled = backend.assemble(&posed)?;
-            system = Some(backend.prepare(&posed, assembled, None, Limits::default(), &mut Silent)?);
+            let mut prepared = backend.prepare(&posed, assembled, None, Limits::default(), &mut Silent)?;
+            backend.begin(&mut prepared, &posed, None, &[], &mut Silent)?;
+            system = Some(prepared);
         }
         let Some(system) = system.as_mut() else { continue };
-        let solved = backend.solve_instant(&posed, system, None, &mut Silent)?;
-        let Some((u, phi)) = backend.gather(&posed, system, &solved.x)? else {
+        let Some(InstantSolution { x: (u, phi), .. }) = backend.instant_fields(system, &posed, None, &mut Silent)?
+        else {
             continue;
         };
         let (u, phi) = (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&phi));
@@ -111,6 +113,9 @@ pub(crate) fn capacitance<B: Backend>(
         {
             matrix[conductor[g]][j] += charge;
         }
+    }
+    if let Some(system) = system {
+        backend.finish(system)?;
     }
     let big = matrix
         .iter()

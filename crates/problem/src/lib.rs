@@ -80,11 +80,11 @@ pub use capacitance::Capacitance;
 pub use exact::ExactReport;
 pub use fe_assembly::CellFields;
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
-pub use path::{PathSolution, Step, StepFields};
+pub use path::{run, PathSolution, Step, StepFields};
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
-pub use run::{run, ContactResult, Solution, EQUILIBRIUM_TOL};
+pub use run::{ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, Contacts, DirichletSpec, ElectricCondition,
     ElectrodeSpec, Electrodes, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, Loads,
@@ -119,7 +119,7 @@ pub fn solve_within(
 ) -> Result<Solution, ProblemError> {
     // a path's instants are the run's too (each step's files unwritten: the last instant,
     // with the rows)
-    let solution = run::run(&mut SharedMemory, scene, mesh, limits, reporter)?;
+    let solution = path::run(&mut SharedMemory, scene, mesh, limits, reporter)?;
     Ok(solution.expect("the default backend runs in one process, which holds the solution"))
 }
 
@@ -154,7 +154,10 @@ pub fn solve_path(
     with_fields: bool,
     each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
 ) -> Result<PathSolution, ProblemError> {
-    path::walk(&mut SharedMemory, scene, mesh, limits, reporter, with_fields, each)
+    let last = path::walk(&mut SharedMemory, scene, mesh, limits, reporter, with_fields, each)?;
+    Ok(PathSolution {
+        last: last.expect("the default backend runs in one process, which holds the solution"),
+    })
 }
 
 /// "the most extreme inputs are ..." naming the scene's numbers far from 1 (each key once), or

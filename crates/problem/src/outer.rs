@@ -37,19 +37,21 @@ impl ForceControl {
 /// Force control (`contact.indenter.force`): [`contact::solve_force_controlled`] around the
 /// contact solve `solve`, the indenter's points of `control` driven to carry `force`; where
 /// no depth carries the force, no solution keyed `contact.indenter.force`.
-pub(crate) fn force_controlled(
+pub(crate) fn force_controlled<E: From<ProblemError>>(
     points: &mut ContactPoints,
     control: &ForceControl,
     force: f64,
     start: Option<PointValues>,
-    solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, ProblemError>,
-) -> Result<ContactSolution, ProblemError> {
-    contact::solve_force_controlled(points, control.driven.as_deref(), force, start, solve).map_err(|e| match e {
-        contact::ForceError::Solve(e) => e,
-        other => ProblemError::NoSolution {
-            sought: "contact.indenter.force",
-            why: other.to_string(),
-        },
+    solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, E>,
+) -> Result<ContactSolution, E> {
+    contact::solve_force_controlled(points, control.driven.as_deref(), force, start, solve).map_err(|e| {
+        e.into_solve().unwrap_or_else(|why| {
+            ProblemError::NoSolution {
+                sought: "contact.indenter.force",
+                why,
+            }
+            .into()
+        })
     })
 }
 

@@ -1,31 +1,37 @@
-//! The quasi-static process along a load path (`[path]`): the scene's loads, prescribed
-//! displacements, potentials and gap scaled by their factors at each instant, the contact
-//! problem solved at each with the friction law on the slip since the instant before
-//! (backward Euler of the quasi-static law: friction remembers), on one factorisation of `K`
-//! and one condensation onto the contact dofs (the matrix does not change along the path).
+//! The run's quasi-static loop (deal.II step-18's shape: set up, then each instant in turn):
+//! a scene with a load path (`[path]`) solves its instants in order, its loads, prescribed
+//! displacements, potentials and gap scaled by their factors at each, friction on the slip
+//! since the instant before (backward Euler of the quasi-static law: friction remembers); a
+//! static scene is a path of one instant. One preparation of the system (one factorisation,
+//! one condensation onto the contact dofs) serves every instant: the matrix does not change
+//! along the path. The run knows no backend: each instant is posed
+//! ([`Backend::prime`]), its contact problem solved ([`Backend::solve_posed`], around it the
+//! outer unknowns: force control's depth, a compliant bed's springs), and, at the instants
+//! that need them, its fields computed ([`Backend::instant_fields`]).
 //!
-//! Each step's right-hand side is the sum of the parts of [`Discretization::rhs_parts`]
-//! scaled by the step's factors, and so is the loads' displacement at the points: the parts
-//! are solved once. A step is then its contact solve on the condensed compliance,
-//! warm-started from the step before: its row (forces, slips, counts, the charges through the
-//! terminals) comes from the multipliers alone, the charges by their functionals
+//! A path's right-hand side at an instant is the sum of the parts of
+//! [`Discretization::rhs_parts`] scaled by the instant's factors, and so is the loads'
+//! displacement at the points: the backend solves the parts once. An instant whose fields are
+//! not written has its row (forces, slips, counts, the charges through the terminals) from
+//! the multipliers alone, the charges by their functionals
 //! ([`Discretization::charge_functionals`]: `Σ_q f_q Q_q - Σ_i w_i λ_i · z_i`, `Q_q` the
 //! charge of part `q`'s solution and `z` the response `K⁻¹ a` of the functional `a` at the
 //! points, both computed once). The fields (a solve with `K`'s factors, refined, and the
 //! recovery) are computed only at the instants whose files are written, and at the last.
 
-use crate::backend::{At, Bed, ContactSolve, Framed, InstantOf, Limits, Loads, PathBackend, Posed};
+use crate::backend::{
+    At, Backend, Bed, Contact, ContactSolve, Figures, Framed, InstantOf, InstantSolution, Limits, Loads, Posed, Primed,
+};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
-use crate::report::{PathReport, RunReport, StepRow, Timings};
+use crate::report::{Iterations, PathReport, RunReport, StepRow, Timings};
 use crate::run::{
-    begin, check_accurate, check_solved, contact_result, indenter_report, recover, report, stop_if_interrupted,
-    terminal_groups, ContactResult, Measured, Recovered,
+    begin, check_accurate, check_solved, contact_boundary, contact_result, indenter_report, pose, recover, report,
+    stop_if_interrupted, terminal_groups, ContactResult, Measured, Recovered,
 };
 use crate::scene::{Factors, PathSpec, Scene};
 use crate::setup::Setup;
 use crate::ProblemError;
-use crate::SetupError;
 use crate::Solution;
 use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization, RhsParts};
@@ -61,12 +67,36 @@ pub struct PathSolution {
     pub last: Solution,
 }
 
-/// [`crate::solve_path`] on `backend`: the walk over the instants, written once for every
-/// [`PathBackend`].
+/// Solves `scene` on `backend`, within `limits`: validate, refuse what the backend does not
+/// take, set up (the memory estimate checked first), discretise, assemble, build the contact
+/// boundary, prepare (factor), then each instant of its path (a static scene is a path of one
+/// instant) posed and solved, checked, recovered; the report built once.
+/// `mesh` is the mesh of a `gmsh` scene, read by the caller. A backend on several processes
+/// returns the solution on the one that gathers it, `None` on the others.
 ///
 /// # Errors
-/// As [`crate::solve_path`].
-pub(crate) fn walk<B: PathBackend>(
+/// The problem's errors ([`ProblemError`], naming the scene key, mesh item, material or
+/// solver step at fault, and a path's step) and the backend's own.
+pub fn run<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<Option<Solution>, B::Error> {
+    walk(backend, scene, mesh, limits, reporter, false, &mut |_| Ok(()))
+}
+
+/// The run of `scene` on `backend` ([`run`], [`crate::solve_path`]): validate, refuse
+/// what the backend does not take, set up (the memory estimate checked first), discretise,
+/// assemble, build the contact boundary, prepare (factor), then each instant (one for a
+/// static scene) posed, solved, checked and, where asked, recovered; each instant with contact
+/// handed to `each`; the report built once. A backend on several processes returns the
+/// solution on the one that gathers it, `None` on the others.
+///
+/// # Errors
+/// As [`crate::run`], naming the path's step where one happened; the error `each` returns.
+pub(crate) fn walk<B: Backend>(
     backend: &mut B,
     scene: &Scene,
     mesh: Option<mesh::Mesh>,
@@ -74,102 +104,128 @@ pub(crate) fn walk<B: PathBackend>(
     reporter: &mut dyn Reporter,
     with_fields: bool,
     each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
-) -> Result<PathSolution, ProblemError> {
-    let spec = scene.path.clone().unwrap_or_else(|| PathSpec {
-        t: vec![0.0, 1.0],
-        steps: Some(1),
-        ..Default::default()
-    });
-    let instants = if scene.path.is_some() {
-        spec.instants()
-    } else {
-        vec![1.0]
-    };
-    let valid = scene.validate()?;
-    backend.supports(&valid)?;
-    let Some(spec_contact) = scene.active_contact().cloned() else {
-        return Err(SetupError::new("path", "a path carries friction's history: the scene has no contact").into());
-    };
+) -> Result<Option<Solution>, B::Error> {
+    let valid = scene.validate().map_err(ProblemError::from)?;
+    backend.supports(&valid).map_err(ProblemError::from)?;
     let t_total = Instant::now();
     let setup = begin(valid, mesh, backend.estimate(&valid), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
-    let mut disc = setup.discretize()?;
-    let parts = disc.rhs_parts(&setup.loads)?;
+    let t = Instant::now();
+    let mut disc = setup.discretize().map_err(ProblemError::from)?;
+    let instants = scene.path.as_ref().map_or_else(|| vec![1.0], PathSpec::instants);
+    let parts = match scene.path {
+        Some(_) => Some(disc.rhs_parts(&setup.loads).map_err(ProblemError::from)?),
+        None => None,
+    };
     let mut walk = Walk {
         scene,
         valid,
         setup: &setup,
-        spec: &spec,
-        contact: &spec_contact,
-        parts: &parts,
+        spec: scene.path.as_ref(),
+        parts: parts.as_ref(),
         base_dofs: disc.dofs.clone(),
         with_fields,
         terminals: Terminals::default(),
+        first: Loads::default(),
+        bed: None,
+        held_to_tolerance: B::HELD_TO_TOLERANCE,
+        of: instants.len() - 1,
     };
-    let (mut system, boundary, t_assembly, bed) = walk.factor(backend, &disc, &instants, &limits, reporter)?;
-    let how = ContactSolve::new(&setup.plan, scene, &boundary, limits.interrupt);
-    let ordered: Vec<(Vec<f64>, Vec<f64>)> = std::iter::once(parts.loads.clone())
-        .chain(parts.displacements.iter().cloned())
-        .chain(std::iter::once(parts.potentials.clone()))
-        .collect();
-    let (mut path, solved) = backend.begin_path(&mut system, &boundary, &how, &ordered, reporter)?;
-    walk.terminals = Terminals::new(&walk, &disc, (&mut *backend, &mut system), &boundary, &solved)?;
+    let mut posed = match walk.parts {
+        Some(parts) => Posed {
+            scene: valid,
+            setup: &setup,
+            disc: &disc,
+            loads: step_loads(parts, &walk.factors(instants[0]), scene)?,
+            bed: None,
+        },
+        None => pose(valid, &setup, &disc)?,
+    };
+    let boundary = contact_boundary(&posed, reporter)?;
+    posed.bed = walk.bed(&posed, &instants, boundary.as_ref())?;
+    let assembled = backend.assemble(&posed)?;
+    let t_assembly = t.elapsed().as_secs_f64();
+    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
+    stop_if_interrupted(&limits, "assembly")?;
+    let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
+    stop_if_interrupted(&limits, "factorisation")?;
+    let how = boundary
+        .as_ref()
+        .map(|b| ContactSolve::new(&setup.plan, scene, b, limits.interrupt));
+    let contact = boundary
+        .as_ref()
+        .zip(how.as_ref())
+        .map(|(boundary, how)| Contact { boundary, how });
+    let ordered = walk.ordered_parts();
+    let solved = backend.begin(&mut system, &posed, contact, &ordered, reporter)?;
+    let Posed { loads, bed, .. } = posed;
+    (walk.first, walk.bed) = (loads, bed);
+    if let (Some(b), false) = (&boundary, solved.is_empty()) {
+        walk.terminals = Terminals::new(&walk, &disc, (&mut *backend, &mut system), b, &solved)?;
+    }
     drop(solved);
     let t_steps = Instant::now();
-    let mut state = History::new(boundary.points.len(), setup.plan.n_tangential(), instants.len());
-    let mut on = On {
-        backend: &mut *backend,
-        base: &boundary,
-        disc: &mut disc,
-        system: &mut system,
-        path: &mut path,
-        how: &how,
-        state: &mut state,
-        bed,
+    let n = boundary.as_ref().map_or(0, |b| b.points.len());
+    let mut state = History::new(n, setup.plan.n_tangential(), instants.len());
+    let prepared = Prepared {
+        backend,
+        system,
+        boundary: boundary.as_ref(),
+        how: how.as_ref(),
     };
-    walk.all_steps(&instants, &mut on, reporter, each)?;
+    let figures = walk.all_steps(prepared, &mut disc, &instants, &mut state, reporter, each)?;
     let steps_s = t_steps.elapsed().as_secs_f64();
+    let Some(mut last) = state.last.take() else {
+        // a process that does not hold the gathered fields
+        return Ok(None);
+    };
+    let Some((recovered, equilibrium, loads)) = last.fields.take() else {
+        return Ok(None);
+    };
     let timings = (t_setup, t_assembly, steps_s, t_total);
-    let figures = backend.figures(&system);
-    let (report, done) = walk.finish(&disc, figures, state, timings);
+    let last = (last, recovered, equilibrium, loads);
+    let (report, result, recovered) = walk.finish(&disc, figures, state, last, timings);
     drop(disc);
-    let (recovered, _, _) = done.fields.expect("the last instant has its fields");
-    Ok(PathSolution {
-        last: Solution {
-            report,
-            contact: Some(done.result),
-            mesh: setup.mesh,
-            u: recovered.u,
-            phi: recovered.phi,
-            fields: recovered.fields,
-        },
-    })
+    Ok(Some(Solution {
+        report,
+        contact: result,
+        mesh: setup.mesh,
+        u: recovered.u,
+        phi: recovered.phi,
+        fields: recovered.fields,
+    }))
 }
 
-/// What a path's steps work on: the boundary at the scene's own factors, the discretisation
-/// (its prescribed values scaled at each step), the factors of `K` and the path's condensed
-/// system on them, the contact solve, and friction's history.
-struct On<'a, 'd, B: PathBackend> {
+/// The backend with its prepared system, the contact boundary and its solve: what the
+/// instants run on.
+struct Prepared<'a, B: Backend> {
     backend: &'a mut B,
-    base: &'a ContactBoundary,
-    disc: &'a mut Discretization<'d>,
-    system: &'a mut B::System,
-    path: &'a mut B::Path,
-    how: &'a ContactSolve<'a>,
-    state: &'a mut History,
-    /// The springs that hold a body only its compliant bed holds.
-    bed: Option<Bed>,
+    system: B::System,
+    boundary: Option<&'a ContactBoundary>,
+    how: Option<&'a ContactSolve<'a>>,
 }
 
-/// What stays the same along a path: the scene, its set-up, the parts of the right-hand side.
+/// What an instant's steps work on: the backend and its prepared system, the boundary at the
+/// scene's own factors, the contact solve, friction's history.
+struct On<'a, B: Backend> {
+    backend: &'a mut B,
+    base: Option<&'a ContactBoundary>,
+    system: &'a mut B::System,
+    how: Option<&'a ContactSolve<'a>>,
+    state: &'a mut History,
+}
+
+/// What stays the same along the run: the scene, its set-up, the parts of a path's
+/// right-hand side.
 struct Walk<'a> {
     scene: &'a Scene,
     valid: crate::Valid<'a>,
     setup: &'a Setup,
-    spec: &'a PathSpec,
-    contact: &'a crate::ContactSpec,
-    parts: &'a RhsParts,
+    /// The path (`None`: a static scene, one instant at the scene's own data).
+    spec: Option<&'a PathSpec>,
+    /// A path's parts of the right-hand side.
+    parts: Option<&'a RhsParts>,
     /// The dof map with the scene's prescribed values (scaled at each step).
     base_dofs: fe_assembly::DofMap,
     /// Whether the fields of the output instants are computed ([`PathSpec::has_fields`]; the
@@ -177,6 +233,31 @@ struct Walk<'a> {
     with_fields: bool,
     /// The charges' functionals.
     terminals: Terminals,
+    /// The loads of a static scene's instant.
+    first: Loads,
+    /// The springs that hold a body only its compliant bed holds.
+    bed: Option<Bed>,
+    /// Whether the backend is held to the tight rule's tolerances.
+    held_to_tolerance: bool,
+    /// The last instant's index.
+    of: usize,
+}
+
+/// An instant's collective steps done ([`Walk::solve_step`]): its factors and boundary, the
+/// contact solve (where its fields were not computed), the fields where asked (`Some(None)`
+/// on a process that does not hold them), its loads, the bed's springs, its seconds.
+struct Stepped {
+    k: usize,
+    t: f64,
+    f: Factors,
+    /// A path's factors of the parts, in their order.
+    factors: Option<Vec<f64>>,
+    boundary: Option<ContactBoundary>,
+    sol: Option<ContactSolution>,
+    fields: Option<Option<InstantSolution>>,
+    loads: Loads,
+    springs: Springs,
+    seconds: f64,
 }
 
 /// The charges through the terminals and their potentials at any step from its factors and
@@ -219,13 +300,13 @@ impl Functional {
 impl Terminals {
     /// The functionals of the setup's terminals: each part's charge and potential, from its
     /// solution's fields, and the response of each functional at the points (one solve each).
-    fn new<B: PathBackend>(
+    fn new<B: Backend>(
         walk: &Walk<'_>,
         disc: &Discretization<'_>,
         (backend, system): (&mut B, &mut B::System),
         boundary: &ContactBoundary,
         solved: &[(Vec<f64>, Vec<f64>)],
-    ) -> Result<Terminals, ProblemError> {
+    ) -> Result<Terminals, B::Error> {
         let setup = walk.setup;
         let groups = terminal_groups(setup);
         if groups.is_empty() {
@@ -247,20 +328,26 @@ impl Terminals {
                 .scaled([unit(0), unit(1), unit(2)], if q == dim + 1 { 1.0 } else { 0.0 });
             let (u, phi) = (dofs.expand_u(u), dofs.expand_phi(phi));
             let loads: &[fe_assembly::Load] = if q == 0 { &setup.loads } else { &[] };
-            for (g, charge) in disc.charges(&u, &phi, &groups, loads)?.into_iter().enumerate() {
+            for (g, charge) in disc
+                .charges(&u, &phi, &groups, loads)
+                .map_err(ProblemError::from)?
+                .into_iter()
+                .enumerate()
+            {
                 charges[g].push(charge);
                 potentials[g].push(firsts[g].map_or(0.0, |v| phi[v]));
             }
         }
         let points = &boundary.points;
-        let mut respond = |a_u: &[f64], a_phi: &[f64]| -> Result<PointValues, ProblemError> {
+        let mut respond = |a_u: &[f64], a_phi: &[f64]| -> Result<PointValues, B::Error> {
             let (z, _) = backend.respond(system, a_u, a_phi)?;
             let mut out = PointValues::zeros(points.len(), points.n_tangential());
             boundary.extract_free(&z, &mut out);
             Ok(out)
         };
         let mut out = Terminals::default();
-        for ((a_u, a_phi), of_parts) in disc.charge_functionals(&groups)?.into_iter().zip(charges) {
+        let functionals = disc.charge_functionals(&groups).map_err(ProblemError::from)?;
+        for ((a_u, a_phi), of_parts) in functionals.into_iter().zip(charges) {
             out.charges.push(Functional {
                 of_parts,
                 at_points: Some(respond(&a_u, &a_phi)?),
@@ -318,8 +405,8 @@ impl History {
 
     /// The step is done: its tangential displacement `now` the next step's frame, the slip of
     /// its points in contact added to what they slipped, its multipliers the next start.
-    fn advance(&mut self, now: &PointValues, sol: &ContactSolution) {
-        self.iterations.add(&crate::report::Iterations::of(Some(&sol.info), 0));
+    fn advance(&mut self, now: &PointValues, sol: &ContactSolution, iterations: &Iterations) {
+        self.iterations.add(iterations);
         let nt = self.shift.n_tangential();
         if nt > 0 {
             for i in 0..self.slipped.len() {
@@ -334,11 +421,6 @@ impl History {
     }
 }
 
-/// One instant solved: its row, its contact solution, and where computed its fields (with the
-/// equilibrium residual and the step's loads).
-/// An instant's fields: recovered, their equilibrium residual, the loads, the displacement.
-type InstantFields = (Recovered, f64, Loads, Vec<f64>);
-
 /// The springs' multipliers of an instant of a body only its compliant bed holds (zeros
 /// otherwise), the bed's fixed-point steps, and its last change (relative to the forces).
 struct Springs {
@@ -348,6 +430,15 @@ struct Springs {
 }
 
 impl Springs {
+    /// No springs, at `n` points of `nt` tangential components.
+    fn none(n: usize, nt: usize) -> Springs {
+        Springs {
+            lambda: PointValues::zeros(n, nt),
+            steps: 0,
+            change: 0.0,
+        }
+    }
+
     /// The multipliers that act on the springs' `K`: the contact's `lambda` and the springs'.
     fn applied(&self, lambda: &PointValues) -> PointValues {
         let mut out = lambda.clone();
@@ -358,53 +449,109 @@ impl Springs {
     }
 }
 
+/// An instant's data for its contact solves: the discrete problem with its loads, a path's
+/// factors of the parts, and its load factor (force control's force scales with it).
+#[derive(Clone, Copy)]
+struct InstantData<'a> {
+    posed: &'a Posed<'a>,
+    factors: Option<&'a [f64]>,
+    load: f64,
+}
+
+/// An instant checked ([`Walk::checked`]): its contact solution, where computed its fields
+/// recovered with their equilibrium residual and free displacements, its PCG iterations.
+type Checked = (Option<ContactSolution>, Option<(Recovered, f64, Vec<f64>)>, usize);
+
+/// One instant completed: its contact result (with contact), its fields (the last
+/// instant's, and where asked), its own iterations and PCG count, its seconds.
 struct Done {
-    row: StepRow,
-    result: ContactResult,
+    result: Option<ContactResult>,
     fields: Option<(Recovered, f64, Loads)>,
+    iterations: Iterations,
+    pcg_iters: usize,
+    seconds: f64,
 }
 
 impl Walk<'_> {
-    /// Assembles and factors `K` with the boundary's dofs last (at the first instant's
-    /// factors); the boundary, and the assembly's time.
-    fn factor<B: PathBackend>(
+    /// Every instant in order: its collective steps, then (at the last, after the backend
+    /// finished and freed its system) its completion; the last instant kept in `state`. Returns
+    /// the backend's figures.
+    fn all_steps<B: Backend>(
         &self,
-        backend: &mut B,
-        disc: &Discretization<'_>,
+        Prepared {
+            backend,
+            system,
+            boundary,
+            how,
+        }: Prepared<'_, B>,
+        disc: &mut Discretization<'_>,
         instants: &[f64],
-        limits: &Limits,
+        state: &mut History,
         reporter: &mut dyn Reporter,
-    ) -> Result<(B::System, ContactBoundary, f64, Option<Bed>), ProblemError> {
-        let t = Instant::now();
-        let mut posed = Posed {
-            scene: self.valid,
-            setup: self.setup,
-            disc,
-            loads: step_loads(self.parts, &self.spec.factors(instants[0]), self.scene)?,
-            bed: None,
-        };
-        let assembled = backend.assemble(&posed)?;
-        let t_assembly = t.elapsed().as_secs_f64();
-        reporter.event(&Event::assembled(&self.setup.mesh, &disc.dofs, t_assembly));
-        let boundary = ContactBoundary::of_groups(disc, &self.scene.zones())?;
-        boundary.report_held(&self.contact.group, reporter);
-        posed.bed = self.bed(disc, instants, &boundary)?;
-        let system = backend.prepare(&posed, assembled, Some(&boundary), *limits, reporter)?;
-        stop_if_interrupted(limits, "factorisation")?;
-        Ok((system, boundary, t_assembly, posed.bed))
+        each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+    ) -> Result<Figures, B::Error> {
+        let of = instants.len() - 1;
+        let mut system = Some(system);
+        let mut figures = Figures::default();
+        for (k, &t) in instants.iter().enumerate() {
+            let at = |e: B::Error| if self.spec.is_some() { B::at_step(e, k, t) } else { e };
+            let Some(prepared) = system.as_mut() else { break };
+            if self.spec.is_some() {
+                reporter.event(&Event::PathStep { step: k, of, t });
+            }
+            let mut on = On {
+                backend: &mut *backend,
+                base: boundary,
+                system: prepared,
+                how,
+                state: &mut *state,
+            };
+            let fields = k == of || (self.with_fields && self.spec.is_some_and(|s| s.has_fields(k, of + 1)));
+            let stepped = self.solve_step(&mut on, disc, k, t, fields, reporter).map_err(at)?;
+            if k == of {
+                // the system's memory freed before the last instant's recovery
+                if let Some(prepared) = system.take() {
+                    figures = backend.finish(prepared)?;
+                }
+            }
+            let done = self.complete_step(state, disc, stepped, reporter, each);
+            let done = done.map_err(|e| at(e.into()))?;
+            if k == of {
+                state.last = done;
+            }
+        }
+        Ok(figures)
+    }
+
+    /// The factors at `t` (a static scene's: every factor 1, the scene as written).
+    fn factors(&self, t: f64) -> Factors {
+        self.spec.map_or(Factors::ONE, |s| s.factors(t))
+    }
+
+    /// A path's parts of the right-hand side in the backend's order: the loads, each
+    /// displacement component's lifting, the potentials' lifting (none for a static scene).
+    fn ordered_parts(&self) -> Vec<(Vec<f64>, Vec<f64>)> {
+        let Some(parts) = self.parts else { return vec![] };
+        std::iter::once(parts.loads.clone())
+            .chain(parts.displacements.iter().cloned())
+            .chain(std::iter::once(parts.potentials.clone()))
+            .collect()
     }
 
     /// The springs that hold a body only its compliant bed holds (`None` where the conditions
-    /// hold it), sized by the loads of the path's strongest instant.
+    /// hold it), sized by the loads of `posed` (a path's: its strongest instant's).
     fn bed(
         &self,
-        disc: &Discretization<'_>,
+        posed: &Posed<'_>,
         instants: &[f64],
-        boundary: &ContactBoundary,
+        boundary: Option<&ContactBoundary>,
     ) -> Result<Option<Bed>, ProblemError> {
-        let mut strongest = step_loads(self.parts, &self.spec.factors(instants[0]), self.scene)?;
+        let Some(parts) = self.parts else {
+            return Bed::needed(posed, boundary);
+        };
+        let mut strongest = step_loads(parts, &self.factors(instants[0]), self.scene)?;
         for &t in &instants[1..] {
-            let loads = step_loads(self.parts, &self.spec.factors(t), self.scene)?;
+            let loads = step_loads(parts, &self.factors(t), self.scene)?;
             if linalg::norm(&loads.b_u) > linalg::norm(&strongest.b_u) {
                 strongest = loads;
             }
@@ -412,206 +559,162 @@ impl Walk<'_> {
         let posed = Posed {
             scene: self.valid,
             setup: self.setup,
-            disc,
+            disc: posed.disc,
             loads: strongest,
             bed: None,
         };
-        Bed::needed(&posed, Some(boundary))
+        Bed::needed(&posed, boundary)
     }
 
-    /// Every instant in order, each handed to `each` and its row kept; the last kept whole.
-    fn all_steps<B: PathBackend>(
+    /// The instant `t` (the run's `k`-th) on every process: its prescribed values, gap and
+    /// loads scaled, the contact problem in the frame of the instant before; where
+    /// `with_fields`, its fields.
+    fn solve_step<B: Backend>(
         &self,
-        instants: &[f64],
-        on: &mut On<'_, '_, B>,
-        reporter: &mut dyn Reporter,
-        each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
-    ) -> Result<(), ProblemError> {
-        let of = instants.len() - 1;
-        for (k, &t) in instants.iter().enumerate() {
-            reporter.event(&Event::PathStep { step: k, of, t });
-            let at = |e: ProblemError| e.at_step(k, t);
-            let fields = k == of || (self.with_fields && self.spec.has_fields(k, of + 1));
-            let done = self.step(on, k, t, fields, reporter).map_err(at)?;
-            reporter.event(&Event::PathStepDone { row: &done.row, of });
-            each(Step {
-                row: &done.row,
-                mesh: &self.setup.mesh,
-                contact: &done.result,
-                fields: done.fields.as_ref().map(|(r, _, _)| StepFields {
-                    u: &r.u,
-                    phi: &r.phi,
-                    fields: &r.fields,
-                }),
-            })?;
-            on.state.rows.push(done.row.clone());
-            if k == of {
-                on.state.last = Some(done);
-            }
-        }
-        Ok(())
-    }
-
-    /// The instant `t` (the path's `k`-th): its prescribed values, gap and loads scaled, the
-    /// contact problem in the frame of the step before; where `with_fields`, the fields
-    /// recovered and checked.
-    fn step<B: PathBackend>(
-        &self,
-        on: &mut On<'_, '_, B>,
+        on: &mut On<'_, B>,
+        disc: &mut Discretization<'_>,
         k: usize,
         t: f64,
         with_fields: bool,
         reporter: &mut dyn Reporter,
-    ) -> Result<Done, ProblemError> {
-        let (scene, setup) = (self.scene, self.setup);
-        let f = self.spec.factors(t);
-        on.disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
-        let mut boundary = on.base.at_factors(f.gap, f.displacement);
-        if on.base.points.weakens() {
-            boundary.points.slipped.clone_from(&on.state.slipped);
-        }
-        let mut factors = vec![f.load];
-        factors.extend_from_slice(&f.displacement[..setup.mesh.dim]);
-        factors.push(f.voltage);
-        let (sol, spring) = self.contact_at(on, &mut boundary, &factors, f.load, reporter)?;
-        if let Some(contraction) = sol.info.contraction.filter(|c| *c >= 1.0) {
-            reporter.event(&Event::NotContractive { contraction });
-        }
-        // the instant's own displacement scale: its loads' and prescribed values', and how far
-        // its gaps press in
-        let pressed = boundary.points.gap.iter().fold(0.0f64, |m, g| m.max(-g));
-        check_history(
-            &on.state.shift,
-            on.backend.own_scale(on.path, &factors).max(pressed),
-            &setup.plan,
-        )?;
-        let (mut sol, fields) = if with_fields {
-            self.fields_at(on, &boundary, &f, (sol, &spring), reporter)?
-        } else {
-            check_solved(scene, (&[], &[]), Some(&sol), 0.0)?;
-            check_accurate(scene, &setup.plan, Some(&sol), 0.0)?;
-            (sol, None)
-        };
-        let state = &mut *on.state;
-        // the multipliers and displacements of the step in the body's frame
-        for (v, s) in sol.u.tangential.iter_mut().zip(&state.shift.tangential) {
-            *v += s;
-        }
-        let now = match &fields {
-            Some((_, _, _, u)) => {
-                let mut now = PointValues::zeros(boundary.points.len(), boundary.points.n_tangential());
-                boundary.extract(u, &mut now);
-                now
+    ) -> Result<Stepped, B::Error> {
+        let started = Instant::now();
+        let f = self.factors(t);
+        let (loads, factors) = match self.parts {
+            Some(parts) => {
+                disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
+                let mut factors = vec![f.load];
+                factors.extend_from_slice(&f.displacement[..self.setup.mesh.dim]);
+                factors.push(f.voltage);
+                (step_loads(parts, &f, self.scene)?, Some(factors))
             }
-            None => sol.u.clone(),
+            None => (self.first.clone(), None),
         };
-        let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift);
-        if let Some(indenter) = indenter_report(scene, &boundary, &sol) {
-            (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
+        let mut boundary = on.base.map(|b| match self.parts {
+            Some(_) => b.at_factors(f.gap, f.displacement),
+            None => b.clone(),
+        });
+        if let (Some(b), Some(_)) = (boundary.as_mut(), self.parts) {
+            if b.points.weakens() {
+                b.points.slipped.clone_from(&on.state.slipped);
+            }
         }
-        // the charges of the fields where they are computed, else of the functionals (equal to
-        // the condensed solve's accuracy: tests/path.rs)
-        (row.charges, row.potentials) = match &fields {
-            Some((recovered, _, _, _)) => recovered.terminals.iter().map(|x| (x.charge, x.potential)).unzip(),
-            None => self
-                .terminals
-                .at(&factors, &spring.applied(&sol.lambda), &boundary.points.weight),
-        };
-        row.equilibrium = fields.as_ref().map(|(_, e, _, _)| *e);
-        state.advance(&now, &sol);
-        state.iterations.bed += spring.steps;
-        let result = match &fields {
-            Some((_, _, _, u)) => contact_result(boundary, sol, u),
-            None => ContactResult::condensed(boundary, sol),
-        };
-        Ok(Done {
-            row,
-            result,
-            fields: fields.map(|(r, e, l, _)| (r, e, l)),
-        })
-    }
-
-    /// The fields of an instant (factors `f`) under the contact forces of `sol`: refined, the
-    /// law judged on them, checked and recovered; with the equilibrium residual, the loads and
-    /// the displacement.
-    fn fields_at<B: PathBackend>(
-        &self,
-        on: &mut On<'_, '_, B>,
-        boundary: &ContactBoundary,
-        f: &Factors,
-        (sol, spring): (ContactSolution, &Springs),
-        reporter: &mut dyn Reporter,
-    ) -> Result<(ContactSolution, Option<InstantFields>), ProblemError> {
-        let (scene, setup) = (self.scene, self.setup);
-        let mut loads = step_loads(self.parts, f, scene)?;
-        // the springs' forces of a body only its bed holds are loads of the springs' K
-        boundary.add_forces(&spring.lambda, &mut loads.b_u);
-        let posed = Posed {
+        let mut posed = Posed {
             scene: self.valid,
-            setup,
-            disc: on.disc,
+            setup: self.setup,
+            disc,
             loads,
             bed: None,
         };
-        let framed = Framed {
+        let (mut sol, springs) = match (boundary.as_mut(), on.how) {
+            (Some(b), Some(how)) => {
+                let data = InstantData {
+                    posed: &posed,
+                    factors: factors.as_deref(),
+                    load: f.load,
+                };
+                let (sol, springs) = self.contact_at(on, how, b, data, reporter)?;
+                (Some(sol), springs)
+            }
+            _ => (None, Springs::none(0, 0)),
+        };
+        if let Some(contraction) = sol.as_ref().and_then(|s| s.info.contraction).filter(|c| *c >= 1.0) {
+            reporter.event(&Event::NotContractive { contraction });
+        }
+        if let (Some(b), Some(factors)) = (&boundary, &factors) {
+            // the instant's own displacement scale: its loads' and prescribed values', and how
+            // far its gaps press in
+            let pressed = b.points.gap.iter().fold(0.0f64, |m, g| m.max(-g));
+            let own = on.backend.own_scale(on.system, factors).max(pressed);
+            check_history(&on.state.shift, own, &self.setup.plan)?;
+        }
+        if let (Some(b), Some(_)) = (&boundary, self.bed) {
+            // the springs' forces of a body only its bed holds are loads of the springs' K
+            b.add_forces(&springs.lambda, &mut posed.loads.b_u);
+        }
+        let fields = match (with_fields, &boundary, on.how, sol.take()) {
+            (false, _, _, kept) => {
+                sol = kept;
+                None
+            }
+            (true, Some(b), Some(how), Some(found)) => {
+                let framed = Framed {
+                    boundary: b,
+                    shift: &on.state.shift,
+                };
+                let instant = InstantOf {
+                    how,
+                    framed,
+                    sol: found,
+                };
+                Some(on.backend.instant_fields(on.system, &posed, Some(instant), reporter)?)
+            }
+            (true, ..) => Some(on.backend.instant_fields(on.system, &posed, None, reporter)?),
+        };
+        let seconds = started.elapsed().as_secs_f64();
+        if let (None, Some(Some(x))) = (self.spec, &fields) {
+            reporter.event(&Event::Solved {
+                seconds,
+                pcg_iters: x.pcg_iters,
+                equilibrium: x.equilibrium + springs.change,
+            });
+        }
+        Ok(Stepped {
+            k,
+            t,
+            f,
+            factors,
             boundary,
-            shift: &on.state.shift,
-        };
-        let instant = InstantOf {
-            how: on.how,
-            framed,
-            posed: &posed,
-        };
-        let (sol, (u, phi), equilibrium) = on.backend.instant_fields(on.path, on.system, instant, sol, reporter)?;
-        let equilibrium = equilibrium + spring.change;
-        check_solved(scene, (&u, &phi), Some(&sol), equilibrium)?;
-        check_accurate(scene, &setup.plan, Some(&sol), equilibrium)?;
-        let pair = Some((boundary, &sol));
-        let recovered = recover(scene, setup, on.disc, (&u, &phi), pair, equilibrium, reporter)?;
-        Ok((sol, Some((recovered, equilibrium, posed.loads, u))))
+            sol,
+            fields,
+            loads: posed.loads,
+            springs,
+            seconds,
+        })
     }
 
-    /// The contact solve of an instant at `factors` (force control: the depth found for the
-    /// indenter's force times the `load` factor, from the step before's multipliers); where
-    /// only a compliant bed holds the body, the bed's fixed point around it (the springs'
-    /// forces a multiplier of their own on the condensed problem, as in the run:
-    /// `crate::bed`), with the springs' multipliers and steps.
-    fn contact_at<B: PathBackend>(
+    /// The contact solve of an instant (force control: the depth found for the indenter's
+    /// force times the `load` factor, from the step before's multipliers); where only a
+    /// compliant bed holds the body, the bed's fixed point around it (the springs' forces a
+    /// multiplier of their own among the instant's loads: `crate::bed`), with the springs'
+    /// multipliers and steps.
+    fn contact_at<B: Backend>(
         &self,
-        on: &mut On<'_, '_, B>,
+        on: &mut On<'_, B>,
+        how: &ContactSolve<'_>,
         boundary: &mut ContactBoundary,
-        factors: &[f64],
-        load: f64,
+        data: InstantData<'_>,
         reporter: &mut dyn Reporter,
-    ) -> Result<(ContactSolution, Springs), ProblemError> {
-        let (backend, path, how, state) = (&mut *on.backend, &mut *on.path, on.how, &mut *on.state);
+    ) -> Result<(ContactSolution, Springs), B::Error> {
+        let (backend, system, state) = (&mut *on.backend, &mut *on.system, &mut *on.state);
         let control = crate::outer::ForceControl::of(self.scene, boundary);
         let base_gap = boundary.points.gap.clone();
-        let n = boundary.points.len();
-        let mut springs = Springs {
-            lambda: PointValues::zeros(n, self.setup.plan.n_tangential()),
-            steps: 0,
-            change: 0.0,
-        };
+        let mut springs = Springs::none(boundary.points.len(), self.setup.plan.n_tangential());
+        let scale = linalg::norm(&data.posed.loads.b_u);
         let mut start = state.start.take();
         let mut last = f64::INFINITY;
         loop {
-            let framed = Framed {
-                boundary,
-                shift: &state.shift,
+            let primed = Primed {
+                posed: data.posed,
+                framed: Framed {
+                    boundary,
+                    shift: &state.shift,
+                },
+                factors: data.factors,
+                springs: &springs.lambda,
             };
-            backend.prime(path, framed, factors, &springs.lambda)?;
+            backend.prime(system, primed)?;
             boundary.points.gap.clone_from(&base_gap);
             let sol = match &control {
                 Some(control) => {
-                    let force = control.force * load;
+                    let force = control.force * data.load;
                     crate::outer::force_controlled(&mut boundary.points, control, force, start, |points, warm| {
                         let at = At {
                             points,
                             start: warm,
                             refine_start: true,
                         };
-                        backend.solve_posed(path, how, at, reporter)
+                        backend.solve_posed(system, how, at, reporter)
                     })?
                 }
                 None => {
@@ -620,12 +723,12 @@ impl Walk<'_> {
                         start,
                         refine_start: false,
                     };
-                    backend.solve_posed(path, how, at, reporter)?
+                    backend.solve_posed(system, how, at, reporter)?
                 }
             };
-            let Some(bed) = on.bed else { return Ok((sol, springs)) };
+            let Some(bed) = self.bed else { return Ok((sol, springs)) };
             springs.steps += 1;
-            let (next, change) = crate::bed::settle(boundary, bed, &sol, &springs.lambda, 0.0)?;
+            let (next, change) = crate::bed::settle(boundary, bed, &sol, &springs.lambda, scale)?;
             reporter.event(&Event::BedStep {
                 step: springs.steps,
                 change,
@@ -636,7 +739,7 @@ impl Walk<'_> {
                 return Ok((sol, springs));
             }
             if springs.steps == crate::bed::MAX_STEPS {
-                return Err(crate::bed::unsettled(change));
+                return Err(crate::bed::unsettled(change).into());
             }
             last = change;
             springs.lambda = next;
@@ -644,51 +747,204 @@ impl Walk<'_> {
         }
     }
 
-    /// The report of the last instant with the path's section, and the last instant.
+    /// An instant completed on the process that holds its fields (`None` elsewhere): checked,
+    /// recovered where its fields were computed, its row made (forces, slips, counts, charges)
+    /// and handed to `each`, friction's history advanced.
+    fn complete_step(
+        &self,
+        state: &mut History,
+        disc: &Discretization<'_>,
+        stepped: Stepped,
+        reporter: &mut dyn Reporter,
+        each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+    ) -> Result<Option<Done>, ProblemError> {
+        let Stepped {
+            k,
+            t,
+            f,
+            factors,
+            boundary,
+            sol,
+            fields,
+            loads,
+            springs,
+            seconds,
+        } = stepped;
+        let setup = self.setup;
+        let Some((sol, fielded, pcg_iters)) =
+            self.checked(boundary.as_ref(), disc, (sol, fields), &springs, reporter)?
+        else {
+            return Ok(None);
+        };
+        let mut iterations = Iterations::of(sol.as_ref().map(|s| &s.info), pcg_iters);
+        iterations.bed = springs.steps;
+        let (Some(boundary), Some(mut sol)) = (boundary, sol) else {
+            // no contact: the instant's fields alone
+            return Ok(Some(Done {
+                result: None,
+                fields: fielded.map(|(r, e, _)| (r, e, loads)),
+                iterations,
+                pcg_iters,
+                seconds,
+            }));
+        };
+        if self.spec.is_some() {
+            // the multipliers and displacements of the step in the body's frame
+            for (v, s) in sol.u.tangential.iter_mut().zip(&state.shift.tangential) {
+                *v += s;
+            }
+        }
+        let now = match &fielded {
+            Some((_, _, u)) => {
+                let mut now = PointValues::zeros(boundary.points.len(), boundary.points.n_tangential());
+                boundary.extract(u, &mut now);
+                now
+            }
+            None => sol.u.clone(),
+        };
+        let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift);
+        if let Some(indenter) = indenter_report(self.scene, &boundary, &sol) {
+            (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
+        }
+        // the charges of the fields where they are computed, else of the functionals (equal to
+        // the condensed solve's accuracy: tests/path.rs)
+        (row.charges, row.potentials) = match (&fielded, &factors) {
+            (Some((recovered, _, _)), _) => recovered.terminals.iter().map(|x| (x.charge, x.potential)).unzip(),
+            (None, Some(factors)) => {
+                let applied = springs.applied(&sol.lambda);
+                self.terminals.at(factors, &applied, &boundary.points.weight)
+            }
+            (None, None) => (vec![], vec![]),
+        };
+        row.equilibrium = fielded.as_ref().map(|(_, e, _)| *e);
+        state.advance(&now, &sol, &iterations);
+        let result = match &fielded {
+            Some((_, _, u)) => contact_result(boundary, sol, u),
+            None => ContactResult::condensed(boundary, sol),
+        };
+        if self.spec.is_some() {
+            reporter.event(&Event::PathStepDone { row: &row, of: self.of });
+        }
+        each(Step {
+            row: &row,
+            mesh: &setup.mesh,
+            contact: &result,
+            fields: fielded.as_ref().map(|(r, _, _)| StepFields {
+                u: &r.u,
+                phi: &r.phi,
+                fields: &r.fields,
+            }),
+        })?;
+        state.rows.push(row.clone());
+        Ok(Some(Done {
+            result: Some(result),
+            fields: fielded.map(|(r, e, _)| (r, e, loads)),
+            iterations,
+            pcg_iters,
+            seconds,
+        }))
+    }
+
+    /// An instant's contact solution and fields checked, the fields recovered where computed
+    /// (with their equilibrium residual, the springs' last change added, and the free
+    /// displacements), and its PCG iterations; `None` on a process that does not hold them.
+    fn checked(
+        &self,
+        boundary: Option<&ContactBoundary>,
+        disc: &Discretization<'_>,
+        (sol, fields): (Option<ContactSolution>, Option<Option<InstantSolution>>),
+        springs: &Springs,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Option<Checked>, ProblemError> {
+        let (scene, setup) = (self.scene, self.setup);
+        Ok(Some(match fields {
+            Some(None) => return Ok(None),
+            Some(Some(x)) => {
+                let equilibrium = x.equilibrium + springs.change;
+                let (u, phi) = &x.x;
+                check_solved(scene, (u, phi), x.contact.as_ref(), equilibrium)?;
+                self.check_accurate(x.contact.as_ref(), equilibrium)?;
+                let pair = boundary.zip(x.contact.as_ref());
+                let recovered = recover(scene, setup, disc, (u, phi), pair, equilibrium, reporter)?;
+                (x.contact, Some((recovered, equilibrium, x.x.0)), x.pcg_iters)
+            }
+            None => {
+                check_solved(scene, (&[], &[]), sol.as_ref(), 0.0)?;
+                self.check_accurate(sol.as_ref(), 0.0)?;
+                (sol, None, 0)
+            }
+        }))
+    }
+
+    /// Under the tight rule, a backend held to its tolerances meets them
+    /// ([`check_accurate`]); where only a compliant bed holds the body, its softness is named
+    /// as the likely cause of an ill-conditioned system.
+    fn check_accurate(&self, sol: Option<&ContactSolution>, equilibrium: f64) -> Result<(), ProblemError> {
+        if !self.held_to_tolerance {
+            return Ok(());
+        }
+        check_accurate(self.scene, &self.setup.plan, sol, equilibrium).map_err(|e| match (e, self.bed) {
+            (ProblemError::IllConditioned { what, .. }, Some(bed)) => ProblemError::IllConditioned {
+                what,
+                factors: bed.conditioning_in_words(),
+            },
+            (e, _) => e,
+        })
+    }
+
+    /// The report of the last instant (with a path's section), its contact result and
+    /// recovered fields.
     fn finish(
         self,
         disc: &Discretization<'_>,
-        figures: crate::backend::Figures,
+        figures: Figures,
         state: History,
+        (done, recovered, equilibrium, loads): (Done, Recovered, f64, Loads),
         (t_setup, t_assembly, steps_s, t_total): (f64, f64, f64, Instant),
-    ) -> (RunReport, Done) {
-        let mut done = state.last.expect("a path has at least one instant");
+    ) -> (RunReport, Option<ContactResult>, Recovered) {
+        let path = self.spec.is_some();
+        let contact_s = match (path, &done.result) {
+            (true, _) => steps_s,
+            (false, Some(_)) => done.seconds,
+            (false, None) => 0.0,
+        };
         let timings_s = Timings {
             setup: t_setup,
             assembly: t_assembly,
             factorization: figures.factor_seconds,
             condense: figures.condense.map_or(0.0, |c| c.1),
-            contact: steps_s,
-            solve: steps_s,
+            contact: contact_s,
+            solve: if path { steps_s } else { done.seconds },
             total: t_total.elapsed().as_secs_f64(),
         };
-        let (recovered, equilibrium, loads) = done.fields.as_mut().expect("the last instant has its fields");
         let posed = Posed {
             scene: self.valid,
             setup: self.setup,
             disc,
-            loads: std::mem::take(loads),
+            loads,
             bed: None,
         };
         let measured = Measured {
-            info: Some(&done.result.solution.info),
-            pcg_iters: 0,
-            equilibrium: *equilibrium,
+            info: done.result.as_ref().map(|r| &r.solution.info),
+            pcg_iters: done.pcg_iters,
+            equilibrium,
             timings_s,
             figures,
-            bed_steps: 0,
+            bed_steps: done.iterations.bed,
         };
-        let mut report: RunReport = report(&posed, measured, recovered);
-        // the path's iterations are its steps' summed
-        report.iterations = state.iterations;
-        report.path = Some(PathReport {
-            instants: state.rows.len(),
-            factorisations: 1,
-            condensations: 1,
-            steps_s,
-            rows: state.rows,
-        });
-        (report, done)
+        let mut report: RunReport = report(&posed, measured, &recovered);
+        if path {
+            // the path's iterations are its steps' summed
+            report.iterations = state.iterations;
+            report.path = Some(PathReport {
+                instants: state.rows.len(),
+                factorisations: 1,
+                condensations: 1,
+                steps_s,
+                rows: state.rows,
+            });
+        }
+        (report, done.result, recovered)
     }
 }
 

@@ -1,10 +1,11 @@
 //! A run, read as the method (as deal.II's step-41 reads): set up, discretise, assemble,
 //! factor (or prepare the Krylov solvers), solve the contact problem (or the one linear
-//! system), check, recover the fields, report. [`run`] calls the steps in order on any
-//! [`Backend`] and builds the report once; [`solve`] runs the default backend.
+//! system) at each instant, check, recover the fields, report. The run (`crate::run`, its loop
+//! over the instants in the `path` module) calls the steps in order on any backend and builds
+//! the report once; here are the steps it shares between its instants: the set-up, the
+//! checks, the recovery and the report.
 
-use crate::backend::{Backend, Bed, ContactAt, ContactSolve, Figures, Finished, Limits, Loads, Posed, Solved};
-use crate::bed::Balanced;
+use crate::backend::{Figures, Limits, Loads, Posed};
 use crate::boundary::ContactBoundary;
 use crate::exact::contact_errors;
 use crate::plan::Plan;
@@ -19,152 +20,6 @@ pub use crate::solution::{ContactResult, Solution};
 use crate::ProblemError;
 use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization};
-use std::time::Instant;
-
-/// Solves `scene` on `backend`, within `limits`: validate, refuse what the backend does not
-/// take, set up (the memory estimate checked first), discretise, assemble, build the contact
-/// boundary, prepare (factor), solve, measure the equilibrium, gather, check, recover,
-/// report. `mesh` is the mesh of a `gmsh` scene, read by the caller. A backend on several
-/// processes returns the solution on the one that gathers it, `None` on the others.
-///
-/// # Errors
-/// The problem's errors ([`ProblemError`], naming the scene key, mesh item, material or
-/// solver step at fault) and the backend's own.
-pub fn run<B: Backend>(
-    backend: &mut B,
-    scene: &Scene,
-    mesh: Option<mesh::Mesh>,
-    limits: Limits,
-    reporter: &mut dyn Reporter,
-) -> Result<Option<Solution>, B::Error> {
-    let scene = scene.validate().map_err(ProblemError::from)?;
-    backend.supports(&scene).map_err(ProblemError::from)?;
-    if scene.scene().path.is_some() {
-        // the instants on one preparation of the system
-        return backend.run_path(scene.scene(), mesh, limits, reporter);
-    }
-    let t_total = Instant::now();
-    let setup = begin(scene, mesh, backend.estimate(&scene), &limits, reporter)?;
-    let t_setup = t_total.elapsed().as_secs_f64();
-    stop_if_interrupted(&limits, "set-up")?;
-    let t = Instant::now();
-    let disc = setup.discretize().map_err(ProblemError::from)?;
-    let mut posed = pose(scene, &setup, &disc)?;
-    let boundary = contact_boundary(&posed, reporter)?;
-    posed.bed = Bed::needed(&posed, boundary.as_ref())?;
-    let assembled = backend.assemble(&posed)?;
-    let t_assembly = t.elapsed().as_secs_f64();
-    reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
-    stop_if_interrupted(&limits, "assembly")?;
-    let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
-    stop_if_interrupted(&limits, "factorisation")?;
-    let Balanced {
-        solved,
-        equilibrium,
-        steps: bed_steps,
-    } = solve(backend, &mut posed, &mut system, boundary, limits, reporter)?;
-    if let Some(contraction) = solved.contact.as_ref().and_then(|(_, sol)| sol.info.contraction) {
-        if contraction >= 1.0 {
-            reporter.event(&Event::NotContractive { contraction });
-        }
-    }
-    reporter.event(&Event::Solved {
-        seconds: solved.seconds,
-        pcg_iters: solved.pcg_iters,
-        equilibrium,
-    });
-    let bed = posed.bed;
-    let Solved {
-        x,
-        contact,
-        seconds,
-        pcg_iters,
-    } = solved;
-    let Some(Finished { u, phi, figures }) = backend.finish(&posed, system, x)? else {
-        return Ok(None);
-    };
-    let sol = contact.as_ref().map(|(_, sol)| sol);
-    check_solved(&scene, (&u, &phi), sol, equilibrium)?;
-    if B::HELD_TO_TOLERANCE {
-        check_accurate(&scene, &setup.plan, sol, equilibrium).map_err(|e| match (e, bed) {
-            // a body only its bed holds: the bed's softness is the likely cause
-            (ProblemError::IllConditioned { what, .. }, Some(bed)) => ProblemError::IllConditioned {
-                what,
-                factors: bed.conditioning_in_words(),
-            },
-            (e, _) => e,
-        })?;
-    }
-    let contact_pair = contact.as_ref().map(|(b, sol)| (b, sol));
-    let recovered = recover(&scene, &setup, &disc, (&u, &phi), contact_pair, equilibrium, reporter)?;
-    let timings_s = Timings {
-        setup: t_setup,
-        assembly: t_assembly,
-        factorization: figures.factor_seconds,
-        condense: figures.condense.map_or(0.0, |c| c.1),
-        contact: if contact.is_some() { seconds } else { 0.0 },
-        solve: seconds,
-        total: t_total.elapsed().as_secs_f64(),
-    };
-    let measured = Measured {
-        info: contact.as_ref().map(|(_, sol)| &sol.info),
-        pcg_iters,
-        equilibrium,
-        timings_s,
-        figures,
-        bed_steps,
-    };
-    let report = report(&posed, measured, &recovered);
-    drop(posed);
-    Ok(Some(Solution {
-        report,
-        contact: contact.map(|(b, solution)| contact_result(b, solution, &u)),
-        mesh: setup.mesh,
-        u: recovered.u,
-        phi: recovered.phi,
-        fields: recovered.fields,
-    }))
-}
-
-/// The run's solve on the prepared `system`: the contact problem on `boundary` (through the
-/// bed's fixed point where only a compliant bed holds the body), or the one linear solve;
-/// with the equilibrium residual and the bed's steps.
-fn solve<B: Backend>(
-    backend: &mut B,
-    posed: &mut Posed<'_>,
-    system: &mut B::System,
-    boundary: Option<ContactBoundary>,
-    limits: Limits,
-    reporter: &mut dyn Reporter,
-) -> Result<Balanced<B::Solution>, B::Error> {
-    let (scene, plan) = (posed.scene, &posed.setup.plan);
-    match (boundary, posed.bed) {
-        (Some(b), Some(bed)) => {
-            let how = ContactSolve::new(plan, scene.scene(), &b, limits.interrupt);
-            crate::bed::solve_held(backend, posed, system, &b, &how, bed, reporter)
-        }
-        (Some(b), None) => {
-            let how = ContactSolve::new(plan, scene.scene(), &b, limits.interrupt);
-            let contact = ContactAt { boundary: b, how: &how };
-            let solved = backend.solve_instant(posed, system, Some(contact), reporter)?;
-            let equilibrium = backend.equilibrium(posed, system, &solved)?;
-            Ok(Balanced {
-                solved,
-                equilibrium,
-                steps: 0,
-            })
-        }
-        (None, _) => {
-            let solved = backend.solve_instant(posed, system, None, reporter)?;
-            let equilibrium = backend.equilibrium(posed, system, &solved)?;
-            Ok(Balanced {
-                solved,
-                equilibrium,
-                steps: 0,
-            })
-        }
-    }
-}
 
 /// The start of a run: the memory `estimate` (bytes, and what it counts) checked against
 /// `limits` before the memory is taken, then the [`Setup`], its plan and what the mesh's
@@ -214,7 +69,11 @@ pub(crate) fn stop_if_interrupted(limits: &Limits, after: &'static str) -> Resul
 
 /// The discrete problem: the loads on the free dofs, checked finite (what holds the body is
 /// judged with the contact boundary, [`Bed::needed`]).
-fn pose<'a>(scene: Valid<'a>, setup: &'a Setup, disc: &'a Discretization<'a>) -> Result<Posed<'a>, ProblemError> {
+pub(crate) fn pose<'a>(
+    scene: Valid<'a>,
+    setup: &'a Setup,
+    disc: &'a Discretization<'a>,
+) -> Result<Posed<'a>, ProblemError> {
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     ProblemError::check_finite(&b_u, "the mechanical load vector", &scene)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", &scene)?;
@@ -229,7 +88,10 @@ fn pose<'a>(scene: Valid<'a>, setup: &'a Setup, disc: &'a Discretization<'a>) ->
 
 /// The contact boundary, where the plan has contact; its nodes that the Dirichlet conditions
 /// hold reported.
-fn contact_boundary(posed: &Posed<'_>, reporter: &mut dyn Reporter) -> Result<Option<ContactBoundary>, ProblemError> {
+pub(crate) fn contact_boundary(
+    posed: &Posed<'_>,
+    reporter: &mut dyn Reporter,
+) -> Result<Option<ContactBoundary>, ProblemError> {
     let specs = posed.scene.zones();
     if specs.is_empty() || posed.plan().contact_law == ContactLaw::None {
         return Ok(None);
@@ -707,7 +569,7 @@ mod tests {
             load: Some(vec![0.0, 1.0]),
             ..Default::default()
         });
-        let ran = run(&mut crate::SharedMemory, &scene, None, Limits::default(), &mut Silent)
+        let ran = crate::run(&mut crate::SharedMemory, &scene, None, Limits::default(), &mut Silent)
             .unwrap()
             .unwrap();
         let walked = crate::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())).unwrap();

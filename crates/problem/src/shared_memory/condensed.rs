@@ -1,15 +1,12 @@
 //! The contact solve of the default backend: on the condensed compliance (semismooth Newton or
-//! a first-order method, the electric rows an optional block, force control and a floating
-//! tip around it), or one full primal solve per first-order step; then the fields under the
-//! forces found, refined with the factors of `K`, and the law judged on them.
+//! a first-order method), or one full primal solve per first-order step; the condensation;
+//! the fields under the forces found, refined with the factors of `K`, and the law judged on
+//! them.
 
-use super::{Factored, LinearSolver};
-use crate::backend::Fields;
-use crate::backend::{ContactSolve, Posed, Solved};
-use crate::boundary::{ContactBoundary, FullSolve};
-use crate::outer::{floating_tip, force_controlled, ForceControl};
+use crate::backend::{ContactSolve, Posed};
+use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
-use crate::scene::{ContactSolver, Rule, ZoneElectric};
+use crate::scene::{ContactSolver, Rule};
 use crate::ProblemError;
 use contact::{
     ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, NewtonParams, PointValues,
@@ -29,7 +26,7 @@ pub(super) enum Operator<'a> {
 
 impl ContactSolve<'_> {
     /// Semismooth Newton's parameters for this solve: its tolerance and interrupt.
-    fn newton_params(&self) -> NewtonParams {
+    pub(super) fn newton_params(&self) -> NewtonParams {
         NewtonParams {
             tol: self.tol,
             interrupt: self.interrupt,
@@ -113,82 +110,6 @@ impl ContactSolve<'_> {
     }
 }
 
-/// The contact solve: on the condensed compliance (Newton, or a first-order method), or with
-/// one full primal solve per first-order step; then `(u, φ)` under the contact forces found.
-pub(super) fn solve_contact(
-    how: &ContactSolve<'_>,
-    system: &mut Factored,
-    mut boundary: ContactBoundary,
-    posed: &Posed<'_>,
-    reporter: &mut dyn Reporter,
-) -> Result<Solved<Fields>, ProblemError> {
-    let t = Instant::now();
-    let nt = how.plan.n_tangential();
-    let condensed = how.plan.linear_strategy.is_condensed();
-    // electrical contact: its law, owned (force control lowers the boundary's gaps)
-    let electric = boundary.electric.as_ref().map(|(e, _)| e.clone());
-    let (sol, (u, phi)) = match (&mut system.solver, electric) {
-        (LinearSolver::Direct(direct), Some(electric)) if condensed => {
-            let (sol, fields, condense, refinement) =
-                electric_contact(how, &electric, direct, &system.blocks, &mut boundary, posed, reporter)?;
-            system.condense = Some(condense);
-            system.refinement = refinement;
-            (sol, fields)
-        }
-        (LinearSolver::Direct(direct), None) if condensed => {
-            let loads = &posed.loads;
-            let (mut dense, condensed) = condense_reported(
-                &boundary,
-                direct,
-                (&loads.b_u, &loads.b_phi),
-                nt,
-                &mut system.condense,
-                reporter,
-            )?;
-            let sol = match ForceControl::of(posed.scene.scene(), &boundary) {
-                Some(control) => {
-                    force_controlled(&mut boundary.points, &control, control.force, None, |points, start| {
-                        how.run_with(Operator::Condensed(&mut dense), points, start, true, reporter)
-                    })?
-                }
-                None => how.run(Operator::Condensed(&mut dense), &boundary.points, None, reporter)?,
-            };
-            let (mut u, mut phi) = boundary.recover(direct, condensed, &sol.lambda, &loads.b_u, &loads.b_phi)?;
-            let mut on = Refining {
-                direct,
-                blocks: &system.blocks,
-                posed,
-                boundary: &boundary,
-                refinement: 0,
-                shift: None,
-                refine_tol: REFINE_TOL,
-            };
-            let sol = on.correct(how, &mut dense, sol, (&mut u, &mut phi), reporter)?;
-            system.refinement = on.refinement;
-            (sol, (u, phi))
-        }
-        (other, _) => {
-            let mut op = FullSolve {
-                boundary: &boundary,
-                solver: other.coupled(),
-                b_u: &posed.loads.b_u,
-                b_phi: &posed.loads.b_phi,
-                nt,
-                u: vec![0.0; posed.disc.dofs.n_u],
-                phi: vec![0.0; posed.disc.dofs.n_phi],
-            };
-            let sol = how.run(Operator::FullSolves(&mut op), &boundary.points, None, reporter)?;
-            (sol, (op.u, op.phi))
-        }
-    };
-    Ok(Solved {
-        x: (u, phi),
-        pcg_iters: sol.info.inner_iters,
-        contact: Some((boundary, sol)),
-        seconds: t.elapsed().as_secs_f64(),
-    })
-}
-
 /// `boundary.condense` with `direct` for the right-hand side `(b_u, b_φ)`, timed, reported
 /// (`Event::Condensed`) and its route and seconds kept in `condense`.
 pub(super) fn condense_reported(
@@ -209,69 +130,6 @@ pub(super) fn condense_reported(
     });
     *condense = Some((route, seconds));
     Ok((dense, condensed))
-}
-
-/// The contact solve with electrical contact: the condensation onto the points'
-/// displacements and free potentials, semismooth Newton on all their rows, the fields under
-/// the forces and the flux found, refined; the law judged on the refined fields. Returns the
-/// solution, the fields, how the condensation was formed and in how long, and the refinement
-/// steps.
-fn electric_contact(
-    how: &ContactSolve<'_>,
-    electric: &contact::ElectricContact,
-    direct: &mut DirectLdlt,
-    blocks: &Blocks,
-    boundary: &mut ContactBoundary,
-    posed: &Posed<'_>,
-    reporter: &mut dyn Reporter,
-) -> Result<(ContactSolution, Fields, (CondenseRoute, f64), usize), ProblemError> {
-    let t = Instant::now();
-    let loads = &posed.loads;
-    let nt = how.plan.n_tangential();
-    let (problem, condensed) = boundary.condense_electric(electric, direct, &loads.b_u, &loads.b_phi, nt)?;
-    let condense = (condensed.route, t.elapsed().as_secs_f64());
-    reporter.event(&Event::Condensed {
-        m: problem.order(),
-        route: condense.0,
-        seconds: condense.1,
-    });
-    let tol = how.tol;
-    let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-    let params = NewtonParams {
-        schedule: Schedule::of(ProblemClass::CoupledElectric),
-        ..how.newton_params()
-    };
-    let mut newton = |problem: &contact::ElectricContactProblem, points: &ContactPoints| {
-        contact::solve_newton_electric(problem, points, &how.law, &params, &mut progress)
-            .map_err(|e| ProblemError::contact(e, how.plan.linear_strategy, how.scene))
-    };
-    let mut problem = problem;
-    // the conducting zone's charge where it floats (one zone conducts: validated)
-    let floating = posed.scene.zones().into_iter().find_map(|c| match c.model()?.electric {
-        ZoneElectric::Floating { charge, .. } => Some(charge),
-        _ => None,
-    });
-    let mut solve = |points: &ContactPoints, _: Option<PointValues>| match floating {
-        Some(charge) => floating_tip(&mut problem, points, charge, &mut newton),
-        None => newton(&problem, points),
-    };
-    let mut sol = match ForceControl::of(posed.scene.scene(), boundary) {
-        Some(control) => force_controlled(&mut boundary.points, &control, control.force, None, &mut solve)?,
-        None => solve(&boundary.points, None)?,
-    };
-    let (mut u, mut phi) = boundary.recover_electric(direct, condensed, &sol, &loads.b_u, &loads.b_phi)?;
-    let b = rhs_with_contact(posed, Some((boundary, &sol)));
-    let refinement = refine(direct, blocks, rhs(&b), &mut u, &mut phi, REFINE_TOL)?.steps;
-    // the potentials reported are the refined fields'
-    if let (Some(e), Some((_, dofs))) = (&mut sol.electric, &boundary.electric) {
-        let n_u = loads.b_u.len();
-        for (v, &d) in e.potential.iter_mut().zip(dofs) {
-            *v = phi[d - n_u];
-        }
-    }
-    sol.info.complementarity = law_residual(boundary, how, &sol, &problem.u0, &u, None);
-    sol.info.residual = sol.info.residual.max(sol.info.complementarity);
-    Ok((sol, (u, phi), condense, refinement))
 }
 
 /// The fields of a condensed contact solve, refined with the factors of `K`.
@@ -428,7 +286,7 @@ pub(super) fn in_frame(mut at: PointValues, shift: Option<&PointValues>) -> Poin
 
 /// The complementarity residual of the law on the final fields: the multipliers of `sol` with
 /// the displacement of the points in `u` (the last, refined solve), against the loads' `u0`.
-fn law_residual(
+pub(super) fn law_residual(
     boundary: &ContactBoundary,
     how: &ContactSolve<'_>,
     sol: &ContactSolution,

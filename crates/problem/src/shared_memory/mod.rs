@@ -5,12 +5,15 @@
 //! Uzawa) solves the primal problem once per first-order step.
 
 mod condensed;
-mod path_system;
+mod instants;
 
-use condensed::{coupled, refine, rhs, rhs_with_contact, solve_contact, REFINE_TOL};
+use condensed::{coupled, refine, rhs, rhs_with_contact, REFINE_TOL};
+use instants::Kept;
 
 use crate::backend::Unsupported;
-use crate::backend::{Backend, ContactAt, Fields, Figures, Finished, Limits, Posed, Solved};
+use crate::backend::{
+    At, Backend, Contact, ContactSolve, Fields, Figures, InstantOf, InstantSolution, Limits, Posed, Primed,
+};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
 use crate::scene::{BackendChoice, Rule, Scene};
@@ -29,7 +32,6 @@ impl Backend for SharedMemory {
     const NAME: &'static str = "faer";
     type Assembled = Blocks;
     type System = Factored;
-    type Solution = Fields;
     type Error = ProblemError;
     const HELD_TO_TOLERANCE: bool = true;
 
@@ -77,55 +79,57 @@ impl Backend for SharedMemory {
         factor(posed, blocks, boundary, limits, reporter)
     }
 
-    fn solve_instant(
+    fn begin(
         &mut self,
-        posed: &Posed<'_>,
         system: &mut Factored,
-        contact: Option<ContactAt<'_>>,
-        reporter: &mut dyn Reporter,
-    ) -> Result<Solved<Self::Solution>, ProblemError> {
-        match contact {
-            Some(ContactAt { boundary, how }) => solve_contact(how, system, boundary, posed, reporter),
-            None => solve_linear(system, posed),
-        }
-        .map_err(|e| e.on_scene(&posed.scene))
-    }
-
-    fn equilibrium(
-        &mut self,
         posed: &Posed<'_>,
-        system: &Factored,
-        solved: &Solved<Self::Solution>,
-    ) -> Result<f64, ProblemError> {
-        let b = rhs_with_contact(posed, solved.contact.as_ref().map(|(b, sol)| (b, sol)));
-        let (u, phi) = &solved.x;
-        Ok(system.equilibrium_of(u, phi, &b))
-    }
-
-    fn finish(
-        &mut self,
-        _: &Posed<'_>,
-        system: Factored,
-        (u, phi): Self::Solution,
-    ) -> Result<Option<Finished>, ProblemError> {
-        let figures = system.figures();
-        Ok(Some(Finished { u, phi, figures }))
-    }
-
-    fn gather(&mut self, _: &Posed<'_>, _: &Factored, x: &Fields) -> Result<Option<Fields>, ProblemError> {
-        Ok(Some(x.clone()))
-    }
-
-    /// The path's instants on one factorisation and one condensation (`problem::solve_path`).
-    fn run_path(
-        &mut self,
-        scene: &Scene,
-        mesh: Option<mesh::Mesh>,
-        limits: Limits,
+        contact: Option<Contact<'_>>,
+        parts: &[Fields],
         reporter: &mut dyn Reporter,
-    ) -> Result<Option<crate::Solution>, ProblemError> {
-        let path = crate::path::walk(self, scene, mesh, limits, reporter, false, &mut |_| Ok(()))?;
-        Ok(Some(path.last))
+    ) -> Result<Vec<Fields>, ProblemError> {
+        SharedMemory::begin_instants(system, posed, contact, parts, reporter).map_err(|e| e.on_scene(&posed.scene))
+    }
+
+    fn respond(&mut self, system: &mut Factored, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError> {
+        instants::respond(system, a_u, a_phi)
+    }
+
+    fn prime(&mut self, system: &mut Factored, primed: Primed<'_>) -> Result<(), ProblemError> {
+        SharedMemory::prime_instant(system, primed).map_err(|e| e.on_scene(&primed.posed.scene))
+    }
+
+    fn solve_posed(
+        &mut self,
+        system: &mut Factored,
+        how: &ContactSolve<'_>,
+        at: At<'_>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<contact::ContactSolution, ProblemError> {
+        SharedMemory::solve_kept(system, how, at, reporter).map_err(|e| e.on_scene(how.scene))
+    }
+
+    fn own_scale(&self, system: &Factored, factors: &[f64]) -> f64 {
+        SharedMemory::own_scale_of(system, factors)
+    }
+
+    fn instant_fields(
+        &mut self,
+        system: &mut Factored,
+        posed: &Posed<'_>,
+        contact: Option<InstantOf<'_>>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Option<InstantSolution>, ProblemError> {
+        SharedMemory::fields_of(system, posed, contact, reporter)
+            .map(Some)
+            .map_err(|e| e.on_scene(&posed.scene))
+    }
+
+    fn finish(&mut self, system: Factored) -> Result<Figures, ProblemError> {
+        Ok(system.figures())
+    }
+
+    fn at_step(e: ProblemError, k: usize, t: f64) -> ProblemError {
+        e.at_step(k, t)
     }
 }
 
@@ -158,6 +162,8 @@ pub struct Factored {
     refinement: usize,
     /// How the contact compliance was formed, and in how long (condensed strategies).
     condense: Option<(CondenseRoute, f64)>,
+    /// What the run's instants keep on the factorisation.
+    kept: Kept,
 }
 
 impl Factored {
@@ -255,6 +261,7 @@ fn factor(
         seconds,
         refinement: 0,
         condense: None,
+        kept: Kept::Nothing,
     })
 }
 
@@ -320,23 +327,23 @@ fn too_large(e: linalg::LinalgError, limits: Limits, scene: &Scene) -> ProblemEr
     }
 }
 
-/// The one linear solve of a run without contact, refined with the factors of `K`.
-fn solve_linear(system: &mut Factored, posed: &Posed<'_>) -> Result<Solved<Fields>, ProblemError> {
-    let t = Instant::now();
+/// The one linear solve of an instant without contact, refined with the factors of `K`.
+fn solve_linear(system: &mut Factored, posed: &Posed<'_>) -> Result<InstantSolution, ProblemError> {
     let (dofs, loads) = (&posed.disc.dofs, &posed.loads);
     let (mut u, mut phi) = (vec![0.0; dofs.n_u], vec![0.0; dofs.n_phi]);
     let info = system
         .solver
         .coupled()
         .solve(&loads.b_u, &loads.b_phi, &mut u, &mut phi)?;
+    let b = rhs_with_contact(posed, None);
     if let LinearSolver::Direct(direct) = &mut system.solver {
-        let b = rhs_with_contact(posed, None);
         system.refinement = refine(direct, &system.blocks, rhs(&b), &mut u, &mut phi, REFINE_TOL)?.steps;
     }
-    Ok(Solved {
+    let equilibrium = system.equilibrium_of(&u, &phi, &b);
+    Ok(InstantSolution {
         x: (u, phi),
         contact: None,
+        equilibrium,
         pcg_iters: info.pcg_iters,
-        seconds: t.elapsed().as_secs_f64(),
     })
 }
