@@ -509,7 +509,8 @@ fn one_conducting_zone_among_several_is_a_terminal_where_it_touches() {
     zones[1].electric = Some(ElectricCondition::Conducting);
     let e = both.validate().unwrap_err();
     assert_eq!(e.key, "contact.electric", "{e}");
-    // along a path, electrical contact is refused on any zone, not the first's alone
+    // along a path, a second zone's conductor is the path's too (it once was refused, and
+    // before that solved without it: tests below check the path against the static answer)
     let sets: Vec<String> = [
         "~electrode",
         "contact.1.electric=\"conducting\"",
@@ -518,14 +519,171 @@ fn one_conducting_zone_among_several_is_a_terminal_where_it_touches() {
     .iter()
     .map(|s| s.to_string())
     .collect();
-    let Err(e) = files::scene_file::load("corner", &sets) else {
-        panic!("a path with a conducting second zone was accepted")
-    };
-    assert!(
-        e.to_string()
-            .contains("path does not apply: electrical contact along a path"),
-        "{e}"
-    );
+    let (scene, _) = files::scene_file::load("corner", &sets).unwrap();
+    let path = problem::solve_path(
+        &scene,
+        None,
+        problem::Limits::default(),
+        &mut Silent,
+        false,
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    let last = path.last.contact.as_ref().unwrap();
+    let e = last
+        .solution
+        .electric
+        .as_ref()
+        .expect("the conducting wall's electric rows");
+    assert!(!e.points.is_empty());
+}
+
+/// Electrical contact along a load path: `paper-conducting` (a conducting foundation at
+/// `φ_F`), frictionless, its load, electrode voltage and foundation potential ramped together
+/// from 0. Without friction the answer has no history, so each instant is the static answer
+/// at its own data: the path's instant at `t` equals the static run with the load, the
+/// voltage and `φ_F` scaled by `t` (its contact force, the electrode's charge, the
+/// foundation's flux), to the solver's tolerance, on the conducting and the conductive
+/// foundation.
+#[test]
+fn electrical_contact_follows_a_path_as_its_instants_static_answers() {
+    for (electric, extra) in [("conducting", None), ("conductive", Some("contact.conductance=2.0"))] {
+        let base = |sets: &[String]| {
+            let mut all: Vec<String> = [
+                "mesh.n=16",
+                "contact.law=\"signorini\"",
+                "~contact.friction",
+                "contact.foundation_potential=0.01",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+            all.push(format!("contact.electric=\"{electric}\""));
+            all.extend(extra.map(String::from));
+            all.extend(sets.iter().cloned());
+            files::scene_file::load("paper-conducting", &all).unwrap().0
+        };
+        let scene = base(&["path={t=[0.0,1.0],steps=4,load=[0.0,1.0],voltage=[0.0,1.0]}".into()]);
+        let mut rows = vec![];
+        let path = problem::solve_path(
+            &scene,
+            None,
+            problem::Limits::default(),
+            &mut Silent,
+            false,
+            &mut |step| {
+                rows.push(step.row.clone());
+                Ok(())
+            },
+        )
+        .unwrap();
+        assert_eq!(rows.len(), 5);
+        for (k, row) in rows.iter().enumerate().skip(1) {
+            let t = k as f64 / 4.0;
+            let fixed = base(&[
+                format!("load.p={}", -2.0 * t),
+                format!("electrode.v={}", 0.05 * t),
+                format!("contact.foundation_potential={}", 0.01 * t),
+            ]);
+            let alone = problem::solve(&fixed, None, &mut Silent).unwrap();
+            let force = alone.report.contact.normal_force;
+            let rel = (row.normal_force - force).abs() / force.abs();
+            assert!(
+                rel < 1e-7,
+                "{electric} t = {t}: force {} against {force} ({rel:.1e})",
+                row.normal_force
+            );
+            // the row's charges are the terminals' in the report's order
+            let terminals = &alone.report.terminals;
+            let at = terminals.iter().position(|x| x.group == "electrode").unwrap();
+            assert_eq!(row.charges.len(), terminals.len());
+            let (q, q_path) = (terminals[at].charge, row.charges[at]);
+            assert!(
+                (q_path - q).abs() <= 1e-7 * q.abs(),
+                "{electric} t = {t}: electrode charge {q_path} against {q}"
+            );
+            if k == 4 {
+                // the last instant's fields and the foundation's flux
+                let flux = |s: &problem::Solution| -> f64 {
+                    let c = s.contact.as_ref().unwrap();
+                    let e = c.solution.electric.as_ref().unwrap();
+                    e.points.iter().zip(&e.flux).map(|(&i, q)| c.points.weight[i] * q).sum()
+                };
+                let (f_path, f_alone) = (flux(&path.last), flux(&alone));
+                assert!(
+                    (f_path - f_alone).abs() <= 1e-7 * f_alone.abs(),
+                    "{electric}: flux {f_path} against {f_alone}"
+                );
+                let big = alone.phi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let dphi = path
+                    .last
+                    .phi
+                    .iter()
+                    .zip(&alone.phi)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                assert!(
+                    dphi <= 1e-7 * big,
+                    "{electric}: potentials differ by {dphi:.1e} of {big:.1e}"
+                );
+            }
+        }
+    }
+}
+
+/// The block of the closed form pushed along a path onto a conducting foundation, in 2D and
+/// 3D, with Coulomb friction (which the uniaxial state does not engage): its displacement,
+/// and the foundation's potential with it, ramped from 0 in 3 steps. The conducting answer is
+/// linear in `(δ, φ_F)` together, so each instant carries `t` times the static force, and the
+/// last instant is the static run (the closed form) to round-off: the pressure, the flux and
+/// the potentials at the points.
+#[test]
+fn a_block_pushed_along_a_path_onto_a_conductor_is_the_static_answer_scaled() {
+    for dim in [2, 3] {
+        let fixed = block(dim, ElectricCondition::Conducting, None);
+        let alone = problem::solve(&fixed, None, &mut Silent).unwrap();
+        let mut walked = fixed.clone();
+        walked.path = Some(problem::PathSpec {
+            t: vec![0.0, 1.0],
+            steps: Some(3),
+            displacement: Some(vec![0.0, 1.0]),
+            voltage: Some(vec![0.0, 1.0]),
+            ..Default::default()
+        });
+        let mut forces = vec![];
+        let path = problem::solve_path(
+            &walked,
+            None,
+            problem::Limits::default(),
+            &mut Silent,
+            false,
+            &mut |step| {
+                forces.push((step.row.t, step.row.normal_force));
+                Ok(())
+            },
+        )
+        .unwrap();
+        let force = alone.report.contact.normal_force;
+        for (t, f) in forces {
+            assert!(
+                (f - t * force).abs() <= 1e-9 * force,
+                "{dim}D t = {t}: force {f} against {}",
+                t * force
+            );
+        }
+        let (a, b) = (path.last.contact.as_ref().unwrap(), alone.contact.as_ref().unwrap());
+        let close = |x: &[f64], y: &[f64], what: &str| {
+            let big = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let d = x.iter().zip(y).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+            assert!(d <= 1e-9 * big, "{dim}D {what}: {d:.1e} of {big:.1e}");
+        };
+        close(&a.solution.lambda.normal, &b.solution.lambda.normal, "pressure");
+        let (ea, eb) = (
+            a.solution.electric.as_ref().unwrap(),
+            b.solution.electric.as_ref().unwrap(),
+        );
+        close(&ea.flux, &eb.flux, "flux");
+        close(&ea.potential, &eb.potential, "potential");
+    }
 }
 
 /// A floating conducting zone among several (zones once could not float): the corner, its

@@ -229,7 +229,8 @@ class Result:
         fields were not computed), `charges` (n_instants, n_terminals: the charge on each
         conductor) with `terminals` their groups; with `run(..., series=True)` also
         `lambda_n`, `u_n`, `status` (n_instants, n_points) and `lambda_t`, `u_t` (n_instants,
-        n_points, dim - 1)."""
+        n_points, dim - 1), and with electrical contact `flux` (n_instants, n_points: the
+        outward flux D·n, NaN at a point without an electric unknown)."""
     @property
     def report(self) -> dict[str, Any]:
         """run.json as a dict."""

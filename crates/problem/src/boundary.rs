@@ -374,10 +374,10 @@ impl ContactBoundary {
     }
 
     /// The boundary at an instant of a load path: the uniform part of every gap (its group's
-    /// `contact.gap` less an indenter's depth) scaled by `gap`, and each prescribed
-    /// displacement component `k` of a point by `displacement[k]` (the points, their dofs and
-    /// weights are the same).
-    pub fn at_factors(&self, gap: f64, displacement: [f64; 3]) -> ContactBoundary {
+    /// `contact.gap` less an indenter's depth) scaled by `gap`, each prescribed displacement
+    /// component `k` of a point by `displacement[k]`, and a conducting foundation's potential
+    /// (a prescribed potential) by `voltage` (the points, their dofs and weights are the same).
+    pub fn at_factors(&self, gap: f64, displacement: [f64; 3], voltage: f64) -> ContactBoundary {
         let dim = self.points.dim;
         let mut b = ContactBoundary {
             points: self.points.clone(),
@@ -393,6 +393,9 @@ impl ContactBoundary {
         };
         for (g, g0) in b.points.gap.iter_mut().zip(&self.uniform) {
             *g += (gap - 1.0) * g0;
+        }
+        if let Some((electric, _)) = b.electric.as_mut() {
+            electric.potential *= voltage;
         }
         for (j, slot) in b.slots.iter_mut().enumerate() {
             if let Slot::Fixed(v) = slot {

@@ -126,23 +126,16 @@ pub(crate) fn walk<B: Backend>(
         parts: parts.as_ref(),
         base_dofs: disc.dofs.clone(),
         with_fields,
+        every_fields: false,
         terminals: Terminals::default(),
         first: Loads::default(),
         bed: None,
         held_to_tolerance: B::HELD_TO_TOLERANCE,
         of: instants.len() - 1,
     };
-    let mut posed = match walk.parts {
-        Some(parts) => Posed {
-            scene: valid,
-            setup: &setup,
-            disc: &disc,
-            loads: step_loads(parts, &walk.factors(instants[0]), scene)?,
-            bed: None,
-        },
-        None => pose(valid, &setup, &disc)?,
-    };
+    let mut posed = walk.first_posed(&disc, instants[0])?;
     let boundary = contact_boundary(&posed, reporter)?;
+    walk.every_fields = boundary.as_ref().is_some_and(|b| b.electric.is_some());
     posed.bed = walk.bed(&posed, &instants, boundary.as_ref())?;
     let assembled = backend.assemble(&posed)?;
     let t_assembly = t.elapsed().as_secs_f64();
@@ -231,6 +224,9 @@ struct Walk<'a> {
     /// Whether the fields of the output instants are computed ([`PathSpec::has_fields`]; the
     /// last instant's always are).
     with_fields: bool,
+    /// Whether every instant's fields are computed: with electrical contact, whose flux the
+    /// charges' functionals do not carry, the charges are the fields'.
+    every_fields: bool,
     /// The charges' functionals.
     terminals: Terminals,
     /// The loads of a static scene's instant.
@@ -506,7 +502,8 @@ impl Walk<'_> {
                 how,
                 state: &mut *state,
             };
-            let fields = k == of || (self.with_fields && self.spec.is_some_and(|s| s.has_fields(k, of + 1)));
+            let written = self.with_fields && self.spec.is_some_and(|s| s.has_fields(k, of + 1));
+            let fields = k == of || written || self.every_fields;
             let stepped = self.solve_step(&mut on, disc, k, t, fields, reporter).map_err(at)?;
             if k == of {
                 // the system's memory freed before the last instant's recovery
@@ -526,6 +523,37 @@ impl Walk<'_> {
     /// The factors at `t` (a static scene's: every factor 1, the scene as written).
     fn factors(&self, t: f64) -> Factors {
         self.spec.map_or(Factors::ONE, |s| s.factors(t))
+    }
+
+    /// The discrete problem at the first instant `t0`: the scene's own loads, or a path's parts
+    /// summed at its first factors.
+    fn first_posed<'a>(&self, disc: &'a Discretization<'a>, t0: f64) -> Result<Posed<'a>, ProblemError>
+    where
+        Self: 'a,
+    {
+        match self.parts {
+            Some(parts) => Ok(Posed {
+                scene: self.valid,
+                setup: self.setup,
+                disc,
+                loads: step_loads(parts, &self.factors(t0), self.scene)?,
+                bed: None,
+            }),
+            None => pose(self.valid, self.setup, disc),
+        }
+    }
+
+    /// An instant's loads at the factors `f`, and a path's factors of the parts in their order,
+    /// its prescribed values scaled in `disc`'s dof map (a static scene's: its own loads).
+    fn data_at(&self, f: &Factors, disc: &mut Discretization<'_>) -> Result<(Loads, Option<Vec<f64>>), ProblemError> {
+        let Some(parts) = self.parts else {
+            return Ok((self.first.clone(), None));
+        };
+        disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
+        let mut factors = vec![f.load];
+        factors.extend_from_slice(&f.displacement[..self.setup.mesh.dim]);
+        factors.push(f.voltage);
+        Ok((step_loads(parts, f, self.scene)?, Some(factors)))
     }
 
     /// A path's parts of the right-hand side in the backend's order: the loads, each
@@ -580,18 +608,9 @@ impl Walk<'_> {
     ) -> Result<Stepped, B::Error> {
         let started = Instant::now();
         let f = self.factors(t);
-        let (loads, factors) = match self.parts {
-            Some(parts) => {
-                disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
-                let mut factors = vec![f.load];
-                factors.extend_from_slice(&f.displacement[..self.setup.mesh.dim]);
-                factors.push(f.voltage);
-                (step_loads(parts, &f, self.scene)?, Some(factors))
-            }
-            None => (self.first.clone(), None),
-        };
+        let (loads, factors) = self.data_at(&f, disc)?;
         let mut boundary = on.base.map(|b| match self.parts {
-            Some(_) => b.at_factors(f.gap, f.displacement),
+            Some(_) => b.at_factors(f.gap, f.displacement, f.voltage),
             None => b.clone(),
         });
         if let (Some(b), Some(_)) = (boundary.as_mut(), self.parts) {

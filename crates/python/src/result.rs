@@ -45,6 +45,9 @@ pub struct Series {
     pub u_t: Vec<f64>,
     /// Contact status codes.
     pub status: Vec<i8>,
+    /// With electrical contact, the outward flux `q = D·ν` of each point (NaN at a point
+    /// without an electric unknown); empty without.
+    pub flux: Vec<f64>,
 }
 
 impl Series {
@@ -65,6 +68,13 @@ impl Series {
             self.u_n.push(u.normal[i]);
             all(u, i, &mut self.u_t);
             self.status.push(status_code(c.solution.status[i]));
+        }
+        if let Some(e) = &c.solution.electric {
+            let start = self.flux.len();
+            self.flux.resize(start + n, f64::NAN);
+            for (&i, q) in e.points.iter().zip(&e.flux) {
+                self.flux[start + i] = *q;
+            }
         }
     }
 }
@@ -286,6 +296,9 @@ impl RunResult {
             let status = numpy::ndarray::Array2::from_shape_vec(shape, series.status.clone())
                 .map_err(|e| Kind::Base.err(e.to_string()))?;
             out.set_item("status", owned(py, status))?;
+            if series.flux.len() == series.lambda_n.len() {
+                out.set_item("flux", owned(py, table(&series.flux)?))?;
+            }
         }
         Ok(Some(out))
     }

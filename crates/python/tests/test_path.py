@@ -110,3 +110,24 @@ def test_each_contact_groups_forces_along_a_path():
     for g in ["right", "top"]:
         for key in [f"tangential_force_{g}", f"tangential_force_x_{g}", f"tangential_force_y_{g}"]:
             assert np.all(p[key] == 0.0), key
+
+
+def test_a_conducting_foundation_follows_a_path():
+    """paper-conducting, frictionless, its load, electrode voltage and foundation potential
+    ramped from 0: without friction each instant is the static run at its own data (its force
+    and the foundation's flux), and the series carries each point's flux."""
+    base = {"mesh.n": 12, "contact.law": "signorini", "contact.friction": None,
+            "contact.foundation_potential": 0.01}
+    path = dict(base, path={"t": [0.0, 1.0], "steps": 2, "load": [0.0, 1.0], "voltage": [0.0, 1.0]})
+    r = pc.run(pc.Scene.load("paper-conducting", path), series=True)
+    p = r.path
+    assert p["flux"].shape == p["lambda_n"].shape == (3, len(r.contact.lambda_n))
+    w = r.contact.weight
+    for k, t in enumerate(p["t"]):
+        if t == 0.0:
+            continue
+        alone = pc.run(pc.Scene.load("paper-conducting", dict(
+            base, **{"load.p": -2.0 * t, "electrode.v": 0.05 * t, "contact.foundation_potential": 0.01 * t})))
+        assert np.isclose(p["normal_force"][k], alone.report["contact"]["normal_force"], rtol=1e-7)
+        flux = np.nansum(w * p["flux"][k])
+        assert np.isclose(flux, np.nansum(w * alone.contact.flux), rtol=1e-7)

@@ -534,6 +534,32 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "conducting cycle",
+        why: "paper-conducting's load and voltage cycled 0, 1, -1, 1 with Coulomb friction: the conducting foundation along a path, friction's history with the electric rows",
+        scene: "paper-conducting",
+        sets: &[
+            "mesh.n=128",
+            "path={t=[0.0,1.0,2.0,3.0],steps=12,load=[0.0,1.0,-1.0,1.0],voltage=[0.0,1.0,-1.0,1.0]}",
+        ],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
+        name: "grounded tip path",
+        why: "a grounded conducting sphere pushed into PZT-4 along a 10-step depth path (path.gap): the force-depth curve with a conducting tip",
+        scene: "indent-sphere",
+        sets: &[
+            "mesh.n=160",
+            "~exact",
+            "contact.electric=\"conducting\"",
+            "path={t=[0.0,1.0],steps=10,gap=[0.0,1.0]}",
+        ],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "open tip",
         why: "a floating conducting sphere on PZT-4 (contact.charge = 0): its potential found with the contact zone, no charge on it",
         scene: "indent-sphere",

@@ -313,7 +313,8 @@ const MAX_PATH_STEPS: usize = 1_000_000;
 
 /// A path: at least two strictly increasing finite instants, each table as long as `t` and
 /// finite, `steps` in range; refused where the run cannot carry friction's history (a solver
-/// without the condensed compliance, slip weakening, electrical contact, an exact solution).
+/// without the condensed compliance, an exact solution; a floating conducting tip is refused
+/// with its charge).
 fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
     all_finite("path.t", &p.t)?;
     if p.t.len() < 2 || p.t.windows(2).any(|w| !(w[0] < w[1])) {
@@ -372,12 +373,6 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "an exact solution is checked at one instant; a path solves many (remove [exact] or [path])",
     )?;
     if scene.active_contact().is_some() {
-        // every zone's condition, not the first's alone
-        refuse_if(
-            scene.zones().into_iter().any(|c| c.electric_law().is_some()),
-            "path",
-            "electrical contact along a path is not built yet: solve its instants one by one",
-        )?;
         refuse_if(
             !scene.solver.strategy.is_condensed(),
             "path",

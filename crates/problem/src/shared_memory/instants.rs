@@ -50,11 +50,15 @@ pub(super) struct Condensed {
     parts: Vec<Vec<f64>>,
 }
 
-/// The condensed problem with electrical contact, its loads part and `u⁰`, `φ⁰`.
+/// The condensed problem with electrical contact, its loads part and `u⁰`, `φ⁰`, and a path's
+/// parts.
 pub(super) struct Electric {
     problem: ElectricContactProblem,
     loads: Option<CondensedLoads>,
     first: (PointValues, Vec<f64>),
+    /// Per part of a path's right-hand side, its solution's displacements and its potentials
+    /// at the electric points (empty for one instant).
+    parts: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 /// An instant of a strategy without the condensation: its loads, boundary, and the fields of
@@ -97,7 +101,7 @@ impl SharedMemory {
         let LinearSolver::Direct(direct) = &mut system.solver else {
             return Err(not_direct());
         };
-        if let Some((electric, _)) = &boundary.electric {
+        if let Some((electric, dofs)) = &boundary.electric {
             let t = Instant::now();
             let (problem, condensed) = boundary.condense_electric(electric, direct, &loads.b_u, &loads.b_phi, nt)?;
             let seconds = t.elapsed().as_secs_f64();
@@ -108,12 +112,19 @@ impl SharedMemory {
             });
             system.condense = Some((condensed.route, seconds));
             let first = (problem.u0.clone(), problem.phi0.clone());
+            let n_u = loads.b_u.len();
+            let mut solved = Vec::with_capacity(parts.len());
+            for (b_u, b_phi) in parts {
+                solved.push(solve(system, b_u, b_phi)?);
+            }
+            let at_points = |(u, phi): &Fields| (u.clone(), dofs.iter().map(|&d| phi[d - n_u]).collect());
             system.kept = Kept::Electric(Electric {
                 problem,
                 loads: Some(condensed),
                 first,
+                parts: solved.iter().map(at_points).collect(),
             });
-            return Ok(vec![]);
+            return Ok(solved);
         }
         let (dense, condensed) = condense_reported(
             boundary,
@@ -166,20 +177,33 @@ impl SharedMemory {
                 Ok(())
             }
             Kept::Electric(e) => {
-                (e.problem.u0, e.problem.phi0) = e.first.clone();
-                if pressed {
-                    // the springs' forces among the loads: `u⁰` and `φ⁰` of a solve with them
-                    let mut b_u = posed.loads.b_u.clone();
-                    framed.boundary.add_forces(springs, &mut b_u);
-                    let (u, phi) = solve(system, &b_u, &posed.loads.b_phi)?;
-                    let Kept::Electric(e) = &mut system.kept else {
-                        unreachable!()
-                    };
-                    let n_u = b_u.len();
-                    e.problem.u0 = fields_at_points(framed.boundary, &u, e.problem.nt);
-                    let dofs = framed.boundary.electric.as_ref().map_or(&[][..], |(_, d)| &d[..]);
-                    e.problem.phi0 = dofs.iter().map(|&d| phi[d - n_u]).collect();
-                    e.loads = None;
+                // the instant's foundation potential (a path scales it with the voltage)
+                if let Some((electric, _)) = &framed.boundary.electric {
+                    e.problem.electric.potential = electric.potential;
+                }
+                match factors {
+                    Some(factors) if !pressed => {
+                        let (u, phi0) = e.own_data(factors);
+                        let at = fields_at_points(framed.boundary, &u, e.problem.nt);
+                        (e.problem.u0, e.problem.phi0) = (in_frame(at, Some(framed.shift)), phi0);
+                        e.loads = None;
+                    }
+                    None if !pressed => (e.problem.u0, e.problem.phi0) = e.first.clone(),
+                    _ => {
+                        // the springs' forces among the loads: `u⁰` and `φ⁰` of a solve with them
+                        let mut b_u = posed.loads.b_u.clone();
+                        framed.boundary.add_forces(springs, &mut b_u);
+                        let (u, phi) = solve(system, &b_u, &posed.loads.b_phi)?;
+                        let Kept::Electric(e) = &mut system.kept else {
+                            unreachable!()
+                        };
+                        let n_u = b_u.len();
+                        let at = fields_at_points(framed.boundary, &u, e.problem.nt);
+                        e.problem.u0 = in_frame(at, factors.map(|_| framed.shift));
+                        let dofs = framed.boundary.electric.as_ref().map_or(&[][..], |(_, d)| &d[..]);
+                        e.problem.phi0 = dofs.iter().map(|&d| phi[d - n_u]).collect();
+                        e.loads = None;
+                    }
                 }
                 Ok(())
             }
@@ -271,6 +295,9 @@ impl SharedMemory {
     pub(super) fn own_scale_of(system: &Factored, factors: &[f64]) -> f64 {
         match &system.kept {
             Kept::Condensed(c) if !c.parts.is_empty() => c.own_data(factors).iter().fold(0.0f64, |m, v| m.max(v.abs())),
+            Kept::Electric(e) if !e.parts.is_empty() => {
+                e.own_data(factors).0.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+            }
             _ => 0.0,
         }
     }
@@ -345,7 +372,10 @@ fn electric_fields(
     let LinearSolver::Direct(direct) = &mut system.solver else {
         return Err(not_direct());
     };
-    system.refinement = refine(direct, blocks, rhs(&b), &mut u, &mut phi, REFINE_TOL)?.steps;
+    // a path's step: friction's frame, and refinement only where a direct solve missed
+    let path = !e.parts.is_empty();
+    let refine_tol = if path { PATH_REFINE_TOL } else { REFINE_TOL };
+    system.refinement = refine(direct, blocks, rhs(&b), &mut u, &mut phi, refine_tol)?.steps;
     // the potentials reported are the refined fields'
     if let (Some(values), Some((_, dofs))) = (&mut sol.electric, &boundary.electric) {
         let n_u = loads.b_u.len();
@@ -353,7 +383,7 @@ fn electric_fields(
             *v = phi[d - n_u];
         }
     }
-    sol.info.complementarity = law_residual(boundary, how, &sol, &e.problem.u0, &u, None);
+    sol.info.complementarity = law_residual(boundary, how, &sol, &e.problem.u0, &u, path.then_some(framed.shift));
     sol.info.residual = sol.info.residual.max(sol.info.complementarity);
     let equilibrium = system.equilibrium_of(&u, &phi, &b);
     Ok(InstantSolution {
@@ -390,6 +420,25 @@ fn electric_solve(
     match floating {
         Some(charge) => floating_tip(problem, points, charge, &mut newton),
         None => newton(problem, points),
+    }
+}
+
+impl Electric {
+    /// The displacements and the electric points' potentials that a step's own data make,
+    /// `Σ_q f_q x_q` at `factors` (no contact force, no flux).
+    fn own_data(&self, factors: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let (mut u, mut phi) = (vec![0.0; self.parts[0].0.len()], vec![0.0; self.parts[0].1.len()]);
+        for ((pu, pphi), f) in self.parts.iter().zip(factors) {
+            if *f != 0.0 {
+                for (x, p) in u.iter_mut().zip(pu) {
+                    *x += f * p;
+                }
+                for (x, p) in phi.iter_mut().zip(pphi) {
+                    *x += f * p;
+                }
+            }
+        }
+        (u, phi)
     }
 }
 
