@@ -92,6 +92,7 @@ pub use scene::{
     SolverSpec, Strategy, Valid,
 };
 pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
+pub use scene::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, CRYSTALS};
 pub use shared_memory::SharedMemory;
 
 use contact::ContactError;

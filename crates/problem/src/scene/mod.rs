@@ -4,12 +4,15 @@
 //! reads the text) or is built in code; either way [`Scene::validate`] checks it before
 //! anything is computed (`validate.rs`), and refuses keys that do not exist or do not apply.
 
+mod crystals;
 mod validate;
 mod zone;
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
+use crystals::named as named_crystal;
+pub use crystals::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, LIBRARY as CRYSTALS};
 pub use validate::{SceneError, Valid};
 pub use zone::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
 
@@ -823,9 +826,11 @@ pub struct RegionSpec {
     pub hi: Vec<f64>,
 }
 
-/// A material on a region.
+/// A material on a region: its constants given, or a crystal of the library by name
+/// (`crystal`), or its datasheet (`datasheet`), the last two resolved into `c`, `e` and
+/// `permittivity` when the scene is read (in the unit system `units` names).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "crystals::MaterialInput")]
 pub struct MaterialSpec {
     /// The region (`body` = every cell of a generated mesh).
     pub region: String,
@@ -853,6 +858,16 @@ pub struct MaterialSpec {
     /// Multiplies the piezoelectric constants (`material.coupling_scale`; crystal-6mm; default 1).
     #[serde(default)]
     pub coupling_scale: Option<f64>,
+    /// The library's crystal whose constants `c`, `e`, `permittivity` are
+    /// (`material.crystal`: PZT-4, PZT-5A, PZT-5H, BaTiO3, AlN).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crystal: Option<String>,
+    /// The datasheet (strain-charge form) whose conversion `c`, `e`, `permittivity` are.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub datasheet: Option<Datasheet>,
+    /// The unit system of a crystal by name or of a datasheet's conversion.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<CrystalUnits>,
 }
 
 impl MaterialSpec {
@@ -904,7 +919,26 @@ impl MaterialSpec {
             young: None,
             poisson: None,
             coupling_scale: None,
+            crystal: None,
+            datasheet: None,
+            units: None,
         }
+    }
+
+    /// The library's crystal `name` on `region` (its constants in `units`), poled along
+    /// `poling`; `None` where the library has no such crystal ([`CRYSTALS`]).
+    pub fn named(region: &str, name: &str, units: CrystalUnits, poling: [f64; 3]) -> Option<Self> {
+        let crystal = named_crystal(name)?;
+        let (c, e, permittivity) = crystal.constants.in_units(units);
+        Some(MaterialSpec {
+            c,
+            e,
+            permittivity,
+            poling: poling.to_vec(),
+            crystal: Some(crystal.name.into()),
+            units: Some(units),
+            ..Self::bare(region, MaterialModel::Crystal6mm)
+        })
     }
 }
 
