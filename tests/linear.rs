@@ -232,3 +232,136 @@ fn a_datasheet_material_runs_as_its_stress_charge_table() {
     assert!(du < 0.01 * big(&table.u), "{du:e} of {:e}", big(&table.u));
     assert!(sheet.u != table.u);
 }
+
+/// A scene from TOML text.
+fn scene_of(text: &str) -> problem::Scene {
+    files::scene_file::from_tree(toml::from_str(text).unwrap(), "test").unwrap()
+}
+
+/// A layered body (`[[mesh.layer]]`) in uniaxial strain: two isotropic layers on rollers
+/// pressed by `p` on top, in 2D, as a body of revolution and in 3D. Each layer's strain is `-p / M` with `M` its
+/// constrained modulus `E (1 - ν) / ((1 + ν)(1 - 2ν))`, so the interface sinks by `p t1 / M1`
+/// and the top by `p (t1 / M1 + t2 / M2)`: P1 holds it exactly when the nodes lie on the
+/// interface, which the layers put there (with 5 and 3 cells across layers of 0.3 and 0.7).
+#[test]
+fn a_layered_body_in_uniaxial_strain_is_its_closed_form() {
+    let modulus = |e: f64, nu: f64| e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let (p, t1, t2) = (0.5, 0.3, 0.7);
+    let expected_interface = -p * t1 / modulus(1.0, 0.3);
+    let expected_top = expected_interface - p * t2 / modulus(10.0, 0.25);
+    // a plane body, a body of revolution (its axis held by the run, its rim on rollers), a box
+    for (dim, revolved) in [(2, false), (2, true), (3, false)] {
+        let (mesh, rollers, up) = if revolved {
+            (
+                "kind = \"rectangle\"\nlo = [0.0, 0.0]\nhi = [2.0, 1.0]\nnx = 4\naxisymmetric = true",
+                "[[dirichlet]]\ngroup = \"right\"\nux = 0.0\n[[dirichlet]]\ngroup = \"bottom\"\nuy = 0.0\n",
+                "[0.0, 1.0]",
+            )
+        } else if dim == 2 {
+            ("kind = \"rectangle\"\nlo = [0.0, 0.0]\nhi = [2.0, 1.0]\nnx = 4", "[[dirichlet]]\ngroup = \"left\"\nux = 0.0\n[[dirichlet]]\ngroup = \"right\"\nux = 0.0\n[[dirichlet]]\ngroup = \"bottom\"\nuy = 0.0\n", "[0.0, 1.0]")
+        } else {
+            ("kind = \"box\"\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, 1.0]\nnx = 2\nny = 2", "[[dirichlet]]\ngroup = \"left\"\nux = 0.0\n[[dirichlet]]\ngroup = \"right\"\nux = 0.0\n[[dirichlet]]\ngroup = \"front\"\nuy = 0.0\n[[dirichlet]]\ngroup = \"back\"\nuy = 0.0\n[[dirichlet]]\ngroup = \"bottom\"\nuz = 0.0\n", "[0.0, 0.0, 1.0]")
+        };
+        let text = format!(
+            "name = \"layers\"\ndescription = \"\"\n[mesh]\n{mesh}\n[[mesh.layer]]\nregion = \"soft\"\nthickness = {t1}\nn = 5\n[[mesh.layer]]\nregion = \"hard\"\nthickness = {t2}\nn = 3\ninterface = \"joint\"\n\
+             [[material]]\nregion = \"soft\"\nmodel = \"isotropic\"\nyoung = 1.0\npoisson = 0.3\n[[material]]\nregion = \"hard\"\nmodel = \"isotropic\"\nyoung = 10.0\npoisson = 0.25\n\
+             {rollers}[load]\ngroup = \"top\"\np = {}\ndirection = {up}\n",
+            -p
+        );
+        let scene = scene_of(&text);
+        let solution = problem::solve(&scene, None, &mut Silent).unwrap();
+        let mesh = &solution.mesh;
+        let axis = dim - 1;
+        let joint = mesh.boundary("joint").unwrap().nodes();
+        assert!(!joint.is_empty());
+        for &v in &joint {
+            assert_eq!(mesh.points[v][axis], t1, "{dim}D: an interface node off its plane");
+            let u = solution.u[v][axis];
+            assert!(
+                (u - expected_interface).abs() < 1e-12,
+                "{dim}D interface: {u} against {expected_interface}"
+            );
+        }
+        for v in mesh.boundary("top").unwrap().nodes() {
+            let u = solution.u[v][axis];
+            assert!(
+                (u - expected_top).abs() < 1e-12,
+                "{dim}D top: {u} against {expected_top}"
+            );
+        }
+        let cells = mesh.n_cells();
+        let (soft, hard) = (mesh.region("soft").unwrap().len(), mesh.region("hard").unwrap().len());
+        assert_eq!(soft + hard, cells);
+        assert_eq!(
+            soft * 3,
+            hard * 5,
+            "{dim}D: 5 rows of cells in the soft layer, 3 in the hard one"
+        );
+    }
+}
+
+/// A film's bottom electrode at an interface: a PZT-5A film (0.2) on an elastic substrate, on
+/// rollers, its top at the potential `V` and the interface between the layers grounded (the
+/// group `[[mesh.layer]]` names). The film is in uniaxial strain with no stress along the
+/// poling, `σ = c33 ε + e33 φ' = 0`, so its top rises by `-e33 V / c33` over the interface and
+/// the substrate carries nothing: P1 exact.
+#[test]
+fn a_film_on_its_bottom_electrode_at_an_interface_is_its_closed_form() {
+    let v = 0.01;
+    let text = format!(
+        "name = \"film\"\ndescription = \"\"\n[mesh]\nkind = \"rectangle\"\nlo = [0.0, 0.0]\nhi = [1.0, 1.0]\nnx = 4\n\
+         [[mesh.layer]]\nregion = \"substrate\"\nthickness = 0.8\nn = 4\n[[mesh.layer]]\nregion = \"film\"\nthickness = 0.2\nn = 2\ninterface = \"bottom_electrode\"\n\
+         [[material]]\nregion = \"film\"\ncrystal = \"PZT-5A\"\nunits = \"GPa\"\npoling = [0.0, 1.0, 0.0]\n\
+         [[material]]\nregion = \"substrate\"\nmodel = \"isotropic\"\nyoung = 130.0\npoisson = 0.28\n\
+         [[dirichlet]]\ngroup = \"left\"\nux = 0.0\n[[dirichlet]]\ngroup = \"right\"\nux = 0.0\n[[dirichlet]]\ngroup = \"bottom\"\nuy = 0.0\n\
+         [[dirichlet]]\ngroup = \"bottom_electrode\"\nphi = 0.0\n[[dirichlet]]\ngroup = \"top\"\nphi = {v}\n"
+    );
+    let solution = problem::solve(&scene_of(&text), None, &mut Silent).unwrap();
+    let mesh = &solution.mesh;
+    let rise = -15.8 * v / 111.0;
+    for node in mesh.boundary("top").unwrap().nodes() {
+        let u = solution.u[node][1];
+        assert!(
+            (u - rise).abs() < 1e-12 * rise.abs().max(1.0),
+            "top: {u} against {rise}"
+        );
+    }
+    for node in mesh.boundary("bottom_electrode").unwrap().nodes() {
+        assert!(solution.u[node][1].abs() < 1e-14, "interface: {}", solution.u[node][1]);
+        assert_eq!(solution.phi[node], 0.0);
+    }
+    // the charge on the bottom electrode is the top's, opposite (Gauss)
+    let t = &solution.report.terminals;
+    let q = |g: &str| t.iter().find(|x| x.group == g).unwrap().charge;
+    assert!((q("top") + q("bottom_electrode")).abs() < 1e-10 * q("top").abs());
+}
+
+/// Layers whose data cannot make a body are refused by key: thicknesses that do not fill the
+/// height, a count given twice, a grading across them, a layer named `body`, an interface
+/// that would replace a face's group, layers of a Gmsh mesh.
+#[test]
+fn layers_that_cannot_make_the_body_are_refused_by_key() {
+    let layers = "mesh.layer=[{region=\"a\",thickness=0.5,n=2},{region=\"b\",thickness=0.5,n=2}]";
+    let refused = |sets: &[&str], key: &str| {
+        let mut all = vec!["mesh.n=8".to_string(), layers.to_string()];
+        all.extend(sets.iter().map(|s| s.to_string()));
+        let e = match files::scene_file::load("paper-elastic", &all) {
+            Err(e) => e.to_string(),
+            Ok((scene, _)) => problem::solve(&scene, None, &mut Silent)
+                .err()
+                .expect("refused")
+                .to_string(),
+        };
+        assert!(e.contains(key), "{sets:?}: {e}");
+    };
+    refused(&["mesh.layer.1.thickness=0.6"], "sum to 1.1");
+    refused(&["mesh.ny=4"], "mesh.ny");
+    refused(&["mesh.grading=2.0"], "mesh.grading");
+    refused(&["mesh.layer.0.region=\"body\""], "mesh.layer.region");
+    refused(&["mesh.layer.1.interface=\"top\""], "mesh.layer.interface");
+    refused(&["mesh.layer.0.interface=\"x\""], "mesh.layer.interface");
+    refused(
+        &["mesh.layer.0.thickness=-0.5", "mesh.layer.1.thickness=1.5"],
+        "positive length",
+    );
+}

@@ -62,6 +62,8 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ("paper-3d", include_str!("../../../scenes/paper-3d.toml")),
     ("actuator", include_str!("../../../scenes/actuator.toml")),
     ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),
+    ("pfm-film", include_str!("../../../scenes/pfm-film.toml")),
+    ("stack", include_str!("../../../scenes/stack.toml")),
     ("layered", include_str!("../../../scenes/layered.toml")),
     (
         "near-incompressible",

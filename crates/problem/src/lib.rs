@@ -87,9 +87,9 @@ pub use report::{PetscReport, RunReport};
 pub use run::{ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, Contacts, DirichletSpec, ElectricCondition,
-    ElectrodeSpec, Electrodes, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LoadSpec, Loads,
-    MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError, SlipBoundProfile,
-    SolverSpec, Strategy, Valid,
+    ElectrodeSpec, Electrodes, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LayerSpec,
+    LoadSpec, Loads, MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError,
+    SlipBoundProfile, SolverSpec, Strategy, Valid,
 };
 pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
 pub use scene::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, CRYSTALS};

@@ -186,6 +186,9 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     if let Some(g) = &m.grading {
         grade(&mut mesh, m, &g.ratios());
     }
+    if !m.layers.is_empty() {
+        layer(&mut mesh, m)?;
+    }
     if m.cylinder {
         mesh::round_quarter_section(&mut mesh);
     }
@@ -198,21 +201,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     for l in scene.loads() {
         crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;
     }
-    for r in &m.regions {
-        let cells: Vec<usize> = (0..mesh.n_cells())
-            .filter(|&c| {
-                let cell = mesh.cell(c);
-                (0..r.lo.len()).all(|k| {
-                    let x = cell.iter().map(|&v| mesh.points[v][k]).sum::<f64>() / cell.len() as f64;
-                    x >= r.lo[k] && x <= r.hi[k]
-                })
-            })
-            .collect();
-        if cells.is_empty() {
-            return Err(SetupError::new("mesh.region", format!("mesh.region `{}` holds no cell", r.name)).into());
-        }
-        mesh.regions.insert(r.name.clone(), cells);
-    }
+    box_regions(&mut mesh, &m.regions)?;
     for (k, e) in scene.electrodes().iter().enumerate() {
         let range = e
             .x_range
@@ -244,6 +233,26 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         axis_group(&mut mesh)?;
     }
     Ok((mesh, notes))
+}
+
+/// The regions by box (`[[mesh.region]]`): the cells whose centroid lies in each box.
+fn box_regions(mesh: &mut mesh::Mesh, regions: &[crate::scene::RegionSpec]) -> Result<(), ProblemError> {
+    for r in regions {
+        let cells: Vec<usize> = (0..mesh.n_cells())
+            .filter(|&c| {
+                let cell = mesh.cell(c);
+                (0..r.lo.len()).all(|k| {
+                    let x = cell.iter().map(|&v| mesh.points[v][k]).sum::<f64>() / cell.len() as f64;
+                    x >= r.lo[k] && x <= r.hi[k]
+                })
+            })
+            .collect();
+        if cells.is_empty() {
+            return Err(SetupError::new("mesh.region", format!("mesh.region `{}` holds no cell", r.name)).into());
+        }
+        mesh.regions.insert(r.name.clone(), cells);
+    }
+    Ok(())
 }
 
 /// The group `axis` of a body of revolution's meridian section: its boundary segments on
@@ -282,6 +291,75 @@ fn axis_group(mesh: &mut mesh::Mesh) -> Result<(), ProblemError> {
                 facets,
             },
         );
+    }
+    Ok(())
+}
+
+/// A layered body (`mesh.layer`): the rows of nodes along the stacking axis (the last) moved so
+/// that each layer's cells span its thickness uniformly, each layer's cells added to its
+/// region, and each interface made a facet group (the cell facets in its plane, oriented as
+/// the layer below's: their normal points up).
+fn layer(mesh: &mut mesh::Mesh, m: &crate::scene::MeshSpec) -> Result<(), ProblemError> {
+    let axis = mesh.dim - 1;
+    let cells = m.layer_cells();
+    let total: usize = cells.iter().sum();
+    let (lo, hi) = (m.lo[axis], m.hi[axis]);
+    // the planes of the rows of nodes, and the first row of each layer
+    let mut at = vec![lo];
+    let mut first = vec![];
+    let mut base = lo;
+    for (layer, &n) in m.layers.iter().zip(&cells) {
+        first.push(at.len() - 1);
+        at.extend((1..=n).map(|j| base + layer.thickness * j as f64 / n as f64));
+        base += layer.thickness;
+    }
+    at[total] = hi;
+    for p in &mut mesh.points {
+        let row = (((p[axis] - lo) / (hi - lo)) * total as f64)
+            .round()
+            .clamp(0.0, total as f64) as usize;
+        p[axis] = at[row];
+    }
+    // each cell's layer: the one whose rows hold its centroid
+    let layer_of = |c: &[usize], points: &[[f64; 3]]| {
+        let y = c.iter().map(|&v| points[v][axis]).sum::<f64>() / c.len() as f64;
+        first.iter().rposition(|&r| at[r] <= y).unwrap_or(0)
+    };
+    let of: Vec<usize> = mesh.iter_cells().map(|c| layer_of(c, &mesh.points)).collect();
+    for (k, layer) in m.layers.iter().enumerate() {
+        let region = mesh.regions.entry(layer.region.clone()).or_default();
+        region.extend((0..of.len()).filter(|&c| of[c] == k));
+        region.sort_unstable();
+    }
+    let kind = mesh.kind;
+    for k in 1..m.layers.len() {
+        let name = m.interface_name(k);
+        if mesh.boundaries.contains_key(&name) {
+            return Err(SetupError::new(
+                "mesh.layer.interface",
+                format!("the interface `{name}` below layer {k} would replace the mesh's own group of that name: name it otherwise (mesh.layer.interface)"),
+            )
+            .into());
+        }
+        let plane = at[first[k]];
+        let mut facets = vec![];
+        for cell in mesh
+            .iter_cells()
+            .enumerate()
+            .filter(|&(c, _)| of[c] == k - 1)
+            .map(|(_, cell)| cell)
+        {
+            for local in kind.facets() {
+                if local.iter().all(|&i| mesh.points[cell[i]][axis] == plane) {
+                    facets.extend(local.iter().map(|&i| cell[i]));
+                }
+            }
+        }
+        let group = mesh::FacetGroup {
+            nodes_per_facet: kind.facet_n_nodes(),
+            facets,
+        };
+        mesh.boundaries.insert(name, group);
     }
     Ok(())
 }

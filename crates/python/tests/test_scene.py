@@ -83,3 +83,19 @@ def test_a_crystal_by_name_and_by_datasheet():
     with pytest.raises(pc.InputError) as e:
         pc.Scene.load("paper", {"material.crystal": "PZT-4", "material.units": "GPa"})
     assert "material.c" in str(e.value)
+
+
+def test_a_layered_body_from_a_dict():
+    """`mesh.layer` from Python: the stack's layers and its internal electrodes (the groups
+    the layers name) as the shipped scene has them, and a thickness that does not fill the
+    body refused by key."""
+    r = pc.run(pc.Scene.load("stack"))
+    groups = [t["group"] for t in r.report["terminals"]]
+    assert set(groups) == {"top", "bottom", "e1", "e2", "e3"}
+    assert r.report["contact"]["normal_force"] > 0.9
+    assert abs(sum(t["charge"] for t in r.report["terminals"])) < 1e-3
+    data = pc.Scene.load("stack").to_dict()
+    data["mesh"]["layer"][0]["thickness"] = 0.5
+    with pytest.raises(pc.InputError) as e:
+        pc.Scene.from_dict(data)
+    assert "mesh.layer.thickness" in str(e.value)

@@ -715,6 +715,30 @@ pub struct MeshSpec {
     /// this many segments (its cells are `revolve` times the meridian's; absent: not written).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub revolve: Option<usize>,
+    /// A layered body (`[[mesh.layer]]`): layers stacked along the last axis (y in 2D, z in
+    /// 3D) from `lo` to `hi`, their thicknesses summing to the height, each its own cell
+    /// region and its own number of cells across; each interface a facet group of the mesh
+    /// (an interior one: an electrode between two layers, a film's bottom electrode).
+    #[serde(default, rename = "layer", skip_serializing_if = "Vec::is_empty")]
+    pub layers: Vec<LayerSpec>,
+}
+
+/// One layer of a layered body (`[[mesh.layer]]`), from the bottom up.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LayerSpec {
+    /// The cell region the layer's cells make (materials refer to it; layers may share one).
+    pub region: String,
+    /// Its thickness along the stacking axis (a length).
+    pub thickness: f64,
+    /// Cells across it (default: the mesh's cell count along the stacking axis shared out by
+    /// thickness, at least 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub n: Option<usize>,
+    /// The name of the facet group at its bottom, the interface with the layer below (default
+    /// `REGIONBELOW_REGION`); the first layer's bottom is the mesh's own bottom group.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interface: Option<String>,
 }
 
 /// `mesh.grading`: one stretch (last cell over first) for every axis, or one per axis.
@@ -778,7 +802,33 @@ impl MeshSpec {
             grading: None,
             cylinder: false,
             revolve: None,
+            layers: vec![],
         }
+    }
+
+    /// The cells across each layer of a layered body (none without layers): each layer's `n`,
+    /// or the count along the stacking axis shared out by thickness (at least 1 each).
+    pub fn layer_cells(&self) -> Vec<usize> {
+        if self.layers.is_empty() {
+            return vec![];
+        }
+        let along = self.cells_per_axis_plain().last().copied().unwrap_or(1);
+        let height: f64 = self.layers.iter().map(|l| l.thickness).sum();
+        self.layers
+            .iter()
+            .map(|l| {
+                l.n.unwrap_or_else(|| (along as f64 * l.thickness / height).round().max(1.0) as usize)
+            })
+            .collect()
+    }
+
+    /// The facet group at the bottom of layer `k >= 1` (its interface with the layer below).
+    pub fn interface_name(&self, k: usize) -> String {
+        let layer = &self.layers[k];
+        layer
+            .interface
+            .clone()
+            .unwrap_or_else(|| format!("{}_{}", self.layers[k - 1].region, layer.region))
     }
 
     /// The dimension of a generated mesh (`None` for a Gmsh file or a given mesh: known once it
@@ -792,8 +842,18 @@ impl MeshSpec {
     }
 
     /// Cells per axis of a generated mesh from `n` (along the shortest edge), `h`, `nx`, `ny`,
-    /// `nz` (8 along the shortest edge when none is given).
+    /// `nz` (8 along the shortest edge when none is given); along the stacking axis of a layered
+    /// body, the layers' cells together.
     pub fn cells_per_axis(&self) -> Vec<usize> {
+        let mut out = self.cells_per_axis_plain();
+        if let Some(last) = out.last_mut().filter(|_| !self.layers.is_empty()) {
+            *last = self.layer_cells().iter().sum();
+        }
+        out
+    }
+
+    /// [`MeshSpec::cells_per_axis`] without the layers' counts.
+    fn cells_per_axis_plain(&self) -> Vec<usize> {
         let lens: Vec<f64> = self.lo.iter().zip(&self.hi).map(|(a, b)| b - a).collect();
         let shortest = lens.iter().cloned().fold(f64::INFINITY, f64::min);
         let n = match (self.h, self.n) {

@@ -463,10 +463,80 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
             "mesh.cylinder makes the section [0, R]² a quarter disc of radius R: give mesh.lo = [0, 0, z0] and mesh.hi = [R, R, z1]",
         )?;
     }
+    validate_layers(m)?;
     match m.dim() {
         None => validate_read(m),
         Some(d) => validate_generated(m, d),
     }
+}
+
+/// A layered body's layers (`[[mesh.layer]]`): on a generated mesh, each a named region of a
+/// positive thickness, together the height along the stacking axis; its cell counts given once
+/// (per layer, or by `mesh.ny`/`mesh.nz` shared out); no grading across them.
+fn validate_layers(m: &MeshSpec) -> Result<(), SceneError> {
+    if m.layers.is_empty() {
+        return Ok(());
+    }
+    let Some(dim) = m.dim() else {
+        return Err(SceneError::new(
+            "mesh.layer",
+            format!("layers of a generated mesh, and mesh.kind = \"{}\" fixes its own cells (name the layers' regions in the mesh file)", m.kind),
+        ));
+    };
+    for (k, layer) in m.layers.iter().enumerate() {
+        check_name("mesh.layer.region", &layer.region)?;
+        refuse_if(
+            layer.region == "body",
+            "mesh.layer.region",
+            "a layer named `body`, the region of every cell of a generated mesh: name it for what it is (film, substrate)",
+        )?;
+        if !(layer.thickness.is_finite() && layer.thickness > 0.0) {
+            return Err(SceneError::new(
+                "mesh.layer.thickness",
+                format!(
+                    "mesh.layer.{k}.thickness = {} must be a positive length",
+                    layer.thickness
+                ),
+            ));
+        }
+        if layer.n == Some(0) {
+            return Err(SceneError::new(
+                "mesh.layer.n",
+                format!("mesh.layer.{k}.n must be at least 1"),
+            ));
+        }
+        if let Some(name) = &layer.interface {
+            check_name("mesh.layer.interface", name)?;
+            refuse_if(
+                k == 0,
+                "mesh.layer.interface",
+                "the first layer's interface: its bottom is the mesh's own bottom face (`bottom` in 2D, `bottom` in 3D)",
+            )?;
+        }
+    }
+    let axis = dim - 1;
+    if m.lo.len() == dim && m.hi.len() == dim {
+        let height = m.hi[axis] - m.lo[axis];
+        let sum: f64 = m.layers.iter().map(|l| l.thickness).sum();
+        if !((sum - height).abs() <= 1e-9 * height.abs()) {
+            let axis_name = ["x", "y", "z"][axis];
+            return Err(SceneError::new(
+                "mesh.layer.thickness",
+                format!("the layers' thicknesses sum to {sum}, and the body's height along {axis_name} (mesh.hi - mesh.lo) is {height}: make them equal"),
+            ));
+        }
+    }
+    let count = if dim == 2 { ("mesh.ny", m.ny) } else { ("mesh.nz", m.nz) };
+    refuse_if(
+        count.1.is_some() && m.layers.iter().any(|l| l.n.is_some()),
+        count.0,
+        "cells along the stacking axis, and the layers give their own (mesh.layer.n): give one or the other",
+    )?;
+    refuse_if(
+        m.grading.is_some(),
+        "mesh.grading",
+        "a graded mesh, and layers (mesh.layer): each layer's cells are uniform across it; grade by thinner layers",
+    )
 }
 
 /// A Gmsh mesh, a file, or a given mesh, no file; and none of the generator's keys (they would
