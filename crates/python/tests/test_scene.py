@@ -98,4 +98,4 @@ def test_a_layered_body_from_a_dict():
     data["mesh"]["layer"][0]["thickness"] = 0.5
     with pytest.raises(pc.InputError) as e:
         pc.Scene.from_dict(data)
-    assert "mesh.layer.thickness" in str(e.value)
+    assert e.value.key == "mesh.layer.thickness" and "sum to 1.25" in str(e.value)
