@@ -364,4 +364,13 @@ fn layers_that_cannot_make_the_body_are_refused_by_key() {
         &["mesh.layer.0.thickness=-0.5", "mesh.layer.1.thickness=1.5"],
         "positive length",
     );
+    let three = "mesh.layer=[{region=\"a\",thickness=0.25},{region=\"b\",thickness=0.5,interface=\"j\"},{region=\"c\",thickness=0.25,interface=\"j\"}]";
+    let e = files::scene_file::load("paper-elastic", &["mesh.n=8".to_string(), three.to_string()]).unwrap_err();
+    assert!(e.to_string().contains("two interfaces"), "{e}");
+    // a stack's alternate layers: the default names of its repeated pairs made distinct
+    let alternate = "mesh.layer=[{region=\"u\",thickness=0.25},{region=\"d\",thickness=0.25},{region=\"u\",thickness=0.25},{region=\"d\",thickness=0.25}]";
+    let (scene, _) =
+        files::scene_file::load("paper-elastic", &["mesh.n=8".to_string(), alternate.to_string()]).unwrap();
+    let names: Vec<String> = (1..4).map(|k| scene.mesh.interface_name(k)).collect();
+    assert_eq!(names, ["u_d_1", "d_u", "u_d_3"]);
 }

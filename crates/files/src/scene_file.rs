@@ -63,6 +63,7 @@ pub const SHIPPED: &[(&str, &str)] = &[
     ("actuator", include_str!("../../../scenes/actuator.toml")),
     ("pzt5a-si", include_str!("../../../scenes/pzt5a-si.toml")),
     ("pfm-film", include_str!("../../../scenes/pfm-film.toml")),
+    ("pfm-curve", include_str!("../../../scenes/pfm-curve.toml")),
     ("stack", include_str!("../../../scenes/stack.toml")),
     ("layered", include_str!("../../../scenes/layered.toml")),
     (

@@ -363,9 +363,23 @@ pub fn contact_errors(
 /// outside its domain: nothing touches (the run's or the closed form's force 0: no relative
 /// error exists), or the closed form does not evaluate to a finite contact at these data (a
 /// radius of 1e-300 gave a force of -4.6e210).
-pub(crate) fn half_space(scene: &Scene, electric: bool, run: &Measured) -> Option<Result<HalfSpaceReport, String>> {
+pub(crate) fn half_space(
+    scene: &Scene,
+    electric: bool,
+    run: &Measured,
+    f: &crate::Factors,
+) -> Option<Result<HalfSpaceReport, String>> {
+    use crate::halfspace::Tip;
     let (body, profile, tip) = scene.half_space_problem(electric).ok()?;
-    let force = scene.active_contact()?.indenter.as_ref()?.force;
+    // a path's instant: the tip's potential (a prescribed one) scaled by the voltage factor,
+    // an indenter's force by the load factor
+    let tip = match tip {
+        Tip::Conducting { potential } => Tip::Conducting {
+            potential: potential * f.voltage,
+        },
+        other => other,
+    };
+    let force = scene.active_contact()?.indenter.as_ref()?.force.map(|x| x * f.load);
     Some(half_space_in_domain(&body, &profile, tip, force, run))
 }
 

@@ -26,8 +26,8 @@ use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
 use crate::report::{Iterations, PathReport, RunReport, StepRow, Timings};
 use crate::run::{
-    begin, check_accurate, check_solved, contact_boundary, contact_result, indenter_report, pose, recover, report,
-    stop_if_interrupted, terminal_groups, ContactResult, Measured, Recovered,
+    begin, check_accurate, check_solved, closed_form, contact_boundary, contact_result, indenter_report, pose, recover,
+    report, stop_if_interrupted, terminal_groups, ContactResult, Measured, Recovered,
 };
 use crate::scene::{Factors, PathSpec, Scene};
 use crate::setup::Setup;
@@ -790,7 +790,7 @@ impl Walk<'_> {
             seconds,
         } = stepped;
         let setup = self.setup;
-        let Some((sol, fielded, pcg_iters)) =
+        let Some((sol, mut fielded, pcg_iters)) =
             self.checked(boundary.as_ref(), disc, (sol, fields), &springs, reporter)?
         else {
             return Ok(None);
@@ -822,9 +822,7 @@ impl Walk<'_> {
             None => sol.u.clone(),
         };
         let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift);
-        if let Some(indenter) = indenter_report(self.scene, &boundary, &sol) {
-            (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
-        }
+        self.indenter_row(&mut row, (&boundary, &sol), fielded.as_mut().map(|(r, _, _)| r), &f);
         // the charges of the fields where they are computed, else of the functionals (equal to
         // the condensed solve's accuracy: tests/path.rs)
         (row.charges, row.potentials) = match (&fielded, &factors) {
@@ -893,6 +891,35 @@ impl Walk<'_> {
                 (sol, None, 0)
             }
         }))
+    }
+
+    /// An indenter's figures in the step's row (its depth, contact radius, a conducting tip's
+    /// charge, and the half-space's closed form beside them at the step's factors `f`), and a
+    /// path's recovered report's closed form at those factors too.
+    fn indenter_row(
+        &self,
+        row: &mut StepRow,
+        (boundary, sol): (&ContactBoundary, &ContactSolution),
+        recovered: Option<&mut Recovered>,
+        f: &Factors,
+    ) {
+        let electric = self.setup.plan.electric;
+        if let Some(mut indenter) = indenter_report(self.scene, boundary, sol) {
+            (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
+            row.tip_charge = indenter.charge;
+            closed_form(self.scene, electric, &mut indenter, f);
+            row.half_space = indenter.half_space.map(|h| crate::report::HalfSpaceRow {
+                depth: h.depth,
+                force: h.force,
+                contact_radius: h.contact_radius,
+                charge: h.charge,
+            });
+        }
+        if let (Some(recovered), Some(_)) = (recovered, self.spec) {
+            if let Some(indenter) = recovered.indenter.as_mut() {
+                closed_form(self.scene, electric, indenter, f);
+            }
+        }
     }
 
     /// Under the tight rule, a backend held to its tolerances meets them
@@ -1066,6 +1093,8 @@ fn step_row(
         iterations: sol.info.newton_iters + sol.info.uzawa_iters,
         depth: None,
         contact_radius: None,
+        tip_charge: None,
+        half_space: None,
         charges: vec![],
         potentials: vec![],
         complementarity: sol.info.complementarity,

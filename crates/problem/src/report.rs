@@ -162,6 +162,15 @@ pub struct StepRow {
     /// axis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_radius: Option<f64>,
+    /// A conducting indenter's charge at the step (the charge on it across its zone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip_charge: Option<f64>,
+    /// The half-space's closed form at the step, where it applies to the scene (a frictionless
+    /// axisymmetric indenter on a body of revolution): its force at the step's depth (under
+    /// force control, its depth at the step's force: `half_space_depth`), contact radius and
+    /// a conducting tip's charge.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_space: Option<HalfSpaceRow>,
     /// The charge on each terminal (the charge on the conductor), in the order of
     /// [`RunReport::terminals`].
     #[serde(default)]
@@ -175,6 +184,20 @@ pub struct StepRow {
     /// The equilibrium residual of the step, where its fields were computed (the instants
     /// whose files are written, and the last).
     pub equilibrium: Option<f64>,
+}
+
+/// The half-space's closed form at a step of a path ([`StepRow::half_space`]).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct HalfSpaceRow {
+    /// Its depth (the step's under depth control).
+    pub depth: f64,
+    /// Its force (the step's under force control).
+    pub force: f64,
+    /// Its contact radius.
+    pub contact_radius: f64,
+    /// A conducting tip's charge.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charge: Option<f64>,
 }
 
 impl SceneReport {

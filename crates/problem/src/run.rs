@@ -249,7 +249,7 @@ pub(crate) fn recover(
             .zones()
             .into_iter()
             .find(|c| c.electric_law().is_some())
-            .and_then(|c| conductor_potential(c, sol)),
+            .and_then(|c| conductor_potential(c, b, sol)),
         ..ContactReport::of_groups(&b.points, sol, &b.groups, &b.group_of)
     });
     let indenter = contact.and_then(|(b, sol)| {
@@ -265,20 +265,7 @@ pub(crate) fn recover(
             });
             r.tip_potential = nearest.map(|i| phi[b.nodes[i]]);
         }
-        let measured = crate::exact::Measured {
-            depth: r.depth,
-            force: r.force,
-            contact_radius: r.contact_radius,
-            potential: r.potential,
-            charge: r.charge,
-            tip_potential: r.tip_potential,
-        };
-        // outside its domain it is absent and why is said (not applying, it is not said)
-        match crate::exact::half_space(scene, setup.plan.electric, &measured) {
-            Some(Ok(h)) => r.half_space = Some(h),
-            Some(Err(why)) => r.half_space_absent = Some(why),
-            None => {}
-        }
+        closed_form(scene, setup.plan.electric, &mut r, &crate::Factors::ONE);
         Some(r)
     });
     let half_space = scene
@@ -331,6 +318,26 @@ pub(crate) fn recover(
     })
 }
 
+/// The half-space's closed form beside an indenter's figures `r` (`r.half_space`, or why it is
+/// absent), at the instant's factors `f` (a path scales a conducting tip's potential by the
+/// voltage factor and an indenter's force by the load factor; a static run's are 1).
+pub(crate) fn closed_form(scene: &Scene, electric: bool, r: &mut crate::report::IndenterReport, f: &crate::Factors) {
+    let measured = crate::exact::Measured {
+        depth: r.depth,
+        force: r.force,
+        contact_radius: r.contact_radius,
+        potential: r.potential,
+        charge: r.charge,
+        tip_potential: r.tip_potential,
+    };
+    // outside its domain it is absent and why is said (not applying, it is not said)
+    (r.half_space, r.half_space_absent) = match crate::exact::half_space(scene, electric, &measured, f) {
+        Some(Ok(h)) => (Some(h), None),
+        Some(Err(why)) => (None, Some(why)),
+        None => (None, None),
+    };
+}
+
 /// A rigid indenter's figures at the solution `sol` on `points` (the depth read off their
 /// gaps), the body carrying `normal_force`; `None` without `contact.indenter`.
 pub(crate) fn indenter_report(
@@ -358,7 +365,7 @@ pub(crate) fn indenter_report(
         force,
         contact_radius: radius,
         points_in_contact: count,
-        potential: conductor_potential(c, sol),
+        potential: conductor_potential(c, b, sol),
         // the charge across its own zone, where it conducts (another zone may)
         charge: sol
             .electric
@@ -371,9 +378,10 @@ pub(crate) fn indenter_report(
     })
 }
 
-/// The potential of a conducting foundation or tip (`None` on an insulating one): prescribed,
-/// or, floating with a given charge, found: that of a point it presses.
-fn conductor_potential(c: &crate::ContactSpec, sol: &ContactSolution) -> Option<f64> {
+/// The potential of a conducting foundation or tip (`None` on an insulating one): prescribed
+/// (the boundary's: a path's instant scales it by its voltage factor), or, floating with a
+/// given charge, found: that of a point it presses.
+fn conductor_potential(c: &crate::ContactSpec, b: &ContactBoundary, sol: &ContactSolution) -> Option<f64> {
     match (c.charge, sol.electric.as_ref()) {
         (Some(_), Some(e)) => e
             .points
@@ -382,7 +390,7 @@ fn conductor_potential(c: &crate::ContactSpec, sol: &ContactSolution) -> Option<
             .filter(|&(&i, _)| sol.lambda.normal[i] > 0.0)
             .map(|(_, &v)| v)
             .next(),
-        _ => c.electric_law().map(|(_, potential)| potential),
+        _ => c.electric_law().and(b.electric.as_ref().map(|(e, _)| e.potential)),
     }
 }
 

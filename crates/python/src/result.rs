@@ -211,7 +211,8 @@ impl RunResult {
     /// `uz`, `gap`, `normal_force`, `tangential_force`, `max_slip`, `max_slip_increment`,
     /// `n_stick`, `n_slip`, `n_separated`, `iterations`, `complementarity`, `equilibrium` (NaN
     /// where the instant's fields were not computed), and under an indenter `depth` and
-    /// `contact_radius`), the tangential force's components `tangential_force_x`, `_y`
+    /// `contact_radius`, a conducting tip's `tip_charge`, and where the half-space's closed form
+    /// applies `half_space_depth`, `_force`, `_contact_radius`, `_charge`), the tangential force's components `tangential_force_x`, `_y`
     /// (`_z` in 3D) beside its magnitude `tangential_force`, `charges` and `potentials`
     /// (n_instants, n_terminals: the charge on each conductor) with `terminals` their groups;
     /// and with `run(..., series=True)` the contact values of every point at every instant:
@@ -264,6 +265,18 @@ impl RunResult {
         if rows.iter().any(|r| r.depth.is_some()) {
             out.set_item("depth", column(&|r| r.depth.unwrap_or(f64::NAN)))?;
             out.set_item("contact_radius", column(&|r| r.contact_radius.unwrap_or(f64::NAN)))?;
+        }
+        if rows.iter().any(|r| r.tip_charge.is_some()) {
+            out.set_item("tip_charge", column(&|r| r.tip_charge.unwrap_or(f64::NAN)))?;
+        }
+        if rows.iter().any(|r| r.half_space.is_some()) {
+            let of = |f: &dyn Fn(&problem::report::HalfSpaceRow) -> f64| {
+                column(&|r| r.half_space.as_ref().map_or(f64::NAN, f))
+            };
+            out.set_item("half_space_depth", of(&|h| h.depth))?;
+            out.set_item("half_space_force", of(&|h| h.force))?;
+            out.set_item("half_space_contact_radius", of(&|h| h.contact_radius))?;
+            out.set_item("half_space_charge", of(&|h| h.charge.unwrap_or(f64::NAN)))?;
         }
         let terminals: Vec<&str> = self
             .solution

@@ -131,3 +131,14 @@ def test_a_conducting_foundation_follows_a_path():
         assert np.isclose(p["normal_force"][k], alone.report["contact"]["normal_force"], rtol=1e-7)
         flux = np.nansum(w * p["flux"][k])
         assert np.isclose(flux, np.nansum(w * alone.contact.flux), rtol=1e-7)
+
+
+def test_the_force_depth_charge_curve_of_a_conducting_tip():
+    """pfm-curve from Python: the tip's charge and the half-space's closed form beside each
+    instant, the force and the charge within 2.5 % of it at the smoke size."""
+    r = pc.run(pc.Scene.load("pfm-curve", {"mesh.n": 48, "path.steps": 4}))
+    p = r.path
+    touching = p["t"] > 0
+    for run, form in [("normal_force", "half_space_force"), ("tip_charge", "half_space_charge")]:
+        assert np.allclose(p[run][touching], p[form][touching], rtol=0.025), run
+    assert np.all(np.diff(p["half_space_force"][touching]) > 0)

@@ -476,7 +476,10 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     Ok(out)
 }
 
-/// `path.csv`: one row per instant, with the tangential force's magnitude (`tangential_force`)
+/// `path.csv`: one row per instant (an indenter's depth, contact radius and a conducting tip's
+/// charge, with the half-space's closed form beside them where it applies:
+/// `half_space_depth`, `_force`, `_contact_radius`, `_charge`), with the tangential force's
+/// magnitude (`tangential_force`)
 /// and its components in the global frame (`tangential_force_x`, `_y`, `_z` in 3D), with
 /// several contact groups each one's forces (`normal_force_G`, `tangential_force_G`,
 /// `tangential_force_x_G`, ...), the charge
@@ -484,7 +487,7 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
 /// (`potential_GROUP`).
 fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
     let mut s = String::from(
-        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius",
+        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius,tip_charge,half_space_depth,half_space_force,half_space_contact_radius,half_space_charge",
     );
     let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
     let axes = ["x", "y", "z"];
@@ -527,6 +530,12 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         row.push(r.equilibrium.map_or(String::new(), num));
         row.push(r.depth.map_or(String::new(), num));
         row.push(r.contact_radius.map_or(String::new(), num));
+        row.push(r.tip_charge.map_or(String::new(), num));
+        let h = r.half_space.as_ref();
+        row.push(h.map_or(String::new(), |h| num(h.depth)));
+        row.push(h.map_or(String::new(), |h| num(h.force)));
+        row.push(h.map_or(String::new(), |h| num(h.contact_radius)));
+        row.push(h.and_then(|h| h.charge).map_or(String::new(), num));
         row.extend((0..dim).map(|k| num(r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN))));
         for k in 0..groups.len() {
             let g = r.groups.get(k);

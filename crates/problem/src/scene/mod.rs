@@ -822,13 +822,26 @@ impl MeshSpec {
             .collect()
     }
 
-    /// The facet group at the bottom of layer `k >= 1` (its interface with the layer below).
+    /// The facet group at the bottom of layer `k >= 1` (its interface with the layer below):
+    /// its `interface`, or `LOWER_UPPER` after the two layers' regions, with `_k` added where
+    /// another interface of the stack would take that name too (a stack's alternate layers).
     pub fn interface_name(&self, k: usize) -> String {
-        let layer = &self.layers[k];
-        layer
-            .interface
-            .clone()
-            .unwrap_or_else(|| format!("{}_{}", self.layers[k - 1].region, layer.region))
+        let default = |k: usize| format!("{}_{}", self.layers[k - 1].region, self.layers[k].region);
+        match &self.layers[k].interface {
+            Some(name) => name.clone(),
+            None => {
+                let name = default(k);
+                let taken = (1..self.layers.len()).filter(|&j| j != k).any(|j| {
+                    self.layers[j].interface.as_deref() == Some(name.as_str())
+                        || (self.layers[j].interface.is_none() && default(j) == name)
+                });
+                if taken {
+                    format!("{name}_{k}")
+                } else {
+                    name
+                }
+            }
+        }
     }
 
     /// The dimension of a generated mesh (`None` for a Gmsh file or a given mesh: known once it

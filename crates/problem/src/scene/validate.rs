@@ -522,9 +522,16 @@ fn validate_layers(m: &MeshSpec) -> Result<(), SceneError> {
             let axis_name = ["x", "y", "z"][axis];
             return Err(SceneError::new(
                 "mesh.layer.thickness",
-                format!("the layers' thicknesses sum to {sum}, and the body's height along {axis_name} (mesh.hi - mesh.lo) is {height}: make them equal"),
+                format!("the layers' thicknesses (mesh.layer.thickness) sum to {sum}, and the body's height along {axis_name} (mesh.hi - mesh.lo) is {height}: make them equal"),
             ));
         }
+    }
+    let names: Vec<String> = (1..m.layers.len()).map(|k| m.interface_name(k)).collect();
+    if let Some(name) = names.iter().find(|n| names.iter().filter(|x| x == n).count() > 1) {
+        return Err(SceneError::new(
+            "mesh.layer.interface",
+            format!("two interfaces of the layers are named `{name}`: name each its own (mesh.layer.interface)"),
+        ));
     }
     let count = if dim == 2 { ("mesh.ny", m.ny) } else { ("mesh.nz", m.nz) };
     refuse_if(
