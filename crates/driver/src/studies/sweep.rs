@@ -29,12 +29,32 @@ pub struct SweepRow {
     pub fixed_point: usize,
     /// Wall time of the run (s).
     pub seconds: f64,
-    /// A rigid indenter's depth and (a conducting one's) charge, where the scene has one (a
-    /// force-controlled indenter's depth against a voltage: piezoresponse).
-    pub indenter: Option<(f64, Option<f64>)>,
+    /// A rigid indenter's figures, where the scene has one (a force-controlled indenter's
+    /// depth against a voltage: piezoresponse).
+    pub indenter: Option<SweepIndenter>,
+    /// Each terminal's group, charge and potential (run.json's `terminals`).
+    pub terminals: Vec<(String, f64, f64)>,
     /// The run's error where this point failed (its numbers then NaN): the other points are
     /// kept.
     pub error: Option<String>,
+}
+
+/// An indenter's figures at a point of a sweep, with the half-space's closed form where it
+/// applies.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SweepIndenter {
+    /// The depth (under force control, the depth found).
+    pub depth: f64,
+    /// The force it carries.
+    pub force: f64,
+    /// The contact radius.
+    pub contact_radius: f64,
+    /// A conducting tip's charge.
+    pub charge: Option<f64>,
+    /// A conducting tip's potential.
+    pub potential: Option<f64>,
+    /// The half-space's force, contact radius and charge at the point's depth.
+    pub half_space: Option<(f64, f64, Option<f64>)>,
 }
 
 /// The parameter a sweep varies: `steps` values from `from` to `to`, inclusive.
@@ -105,20 +125,7 @@ pub fn sweep(
                 continue;
             }
         };
-        let c = &r.contact;
-        let row = SweepRow {
-            value,
-            counts: (c.n_stick, c.n_slip, c.n_separated),
-            normal_force: c.normal_force,
-            tangential_force: c.tangential_force,
-            complementarity: r.residuals.complementarity,
-            equilibrium: r.residuals.equilibrium,
-            uzawa: r.iterations.uzawa,
-            fixed_point: r.iterations.fixed_point,
-            seconds: t.elapsed().as_secs_f64(),
-            indenter: r.indenter.as_ref().map(|i| (i.depth, i.charge)),
-            error: None,
-        };
+        let row = SweepRow::of(value, &r, t.elapsed().as_secs_f64());
         progress(&format!(
             "[{}/{steps}] {param} = {value:.6e}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}",
             k + 1,
@@ -155,6 +162,36 @@ pub fn sweep(
 }
 
 impl SweepRow {
+    /// The point `value` whose run reported `r` in `seconds`.
+    fn of(value: f64, r: &problem::RunReport, seconds: f64) -> Self {
+        let c = &r.contact;
+        SweepRow {
+            value,
+            counts: (c.n_stick, c.n_slip, c.n_separated),
+            normal_force: c.normal_force,
+            tangential_force: c.tangential_force,
+            complementarity: r.residuals.complementarity,
+            equilibrium: r.residuals.equilibrium,
+            uzawa: r.iterations.uzawa,
+            fixed_point: r.iterations.fixed_point,
+            seconds,
+            indenter: r.indenter.as_ref().map(|i| SweepIndenter {
+                depth: i.depth,
+                force: i.force,
+                contact_radius: i.contact_radius,
+                charge: i.charge,
+                potential: i.potential,
+                half_space: i.half_space.as_ref().map(|h| (h.force, h.contact_radius, h.charge)),
+            }),
+            terminals: r
+                .terminals
+                .iter()
+                .map(|t| (t.group.clone(), t.charge, t.potential))
+                .collect(),
+            error: None,
+        }
+    }
+
     /// A point whose run failed with `error`: its numbers NaN, its error kept.
     fn failed(value: f64, seconds: f64, error: String) -> Self {
         SweepRow {
@@ -168,6 +205,7 @@ impl SweepRow {
             fixed_point: 0,
             seconds,
             indenter: None,
+            terminals: vec![],
             error: Some(error),
         }
     }
@@ -195,22 +233,62 @@ fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> b
     }
 }
 
-/// The rows as CSV (with `indenter_depth,indenter_charge` where the scene has an indenter;
-/// `nan` for an insulating one's charge).
+/// The rows as CSV: the counts, forces, residuals, iterations and seconds; where the scene has
+/// an indenter its figures (`indenter_depth`, `indenter_charge` (`nan` for an insulating
+/// one's), `indenter_force`, `indenter_contact_radius`, `indenter_potential`) and the
+/// half-space's closed form beside them (`half_space_force`, `_contact_radius`, `_charge`,
+/// `nan` where it does not apply); each terminal's `charge_GROUP` and `potential_GROUP`; a
+/// failed point's `error`.
 pub fn csv(param: &str, rows: &[SweepRow]) -> String {
     let indenter = rows.iter().any(|r| r.indenter.is_some());
     let errors = rows.iter().any(|r| r.error.is_some());
-    let mut csv = format!(
-        "{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds{}{}\n",
-        if indenter { ",indenter_depth,indenter_charge" } else { "" },
-        if errors { ",error" } else { "" }
+    let groups: Vec<String> = rows
+        .iter()
+        .find(|r| !r.terminals.is_empty())
+        .map_or(vec![], |r| r.terminals.iter().map(|t| t.0.clone()).collect());
+    let mut header = format!(
+        "{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds"
     );
+    if indenter {
+        header.push_str(",indenter_depth,indenter_charge,indenter_force,indenter_contact_radius,indenter_potential,half_space_force,half_space_contact_radius,half_space_charge");
+    }
+    for (prefix, g) in ["charge", "potential"]
+        .iter()
+        .flat_map(|p| groups.iter().map(move |g| (p, g)))
+    {
+        header.push_str(&format!(",{}", files::output::csv_field(&format!("{prefix}_{g}"))));
+    }
+    if errors {
+        header.push_str(",error");
+    }
+    let mut csv = header + "\n";
+    let or_nan = |v: Option<f64>| v.unwrap_or(f64::NAN);
     for r in rows {
-        let extra = match (indenter, r.indenter) {
-            (false, _) => String::new(),
-            (true, Some((depth, charge))) => format!(",{depth:e},{:e}", charge.unwrap_or(f64::NAN)),
-            (true, None) => ",nan,nan".into(),
-        };
+        let mut extra = String::new();
+        if indenter {
+            let i = r.indenter.clone();
+            let h = i.as_ref().and_then(|i| i.half_space);
+            let values = [
+                i.as_ref().map(|i| i.depth),
+                i.as_ref().and_then(|i| i.charge),
+                i.as_ref().map(|i| i.force),
+                i.as_ref().map(|i| i.contact_radius),
+                i.as_ref().and_then(|i| i.potential),
+                h.map(|h| h.0),
+                h.map(|h| h.1),
+                h.and_then(|h| h.2),
+            ];
+            for v in values {
+                extra.push_str(&format!(",{:e}", or_nan(v)));
+            }
+        }
+        for pick in [1, 2] {
+            for g in &groups {
+                let t = r.terminals.iter().find(|t| &t.0 == g);
+                let v = t.map(|t| if pick == 1 { t.1 } else { t.2 });
+                extra.push_str(&format!(",{:e}", or_nan(v)));
+            }
+        }
         let error = match (errors, &r.error) {
             (false, _) => String::new(),
             (true, e) => format!(",{}", files::output::csv_field(e.as_deref().unwrap_or(""))),
@@ -233,35 +311,73 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
     csv
 }
 
-/// Two panels against the parameter: the contact states, and the contact forces.
+/// The panels against the parameter: the contact states, the contact forces, and where the
+/// sweep has them, an indenter's depth (the piezoresponse against a voltage) and the charges
+/// (each terminal's, a conducting tip's).
 ///
 /// # Errors
 /// [`files::Error::Picture`] where plotters cannot draw.
 pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverError> {
-    let along = |f: fn(&SweepRow) -> f64| rows.iter().map(|r| (r.value, f(r))).collect::<Vec<_>>();
+    let along = |f: &dyn Fn(&SweepRow) -> f64| rows.iter().map(|r| (r.value, f(r))).collect::<Vec<_>>();
     let states = Panel {
         title: format!("Contact states along {param}"),
         labels: (String::new(), "points".into()),
         series: vec![
-            Series::line("separated", along(|r| r.counts.2 as f64)),
-            Series::line("slip", along(|r| r.counts.1 as f64)),
-            Series::line("stick", along(|r| r.counts.0 as f64)),
+            Series::line("separated", along(&|r| r.counts.2 as f64)),
+            Series::line("slip", along(&|r| r.counts.1 as f64)),
+            Series::line("stick", along(&|r| r.counts.0 as f64)),
         ],
     };
     let forces = Panel {
         title: "Contact forces".into(),
         labels: (param.into(), "force".into()),
         series: vec![
-            Series::line("normal (sum w lambda_n)", along(|r| r.normal_force)),
-            Series::line("tangential |sum w lambda_t|", along(|r| r.tangential_force)),
+            Series::line("normal (sum w lambda_n)", along(&|r| r.normal_force)),
+            Series::line("tangential |sum w lambda_t|", along(&|r| r.tangential_force)),
         ],
     };
-    Ok(plots::panels("sweep", &[states, forces])?)
+    let mut panels = vec![states, forces];
+    if rows.iter().any(|r| r.indenter.is_some()) {
+        panels.push(Panel {
+            title: "Indenter depth".into(),
+            labels: (param.into(), "depth".into()),
+            series: vec![Series::line(
+                "depth",
+                along(&|r| r.indenter.as_ref().map_or(f64::NAN, |i| i.depth)),
+            )],
+        });
+    }
+    let groups: Vec<String> = rows
+        .iter()
+        .find(|r| !r.terminals.is_empty())
+        .map_or(vec![], |r| r.terminals.iter().map(|t| t.0.clone()).collect());
+    let mut charges: Vec<Series> = groups
+        .iter()
+        .map(|g| {
+            let of = |r: &SweepRow| r.terminals.iter().find(|t| &t.0 == g).map_or(f64::NAN, |t| t.1);
+            Series::line(&format!("on {g}"), along(&of))
+        })
+        .collect();
+    if rows
+        .iter()
+        .any(|r| r.indenter.as_ref().is_some_and(|i| i.charge.is_some()))
+    {
+        let tip = |r: &SweepRow| r.indenter.as_ref().and_then(|i| i.charge).unwrap_or(f64::NAN);
+        charges.push(Series::line("on the tip", along(&tip)));
+    }
+    if !charges.is_empty() {
+        panels.push(Panel {
+            title: "Charges".into(),
+            labels: (param.into(), "charge".into()),
+            series: charges,
+        });
+    }
+    Ok(plots::panels("sweep", &panels)?)
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{integer_key, sweep, SweepSpec};
+    use super::{csv, integer_key, picture, sweep, SweepSpec};
     use crate::DriverError;
 
     /// A sweep whose first points fail (nothing touches, and [exact] is refused there) keeps
@@ -301,6 +417,46 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().contains("exact.kind"), "{e}");
         assert!(!none.exists());
+    }
+
+    /// A piezoresponse sweep (`pfm`: a conductive tip pressed with a constant force, its
+    /// voltage swept) keeps every figure the run reports: the indenter's depth (which the
+    /// voltage moves: the response), force, contact radius, charge and potential, and each
+    /// terminal's charge and potential; its picture has a panel for the depth and the charges.
+    #[test]
+    fn a_sweep_keeps_every_figure_of_its_runs() {
+        let spec = SweepSpec {
+            param: "contact.foundation_potential".into(),
+            from: -2e-4,
+            to: 2e-4,
+            steps: 2,
+        };
+        let rows = sweep("pfm", &["mesh.n=24".into()], &spec, None, &mut |_| {}).unwrap();
+        let text = csv(&spec.param, &rows);
+        let lines: Vec<&str> = text.lines().collect();
+        let header: Vec<&str> = lines[0].split(',').collect();
+        for column in [
+            "indenter_depth",
+            "indenter_force",
+            "indenter_contact_radius",
+            "indenter_charge",
+            "indenter_potential",
+            "charge_top",
+            "potential_top",
+        ] {
+            assert!(header.contains(&column), "{column}: {}", lines[0]);
+        }
+        let at = |line: &str, column: &str| -> f64 {
+            let k = header.iter().position(|h| *h == column).unwrap();
+            line.split(',').nth(k).unwrap().parse().unwrap()
+        };
+        // the response: the depth under a constant force moves with the voltage
+        let (d0, d1) = (at(lines[1], "indenter_depth"), at(lines[2], "indenter_depth"));
+        assert!((d0 - d1).abs() > 1e-6 * d0.abs(), "{d0} {d1}");
+        assert_eq!(at(lines[2], "indenter_potential"), 2e-4);
+        assert!((at(lines[1], "indenter_force") - 0.3).abs() < 1e-9);
+        let panels = picture(&spec.param, &rows).unwrap();
+        assert_eq!(panels.len(), 2);
     }
 
     #[test]

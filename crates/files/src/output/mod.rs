@@ -596,34 +596,26 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
         2..=4 => format!("tangential force along {}", &FACTORS[driver][1..]),
         _ => "tangential force (magnitude)".to_string(),
     };
-    let mut panels = vec![
-        Panel {
-            title: "Contact forces along the path".into(),
-            labels: ("t".into(), "force".into()),
-            series: vec![
-                Series::line("normal force", over(&|r| (r.t, r.normal_force))),
-                Series::line("tangential force", over(&|r| (r.t, r.tangential_force))),
-            ],
-        },
-        Panel {
+    let mut panels = vec![Panel {
+        title: "Contact forces along the path".into(),
+        labels: ("t".into(), "force".into()),
+        series: vec![
+            Series::line("normal force", over(&|r| (r.t, r.normal_force))),
+            Series::line("tangential force", over(&|r| (r.t, r.tangential_force))),
+        ],
+    }];
+    // friction's loop where there is friction (a frictionless path has no tangential force)
+    if rows.iter().any(|r| r.tangential_force != 0.0) {
+        panels.push(Panel {
             title: format!(
                 "Tangential force against the {} factor (friction's loop)",
                 FACTORS[driver]
             ),
             labels: (format!("{} factor", FACTORS[driver]), loop_label.clone()),
             series: vec![Series::line(&loop_label, over(&|r| (r.factors[driver], along(r))))],
-        },
-    ];
-    if rows.iter().any(|r| r.depth.is_some()) {
-        panels.push(Panel {
-            title: "Indenter force against depth".into(),
-            labels: ("depth".into(), "force".into()),
-            series: vec![Series::line(
-                "normal force",
-                over(&|r| (r.depth.unwrap_or(f64::NAN), r.normal_force)),
-            )],
         });
     }
+    panels.extend(indenter_panels(rows));
     if !terminals.is_empty() {
         panels.push(Panel {
             title: "Charge on each terminal".into(),
@@ -634,17 +626,71 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
                 .map(|(g, name)| Series::line(name, over(&|r| (r.t, r.charges.get(g).copied().unwrap_or(f64::NAN)))))
                 .collect(),
         });
-        panels.push(Panel {
-            title: "Potential of each terminal".into(),
-            labels: ("t".into(), "potential".into()),
-            series: terminals
-                .iter()
-                .enumerate()
-                .map(|(g, name)| Series::line(name, over(&|r| (r.t, r.potentials.get(g).copied().unwrap_or(f64::NAN)))))
-                .collect(),
+        // the potentials where one moves (a floating terminal's, or a voltage along the path)
+        let moves = (0..terminals.len()).any(|g| {
+            let of = |r: &problem::report::StepRow| r.potentials.get(g).copied().unwrap_or(f64::NAN);
+            rows.iter().any(|r| of(r) != of(&rows[0]))
         });
+        if moves {
+            panels.push(Panel {
+                title: "Potential of each terminal".into(),
+                labels: ("t".into(), "potential".into()),
+                series: terminals
+                    .iter()
+                    .enumerate()
+                    .map(|(g, name)| {
+                        Series::line(name, over(&|r| (r.t, r.potentials.get(g).copied().unwrap_or(f64::NAN))))
+                    })
+                    .collect(),
+            });
+        }
     }
     plots::panels_apart("path", &panels)
+}
+
+/// An indenter's panels of a path: its force against its depth, and a conducting tip's charge,
+/// each with the half-space's closed form beside it where it applies (none without an
+/// indenter).
+fn indenter_panels(rows: &[problem::report::StepRow]) -> Vec<Panel> {
+    let over = |f: &dyn Fn(&problem::report::StepRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
+    let mut panels = vec![];
+    if rows.iter().any(|r| r.depth.is_some()) {
+        let depth = |r: &problem::report::StepRow| r.depth.unwrap_or(f64::NAN);
+        let mut series = vec![Series::line("normal force", over(&|r| (depth(r), r.normal_force)))];
+        if rows.iter().any(|r| r.half_space.is_some()) {
+            let form = |r: &problem::report::StepRow| r.half_space.as_ref().map_or(f64::NAN, |h| h.force);
+            series.push(Series::reference(
+                "half-space (closed form)",
+                over(&|r| (depth(r), form(r))),
+            ));
+        }
+        panels.push(Panel {
+            title: "Indenter force against depth".into(),
+            labels: ("depth".into(), "force".into()),
+            series,
+        });
+        if rows.iter().any(|r| r.tip_charge.is_some()) {
+            let charge = |r: &problem::report::StepRow| r.tip_charge.unwrap_or(f64::NAN);
+            let mut series = vec![Series::line("tip's charge", over(&|r| (depth(r), charge(r))))];
+            if rows
+                .iter()
+                .any(|r| r.half_space.as_ref().is_some_and(|h| h.charge.is_some()))
+            {
+                let form =
+                    |r: &problem::report::StepRow| r.half_space.as_ref().and_then(|h| h.charge).unwrap_or(f64::NAN);
+                series.push(Series::reference(
+                    "half-space (closed form)",
+                    over(&|r| (depth(r), form(r))),
+                ));
+            }
+            panels.push(Panel {
+                title: "Tip's charge against depth".into(),
+                labels: ("depth".into(), "charge".into()),
+                series,
+            });
+        }
+    }
+    panels
 }
 
 /// Where a run writes by default: `out/<scene>/`, the scene's name made a safe single path

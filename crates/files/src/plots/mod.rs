@@ -42,22 +42,32 @@ type DrawPng<'a> = &'a dyn Fn(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<
 
 /// Draws with `draw` into an SVG string and a PNG image.
 pub(crate) fn render(name: &str, draw: DrawSvg<'_>, draw_png: DrawPng<'_>) -> Result<Files, Error> {
+    render_sized(name, SIZE, draw, draw_png)
+}
+
+/// [`render`] at `size` pixels.
+pub(crate) fn render_sized(
+    name: &str,
+    size: (u32, u32),
+    draw: DrawSvg<'_>,
+    draw_png: DrawPng<'_>,
+) -> Result<Files, Error> {
     register_font();
     let mut svg = String::new();
     {
-        let area = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        let area = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         draw(&area).map_err(|e| err(name, e))?;
         area.present().map_err(|e| err(name, e))?;
     }
-    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    let mut rgb = vec![0u8; (size.0 * size.1 * 3) as usize];
     {
-        let area = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        let area = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
         draw_png(&area).map_err(|e| err(name, e))?;
         area.present().map_err(|e| err(name, e))?;
     }
     let mut png_bytes = Vec::new();
     {
-        let mut enc = png::Encoder::new(&mut png_bytes, SIZE.0, SIZE.1);
+        let mut enc = png::Encoder::new(&mut png_bytes, size.0, size.1);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
         let mut w = enc.write_header().map_err(|e| err(name, e))?;
@@ -119,6 +129,15 @@ impl Series {
             mark: Mark::Line,
         }
     }
+
+    /// A thin grey line through `points`: a reference (a bound, a closed form).
+    pub fn reference(name: &str, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            name: name.into(),
+            points,
+            mark: Mark::Reference,
+        }
+    }
 }
 
 /// One chart with linear axes.
@@ -138,10 +157,22 @@ const LIMIT: f64 = 1e300;
 /// The range of the finite `values` (clamped to `±LIMIT`), always holding 0, padded by a tenth
 /// of its span (a range of width `max(1, |v|)` where all values are one `v`).
 fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) = values
+    let finite: Vec<f64> = values
         .filter(|v| v.is_finite())
         .map(|v| v.clamp(-LIMIT, LIMIT))
-        .fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        .collect();
+    let (a, b) = finite
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    // values of one sign that vary by a visible fraction of their size (a depth under force
+    // control against the voltage): their own range, zero left out; round-off (a span below
+    // 1e-6 of them) is drawn flat, at its size from zero
+    let size = a.abs().max(b.abs());
+    if a * b > 0.0 && b - a > 1e-6 * size && b - a < 0.2 * size {
+        let pad = 0.1 * (b - a);
+        return (a - pad, b + pad);
+    }
+    let (lo, hi) = finite.iter().fold((0.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
     let span = hi - lo;
     if !(span > 0.0) {
         let w = 0.5 * lo.abs().max(1.0);
@@ -176,7 +207,7 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
         .caption(&panel.title, (FONT, 22))
         .margin(12)
         .x_label_area_size(38)
-        .y_label_area_size(60)
+        .y_label_area_size(76)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
         .map_err(e)?;
     chart
@@ -251,7 +282,15 @@ fn draw_panels<DB: DrawingBackend>(
 /// # Errors
 /// [`Error::Picture`] where plotters cannot draw.
 pub fn panels(name: &str, panels: &[Panel]) -> Result<Files, Error> {
-    both!(name, |a| draw_panels(a, panels, true))
+    render_sized(name, stacked(panels.len()), &|a| draw_panels(a, panels, true), &|a| {
+        draw_panels(a, panels, true)
+    })
+}
+
+/// The size of a picture of `n` stacked panels: the standard width, and a height that gives
+/// each panel room for its title, ticks and labels (260 px each, at least the standard).
+fn stacked(n: usize) -> (u32, u32) {
+    (SIZE.0, SIZE.1.max(260 * n as u32))
 }
 
 /// Panels stacked in one picture as [`panels`] draws them, each on its own x range.
@@ -259,7 +298,9 @@ pub fn panels(name: &str, panels: &[Panel]) -> Result<Files, Error> {
 /// # Errors
 /// As [`panels`].
 pub fn panels_apart(name: &str, panels: &[Panel]) -> Result<Files, Error> {
-    both!(name, |a| draw_panels(a, panels, false))
+    render_sized(name, stacked(panels.len()), &|a| draw_panels(a, panels, false), &|a| {
+        draw_panels(a, panels, false)
+    })
 }
 
 /// A log-log chart of `series` with markers and lines.
