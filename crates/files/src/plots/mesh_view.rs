@@ -91,7 +91,9 @@ pub fn potential_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], phi: &[f64]) -> Resu
         .transpose()
 }
 
-/// The axes of a picture of a [`View`]: caption, ranges, axis names, no grid.
+/// The axes of a picture of a [`View`]: caption, ranges, axis names, no grid; the ranges grown
+/// along one axis so that a unit of x and of y are drawn the same length (the body's true
+/// shape: a 2 x 1 block twice as wide as high).
 fn view_chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     caption: String,
@@ -100,11 +102,16 @@ fn view_chart<'a, DB: DrawingBackend>(
     labels: (&str, &str),
 ) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let (margin, x_labels, y_labels, caption_px) = (15u32, 35u32, 45u32, 34u32);
+    let (w, h) = area.dim_in_pixel();
+    let plot_w = w.saturating_sub(2 * margin + y_labels).max(1) as f64;
+    let plot_h = h.saturating_sub(2 * margin + x_labels + caption_px).max(1) as f64;
+    let (x, y) = equal_aspect(x, y, plot_w / plot_h);
     let mut chart = ChartBuilder::on(area)
         .caption(caption, (FONT, 20))
-        .margin(15)
-        .x_label_area_size(35)
-        .y_label_area_size(45)
+        .margin(margin)
+        .x_label_area_size(x_labels)
+        .y_label_area_size(y_labels)
         .build_cartesian_2d(x, y)
         .map_err(e)?;
     chart
@@ -116,6 +123,28 @@ fn view_chart<'a, DB: DrawingBackend>(
         .draw()
         .map_err(e)?;
     Ok(chart)
+}
+
+/// The ranges `x`, `y` grown about their centres so that their lengths stand as `aspect`
+/// (the plotting area's width over its height): equal units along both axes.
+fn equal_aspect(
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    aspect: f64,
+) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
+    let (dx, dy) = (x.end - x.start, y.end - y.start);
+    if !(dx > 0.0 && dy > 0.0 && aspect > 0.0) {
+        return (x, y);
+    }
+    let grow = |r: std::ops::Range<f64>, length: f64| {
+        let c = 0.5 * (r.start + r.end);
+        c - 0.5 * length..c + 0.5 * length
+    };
+    if dx / dy < aspect {
+        (grow(x, dy * aspect), y)
+    } else {
+        (x, grow(y, dx / aspect))
+    }
 }
 
 fn deformed<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View) -> Result<(), String> {
@@ -176,22 +205,19 @@ fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View, phi
         .map(|&v| phi[v])
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     let span = if pmax > pmin { pmax - pmin } else { 1.0 };
+    // a diverging map centred at zero: white at phi = 0, blue below, red above, at full
+    // strength at the larger of |min| and |max|
+    let reach = pmin.abs().max(pmax.abs());
+    let reach = if reach > 0.0 { reach } else { 1.0 };
     let caption = format!(
-        "Electric potential{}: {pmin:.3e} (blue) to {pmax:.3e} (red), 12 contours",
+        "Electric potential{}: {pmin:.3e} to {pmax:.3e}, 12 contours",
         view.title
     );
-    let mut chart = view_chart(area, caption, lo[0]..hi[0], lo[1]..hi[1], view.labels)?;
-    // blue -> white -> red
-    let color = |v: f64| {
-        let t = ((v - pmin) / span).clamp(0.0, 1.0);
-        if t < 0.5 {
-            let s = t / 0.5;
-            RGBColor((255.0 * s) as u8, (255.0 * s) as u8, 255)
-        } else {
-            let s = (1.0 - t) / 0.5;
-            RGBColor(255, (255.0 * s) as u8, (255.0 * s) as u8)
-        }
-    };
+    let (w, _) = area.dim_in_pixel();
+    let (plot, bar) = area.split_horizontally(w.saturating_sub(130));
+    let mut chart = view_chart(&plot, caption, lo[0]..hi[0], lo[1]..hi[1], view.labels)?;
+    let color = |v: f64| diverging(v / reach);
+    colour_bar(&bar, (pmin, pmax), &color)?;
     let xy = |v: usize| (view.xy[v][0], view.xy[v][1]);
     chart
         .draw_series(view.tris.iter().map(|t| {
@@ -224,6 +250,58 @@ fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View, phi
     }
     chart
         .draw_series(segments.into_iter().map(|s| PathElement::new(s, BLACK.mix(0.7))))
+        .map_err(e)?;
+    Ok(())
+}
+
+/// The diverging map at `t` in [-1, 1]: blue at -1, white at 0, red at 1.
+fn diverging(t: f64) -> RGBColor {
+    let t = if t.is_finite() { t.clamp(-1.0, 1.0) } else { 0.0 };
+    let s = (255.0 * (1.0 - t.abs())) as u8;
+    if t < 0.0 {
+        RGBColor(s, s, 255)
+    } else {
+        RGBColor(255, s, s)
+    }
+}
+
+/// A vertical colour bar of `color` over the values `(lo, hi)`, with their ticks.
+fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (lo, hi): (f64, f64),
+    color: &dyn Fn(f64) -> RGBColor,
+) -> Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let (lo, hi) = if hi > lo {
+        (lo, hi)
+    } else {
+        (lo - 0.5 * lo.abs().max(1.0), lo + 0.5 * lo.abs().max(1.0))
+    };
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(49)
+        .margin_bottom(50)
+        .margin_right(12)
+        .y_label_area_size(84)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(7)
+        .y_label_formatter(&|v| format!("{v:.2e}"))
+        .label_style((FONT, 12))
+        .draw()
+        .map_err(e)?;
+    let steps = 120;
+    chart
+        .draw_series((0..steps).map(|k| {
+            let (a, b) = (
+                lo + (hi - lo) * k as f64 / steps as f64,
+                lo + (hi - lo) * (k + 1) as f64 / steps as f64,
+            );
+            Rectangle::new([(0.0, a), (1.0, b)], color(0.5 * (a + b)).filled())
+        }))
         .map_err(e)?;
     Ok(())
 }
