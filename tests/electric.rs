@@ -520,16 +520,9 @@ fn one_conducting_zone_among_several_is_a_terminal_where_it_touches() {
     .map(|s| s.to_string())
     .collect();
     let (scene, _) = files::scene_file::load("corner", &sets).unwrap();
-    let path = problem::solve_path(
-        &scene,
-        None,
-        problem::Limits::default(),
-        &mut Silent,
-        false,
-        &mut |_| Ok(()),
-    )
-    .unwrap();
-    let last = path.last.contact.as_ref().unwrap();
+    // a scene with a [path] solves it whole: its last instant, its rows in the report
+    let solved = problem::solve(&scene, None, &mut Silent).unwrap();
+    let last = solved.contact.as_ref().unwrap();
     let e = last
         .solution
         .electric
@@ -564,19 +557,9 @@ fn electrical_contact_follows_a_path_as_its_instants_static_answers() {
             files::scene_file::load("paper-conducting", &all).unwrap().0
         };
         let scene = base(&["path={t=[0.0,1.0],steps=4,load=[0.0,1.0],voltage=[0.0,1.0]}".into()]);
-        let mut rows = vec![];
-        let path = problem::solve_path(
-            &scene,
-            None,
-            problem::Limits::default(),
-            &mut Silent,
-            false,
-            &mut |step| {
-                rows.push(step.row.clone());
-                Ok(())
-            },
-        )
-        .unwrap();
+        // a scene with a [path] solves it whole: its last instant, its rows in the report
+        let solved = problem::solve(&scene, None, &mut Silent).unwrap();
+        let rows = solved.report.path.clone().unwrap().rows;
         assert_eq!(rows.len(), 5);
         for (k, row) in rows.iter().enumerate().skip(1) {
             let t = k as f64 / 4.0;
@@ -609,14 +592,13 @@ fn electrical_contact_follows_a_path_as_its_instants_static_answers() {
                     let e = c.solution.electric.as_ref().unwrap();
                     e.points.iter().zip(&e.flux).map(|(&i, q)| c.points.weight[i] * q).sum()
                 };
-                let (f_path, f_alone) = (flux(&path.last), flux(&alone));
+                let (f_path, f_alone) = (flux(&solved), flux(&alone));
                 assert!(
                     (f_path - f_alone).abs() <= 1e-7 * f_alone.abs(),
                     "{electric}: flux {f_path} against {f_alone}"
                 );
                 let big = alone.phi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let dphi = path
-                    .last
+                let dphi = solved
                     .phi
                     .iter()
                     .zip(&alone.phi)

@@ -966,19 +966,9 @@ fn the_half_spaces_closed_form_is_reported_only_inside_its_domain() {
 fn a_conducting_tip_along_a_depth_path_meets_the_half_space_at_every_depth() {
     let sets: Vec<String> = ["mesh.n=48", "path.steps=4"].iter().map(|s| s.to_string()).collect();
     let (scene, _) = files::scene_file::load("pfm-curve", &sets).unwrap();
-    let mut rows = vec![];
-    let path = problem::solve_path(
-        &scene,
-        None,
-        problem::Limits::default(),
-        &mut Silent,
-        false,
-        &mut |step| {
-            rows.push(step.row.clone());
-            Ok(())
-        },
-    )
-    .unwrap();
+    // a scene with a [path] solves it whole: its last instant, its rows in the report
+    let solved = problem::solve(&scene, None, &mut Silent).unwrap();
+    let rows = solved.report.path.clone().unwrap().rows;
     let last = rows.last().unwrap().half_space.clone().unwrap();
     for row in rows.iter().skip(1) {
         let h = row
@@ -1006,6 +996,6 @@ fn a_conducting_tip_along_a_depth_path_meets_the_half_space_at_every_depth() {
             row.t
         );
     }
-    let reported = path.last.report.indenter.as_ref().unwrap().half_space.as_ref().unwrap();
+    let reported = solved.report.indenter.as_ref().unwrap().half_space.as_ref().unwrap();
     assert!((reported.force - last.force).abs() <= 1e-12 * last.force);
 }
