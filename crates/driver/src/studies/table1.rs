@@ -52,6 +52,16 @@ pub fn table1(
     let mut sizes: Vec<usize> = loose_sizes.iter().chain(tight_sizes).copied().collect();
     sizes.sort_unstable();
     sizes.dedup();
+    let runs = loose_sizes.len() + tight_sizes.len();
+    let whole: f64 = loose_sizes
+        .iter()
+        .map(|&n| expected_seconds(Rule::Paper, n))
+        .chain(tight_sizes.iter().map(|&n| expected_seconds(Rule::Tight, n)))
+        .sum();
+    progress(&format!(
+        "table1: {runs} runs, about {} in all (as measured on 2 cores, docs/table1.md)",
+        in_words(whole)
+    ));
     for n in sizes {
         let mesh = format!("mesh.n={n}");
         let exact = solve("paper", &[mesh.clone(), "solver.tol=1e-13".into()])?;
@@ -64,6 +74,10 @@ pub fn table1(
                 format!("solver.rule={rule}"),
                 "solver.strategy=uzawa-schur-pcg".into(),
             ];
+            progress(&format!(
+                "h = 1/{n:<4} {rule:5} rule: running, about {}",
+                in_words(expected_seconds(rule, n))
+            ));
             let r = solve("paper", &sets)?;
             let (it, report) = (&r.report.iterations, &r.report);
             let row = Table1Row {
@@ -87,6 +101,37 @@ pub fn table1(
     Ok(rows)
 }
 
+/// The seconds a row takes, as measured on this machine's 2 cores (docs/table1.md: the loose
+/// rule's rows at n = 32 to 256, the tight rule's at 32, 64 and 128), other sizes scaled from
+/// the nearest measured one below by the growth the measured rows show (n³ loose, n⁵ tight:
+/// the tight rule's Uzawa iterations double with n, each a PCG solve).
+fn expected_seconds(rule: Rule, n: usize) -> f64 {
+    let (measured, power): (&[(usize, f64)], i32) = match rule {
+        Rule::Paper => (&[(32, 0.083), (64, 0.44), (128, 3.6), (256, 20.3)], 3),
+        Rule::Tight => (&[(32, 2.9), (64, 42.4), (128, 2236.0)], 5),
+    };
+    let (m, seconds) = measured
+        .iter()
+        .rev()
+        .find(|&&(m, _)| m <= n)
+        .copied()
+        .unwrap_or(measured[0]);
+    seconds * (n as f64 / m as f64).powi(power)
+}
+
+/// A duration in words: seconds, minutes or hours.
+fn in_words(seconds: f64) -> String {
+    if seconds < 1.0 {
+        "a second or less".into()
+    } else if seconds < 90.0 {
+        format!("{seconds:.0} s")
+    } else if seconds < 5400.0 {
+        format!("{:.0} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
+}
+
 /// The Table 1 rows as Markdown.
 pub fn markdown(rows: &[Table1Row]) -> String {
     let mut s = String::from("| h | rule | fixed point | Uzawa | PCG per solve | time (s) | error of lambda | complementarity |\n|---|---|---|---|---|---|---|---|\n");
@@ -97,4 +142,26 @@ pub fn markdown(rows: &[Table1Row]) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The estimates are the measured rows where measured, and grow from them elsewhere; the
+    /// default table (tight to n = 64) is told as under a minute, the paper's tight n = 128 as
+    /// about 37 minutes.
+    #[test]
+    fn the_table_tells_how_long_it_takes() {
+        assert_eq!(expected_seconds(Rule::Tight, 128), 2236.0);
+        assert_eq!(in_words(expected_seconds(Rule::Tight, 128)), "37 min");
+        let quick: f64 = [32, 64, 128, 256]
+            .iter()
+            .map(|&n| expected_seconds(Rule::Paper, n))
+            .sum::<f64>()
+            + [32, 64].iter().map(|&n| expected_seconds(Rule::Tight, n)).sum::<f64>();
+        assert!(quick < 90.0, "{quick}");
+        assert!(expected_seconds(Rule::Tight, 256) > expected_seconds(Rule::Tight, 128));
+        assert!(expected_seconds(Rule::Paper, 16) > 0.0);
+    }
 }
