@@ -173,19 +173,19 @@ impl<'p> Backend for DistributedMemory<'p> {
     ) -> Result<Vec<Free>, DistributedError> {
         match parts.is_empty() {
             true => Ok(vec![]),
-            false => Err(ProblemError::from(path_unsupported()).into()),
+            false => Err(ProblemError::from(crate::supports::path_unsupported()).into()),
         }
     }
 
     fn respond(&mut self, _: &mut Prepared<'p>, _: &[f64], _: &[f64]) -> Result<Free, DistributedError> {
-        Err(ProblemError::from(path_unsupported()).into())
+        Err(ProblemError::from(crate::supports::path_unsupported()).into())
     }
 
     /// The instant's boundary, kept for its active sets (its loads are the assembled ones: a
     /// path's factors and a bed's springs are refused).
     fn prime(&mut self, s: &mut Prepared<'p>, primed: Primed<'_>) -> Result<(), DistributedError> {
         if primed.factors.is_some() {
-            return Err(ProblemError::from(path_unsupported()).into());
+            return Err(ProblemError::from(crate::supports::path_unsupported()).into());
         }
         s.boundary = Some(primed.framed.boundary.clone());
         Ok(())
@@ -293,16 +293,6 @@ impl<'p> Backend for DistributedMemory<'p> {
             ..Figures::default()
         })
     }
-}
-
-/// A load path: refused by [`crate::supports`] before anything is built; said again where a
-/// run would walk one.
-fn path_unsupported() -> Unsupported {
-    Unsupported::new(
-        "petsc",
-        "path",
-        "a load path (it solves one instant; a path reuses one factorisation)",
-    )
 }
 
 /// A step out of the run's order (a solve before the instant was posed).

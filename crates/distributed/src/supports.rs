@@ -80,12 +80,20 @@ pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
         .advise("remove solver.rule"));
     }
     if scene.path.is_some() {
-        return lacks(
-            "path",
-            "a load path (it solves one instant; a path reuses one factorisation)",
-        );
+        return Err(path_unsupported());
     }
     Ok(())
+}
+
+/// A load path: the backend solves one instant (refused here before anything is built, and
+/// again by the run's steps should one be asked a path's parts).
+pub(crate) fn path_unsupported() -> Unsupported {
+    Unsupported::new(
+        BACKEND,
+        "path",
+        "a load path (it solves one instant; a path reuses one factorisation)",
+    )
+    .advise(DEFAULT)
 }
 
 /// What one contact zone asks for that the PETSc backend's active sets do not hold.

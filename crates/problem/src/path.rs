@@ -790,8 +790,8 @@ impl Walk<'_> {
             seconds,
         } = stepped;
         let setup = self.setup;
-        let Some((sol, mut fielded, pcg_iters)) =
-            self.checked(boundary.as_ref(), disc, (sol, fields), &springs, reporter)?
+        let Some((sol, fielded, pcg_iters)) =
+            self.checked((boundary.as_ref(), &f), disc, (sol, fields), &springs, reporter)?
         else {
             return Ok(None);
         };
@@ -822,7 +822,7 @@ impl Walk<'_> {
             None => sol.u.clone(),
         };
         let mut row = step_row(k, t, &f, &boundary, &sol, &now, &state.shift);
-        self.indenter_row(&mut row, (&boundary, &sol), fielded.as_mut().map(|(r, _, _)| r), &f);
+        self.indenter_row(&mut row, (&boundary, &sol), &f);
         // the charges of the fields where they are computed, else of the functionals (equal to
         // the condensed solve's accuracy: tests/path.rs)
         (row.charges, row.potentials) = match (&fielded, &factors) {
@@ -867,7 +867,7 @@ impl Walk<'_> {
     /// displacements), and its PCG iterations; `None` on a process that does not hold them.
     fn checked(
         &self,
-        boundary: Option<&ContactBoundary>,
+        (boundary, f): (Option<&ContactBoundary>, &Factors),
         disc: &Discretization<'_>,
         (sol, fields): (Option<ContactSolution>, Option<Option<InstantSolution>>),
         springs: &Springs,
@@ -882,7 +882,7 @@ impl Walk<'_> {
                 check_solved(scene, (u, phi), x.contact.as_ref(), equilibrium)?;
                 self.check_accurate(x.contact.as_ref(), equilibrium)?;
                 let pair = boundary.zip(x.contact.as_ref());
-                let recovered = recover(scene, setup, disc, (u, phi), pair, equilibrium, reporter)?;
+                let recovered = recover(scene, (setup, disc), f, (u, phi), pair, equilibrium, reporter)?;
                 (x.contact, Some((recovered, equilibrium, x.x.0)), x.pcg_iters)
             }
             None => {
@@ -893,32 +893,19 @@ impl Walk<'_> {
         }))
     }
 
-    /// An indenter's figures in the step's row (its depth, contact radius, a conducting tip's
-    /// charge, and the half-space's closed form beside them at the step's factors `f`), and a
-    /// path's recovered report's closed form at those factors too.
-    fn indenter_row(
-        &self,
-        row: &mut StepRow,
-        (boundary, sol): (&ContactBoundary, &ContactSolution),
-        recovered: Option<&mut Recovered>,
-        f: &Factors,
-    ) {
-        let electric = self.setup.plan.electric;
+    /// An indenter's figures in the step's row: its depth, contact radius, a conducting tip's
+    /// charge, and the half-space's closed form beside them at the step's factors `f`.
+    fn indenter_row(&self, row: &mut StepRow, (boundary, sol): (&ContactBoundary, &ContactSolution), f: &Factors) {
         if let Some(mut indenter) = indenter_report(self.scene, boundary, sol) {
             (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
             row.tip_charge = indenter.charge;
-            closed_form(self.scene, electric, &mut indenter, f);
+            closed_form(self.scene, self.setup.plan.electric, &mut indenter, f);
             row.half_space = indenter.half_space.map(|h| crate::report::HalfSpaceRow {
                 depth: h.depth,
                 force: h.force,
                 contact_radius: h.contact_radius,
                 charge: h.charge,
             });
-        }
-        if let (Some(recovered), Some(_)) = (recovered, self.spec) {
-            if let Some(indenter) = recovered.indenter.as_mut() {
-                closed_form(self.scene, electric, indenter, f);
-            }
         }
     }
 

@@ -228,12 +228,13 @@ pub(crate) struct Recovered {
 
 /// Expands the free unknowns `(u, φ)` to the nodes, recovers stress and electric
 /// displacement per cell, counts the contact solution (on its boundary), measures the error
-/// against the scene's exact solution, and checks that every reported number (with the
-/// run's `equilibrium` residual) is finite.
+/// against the scene's exact solution (an indenter's closed form at the instant's factors `f`:
+/// a static run's are 1), and checks that every reported number (with the run's
+/// `equilibrium` residual) is finite.
 pub(crate) fn recover(
     scene: &Scene,
-    setup: &Setup,
-    disc: &Discretization<'_>,
+    (setup, disc): (&Setup, &Discretization<'_>),
+    f: &crate::Factors,
     (u_free, phi_free): (&[f64], &[f64]),
     contact: Option<(&ContactBoundary, &ContactSolution)>,
     equilibrium: f64,
@@ -265,7 +266,7 @@ pub(crate) fn recover(
             });
             r.tip_potential = nearest.map(|i| phi[b.nodes[i]]);
         }
-        closed_form(scene, setup.plan.electric, &mut r, &crate::Factors::ONE);
+        closed_form(scene, setup.plan.electric, &mut r, f);
         Some(r)
     });
     let half_space = scene

@@ -233,6 +233,14 @@ fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> b
     }
 }
 
+/// The terminals' groups of a sweep, as its first point that has them names them (a failed
+/// point has none).
+fn terminal_groups(rows: &[SweepRow]) -> Vec<String> {
+    rows.iter()
+        .find(|r| !r.terminals.is_empty())
+        .map_or(vec![], |r| r.terminals.iter().map(|t| t.0.clone()).collect())
+}
+
 /// The rows as CSV: the counts, forces, residuals, iterations and seconds; where the scene has
 /// an indenter its figures (`indenter_depth`, `indenter_charge` (`nan` for an insulating
 /// one's), `indenter_force`, `indenter_contact_radius`, `indenter_potential`) and the
@@ -242,10 +250,7 @@ fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> b
 pub fn csv(param: &str, rows: &[SweepRow]) -> String {
     let indenter = rows.iter().any(|r| r.indenter.is_some());
     let errors = rows.iter().any(|r| r.error.is_some());
-    let groups: Vec<String> = rows
-        .iter()
-        .find(|r| !r.terminals.is_empty())
-        .map_or(vec![], |r| r.terminals.iter().map(|t| t.0.clone()).collect());
+    let groups = terminal_groups(rows);
     let mut header = format!(
         "{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds"
     );
@@ -266,14 +271,14 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
     for r in rows {
         let mut extra = String::new();
         if indenter {
-            let i = r.indenter.clone();
-            let h = i.as_ref().and_then(|i| i.half_space);
+            let i = r.indenter.as_ref();
+            let h = i.and_then(|i| i.half_space);
             let values = [
-                i.as_ref().map(|i| i.depth),
-                i.as_ref().and_then(|i| i.charge),
-                i.as_ref().map(|i| i.force),
-                i.as_ref().map(|i| i.contact_radius),
-                i.as_ref().and_then(|i| i.potential),
+                i.map(|i| i.depth),
+                i.and_then(|i| i.charge),
+                i.map(|i| i.force),
+                i.map(|i| i.contact_radius),
+                i.and_then(|i| i.potential),
                 h.map(|h| h.0),
                 h.map(|h| h.1),
                 h.and_then(|h| h.2),
@@ -347,10 +352,7 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
             )],
         });
     }
-    let groups: Vec<String> = rows
-        .iter()
-        .find(|r| !r.terminals.is_empty())
-        .map_or(vec![], |r| r.terminals.iter().map(|t| t.0.clone()).collect());
+    let groups = terminal_groups(rows);
     let mut charges: Vec<Series> = groups
         .iter()
         .map(|g| {

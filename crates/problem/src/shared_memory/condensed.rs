@@ -122,14 +122,22 @@ pub(super) fn condense_reported(
 ) -> Result<(DenseContactProblem, linalg::CondensedLoads), ProblemError> {
     let t = Instant::now();
     let (dense, condensed) = boundary.condense(direct, b_u, b_phi, nt)?;
-    let (route, seconds) = (condensed.route, t.elapsed().as_secs_f64());
-    reporter.event(&Event::Condensed {
-        m: dense.m(),
-        route,
-        seconds,
-    });
-    *condense = Some((route, seconds));
+    note_condensed(condense, reporter, dense.m(), condensed.route, t);
     Ok((dense, condensed))
+}
+
+/// The condensation formed in the time since `t` (of order `m`, by `route`): reported, and
+/// kept for the report.
+pub(super) fn note_condensed(
+    condense: &mut Option<(linalg::CondenseRoute, f64)>,
+    reporter: &mut dyn Reporter,
+    m: usize,
+    route: linalg::CondenseRoute,
+    t: Instant,
+) {
+    let seconds = t.elapsed().as_secs_f64();
+    reporter.event(&Event::Condensed { m, route, seconds });
+    *condense = Some((route, seconds));
 }
 
 /// The fields of a condensed contact solve, refined with the factors of `K`.

@@ -5,8 +5,8 @@
 //! under the contact forces found, refined, the law judged on them.
 
 use super::condensed::{
-    condense_reported, fields_at_points, in_frame, law_residual, refine, rhs, rhs_with_contact, Operator, Refining,
-    PATH_REFINE_TOL, REFINE_TOL,
+    condense_reported, fields_at_points, in_frame, law_residual, note_condensed, refine, rhs, rhs_with_contact,
+    Operator, Refining, PATH_REFINE_TOL, REFINE_TOL,
 };
 use super::{Factored, LinearSolver, SharedMemory};
 use crate::backend::{At, Contact, ContactSolve, Fields, InstantOf, InstantSolution, Posed, Primed};
@@ -101,23 +101,13 @@ impl SharedMemory {
         let LinearSolver::Direct(direct) = &mut system.solver else {
             return Err(not_direct());
         };
-        if let Some((electric, dofs)) = &boundary.electric {
+        if let Some((electric, _)) = &boundary.electric {
             let t = Instant::now();
             let (problem, condensed) = boundary.condense_electric(electric, direct, &loads.b_u, &loads.b_phi, nt)?;
-            let seconds = t.elapsed().as_secs_f64();
-            reporter.event(&Event::Condensed {
-                m: problem.order(),
-                route: condensed.route,
-                seconds,
-            });
-            system.condense = Some((condensed.route, seconds));
+            note_condensed(&mut system.condense, reporter, problem.order(), condensed.route, t);
             let first = (problem.u0.clone(), problem.phi0.clone());
-            let n_u = loads.b_u.len();
-            let mut solved = Vec::with_capacity(parts.len());
-            for (b_u, b_phi) in parts {
-                solved.push(solve(system, b_u, b_phi)?);
-            }
-            let at_points = |(u, phi): &Fields| (u.clone(), dofs.iter().map(|&d| phi[d - n_u]).collect());
+            let solved = solve_parts(system, parts)?;
+            let at_points = |(u, phi): &Fields| (u.clone(), at_electric_points(boundary, phi, u.len()));
             system.kept = Kept::Electric(Electric {
                 problem,
                 loads: Some(condensed),
@@ -134,10 +124,7 @@ impl SharedMemory {
             &mut system.condense,
             reporter,
         )?;
-        let mut solved = Vec::with_capacity(parts.len());
-        for (b_u, b_phi) in parts {
-            solved.push(solve(system, b_u, b_phi)?);
-        }
+        let solved = solve_parts(system, parts)?;
         system.kept = Kept::Condensed(Condensed {
             first: dense.u0.clone(),
             dense,
@@ -164,7 +151,7 @@ impl SharedMemory {
                 let nt = c.dense.nt;
                 match factors {
                     Some(factors) => {
-                        let x0 = c.own_data(factors);
+                        let x0 = superpose(c.parts.iter().map(|u| &u[..]), factors);
                         c.dense.u0 = in_frame(fields_at_points(framed.boundary, &x0, nt), Some(framed.shift));
                         c.loads = None;
                     }
@@ -181,27 +168,32 @@ impl SharedMemory {
                 if let Some((electric, _)) = &framed.boundary.electric {
                     e.problem.electric.potential = electric.potential;
                 }
-                match factors {
-                    Some(factors) if !pressed => {
-                        let (u, phi0) = e.own_data(factors);
-                        let at = fields_at_points(framed.boundary, &u, e.problem.nt);
-                        (e.problem.u0, e.problem.phi0) = (in_frame(at, Some(framed.shift)), phi0);
-                        e.loads = None;
+                let nt = e.problem.nt;
+                let (u0, phi0) = match (factors, pressed) {
+                    (None, false) => e.first.clone(),
+                    (Some(factors), false) => {
+                        let u = superpose(e.parts.iter().map(|(u, _)| &u[..]), factors);
+                        let phi0 = superpose(e.parts.iter().map(|(_, phi)| &phi[..]), factors);
+                        (
+                            in_frame(fields_at_points(framed.boundary, &u, nt), Some(framed.shift)),
+                            phi0,
+                        )
                     }
-                    None if !pressed => (e.problem.u0, e.problem.phi0) = e.first.clone(),
-                    _ => {
+                    (_, true) => {
                         // the springs' forces among the loads: `u⁰` and `φ⁰` of a solve with them
                         let mut b_u = posed.loads.b_u.clone();
                         framed.boundary.add_forces(springs, &mut b_u);
                         let (u, phi) = solve(system, &b_u, &posed.loads.b_phi)?;
-                        let Kept::Electric(e) = &mut system.kept else {
-                            unreachable!()
-                        };
-                        let n_u = b_u.len();
-                        let at = fields_at_points(framed.boundary, &u, e.problem.nt);
-                        e.problem.u0 = in_frame(at, factors.map(|_| framed.shift));
-                        let dofs = framed.boundary.electric.as_ref().map_or(&[][..], |(_, d)| &d[..]);
-                        e.problem.phi0 = dofs.iter().map(|&d| phi[d - n_u]).collect();
+                        let at = fields_at_points(framed.boundary, &u, nt);
+                        (
+                            in_frame(at, factors.map(|_| framed.shift)),
+                            at_electric_points(framed.boundary, &phi, u.len()),
+                        )
+                    }
+                };
+                if let Kept::Electric(e) = &mut system.kept {
+                    (e.problem.u0, e.problem.phi0) = (u0, phi0);
+                    if factors.is_some() || pressed {
                         e.loads = None;
                     }
                 }
@@ -294,9 +286,9 @@ impl SharedMemory {
     /// [`crate::backend::Backend::own_scale`].
     pub(super) fn own_scale_of(system: &Factored, factors: &[f64]) -> f64 {
         match &system.kept {
-            Kept::Condensed(c) if !c.parts.is_empty() => c.own_data(factors).iter().fold(0.0f64, |m, v| m.max(v.abs())),
+            Kept::Condensed(c) if !c.parts.is_empty() => largest(&superpose(c.parts.iter().map(|u| &u[..]), factors)),
             Kept::Electric(e) if !e.parts.is_empty() => {
-                e.own_data(factors).0.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                largest(&superpose(e.parts.iter().map(|(u, _)| &u[..]), factors))
             }
             _ => 0.0,
         }
@@ -360,14 +352,11 @@ fn electric_fields(
 ) -> Result<InstantSolution, ProblemError> {
     let boundary = framed.boundary;
     let loads = &posed.loads;
+    let b = rhs_with_contact(posed, Some((boundary, &sol)));
     let (mut u, mut phi) = match e.loads.take() {
         Some(condensed) => boundary.recover_electric(direct(system)?, condensed, &sol, &loads.b_u, &loads.b_phi)?,
-        None => {
-            let (b_u, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
-            solve(system, &b_u, &b_phi)?
-        }
+        None => solve(system, &b.0, &b.1)?,
     };
-    let b = rhs_with_contact(posed, Some((boundary, &sol)));
     let blocks = &system.blocks;
     let LinearSolver::Direct(direct) = &mut system.solver else {
         return Err(not_direct());
@@ -377,11 +366,8 @@ fn electric_fields(
     let refine_tol = if path { PATH_REFINE_TOL } else { REFINE_TOL };
     system.refinement = refine(direct, blocks, rhs(&b), &mut u, &mut phi, refine_tol)?.steps;
     // the potentials reported are the refined fields'
-    if let (Some(values), Some((_, dofs))) = (&mut sol.electric, &boundary.electric) {
-        let n_u = loads.b_u.len();
-        for (v, &d) in values.potential.iter_mut().zip(dofs) {
-            *v = phi[d - n_u];
-        }
+    if let Some(values) = &mut sol.electric {
+        values.potential = at_electric_points(boundary, &phi, u.len());
     }
     sol.info.complementarity = law_residual(boundary, how, &sol, &e.problem.u0, &u, path.then_some(framed.shift));
     sol.info.residual = sol.info.residual.max(sol.info.complementarity);
@@ -423,40 +409,7 @@ fn electric_solve(
     }
 }
 
-impl Electric {
-    /// The displacements and the electric points' potentials that a step's own data make,
-    /// `Σ_q f_q x_q` at `factors` (no contact force, no flux).
-    fn own_data(&self, factors: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let (mut u, mut phi) = (vec![0.0; self.parts[0].0.len()], vec![0.0; self.parts[0].1.len()]);
-        for ((pu, pphi), f) in self.parts.iter().zip(factors) {
-            if *f != 0.0 {
-                for (x, p) in u.iter_mut().zip(pu) {
-                    *x += f * p;
-                }
-                for (x, p) in phi.iter_mut().zip(pphi) {
-                    *x += f * p;
-                }
-            }
-        }
-        (u, phi)
-    }
-}
-
 impl Condensed {
-    /// The displacement of the boundary's dofs that a step's own data make, `Σ_q f_q x_q` at
-    /// `factors` (no contact force).
-    fn own_data(&self, factors: &[f64]) -> Vec<f64> {
-        let mut x0 = vec![0.0; self.parts[0].len()];
-        for (part, f) in self.parts.iter().zip(factors) {
-            if *f != 0.0 {
-                for (x, p) in x0.iter_mut().zip(part) {
-                    *x += f * p;
-                }
-            }
-        }
-        x0
-    }
-
     /// Adds the displacement of the forces of the multipliers `lambda` to the primed
     /// instant's `u⁰` (the springs that hold a body only its bed holds, which act as
     /// multipliers).
@@ -479,6 +432,38 @@ impl Condensed {
         }
         Ok(())
     }
+}
+
+/// `Σ_q f_q x_q`: the parts `x_q` of a path's right-hand side's solution (all of one length)
+/// summed at `factors`, in their order.
+fn superpose<'a>(parts: impl Iterator<Item = &'a [f64]>, factors: &[f64]) -> Vec<f64> {
+    let mut sum: Vec<f64> = vec![];
+    for (part, f) in parts.zip(factors) {
+        sum.resize(part.len(), 0.0);
+        if *f != 0.0 {
+            for (x, p) in sum.iter_mut().zip(part) {
+                *x += f * p;
+            }
+        }
+    }
+    sum
+}
+
+/// The largest magnitude of `values`.
+fn largest(values: &[f64]) -> f64 {
+    values.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
+/// The potentials at the boundary's electric points, from the free potentials `phi` (the free
+/// unknowns laid out `[u; φ]`, `n_u` displacements first).
+fn at_electric_points(boundary: &ContactBoundary, phi: &[f64], n_u: usize) -> Vec<f64> {
+    let dofs = boundary.electric.as_ref().map_or(&[][..], |(_, d)| &d[..]);
+    dofs.iter().map(|&d| phi[d - n_u]).collect()
+}
+
+/// `K⁻¹ b_q` for each part `q` of a path's right-hand side, in their order.
+fn solve_parts(system: &mut Factored, parts: &[Fields]) -> Result<Vec<Fields>, ProblemError> {
+    parts.iter().map(|(b_u, b_phi)| solve(system, b_u, b_phi)).collect()
 }
 
 /// `K⁻¹ [b_u; b_φ]` with the factors of `K`.
