@@ -1,5 +1,6 @@
 //! Generates the bindings when the feature `bind` is on: the include and link flags of PETSc
-//! and of MPI (Open MPI's `ompi-c`, or `mpi`) from pkg-config, bindgen over `wrapper.h`.
+//! and of MPI (Open MPI's `ompi-c`, or `mpi`) from pkg-config, bindgen over `wrapper.h`
+//! (PETSc's headers and MUMPS' `dmumps_c.h`), MUMPS' `dmumps` linked.
 //! Without the feature there is nothing to build, so the default workspace needs no PETSc.
 
 #[cfg(feature = "bind")]
@@ -23,6 +24,8 @@ fn main() {
     let mut builder = bindgen::Builder::default()
         .header("wrapper.h")
         .allowlist_function("(Petsc|Vec|Mat|KSP|PC|IS|ISLocalToGlobalMapping|MPI)_?[A-Za-z0-9_]*")
+        .allowlist_function("dmumps_c")
+        .allowlist_type("DMUMPS_STRUC_C")
         .allowlist_type("(Petsc|Vec|Mat|KSP|PC|IS|MPI|Insert|Norm|Scatter)_?[A-Za-z0-9_]*")
         .allowlist_var("(PETSC|MPI|ompi_mpi|Petsc|KSP|PC|MAT|VEC|NORM|INSERT|ADD)_?[A-Za-z0-9_]*")
         .allowlist_var("ompi_mpi_comm_(world|self)")
@@ -42,6 +45,9 @@ fn main() {
     bindings
         .write_to_file(out.join("bindings.rs"))
         .expect("bindings.rs is written to OUT_DIR");
+    // MUMPS (a dependency of Debian's petsc-dev, its headers beside PETSc's): PETSc links it
+    // for itself; the layer calls its C interface directly
+    println!("cargo:rustc-link-lib=dmumps");
     // pkg-config printed the link lines of both; the rpath lets the binaries run uninstalled.
     for dir in petsc.link_paths.iter().chain(mpi.link_paths.iter()) {
         println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());

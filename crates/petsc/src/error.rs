@@ -52,6 +52,18 @@ pub enum PetscError {
     /// The arguments of a call do not agree with each other (lengths, ranges).
     #[error("{0}")]
     Argument(String),
+    /// MUMPS failed (its `INFOG(1)` negative).
+    #[error("MUMPS: the {what} failed (INFOG(1) = {info}, INFOG(2) = {detail}): {meaning}")]
+    Mumps {
+        /// The phase (analysis, factorisation, a solve's half).
+        what: &'static str,
+        /// MUMPS' `INFOG(1)`.
+        info: i32,
+        /// MUMPS' `INFOG(2)`, the detail of the error.
+        detail: i32,
+        /// What the code means.
+        meaning: String,
+    },
     /// A Krylov solve stopped without converging; `reason` is PETSc's `KSPConvergedReason`.
     #[error("the Krylov solve did not converge: {reason} after {iterations} iterations (residual norm {residual_norm:.3e}); try other -ksp_type/-pc_type options, or -ksp_max_it")]
     KspDiverged {

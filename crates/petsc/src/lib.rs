@@ -12,6 +12,8 @@
 //!   entries anywhere set through PETSc's assembly, which sends off-rank ones to their owners).
 //! - [`Ksp`]: a Krylov solver with its preconditioner (`KSP`, `PC`), field splits by
 //!   [`IndexSet`], options from the options database ([`Petsc::insert_options`]).
+//! - [`Mumps`]: a sparse matrix factored by MUMPS on the ranks (its own C interface), with the
+//!   Schur complement of chosen unknowns whole on rank 0, solves in two halves around it.
 //! - [`partition()`]: a graph partitioned among the ranks (`MatPartitioning` on a `MATMPIADJ`).
 //!
 //! Errors are typed ([`PetscError`]): PETSc's error handler is replaced by one that records the
@@ -56,6 +58,8 @@ mod ksp;
 #[cfg(feature = "bind")]
 mod matrix;
 #[cfg(feature = "bind")]
+pub mod mumps;
+#[cfg(feature = "bind")]
 mod partition;
 #[cfg(feature = "bind")]
 mod petsc;
@@ -70,6 +74,8 @@ pub use error::{PetscError, Result};
 pub use ksp::{IndexSet, Ksp, KspInfo};
 #[cfg(feature = "bind")]
 pub use matrix::Matrix;
+#[cfg(feature = "bind")]
+pub use mumps::{Mumps, Symmetry};
 #[cfg(feature = "bind")]
 pub use partition::partition;
 #[cfg(feature = "bind")]

@@ -149,6 +149,23 @@ impl Petsc {
         Ok(out)
     }
 
+    /// Rank 0's `values` on every rank (the other ranks' `values` overwritten; every rank
+    /// passes a slice of the same length).
+    pub fn broadcast(&self, values: &mut [f64]) -> Result<()> {
+        let count = mpi_count(values.len())?;
+        // SAFETY: a buffer of `count` doubles on every rank; MPI_DOUBLE is f64.
+        let code = unsafe {
+            sys::MPI_Bcast(
+                values.as_mut_ptr().cast(),
+                count,
+                (&raw mut sys::ompi_mpi_double).cast(),
+                0,
+                self.comm(),
+            )
+        };
+        check_mpi("MPI_Bcast", code)
+    }
+
     /// Every rank's `value`, in rank order, on every rank.
     pub fn all_gather(&self, value: u64) -> Result<Vec<u64>> {
         let mut out = vec![0u64; self.size];

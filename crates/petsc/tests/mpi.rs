@@ -187,3 +187,148 @@ fn a_grid_graph_is_split_in_balanced_connected_halves() {
         assert!(matches!(partition(p, &[0, 1], &[n], n), Err(PetscError::Argument(_))));
     });
 }
+
+/// The entries `(i, j, v)` of a quasi-definite matrix of order `k² + k`: the grid Laplacian
+/// on the first `k²` unknowns, `-I - 0.1 L₁` (a 1D Laplacian) on the last `k`, coupled by
+/// `0.3` between unknown `k² + i` and grid vertex `i (k + 1)`. Symmetric and indefinite, as
+/// the piezoelectric system is.
+fn quasi_definite(k: usize) -> (usize, Vec<(usize, usize, f64)>) {
+    let (n1, n) = (k * k, k * k + k);
+    let mut e = vec![];
+    for r in 0..n1 {
+        e.push((r, r, 4.0));
+        for c in grid_neighbours(k, r) {
+            e.push((r, c, -1.0));
+        }
+    }
+    for i in 0..k {
+        let r = n1 + i;
+        e.push((r, r, -1.2));
+        if i + 1 < k {
+            e.push((r, r + 1, 0.1));
+            e.push((r + 1, r, 0.1));
+        }
+        let g = (i * (k + 1)) % n1;
+        e.push((r, g, 0.3));
+        e.push((g, r, 0.3));
+    }
+    (n, e)
+}
+
+/// `A x = b` by Gaussian elimination with partial pivoting (dense, row-major `A`).
+fn dense_solve(n: usize, mut a: Vec<f64>, mut b: Vec<f64>) -> Vec<f64> {
+    for c in 0..n {
+        let p = (c..n).max_by(|&x, &y| a[x * n + c].abs().total_cmp(&a[y * n + c].abs())).unwrap();
+        for j in 0..n {
+            a.swap(c * n + j, p * n + j);
+        }
+        b.swap(c, p);
+        for r in c + 1..n {
+            let f = a[r * n + c] / a[c * n + c];
+            for j in c..n {
+                a[r * n + j] -= f * a[c * n + j];
+            }
+            b[r] -= f * b[c];
+        }
+    }
+    for r in (0..n).rev() {
+        let s: f64 = (r + 1..n).map(|j| a[r * n + j] * b[j]).sum();
+        b[r] = (b[r] - s) / a[r * n + r];
+    }
+    b
+}
+
+#[test]
+fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
+    use petsc::{Mumps, Symmetry};
+    on_ranks(
+        "mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns",
+        2,
+        |p| {
+            let k = 9;
+            let (n, entries) = quasi_definite(k);
+            let mut dense = vec![0.0; n * n];
+            for &(i, j, v) in &entries {
+                dense[i * n + j] += v;
+            }
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
+            let exact = dense_solve(n, dense.clone(), b.clone());
+            // every entry given by one rank, the diagonal's in halves by both (MUMPS sums them)
+            let mine = |symmetric: bool| {
+                let (mut r, mut c, mut v) = (vec![], vec![], vec![]);
+                for (e, &(i, j, x)) in entries.iter().enumerate() {
+                    if symmetric && i < j {
+                        continue;
+                    }
+                    let (give, x) = if i == j { (true, 0.5 * x) } else { (e % 2 == p.rank(), x) };
+                    if give {
+                        r.push(i);
+                        c.push(j);
+                        v.push(x);
+                    }
+                }
+                (r, c, v)
+            };
+            // the chosen unknowns: three grid vertices and two of the last block
+            let chosen = [3, 40, 77, k * k + 1, k * k + 5];
+            for symmetry in [Symmetry::Indefinite, Symmetry::General] {
+                let (r, c, v) = mine(symmetry != Symmetry::General);
+                // without a Schur complement: one solve
+                let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), symmetry, &[]).unwrap();
+                let mut x = if p.rank() == 0 { b.clone() } else { vec![] };
+                plain.solve(&mut x).unwrap();
+                if p.rank() == 0 {
+                    let err = x.iter().zip(&exact).map(|(a, e)| (a - e).abs()).fold(0.0, f64::max);
+                    assert!(err < 1e-12, "{symmetry:?}: the solve is off by {err:.2e}");
+                }
+                // with one: S, the condensed right-hand side, the expansion
+                let mut m = Mumps::factor(p, n, (&r, &c, v), symmetry, &chosen).unwrap();
+                let mut rhs = if p.rank() == 0 { b.clone() } else { vec![] };
+                let reduced = m.condense(&mut rhs).unwrap();
+                let s = m.schur_complement().map(<[f64]>::to_vec);
+                let x_s = match &s {
+                    Some(s) => dense_solve(chosen.len(), s.clone(), reduced.clone()),
+                    None => vec![],
+                };
+                m.expand(&mut rhs, &x_s).unwrap();
+                if p.rank() == 0 {
+                    let s = s.expect("rank 0 holds the Schur complement");
+                    // S is symmetric, and its inverse is the chosen block of K's inverse
+                    for i in 0..chosen.len() {
+                        for j in 0..chosen.len() {
+                            let d = (s[i * chosen.len() + j] - s[j * chosen.len() + i]).abs();
+                            assert!(d < 1e-12, "{symmetry:?}: S is not symmetric at ({i}, {j})");
+                        }
+                    }
+                    for (jj, &j) in chosen.iter().enumerate() {
+                        let mut e = vec![0.0; n];
+                        e[j] = 1.0;
+                        let col = dense_solve(n, dense.clone(), e);
+                        let mut unit = vec![0.0; chosen.len()];
+                        unit[jj] = 1.0;
+                        let inv = dense_solve(chosen.len(), s.clone(), unit);
+                        for (ii, &i) in chosen.iter().enumerate() {
+                            assert!((inv[ii] - col[i]).abs() < 1e-12, "{symmetry:?}: (S⁻¹)[{ii}, {jj}]");
+                        }
+                    }
+                    let err = rhs.iter().zip(&exact).map(|(a, e)| (a - e).abs()).fold(0.0, f64::max);
+                    assert!(err < 1e-12, "{symmetry:?}: the solve in two halves is off by {err:.2e}");
+                } else {
+                    assert!(s.is_none() && reduced.is_empty());
+                }
+            }
+            // a singular matrix: MUMPS' error, typed
+            let (r, c) = (vec![0, 1], vec![0, 1]);
+            let v = if p.rank() == 0 { vec![1.0, 0.0] } else { vec![0.0, 0.0] };
+            match Mumps::factor(p, 2, (&r, &c, v), Symmetry::General, &[]) {
+                Err(PetscError::Mumps { info: -10, .. }) => {}
+                Err(other) => panic!("expected MUMPS' singular matrix, got {other}"),
+                Ok(_) => panic!("a singular matrix was factored"),
+            }
+            // the same data broadcast from rank 0
+            let mut values = vec![p.rank() as f64; 3];
+            p.broadcast(&mut values).unwrap();
+            assert_eq!(values, vec![0.0; 3]);
+        },
+    );
+}
