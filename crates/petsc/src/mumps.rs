@@ -106,8 +106,8 @@ impl<'p> Mumps<'p> {
             Symmetry::General => 0,
         };
         m.id.par = 1; // the host works too
-        // SAFETY: PETSc is initialised (the borrow of `petsc`), so MPI is; the communicator is
-        // PETSc's.
+                      // SAFETY: PETSc is initialised (the borrow of `petsc`), so MPI is; the communicator is
+                      // PETSc's.
         m.id.comm_fortran = unsafe { sys::MPI_Comm_c2f(petsc.comm()) };
         m.call(JOB_INIT, "initialisation")?;
         m.initialised = true;
@@ -217,7 +217,14 @@ impl<'p> Mumps<'p> {
     /// # Errors
     /// MUMPS' errors; a right-hand side of the wrong length.
     pub fn condense(&mut self, rhs: &mut [f64]) -> Result<Vec<f64>> {
-        let mut reduced = vec![0.0; if self.petsc.rank() == 0 { self.schur_list.len() } else { 0 }];
+        let mut reduced = vec![
+            0.0;
+            if self.petsc.rank() == 0 {
+                self.schur_list.len()
+            } else {
+                0
+            }
+        ];
         self.solve_phase(rhs, 1, &mut reduced)?;
         Ok(reduced)
     }

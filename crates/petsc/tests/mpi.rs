@@ -218,7 +218,9 @@ fn quasi_definite(k: usize) -> (usize, Vec<(usize, usize, f64)>) {
 /// `A x = b` by Gaussian elimination with partial pivoting (dense, row-major `A`).
 fn dense_solve(n: usize, mut a: Vec<f64>, mut b: Vec<f64>) -> Vec<f64> {
     for c in 0..n {
-        let p = (c..n).max_by(|&x, &y| a[x * n + c].abs().total_cmp(&a[y * n + c].abs())).unwrap();
+        let p = (c..n)
+            .max_by(|&x, &y| a[x * n + c].abs().total_cmp(&a[y * n + c].abs()))
+            .unwrap();
         for j in 0..n {
             a.swap(c * n + j, p * n + j);
         }
@@ -260,7 +262,11 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
                     if symmetric && i < j {
                         continue;
                     }
-                    let (give, x) = if i == j { (true, 0.5 * x) } else { (e % 2 == p.rank(), x) };
+                    let (give, x) = if i == j {
+                        (true, 0.5 * x)
+                    } else {
+                        (e % 2 == p.rank(), x)
+                    };
                     if give {
                         r.push(i);
                         c.push(j);

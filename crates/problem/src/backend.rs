@@ -216,8 +216,7 @@ pub trait Backend {
     }
 }
 
-/// The free unknowns `(u, φ)` of the discretisation.
-pub type Fields = (Vec<f64>, Vec<f64>);
+pub use crate::factorization::Fields;
 
 /// The contact problem of a run's instants ([`Backend::begin`]): its boundary at the first
 /// instant's data, and how it is solved.

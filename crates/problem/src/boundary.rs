@@ -6,6 +6,7 @@
 //! contact dofs onto each point's normal and tangents is this module's; the sparse work is
 //! linalg's.
 
+use crate::factorization::Factorization;
 use crate::scene::{ContactSpec, Friction};
 use crate::ProblemError;
 use crate::SetupError;
@@ -13,7 +14,7 @@ use contact::{
     ContactOperator, ContactPoints, DenseContactProblem, ElectricContactProblem, OperatorError, PointValues,
 };
 use fe_assembly::{facet_measure, Coordinates, Discretization, Dof, DofMap};
-use linalg::{CondensedLoads, CoupledSolver, DirectLdlt};
+use linalg::{CondensedLoads, CoupledSolver};
 use rayon::prelude::*;
 
 /// The foundation a contact zone presses on: its `contact.compliance`, or rigid.
@@ -589,7 +590,7 @@ impl ContactBoundary {
     /// The condensation's linear-algebra error.
     pub fn condense(
         &self,
-        solver: &mut DirectLdlt,
+        solver: &mut dyn Factorization,
         b_u: &[f64],
         b_phi: &[f64],
         nt: usize,
@@ -619,7 +620,7 @@ impl ContactBoundary {
     pub fn condense_electric(
         &self,
         electric: &contact::ElectricContact,
-        solver: &mut DirectLdlt,
+        solver: &mut dyn Factorization,
         b_u: &[f64],
         b_phi: &[f64],
         nt: usize,
@@ -725,13 +726,13 @@ impl ContactBoundary {
     /// The solve's linear-algebra error.
     pub fn recover(
         &self,
-        solver: &mut DirectLdlt,
+        solver: &mut dyn Factorization,
         loads: CondensedLoads,
         lambda: &PointValues,
         b_u: &[f64],
         b_phi: &[f64],
     ) -> Result<(Vec<f64>, Vec<f64>), ProblemError> {
-        Ok(solver.solve_with_update(loads, b_u, b_phi, &self.forces(lambda))?)
+        solver.solve_with_update(loads, b_u, b_phi, &self.forces(lambda))
     }
 
     /// `u` and `φ` under the loads, the contact forces and the electric flux of `sol`
@@ -741,7 +742,7 @@ impl ContactBoundary {
     /// The solve's linear-algebra error.
     pub fn recover_electric(
         &self,
-        solver: &mut DirectLdlt,
+        solver: &mut dyn Factorization,
         loads: CondensedLoads,
         sol: &contact::ContactSolution,
         b_u: &[f64],
@@ -749,7 +750,7 @@ impl ContactBoundary {
     ) -> Result<(Vec<f64>, Vec<f64>), ProblemError> {
         let mut d = self.forces(&sol.lambda);
         d.extend(self.electric_charges(sol, b_u.len()).iter().map(|(_, v)| v));
-        Ok(solver.solve_with_update(loads, b_u, b_phi, &d)?)
+        solver.solve_with_update(loads, b_u, b_phi, &d)
     }
 }
 

@@ -4,22 +4,18 @@
 //! the dense contact problem by semismooth Newton or a first-order method, or (the paper's
 //! Uzawa) solves the primal problem once per first-order step.
 
-mod condensed;
-mod instants;
-
-use condensed::{coupled, refine, rhs, rhs_with_contact, REFINE_TOL};
-use instants::Kept;
-
 use crate::backend::Unsupported;
 use crate::backend::{
     At, Backend, Contact, ContactSolve, Fields, Figures, InstantOf, InstantSolution, Limits, Posed, Primed,
 };
 use crate::boundary::ContactBoundary;
+use crate::factorization::Factorization;
+use crate::instants::Instants;
 use crate::progress::{Event, Reporter};
 use crate::scene::{BackendChoice, Rule, Scene};
 use crate::ProblemError;
 use fe_assembly::{Blocks, Parallelism};
-use linalg::{CondenseRoute, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
+use linalg::{CondensedLoads, CoupledSolver, DirectLdlt, Ordering, PcgParams, PcgStop, SchurPcg};
 use std::time::Instant;
 
 /// The default backend, named for its role: one process on one machine's shared memory, its
@@ -87,15 +83,20 @@ impl Backend for SharedMemory {
         parts: &[Fields],
         reporter: &mut dyn Reporter,
     ) -> Result<Vec<Fields>, ProblemError> {
-        SharedMemory::begin_instants(system, posed, contact, parts, reporter).map_err(|e| e.on_scene(&posed.scene))
+        let Factored { linear, instants } = system;
+        instants
+            .begin(linear, posed, contact, parts, reporter)
+            .map_err(|e| e.on_scene(&posed.scene))
     }
 
     fn respond(&mut self, system: &mut Factored, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError> {
-        instants::respond(system, a_u, a_phi)
+        Instants::respond(&mut system.linear, a_u, a_phi)
     }
 
     fn prime(&mut self, system: &mut Factored, primed: Primed<'_>) -> Result<(), ProblemError> {
-        SharedMemory::prime_instant(system, primed).map_err(|e| e.on_scene(&primed.posed.scene))
+        let scene = &primed.posed.scene;
+        let Factored { linear, instants } = system;
+        instants.prime(linear, primed).map_err(|e| e.on_scene(scene))
     }
 
     fn solve_posed(
@@ -105,11 +106,14 @@ impl Backend for SharedMemory {
         at: At<'_>,
         reporter: &mut dyn Reporter,
     ) -> Result<contact::ContactSolution, ProblemError> {
-        SharedMemory::solve_kept(system, how, at, reporter).map_err(|e| e.on_scene(how.scene))
+        let Factored { linear, instants } = system;
+        instants
+            .solve(linear, how, at, reporter)
+            .map_err(|e| e.on_scene(how.scene))
     }
 
     fn own_scale(&self, system: &Factored, factors: &[f64]) -> f64 {
-        SharedMemory::own_scale_of(system, factors)
+        system.instants.own_scale(factors)
     }
 
     fn instant_fields(
@@ -119,7 +123,9 @@ impl Backend for SharedMemory {
         contact: Option<InstantOf<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<Option<InstantSolution>, ProblemError> {
-        SharedMemory::fields_of(system, posed, contact, reporter)
+        let Factored { linear, instants } = system;
+        instants
+            .fields(linear, posed, contact, reporter)
             .map(Some)
             .map_err(|e| e.on_scene(&posed.scene))
     }
@@ -151,43 +157,118 @@ impl LinearSolver {
     }
 }
 
-/// The assembled blocks and the factored solver, with what the solves measured on it.
+/// The factored system, and what the run's instants keep on it.
 pub struct Factored {
+    linear: Linear,
+    instants: Instants,
+}
+
+/// The assembled blocks and the factored solver.
+struct Linear {
     blocks: Blocks,
     solver: LinearSolver,
     pcg_params: PcgParams,
     /// Wall time of the factorisation.
     seconds: f64,
-    /// Steps of iterative refinement of the last solve.
-    refinement: usize,
-    /// How the contact compliance was formed, and in how long (condensed strategies).
-    condense: Option<(CondenseRoute, f64)>,
-    /// What the run's instants keep on the factorisation.
-    kept: Kept,
 }
 
 impl Factored {
     /// What the factorisation and the solves on it measured, for the report.
     pub(crate) fn figures(&self) -> Figures {
-        let (smallest_pivot_ratio, factor_bytes) = match &self.solver {
+        let linear = &self.linear;
+        let (smallest_pivot_ratio, factor_bytes) = match &linear.solver {
             LinearSolver::Direct(d) => (Some(d.factor().pivot_ratio()), d.factor_bytes()),
             LinearSolver::SchurPcg(p) => (None, p.factor_bytes()),
         };
         Figures {
-            factor_seconds: self.seconds,
-            condense: self.condense,
-            pcg_rel_tol: self.pcg_params.rel_tol,
+            factor_seconds: linear.seconds,
+            condense: self.instants.condense,
+            pcg_rel_tol: linear.pcg_params.rel_tol,
             smallest_pivot_ratio,
-            refinement_steps: self.refinement,
+            refinement_steps: self.instants.refinement,
             factor_bytes,
             petsc: None,
         }
     }
+}
 
-    /// The equilibrium residual of `(u, φ)` against the right-hand side `b` (`(b_u, b_φ, scale)`,
-    /// as [`rhs_with_contact`] gives it).
-    pub(crate) fn equilibrium_of(&self, u: &[f64], phi: &[f64], b: &(Vec<f64>, Vec<f64>, f64)) -> f64 {
-        linalg::equilibrium_residual(coupled(&self.blocks), u, phi, rhs(b))
+impl Linear {
+    /// The `L D Lᵀ` of `K`, for what only a direct factorisation does.
+    fn direct(&mut self) -> Result<&mut DirectLdlt, ProblemError> {
+        match &mut self.solver {
+            LinearSolver::Direct(direct) => Ok(direct),
+            LinearSolver::SchurPcg(_) => Err(Unsupported::new(
+                SharedMemory::NAME,
+                "solver.strategy",
+                "a condensed contact solve on the Schur-complement PCG (it needs the L D Lᵀ of K)",
+            )
+            .advise("use a condensed strategy")
+            .into()),
+        }
+    }
+
+    /// `K`'s blocks as linalg takes them.
+    fn coupled_blocks(&self) -> linalg::CoupledBlocks<'_> {
+        linalg::CoupledBlocks {
+            a: &self.blocks.a,
+            g: &self.blocks.g,
+            b: &self.blocks.b,
+        }
+    }
+}
+
+impl Factorization for Linear {
+    fn solve(&mut self, b_u: &[f64], b_phi: &[f64]) -> Result<(Fields, usize), ProblemError> {
+        let (mut u, mut phi) = (vec![0.0; b_u.len()], vec![0.0; b_phi.len()]);
+        let info = self.solver.coupled().solve(b_u, b_phi, &mut u, &mut phi)?;
+        Ok(((u, phi), info.pcg_iters))
+    }
+
+    fn condense(&mut self, b_u: &[f64], b_phi: &[f64], dofs: &[usize]) -> Result<linalg::Condensed, ProblemError> {
+        Ok(self.direct()?.condense(b_u, b_phi, dofs)?)
+    }
+
+    fn solve_with_update(
+        &mut self,
+        loads: CondensedLoads,
+        b_u: &[f64],
+        b_phi: &[f64],
+        d: &[f64],
+    ) -> Result<Fields, ProblemError> {
+        Ok(self.direct()?.solve_with_update(loads, b_u, b_phi, d)?)
+    }
+
+    /// At most 3 corrections with the factors of `K`, each kept only where it lowers the
+    /// residual; none on the Schur-complement PCG (its tolerance is its accuracy).
+    fn refine(
+        &mut self,
+        rhs: linalg::Rhs<'_>,
+        u: &mut [f64],
+        phi: &mut [f64],
+        tol: f64,
+    ) -> Result<usize, ProblemError> {
+        let Linear { blocks, solver, .. } = self;
+        let LinearSolver::Direct(direct) = solver else {
+            return Ok(0);
+        };
+        let k = linalg::CoupledBlocks {
+            a: &blocks.a,
+            g: &blocks.g,
+            b: &blocks.b,
+        };
+        Ok(linalg::refine(direct, k, rhs, u, phi, tol, 3)?.steps)
+    }
+
+    fn equilibrium(&mut self, u: &[f64], phi: &[f64], rhs: linalg::Rhs<'_>) -> Result<f64, ProblemError> {
+        Ok(linalg::equilibrium_residual(self.coupled_blocks(), u, phi, rhs))
+    }
+
+    fn coupled(&mut self) -> Option<&mut dyn CoupledSolver> {
+        Some(self.solver.coupled())
+    }
+
+    fn condenses(&self) -> bool {
+        matches!(self.solver, LinearSolver::Direct(_))
     }
 }
 
@@ -255,13 +336,13 @@ fn factor(
     let seconds = t.elapsed().as_secs_f64();
     reporter.event(&Event::Factored { seconds });
     Ok(Factored {
-        blocks,
-        solver,
-        pcg_params,
-        seconds,
-        refinement: 0,
-        condense: None,
-        kept: Kept::Nothing,
+        linear: Linear {
+            blocks,
+            solver,
+            pcg_params,
+            seconds,
+        },
+        instants: Instants::default(),
     })
 }
 
@@ -325,25 +406,4 @@ fn too_large(e: linalg::LinalgError, limits: Limits, scene: &Scene) -> ProblemEr
         },
         _ => ProblemError::linear(e, scene),
     }
-}
-
-/// The one linear solve of an instant without contact, refined with the factors of `K`.
-fn solve_linear(system: &mut Factored, posed: &Posed<'_>) -> Result<InstantSolution, ProblemError> {
-    let (dofs, loads) = (&posed.disc.dofs, &posed.loads);
-    let (mut u, mut phi) = (vec![0.0; dofs.n_u], vec![0.0; dofs.n_phi]);
-    let info = system
-        .solver
-        .coupled()
-        .solve(&loads.b_u, &loads.b_phi, &mut u, &mut phi)?;
-    let b = rhs_with_contact(posed, None);
-    if let LinearSolver::Direct(direct) = &mut system.solver {
-        system.refinement = refine(direct, &system.blocks, rhs(&b), &mut u, &mut phi, REFINE_TOL)?.steps;
-    }
-    let equilibrium = system.equilibrium_of(&u, &phi, &b);
-    Ok(InstantSolution {
-        x: (u, phi),
-        contact: None,
-        equilibrium,
-        pcg_iters: info.pcg_iters,
-    })
 }

@@ -1,8 +1,9 @@
-//! The contact solve of the default backend: on the condensed compliance (semismooth Newton or
-//! a first-order method), or one full primal solve per first-order step; the condensation;
+//! The contact solve on what the instants keep: on the condensed compliance (semismooth Newton
+//! or a first-order method), or one full primal solve per first-order step; the condensation;
 //! the fields under the forces found, refined with the factors of `K`, and the law judged on
 //! them.
 
+use super::Factorization;
 use crate::backend::{ContactSolve, Posed};
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
@@ -12,8 +13,7 @@ use contact::{
     ContactError, ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, NewtonParams, PointValues,
     ProblemClass, Schedule, StopRule, UzawaParams,
 };
-use fe_assembly::Blocks;
-use linalg::{CondenseRoute, CoupledSolver, DirectLdlt};
+use linalg::CondenseRoute;
 use std::time::Instant;
 
 /// The contact problem as its solvers see it.
@@ -110,18 +110,18 @@ impl ContactSolve<'_> {
     }
 }
 
-/// `boundary.condense` with `direct` for the right-hand side `(b_u, b_φ)`, timed, reported
+/// `boundary.condense` with `f` for the right-hand side `(b_u, b_φ)`, timed, reported
 /// (`Event::Condensed`) and its route and seconds kept in `condense`.
 pub(super) fn condense_reported(
     boundary: &ContactBoundary,
-    direct: &mut DirectLdlt,
+    f: &mut dyn Factorization,
     (b_u, b_phi): (&[f64], &[f64]),
     nt: usize,
     condense: &mut Option<(CondenseRoute, f64)>,
     reporter: &mut dyn Reporter,
 ) -> Result<(DenseContactProblem, linalg::CondensedLoads), ProblemError> {
     let t = Instant::now();
-    let (dense, condensed) = boundary.condense(direct, b_u, b_phi, nt)?;
+    let (dense, condensed) = boundary.condense(f, b_u, b_phi, nt)?;
     note_condensed(condense, reporter, dense.m(), condensed.route, t);
     Ok((dense, condensed))
 }
@@ -142,8 +142,7 @@ pub(super) fn note_condensed(
 
 /// The fields of a condensed contact solve, refined with the factors of `K`.
 pub(super) struct Refining<'a> {
-    pub(super) direct: &'a mut DirectLdlt,
-    pub(super) blocks: &'a Blocks,
+    pub(super) f: &'a mut dyn Factorization,
     pub(super) posed: &'a Posed<'a>,
     pub(super) boundary: &'a ContactBoundary,
     /// Steps of iterative refinement of the last solve.
@@ -183,7 +182,7 @@ impl Refining<'_> {
         let mut corrections = 0;
         loop {
             let b = rhs_with_contact(posed, Some((boundary, &sol)));
-            self.refinement += refine(self.direct, self.blocks, rhs(&b), u, phi, self.refine_tol)?.steps;
+            self.refinement += self.f.refine(rhs(&b), u, phi, self.refine_tol)?;
             sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u, self.shift);
             if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
                 break;
@@ -201,7 +200,7 @@ impl Refining<'_> {
             let start = sol.lambda.clone();
             sol = how.run(Operator::Condensed(dense), &boundary.points, Some(start), reporter)?;
             let (b_full, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
-            self.direct.solve(&b_full, &b_phi, u, phi)?;
+            (*u, *phi) = self.f.solve(&b_full, &b_phi)?.0;
             corrections += 1;
         }
         sol.info.residual = sol.info.residual.max(sol.info.complementarity);
@@ -233,28 +232,6 @@ pub(crate) fn rhs_with_contact(
         }
     }
     (b_full, b_phi, scale)
-}
-
-/// Iterative refinement of the last solve (with `K`'s factors), to the equilibrium residual
-/// `tol`: at most 3 corrections, each kept only where it lowers the residual.
-pub(super) fn refine(
-    direct: &mut DirectLdlt,
-    b: &Blocks,
-    rhs: linalg::Rhs<'_>,
-    u: &mut [f64],
-    phi: &mut [f64],
-    tol: f64,
-) -> Result<linalg::Refined, ProblemError> {
-    Ok(linalg::refine(direct, coupled(b), rhs, u, phi, tol, 3)?)
-}
-
-/// `K`'s blocks as linalg takes them.
-pub(super) fn coupled(b: &Blocks) -> linalg::CoupledBlocks<'_> {
-    linalg::CoupledBlocks {
-        a: &b.a,
-        g: &b.g,
-        b: &b.b,
-    }
 }
 
 /// The right-hand side `(b_u, b_φ)` of size `scale`, as linalg takes it.

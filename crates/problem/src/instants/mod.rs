@@ -1,30 +1,45 @@
-//! What the run's instants keep on the default backend's one factorisation, and each
-//! instant's steps on it: the contact problem condensed once (mechanical, or with the electric
-//! rows of electrical contact) or one full solve per first-order step; a path's parts of the
-//! right-hand side, solved once, whose sums are its instants' loads; the fields of an instant
-//! under the contact forces found, refined, the law judged on them.
+//! What a run's instants keep on one factorisation of `K`, and each instant's steps on it,
+//! for any backend whose factorisation condenses ([`Factorization`]): the contact problem
+//! condensed once (mechanical, or with the electric rows of electrical contact) or one full
+//! solve per first-order step; a path's parts of the right-hand side, solved once, whose sums
+//! are its instants' loads; the fields of an instant under the contact forces found, refined,
+//! the law judged on them. The contact solvers run on the condensed problem unchanged, so
+//! every law of the `contact` crate reaches every backend that factors.
 
-use super::condensed::{
-    condense_reported, fields_at_points, in_frame, law_residual, note_condensed, refine, rhs, rhs_with_contact,
-    Operator, Refining, PATH_REFINE_TOL, REFINE_TOL,
-};
-use super::{Factored, LinearSolver, SharedMemory};
+mod condensed;
+
 use crate::backend::{At, Contact, ContactSolve, Fields, InstantOf, InstantSolution, Posed, Primed};
 use crate::boundary::{ContactBoundary, FullSolve};
+use crate::factorization::Factorization;
 use crate::outer::floating_tip;
 use crate::progress::{Event, Reporter};
 use crate::scene::ZoneElectric;
 use crate::ProblemError;
+pub(crate) use condensed::rhs_with_contact;
+use condensed::{
+    condense_reported, fields_at_points, in_frame, law_residual, note_condensed, rhs, Operator, Refining,
+    PATH_REFINE_TOL, REFINE_TOL,
+};
 use contact::{
     ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, ElectricContactProblem, NewtonParams,
     PointValues, ProblemClass, Schedule,
 };
-use linalg::{CondensedLoads, CoupledSolver};
+use linalg::{CondenseRoute, CondensedLoads};
 use std::time::Instant;
+
+/// What the instants keep, and what their solves measured.
+#[derive(Default)]
+pub struct Instants {
+    kept: Kept,
+    /// How the contact compliance was formed, and in how long.
+    pub condense: Option<(CondenseRoute, f64)>,
+    /// Steps of iterative refinement of the last instant's fields.
+    pub refinement: usize,
+}
 
 /// What the instants keep from one to the next.
 #[derive(Default)]
-pub(super) enum Kept {
+enum Kept {
     /// Nothing: no contact (each instant one solve with the factors).
     #[default]
     Nothing,
@@ -38,7 +53,7 @@ pub(super) enum Kept {
 }
 
 /// The condensed compliance, the first instant's loads part, and a path's parts.
-pub(super) struct Condensed {
+struct Condensed {
     dense: DenseContactProblem,
     /// The loads' part of the condensation (the first instant's), while `dense.u0` is its
     /// own: the fields of that instant finish its solve.
@@ -52,7 +67,7 @@ pub(super) struct Condensed {
 
 /// The condensed problem with electrical contact, its loads part and `u⁰`, `φ⁰`, and a path's
 /// parts.
-pub(super) struct Electric {
+struct Electric {
     problem: ElectricContactProblem,
     loads: Option<CondensedLoads>,
     first: (PointValues, Vec<f64>),
@@ -63,25 +78,29 @@ pub(super) struct Electric {
 
 /// An instant of a strategy without the condensation: its loads, boundary, and the fields of
 /// its last solve.
-pub(super) struct Full {
+struct Full {
     b_u: Vec<f64>,
     b_phi: Vec<f64>,
     boundary: Option<ContactBoundary>,
     x: Option<Fields>,
 }
 
-impl SharedMemory {
+impl Instants {
     /// [`crate::backend::Backend::begin`]: the condensation (once, for the first instant's
     /// loads), and the parts' solutions (one solve each).
-    pub(super) fn begin_instants(
-        system: &mut Factored,
+    ///
+    /// # Errors
+    /// The factorisation's; a path on a strategy without the condensation.
+    pub fn begin(
+        &mut self,
+        f: &mut dyn Factorization,
         posed: &Posed<'_>,
         contact: Option<Contact<'_>>,
         parts: &[Fields],
         reporter: &mut dyn Reporter,
     ) -> Result<Vec<Fields>, ProblemError> {
         let Some(Contact { boundary, how }) = contact else {
-            system.kept = Kept::Nothing;
+            self.kept = Kept::Nothing;
             return Ok(vec![]);
         };
         let loads = &posed.loads;
@@ -90,7 +109,7 @@ impl SharedMemory {
             if !parts.is_empty() {
                 return Err(not_direct());
             }
-            system.kept = Kept::Full(Box::new(Full {
+            self.kept = Kept::Full(Box::new(Full {
                 b_u: vec![],
                 b_phi: vec![],
                 boundary: None,
@@ -98,17 +117,17 @@ impl SharedMemory {
             }));
             return Ok(vec![]);
         }
-        let LinearSolver::Direct(direct) = &mut system.solver else {
+        if !f.condenses() {
             return Err(not_direct());
-        };
+        }
         if let Some((electric, _)) = &boundary.electric {
             let t = Instant::now();
-            let (problem, condensed) = boundary.condense_electric(electric, direct, &loads.b_u, &loads.b_phi, nt)?;
-            note_condensed(&mut system.condense, reporter, problem.order(), condensed.route, t);
+            let (problem, condensed) = boundary.condense_electric(electric, f, &loads.b_u, &loads.b_phi, nt)?;
+            note_condensed(&mut self.condense, reporter, problem.order(), condensed.route, t);
             let first = (problem.u0.clone(), problem.phi0.clone());
-            let solved = solve_parts(system, parts)?;
+            let solved = solve_parts(f, parts)?;
             let at_points = |(u, phi): &Fields| (u.clone(), at_electric_points(boundary, phi, u.len()));
-            system.kept = Kept::Electric(Electric {
+            self.kept = Kept::Electric(Electric {
                 problem,
                 loads: Some(condensed),
                 first,
@@ -118,14 +137,14 @@ impl SharedMemory {
         }
         let (dense, condensed) = condense_reported(
             boundary,
-            direct,
+            f,
             (&loads.b_u, &loads.b_phi),
             nt,
-            &mut system.condense,
+            &mut self.condense,
             reporter,
         )?;
-        let solved = solve_parts(system, parts)?;
-        system.kept = Kept::Condensed(Condensed {
+        let solved = solve_parts(f, parts)?;
+        self.kept = Kept::Condensed(Condensed {
             first: dense.u0.clone(),
             dense,
             loads: Some(condensed),
@@ -137,7 +156,10 @@ impl SharedMemory {
     /// [`crate::backend::Backend::prime`]: `u⁰` of the instant: a path's parts summed at its
     /// factors, in its frame; the condensation's own for the first instant; the springs'
     /// forces added.
-    pub(super) fn prime_instant(system: &mut Factored, primed: Primed<'_>) -> Result<(), ProblemError> {
+    ///
+    /// # Errors
+    /// The factorisation's (a solve with the springs' forces, with electrical contact).
+    pub fn prime(&mut self, f: &mut dyn Factorization, primed: Primed<'_>) -> Result<(), ProblemError> {
         let Primed {
             posed,
             framed,
@@ -145,7 +167,7 @@ impl SharedMemory {
             springs,
         } = primed;
         let pressed = springs.normal.iter().any(|&l| l != 0.0);
-        match &mut system.kept {
+        match &mut self.kept {
             Kept::Nothing => Ok(()),
             Kept::Condensed(c) => {
                 let nt = c.dense.nt;
@@ -183,7 +205,7 @@ impl SharedMemory {
                         // the springs' forces among the loads: `u⁰` and `φ⁰` of a solve with them
                         let mut b_u = posed.loads.b_u.clone();
                         framed.boundary.add_forces(springs, &mut b_u);
-                        let (u, phi) = solve(system, &b_u, &posed.loads.b_phi)?;
+                        let ((u, phi), _) = f.solve(&b_u, &posed.loads.b_phi)?;
                         let at = fields_at_points(framed.boundary, &u, nt);
                         (
                             in_frame(at, factors.map(|_| framed.shift)),
@@ -191,19 +213,17 @@ impl SharedMemory {
                         )
                     }
                 };
-                if let Kept::Electric(e) = &mut system.kept {
-                    (e.problem.u0, e.problem.phi0) = (u0, phi0);
-                    if factors.is_some() || pressed {
-                        e.loads = None;
-                    }
+                (e.problem.u0, e.problem.phi0) = (u0, phi0);
+                if factors.is_some() || pressed {
+                    e.loads = None;
                 }
                 Ok(())
             }
-            Kept::Full(f) => {
-                f.b_u.clone_from(&posed.loads.b_u);
-                framed.boundary.add_forces(springs, &mut f.b_u);
-                f.b_phi.clone_from(&posed.loads.b_phi);
-                f.boundary = Some(framed.boundary.clone());
+            Kept::Full(full) => {
+                full.b_u.clone_from(&posed.loads.b_u);
+                framed.boundary.add_forces(springs, &mut full.b_u);
+                full.b_phi.clone_from(&posed.loads.b_phi);
+                full.boundary = Some(framed.boundary.clone());
                 Ok(())
             }
         }
@@ -211,8 +231,12 @@ impl SharedMemory {
 
     /// [`crate::backend::Backend::solve_posed`]: the strategy's contact solver on what the
     /// instants keep.
-    pub(super) fn solve_kept(
-        system: &mut Factored,
+    ///
+    /// # Errors
+    /// The contact solver's; a solve before the instants began.
+    pub fn solve(
+        &mut self,
+        f: &mut dyn Factorization,
         how: &ContactSolve<'_>,
         At {
             points,
@@ -221,57 +245,63 @@ impl SharedMemory {
         }: At<'_>,
         reporter: &mut dyn Reporter,
     ) -> Result<ContactSolution, ProblemError> {
-        match &mut system.kept {
+        match &mut self.kept {
             Kept::Condensed(c) => {
                 how.run_with(Operator::Condensed(&mut c.dense), points, start, refine_start, reporter)
             }
             Kept::Electric(e) => electric_solve(how, &mut e.problem, points, reporter),
-            Kept::Full(f) => {
-                let boundary = f.boundary.as_ref().ok_or_else(unprimed)?;
+            Kept::Full(full) => {
+                let boundary = full.boundary.as_ref().ok_or_else(unprimed)?;
+                let solver = f.coupled().ok_or_else(not_direct)?;
                 let mut op = FullSolve {
                     boundary,
-                    solver: system.solver.coupled(),
-                    b_u: &f.b_u,
-                    b_phi: &f.b_phi,
+                    solver,
+                    b_u: &full.b_u,
+                    b_phi: &full.b_phi,
                     nt: how.plan.n_tangential(),
-                    u: vec![0.0; f.b_u.len()],
-                    phi: vec![0.0; f.b_phi.len()],
+                    u: vec![0.0; full.b_u.len()],
+                    phi: vec![0.0; full.b_phi.len()],
                 };
                 let sol = how.run(Operator::FullSolves(&mut op), points, start, reporter)?;
-                f.x = Some((op.u, op.phi));
+                full.x = Some((op.u, op.phi));
                 Ok(sol)
             }
             Kept::Nothing => Err(unprimed()),
         }
     }
 
-    /// [`crate::backend::Backend::instant_fields`].
-    pub(super) fn fields_of(
-        system: &mut Factored,
+    /// [`crate::backend::Backend::instant_fields`]: one solve without contact; with contact,
+    /// the fields under the forces found.
+    ///
+    /// # Errors
+    /// The factorisation's; a step out of the run's order.
+    pub fn fields(
+        &mut self,
+        f: &mut dyn Factorization,
         posed: &Posed<'_>,
         contact: Option<InstantOf<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<InstantSolution, ProblemError> {
         let Some(InstantOf { how, framed, sol }) = contact else {
-            return super::solve_linear(system, posed);
+            return self.linear(f, posed);
         };
         let boundary = framed.boundary;
-        match std::mem::take(&mut system.kept) {
+        match std::mem::take(&mut self.kept) {
             Kept::Condensed(mut c) => {
-                let result = condensed_fields(system, &mut c, posed, InstantOf { how, framed, sol }, reporter);
-                system.kept = Kept::Condensed(c);
+                let result = self.condensed_fields(f, &mut c, posed, InstantOf { how, framed, sol }, reporter);
+                self.kept = Kept::Condensed(c);
                 result
             }
             Kept::Electric(mut e) => {
-                let result = electric_fields(system, &mut e, posed, InstantOf { how, framed, sol });
-                system.kept = Kept::Electric(e);
+                let result = self.electric_fields(f, &mut e, posed, InstantOf { how, framed, sol });
+                self.kept = Kept::Electric(e);
                 result
             }
-            Kept::Full(mut f) => {
-                let x = f.x.take().ok_or_else(unprimed)?;
-                system.kept = Kept::Full(f);
+            Kept::Full(mut full) => {
+                let x = full.x.take().ok_or_else(unprimed)?;
+                self.kept = Kept::Full(full);
                 let b = rhs_with_contact(posed, Some((boundary, &sol)));
-                let equilibrium = system.equilibrium_of(&x.0, &x.1, &b);
+                let equilibrium = f.equilibrium(&x.0, &x.1, rhs(&b))?;
                 Ok(InstantSolution {
                     x,
                     pcg_iters: sol.info.inner_iters,
@@ -283,9 +313,17 @@ impl SharedMemory {
         }
     }
 
+    /// [`crate::backend::Backend::respond`]: `K⁻¹ [a_u; a_φ]`.
+    ///
+    /// # Errors
+    /// The factorisation's.
+    pub fn respond(f: &mut dyn Factorization, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError> {
+        Ok(f.solve(a_u, a_phi)?.0)
+    }
+
     /// [`crate::backend::Backend::own_scale`].
-    pub(super) fn own_scale_of(system: &Factored, factors: &[f64]) -> f64 {
-        match &system.kept {
+    pub fn own_scale(&self, factors: &[f64]) -> f64 {
+        match &self.kept {
             Kept::Condensed(c) if !c.parts.is_empty() => largest(&superpose(c.parts.iter().map(|u| &u[..]), factors)),
             Kept::Electric(e) if !e.parts.is_empty() => {
                 largest(&superpose(e.parts.iter().map(|(u, _)| &u[..]), factors))
@@ -293,95 +331,100 @@ impl SharedMemory {
             _ => 0.0,
         }
     }
-}
 
-/// The fields of a condensed contact solve: the condensation's solve finished for the
-/// instant whose loads it carried, else one solve with the factors; refined, the law judged
-/// on them (and the contact solve corrected where they miss it); with their equilibrium
-/// residual.
-fn condensed_fields(
-    system: &mut Factored,
-    c: &mut Condensed,
-    posed: &Posed<'_>,
-    InstantOf { how, framed, sol }: InstantOf<'_>,
-    reporter: &mut dyn Reporter,
-) -> Result<InstantSolution, ProblemError> {
-    let boundary = framed.boundary;
-    let loads = &posed.loads;
-    let path = !c.parts.is_empty();
-    let (mut u, mut phi) = match c.loads.take() {
-        Some(condensed) => boundary.recover(direct(system)?, condensed, &sol.lambda, &loads.b_u, &loads.b_phi)?,
-        None => {
-            let (b_u, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
-            solve(system, &b_u, &b_phi)?
-        }
-    };
-    let blocks = &system.blocks;
-    let LinearSolver::Direct(direct) = &mut system.solver else {
-        return Err(not_direct());
-    };
-    let mut on = Refining {
-        direct,
-        blocks,
-        posed,
-        boundary,
-        refinement: 0,
-        // a path's step: friction's frame, and refinement only where a direct solve missed
-        shift: path.then_some(framed.shift),
-        refine_tol: if path { PATH_REFINE_TOL } else { REFINE_TOL },
-    };
-    let sol = on.correct(how, &mut c.dense, sol, (&mut u, &mut phi), reporter)?;
-    system.refinement = on.refinement;
-    let b = rhs_with_contact(posed, Some((boundary, &sol)));
-    let equilibrium = system.equilibrium_of(&u, &phi, &b);
-    Ok(InstantSolution {
-        x: (u, phi),
-        contact: Some(sol),
-        equilibrium,
-        pcg_iters: 0,
-    })
-}
-
-/// The fields of a contact solve with electrical contact, under the forces and the flux
-/// found, refined; the potentials reported the refined fields', the law judged on them.
-fn electric_fields(
-    system: &mut Factored,
-    e: &mut Electric,
-    posed: &Posed<'_>,
-    InstantOf { how, framed, mut sol }: InstantOf<'_>,
-) -> Result<InstantSolution, ProblemError> {
-    let boundary = framed.boundary;
-    let loads = &posed.loads;
-    let b = rhs_with_contact(posed, Some((boundary, &sol)));
-    let (mut u, mut phi) = match e.loads.take() {
-        Some(condensed) => boundary.recover_electric(direct(system)?, condensed, &sol, &loads.b_u, &loads.b_phi)?,
-        None => solve(system, &b.0, &b.1)?,
-    };
-    let blocks = &system.blocks;
-    let LinearSolver::Direct(direct) = &mut system.solver else {
-        return Err(not_direct());
-    };
-    // a path's step: friction's frame, and refinement only where a direct solve missed
-    let path = !e.parts.is_empty();
-    let refine_tol = if path { PATH_REFINE_TOL } else { REFINE_TOL };
-    system.refinement = refine(direct, blocks, rhs(&b), &mut u, &mut phi, refine_tol)?.steps;
-    // the potentials reported are the refined fields'
-    if let Some(values) = &mut sol.electric {
-        values.potential = at_electric_points(boundary, &phi, u.len());
+    /// The one linear solve of an instant without contact, refined.
+    fn linear(&mut self, f: &mut dyn Factorization, posed: &Posed<'_>) -> Result<InstantSolution, ProblemError> {
+        let loads = &posed.loads;
+        let ((mut u, mut phi), pcg_iters) = f.solve(&loads.b_u, &loads.b_phi)?;
+        let b = rhs_with_contact(posed, None);
+        self.refinement = f.refine(rhs(&b), &mut u, &mut phi, REFINE_TOL)?;
+        let equilibrium = f.equilibrium(&u, &phi, rhs(&b))?;
+        Ok(InstantSolution {
+            x: (u, phi),
+            contact: None,
+            equilibrium,
+            pcg_iters,
+        })
     }
-    sol.info.complementarity = law_residual(boundary, how, &sol, &e.problem.u0, &u, path.then_some(framed.shift));
-    sol.info.residual = sol.info.residual.max(sol.info.complementarity);
-    let equilibrium = system.equilibrium_of(&u, &phi, &b);
-    Ok(InstantSolution {
-        x: (u, phi),
-        contact: Some(sol),
-        equilibrium,
-        pcg_iters: 0,
-    })
-}
 
-/// Semismooth Newton on the displacement and electric rows; where the conducting zone
-/// floats, around it the search for the potential that carries its charge.
+    /// The fields of a condensed contact solve: the condensation's solve finished for the
+    /// instant whose loads it carried, else one solve with the factors; refined, the law
+    /// judged on them (and the contact solve corrected where they miss it); with their
+    /// equilibrium residual.
+    fn condensed_fields(
+        &mut self,
+        f: &mut dyn Factorization,
+        c: &mut Condensed,
+        posed: &Posed<'_>,
+        InstantOf { how, framed, sol }: InstantOf<'_>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<InstantSolution, ProblemError> {
+        let boundary = framed.boundary;
+        let loads = &posed.loads;
+        let path = !c.parts.is_empty();
+        let (mut u, mut phi) = match c.loads.take() {
+            Some(condensed) => boundary.recover(f, condensed, &sol.lambda, &loads.b_u, &loads.b_phi)?,
+            None => {
+                let (b_u, b_phi, _) = rhs_with_contact(posed, Some((boundary, &sol)));
+                f.solve(&b_u, &b_phi)?.0
+            }
+        };
+        let mut on = Refining {
+            f,
+            posed,
+            boundary,
+            refinement: 0,
+            // a path's step: friction's frame, and refinement only where a direct solve missed
+            shift: path.then_some(framed.shift),
+            refine_tol: if path { PATH_REFINE_TOL } else { REFINE_TOL },
+        };
+        let sol = on.correct(how, &mut c.dense, sol, (&mut u, &mut phi), reporter)?;
+        self.refinement = on.refinement;
+        let b = rhs_with_contact(posed, Some((boundary, &sol)));
+        let equilibrium = f.equilibrium(&u, &phi, rhs(&b))?;
+        Ok(InstantSolution {
+            x: (u, phi),
+            contact: Some(sol),
+            equilibrium,
+            pcg_iters: 0,
+        })
+    }
+
+    /// The fields of a contact solve with electrical contact, under the forces and the flux
+    /// found, refined; the potentials reported the refined fields', the law judged on them.
+    fn electric_fields(
+        &mut self,
+        f: &mut dyn Factorization,
+        e: &mut Electric,
+        posed: &Posed<'_>,
+        InstantOf { how, framed, mut sol }: InstantOf<'_>,
+    ) -> Result<InstantSolution, ProblemError> {
+        let boundary = framed.boundary;
+        let loads = &posed.loads;
+        let b = rhs_with_contact(posed, Some((boundary, &sol)));
+        let (mut u, mut phi) = match e.loads.take() {
+            Some(condensed) => boundary.recover_electric(f, condensed, &sol, &loads.b_u, &loads.b_phi)?,
+            None => f.solve(&b.0, &b.1)?.0,
+        };
+        // a path's step: friction's frame, and refinement only where a direct solve missed
+        let path = !e.parts.is_empty();
+        let refine_tol = if path { PATH_REFINE_TOL } else { REFINE_TOL };
+        self.refinement = f.refine(rhs(&b), &mut u, &mut phi, refine_tol)?;
+        // the potentials reported are the refined fields'
+        if let Some(values) = &mut sol.electric {
+            values.potential = at_electric_points(boundary, &phi, u.len());
+        }
+        sol.info.complementarity = law_residual(boundary, how, &sol, &e.problem.u0, &u, path.then_some(framed.shift));
+        sol.info.residual = sol.info.residual.max(sol.info.complementarity);
+        let equilibrium = f.equilibrium(&u, &phi, rhs(&b))?;
+        Ok(InstantSolution {
+            x: (u, phi),
+            contact: Some(sol),
+            equilibrium,
+            pcg_iters: 0,
+        })
+    }
+}
 fn electric_solve(
     how: &ContactSolve<'_>,
     problem: &mut ElectricContactProblem,
@@ -462,41 +505,18 @@ fn at_electric_points(boundary: &ContactBoundary, phi: &[f64], n_u: usize) -> Ve
 }
 
 /// `K⁻¹ b_q` for each part `q` of a path's right-hand side, in their order.
-fn solve_parts(system: &mut Factored, parts: &[Fields]) -> Result<Vec<Fields>, ProblemError> {
-    parts.iter().map(|(b_u, b_phi)| solve(system, b_u, b_phi)).collect()
+fn solve_parts(f: &mut dyn Factorization, parts: &[Fields]) -> Result<Vec<Fields>, ProblemError> {
+    parts.iter().map(|(b_u, b_phi)| Ok(f.solve(b_u, b_phi)?.0)).collect()
 }
 
-/// `K⁻¹ [b_u; b_φ]` with the factors of `K`.
-fn solve(system: &mut Factored, b_u: &[f64], b_phi: &[f64]) -> Result<Fields, ProblemError> {
-    let (mut u, mut phi) = (vec![0.0; b_u.len()], vec![0.0; b_phi.len()]);
-    direct(system)?.solve(b_u, b_phi, &mut u, &mut phi)?;
-    Ok((u, phi))
-}
-
-/// [`SharedMemory`]'s `respond`: `K⁻¹ [a_u; a_φ]`.
-pub(super) fn respond(system: &mut Factored, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError> {
-    solve(system, a_u, a_phi)
-}
-
-/// The `L D Lᵀ` of `K`.
-fn direct(system: &mut Factored) -> Result<&mut linalg::DirectLdlt, ProblemError> {
-    match &mut system.solver {
-        LinearSolver::Direct(direct) => Ok(direct),
-        LinearSolver::SchurPcg(_) => Err(not_direct()),
-    }
-}
-
-/// A path on a strategy without the `L D Lᵀ` of `K` (the scene's checks refuse it first).
+/// A path, or a condensed strategy, on a factorisation that does not condense (the scene's
+/// checks refuse it first).
 fn not_direct() -> ProblemError {
     let feature =
-        "a path on a strategy without the L D Lᵀ of K (it carries friction's history on the condensed compliance)";
-    crate::backend::Unsupported::new(
-        <SharedMemory as crate::backend::Backend>::NAME,
-        "solver.strategy",
-        feature,
-    )
-    .advise("use a condensed strategy")
-    .into()
+        "a path or a condensed contact solve on a strategy without the L D Lᵀ of K (it carries friction's history on the condensed compliance)";
+    crate::backend::Unsupported::new("faer", "solver.strategy", feature)
+        .advise("use a condensed strategy")
+        .into()
 }
 
 /// A step out of the run's order (a contact solve before the instants began or were posed):
