@@ -62,7 +62,10 @@ fn crate_dependencies_point_one_way() {
         // the PETSc layer knows no finite elements, as linalg does not
         ("petsc-sys", &[]),
         ("petsc", &["petsc-sys"]),
-        ("distributed", &["mesh", "fe-assembly", "contact", "problem", "petsc"]),
+        (
+            "distributed",
+            &["mesh", "fe-assembly", "linalg", "contact", "problem", "petsc"],
+        ),
         // the files of a run (scenes, meshes, outputs) over the core, for every user of it
         ("files", &["mesh", "contact", "problem"]),
         (

@@ -34,10 +34,10 @@
 
 mod supports;
 
-pub use supports::supports;
+pub use supports::{direct as factors_directly, supports};
 
 #[cfg(feature = "petsc")]
-pub mod contact;
+mod direct;
 #[cfg(feature = "petsc")]
 mod layout;
 #[cfg(feature = "petsc")]
@@ -46,9 +46,10 @@ mod run;
 pub mod system;
 
 #[cfg(feature = "petsc")]
+pub use direct::Direct;
+#[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
 pub use run::{
-    solve, Assembled, DistributedError, DistributedMemory, Prepared, COUPLED_OPTIONS, ELASTIC_OPTIONS,
-    MAX_ACTIVE_SET_STEPS,
+    solve, solve_path, Assembled, DistributedError, DistributedMemory, Prepared, COUPLED_OPTIONS, ELASTIC_OPTIONS,
 };

@@ -1,23 +1,21 @@
-//! A run on the ranks: the PETSc backend of [`problem::run`]. It partitions and assembles the
-//! system in parallel, configures the Krylov solvers, solves by one Krylov solve or by the
-//! active-set iteration, and gathers the solution on rank 0; the run around it (set-up,
-//! contact boundary, checks, recovery, report) is the default backend's.
+//! A run on the ranks: the PETSc backend of [`problem::run`]. It partitions the cells among
+//! the ranks and, on them, either factors `K` by MUMPS (any run with contact: [`Direct`], the
+//! contact dofs' Schur complement for the instants' condensed route, the default backend's
+//! contact solvers on it) or assembles a parallel matrix for Krylov solves with algebraic
+//! multigrid (a run without contact: `Krylov`). Every rank holds the whole solution of each
+//! instant (the mesh is whole on every rank too); rank 0 returns the run's solution.
 
-use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
+use crate::direct::Direct;
 use crate::layout::Layout;
 use crate::system::{assemble, System};
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, IndexSet, Ksp, Matrix, Petsc, PetscError, Vector};
-use problem::backend::Fields as Free;
 use problem::backend::{
-    At, Backend, Contact, ContactBoundary, ContactSolve, Figures, InstantOf, InstantSolution, Posed, Primed, Setup,
-    Unsupported,
+    At, Backend, Contact, ContactBoundary, ContactSolve, Fields, Figures, InstantOf, InstantSolution, Posed, Primed,
+    Setup, Unsupported,
 };
-use problem::{ContactLaw, Event, PetscReport, ProblemError, Reporter, Scene, Solution};
+use problem::{Event, Factorization, Instants, PetscReport, ProblemError, Reporter, Scene, Solution, Step};
 use std::time::Instant;
-
-/// Steps of the active-set iteration at most.
-pub const MAX_ACTIVE_SET_STEPS: usize = 60;
 
 /// What can stop a run of the PETSc backend.
 #[derive(Debug, thiserror::Error)]
@@ -26,12 +24,9 @@ pub enum DistributedError {
     /// The scene, its mesh or its data (as the default backend reports them).
     #[error(transparent)]
     Problem(#[from] ProblemError),
-    /// PETSc or MPI.
+    /// PETSc, MPI or MUMPS.
     #[error(transparent)]
     Petsc(#[from] PetscError),
-    /// The contact iteration did not converge.
-    #[error("contact: {0}")]
-    Contact(ActiveSetError),
 }
 
 impl From<fe_assembly::AssemblyError> for DistributedError {
@@ -46,14 +41,15 @@ impl From<problem::SceneError> for DistributedError {
     }
 }
 
-/// The backend's choices, as options of PETSc's database (the scene's `solver.petsc_options`
-/// come after them and win). With potentials: FGMRES outside (the preconditioner is not a
-/// fixed linear map when its blocks are multigrid cycles), the upper-triangular Schur
-/// factorisation of the potentials, `selfp` (`B + G diag(A)⁻¹ Gᵀ`) for the Schur complement,
-/// one GAMG cycle (smoothed aggregation with the rigid-body modes) for the elastic block and
-/// one BoomerAMG cycle (hypre) for the Schur block, where PETSc has hypre, else GAMG. Without
-/// potentials: CG with GAMG. Chosen by measurement on `paper-3d` (docs/performance.md): the
-/// full factorisation with GAMG on both blocks took 2.6 times as long.
+/// The backend's choices for the Krylov route, as options of PETSc's database (the scene's
+/// `solver.petsc_options` come after them and win). With potentials: FGMRES outside (the
+/// preconditioner is not a fixed linear map when its blocks are multigrid cycles), the
+/// upper-triangular Schur factorisation of the potentials, `selfp` (`B + G diag(A)⁻¹ Gᵀ`) for
+/// the Schur complement, one GAMG cycle (smoothed aggregation with the rigid-body modes) for
+/// the elastic block and one BoomerAMG cycle (hypre) for the Schur block, where PETSc has
+/// hypre, else GAMG. Without potentials: CG with GAMG. Chosen by measurement on `paper-3d`
+/// (docs/performance.md): the full factorisation with GAMG on both blocks took 2.6 times as
+/// long.
 pub const COUPLED_OPTIONS: &str = "-ksp_type fgmres -ksp_gmres_restart 200 -ksp_rtol 1e-10 -ksp_max_it 5000 \
 -pc_type fieldsplit -pc_fieldsplit_type schur -pc_fieldsplit_schur_fact_type upper \
 -pc_fieldsplit_schur_precondition selfp -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type gamg \
@@ -69,8 +65,8 @@ pub const ELASTIC_OPTIONS: &str = "-ksp_type cg -ksp_rtol 1e-10 -ksp_max_it 5000
 /// anything is built. Only rank 0 should pass a reporter that prints.
 ///
 /// # Errors
-/// The default backend's errors for the scene and its data; PETSc's (a Krylov solve that did
-/// not converge among them) as [`DistributedError::Petsc`].
+/// The default backend's errors for the scene and its data; PETSc's and MUMPS' (a Krylov
+/// solve that did not converge among them) as [`DistributedError::Petsc`].
 pub fn solve(
     scene: &Scene,
     mesh: Option<mesh::Mesh>,
@@ -78,7 +74,25 @@ pub fn solve(
     limits: problem::Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DistributedError> {
-    problem::run(&mut DistributedMemory { petsc }, scene, mesh, limits, reporter)
+    solve_path(scene, mesh, petsc, limits, reporter, &mut |_| Ok(()))
+}
+
+/// [`solve`], each instant of the scene's path (one for a static scene) handed to `each` on
+/// every rank, with its fields where they were computed (as [`problem::solve_path`] hands them:
+/// the driver writes a path's files from rank 0's).
+///
+/// # Errors
+/// As [`solve`]; the error `each` returns.
+pub fn solve_path(
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    petsc: &Petsc,
+    limits: problem::Limits,
+    reporter: &mut dyn Reporter,
+    each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+) -> Result<Option<Solution>, DistributedError> {
+    let solution = problem::run_steps(&mut DistributedMemory { petsc }, scene, mesh, limits, reporter, each)?;
+    Ok(solution.filter(|_| petsc.rank() == 0))
 }
 
 /// The backend named for its role: the ranks of an MPI run, each its own memory
@@ -88,28 +102,37 @@ pub struct DistributedMemory<'p> {
     pub petsc: &'p Petsc,
 }
 
-/// The dofs laid out over the ranks, and the system assembled on them.
+/// The cells laid out over the ranks, and (the Krylov route) the system assembled on them.
 pub struct Assembled<'p> {
     layout: Layout,
-    system: System<'p>,
+    system: Option<System<'p>>,
 }
 
-/// The assembled system with its Krylov solvers configured, and what the solves measured.
+/// The system ready to be solved on the ranks (factored, or its Krylov solver configured),
+/// with what the run's instants keep on it.
 pub struct Prepared<'p> {
+    route: Route<'p>,
+    instants: Instants,
     layout: Layout,
-    system: System<'p>,
-    fields: Fields,
-    /// The options in force.
+    /// The options in force (the Krylov route), or the factorisation's description.
     options: String,
-    /// Wall time of the preconditioners' set-up, s.
-    t_pc: f64,
-    /// Krylov iterations, and the last solve's reason.
-    krylov: usize,
-    reason: String,
-    /// The instant's contact boundary ([`Backend::prime`]).
-    boundary: Option<ContactBoundary>,
-    /// The last contact solve's solution, until its fields are taken.
-    x: Option<Vector<'p>>,
+}
+
+/// How `K` is solved on the ranks.
+enum Route<'p> {
+    /// MUMPS' factorisation (runs with contact).
+    Direct(Box<Direct<'p>>),
+    /// Krylov solves with algebraic multigrid (runs without contact).
+    Krylov(Box<Krylov<'p>>),
+}
+
+impl<'p> Route<'p> {
+    fn factorization(&mut self) -> &mut dyn Factorization {
+        match self {
+            Route::Direct(d) => &mut **d,
+            Route::Krylov(k) => &mut **k,
+        }
+    }
 }
 
 impl<'p> Backend for DistributedMemory<'p> {
@@ -129,7 +152,16 @@ impl<'p> Backend for DistributedMemory<'p> {
 
     fn assemble(&mut self, posed: &Posed<'_>) -> Result<Assembled<'p>, DistributedError> {
         let layout = Layout::new(self.petsc, &posed.setup.mesh, &posed.disc.dofs)?;
-        let system = assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?;
+        let system = match direct_route(posed) {
+            true => None,
+            false => Some(assemble(
+                self.petsc,
+                posed.disc,
+                &layout,
+                &posed.loads.b_u,
+                &posed.loads.b_phi,
+            )?),
+        };
         Ok(Assembled { layout, system })
     }
 
@@ -137,62 +169,68 @@ impl<'p> Backend for DistributedMemory<'p> {
         &mut self,
         posed: &Posed<'_>,
         Assembled { layout, system }: Assembled<'p>,
-        _: Option<&ContactBoundary>,
+        boundary: Option<&ContactBoundary>,
         _: problem::Limits,
-        _: &mut dyn Reporter,
+        reporter: &mut dyn Reporter,
     ) -> Result<Prepared<'p>, DistributedError> {
-        if posed.bed.is_some() {
-            // a compliant bed is refused by supports(); a body only it holds is refused here too
-            let feature = "a body that only its compliant bed holds (the springs that hold it in K)";
-            return Err(ProblemError::from(Unsupported::new("petsc", "contact.compliance", feature)).into());
-        }
-        let options = configure(self.petsc, &posed.scene, posed.setup, &layout)?;
-        let fields = Fields::new(self.petsc, posed.setup, &layout);
+        let (route, options) = match system {
+            None => {
+                let chosen = match boundary {
+                    Some(cb) if posed.plan().linear_strategy.is_condensed() => cb.condensed_dofs(),
+                    _ => vec![],
+                };
+                let springs = match (posed.bed, boundary) {
+                    (Some(bed), Some(cb)) => cb.normal_springs(bed.stiffness),
+                    _ => vec![],
+                };
+                let k = chosen.len();
+                let direct = Direct::new(self.petsc, posed.disc, &layout, &springs, chosen)?;
+                reporter.event(&Event::Factored {
+                    seconds: direct.seconds,
+                });
+                let options = format!(
+                    "MUMPS (L D Lᵀ on {} ranks, its own C interface), the Schur complement of {k} contact dofs",
+                    self.petsc.size()
+                );
+                (Route::Direct(Box::new(direct)), options)
+            }
+            Some(system) => {
+                let options = configure(self.petsc, &posed.scene, &layout)?;
+                let fields = KrylovFields::new(self.petsc, posed.setup, &layout);
+                let krylov = Krylov::new(self.petsc, posed.disc, &layout, system, fields);
+                (Route::Krylov(Box::new(krylov)), options)
+            }
+        };
         Ok(Prepared {
+            route,
+            instants: Instants::default(),
             layout,
-            system,
-            fields,
             options,
-            t_pc: 0.0,
-            krylov: 0,
-            reason: String::new(),
-            boundary: None,
-            x: None,
         })
     }
 
-    /// Nothing is kept from instant to instant: each solve is on the whole system (a path's
-    /// parts are refused, as `supports` refuses a path).
     fn begin(
         &mut self,
-        _: &mut Prepared<'p>,
-        _: &Posed<'_>,
-        _: Option<Contact<'_>>,
-        parts: &[Free],
-        _: &mut dyn Reporter,
-    ) -> Result<Vec<Free>, DistributedError> {
-        match parts.is_empty() {
-            true => Ok(vec![]),
-            false => Err(ProblemError::from(crate::supports::path_unsupported()).into()),
-        }
+        s: &mut Prepared<'p>,
+        posed: &Posed<'_>,
+        contact: Option<Contact<'_>>,
+        parts: &[Fields],
+        reporter: &mut dyn Reporter,
+    ) -> Result<Vec<Fields>, DistributedError> {
+        let f = s.route.factorization();
+        Ok(s.instants.begin(f, posed, contact, parts, reporter)?)
     }
 
-    fn respond(&mut self, _: &mut Prepared<'p>, _: &[f64], _: &[f64]) -> Result<Free, DistributedError> {
-        Err(ProblemError::from(crate::supports::path_unsupported()).into())
+    fn respond(&mut self, s: &mut Prepared<'p>, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, DistributedError> {
+        Ok(Instants::respond(s.route.factorization(), a_u, a_phi)?)
     }
 
-    /// The instant's boundary, kept for its active sets (its loads are the assembled ones: a
-    /// path's factors and a bed's springs are refused).
     fn prime(&mut self, s: &mut Prepared<'p>, primed: Primed<'_>) -> Result<(), DistributedError> {
-        if primed.factors.is_some() {
-            return Err(ProblemError::from(crate::supports::path_unsupported()).into());
-        }
-        s.boundary = Some(primed.framed.boundary.clone());
-        Ok(())
+        Ok(s.instants.prime(s.route.factorization(), primed)?)
     }
 
-    /// The active-set iteration over the distributed system, each step one Krylov solve (a
-    /// tangent of a contact point held by a Dirichlet condition refused by name).
+    /// The default backend's contact solvers on the condensed problem, on every rank (each
+    /// holds it whole, and they find the same solution).
     fn solve_posed(
         &mut self,
         s: &mut Prepared<'p>,
@@ -200,43 +238,14 @@ impl<'p> Backend for DistributedMemory<'p> {
         at: At<'_>,
         reporter: &mut dyn Reporter,
     ) -> Result<contact::ContactSolution, DistributedError> {
-        let boundary = s.boundary.as_ref().ok_or_else(unprimed)?;
-        refuse_held_tangent(how.scene, boundary)?;
-        let rows = ContactRows::new(self.petsc, at.points, &boundary.nodes, &s.layout, &s.system);
-        let params = ActiveSetParams {
-            tol: how.tol,
-            max_steps: MAX_ACTIVE_SET_STEPS,
-        };
-        let tol = how.tol;
-        let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
-        let mut solve_one = krylov_solve(self.petsc, &s.fields, &mut s.t_pc);
-        let out = active_set(
-            self.petsc,
-            &s.layout,
-            &s.system,
-            &rows,
-            &how.law,
-            params,
-            &mut solve_one,
-            &mut progress,
-        )
-        .map_err(|e| match e {
-            ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
-            other => DistributedError::Contact(other),
-        })?;
-        drop(solve_one);
-        (s.krylov, s.reason) = (out.krylov_iterations, out.reason);
-        s.report_krylov(reporter);
-        s.x = Some(out.x);
-        Ok(out.solution)
+        Ok(s.instants.solve(s.route.factorization(), how, at, reporter)?)
     }
 
-    fn own_scale(&self, _: &Prepared<'p>, _: &[f64]) -> f64 {
-        0.0
+    fn own_scale(&self, s: &Prepared<'p>, factors: &[f64]) -> f64 {
+        s.instants.own_scale(factors)
     }
 
-    /// One Krylov solve without contact; with contact, the contact solve's solution. Its
-    /// equilibrium residual (collective), then the solution gathered on rank 0.
+    /// The instant's fields, whole on every rank.
     fn instant_fields(
         &mut self,
         s: &mut Prepared<'p>,
@@ -244,115 +253,265 @@ impl<'p> Backend for DistributedMemory<'p> {
         contact: Option<InstantOf<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<Option<InstantSolution>, DistributedError> {
-        let (x, contact) = match contact {
-            None => {
-                let mut x = s.system.rhs.duplicate()?;
-                (s.krylov, s.reason) =
-                    krylov_solve(self.petsc, &s.fields, &mut s.t_pc)(&mut s.system.matrix, &s.system.rhs, &mut x)?;
-                s.report_krylov(reporter);
-                (x, None)
-            }
-            Some(InstantOf { framed, sol, .. }) => {
-                let x = s.x.take().ok_or_else(unprimed)?;
-                (x, Some((framed.boundary.clone(), sol)))
-            }
-        };
-        let equilibrium = residual(&s.system, &x, contact.as_ref(), &s.layout, self.petsc)?;
-        let Some(gathered) = x.gather()? else {
-            return Ok(None);
-        };
-        Ok(Some(InstantSolution {
-            x: unpermute(posed.disc, &s.layout, &gathered),
-            contact: contact.map(|(_, sol)| sol),
-            equilibrium,
-            pcg_iters: 0,
-        }))
+        let x = s.instants.fields(s.route.factorization(), posed, contact, reporter)?;
+        if let Route::Krylov(k) = &s.route {
+            k.report(reporter);
+        }
+        Ok(Some(x))
     }
 
     /// The PETSc section of the report (collective).
     fn finish(&mut self, s: Prepared<'p>) -> Result<Figures, DistributedError> {
         let petsc = self.petsc;
-        let (nonzeros, _) = s.system.matrix.local_info()?;
-        let nonzeros = petsc.sum(&[nonzeros])?[0];
         let cells_per_rank = per_rank(petsc, &s.layout)?;
+        let unknowns_per_rank = (0..petsc.size()).map(|r| s.layout.owned(r).len()).collect();
+        let (nonzeros, krylov, reason, setup, factor_bytes) = match &s.route {
+            Route::Krylov(k) => {
+                let (nonzeros, _) = k.system.matrix.local_info()?;
+                let nonzeros = petsc.sum(&[nonzeros])?[0];
+                (nonzeros, k.iterations, k.reason.clone(), k.t_pc, 0)
+            }
+            Route::Direct(d) => (
+                0.0,
+                0,
+                "direct (MUMPS)".to_owned(),
+                d.seconds,
+                d.factor_bytes() as usize,
+            ),
+        };
         let report = PetscReport {
             ranks: petsc.size(),
             unknowns: s.layout.n_global(),
             nonzeros,
-            krylov_iterations: s.krylov,
-            reason: s.reason,
+            krylov_iterations: krylov,
+            reason,
             options: s.options,
             cells_per_rank,
-            unknowns_per_rank: (0..petsc.size()).map(|r| s.layout.owned(r).len()).collect(),
+            unknowns_per_rank,
             peak_bytes_per_rank: vec![],
-            preconditioner_setup_s: s.t_pc,
+            preconditioner_setup_s: setup,
         };
         Ok(Figures {
-            factor_seconds: s.t_pc,
+            factor_seconds: setup,
+            condense: s.instants.condense,
+            refinement_steps: s.instants.refinement,
+            factor_bytes,
             petsc: Some(report),
             ..Figures::default()
         })
     }
 }
 
-/// A step out of the run's order (a solve before the instant was posed).
-fn unprimed() -> DistributedError {
-    ProblemError::NoSolution {
-        sought: "the contact solve",
-        why: "the backend was asked for an instant it was not given (prime comes first)".into(),
-    }
-    .into()
+/// Whether the run factors `K` by MUMPS ([`crate::factors_directly`]).
+fn direct_route(posed: &Posed<'_>) -> bool {
+    crate::factors_directly(&posed.scene)
 }
 
-impl Prepared<'_> {
+/// The Krylov route: the parallel matrix, its solver (set up once, at the first solve), and the
+/// map between the free unknowns and the layout's rows.
+pub(crate) struct Krylov<'p> {
+    petsc: &'p Petsc,
+    system: System<'p>,
+    fields: KrylovFields,
+    ksp: Option<Ksp<'p>>,
+    /// Each global row's free unknown in `[u; φ]` (the potentials' rows negated), or `None`
+    /// for a prescribed one.
+    free_of_row: Vec<Option<usize>>,
+    /// This rank's rows.
+    owned: std::ops::Range<usize>,
+    n_u: usize,
+    /// Wall time of the preconditioner's set-up, s; Krylov iterations and the last reason.
+    t_pc: f64,
+    iterations: usize,
+    reason: String,
+}
+
+impl<'p> Krylov<'p> {
+    fn new(
+        petsc: &'p Petsc,
+        disc: &Discretization<'_>,
+        layout: &Layout,
+        system: System<'p>,
+        fields: KrylovFields,
+    ) -> Self {
+        let d = &disc.dofs;
+        let mut free_of_row = vec![None; layout.n_global()];
+        for v in 0..layout.first.len() {
+            let f = layout.first[v];
+            for k in 0..layout.dim {
+                if let Dof::Free(j) = d.u[v * layout.dim + k] {
+                    free_of_row[f + k] = Some(j);
+                }
+            }
+            if let Dof::Free(j) = d.phi[v] {
+                free_of_row[f + layout.dim] = Some(d.n_u + j);
+            }
+        }
+        Krylov {
+            petsc,
+            system,
+            fields,
+            ksp: None,
+            free_of_row,
+            owned: layout.owned(petsc.rank()),
+            n_u: d.n_u,
+            t_pc: 0.0,
+            iterations: 0,
+            reason: String::new(),
+        }
+    }
+
+    /// This rank's rows of the free vector `v` (`[u; φ]`; prescribed rows 0), the potentials'
+    /// negated where `rhs` (the parallel system's right-hand side is `[b_u; -b_φ]`).
+    fn distributed(&self, v: &[f64], rhs: bool) -> Result<Vector<'p>, PetscError> {
+        let local: Vec<f64> = self
+            .owned
+            .clone()
+            .map(|r| match self.free_of_row[r] {
+                Some(j) if rhs && j >= self.n_u => -v[j],
+                Some(j) => v[j],
+                None => 0.0,
+            })
+            .collect();
+        Vector::from_local(self.petsc, &local)
+    }
+
+    /// A distributed vector in the free unknowns `[u; φ]`, whole on every rank (the
+    /// potentials' rows negated back where `negate`).
+    fn whole(&self, x: &Vector<'p>, negate: bool) -> Result<Vec<f64>, PetscError> {
+        let n = self.free_of_row.len();
+        let mut all = x.gather()?.unwrap_or_else(|| vec![0.0; n]);
+        self.petsc.broadcast(&mut all)?;
+        let mut out = vec![0.0; self.free_of_row.iter().flatten().count()];
+        for (r, j) in self.free_of_row.iter().enumerate() {
+            if let Some(j) = *j {
+                out[j] = if negate && j >= self.n_u { -all[r] } else { all[r] };
+            }
+        }
+        Ok(out)
+    }
+
+    /// `K⁻¹ b` by the Krylov solver, whole on every rank.
+    fn solve_whole(&mut self, b: &[f64]) -> Result<Vec<f64>, PetscError> {
+        let rhs = self.distributed(b, true)?;
+        let mut x = rhs.duplicate()?;
+        if self.ksp.is_none() {
+            let t = Instant::now();
+            self.ksp = Some(self.fields.krylov(self.petsc, &mut self.system.matrix)?);
+            self.t_pc += t.elapsed().as_secs_f64();
+        }
+        let ksp = self
+            .ksp
+            .as_mut()
+            .ok_or_else(|| PetscError::Argument("no Krylov solver".into()))?;
+        let info = ksp.solve(&rhs, &mut x)?;
+        (self.iterations, self.reason) = (info.iterations, info.reason);
+        self.whole(&x, false)
+    }
+
     /// Reports the last Krylov solve's figures.
-    fn report_krylov(&self, reporter: &mut dyn Reporter) {
+    fn report(&self, reporter: &mut dyn Reporter) {
         reporter.event(&Event::Krylov {
-            iterations: self.krylov,
+            iterations: self.iterations,
             reason: &self.reason,
             setup_seconds: self.t_pc,
         });
     }
 }
 
-/// One Krylov solve with the options in force, the preconditioner's set-up time added to
-/// `t_pc`.
-fn krylov_solve<'a, 'p: 'a>(
-    petsc: &'p Petsc,
-    fields: &'a Fields,
-    t_pc: &'a mut f64,
-) -> impl FnMut(&mut Matrix<'p>, &Vector<'p>, &mut Vector<'p>) -> Result<(usize, String), PetscError> + 'a {
-    move |m, b, x| {
-        let t = Instant::now();
-        let mut ksp = fields.krylov(petsc, m)?;
-        *t_pc += t.elapsed().as_secs_f64();
-        let info = ksp.solve(b, x)?;
-        Ok((info.iterations, info.reason))
+/// A PETSc error among the problem's.
+fn problem(e: PetscError) -> ProblemError {
+    ProblemError::NoSolution {
+        sought: "the Krylov solve on the ranks",
+        why: e.to_string(),
     }
 }
 
-/// The active sets hold the normal and tangential components of a contact point as unknowns
-/// of the system: a tangent prescribed by a Dirichlet condition is refused, naming its node.
-fn refuse_held_tangent(scene: &Scene, boundary: &ContactBoundary) -> Result<(), ProblemError> {
-    let (Some(node), Some(spec)) = (boundary.first_held_tangent(), scene.active_contact()) else {
-        return Ok(());
-    };
-    // found once the mesh is read (the scene alone does not tell it): the backend's refusal
-    Err(Unsupported::new(
-        "petsc",
-        "contact.group",
-        format!(
-            "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face), and its active sets do not hold a tangent of a contact point",
-            spec.group
-        ),
-    )
-    .advise("the default backend does: remove solver.backend")
-    .into())
+impl Factorization for Krylov<'_> {
+    fn solve(&mut self, b_u: &[f64], b_phi: &[f64]) -> Result<(Fields, usize), ProblemError> {
+        let b: Vec<f64> = b_u.iter().chain(b_phi).copied().collect();
+        let mut x = self.solve_whole(&b).map_err(problem)?;
+        let phi = x.split_off(self.n_u);
+        Ok(((x, phi), 0))
+    }
+
+    fn condense(&mut self, _: &[f64], _: &[f64], _: &[usize]) -> Result<linalg::Condensed, ProblemError> {
+        Err(ProblemError::NoSolution {
+            sought: "the condensation on the ranks",
+            why: "the Krylov route does not condense (a run with contact factors by MUMPS)".into(),
+        })
+    }
+
+    fn solve_with_update(
+        &mut self,
+        _: linalg::CondensedLoads,
+        _: &[f64],
+        _: &[f64],
+        _: &[f64],
+    ) -> Result<Fields, ProblemError> {
+        self.condense(&[], &[], &[]).map(|_| (vec![], vec![]))
+    }
+
+    /// None: the Krylov solver's tolerance is its accuracy.
+    fn refine(&mut self, _: linalg::Rhs<'_>, _: &mut [f64], _: &mut [f64], _: f64) -> Result<usize, ProblemError> {
+        Ok(0)
+    }
+
+    fn equilibrium(&mut self, u: &[f64], phi: &[f64], rhs: linalg::Rhs<'_>) -> Result<f64, ProblemError> {
+        let x: Vec<f64> = u.iter().chain(phi).copied().collect();
+        let b: Vec<f64> = rhs.u.iter().chain(rhs.phi).copied().collect();
+        let run = || -> Result<Vec<f64>, PetscError> {
+            let xd = self.distributed(&x, false)?;
+            let mut r = self.distributed(&b, true)?;
+            let mut kx = r.duplicate()?;
+            self.system.matrix.mult(&xd, &mut kx)?;
+            // r = K x - b, the potentials' rows of both negated alike
+            r.axpy(-1.0, &kx)?;
+            self.whole(&r, true)
+        };
+        let r = run().map_err(problem)?;
+        let (ru, rp) = r.split_at(self.n_u);
+        Ok(linalg::relative_residual(ru, rp, rhs))
+    }
+
+    fn coupled(&mut self) -> Option<&mut dyn linalg::CoupledSolver> {
+        Some(self)
+    }
+
+    fn condenses(&self) -> bool {
+        false
+    }
+}
+
+/// One Krylov solve of the whole system (the paper's Uzawa: one Schur-complement solve per
+/// step, here PETSc's field split with the potentials' Schur complement).
+impl linalg::CoupledSolver for Krylov<'_> {
+    fn solve(
+        &mut self,
+        b_u: &[f64],
+        b_phi: &[f64],
+        u: &mut [f64],
+        phi: &mut [f64],
+    ) -> Result<linalg::SolveInfo, linalg::LinalgError> {
+        let b: Vec<f64> = b_u.iter().chain(b_phi).copied().collect();
+        let x = self
+            .solve_whole(&b)
+            .map_err(|e| linalg::LinalgError::Solver(e.to_string()))?;
+        u.copy_from_slice(&x[..self.n_u]);
+        phi.copy_from_slice(&x[self.n_u..]);
+        Ok(linalg::SolveInfo {
+            pcg_iters: self.iterations,
+        })
+    }
+
+    fn factor_bytes(&self) -> usize {
+        0
+    }
 }
 
 /// Puts the backend's options, then the scene's, into PETSc's database; returns them as one
 /// string.
-fn configure(petsc: &Petsc, scene: &Scene, setup: &Setup, layout: &Layout) -> Result<String, PetscError> {
+fn configure(petsc: &Petsc, scene: &Scene, layout: &Layout) -> Result<String, PetscError> {
     let mut all = if layout.has_phi.iter().any(|&p| p) {
         let mut o = COUPLED_OPTIONS.to_owned();
         if !petsc.has_package("hypre")? {
@@ -362,16 +521,6 @@ fn configure(petsc: &Petsc, scene: &Scene, setup: &Setup, layout: &Layout) -> Re
     } else {
         ELASTIC_OPTIONS.to_owned()
     };
-    if setup.plan.contact_law == ContactLaw::Coulomb && setup.plan.friction && all.starts_with(ELASTIC_OPTIONS) {
-        // Coulomb's slip rows make the system unsymmetric: GMRES instead of CG
-        all.push_str(" -ksp_type gmres -ksp_gmres_restart 200");
-    }
-    if setup.plan.contact_law != ContactLaw::None {
-        // the multipliers are reactions of the Krylov solution: its error bounds the
-        // complementarity residual, which must reach solver.tol
-        let rtol = (1e-2 * setup.plan.tol).min(1e-10);
-        all.push_str(&format!(" -ksp_rtol {rtol:e}"));
-    }
     petsc.insert_options(&all)?;
     if let Some(user) = &scene.solver.petsc_options {
         petsc.insert_options(user)?;
@@ -384,7 +533,7 @@ fn configure(petsc: &Petsc, scene: &Scene, setup: &Setup, layout: &Layout) -> Re
 /// What the Krylov solver needs to know of the unknowns: this rank's rows of the
 /// displacements (with their nodes' coordinates, for the rigid-body modes) and of the
 /// potentials.
-struct Fields {
+struct KrylovFields {
     dim: usize,
     u_rows: Vec<Index>,
     phi_rows: Vec<Index>,
@@ -392,7 +541,7 @@ struct Fields {
     coupled: bool,
 }
 
-impl Fields {
+impl KrylovFields {
     fn new(petsc: &Petsc, setup: &Setup, layout: &Layout) -> Self {
         let dim = layout.dim;
         let (mut u_rows, mut phi_rows, mut coords) = (vec![], vec![], vec![]);
@@ -404,7 +553,7 @@ impl Fields {
                 phi_rows.push((f + dim) as Index);
             }
         }
-        Fields {
+        KrylovFields {
             dim,
             u_rows,
             phi_rows,
@@ -442,61 +591,10 @@ impl Fields {
     }
 }
 
-/// `|K x - b - f_c| / max(|loads|, |f_c|)` over all unknowns, with `f_c` the contact forces
-/// of the multipliers (the prescribed rows hold exactly), as the default backend measures it.
-fn residual(
-    system: &System<'_>,
-    x: &petsc::Vector<'_>,
-    contact: Option<&(ContactBoundary, contact::ContactSolution)>,
-    layout: &Layout,
-    petsc: &Petsc,
-) -> Result<f64, PetscError> {
-    let mut r = system.reactions(x)?;
-    let mut scale = system.load_norm;
-    if let Some((b, sol)) = contact {
-        // the points' forces, each added once, by the rank that owns its node
-        let forces = b.forces(&sol.lambda);
-        scale = scale.max(forces.iter().map(|f| f * f).sum::<f64>().sqrt());
-        let dim = layout.dim;
-        let (mut idx, mut vals) = (vec![], vec![]);
-        for (i, &node) in b.nodes.iter().enumerate() {
-            if layout.node_rank[node] == petsc.rank() {
-                for k in 0..dim {
-                    idx.push((layout.first[node] + k) as Index);
-                    vals.push(-forces[i * dim + k]);
-                }
-            }
-        }
-        r.add_values(&idx, &vals)?;
-        r.assemble()?;
-    }
-    let scale = if scale > 0.0 { scale } else { 1.0 };
-    Ok(r.norm()? / scale)
-}
-
 /// The cells each rank assembled.
 fn per_rank(petsc: &Petsc, layout: &Layout) -> Result<Vec<usize>, PetscError> {
     let mine = layout.cell_rank.iter().filter(|&&r| r == petsc.rank()).count();
     Ok(petsc.all_gather(mine as u64)?.into_iter().map(|c| c as usize).collect())
-}
-
-/// The distributed solution (global order of the layout) as the free unknowns of the
-/// discretisation, `(u, φ)`.
-fn unpermute(disc: &Discretization<'_>, layout: &Layout, x: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let d = &disc.dofs;
-    let (mut u, mut phi) = (vec![0.0; d.n_u], vec![0.0; d.n_phi]);
-    for v in 0..layout.first.len() {
-        let f = layout.first[v];
-        for k in 0..layout.dim {
-            if let Dof::Free(j) = d.u[v * layout.dim + k] {
-                u[j] = x[f + k];
-            }
-        }
-        if let Dof::Free(j) = d.phi[v] {
-            phi[j] = x[f + layout.dim];
-        }
-    }
-    (u, phi)
 }
 
 /// Bytes per unknown on its rank in a run of the PETSc backend: the matrix, its copy for a

@@ -20,10 +20,6 @@ pub enum DriverError {
     #[cfg(feature = "petsc")]
     #[error(transparent)]
     Petsc(#[from] petsc::PetscError),
-    /// The PETSc backend's contact iteration did not converge.
-    #[cfg(feature = "petsc")]
-    #[error("contact: {0}")]
-    ActiveSet(distributed::contact::ActiveSetError),
     /// Another failure of the PETSc backend's run.
     #[cfg(feature = "petsc")]
     #[error(transparent)]

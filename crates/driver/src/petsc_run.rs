@@ -35,10 +35,25 @@ pub fn run_distributed(
         memory_limit,
         ..Default::default()
     };
-    let solved = distributed::solve(scene, mesh, &petsc, limits, reporter).map_err(|e| match e {
+    // a path's steps written by rank 0 as they come, into a set committed at the end
+    let mut writer = match (petsc.rank(), &scene.path) {
+        (0, Some(_)) => Some(output::SetWriter::begin(
+            dir,
+            &output::PathFiles::expected_names(scene),
+        )?),
+        _ => None,
+    };
+    let mut files = output::PathFiles::default();
+    let mut each = |step: problem::Step<'_>| match writer.as_mut() {
+        Some(w) => files.step(&step, w).map_err(|e| problem::ProblemError::NoSolution {
+            sought: "a path's step file",
+            why: e.to_string(),
+        }),
+        None => Ok(()),
+    };
+    let solved = distributed::solve_path(scene, mesh, &petsc, limits, reporter, &mut each).map_err(|e| match e {
         distributed::DistributedError::Problem(p) => DriverError::from(p),
         distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
-        distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),
         other => DriverError::Distributed(other),
     })?;
     let peaks = petsc.all_gather(peak_memory_bytes())?;
@@ -50,6 +65,12 @@ pub fn run_distributed(
     if let Some(p) = solution.report.petsc.as_mut() {
         p.peak_bytes_per_rank = peaks;
     }
-    output::write(&solution, dir)?;
+    match writer {
+        Some(mut w) => {
+            w.write_all(files.finish(&solution)?)?;
+            w.finish()?;
+        }
+        None => output::write(&solution, dir)?,
+    }
     Ok(Some(solution))
 }

@@ -20,6 +20,8 @@ pub enum CondenseRoute {
     TrailingBlock,
     /// Block solves with the factor, 64 right-hand sides at a time.
     BlockSolves,
+    /// Another solver's own Schur complement of the dofs (MUMPS' on the ranks of an MPI run).
+    SchurComplement,
 }
 
 /// `K` condensed onto the dofs `c`.
@@ -162,6 +164,22 @@ impl DirectLdlt {
 }
 
 impl CondensedLoads {
+    /// The loads' part of a condensation that another solver formed (`route`): `solution` at
+    /// `dofs` (its final solve is that solver's own).
+    pub fn formed(solution: Vec<f64>, route: CondenseRoute, dofs: Vec<usize>) -> Self {
+        CondensedLoads {
+            solution,
+            route,
+            dofs,
+            forward: None,
+        }
+    }
+
+    /// The dofs of the condensation.
+    pub fn dofs(&self) -> &[usize] {
+        &self.dofs
+    }
+
     /// The number of condensed dofs.
     pub fn len(&self) -> usize {
         self.dofs.len()

@@ -304,17 +304,50 @@ pub fn refine(
     tol: f64,
     max_steps: usize,
 ) -> Result<Refined, LinalgError> {
-    let Rhs { u: b_u, phi: b_phi, .. } = rhs;
-    let measure = |u: &[f64], phi: &[f64]| equilibrium_residual(k, u, phi, rhs);
-    let mut residual = measure(u, phi);
+    refine_by(&mut Blockwise { solver, k, rhs }, u, phi, tol, max_steps)
+}
+
+/// What iterative refinement asks of a system and its solver ([`refine_by`]), for a system
+/// held otherwise than by blocks in memory (on the ranks of an MPI run, say).
+pub trait Refinable {
+    /// The error of its products and solves.
+    type Error;
+    /// The equilibrium residual of `x` ([`equilibrium_residual`]'s measure).
+    ///
+    /// # Errors
+    /// The system's.
+    fn measure(&mut self, u: &[f64], phi: &[f64]) -> Result<f64, Self::Error>;
+    /// `b - K x`.
+    ///
+    /// # Errors
+    /// The system's.
+    fn minus_k_x(&mut self, u: &[f64], phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
+    /// `K⁻¹ r` with the factors.
+    ///
+    /// # Errors
+    /// The solver's.
+    fn correction(&mut self, r_u: &[f64], r_phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
+}
+
+/// [`refine`]'s iteration on any [`Refinable`] system.
+///
+/// # Errors
+/// The system's.
+pub fn refine_by<R: Refinable + ?Sized>(
+    system: &mut R,
+    u: &mut [f64],
+    phi: &mut [f64],
+    tol: f64,
+    max_steps: usize,
+) -> Result<Refined, R::Error> {
+    let mut residual = system.measure(u, phi)?;
     let mut steps = 0;
     while steps < max_steps && residual > tol && residual.is_finite() {
-        let (ru, rp) = minus_k_x(k, u, phi, b_u, b_phi);
-        let (mut du, mut dp) = (vec![0.0; u.len()], vec![0.0; phi.len()]);
-        solver.solve(&ru, &rp, &mut du, &mut dp)?;
+        let (ru, rp) = system.minus_k_x(u, phi)?;
+        let (du, dp) = system.correction(&ru, &rp)?;
         let nu: Vec<f64> = u.iter().zip(&du).map(|(a, b)| a + b).collect();
         let np: Vec<f64> = phi.iter().zip(&dp).map(|(a, b)| a + b).collect();
-        let after = measure(&nu, &np);
+        let after = system.measure(&nu, &np)?;
         if !(after < residual) {
             break;
         }
@@ -330,23 +363,55 @@ pub fn refine(
     Ok(Refined { steps, residual })
 }
 
+/// The blocks in memory and a solver, as [`refine`] refines with them.
+struct Blockwise<'a, 'k> {
+    solver: &'a mut dyn CoupledSolver,
+    k: CoupledBlocks<'k>,
+    rhs: Rhs<'k>,
+}
+
+impl Refinable for Blockwise<'_, '_> {
+    type Error = LinalgError;
+
+    fn measure(&mut self, u: &[f64], phi: &[f64]) -> Result<f64, LinalgError> {
+        Ok(equilibrium_residual(self.k, u, phi, self.rhs))
+    }
+
+    fn minus_k_x(&mut self, u: &[f64], phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), LinalgError> {
+        Ok(minus_k_x(self.k, u, phi, self.rhs.u, self.rhs.phi))
+    }
+
+    fn correction(&mut self, r_u: &[f64], r_phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), LinalgError> {
+        let (mut du, mut dp) = (vec![0.0; r_u.len()], vec![0.0; r_phi.len()]);
+        self.solver.solve(r_u, r_phi, &mut du, &mut dp)?;
+        Ok((du, dp))
+    }
+}
+
 /// `‖K x - b‖₂ / max(‖b‖₂, scale)` from the blocks (`‖K x - b‖₂` when both are 0). `scale`
 /// is the size of the parts `b` is made of, for a `b` whose parts cancel (loads balanced by
 /// contact forces: `‖b‖` then says nothing of the error's size). The norms are scaled, so the
 /// residual is the same for data of any magnitude.
 pub fn equilibrium_residual(k: CoupledBlocks<'_>, u: &[f64], phi: &[f64], rhs: Rhs<'_>) -> f64 {
     let CoupledBlocks { a, g, b } = k;
-    let Rhs {
-        u: b_u,
-        phi: b_phi,
-        scale,
-    } = rhs;
+    let Rhs { u: b_u, phi: b_phi, .. } = rhs;
     let mut ru: Vec<f64> = b_u.iter().map(|x| -x).collect();
     mul_add(a.as_ref(), u, &mut ru, 1.0);
     mul_t_add(g.as_ref(), phi, &mut ru, 1.0);
     let mut rp: Vec<f64> = b_phi.iter().map(|x| -x).collect();
     mul_add(g.as_ref(), u, &mut rp, 1.0);
     mul_add(b.as_ref(), phi, &mut rp, -1.0);
+    relative_residual(&ru, &rp, rhs)
+}
+
+/// `‖r‖₂ / max(‖b‖₂, scale)` (`‖r‖₂` when both are 0), `r = (r_u, r_φ)` a residual of `K x = b`
+/// ([`equilibrium_residual`]'s measure, for a residual formed elsewhere).
+pub fn relative_residual(ru: &[f64], rp: &[f64], rhs: Rhs<'_>) -> f64 {
+    let Rhs {
+        u: b_u,
+        phi: b_phi,
+        scale,
+    } = rhs;
     let both = |a: &[f64], b: &[f64]| {
         let s = crate::pcg::dot(a, a) + crate::pcg::dot(b, b);
         if s > 1e-290 && s < 1e290 {
@@ -355,7 +420,7 @@ pub fn equilibrium_residual(k: CoupledBlocks<'_>, u: &[f64], phi: &[f64], rhs: R
             crate::pcg::norm(a).hypot(crate::pcg::norm(b))
         }
     };
-    let num = both(&ru, &rp);
+    let num = both(ru, rp);
     let den = both(b_u, b_phi).max(scale);
     if den > 0.0 {
         num / den

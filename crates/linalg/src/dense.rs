@@ -102,6 +102,35 @@ pub(crate) fn symmetric_row_major(m: &faer::Mat<f64>) -> Vec<f64> {
     out
 }
 
+/// The inverse of the symmetric, nonsingular `k x k` matrix `a` (row-major), row-major: by
+/// Cholesky where `a` is positive definite, else by LU with partial pivoting (a quasi-definite
+/// Schur complement, say, whose potentials' block is negative); symmetric to the last bit (its
+/// lower half mirrored).
+///
+/// # Errors
+/// [`crate::LinalgError::NonFinite`] where the inverse is not finite (a singular `a`).
+pub fn symmetric_inverse(a: &[f64], k: usize) -> Result<Vec<f64>, crate::LinalgError> {
+    use faer::linalg::solvers::DenseSolveCore;
+    let m = faer::Mat::<f64>::from_fn(k, k, |i, j| a[i * k + j]);
+    let inv = match m.llt(faer::Side::Lower) {
+        Ok(llt) => llt.inverse(),
+        Err(_) => m.partial_piv_lu().inverse(),
+    };
+    let mut out = vec![0.0; k * k];
+    for i in 0..k {
+        for j in 0..=i {
+            out[i * k + j] = inv[(i, j)];
+        }
+    }
+    if out.iter().any(|v| !v.is_finite()) {
+        return Err(crate::LinalgError::NonFinite {
+            what: "the inverse of a dense symmetric matrix (singular?)".into(),
+        });
+    }
+    mirror_lower(&mut out, k);
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -157,5 +186,24 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `a · a⁻¹ = I` for a definite and an indefinite (quasi-definite) matrix, and a singular
+    /// one refused.
+    #[test]
+    fn the_symmetric_inverse_inverts_definite_and_indefinite_matrices() {
+        let definite = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0];
+        let indefinite = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, -2.0];
+        for a in [definite, indefinite] {
+            let inv = super::symmetric_inverse(&a, 3).unwrap();
+            for i in 0..3 {
+                for j in 0..3 {
+                    let p: f64 = (0..3).map(|l| a[i * 3 + l] * inv[l * 3 + j]).sum();
+                    assert!((p - f64::from(u8::from(i == j))).abs() < 1e-14, "({i}, {j}): {p}");
+                    assert_eq!(inv[i * 3 + j], inv[j * 3 + i]);
+                }
+            }
+        }
+        assert!(super::symmetric_inverse(&[1.0, 1.0, 1.0, 1.0], 2).is_err());
     }
 }

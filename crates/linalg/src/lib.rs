@@ -46,10 +46,10 @@ mod values;
 
 pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{
-    equilibrium_residual, refine, CoupledBlocks, CoupledSolver, DirectLdlt, FactorPreconditioner, Refined, Rhs,
-    SchurOperator, SchurPcg, SolveInfo,
+    equilibrium_residual, refine, refine_by, relative_residual, CoupledBlocks, CoupledSolver, DirectLdlt,
+    FactorPreconditioner, Refinable, Refined, Rhs, SchurOperator, SchurPcg, SolveInfo,
 };
-pub use dense::mirror_lower;
+pub use dense::{mirror_lower, symmetric_inverse};
 pub use factor::{pool_par, FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};
 
@@ -110,6 +110,10 @@ pub enum LinalgError {
         /// Bytes allowed.
         budget: usize,
     },
+    /// A solver outside this crate failed (one implementing [`CoupledSolver`] on the ranks
+    /// of an MPI run, say), in its own words.
+    #[error("{0}")]
+    Solver(String),
     /// Sizes that do not fit.
     #[error("shape mismatch: {0}")]
     Shape(#[from] ShapeError),

@@ -138,6 +138,7 @@ impl<'p> Mumps<'p> {
             let k = self.schur_list.len();
             id.icntl[18] = 1; // ICNTL(19): the Schur complement whole on the host, by rows
             id.size_schur = fortran_index(k)?;
+            id.schur_lld = fortran_index(k)?;
             id.listvar_schur = self.schur_list.as_mut_ptr();
             if self.petsc.rank() == 0 {
                 self.schur = vec![0.0; k * k];
@@ -164,22 +165,18 @@ impl<'p> Mumps<'p> {
         Err(last)
     }
 
-    /// A symmetric factorisation returns one triangle of the Schur complement: the other is
-    /// filled from it.
+    /// A symmetric factorisation returns the Schur complement's lower triangle, and of the
+    /// upper one only what its fronts happened to hold (measured: whole blocks of it left
+    /// unset above a few hundred unknowns): the upper triangle is taken from the lower.
     fn symmetrise_schur(&mut self) {
         let k = self.schur_list.len();
         if self.id.sym == 0 || self.schur.len() != k * k {
             return;
         }
         let s = &mut self.schur;
-        let upper_empty = (0..k).all(|i| (i + 1..k).all(|j| s[i * k + j] == 0.0));
         for i in 0..k {
             for j in i + 1..k {
-                if upper_empty {
-                    s[i * k + j] = s[j * k + i];
-                } else {
-                    s[j * k + i] = s[i * k + j];
-                }
+                s[i * k + j] = s[j * k + i];
             }
         }
     }
@@ -230,7 +227,9 @@ impl<'p> Mumps<'p> {
     }
 
     /// The backward half: with `rhs` as [`Mumps::condense`] left it and `x_s` the chosen
-    /// unknowns' solution (rank 0's), `rhs` becomes the whole solution on rank 0. Collective.
+    /// unknowns' solution (rank 0's), `rhs` becomes the whole solution on rank 0. MUMPS keeps
+    /// the forward half inside itself for one expansion: it must follow its condensation, with
+    /// no other solve between (else MUMPS' `INFOG(1) = -35`). Collective.
     ///
     /// # Errors
     /// MUMPS' errors; arguments of the wrong length.
@@ -350,6 +349,7 @@ fn meaning(info: i32, detail: i32) -> String {
         -10 => "the matrix is numerically singular (a body or a potential not held?)".into(),
         -16 => format!("the order {detail} is out of range"),
         -17 | -20 | -22 => "an argument of the solve was invalid".into(),
+        -35 => "an expansion without the condensation just before it".into(),
         _ => "see MUMPS' users' guide, section 8".into(),
     }
 }

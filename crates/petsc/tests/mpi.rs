@@ -190,9 +190,9 @@ fn a_grid_graph_is_split_in_balanced_connected_halves() {
 
 /// The entries `(i, j, v)` of a quasi-definite matrix of order `k² + k`: the grid Laplacian
 /// on the first `k²` unknowns, `-I - 0.1 L₁` (a 1D Laplacian) on the last `k`, coupled by
-/// `0.3` between unknown `k² + i` and grid vertex `i (k + 1)`. Symmetric and indefinite, as
-/// the piezoelectric system is.
-fn quasi_definite(k: usize) -> (usize, Vec<(usize, usize, f64)>) {
+/// `0.3` between unknown `k² + i` and grid vertex `i (k + 1)`, the last block's diagonal
+/// `last`: negative, symmetric and indefinite as the piezoelectric system is; positive, definite.
+fn quasi_definite(k: usize, last: f64) -> (usize, Vec<(usize, usize, f64)>) {
     let (n1, n) = (k * k, k * k + k);
     let mut e = vec![];
     for r in 0..n1 {
@@ -203,7 +203,7 @@ fn quasi_definite(k: usize) -> (usize, Vec<(usize, usize, f64)>) {
     }
     for i in 0..k {
         let r = n1 + i;
-        e.push((r, r, -1.2));
+        e.push((r, r, last));
         if i + 1 < k {
             e.push((r, r + 1, 0.1));
             e.push((r + 1, r, 0.1));
@@ -248,15 +248,8 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
         2,
         |p| {
             let k = 9;
-            let (n, entries) = quasi_definite(k);
-            let mut dense = vec![0.0; n * n];
-            for &(i, j, v) in &entries {
-                dense[i * n + j] += v;
-            }
-            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
-            let exact = dense_solve(n, dense.clone(), b.clone());
             // every entry given by one rank, the diagonal's in halves by both (MUMPS sums them)
-            let mine = |symmetric: bool| {
+            let mine = |entries: &[(usize, usize, f64)], symmetric: bool| {
                 let (mut r, mut c, mut v) = (vec![], vec![], vec![]);
                 for (e, &(i, j, x)) in entries.iter().enumerate() {
                     if symmetric && i < j {
@@ -277,8 +270,16 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
             };
             // the chosen unknowns: three grid vertices and two of the last block
             let chosen = [3, 40, 77, k * k + 1, k * k + 5];
-            for symmetry in [Symmetry::Indefinite, Symmetry::General] {
-                let (r, c, v) = mine(symmetry != Symmetry::General);
+            for symmetry in [Symmetry::Indefinite, Symmetry::General, Symmetry::Definite] {
+                let last = if symmetry == Symmetry::Definite { 1.2 } else { -1.2 };
+                let (n, entries) = quasi_definite(k, last);
+                let mut dense = vec![0.0; n * n];
+                for &(i, j, v) in &entries {
+                    dense[i * n + j] += v;
+                }
+                let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
+                let exact = dense_solve(n, dense.clone(), b.clone());
+                let (r, c, v) = mine(&entries, symmetry != Symmetry::General);
                 // without a Schur complement: one solve
                 let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), symmetry, &[]).unwrap();
                 let mut x = if p.rank() == 0 { b.clone() } else { vec![] };
@@ -297,6 +298,13 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
                     None => vec![],
                 };
                 m.expand(&mut rhs, &x_s).unwrap();
+                // MUMPS keeps a condensation's forward half inside itself for the expansion
+                // that follows it: a second expansion is refused, typed
+                let mut again = rhs.clone();
+                match m.expand(&mut again, &x_s) {
+                    Err(PetscError::Mumps { info: -35, .. }) => {}
+                    other => panic!("a second expansion: {:?}", other.map(|_| ())),
+                }
                 if p.rank() == 0 {
                     let s = s.expect("rank 0 holds the Schur complement");
                     // S is symmetric, and its inverse is the chosen block of K's inverse
@@ -321,6 +329,31 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
                     assert!(err < 1e-12, "{symmetry:?}: the solve in two halves is off by {err:.2e}");
                 } else {
                     assert!(s.is_none() && reduced.is_empty());
+                }
+            }
+            // a Schur complement of hundreds of unknowns (MUMPS fills its upper triangle only in
+            // part): its inverse is the chosen block of K's inverse, K's columns by MUMPS alone
+            let k = 30;
+            let (n, entries) = quasi_definite(k, -1.2);
+            let (r, c, v) = mine(&entries, true);
+            let chosen: Vec<usize> = (0..n).filter(|i| i % 2 == 0).collect();
+            let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), Symmetry::Indefinite, &[]).unwrap();
+            let m = Mumps::factor(p, n, (&r, &c, v), Symmetry::Indefinite, &chosen).unwrap();
+            let ks = chosen.len();
+            for jj in [0, ks / 3, ks - 1] {
+                let mut col = vec![0.0; n];
+                col[chosen[jj]] = 1.0;
+                plain.solve(&mut col).unwrap();
+                if let Some(s) = m.schur_complement() {
+                    let mut unit = vec![0.0; ks];
+                    unit[jj] = 1.0;
+                    let inv = dense_solve(ks, s.to_vec(), unit);
+                    for (ii, &i) in chosen.iter().enumerate() {
+                        assert!(
+                            (inv[ii] - col[i]).abs() < 1e-12,
+                            "a large Schur complement: ({ii}, {jj})"
+                        );
+                    }
                 }
             }
             // a singular matrix: MUMPS' error, typed

@@ -84,7 +84,7 @@ pub use factorization::Factorization;
 pub use fe_assembly::CellFields;
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
 pub use instants::Instants;
-pub use path::{run, PathSolution, Step, StepFields};
+pub use path::{run, run_steps, PathSolution, Step, StepFields};
 pub use plan::{Output, Plan};
 pub use progress::{Event, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};

@@ -87,6 +87,23 @@ pub fn run<B: Backend>(
     walk(backend, scene, mesh, limits, reporter, false, &mut |_| Ok(()))
 }
 
+/// [`run`], each instant (one for a static scene) handed to `each` with its fields where they
+/// were computed: for a backend outside this crate whose run writes a path's files as it goes
+/// (as [`crate::solve_path`] does for the default one).
+///
+/// # Errors
+/// As [`run`]; the error `each` returns.
+pub fn run_steps<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    limits: Limits,
+    reporter: &mut dyn Reporter,
+    each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+) -> Result<Option<Solution>, B::Error> {
+    walk(backend, scene, mesh, limits, reporter, true, each)
+}
+
 /// The run of `scene` on `backend` ([`run`], [`crate::solve_path`]): validate, refuse
 /// what the backend does not take, set up (the memory estimate checked first), discretise,
 /// assemble, build the contact boundary, prepare (factor), then each instant (one for a
