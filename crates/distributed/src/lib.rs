@@ -34,8 +34,12 @@
 
 mod supports;
 
-pub use supports::{direct as factors_directly, supports};
+pub use supports::{active_sets_hold, direct as factors_directly, supports};
 
+#[cfg(feature = "petsc")]
+mod active;
+#[cfg(feature = "petsc")]
+pub mod contact;
 #[cfg(feature = "petsc")]
 mod direct;
 #[cfg(feature = "petsc")]
@@ -46,10 +50,13 @@ mod run;
 pub mod system;
 
 #[cfg(feature = "petsc")]
+pub use active::MAX_ACTIVE_SET_STEPS;
+#[cfg(feature = "petsc")]
 pub use direct::Direct;
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
 pub use run::{
-    solve, solve_path, Assembled, DistributedError, DistributedMemory, Prepared, COUPLED_OPTIONS, ELASTIC_OPTIONS,
+    solve, solve_path, solve_with, Assembled, ContactRoute, DistributedError, DistributedMemory, Prepared,
+    COUPLED_OPTIONS, ELASTIC_OPTIONS,
 };

@@ -27,6 +27,9 @@ pub enum DistributedError {
     /// PETSc, MPI or MUMPS.
     #[error(transparent)]
     Petsc(#[from] PetscError),
+    /// The active sets (the Krylov route's contact) did not converge.
+    #[error("contact: {0}")]
+    Contact(crate::contact::ActiveSetError),
 }
 
 impl From<fe_assembly::AssemblyError> for DistributedError {
@@ -91,8 +94,42 @@ pub fn solve_path(
     reporter: &mut dyn Reporter,
     each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
 ) -> Result<Option<Solution>, DistributedError> {
-    let solution = problem::run_steps(&mut DistributedMemory { petsc }, scene, mesh, limits, reporter, each)?;
+    let mut backend = DistributedMemory {
+        petsc,
+        limits,
+        contact: ContactRoute::Auto,
+    };
+    solve_with(&mut backend, scene, mesh, reporter, each)
+}
+
+/// [`solve_path`] on `backend` (its limits, its contact route).
+///
+/// # Errors
+/// As [`solve`]; the error `each` returns.
+pub fn solve_with(
+    backend: &mut DistributedMemory<'_>,
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+    reporter: &mut dyn Reporter,
+    each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+) -> Result<Option<Solution>, DistributedError> {
+    let (petsc, limits) = (backend.petsc, backend.limits);
+    let solution = problem::run_steps(backend, scene, mesh, limits, reporter, each)?;
     Ok(solution.filter(|_| petsc.rank() == 0))
+}
+
+/// How a run with contact solves it on the ranks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ContactRoute {
+    /// MUMPS' condensed route where its factorisation fits the memory of a rank, else the
+    /// Krylov route's active sets where they hold the scene.
+    #[default]
+    Auto,
+    /// MUMPS' condensed route (every law).
+    Condensed,
+    /// The Krylov route's active sets (the paper's base model on one zone; other scenes
+    /// refused by key).
+    ActiveSets,
 }
 
 /// The backend named for its role: the ranks of an MPI run, each its own memory
@@ -100,6 +137,45 @@ pub fn solve_path(
 pub struct DistributedMemory<'p> {
     /// PETSc, initialised on the ranks of the run.
     pub petsc: &'p Petsc,
+    /// What each rank may use (the route is chosen by it: MUMPS where its factorisation fits,
+    /// else the Krylov route's active sets where they hold the scene).
+    pub limits: problem::Limits,
+    /// How a run with contact solves it.
+    pub contact: ContactRoute,
+}
+
+impl DistributedMemory<'_> {
+    /// Whether a run of `scene` factors `K` by MUMPS ([`crate::factors_directly`]), unless the
+    /// factorisation's estimate per rank exceeds the memory each rank may use and the Krylov
+    /// route's active sets hold the scene ([`crate::active_sets_hold`]).
+    fn direct_route(&self, scene: &Scene) -> bool {
+        let held = || crate::active_sets_hold(scene).is_ok();
+        crate::factors_directly(scene)
+            && match self.contact {
+                ContactRoute::Auto => !(self.direct_too_large(scene) && held()),
+                ContactRoute::Condensed => true,
+                ContactRoute::ActiveSets => !held(),
+            }
+    }
+
+    /// Whether MUMPS' factorisation, estimated as the default backend's run shared among the
+    /// ranks, exceeds the memory of a rank.
+    fn direct_too_large(&self, scene: &Scene) -> bool {
+        match (self.limits.memory_bytes, direct_estimate(scene, self.petsc.size())) {
+            (Some(limit), Some((bytes, _))) => bytes > limit as f64,
+            _ => false,
+        }
+    }
+}
+
+/// The default backend's estimate of its run's peak (the factor, the dense compliance) shared
+/// among `ranks`: MUMPS' factorisation on them.
+fn direct_estimate(scene: &Scene, ranks: usize) -> Option<(f64, String)> {
+    let (bytes, what) = Backend::estimate(&problem::SharedMemory, scene)?;
+    Some((
+        bytes / ranks.max(1) as f64,
+        format!("on each of {ranks} ranks, its share of MUMPS' factorisation: {what}"),
+    ))
 }
 
 /// The cells laid out over the ranks, and (the Krylov route) the system assembled on them.
@@ -122,11 +198,20 @@ pub struct Prepared<'p> {
 enum Route<'p> {
     /// MUMPS' factorisation (runs with contact).
     Direct(Box<Direct<'p>>),
-    /// Krylov solves with algebraic multigrid (runs without contact).
+    /// Krylov solves with algebraic multigrid (runs without contact; with contact, the active
+    /// sets, where MUMPS would not fit).
     Krylov(Box<Krylov<'p>>),
 }
 
 impl<'p> Route<'p> {
+    /// The Krylov route's active sets, where its run has contact.
+    fn active(&mut self) -> Option<&mut crate::active::ActiveSets<'p>> {
+        match self {
+            Route::Krylov(k) => k.active.as_mut(),
+            Route::Direct(_) => None,
+        }
+    }
+
     fn factorization(&mut self) -> &mut dyn Factorization {
         match self {
             Route::Direct(d) => &mut **d,
@@ -143,16 +228,23 @@ impl<'p> Backend for DistributedMemory<'p> {
     const HELD_TO_TOLERANCE: bool = false;
 
     fn supports(&self, scene: &Scene) -> Result<(), Unsupported> {
-        crate::supports(scene)
+        crate::supports(scene)?;
+        match self.contact {
+            ContactRoute::ActiveSets if !scene.zones().is_empty() => crate::active_sets_hold(scene),
+            _ => Ok(()),
+        }
     }
 
     fn estimate(&self, scene: &Scene) -> Option<(f64, String)> {
-        per_rank_estimate(scene, self.petsc.size())
+        match self.direct_route(scene) {
+            true => direct_estimate(scene, self.petsc.size()),
+            false => per_rank_estimate(scene, self.petsc.size()),
+        }
     }
 
     fn assemble(&mut self, posed: &Posed<'_>) -> Result<Assembled<'p>, DistributedError> {
         let layout = Layout::new(self.petsc, &posed.setup.mesh, &posed.disc.dofs)?;
-        let system = match direct_route(posed) {
+        let system = match self.direct_route(&posed.scene) {
             true => None,
             false => Some(assemble(
                 self.petsc,
@@ -189,15 +281,19 @@ impl<'p> Backend for DistributedMemory<'p> {
                     seconds: direct.seconds,
                 });
                 let options = format!(
-                    "MUMPS (L D Lᵀ on {} ranks, its own C interface), the Schur complement of {k} contact dofs",
-                    self.petsc.size()
+                    "MUMPS (L D Lᵀ on {} ranks, its own C interface; the default backend's nested dissection), the Schur complement of {k} contact dofs; {:.3e} flops, {:.3e} bytes of factors",
+                    self.petsc.size(),
+                    direct.factor_flops(),
+                    direct.factor_bytes()
                 );
                 (Route::Direct(Box::new(direct)), options)
             }
             Some(system) => {
-                let options = configure(self.petsc, &posed.scene, &layout)?;
+                let contact = boundary.is_some();
+                let options = configure(self.petsc, &posed.scene, &layout, contact.then_some(posed.plan().tol))?;
                 let fields = KrylovFields::new(self.petsc, posed.setup, &layout);
-                let krylov = Krylov::new(self.petsc, posed.disc, &layout, system, fields);
+                let mut krylov = Krylov::new(self.petsc, posed.disc, &layout, system, fields);
+                krylov.active = contact.then(crate::active::ActiveSets::default);
                 (Route::Krylov(Box::new(krylov)), options)
             }
         };
@@ -217,6 +313,9 @@ impl<'p> Backend for DistributedMemory<'p> {
         parts: &[Fields],
         reporter: &mut dyn Reporter,
     ) -> Result<Vec<Fields>, DistributedError> {
+        if let Some(active) = s.route.active() {
+            return active.begin(parts);
+        }
         let f = s.route.factorization();
         Ok(s.instants.begin(f, posed, contact, parts, reporter)?)
     }
@@ -226,11 +325,14 @@ impl<'p> Backend for DistributedMemory<'p> {
     }
 
     fn prime(&mut self, s: &mut Prepared<'p>, primed: Primed<'_>) -> Result<(), DistributedError> {
+        if let Some(active) = s.route.active() {
+            return active.prime(primed);
+        }
         Ok(s.instants.prime(s.route.factorization(), primed)?)
     }
 
     /// The default backend's contact solvers on the condensed problem, on every rank (each
-    /// holds it whole, and they find the same solution).
+    /// holds it whole, and they find the same solution); on the Krylov route, its active sets.
     fn solve_posed(
         &mut self,
         s: &mut Prepared<'p>,
@@ -238,6 +340,11 @@ impl<'p> Backend for DistributedMemory<'p> {
         at: At<'_>,
         reporter: &mut dyn Reporter,
     ) -> Result<contact::ContactSolution, DistributedError> {
+        if let Route::Krylov(k) = &mut s.route {
+            if k.active.is_some() {
+                return crate::active::solve(self.petsc, &s.layout, k, how, at, reporter);
+            }
+        }
         Ok(s.instants.solve(s.route.factorization(), how, at, reporter)?)
     }
 
@@ -253,6 +360,11 @@ impl<'p> Backend for DistributedMemory<'p> {
         contact: Option<InstantOf<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<Option<InstantSolution>, DistributedError> {
+        if let (Route::Krylov(k), Some(of)) = (&mut s.route, contact.as_ref()) {
+            if k.active.is_some() {
+                return crate::active::fields(k, &s.layout, posed, of).map(Some);
+            }
+        }
         let x = s.instants.fields(s.route.factorization(), posed, contact, reporter)?;
         if let Route::Krylov(k) = &s.route {
             k.report(reporter);
@@ -302,18 +414,15 @@ impl<'p> Backend for DistributedMemory<'p> {
     }
 }
 
-/// Whether the run factors `K` by MUMPS ([`crate::factors_directly`]).
-fn direct_route(posed: &Posed<'_>) -> bool {
-    crate::factors_directly(&posed.scene)
-}
-
 /// The Krylov route: the parallel matrix, its solver (set up once, at the first solve), and the
 /// map between the free unknowns and the layout's rows.
 pub(crate) struct Krylov<'p> {
-    petsc: &'p Petsc,
-    system: System<'p>,
-    fields: KrylovFields,
+    pub(crate) petsc: &'p Petsc,
+    pub(crate) system: System<'p>,
+    pub(crate) fields: KrylovFields,
     ksp: Option<Ksp<'p>>,
+    /// The active sets of a run with contact on this route.
+    pub(crate) active: Option<crate::active::ActiveSets<'p>>,
     /// Each global row's free unknown in `[u; φ]` (the potentials' rows negated), or `None`
     /// for a prescribed one.
     free_of_row: Vec<Option<usize>>,
@@ -321,9 +430,9 @@ pub(crate) struct Krylov<'p> {
     owned: std::ops::Range<usize>,
     n_u: usize,
     /// Wall time of the preconditioner's set-up, s; Krylov iterations and the last reason.
-    t_pc: f64,
-    iterations: usize,
-    reason: String,
+    pub(crate) t_pc: f64,
+    pub(crate) iterations: usize,
+    pub(crate) reason: String,
 }
 
 impl<'p> Krylov<'p> {
@@ -352,6 +461,7 @@ impl<'p> Krylov<'p> {
             system,
             fields,
             ksp: None,
+            active: None,
             free_of_row,
             owned: layout.owned(petsc.rank()),
             n_u: d.n_u,
@@ -378,7 +488,7 @@ impl<'p> Krylov<'p> {
 
     /// A distributed vector in the free unknowns `[u; φ]`, whole on every rank (the
     /// potentials' rows negated back where `negate`).
-    fn whole(&self, x: &Vector<'p>, negate: bool) -> Result<Vec<f64>, PetscError> {
+    pub(crate) fn whole(&self, x: &Vector<'p>, negate: bool) -> Result<Vec<f64>, PetscError> {
         let n = self.free_of_row.len();
         let mut all = x.gather()?.unwrap_or_else(|| vec![0.0; n]);
         self.petsc.broadcast(&mut all)?;
@@ -410,7 +520,7 @@ impl<'p> Krylov<'p> {
     }
 
     /// Reports the last Krylov solve's figures.
-    fn report(&self, reporter: &mut dyn Reporter) {
+    pub(crate) fn report(&self, reporter: &mut dyn Reporter) {
         reporter.event(&Event::Krylov {
             iterations: self.iterations,
             reason: &self.reason,
@@ -511,7 +621,7 @@ impl linalg::CoupledSolver for Krylov<'_> {
 
 /// Puts the backend's options, then the scene's, into PETSc's database; returns them as one
 /// string.
-fn configure(petsc: &Petsc, scene: &Scene, layout: &Layout) -> Result<String, PetscError> {
+fn configure(petsc: &Petsc, scene: &Scene, layout: &Layout, contact_tol: Option<f64>) -> Result<String, PetscError> {
     let mut all = if layout.has_phi.iter().any(|&p| p) {
         let mut o = COUPLED_OPTIONS.to_owned();
         if !petsc.has_package("hypre")? {
@@ -521,6 +631,16 @@ fn configure(petsc: &Petsc, scene: &Scene, layout: &Layout) -> Result<String, Pe
     } else {
         ELASTIC_OPTIONS.to_owned()
     };
+    if let Some(tol) = contact_tol {
+        if all.starts_with(ELASTIC_OPTIONS) {
+            // Coulomb's slip rows make the system unsymmetric: GMRES instead of CG
+            all.push_str(" -ksp_type gmres -ksp_gmres_restart 200");
+        }
+        // the multipliers are reactions of the Krylov solution: its error bounds the
+        // complementarity residual, which must reach solver.tol
+        let rtol = (1e-2 * tol).min(1e-10);
+        all.push_str(&format!(" -ksp_rtol {rtol:e}"));
+    }
     petsc.insert_options(&all)?;
     if let Some(user) = &scene.solver.petsc_options {
         petsc.insert_options(user)?;
@@ -533,7 +653,7 @@ fn configure(petsc: &Petsc, scene: &Scene, layout: &Layout) -> Result<String, Pe
 /// What the Krylov solver needs to know of the unknowns: this rank's rows of the
 /// displacements (with their nodes' coordinates, for the rigid-body modes) and of the
 /// potentials.
-struct KrylovFields {
+pub(crate) struct KrylovFields {
     dim: usize,
     u_rows: Vec<Index>,
     phi_rows: Vec<Index>,
@@ -565,7 +685,7 @@ impl KrylovFields {
     /// The Krylov solver for `matrix`, configured from the options database, with the fields
     /// (displacements with their rigid-body modes, potentials) named for a field split, and
     /// its preconditioner built.
-    fn krylov<'p>(&self, petsc: &'p Petsc, matrix: &mut Matrix<'p>) -> Result<Ksp<'p>, PetscError> {
+    pub(crate) fn krylov<'p>(&self, petsc: &'p Petsc, matrix: &mut Matrix<'p>) -> Result<Ksp<'p>, PetscError> {
         if !self.coupled {
             // the matrix's own near null space (its rows are the nodes' displacements, in order)
             matrix.set_rigid_body_modes(self.dim, &self.coords)?;

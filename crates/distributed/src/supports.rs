@@ -6,9 +6,14 @@
 //! solves every scene the default backend solves: every law, path, indenter, terminal and
 //! strategy. It refuses only a scene that asks for the default backend, and PETSc's options
 //! where the run does not take them ([`direct`]).
+//!
+//! Where MUMPS' factorisation would not fit the ranks' memory, a run whose contact the Krylov
+//! route's active sets hold ([`active_sets_hold`]: the paper's base model on one zone) takes
+//! that route instead: Krylov solves on the whole system, no factorisation, no dense
+//! compliance (`paper-3d` at n = 64, 2.2 million unknowns, on this machine).
 
 use problem::backend::Unsupported;
-use problem::{BackendChoice, Scene, Strategy};
+use problem::{BackendChoice, ContactSpec, Rule, Scene, Strategy};
 
 const BACKEND: &str = "petsc";
 
@@ -51,4 +56,72 @@ pub fn direct(scene: &Scene) -> bool {
     let floating =
         scene.dirichlet.iter().any(|d| d.charge.is_some()) || scene.electrodes().iter().any(|e| e.charge.is_some());
     contact || floating || scene.mesh.axisymmetric
+}
+
+/// Whether the Krylov route's active sets hold `scene`'s contact (`Err`: the first thing they
+/// lack, by key): Signorini's conditions with Coulomb or Tresca friction on one insulating,
+/// rigid, flat or indenting zone whose normal is a coordinate axis, at one instant, with a
+/// given depth and prescribed potentials, on plane and 3D bodies, with Newton's strategy and
+/// the tight rule. The route a run takes where MUMPS would not fit.
+///
+/// # Errors
+/// [`Unsupported`] naming the key.
+pub fn active_sets_hold(scene: &Scene) -> Result<(), Unsupported> {
+    let lacks = |key: &str, feature: &str| {
+        Err(Unsupported::new(
+            BACKEND,
+            key,
+            format!("{feature}, which the active sets do not hold"),
+        ))
+    };
+    let zones = scene.zones();
+    if zones.len() > 1 {
+        return lacks("contact", "several [[contact]] zones");
+    }
+    if scene.mesh.axisymmetric {
+        return lacks("mesh.axisymmetric", "a body of revolution");
+    }
+    if scene.dirichlet.iter().any(|d| d.charge.is_some()) || scene.electrodes().iter().any(|e| e.charge.is_some()) {
+        return lacks("dirichlet.charge", "a floating terminal");
+    }
+    if scene.path.is_some() {
+        return lacks("path", "a load path");
+    }
+    if scene.solver.strategy != Strategy::NewtonCondensed {
+        return lacks("solver.strategy", "a strategy other than Newton's");
+    }
+    if scene.solver.rule != Rule::Tight {
+        return lacks("solver.rule", "the paper's stopping rule");
+    }
+    zones.into_iter().try_for_each(zone_held)
+}
+
+/// What one contact zone asks for that the active sets do not hold.
+fn zone_held(c: &ContactSpec) -> Result<(), Unsupported> {
+    let lacks = |key: &str, feature: String| {
+        Err(Unsupported::new(
+            BACKEND,
+            key,
+            format!("{feature}, which the active sets do not hold"),
+        ))
+    };
+    if c.indenter.as_ref().is_some_and(|i| i.force.is_some()) {
+        return lacks("contact.indenter.force", "force control".into());
+    }
+    if c.compliance.is_some() {
+        return lacks("contact.compliance", "a deformable foundation".into());
+    }
+    if c.slip_weakening().is_some() {
+        return lacks("contact.friction_law", "slip-weakening friction".into());
+    }
+    if let Some(condition) = c.electric.filter(|_| c.electric_law().is_some()) {
+        return lacks("contact.electric", format!("contact.electric = \"{condition}\""));
+    }
+    if c.normal.iter().filter(|&&x| x != 0.0).count() != 1 {
+        return lacks(
+            "contact.normal",
+            format!("contact.normal = {:?}, an oblique face", c.normal),
+        );
+    }
+    Ok(())
 }

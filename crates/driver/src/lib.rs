@@ -20,6 +20,10 @@ pub enum DriverError {
     #[cfg(feature = "petsc")]
     #[error(transparent)]
     Petsc(#[from] petsc::PetscError),
+    /// The PETSc backend's active sets (its Krylov route's contact) did not converge.
+    #[cfg(feature = "petsc")]
+    #[error("contact: {0}")]
+    ActiveSet(distributed::contact::ActiveSetError),
     /// Another failure of the PETSc backend's run.
     #[cfg(feature = "petsc")]
     #[error(transparent)]

@@ -54,6 +54,7 @@ pub fn run_distributed(
     let solved = distributed::solve_path(scene, mesh, &petsc, limits, reporter, &mut each).map_err(|e| match e {
         distributed::DistributedError::Problem(p) => DriverError::from(p),
         distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
+        distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),
         other => DriverError::Distributed(other),
     })?;
     let peaks = petsc.all_gather(peak_memory_bytes())?;

@@ -187,6 +187,79 @@ fn every_shipped_scene_on_two_ranks_agrees_with_the_default_backend() {
     );
 }
 
+/// Contact cases of the paper's base model: every law, stick and slip zones, 2D and 3D (where
+/// the slip direction turns), separation (the actuator's lift-off), an elastic body, a Tresca
+/// bound along the zone.
+const ACTIVE_SET_CASES: &[(&str, &[&str])] = &[
+    ("paper", &["mesh.n=32"]),
+    ("paper-slip", &["mesh.n=32"]),
+    ("paper-tresca", &["mesh.n=32"]),
+    (
+        "paper-tresca",
+        &[
+            "mesh.n=32",
+            "~contact.slip_bound",
+            "contact.slip_bound_profile={along=[1.0,0.0],at=[0.0,2.0],value=[0.01,0.1]}",
+        ],
+    ),
+    ("paper-frictionless", &["mesh.n=32"]),
+    ("paper-3d", &["mesh.n=6"]),
+    ("paper-3d", &["mesh.n=6", "contact.friction=0.1"]),
+    ("actuator", &[]),
+    ("paper-elastic", &["mesh.n=32"]),
+];
+
+/// The Krylov route's active sets (taken where MUMPS' factorisation would not fit the memory
+/// of a rank; asked for here by the library's `ContactRoute`) give the default backend's
+/// answers on the base model, and refuse by key what they do not hold.
+fn agree_on_active_sets(petsc: &Petsc) {
+    let mut backend = distributed::DistributedMemory {
+        petsc,
+        limits: problem::Limits::default(),
+        contact: distributed::ContactRoute::ActiveSets,
+    };
+    for (name, sets) in ACTIVE_SET_CASES {
+        let (faer, scene) = both(name, sets, &[]);
+        let dist = distributed::solve_with(&mut backend, &scene, None, &mut problem::Silent, &mut |_| Ok(()))
+            .unwrap_or_else(|e| panic!("{name} {sets:?}: the PETSc run: {e}"));
+        let Some(dist) = dist else { continue };
+        let report = dist.report.petsc.as_ref().expect("the PETSc section");
+        assert!(!report.options.contains("MUMPS"), "{name}: {}", report.options);
+        let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+        let (d, what) = farthest(&direct, &dist);
+        eprintln!(
+            "{name} {sets:?}: {} Krylov iterations, farthest {what} at {d:.1e}",
+            report.krylov_iterations
+        );
+        assert!(d < 1e-7, "{name} {sets:?}: {what} differs by {d:.2e}");
+        assert!(dist.report.residuals.complementarity <= scene.solver.tol);
+    }
+    // a law they do not hold: refused by its key
+    let (_, scene) = both("paper-compliance", &["mesh.n=32"], &[]);
+    let e = distributed::solve_with(&mut backend, &scene, None, &mut problem::Silent, &mut |_| Ok(()))
+        .map(|_| ())
+        .unwrap_err();
+    assert!(e.to_string().contains("contact.compliance"), "{e}");
+}
+
+#[test]
+fn the_active_sets_agree_with_the_default_backend_on_one_rank() {
+    on_ranks(
+        "the_active_sets_agree_with_the_default_backend_on_one_rank",
+        1,
+        agree_on_active_sets,
+    );
+}
+
+#[test]
+fn the_active_sets_agree_with_the_default_backend_on_two_ranks() {
+    on_ranks(
+        "the_active_sets_agree_with_the_default_backend_on_two_ranks",
+        2,
+        agree_on_active_sets,
+    );
+}
+
 fn agree(petsc: &Petsc) {
     for (name, sets) in CASES {
         let (faer, scene) = both(name, sets, &[]);

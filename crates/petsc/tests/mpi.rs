@@ -281,7 +281,7 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
                 let exact = dense_solve(n, dense.clone(), b.clone());
                 let (r, c, v) = mine(&entries, symmetry != Symmetry::General);
                 // without a Schur complement: one solve
-                let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), symmetry, &[]).unwrap();
+                let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), symmetry, &[], None).unwrap();
                 let mut x = if p.rank() == 0 { b.clone() } else { vec![] };
                 plain.solve(&mut x).unwrap();
                 if p.rank() == 0 {
@@ -289,7 +289,7 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
                     assert!(err < 1e-12, "{symmetry:?}: the solve is off by {err:.2e}");
                 }
                 // with one: S, the condensed right-hand side, the expansion
-                let mut m = Mumps::factor(p, n, (&r, &c, v), symmetry, &chosen).unwrap();
+                let mut m = Mumps::factor(p, n, (&r, &c, v), symmetry, &chosen, None).unwrap();
                 let mut rhs = if p.rank() == 0 { b.clone() } else { vec![] };
                 let reduced = m.condense(&mut rhs).unwrap();
                 let s = m.schur_complement().map(<[f64]>::to_vec);
@@ -337,8 +337,11 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
             let (n, entries) = quasi_definite(k, -1.2);
             let (r, c, v) = mine(&entries, true);
             let chosen: Vec<usize> = (0..n).filter(|i| i % 2 == 0).collect();
-            let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), Symmetry::Indefinite, &[]).unwrap();
-            let m = Mumps::factor(p, n, (&r, &c, v), Symmetry::Indefinite, &chosen).unwrap();
+            // a pivot order given (the others first, reversed; the chosen last)
+            let mut order: Vec<usize> = (0..n).rev().filter(|i| i % 2 == 1).collect();
+            order.extend(&chosen);
+            let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), Symmetry::Indefinite, &[], None).unwrap();
+            let m = Mumps::factor(p, n, (&r, &c, v), Symmetry::Indefinite, &chosen, Some(&order)).unwrap();
             let ks = chosen.len();
             for jj in [0, ks / 3, ks - 1] {
                 let mut col = vec![0.0; n];
@@ -359,7 +362,7 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
             // a singular matrix: MUMPS' error, typed
             let (r, c) = (vec![0, 1], vec![0, 1]);
             let v = if p.rank() == 0 { vec![1.0, 0.0] } else { vec![0.0, 0.0] };
-            match Mumps::factor(p, 2, (&r, &c, v), Symmetry::General, &[]) {
+            match Mumps::factor(p, 2, (&r, &c, v), Symmetry::General, &[], None) {
                 Err(PetscError::Mumps { info: -10, .. }) => {}
                 Err(other) => panic!("expected MUMPS' singular matrix, got {other}"),
                 Ok(_) => panic!("a singular matrix was factored"),

@@ -1,0 +1,179 @@
+//! The Krylov route's contact, where MUMPS' factorisation would not fit the ranks' memory: the
+//! primal-dual active set iteration on the whole system ([`crate::contact::active_set`]), each
+//! step one Krylov solve, no factorisation and no dense compliance. It holds the paper's base
+//! model on one zone ([`crate::active_sets_hold`] chooses it); its steps here are the
+//! backend's `begin`, `prime`, `solve_posed` and `instant_fields` on that route.
+
+use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
+use crate::layout::Layout;
+use crate::run::{DistributedError, Krylov};
+use crate::system::System;
+use petsc::{Index, Petsc, PetscError, Vector};
+use problem::backend::{At, ContactBoundary, ContactSolve, Fields, InstantOf, InstantSolution, Posed, Primed};
+use problem::{Event, ProblemError, Reporter, Scene};
+
+/// Steps of the active-set iteration at most.
+pub const MAX_ACTIVE_SET_STEPS: usize = 60;
+
+/// The instant's boundary and the last contact solve's solution, until its fields are taken.
+#[derive(Default)]
+pub struct ActiveSets<'p> {
+    boundary: Option<ContactBoundary>,
+    x: Option<Vector<'p>>,
+}
+
+impl ActiveSets<'_> {
+    /// Nothing is kept from instant to instant (the route is taken by one instant's runs).
+    pub(crate) fn begin(&mut self, parts: &[Fields]) -> Result<Vec<Fields>, DistributedError> {
+        match parts.is_empty() {
+            true => Ok(vec![]),
+            false => Err(path_refused()),
+        }
+    }
+
+    /// The instant's boundary, kept for its active sets.
+    pub(crate) fn prime(&mut self, primed: Primed<'_>) -> Result<(), DistributedError> {
+        if primed.factors.is_some() {
+            return Err(path_refused());
+        }
+        self.boundary = Some(primed.framed.boundary.clone());
+        Ok(())
+    }
+}
+
+/// The active-set iteration over the distributed system, each step one Krylov solve (a
+/// tangent of a contact point held by a Dirichlet condition refused by name).
+pub(crate) fn solve<'p>(
+    petsc: &'p Petsc,
+    layout: &Layout,
+    k: &mut Krylov<'p>,
+    how: &ContactSolve<'_>,
+    at: At<'_>,
+    reporter: &mut dyn Reporter,
+) -> Result<contact::ContactSolution, DistributedError> {
+    let active = k.active.as_mut().ok_or_else(unprimed)?;
+    let boundary = active.boundary.as_ref().ok_or_else(unprimed)?;
+    refuse_held_tangent(how.scene, boundary)?;
+    let rows = ContactRows::new(petsc, at.points, &boundary.nodes, layout, &k.system);
+    let params = ActiveSetParams {
+        tol: how.tol,
+        max_steps: MAX_ACTIVE_SET_STEPS,
+    };
+    let tol = how.tol;
+    let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+    let (fields, t_pc) = (&k.fields, &mut k.t_pc);
+    let mut solve_one = |m: &mut petsc::Matrix<'p>, b: &Vector<'p>, x: &mut Vector<'p>| {
+        let t = std::time::Instant::now();
+        let mut ksp = fields.krylov(petsc, m)?;
+        *t_pc += t.elapsed().as_secs_f64();
+        let info = ksp.solve(b, x)?;
+        Ok((info.iterations, info.reason))
+    };
+    let out = active_set(
+        petsc,
+        layout,
+        &k.system,
+        &rows,
+        &how.law,
+        params,
+        &mut solve_one,
+        &mut progress,
+    )
+    .map_err(|e| match e {
+        ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+        other => DistributedError::Contact(other),
+    })?;
+    (k.iterations, k.reason) = (out.krylov_iterations, out.reason);
+    k.report(reporter);
+    if let Some(active) = k.active.as_mut() {
+        active.x = Some(out.x);
+    }
+    Ok(out.solution)
+}
+
+/// The contact solve's solution, whole on every rank, with its equilibrium residual
+/// (collective).
+pub(crate) fn fields(
+    k: &mut Krylov<'_>,
+    layout: &Layout,
+    posed: &Posed<'_>,
+    InstantOf { framed, sol, .. }: &InstantOf<'_>,
+) -> Result<InstantSolution, DistributedError> {
+    let x = k.active.as_mut().and_then(|a| a.x.take()).ok_or_else(unprimed)?;
+    let equilibrium = residual(&k.system, &x, (framed.boundary, sol), layout, k.petsc)?;
+    let mut free = k.whole(&x, false)?;
+    let phi = free.split_off(posed.disc.dofs.n_u);
+    Ok(InstantSolution {
+        x: (free, phi),
+        contact: Some(sol.clone()),
+        equilibrium,
+        pcg_iters: 0,
+    })
+}
+
+/// `|K x - b - f_c| / max(|loads|, |f_c|)` over all unknowns, with `f_c` the contact forces of
+/// the multipliers (the prescribed rows hold exactly), as the default backend measures it.
+fn residual(
+    system: &System<'_>,
+    x: &Vector<'_>,
+    (b, sol): (&ContactBoundary, &contact::ContactSolution),
+    layout: &Layout,
+    petsc: &Petsc,
+) -> Result<f64, PetscError> {
+    let mut r = system.reactions(x)?;
+    // the points' forces, each added once, by the rank that owns its node
+    let forces = b.forces(&sol.lambda);
+    let scale = system.load_norm.max(forces.iter().map(|f| f * f).sum::<f64>().sqrt());
+    let dim = layout.dim;
+    let (mut idx, mut vals) = (vec![], vec![]);
+    for (i, &node) in b.nodes.iter().enumerate() {
+        if layout.node_rank[node] == petsc.rank() {
+            for c in 0..dim {
+                idx.push((layout.first[node] + c) as Index);
+                vals.push(-forces[i * dim + c]);
+            }
+        }
+    }
+    r.add_values(&idx, &vals)?;
+    r.assemble()?;
+    let scale = if scale > 0.0 { scale } else { 1.0 };
+    Ok(r.norm()? / scale)
+}
+
+/// The active sets hold the normal and tangential components of a contact point as unknowns
+/// of the system: a tangent prescribed by a Dirichlet condition is refused, naming its node.
+fn refuse_held_tangent(scene: &Scene, boundary: &ContactBoundary) -> Result<(), ProblemError> {
+    let (Some(node), Some(spec)) = (boundary.first_held_tangent(), scene.active_contact()) else {
+        return Ok(());
+    };
+    // found once the mesh is read (the scene alone does not tell it): the route's refusal
+    Err(problem::backend::Unsupported::new(
+        "petsc",
+        "contact.group",
+        format!(
+            "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face), and the active sets (the route taken where MUMPS' factorisation would not fit the memory) do not hold a tangent of a contact point",
+            spec.group
+        ),
+    )
+    .advise("more memory per rank, or more ranks, for MUMPS' factorisation")
+    .into())
+}
+
+/// A path on the active sets' route (chosen only for one instant: `active_sets_hold`).
+fn path_refused() -> DistributedError {
+    ProblemError::from(problem::backend::Unsupported::new(
+        "petsc",
+        "path",
+        "a load path on the active sets' route (taken where MUMPS' factorisation would not fit the memory)",
+    ))
+    .into()
+}
+
+/// A step out of the run's order (a solve before the instant was posed).
+fn unprimed() -> DistributedError {
+    ProblemError::NoSolution {
+        sought: "the contact solve",
+        why: "the backend was asked for an instant it was not given (prime comes first)".into(),
+    }
+    .into()
+}

@@ -1,0 +1,563 @@
+//! Contact on the full system: a primal-dual active set method (Hüeber, Stadler and Wohlmuth,
+//! SIAM J. Sci. Comput. 30 (2008) 572-596; a semismooth Newton method on the natural map),
+//! each step one Krylov solve of the full system with the step's constraints.
+//!
+//! With `z_n = λ_n + c (u_n - g)` and `z_t = λ_t + c u_t` from the last iterate, per point:
+//!
+//! - `z_n ≤ 0`: separated, `λ = 0`;
+//! - `z_n > 0` and `|z_t| ≤ S`: stick, `u_n = g` and `u_t = 0` (the point is held; `λ` is its
+//!   reaction);
+//! - `z_n > 0` and `|z_t| > S`: slip, `u_n = g` and `λ_t = S z_t / |z_t|` (a given force);
+//!
+//! with `S` Tresca's bound, `F max(0, z_n)` for Coulomb, 0 without friction. A held component
+//! is an eliminated row (`MatZeroRowsColumns`), a slip force a load: each step is a linear
+//! problem of the same kind as a run without contact, solved by the same Krylov method. The
+//! multipliers are the reactions, `λ = -Wᵀ⁻¹ (K x - b)` at the points (`W`: the lumped
+//! weights). The method stops when the sets repeat and the complementarity residual of the
+//! contact crate is within the tolerance; for Tresca and Signorini it is Newton's method and
+//! converges in a few steps; for Coulomb the bound follows `z_n` (as in Hüeber, Stadler and
+//! Wohlmuth), the slip direction is the last iterate's.
+//!
+//! The normal must be a coordinate axis (the held components are then unknowns of the
+//! system; the scene's validation says so).
+
+use crate::layout::Layout;
+use crate::system::System;
+use contact::{
+    classify, complementarity_residual, ContactInfo, ContactPoints, ContactSolution, Law, PointValues, Progress, Stage,
+    Status,
+};
+use petsc::{Index, Matrix, Petsc, PetscError, Vector};
+
+/// The active-set iteration's limits.
+#[derive(Clone, Copy, Debug)]
+pub struct ActiveSetParams {
+    /// The complementarity residual to reach.
+    pub tol: f64,
+    /// Steps at most.
+    pub max_steps: usize,
+}
+
+/// The contact points owned by this rank, with their rows.
+#[derive(Clone)]
+pub struct ContactRows<'a> {
+    points: &'a ContactPoints,
+    /// The mesh node of each point.
+    nodes: &'a [usize],
+    /// The points whose node this rank owns.
+    mine: Vec<usize>,
+    /// This rank.
+    rank: usize,
+    /// `c` of the natural map, pressure per length: [`C_START`] times the stiffness scale (the
+    /// mean diagonal of `A` over the mean weight) to begin with, divided by 10 where the sets
+    /// cycle.
+    c: f64,
+}
+
+/// One step's sets: per point, whether it is in contact, and whether held tangentially; and
+/// for a slipping point `κ = S / |z_t| < 1`, the weight of the direction's linearisation.
+#[derive(Clone, Debug)]
+struct Sets {
+    active: Vec<bool>,
+    stick: Vec<bool>,
+    kappa: Vec<f64>,
+}
+
+impl PartialEq for Sets {
+    /// The same sets (κ, a number of the iterate, aside).
+    fn eq(&self, other: &Self) -> bool {
+        self.active == other.active && self.stick == other.stick
+    }
+}
+
+/// What the iteration produced: the multipliers and displacements at the points (every rank),
+/// the final solution vector, counts.
+pub struct ContactOutcome<'p> {
+    /// The contact solution (multipliers, displacements, statuses, counts).
+    pub solution: ContactSolution,
+    /// The solution of the last step.
+    pub x: Vector<'p>,
+    /// Krylov iterations over all steps.
+    pub krylov_iterations: usize,
+    /// The last solve's reason.
+    pub reason: String,
+}
+
+impl<'a> ContactRows<'a> {
+    /// The points of `points` (at the mesh `nodes`) this rank owns under `layout`.
+    pub fn new(
+        petsc: &Petsc,
+        points: &'a ContactPoints,
+        nodes: &'a [usize],
+        layout: &Layout,
+        system: &System<'_>,
+    ) -> Self {
+        let mine = (0..points.len())
+            .filter(|&i| layout.node_rank[nodes[i]] == petsc.rank())
+            .collect();
+        let mean_w = points.weight.iter().sum::<f64>() / points.len().max(1) as f64;
+        ContactRows {
+            points,
+            nodes,
+            mine,
+            rank: petsc.rank(),
+            c: C_START * system.diagonal[0] / mean_w,
+        }
+    }
+}
+
+/// `a · b` over the first `dim` components.
+fn dot(a: &[f64; 3], b: &[f64; 3], dim: usize) -> f64 {
+    (0..dim).map(|k| a[k] * b[k]).sum()
+}
+
+/// The linear solve of one step: matrix, right-hand side, and the initial guess, overwritten
+/// by the solution; returns Krylov iterations and PETSc's reason.
+pub type LinearSolve<'s, 'p> =
+    dyn FnMut(&mut Matrix<'p>, &Vector<'p>, &mut Vector<'p>) -> Result<(usize, String), PetscError> + 's;
+
+/// The iterate: multipliers, point displacements, the solution vector, and the counts.
+struct Iterate<'p> {
+    lambda: PointValues,
+    u: PointValues,
+    x: Vector<'p>,
+    steps: usize,
+    reductions: usize,
+    krylov: usize,
+    reason: String,
+    /// The multiplier scale of the residual, `c |(u_n(0) - g, u_t(0))|_W`.
+    reference: f64,
+}
+
+/// How one run of active-set steps on a law ended.
+enum Ended {
+    /// The law's residual is within the tolerance, the sets repeated.
+    Converged,
+    /// The sets came back to an earlier state (a cycle), or the residual stopped falling; the
+    /// residual then.
+    Cycled(f64),
+}
+
+/// Solves the contact problem by active sets. `solve` solves one linear system. Where the
+/// sets cycle or the residual stops falling, `c` is divided by 10 and the steps go on from
+/// the iterate (at most [`MAX_REDUCTIONS`] times). Collective.
+#[allow(clippy::too_many_arguments)]
+pub fn active_set<'p>(
+    petsc: &'p Petsc,
+    layout: &Layout,
+    system: &System<'p>,
+    rows: &ContactRows<'_>,
+    law: &Law,
+    params: ActiveSetParams,
+    solve: &mut LinearSolve<'_, 'p>,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<ContactOutcome<'p>, ActiveSetError> {
+    let p = rows.points;
+    let (n, nt) = (p.len(), p.n_tangential());
+    // the loads alone: the first iterate, and the residual's multiplier scale
+    let mut x = system.rhs.duplicate()?;
+    let mut k0 = system.matrix.duplicate()?;
+    let (krylov, reason) = solve(&mut k0, &system.rhs, &mut x)?;
+    drop(k0);
+    let u = displacements(petsc, layout, rows, &x)?;
+    let mut gap_u = u.clone();
+    for i in 0..n {
+        gap_u.normal[i] -= p.gap[i];
+    }
+    let reference = rows.c * gap_u.weighted_norm(&p.weight);
+    let mut it = Iterate {
+        lambda: PointValues::zeros(n, nt),
+        u,
+        x,
+        steps: 0,
+        reductions: 0,
+        krylov,
+        reason,
+        reference,
+    };
+    let mut rows = rows.clone();
+    loop {
+        let ctx = Context {
+            petsc,
+            layout,
+            system,
+            rows: &rows,
+        };
+        let residual = match ctx.steps(&mut it, law, params, solve, progress)? {
+            Ended::Converged => return Ok(ctx.outcome(it, law)),
+            Ended::Cycled(r) => r,
+        };
+        if it.reductions == MAX_REDUCTIONS || it.steps >= params.max_steps {
+            return Err(ActiveSetError::NoConvergence {
+                steps: it.steps,
+                residual,
+            });
+        }
+        // a smaller c weighs the multipliers more than the displacements in the sets' tests
+        // (the solution does not depend on c; the default backend's Newton takes c = 1/μ_max,
+        // the inverse of the largest compliance)
+        rows.c /= 10.0;
+        it.reductions += 1;
+        it.reference /= 10.0;
+    }
+}
+
+/// `c`'s first value, in units of the stiffness scale (mean diagonal of `A` over the mean
+/// weight): the diagonal is the stiffness of the stiffest local mode, `1/μ_max` that of the
+/// softest. Measured (2 ranks, steps to round-off): `paper` n = 32 / 128: 6 / 11 steps at 1,
+/// 4 / 4 at 0.1, 4 / 4 at 0.01; `paper-slip`: 4 / 15, 5 / 8, 5 / 8; `paper-3d` n = 8 / 16:
+/// 3 / 4 at 0.1 and 0.01.
+pub const C_START: f64 = 0.1;
+
+/// Divisions of `c` by 10 at most.
+pub const MAX_REDUCTIONS: usize = 6;
+
+/// Steps without a new best residual before the direct iteration counts as stalled.
+const PATIENCE: usize = 8;
+
+/// What every step needs.
+struct Context<'a, 'p> {
+    petsc: &'p Petsc,
+    layout: &'a Layout,
+    system: &'a System<'p>,
+    rows: &'a ContactRows<'a>,
+}
+
+impl<'p> Context<'_, 'p> {
+    /// Active-set steps on `law` from `it` until its residual is within the tolerance and the
+    /// sets repeat, or the sets cycle or stall (reported against `report`'s residual).
+    fn steps(
+        &self,
+        it: &mut Iterate<'p>,
+        law: &Law,
+        params: ActiveSetParams,
+        solve: &mut LinearSolve<'_, 'p>,
+        progress: &mut dyn FnMut(&Progress),
+    ) -> Result<Ended, ActiveSetError> {
+        let p = self.rows.points;
+        let mut seen: Vec<Sets> = vec![];
+        let (mut best, mut since_best) = (f64::INFINITY, 0);
+        while it.steps < params.max_steps {
+            it.steps += 1;
+            let (sets, direction) = sets(self.rows, law, &it.lambda, &it.u);
+            self.step(it, law, &sets, &direction, solve)?;
+            let residual = self.residual(it, law);
+            progress(&Progress {
+                stage: Stage::Newton,
+                iter: it.steps,
+                residual,
+                counts: counts(&classify(&it.lambda, &bound(p, law, &it.lambda.normal))),
+            });
+            let repeated = seen.last() == Some(&sets);
+            if residual <= params.tol && (repeated || residual <= 0.01 * params.tol) {
+                return Ok(Ended::Converged);
+            }
+            if residual < best {
+                (best, since_best) = (residual, 0);
+            } else {
+                since_best += 1;
+            }
+            let cycled = !repeated && seen.iter().rev().skip(1).any(|s| *s == sets);
+            if cycled || since_best >= PATIENCE {
+                return Ok(Ended::Cycled(residual));
+            }
+            seen.push(sets);
+        }
+        Ok(Ended::Cycled(self.residual(it, law)))
+    }
+
+    /// One step: hold the active and sticking components, load the slipping ones, solve.
+    fn step(
+        &self,
+        it: &mut Iterate<'p>,
+        law: &Law,
+        sets: &Sets,
+        direction: &PointValues,
+        solve: &mut LinearSolve<'_, 'p>,
+    ) -> Result<(), PetscError> {
+        let (petsc, layout, system) = (self.petsc, self.layout, self.system);
+        let mut matrix = system.matrix.duplicate()?;
+        let mut b = system.rhs.copy()?;
+        let held = hold(self.rows, layout, law, sets, direction, &mut matrix, &mut b)?;
+        let mut values = Vector::mpi(petsc, layout.owned(petsc.rank()).len())?;
+        set_held_values(layout, petsc.rank(), &held, &mut values)?;
+        let rows_only: Vec<Index> = held.iter().map(|&(r, _)| r).collect();
+        matrix.zero_rows_columns(&rows_only, system.diagonal[0], &values, &mut b)?;
+        let (its, reason) = solve(&mut matrix, &b, &mut it.x)?;
+        it.krylov += its;
+        it.reason = reason;
+        it.u = displacements(petsc, layout, self.rows, &it.x)?;
+        it.lambda = multipliers(petsc, layout, system, self.rows, sets, &it.x)?;
+        Ok(())
+    }
+
+    /// The natural-map residual of `law` at the iterate.
+    fn residual(&self, it: &Iterate<'_>, law: &Law) -> f64 {
+        let p = self.rows.points;
+        let radius = bound(p, law, &it.lambda.normal);
+        complementarity_residual(p, &radius, &it.lambda, &it.u, self.rows.c, it.reference)
+    }
+
+    /// The converged iterate as the contact crate's solution.
+    fn outcome(&self, it: Iterate<'p>, law: &Law) -> ContactOutcome<'p> {
+        let residual = self.residual(&it, law);
+        let status = classify(&it.lambda, &bound(self.rows.points, law, &it.lambda.normal));
+        let info = ContactInfo {
+            newton_iters: it.steps,
+            operator_calls: it.steps + 1,
+            complementarity: residual,
+            residual,
+            augmentation: Some(self.rows.c),
+            ..ContactInfo::new(1.0 / self.rows.c)
+        };
+        ContactOutcome {
+            solution: ContactSolution {
+                lambda: it.lambda,
+                u: it.u,
+                status,
+                info,
+                electric: None,
+            },
+            x: it.x,
+            krylov_iterations: it.krylov,
+            reason: it.reason,
+        }
+    }
+}
+
+/// Why the active-set iteration stopped without an answer.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ActiveSetError {
+    /// PETSc or MPI failed.
+    #[error(transparent)]
+    Petsc(#[from] PetscError),
+    /// The sets did not settle within the step limit.
+    #[error("the active-set iteration did not converge in {steps} steps (complementarity residual {residual:.3e}); for Coulomb friction the sets may cycle: try the default backend, whose Newton has a proximal stage and a Gauss-Seidel fallback")]
+    NoConvergence {
+        /// Steps taken.
+        steps: usize,
+        /// The last residual.
+        residual: f64,
+    },
+}
+
+/// `(stick, slip, separated)` counts.
+fn counts(status: &[Status]) -> (usize, usize, usize) {
+    let c = |s| status.iter().filter(|&&x| x == s).count();
+    (c(Status::Stick), c(Status::Slip), c(Status::Separated))
+}
+
+/// The slip bound of each point for the multipliers' normal part.
+fn bound(p: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f64> {
+    contact::slip_bound(p, law, lambda_n)
+}
+
+/// The step's sets, and the slip direction `d = z_t / |z_t|` of each slipping point (zero
+/// elsewhere).
+fn sets(rows: &ContactRows<'_>, law: &Law, lambda: &PointValues, u: &PointValues) -> (Sets, PointValues) {
+    let p = rows.points;
+    let (n, nt) = (p.len(), p.n_tangential());
+    let c = rows.c;
+    let mut active = vec![false; n];
+    let mut stick = vec![false; n];
+    let mut direction = PointValues::zeros(n, nt);
+    let mut kappa = vec![0.0; n];
+    for i in 0..n {
+        let zn = lambda.normal[i] + c * (u.normal[i] - p.gap[i]);
+        if !(zn > 0.0) {
+            continue;
+        }
+        active[i] = true;
+        let s = match law {
+            Law::Frictionless => 0.0,
+            Law::Tresca(s) => s[i],
+            Law::Coulomb => p.friction[i] * zn,
+        };
+        if nt == 0 || !(s > 0.0) {
+            continue;
+        }
+        let zt: Vec<f64> = (0..nt)
+            .map(|q| lambda.tangential[i * nt + q] + c * u.tangential[i * nt + q])
+            .collect();
+        let norm = mesh::scaled_norm(&zt);
+        if norm <= s {
+            stick[i] = true;
+            continue;
+        }
+        for q in 0..nt {
+            direction.tangential[i * nt + q] = zt[q] / norm;
+        }
+        kappa[i] = s / norm;
+    }
+    (Sets { active, stick, kappa }, direction)
+}
+
+/// Applies the step's conditions to this rank's points: returns the held components as
+/// `(row, value)` (`u_n = g` where active, `u_t = 0` where sticking), and writes the slipping
+/// points' tangential rows as Newton's linearisation of `λ_t = S z_t / |z_t|` at the iterate,
+///
+/// ```text
+/// λ_t = S d + β P u_t,   P = I - d dᵀ,   β = c κ / (1 - κ),   κ = S / |z_t|
+/// ```
+///
+/// (a spring across the slip direction, zero in 2D): Tresca's `S d` as a load (`-w λ_t t`);
+/// Coulomb's `S = F λ_n` with the step's own normal reaction, as the equation
+/// `r_t = F d (n·e)(t·e) r_n` between the reactions `r = K x - b` (the row of `u_t` minus a
+/// multiple of the row of `u_n`). Collective (the matrix and `b` are assembled).
+#[allow(clippy::too_many_arguments)]
+fn hold(
+    rows: &ContactRows<'_>,
+    layout: &Layout,
+    law: &Law,
+    sets: &Sets,
+    direction: &PointValues,
+    matrix: &mut Matrix<'_>,
+    b: &mut Vector<'_>,
+) -> Result<Vec<(Index, f64)>, PetscError> {
+    let p = rows.points;
+    let (dim, nt) = (p.dim, p.n_tangential());
+    let b_local = b.local()?;
+    let start = layout.rank_start[rows.rank];
+    let mut held = vec![];
+    let (mut idx, mut forces) = (vec![], vec![]);
+    let mut new_rows = vec![];
+    for &i in &rows.mine {
+        if !sets.active[i] {
+            continue;
+        }
+        let first = layout.first[rows.nodes[i]];
+        // the normal is an axis: its component holds u_n = g
+        let kn = axis(&p.normal[i], dim);
+        held.push(((first + kn) as Index, p.gap[i] * p.normal[i][kn]));
+        let kt: Vec<usize> = (0..nt).map(|q| axis(&p.tangent[i][q], dim)).collect();
+        if sets.stick[i] {
+            held.extend(kt.iter().map(|&k| ((first + k) as Index, 0.0)));
+            continue;
+        }
+        let d = &direction.tangential[i * nt..(i + 1) * nt];
+        if d.iter().all(|&x| x == 0.0) {
+            continue; // frictionless: the tangential rows stay free
+        }
+        let kappa = sets.kappa[i];
+        let beta = rows.c * kappa / (1.0 - kappa);
+        let w = p.weight[i];
+        let normal_row = match law {
+            Law::Coulomb => Some(matrix.row((first + kn) as Index)?),
+            _ => None,
+        };
+        for q in 0..nt {
+            let rt = (first + kt[q]) as Index;
+            let (cols, mut vals) = matrix.row(rt)?;
+            let sign_t = p.tangent[i][q][kt[q]];
+            match (law, &normal_row) {
+                (Law::Tresca(s), _) => {
+                    idx.push(rt);
+                    forces.push(-w * s[i] * d[q] * sign_t);
+                }
+                (_, Some((cols_n, vn))) => {
+                    debug_assert_eq!(&cols, cols_n, "a node's rows share their columns");
+                    let alpha = p.friction[i] * d[q] * p.normal[i][kn] * sign_t;
+                    for (v, n) in vals.iter_mut().zip(vn) {
+                        *v -= alpha * n;
+                    }
+                    idx.push(rt);
+                    forces.push(-alpha * b_local[first + kn - start]);
+                }
+                _ => {}
+            }
+            // the spring w β P across the slip direction
+            for q2 in 0..nt {
+                let pq = f64::from(u8::from(q == q2)) - d[q] * d[q2];
+                let col = (first + kt[q2]) as Index;
+                if let Ok(at) = cols.binary_search(&col) {
+                    vals[at] += w * beta * sign_t * pq * p.tangent[i][q2][kt[q2]];
+                }
+            }
+            new_rows.push((rt, cols, vals));
+        }
+    }
+    for (rt, cols, vals) in &new_rows {
+        matrix.set_values(&[*rt], cols, vals)?;
+    }
+    matrix.assemble()?;
+    b.add_values(&idx, &forces)?;
+    b.assemble()?;
+    Ok(held)
+}
+
+/// The component along which a unit axis vector points.
+fn axis(v: &[f64; 3], dim: usize) -> usize {
+    (0..dim).max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs())).unwrap_or(0)
+}
+
+/// Writes the held values into this rank's entries of `values`.
+fn set_held_values(
+    layout: &Layout,
+    rank: usize,
+    held: &[(Index, f64)],
+    values: &mut Vector<'_>,
+) -> Result<(), PetscError> {
+    let start = layout.owned(rank).start;
+    values.with_local_mut(|v| {
+        for &(r, x) in held {
+            v[r as usize - start] = x;
+        }
+    })
+}
+
+/// `u_n` and `u_t` at every point (each rank fills its own points; a sum gathers them).
+fn displacements(
+    petsc: &Petsc,
+    layout: &Layout,
+    rows: &ContactRows<'_>,
+    x: &Vector<'_>,
+) -> Result<PointValues, PetscError> {
+    let p = rows.points;
+    let (n, dim, nt) = (p.len(), p.dim, p.n_tangential());
+    let local = x.local()?;
+    let start = layout.owned(petsc.rank()).start;
+    let mut flat = vec![0.0; n * (1 + nt)];
+    for &i in &rows.mine {
+        let first = layout.first[rows.nodes[i]] - start;
+        let ui: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
+        flat[i] = dot(&ui, &p.normal[i], dim);
+        for q in 0..nt {
+            flat[n + i * nt + q] = dot(&ui, &p.tangent[i][q], dim);
+        }
+    }
+    let all = petsc.sum(&flat)?;
+    Ok(PointValues::from_parts(all[..n].to_vec(), all[n..].to_vec(), nt).expect("lengths agree"))
+}
+
+/// The multipliers of the step: the reactions `r = K x - b` of the loads without contact, at
+/// the active points (`λ_n = -(r·n)/w`, `λ_t = -(r·t)/w`: held components, Tresca's load and
+/// Coulomb's equation alike), zero where separated.
+fn multipliers(
+    petsc: &Petsc,
+    layout: &Layout,
+    system: &System<'_>,
+    rows: &ContactRows<'_>,
+    sets: &Sets,
+    x: &Vector<'_>,
+) -> Result<PointValues, PetscError> {
+    let p = rows.points;
+    let (n, dim, nt) = (p.len(), p.dim, p.n_tangential());
+    let local = system.reactions(x)?.local()?;
+    let start = layout.owned(petsc.rank()).start;
+    let mut flat = vec![0.0; n * (1 + nt)];
+    for &i in &rows.mine {
+        if !sets.active[i] {
+            continue;
+        }
+        let first = layout.first[rows.nodes[i]] - start;
+        let f: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
+        let w = p.weight[i];
+        flat[i] = -dot(&f, &p.normal[i], dim) / w;
+        for q in 0..nt {
+            flat[n + i * nt + q] = -dot(&f, &p.tangent[i][q], dim) / w;
+        }
+    }
+    let all = petsc.sum(&flat)?;
+    Ok(PointValues::from_parts(all[..n].to_vec(), all[n..].to_vec(), nt).expect("lengths agree"))
+}
