@@ -5,8 +5,9 @@
 //! backend's `begin`, `prime`, `solve_posed` and `instant_fields` on that route.
 
 use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
+use crate::error::DistributedError;
+use crate::krylov::Krylov;
 use crate::layout::Layout;
-use crate::run::{DistributedError, Krylov};
 use crate::system::System;
 use petsc::{Index, Petsc, PetscError, Vector};
 use problem::backend::{At, ContactBoundary, ContactSolve, Fields, InstantOf, InstantSolution, Posed, Primed};
@@ -44,14 +45,14 @@ impl ActiveSets<'_> {
 /// The active-set iteration over the distributed system, each step one Krylov solve (a
 /// tangent of a contact point held by a Dirichlet condition refused by name).
 pub(crate) fn solve<'p>(
-    petsc: &'p Petsc,
+    active: &mut ActiveSets<'p>,
     layout: &Layout,
     k: &mut Krylov<'p>,
     how: &ContactSolve<'_>,
     at: At<'_>,
     reporter: &mut dyn Reporter,
 ) -> Result<contact::ContactSolution, DistributedError> {
-    let active = k.active.as_mut().ok_or_else(unprimed)?;
+    let petsc = k.petsc;
     let boundary = active.boundary.as_ref().ok_or_else(unprimed)?;
     refuse_held_tangent(how.scene, boundary)?;
     let rows = ContactRows::new(petsc, at.points, &boundary.nodes, layout, &k.system);
@@ -85,21 +86,20 @@ pub(crate) fn solve<'p>(
     })?;
     (k.iterations, k.reason) = (out.krylov_iterations, out.reason);
     k.report(reporter);
-    if let Some(active) = k.active.as_mut() {
-        active.x = Some(out.x);
-    }
+    active.x = Some(out.x);
     Ok(out.solution)
 }
 
 /// The contact solve's solution, whole on every rank, with its equilibrium residual
 /// (collective).
 pub(crate) fn fields(
+    active: &mut ActiveSets<'_>,
     k: &mut Krylov<'_>,
     layout: &Layout,
     posed: &Posed<'_>,
     InstantOf { framed, sol, .. }: &InstantOf<'_>,
 ) -> Result<InstantSolution, DistributedError> {
-    let x = k.active.as_mut().and_then(|a| a.x.take()).ok_or_else(unprimed)?;
+    let x = active.x.take().ok_or_else(unprimed)?;
     let equilibrium = residual(&k.system, &x, (framed.boundary, sol), layout, k.petsc)?;
     let mut free = k.whole(&x, false)?;
     let phi = free.split_off(posed.disc.dofs.n_u);

@@ -43,6 +43,10 @@ pub mod contact;
 #[cfg(feature = "petsc")]
 mod direct;
 #[cfg(feature = "petsc")]
+mod error;
+#[cfg(feature = "petsc")]
+mod krylov;
+#[cfg(feature = "petsc")]
 mod layout;
 #[cfg(feature = "petsc")]
 mod run;
@@ -54,9 +58,10 @@ pub use active::MAX_ACTIVE_SET_STEPS;
 #[cfg(feature = "petsc")]
 pub use direct::Direct;
 #[cfg(feature = "petsc")]
+pub use error::DistributedError;
+#[cfg(feature = "petsc")]
+pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS};
+#[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
-pub use run::{
-    solve, solve_path, solve_with, Assembled, ContactRoute, DistributedError, DistributedMemory, Prepared,
-    COUPLED_OPTIONS, ELASTIC_OPTIONS,
-};
+pub use run::{solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared};

@@ -1,0 +1,32 @@
+//! What can stop a run of the PETSc backend: the problem's errors, PETSc's, MPI's and MUMPS',
+//! and the active sets' (the Krylov route's contact).
+
+use petsc::PetscError;
+use problem::ProblemError;
+
+/// What can stop a run of the PETSc backend.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DistributedError {
+    /// The scene, its mesh or its data (as the default backend reports them).
+    #[error(transparent)]
+    Problem(#[from] ProblemError),
+    /// PETSc, MPI or MUMPS.
+    #[error(transparent)]
+    Petsc(#[from] PetscError),
+    /// The active sets (the Krylov route's contact) did not converge.
+    #[error("contact: {0}")]
+    Contact(crate::contact::ActiveSetError),
+}
+
+impl From<fe_assembly::AssemblyError> for DistributedError {
+    fn from(e: fe_assembly::AssemblyError) -> Self {
+        DistributedError::Problem(e.into())
+    }
+}
+
+impl From<problem::SceneError> for DistributedError {
+    fn from(e: problem::SceneError) -> Self {
+        DistributedError::Problem(e.into())
+    }
+}
