@@ -242,15 +242,17 @@ impl<'p> Backend for DistributedMemory<'p> {
             Some(system) => {
                 let contact = boundary.is_some();
                 let options = configure(self.petsc, &posed.scene, &layout, contact.then_some(posed.plan().tol))?;
+                // (the paper's Uzawa on this route takes the same tolerance: its multipliers are
+                // updated from the solves' displacements)
                 let fields = KrylovFields::new(self.petsc, posed.setup, &layout);
                 let krylov = Krylov::new(self.petsc, posed.disc, &layout, system, fields);
                 (Route::Krylov(Box::new(krylov)), options)
             }
         };
-        let active = match (&route, boundary) {
-            (Route::Krylov(_), Some(_)) => Some(ActiveSets::default()),
-            _ => None,
-        };
+        // the active sets where the run's contact would have factored by MUMPS; on the Krylov
+        // route otherwise (the paper's Uzawa) the instants' full solves
+        let active = (boundary.is_some() && crate::factors_directly(&posed.scene) && !self.direct_route(&posed.scene))
+            .then(ActiveSets::default);
         Ok(Prepared {
             route,
             active,

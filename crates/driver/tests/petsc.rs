@@ -234,6 +234,19 @@ fn agree_on_active_sets(petsc: &Petsc) {
         assert!(d < 1e-7, "{name} {sets:?}: {what} differs by {d:.2e}");
         assert!(dist.report.residuals.complementarity <= scene.solver.tol);
     }
+    // the paper's Uzawa with one Krylov solve per step (the Krylov route without the active
+    // sets): the default backend's answer to the tolerance
+    backend.contact = distributed::ContactRoute::Auto;
+    let (faer, scene) = both("paper", &["mesh.n=8", "solver.strategy=\"uzawa-schur-pcg\""], &[]);
+    let dist = distributed::solve_with(&mut backend, &scene, None, &mut problem::Silent, &mut |_| Ok(()))
+        .unwrap_or_else(|e| panic!("uzawa-schur-pcg: the PETSc run: {e}"));
+    if let Some(dist) = dist {
+        let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+        let (d, what) = farthest(&direct, &dist);
+        assert!(d < 1e-6, "uzawa-schur-pcg: {what} differs by {d:.2e}");
+        assert!(dist.report.iterations.uzawa > 1, "{:?}", dist.report.iterations);
+    }
+    backend.contact = distributed::ContactRoute::ActiveSets;
     // a law they do not hold: refused by its key
     let (_, scene) = both("paper-compliance", &["mesh.n=32"], &[]);
     let e = distributed::solve_with(&mut backend, &scene, None, &mut problem::Silent, &mut |_| Ok(()))
