@@ -12,6 +12,7 @@
 //! around `S⁻¹`: the loads condensed onto the contact dofs, the dense solve, the expansion.
 //! The right-hand sides and solutions are whole on every rank (the mesh is, too).
 
+use crate::free::{copy_into, joined, split};
 use crate::layout::Layout;
 use fe_assembly::kernels::{coupling_column, dielectric_column, elasticity_column};
 use fe_assembly::{Discretization, Dof};
@@ -190,23 +191,9 @@ fn pivot_order(disc: &Discretization<'_>, chosen: &[usize]) -> Vec<usize> {
     out
 }
 
-/// `[a; b]`.
-fn joined(a: &[f64], b: &[f64]) -> Vec<f64> {
-    a.iter().chain(b).copied().collect()
-}
-
-/// `x` split after its `n_u` displacements.
-fn split(mut x: Vec<f64>, n_u: usize) -> Fields {
-    let phi = x.split_off(n_u);
-    (x, phi)
-}
-
 /// A PETSc error among the problem's.
 fn problem(e: PetscError) -> ProblemError {
-    ProblemError::NoSolution {
-        sought: "the direct solve on the ranks (MUMPS)",
-        why: e.to_string(),
-    }
+    crate::error::solve_failed("the direct solve on the ranks (MUMPS)", e)
 }
 
 impl Factorization for Direct<'_> {
@@ -289,8 +276,7 @@ impl CoupledSolver for Direct<'_> {
         let x = self
             .solve_whole(joined(b_u, b_phi))
             .map_err(|e| linalg::LinalgError::Solver(e.to_string()))?;
-        u.copy_from_slice(&x[..self.n_u]);
-        phi.copy_from_slice(&x[self.n_u..]);
+        copy_into(&x, u, phi);
         Ok(linalg::SolveInfo { pcg_iters: 0 })
     }
 

@@ -30,3 +30,11 @@ impl From<problem::SceneError> for DistributedError {
         DistributedError::Problem(e.into())
     }
 }
+
+/// A PETSc error of a solve on the ranks (`sought`: which), among the problem's.
+pub(crate) fn solve_failed(sought: &'static str, e: PetscError) -> ProblemError {
+    ProblemError::NoSolution {
+        sought,
+        why: e.to_string(),
+    }
+}

@@ -4,6 +4,7 @@
 //! and the map between the free unknowns `[u; φ]` and the layout's rows, so that the run's
 //! instants ([`problem::Instants`]) solve on it as on a factorisation.
 
+use crate::free::{copy_into, joined, split};
 use crate::layout::Layout;
 use crate::system::System;
 use fe_assembly::{Discretization, Dof};
@@ -144,18 +145,13 @@ impl<'p> Krylov<'p> {
 
 /// A PETSc error among the problem's.
 fn problem(e: PetscError) -> ProblemError {
-    ProblemError::NoSolution {
-        sought: "the Krylov solve on the ranks",
-        why: e.to_string(),
-    }
+    crate::error::solve_failed("the Krylov solve on the ranks", e)
 }
 
 impl Factorization for Krylov<'_> {
     fn solve(&mut self, b_u: &[f64], b_phi: &[f64]) -> Result<(Fields, usize), ProblemError> {
-        let b: Vec<f64> = b_u.iter().chain(b_phi).copied().collect();
-        let mut x = self.solve_whole(&b).map_err(problem)?;
-        let phi = x.split_off(self.n_u);
-        Ok(((x, phi), 0))
+        let x = self.solve_whole(&joined(b_u, b_phi)).map_err(problem)?;
+        Ok((split(x, self.n_u), 0))
     }
 
     fn condense(&mut self, _: &[f64], _: &[f64], _: &[usize]) -> Result<linalg::Condensed, ProblemError> {
@@ -181,8 +177,7 @@ impl Factorization for Krylov<'_> {
     }
 
     fn equilibrium(&mut self, u: &[f64], phi: &[f64], rhs: linalg::Rhs<'_>) -> Result<f64, ProblemError> {
-        let x: Vec<f64> = u.iter().chain(phi).copied().collect();
-        let b: Vec<f64> = rhs.u.iter().chain(rhs.phi).copied().collect();
+        let (x, b) = (joined(u, phi), joined(rhs.u, rhs.phi));
         let run = || -> Result<Vec<f64>, PetscError> {
             let xd = self.distributed(&x, false)?;
             let mut r = self.distributed(&b, true)?;
@@ -216,12 +211,10 @@ impl linalg::CoupledSolver for Krylov<'_> {
         u: &mut [f64],
         phi: &mut [f64],
     ) -> Result<linalg::SolveInfo, linalg::LinalgError> {
-        let b: Vec<f64> = b_u.iter().chain(b_phi).copied().collect();
         let x = self
-            .solve_whole(&b)
+            .solve_whole(&joined(b_u, b_phi))
             .map_err(|e| linalg::LinalgError::Solver(e.to_string()))?;
-        u.copy_from_slice(&x[..self.n_u]);
-        phi.copy_from_slice(&x[self.n_u..]);
+        copy_into(&x, u, phi);
         Ok(linalg::SolveInfo {
             pcg_iters: self.iterations,
         })

@@ -45,6 +45,8 @@ mod direct;
 #[cfg(feature = "petsc")]
 mod error;
 #[cfg(feature = "petsc")]
+mod free;
+#[cfg(feature = "petsc")]
 mod krylov;
 #[cfg(feature = "petsc")]
 mod layout;

@@ -169,6 +169,10 @@ enum Command {
         /// 1800 s at least).
         #[arg(long, default_value_t = 600)]
         limit: u64,
+        /// Run every case on the PETSc backend under `mpirun -np RANKS` (a build with the
+        /// feature `petsc`), into stability-petsc.md.
+        #[arg(long)]
+        ranks: Option<usize>,
     },
 }
 
@@ -274,10 +278,20 @@ fn main() -> ExitCode {
     match dispatch(command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // under mpirun every rank meets the same error: the first rank says it
+            if mpi_rank().is_none_or(|r| r == 0) {
+                eprintln!("error: {e}");
+            }
             ExitCode::FAILURE
         }
     }
+}
+
+/// This process's rank under Open MPI's or MPICH's `mpirun` (`None` outside one).
+fn mpi_rank() -> Option<u64> {
+    ["OMPI_COMM_WORLD_RANK", "PMI_RANK"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok()?.parse().ok())
 }
 
 /// What a signal does to a run. SIGINT, SIGTERM and SIGHUP end it at once (their usual exit
@@ -400,7 +414,12 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             study(&scene, sizes, strategies, tols, reference, &set, out)
         }
         Command::Verification { full, out } => verification(full, &out),
-        Command::Stability { quick, out, limit } => stability(quick, &out, limit),
+        Command::Stability {
+            quick,
+            out,
+            limit,
+            ranks,
+        } => stability(quick, &out, limit, ranks),
     }
 }
 
@@ -555,16 +574,27 @@ fn verification(full: bool, out: &std::path::Path) -> Result<(), DriverError> {
 }
 
 /// `piezocontact stability`: the cases, each in a child process of this program.
-fn stability(quick: bool, out: &std::path::Path, limit: u64) -> Result<(), DriverError> {
+fn stability(quick: bool, out: &std::path::Path, limit: u64, ranks: Option<usize>) -> Result<(), DriverError> {
     let exe = std::env::current_exe().map_err(|e| files::Error::Output {
         what: "cannot find this program's path to run the cases".into(),
         source: e,
     })?;
-    let rows = stability::write(&exe, quick, std::time::Duration::from_secs(limit), out, &mut say)?;
+    let backend = match ranks {
+        Some(0) => return Err(DriverError::Usage("--ranks: at least 1".into())),
+        Some(ranks) => stability::Backend::Petsc { ranks },
+        None => stability::Backend::Default,
+    };
+    let limit = std::time::Duration::from_secs(limit);
+    let rows = stability::write(&exe, (backend, quick), limit, out, &mut say)?;
+    let name = if ranks.is_some() {
+        "stability-petsc.md"
+    } else {
+        "stability.md"
+    };
     say(&format!(
         "{} runs as expected; wrote {}",
         rows.len(),
-        out.join("stability.md").display()
+        out.join(name).display()
     ));
     Ok(())
 }

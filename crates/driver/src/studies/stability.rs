@@ -785,11 +785,64 @@ pub fn check(expect: Expect, report: &RunReport) -> Result<String, String> {
     }
 }
 
+/// Where the cases run: the default backend in one process, or the PETSc backend on the ranks
+/// of `mpirun -np ranks` (the program built with the feature `petsc`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// The default backend.
+    Default,
+    /// The PETSc backend on this many ranks.
+    Petsc {
+        /// MPI ranks.
+        ranks: usize,
+    },
+}
+
+/// `timeout`'s exit code where it stopped its command.
+const TIMED_OUT: i32 = 124;
+
+/// The command that runs `exe run` on `backend`: under `timeout` and `mpirun` for PETSc (mpirun
+/// stops its ranks on timeout's SIGTERM, where a SIGKILL to it would leave them running).
+fn command(exe: &Path, backend: Backend, limit: Duration) -> Command {
+    match backend {
+        Backend::Default => Command::new(exe),
+        Backend::Petsc { ranks } => {
+            let mut cmd = Command::new("timeout");
+            cmd.args([
+                "-s",
+                "TERM",
+                &limit.as_secs().to_string(),
+                "mpirun",
+                "--allow-run-as-root",
+            ]);
+            cmd.args([
+                "--oversubscribe",
+                "-x",
+                "OPENBLAS_NUM_THREADS=1",
+                "-np",
+                &ranks.to_string(),
+            ]);
+            cmd.arg(exe);
+            cmd
+        }
+    }
+}
+
 /// Runs one case with one strategy through `exe run`, in a scratch directory that is removed.
-fn run_case(exe: &Path, case: &Case, strategy: Strategy, sets: &[&str], index: usize, limit: Duration) -> Row {
+fn run_case(
+    exe: &Path,
+    backend: Backend,
+    case: &Case,
+    (strategy, sets): (Strategy, &[&str]),
+    index: usize,
+    limit: Duration,
+) -> Row {
     let scratch = std::env::temp_dir().join(format!("piezocontact-stability-{}-{index}", std::process::id()));
-    let mut cmd = Command::new(exe);
+    let mut cmd = command(exe, backend, limit);
     cmd.arg("run").arg(case.scene);
+    if backend != Backend::Default {
+        cmd.arg("--set").arg("solver.backend=\"petsc\"");
+    }
     for s in sets {
         cmd.arg("--set").arg(s);
     }
@@ -809,7 +862,7 @@ fn run_case(exe: &Path, case: &Case, strategy: Strategy, sets: &[&str], index: u
         as_expected: false,
     };
     let started = std::time::Instant::now();
-    let output = run_with_limit(cmd, limit);
+    let output = run_with_limit(cmd, limit + Duration::from_secs(30));
     let report = std::fs::read(scratch.join("run.json"))
         .ok()
         .and_then(|b| serde_json::from_slice::<RunReport>(&b).ok());
@@ -830,7 +883,9 @@ fn run_case(exe: &Path, case: &Case, strategy: Strategy, sets: &[&str], index: u
                 Err(e) => row.outcome = format!("UNEXPECTED: {e}"),
             }
         }
-        (Ok(out), _) if out.status.code().is_none() && started.elapsed() >= limit => {
+        (Ok(out), _)
+            if (out.status.code().is_none() || out.status.code() == Some(TIMED_OUT)) && started.elapsed() >= limit =>
+        {
             row.seconds = started.elapsed().as_secs_f64();
             row.outcome = format!(
                 "not finished in the study's time limit of {} s (stopped)",
@@ -868,10 +923,10 @@ fn run_case(exe: &Path, case: &Case, strategy: Strategy, sets: &[&str], index: u
     row
 }
 
-/// Runs the cases (without the fine ones when `quick`), with the default strategy and, where
-/// the case has one, the paper's strategy on its smaller mesh. `exe` is the `piezocontact`
-/// binary.
-pub fn study(exe: &Path, quick: bool, limit: Duration, progress: &mut dyn FnMut(&str)) -> Vec<Row> {
+/// Runs the cases (without the fine ones when `quick`) on `backend`, with the default strategy
+/// and, where the case has one, the paper's strategy on its smaller mesh. `exe` is the
+/// `piezocontact` binary.
+pub fn study(exe: &Path, backend: Backend, quick: bool, limit: Duration, progress: &mut dyn FnMut(&str)) -> Vec<Row> {
     let mut rows = vec![];
     for case in CASES.iter().filter(|c| !(quick && c.fine)) {
         let mut runs = vec![(Strategy::NewtonCondensed, case.sets)];
@@ -886,7 +941,7 @@ pub fn study(exe: &Path, quick: bool, limit: Duration, progress: &mut dyn FnMut(
             } else {
                 limit.max(Duration::from_secs(1800))
             };
-            let row = run_case(exe, case, strategy, sets, rows.len(), limit);
+            let row = run_case(exe, backend, case, (strategy, sets), rows.len(), limit);
             progress(&format!(
                 "{:14} {:17} {:>9} dofs  {:>26}  {:8.2} s  {:7.0} MiB  {}",
                 row.case, row.strategy, row.dofs, row.iterations, row.seconds, row.peak_mib, row.outcome
@@ -931,24 +986,38 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     s
 }
 
-/// Runs the study and writes `stability.md` into `dir`; an error if any run is not as expected.
+/// Runs the study on `backend` and writes `stability.md` into `dir` (`stability-petsc.md` for
+/// the PETSc backend, the cases alone: the inputs' refusals are the scene's, the same on both);
+/// an error if any run is not as expected.
 pub fn write(
     exe: &Path,
-    quick: bool,
+    (backend, quick): (Backend, bool),
     limit: Duration,
     dir: &Path,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<Row>, DriverError> {
-    let rows = study(exe, quick, limit, progress);
-    let inputs = super::inputs::study(exe, progress);
+    let rows = study(exe, backend, quick, limit, progress);
+    let (inputs, name, ranks) = match backend {
+        Backend::Default => (super::inputs::study(exe, progress), "stability.md", String::new()),
+        Backend::Petsc { ranks } => (vec![], "stability-petsc.md", format!(" --ranks {ranks}")),
+    };
     let command = format!(
-        "piezocontact stability{} --limit {}",
+        "piezocontact stability{} --limit {}{ranks}",
         if quick { " --quick" } else { "" },
         limit.as_secs()
     );
     let mut out = Outputs::documents(dir);
-    let page = markdown(&rows, &command) + &super::inputs::markdown(&inputs);
-    out.add("stability.md", page.into_bytes());
+    let mut page = markdown(&rows, &command);
+    match backend {
+        Backend::Default => page += &super::inputs::markdown(&inputs),
+        Backend::Petsc { ranks } => {
+            let title = format!(
+                "# Stability on the PETSc backend ({ranks} ranks): stiff and extreme cases\n\nThe cases of stability.md, each under `mpirun -np {ranks}` with `solver.backend = \"petsc\"`: the default strategy on MUMPS' condensed route, the paper's Uzawa on the Krylov route (one Krylov solve per step).\n"
+            );
+            page = page.replacen("# Stability: stiff and extreme cases\n", &title, 1);
+        }
+    }
+    out.add(name, page.into_bytes());
     out.commit()?;
     let bad: Vec<String> = rows
         .iter()

@@ -381,13 +381,7 @@ impl Instants {
         let sol = on.correct(how, &mut c.dense, sol, (&mut u, &mut phi), reporter)?;
         self.refinement = on.refinement;
         let b = rhs_with_contact(posed, Some((boundary, &sol)));
-        let equilibrium = f.equilibrium(&u, &phi, rhs(&b))?;
-        Ok(InstantSolution {
-            x: (u, phi),
-            contact: Some(sol),
-            equilibrium,
-            pcg_iters: 0,
-        })
+        finished(f, (u, phi), sol, &b)
     }
 
     /// The fields of a contact solve with electrical contact, under the forces and the flux
@@ -416,15 +410,28 @@ impl Instants {
         }
         sol.info.complementarity = law_residual(boundary, how, &sol, &e.problem.u0, &u, path.then_some(framed.shift));
         sol.info.residual = sol.info.residual.max(sol.info.complementarity);
-        let equilibrium = f.equilibrium(&u, &phi, rhs(&b))?;
-        Ok(InstantSolution {
-            x: (u, phi),
-            contact: Some(sol),
-            equilibrium,
-            pcg_iters: 0,
-        })
+        finished(f, (u, phi), sol, &b)
     }
 }
+
+/// The fields `x` of a contact solve `sol`, with their equilibrium residual against `b`.
+fn finished(
+    f: &mut dyn Factorization,
+    x: Fields,
+    sol: ContactSolution,
+    b: &(Vec<f64>, Vec<f64>, f64),
+) -> Result<InstantSolution, ProblemError> {
+    let equilibrium = f.equilibrium(&x.0, &x.1, rhs(b))?;
+    Ok(InstantSolution {
+        x,
+        contact: Some(sol),
+        equilibrium,
+        pcg_iters: 0,
+    })
+}
+
+/// Semismooth Newton on the displacement and electric rows; where the conducting zone
+/// floats, around it the search for the potential that carries its charge.
 fn electric_solve(
     how: &ContactSolve<'_>,
     problem: &mut ElectricContactProblem,
