@@ -149,6 +149,16 @@ impl Petsc {
         Ok(out)
     }
 
+    /// Ends every rank of the run at once (`MPI_Abort`), with `code`: for a rank that cannot go
+    /// on while the others wait for it in a collective.
+    pub fn abort(&self, code: i32) -> ! {
+        // SAFETY: PETSc (so MPI) is initialised; MPI_Abort does not return.
+        unsafe {
+            sys::MPI_Abort(self.comm(), code);
+        }
+        std::process::exit(code)
+    }
+
     /// Rank 0's `values` on every rank (the other ranks' `values` overwritten; every rank
     /// passes a slice of the same length).
     pub fn broadcast(&self, values: &mut [f64]) -> Result<()> {

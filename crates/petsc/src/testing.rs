@@ -7,11 +7,15 @@ use std::process::Command;
 
 /// Runs `body` on `ranks` ranks, `name` being the test's own name (the filter its children run
 /// with). Panics, as a test does, with every rank's output, where a rank fails; a rank that
-/// hangs (waiting in a collective for one that died) is stopped after 15 minutes.
+/// panics aborts the others (`MPI_Abort`), and a rank that hangs is stopped after 15 minutes.
 pub fn on_ranks(name: &str, ranks: usize, body: impl FnOnce(&Petsc)) {
     if std::env::var_os("OMPI_COMM_WORLD_SIZE").is_some() {
         let p = Petsc::init().expect("PETSc starts");
-        body(&p);
+        // a rank that fails ends them all: the others would wait for it in their next
+        // collective until the timeout
+        if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(&p))).is_err() {
+            p.abort(101);
+        }
         return;
     }
     let exe = std::env::current_exe().expect("the test binary's path");
