@@ -115,10 +115,13 @@ impl<'p> Krylov<'p> {
         Ok(out)
     }
 
-    /// `K⁻¹ b` by the Krylov solver, whole on every rank.
-    fn solve_whole(&mut self, b: &[f64]) -> Result<Vec<f64>, PetscError> {
+    /// `K⁻¹ b` by the Krylov solver from `start` (zero without), whole on every rank.
+    fn solve_whole(&mut self, b: &[f64], start: Option<&[f64]>) -> Result<Vec<f64>, PetscError> {
         let rhs = self.distributed(b, true)?;
-        let mut x = rhs.duplicate()?;
+        let mut x = match start {
+            Some(x0) => self.distributed(x0, false)?,
+            None => rhs.duplicate()?,
+        };
         if self.ksp.is_none() {
             let t = Instant::now();
             self.ksp = Some(self.fields.krylov(self.petsc, &mut self.system.matrix)?);
@@ -150,7 +153,7 @@ fn problem(e: PetscError) -> ProblemError {
 
 impl Factorization for Krylov<'_> {
     fn solve(&mut self, b_u: &[f64], b_phi: &[f64]) -> Result<(Fields, usize), ProblemError> {
-        let x = self.solve_whole(&joined(b_u, b_phi)).map_err(problem)?;
+        let x = self.solve_whole(&joined(b_u, b_phi), None).map_err(problem)?;
         Ok((split(x, self.n_u), 0))
     }
 
@@ -211,8 +214,9 @@ impl linalg::CoupledSolver for Krylov<'_> {
         u: &mut [f64],
         phi: &mut [f64],
     ) -> Result<linalg::SolveInfo, linalg::LinalgError> {
+        // the warm start `(u, φ)`: the paper's Uzawa hands each step the step before's solution
         let x = self
-            .solve_whole(&joined(b_u, b_phi))
+            .solve_whole(&joined(b_u, b_phi), Some(&joined(u, phi)))
             .map_err(|e| linalg::LinalgError::Solver(e.to_string()))?;
         copy_into(&x, u, phi);
         Ok(linalg::SolveInfo {
