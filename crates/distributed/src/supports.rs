@@ -67,61 +67,56 @@ pub fn direct(scene: &Scene) -> bool {
 /// # Errors
 /// [`Unsupported`] naming the key.
 pub fn active_sets_hold(scene: &Scene) -> Result<(), Unsupported> {
-    let lacks = |key: &str, feature: &str| {
-        Err(Unsupported::new(
-            BACKEND,
-            key,
-            format!("{feature}, which the active sets do not hold"),
-        ))
-    };
     let zones = scene.zones();
     if zones.len() > 1 {
-        return lacks("contact", "several [[contact]] zones");
+        return not_held("contact", "several [[contact]] zones");
     }
     if scene.mesh.axisymmetric {
-        return lacks("mesh.axisymmetric", "a body of revolution");
+        return not_held("mesh.axisymmetric", "a body of revolution");
     }
-    if scene.dirichlet.iter().any(|d| d.charge.is_some()) || scene.electrodes().iter().any(|e| e.charge.is_some()) {
-        return lacks("dirichlet.charge", "a floating terminal");
+    if let Some(key) = scene.floating_key() {
+        return not_held(key, "a floating terminal");
     }
     if scene.path.is_some() {
-        return lacks("path", "a load path");
+        return not_held("path", "a load path");
     }
     if scene.solver.strategy != Strategy::NewtonCondensed {
-        return lacks("solver.strategy", "a strategy other than Newton's");
+        return not_held("solver.strategy", "a strategy other than Newton's");
     }
     if scene.solver.rule != Rule::Tight {
-        return lacks("solver.rule", "the paper's stopping rule");
+        return not_held("solver.rule", "the paper's stopping rule");
     }
     zones.into_iter().try_for_each(zone_held)
 }
 
 /// What one contact zone asks for that the active sets do not hold.
 fn zone_held(c: &ContactSpec) -> Result<(), Unsupported> {
-    let lacks = |key: &str, feature: String| {
-        Err(Unsupported::new(
-            BACKEND,
-            key,
-            format!("{feature}, which the active sets do not hold"),
-        ))
-    };
     if c.indenter.as_ref().is_some_and(|i| i.force.is_some()) {
-        return lacks("contact.indenter.force", "force control".into());
+        return not_held("contact.indenter.force", "force control");
     }
     if c.compliance.is_some() {
-        return lacks("contact.compliance", "a deformable foundation".into());
+        return not_held("contact.compliance", "a deformable foundation");
     }
     if c.slip_weakening().is_some() {
-        return lacks("contact.friction_law", "slip-weakening friction".into());
+        return not_held("contact.friction_law", "slip-weakening friction");
     }
     if let Some(condition) = c.electric.filter(|_| c.electric_law().is_some()) {
-        return lacks("contact.electric", format!("contact.electric = \"{condition}\""));
+        return not_held("contact.electric", &format!("contact.electric = \"{condition}\""));
     }
     if c.normal.iter().filter(|&&x| x != 0.0).count() != 1 {
-        return lacks(
+        return not_held(
             "contact.normal",
-            format!("contact.normal = {:?}, an oblique face", c.normal),
+            &format!("contact.normal = {:?}, an oblique face", c.normal),
         );
     }
     Ok(())
+}
+
+/// `feature`, asked for by `key`, which the active sets do not hold.
+fn not_held(key: &str, feature: &str) -> Result<(), Unsupported> {
+    Err(Unsupported::new(
+        BACKEND,
+        key,
+        format!("{feature}, which the active sets do not hold"),
+    ))
 }

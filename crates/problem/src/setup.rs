@@ -51,13 +51,12 @@ fn refuse_electric_keys_without_unknowns(scene: &Scene, plan: &Plan) -> Result<(
         return Ok(());
     }
     let why = "the body has no electric unknowns (no piezoelectric coupling, no potential or charge that is not 0), so it would be ignored";
-    let key = if scene.dirichlet.iter().any(|d| d.charge.is_some()) {
-        "dirichlet.charge"
-    } else if scene.electrodes().iter().any(|e| e.charge.is_some()) {
-        "electrode.charge"
-    } else if scene.path.as_ref().is_some_and(|p| p.voltage.is_some()) {
-        "path.voltage"
-    } else {
+    let voltage = scene
+        .path
+        .as_ref()
+        .is_some_and(|p| p.voltage.is_some())
+        .then_some("path.voltage");
+    let Some(key) = scene.floating_key().or(voltage) else {
         return Ok(());
     };
     Err(SetupError::new(

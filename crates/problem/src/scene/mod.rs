@@ -521,6 +521,18 @@ impl Scene {
         self.contacts().iter().filter(|c| c.law != ContactLaw::None).collect()
     }
 
+    /// The key of the scene's first floating terminal (`dirichlet.charge`, else
+    /// `electrode.charge`), `None` without one.
+    pub fn floating_key(&self) -> Option<&'static str> {
+        if self.dirichlet.iter().any(|d| d.charge.is_some()) {
+            Some("dirichlet.charge")
+        } else if self.electrodes().iter().any(|e| e.charge.is_some()) {
+            Some("electrode.charge")
+        } else {
+            None
+        }
+    }
+
     /// The contact section, or the first of several.
     pub fn first_contact(&self) -> Option<&ContactSpec> {
         self.contacts().first()
