@@ -31,8 +31,6 @@ pub struct Direct<'p> {
     chosen: Vec<usize>,
     /// `S⁻¹ = (K⁻¹)_cc`, row-major, on every rank.
     inverse: Vec<f64>,
-    /// This rank's entries of `K` (one triangle), for `K x`.
-    entries: Entries,
     /// Wall time of the analysis and factorisation, s.
     pub seconds: f64,
 }
@@ -52,16 +50,6 @@ impl Entries {
             self.rows.push(i);
             self.cols.push(j);
             self.values.push(v);
-        }
-    }
-
-    /// `y += M x` for the symmetric `M` of these entries.
-    fn mul_add(&self, x: &[f64], y: &mut [f64]) {
-        for ((&i, &j), &v) in self.rows.iter().zip(&self.cols).zip(&self.values) {
-            y[i] += v * x[j];
-            if i != j {
-                y[j] += v * x[i];
-            }
         }
     }
 }
@@ -97,12 +85,11 @@ impl<'p> Direct<'p> {
         } else {
             Symmetry::Indefinite
         };
-        let values = entries.values.clone();
         let order = pivot_order(disc, &chosen);
         let mumps = Mumps::factor(
             petsc,
             n_u + n_phi,
-            (&entries.rows, &entries.cols, values),
+            (&entries.rows, &entries.cols, entries.values),
             symmetry,
             &chosen,
             Some(&order),
@@ -125,7 +112,6 @@ impl<'p> Direct<'p> {
             n_u,
             chosen,
             inverse,
-            entries,
             seconds: t.elapsed().as_secs_f64(),
         })
     }
@@ -168,7 +154,15 @@ impl<'p> Direct<'p> {
     /// `b - K x` for the whole `x` and `b`, whole on every rank (each rank's entries, summed).
     fn minus_k_x_whole(&self, x: &[f64], b: &[f64]) -> Result<Vec<f64>, PetscError> {
         let mut y = vec![0.0; x.len()];
-        self.entries.mul_add(x, &mut y);
+        // this rank's entries as MUMPS holds them (one triangle, 1-based)
+        let (rows, cols, values) = self.mumps.entries();
+        for ((&i, &j), &v) in rows.iter().zip(cols).zip(values) {
+            let (i, j) = (i as usize - 1, j as usize - 1);
+            y[i] += v * x[j];
+            if i != j {
+                y[j] += v * x[i];
+            }
+        }
         let kx = self.petsc.sum(&y)?;
         Ok(b.iter().zip(&kx).map(|(b, k)| b - k).collect())
     }
@@ -294,16 +288,12 @@ struct Refining<'a, 'p> {
 impl linalg::Refinable for Refining<'_, '_> {
     type Error = PetscError;
 
-    fn measure(&mut self, u: &[f64], phi: &[f64]) -> Result<f64, PetscError> {
-        let (ru, rp) = self.minus_k_x(u, phi)?;
-        Ok(linalg::relative_residual(&ru, &rp, self.rhs))
-    }
-
-    fn minus_k_x(&mut self, u: &[f64], phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), PetscError> {
+    fn residual(&mut self, u: &[f64], phi: &[f64]) -> Result<linalg::Residual, PetscError> {
         let r = self
             .direct
             .minus_k_x_whole(&joined(u, phi), &joined(self.rhs.u, self.rhs.phi))?;
-        Ok(split(r, self.direct.n_u))
+        let (ru, rp) = split(r, self.direct.n_u);
+        Ok(linalg::Residual::of(ru, rp, self.rhs))
     }
 
     fn correction(&mut self, r_u: &[f64], r_phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), PetscError> {

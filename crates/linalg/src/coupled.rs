@@ -312,16 +312,12 @@ pub fn refine(
 pub trait Refinable {
     /// The error of its products and solves.
     type Error;
-    /// The equilibrium residual of `x` ([`equilibrium_residual`]'s measure).
+    /// `r = b - K x` and the equilibrium residual of `x` measured on it
+    /// ([`relative_residual`]), from one product with `K`.
     ///
     /// # Errors
     /// The system's.
-    fn measure(&mut self, u: &[f64], phi: &[f64]) -> Result<f64, Self::Error>;
-    /// `b - K x`.
-    ///
-    /// # Errors
-    /// The system's.
-    fn minus_k_x(&mut self, u: &[f64], phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
+    fn residual(&mut self, u: &[f64], phi: &[f64]) -> Result<Residual, Self::Error>;
     /// `K⁻¹ r` with the factors.
     ///
     /// # Errors
@@ -329,7 +325,27 @@ pub trait Refinable {
     fn correction(&mut self, r_u: &[f64], r_phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
 }
 
-/// [`refine`]'s iteration on any [`Refinable`] system.
+/// A residual `r = b - K x` by blocks, with its equilibrium residual ([`relative_residual`]).
+#[derive(Clone, Debug)]
+pub struct Residual {
+    /// `r_u`.
+    pub u: Vec<f64>,
+    /// `r_φ`.
+    pub phi: Vec<f64>,
+    /// `‖r‖ / max(‖b‖, scale)`.
+    pub measure: f64,
+}
+
+impl Residual {
+    /// `r = (r_u, r_φ)` of the right-hand side `rhs`, measured.
+    pub fn of(u: Vec<f64>, phi: Vec<f64>, rhs: Rhs<'_>) -> Self {
+        let measure = relative_residual(&u, &phi, rhs);
+        Residual { u, phi, measure }
+    }
+}
+
+/// [`refine`]'s iteration on any [`Refinable`] system: one product with `K` per iterate, its
+/// residual both measured and, where the iterate is kept, corrected.
 ///
 /// # Errors
 /// The system's.
@@ -340,19 +356,21 @@ pub fn refine_by<R: Refinable + ?Sized>(
     tol: f64,
     max_steps: usize,
 ) -> Result<Refined, R::Error> {
-    let mut residual = system.measure(u, phi)?;
+    let mut r = system.residual(u, phi)?;
+    let mut residual = r.measure;
     let mut steps = 0;
     while steps < max_steps && residual > tol && residual.is_finite() {
-        let (ru, rp) = system.minus_k_x(u, phi)?;
-        let (du, dp) = system.correction(&ru, &rp)?;
+        let (du, dp) = system.correction(&r.u, &r.phi)?;
         let nu: Vec<f64> = u.iter().zip(&du).map(|(a, b)| a + b).collect();
         let np: Vec<f64> = phi.iter().zip(&dp).map(|(a, b)| a + b).collect();
-        let after = system.measure(&nu, &np)?;
+        let next = system.residual(&nu, &np)?;
+        let after = next.measure;
         if !(after < residual) {
             break;
         }
         u.copy_from_slice(&nu);
         phi.copy_from_slice(&np);
+        r = next;
         let halved = 2.0 * after <= residual;
         residual = after;
         steps += 1;
@@ -373,12 +391,9 @@ struct Blockwise<'a, 'k> {
 impl Refinable for Blockwise<'_, '_> {
     type Error = LinalgError;
 
-    fn measure(&mut self, u: &[f64], phi: &[f64]) -> Result<f64, LinalgError> {
-        Ok(equilibrium_residual(self.k, u, phi, self.rhs))
-    }
-
-    fn minus_k_x(&mut self, u: &[f64], phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), LinalgError> {
-        Ok(minus_k_x(self.k, u, phi, self.rhs.u, self.rhs.phi))
+    fn residual(&mut self, u: &[f64], phi: &[f64]) -> Result<Residual, LinalgError> {
+        let (ru, rp) = minus_k_x(self.k, u, phi, self.rhs.u, self.rhs.phi);
+        Ok(Residual::of(ru, rp, self.rhs))
     }
 
     fn correction(&mut self, r_u: &[f64], r_phi: &[f64]) -> Result<(Vec<f64>, Vec<f64>), LinalgError> {

@@ -196,6 +196,12 @@ impl<'p> Mumps<'p> {
         }
     }
 
+    /// The entries this rank gave, as MUMPS reads them: rows and columns 1-based (MUMPS
+    /// summed duplicates; these are as given).
+    pub fn entries(&self) -> (&[i32], &[i32], &[f64]) {
+        (&self.irn, &self.jcn, &self.values)
+    }
+
     /// The order of the matrix.
     pub fn order(&self) -> usize {
         self.n
