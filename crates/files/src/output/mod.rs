@@ -652,45 +652,50 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
 /// each with the half-space's closed form beside it where it applies (none without an
 /// indenter).
 fn indenter_panels(rows: &[problem::report::StepRow]) -> Vec<Panel> {
-    let over = |f: &dyn Fn(&problem::report::StepRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
+    type Row = problem::report::StepRow;
     let mut panels = vec![];
-    if rows.iter().any(|r| r.depth.is_some()) {
-        let depth = |r: &problem::report::StepRow| r.depth.unwrap_or(f64::NAN);
-        let mut series = vec![Series::line("normal force", over(&|r| (depth(r), r.normal_force)))];
-        if rows.iter().any(|r| r.half_space.is_some()) {
-            let form = |r: &problem::report::StepRow| r.half_space.as_ref().map_or(f64::NAN, |h| h.force);
-            series.push(Series::reference(
-                "half-space (closed form)",
-                over(&|r| (depth(r), form(r))),
-            ));
-        }
-        panels.push(Panel {
-            title: "Indenter force against depth".into(),
-            labels: ("depth".into(), "force".into()),
-            series,
-        });
-        if rows.iter().any(|r| r.tip_charge.is_some()) {
-            let charge = |r: &problem::report::StepRow| r.tip_charge.unwrap_or(f64::NAN);
-            let mut series = vec![Series::line("tip's charge", over(&|r| (depth(r), charge(r))))];
-            if rows
-                .iter()
-                .any(|r| r.half_space.as_ref().is_some_and(|h| h.charge.is_some()))
-            {
-                let form =
-                    |r: &problem::report::StepRow| r.half_space.as_ref().and_then(|h| h.charge).unwrap_or(f64::NAN);
-                series.push(Series::reference(
-                    "half-space (closed form)",
-                    over(&|r| (depth(r), form(r))),
-                ));
-            }
-            panels.push(Panel {
-                title: "Tip's charge against depth".into(),
-                labels: ("depth".into(), "charge".into()),
-                series,
-            });
-        }
+    if !rows.iter().any(|r| r.depth.is_some()) {
+        return panels;
+    }
+    panels.push(against_depth(
+        rows,
+        ("Indenter force against depth", "force", "normal force"),
+        &|r: &Row| Some(r.normal_force),
+        &|r: &Row| r.half_space.as_ref().map(|h| h.force),
+    ));
+    if rows.iter().any(|r| r.tip_charge.is_some()) {
+        panels.push(against_depth(
+            rows,
+            ("Tip's charge against depth", "charge", "tip's charge"),
+            &|r: &Row| r.tip_charge,
+            &|r: &Row| r.half_space.as_ref().and_then(|h| h.charge),
+        ));
     }
     panels
+}
+
+/// A panel of `value` against the indenter's depth over the path's `rows`, with the half-space's
+/// closed form `form` beside it where any row has one (`(title, axis label, series name)`).
+fn against_depth(
+    rows: &[problem::report::StepRow],
+    (title, label, name): (&str, &str, &str),
+    value: &dyn Fn(&problem::report::StepRow) -> Option<f64>,
+    form: &dyn Fn(&problem::report::StepRow) -> Option<f64>,
+) -> Panel {
+    let over = |f: &dyn Fn(&problem::report::StepRow) -> Option<f64>| {
+        rows.iter()
+            .map(|r| (r.depth.unwrap_or(f64::NAN), f(r).unwrap_or(f64::NAN)))
+            .collect::<Vec<_>>()
+    };
+    let mut series = vec![Series::line(name, over(value))];
+    if rows.iter().any(|r| form(r).is_some()) {
+        series.push(Series::reference("half-space (closed form)", over(form)));
+    }
+    Panel {
+        title: title.into(),
+        labels: ("depth".into(), label.into()),
+        series,
+    }
 }
 
 /// Where a run writes by default: `out/<scene>/`, the scene's name made a safe single path
