@@ -403,3 +403,56 @@ fn the_sphere_dissipates_mindlin_deresiewicz_energy() {
         .collect();
     assert!(errors[1] < 0.5 * errors[0] && errors[1] < 0.2, "{errors:?}");
 }
+
+/// A path's time series: a compressed `step-NNNN.vtu` per written instant (its point data and
+/// the contact's; the cell fields only where `path.cell_fields` asks), each listed in
+/// `path.pvd` at its instant, the steps' writing booked as run.json's `output` stage; the
+/// values inflate to the path's own (the last step's `u` is the last instant's, which
+/// `solution.vtu` holds too).
+#[test]
+fn a_path_s_steps_are_compressed_series_with_cell_fields_on_request() {
+    use std::io::Read;
+    let dir = tempfile::tempdir().unwrap();
+    for cells in [false, true] {
+        let out = dir.path().join(format!("cells-{cells}"));
+        let sets = [
+            "mesh.n=8".to_string(),
+            "path.steps=4".into(),
+            format!("path.cell_fields={cells}"),
+        ];
+        let (scene, source) = scene_file::load("paper-cycle", &sets).unwrap();
+        let solution = files::run::run(&scene, &source, &out, &mut Silent).unwrap();
+        let pvd = std::fs::read_to_string(out.join("path.pvd")).unwrap();
+        for k in 0..=4 {
+            let name = format!("step-{k:04}.vtu");
+            assert!(pvd.contains(&format!("file=\"{name}\"")), "{name} in path.pvd");
+            let bytes = std::fs::read(out.join(&name)).unwrap();
+            let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4000)]).into_owned();
+            assert!(head.contains("compressor=\"vtkZLibDataCompressor\""), "{name}");
+            assert!(head.contains("Name=\"contact_pressure\""), "{name}");
+            assert_eq!(head.contains("Name=\"stress\""), cells, "{name}");
+            if k == 4 {
+                // the first array, `u`, inflated: the last instant's displacements
+                let marker = b"<AppendedData encoding=\"raw\">\n_";
+                let at = bytes.windows(marker.len()).position(|w| w == marker).unwrap() + marker.len();
+                let word =
+                    |i: usize| u64::from_le_bytes(bytes[at + 8 * i..at + 8 * i + 8].try_into().unwrap()) as usize;
+                let blocks = word(0);
+                let mut data = at + 8 * (3 + blocks);
+                let mut u = vec![];
+                for b in 0..blocks {
+                    let len = word(3 + b);
+                    flate2::read::ZlibDecoder::new(&bytes[data..data + len])
+                        .read_to_end(&mut u)
+                        .unwrap();
+                    data += len;
+                }
+                let u: Vec<f64> = u.chunks(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect();
+                let want: Vec<f64> = solution.u.iter().flatten().copied().collect();
+                assert_eq!(u, want);
+            }
+        }
+        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
+        assert!(json["timings_s"]["output"].as_f64().unwrap() > 0.0);
+    }
+}

@@ -43,7 +43,7 @@ pub fn run_distributed(
         )?),
         _ => None,
     };
-    let mut files = output::PathFiles::default();
+    let mut files = output::PathFiles::new(scene);
     let mut each = |step: problem::Step<'_>| match writer.as_mut() {
         Some(w) => files.step(&step, w).map_err(|e| problem::ProblemError::NoSolution {
             sought: "a path's step file",
@@ -68,7 +68,8 @@ pub fn run_distributed(
     }
     match writer {
         Some(mut w) => {
-            w.write_all(files.finish(&solution)?)?;
+            let outputs = files.finish(&mut solution, &mut w)?;
+            w.write_all(outputs)?;
             w.finish()?;
         }
         None => output::write(&solution, dir)?,

@@ -126,8 +126,8 @@ pub fn solve_path_with(
 /// As [`run`].
 pub fn run_path(scene: &Scene, source: &Source, dir: &Path, reporter: &mut dyn Reporter) -> Result<Solution, Error> {
     let mut writer = output::SetWriter::begin(dir, &output::PathFiles::expected_names(scene))?;
-    let mut files = output::PathFiles::default();
-    let solution = solve_path_with(
+    let mut files = output::PathFiles::new(scene);
+    let mut solution = solve_path_with(
         scene,
         source,
         None,
@@ -135,7 +135,8 @@ pub fn run_path(scene: &Scene, source: &Source, dir: &Path, reporter: &mut dyn R
         reporter,
         &mut |step| files.step(&step, &mut writer),
     )?;
-    writer.write_all(files.finish(&solution)?)?;
+    let outputs = files.finish(&mut solution, &mut writer)?;
+    writer.write_all(outputs)?;
     writer.finish()?;
     Ok(solution)
 }

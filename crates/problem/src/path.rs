@@ -965,6 +965,7 @@ impl Walk<'_> {
             condense: figures.condense.map_or(0.0, |c| c.1),
             contact: contact_s,
             solve: if path { steps_s } else { done.seconds },
+            output: 0.0,
             total: t_total.elapsed().as_secs_f64(),
         };
         let posed = Posed {

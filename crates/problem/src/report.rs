@@ -627,6 +627,10 @@ pub struct Timings {
     pub contact: f64,
     /// The solve, contact included.
     pub solve: f64,
+    /// Writing a path's step files as it runs (the rest of a set is written after the report
+    /// is made); 0 for one instant.
+    #[serde(default)]
+    pub output: f64,
     /// Set-up to solution.
     pub total: f64,
 }

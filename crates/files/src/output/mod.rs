@@ -3,9 +3,11 @@
 //! `contact.csv`, the pictures), written as one set ([`Outputs`], in `set`): the new set
 //! appears all at once, in place of the previous one, or not at all.
 
+mod frames;
 mod set;
 mod vtu;
 
+pub use frames::PathFiles;
 pub use set::{abandon_and_exit, Outputs, SetWriter};
 
 use crate::plots::{self, Mark, Panel, Series};
@@ -103,10 +105,24 @@ pub fn write(solution: &Solution, dir: &Path) -> Result<(), Error> {
 /// contact, point data `contact_status` (0 none, 1 stick, 2 slip, 3 separated).
 fn vtu(
     mesh: &mesh::Mesh,
-    (u, phi): (&[[f64; 3]], &[f64]),
-    fields: &problem::CellFields,
+    fields: (&[[f64; 3]], &[f64]),
+    cells: &problem::CellFields,
     contact: Option<&ContactResult>,
 ) -> Result<Vec<u8>, Error> {
+    let (points, connectivity, offsets, cell_type) = mesh_arrays(mesh);
+    let data = FieldArrays::new(mesh, fields, Some(cells), contact);
+    Ok(vtu::write(&Grid {
+        points: &points,
+        connectivity: &connectivity,
+        offsets: &offsets,
+        cell_type,
+        point: data.point.iter().map(NamedValues::array).collect(),
+        cell: data.cell.iter().map(NamedValues::array).collect(),
+    }))
+}
+
+/// The mesh as VTK's arrays: coordinates (3 per point), connectivity, offsets, the cell type.
+fn mesh_arrays(mesh: &mesh::Mesh) -> (Vec<f64>, Vec<u64>, Vec<u64>, CellType) {
     let points: Vec<f64> = mesh.points.iter().flatten().copied().collect();
     let k = mesh.kind.n_nodes();
     let connectivity: Vec<u64> = mesh.cells.iter().map(|&v| v as u64).collect();
@@ -116,52 +132,100 @@ fn vtu(
         mesh::CellKind::Quad4 => CellType::Quad,
         mesh::CellKind::Tet4 => CellType::Tetra,
     };
-    let dim = mesh.dim;
-    // Voigt components per cell: 3 in plane strain, 4 on a body of revolution ([rr, zz, rz,
-    // θθ]), 6 in 3D
-    let nv = fields.stress.len() / mesh.n_cells().max(1);
-    let u: Vec<f64> = u.iter().flatten().copied().collect();
-    let status = contact.map(|c| {
-        let mut status = vec![0.0; mesh.n_nodes()];
-        for (i, &node) in c.nodes.iter().enumerate() {
-            status[node] = match c.solution.status[i] {
-                contact::Status::Stick => 1.0,
-                contact::Status::Slip => 2.0,
-                contact::Status::Separated => 3.0,
-            };
-        }
-        status
-    });
-    let array = |name, components, values| Array {
-        name,
-        components,
-        values: Values::F64(values),
-    };
-    let mut point = vec![array("u", 3, &u), array("phi", 1, phi)];
-    let on_face = contact.map(|c| contact_point_data(c, mesh.n_nodes()));
-    if let (Some(status), Some(data)) = (&status, &on_face) {
-        point.push(array("contact_status", 1, status));
-        point.push(array("contact_pressure", 1, &data.pressure));
-        point.push(array("contact_traction", 3, &data.traction));
-        point.push(array("contact_gap", 1, &data.gap));
-        if let Some(flux) = &data.flux {
-            point.push(array("contact_flux", 1, flux));
+    (points, connectivity, offsets, cell_type)
+}
+
+/// A named array of `f64`, borrowed or owned (a path's frame owns its copies, to be written
+/// on another thread).
+struct NamedValues<'a> {
+    name: &'static str,
+    components: usize,
+    values: std::borrow::Cow<'a, [f64]>,
+}
+
+impl NamedValues<'_> {
+    fn array(&self) -> Array<'_> {
+        Array {
+            name: self.name,
+            components: self.components,
+            values: Values::F64(&self.values),
         }
     }
-    let cell = vec![
-        array("stress", nv, &fields.stress),
-        array("strain", nv, &fields.strain),
-        array("electric_displacement", dim, &fields.electric_displacement),
-        array("electric_field", dim, &fields.electric_field),
-    ];
-    Ok(vtu::write(&Grid {
-        points: &points,
-        connectivity: &connectivity,
-        offsets: &offsets,
-        cell_type,
-        point,
-        cell,
-    }))
+
+    fn into_owned(self) -> NamedValues<'static> {
+        NamedValues {
+            name: self.name,
+            components: self.components,
+            values: std::borrow::Cow::Owned(self.values.into_owned()),
+        }
+    }
+}
+
+/// The point and cell data of a solution's grid: `u`, `phi` and, with contact, its point data
+/// (status, pressure, traction, gap, flux); with `cells`, the cell data (stress, strain, D, E).
+struct FieldArrays<'a> {
+    point: Vec<NamedValues<'a>>,
+    cell: Vec<NamedValues<'a>>,
+}
+
+impl<'a> FieldArrays<'a> {
+    fn new(
+        mesh: &mesh::Mesh,
+        (u, phi): (&[[f64; 3]], &'a [f64]),
+        cells: Option<&'a problem::CellFields>,
+        contact: Option<&ContactResult>,
+    ) -> Self {
+        use std::borrow::Cow;
+        let named = |name, components, values| NamedValues {
+            name,
+            components,
+            values,
+        };
+        let u: Vec<f64> = u.iter().flatten().copied().collect();
+        let mut point = vec![named("u", 3, Cow::Owned(u)), named("phi", 1, Cow::Borrowed(phi))];
+        if let Some(c) = contact {
+            let mut status = vec![0.0; mesh.n_nodes()];
+            for (i, &node) in c.nodes.iter().enumerate() {
+                status[node] = match c.solution.status[i] {
+                    contact::Status::Stick => 1.0,
+                    contact::Status::Slip => 2.0,
+                    contact::Status::Separated => 3.0,
+                };
+            }
+            let data = contact_point_data(c, mesh.n_nodes());
+            point.push(named("contact_status", 1, Cow::Owned(status)));
+            point.push(named("contact_pressure", 1, Cow::Owned(data.pressure)));
+            point.push(named("contact_traction", 3, Cow::Owned(data.traction)));
+            point.push(named("contact_gap", 1, Cow::Owned(data.gap)));
+            if let Some(flux) = data.flux {
+                point.push(named("contact_flux", 1, Cow::Owned(flux)));
+            }
+        }
+        let cell = cells.map_or(vec![], |f| {
+            // Voigt components per cell: 3 in plane strain, 4 on a body of revolution ([rr,
+            // zz, rz, θθ]), 6 in 3D
+            let nv = f.stress.len() / mesh.n_cells().max(1);
+            vec![
+                named("stress", nv, Cow::Borrowed(&f.stress[..])),
+                named("strain", nv, Cow::Borrowed(&f.strain[..])),
+                named(
+                    "electric_displacement",
+                    mesh.dim,
+                    Cow::Borrowed(&f.electric_displacement[..]),
+                ),
+                named("electric_field", mesh.dim, Cow::Borrowed(&f.electric_field[..])),
+            ]
+        });
+        FieldArrays { point, cell }
+    }
+
+    /// The arrays, every one owned.
+    fn into_owned(self) -> FieldArrays<'static> {
+        FieldArrays {
+            point: self.point.into_iter().map(NamedValues::into_owned).collect(),
+            cell: self.cell.into_iter().map(NamedValues::into_owned).collect(),
+        }
+    }
 }
 
 /// The contact values as point data of the mesh's nodes (0 off the contact face, where
@@ -409,61 +473,6 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
     plots::panels("multipliers", &panels)
 }
 
-/// The files of a load path, written step by step ([`PathFiles::step`]: each instant's
-/// `step-NNNN.vtu`, a ParaView time series) and finished with the last instant's solution
-/// ([`PathFiles::finish`]): the plan's files of the last instant, `path.csv` (one row per
-/// instant), `path.pvd` (the series' collection), and `path.svg`/`.png` (the contact forces
-/// against time, and the tangential force against the prescribed x displacement: friction's
-/// loop).
-#[derive(Default)]
-pub struct PathFiles {
-    series: Vec<(f64, String)>,
-}
-
-impl PathFiles {
-    /// The names a path's set is sure to hold (checked before anything is written): its steps'
-    /// files, the path's own, and the last instant's report, solution and contact table.
-    pub fn expected_names(scene: &problem::Scene) -> Vec<String> {
-        let steps = scene.path.as_ref().map_or(1, |p| p.instants().len());
-        let written = |k: &usize| scene.path.as_ref().is_none_or(|p| p.has_fields(*k, steps));
-        let mut names: Vec<String> = (0..steps).filter(written).map(step_name).collect();
-        names.extend(["path.csv", "path.pvd", "run.json", "solution.vtu", "contact.csv"].map(String::from));
-        names
-    }
-
-    /// Writes one instant's `step-NNNN.vtu` into the set.
-    ///
-    /// # Errors
-    /// [`Error::Picture`] where its VTU cannot be made, [`Error::Output`] where it cannot be
-    /// written.
-    pub fn step(&mut self, step: &problem::Step<'_>, writer: &mut SetWriter) -> Result<(), Error> {
-        let Some(f) = &step.fields else {
-            return Ok(());
-        };
-        let name = step_name(step.row.step);
-        writer.write(&name, &vtu(step.mesh, (f.u, f.phi), f.fields, Some(step.contact))?)?;
-        self.series.push((step.row.t, name));
-        Ok(())
-    }
-
-    /// The files of the last instant and the path's own.
-    ///
-    /// # Errors
-    /// As [`files`].
-    pub fn finish(self, last: &Solution) -> Result<Outputs, Error> {
-        let mut out = files(last)?;
-        if !self.series.is_empty() {
-            out.add("path.pvd", pvd(&self.series));
-        }
-        Ok(out)
-    }
-}
-
-/// The name of a path's instant `k` in its series.
-fn step_name(k: usize) -> String {
-    format!("step-{k:04}.vtu")
-}
-
 /// A path's own files without its series: `path.csv` and the pictures of its global curves
 /// (none for a run of one instant).
 fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
@@ -553,20 +562,6 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         s.push_str(&row.join(","));
         s.push('\n');
     }
-    s.into_bytes()
-}
-
-/// `path.pvd`: ParaView's collection of the steps' files, each at its instant.
-fn pvd(series: &[(f64, String)]) -> Vec<u8> {
-    let mut s = String::from(
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
-    );
-    for (t, name) in series {
-        s.push_str(&format!(
-            "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
-        ));
-    }
-    s.push_str("  </Collection>\n</VTKFile>\n");
     s.into_bytes()
 }
 

@@ -378,11 +378,21 @@ pub struct PathSpec {
     /// The factor on the uniform gap (`contact.gap` less an indenter's `depth`; the shape's part stays).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gap: Option<Vec<f64>>,
-    /// The fields (and a run's `step-NNNN.vtu`) of every `output_every`-th instant (1, the
-    /// default: every one; 0: the last alone); the rows of `path.csv` are every instant's.
+    /// The fields (and a run's `step-NNNN.vtu`) of every `output_every`-th instant (0: the
+    /// last alone; by default every instant up to [`DEFAULT_FRAMES`] steps, every
+    /// `⌈(n - 1) / 50⌉`-th of `n` instants beyond); the rows of `path.csv` are every instant's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_every: Option<usize>,
+    /// Whether each `step-NNNN.vtu` also holds the cell fields (stress, strain, D, E), which
+    /// the last instant's `solution.vtu` always holds: false by default (they are 3/4 of a
+    /// step's bytes in 2D, more in 3D).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub cell_fields: bool,
 }
+
+/// The steps after the first whose fields a path writes by default: every instant of a path
+/// of up to 50 steps, and at most 51 steps' files of a longer one.
+pub const DEFAULT_FRAMES: usize = 50;
 
 /// The factors of one instant of a path.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -433,10 +443,17 @@ impl PathSpec {
             .collect()
     }
 
+    /// Every how many of `n` instants the fields are written: `output_every`, by default 1 up
+    /// to [`DEFAULT_FRAMES`] steps and `⌈(n - 1) / DEFAULT_FRAMES⌉` beyond.
+    pub fn output_every(&self, n: usize) -> usize {
+        self.output_every
+            .unwrap_or_else(|| n.saturating_sub(1).div_ceil(DEFAULT_FRAMES).max(1))
+    }
+
     /// Whether instant `k` of `n` has its fields (and a run its `step-NNNN.vtu`): every
-    /// `output_every`-th (1 by default; 0: none), and the last.
+    /// [`PathSpec::output_every`]-th (0: none), and the last.
     pub fn has_fields(&self, k: usize, n: usize) -> bool {
-        let every = self.output_every.unwrap_or(1);
+        let every = self.output_every(n);
         k + 1 == n || (every > 0 && k.is_multiple_of(every))
     }
 
@@ -1842,6 +1859,44 @@ impl<'de> Deserialize<'de> for Contacts {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A path's frames by default: every instant up to 50 steps, at most 51 files beyond (the
+    /// first, every `⌈(n - 1)/50⌉`-th, and the last), and `output_every` as given.
+    #[test]
+    fn a_path_writes_at_most_51_frames_by_default() {
+        let frames = |spec: &PathSpec| {
+            let n = spec.instants().len();
+            (0..n).filter(|&k| spec.has_fields(k, n)).count()
+        };
+        for (steps, want) in [
+            (1, 2),
+            (30, 31),
+            (50, 51),
+            (51, 27),
+            (100, 51),
+            (101, 35),
+            (1000, 51),
+            (1001, 49),
+        ] {
+            let spec = PathSpec {
+                t: vec![0.0, 1.0],
+                steps: Some(steps),
+                ..Default::default()
+            };
+            assert_eq!(frames(&spec), want, "{steps} steps");
+            assert!(frames(&spec) <= DEFAULT_FRAMES + 1);
+        }
+        let every = |k| PathSpec {
+            t: vec![0.0, 1.0],
+            steps: Some(100),
+            output_every: Some(k),
+            ..Default::default()
+        };
+        let spec = every(1);
+        assert_eq!(frames(&spec), 101);
+        let spec = every(0);
+        assert_eq!(frames(&spec), 1);
+    }
 
     /// A sphere's height in the limits of its parameters: against the paraboloid `ρ²/2R` (its
     /// first term; the next, `ρ⁴/8R³`, below round-off once `ρ²/R² < 1e-16`) for radii up to
