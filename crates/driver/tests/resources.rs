@@ -103,6 +103,8 @@ fn a_signal_removes_the_partial_set_and_keeps_the_previous_one() {
                 "mesh.n=64",
                 "--set",
                 "path.steps=2000",
+                "--set",
+                "path.output_every=1",
                 "--out",
             ])
             .arg(&out)

@@ -142,3 +142,26 @@ def test_the_force_depth_charge_curve_of_a_conducting_tip():
     for run, form in [("normal_force", "half_space_force"), ("tip_charge", "half_space_charge")]:
         assert np.allclose(p[run][touching], p[form][touching], rtol=0.025), run
     assert np.all(np.diff(p["half_space_force"][touching]) > 0)
+
+
+def test_the_programs_steps_are_compressed_files_meshio_reads(binary, tmp_path):
+    """A path's step-NNNN.vtu: zlib-compressed, read by meshio; u, phi and the contact's
+    fields in every step, the cell fields where path.cell_fields asks; the last step's u is
+    solution.vtu's. The key reaches the library's scenes too."""
+    import meshio
+
+    for cells in [False, True]:
+        out = tmp_path / f"cells-{cells}"
+        args = [str(binary), "run", "cattaneo-mindlin-cycle", "--out", str(out)]
+        for k, v in {"mesh.n": 8, "path.steps": 4, "path.cell_fields": str(cells).lower()}.items():
+            args += ["--set", f"{k}={v}"]
+        subprocess.run(args, check=True, capture_output=True)
+        last = meshio.read(out / "step-0004.vtu")
+        assert b'compressor="vtkZLibDataCompressor"' in (out / "step-0004.vtu").read_bytes()[:600]
+        for key in ["u", "phi", "contact_status", "contact_pressure", "contact_traction", "contact_gap"]:
+            assert key in last.point_data, key
+        assert ("stress" in last.cell_data) == cells
+        solution = meshio.read(out / "solution.vtu")
+        assert np.array_equal(last.point_data["u"], solution.point_data["u"])
+        scene = pc.Scene.load("cattaneo-mindlin-cycle", {"mesh.n": 8, "path.steps": 4, "path.cell_fields": cells})
+        assert pc.run(scene).path is not None
