@@ -183,6 +183,7 @@ struct Terminal {
     bar: Option<indicatif::ProgressBar>,
     first_residual: Option<f64>,
     path: Option<indicatif::ProgressBar>,
+    factoring: Option<FactorBar>,
 }
 
 impl Terminal {
@@ -191,6 +192,7 @@ impl Terminal {
             bar: None,
             first_residual: None,
             path: None,
+            factoring: None,
         }
     }
 
@@ -227,8 +229,74 @@ fn path_bar(steps: u64) -> indicatif::ProgressBar {
     bar
 }
 
+/// The bar of a factorisation that takes more than a second: the share of its work done
+/// (its supernodes' operations) and the time left at that rate, redrawn by a thread of its own
+/// while the factorisation runs on the caller's; gone when it ends (or is dropped).
+struct FactorBar {
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl FactorBar {
+    /// Shown after this long only: most factorisations end before.
+    const DELAY: std::time::Duration = std::time::Duration::from_secs(1);
+
+    fn start(watch: problem::FactorWatch) -> Self {
+        use std::sync::atomic::Ordering;
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let stopped = stop.clone();
+        let thread = std::thread::spawn(move || {
+            let tick = std::time::Duration::from_millis(100);
+            let started = std::time::Instant::now();
+            let mut bar: Option<indicatif::ProgressBar> = None;
+            while !stopped.load(Ordering::Relaxed) {
+                std::thread::park_timeout(tick);
+                let Some(fraction) = watch.0.fraction() else { continue };
+                if started.elapsed() < Self::DELAY {
+                    continue;
+                }
+                let bar = bar.get_or_insert_with(|| factor_bar().with_elapsed(started.elapsed()));
+                bar.set_position((fraction * 1000.0) as u64);
+            }
+            if let Some(bar) = bar {
+                bar.finish_and_clear();
+            }
+        });
+        FactorBar {
+            stop,
+            thread: Some(thread),
+        }
+    }
+}
+
+impl Drop for FactorBar {
+    fn drop(&mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        if let Some(thread) = self.thread.take() {
+            thread.thread().unpark();
+            let _ = thread.join();
+        }
+    }
+}
+
+/// The progress bar of a factorisation: its work done, and the time left at its rate so far.
+fn factor_bar() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "factorisation [{bar:40}] {percent:>3}% of its work, {elapsed}, about {eta} left",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
 impl problem::Reporter for Terminal {
     fn event(&mut self, event: &Event<'_>) {
+        // a factorisation's bar lasts until the next event (its end, or the run's error)
+        self.factoring = match event {
+            Event::Factoring { watch } => Some(FactorBar::start(watch.clone())),
+            _ => None,
+        };
         if self.path_event(event) {
             return;
         }

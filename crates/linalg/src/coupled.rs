@@ -208,8 +208,22 @@ impl DirectLdlt {
         par: Par,
         budget: Option<usize>,
     ) -> Result<Self, LinalgError> {
+        Self::new_watched([a, g, b], ordering, (par, budget), None)
+    }
+
+    /// As [`DirectLdlt::new_within`] on the blocks `[A, G, B]`, the factorisation's progress
+    /// kept in `progress` as it goes ([`crate::FactorProgress`]).
+    ///
+    /// # Errors
+    /// As [`DirectLdlt::new_within`].
+    pub fn new_watched(
+        [a, g, b]: [&SparseColMat<usize, f64>; 3],
+        ordering: &Ordering,
+        (par, budget): (Par, Option<usize>),
+        progress: Option<&crate::FactorProgress>,
+    ) -> Result<Self, LinalgError> {
         let k = lower_quasi_definite(a.as_ref(), g.as_ref(), b.as_ref());
-        let factor = SparseFactor::new_within(k.as_ref(), FactorKind::Ldlt, ordering, par, budget)
+        let factor = SparseFactor::new_watched(k.as_ref(), FactorKind::Ldlt, ordering, (par, budget), progress)
             .map_err(|e| e.context("the coupled matrix K"))?;
         Ok(DirectLdlt {
             factor,

@@ -20,6 +20,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
+use std::sync::atomic::{AtomicU64, Ordering as AtomicOrdering};
 
 /// Below this `|pivot| / |diagonal entry|` a factorisation reports the matrix singular to
 /// working precision ([`LinalgError::NearlySingular`]).
@@ -94,6 +95,36 @@ impl std::fmt::Debug for SparseFactor {
     }
 }
 
+/// How far a factorisation has got, read from another thread while it runs: the
+/// floating-point operations of the supernodes done against those of all (the tree's
+/// `L D Lᵀ` reports them; a factorisation faer walks reports none). A run's progress bar reads
+/// it.
+#[derive(Debug, Default)]
+pub struct FactorProgress {
+    done: AtomicU64,
+    total: AtomicU64,
+}
+
+impl FactorProgress {
+    /// The fraction done, `None` before the factorisation reports its total.
+    pub fn fraction(&self) -> Option<f64> {
+        let total = self.total.load(AtomicOrdering::Relaxed);
+        (total > 0).then(|| (self.done.load(AtomicOrdering::Relaxed) as f64 / total as f64).min(1.0))
+    }
+
+    /// A factorisation of the supernodes' `work` (operations each) begins.
+    pub(crate) fn start(&self, work: &[f64]) {
+        let total: u64 = work.iter().map(|&w| w as u64).sum();
+        self.done.store(0, AtomicOrdering::Relaxed);
+        self.total.store(total.max(1), AtomicOrdering::Relaxed);
+    }
+
+    /// A supernode of `work` operations is done (all of them: the fraction is 1).
+    pub(crate) fn add(&self, work: f64) {
+        self.done.fetch_add(work as u64, AtomicOrdering::Relaxed);
+    }
+}
+
 impl SparseFactor {
     /// Analyses and factors `a` (square; the lower triangle is read).
     ///
@@ -128,6 +159,21 @@ impl SparseFactor {
         ordering: &Ordering,
         par: Par,
         budget: Option<usize>,
+    ) -> Result<Self, LinalgError> {
+        Self::new_watched(a, kind, ordering, (par, budget), None)
+    }
+
+    /// As [`SparseFactor::new_within`] (`par`, `budget`), the numeric factorisation's progress
+    /// kept in `progress` as it goes.
+    ///
+    /// # Errors
+    /// As [`SparseFactor::new_within`].
+    pub fn new_watched(
+        a: SparseColMatRef<'_, usize, f64>,
+        kind: FactorKind,
+        ordering: &Ordering,
+        (par, budget): (Par, Option<usize>),
+        progress: Option<&FactorProgress>,
     ) -> Result<Self, LinalgError> {
         let n = a.nrows();
         if n != a.ncols() {
@@ -178,12 +224,24 @@ impl SparseFactor {
             tree,
             pivot_ratio: f64::NAN,
         };
-        f.refactor(a)?;
+        f.refactor_watched(a, progress)?;
         Ok(f)
     }
 
     /// Factors again, in place, a matrix with the same pattern and new values.
+    ///
+    /// # Errors
+    /// A matrix that is not (quasi-)definite, or non-finite values in the factor.
     pub fn refactor(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), LinalgError> {
+        self.refactor_watched(a, None)
+    }
+
+    /// [`SparseFactor::refactor`], its progress kept in `progress`.
+    fn refactor_watched(
+        &mut self,
+        a: SparseColMatRef<'_, usize, f64>,
+        progress: Option<&FactorProgress>,
+    ) -> Result<(), LinalgError> {
         let stack = MemStack::new(&mut self.factor_mem);
         match self.kind {
             FactorKind::Cholesky => {
@@ -211,12 +269,13 @@ impl SparseFactor {
             FactorKind::Ldlt => match (self.tree.as_ref(), self.symbolic.supernodal(), &self.symbolic) {
                 (Some(tree), Some(sym), _) => {
                     // the tree checks each supernode's values as it factors it
-                    tree.factor(sym, a, &mut self.values, self.par).map_err(|b| match b {
-                        Breakdown::ZeroPivot(index) => LinalgError::ZeroPivot {
-                            pivot: original(&self.symbolic, index),
-                        },
-                        Breakdown::NonFinite(i) => non_finite_entry(i),
-                    })?;
+                    tree.factor(sym, a, &mut self.values, (self.par, progress))
+                        .map_err(|b| match b {
+                            Breakdown::ZeroPivot(index) => LinalgError::ZeroPivot {
+                                pivot: original(&self.symbolic, index),
+                            },
+                            Breakdown::NonFinite(i) => non_finite_entry(i),
+                        })?;
                 }
                 (_, _, Analysis::Own { .. }) => unreachable!("this crate's analysis comes with its tree"),
                 (_, _, Analysis::Faer(symbolic)) => {

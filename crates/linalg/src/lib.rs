@@ -50,7 +50,7 @@ pub use coupled::{
     FactorPreconditioner, Refinable, Refined, Residual, Rhs, SchurOperator, SchurPcg, SolveInfo,
 };
 pub use dense::{mirror_lower, symmetric_inverse};
-pub use factor::{pool_par, FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
+pub use factor::{pool_par, FactorKind, FactorProgress, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};
 
 /// What can go wrong in the linear algebra.

@@ -14,6 +14,7 @@
 //! which on a 2D mesh's many small supernodes costs more than it gains
 //! (docs/performance.md); here the tree gives the second core its own half of the work.
 
+use crate::factor::FactorProgress;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{
     cholesky_in_place, cholesky_in_place_scratch, LdltParams, LdltRegularization,
@@ -75,6 +76,8 @@ pub(crate) struct Tree {
     updaters: Vec<usize>,
     /// Floating-point operations of each supernode's subtree.
     work: Vec<f64>,
+    /// Floating-point operations of each supernode's own columns.
+    own_work: Vec<f64>,
     /// The lower triangle in the factor's order: column pointers, rows, and the index of each
     /// value in the input matrix's values.
     col_ptr: Vec<usize>,
@@ -97,7 +100,7 @@ impl Tree {
             Some(lower) => (Tree::shape(sym), lower),
             None => rayon::join(|| Tree::shape(sym), || Lower::new(a, inv)),
         };
-        let (parent, first, upd_ptr, updaters, work) = shape?;
+        let (parent, first, upd_ptr, updaters, (work, own_work)) = shape?;
         let Lower { col_ptr, rows, src } = lower;
         Some(Tree {
             parent,
@@ -105,18 +108,19 @@ impl Tree {
             upd_ptr,
             updaters,
             work,
+            own_work,
             col_ptr,
             row_idx: rows,
             src,
         })
     }
 
-    /// The supernodes' parents, first descendants, updaters (pointers and list) and subtree
-    /// work; `None` where they are not in postorder.
+    /// The supernodes' parents, first descendants, updaters (pointers and list), and subtree
+    /// and own work; `None` where they are not in postorder.
     #[allow(clippy::type_complexity)]
     fn shape(
         sym: &SymbolicSupernodalCholesky<usize>,
-    ) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>, Vec<usize>, Vec<f64>)> {
+    ) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>, Vec<usize>, (Vec<f64>, Vec<f64>))> {
         let ns = sym.n_supernodes();
         let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
         let (cp_row, row_idx) = (sym.col_ptr_for_row_idx(), sym.row_idx());
@@ -146,6 +150,7 @@ impl Tree {
                 })
                 .sum::<f64>();
         }
+        let own_work = work.clone();
         for s in 0..ns {
             if parent[s] != usize::MAX {
                 if parent[s] <= s {
@@ -170,23 +175,28 @@ impl Tree {
             updaters.extend(l);
             upd_ptr.push(updaters.len());
         }
-        Some((parent, first, upd_ptr, updaters, work))
+        Some((parent, first, upd_ptr, updaters, (work, own_work)))
     }
 
     /// Factors `a` (the pattern the tree was built for) into `values`, faer's supernodal
-    /// layout, on rayon's pool, every value checked finite.
+    /// layout, on rayon's pool, every value checked finite; each supernode's work added to
+    /// `progress` as it is done.
     pub(crate) fn factor(
         &self,
         sym: &SymbolicSupernodalCholesky<usize>,
         a: SparseColMatRef<'_, usize, f64>,
         values: &mut [f64],
-        par: Par,
+        (par, progress): (Par, Option<&FactorProgress>),
     ) -> Result<(), Breakdown> {
+        if let Some(p) = progress {
+            p.start(&self.own_work);
+        }
         let ctx = Ctx {
             sym,
             tree: self,
             values: a.val(),
             par,
+            progress,
         };
         let ns = sym.n_supernodes();
         ctx.forest(0, ns, values, 0)
@@ -490,6 +500,7 @@ struct Ctx<'a> {
     /// The input matrix's values, read through `tree.src`.
     values: &'a [f64],
     par: Par,
+    progress: Option<&'a FactorProgress>,
 }
 
 /// A task's workspace: the map from a row to its place in the current supernode, the
@@ -746,10 +757,13 @@ impl Ctx<'_> {
                 bot[(i, j)] *= d;
             }
         }
-        match first_non_finite(&tail[..cpv[s + 1] - cpv[s]], par) {
-            Some(i) => Err(Breakdown::NonFinite(cpv[s] + i)),
-            None => Ok(()),
+        if let Some(i) = first_non_finite(&tail[..cpv[s + 1] - cpv[s]], par) {
+            return Err(Breakdown::NonFinite(cpv[s] + i));
         }
+        if let Some(p) = self.progress {
+            p.add(self.tree.own_work[s]);
+        }
+        Ok(())
     }
 }
 

@@ -333,3 +333,45 @@ fn a_matrix_of_two_unconnected_blocks_has_two_roots_and_factors_alike() {
     par.solve_in_place(&mut y);
     assert!(relative_gap(&y, &x) < 1e-12);
 }
+
+/// A factorisation's progress, read from another thread while it runs on 1 and 2 threads:
+/// none before it starts, then fractions that never fall, ending at exactly 1; the factor
+/// the same as without a watch (its pivots to the last bit).
+#[test]
+fn a_factorisation_s_progress_rises_to_one() {
+    use std::sync::atomic::{AtomicBool, Ordering as Atomic};
+    let m = 120;
+    let (a, g, b) = grid(m, 7);
+    let ord = Ordering::Given(dissection(m));
+    for threads in [1, 2] {
+        let progress = linalg::FactorProgress::default();
+        assert_eq!(progress.fraction(), None);
+        let done = AtomicBool::new(false);
+        let (watched, seen) = std::thread::scope(|s| {
+            let reader = s.spawn(|| {
+                let mut seen = vec![];
+                while !done.load(Atomic::Relaxed) {
+                    if let Some(f) = progress.fraction() {
+                        seen.push(f);
+                    }
+                    std::thread::yield_now();
+                }
+                seen
+            });
+            let f = on_threads(threads, || {
+                DirectLdlt::new_watched([&a, &g, &b], &ord, (Par::rayon(2), None), Some(&progress))
+            })
+            .unwrap();
+            done.store(true, Atomic::Relaxed);
+            (f, reader.join().unwrap())
+        });
+        assert_eq!(progress.fraction(), Some(1.0), "{threads} threads");
+        assert!(
+            seen.windows(2).all(|w| w[0] <= w[1]),
+            "{threads} threads: a fraction fell"
+        );
+        assert!(seen.iter().all(|f| (0.0..=1.0).contains(f)));
+        let plain = on_threads(threads, || DirectLdlt::new(&a, &g, &b, &ord, Par::rayon(2))).unwrap();
+        assert_eq!(watched.factor().pivots(), plain.factor().pivots());
+    }
+}

@@ -86,7 +86,7 @@ pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
 pub use instants::Instants;
 pub use path::{run, run_steps, PathSolution, Step, StepFields};
 pub use plan::{Output, Plan};
-pub use progress::{Event, Lines, Reporter, Silent};
+pub use progress::{Event, FactorWatch, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
 pub use run::{ContactResult, Solution, EQUILIBRIUM_TOL};
 pub use scene::{

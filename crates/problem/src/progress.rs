@@ -39,6 +39,12 @@ pub enum Event<'a> {
         /// Wall time (s).
         seconds: f64,
     },
+    /// The factorisation of `K` begins: `watch` follows it (a progress bar reads it from
+    /// another thread; it has no line of its own).
+    Factoring {
+        /// The factorisation's progress.
+        watch: FactorWatch,
+    },
     /// The linear solver is factored.
     Factored {
         /// Wall time (s).
@@ -141,6 +147,7 @@ impl Event<'_> {
     pub fn line(&self) -> Option<String> {
         match self {
             Event::Contact { progress: p, .. } if p.stage == contact::Stage::Uzawa && p.iter % 500 != 0 => None,
+            Event::Factoring { .. } => None,
             _ => Some(self.to_string()),
         }
     }
@@ -185,6 +192,7 @@ impl fmt::Display for Event<'_> {
                 f,
                 "mesh: {n_nodes} nodes, {n_cells} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
             ),
+            Event::Factoring { .. } => write!(f, "factorisation begins"),
             Event::Factored { seconds } => write!(f, "factorisation {seconds:.3} s"),
             Event::NotContractive { contraction } => write!(
                 f,
@@ -288,6 +296,17 @@ fn held_notes(tangents: usize, nodes: usize, inside: usize) -> Vec<String> {
         ));
     }
     notes
+}
+
+/// A handle to a factorisation's progress ([`linalg::FactorProgress`]), shared with whoever
+/// draws it; two handles are equal where they follow the same factorisation.
+#[derive(Clone, Debug, Default)]
+pub struct FactorWatch(pub std::sync::Arc<linalg::FactorProgress>);
+
+impl PartialEq for FactorWatch {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 /// Receives the events of a run.

@@ -328,8 +328,11 @@ fn factor(
             },
             _ => Ordering::Given(order),
         };
+        let watch = crate::progress::FactorWatch::default();
+        reporter.event(&Event::Factoring { watch: watch.clone() });
+        let blocks3 = [&blocks.a, &blocks.g, &blocks.b];
         LinearSolver::Direct(
-            DirectLdlt::new_within(&blocks.a, &blocks.g, &blocks.b, &ordering, linalg::pool_par(), budget)
+            DirectLdlt::new_watched(blocks3, &ordering, (linalg::pool_par(), budget), Some(&watch.0))
                 .map_err(too_large)?,
         )
     };
