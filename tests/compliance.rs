@@ -73,6 +73,7 @@ fn block(dim: usize, compliance: Option<ComplianceSpec>, friction: bool) -> Scen
         solver: Default::default(),
         exact: None,
         path: None,
+        units: None,
     }
 }
 

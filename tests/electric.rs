@@ -82,6 +82,7 @@ fn block(dim: usize, condition: ElectricCondition, conductance: Option<f64>) -> 
         solver: Default::default(),
         exact: None,
         path: None,
+        units: None,
     }
 }
 

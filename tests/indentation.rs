@@ -400,6 +400,7 @@ fn block(kind: &str, depth: f64) -> Scene {
         solver: Default::default(),
         exact: None,
         path: None,
+        units: None,
     }
 }
 
@@ -471,6 +472,7 @@ fn a_poled_disc_of_revolution_carries_its_whole_charge() {
         solver: Default::default(),
         exact: None,
         path: None,
+        units: None,
     };
     scene.mesh.axisymmetric = true;
     let solution = problem::solve(&scene, None, &mut Silent).unwrap();

@@ -374,3 +374,54 @@ fn layers_that_cannot_make_the_body_are_refused_by_key() {
     let names: Vec<String> = (1..4).map(|k| scene.mesh.interface_name(k)).collect();
     assert_eq!(names, ["u_d_1", "d_u", "u_d_3"]);
 }
+
+/// Units stated and carried: a scene in µm and GPa reports potentials in kV, forces in mN,
+/// charges in pC, its CSV columns' units in run.json and its pictures' axes in them; a scene
+/// in GPa that states no `[units]` is taken as SI and told that its stiffness is no solid's in
+/// pascals (and which unit it likely meant); the numbers are the same whatever the labels.
+#[test]
+fn units_are_stated_and_carried_to_every_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pfm");
+    let (scene, source) = files::scene_file::load("pfm", &["mesh.n=16".into()]).unwrap();
+    let solution = files::run::run(&scene, &source, &out, &mut Silent).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
+    let u = &json["units"];
+    assert_eq!(u["quantities"]["potential"], "kV");
+    assert_eq!(u["quantities"]["force"], "mN");
+    assert_eq!(u["quantities"]["charge"], "pC");
+    assert_eq!(u["quantities"]["permittivity"], "nF/m");
+    assert_eq!(u["columns"]["contact.csv"]["lambda_n"], "GPa");
+    assert_eq!(u["columns"]["contact.csv"]["x"], "µm");
+    assert_eq!(u["columns"]["contact.csv"]["status"], "");
+    assert_eq!(u["pm_per_volt"], 1000.0);
+    assert!(u.get("note").is_none());
+    let svg = std::fs::read_to_string(out.join("multipliers.svg")).unwrap();
+    assert!(
+        svg.contains("[µm]") && svg.contains("[GPa]"),
+        "axes in the scene's units"
+    );
+    // the same scene without its [units]: SI assumed, labelled so, and a note; same numbers
+    let (bare, _) = files::scene_file::load("pfm", &["mesh.n=16".into(), "~units".into()]).unwrap();
+    let again = files::run::solve(&bare, &source, &mut Silent).unwrap();
+    let units = &again.report.units;
+    assert!(!units.stated && units.of_quantity("potential") == "V");
+    let note = units.note.as_deref().unwrap();
+    assert!(note.contains("[units] stress = \"GPa\""), "{note}");
+    assert_eq!(again.u, solution.u);
+    // a system of its own: mm and MPa
+    let (mm, _) = files::scene_file::load(
+        "paper",
+        &[
+            "mesh.n=4".into(),
+            "units.length=\"mm\"".into(),
+            "units.stress=\"MPa\"".into(),
+        ],
+    )
+    .unwrap();
+    let r = files::run::solve(&mm, &source, &mut Silent).unwrap().report.units;
+    assert_eq!(r.of_quantity("potential"), "kV");
+    assert_eq!(r.of_quantity("force"), "N/mm");
+    assert_eq!(r.of_quantity("charge"), "µC/mm");
+    assert!(r.note.is_none(), "121 MPa is a solid's stiffness");
+}

@@ -131,6 +131,7 @@ fn block(dim: usize, law: ContactLaw, gap: f64, half: bool) -> Scene {
         solver: Default::default(),
         exact: None,
         path: None,
+        units: None,
     }
 }
 

@@ -62,6 +62,7 @@ fn plate(axisymmetric: bool, top_free: bool) -> Scene {
         solver: Default::default(),
         exact: None,
         path: None,
+        units: None,
     }
 }
 

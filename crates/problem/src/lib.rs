@@ -11,7 +11,8 @@
 //! - plan ([`Plan`]): what a run computes, decided before computing (electric unknowns or
 //!   not, which contact loops, which strategy, which outputs); the run obeys it.
 //! - `λ_n ≥ 0`: the contact pressure; `λ_t`: the tangential multiplier; `u_n ≤ g`.
-//! - Units are those of the scene (the scaled scenes: m, GPa, C/m², nF/m; φ in GV).
+//! - Units are the scene's (`[units]`, [`UnitsSpec`]; SI where it says nothing): the solver
+//!   never converts, and every output says its unit ([`Units`]).
 //!
 //! # Example
 //! A scene built in code (no file): the paper's PZT-5A block, clamped at its sides, pressed
@@ -40,6 +41,7 @@
 //!     solver: Default::default(),
 //!     exact: None,
 //!     path: None,
+//!     units: Some(problem::UnitsSpec { length: None, stress: Some(problem::StressUnit::Gpa) }),
 //! };
 //! let solution = problem::solve(&scene, None, &mut Silent).unwrap();
 //! let contact = solution.contact.as_ref().unwrap();
@@ -75,6 +77,7 @@ mod scene;
 mod setup;
 mod shared_memory;
 mod solution;
+mod units;
 
 pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindlin_deresiewicz_traction};
 pub use backend::Limits;
@@ -98,6 +101,7 @@ pub use scene::{
 pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
 pub use scene::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, CRYSTALS};
 pub use shared_memory::SharedMemory;
+pub use units::{LengthUnit, StressUnit, Units, UnitsSpec};
 
 use contact::ContactError;
 

@@ -11,6 +11,9 @@ use std::fmt;
 pub enum Event<'a> {
     /// The plan is made.
     Planned(&'a Plan),
+    /// The units of the run's numbers (and, where the materials' stiffness is no solid's in
+    /// them, a note saying so).
+    Units(&'a crate::Units),
     /// The mesh's checks noted something without refusing the mesh.
     MeshNotes(crate::setup::MeshNotes),
     /// Dirichlet conditions hold some nodes or directions of the contact group.
@@ -170,6 +173,10 @@ impl fmt::Display for Event<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Event::Planned(plan) => write!(f, "{plan}"),
+            Event::Units(units) => match &units.note {
+                Some(note) => write!(f, "{units}\nnote: {note}"),
+                None => write!(f, "{units}"),
+            },
             Event::MeshNotes(n) => write!(f, "note: {}", mesh_notes(n).join("; ")),
             Event::ContactHeld {
                 group,

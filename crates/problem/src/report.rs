@@ -48,6 +48,9 @@ pub struct RunReport {
     /// A rigid indenter's figures (absent without `contact.indenter`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub indenter: Option<IndenterReport>,
+    /// The unit of every reported quantity, from the scene's system.
+    #[serde(default)]
+    pub units: crate::Units,
 }
 
 /// A rigid indenter's figures (`run.json`'s `indenter`), in the scene's units (a body of

@@ -253,3 +253,15 @@ def test_a_tresca_bound_along_the_zone_from_python():
     with pytest.raises(pc.InputError) as info:
         s.set("contact.slip_bound_profile.at", [2.0, 0.0])
     assert info.value.key == "contact.slip_bound_profile.at"
+
+
+def test_the_report_carries_the_scenes_units():
+    """run.json's units block in the library's report: the scene's system (pfm: µm and GPa)
+    and the units derived from it; a system set like any key."""
+    r = pc.run(pc.Scene.load("pfm", {"mesh.n": 16}))
+    u = r.report["units"]
+    assert u["length"] == "µm" and u["stress"] == "GPa" and u["stated"]
+    assert u["quantities"]["potential"] == "kV" and u["quantities"]["force"] == "mN"
+    assert u["pm_per_volt"] == 1000.0
+    r = pc.run(pc.Scene.load("paper", {"mesh.n": 4, "units.length": "mm", "units.stress": "MPa"}))
+    assert r.report["units"]["quantities"]["potential"] == "kV"

@@ -37,6 +37,8 @@ pub struct SweepRow {
     /// The run's error where this point failed (its numbers then NaN): the other points are
     /// kept.
     pub error: Option<String>,
+    /// The units of the run's numbers (none where it failed).
+    pub units: Option<problem::Units>,
 }
 
 /// An indenter's figures at a point of a sweep, with the half-space's closed form where it
@@ -152,6 +154,11 @@ pub fn sweep(
         outs.commit()?;
         progress(&format!("wrote sweep.csv, sweep.svg, sweep.png in {}", dir.display()));
     }
+    if let Some((response, n)) = piezoresponse(param, &rows) {
+        progress(&format!(
+            "piezoresponse: {response:.1} pm/V (the indenter's depth against {param}, a least-squares line through {n} points)"
+        ));
+    }
     if !failed.is_empty() {
         return Err(DriverError::Unexpected {
             what: "sweep points that failed (the others are in sweep.csv)",
@@ -189,6 +196,7 @@ impl SweepRow {
                 .map(|t| (t.group.clone(), t.charge, t.potential))
                 .collect(),
             error: None,
+            units: Some(r.units.clone()),
         }
     }
 
@@ -207,6 +215,7 @@ impl SweepRow {
             indenter: None,
             terminals: vec![],
             error: Some(error),
+            units: None,
         }
     }
 }
@@ -316,6 +325,45 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
     csv
 }
 
+/// The quantity a swept key is (for its unit): a potential, a pressure, a force, a length, or
+/// none known ("").
+pub fn param_quantity(param: &str) -> &'static str {
+    let last = param.rsplit('.').next().unwrap_or(param);
+    match last {
+        l if l.ends_with("potential") || l == "phi" || l == "voltage" => "potential",
+        "p" | "pressure" => "pressure",
+        l if l.ends_with("force") => "force",
+        l if l.ends_with("depth") || l.ends_with("gap") || l.ends_with("radius") => "length",
+        _ => "",
+    }
+}
+
+/// The piezoresponse of a sweep over a potential with an indenter: the slope of the indenter's
+/// depth against the potential, a least-squares line through the points that solved, in pm/V
+/// (the scene's units converted, [`problem::Units::pm_per_volt`]), and the number of points;
+/// `None` where the key is not a potential or fewer than two points have a depth.
+pub fn piezoresponse(param: &str, rows: &[SweepRow]) -> Option<(f64, usize)> {
+    if param_quantity(param) != "potential" {
+        return None;
+    }
+    let points: Vec<(f64, f64, f64)> = rows
+        .iter()
+        .filter_map(|r| Some((r.value, r.indenter.as_ref()?.depth, r.units.as_ref()?.pm_per_volt)))
+        .filter(|(v, d, _)| v.is_finite() && d.is_finite())
+        .collect();
+    let n = points.len();
+    if n < 2 {
+        return None;
+    }
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y, _)| (a + x / n as f64, b + y / n as f64));
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y, _)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    (sxx > 0.0).then(|| (sxy / sxx * points[0].2, n))
+}
+
 /// The panels against the parameter: the contact states, the contact forces, and where the
 /// sweep has them, an indenter's depth (the piezoresponse against a voltage) and the charges
 /// (each terminal's, a conducting tip's).
@@ -324,6 +372,8 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
 /// [`files::Error::Picture`] where plotters cannot draw.
 pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverError> {
     let along = |f: &dyn Fn(&SweepRow) -> f64| rows.iter().map(|r| (r.value, f(r))).collect::<Vec<_>>();
+    let units = rows.iter().find_map(|r| r.units.clone()).unwrap_or_default();
+    let x = units.label(param, param_quantity(param));
     let states = Panel {
         title: format!("Contact states along {param}"),
         labels: (String::new(), "points".into()),
@@ -335,7 +385,7 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
     };
     let forces = Panel {
         title: "Contact forces".into(),
-        labels: (param.into(), "force".into()),
+        labels: (x.clone(), units.label("force", "force")),
         series: vec![
             Series::line("normal (sum w lambda_n)", along(&|r| r.normal_force)),
             Series::line("tangential |sum w lambda_t|", along(&|r| r.tangential_force)),
@@ -343,9 +393,13 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
     };
     let mut panels = vec![states, forces];
     if rows.iter().any(|r| r.indenter.is_some()) {
+        let title = match piezoresponse(param, rows) {
+            Some((r, n)) => format!("Indenter depth: response {r:.1} pm/V (least squares over {n} points)"),
+            None => "Indenter depth".into(),
+        };
         panels.push(Panel {
-            title: "Indenter depth".into(),
-            labels: (param.into(), "depth".into()),
+            title,
+            labels: (x.clone(), units.label("depth", "length")),
             series: vec![Series::line(
                 "depth",
                 along(&|r| r.indenter.as_ref().map_or(f64::NAN, |i| i.depth)),
@@ -370,7 +424,7 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
     if !charges.is_empty() {
         panels.push(Panel {
             title: "Charges".into(),
-            labels: (param.into(), "charge".into()),
+            labels: (x.clone(), units.label("charge", "charge")),
             series: charges,
         });
     }

@@ -22,18 +22,36 @@ use vtu::{Array, CellType, Grid, Values};
 /// # Errors
 /// [`Error::Picture`] if serde cannot write it (it always can).
 pub fn run_json(report: &RunReport) -> Result<Vec<u8>, Error> {
+    run_json_with(report, &[])
+}
+
+/// `run.json` with `units.columns`: the unit of each column of the CSV files among `files`
+/// (their headers as written), none for a count, a factor or a relative residual.
+fn run_json_with(report: &RunReport, files: &[(String, Vec<u8>)]) -> Result<Vec<u8>, Error> {
     let encode = |e: serde_json::Error| Error::Picture {
         name: "run.json".into(),
         message: e.to_string(),
     };
-    let tree = serde_json::to_value(report).map_err(encode)?;
+    let mut tree = serde_json::to_value(report).map_err(encode)?;
+    let mut columns = serde_json::Map::new();
+    for (name, bytes) in files.iter().filter(|(n, _)| n.ends_with(".csv")) {
+        let header = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
+        let of: serde_json::Map<String, serde_json::Value> = String::from_utf8_lossy(header)
+            .split(',')
+            .map(|c| (c.to_string(), column_unit(name, c, &report.units).into()))
+            .collect();
+        columns.insert(name.clone(), of.into());
+    }
+    if let Some(u) = tree.get_mut("units").and_then(|u| u.as_object_mut()) {
+        u.insert("columns".into(), columns.into());
+    }
     serde_json::to_vec_pretty(&tree).map_err(encode)
 }
 
 /// The files of a solution, those its plan lists (and, for the last instant of a load path,
 /// `path.csv` and its pictures), each made on rayon's pool at the same time as the others (the
 /// grid's encoding and the pictures' rendering do not depend on each other), in the plan's
-/// order.
+/// order; `run.json` after them (first in the set), with the units of their CSV columns.
 ///
 /// # Errors
 /// [`Error::Picture`] where a file cannot be made (the first in the plan's order).
@@ -43,15 +61,52 @@ pub fn files(solution: &Solution) -> Result<Outputs, Error> {
         .plan
         .outputs
         .par_iter()
+        .filter(|&&output| output != Output::RunJson)
         .map(|&output| output_files(solution, output))
         .collect();
-    let mut out = Outputs::new(Path::new(""));
+    let mut all: plots::Files = vec![];
     for files in made {
-        out.extend(files?);
+        all.extend(files?);
     }
     // a load path's rows and curves
-    out.extend(path_files(solution)?);
+    all.extend(path_files(solution)?);
+    if solution.report.plan.outputs.contains(&Output::RunJson) {
+        let json = run_json_with(&solution.report, &all)?;
+        all.insert(0, ("run.json".into(), json));
+    }
+    let mut out = Outputs::new(Path::new(""));
+    out.extend(all);
     Ok(out)
+}
+
+/// The unit of the column `column` of the CSV file `file`, from the run's `units` ("" where it
+/// has none: a count, a status, a path's time or factor, a relative residual).
+pub fn column_unit(file: &str, column: &str, units: &problem::Units) -> String {
+    let path = file == "path.csv";
+    let quantity = match column {
+        // a path's factors and its time are pure numbers
+        "t" | "load" | "voltage" | "ux" | "uy" | "uz" | "gap" if path => "",
+        "x"
+        | "y"
+        | "z"
+        | "gap"
+        | "u_n"
+        | "u_t"
+        | "u_t2"
+        | "depth"
+        | "contact_radius"
+        | "max_slip"
+        | "max_slip_increment"
+        | "half_space_depth"
+        | "half_space_contact_radius" => "length",
+        "lambda_n" | "lambda_t" | "lambda_t2" => "traction",
+        "flux" => "flux",
+        c if c.starts_with("potential") => "potential",
+        c if c.contains("force") => "force",
+        c if c.contains("charge") => "charge",
+        _ => "",
+    };
+    units.of_quantity(quantity).to_string()
 }
 
 /// The files of one output of the plan.
@@ -79,14 +134,15 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
         }
         Output::Multipliers => {
             let c = solution.contact.as_ref().ok_or_else(|| missing("multipliers"))?;
-            multipliers_picture(c)?
+            multipliers_picture(c, &solution.report.units)?
         }
         Output::Deformed => {
-            let pic = plots::mesh_view::deformed_picture(&solution.mesh, &solution.u)?;
+            let pic = plots::mesh_view::deformed_picture(&solution.mesh, &solution.u, &solution.report.units)?;
             pic.ok_or_else(|| missing("deformed"))?
         }
         Output::Potential => {
-            let pic = plots::mesh_view::potential_picture(&solution.mesh, &solution.u, &solution.phi)?;
+            let fields = (&solution.u[..], &solution.phi[..]);
+            let pic = plots::mesh_view::potential_picture(&solution.mesh, fields, &solution.report.units)?;
             pic.ok_or_else(|| missing("potential"))?
         }
     })
@@ -405,7 +461,7 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
 /// The multipliers along the contact boundary (in 3D, along the contact face's middle line
 /// y = y_mid), like the paper's figures: `λ_n`, `λ_t` (first component), the Coulomb bound
 /// `F λ_n`, and the sliding points.
-fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
+fn multipliers_picture(c: &ContactResult, units: &problem::Units) -> Result<plots::Files, Error> {
     let (p, s) = (&c.points, &c.solution);
     let nt = s.lambda.n_tangential();
     let mut idx: Vec<usize> = (0..p.len()).collect();
@@ -450,7 +506,7 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
     };
     let mut panels = vec![Panel {
         title: title.into(),
-        labels: ("x".into(), "multiplier".into()),
+        labels: (units.label("x", "length"), units.label("multiplier", "traction")),
         series,
     }];
     if let Some(e) = &s.electric {
@@ -466,7 +522,7 @@ fn multipliers_picture(c: &ContactResult) -> Result<plots::Files, Error> {
             .collect();
         panels.push(Panel {
             title: "Electric flux D.n through the contact boundary".into(),
-            labels: ("x".into(), "flux".into()),
+            labels: (units.label("x", "length"), units.label("flux", "flux")),
             series: vec![Series::line("D.n (leaving the body)", flux)],
         });
     }
@@ -481,7 +537,7 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     };
     let terminals: Vec<&str> = solution.report.terminals.iter().map(|t| t.group.as_str()).collect();
     let mut out = vec![("path.csv".to_string(), path_csv(&path.rows, &terminals))];
-    out.extend(path_picture(&path.rows, &terminals)?);
+    out.extend(path_picture(&path.rows, &terminals, &solution.report.units)?);
     Ok(out)
 }
 
@@ -569,7 +625,11 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
 /// that drives the path (the one that varies most: a load, a voltage, a displacement), whose
 /// loop is friction's hysteresis; an indenter's force against its depth; and the charges
 /// through the terminals and their potentials against time.
-fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result<plots::Files, Error> {
+fn path_picture(
+    rows: &[problem::report::StepRow],
+    terminals: &[&str],
+    units: &problem::Units,
+) -> Result<plots::Files, Error> {
     let over = |f: &dyn Fn(&problem::report::StepRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
     const FACTORS: [&str; 6] = ["load", "voltage", "ux", "uy", "uz", "gap"];
     let range = |k: usize| {
@@ -593,7 +653,7 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
     };
     let mut panels = vec![Panel {
         title: "Contact forces along the path".into(),
-        labels: ("t".into(), "force".into()),
+        labels: ("t".into(), units.label("force", "force")),
         series: vec![
             Series::line("normal force", over(&|r| (r.t, r.normal_force))),
             Series::line("tangential force", over(&|r| (r.t, r.tangential_force))),
@@ -606,15 +666,15 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
                 "Tangential force against the {} factor (friction's loop)",
                 FACTORS[driver]
             ),
-            labels: (format!("{} factor", FACTORS[driver]), loop_label.clone()),
+            labels: (format!("{} factor", FACTORS[driver]), units.label(&loop_label, "force")),
             series: vec![Series::line(&loop_label, over(&|r| (r.factors[driver], along(r))))],
         });
     }
-    panels.extend(indenter_panels(rows));
+    panels.extend(indenter_panels(rows, units));
     if !terminals.is_empty() {
         panels.push(Panel {
             title: "Charge on each terminal".into(),
-            labels: ("t".into(), "charge".into()),
+            labels: ("t".into(), units.label("charge", "charge")),
             series: terminals
                 .iter()
                 .enumerate()
@@ -629,7 +689,7 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
         if moves {
             panels.push(Panel {
                 title: "Potential of each terminal".into(),
-                labels: ("t".into(), "potential".into()),
+                labels: ("t".into(), units.label("potential", "potential")),
                 series: terminals
                     .iter()
                     .enumerate()
@@ -646,7 +706,7 @@ fn path_picture(rows: &[problem::report::StepRow], terminals: &[&str]) -> Result
 /// An indenter's panels of a path: its force against its depth, and a conducting tip's charge,
 /// each with the half-space's closed form beside it where it applies (none without an
 /// indenter).
-fn indenter_panels(rows: &[problem::report::StepRow]) -> Vec<Panel> {
+fn indenter_panels(rows: &[problem::report::StepRow], units: &problem::Units) -> Vec<Panel> {
     type Row = problem::report::StepRow;
     let mut panels = vec![];
     if !rows.iter().any(|r| r.depth.is_some()) {
@@ -654,14 +714,24 @@ fn indenter_panels(rows: &[problem::report::StepRow]) -> Vec<Panel> {
     }
     panels.push(against_depth(
         rows,
-        ("Indenter force against depth", "force", "normal force"),
+        (
+            "Indenter force against depth",
+            &units.label("force", "force"),
+            "normal force",
+        ),
+        units,
         &|r: &Row| Some(r.normal_force),
         &|r: &Row| r.half_space.as_ref().map(|h| h.force),
     ));
     if rows.iter().any(|r| r.tip_charge.is_some()) {
         panels.push(against_depth(
             rows,
-            ("Tip's charge against depth", "charge", "tip's charge"),
+            (
+                "Tip's charge against depth",
+                &units.label("charge", "charge"),
+                "tip's charge",
+            ),
+            units,
             &|r: &Row| r.tip_charge,
             &|r: &Row| r.half_space.as_ref().and_then(|h| h.charge),
         ));
@@ -674,6 +744,7 @@ fn indenter_panels(rows: &[problem::report::StepRow]) -> Vec<Panel> {
 fn against_depth(
     rows: &[problem::report::StepRow],
     (title, label, name): (&str, &str, &str),
+    units: &problem::Units,
     value: &dyn Fn(&problem::report::StepRow) -> Option<f64>,
     form: &dyn Fn(&problem::report::StepRow) -> Option<f64>,
 ) -> Panel {
@@ -688,7 +759,7 @@ fn against_depth(
     }
     Panel {
         title: title.into(),
-        labels: ("depth".into(), label.into()),
+        labels: (units.label("depth", "length"), label.into()),
         series,
     }
 }

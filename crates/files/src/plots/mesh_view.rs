@@ -17,11 +17,12 @@ struct View {
     xy: Vec<[f64; 2]>,
     uv: Vec<[f64; 2]>,
     outline: Vec<[usize; 2]>,
-    labels: (&'static str, &'static str),
+    labels: (String, String),
 }
 
 impl View {
-    fn new(mesh: &mesh::Mesh, u: &[[f64; 3]]) -> Option<View> {
+    fn new(mesh: &mesh::Mesh, u: &[[f64; 3]], units: &problem::Units) -> Option<View> {
+        let axis = |name: &str| units.label(name, "length");
         if mesh.dim == 2 {
             return Some(View {
                 title: "",
@@ -33,7 +34,7 @@ impl View {
                     .values()
                     .flat_map(|g| g.iter().map(|f| [f[0], f[1]]).collect::<Vec<_>>())
                     .collect(),
-                labels: ("x", "y"),
+                labels: (axis("x"), axis("y")),
             });
         }
         let face = mesh.boundaries.get("front")?;
@@ -51,7 +52,7 @@ impl View {
             xy: mesh.points.iter().map(|p| [p[0], p[2]]).collect(),
             uv: u.iter().map(|v| [v[0], v[2]]).collect(),
             outline: edges.into_iter().filter(|(_, k)| *k == 1).map(|(e, _)| e).collect(),
-            labels: ("x", "z"),
+            labels: (axis("x"), axis("z")),
         })
     }
 
@@ -74,20 +75,25 @@ impl View {
 ///
 /// # Errors
 /// [`Error::Picture`] where plotters cannot draw.
-pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]]) -> Result<Option<Files>, Error> {
-    View::new(mesh, u)
+pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], units: &problem::Units) -> Result<Option<Files>, Error> {
+    View::new(mesh, u, units)
         .map(|view| both!("deformed", |a| deformed(a, &view)))
         .transpose()
 }
 
-/// Filled contours of the nodal field `phi` with 12 isolines, as SVG and PNG named
-/// `potential`; `None` where the mesh has no view.
+/// Filled contours of the nodal field `phi` with 12 isolines and a colour bar in the
+/// potential's unit, as SVG and PNG named `potential`; `None` where the mesh has no view.
 ///
 /// # Errors
 /// [`Error::Picture`] where plotters cannot draw.
-pub fn potential_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], phi: &[f64]) -> Result<Option<Files>, Error> {
-    View::new(mesh, u)
-        .map(|view| both!("potential", |a| potential(a, &view, phi)))
+pub fn potential_picture(
+    mesh: &mesh::Mesh,
+    (u, phi): (&[[f64; 3]], &[f64]),
+    units: &problem::Units,
+) -> Result<Option<Files>, Error> {
+    let unit = units.of_quantity("potential");
+    View::new(mesh, u, units)
+        .map(|view| both!("potential", |a| potential(a, &view, phi, unit)))
         .transpose()
 }
 
@@ -166,7 +172,7 @@ fn deformed<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View) -> R
         caption,
         lo[0] - pad..hi[0] + pad,
         lo[1] - pad..hi[1] + pad,
-        view.labels,
+        (&view.labels.0, &view.labels.1),
     )?;
     chart
         .draw_series(view.outline.iter().map(|&[a, b]| {
@@ -194,7 +200,12 @@ fn deformed<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View) -> R
     Ok(())
 }
 
-fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View, phi: &[f64]) -> Result<(), String> {
+fn potential<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    view: &View,
+    phi: &[f64],
+    unit: &str,
+) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
     let (lo, hi) = view.bounds();
@@ -209,15 +220,26 @@ fn potential<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View, phi
     // strength at the larger of |min| and |max|
     let reach = pmin.abs().max(pmax.abs());
     let reach = if reach > 0.0 { reach } else { 1.0 };
+    let in_unit = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" [{unit}]")
+    };
     let caption = format!(
-        "Electric potential{}: {pmin:.3e} to {pmax:.3e}, 12 contours",
+        "Electric potential{in_unit}{}: {pmin:.3e} to {pmax:.3e}, 12 contours",
         view.title
     );
     let (w, _) = area.dim_in_pixel();
-    let (plot, bar) = area.split_horizontally(w.saturating_sub(130));
-    let mut chart = view_chart(&plot, caption, lo[0]..hi[0], lo[1]..hi[1], view.labels)?;
+    let (plot, bar) = area.split_horizontally(w.saturating_sub(146));
+    let mut chart = view_chart(
+        &plot,
+        caption,
+        lo[0]..hi[0],
+        lo[1]..hi[1],
+        (&view.labels.0, &view.labels.1),
+    )?;
     let color = |v: f64| diverging(v / reach);
-    colour_bar(&bar, (pmin, pmax), &color)?;
+    colour_bar(&bar, (pmin, pmax), &color, unit)?;
     let xy = |v: usize| (view.xy[v][0], view.xy[v][1]);
     chart
         .draw_series(view.tris.iter().map(|t| {
@@ -265,11 +287,12 @@ fn diverging(t: f64) -> RGBColor {
     }
 }
 
-/// A vertical colour bar of `color` over the values `(lo, hi)`, with their ticks.
+/// A vertical colour bar of `color` over the values `(lo, hi)`, with their ticks and `unit`.
 fn colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     (lo, hi): (f64, f64),
     color: &dyn Fn(f64) -> RGBColor,
+    unit: &str,
 ) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     let (lo, hi) = if hi > lo {
@@ -281,7 +304,7 @@ fn colour_bar<DB: DrawingBackend>(
         .margin_top(49)
         .margin_bottom(50)
         .margin_right(12)
-        .y_label_area_size(84)
+        .y_label_area_size(100)
         .build_cartesian_2d(0.0..1.0, lo..hi)
         .map_err(e)?;
     chart
@@ -290,6 +313,7 @@ fn colour_bar<DB: DrawingBackend>(
         .disable_x_axis()
         .y_labels(7)
         .y_label_formatter(&|v| format!("{v:.2e}"))
+        .y_desc(unit)
         .label_style((FONT, 12))
         .draw()
         .map_err(e)?;

@@ -339,6 +339,11 @@ pub struct Scene {
     /// A load path: the quasi-static process over instants, friction on the slip increment.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<PathSpec>,
+    /// The unit system of the scene's numbers (`[units]`: `length`, `stress`); SI where it
+    /// says nothing. The solver never converts: the outputs carry these units
+    /// ([`crate::Units`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::UnitsSpec>,
 }
 
 /// A quasi-static load path (`[path]`): instants `t` and, per quantity, its factor at each

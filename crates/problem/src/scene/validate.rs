@@ -114,6 +114,36 @@ impl Scene {
         Ok(Valid(self))
     }
 
+    /// A named crystal's or datasheet's `material.units` is the scene's system's stress unit
+    /// (where `[units]` names one), and every material's the same: the constants are written
+    /// in it, and every other number of the scene read in `[units]`'.
+    fn check_units(&self) -> Result<(), SceneError> {
+        let stress = |u: crate::CrystalUnits| match u {
+            crate::CrystalUnits::Gpa => crate::StressUnit::Gpa,
+            crate::CrystalUnits::Si => crate::StressUnit::Pa,
+        };
+        let declared = self.units.and_then(|u| u.stress);
+        let mut first: Option<(crate::StressUnit, &str)> = declared.map(|s| (s, "units.stress"));
+        for m in &self.material {
+            let Some(u) = m.units.map(stress) else { continue };
+            match first {
+                Some((s, key)) if s != u => {
+                    return Err(SceneError::new(
+                        "material.units",
+                        format!(
+                            "material `{}`: material.units = \"{}\" puts its constants in {u}, and {key} says the scene's stresses are in {s}: give one system",
+                            m.region,
+                            m.units.map_or("", |x| x.name()),
+                        ),
+                    ))
+                }
+                None => first = Some((u, "the material before")),
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
     /// Every check of [`Scene::validate`].
     fn check_all(&self) -> Result<(), SceneError> {
         validate_mesh(&self.mesh)?;
@@ -124,6 +154,7 @@ impl Scene {
             validate_material(m)
                 .map_err(|e| SceneError::new(&e.key, format!("material `{}`: {}", m.region, e.message)))?;
         }
+        self.check_units()?;
         for d in &self.dirichlet {
             let values =
                 d.u.iter()
