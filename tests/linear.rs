@@ -169,7 +169,13 @@ fn a_crystal_by_name_is_the_librarys_constants() {
     assert_eq!(named.u, given.u);
     assert_eq!(named.phi, given.phi);
     let load = |extra: &[&str]| files::scene_file::load("paper", &sets(extra));
-    let (si, _) = load(&["material.0.crystal=\"pzt-5a\"", "material.0.units=\"SI\""]).unwrap();
+    // in SI the scene's own system says so too: the two must agree
+    let (si, _) = load(&[
+        "material.0.crystal=\"pzt-5a\"",
+        "material.0.units=\"SI\"",
+        "units.stress=\"Pa\"",
+    ])
+    .unwrap();
     assert_eq!(si.material[0].c[0], 121e9);
     assert_eq!(si.material[0].crystal.as_deref(), Some("PZT-5A"));
     assert!((si.material[0].permittivity[1] - 7.35e-9).abs() < 1e-24);

@@ -2,6 +2,7 @@
 //! low-level API: the symbolic analysis is done once, the numeric factorisation can be redone
 //! in place when the values change, and solves reuse their workspace (no allocation).
 
+use crate::progress::FactorProgress;
 use crate::tree::Breakdown;
 use crate::LinalgError;
 use crate::ShapeError;
@@ -20,7 +21,6 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
-use std::sync::atomic::{AtomicU64, Ordering as AtomicOrdering};
 
 /// Below this `|pivot| / |diagonal entry|` a factorisation reports the matrix singular to
 /// working precision ([`LinalgError::NearlySingular`]).
@@ -92,36 +92,6 @@ impl std::fmt::Debug for SparseFactor {
             self.n(),
             self.values.len()
         )
-    }
-}
-
-/// How far a factorisation has got, read from another thread while it runs: the
-/// floating-point operations of the supernodes done against those of all (the tree's
-/// `L D Lᵀ` reports them; a factorisation faer walks reports none). A run's progress bar reads
-/// it.
-#[derive(Debug, Default)]
-pub struct FactorProgress {
-    done: AtomicU64,
-    total: AtomicU64,
-}
-
-impl FactorProgress {
-    /// The fraction done, `None` before the factorisation reports its total.
-    pub fn fraction(&self) -> Option<f64> {
-        let total = self.total.load(AtomicOrdering::Relaxed);
-        (total > 0).then(|| (self.done.load(AtomicOrdering::Relaxed) as f64 / total as f64).min(1.0))
-    }
-
-    /// A factorisation of the supernodes' `work` (operations each) begins.
-    pub(crate) fn start(&self, work: &[f64]) {
-        let total: u64 = work.iter().map(|&w| w as u64).sum();
-        self.done.store(0, AtomicOrdering::Relaxed);
-        self.total.store(total.max(1), AtomicOrdering::Relaxed);
-    }
-
-    /// A supernode of `work` operations is done (all of them: the fraction is 1).
-    pub(crate) fn add(&self, work: f64) {
-        self.done.fetch_add(work as u64, AtomicOrdering::Relaxed);
     }
 }
 

@@ -40,6 +40,7 @@ mod coupled;
 mod dense;
 mod factor;
 mod pcg;
+mod progress;
 pub mod sparse;
 mod tree;
 mod values;
@@ -50,8 +51,9 @@ pub use coupled::{
     FactorPreconditioner, Refinable, Refined, Residual, Rhs, SchurOperator, SchurPcg, SolveInfo,
 };
 pub use dense::{mirror_lower, symmetric_inverse};
-pub use factor::{pool_par, FactorKind, FactorProgress, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
+pub use factor::{pool_par, FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};
 pub use pcg::{dot, norm, pcg, Identity, LinearOperator, PcgInfo, PcgParams, PcgStop};
+pub use progress::FactorProgress;
 
 /// What can go wrong in the linear algebra.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]

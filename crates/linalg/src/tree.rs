@@ -14,7 +14,7 @@
 //! which on a 2D mesh's many small supernodes costs more than it gains
 //! (docs/performance.md); here the tree gives the second core its own half of the work.
 
-use crate::factor::FactorProgress;
+use crate::progress::FactorProgress;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{
     cholesky_in_place, cholesky_in_place_scratch, LdltParams, LdltRegularization,
