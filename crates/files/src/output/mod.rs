@@ -134,7 +134,7 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
         }
         Output::Multipliers => {
             let c = solution.contact.as_ref().ok_or_else(|| missing("multipliers"))?;
-            multipliers_picture(c, &solution.report.units)?
+            multipliers_picture(c, &solution.report.units, indenter_zone(solution, c))?
         }
         Output::Deformed => {
             let pic = plots::mesh_view::deformed_picture(&solution.mesh, &solution.u, &solution.report.units)?;
@@ -458,38 +458,81 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
     s.into_bytes()
 }
 
+/// Under an indenter that touches: each contact point's distance from its axis (NaN off its
+/// zone) and the contact radius; `None` without an indenter or contact.
+fn indenter_zone(solution: &Solution, c: &ContactResult) -> Option<(Vec<f64>, f64)> {
+    let a = solution.report.indenter.as_ref()?.contact_radius;
+    if !(a > 0.0) {
+        return None;
+    }
+    let (k, spec) = solution.report.scene.settings.indenter_contact()?;
+    let indenter = spec.indenter.as_ref()?;
+    let p = &c.points;
+    let rho = (0..p.len())
+        .map(|i| match c.group_of.get(i) {
+            Some(&g) if g == k => indenter.local(&p.position[i], &p.normal[i]).1,
+            _ => f64::NAN,
+        })
+        .collect();
+    Some((rho, a))
+}
+
 /// The multipliers along the contact boundary (in 3D, along the contact face's middle line
 /// y = y_mid), like the paper's figures: `λ_n`, `λ_t` (first component), the Coulomb bound
-/// `F λ_n`, and the sliding points.
-fn multipliers_picture(c: &ContactResult, units: &problem::Units) -> Result<plots::Files, Error> {
+/// `F λ_n`, and the sliding points. Under an indenter that touches (`zone`: each point's
+/// distance from its axis, NaN off its zone, and the contact radius `a`), the zone seen close:
+/// against `r/a` from 0 to 3, every point of the zone within (in 3D each as a dot).
+fn multipliers_picture(
+    c: &ContactResult,
+    units: &problem::Units,
+    zone: Option<(Vec<f64>, f64)>,
+) -> Result<plots::Files, Error> {
     let (p, s) = (&c.points, &c.solution);
     let nt = s.lambda.n_tangential();
     let mut idx: Vec<usize> = (0..p.len()).collect();
-    if p.dim == 3 {
-        let ys: Vec<f64> = p.position.iter().map(|x| x[1]).collect();
-        let (ymin, ymax) = ys
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| (a.min(y), b.max(y)));
-        let mid = 0.5 * (ymin + ymax);
-        let best = ys.iter().map(|y| (y - mid).abs()).fold(f64::INFINITY, f64::min);
-        idx.retain(|&i| ((ys[i] - mid).abs() - best).abs() < 1e-12);
-    }
-    idx.sort_by(|&a, &b| p.position[a][0].total_cmp(&p.position[b][0]));
-    let along = |f: &dyn Fn(usize) -> f64| idx.iter().map(|&i| (p.position[i][0], f(i))).collect::<Vec<_>>();
-    let mut series = vec![Series::line("lambda_n (pressure)", along(&|i| s.lambda.normal[i]))];
+    let x: Vec<f64> = match &zone {
+        Some((rho, a)) => {
+            idx.retain(|&i| rho[i] <= 3.0 * a);
+            rho.iter().map(|r| r / a).collect()
+        }
+        None => {
+            if p.dim == 3 {
+                let ys: Vec<f64> = p.position.iter().map(|x| x[1]).collect();
+                let (ymin, ymax) = ys
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| (a.min(y), b.max(y)));
+                let mid = 0.5 * (ymin + ymax);
+                let best = ys.iter().map(|y| (y - mid).abs()).fold(f64::INFINITY, f64::min);
+                idx.retain(|&i| ((ys[i] - mid).abs() - best).abs() < 1e-12);
+            }
+            p.position.iter().map(|x| x[0]).collect()
+        }
+    };
+    idx.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
+    let along = |f: &dyn Fn(usize) -> f64| idx.iter().map(|&i| (x[i], f(i))).collect::<Vec<_>>();
+    // in 3D the zone's points lie at every angle: dots, not a line
+    let dots = zone.is_some() && p.dim == 3;
+    let curve = |name: &str, points| {
+        let mut series = Series::line(name, points);
+        if dots {
+            series.mark = Mark::Dots;
+        }
+        series
+    };
+    let mut series = vec![curve("lambda_n (pressure)", along(&|i| s.lambda.normal[i]))];
     if nt > 0 {
         let name = if nt > 1 {
             "lambda_t (first component)"
         } else {
             "lambda_t"
         };
-        series.push(Series::line(name, along(&|i| s.lambda.tangential[i * nt])));
+        series.push(curve(name, along(&|i| s.lambda.tangential[i * nt])));
         series.push(Series {
             name: "slipping point".into(),
             points: idx
                 .iter()
                 .filter(|&&i| s.status[i] == contact::Status::Slip)
-                .map(|&i| (p.position[i][0], s.lambda.tangential[i * nt]))
+                .map(|&i| (x[i], s.lambda.tangential[i * nt]))
                 .collect(),
             mark: Mark::Dots,
         });
@@ -499,31 +542,41 @@ fn multipliers_picture(c: &ContactResult, units: &problem::Units) -> Result<plot
             mark: Mark::Reference,
         });
     }
-    let title = if p.dim == 3 {
-        "Multipliers on the contact face's middle line"
-    } else {
-        "Multipliers along the contact boundary"
+    let (title, x_label) = match &zone {
+        Some((_, a)) => (
+            format!(
+                "Multipliers under the indenter (a = {a:.4e}{})",
+                match units.of_quantity("length") {
+                    "" => String::new(),
+                    unit => format!(" {unit}"),
+                }
+            ),
+            "r/a".to_string(),
+        ),
+        None if p.dim == 3 => (
+            "Multipliers on the contact face's middle line".into(),
+            units.label("x", "length"),
+        ),
+        None => (
+            "Multipliers along the contact boundary".into(),
+            units.label("x", "length"),
+        ),
     };
     let mut panels = vec![Panel {
-        title: title.into(),
-        labels: (units.label("x", "length"), units.label("multiplier", "traction")),
+        title,
+        labels: (x_label.clone(), units.label("multiplier", "traction")),
         series,
     }];
     if let Some(e) = &s.electric {
         // the flux through the points (those with a free potential), along the same line
         let flux: Vec<(f64, f64)> = idx
             .iter()
-            .filter_map(|&i| {
-                e.points
-                    .iter()
-                    .position(|&j| j == i)
-                    .map(|k| (p.position[i][0], e.flux[k]))
-            })
+            .filter_map(|&i| e.points.iter().position(|&j| j == i).map(|k| (x[i], e.flux[k])))
             .collect();
         panels.push(Panel {
             title: "Electric flux D.n through the contact boundary".into(),
-            labels: (units.label("x", "length"), units.label("flux", "flux")),
-            series: vec![Series::line("D.n (leaving the body)", flux)],
+            labels: (x_label, units.label("flux", "flux")),
+            series: vec![curve("D.n (leaving the body)", flux)],
         });
     }
     plots::panels("multipliers", &panels)
