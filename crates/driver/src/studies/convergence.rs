@@ -198,6 +198,28 @@ fn check(spec: &StudySpec) -> Result<(), DriverError> {
     Ok(())
 }
 
+/// The size of every run of a study, in the order it runs them: the finer reference (without
+/// an exact solution), then per size its tight run and its strategies' runs at each tolerance.
+fn planned_sizes(spec: &StudySpec, sizes: &[usize], has_contact: bool, exact: bool) -> Vec<usize> {
+    let mut out = vec![];
+    if !exact {
+        let largest = *sizes.last().unwrap_or(&1);
+        out.push(spec.reference_n.unwrap_or(4 * largest));
+    }
+    for &n in sizes {
+        out.push(n);
+        for strategy in &spec.strategies {
+            let tols = if !has_contact && !strategy.runs_pcg() {
+                1
+            } else {
+                spec.tols.len()
+            };
+            out.extend(std::iter::repeat_n(n, tols));
+        }
+    }
+    out
+}
+
 /// Runs the study of `scene_name` (with the overrides `sets`); `progress` gets a line per run.
 ///
 /// # Errors
@@ -215,11 +237,22 @@ pub fn study(
     sizes.dedup();
     let (base, _) = files::scene_file::load(scene_name, sets)?;
     let has_contact = base.contact_law() != ContactLaw::None;
+    // the runs' sizes in the order they run, for the estimate of the time left
+    let mut pending = planned_sizes(spec, &sizes, has_contact, base.exact.is_some());
+    pending.reverse();
+    let mut eta = super::Eta::default();
     let mut one = |n: usize, strategy: Strategy, tol: f64| -> Result<Solution, DriverError> {
+        let t = std::time::Instant::now();
         let r = solve(scene_name, &settings(sets, n, strategy, tol, has_contact))?;
+        eta.record(n, t.elapsed().as_secs_f64());
+        pending.pop();
         progress(&format!(
-            "study {}: n = {n}, {strategy}, tol {tol:.0e}: {:.3} s",
-            base.name, r.report.timings_s.total
+            "study {}: n = {n}, {strategy}, tol {tol:.0e}: {:.3} s; {} run{} to go, {}",
+            base.name,
+            r.report.timings_s.total,
+            pending.len(),
+            if pending.len() == 1 { "" } else { "s" },
+            eta.words(&pending)
         ));
         Ok(r)
     };

@@ -98,6 +98,7 @@ pub fn sweep(
     }
     let integer = integer_key(scene, sets, param, [*from, *to]);
     let mut rows = vec![];
+    let mut eta = super::Eta::default();
     let mut first_error: Option<files::Error> = None;
     for k in 0..*steps {
         // a weighted mean of the bounds: finite for any finite bounds (their difference may
@@ -121,6 +122,7 @@ pub fn sweep(
         let r = match solve(scene, &s) {
             Ok(solved) => solved.report,
             Err(e) => {
+                eta.record(0, t.elapsed().as_secs_f64());
                 progress(&format!("[{}/{steps}] {param} = {value:.6e}: failed: {e}", k + 1));
                 rows.push(SweepRow::failed(value, t.elapsed().as_secs_f64(), e.to_string()));
                 first_error.get_or_insert(e);
@@ -128,14 +130,16 @@ pub fn sweep(
             }
         };
         let row = SweepRow::of(value, &r, t.elapsed().as_secs_f64());
+        eta.record(0, row.seconds);
         progress(&format!(
-            "[{}/{steps}] {param} = {value:.6e}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}",
+            "[{}/{steps}] {param} = {value:.6e}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}; {}",
             k + 1,
             row.counts.0,
             row.counts.1,
             row.counts.2,
             row.normal_force,
-            row.complementarity
+            row.complementarity,
+            eta.words(&vec![0; steps - k - 1])
         ));
         rows.push(row);
     }
