@@ -403,10 +403,13 @@ fn units_are_stated_and_carried_to_every_output() {
     assert_eq!(u["pm_per_volt"], 1000.0);
     assert!(u.get("note").is_none());
     let svg = std::fs::read_to_string(out.join("multipliers.svg")).unwrap();
+    // under the indenter: against r/a, the contact radius in µm in the title, tractions in GPa
     assert!(
-        svg.contains("[µm]") && svg.contains("[GPa]"),
+        svg.contains("r/a") && svg.contains(" µm)") && svg.contains("[GPa]"),
         "axes in the scene's units"
     );
+    let potential = std::fs::read_to_string(out.join("potential.svg")).unwrap();
+    assert!(potential.contains("[µm]") && potential.contains("[kV]"));
     // the same scene without its [units]: SI assumed, labelled so, and a note; same numbers
     let (bare, _) = files::scene_file::load("pfm", &["mesh.n=16".into(), "~units".into()]).unwrap();
     let again = files::run::solve(&bare, &source, &mut Silent).unwrap();
