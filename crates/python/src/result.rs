@@ -320,7 +320,7 @@ impl RunResult {
     /// residuals, the contact forces and counts, the timings.
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let bytes = files::output::run_json(&self.solution.report).map_err(to_py)?;
+        let bytes = files::output::run_json_of(&self.solution).map_err(to_py)?;
         from_json(py, &String::from_utf8_lossy(&bytes))
     }
 

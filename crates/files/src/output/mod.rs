@@ -17,31 +17,51 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use vtu::{Array, CellType, Grid, Values};
 
-/// `run.json`: the report, pretty, its keys in sorted order.
+/// `run.json` of a report alone: the report, pretty, its keys in sorted order (without the
+/// units of its CSV files' columns, which [`run_json_of`] adds from the solution).
 ///
 /// # Errors
 /// [`Error::Picture`] if serde cannot write it (it always can).
 pub fn run_json(report: &RunReport) -> Result<Vec<u8>, Error> {
-    run_json_with(report, &[])
+    let encode = |e: serde_json::Error| Error::Picture {
+        name: "run.json".into(),
+        message: e.to_string(),
+    };
+    let tree = serde_json::to_value(report).map_err(encode)?;
+    serde_json::to_vec_pretty(&tree).map_err(encode)
 }
 
-/// `run.json` with `units.columns`: the unit of each column of the CSV files among `files`
-/// (their headers as written), none for a count, a factor or a relative residual.
-fn run_json_with(report: &RunReport, files: &[(String, Vec<u8>)]) -> Result<Vec<u8>, Error> {
+/// `run.json` of `solution`, with `units.columns`: the unit of each column of the CSV files
+/// its set holds (`contact.csv`, `path.csv`), none for a count, a factor or a relative
+/// residual.
+///
+/// # Errors
+/// [`Error::Picture`] if serde cannot write it (it always can).
+pub fn run_json_of(solution: &Solution) -> Result<Vec<u8>, Error> {
+    let report = &solution.report;
+    let mut csv: Vec<(&str, Vec<String>)> = vec![];
+    if let (Some(c), true) = (&solution.contact, report.plan.outputs.contains(&Output::ContactCsv)) {
+        csv.push(("contact.csv", contact_columns(c)));
+    }
+    if let Some(path) = &report.path {
+        let terminals: Vec<&str> = report.terminals.iter().map(|t| t.group.as_str()).collect();
+        csv.push(("path.csv", path_columns(&path.rows, &terminals)));
+    }
     let encode = |e: serde_json::Error| Error::Picture {
         name: "run.json".into(),
         message: e.to_string(),
     };
     let mut tree = serde_json::to_value(report).map_err(encode)?;
-    let mut columns = serde_json::Map::new();
-    for (name, bytes) in files.iter().filter(|(n, _)| n.ends_with(".csv")) {
-        let header = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
-        let of: serde_json::Map<String, serde_json::Value> = String::from_utf8_lossy(header)
-            .split(',')
-            .map(|c| (c.to_string(), column_unit(name, c, &report.units).into()))
-            .collect();
-        columns.insert(name.clone(), of.into());
-    }
+    let columns: serde_json::Map<String, serde_json::Value> = csv
+        .into_iter()
+        .map(|(name, cols)| {
+            let of: serde_json::Map<String, serde_json::Value> = cols
+                .iter()
+                .map(|c| (c.clone(), column_unit(name, c, &report.units).into()))
+                .collect();
+            (name.to_string(), of.into())
+        })
+        .collect();
     if let Some(u) = tree.get_mut("units").and_then(|u| u.as_object_mut()) {
         u.insert("columns".into(), columns.into());
     }
@@ -51,7 +71,7 @@ fn run_json_with(report: &RunReport, files: &[(String, Vec<u8>)]) -> Result<Vec<
 /// The files of a solution, those its plan lists (and, for the last instant of a load path,
 /// `path.csv` and its pictures), each made on rayon's pool at the same time as the others (the
 /// grid's encoding and the pictures' rendering do not depend on each other), in the plan's
-/// order; `run.json` after them (first in the set), with the units of their CSV columns.
+/// order.
 ///
 /// # Errors
 /// [`Error::Picture`] where a file cannot be made (the first in the plan's order).
@@ -61,21 +81,14 @@ pub fn files(solution: &Solution) -> Result<Outputs, Error> {
         .plan
         .outputs
         .par_iter()
-        .filter(|&&output| output != Output::RunJson)
         .map(|&output| output_files(solution, output))
         .collect();
-    let mut all: plots::Files = vec![];
+    let mut out = Outputs::new(Path::new(""));
     for files in made {
-        all.extend(files?);
+        out.extend(files?);
     }
     // a load path's rows and curves
-    all.extend(path_files(solution)?);
-    if solution.report.plan.outputs.contains(&Output::RunJson) {
-        let json = run_json_with(&solution.report, &all)?;
-        all.insert(0, ("run.json".into(), json));
-    }
-    let mut out = Outputs::new(Path::new(""));
-    out.extend(all);
+    out.extend(path_files(solution)?);
     Ok(out)
 }
 
@@ -118,7 +131,7 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
     let one = |name: &str, bytes: Vec<u8>| vec![(name.to_string(), bytes)];
     let (mesh, fields) = (&solution.mesh, (&solution.u[..], &solution.phi[..]));
     Ok(match output {
-        Output::RunJson => one("run.json", run_json(&solution.report)?),
+        Output::RunJson => one("run.json", run_json_of(solution)?),
         Output::SolutionVtu => one(
             "solution.vtu",
             vtu(mesh, fields, &solution.fields, solution.contact.as_ref())?,
@@ -406,6 +419,42 @@ fn num(x: f64) -> String {
     format!("{:e}", x + 0.0)
 }
 
+/// `contact.csv`'s columns: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`,
+/// with electrical contact `flux,potential`, with several contact groups `group`.
+fn contact_columns(c: &ContactResult) -> Vec<String> {
+    let mut out: Vec<&str> = if c.points.dim == 2 {
+        vec!["x", "y", "gap", "u_n", "u_t", "lambda_n", "lambda_t", "status"]
+    } else {
+        vec![
+            "x",
+            "y",
+            "z",
+            "gap",
+            "u_n",
+            "u_t",
+            "u_t2",
+            "lambda_n",
+            "lambda_t",
+            "lambda_t2",
+            "status",
+        ]
+    };
+    if c.solution.electric.is_some() {
+        out.extend(["flux", "potential"]);
+    }
+    if c.groups.len() > 1 {
+        out.push("group");
+    }
+    out.into_iter().map(String::from).collect()
+}
+
+/// A CSV header line of `columns`, each quoted where it needs it.
+fn header(columns: &[String]) -> String {
+    let mut s = columns.iter().map(|c| csv_field(c)).collect::<Vec<_>>().join(",");
+    s.push('\n');
+    s
+}
+
 /// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
 /// and, with electrical contact, `flux,potential` (`nan` where an electrode holds the point),
 /// with several contact groups `group`;
@@ -415,12 +464,7 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
     let (points, sol, u) = (&c.points, &c.solution, &c.displacement);
     let dim = points.dim;
     let nt = sol.lambda.n_tangential();
-    let mut s = String::new();
-    s.push_str(if dim == 2 {
-        "x,y,gap,u_n,u_t,lambda_n,lambda_t,status"
-    } else {
-        "x,y,z,gap,u_n,u_t,u_t2,lambda_n,lambda_t,lambda_t2,status"
-    });
+    let mut s = header(&contact_columns(c));
     // electrical contact: the flux D.n and the potential of each point (nan on an electrode)
     let electric = sol.electric.as_ref().map(|e| {
         let mut at = vec![(f64::NAN, f64::NAN); points.len()];
@@ -429,10 +473,7 @@ fn contact_csv(c: &ContactResult) -> Vec<u8> {
         }
         at
     });
-    s.push_str(if electric.is_some() { ",flux,potential" } else { "" });
-    // several contact groups: each point's
     let several = c.groups.len() > 1;
-    s.push_str(if several { ",group\n" } else { "\n" });
     for i in 0..points.len() {
         let mut row: Vec<String> = points.position[i][..dim].iter().map(|x| num(*x)).collect();
         row.push(num(points.gap[i]));
@@ -594,6 +635,29 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     Ok(out)
 }
 
+/// `path.csv`'s columns (see [`path_csv`]).
+fn path_columns(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<String> {
+    let mut out: Vec<String> = "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius,tip_charge,half_space_depth,half_space_force,half_space_contact_radius,half_space_charge"
+        .split(',')
+        .map(String::from)
+        .collect();
+    let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
+    let axes = ["x", "y", "z"];
+    out.extend(axes.iter().take(dim).map(|axis| format!("tangential_force_{axis}")));
+    // several contact groups: each one's normal force and tangential force (magnitude, then
+    // components), named after the group
+    let groups: Vec<&str> = rows
+        .first()
+        .map_or(vec![], |r| r.groups.iter().map(|g| g.group.as_str()).collect());
+    for g in &groups {
+        out.extend([format!("normal_force_{g}"), format!("tangential_force_{g}")]);
+        out.extend(axes.iter().take(dim).map(|axis| format!("tangential_force_{axis}_{g}")));
+    }
+    out.extend(terminals.iter().map(|t| format!("charge_{t}")));
+    out.extend(terminals.iter().map(|t| format!("potential_{t}")));
+    out
+}
+
 /// `path.csv`: one row per instant (an indenter's depth, contact radius and a conducting tip's
 /// charge, with the half-space's closed form beside them where it applies:
 /// `half_space_depth`, `_force`, `_contact_radius`, `_charge`), with the tangential force's
@@ -604,33 +668,9 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
 /// on each terminal (`charge_GROUP`, the charge on the conductor) and its potential
 /// (`potential_GROUP`).
 fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
-    let mut s = String::from(
-        "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius,tip_charge,half_space_depth,half_space_force,half_space_contact_radius,half_space_charge",
-    );
+    let mut s = header(&path_columns(rows, terminals));
     let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
-    let axes = ["x", "y", "z"];
-    for axis in axes.iter().take(dim) {
-        s.push_str(&format!(",tangential_force_{axis}"));
-    }
-    // several contact groups: each one's normal force and tangential force (magnitude, then
-    // components), named after the group
-    let groups: Vec<&str> = rows
-        .first()
-        .map_or(vec![], |r| r.groups.iter().map(|g| g.group.as_str()).collect());
-    for g in &groups {
-        let mut names = vec![format!("normal_force_{g}"), format!("tangential_force_{g}")];
-        names.extend(axes.iter().take(dim).map(|axis| format!("tangential_force_{axis}_{g}")));
-        for name in names {
-            s.push_str(&format!(",{}", csv_field(&name)));
-        }
-    }
-    for t in terminals {
-        s.push_str(&format!(",{}", csv_field(&format!("charge_{t}"))));
-    }
-    for t in terminals {
-        s.push_str(&format!(",{}", csv_field(&format!("potential_{t}"))));
-    }
-    s.push('\n');
+    let n_groups = rows.first().map_or(0, |r| r.groups.len());
     for r in rows {
         let mut row = vec![r.step.to_string(), num(r.t)];
         row.extend(r.factors.iter().map(|f| num(*f)));
@@ -655,7 +695,7 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
         row.push(h.map_or(String::new(), |h| num(h.contact_radius)));
         row.push(h.and_then(|h| h.charge).map_or(String::new(), num));
         row.extend((0..dim).map(|k| num(r.tangential_resultant.get(k).copied().unwrap_or(f64::NAN))));
-        for k in 0..groups.len() {
+        for k in 0..n_groups {
             let g = r.groups.get(k);
             row.push(num(g.map_or(f64::NAN, |g| g.normal_force)));
             row.push(num(g.map_or(f64::NAN, |g| g.tangential_force)));
