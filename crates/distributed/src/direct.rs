@@ -80,10 +80,11 @@ impl<'p> Direct<'p> {
                 entries.push(i, j, v);
             }
         }
+        // K is quasi-definite: no pivoting, as the default backend's L D Lᵀ
         let symmetry = if n_phi == 0 {
             Symmetry::Definite
         } else {
-            Symmetry::Indefinite
+            Symmetry::QuasiDefinite
         };
         let order = pivot_order(disc, &chosen);
         let mumps = Mumps::factor(

@@ -36,6 +36,12 @@ pub enum Symmetry {
     /// Symmetric, possibly indefinite (`L D Lᵀ` with 2 x 2 pivots, `SYM = 2`); one
     /// triangle's entries given.
     Indefinite,
+    /// Symmetric quasi-definite, `[[A, Gᵀ], [G, -B]]` with `A` and `B` positive definite
+    /// (`L D Lᵀ` without pivoting, `SYM = 2` and `CNTL(1) = 0`): its `L D Lᵀ` exists in every
+    /// symmetric order (Vanderbei, SIAM J. Optim. 5 (1995) 100), as the default backend takes
+    /// it, and MUMPS' threshold pivoting would delay pivots for nothing. One triangle's
+    /// entries given.
+    QuasiDefinite,
     /// Unsymmetric (`L U`, `SYM = 0`); every entry given.
     General,
 }
@@ -58,6 +64,9 @@ pub struct Mumps<'p> {
     schur: Vec<f64>,
     /// Whether MUMPS' initialisation succeeded (its instance is then ended on drop).
     initialised: bool,
+    /// What MUMPS was told of the matrix (after its initialisation, which resets the controls,
+    /// [`Mumps::configure`] reads it).
+    symmetry: Symmetry,
 }
 
 impl<'p> Mumps<'p> {
@@ -110,10 +119,11 @@ impl<'p> Mumps<'p> {
             schur_list: one_based(schur)?,
             schur: vec![],
             initialised: false,
+            symmetry,
         };
         m.id.sym = match symmetry {
             Symmetry::Definite => 1,
-            Symmetry::Indefinite => 2,
+            Symmetry::Indefinite | Symmetry::QuasiDefinite => 2,
             Symmetry::General => 0,
         };
         m.id.par = 1; // the host works too
@@ -139,6 +149,9 @@ impl<'p> Mumps<'p> {
         id.icntl[2] = -1;
         id.icntl[3] = 0;
         id.icntl[17] = 3; // ICNTL(18): the entries distributed, as the ranks give them
+        if self.symmetry == Symmetry::QuasiDefinite {
+            id.cntl[0] = 0.0; // CNTL(1): no threshold pivoting
+        }
         id.n = fortran_index(self.n)?;
         id.nnz_loc = self.values.len() as i64;
         id.nz_loc = i32::try_from(self.values.len()).unwrap_or(0);

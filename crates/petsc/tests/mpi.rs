@@ -270,7 +270,12 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
             };
             // the chosen unknowns: three grid vertices and two of the last block
             let chosen = [3, 40, 77, k * k + 1, k * k + 5];
-            for symmetry in [Symmetry::Indefinite, Symmetry::General, Symmetry::Definite] {
+            for symmetry in [
+                Symmetry::Indefinite,
+                Symmetry::QuasiDefinite,
+                Symmetry::General,
+                Symmetry::Definite,
+            ] {
                 let last = if symmetry == Symmetry::Definite { 1.2 } else { -1.2 };
                 let (n, entries) = quasi_definite(k, last);
                 let mut dense = vec![0.0; n * n];
