@@ -631,7 +631,8 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     };
     let terminals: Vec<&str> = solution.report.terminals.iter().map(|t| t.group.as_str()).collect();
     let mut out = vec![("path.csv".to_string(), path_csv(&path.rows, &terminals))];
-    out.extend(path_picture(&path.rows, &terminals, &solution.report.units)?);
+    let scene = &solution.report.scene.settings;
+    out.extend(path_picture(&path.rows, &terminals, (scene, &solution.report.units))?);
     Ok(out)
 }
 
@@ -721,7 +722,7 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
 fn path_picture(
     rows: &[problem::report::StepRow],
     terminals: &[&str],
-    units: &problem::Units,
+    (scene, units): (&problem::Scene, &problem::Units),
 ) -> Result<plots::Files, Error> {
     let over = |f: &dyn Fn(&problem::report::StepRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
     const FACTORS: [&str; 6] = ["load", "voltage", "ux", "uy", "uz", "gap"];
@@ -752,15 +753,24 @@ fn path_picture(
             Series::line("tangential force", over(&|r| (r.t, r.tangential_force))),
         ],
     }];
-    // friction's loop where there is friction (a frictionless path has no tangential force)
+    // friction's loop where there is friction (a frictionless path has no tangential force),
+    // against the quantity the driving factor scales where the scene prescribes one
     if rows.iter().any(|r| r.tangential_force != 0.0) {
-        panels.push(Panel {
-            title: format!(
-                "Tangential force against the {} factor (friction's loop)",
-                FACTORS[driver]
+        let (scale, x_label, what) = match driven(scene, driver) {
+            Some((value, quantity, name)) => (value, units.label(&name, quantity), name),
+            None => (
+                1.0,
+                format!("{} factor", FACTORS[driver]),
+                format!("{} factor", FACTORS[driver]),
             ),
-            labels: (format!("{} factor", FACTORS[driver]), units.label(&loop_label, "force")),
-            series: vec![Series::line(&loop_label, over(&|r| (r.factors[driver], along(r))))],
+        };
+        panels.push(Panel {
+            title: format!("Tangential force against the {what} (friction's loop)"),
+            labels: (x_label, units.label(&loop_label, "force")),
+            series: vec![Series::line(
+                &loop_label,
+                over(&|r| (scale * r.factors[driver], along(r))),
+            )],
         });
     }
     panels.extend(indenter_panels(rows, units));
@@ -794,6 +804,37 @@ fn path_picture(
         }
     }
     plots::panels_apart("path", &panels)
+}
+
+/// The value a path's driving factor (`driver`: load, voltage, ux, uy, uz, gap) multiplies,
+/// its quantity and its name: the largest in magnitude of the scene's pressures, prescribed
+/// potentials or prescribed displacement components; `None` for the gap and where the scene
+/// prescribes none (the loop is then drawn against the factor).
+fn driven(scene: &problem::Scene, driver: usize) -> Option<(f64, &'static str, String)> {
+    let largest = |values: Vec<f64>| {
+        values
+            .into_iter()
+            .filter(|v| v.is_finite() && *v != 0.0)
+            .max_by(|a, b| a.abs().total_cmp(&b.abs()))
+    };
+    match driver {
+        0 => largest(scene.loads().iter().map(|l| l.p).collect()).map(|p| (p, "pressure", "load p".into())),
+        1 => {
+            let mut v: Vec<f64> = scene.electrodes().iter().filter_map(|e| e.v).collect();
+            v.extend(scene.dirichlet.iter().filter_map(|d| d.phi));
+            largest(v).map(|v| (v, "potential", "prescribed potential".into()))
+        }
+        2..=4 => {
+            let k = driver - 2;
+            let component = |d: &problem::DirichletSpec| {
+                [d.ux, d.uy, d.uz][k].or_else(|| d.u.as_ref().and_then(|u| u.get(k).copied()))
+            };
+            let axis = ["x", "y", "z"][k];
+            largest(scene.dirichlet.iter().filter_map(component).collect())
+                .map(|u| (u, "length", format!("prescribed u_{axis}")))
+        }
+        _ => None,
+    }
 }
 
 /// An indenter's panels of a path: its force against its depth, and a conducting tip's charge,

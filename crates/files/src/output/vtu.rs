@@ -241,26 +241,16 @@ pub(super) fn write_compressed(mesh: &CompressedMesh, point: &[Array<'_>], cell:
         .find(|a| a.components == 1)
         .map_or(String::new(), |a| format!(" Scalars=\"{}\"", a.name));
     let mut bytes = data.iter().map(Vec::len);
+    let mut named = |xml: &mut String, arrays: &[Array<'_>]| {
+        for a in arrays {
+            let len = bytes.next().unwrap_or(0);
+            tag(xml, Some(a.name), type_name(a.values), a.components, len);
+        }
+    };
     xml.push_str(&format!("<PointData{scalars}>\n"));
-    for a in point {
-        tag(
-            &mut xml,
-            Some(a.name),
-            type_name(a.values),
-            a.components,
-            bytes.next().unwrap_or(0),
-        );
-    }
+    named(&mut xml, point);
     xml.push_str("</PointData>\n<CellData>\n");
-    for a in cell {
-        tag(
-            &mut xml,
-            Some(a.name),
-            type_name(a.values),
-            a.components,
-            bytes.next().unwrap_or(0),
-        );
-    }
+    named(&mut xml, cell);
     let [points, connectivity, offsets, types] = &mesh.arrays;
     xml.push_str("</CellData>\n<Points>\n");
     tag(&mut xml, None, "Float64", 3, points.len());

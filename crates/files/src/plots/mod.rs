@@ -200,6 +200,29 @@ fn x_range(panels: &[Panel]) -> (f64, f64) {
     }
 }
 
+/// The tick labels of an axis spanning `span`: plotters' own form (up to 5 decimals), in
+/// scientific notation where the span is below 1e-3 or from 1e6 on (5 decimals would print
+/// every tick of a small range as 0.0), and a tick within round-off of zero printed as `0`
+/// (a grid line at -2e-18 was labelled -0.0).
+fn tick(span: f64) -> impl Fn(&f64) -> String {
+    let scientific = !(1e-3..1e6).contains(&span);
+    move |&v: &f64| {
+        let v = if v.abs() <= 1e-9 * span { 0.0 } else { v };
+        if v == 0.0 {
+            return "0".into();
+        }
+        if scientific {
+            return format!("{v:.2e}");
+        }
+        plotters::data::float::FloatPrettyPrinter {
+            allow_scientific: false,
+            min_decimal: 1,
+            max_decimal: 5,
+        }
+        .print(v)
+    }
+}
+
 fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, x: (f64, f64)) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     let y = padded_range(panel.series.iter().flat_map(|s| s.points.iter().map(|q| q.1)));
@@ -210,10 +233,13 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
         .y_label_area_size(76)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
         .map_err(e)?;
+    let (x_tick, y_tick) = (tick(x.1 - x.0), tick(y.1 - y.0));
     chart
         .configure_mesh()
         .x_desc(panel.labels.0.as_str())
         .y_desc(panel.labels.1.as_str())
+        .x_label_formatter(&x_tick)
+        .y_label_formatter(&y_tick)
         .label_style((FONT, 13))
         .draw()
         .map_err(e)?;
