@@ -98,7 +98,7 @@ pub use scene::{
     LoadSpec, Loads, MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError,
     SlipBoundProfile, SolverSpec, Strategy, Valid,
 };
-pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
+pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel, DEFAULT_FRAMES};
 pub use scene::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, CRYSTALS};
 pub use shared_memory::SharedMemory;
 pub use units::{LengthUnit, StressUnit, Units, UnitsSpec};
