@@ -81,6 +81,8 @@ pub struct SparseFactor {
     tree: Option<crate::tree::Tree>,
     /// The smallest `|pivot| / |diagonal entry|` of the last numeric factorisation.
     pivot_ratio: f64,
+    /// Wall time of the last numeric factorisation, s.
+    numeric_seconds: f64,
 }
 
 impl std::fmt::Debug for SparseFactor {
@@ -193,6 +195,7 @@ impl SparseFactor {
             par,
             tree,
             pivot_ratio: f64::NAN,
+            numeric_seconds: 0.0,
         };
         f.refactor_watched(a, progress)?;
         Ok(f)
@@ -208,6 +211,18 @@ impl SparseFactor {
 
     /// [`SparseFactor::refactor`], its progress kept in `progress`.
     fn refactor_watched(
+        &mut self,
+        a: SparseColMatRef<'_, usize, f64>,
+        progress: Option<&FactorProgress>,
+    ) -> Result<(), LinalgError> {
+        let started = std::time::Instant::now();
+        let done = self.numeric(a, progress);
+        self.numeric_seconds = started.elapsed().as_secs_f64();
+        done
+    }
+
+    /// The numeric factorisation of [`SparseFactor::refactor_watched`].
+    fn numeric(
         &mut self,
         a: SparseColMatRef<'_, usize, f64>,
         progress: Option<&FactorProgress>,
@@ -283,6 +298,18 @@ impl SparseFactor {
             return Err(LinalgError::NearlySingular { index: at, ratio });
         }
         Ok(())
+    }
+
+    /// The floating-point operations of a numeric factorisation, as the tree's `L D Lᵀ` counts
+    /// them (per column of a supernode of `c` rows below and at it, `c (c + 3)`: its update's
+    /// multiply-adds and the column's scaling); `None` for a factorisation faer walks.
+    pub fn flops(&self) -> Option<f64> {
+        self.tree.as_ref().map(crate::tree::Tree::work_total)
+    }
+
+    /// Wall time of the last numeric factorisation, s (the analysis left out).
+    pub fn numeric_seconds(&self) -> f64 {
+        self.numeric_seconds
     }
 
     /// The smallest `|pivot| / |diagonal entry|` of the last numeric factorisation: a measure of

@@ -178,6 +178,11 @@ impl Tree {
         Some((parent, first, upd_ptr, updaters, (work, own_work)))
     }
 
+    /// The operations of a numeric factorisation: the supernodes' own work, summed.
+    pub(crate) fn work_total(&self) -> f64 {
+        self.own_work.iter().sum()
+    }
+
     /// Factors `a` (the pattern the tree was built for) into `values`, faer's supernodal
     /// layout, on rayon's pool, every value checked finite; each supernode's work added to
     /// `progress` as it is done.

@@ -343,6 +343,9 @@ pub struct InstantSolution {
 pub struct Figures {
     /// Wall time of the factorisation, or of the preconditioners' set-up, s.
     pub factor_seconds: f64,
+    /// The numeric factorisation's floating-point operations and wall time (s), where the
+    /// factorisation counts them (the tree's `L D Lᵀ`).
+    pub factor_rate: Option<(f64, f64)>,
     /// How the contact compliance was formed, and in how long (condensed strategies).
     pub condense: Option<(CondenseRoute, f64)>,
     /// The PCG's relative tolerance (0 where none ran).

@@ -672,6 +672,14 @@ pub struct SolverReport {
     pub condense_route: Option<String>,
     /// The smallest `|pivot| / |diagonal entry|` of the `L D Lᵀ` (direct strategies).
     pub smallest_pivot_ratio: Option<f64>,
+    /// The numeric factorisation's floating-point operations (the tree's `L D Lᵀ` counts
+    /// them; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_flops: Option<f64>,
+    /// Its rate, GFlop/s: the operations over the numeric factorisation's wall time (the
+    /// analysis left out).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_gflops: Option<f64>,
     /// Steps of iterative refinement of the last solve (direct strategies; 0 where its
     /// residual was at round-off already).
     #[serde(default)]
@@ -704,6 +712,8 @@ impl SolverReport {
             fixed_point_relaxations: info.map_or(0, |i| i.relaxations),
             condense_route: None,
             smallest_pivot_ratio: None,
+            factor_flops: None,
+            factor_gflops: None,
             refinement_steps: 0,
             friction_map_contraction: info.and_then(|i| i.contraction),
             threads: rayon::current_num_threads(),

@@ -499,6 +499,8 @@ pub(crate) fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunRe
             pcg_rel_tol: figures.pcg_rel_tol,
             condense_route: figures.condense.map(|(route, _)| format!("{route:?}")),
             smallest_pivot_ratio: figures.smallest_pivot_ratio,
+            factor_flops: figures.factor_rate.map(|r| r.0),
+            factor_gflops: figures.factor_rate.filter(|r| r.1 > 0.0).map(|r| r.0 / r.1 / 1e9),
             refinement_steps: figures.refinement_steps,
             ..SolverReport::of(info)
         },

@@ -180,8 +180,13 @@ impl Factored {
             LinearSolver::Direct(d) => (Some(d.factor().pivot_ratio()), d.factor_bytes()),
             LinearSolver::SchurPcg(p) => (None, p.factor_bytes()),
         };
+        let factor_rate = match &linear.solver {
+            LinearSolver::Direct(d) => d.factor().flops().map(|f| (f, d.factor().numeric_seconds())),
+            LinearSolver::SchurPcg(_) => None,
+        };
         Figures {
             factor_seconds: linear.seconds,
+            factor_rate,
             condense: self.instants.condense,
             pcg_rel_tol: linear.pcg_params.rel_tol,
             smallest_pivot_ratio,
