@@ -233,7 +233,9 @@ class Result:
         outward flux D·n, NaN at a point without an electric unknown)."""
     @property
     def report(self) -> dict[str, Any]:
-        """run.json as a dict."""
+        """run.json as a dict; its `units` block gives the unit of every quantity
+        (`units["quantities"]["potential"]`, ...) and of every CSV column, from the scene's
+        `[units]` (SI where absent)."""
     def write(self, directory: _Path) -> None:
         """Writes run.json, solution.vtu, contact.csv and the plan's pictures into
         `directory`, as one set (`OutputError`; nothing half-written)."""
