@@ -122,6 +122,11 @@ impl<'p> Direct<'p> {
         self.mumps.factor_flops()
     }
 
+    /// The numeric factorisation's operations and wall time, s (the analysis left out).
+    pub fn factor_rate(&self) -> (f64, f64) {
+        (self.mumps.factor_flops(), self.mumps.numeric_seconds())
+    }
+
     /// Bytes of the factors (all ranks).
     pub fn factor_bytes(&self) -> f64 {
         self.mumps.factor_bytes()

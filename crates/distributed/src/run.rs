@@ -356,8 +356,13 @@ impl<'p> Backend for DistributedMemory<'p> {
             peak_bytes_per_rank: vec![],
             preconditioner_setup_s: setup,
         };
+        let factor_rate = match &s.route {
+            Route::Direct(d) => Some(d.factor_rate()),
+            Route::Krylov(_) => None,
+        };
         Ok(Figures {
             factor_seconds: setup,
+            factor_rate,
             condense: s.instants.condense,
             refinement_steps: s.instants.refinement,
             factor_bytes,

@@ -22,7 +22,7 @@ const JOB_INIT: i32 = -1;
 const JOB_END: i32 = -2;
 const JOB_FACTOR: i32 = 2;
 const JOB_SOLVE: i32 = 3;
-const JOB_ANALYSE_FACTOR: i32 = 4;
+const JOB_ANALYSE: i32 = 1;
 
 /// How many times a factorisation whose workspace MUMPS' estimate left too small (`INFOG(1)`
 /// -8 or -9) is tried again, each time with twice the extra space (`ICNTL(14)`).
@@ -67,6 +67,8 @@ pub struct Mumps<'p> {
     /// What MUMPS was told of the matrix (after its initialisation, which resets the controls,
     /// [`Mumps::configure`] reads it).
     symmetry: Symmetry,
+    /// Wall time of the numeric factorisation (its retries with more workspace included), s.
+    numeric_seconds: f64,
 }
 
 impl<'p> Mumps<'p> {
@@ -120,6 +122,7 @@ impl<'p> Mumps<'p> {
             schur: vec![],
             initialised: false,
             symmetry,
+            numeric_seconds: 0.0,
         };
         m.id.sym = match symmetry {
             Symmetry::Definite => 1,
@@ -133,8 +136,11 @@ impl<'p> Mumps<'p> {
         m.call(JOB_INIT, "initialisation")?;
         m.initialised = true;
         m.configure()?;
-        m.call(JOB_ANALYSE_FACTOR, "analysis and factorisation")
+        m.call(JOB_ANALYSE, "analysis")?;
+        let started = std::time::Instant::now();
+        m.call(JOB_FACTOR, "factorisation")
             .or_else(|e| m.factor_with_more_space(e))?;
+        m.numeric_seconds = started.elapsed().as_secs_f64();
         m.symmetrise_schur();
         Ok(m)
     }
@@ -322,6 +328,11 @@ impl<'p> Mumps<'p> {
     /// Floating-point operations of the factorisation, over all ranks (`RINFOG(3)`).
     pub fn factor_flops(&self) -> f64 {
         self.id.rinfog[2]
+    }
+
+    /// Wall time of the numeric factorisation (the analysis left out), s.
+    pub fn numeric_seconds(&self) -> f64 {
+        self.numeric_seconds
     }
 
     /// Bytes of the factors over all ranks (`INFOG(9)` entries of 8 bytes; a negative `INFOG`
