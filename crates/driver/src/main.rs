@@ -222,8 +222,13 @@ impl Terminal {
 
 /// The progress bar over a load path's steps.
 fn path_bar(steps: u64) -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::with_draw_target(Some(steps), indicatif::ProgressDrawTarget::stderr());
-    if let Ok(style) = indicatif::ProgressStyle::with_template("path [{bar:40}] {pos}/{len} steps, {msg}, {elapsed}") {
+    bar(steps, "path [{bar:40}] {pos}/{len} steps, {msg}, {elapsed}")
+}
+
+/// A bar of `len` positions on stderr (hidden where it is not a terminal), drawn by `template`.
+fn bar(len: u64, template: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::with_draw_target(Some(len), indicatif::ProgressDrawTarget::stderr());
+    if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
         bar.set_style(style.progress_chars("=> "));
     }
     bar
@@ -281,13 +286,10 @@ impl Drop for FactorBar {
 
 /// The progress bar of a factorisation: its work done, and the time left at its rate so far.
 fn factor_bar() -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
+    bar(
+        1000,
         "factorisation [{bar:40}] {percent:>3}% of its work, {elapsed}, about {eta} left",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
+    )
 }
 
 impl problem::Reporter for Terminal {
@@ -322,14 +324,10 @@ impl problem::Reporter for Terminal {
 
 /// The progress bar of the contact solve: the way down to the tolerance, on a log scale.
 fn contact_bar() -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "{prefix} [{bar:40}] {percent:>3}% of the way to the tolerance, {elapsed}",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_prefix("contact");
-    bar
+    bar(
+        1000,
+        "contact [{bar:40}] {percent:>3}% of the way to the tolerance, {elapsed}",
+    )
 }
 
 fn main() -> ExitCode {

@@ -37,7 +37,7 @@ pub(crate) fn begin(
     // on it
     check_memory(limits, crate::estimate::after_mesh(&setup.mesh, setup.plan.electric))?;
     reporter.event(&Event::Planned(&setup.plan));
-    reporter.event(&Event::Units(&crate::Units::of(scene.scene(), setup.mesh.dim)));
+    reporter.event(&Event::Units(&setup.units));
     if setup.notes != MeshNotes::default() {
         reporter.event(&Event::MeshNotes(setup.notes));
     }
@@ -491,7 +491,7 @@ pub(crate) fn report(posed: &Posed<'_>, m: Measured<'_>, r: &Recovered) -> RunRe
         path: None,
         terminals: r.terminals.clone(),
         indenter: r.indenter.clone(),
-        units: crate::Units::of(scene, posed.setup.mesh.dim),
+        units: posed.setup.units.clone(),
         solver: SolverReport {
             strategy: plan.linear_strategy,
             rule: rule_in_words(plan.rule).into(),

@@ -31,6 +31,8 @@ pub struct Setup {
     pub exact: Option<FieldSolution>,
     /// What the mesh's checks noted without refusing it.
     pub notes: MeshNotes,
+    /// The unit of every reported quantity, from the scene's system.
+    pub units: crate::Units,
 }
 
 /// What the mesh's checks noted without refusing it.
@@ -121,6 +123,7 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         true => Coordinates::Axisymmetric,
         false => Coordinates::Cartesian,
     };
+    let units = crate::Units::of(scene, mesh.dim);
     Ok(Setup {
         mesh,
         coordinates,
@@ -130,6 +133,7 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
         loads,
         exact,
         notes,
+        units,
     })
 }
 

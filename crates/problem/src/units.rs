@@ -57,6 +57,14 @@ impl LengthUnit {
 }
 
 impl StressUnit {
+    /// The stress unit of a named or datasheet material's system (`material.units`).
+    pub fn of_crystals(units: crate::CrystalUnits) -> Self {
+        match units {
+            crate::CrystalUnits::Gpa => StressUnit::Gpa,
+            crate::CrystalUnits::Si => StressUnit::Pa,
+        }
+    }
+
     /// The power of ten of the unit in pascals.
     pub fn exponent(self) -> i32 {
         match self {
@@ -108,10 +116,7 @@ impl Units {
     /// and charges per unit thickness.
     pub fn of(scene: &Scene, dim: usize) -> Self {
         let spec = scene.units.unwrap_or_default();
-        let from_crystals = scene.material.iter().find_map(|m| m.units).map(|u| match u {
-            crate::CrystalUnits::Gpa => StressUnit::Gpa,
-            crate::CrystalUnits::Si => StressUnit::Pa,
-        });
+        let from_crystals = scene.material.iter().find_map(|m| m.units).map(StressUnit::of_crystals);
         let length = spec.length.unwrap_or(LengthUnit::M);
         let stress = spec.stress.or(from_crystals).unwrap_or(StressUnit::Pa);
         let stated = scene.units.is_some() || from_crystals.is_some();

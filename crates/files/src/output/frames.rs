@@ -3,7 +3,7 @@
 //! collection), then the last instant's files and the path's own.
 
 use super::vtu::{self, CompressedMesh};
-use super::{files, mesh_arrays, FieldArrays, Grid, NamedValues, Outputs, SetWriter};
+use super::{files, mesh_arrays, FieldArrays, NamedValues, Outputs, SetWriter};
 use crate::Error;
 use problem::Solution;
 use std::sync::Arc;
@@ -26,7 +26,7 @@ pub struct PathFiles {
     cell_fields: bool,
     mesh: Option<Arc<CompressedMesh>>,
     pending: Option<JoinHandle<(String, Vec<u8>)>>,
-    /// Seconds the path waited on its steps' files.
+    /// Seconds the path waited on its steps' files while it ran.
     seconds: f64,
 }
 
@@ -67,14 +67,7 @@ impl PathFiles {
             .mesh
             .get_or_insert_with(|| {
                 let (points, connectivity, offsets, cell_type) = mesh_arrays(step.mesh);
-                Arc::new(CompressedMesh::new(&Grid {
-                    points: &points,
-                    connectivity: &connectivity,
-                    offsets: &offsets,
-                    cell_type,
-                    point: vec![],
-                    cell: vec![],
-                }))
+                Arc::new(CompressedMesh::new(&points, (&connectivity, &offsets), cell_type))
             })
             .clone();
         let cells = self.cell_fields.then_some(f.fields);
@@ -103,20 +96,20 @@ impl PathFiles {
     }
 
     /// The files of the last instant and the path's own, after the last step's file is
-    /// written; the time the path waited on its steps' files is booked in `last`'s report as
-    /// `timings_s.output` (and taken out of the contact and solve stages, whose clocks ran
-    /// while the steps were written).
+    /// written; the time spent on the steps' files is booked in `last`'s report as
+    /// `timings_s.output`, and what of it the path waited while it ran is taken out of the
+    /// contact and solve stages, whose clocks ran then (the last step's, written after the
+    /// path, is not).
     ///
     /// # Errors
     /// As [`files`], and [`Error::Output`] where the last step's file cannot be written.
     pub fn finish(mut self, last: &mut Solution, writer: &mut SetWriter) -> Result<Outputs, Error> {
         let started = Instant::now();
         self.flush(writer)?;
-        let seconds = self.seconds + started.elapsed().as_secs_f64();
         let t = &mut last.report.timings_s;
-        t.output += seconds;
-        t.contact = (t.contact - seconds).max(0.0);
-        t.solve = (t.solve - seconds).max(0.0);
+        t.output += self.seconds + started.elapsed().as_secs_f64();
+        t.contact = (t.contact - self.seconds).max(0.0);
+        t.solve = (t.solve - self.seconds).max(0.0);
         let mut out = files(last)?;
         if !self.series.is_empty() {
             out.add("path.pvd", pvd(&self.series));

@@ -23,12 +23,7 @@ use vtu::{Array, CellType, Grid, Values};
 /// # Errors
 /// [`Error::Picture`] if serde cannot write it (it always can).
 pub fn run_json(report: &RunReport) -> Result<Vec<u8>, Error> {
-    let encode = |e: serde_json::Error| Error::Picture {
-        name: "run.json".into(),
-        message: e.to_string(),
-    };
-    let tree = serde_json::to_value(report).map_err(encode)?;
-    serde_json::to_vec_pretty(&tree).map_err(encode)
+    json(report, None)
 }
 
 /// `run.json` of `solution`, with `units.columns`: the unit of each column of the CSV files
@@ -44,14 +39,8 @@ pub fn run_json_of(solution: &Solution) -> Result<Vec<u8>, Error> {
         csv.push(("contact.csv", contact_columns(c)));
     }
     if let Some(path) = &report.path {
-        let terminals: Vec<&str> = report.terminals.iter().map(|t| t.group.as_str()).collect();
-        csv.push(("path.csv", path_columns(&path.rows, &terminals)));
+        csv.push(("path.csv", path_columns(&path.rows, &terminal_groups(report))));
     }
-    let encode = |e: serde_json::Error| Error::Picture {
-        name: "run.json".into(),
-        message: e.to_string(),
-    };
-    let mut tree = serde_json::to_value(report).map_err(encode)?;
     let columns: serde_json::Map<String, serde_json::Value> = csv
         .into_iter()
         .map(|(name, cols)| {
@@ -62,10 +51,26 @@ pub fn run_json_of(solution: &Solution) -> Result<Vec<u8>, Error> {
             (name.to_string(), of.into())
         })
         .collect();
-    if let Some(u) = tree.get_mut("units").and_then(|u| u.as_object_mut()) {
+    json(report, Some(columns))
+}
+
+/// The report as pretty JSON, its keys in sorted order, with `columns` in its `units` block
+/// where given.
+fn json(report: &RunReport, columns: Option<serde_json::Map<String, serde_json::Value>>) -> Result<Vec<u8>, Error> {
+    let encode = |e: serde_json::Error| Error::Picture {
+        name: "run.json".into(),
+        message: e.to_string(),
+    };
+    let mut tree = serde_json::to_value(report).map_err(encode)?;
+    if let (Some(columns), Some(u)) = (columns, tree.get_mut("units").and_then(|u| u.as_object_mut())) {
         u.insert("columns".into(), columns.into());
     }
     serde_json::to_vec_pretty(&tree).map_err(encode)
+}
+
+/// The terminals' groups of a report, in its order (`path.csv`'s `charge_G`, `potential_G`).
+fn terminal_groups(report: &RunReport) -> Vec<&str> {
+    report.terminals.iter().map(|t| t.group.as_str()).collect()
 }
 
 /// The files of a solution, those its plan lists (and, for the last instant of a load path,
@@ -629,7 +634,7 @@ fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     let Some(path) = &solution.report.path else {
         return Ok(vec![]);
     };
-    let terminals: Vec<&str> = solution.report.terminals.iter().map(|t| t.group.as_str()).collect();
+    let terminals = terminal_groups(&solution.report);
     let mut out = vec![("path.csv".to_string(), path_csv(&path.rows, &terminals))];
     let scene = &solution.report.scene.settings;
     out.extend(path_picture(&path.rows, &terminals, (scene, &solution.report.units))?);
@@ -758,11 +763,10 @@ fn path_picture(
     if rows.iter().any(|r| r.tangential_force != 0.0) {
         let (scale, x_label, what) = match driven(scene, driver) {
             Some((value, quantity, name)) => (value, units.label(&name, quantity), name),
-            None => (
-                1.0,
-                format!("{} factor", FACTORS[driver]),
-                format!("{} factor", FACTORS[driver]),
-            ),
+            None => {
+                let factor = format!("{} factor", FACTORS[driver]);
+                (1.0, factor.clone(), factor)
+            }
         };
         panels.push(Panel {
             title: format!("Tangential force against the {what} (friction's loop)"),

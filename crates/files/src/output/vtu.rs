@@ -88,11 +88,7 @@ pub(super) fn write(grid: &Grid<'_>) -> Vec<u8> {
         }
         out.push_str(close);
     };
-    let scalars = grid
-        .point
-        .iter()
-        .find(|a| a.components == 1)
-        .map_or(String::new(), |a| format!(" Scalars=\"{}\"", a.name));
+    let scalars = scalars(&grid.point);
     section(
         &mut out,
         format!("<PointData{scalars}>"),
@@ -104,6 +100,15 @@ pub(super) fn write(grid: &Grid<'_>) -> Vec<u8> {
     section(&mut out, "<Cells>".into(), "</Cells>", 3);
     out.push_str("</Piece></UnstructuredGrid></VTKFile>");
     out.into_bytes()
+}
+
+/// `PointData`'s attribute naming the active scalars: the first point array of one component
+/// (none without one).
+fn scalars(point: &[Array<'_>]) -> String {
+    point
+        .iter()
+        .find(|a| a.components == 1)
+        .map_or(String::new(), |a| format!(" Scalars=\"{}\"", a.name))
 }
 
 /// VTK's name of the values' type.
@@ -202,17 +207,18 @@ pub(super) struct CompressedMesh {
 }
 
 impl CompressedMesh {
-    /// The mesh of `grid` (its data left out).
-    pub fn new(grid: &Grid<'_>) -> Self {
-        let n_cells = grid.offsets.len();
-        let types = vec![grid.cell_type as u8; n_cells];
+    /// The grid of `points` (3 coordinates each) and cells of `cell_type` (`connectivity`,
+    /// `offsets`, as [`Grid`] holds them).
+    pub fn new(points: &[f64], (connectivity, offsets): (&[u64], &[u64]), cell_type: CellType) -> Self {
+        let n_cells = offsets.len();
+        let types = vec![cell_type as u8; n_cells];
         CompressedMesh {
-            n_points: grid.points.len() / 3,
+            n_points: points.len() / 3,
             n_cells,
             arrays: [
-                compressed(Values::F64(grid.points)),
-                compressed(Values::U64(grid.connectivity)),
-                compressed(Values::U64(grid.offsets)),
+                compressed(Values::F64(points)),
+                compressed(Values::U64(connectivity)),
+                compressed(Values::U64(offsets)),
                 compressed(Values::U8(&types)),
             ],
         }
@@ -236,10 +242,7 @@ pub(super) fn write_compressed(mesh: &CompressedMesh, point: &[Array<'_>], cell:
         ));
         offset += len;
     };
-    let scalars = point
-        .iter()
-        .find(|a| a.components == 1)
-        .map_or(String::new(), |a| format!(" Scalars=\"{}\"", a.name));
+    let scalars = scalars(point);
     let mut bytes = data.iter().map(Vec::len);
     let mut named = |xml: &mut String, arrays: &[Array<'_>]| {
         for a in arrays {
@@ -330,15 +333,7 @@ mod tests {
         let points: Vec<f64> = (0..3 * 40).map(|i| i as f64 * 0.25).collect();
         let connectivity: Vec<u64> = (0..4 * 30).map(|i| (i % 40) as u64).collect();
         let offsets: Vec<u64> = (1..=30).map(|c| 4 * c as u64).collect();
-        let grid = Grid {
-            points: &points,
-            connectivity: &connectivity,
-            offsets: &offsets,
-            cell_type: CellType::Tetra,
-            point: vec![],
-            cell: vec![],
-        };
-        let mesh = CompressedMesh::new(&grid);
+        let mesh = CompressedMesh::new(&points, (&connectivity, &offsets), CellType::Tetra);
         let u: Vec<f64> = (0..3 * 40).map(|i| -(i as f64)).collect();
         let stress: Vec<f64> = (0..6 * 30).map(|i| i as f64 * 1e3).collect();
         let point = [Array {

@@ -118,14 +118,12 @@ impl Scene {
     /// (where `[units]` names one), and every material's the same: the constants are written
     /// in it, and every other number of the scene read in `[units]`'.
     fn check_units(&self) -> Result<(), SceneError> {
-        let stress = |u: crate::CrystalUnits| match u {
-            crate::CrystalUnits::Gpa => crate::StressUnit::Gpa,
-            crate::CrystalUnits::Si => crate::StressUnit::Pa,
-        };
         let declared = self.units.and_then(|u| u.stress);
         let mut first: Option<(crate::StressUnit, &str)> = declared.map(|s| (s, "units.stress"));
         for m in &self.material {
-            let Some(u) = m.units.map(stress) else { continue };
+            let Some(u) = m.units.map(crate::StressUnit::of_crystals) else {
+                continue;
+            };
             match first {
                 Some((s, key)) if s != u => {
                     return Err(SceneError::new(
