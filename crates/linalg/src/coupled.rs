@@ -9,9 +9,9 @@
 use crate::factor::{FactorKind, Ordering, SparseFactor};
 use crate::pcg::{pcg, LinearOperator, PcgParams};
 use crate::sparse::{lower_quasi_definite, mul_add, mul_t_add};
-use crate::LinalgError;
+use crate::{LinalgError, ShapeError};
 use faer::sparse::SparseColMat;
-use faer::Par;
+use faer::{MatMut, Par};
 
 /// What one coupled solve reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -232,6 +232,35 @@ impl DirectLdlt {
         })
     }
 
+    /// `K⁻¹ [b_u; b_φ]` for several right-hand sides at once, each `(b_u, b_φ)` of the
+    /// blocks' sizes, in one pair of sweeps over the factor (a sweep reads the whole factor
+    /// whatever the number of columns: several cost little more than one).
+    ///
+    /// # Errors
+    /// [`ShapeError::Rhs`] where a right-hand side is not of the blocks' sizes.
+    pub fn solve_many(&mut self, rhs: &[(&[f64], &[f64])]) -> Result<Vec<(Vec<f64>, Vec<f64>)>, LinalgError> {
+        let (n, n_u, k) = (self.buf.len(), self.n_u, rhs.len());
+        let mut x = vec![0.0; n * k];
+        for ((b_u, b_phi), col) in rhs.iter().zip(x.chunks_exact_mut(n.max(1))) {
+            if b_u.len() != n_u || b_phi.len() != n - n_u {
+                return Err(ShapeError::Rhs {
+                    expected: n,
+                    got: b_u.len() + b_phi.len(),
+                }
+                .into());
+            }
+            col[..n_u].copy_from_slice(b_u);
+            col[n_u..].copy_from_slice(b_phi);
+        }
+        if k > 0 && n > 0 {
+            self.factor.solve_many(MatMut::from_column_major_slice_mut(&mut x, n, k));
+        }
+        Ok(x.chunks_exact(n.max(1))
+            .take(k)
+            .map(|c| (c[..n_u].to_vec(), c[n_u..].to_vec()))
+            .collect())
+    }
+
     /// The factor (for its inertia, pivots, ordering and size).
     pub fn factor(&self) -> &SparseFactor {
         &self.factor
@@ -319,6 +348,76 @@ pub fn refine(
     max_steps: usize,
 ) -> Result<Refined, LinalgError> {
     refine_by(&mut Blockwise { solver, k, rhs }, u, phi, tol, max_steps)
+}
+
+/// [`refine`] of several solutions `xs` of `K x = b` (one per right-hand side of `rhs`, in
+/// their order) at once: each round measures every residual, and the corrections of those
+/// still above `tol` are one solve with several right-hand sides ([`DirectLdlt::solve_many`]);
+/// each solution follows [`refine`]'s rule on its own (a correction kept only where it lowers
+/// the residual, no further step after one that did not halve it), so each ends where
+/// [`refine`] would have taken it.
+///
+/// # Errors
+/// The solver's; [`ShapeError::Rhs`] where `xs` and `rhs` differ in number.
+pub fn refine_many(
+    solver: &mut DirectLdlt,
+    k: CoupledBlocks<'_>,
+    rhs: &[Rhs<'_>],
+    xs: &mut [(Vec<f64>, Vec<f64>)],
+    tol: f64,
+    max_steps: usize,
+) -> Result<Vec<Refined>, LinalgError> {
+    if xs.len() != rhs.len() {
+        return Err(ShapeError::Rhs {
+            expected: rhs.len(),
+            got: xs.len(),
+        }
+        .into());
+    }
+    let measure = |(u, phi): &(Vec<f64>, Vec<f64>), b: &Rhs<'_>| {
+        let (ru, rp) = minus_k_x(k, u, phi, b.u, b.phi);
+        Residual::of(ru, rp, *b)
+    };
+    let mut r: Vec<Residual> = xs.iter().zip(rhs).map(|(x, b)| measure(x, b)).collect();
+    let mut out: Vec<Refined> = r
+        .iter()
+        .map(|r| Refined {
+            steps: 0,
+            residual: r.measure,
+        })
+        .collect();
+    let mut active: Vec<usize> = (0..xs.len()).collect();
+    for _ in 0..max_steps {
+        active.retain(|&j| out[j].residual > tol && out[j].residual.is_finite());
+        if active.is_empty() {
+            break;
+        }
+        let columns: Vec<(&[f64], &[f64])> = active.iter().map(|&j| (&r[j].u[..], &r[j].phi[..])).collect();
+        let corrections = solver.solve_many(&columns)?;
+        let mut next_active = Vec::with_capacity(active.len());
+        for (&j, (du, dp)) in active.iter().zip(corrections) {
+            let (u, phi) = &xs[j];
+            let nu: Vec<f64> = u.iter().zip(&du).map(|(a, b)| a + b).collect();
+            let np: Vec<f64> = phi.iter().zip(&dp).map(|(a, b)| a + b).collect();
+            let x = (nu, np);
+            let next = measure(&x, &rhs[j]);
+            let (before, after) = (out[j].residual, next.measure);
+            if !(after < before) {
+                continue;
+            }
+            xs[j] = x;
+            r[j] = next;
+            out[j] = Refined {
+                steps: out[j].steps + 1,
+                residual: after,
+            };
+            if 2.0 * after <= before {
+                next_active.push(j);
+            }
+        }
+        active = next_active;
+    }
+    Ok(out)
 }
 
 /// What iterative refinement asks of a system and its solver ([`refine_by`]), for a system

@@ -47,7 +47,7 @@ mod values;
 
 pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{
-    equilibrium_residual, refine, refine_by, relative_residual, CoupledBlocks, CoupledSolver, DirectLdlt,
+    equilibrium_residual, refine, refine_by, refine_many, relative_residual, CoupledBlocks, CoupledSolver, DirectLdlt,
     FactorPreconditioner, Refinable, Refined, Residual, Rhs, SchurOperator, SchurPcg, SolveInfo,
 };
 pub use dense::{mirror_lower, symmetric_inverse};
@@ -167,6 +167,14 @@ pub enum ShapeError {
         values: usize,
         /// Condensed dofs.
         dofs: usize,
+    },
+    /// A right-hand side whose length is not the system's.
+    #[error("a right-hand side of {got} entries for a system of {expected}")]
+    Rhs {
+        /// The system's unknowns.
+        expected: usize,
+        /// The right-hand side's entries.
+        got: usize,
     },
     /// Vectors of PCG whose sizes are not the operator's.
     #[error("pcg: operator {operator}, preconditioner {preconditioner}, b {b}, x {x}")]

@@ -195,6 +195,58 @@ fn the_condensation_reads_the_same_trailing_block_off_the_parallel_factor() {
     assert!(relative_gap(&pp, &ps) < 1e-12);
 }
 
+/// Several right-hand sides solved together are each one's own solve (on one core and on the
+/// tree's two), and refined together each ends where its own refinement does: below the
+/// tolerance, with its residual measured as [`linalg::equilibrium_residual`] measures it.
+#[test]
+fn right_hand_sides_solved_and_refined_together_are_each_one_s_own() {
+    let m = 40;
+    let (a, g, b) = grid(m, 5);
+    let (n_u, n_phi) = (a.nrows(), b.nrows());
+    let ordering = Ordering::Given(dissection(m));
+    let column = |s: usize| -> (Vec<f64>, Vec<f64>) {
+        let u = (0..n_u).map(|i| ((i * (7 + s)) % 11) as f64 - 5.0).collect();
+        let phi = (0..n_phi).map(|i| ((i * (3 + s)) % 5) as f64 * 0.3).collect();
+        (u, phi)
+    };
+    let rhs: Vec<_> = (0..5).map(column).collect();
+    let columns: Vec<(&[f64], &[f64])> = rhs.iter().map(|(u, p)| (&u[..], &p[..])).collect();
+    for threads in [1, 2] {
+        let mut f = on_threads(threads, || DirectLdlt::new(&a, &g, &b, &ordering, Par::rayon(threads))).unwrap();
+        let together = on_threads(threads, || f.solve_many(&columns)).unwrap();
+        assert_eq!(together.len(), 5);
+        for ((b_u, b_phi), (u, phi)) in rhs.iter().zip(&together) {
+            let (mut u1, mut p1) = (vec![0.0; n_u], vec![0.0; n_phi]);
+            linalg::CoupledSolver::solve(&mut f, b_u, b_phi, &mut u1, &mut p1).unwrap();
+            assert!(relative_gap(u, &u1) < 1e-13 && relative_gap(phi, &p1) < 1e-13);
+        }
+        let k = linalg::CoupledBlocks { a: &a, g: &g, b: &b };
+        let measures: Vec<linalg::Rhs<'_>> = rhs
+            .iter()
+            .map(|(u, phi)| linalg::Rhs { u, phi, scale: 0.0 })
+            .collect();
+        // perturbed solutions: each refined back below the tolerance, in at most 3 steps
+        let mut xs: Vec<(Vec<f64>, Vec<f64>)> = together
+            .iter()
+            .enumerate()
+            .map(|(s, (u, phi))| {
+                let bump = 1e-6 * (s as f64 + 1.0);
+                (u.iter().map(|x| x * (1.0 + bump)).collect(), phi.clone())
+            })
+            .collect();
+        let refined = on_threads(threads, || linalg::refine_many(&mut f, k, &measures, &mut xs, 1e-13, 3)).unwrap();
+        for ((r, (u, phi)), b) in refined.iter().zip(&xs).zip(&measures) {
+            assert!((1..=3).contains(&r.steps), "{r:?}");
+            assert!(r.residual < 1e-13, "{r:?}");
+            assert_eq!(r.residual, linalg::equilibrium_residual(k, u, phi, *b));
+        }
+        // a solution already below the tolerance is left as it is
+        let again = linalg::refine_many(&mut f, k, &measures, &mut xs, 1e-13, 3).unwrap();
+        assert!(again.iter().all(|r| r.steps == 0));
+        assert!(linalg::refine_many(&mut f, k, &measures[..2], &mut xs, 1e-13, 3).is_err());
+    }
+}
+
 /// A root supernode wider than 4096 columns (the displacements of the grid's first 30 rows
 /// ordered last: 4200 dofs coupled through the whole grid), whose dense `L D Lᵀ` the tree
 /// makes with 512-column panels (faer's default is 128): the same pivots and solution as
