@@ -94,16 +94,36 @@ impl DofMap {
     /// The same map with its prescribed values scaled: displacement component `k` by `u[k]`,
     /// potentials by `phi` (the same dofs free: a load path's instant).
     pub fn scaled(&self, u: [f64; 3], phi: f64) -> DofMap {
-        let dim = self.dim;
+        let mut out = DofMap {
+            dim: self.dim,
+            u: vec![],
+            phi: vec![],
+            n_u: self.n_u,
+            n_phi: self.n_phi,
+            floating: self.floating.clone(),
+        };
+        out.scale_from(self, u, phi);
+        out
+    }
+
+    /// Makes this map `base` with its prescribed values scaled ([`DofMap::scaled`]), in place:
+    /// a path's instant after instant, without a new map each time.
+    pub fn scale_from(&mut self, base: &DofMap, u: [f64; 3], phi: f64) {
         let scale = |d: &Dof, f: f64| match *d {
             Dof::Fixed(v) => Dof::Fixed(v * f),
             other => other,
         };
-        DofMap {
-            u: self.u.iter().enumerate().map(|(i, d)| scale(d, u[i % dim])).collect(),
-            phi: self.phi.iter().map(|d| scale(d, phi)).collect(),
-            ..self.clone()
-        }
+        let dim = base.dim.max(1);
+        self.u.clear();
+        self.u.extend(
+            base.u
+                .chunks(dim)
+                .flat_map(|node| node.iter().zip(&u).map(|(d, &f)| scale(d, f))),
+        );
+        self.phi.clear();
+        self.phi.extend(base.phi.iter().map(|d| scale(d, phi)));
+        (self.dim, self.n_u, self.n_phi) = (base.dim, base.n_u, base.n_phi);
+        self.floating.clone_from(&base.floating);
     }
 
     /// Builds the map: `has_phi[node]` says which nodes carry a potential; `constraints` are
@@ -398,5 +418,32 @@ impl Held<'_> {
             n_phi,
             floating,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Dof, DofMap};
+
+    /// A path's instant's map: every prescribed value scaled by its component's factor (each
+    /// node's `dim` components in turn), the free dofs as they were, in place as new.
+    #[test]
+    fn scaling_in_place_is_scaling_anew() {
+        let base = DofMap {
+            dim: 2,
+            u: vec![Dof::Fixed(1.0), Dof::Free(0), Dof::Free(1), Dof::Fixed(-3.0), Dof::Fixed(5.0), Dof::Fixed(7.0)],
+            phi: vec![Dof::Fixed(2.0), Dof::Free(0), Dof::Fixed(-1.0)],
+            n_u: 2,
+            n_phi: 1,
+            floating: vec![],
+        };
+        let scaled = base.scaled([10.0, 100.0, 1000.0], 0.5);
+        let expected_u = [Dof::Fixed(10.0), Dof::Free(0), Dof::Free(1), Dof::Fixed(-300.0), Dof::Fixed(50.0), Dof::Fixed(700.0)];
+        assert_eq!(scaled.u, expected_u);
+        assert_eq!(scaled.phi, [Dof::Fixed(1.0), Dof::Free(0), Dof::Fixed(-0.5)]);
+        assert_eq!((scaled.dim, scaled.n_u, scaled.n_phi), (2, 2, 1));
+        let mut again = base.scaled([0.0; 3], 0.0);
+        again.scale_from(&base, [10.0, 100.0, 1000.0], 0.5);
+        assert_eq!(again, scaled);
     }
 }
