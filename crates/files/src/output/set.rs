@@ -541,6 +541,10 @@ mod unix {
                     "is twice in the set: two files would write one name",
                 ));
             }
+            // held while the file is written: a signal's removal of the set waits for it, and
+            // no file is written into the set after it (a file made while the set's directory
+            // was being removed would leave it behind)
+            let _writing = staging();
             std::fs::write(self.set.join(name), bytes).map_err(|e| io("cannot write", &self.dir.join(name), e))?;
             self.names.push(name.to_string());
             Ok(())
@@ -552,6 +556,9 @@ mod unix {
             let (dir, hidden) = (&self.dir, &self.hidden);
             let old = current_names(hidden);
             let old_set = std::fs::read_link(hidden.join(CURRENT)).ok().map(|t| hidden.join(t));
+            // held while the directory turns to the set: a signal then either removes the set
+            // before the turn or finds it the directory's own (no longer staged)
+            let mut sets = staging();
             let staged = (|| -> Result<(), Error> {
                 // the links the new set's files need (each an absent file until the turn)
                 for name in &self.names {
@@ -571,6 +578,8 @@ mod unix {
                 }
                 return Err(e);
             }
+            sets.retain(|s| s != &self.set);
+            drop(sets);
             self.done = true;
             // what the old set had and the new one lacks
             for name in old.iter().filter(|n| !self.names.contains(n)) {
