@@ -319,6 +319,41 @@ fn the_rows_without_fields_are_the_rows_with_them() {
     }
 }
 
+/// Which instants a path writes changes none of its contact: the rows of a path that writes
+/// every instant's fields (computed several together, after the path has gone on) are those
+/// of one that writes only the last, but for what the fields measure (the equilibrium
+/// residual, the charges and potentials, within 1e-9 of the functionals'); every instant is
+/// handed on in order, the written ones with their fields.
+#[test]
+fn what_a_path_writes_changes_none_of_its_contact() {
+    let run = |every: usize| {
+        let sets = ["mesh.n=16".to_string(), format!("path.output_every={every}")];
+        let (scene, _) = scene_file::load("actuator-cycle", &sets).unwrap();
+        let mut handed = vec![];
+        let p = problem::solve_path(&scene, None, Limits::default(), &mut Silent, true, &mut |step| {
+            handed.push((step.row.step, step.fields.is_some()));
+            Ok(())
+        })
+        .unwrap();
+        (p.last.report.path.unwrap().rows, handed)
+    };
+    let ((last_only, handed_last), (every, handed_every)) = (run(0), run(1));
+    let n = every.len();
+    assert!(n > 10 && last_only.len() == n);
+    assert_eq!(handed_every, (0..n).map(|k| (k, true)).collect::<Vec<_>>());
+    assert_eq!(handed_last, (0..n).map(|k| (k, k + 1 == n)).collect::<Vec<_>>());
+    let scale = every.iter().flat_map(|r| &r.charges).fold(0.0f64, |m, q| m.max(q.abs()));
+    for (a, b) in last_only.iter().zip(&every) {
+        let same = (a.normal_force, a.tangential_force, a.max_slip, a.n_stick, a.n_slip, a.iterations)
+            == (b.normal_force, b.tangential_force, b.max_slip, b.n_stick, b.n_slip, b.iterations);
+        assert!(same && a.complementarity == b.complementarity, "step {}", a.step);
+        assert!(b.equilibrium.is_some_and(|e| e < 1e-12), "step {}: {:?}", b.step, b.equilibrium);
+        for (qa, qb) in a.charges.iter().zip(&b.charges) {
+            assert!((qa - qb).abs() <= 1e-9 * scale, "step {}: {qa} against {qb}", a.step);
+        }
+    }
+}
+
 /// `cattaneo-mindlin-cycle` with slip-weakening friction (the coefficient at each point's slip
 /// accumulated in contact along the path).
 fn weakening_cycle(n: usize, static_coefficient: f64, dynamic: f64) -> Vec<StepRowLite> {

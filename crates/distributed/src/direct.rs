@@ -19,7 +19,7 @@ use fe_assembly::{Discretization, Dof};
 use linalg::{CondenseRoute, Condensed, CondensedLoads, CoupledSolver, Rhs};
 use petsc::{Mumps, Petsc, PetscError, Symmetry};
 use problem::backend::Fields;
-use problem::{Factorization, ProblemError};
+use problem::{Factorization, ProblemError, Refinement};
 
 /// `K` factored by MUMPS on the ranks, with `(K⁻¹)_cc` of its chosen dofs on every rank.
 pub struct Direct<'p> {
@@ -241,9 +241,15 @@ impl Factorization for Direct<'_> {
         Ok(split(x, self.n_u))
     }
 
-    fn refine(&mut self, rhs: Rhs<'_>, u: &mut [f64], phi: &mut [f64], tol: f64) -> Result<usize, ProblemError> {
+    fn refine(
+        &mut self,
+        rhs: Rhs<'_>,
+        u: &mut [f64],
+        phi: &mut [f64],
+        tol: f64,
+    ) -> Result<Refinement, ProblemError> {
         let mut system = Refining { direct: self, rhs };
-        Ok(linalg::refine_by(&mut system, u, phi, tol, 3).map_err(problem)?.steps)
+        Ok(linalg::refine_by(&mut system, u, phi, tol, 3).map_err(problem)?.into())
     }
 
     fn equilibrium(&mut self, u: &[f64], phi: &[f64], rhs: Rhs<'_>) -> Result<f64, ProblemError> {

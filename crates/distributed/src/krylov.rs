@@ -175,8 +175,14 @@ impl Factorization for Krylov<'_> {
     }
 
     /// None: the Krylov solver's tolerance is its accuracy.
-    fn refine(&mut self, _: linalg::Rhs<'_>, _: &mut [f64], _: &mut [f64], _: f64) -> Result<usize, ProblemError> {
-        Ok(0)
+    fn refine(
+        &mut self,
+        _: linalg::Rhs<'_>,
+        _: &mut [f64],
+        _: &mut [f64],
+        _: f64,
+    ) -> Result<problem::Refinement, ProblemError> {
+        Ok(problem::Refinement::default())
     }
 
     fn equilibrium(&mut self, u: &[f64], phi: &[f64], rhs: linalg::Rhs<'_>) -> Result<f64, ProblemError> {

@@ -277,8 +277,8 @@ impl<'p> Backend for DistributedMemory<'p> {
         Ok(s.instants.begin(f, posed, contact, parts, reporter)?)
     }
 
-    fn respond(&mut self, s: &mut Prepared<'p>, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, DistributedError> {
-        Ok(Instants::respond(s.route.factorization(), a_u, a_phi)?)
+    fn respond(&mut self, s: &mut Prepared<'p>, a: &[(&[f64], &[f64])]) -> Result<Vec<Fields>, DistributedError> {
+        Ok(Instants::respond(s.route.factorization(), a)?)
     }
 
     fn prime(&mut self, s: &mut Prepared<'p>, primed: Primed<'_>) -> Result<(), DistributedError> {
@@ -323,6 +323,23 @@ impl<'p> Backend for DistributedMemory<'p> {
             k.report(reporter);
         }
         Ok(Some(x))
+    }
+
+    /// The direct route's instants' fields come from their loads and multipliers alone; the
+    /// active-set route's are its last Krylov solve's.
+    fn defers_fields(&self, s: &Prepared<'p>) -> bool {
+        !matches!((&s.route, &s.active), (Route::Krylov(_), Some(_)))
+    }
+
+    /// The instants' fields, whole on every rank, together ([`Self::defers_fields`]).
+    fn frames_fields(
+        &mut self,
+        s: &mut Prepared<'p>,
+        frames: Vec<(Posed<'_>, InstantOf<'_>)>,
+        _: &mut dyn Reporter,
+    ) -> Result<Vec<Option<InstantSolution>>, DistributedError> {
+        let solved = problem::Instants::frames(s.route.factorization(), frames)?;
+        Ok(solved.into_iter().map(Some).collect())
     }
 
     /// The PETSc section of the report (collective).

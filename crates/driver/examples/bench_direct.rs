@@ -74,8 +74,9 @@ fn main() {
         // numeric factorisation)
         let analysis = (both - numeric).max(0.0);
         println!(
-            "faer analysis {analysis:.4} factor {numeric:.4} solve {solve:.4} residual {:.2e}",
-            residual(&k, &x, &rhs)
+            "faer analysis {analysis:.4} factor {numeric:.4} solve {solve:.4} residual {:.2e} values {:.1} MB",
+            residual(&k, &x, &rhs),
+            factor.values_bytes() as f64 / 1e6
         );
     }
 }

@@ -155,11 +155,12 @@ pub trait Backend {
         reporter: &mut dyn Reporter,
     ) -> Result<Vec<Fields>, Self::Error>;
 
-    /// `K⁻¹ [a_u; a_φ]` (a functional's response).
+    /// `K⁻¹ [a_u; a_φ]` for each functional `(a_u, a_φ)` of `a` (their responses), in their
+    /// order.
     ///
     /// # Errors
     /// A solve that failed.
-    fn respond(&mut self, system: &mut Self::System, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, Self::Error>;
+    fn respond(&mut self, system: &mut Self::System, a: &[(&[f64], &[f64])]) -> Result<Vec<Fields>, Self::Error>;
 
     /// Poses an instant's contact problem: its data (`primed.posed`'s loads and prescribed
     /// values; on a path, the parts' `factors`), on its boundary in its frame (the instant
@@ -201,6 +202,27 @@ pub trait Backend {
         contact: Option<InstantOf<'_>>,
         reporter: &mut dyn Reporter,
     ) -> Result<Option<InstantSolution>, Self::Error>;
+
+    /// Whether [`Backend::frames_fields`] computes a path's written instants' fields after the
+    /// path has gone on from them (from their loads and multipliers alone); where not, the
+    /// fields of each written instant are computed at the instant.
+    fn defers_fields(&self, system: &Self::System) -> bool;
+
+    /// The fields of several of a path's instants at once, in their order, each under its loads
+    /// and the contact forces of its solve (in its frame), refined, with its equilibrium
+    /// residual; no instant's contact solve changed (the path has gone on from it), its law
+    /// judged on the condensed problem as the instants whose fields are not computed. A
+    /// factorisation solves them together (one pair of sweeps for all). `None` for each on a
+    /// process that does not hold the gathered fields.
+    ///
+    /// # Errors
+    /// A solve that failed.
+    fn frames_fields(
+        &mut self,
+        system: &mut Self::System,
+        frames: Vec<(Posed<'_>, InstantOf<'_>)>,
+        reporter: &mut dyn Reporter,
+    ) -> Result<Vec<Option<InstantSolution>>, Self::Error>;
 
     /// What the backend measured, for the report; the system dropped (its memory freed
     /// before the last instant's recovery).

@@ -9,6 +9,25 @@ use linalg::{Condensed, CondensedLoads, CoupledSolver};
 /// The free unknowns `(u, φ)` of the discretisation.
 pub type Fields = (Vec<f64>, Vec<f64>);
 
+/// What [`Factorization::refine`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Refinement {
+    /// Corrections applied (each one solve with the factors).
+    pub steps: usize,
+    /// The equilibrium residual of the result, where the refinement measured it (a direct
+    /// factorisation's; `None` where it does not refine).
+    pub residual: Option<f64>,
+}
+
+impl From<linalg::Refined> for Refinement {
+    fn from(r: linalg::Refined) -> Self {
+        Refinement {
+            steps: r.steps,
+            residual: Some(r.residual),
+        }
+    }
+}
+
 /// What the instants ask of a backend's factorisation of `K` (the free unknowns laid out
 /// `[u; φ]`, `K = [[A, Gᵀ], [G, -B]]` as docs/theory.md writes it). Its calls are collective
 /// where the backend's are (every rank makes them, in the same order), and every rank holds
@@ -41,13 +60,46 @@ pub trait Factorization {
         d: &[f64],
     ) -> Result<Fields, ProblemError>;
 
-    /// Iterative refinement of `(u, φ)` towards `rhs`, to the equilibrium residual `tol`; the
-    /// steps taken (none where the factorisation is not a direct one).
+    /// Iterative refinement of `(u, φ)` towards `rhs`, to the equilibrium residual `tol`: the
+    /// steps taken (none where the factorisation is not a direct one), and the equilibrium
+    /// residual of the result where the refinement measured it (what [`Self::equilibrium`]
+    /// would give, without its product with `K`).
     ///
     /// # Errors
     /// The solver's.
-    fn refine(&mut self, rhs: linalg::Rhs<'_>, u: &mut [f64], phi: &mut [f64], tol: f64)
-        -> Result<usize, ProblemError>;
+    fn refine(
+        &mut self,
+        rhs: linalg::Rhs<'_>,
+        u: &mut [f64],
+        phi: &mut [f64],
+        tol: f64,
+    ) -> Result<Refinement, ProblemError>;
+
+    /// `K⁻¹ [b_u; b_φ]` for each right-hand side of `rhs`, in their order (one solve each,
+    /// unless the factorisation solves several at once).
+    ///
+    /// # Errors
+    /// The solver's.
+    fn solve_many(&mut self, rhs: &[(&[f64], &[f64])]) -> Result<Vec<Fields>, ProblemError> {
+        rhs.iter().map(|(b_u, b_phi)| Ok(self.solve(b_u, b_phi)?.0)).collect()
+    }
+
+    /// [`Self::refine`] of several solutions `xs`, one per right-hand side of `rhs` (one at a
+    /// time, unless the factorisation corrects several at once).
+    ///
+    /// # Errors
+    /// The solver's.
+    fn refine_many(
+        &mut self,
+        rhs: &[linalg::Rhs<'_>],
+        xs: &mut [Fields],
+        tol: f64,
+    ) -> Result<Vec<Refinement>, ProblemError> {
+        rhs.iter()
+            .zip(xs.iter_mut())
+            .map(|(b, (u, phi))| self.refine(*b, u, phi, tol))
+            .collect()
+    }
 
     /// `‖K x - b‖ / max(‖b‖, scale)` ([`linalg::equilibrium_residual`]).
     ///

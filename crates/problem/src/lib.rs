@@ -83,7 +83,7 @@ pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindl
 pub use backend::Limits;
 pub use capacitance::Capacitance;
 pub use exact::ExactReport;
-pub use factorization::Factorization;
+pub use factorization::{Factorization, Refinement};
 pub use fe_assembly::CellFields;
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
 pub use instants::Instants;

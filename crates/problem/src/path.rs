@@ -56,8 +56,16 @@ pub struct StepFields<'a> {
     pub u: &'a [[f64; 3]],
     /// Nodal potentials.
     pub phi: &'a [f64],
-    /// Per-cell fields.
-    pub fields: &'a CellFields,
+    /// Per-cell fields: the last instant's, and every written instant's where the path asks
+    /// for them (`path.cell_fields`).
+    pub fields: Option<&'a CellFields>,
+}
+
+/// A written instant's nodal fields, and its cells' where the path asks for them.
+struct FrameFields {
+    u: Vec<[f64; 3]>,
+    phi: Vec<f64>,
+    cells: Option<CellFields>,
 }
 
 /// What a path produced: the last instant's solution (its report with the path's section)
@@ -144,6 +152,7 @@ pub(crate) fn walk<B: Backend>(
         base_dofs: disc.dofs.clone(),
         with_fields,
         every_fields: false,
+        defer: false,
         terminals: Terminals::default(),
         first: Loads::default(),
         bed: None,
@@ -160,6 +169,11 @@ pub(crate) fn walk<B: Backend>(
     stop_if_interrupted(&limits, "assembly")?;
     let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
     stop_if_interrupted(&limits, "factorisation")?;
+    walk.defer = with_fields
+        && walk.spec.is_some()
+        && boundary.is_some()
+        && !walk.every_fields
+        && backend.defers_fields(&system);
     let how = boundary
         .as_ref()
         .map(|b| ContactSolve::new(&setup.plan, scene, b, limits.interrupt));
@@ -244,6 +258,11 @@ struct Walk<'a> {
     /// Whether every instant's fields are computed: with electrical contact, whose flux the
     /// charges' functionals do not carry, the charges are the fields'.
     every_fields: bool,
+    /// Whether the written instants before the last have their fields computed later, several
+    /// together ([`Frames`]): their contact results and friction's history then come from the
+    /// contact solve, as every other instant's (the path does not depend on which instants it
+    /// writes), and their rows take what the fields measure when they come.
+    defer: bool,
     /// The charges' functionals.
     terminals: Terminals,
     /// The loads of a static scene's instant.
@@ -351,32 +370,39 @@ impl Terminals {
                 potentials[g].push(firsts[g].map_or(0.0, |v| phi[v]));
             }
         }
-        let points = &boundary.points;
-        let mut respond = |a_u: &[f64], a_phi: &[f64]| -> Result<PointValues, B::Error> {
-            let (z, _) = backend.respond(system, a_u, a_phi)?;
-            let mut out = PointValues::zeros(points.len(), points.n_tangential());
-            boundary.extract_free(&z, &mut out);
-            Ok(out)
-        };
-        let mut out = Terminals::default();
-        let functionals = disc.charge_functionals(&groups).map_err(ProblemError::from)?;
-        for ((a_u, a_phi), of_parts) in functionals.into_iter().zip(charges) {
-            out.charges.push(Functional {
-                of_parts,
-                at_points: Some(respond(&a_u, &a_phi)?),
-            });
-        }
+        // the functionals whose responses the points need: every charge's, and a floating
+        // terminal's potential (a free unknown: e_j's), solved together
         let dofs = &disc.dofs;
-        for (first, of_parts) in firsts.into_iter().zip(potentials) {
-            // a floating terminal's potential is a free unknown: e_j's response
-            let at_points = match first.map(|v| dofs.phi[v]) {
+        let mut functionals = disc.charge_functionals(&groups).map_err(ProblemError::from)?;
+        let n_charges = functionals.len();
+        let floating: Vec<bool> = firsts
+            .iter()
+            .map(|first| match first.map(|v| dofs.phi[v]) {
                 Some(fe_assembly::Dof::Free(j)) => {
                     let mut a_phi = vec![0.0; dofs.n_phi];
                     a_phi[j] = 1.0;
-                    Some(respond(&vec![0.0; dofs.n_u], &a_phi)?)
+                    functionals.push((vec![0.0; dofs.n_u], a_phi));
+                    true
                 }
-                _ => None,
-            };
+                _ => false,
+            })
+            .collect();
+        let a: Vec<(&[f64], &[f64])> = functionals.iter().map(|(a_u, a_phi)| (&a_u[..], &a_phi[..])).collect();
+        let points = &boundary.points;
+        let mut responses = backend.respond(system, &a)?.into_iter().map(|(z, _)| {
+            let mut out = PointValues::zeros(points.len(), points.n_tangential());
+            boundary.extract_free(&z, &mut out);
+            out
+        });
+        let mut out = Terminals::default();
+        for of_parts in charges.into_iter().take(n_charges) {
+            out.charges.push(Functional {
+                of_parts,
+                at_points: responses.next(),
+            });
+        }
+        for (floats, of_parts) in floating.into_iter().zip(potentials) {
+            let at_points = if floats { responses.next() } else { None };
             out.potentials.push(Functional { of_parts, at_points });
         }
         Ok(out)
@@ -475,6 +501,45 @@ struct InstantData<'a> {
 /// recovered with their equilibrium residual and free displacements, its PCG iterations.
 type Checked = (Option<ContactSolution>, Option<(Recovered, f64, Vec<f64>)>, usize);
 
+/// A path's written instants whose fields wait to be computed together (before the last
+/// instant, at most [`frames_at_once`] of them: one solve with as many right-hand sides reads
+/// the factor once for all, where one each reads it once each), and every step completed since
+/// the first of them, in order, for `each`.
+#[derive(Default)]
+struct Frames {
+    waiting: Vec<Frame>,
+    queue: Vec<Queued>,
+}
+
+/// A written instant's data for its fields: its step, factors and loads, its boundary and
+/// contact solve (in its frame), the frame (the step before's tangential displacements), the
+/// bed's last change, and its row's index.
+struct Frame {
+    k: usize,
+    t: f64,
+    f: Factors,
+    loads: Loads,
+    boundary: ContactBoundary,
+    sol: ContactSolution,
+    shift: PointValues,
+    change: f64,
+    row: usize,
+}
+
+/// A completed step waiting to be handed to `each`: its row's index and its contact result
+/// (`None`: a written instant, whose result comes with its fields).
+struct Queued {
+    row: usize,
+    result: Option<ContactResult>,
+}
+
+/// How many written instants' fields are computed together for a system of `n` unknowns:
+/// up to 16, within about 128 MB of right-hand sides, solutions and loads (4 vectors each).
+fn frames_at_once(n: usize) -> usize {
+    const BYTES: usize = 128 << 20;
+    (BYTES / (32 * n.max(1))).clamp(1, 16)
+}
+
 /// One instant completed: its contact result (with contact), its fields (the last
 /// instant's, and where asked), its own iterations and PCG count, its seconds.
 struct Done {
@@ -506,9 +571,17 @@ impl Walk<'_> {
         let of = instants.len() - 1;
         let mut system = Some(system);
         let mut figures = Figures::default();
+        let mut frames = Frames::default();
+        let batch = frames_at_once(disc.dofs.n_u + disc.dofs.n_phi);
         for (k, &t) in instants.iter().enumerate() {
             let at = |e: B::Error| if self.spec.is_some() { B::at_step(e, k, t) } else { e };
             let Some(prepared) = system.as_mut() else { break };
+            if k == of {
+                // the written instants before the last (their recovery scales the dof map to
+                // their own factors: before the last instant's is set)
+                let on = (&mut *backend, &mut *prepared, how);
+                self.flush_frames(&mut frames, on, disc, state, (reporter, &mut *each))?;
+            }
             if self.spec.is_some() {
                 reporter.event(&Event::PathStep { step: k, of, t });
             }
@@ -520,7 +593,8 @@ impl Walk<'_> {
                 state: &mut *state,
             };
             let written = self.with_fields && self.spec.is_some_and(|s| s.has_fields(k, of + 1));
-            let fields = k == of || written || self.every_fields;
+            let deferred = written && k != of && self.defer;
+            let fields = k == of || (written && !deferred) || self.every_fields;
             let stepped = self.solve_step(&mut on, disc, k, t, fields, reporter).map_err(at)?;
             if k == of {
                 // the system's memory freed before the last instant's recovery
@@ -528,13 +602,147 @@ impl Walk<'_> {
                     figures = backend.finish(prepared)?;
                 }
             }
-            let done = self.complete_step(state, disc, stepped, reporter, each);
+            let done = self.complete_step(state, disc, stepped, (reporter, &mut *each), (&mut frames, deferred));
             let done = done.map_err(|e| at(e.into()))?;
             if k == of {
                 state.last = done;
+            } else if frames.waiting.len() >= batch {
+                if let Some(prepared) = system.as_mut() {
+                    let on = (&mut *backend, prepared, how);
+                    self.flush_frames(&mut frames, on, disc, state, (reporter, &mut *each))?;
+                }
             }
         }
         Ok(figures)
+    }
+
+    /// The fields of the written instants that wait for them ([`Frames`]), computed together,
+    /// checked and recovered, each handed to `each` with the steps queued after it, in order;
+    /// the written instants' rows given their equilibrium residual.
+    ///
+    /// # Errors
+    /// The backend's; a written instant's fields that fail the checks (named by its step).
+    fn flush_frames<B: Backend>(
+        &self,
+        frames: &mut Frames,
+        (backend, system, how): (&mut B, &mut B::System, Option<&ContactSolve<'_>>),
+        disc: &mut Discretization<'_>,
+        state: &mut History,
+        (reporter, each): (&mut dyn Reporter, &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>),
+    ) -> Result<(), B::Error> {
+        let waiting = std::mem::take(&mut frames.waiting);
+        let queue = std::mem::take(&mut frames.queue);
+        let mut fields = vec![];
+        if let (Some(how), false) = (how, waiting.is_empty()) {
+            let posed: Vec<_> = waiting
+                .iter()
+                .map(|w| {
+                    let posed = Posed {
+                        scene: self.valid,
+                        setup: self.setup,
+                        disc,
+                        loads: w.loads.clone(),
+                        bed: None,
+                    };
+                    let framed = Framed {
+                        boundary: &w.boundary,
+                        shift: &w.shift,
+                    };
+                    let sol = w.sol.clone();
+                    (posed, InstantOf { how, framed, sol })
+                })
+                .collect();
+            let solved = backend.frames_fields(system, posed, reporter)?;
+            for (w, x) in waiting.into_iter().zip(solved) {
+                let (k, t) = (w.k, w.t);
+                let done = self.frame_fields(w, x, disc, state);
+                fields.push(done.map_err(|e| B::at_step(e.into(), k, t))?);
+            }
+        }
+        self.hand_queued(queue, state, fields, each).map_err(Into::into)
+    }
+
+    /// A written instant's fields `x` (`None` on a process that does not hold them) checked
+    /// and recovered at its factors, its row given what they measure (their equilibrium
+    /// residual, the charges through the terminals and their potentials, as the fields of an
+    /// instant computed at once give them); its contact result in the body's frame with them.
+    fn frame_fields(
+        &self,
+        w: Frame,
+        x: Option<InstantSolution>,
+        disc: &mut Discretization<'_>,
+        state: &mut History,
+    ) -> Result<Option<(ContactResult, FrameFields)>, ProblemError> {
+        let Some(x) = x else { return Ok(None) };
+        let equilibrium = x.equilibrium + w.change;
+        let (u, phi) = &x.x;
+        check_solved(self.scene, (u, phi), x.contact.as_ref(), equilibrium)?;
+        self.check_accurate(x.contact.as_ref(), equilibrium)?;
+        disc.dofs.scale_from(&self.base_dofs, w.f.displacement, w.f.voltage);
+        let (nodal_u, nodal_phi) = (disc.dofs.expand_u(u), disc.dofs.expand_phi(phi));
+        let cells = match self.spec.is_some_and(|p| p.cell_fields) {
+            true => {
+                let cells = disc.recover(&nodal_u, &nodal_phi);
+                ProblemError::check_finite(&cells.stress, "the stress", self.scene)?;
+                Some(cells)
+            }
+            false => None,
+        };
+        let terminals = crate::run::terminals(self.setup, disc, &nodal_u, &nodal_phi)?;
+        let recovered = FrameFields {
+            u: nodal_u,
+            phi: nodal_phi,
+            cells,
+        };
+        let mut sol = x.contact.unwrap_or(w.sol);
+        if let Some(row) = state.rows.get_mut(w.row) {
+            // what the fields measure: their equilibrium, the charges through the terminals
+            row.equilibrium = Some(equilibrium);
+            (row.charges, row.potentials) = terminals.iter().map(|x| (x.charge, x.potential)).unzip();
+        }
+        // the multipliers and displacements of the step in the body's frame
+        for (v, s) in sol.u.tangential.iter_mut().zip(&w.shift.tangential) {
+            *v += s;
+        }
+        Ok(Some((contact_result(w.boundary, sol, u), recovered)))
+    }
+
+    /// The queued steps handed to `each` in order: a written one with its `fields` (in their
+    /// order; none on a process that does not hold them), the others with none.
+    fn hand_queued(
+        &self,
+        queue: Vec<Queued>,
+        state: &History,
+        fields: Vec<Option<(ContactResult, FrameFields)>>,
+        each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+    ) -> Result<(), ProblemError> {
+        let mut fields = fields.into_iter();
+        let mesh = &self.setup.mesh;
+        for q in queue {
+            let Some(row) = state.rows.get(q.row) else { continue };
+            match q.result {
+                Some(contact) => each(Step {
+                    row,
+                    mesh,
+                    contact: &contact,
+                    fields: None,
+                })?,
+                None => {
+                    let Some(Some((contact, r))) = fields.next() else { continue };
+                    each(Step {
+                        row,
+                        mesh,
+                        contact: &contact,
+                        fields: Some(StepFields {
+                            u: &r.u,
+                            phi: &r.phi,
+                            fields: r.cells.as_ref(),
+                        }),
+                    })?;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The factors at `t` (a static scene's: every factor 1, the scene as written).
@@ -566,7 +774,7 @@ impl Walk<'_> {
         let Some(parts) = self.parts else {
             return Ok((self.first.clone(), None));
         };
-        disc.dofs = self.base_dofs.scaled(f.displacement, f.voltage);
+        disc.dofs.scale_from(&self.base_dofs, f.displacement, f.voltage);
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..self.setup.mesh.dim]);
         factors.push(f.voltage);
@@ -791,8 +999,8 @@ impl Walk<'_> {
         state: &mut History,
         disc: &Discretization<'_>,
         stepped: Stepped,
-        reporter: &mut dyn Reporter,
-        each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+        (reporter, each): (&mut dyn Reporter, &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>),
+        (frames, deferred): (&mut Frames, bool),
     ) -> Result<Option<Done>, ProblemError> {
         let Stepped {
             k,
@@ -802,11 +1010,10 @@ impl Walk<'_> {
             boundary,
             sol,
             fields,
-            loads,
+            mut loads,
             springs,
             seconds,
         } = stepped;
-        let setup = self.setup;
         let Some((sol, fielded, pcg_iters)) =
             self.checked((boundary.as_ref(), &f), disc, (sol, fields), &springs, reporter)?
         else {
@@ -824,6 +1031,18 @@ impl Walk<'_> {
                 seconds,
             }));
         };
+        // a written instant whose fields come later: what they are computed from
+        let frame = deferred.then(|| Frame {
+            k,
+            t,
+            f,
+            loads: std::mem::take(&mut loads),
+            boundary: boundary.clone(),
+            sol: sol.clone(),
+            shift: state.shift.clone(),
+            change: springs.change,
+            row: state.rows.len(),
+        });
         if self.spec.is_some() {
             // the multipliers and displacements of the step in the body's frame
             for (v, s) in sol.u.tangential.iter_mut().zip(&state.shift.tangential) {
@@ -859,24 +1078,58 @@ impl Walk<'_> {
         if self.spec.is_some() {
             reporter.event(&Event::PathStepDone { row: &row, of: self.of });
         }
-        each(Step {
-            row: &row,
-            mesh: &setup.mesh,
-            contact: &result,
-            fields: fielded.as_ref().map(|(r, _, _)| StepFields {
-                u: &r.u,
-                phi: &r.phi,
-                fields: &r.fields,
-            }),
-        })?;
-        state.rows.push(row.clone());
+        let handed = (&row, state.rows.len());
+        let result = self.hand_on((frames, frame), handed, result, fielded.as_ref().map(|(r, _, _)| r), each)?;
+        state.rows.push(row);
         Ok(Some(Done {
-            result: Some(result),
+            result,
             fields: fielded.map(|(r, e, _)| (r, e, loads)),
             iterations,
             pcg_iters,
             seconds,
         }))
+    }
+
+    /// A completed step handed on: a written instant whose fields come later waits (its
+    /// `frame`), and a step after one that waits is queued, each with its row's `index`;
+    /// any other goes to `each` at once (with its fields where computed). The contact result
+    /// is given back where it was handed on.
+    fn hand_on(
+        &self,
+        (frames, frame): (&mut Frames, Option<Frame>),
+        (row, index): (&StepRow, usize),
+        result: ContactResult,
+        fielded: Option<&Recovered>,
+        each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+    ) -> Result<Option<ContactResult>, ProblemError> {
+        if let Some(frame) = frame {
+            // its row and result now, its fields with the next written instants'
+            frames.waiting.push(frame);
+            frames.queue.push(Queued {
+                row: index,
+                result: None,
+            });
+            return Ok(None);
+        }
+        if !frames.queue.is_empty() {
+            // after a written instant that waits: handed on in order
+            frames.queue.push(Queued {
+                row: index,
+                result: Some(result),
+            });
+            return Ok(None);
+        }
+        each(Step {
+            row,
+            mesh: &self.setup.mesh,
+            contact: &result,
+            fields: fielded.map(|r| StepFields {
+                u: &r.u,
+                phi: &r.phi,
+                fields: Some(&r.fields),
+            }),
+        })?;
+        Ok(Some(result))
     }
 
     /// An instant's contact solution and fields checked, the fields recovered where computed

@@ -417,7 +417,7 @@ pub(crate) fn terminal_groups(setup: &Setup) -> Vec<&str> {
 
 /// The terminals (the groups where the potential is prescribed or floats), each with its
 /// potential and the charge through it (none without electric unknowns).
-fn terminals(
+pub(crate) fn terminals(
     setup: &Setup,
     disc: &Discretization<'_>,
     u: &[[f64; 3]],

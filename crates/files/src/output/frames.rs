@@ -1,13 +1,18 @@
 //! A load path's files: its time series (each written instant a `step-NNNN.vtu`, compressed,
-//! encoded on a thread of its own while the next instant is solved; `path.pvd` their
-//! collection), then the last instant's files and the path's own.
+//! encoded on a thread of its own while the path goes on; `path.pvd` their collection), then
+//! the last instant's files and the path's own.
 
 use super::vtu::{self, CompressedMesh};
 use super::{files, mesh_arrays, FieldArrays, NamedValues, Outputs, SetWriter};
 use crate::Error;
 use problem::Solution;
+use std::collections::VecDeque;
 use std::sync::Arc;
 use std::thread::JoinHandle;
+
+/// Steps encoded at once, at most (each holds its fields' copy and its bytes: about 4 MB for a
+/// 2D mesh of 130,000 nodes).
+const ENCODING: usize = 4;
 use std::time::Instant;
 
 /// The files of a load path, written step by step ([`PathFiles::step`]: each written instant's
@@ -20,12 +25,14 @@ use std::time::Instant;
 /// A step's file holds the point data (`u`, `phi`, and the contact's status, pressure,
 /// traction, gap and flux), and the cell data (stress, strain, D, E) where the scene asks for
 /// it (`path.cell_fields`); its arrays are zlib-compressed, the mesh's compressed once for all
-/// steps. One step is encoded at a time, on its own thread, while the path goes on.
+/// steps. Each step is encoded on its own thread while the path goes on, at most
+/// [`ENCODING`] at a time (the written instants of a path come several together: their fields
+/// are solved together), and written in order.
 pub struct PathFiles {
     series: Vec<(f64, String)>,
     cell_fields: bool,
     mesh: Option<Arc<CompressedMesh>>,
-    pending: Option<JoinHandle<(String, Vec<u8>)>>,
+    pending: VecDeque<JoinHandle<(String, Vec<u8>)>>,
     /// Seconds the path waited on its steps' files while it ran.
     seconds: f64,
 }
@@ -37,7 +44,7 @@ impl PathFiles {
             series: vec![],
             cell_fields: scene.path.as_ref().is_some_and(|p| p.cell_fields),
             mesh: None,
-            pending: None,
+            pending: VecDeque::new(),
             seconds: 0.0,
         }
     }
@@ -52,17 +59,20 @@ impl PathFiles {
         names
     }
 
-    /// Starts one instant's `step-NNNN.vtu` (written by the next step or by
-    /// [`PathFiles::finish`]), after writing the one before into the set.
+    /// Starts one instant's `step-NNNN.vtu` (written by a later step or by
+    /// [`PathFiles::finish`]), after writing the oldest being encoded into the set where
+    /// [`ENCODING`] are.
     ///
     /// # Errors
-    /// [`Error::Output`] where the step before cannot be written.
+    /// [`Error::Output`] where a step before cannot be written.
     pub fn step(&mut self, step: &problem::Step<'_>, writer: &mut SetWriter) -> Result<(), Error> {
         let Some(f) = &step.fields else {
             return Ok(());
         };
         let started = Instant::now();
-        self.flush(writer)?;
+        while self.pending.len() >= ENCODING {
+            self.flush_one(writer)?;
+        }
         let mesh = self
             .mesh
             .get_or_insert_with(|| {
@@ -70,11 +80,11 @@ impl PathFiles {
                 Arc::new(CompressedMesh::new(&points, (&connectivity, &offsets), cell_type))
             })
             .clone();
-        let cells = self.cell_fields.then_some(f.fields);
+        let cells = f.fields.filter(|_| self.cell_fields);
         let data = FieldArrays::new(step.mesh, (f.u, f.phi), cells, Some(step.contact)).into_owned();
         let name = step_name(step.row.step);
         self.series.push((step.row.t, name.clone()));
-        self.pending = Some(std::thread::spawn(move || {
+        self.pending.push_back(std::thread::spawn(move || {
             let point: Vec<_> = data.point.iter().map(NamedValues::array).collect();
             let cell: Vec<_> = data.cell.iter().map(NamedValues::array).collect();
             (name, vtu::write_compressed(&mesh, &point, &cell))
@@ -83,9 +93,17 @@ impl PathFiles {
         Ok(())
     }
 
-    /// Writes the step being encoded, if any, into the set.
+    /// Writes every step being encoded into the set, in order.
     fn flush(&mut self, writer: &mut SetWriter) -> Result<(), Error> {
-        let Some(pending) = self.pending.take() else {
+        while !self.pending.is_empty() {
+            self.flush_one(writer)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the oldest step being encoded, if any, into the set.
+    fn flush_one(&mut self, writer: &mut SetWriter) -> Result<(), Error> {
+        let Some(pending) = self.pending.pop_front() else {
             return Ok(());
         };
         let (name, bytes) = pending.join().map_err(|_| Error::Picture {

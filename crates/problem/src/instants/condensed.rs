@@ -154,6 +154,8 @@ pub(super) struct Refining<'a> {
     /// instant; a path's steps refine only what a direct solve did not reach,
     /// [`PATH_REFINE_TOL`]).
     pub(super) refine_tol: f64,
+    /// The equilibrium residual of the fields as their last refinement measured it.
+    pub(super) residual: Option<f64>,
 }
 
 /// The equilibrium residual a run's fields are refined to.
@@ -182,7 +184,8 @@ impl Refining<'_> {
         let mut corrections = 0;
         loop {
             let b = rhs_with_contact(posed, Some((boundary, &sol)));
-            self.refinement += self.f.refine(rhs(&b), u, phi, self.refine_tol)?;
+            let refined = self.f.refine(rhs(&b), u, phi, self.refine_tol)?;
+            (self.refinement, self.residual) = (self.refinement + refined.steps, refined.residual);
             sol.info.complementarity = law_residual(boundary, how, &sol, &u0, u, self.shift);
             if sol.info.complementarity <= how.tol || corrections == MAX_CORRECTIONS {
                 break;

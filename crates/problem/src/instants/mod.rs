@@ -301,7 +301,7 @@ impl Instants {
                 let x = full.x.take().ok_or_else(unprimed)?;
                 self.kept = Kept::Full(full);
                 let b = rhs_with_contact(posed, Some((boundary, &sol)));
-                let equilibrium = f.equilibrium(&x.0, &x.1, rhs(&b))?;
+                let equilibrium = measured(f, (&x.0, &x.1), &b, None)?;
                 Ok(InstantSolution {
                     x,
                     pcg_iters: sol.info.inner_iters,
@@ -313,12 +313,45 @@ impl Instants {
         }
     }
 
-    /// [`crate::backend::Backend::respond`]: `K⁻¹ [a_u; a_φ]`.
+    /// [`crate::backend::Backend::frames_fields`]: the fields of several instants, each under
+    /// its loads and the forces (and, with electrical contact, the flux) of its contact solve,
+    /// solved together ([`Factorization::solve_many`]), each refined where a direct solve
+    /// missed ([`PATH_REFINE_TOL`]), with its equilibrium residual. Nothing the instants keep
+    /// is read or changed: the path has gone on from these instants.
     ///
     /// # Errors
     /// The factorisation's.
-    pub fn respond(f: &mut dyn Factorization, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError> {
-        Ok(f.solve(a_u, a_phi)?.0)
+    pub fn frames(
+        f: &mut dyn Factorization,
+        frames: Vec<(Posed<'_>, InstantOf<'_>)>,
+    ) -> Result<Vec<InstantSolution>, ProblemError> {
+        let b: Vec<_> = frames
+            .iter()
+            .map(|(posed, of)| rhs_with_contact(posed, Some((of.framed.boundary, &of.sol))))
+            .collect();
+        let columns: Vec<(&[f64], &[f64])> = b.iter().map(|(b_u, b_phi, _)| (&b_u[..], &b_phi[..])).collect();
+        let mut solved = f.solve_many(&columns)?;
+        let measures: Vec<_> = b.iter().map(rhs).collect();
+        let refined = f.refine_many(&measures, &mut solved, PATH_REFINE_TOL)?;
+        let mut out = Vec::with_capacity(frames.len());
+        for ((((_, of), (u, phi)), b), refined) in frames.into_iter().zip(solved).zip(&b).zip(refined) {
+            let mut sol = of.sol;
+            if let Some(values) = &mut sol.electric {
+                // the potentials reported are the refined fields'
+                values.potential = at_electric_points(of.framed.boundary, &phi, u.len());
+            }
+            out.push(finished(f, (u, phi), sol, b, refined.residual)?);
+        }
+        Ok(out)
+    }
+
+    /// [`crate::backend::Backend::respond`]: `K⁻¹ [a_u; a_φ]` for each functional of `a`,
+    /// solved together.
+    ///
+    /// # Errors
+    /// The factorisation's.
+    pub fn respond(f: &mut dyn Factorization, a: &[(&[f64], &[f64])]) -> Result<Vec<Fields>, ProblemError> {
+        f.solve_many(a)
     }
 
     /// [`crate::backend::Backend::own_scale`].
@@ -337,8 +370,9 @@ impl Instants {
         let loads = &posed.loads;
         let ((mut u, mut phi), pcg_iters) = f.solve(&loads.b_u, &loads.b_phi)?;
         let b = rhs_with_contact(posed, None);
-        self.refinement = f.refine(rhs(&b), &mut u, &mut phi, REFINE_TOL)?;
-        let equilibrium = f.equilibrium(&u, &phi, rhs(&b))?;
+        let refined = f.refine(rhs(&b), &mut u, &mut phi, REFINE_TOL)?;
+        self.refinement = refined.steps;
+        let equilibrium = measured(f, (&u, &phi), &b, refined.residual)?;
         Ok(InstantSolution {
             x: (u, phi),
             contact: None,
@@ -377,11 +411,13 @@ impl Instants {
             // a path's step: friction's frame, and refinement only where a direct solve missed
             shift: path.then_some(framed.shift),
             refine_tol: if path { PATH_REFINE_TOL } else { REFINE_TOL },
+            residual: None,
         };
         let sol = on.correct(how, &mut c.dense, sol, (&mut u, &mut phi), reporter)?;
-        self.refinement = on.refinement;
+        let (refinement, residual) = (on.refinement, on.residual);
+        self.refinement = refinement;
         let b = rhs_with_contact(posed, Some((boundary, &sol)));
-        finished(f, (u, phi), sol, &b)
+        finished(f, (u, phi), sol, &b, residual)
     }
 
     /// The fields of a contact solve with electrical contact, under the forces and the flux
@@ -403,25 +439,42 @@ impl Instants {
         // a path's step: friction's frame, and refinement only where a direct solve missed
         let path = !e.parts.is_empty();
         let refine_tol = if path { PATH_REFINE_TOL } else { REFINE_TOL };
-        self.refinement = f.refine(rhs(&b), &mut u, &mut phi, refine_tol)?;
+        let refined = f.refine(rhs(&b), &mut u, &mut phi, refine_tol)?;
+        self.refinement = refined.steps;
         // the potentials reported are the refined fields'
         if let Some(values) = &mut sol.electric {
             values.potential = at_electric_points(boundary, &phi, u.len());
         }
         sol.info.complementarity = law_residual(boundary, how, &sol, &e.problem.u0, &u, path.then_some(framed.shift));
         sol.info.residual = sol.info.residual.max(sol.info.complementarity);
-        finished(f, (u, phi), sol, &b)
+        finished(f, (u, phi), sol, &b, refined.residual)
     }
 }
 
-/// The fields `x` of a contact solve `sol`, with their equilibrium residual against `b`.
+/// The equilibrium residual of `(u, φ)` against `b`: `refined`, where the refinement of
+/// these fields measured it (the same number), else one product with `K`.
+fn measured(
+    f: &mut dyn Factorization,
+    (u, phi): (&[f64], &[f64]),
+    b: &(Vec<f64>, Vec<f64>, f64),
+    refined: Option<f64>,
+) -> Result<f64, ProblemError> {
+    match refined {
+        Some(residual) => Ok(residual),
+        None => f.equilibrium(u, phi, rhs(b)),
+    }
+}
+
+/// The fields `x` of a contact solve `sol`, with their equilibrium residual against `b`
+/// (`refined`: as the refinement of `x` measured it).
 fn finished(
     f: &mut dyn Factorization,
     x: Fields,
     sol: ContactSolution,
     b: &(Vec<f64>, Vec<f64>, f64),
+    refined: Option<f64>,
 ) -> Result<InstantSolution, ProblemError> {
-    let equilibrium = f.equilibrium(&x.0, &x.1, rhs(b))?;
+    let equilibrium = measured(f, (&x.0, &x.1), b, refined)?;
     Ok(InstantSolution {
         x,
         contact: Some(sol),
@@ -511,9 +564,10 @@ fn at_electric_points(boundary: &ContactBoundary, phi: &[f64], n_u: usize) -> Ve
     dofs.iter().map(|&d| phi[d - n_u]).collect()
 }
 
-/// `K⁻¹ b_q` for each part `q` of a path's right-hand side, in their order.
+/// `K⁻¹ b_q` for each part `q` of a path's right-hand side, in their order, solved together.
 fn solve_parts(f: &mut dyn Factorization, parts: &[Fields]) -> Result<Vec<Fields>, ProblemError> {
-    parts.iter().map(|(b_u, b_phi)| Ok(f.solve(b_u, b_phi)?.0)).collect()
+    let columns: Vec<(&[f64], &[f64])> = parts.iter().map(|(b_u, b_phi)| (&b_u[..], &b_phi[..])).collect();
+    f.solve_many(&columns)
 }
 
 /// A path, or a condensed strategy, on a factorisation that does not condense (the scene's

@@ -9,7 +9,7 @@ use crate::backend::{
     At, Backend, Contact, ContactSolve, Fields, Figures, InstantOf, InstantSolution, Limits, Posed, Primed,
 };
 use crate::boundary::ContactBoundary;
-use crate::factorization::Factorization;
+use crate::factorization::{Factorization, Refinement};
 use crate::instants::Instants;
 use crate::progress::{Event, Reporter};
 use crate::scene::{BackendChoice, Rule, Scene};
@@ -89,8 +89,8 @@ impl Backend for SharedMemory {
             .map_err(|e| e.on_scene(&posed.scene))
     }
 
-    fn respond(&mut self, system: &mut Factored, a_u: &[f64], a_phi: &[f64]) -> Result<Fields, ProblemError> {
-        Instants::respond(&mut system.linear, a_u, a_phi)
+    fn respond(&mut self, system: &mut Factored, a: &[(&[f64], &[f64])]) -> Result<Vec<Fields>, ProblemError> {
+        Instants::respond(&mut system.linear, a)
     }
 
     fn prime(&mut self, system: &mut Factored, primed: Primed<'_>) -> Result<(), ProblemError> {
@@ -128,6 +128,21 @@ impl Backend for SharedMemory {
             .fields(linear, posed, contact, reporter)
             .map(Some)
             .map_err(|e| e.on_scene(&posed.scene))
+    }
+
+    fn defers_fields(&self, _: &Factored) -> bool {
+        true
+    }
+
+    fn frames_fields(
+        &mut self,
+        system: &mut Factored,
+        frames: Vec<(Posed<'_>, InstantOf<'_>)>,
+        _: &mut dyn Reporter,
+    ) -> Result<Vec<Option<InstantSolution>>, ProblemError> {
+        let Factored { linear, .. } = system;
+        let solved = Instants::frames(linear, frames)?;
+        Ok(solved.into_iter().map(Some).collect())
     }
 
     fn finish(&mut self, system: Factored) -> Result<Figures, ProblemError> {
@@ -251,17 +266,43 @@ impl Factorization for Linear {
         u: &mut [f64],
         phi: &mut [f64],
         tol: f64,
-    ) -> Result<usize, ProblemError> {
+    ) -> Result<Refinement, ProblemError> {
         let Linear { blocks, solver, .. } = self;
         let LinearSolver::Direct(direct) = solver else {
-            return Ok(0);
+            return Ok(Refinement::default());
         };
         let k = linalg::CoupledBlocks {
             a: &blocks.a,
             g: &blocks.g,
             b: &blocks.b,
         };
-        Ok(linalg::refine(direct, k, rhs, u, phi, tol, 3)?.steps)
+        Ok(linalg::refine(direct, k, rhs, u, phi, tol, 3)?.into())
+    }
+
+    fn refine_many(
+        &mut self,
+        rhs: &[linalg::Rhs<'_>],
+        xs: &mut [Fields],
+        tol: f64,
+    ) -> Result<Vec<Refinement>, ProblemError> {
+        let Linear { blocks, solver, .. } = self;
+        let LinearSolver::Direct(direct) = solver else {
+            return Ok(vec![Refinement::default(); xs.len()]);
+        };
+        let k = linalg::CoupledBlocks {
+            a: &blocks.a,
+            g: &blocks.g,
+            b: &blocks.b,
+        };
+        let refined = linalg::refine_many(direct, k, rhs, xs, tol, 3)?;
+        Ok(refined.into_iter().map(Refinement::from).collect())
+    }
+
+    fn solve_many(&mut self, rhs: &[(&[f64], &[f64])]) -> Result<Vec<Fields>, ProblemError> {
+        match &mut self.solver {
+            LinearSolver::Direct(direct) => Ok(direct.solve_many(rhs)?),
+            LinearSolver::SchurPcg(_) => rhs.iter().map(|(b_u, b_phi)| Ok(self.solve(b_u, b_phi)?.0)).collect(),
+        }
     }
 
     fn equilibrium(&mut self, u: &[f64], phi: &[f64], rhs: linalg::Rhs<'_>) -> Result<f64, ProblemError> {
