@@ -90,40 +90,54 @@ pub struct DofMap {
     pub floating: Vec<(String, usize)>,
 }
 
+/// A dof map's prescribed values by index ([`DofMap::prescribed`]): `(index, value)` of the
+/// displacements (`node * dim + k`) and of the potentials.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Prescribed {
+    u: Vec<(usize, f64)>,
+    phi: Vec<(usize, f64)>,
+}
+
 impl DofMap {
     /// The same map with its prescribed values scaled: displacement component `k` by `u[k]`,
     /// potentials by `phi` (the same dofs free: a load path's instant).
     pub fn scaled(&self, u: [f64; 3], phi: f64) -> DofMap {
-        let mut out = DofMap {
-            dim: self.dim,
-            u: vec![],
-            phi: vec![],
-            n_u: self.n_u,
-            n_phi: self.n_phi,
-            floating: self.floating.clone(),
-        };
-        out.scale_from(self, u, phi);
+        let mut out = self.clone();
+        out.rescale(&self.prescribed(), u, phi);
         out
     }
 
-    /// Makes this map `base` with its prescribed values scaled ([`DofMap::scaled`]), in place:
-    /// a path's instant after instant, without a new map each time.
-    pub fn scale_from(&mut self, base: &DofMap, u: [f64; 3], phi: f64) {
-        let scale = |d: &Dof, f: f64| match *d {
-            Dof::Fixed(v) => Dof::Fixed(v * f),
-            other => other,
+    /// The prescribed values of the map, by index: what [`DofMap::rescale`] scales.
+    pub fn prescribed(&self) -> Prescribed {
+        let fixed = |dofs: &[Dof]| {
+            dofs.iter()
+                .enumerate()
+                .filter_map(|(i, d)| match *d {
+                    Dof::Fixed(v) => Some((i, v)),
+                    _ => None,
+                })
+                .collect()
         };
-        let dim = base.dim.max(1);
-        self.u.clear();
-        self.u.extend(
-            base.u
-                .chunks(dim)
-                .flat_map(|node| node.iter().zip(&u).map(|(d, &f)| scale(d, f))),
-        );
-        self.phi.clear();
-        self.phi.extend(base.phi.iter().map(|d| scale(d, phi)));
-        (self.dim, self.n_u, self.n_phi) = (base.dim, base.n_u, base.n_phi);
-        self.floating.clone_from(&base.floating);
+        Prescribed {
+            u: fixed(&self.u),
+            phi: fixed(&self.phi),
+        }
+    }
+
+    /// Sets the prescribed values of this map to those of `prescribed` (a map of the same
+    /// dofs: [`DofMap::prescribed`]) scaled as [`DofMap::scaled`] scales them, in place: a
+    /// path's instant after instant, in the time of its prescribed values alone.
+    ///
+    /// # Panics
+    /// Where `prescribed` holds an index beyond this map's dofs (another map's values).
+    pub fn rescale(&mut self, prescribed: &Prescribed, u: [f64; 3], phi: f64) {
+        let dim = self.dim.max(1);
+        for &(i, v) in &prescribed.u {
+            self.u[i] = Dof::Fixed(v * u[i % dim]);
+        }
+        for &(i, v) in &prescribed.phi {
+            self.phi[i] = Dof::Fixed(v * phi);
+        }
     }
 
     /// Builds the map: `has_phi[node]` says which nodes carry a potential; `constraints` are
@@ -443,7 +457,7 @@ mod tests {
         assert_eq!(scaled.phi, [Dof::Fixed(1.0), Dof::Free(0), Dof::Fixed(-0.5)]);
         assert_eq!((scaled.dim, scaled.n_u, scaled.n_phi), (2, 2, 1));
         let mut again = base.scaled([0.0; 3], 0.0);
-        again.scale_from(&base, [10.0, 100.0, 1000.0], 0.5);
+        again.rescale(&base.prescribed(), [10.0, 100.0, 1000.0], 0.5);
         assert_eq!(again, scaled);
     }
 }

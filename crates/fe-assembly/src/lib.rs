@@ -51,7 +51,7 @@ mod material;
 mod recovery;
 
 pub use assembly::{Blocks, Discretization, Parallelism};
-pub use dofs::{Constraint, Dof, DofMap, Field};
+pub use dofs::{Constraint, Dof, DofMap, Field, Prescribed};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
 pub use held::{Held, Support, Unheld};
 pub use loads::{facet_measure, Load, RhsParts};

@@ -149,6 +149,7 @@ pub(crate) fn walk<B: Backend>(
         setup: &setup,
         spec: scene.path.as_ref(),
         parts: parts.as_ref(),
+        prescribed: disc.dofs.prescribed(),
         base_dofs: disc.dofs.clone(),
         with_fields,
         every_fields: false,
@@ -252,6 +253,8 @@ struct Walk<'a> {
     parts: Option<&'a RhsParts>,
     /// The dof map with the scene's prescribed values (scaled at each step).
     base_dofs: fe_assembly::DofMap,
+    /// Its prescribed values, which each instant scales.
+    prescribed: fe_assembly::Prescribed,
     /// Whether the fields of the output instants are computed ([`PathSpec::has_fields`]; the
     /// last instant's always are).
     with_fields: bool,
@@ -678,7 +681,7 @@ impl Walk<'_> {
         let (u, phi) = &x.x;
         check_solved(self.scene, (u, phi), x.contact.as_ref(), equilibrium)?;
         self.check_accurate(x.contact.as_ref(), equilibrium)?;
-        disc.dofs.scale_from(&self.base_dofs, w.f.displacement, w.f.voltage);
+        disc.dofs.rescale(&self.prescribed, w.f.displacement, w.f.voltage);
         let (nodal_u, nodal_phi) = (disc.dofs.expand_u(u), disc.dofs.expand_phi(phi));
         let cells = match self.spec.is_some_and(|p| p.cell_fields) {
             true => {
@@ -774,7 +777,7 @@ impl Walk<'_> {
         let Some(parts) = self.parts else {
             return Ok((self.first.clone(), None));
         };
-        disc.dofs.scale_from(&self.base_dofs, f.displacement, f.voltage);
+        disc.dofs.rescale(&self.prescribed, f.displacement, f.voltage);
         let mut factors = vec![f.load];
         factors.extend_from_slice(&f.displacement[..self.setup.mesh.dim]);
         factors.push(f.voltage);
