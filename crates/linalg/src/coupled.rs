@@ -8,7 +8,8 @@
 
 use crate::factor::{FactorKind, Ordering, SparseFactor};
 use crate::pcg::{pcg, LinearOperator, PcgParams};
-use crate::sparse::{lower_quasi_definite, mul_add, mul_t_add};
+use crate::sparse::{lower_quasi_definite, mul_add, mul_add_seq, mul_t_add, mul_t_add_seq};
+use rayon::prelude::*;
 use crate::{LinalgError, ShapeError};
 use faer::sparse::SparseColMat;
 use faer::{MatMut, Par};
@@ -374,11 +375,17 @@ pub fn refine_many(
         }
         .into());
     }
+    // the products with `K` one per task, each on one thread
     let measure = |(u, phi): &(Vec<f64>, Vec<f64>), b: &Rhs<'_>| {
-        let (ru, rp) = minus_k_x(k, u, phi, b.u, b.phi);
+        let mut ru = b.u.to_vec();
+        mul_add_seq(k.a.as_ref(), u, &mut ru, -1.0);
+        mul_t_add_seq(k.g.as_ref(), phi, &mut ru, -1.0);
+        let mut rp = b.phi.to_vec();
+        mul_add_seq(k.g.as_ref(), u, &mut rp, -1.0);
+        mul_add_seq(k.b.as_ref(), phi, &mut rp, 1.0);
         Residual::of(ru, rp, *b)
     };
-    let mut r: Vec<Residual> = xs.iter().zip(rhs).map(|(x, b)| measure(x, b)).collect();
+    let mut r: Vec<Residual> = xs.par_iter().zip(rhs).map(|(x, b)| measure(x, b)).collect();
     let mut out: Vec<Refined> = r
         .iter()
         .map(|r| Refined {
@@ -394,13 +401,20 @@ pub fn refine_many(
         }
         let columns: Vec<(&[f64], &[f64])> = active.iter().map(|&j| (&r[j].u[..], &r[j].phi[..])).collect();
         let corrections = solver.solve_many(&columns)?;
+        let corrected: Vec<_> = active
+            .par_iter()
+            .zip(corrections)
+            .map(|(&j, (du, dp))| {
+                let (u, phi) = &xs[j];
+                let nu: Vec<f64> = u.iter().zip(&du).map(|(a, b)| a + b).collect();
+                let np: Vec<f64> = phi.iter().zip(&dp).map(|(a, b)| a + b).collect();
+                let x = (nu, np);
+                let next = measure(&x, &rhs[j]);
+                (j, x, next)
+            })
+            .collect();
         let mut next_active = Vec::with_capacity(active.len());
-        for (&j, (du, dp)) in active.iter().zip(corrections) {
-            let (u, phi) = &xs[j];
-            let nu: Vec<f64> = u.iter().zip(&du).map(|(a, b)| a + b).collect();
-            let np: Vec<f64> = phi.iter().zip(&dp).map(|(a, b)| a + b).collect();
-            let x = (nu, np);
-            let next = measure(&x, &rhs[j]);
+        for (j, x, next) in corrected {
             let (before, after) = (out[j].residual, next.measure);
             if !(after < before) {
                 continue;

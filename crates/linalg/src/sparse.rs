@@ -44,6 +44,21 @@ pub fn mul_add(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alp
     });
 }
 
+/// `y += alpha M x` on the calling thread alone (for products made several at once, one per
+/// task: no task's partial sums to allocate and add).
+pub(crate) fn mul_add_seq(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alpha: f64) {
+    mul_add_columns(m, 0..m.ncols().min(x.len()), x, y, alpha);
+}
+
+/// `y += alpha Mᵀ x` on the calling thread alone ([`mul_add_seq`]'s transpose).
+pub(crate) fn mul_t_add_seq(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alpha: f64) {
+    let (cp, ri, vals) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
+    for (j, yj) in y.iter_mut().enumerate().take(m.ncols()) {
+        let s: f64 = (cp[j]..cp[j + 1]).map(|p| vals[p] * x[ri[p]]).sum();
+        *yj += alpha * s;
+    }
+}
+
 /// `y += alpha M[:, cols] x[cols]`, one column after another.
 fn mul_add_columns(
     m: SparseColMatRef<'_, usize, f64>,
