@@ -342,12 +342,33 @@ fn what_a_path_writes_changes_none_of_its_contact() {
     assert!(n > 10 && last_only.len() == n);
     assert_eq!(handed_every, (0..n).map(|k| (k, true)).collect::<Vec<_>>());
     assert_eq!(handed_last, (0..n).map(|k| (k, k + 1 == n)).collect::<Vec<_>>());
-    let scale = every.iter().flat_map(|r| &r.charges).fold(0.0f64, |m, q| m.max(q.abs()));
+    let scale = every
+        .iter()
+        .flat_map(|r| &r.charges)
+        .fold(0.0f64, |m, q| m.max(q.abs()));
     for (a, b) in last_only.iter().zip(&every) {
-        let same = (a.normal_force, a.tangential_force, a.max_slip, a.n_stick, a.n_slip, a.iterations)
-            == (b.normal_force, b.tangential_force, b.max_slip, b.n_stick, b.n_slip, b.iterations);
+        let same = (
+            a.normal_force,
+            a.tangential_force,
+            a.max_slip,
+            a.n_stick,
+            a.n_slip,
+            a.iterations,
+        ) == (
+            b.normal_force,
+            b.tangential_force,
+            b.max_slip,
+            b.n_stick,
+            b.n_slip,
+            b.iterations,
+        );
         assert!(same && a.complementarity == b.complementarity, "step {}", a.step);
-        assert!(b.equilibrium.is_some_and(|e| e < 1e-12), "step {}: {:?}", b.step, b.equilibrium);
+        assert!(
+            b.equilibrium.is_some_and(|e| e < 1e-12),
+            "step {}: {:?}",
+            b.step,
+            b.equilibrium
+        );
         for (qa, qb) in a.charges.iter().zip(&b.charges) {
             assert!((qa - qb).abs() <= 1e-9 * scale, "step {}: {qa} against {qb}", a.step);
         }

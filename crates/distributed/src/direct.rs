@@ -241,13 +241,7 @@ impl Factorization for Direct<'_> {
         Ok(split(x, self.n_u))
     }
 
-    fn refine(
-        &mut self,
-        rhs: Rhs<'_>,
-        u: &mut [f64],
-        phi: &mut [f64],
-        tol: f64,
-    ) -> Result<Refinement, ProblemError> {
+    fn refine(&mut self, rhs: Rhs<'_>, u: &mut [f64], phi: &mut [f64], tol: f64) -> Result<Refinement, ProblemError> {
         let mut system = Refining { direct: self, rhs };
         Ok(linalg::refine_by(&mut system, u, phi, tol, 3).map_err(problem)?.into())
     }

@@ -445,14 +445,28 @@ mod tests {
     fn scaling_in_place_is_scaling_anew() {
         let base = DofMap {
             dim: 2,
-            u: vec![Dof::Fixed(1.0), Dof::Free(0), Dof::Free(1), Dof::Fixed(-3.0), Dof::Fixed(5.0), Dof::Fixed(7.0)],
+            u: vec![
+                Dof::Fixed(1.0),
+                Dof::Free(0),
+                Dof::Free(1),
+                Dof::Fixed(-3.0),
+                Dof::Fixed(5.0),
+                Dof::Fixed(7.0),
+            ],
             phi: vec![Dof::Fixed(2.0), Dof::Free(0), Dof::Fixed(-1.0)],
             n_u: 2,
             n_phi: 1,
             floating: vec![],
         };
         let scaled = base.scaled([10.0, 100.0, 1000.0], 0.5);
-        let expected_u = [Dof::Fixed(10.0), Dof::Free(0), Dof::Free(1), Dof::Fixed(-300.0), Dof::Fixed(50.0), Dof::Fixed(700.0)];
+        let expected_u = [
+            Dof::Fixed(10.0),
+            Dof::Free(0),
+            Dof::Free(1),
+            Dof::Fixed(-300.0),
+            Dof::Fixed(50.0),
+            Dof::Fixed(700.0),
+        ];
         assert_eq!(scaled.u, expected_u);
         assert_eq!(scaled.phi, [Dof::Fixed(1.0), Dof::Free(0), Dof::Fixed(-0.5)]);
         assert_eq!((scaled.dim, scaled.n_u, scaled.n_phi), (2, 2, 1));

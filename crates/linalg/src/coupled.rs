@@ -9,10 +9,10 @@
 use crate::factor::{FactorKind, Ordering, SparseFactor};
 use crate::pcg::{pcg, LinearOperator, PcgParams};
 use crate::sparse::{lower_quasi_definite, mul_add, mul_add_seq, mul_t_add, mul_t_add_seq};
-use rayon::prelude::*;
 use crate::{LinalgError, ShapeError};
 use faer::sparse::SparseColMat;
 use faer::{MatMut, Par};
+use rayon::prelude::*;
 
 /// What one coupled solve reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -254,7 +254,8 @@ impl DirectLdlt {
             col[n_u..].copy_from_slice(b_phi);
         }
         if k > 0 && n > 0 {
-            self.factor.solve_many(MatMut::from_column_major_slice_mut(&mut x, n, k));
+            self.factor
+                .solve_many(MatMut::from_column_major_slice_mut(&mut x, n, k));
         }
         Ok(x.chunks_exact(n.max(1))
             .take(k)

@@ -221,10 +221,7 @@ fn right_hand_sides_solved_and_refined_together_are_each_one_s_own() {
             assert!(relative_gap(u, &u1) < 1e-13 && relative_gap(phi, &p1) < 1e-13);
         }
         let k = linalg::CoupledBlocks { a: &a, g: &g, b: &b };
-        let measures: Vec<linalg::Rhs<'_>> = rhs
-            .iter()
-            .map(|(u, phi)| linalg::Rhs { u, phi, scale: 0.0 })
-            .collect();
+        let measures: Vec<linalg::Rhs<'_>> = rhs.iter().map(|(u, phi)| linalg::Rhs { u, phi, scale: 0.0 }).collect();
         // perturbed solutions: each refined back below the tolerance, in at most 3 steps
         let mut xs: Vec<(Vec<f64>, Vec<f64>)> = together
             .iter()

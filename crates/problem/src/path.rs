@@ -731,7 +731,9 @@ impl Walk<'_> {
                     fields: None,
                 })?,
                 None => {
-                    let Some(Some((contact, r))) = fields.next() else { continue };
+                    let Some(Some((contact, r))) = fields.next() else {
+                        continue;
+                    };
                     each(Step {
                         row,
                         mesh,
@@ -1081,8 +1083,8 @@ impl Walk<'_> {
         if self.spec.is_some() {
             reporter.event(&Event::PathStepDone { row: &row, of: self.of });
         }
-        let handed = (&row, state.rows.len());
-        let result = self.hand_on((frames, frame), handed, result, fielded.as_ref().map(|(r, _, _)| r), each)?;
+        let recovered = fielded.as_ref().map(|(r, _, _)| r);
+        let result = self.hand_on((frames, frame), (&row, state.rows.len()), result, recovered, each)?;
         state.rows.push(row);
         Ok(Some(Done {
             result,
