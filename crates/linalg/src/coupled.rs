@@ -239,7 +239,7 @@ impl DirectLdlt {
     ///
     /// # Errors
     /// [`ShapeError::Rhs`] where a right-hand side is not of the blocks' sizes.
-    pub fn solve_many(&mut self, rhs: &[(&[f64], &[f64])]) -> Result<Vec<(Vec<f64>, Vec<f64>)>, LinalgError> {
+    pub fn solve_many(&mut self, rhs: &[UPhiRef<'_>]) -> Result<Vec<UPhi>, LinalgError> {
         let (n, n_u, k) = (self.buf.len(), self.n_u, rhs.len());
         let mut x = vec![0.0; n * k];
         for ((b_u, b_phi), col) in rhs.iter().zip(x.chunks_exact_mut(n.max(1))) {
@@ -283,6 +283,12 @@ impl CoupledSolver for DirectLdlt {
         self.factor.values_bytes()
     }
 }
+
+/// A vector of `[u; φ]` by its blocks, `(u, φ)`.
+pub type UPhi = (Vec<f64>, Vec<f64>);
+
+/// A borrowed vector of `[u; φ]` by its blocks, `(u, φ)`.
+pub type UPhiRef<'a> = (&'a [f64], &'a [f64]);
 
 /// The blocks `A`, `G`, `B` of `K = [[A, Gᵀ], [G, -B]]`.
 #[derive(Clone, Copy)]
@@ -365,7 +371,7 @@ pub fn refine_many(
     solver: &mut DirectLdlt,
     k: CoupledBlocks<'_>,
     rhs: &[Rhs<'_>],
-    xs: &mut [(Vec<f64>, Vec<f64>)],
+    xs: &mut [UPhi],
     tol: f64,
     max_steps: usize,
 ) -> Result<Vec<Refined>, LinalgError> {
@@ -377,7 +383,7 @@ pub fn refine_many(
         .into());
     }
     // the products with `K` one per task, each on one thread
-    let measure = |(u, phi): &(Vec<f64>, Vec<f64>), b: &Rhs<'_>| {
+    let measure = |(u, phi): &UPhi, b: &Rhs<'_>| {
         let mut ru = b.u.to_vec();
         mul_add_seq(k.a.as_ref(), u, &mut ru, -1.0);
         mul_t_add_seq(k.g.as_ref(), phi, &mut ru, -1.0);
@@ -400,7 +406,7 @@ pub fn refine_many(
         if active.is_empty() {
             break;
         }
-        let columns: Vec<(&[f64], &[f64])> = active.iter().map(|&j| (&r[j].u[..], &r[j].phi[..])).collect();
+        let columns: Vec<UPhiRef<'_>> = active.iter().map(|&j| (&r[j].u[..], &r[j].phi[..])).collect();
         let corrections = solver.solve_many(&columns)?;
         let corrected: Vec<_> = active
             .par_iter()

@@ -48,7 +48,7 @@ mod values;
 pub use condense::{CondenseRoute, Condensed, CondensedLoads};
 pub use coupled::{
     equilibrium_residual, refine, refine_by, refine_many, relative_residual, CoupledBlocks, CoupledSolver, DirectLdlt,
-    FactorPreconditioner, Refinable, Refined, Residual, Rhs, SchurOperator, SchurPcg, SolveInfo,
+    FactorPreconditioner, Refinable, Refined, Residual, Rhs, SchurOperator, SchurPcg, SolveInfo, UPhi, UPhiRef,
 };
 pub use dense::{mirror_lower, symmetric_inverse};
 pub use factor::{pool_par, FactorKind, Ordering, SparseFactor, SINGULAR_PIVOT_RATIO};

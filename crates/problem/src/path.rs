@@ -50,6 +50,9 @@ pub struct Step<'a> {
     pub fields: Option<StepFields<'a>>,
 }
 
+/// What a path hands each instant to ([`run_steps`], [`crate::solve_path`]).
+type Each<'a> = dyn FnMut(Step<'_>) -> Result<(), ProblemError> + 'a;
+
 /// The fields of an instant of a path.
 pub struct StepFields<'a> {
     /// Nodal displacements.
@@ -631,7 +634,7 @@ impl Walk<'_> {
         (backend, system, how): (&mut B, &mut B::System, Option<&ContactSolve<'_>>),
         disc: &mut Discretization<'_>,
         state: &mut History,
-        (reporter, each): (&mut dyn Reporter, &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>),
+        (reporter, each): (&mut dyn Reporter, &mut Each<'_>),
     ) -> Result<(), B::Error> {
         let waiting = std::mem::take(&mut frames.waiting);
         let queue = std::mem::take(&mut frames.queue);
@@ -1004,7 +1007,7 @@ impl Walk<'_> {
         state: &mut History,
         disc: &Discretization<'_>,
         stepped: Stepped,
-        (reporter, each): (&mut dyn Reporter, &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>),
+        (reporter, each): (&mut dyn Reporter, &mut Each<'_>),
         (frames, deferred): (&mut Frames, bool),
     ) -> Result<Option<Done>, ProblemError> {
         let Stepped {
