@@ -26,7 +26,7 @@ use std::time::Instant;
 /// traction, gap and flux), and the cell data (stress, strain, D, E) where the scene asks for
 /// it (`path.cell_fields`); its arrays are zlib-compressed, the mesh's compressed once for all
 /// steps. Each step is encoded on its own thread while the path goes on, at most
-/// [`ENCODING`] at a time (the written instants of a path come several together: their fields
+/// four at a time (the written instants of a path come several together: their fields
 /// are solved together), and written in order.
 pub struct PathFiles {
     series: Vec<(f64, String)>,
@@ -61,7 +61,7 @@ impl PathFiles {
 
     /// Starts one instant's `step-NNNN.vtu` (written by a later step or by
     /// [`PathFiles::finish`]), after writing the oldest being encoded into the set where
-    /// [`ENCODING`] are.
+    /// four are.
     ///
     /// # Errors
     /// [`Error::Output`] where a step before cannot be written.

@@ -316,7 +316,7 @@ impl Instants {
     /// [`crate::backend::Backend::frames_fields`]: the fields of several instants, each under
     /// its loads and the forces (and, with electrical contact, the flux) of its contact solve,
     /// solved together ([`Factorization::solve_many`]), each refined where a direct solve
-    /// missed ([`PATH_REFINE_TOL`]), with its equilibrium residual. Nothing the instants keep
+    /// missed (an equilibrium residual above 1e-12), with its equilibrium residual. Nothing the instants keep
     /// is read or changed: the path has gone on from these instants.
     ///
     /// # Errors
