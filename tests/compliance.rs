@@ -388,6 +388,28 @@ fn a_path_of_a_body_only_its_bed_holds_meets_the_closed_form_at_each_instant() {
         })
         .unwrap_or_else(|e| panic!("{dim}D: {e}"));
         assert_eq!(rows.len(), 5);
+        // every instant written: its fields (under the springs' forces too, solved with the
+        // others after the path went on) in equilibrium, its contact the same
+        let mut written = 0;
+        let with_fields = problem::solve_path(&s, None, problem::Limits::default(), &mut Silent, true, &mut |step| {
+            written += usize::from(step.fields.is_some());
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{dim}D with fields: {e}"));
+        assert_eq!(written, 5);
+        let (plain, fielded) = (
+            path.last.report.path.as_ref().unwrap(),
+            with_fields.last.report.path.as_ref().unwrap(),
+        );
+        for (a, b) in plain.rows.iter().zip(&fielded.rows) {
+            assert_eq!(a.normal_force, b.normal_force, "{dim}D t = {}", a.t);
+            assert!(
+                b.equilibrium.is_some_and(|e| e < 1e-9),
+                "{dim}D t = {}: {:?}",
+                b.t,
+                b.equilibrium
+            );
+        }
         for (t, lambda, u_n) in &rows {
             let e_pressure = lambda.iter().map(|l| (l - t * q).abs() / q).fold(0.0, f64::max);
             let e_penetration = u_n.iter().map(|u| (u - t * q / k).abs() / DELTA).fold(0.0, f64::max);
