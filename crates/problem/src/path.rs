@@ -636,18 +636,20 @@ impl Walk<'_> {
         state: &mut History,
         (reporter, each): (&mut dyn Reporter, &mut Each<'_>),
     ) -> Result<(), B::Error> {
-        let waiting = std::mem::take(&mut frames.waiting);
+        let mut waiting = std::mem::take(&mut frames.waiting);
         let queue = std::mem::take(&mut frames.queue);
         let mut fields = vec![];
         if let (Some(how), false) = (how, waiting.is_empty()) {
-            let posed: Vec<_> = waiting
-                .iter()
-                .map(|w| {
+            let loads: Vec<Loads> = waiting.iter_mut().map(|w| std::mem::take(&mut w.loads)).collect();
+            let posed: Vec<_> = loads
+                .into_iter()
+                .zip(&waiting)
+                .map(|(loads, w)| {
                     let posed = Posed {
                         scene: self.valid,
                         setup: self.setup,
                         disc,
-                        loads: w.loads.clone(),
+                        loads,
                         bed: None,
                     };
                     let framed = Framed {
