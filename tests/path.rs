@@ -510,5 +510,18 @@ fn a_path_s_steps_are_compressed_series_with_cell_fields_on_request() {
         }
         let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
         assert!(json["timings_s"]["output"].as_f64().unwrap() > 0.0);
+        // the plan's size of a step file bounds each one written, within a factor ten
+        let problem::Event::PathPlan { step_bytes, .. } =
+            problem::Event::path_plan((5, 5), &solution.mesh, 3, (false, cells))
+        else {
+            unreachable!()
+        };
+        for k in 0..=4 {
+            let bytes = std::fs::metadata(out.join(format!("step-{k:04}.vtu"))).unwrap().len() as f64;
+            assert!(
+                bytes <= step_bytes && bytes >= step_bytes / 10.0,
+                "step {k}: {bytes} of {step_bytes}"
+            );
+        }
     }
 }

@@ -170,6 +170,19 @@ pub(crate) fn walk<B: Backend>(
     let assembled = backend.assemble(&posed)?;
     let t_assembly = t.elapsed().as_secs_f64();
     reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
+    if let (Some(spec), true, Some(b)) = (walk.spec, with_fields, boundary.as_ref()) {
+        let written = (0..instants.len())
+            .filter(|&k| spec.has_fields(k, instants.len()))
+            .count();
+        let flux = b.electric.is_some();
+        let counts = (instants.len(), written);
+        reporter.event(&Event::path_plan(
+            counts,
+            &setup.mesh,
+            disc.nv(),
+            (flux, spec.cell_fields),
+        ));
+    }
     stop_if_interrupted(&limits, "assembly")?;
     let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
     stop_if_interrupted(&limits, "factorisation")?;

@@ -48,6 +48,17 @@ pub enum Event<'a> {
         /// The factorisation's progress.
         watch: FactorWatch,
     },
+    /// A path's plan: its instants, the ones whose fields it writes (`step-NNNN.vtu`), and what
+    /// one such file holds before compression.
+    PathPlan {
+        /// Instants.
+        instants: usize,
+        /// Instants written.
+        written: usize,
+        /// Bytes of one written instant's arrays before compression: the mesh's, the nodal
+        /// fields' and the contact's, the cells' fields where the path asks for them.
+        step_bytes: f64,
+    },
     /// The linear solver is factored.
     Factored {
         /// Wall time (s).
@@ -132,7 +143,42 @@ pub enum Event<'a> {
     },
 }
 
+/// `bytes` in kB, MB or GB (powers of 1000), three figures.
+fn in_bytes(bytes: f64) -> String {
+    let (value, unit) = match bytes {
+        b if b >= 1e9 => (b / 1e9, "GB"),
+        b if b >= 1e6 => (b / 1e6, "MB"),
+        b => (b / 1e3, "kB"),
+    };
+    format!("{value:.3} {unit}")
+}
+
 impl Event<'_> {
+    /// A path's plan ([`Event::PathPlan`]) on `mesh`: each written instant's file holds the
+    /// mesh (its points, each cell's nodes, offset and type), the nodal `u`, `φ` and the
+    /// contact's status, pressure, traction (3 components), gap and, with electrical contact,
+    /// flux; with `cells`, the stress and strain (`nv` components each) and `D`, `E`.
+    pub fn path_plan(
+        (instants, written): (usize, usize),
+        mesh: &mesh::Mesh,
+        nv: usize,
+        (flux, cells): (bool, bool),
+    ) -> Self {
+        let (n, c) = (mesh.n_nodes() as f64, mesh.n_cells() as f64);
+        let per_node = 3.0 + 4.0 + 6.0 + if flux { 1.0 } else { 0.0 };
+        let per_cell = (mesh.kind.n_nodes() + 1) as f64 * 8.0 + 1.0;
+        let fields = if cells {
+            (2 * nv + 2 * mesh.dim) as f64 * 8.0
+        } else {
+            0.0
+        };
+        Event::PathPlan {
+            instants,
+            written,
+            step_bytes: 8.0 * per_node * n + (per_cell + fields) * c,
+        }
+    }
+
     /// The event that ends assembly: the mesh's and the dofs' sizes, and the time taken.
     pub fn assembled(mesh: &mesh::Mesh, dofs: &fe_assembly::DofMap, seconds: f64) -> Self {
         Event::Assembled {
@@ -198,6 +244,16 @@ impl fmt::Display for Event<'_> {
             } => write!(
                 f,
                 "mesh: {n_nodes} nodes, {n_cells} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
+            ),
+            Event::PathPlan {
+                instants,
+                written,
+                step_bytes,
+            } => write!(
+                f,
+                "path: {instants} instants, {written} written (step-NNNN.vtu): at most {} before compression, {} each (compressed: about a sixth to a half)",
+                in_bytes(*step_bytes * *written as f64),
+                in_bytes(*step_bytes)
             ),
             Event::Factoring { .. } => write!(f, "factorisation begins"),
             Event::Factored { seconds } => write!(f, "factorisation {seconds:.3} s"),
