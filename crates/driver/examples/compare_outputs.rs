@@ -1,7 +1,8 @@
 //! Compares the outputs of two sets of runs, directory by directory: `run.json` (every number
 //! and string, but the timings, the factorisation's rate and the peak memory, which differ from
 //! run to run), `contact.csv` and `solution.vtu` (every number), and which files each directory
-//! holds. Numbers agree when
+//! holds; the `.vtu` files' binary arrays (`format="binary"`: base64 of an 8-byte count, then
+//! the values) are decoded and compared as numbers. Numbers agree when
 //! `|a - b| <= tol max(|a|, |b|, floor)`, with `floor` the largest magnitude of the same file's
 //! numbers times 1e-12 (round-off of a sum).
 //!
@@ -11,6 +12,7 @@
 //!
 //!   cargo run --release -p driver --example compare_outputs -- BEFORE AFTER [--tol 1e-9]
 
+use base64::Engine;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -39,6 +41,51 @@ fn flatten(prefix: &str, v: &Value, out: &mut BTreeMap<String, Value>) {
             out.insert(prefix.to_string(), v.clone());
         }
     }
+}
+
+/// `text` with each binary `<DataArray>`'s base64 written out as its values (`Float64`,
+/// `Float32`, `Int32`, `Int64`, `UInt8`, `UInt32`, `UInt64`), one token each; an array that
+/// does not decode is left as it is (its bytes then compared as a word).
+fn decoded(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find("<DataArray") {
+        let Some(open_end) = rest[at..].find('>').map(|e| at + e + 1) else {
+            break;
+        };
+        let Some(close) = rest[open_end..].find("</DataArray>").map(|e| open_end + e) else {
+            break;
+        };
+        let tag = &rest[at..open_end];
+        out.push_str(&rest[..open_end]);
+        let body = rest[open_end..close].trim();
+        match (tag.contains("format=\"binary\""), values(tag, body)) {
+            (true, Some(v)) => out.push_str(&v),
+            _ => out.push_str(&rest[open_end..close]),
+        }
+        rest = &rest[close..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The values of a binary array's base64 `body`, by the `type` of its `tag`.
+fn values(tag: &str, body: &str) -> Option<String> {
+    let kind = tag.split("type=\"").nth(1)?.split('"').next()?;
+    let bytes = base64::engine::general_purpose::STANDARD.decode(body).ok()?;
+    let data = bytes.get(8..)?;
+    let of =
+        |w: usize, f: &dyn Fn(&[u8]) -> String| -> String { data.chunks_exact(w).map(f).collect::<Vec<_>>().join(" ") };
+    Some(match kind {
+        "Float64" => of(8, &|c| f64::from_le_bytes(c.try_into().unwrap()).to_string()),
+        "Float32" => of(4, &|c| f32::from_le_bytes(c.try_into().unwrap()).to_string()),
+        "Int64" => of(8, &|c| i64::from_le_bytes(c.try_into().unwrap()).to_string()),
+        "UInt64" => of(8, &|c| u64::from_le_bytes(c.try_into().unwrap()).to_string()),
+        "Int32" => of(4, &|c| i32::from_le_bytes(c.try_into().unwrap()).to_string()),
+        "UInt32" => of(4, &|c| u32::from_le_bytes(c.try_into().unwrap()).to_string()),
+        "UInt8" => of(1, &|c| c[0].to_string()),
+        _ => return None,
+    })
 }
 
 fn tokens(text: &str) -> impl Iterator<Item = &str> {
@@ -171,7 +218,7 @@ fn main() {
             if !a.join(name).exists() {
                 return "-".into();
             }
-            let (ta, tb) = (read(&a.join(name)), read(&b.join(name)));
+            let (ta, tb) = (decoded(&read(&a.join(name))), decoded(&read(&b.join(name))));
             let (w, same_len) = compare_numbers(&numbers(&ta), &numbers(&tb));
             if !same_len || w > tol {
                 problems.push(format!(
