@@ -1001,3 +1001,90 @@ fn a_conducting_tip_along_a_depth_path_meets_the_half_space_at_every_depth() {
     let reported = solved.report.indenter.as_ref().unwrap().half_space.as_ref().unwrap();
     assert!((reported.force - last.force).abs() <= 1e-12 * last.force);
 }
+
+/// `indent-sphere-3d` at `sets`: the static run (its contact problem narrowed to the points
+/// that can touch, where it is) and the same scene as a path of one step from zero, which
+/// keeps every point; with the lines the static run printed.
+fn narrowed_and_whole(sets: &[&str]) -> (problem::Solution, problem::Solution, Vec<String>) {
+    let mut sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let (scene, _) = files::scene_file::load("indent-sphere-3d", &sets).unwrap();
+    let mut lines = vec![];
+    let narrowed = problem::solve(&scene, None, &mut problem::Lines(|l: &str| lines.push(l.to_string()))).unwrap();
+    sets.extend(
+        [
+            "path.t=[0.0,1.0]",
+            "path.steps=1",
+            "path.gap=[0.0,1.0]",
+            "path.displacement=[0.0,1.0]",
+        ]
+        .map(String::from),
+    );
+    let (scene, _) = files::scene_file::load("indent-sphere-3d", &sets).unwrap();
+    let whole = problem::solve(&scene, None, &mut Silent).unwrap();
+    (narrowed, whole, lines)
+}
+
+/// The largest difference of `a` and `b`, relative to the largest of `b`.
+fn relative_gap(a: impl Iterator<Item = f64>, b: impl Iterator<Item = f64> + Clone) -> f64 {
+    let scale = b.clone().fold(0.0_f64, |m, x| m.max(x.abs()));
+    a.zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs())) / scale
+}
+
+/// Both runs of [`narrowed_and_whole`] agree: the multipliers and status of every point, the
+/// displacement and the potential of every node.
+fn assert_same_answer(narrowed: &problem::Solution, whole: &problem::Solution) {
+    let (a, b) = (narrowed.contact.as_ref().unwrap(), whole.contact.as_ref().unwrap());
+    assert_eq!(a.nodes, b.nodes, "the same points, in the same order");
+    assert_eq!(a.solution.status, b.solution.status);
+    let (la, lb) = (&a.solution.lambda, &b.solution.lambda);
+    let lambda = relative_gap(
+        la.normal.iter().chain(&la.tangential).copied(),
+        lb.normal.iter().chain(&lb.tangential).copied(),
+    );
+    assert!(lambda < 1e-9, "multipliers {lambda:.2e} apart");
+    let u = relative_gap(narrowed.u.iter().flatten().copied(), whole.u.iter().flatten().copied());
+    let phi = relative_gap(narrowed.phi.iter().copied(), whole.phi.iter().copied());
+    assert!(u < 1e-10 && phi < 1e-10, "u {u:.2e}, phi {phi:.2e} apart");
+    let gap = relative_gap(
+        a.displacement.normal.iter().copied(),
+        b.displacement.normal.iter().copied(),
+    );
+    assert!(gap < 1e-10, "the points' normal displacement {gap:.2e} apart");
+}
+
+#[test]
+fn an_indenter_condenses_only_the_points_that_can_touch() {
+    for law in [
+        &["mesh.n=8"][..],
+        &["mesh.n=8", "contact.law=\"coulomb\"", "contact.friction=0.4"],
+    ] {
+        let (narrowed, whole, lines) = narrowed_and_whole(law);
+        let line = lines.iter().find(|l| l.contains("points can touch")).expect("narrowed");
+        assert!(line.starts_with("contact: 9 of 81 points"), "{line}");
+        assert!(!lines.iter().any(|l| l.contains("solving again")), "{lines:?}");
+        let contact = narrowed.contact.as_ref().unwrap();
+        let (_, _, separated) = contact.solution.counts();
+        assert!(separated > 70, "{separated} open of 81");
+        assert_same_answer(&narrowed, &whole);
+    }
+    // Tresca's bound acts on the open points too: every point is kept
+    let (narrowed, whole, lines) =
+        narrowed_and_whole(&["mesh.n=8", "contact.law=\"tresca\"", "contact.slip_bound=0.05"]);
+    assert!(!lines.iter().any(|l| l.contains("can touch")), "{lines:?}");
+    assert_same_answer(&narrowed, &whole);
+}
+
+#[test]
+fn points_left_out_that_would_touch_are_solved_again_with_all() {
+    // the clamped top pushed 0.5 towards the indenter (its depth 0.01): the face comes down
+    // onto the sphere far beyond the points within 3 depths of its tip
+    let (narrowed, whole, lines) = narrowed_and_whole(&["mesh.n=8", "dirichlet.0.u=[0.0,0.0,-0.5]"]);
+    let again = lines
+        .iter()
+        .find(|l| l.contains("solving again"))
+        .expect("a second run");
+    assert!(again.starts_with("contact: 26 points left out"), "{again}");
+    let (stick, slip, _) = narrowed.contact.as_ref().unwrap().solution.counts();
+    assert!(stick + slip > 9, "{} in contact", stick + slip);
+    assert_same_answer(&narrowed, &whole);
+}

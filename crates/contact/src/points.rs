@@ -213,6 +213,35 @@ impl ContactPoints {
         }
     }
 
+    /// The points `keep` (indices, in the order given) as points of their own: every
+    /// per-point array taken at them, the per-point arrays left empty where they were.
+    ///
+    /// # Panics
+    /// Where an index of `keep` is not a point's.
+    pub fn select(&self, keep: &[usize]) -> ContactPoints {
+        fn at<T: Clone>(v: &[T], keep: &[usize]) -> Vec<T> {
+            if v.is_empty() {
+                return vec![];
+            }
+            keep.iter().map(|&i| v[i].clone()).collect()
+        }
+        ContactPoints {
+            dim: self.dim,
+            position: at(&self.position, keep),
+            normal: at(&self.normal, keep),
+            tangent: at(&self.tangent, keep),
+            weight: at(&self.weight, keep),
+            gap: at(&self.gap, keep),
+            friction: at(&self.friction, keep),
+            held: at(&self.held, keep),
+            foundation: self.foundation,
+            foundations: at(&self.foundations, keep),
+            slipped: at(&self.slipped, keep),
+            weakening: at(&self.weakening, keep),
+            tresca: at(&self.tresca, keep),
+        }
+    }
+
     /// Tangential components per point.
     pub fn n_tangential(&self) -> usize {
         self.dim - 1
@@ -401,6 +430,22 @@ impl PointValues {
     /// The tangential components of point `i`, to change.
     pub fn tangential_of_mut(&mut self, i: usize) -> &mut [f64] {
         &mut self.tangential[i * self.nt..(i + 1) * self.nt]
+    }
+
+    /// These values (of `keep.len()` points) as values of `n` points, point `j` at `keep[j]`
+    /// and zeros elsewhere: the inverse of [`ContactPoints::select`]'s choice.
+    ///
+    /// # Panics
+    /// Where `keep` does not have one index per point, or an index is `n` or more.
+    pub fn spread(&self, keep: &[usize], n: usize) -> PointValues {
+        assert_eq!(keep.len(), self.normal.len(), "one index per point");
+        let nt = self.nt;
+        let mut out = PointValues::zeros(n, nt);
+        for (j, &i) in keep.iter().enumerate() {
+            out.normal[i] = self.normal[j];
+            out.tangential_of_mut(i).copy_from_slice(self.tangential_of(j));
+        }
+        out
     }
 
     /// The Euclidean norm of the tangential components of point `i`.

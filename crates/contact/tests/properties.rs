@@ -1344,3 +1344,44 @@ fn tight_weakening() -> contact::WeakeningParams {
         ..Default::default()
     }
 }
+
+proptest! {
+    /// Points that a solution leaves open can be left out of the problem
+    /// (`ContactPoints::select`, and the compliance's rows and columns of the rest): its
+    /// solution, spread back to every point (`PointValues::spread`), is the whole problem's.
+    /// What a run that condenses only the points an indenter can touch rests on.
+    #[test]
+    fn points_left_open_can_be_left_out(n in 2usize..=6, dim in 2usize..=3, seed in prop::collection::vec(-1.0f64..1.0, 60), w in prop::collection::vec(-1.0f64..1.0, 6), load in prop::collection::vec(-1.0f64..1.0, 18), mask in 0u32..64, f in 0.0f64..0.2) {
+        // Signorini, or Coulomb's law with a small coefficient (one solution); not Tresca's,
+        // whose bound holds the slip of an open point too
+        let pts = points(n, dim, &w, f);
+        let (law, nt) = if f < 0.05 { (Law::Frictionless, 0) } else { (Law::Coulomb, dim - 1) };
+        let params = NewtonParams { tol: 1e-13, schedule: Schedule::all().without(Phase::Fallback), ..Default::default() };
+        let mut whole = problem(n, nt, &pts, &seed, &load);
+        let all = solve_newton(&mut whole, &pts, &law, &params, None, &mut |_| {}).unwrap();
+        // the points in contact, and some of the open ones
+        let keep: Vec<usize> = (0..n).filter(|&i| all.lambda.normal[i] > 0.0 || mask & (1 << i) != 0).collect();
+        prop_assume!(!keep.is_empty() && keep.len() < n);
+        let sub_pts = pts.select(&keep);
+        let rows: Vec<usize> = keep.iter().copied()
+            .chain(keep.iter().flat_map(|&i| (0..nt).map(move |q| n + i * nt + q)))
+            .collect();
+        let m = whole.compliance.len().isqrt();
+        let u0: Vec<f64> = rows.iter().map(|&r| if r < n { whole.u0.normal[r] } else { whole.u0.tangential[r - n] }).collect();
+        let k = keep.len();
+        let mut part = DenseContactProblem {
+            u0: PointValues::from_parts(u0[..k].to_vec(), u0[k..].to_vec(), nt).unwrap(),
+            compliance: rows.iter().flat_map(|&r| rows.iter().map(move |&c| (r, c))).map(|(r, c)| whole.compliance[r * m + c]).collect(),
+            weight: sub_pts.weight.clone(),
+            nt,
+        };
+        let some = solve_newton(&mut part, &sub_pts, &law, &params, None, &mut |_| {}).unwrap();
+        let spread = some.lambda.spread(&keep, n);
+        let scale = all.lambda.norm().max(whole.u0.norm());
+        let d = spread.minus(&all.lambda).norm();
+        prop_assert!(d <= 1e-9 * scale.max(1e-12), "difference {d} (scale {scale})");
+        for (j, &i) in keep.iter().enumerate() {
+            prop_assert_eq!(sub_pts.weight[j], pts.weight[i]);
+        }
+    }
+}

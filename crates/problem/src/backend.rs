@@ -104,6 +104,13 @@ pub trait Backend {
     /// says whether it met them.
     const HELD_TO_TOLERANCE: bool;
 
+    /// Whether a static run's contact problem may hold only the points that can touch (an
+    /// indenter's zone, `crate::reach`): the last instant's fields on this one process check
+    /// the points left out, and where one would touch the run is done again with every point.
+    /// A backend on several processes, whose ranks would have to agree on the second run,
+    /// keeps every point.
+    const NARROWS_CONTACT: bool = false;
+
     /// Whether this backend solves the (valid) scene: its `solver.backend`, and every law,
     /// condition and process it asks for. Called before anything is built. What a backend
     /// lacks lives here, not in the scene's validation, which knows no backend.

@@ -406,6 +406,54 @@ impl ContactBoundary {
         b
     }
 
+    /// The points `keep` (indices, in order) as a boundary of their own, their free
+    /// displacement dofs alone condensed (in the order the points first name them); what the
+    /// group's Dirichlet conditions hold is counted as before. `None` with electrical contact,
+    /// whose potentials this does not select.
+    ///
+    /// # Panics
+    /// Where an index of `keep` is not a point's.
+    pub fn select(&self, keep: &[usize]) -> Option<ContactBoundary> {
+        if self.electric.is_some() {
+            return None;
+        }
+        let dim = self.points.dim;
+        let mut place = vec![usize::MAX; self.dofs.len()];
+        let (mut dofs, mut slots) = (vec![], Vec::with_capacity(keep.len() * dim));
+        for &i in keep {
+            for slot in &self.slots[i * dim..(i + 1) * dim] {
+                slots.push(match *slot {
+                    Slot::Free(j) => {
+                        if place[j] == usize::MAX {
+                            place[j] = dofs.len();
+                            dofs.push(self.dofs[j]);
+                        }
+                        Slot::Free(place[j])
+                    }
+                    fixed @ Slot::Fixed(_) => fixed,
+                });
+            }
+        }
+        Some(ContactBoundary {
+            points: self.points.select(keep),
+            nodes: keep.iter().map(|&i| self.nodes[i]).collect(),
+            dofs,
+            slots,
+            held_nodes: self.held_nodes,
+            held_inside: self.held_inside,
+            electric: None,
+            group_of: keep.iter().map(|&i| self.group_of[i]).collect(),
+            groups: self.groups.clone(),
+            uniform: keep.iter().map(|&i| self.uniform[i]).collect(),
+        })
+    }
+
+    /// The part of point `i`'s gap that is no uniform offset: an indenter's profile above its
+    /// tip there (or a curved body's parabola), `0` on a flat face.
+    pub fn profile_height(&self, i: usize) -> f64 {
+        self.points.gap[i] - self.uniform[i]
+    }
+
     /// The dofs the condensation puts last: the points' free displacements, then (electrical
     /// contact) their free potentials.
     pub fn condensed_dofs(&self) -> Vec<usize> {

@@ -71,6 +71,7 @@ mod outer;
 mod path;
 mod plan;
 mod progress;
+mod reach;
 pub mod report;
 mod run;
 mod scene;

@@ -24,6 +24,7 @@ use crate::backend::{
 };
 use crate::boundary::ContactBoundary;
 use crate::progress::{Event, Reporter};
+use crate::reach::{Beyond, Reach};
 use crate::report::{Iterations, PathReport, RunReport, StepRow, Timings};
 use crate::run::{
     begin, check_accurate, check_solved, closed_form, contact_boundary, contact_result, indenter_report, pose, recover,
@@ -35,6 +36,7 @@ use crate::ProblemError;
 use crate::Solution;
 use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization, RhsParts};
+use std::cell::Cell;
 use std::time::Instant;
 
 /// One instant of a path, as its step hands it to the caller: the step's row, its contact
@@ -139,6 +141,88 @@ pub(crate) fn walk<B: Backend>(
     let setup = begin(valid, mesh, backend.estimate(&valid), &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
+    let mut points = Points::ThatCanTouch;
+    let walked = loop {
+        let on = SetUp {
+            valid,
+            setup: &setup,
+            limits,
+            with_fields,
+            times: (t_total, t_setup),
+            points,
+        };
+        match walk_set_up(backend, on, reporter, each)? {
+            Walked::Done(done) => break done,
+            Walked::Beyond { beyond, of } => {
+                reporter.event(&Event::BeyondReach {
+                    points: beyond.points,
+                    of,
+                });
+                points = Points::All;
+            }
+        }
+    };
+    let Some(done) = walked else {
+        // a process that does not hold the gathered fields
+        return Ok(None);
+    };
+    let (report, result, recovered) = *done;
+    Ok(Some(Solution {
+        report,
+        contact: result,
+        mesh: setup.mesh,
+        u: recovered.u,
+        phi: recovered.phi,
+        fields: recovered.fields,
+    }))
+}
+
+/// Which contact points a run's contact problem holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Points {
+    /// Those that can touch ([`Reach`]), where the backend, the run and its zones allow.
+    ThatCanTouch,
+    /// Every point of the contact groups: the second walk, after the first left out points
+    /// that touch (its notes said once).
+    All,
+}
+
+/// A run set up: its scene, set-up and limits, and how it is walked.
+struct SetUp<'a> {
+    valid: crate::Valid<'a>,
+    setup: &'a Setup,
+    limits: Limits,
+    with_fields: bool,
+    /// The run's start, and the seconds of its set-up.
+    times: (Instant, f64),
+    points: Points,
+}
+
+/// A walk of a set-up run: its report, contact result and fields (`None` on a process that
+/// does not hold them); or points its contact problem left out that would touch.
+enum Walked {
+    Done(Option<Box<(RunReport, Option<ContactResult>, Recovered)>>),
+    Beyond { beyond: Beyond, of: usize },
+}
+
+/// [`walk`] from the set-up on: discretise, assemble, build the contact boundary (narrowed to
+/// the points that can touch where `on.points` asks and [`Reach`] finds them), prepare, then
+/// each instant.
+fn walk_set_up<B: Backend>(
+    backend: &mut B,
+    on: SetUp<'_>,
+    reporter: &mut dyn Reporter,
+    each: &mut dyn FnMut(Step<'_>) -> Result<(), ProblemError>,
+) -> Result<Walked, B::Error> {
+    let SetUp {
+        valid,
+        setup,
+        limits,
+        with_fields,
+        times: (t_total, t_setup),
+        points,
+    } = on;
+    let scene: &Scene = valid.scene();
     let t = Instant::now();
     let mut disc = setup.discretize().map_err(ProblemError::from)?;
     let instants = scene.path.as_ref().map_or_else(|| vec![1.0], PathSpec::instants);
@@ -149,7 +233,7 @@ pub(crate) fn walk<B: Backend>(
     let mut walk = Walk {
         scene,
         valid,
-        setup: &setup,
+        setup,
         spec: scene.path.as_ref(),
         parts: parts.as_ref(),
         prescribed: disc.dofs.prescribed(),
@@ -162,11 +246,21 @@ pub(crate) fn walk<B: Backend>(
         bed: None,
         held_to_tolerance: B::HELD_TO_TOLERANCE,
         of: instants.len() - 1,
+        reach: None,
+        beyond: Cell::new(None),
     };
     let mut posed = walk.first_posed(&disc, instants[0])?;
-    let boundary = contact_boundary(&posed, reporter)?;
+    // a second walk with every point (the first left out some that touch) said its notes
+    let boundary = match points {
+        Points::ThatCanTouch => contact_boundary(&posed, reporter)?,
+        Points::All => contact_boundary(&posed, &mut crate::Silent)?,
+    };
     walk.every_fields = boundary.as_ref().is_some_and(|b| b.electric.is_some());
     posed.bed = walk.bed(&posed, &instants, boundary.as_ref())?;
+    let boundary = match boundary {
+        Some(b) if points == Points::ThatCanTouch && B::NARROWS_CONTACT => Some(walk.narrowed(b, &posed, reporter)),
+        b => b,
+    };
     let assembled = backend.assemble(&posed)?;
     let t_assembly = t.elapsed().as_secs_f64();
     reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
@@ -217,25 +311,24 @@ pub(crate) fn walk<B: Backend>(
     };
     let figures = walk.all_steps(prepared, &mut disc, &instants, &mut state, reporter, each)?;
     let steps_s = t_steps.elapsed().as_secs_f64();
+    if let (Some(beyond), Some(reach)) = (walk.beyond.get(), &walk.reach) {
+        return Ok(Walked::Beyond {
+            beyond,
+            of: reach.counts().1,
+        });
+    }
     let Some(mut last) = state.last.take() else {
         // a process that does not hold the gathered fields
-        return Ok(None);
+        return Ok(Walked::Done(None));
     };
     let Some((recovered, equilibrium, loads)) = last.fields.take() else {
-        return Ok(None);
+        return Ok(Walked::Done(None));
     };
     let timings = (t_setup, t_assembly, steps_s, t_total);
     let last = (last, recovered, equilibrium, loads);
-    let (report, result, recovered) = walk.finish(&disc, figures, state, last, timings);
-    drop(disc);
-    Ok(Some(Solution {
-        report,
-        contact: result,
-        mesh: setup.mesh,
-        u: recovered.u,
-        phi: recovered.phi,
-        fields: recovered.fields,
-    }))
+    Ok(Walked::Done(Some(Box::new(
+        walk.finish(&disc, figures, state, last, timings),
+    ))))
 }
 
 /// The backend with its prepared system, the contact boundary and its solve: what the
@@ -292,6 +385,12 @@ struct Walk<'a> {
     held_to_tolerance: bool,
     /// The last instant's index.
     of: usize,
+    /// Where the contact problem holds only the points that can touch: the whole boundary,
+    /// which each instant's solution is widened to.
+    reach: Option<Reach>,
+    /// Points left out of the contact problem that the fields found touching: the walk is
+    /// done again with every point.
+    beyond: Cell<Option<Beyond>>,
 }
 
 /// An instant's collective steps done ([`Walk::solve_step`]): its factors and boundary, the
@@ -1037,6 +1136,9 @@ impl Walk<'_> {
             springs,
             seconds,
         } = stepped;
+        let Some((boundary, fields)) = self.widened(boundary, fields, state) else {
+            return Ok(None);
+        };
         let Some((sol, fielded, pcg_iters)) =
             self.checked((boundary.as_ref(), &f), disc, (sol, fields), &springs, reporter)?
         else {
@@ -1186,6 +1288,60 @@ impl Walk<'_> {
         }))
     }
 
+    /// The boundary of a static run's contact problem narrowed to the points that can touch
+    /// ([`Reach`]), where its plan condenses them and no bed needs the whole (the report says
+    /// how many it holds); `whole` itself elsewhere, and for a path, whose instants' fields
+    /// (which check the points left out) are not all computed.
+    fn narrowed(&mut self, whole: ContactBoundary, posed: &Posed<'_>, reporter: &mut dyn Reporter) -> ContactBoundary {
+        if self.spec.is_some() || posed.bed.is_some() || !posed.plan().linear_strategy.is_condensed() {
+            return whole;
+        }
+        let Some((reach, part)) = Reach::of(&whole, &posed.scene.zones()) else {
+            return whole;
+        };
+        let (kept, of) = reach.counts();
+        reporter.event(&Event::Reach {
+            kept,
+            of,
+            depths: crate::reach::REACH,
+        });
+        self.reach = Some(reach);
+        part
+    }
+
+    /// An instant's boundary and fields on the whole boundary where the contact problem held
+    /// only the points that can touch: its solution widened to every point ([`Reach::widen`]).
+    /// Friction's history (its frame and slips, the static run's zeros) widened with it.
+    /// `None` where a point left out would touch ([`Walk::beyond`] says how many).
+    #[allow(clippy::type_complexity)]
+    fn widened(
+        &self,
+        boundary: Option<ContactBoundary>,
+        fields: Option<Option<InstantSolution>>,
+        state: &mut History,
+    ) -> Option<(Option<ContactBoundary>, Option<Option<InstantSolution>>)> {
+        let Some(reach) = &self.reach else {
+            return Some((boundary, fields));
+        };
+        let Some(Some(mut x)) = fields else {
+            return Some((boundary, fields));
+        };
+        let Some(sol) = x.contact.take() else {
+            return Some((boundary, Some(Some(x))));
+        };
+        match reach.widen(sol, &x.x.0) {
+            Ok((whole, sol)) => {
+                x.contact = Some(sol);
+                (state.shift, state.slipped) = (reach.spread(&state.shift), reach.spread_each(&state.slipped));
+                Some((Some(whole), Some(Some(x))))
+            }
+            Err(beyond) => {
+                self.beyond.set(Some(beyond));
+                None
+            }
+        }
+    }
+
     /// An indenter's figures in the step's row: its depth, contact radius, a conducting tip's
     /// charge, and the half-space's closed form beside them at the step's factors `f`.
     fn indenter_row(&self, row: &mut StepRow, (boundary, sol): (&ContactBoundary, &ContactSolution), f: &Factors) {
@@ -1260,6 +1416,7 @@ impl Walk<'_> {
             bed_steps: done.iterations.bed,
         };
         let mut report: RunReport = report(&posed, measured, &recovered);
+        report.solver.condensed_points = self.reach.as_ref().map(|r| r.counts().0);
         if path {
             // the path's iterations are its steps' summed
             report.iterations = state.iterations;

@@ -64,6 +64,23 @@ pub enum Event<'a> {
         /// Wall time (s).
         seconds: f64,
     },
+    /// A static run's contact problem holds only the points that can touch: those whose
+    /// indenter's profile lies within `depths` depths of its tip (`crate::reach`).
+    Reach {
+        /// The points it holds.
+        kept: usize,
+        /// The points of the contact groups.
+        of: usize,
+        /// How many depths above the tip.
+        depths: f64,
+    },
+    /// Points the contact problem left out would touch: the run is done again with all `of`.
+    BeyondReach {
+        /// How many.
+        points: usize,
+        /// The points of the contact groups.
+        of: usize,
+    },
     /// The contact compliance is formed.
     Condensed {
         /// Its size, `m x m`.
@@ -270,6 +287,14 @@ impl fmt::Display for Event<'_> {
             Event::BedStep { step, change, settled } => write!(
                 f,
                 "the bed's springs, step {step}: their forces changed by {change:.3e} of the loads (settled below {settled:.0e})"
+            ),
+            Event::Reach { kept, of, depths } => write!(
+                f,
+                "contact: {kept} of {of} points can touch (the indenter's profile within {depths} depths of its tip); the rest are checked open after the solve"
+            ),
+            Event::BeyondReach { points, of } => write!(
+                f,
+                "contact: {points} points left out of the contact problem would touch: solving again with all {of}"
             ),
             Event::Condensed { m, route, seconds } => write!(
                 f,

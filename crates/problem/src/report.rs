@@ -670,6 +670,11 @@ pub struct SolverReport {
     pub fixed_point_relaxations: usize,
     /// How the contact compliance was formed (condensed strategies).
     pub condense_route: Option<String>,
+    /// The contact points the contact problem held where it held only those an indenter can
+    /// touch (the rest checked open after the solve; docs/theory.md, "The points that can
+    /// touch"); absent where it held every point.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub condensed_points: Option<usize>,
     /// The smallest `|pivot| / |diagonal entry|` of the `L D Lᵀ` (direct strategies).
     pub smallest_pivot_ratio: Option<f64>,
     /// The numeric factorisation's floating-point operations (the tree's `L D Lᵀ` counts
@@ -711,6 +716,7 @@ impl SolverReport {
             step_backoffs: info.map_or(0, |i| i.step_backoffs),
             fixed_point_relaxations: info.map_or(0, |i| i.relaxations),
             condense_route: None,
+            condensed_points: None,
             smallest_pivot_ratio: None,
             factor_flops: None,
             factor_gflops: None,
