@@ -608,10 +608,13 @@ fn charges_read_back_and_sum_to_zero() {
             Some(ExactKind::Manufactured | ExactKind::ManufacturedContact | ExactKind::Affine)
         );
         if !added {
-            // a lone conductor carries no charge: round-off against the scenes' charges (1e-3..1)
+            // a lone conductor carries no charge: round-off against the scenes' charges
+            // (1e-3..1); the sum of its nodes' reactions leaves 5e-14 to 1e-12 (indent-cone's
+            // grounded face at n = 48 to 96, with every contact point condensed or only those
+            // the tip can touch)
             let sum: f64 = charges.iter().sum();
             assert!(
-                sum.abs() <= 1e-9 * scale.max(1e-4),
+                sum.abs() <= 1e-9 * scale.max(1e-3),
                 "{name}: the charges {charges:?} sum to {sum}"
             );
             checked += 1;

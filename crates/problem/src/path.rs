@@ -250,33 +250,11 @@ fn walk_set_up<B: Backend>(
         beyond: Cell::new(None),
     };
     let mut posed = walk.first_posed(&disc, instants[0])?;
-    // a second walk with every point (the first left out some that touch) said its notes
-    let boundary = match points {
-        Points::ThatCanTouch => contact_boundary(&posed, reporter)?,
-        Points::All => contact_boundary(&posed, &mut crate::Silent)?,
-    };
-    walk.every_fields = boundary.as_ref().is_some_and(|b| b.electric.is_some());
-    posed.bed = walk.bed(&posed, &instants, boundary.as_ref())?;
-    let boundary = match boundary {
-        Some(b) if points == Points::ThatCanTouch && B::NARROWS_CONTACT => Some(walk.narrowed(b, &posed, reporter)),
-        b => b,
-    };
+    let boundary = walk.boundary(&mut posed, &instants, (points, B::NARROWS_CONTACT), reporter)?;
     let assembled = backend.assemble(&posed)?;
     let t_assembly = t.elapsed().as_secs_f64();
     reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
-    if let (Some(spec), true, Some(b)) = (walk.spec, with_fields, boundary.as_ref()) {
-        let written = (0..instants.len())
-            .filter(|&k| spec.has_fields(k, instants.len()))
-            .count();
-        let flux = b.electric.is_some();
-        let counts = (instants.len(), written);
-        reporter.event(&Event::path_plan(
-            counts,
-            &setup.mesh,
-            disc.nv(),
-            (flux, spec.cell_fields),
-        ));
-    }
+    walk.plan_path(instants.len(), &disc, boundary.as_ref(), reporter);
     stop_if_interrupted(&limits, "assembly")?;
     let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
     stop_if_interrupted(&limits, "factorisation")?;
@@ -1286,6 +1264,51 @@ impl Walk<'_> {
                 (sol, None, 0)
             }
         }))
+    }
+
+    /// The contact boundary of the run (`None` without contact): whether every instant's
+    /// fields are computed, and the bed where only it holds the body, follow from it; where
+    /// the backend `narrows` and `points` asks, narrowed to the points that can touch
+    /// ([`Walk::narrowed`]). A second walk
+    /// with every point ([`Points::All`]: the first left out some that touch) said its notes.
+    fn boundary(
+        &mut self,
+        posed: &mut Posed<'_>,
+        instants: &[f64],
+        (points, narrows): (Points, bool),
+        reporter: &mut dyn Reporter,
+    ) -> Result<Option<ContactBoundary>, ProblemError> {
+        let boundary = match points {
+            Points::ThatCanTouch => contact_boundary(posed, reporter)?,
+            Points::All => contact_boundary(posed, &mut crate::Silent)?,
+        };
+        self.every_fields = boundary.as_ref().is_some_and(|b| b.electric.is_some());
+        posed.bed = self.bed(posed, instants, boundary.as_ref())?;
+        Ok(match boundary {
+            Some(b) if narrows && points == Points::ThatCanTouch => Some(self.narrowed(b, posed, reporter)),
+            b => b,
+        })
+    }
+
+    /// A path's plan, where it writes its instants' fields: how many, and how large their files
+    /// ([`Event::path_plan`]).
+    fn plan_path(
+        &self,
+        instants: usize,
+        disc: &Discretization<'_>,
+        boundary: Option<&ContactBoundary>,
+        reporter: &mut dyn Reporter,
+    ) {
+        if let (Some(spec), true, Some(b)) = (self.spec, self.with_fields, boundary) {
+            let written = (0..instants).filter(|&k| spec.has_fields(k, instants)).count();
+            let flux = b.electric.is_some();
+            reporter.event(&Event::path_plan(
+                (instants, written),
+                &self.setup.mesh,
+                disc.nv(),
+                (flux, spec.cell_fields),
+            ));
+        }
     }
 
     /// The boundary of a static run's contact problem narrowed to the points that can touch

@@ -232,6 +232,43 @@ impl Event<'_> {
     }
 }
 
+impl Event<'_> {
+    /// The line of an event of the contact solve: the points it holds, its compliance, its
+    /// iterations.
+    fn fmt_contact(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Event::Reach { kept, of, depths } => write!(
+                f,
+                "contact: {kept} of {of} points can touch (the indenter's profile within {depths} depths of its tip); the rest are checked open after the solve"
+            ),
+            Event::BeyondReach { points, of } => write!(
+                f,
+                "contact: {points} points left out of the contact problem would touch: solving again with all {of}"
+            ),
+            Event::Condensed { m, route, seconds } => write!(
+                f,
+                "condensed the contact compliance ({m} x {m}, {route:?}) in {seconds:.3} s"
+            ),
+            Event::Contact { progress: p, .. } if p.stage == contact::Stage::Fallback => write!(
+                f,
+                "semismooth Newton and its proximal stage stalled after {} steps (best residual {:.3e}): the last stage (block Gauss-Seidel for Coulomb's law, the accelerated gradient otherwise) takes over from the best multipliers (run.json: iterations.newton_fallback)",
+                p.iter, p.residual
+            ),
+            Event::Contact { progress: p, .. } => write!(
+                f,
+                "{:>11} {:>6}: residual {:.3e}, stick {}, slip {}, separated {}",
+                p.stage.name(),
+                p.iter,
+                p.residual,
+                p.counts.0,
+                p.counts.1,
+                p.counts.2
+            ),
+            _ => Ok(()),
+        }
+    }
+}
+
 impl fmt::Display for Event<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -288,33 +325,9 @@ impl fmt::Display for Event<'_> {
                 f,
                 "the bed's springs, step {step}: their forces changed by {change:.3e} of the loads (settled below {settled:.0e})"
             ),
-            Event::Reach { kept, of, depths } => write!(
-                f,
-                "contact: {kept} of {of} points can touch (the indenter's profile within {depths} depths of its tip); the rest are checked open after the solve"
-            ),
-            Event::BeyondReach { points, of } => write!(
-                f,
-                "contact: {points} points left out of the contact problem would touch: solving again with all {of}"
-            ),
-            Event::Condensed { m, route, seconds } => write!(
-                f,
-                "condensed the contact compliance ({m} x {m}, {route:?}) in {seconds:.3} s"
-            ),
-            Event::Contact { progress: p, .. } if p.stage == contact::Stage::Fallback => write!(
-                f,
-                "semismooth Newton and its proximal stage stalled after {} steps (best residual {:.3e}): the last stage (block Gauss-Seidel for Coulomb's law, the accelerated gradient otherwise) takes over from the best multipliers (run.json: iterations.newton_fallback)",
-                p.iter, p.residual
-            ),
-            Event::Contact { progress: p, .. } => write!(
-                f,
-                "{:>11} {:>6}: residual {:.3e}, stick {}, slip {}, separated {}",
-                p.stage.name(),
-                p.iter,
-                p.residual,
-                p.counts.0,
-                p.counts.1,
-                p.counts.2
-            ),
+            Event::Reach { .. } | Event::BeyondReach { .. } | Event::Condensed { .. } | Event::Contact { .. } => {
+                self.fmt_contact(f)
+            }
             Event::Solved {
                 seconds,
                 pcg_iters,
