@@ -516,6 +516,15 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "beyond reach",
+        why: "indent-sphere-3d's clamped top pushed 0.5 onto a sphere pushed 0.01: the face comes down far beyond the points within 3 depths of the tip that the contact problem first holds; the run finds them touching and is solved again with every point",
+        scene: "indent-sphere-3d",
+        sets: &["mesh.n=24", "dirichlet.0.u=[0.0,0.0,-0.5]"],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "path excursion",
         why: "paper-cycle's load factor 1, 1, 1e30, 1: friction's history after the excursion (tangential displacements of 7e12) leaves the last instant round-off; the path stops there",
         scene: "paper-cycle",
