@@ -178,6 +178,13 @@ impl<'p> Backend for DistributedMemory<'p> {
     type Error = DistributedError;
     const HELD_TO_TOLERANCE: bool = false;
 
+    fn agree_beyond(&mut self, found: Option<usize>) -> Result<Option<usize>, DistributedError> {
+        // rank 0 holds the fields; -1: no point left out touches
+        let mut count = [found.map_or(-1.0, |n| n as f64)];
+        self.petsc.broadcast(&mut count)?;
+        Ok((count[0] >= 0.0).then_some(count[0] as usize))
+    }
+
     fn supports(&self, scene: &Scene) -> Result<(), Unsupported> {
         crate::supports(scene)?;
         match self.contact {

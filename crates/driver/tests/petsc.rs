@@ -398,3 +398,34 @@ fn a_mesh_too_large_is_refused_by_its_estimate() {
         assert!(e.to_string().contains("on each of 2 ranks"), "{e}");
     });
 }
+
+/// An indenter's contact problem narrowed to the points it can touch (docs/theory.md, "The
+/// points that can touch") on every rank: the default backend's answer; and where the body is
+/// pushed onto the indenter beyond those points, every rank learns it from the one that holds
+/// the fields and all solve again with every point.
+fn narrowed_on_every_rank(petsc: &Petsc) {
+    for (push, narrowed) in [(None, true), (Some("dirichlet.0.u=[0.0,0.0,-0.5]"), false)] {
+        let sets: Vec<&str> = ["mesh.n=8"].into_iter().chain(push).collect();
+        let (faer, scene) = both("indent-sphere-3d", &sets, &[]);
+        let dist = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .unwrap_or_else(|e| panic!("{push:?}: the PETSc run: {e}"));
+        let Some(dist) = dist else { continue };
+        let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+        let (d, what) = farthest(&direct, &dist);
+        assert!(d < 1e-7, "{push:?}: {what} differs by {d:.2e}");
+        assert_eq!(dist.report.solver.condensed_points.is_some(), narrowed, "{push:?}");
+        assert_eq!(
+            dist.report.solver.condensed_points,
+            direct.report.solver.condensed_points
+        );
+    }
+}
+
+#[test]
+fn an_indenters_narrowed_problem_on_two_ranks_agrees_with_the_default_backend() {
+    on_ranks(
+        "an_indenters_narrowed_problem_on_two_ranks_agrees_with_the_default_backend",
+        2,
+        narrowed_on_every_rank,
+    );
+}

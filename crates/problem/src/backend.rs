@@ -104,12 +104,17 @@ pub trait Backend {
     /// says whether it met them.
     const HELD_TO_TOLERANCE: bool;
 
-    /// Whether a static run's contact problem may hold only the points that can touch (an
-    /// indenter's zone, `crate::reach`): the last instant's fields on this one process check
-    /// the points left out, and where one would touch the run is done again with every point.
-    /// A backend on several processes, whose ranks would have to agree on the second run,
-    /// keeps every point.
-    const NARROWS_CONTACT: bool = false;
+    /// How many points left out of a static run's narrowed contact problem would touch
+    /// (`crate::reach`), known to every process: `found` is what the process that holds the
+    /// last instant's fields counted (`None` where none would, and on the processes that do not
+    /// hold them). A backend on one process returns it; one on several sends the holder's to
+    /// every process, so that all of them do the run again with every point, or none.
+    ///
+    /// # Errors
+    /// The backend's own (its communication).
+    fn agree_beyond(&mut self, found: Option<usize>) -> Result<Option<usize>, Self::Error> {
+        Ok(found)
+    }
 
     /// Whether this backend solves the (valid) scene: its `solver.backend`, and every law,
     /// condition and process it asks for. Called before anything is built. What a backend

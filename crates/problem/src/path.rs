@@ -250,7 +250,7 @@ fn walk_set_up<B: Backend>(
         beyond: Cell::new(None),
     };
     let mut posed = walk.first_posed(&disc, instants[0])?;
-    let boundary = walk.boundary(&mut posed, &instants, (points, B::NARROWS_CONTACT), reporter)?;
+    let boundary = walk.boundary(&mut posed, &instants, points, reporter)?;
     let assembled = backend.assemble(&posed)?;
     let t_assembly = t.elapsed().as_secs_f64();
     reporter.event(&Event::assembled(&setup.mesh, &disc.dofs, t_assembly));
@@ -282,18 +282,22 @@ fn walk_set_up<B: Backend>(
     let n = boundary.as_ref().map_or(0, |b| b.points.len());
     let mut state = History::new(n, setup.plan.n_tangential(), instants.len());
     let prepared = Prepared {
-        backend,
+        backend: &mut *backend,
         system,
         boundary: boundary.as_ref(),
         how: how.as_ref(),
     };
     let figures = walk.all_steps(prepared, &mut disc, &instants, &mut state, reporter, each)?;
     let steps_s = t_steps.elapsed().as_secs_f64();
-    if let (Some(beyond), Some(reach)) = (walk.beyond.get(), &walk.reach) {
-        return Ok(Walked::Beyond {
-            beyond,
-            of: reach.counts().1,
-        });
+    if let Some(reach) = &walk.reach {
+        // every process learns whether the one holding the fields found points touching
+        if let Some(points) = backend.agree_beyond(walk.beyond.get().map(|b| b.points))? {
+            let of = reach.counts().1;
+            return Ok(Walked::Beyond {
+                beyond: Beyond { points },
+                of,
+            });
+        }
     }
     let Some(mut last) = state.last.take() else {
         // a process that does not hold the gathered fields
@@ -1268,14 +1272,13 @@ impl Walk<'_> {
 
     /// The contact boundary of the run (`None` without contact): whether every instant's
     /// fields are computed, and the bed where only it holds the body, follow from it; where
-    /// the backend `narrows` and `points` asks, narrowed to the points that can touch
-    /// ([`Walk::narrowed`]). A second walk
+    /// `points` asks, narrowed to the points that can touch ([`Walk::narrowed`]). A second walk
     /// with every point ([`Points::All`]: the first left out some that touch) said its notes.
     fn boundary(
         &mut self,
         posed: &mut Posed<'_>,
         instants: &[f64],
-        (points, narrows): (Points, bool),
+        points: Points,
         reporter: &mut dyn Reporter,
     ) -> Result<Option<ContactBoundary>, ProblemError> {
         let boundary = match points {
@@ -1285,7 +1288,7 @@ impl Walk<'_> {
         self.every_fields = boundary.as_ref().is_some_and(|b| b.electric.is_some());
         posed.bed = self.bed(posed, instants, boundary.as_ref())?;
         Ok(match boundary {
-            Some(b) if narrows && points == Points::ThatCanTouch => Some(self.narrowed(b, posed, reporter)),
+            Some(b) if points == Points::ThatCanTouch => Some(self.narrowed(b, posed, reporter)),
             b => b,
         })
     }

@@ -30,7 +30,6 @@ impl Backend for SharedMemory {
     type System = Factored;
     type Error = ProblemError;
     const HELD_TO_TOLERANCE: bool = true;
-    const NARROWS_CONTACT: bool = true;
 
     fn supports(&self, scene: &Scene) -> Result<(), Unsupported> {
         // the scene asks for another backend: solving it here would ignore that silently
