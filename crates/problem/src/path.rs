@@ -289,15 +289,8 @@ fn walk_set_up<B: Backend>(
     };
     let figures = walk.all_steps(prepared, &mut disc, &instants, &mut state, reporter, each)?;
     let steps_s = t_steps.elapsed().as_secs_f64();
-    if let Some(reach) = &walk.reach {
-        // every process learns whether the one holding the fields found points touching
-        if let Some(points) = backend.agree_beyond(walk.beyond.get().map(|b| b.points))? {
-            let of = reach.counts().1;
-            return Ok(Walked::Beyond {
-                beyond: Beyond { points },
-                of,
-            });
-        }
+    if let Some(beyond) = walk.agreed_beyond(backend)? {
+        return Ok(beyond);
     }
     let Some(mut last) = state.last.take() else {
         // a process that does not hold the gathered fields
@@ -1312,6 +1305,19 @@ impl Walk<'_> {
                 (flux, spec.cell_fields),
             ));
         }
+    }
+
+    /// Where the contact problem was narrowed: whether points left out would touch, as the
+    /// process holding the fields found, agreed by every process ([`Backend::agree_beyond`]).
+    fn agreed_beyond<B: Backend>(&self, backend: &mut B) -> Result<Option<Walked>, B::Error> {
+        let Some(reach) = &self.reach else {
+            return Ok(None);
+        };
+        let found = self.beyond.get().map(|b| b.points);
+        Ok(backend.agree_beyond(found)?.map(|points| Walked::Beyond {
+            beyond: Beyond { points },
+            of: reach.counts().1,
+        }))
     }
 
     /// The boundary of a static run's contact problem narrowed to the points that can touch
