@@ -133,3 +133,22 @@ def test_each_contact_group_keeps_its_own_law_from_python():
         assert lt <= radius * (1 + 1e-8) + 1e-14, (i, lt, radius)
         weakened += g == 1 and c.status[i] == pc.SLIP and radius < 0.3 * ln * (1 - 1e-6)
     assert weakened > 0
+
+
+def test_an_indenter_condenses_only_the_points_it_can_touch():
+    # indent-sphere-3d at n = 8: 9 of the face's 81 points lie within 3 depths of the tip; the
+    # result still has every point, the ones left out open; pushed onto the sphere by its
+    # clamped top, the run is done again with every point
+    lines = []
+    r = pc.run(pc.Scene.load("indent-sphere-3d", {"mesh.n": 8}), progress=lines.append)
+    assert r.report["solver"]["condensed_points"] == 9
+    assert any(line.startswith("contact: 9 of 81 points can touch") for line in lines)
+    assert r.contact.lambda_n.shape == (81,)
+    touching = (r.contact.lambda_n > 0).sum()
+    assert 0 < touching <= 9
+    lines = []
+    pushed = pc.Scene.load("indent-sphere-3d", {"mesh.n": 8, "dirichlet.0.u": [0.0, 0.0, -0.5]})
+    r = pc.run(pushed, progress=lines.append)
+    assert "condensed_points" not in r.report["solver"]
+    assert any("solving again with all 81" in line for line in lines)
+    assert (r.contact.lambda_n > 0).sum() > 9 > touching
