@@ -1,6 +1,6 @@
-//! The contact points that can touch. An indenter pushed to the depth `d` into a face touches
-//! it where its profile `h` (its height above the tip, [`ContactBoundary::profile_height`])
-//! is below about `d / 2` (Hertz's sphere: `a = √(R d)`, `h(a) = d / 2`); a point whose
+//! The contact points that can touch. An indenter pushed to the depth `d` into a face (its
+//! `depth` less the zone's `gap`) touches it where its profile `h` (its height above the tip,
+//! [`ContactBoundary::profile_height`]) is below about `d / 2` (Hertz's sphere: `a = √(R d)`, `h(a) = d / 2`); a point whose
 //! profile lies [`REACH`] depths or more above the tip is far out of that zone. A static run
 //! with such points condenses only the others: the factor's trailing block, the condensed
 //! compliance and the contact problem hold the points that can touch, and an indenter's small
@@ -39,8 +39,8 @@ pub(crate) struct Beyond {
 
 impl Reach {
     /// The points of `whole` that can touch, where a zone of `zones` (in the boundary's group
-    /// order) is an indenter pushed to a depth (force control's depth is an unknown: its zone
-    /// keeps every point) and they are few enough to pay: the narrowed boundary beside what
+    /// order) is an indenter pushed into the face (its depth less the zone's gap, positive;
+    /// force control's depth is an unknown: its zone keeps every point) and they are few enough to pay: the narrowed boundary beside what
     /// widens its solution. `None` where every point is kept, with electrical contact, and
     /// under Tresca's law (whose bound holds an open point's slip too).
     pub(crate) fn of(whole: &ContactBoundary, zones: &[&ContactSpec]) -> Option<(Reach, ContactBoundary)> {
@@ -49,10 +49,11 @@ impl Reach {
         if tresca || whole.points.tresca.iter().any(Option::is_some) {
             return None;
         }
+        // how far the tip presses into the undeformed face: its depth less the zone's gap
         let depth: Vec<Option<f64>> = zones
             .iter()
             .map(|z| match &z.indenter {
-                Some(i) if i.force.is_none() && i.depth > 0.0 && i.depth.is_finite() => Some(i.depth),
+                Some(i) if i.force.is_none() => Some(-z.uniform_gap()).filter(|d| *d > 0.0 && d.is_finite()),
                 _ => None,
             })
             .collect();
