@@ -239,7 +239,7 @@ impl Event<'_> {
         match self {
             Event::Reach { kept, of, depths } => write!(
                 f,
-                "contact: {kept} of {of} points can touch (the indenter's profile within {depths} depths of its tip); the rest are checked open after the solve"
+                "contact: {kept} of {of} points can touch (the indenter's profile within {depths} depths of its tip): the contact problem and its progress lines hold those, the rest are checked open after the solve"
             ),
             Event::BeyondReach { points, of } => write!(
                 f,
