@@ -10,7 +10,7 @@ use crate::factor::{FactorKind, Ordering, SparseFactor};
 use crate::pcg::{pcg, LinearOperator, PcgParams};
 use crate::sparse::{lower_quasi_definite, mul_add, mul_add_seq, mul_t_add, mul_t_add_seq};
 use crate::{LinalgError, ShapeError};
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SparseColMatRef};
 use faer::{MatMut, Par};
 use rayon::prelude::*;
 
@@ -314,14 +314,31 @@ pub struct Rhs<'a> {
     pub scale: f64,
 }
 
-/// `b - K x` by blocks: `(b_u - A u - Gᵀ φ, b_φ - G u + B φ)`.
-fn minus_k_x(k: CoupledBlocks<'_>, u: &[f64], phi: &[f64], b_u: &[f64], b_phi: &[f64]) -> (Vec<f64>, Vec<f64>) {
+/// `y += alpha M x` or `y += alpha Mᵀ x` ([`mul_add`], [`mul_t_add`], or their one-thread
+/// forms).
+type Product = fn(SparseColMatRef<'_, usize, f64>, &[f64], &mut [f64], f64);
+
+/// The products on rayon's pool ([`mul_add`], [`mul_t_add`]).
+const ON_THE_POOL: (Product, Product) = (mul_add, mul_t_add);
+
+/// The products on the calling thread alone, for several residuals formed at once, one per
+/// task ([`mul_add_seq`], [`mul_t_add_seq`]).
+const ON_THIS_THREAD: (Product, Product) = (mul_add_seq, mul_t_add_seq);
+
+/// `b - K x` by blocks, `(b_u - A u - Gᵀ φ, b_φ - G u + B φ)`, with the products `mul`,
+/// `mul_t` ([`ON_THE_POOL`] or [`ON_THIS_THREAD`]).
+fn minus_k_x(
+    k: CoupledBlocks<'_>,
+    (u, phi): (&[f64], &[f64]),
+    (b_u, b_phi): (&[f64], &[f64]),
+    (mul, mul_t): (Product, Product),
+) -> (Vec<f64>, Vec<f64>) {
     let mut ru = b_u.to_vec();
-    mul_add(k.a.as_ref(), u, &mut ru, -1.0);
-    mul_t_add(k.g.as_ref(), phi, &mut ru, -1.0);
+    mul(k.a.as_ref(), u, &mut ru, -1.0);
+    mul_t(k.g.as_ref(), phi, &mut ru, -1.0);
     let mut rp = b_phi.to_vec();
-    mul_add(k.g.as_ref(), u, &mut rp, -1.0);
-    mul_add(k.b.as_ref(), phi, &mut rp, 1.0);
+    mul(k.g.as_ref(), u, &mut rp, -1.0);
+    mul(k.b.as_ref(), phi, &mut rp, 1.0);
     (ru, rp)
 }
 
@@ -384,12 +401,7 @@ pub fn refine_many(
     }
     // the products with `K` one per task, each on one thread
     let measure = |(u, phi): &UPhi, b: &Rhs<'_>| {
-        let mut ru = b.u.to_vec();
-        mul_add_seq(k.a.as_ref(), u, &mut ru, -1.0);
-        mul_t_add_seq(k.g.as_ref(), phi, &mut ru, -1.0);
-        let mut rp = b.phi.to_vec();
-        mul_add_seq(k.g.as_ref(), u, &mut rp, -1.0);
-        mul_add_seq(k.b.as_ref(), phi, &mut rp, 1.0);
+        let (ru, rp) = minus_k_x(k, (u, phi), (b.u, b.phi), ON_THIS_THREAD);
         Residual::of(ru, rp, *b)
     };
     let mut r: Vec<Residual> = xs.par_iter().zip(rhs).map(|(x, b)| measure(x, b)).collect();
@@ -526,7 +538,7 @@ impl Refinable for Blockwise<'_, '_> {
     type Error = LinalgError;
 
     fn residual(&mut self, u: &[f64], phi: &[f64]) -> Result<Residual, LinalgError> {
-        let (ru, rp) = minus_k_x(self.k, u, phi, self.rhs.u, self.rhs.phi);
+        let (ru, rp) = minus_k_x(self.k, (u, phi), (self.rhs.u, self.rhs.phi), ON_THE_POOL);
         Ok(Residual::of(ru, rp, self.rhs))
     }
 
@@ -542,14 +554,7 @@ impl Refinable for Blockwise<'_, '_> {
 /// contact forces: `‖b‖` then says nothing of the error's size). The norms are scaled, so the
 /// residual is the same for data of any magnitude.
 pub fn equilibrium_residual(k: CoupledBlocks<'_>, u: &[f64], phi: &[f64], rhs: Rhs<'_>) -> f64 {
-    let CoupledBlocks { a, g, b } = k;
-    let Rhs { u: b_u, phi: b_phi, .. } = rhs;
-    let mut ru: Vec<f64> = b_u.iter().map(|x| -x).collect();
-    mul_add(a.as_ref(), u, &mut ru, 1.0);
-    mul_t_add(g.as_ref(), phi, &mut ru, 1.0);
-    let mut rp: Vec<f64> = b_phi.iter().map(|x| -x).collect();
-    mul_add(g.as_ref(), u, &mut rp, 1.0);
-    mul_add(b.as_ref(), phi, &mut rp, -1.0);
+    let (ru, rp) = minus_k_x(k, (u, phi), (rhs.u, rhs.phi), ON_THE_POOL);
     relative_residual(&ru, &rp, rhs)
 }
 

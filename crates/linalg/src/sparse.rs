@@ -52,11 +52,21 @@ pub(crate) fn mul_add_seq(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut
 
 /// `y += alpha Mᵀ x` on the calling thread alone ([`mul_add_seq`]'s transpose).
 pub(crate) fn mul_t_add_seq(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alpha: f64) {
+    let n = m.ncols().min(y.len());
+    y[..n]
+        .iter_mut()
+        .enumerate()
+        .for_each(|(j, yj)| *yj += alpha * column_dot(m, x, j));
+}
+
+/// Column `j` of `M` dotted with `x`: entry `j` of `Mᵀ x`.
+fn column_dot(m: SparseColMatRef<'_, usize, f64>, x: &[f64], j: usize) -> f64 {
     let (cp, ri, vals) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
-    for (j, yj) in y.iter_mut().enumerate().take(m.ncols()) {
-        let s: f64 = (cp[j]..cp[j + 1]).map(|p| vals[p] * x[ri[p]]).sum();
-        *yj += alpha * s;
+    let mut s = 0.0;
+    for p in cp[j]..cp[j + 1] {
+        s += vals[p] * x[ri[p]];
     }
+    s
 }
 
 /// `y += alpha M[:, cols] x[cols]`, one column after another.
@@ -83,24 +93,15 @@ fn mul_add_columns(
 /// `y += alpha Mᵀ x`: a dot product per column, on rayon's pool for a large `M` (each writes
 /// its own entry of `y`: the same result on any pool).
 pub fn mul_t_add(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alpha: f64) {
-    let (cp, ri, vals) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
-    let column = |j: usize, yj: &mut f64| {
-        let mut s = 0.0;
-        for p in cp[j]..cp[j + 1] {
-            s += vals[p] * x[ri[p]];
-        }
-        *yj += alpha * s;
-    };
-    let n = m.ncols().min(y.len());
     if m.val().len() < PARALLEL_ENTRIES {
-        y[..n].iter_mut().enumerate().for_each(|(j, yj)| column(j, yj));
-    } else {
-        y[..n]
-            .par_iter_mut()
-            .with_min_len(1024)
-            .enumerate()
-            .for_each(|(j, yj)| column(j, yj));
+        return mul_t_add_seq(m, x, y, alpha);
     }
+    let n = m.ncols().min(y.len());
+    y[..n]
+        .par_iter_mut()
+        .with_min_len(1024)
+        .enumerate()
+        .for_each(|(j, yj)| *yj += alpha * column_dot(m, x, j));
 }
 
 /// The lower triangle of `K = [[A, Gᵀ], [G, -B]]` (what the factorisations read): column `j`
