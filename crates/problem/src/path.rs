@@ -732,13 +732,7 @@ impl Walk<'_> {
                 .into_iter()
                 .zip(&waiting)
                 .map(|(loads, w)| {
-                    let posed = Posed {
-                        scene: self.valid,
-                        setup: self.setup,
-                        disc,
-                        loads,
-                        bed: None,
-                    };
+                    let posed = self.posed(disc, loads);
                     let framed = Framed {
                         boundary: &w.boundary,
                         shift: &w.shift,
@@ -854,14 +848,22 @@ impl Walk<'_> {
         Self: 'a,
     {
         match self.parts {
-            Some(parts) => Ok(Posed {
-                scene: self.valid,
-                setup: self.setup,
-                disc,
-                loads: step_loads(parts, &self.factors(t0), self.scene)?,
-                bed: None,
-            }),
+            Some(parts) => Ok(self.posed(disc, step_loads(parts, &self.factors(t0), self.scene)?)),
             None => pose(self.valid, self.setup, disc),
+        }
+    }
+
+    /// The run's scene and set-up posed on `disc` under `loads` (no bed's springs).
+    fn posed<'a>(&self, disc: &'a Discretization<'a>, loads: Loads) -> Posed<'a>
+    where
+        Self: 'a,
+    {
+        Posed {
+            scene: self.valid,
+            setup: self.setup,
+            disc,
+            loads,
+            bed: None,
         }
     }
 
@@ -906,13 +908,7 @@ impl Walk<'_> {
                 strongest = loads;
             }
         }
-        let posed = Posed {
-            scene: self.valid,
-            setup: self.setup,
-            disc: posed.disc,
-            loads: strongest,
-            bed: None,
-        };
+        let posed = self.posed(posed.disc, strongest);
         Bed::needed(&posed, boundary)
     }
 
@@ -940,13 +936,7 @@ impl Walk<'_> {
                 b.points.slipped.clone_from(&on.state.slipped);
             }
         }
-        let mut posed = Posed {
-            scene: self.valid,
-            setup: self.setup,
-            disc,
-            loads,
-            bed: None,
-        };
+        let mut posed = self.posed(disc, loads);
         let (mut sol, springs) = match (boundary.as_mut(), on.how) {
             (Some(b), Some(how)) => {
                 let data = InstantData {
@@ -1432,13 +1422,7 @@ impl Walk<'_> {
             output: 0.0,
             total: t_total.elapsed().as_secs_f64(),
         };
-        let posed = Posed {
-            scene: self.valid,
-            setup: self.setup,
-            disc,
-            loads,
-            bed: None,
-        };
+        let posed = self.posed(disc, loads);
         let measured = Measured {
             info: done.result.as_ref().map(|r| &r.solution.info),
             pcg_iters: done.pcg_iters,
