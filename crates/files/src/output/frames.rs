@@ -9,11 +9,11 @@ use problem::Solution;
 use std::collections::VecDeque;
 use std::sync::Arc;
 use std::thread::JoinHandle;
+use std::time::Instant;
 
 /// Steps encoded at once, at most (each holds its fields' copy and its bytes: about 4 MB for a
 /// 2D mesh of 130,000 nodes).
 const ENCODING: usize = 4;
-use std::time::Instant;
 
 /// The files of a load path, written step by step ([`PathFiles::step`]: each written instant's
 /// `step-NNNN.vtu`, a ParaView time series) and finished with the last instant's solution

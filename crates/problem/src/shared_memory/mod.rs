@@ -191,13 +191,13 @@ impl Factored {
     /// What the factorisation and the solves on it measured, for the report.
     pub(crate) fn figures(&self) -> Figures {
         let linear = &self.linear;
-        let (smallest_pivot_ratio, factor_bytes) = match &linear.solver {
-            LinearSolver::Direct(d) => (Some(d.factor().pivot_ratio()), d.factor_bytes()),
-            LinearSolver::SchurPcg(p) => (None, p.factor_bytes()),
-        };
-        let factor_rate = match &linear.solver {
-            LinearSolver::Direct(d) => d.factor().flops().map(|f| (f, d.factor().numeric_seconds())),
-            LinearSolver::SchurPcg(_) => None,
+        let (smallest_pivot_ratio, factor_bytes, factor_rate) = match &linear.solver {
+            LinearSolver::Direct(d) => {
+                let factor = d.factor();
+                let rate = factor.flops().map(|f| (f, factor.numeric_seconds()));
+                (Some(factor.pivot_ratio()), d.factor_bytes(), rate)
+            }
+            LinearSolver::SchurPcg(p) => (None, p.factor_bytes(), None),
         };
         Figures {
             factor_seconds: linear.seconds,
