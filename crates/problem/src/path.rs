@@ -153,11 +153,8 @@ pub(crate) fn walk<B: Backend>(
         };
         match walk_set_up(backend, on, reporter, each)? {
             Walked::Done(done) => break done,
-            Walked::Beyond { beyond, of } => {
-                reporter.event(&Event::BeyondReach {
-                    points: beyond.points,
-                    of,
-                });
+            Walked::Beyond { points: beyond, of } => {
+                reporter.event(&Event::BeyondReach { points: beyond, of });
                 points = Points::All;
             }
         }
@@ -202,7 +199,7 @@ struct SetUp<'a> {
 /// does not hold them); or points its contact problem left out that would touch.
 enum Walked {
     Done(Option<Box<(RunReport, Option<ContactResult>, Recovered)>>),
-    Beyond { beyond: Beyond, of: usize },
+    Beyond { points: usize, of: usize },
 }
 
 /// [`walk`] from the set-up on: discretise, assemble, build the contact boundary (narrowed to
@@ -1305,7 +1302,7 @@ impl Walk<'_> {
         };
         let found = self.beyond.get().map(|b| b.points);
         Ok(backend.agree_beyond(found)?.map(|points| Walked::Beyond {
-            beyond: Beyond { points },
+            points,
             of: reach.counts().1,
         }))
     }
