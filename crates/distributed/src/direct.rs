@@ -14,7 +14,7 @@
 
 use crate::free::{copy_into, joined, split};
 use crate::layout::Layout;
-use fe_assembly::kernels::{coupling_column, dielectric_column, elasticity_column};
+use fe_assembly::kernels::{coupling_column, dielectric_column, elasticity_column, MAX_NODES};
 use fe_assembly::{Discretization, Dof};
 use linalg::{CondenseRoute, Condensed, CondensedLoads, CoupledSolver, Rhs};
 use petsc::{Mumps, Petsc, PetscError, Symmetry};
@@ -313,7 +313,7 @@ impl linalg::Refinable for Refining<'_, '_> {
 /// the loads).
 fn cell_entries(disc: &Discretization<'_>, c: usize, out: &mut Entries) {
     let cell = disc.mesh.cell(c);
-    let (dim, nl) = (disc.mesh.dim, cell.len());
+    let dim = disc.mesh.dim;
     let d = &disc.dofs;
     let free_u = |v: usize, k: usize| match d.u[v * dim + k] {
         Dof::Free(j) => Some(j),
@@ -324,13 +324,13 @@ fn cell_entries(disc: &Discretization<'_>, c: usize, out: &mut Entries) {
         _ => None,
     };
     let electric = disc.cell_electric[c];
-    let (m, geo) = (disc.material(c), &disc.geometry[c]);
+    let (m, r) = (disc.material(c), disc.rule(c));
     for (a, &va) in cell.iter().enumerate() {
         for k in 0..dim {
             let Some(col) = free_u(va, k) else {
                 continue;
             };
-            let colv = elasticity_column(m, geo, nl, a, k);
+            let colv: [[f64; 3]; MAX_NODES] = elasticity_column(m, &r, a, k);
             for (b, &vb) in cell.iter().enumerate() {
                 for (l, &v) in colv[b].iter().enumerate().take(dim) {
                     if let Some(row) = free_u(vb, l) {
@@ -339,7 +339,7 @@ fn cell_entries(disc: &Discretization<'_>, c: usize, out: &mut Entries) {
                 }
             }
             if electric {
-                let colg = coupling_column(m, geo, nl, a, k);
+                let colg: [f64; MAX_NODES] = coupling_column(m, &r, a, k);
                 for (b, &vb) in cell.iter().enumerate() {
                     if let Some(row) = free_phi(vb) {
                         // G below the diagonal (the potentials come after the displacements)
@@ -354,7 +354,7 @@ fn cell_entries(disc: &Discretization<'_>, c: usize, out: &mut Entries) {
         let Some(col) = free_phi(va) else {
             continue;
         };
-        let colb = dielectric_column(m, geo, nl, a);
+        let colb: [f64; MAX_NODES] = dielectric_column(m, &r, a);
         for (b, &vb) in cell.iter().enumerate() {
             if let Some(row) = free_phi(vb) {
                 out.push(row, col, -colb[b]);

@@ -12,7 +12,7 @@
 //! [`fe_assembly::Discretization::rhs`] (with the prescribed values already lifted).
 
 use crate::layout::Layout;
-use fe_assembly::kernels::{coupling_column, dielectric_column, elasticity_column};
+use fe_assembly::kernels::{coupling_column, dielectric_column, elasticity_column, MAX_NODES};
 use fe_assembly::{Discretization, Dof};
 use petsc::{Index, Matrix, Petsc, PetscError, Vector};
 
@@ -153,19 +153,19 @@ pub fn element(disc: &Discretization<'_>, layout: &Layout, c: usize) -> (Vec<Ind
     if electric {
         rows.extend(cell.iter().map(|&v| Layout::index(layout.first[v] + dim)));
     }
-    let (m, geo) = (disc.material(c), &disc.geometry[c]);
+    let (m, r) = (disc.material(c), disc.rule(c));
     let mut ke = vec![0.0; ne * ne];
     for a in 0..nl {
         for k in 0..dim {
             let col = a * dim + k;
-            let colv = elasticity_column(m, geo, nl, a, k);
+            let colv: [[f64; 3]; MAX_NODES] = elasticity_column(m, &r, a, k);
             for b in 0..nl {
                 for l in 0..dim {
                     ke[(b * dim + l) * ne + col] = colv[b][l];
                 }
             }
             if electric {
-                let colg = coupling_column(m, geo, nl, a, k);
+                let colg: [f64; MAX_NODES] = coupling_column(m, &r, a, k);
                 for b in 0..nl {
                     // -G in the potential's (negated) rows, Gᵀ in the displacement's
                     ke[(nu + b) * ne + col] = -colg[b];
@@ -174,7 +174,7 @@ pub fn element(disc: &Discretization<'_>, layout: &Layout, c: usize) -> (Vec<Ind
             }
         }
         if electric {
-            let colb = dielectric_column(m, geo, nl, a);
+            let colb: [f64; MAX_NODES] = dielectric_column(m, &r, a);
             for b in 0..nl {
                 ke[(nu + b) * ne + nu + a] = colb[b];
             }

@@ -11,7 +11,9 @@
 //! triplets. Serial assembly is the classic cell loop that scatters whole element matrices; both
 //! give the same matrices (a test checks it).
 
-use crate::kernels::{coupling_column, dielectric_column, elasticity_column, SimplexGeometry};
+use crate::kernels::{
+    coupling_column, dielectric_column, elasticity_column, CellRule, LinearRule, QuadraticRule, SimplexGeometry,
+};
 use crate::InputError;
 use crate::{AssemblyError, Constraint, Coordinates, Dof, DofMap, Material, Unheld};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -70,7 +72,10 @@ impl<'m> Discretization<'m> {
         materials: &[(String, Material)],
         constraints: &[Constraint],
     ) -> Result<Self, AssemblyError> {
-        if !matches!(mesh.kind, CellKind::Tri3 | CellKind::Tet4) {
+        if !matches!(
+            mesh.kind,
+            CellKind::Tri3 | CellKind::Tet4 | CellKind::Tri6 | CellKind::Tet10
+        ) {
             return Err(InputError::CellKind { kind: mesh.kind.name() }.into());
         }
         let axisymmetric = coordinates == Coordinates::Axisymmetric;
@@ -156,6 +161,16 @@ impl<'m> Discretization<'m> {
         &self.materials[self.cell_material[c]]
     }
 
+    /// The quadrature of cell `c` ([`crate::kernels::Rule::of`]).
+    pub fn rule(&self, c: usize) -> crate::kernels::Rule<'_> {
+        crate::kernels::Rule::of(self.mesh.dim, self.mesh.kind.order(), &self.geometry[c])
+    }
+
+    /// The one-point rule at the centroid of cell `c` ([`crate::kernels::Rule::centroid`]).
+    pub fn centroid_rule(&self, c: usize) -> crate::kernels::Rule<'_> {
+        crate::kernels::Rule::centroid(self.mesh.dim, self.mesh.kind.order(), &self.geometry[c])
+    }
+
     /// Assembles `A`, `G` and `B`. A floating terminal's rows and columns are its nodes'
     /// summed (assembled on the untied map, [`DofMap::untied`], then folded).
     pub fn assemble(&self, par: Parallelism) -> Blocks {
@@ -183,9 +198,25 @@ impl<'m> Discretization<'m> {
             },
         );
         let (mut av, mut gv, mut bv) = (a.zeros(), g.zeros(), b.zeros());
-        match par {
-            Parallelism::Rayon => self.assemble_node_owned(d, &node_cells, [&a, &g, &b], [&mut av, &mut gv, &mut bv]),
-            Parallelism::Serial => self.assemble_cell_loop(d, [&a, &g, &b], [&mut av, &mut gv, &mut bv]),
+        let (patterns, values) = ([&a, &g, &b], [&mut av[..], &mut gv[..], &mut bv[..]]);
+        let dim = mesh.dim;
+        match (par, mesh.kind.order()) {
+            (Parallelism::Rayon, 2) => {
+                self.assemble_node_owned::<{ crate::kernels::MAX_NODES }, _>(d, &node_cells, (patterns, values), |c| {
+                    QuadraticRule::new(dim, &self.geometry[c])
+                })
+            }
+            (Parallelism::Rayon, _) => self.assemble_node_owned::<4, _>(d, &node_cells, (patterns, values), |c| {
+                LinearRule::new(dim, &self.geometry[c])
+            }),
+            (Parallelism::Serial, 2) => {
+                self.assemble_cell_loop::<{ crate::kernels::MAX_NODES }, _>(d, (patterns, values), |c| {
+                    QuadraticRule::new(dim, &self.geometry[c])
+                })
+            }
+            (Parallelism::Serial, _) => {
+                self.assemble_cell_loop::<4, _>(d, (patterns, values), |c| LinearRule::new(dim, &self.geometry[c]))
+            }
         }
         let (g, b) = (g.into_matrix(gv), b.into_matrix(bv));
         let (g, b) = match &untied {
@@ -203,17 +234,17 @@ impl<'m> Discretization<'m> {
     }
 
     /// The blocks' values (`[A, G, B]` on their patterns), each node's columns filled by
-    /// one task from the cells around it.
-    fn assemble_node_owned(
-        &self,
+    /// one task from the cells around it; `rule` gives a cell's quadrature (`N` at least its
+    /// nodes).
+    fn assemble_node_owned<'s, const N: usize, R: CellRule>(
+        &'s self,
         d: &DofMap,
         node_cells: &(Vec<usize>, Vec<usize>),
-        [pa, pg, pb]: [&Pattern; 3],
-        [av, gv, bv]: [&mut [f64]; 3],
+        ([pa, pg, pb], [av, gv, bv]): ([&Pattern; 3], [&mut [f64]; 3]),
+        rule: impl Fn(usize) -> R + Sync + 's,
     ) {
         let mesh = self.mesh;
         let dim = mesh.dim;
-        let nl = dim + 1;
         let (off, node_cells) = (&node_cells.0, &node_cells.1);
         // per node: its slice of each block's values (its columns are contiguous)
         let n_nodes = mesh.n_nodes();
@@ -247,18 +278,18 @@ impl<'m> Discretization<'m> {
                 for &c in &node_cells[off[i]..off[i + 1]] {
                     let cell = mesh.cell(c);
                     let a_loc = cell.iter().position(|&v| v == i).unwrap_or(0);
-                    let (m, geo) = (self.material(c), &self.geometry[c]);
+                    let (m, r) = (self.material(c), rule(c));
                     let electric = self.cell_electric[c];
-                    let mut colv = [[[0.0; 3]; 4]; 3];
-                    let mut colg = [[0.0; 4]; 3];
+                    let mut colv = [[[0.0; 3]; N]; 3];
+                    let mut colg = [[0.0; N]; 3];
                     for &(k, q) in ucols {
-                        colv[q] = elasticity_column(m, geo, nl, a_loc, k);
+                        colv[q] = elasticity_column(m, &r, a_loc, k);
                         if electric {
-                            colg[q] = coupling_column(m, geo, nl, a_loc, k);
+                            colg[q] = coupling_column(m, &r, a_loc, k);
                         }
                     }
-                    let colb = match (electric, phi_col) {
-                        (true, Some(_)) => Some(dielectric_column(m, geo, nl, a_loc)),
+                    let colb: Option<[f64; N]> = match (electric, phi_col) {
+                        (true, Some(_)) => Some(dielectric_column(m, &r, a_loc)),
                         _ => None,
                     };
                     for (b, &vb) in cell.iter().enumerate() {
@@ -298,20 +329,25 @@ impl<'m> Discretization<'m> {
             });
     }
 
-    /// The blocks' values (`[A, G, B]` on their patterns), cell after cell.
-    fn assemble_cell_loop(&self, d: &DofMap, [pa, pg, pb]: [&Pattern; 3], [av, gv, bv]: [&mut [f64]; 3]) {
+    /// The blocks' values (`[A, G, B]` on their patterns), cell after cell; `rule` gives a
+    /// cell's quadrature (`N` at least its nodes).
+    fn assemble_cell_loop<const N: usize, R: CellRule>(
+        &self,
+        d: &DofMap,
+        ([pa, pg, pb], [av, gv, bv]): ([&Pattern; 3], [&mut [f64]; 3]),
+        rule: impl Fn(usize) -> R,
+    ) {
         let mesh = self.mesh;
         let dim = mesh.dim;
-        let nl = dim + 1;
         for (c, cell) in mesh.iter_cells().enumerate() {
-            let (m, geo) = (self.material(c), &self.geometry[c]);
+            let (m, r) = (self.material(c), rule(c));
             for (a, &va) in cell.iter().enumerate() {
                 for k in 0..dim {
                     let Dof::Free(col) = d.u[va * dim + k] else {
                         continue;
                     };
-                    let colv = elasticity_column(m, geo, nl, a, k);
-                    let colg = coupling_column(m, geo, nl, a, k);
+                    let colv: [[f64; 3]; N] = elasticity_column(m, &r, a, k);
+                    let colg: [f64; N] = coupling_column(m, &r, a, k);
                     for (b, &vb) in cell.iter().enumerate() {
                         for l in 0..dim {
                             if let Dof::Free(row) = d.u[vb * dim + l] {
@@ -329,7 +365,7 @@ impl<'m> Discretization<'m> {
                     continue;
                 }
                 let Dof::Free(col) = d.phi[va] else { continue };
-                let colb = dielectric_column(m, geo, nl, a);
+                let colb: [f64; N] = dielectric_column(m, &r, a);
                 for (b, &vb) in cell.iter().enumerate() {
                     if let Dof::Free(row) = d.phi[vb] {
                         bv[pb.position(row, col)] += colb[b];

@@ -448,17 +448,27 @@ impl ErrorNorms {
 
 impl Discretization<'_> {
     /// The errors of the nodal solution `(u, φ)` (all nodes, as [`crate::DofMap::expand_u`]
-    /// gives them) against `exact`, by a degree-2 rule on each cell (exact for the square of
-    /// a P1 function; for the smooth part, accurate to `O(h³)` relative, enough for rates).
+    /// gives them) against `exact`, by a rule on each cell of degree 2 with P1 (exact for the
+    /// square of a P1 function; for the smooth part, accurate to `O(h³)` relative, enough for
+    /// rates) and of degree 4 on triangles, 3 on tetrahedra with P2.
     pub fn error_norms(&self, u: &[[f64; 3]], phi: &[f64], exact: &Exact) -> ErrorNorms {
         let (mesh, dim) = (self.mesh, self.mesh.dim);
-        let rule: Vec<[f64; 4]> = if dim == 2 {
-            let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
-            vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]]
-        } else {
-            let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
-            vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]]
+        let order = mesh.kind.order();
+        let (weights, rule): (Vec<f64>, Vec<[f64; 4]>) = match (order, dim) {
+            (2, _) => crate::loads::simplex_rule(dim, 2),
+            (_, 2) => {
+                let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
+                (vec![1.0 / 3.0; 3], vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]])
+            }
+            _ => {
+                let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
+                (
+                    vec![0.25; 4],
+                    vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
+                )
+            }
         };
+        let shapes: Vec<_> = rule.iter().map(|l| crate::loads::shape_values(dim, order, l)).collect();
         let (mut eu, mut ep, mut en) = (0.0, 0.0, 0.0);
         let (mut nu, mut np, mut nn) = (0.0, 0.0, 0.0);
         let energy = |m: &Material, eps: &[f64; 6], grad: &[f64]| {
@@ -479,20 +489,38 @@ impl Discretization<'_> {
         for (c, cell) in mesh.iter_cells().enumerate() {
             let g = &self.geometry[c];
             let m = &self.materials[self.cell_material[c]];
-            let w = g.measure / rule.len() as f64;
             let ul: Vec<[f64; 3]> = cell.iter().map(|&v| u[v]).collect();
             let pl: Vec<f64> = cell.iter().map(|&v| phi[v]).collect();
-            let eps_h = kernels::cell_strain(dim, g, &ul);
-            let gp_h = kernels::cell_gradient(dim, g, &pl);
-            for bary in &rule {
+            // a P1 cell's strain and gradient are its centroid's
+            let centroid = self.centroid_rule(c);
+            let at_centroid = (
+                kernels::strain_at(dim, &centroid, 0, &ul),
+                kernels::gradient_at(dim, &centroid, 0, &pl),
+            );
+            for ((bary, n), weight) in rule.iter().zip(&shapes).zip(&weights) {
+                let w = g.measure * weight;
+                let (eps_h, gp_h) = match order {
+                    2 => {
+                        let r = kernels::QuadraticRule::at(dim, g, &[(*bary, 1.0)]);
+                        (
+                            kernels::strain_at(dim, &r, 0, &ul),
+                            kernels::gradient_at(dim, &r, 0, &pl),
+                        )
+                    }
+                    _ => at_centroid,
+                };
                 let mut x = [0.0; 3];
                 let (mut uh, mut ph) = ([0.0; 3], 0.0);
-                for (a, &v) in cell.iter().enumerate() {
+                for (a, &v) in cell[..=dim].iter().enumerate() {
                     for k in 0..3 {
                         x[k] += bary[a] * mesh.points[v][k];
-                        uh[k] += bary[a] * u[v][k];
                     }
-                    ph += bary[a] * phi[v];
+                }
+                for (a, &v) in cell.iter().enumerate() {
+                    for k in 0..3 {
+                        uh[k] += n[a] * u[v][k];
+                    }
+                    ph += n[a] * phi[v];
                 }
                 let x = &x[..dim];
                 let (ju, jp) = ((exact.u)(x), (exact.phi)(x));

@@ -1,17 +1,21 @@
-//! P1 kernels: geometry of a simplex, the strain-displacement operator, and the columns of
-//! the element matrices
+//! Element kernels: geometry of a simplex, the strain-displacement operator, and the columns
+//! of the element matrices
 //!
 //! - `A_e = ∫_T Bᵀ C B dx`        (elasticity),
 //! - `G_e = ∫_T ∇Nᵀ e B dx`       (coupling, rows ψ, columns u: `∫ (e ε(u)) · ∇ψ`),
 //! - `B_e = ∫_T ∇Nᵀ β ∇N dx`      (dielectric),
 //!
-//! with `N` the P1 shape functions, whose gradients are constant on the cell, so that each
-//! integral is the cell's measure times the integrand.
+//! summed over the points of a cell's quadrature ([`CellRule`]): with the P1 shape functions
+//! ([`LinearRule`]) the gradients are constant on the cell and each integral is the cell's
+//! measure times the integrand; with the P2 ones ([`QuadraticRule`], six-node triangles and
+//! ten-node tetrahedra, straight-sided) the gradients are linear and a rule exact for their
+//! products (degree 2) integrates them.
 //!
 //! A body of revolution (axisymmetric, meshed in its meridian plane `(r, z) = (x, y)`) adds the
 //! hoop strain `ε_θθ = u_r / r` (Voigt entry 3 after `[rr, zz, rz]`) and integrates over the
-//! whole body, `dx = 2π r dr dz`: the three-point interior rule of the triangle (degree 2,
-//! points at `r > 0` even on a cell touching the axis), so that forces and charges are totals.
+//! whole body, `dx = 2π r dr dz`: interior rules of the triangle (P1: three points, degree 2;
+//! P2: six points, degree 4; points at `r > 0` even on a cell touching the axis), so that forces
+//! and charges are totals.
 
 use crate::Material;
 
@@ -137,6 +141,212 @@ impl SimplexGeometry {
     }
 }
 
+/// The most nodes of a cell (the ten-node tetrahedron).
+pub const MAX_NODES: usize = 10;
+
+/// The most points of a cell's quadrature (P2 on a body of revolution).
+pub const MAX_POINTS: usize = 6;
+
+/// What the element kernels read of a cell: the points of its quadrature, and at each the
+/// weight (the measure it stands for, `2π r` included on a body of revolution), every shape
+/// function's value and gradient, and `N_a / r` (0 off a body of revolution).
+pub trait CellRule {
+    /// The cell's shape functions (its nodes).
+    fn n_local(&self) -> usize;
+    /// The points of the quadrature.
+    fn n_points(&self) -> usize;
+    /// The weight of point `p`.
+    fn weight(&self, p: usize) -> f64;
+    /// `N_a` at point `p`.
+    fn value(&self, p: usize, a: usize) -> f64;
+    /// `∇N_a` at point `p`.
+    fn grad(&self, p: usize, a: usize) -> &[f64; 3];
+    /// `N_a / r` at point `p` (0 off a body of revolution).
+    fn hoop(&self, p: usize, a: usize) -> f64;
+    /// The cell's volume where the gradients are the same at every point (a P1 cell), so that
+    /// the sums over the points factor; `None` otherwise.
+    fn constant_gradients(&self) -> Option<f64>;
+}
+
+/// A P1 cell's quadrature ([`SimplexGeometry::points`]): its constant gradients, and the
+/// points where the hoop terms of a body of revolution are taken.
+#[derive(Clone, Copy, Debug)]
+pub struct LinearRule<'g> {
+    g: &'g SimplexGeometry,
+    points: [CellPoint; 3],
+    n_points: usize,
+    n_local: usize,
+    /// The barycentric coordinates of the points (`N_a` there).
+    bary: [[f64; 4]; 3],
+}
+
+impl<'g> LinearRule<'g> {
+    /// The rule of the P1 cell `g` of dimension `dim`.
+    pub fn new(dim: usize, g: &'g SimplexGeometry) -> Self {
+        let (points, n_points) = g.points();
+        let mut bary = [[0.0; 4]; 3];
+        if g.radii.is_some() {
+            for (b, r) in bary.iter_mut().zip(&TRIANGLE_RULE) {
+                b[..3].copy_from_slice(r);
+            }
+        } else {
+            bary[0] = [1.0 / (dim + 1) as f64; 4];
+        }
+        LinearRule {
+            g,
+            points,
+            n_points,
+            n_local: dim + 1,
+            bary,
+        }
+    }
+}
+
+impl CellRule for LinearRule<'_> {
+    fn n_local(&self) -> usize {
+        self.n_local
+    }
+    fn n_points(&self) -> usize {
+        self.n_points
+    }
+    fn weight(&self, p: usize) -> f64 {
+        self.points[p].weight
+    }
+    fn value(&self, p: usize, a: usize) -> f64 {
+        self.bary[p][a]
+    }
+    fn grad(&self, _: usize, a: usize) -> &[f64; 3] {
+        &self.g.grads[a]
+    }
+    fn hoop(&self, p: usize, a: usize) -> f64 {
+        self.points[p].hoop[a]
+    }
+    fn constant_gradients(&self) -> Option<f64> {
+        Some(self.g.volume())
+    }
+}
+
+/// The triangle's interior six-point rule of degree 4 (Dunavant, Int. J. Numer. Methods Eng.
+/// 21 (1985) 1129, table for p = 4): `(a, a, 1 - 2a)` and its permutations, weights of the
+/// unit measure.
+const TRIANGLE_RULE_4: [([f64; 3], f64); 6] = {
+    const A1: f64 = 0.445_948_490_915_965;
+    const W1: f64 = 0.223_381_589_678_011;
+    const A2: f64 = 0.091_576_213_509_771;
+    const W2: f64 = 0.109_951_743_655_322;
+    [
+        ([A1, A1, 1.0 - 2.0 * A1], W1),
+        ([A1, 1.0 - 2.0 * A1, A1], W1),
+        ([1.0 - 2.0 * A1, A1, A1], W1),
+        ([A2, A2, 1.0 - 2.0 * A2], W2),
+        ([A2, 1.0 - 2.0 * A2, A2], W2),
+        ([1.0 - 2.0 * A2, A2, A2], W2),
+    ]
+};
+
+/// The tetrahedron's four-point rule of degree 2: `(b, b, b, a)` and its permutations with
+/// `a = (5 + 3√5) / 20`, `b = (5 - √5) / 20`, each of weight 1/4 (Keast, Comput. Methods Appl.
+/// Mech. Eng. 55 (1986) 339, rule 2).
+const TET_A: f64 = 0.585_410_196_624_968_5;
+const TET_B: f64 = 0.138_196_601_125_010_5;
+
+/// A P2 cell's quadrature: the six-node triangle or ten-node tetrahedron on its straight-sided
+/// simplex, its shape functions in the barycentric coordinates `λ` (corner `i`:
+/// `λ_i (2 λ_i - 1)`; edge `i-j`: `4 λ_i λ_j`), their gradients through the constant `∇λ_i`
+/// of the simplex. The points: degree 2 (three on a triangle, four on a tetrahedron: exact for
+/// the products of gradients); on a body of revolution six of degree 4.
+#[derive(Clone, Debug)]
+pub struct QuadraticRule {
+    n_local: usize,
+    n_points: usize,
+    weight: [f64; MAX_POINTS],
+    value: [[f64; MAX_NODES]; MAX_POINTS],
+    grad: [[[f64; 3]; MAX_NODES]; MAX_POINTS],
+    hoop: [[f64; MAX_NODES]; MAX_POINTS],
+}
+
+impl QuadraticRule {
+    /// The rule of the P2 cell on the simplex `g` of dimension `dim`.
+    pub fn new(dim: usize, g: &SimplexGeometry) -> Self {
+        let mut points: Vec<([f64; 4], f64)> = Vec::with_capacity(MAX_POINTS);
+        if dim == 3 {
+            for i in 0..4 {
+                let mut l = [TET_B; 4];
+                l[i] = TET_A;
+                points.push((l, 0.25));
+            }
+        } else if g.radii.is_some() {
+            points.extend(TRIANGLE_RULE_4.iter().map(|(l, w)| ([l[0], l[1], l[2], 0.0], *w)));
+        } else {
+            points.extend(TRIANGLE_RULE.iter().map(|l| ([l[0], l[1], l[2], 0.0], 1.0 / 3.0)));
+        }
+        Self::at(dim, g, &points)
+    }
+
+    /// The P2 shape functions of the simplex `g` at the points `(λ, w)` (barycentric
+    /// coordinates, and the fraction of the cell's measure each stands for).
+    pub fn at(dim: usize, g: &SimplexGeometry, points: &[([f64; 4], f64)]) -> Self {
+        let corners = dim + 1;
+        let edges: &[[usize; 2]] = if dim == 2 {
+            &[[0, 1], [1, 2], [2, 0]]
+        } else {
+            &[[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]
+        };
+        let mut rule = QuadraticRule {
+            n_local: corners + edges.len(),
+            n_points: points.len().min(MAX_POINTS),
+            weight: [0.0; MAX_POINTS],
+            value: [[0.0; MAX_NODES]; MAX_POINTS],
+            grad: [[[0.0; 3]; MAX_NODES]; MAX_POINTS],
+            hoop: [[0.0; MAX_NODES]; MAX_POINTS],
+        };
+        for (p, (l, w)) in points.iter().enumerate().take(MAX_POINTS) {
+            let gl = &g.grads;
+            for i in 0..corners {
+                rule.value[p][i] = l[i] * (2.0 * l[i] - 1.0);
+                rule.grad[p][i] = gl[i].map(|x| (4.0 * l[i] - 1.0) * x);
+            }
+            for (e, &[i, j]) in edges.iter().enumerate() {
+                rule.value[p][corners + e] = 4.0 * l[i] * l[j];
+                rule.grad[p][corners + e] = std::array::from_fn(|k| 4.0 * (l[i] * gl[j][k] + l[j] * gl[i][k]));
+            }
+            rule.weight[p] = w * g.measure;
+            if let Some(r) = g.radii {
+                let rp: f64 = (0..3).map(|i| l[i] * r[i]).sum();
+                rule.weight[p] *= std::f64::consts::TAU * rp;
+                for a in 0..rule.n_local {
+                    rule.hoop[p][a] = rule.value[p][a] / rp;
+                }
+            }
+        }
+        rule
+    }
+}
+
+impl CellRule for QuadraticRule {
+    fn n_local(&self) -> usize {
+        self.n_local
+    }
+    fn n_points(&self) -> usize {
+        self.n_points
+    }
+    fn weight(&self, p: usize) -> f64 {
+        self.weight[p]
+    }
+    fn value(&self, p: usize, a: usize) -> f64 {
+        self.value[p][a]
+    }
+    fn grad(&self, p: usize, a: usize) -> &[f64; 3] {
+        &self.grad[p][a]
+    }
+    fn hoop(&self, p: usize, a: usize) -> f64 {
+        self.hoop[p][a]
+    }
+    fn constant_gradients(&self) -> Option<f64> {
+        None
+    }
+}
+
 /// `B_a` at a point where `N_a / r = hoop` (0 off a body of revolution): [`strain_columns`]
 /// with the hoop strain `u_r / r` of the radial component in Voigt entry 3 (`[rr, zz, rz, θθ]`).
 pub fn strain_columns_at(dim: usize, grad: &[f64; 3], hoop: f64) -> [[f64; 6]; 3] {
@@ -173,19 +383,24 @@ pub fn strain_columns(dim: usize, grad: &[f64; 3]) -> [[f64; 6]; 3] {
     b
 }
 
-/// Column `(a, k)` of `A_e = ∫ Bᵀ C B`: `out[b][l]` is the entry of row `(b, l)`.
-pub fn elasticity_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize, k: usize) -> [[f64; 3]; 4] {
+/// `B_a` at point `p` of a cell's rule.
+fn b_at(dim: usize, r: &impl CellRule, p: usize, a: usize) -> [[f64; 6]; 3] {
+    strain_columns_at(dim, r.grad(p, a), r.hoop(p, a))
+}
+
+/// Column `(a, k)` of `A_e = ∫ Bᵀ C B`: `out[b][l]` is the entry of row `(b, l)` (`N` at least
+/// the cell's nodes).
+pub fn elasticity_column<const N: usize>(m: &Material, r: &impl CellRule, a: usize, k: usize) -> [[f64; 3]; N] {
     let (dim, nv) = (m.dim, m.nv());
-    let mut out = [[0.0; 3]; 4];
-    let (points, n_points) = g.points();
-    for p in &points[..n_points] {
-        let ba = strain_columns_at(dim, &g.grads[a], p.hoop[a])[k];
+    let mut out = [[0.0; 3]; N];
+    for p in 0..r.n_points() {
+        let ba = b_at(dim, r, p, a)[k];
         let mut cb = [0.0; 6];
         for i in 0..nv {
-            cb[i] = (0..nv).map(|j| m.c[i * nv + j] * ba[j]).sum::<f64>() * p.weight;
+            cb[i] = (0..nv).map(|j| m.c[i * nv + j] * ba[j]).sum::<f64>() * r.weight(p);
         }
-        for (b, row) in out.iter_mut().enumerate().take(n_local) {
-            let bb = strain_columns_at(dim, &g.grads[b], p.hoop[b]);
+        for (b, row) in out.iter_mut().enumerate().take(r.n_local()) {
+            let bb = b_at(dim, r, p, b);
             for (l, v) in row.iter_mut().enumerate().take(dim) {
                 *v += (0..nv).map(|i| bb[l][i] * cb[i]).sum::<f64>();
             }
@@ -194,42 +409,54 @@ pub fn elasticity_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: u
     out
 }
 
-/// Column `(a, k)` of `G_e = ∫ ∇Nᵀ e B` (rows ψ_b): `out[b] = Σ_q w_q ∇N_b · (e B_a(q) e_k)`.
-pub fn coupling_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize, k: usize) -> [f64; 4] {
+/// Column `(a, k)` of `G_e = ∫ ∇Nᵀ e B` (rows ψ_b): `out[b] = Σ_q w_q ∇N_b(q) · (e B_a(q) e_k)`.
+pub fn coupling_column<const N: usize>(m: &Material, r: &impl CellRule, a: usize, k: usize) -> [f64; N] {
     let (dim, nv) = (m.dim, m.nv());
-    let mut eb = [0.0; 3];
-    let (points, n_points) = g.points();
-    for p in &points[..n_points] {
-        let ba = strain_columns_at(dim, &g.grads[a], p.hoop[a])[k];
+    let mut out = [0.0; N];
+    let e_b = |p: usize| {
+        let ba = b_at(dim, r, p, a)[k];
+        let mut eb = [0.0; 3];
         for (i, v) in eb.iter_mut().enumerate().take(dim) {
-            *v += (0..nv).map(|j| m.e[i * nv + j] * ba[j]).sum::<f64>() * p.weight;
+            *v = (0..nv).map(|j| m.e[i * nv + j] * ba[j]).sum::<f64>() * r.weight(p);
         }
+        eb
+    };
+    if r.constant_gradients().is_some() {
+        // the gradients' common value: the points' sum first
+        let mut eb = [0.0; 3];
+        for p in 0..r.n_points() {
+            let ep = e_b(p);
+            for i in 0..dim {
+                eb[i] += ep[i];
+            }
+        }
+        for (b, v) in out.iter_mut().enumerate().take(r.n_local()) {
+            *v = (0..dim).map(|i| r.grad(0, b)[i] * eb[i]).sum();
+        }
+        return out;
     }
-    let mut out = [0.0; 4];
-    for (b, v) in out.iter_mut().enumerate().take(n_local) {
-        *v = (0..dim).map(|i| g.grads[b][i] * eb[i]).sum();
+    for p in 0..r.n_points() {
+        let eb = e_b(p);
+        for (b, v) in out.iter_mut().enumerate().take(r.n_local()) {
+            *v += (0..dim).map(|i| r.grad(p, b)[i] * eb[i]).sum::<f64>();
+        }
     }
     out
 }
 
-/// Row `b` of `G_e` as columns `(a, k)`: `out[a][k] = Σ_q w_q ∇N_b · (e B_a(q) e_k)`; this is
+/// Row `b` of `G_e` as columns `(a, k)`: `out[a][k] = Σ_q w_q ∇N_b(q) · (e B_a(q) e_k)`; this is
 /// the column `b` of `G_eᵀ` (rows u).
-pub fn coupling_row(m: &Material, g: &SimplexGeometry, n_local: usize, b: usize) -> [[f64; 3]; 4] {
+pub fn coupling_row<const N: usize>(m: &Material, r: &impl CellRule, b: usize) -> [[f64; 3]; N] {
     let (dim, nv) = (m.dim, m.nv());
-    // eT grad_b (nv), then B_a^T (eT grad_b)
-    let mut etg = [0.0; 6];
-    for (j, v) in etg.iter_mut().enumerate().take(nv) {
-        *v = (0..dim).map(|i| m.e[i * nv + j] * g.grads[b][i]).sum::<f64>();
-    }
-    let mut out = [[0.0; 3]; 4];
-    let (points, n_points) = g.points();
-    for p in &points[..n_points] {
+    let mut out = [[0.0; 3]; N];
+    for p in 0..r.n_points() {
+        // eᵀ ∇N_b, weighted, then B_aᵀ of it
         let mut weighted = [0.0; 6];
-        for (w, e) in weighted.iter_mut().zip(&etg).take(nv) {
-            *w = e * p.weight;
+        for (j, w) in weighted.iter_mut().enumerate().take(nv) {
+            *w = (0..dim).map(|i| m.e[i * nv + j] * r.grad(p, b)[i]).sum::<f64>() * r.weight(p);
         }
-        for (a, row) in out.iter_mut().enumerate().take(n_local) {
-            let ba = strain_columns_at(dim, &g.grads[a], p.hoop[a]);
+        for (a, row) in out.iter_mut().enumerate().take(r.n_local()) {
+            let ba = b_at(dim, r, p, a);
             for (k, v) in row.iter_mut().enumerate().take(dim) {
                 *v += (0..nv).map(|j| ba[k][j] * weighted[j]).sum::<f64>();
             }
@@ -238,36 +465,42 @@ pub fn coupling_row(m: &Material, g: &SimplexGeometry, n_local: usize, b: usize)
     out
 }
 
-/// Column `a` of `B_e = ∫ ∇Nᵀ β ∇N`: `out[b] = |T| ∇N_b · β ∇N_a` (`|T|` the cell's volume).
-pub fn dielectric_column(m: &Material, g: &SimplexGeometry, n_local: usize, a: usize) -> [f64; 4] {
+/// Column `a` of `B_e = ∫ ∇Nᵀ β ∇N`: `out[b] = Σ_q w_q ∇N_b(q) · β ∇N_a(q)` (on a P1 cell
+/// `|T| ∇N_b · β ∇N_a`, `|T|` the cell's volume).
+pub fn dielectric_column<const N: usize>(m: &Material, r: &impl CellRule, a: usize) -> [f64; N] {
     let dim = m.dim;
-    let mut bg = [0.0; 3];
-    for (i, v) in bg.iter_mut().enumerate().take(dim) {
-        *v = (0..dim).map(|j| m.beta[i * dim + j] * g.grads[a][j]).sum::<f64>() * g.volume();
+    let mut out = [0.0; N];
+    let beta_grad = |p: usize, scale: f64| {
+        let mut bg = [0.0; 3];
+        for (i, v) in bg.iter_mut().enumerate().take(dim) {
+            *v = (0..dim).map(|j| m.beta[i * dim + j] * r.grad(p, a)[j]).sum::<f64>() * scale;
+        }
+        bg
+    };
+    if let Some(volume) = r.constant_gradients() {
+        let bg = beta_grad(0, volume);
+        for (b, v) in out.iter_mut().enumerate().take(r.n_local()) {
+            *v = (0..dim).map(|i| r.grad(0, b)[i] * bg[i]).sum();
+        }
+        return out;
     }
-    let mut out = [0.0; 4];
-    for (b, v) in out.iter_mut().enumerate().take(n_local) {
-        *v = (0..dim).map(|i| g.grads[b][i] * bg[i]).sum();
+    for p in 0..r.n_points() {
+        let bg = beta_grad(p, r.weight(p));
+        for (b, v) in out.iter_mut().enumerate().take(r.n_local()) {
+            *v += (0..dim).map(|i| r.grad(p, b)[i] * bg[i]).sum::<f64>();
+        }
     }
     out
 }
 
-/// Voigt strain of a P1 displacement on a cell: `ε = Σ_a B_a u_a` (at the centroid, where the
-/// hoop strain of a body of revolution varies).
-pub fn cell_strain(dim: usize, g: &SimplexGeometry, u_local: &[[f64; 3]]) -> [f64; 6] {
-    strain_at(dim, g, &g.centroid_hoop(), u_local)
-}
-
-/// Voigt strain of a P1 displacement at a point where `N_a / r = hoop[a]`.
-pub fn strain_at(dim: usize, g: &SimplexGeometry, hoop: &[f64; 4], u_local: &[[f64; 3]]) -> [f64; 6] {
+/// Voigt strain of a cell's displacement `u_local` (its nodes') at point `p` of its rule:
+/// `ε = Σ_a B_a u_a`.
+pub fn strain_at(dim: usize, r: &impl CellRule, p: usize, u_local: &[[f64; 3]]) -> [f64; 6] {
     let mut eps = [0.0; 6];
-    let coordinates = match g.radii {
-        Some(_) => crate::Coordinates::Axisymmetric,
-        None => crate::Coordinates::Cartesian,
-    };
-    let nv = crate::voigt_len(dim, coordinates);
-    for (a, ua) in u_local.iter().enumerate() {
-        let b = strain_columns_at(dim, &g.grads[a], hoop[a]);
+    // plane strain's entry 3 (the hoop strain of a body of revolution) stays 0
+    let nv = if dim == 3 { 6 } else { 4 };
+    for (a, ua) in u_local.iter().enumerate().take(r.n_local()) {
+        let b = b_at(dim, r, p, a);
         for k in 0..dim {
             for v in 0..nv {
                 eps[v] += b[k][v] * ua[k];
@@ -277,15 +510,103 @@ pub fn strain_at(dim: usize, g: &SimplexGeometry, hoop: &[f64; 4], u_local: &[[f
     eps
 }
 
-/// Gradient of a P1 scalar on a cell: `∇φ = Σ_a φ_a ∇N_a`.
-pub fn cell_gradient(dim: usize, g: &SimplexGeometry, phi_local: &[f64]) -> [f64; 3] {
+/// Gradient of a cell's scalar `phi_local` (its nodes') at point `p` of its rule:
+/// `∇φ = Σ_a φ_a ∇N_a`.
+pub fn gradient_at(dim: usize, r: &impl CellRule, p: usize, phi_local: &[f64]) -> [f64; 3] {
     let mut out = [0.0; 3];
-    for (a, &p) in phi_local.iter().enumerate() {
+    for (a, &v) in phi_local.iter().enumerate().take(r.n_local()) {
         for k in 0..dim {
-            out[k] += p * g.grads[a][k];
+            out[k] += v * r.grad(p, a)[k];
         }
     }
     out
+}
+
+/// A cell's quadrature of either order ([`LinearRule`], [`QuadraticRule`]), for the work
+/// done cell by cell outside the assembly's loops (loads, fields, charges, errors).
+// one lives on the stack for one cell: the P1 variant inline (the common case, every cell of
+// a P1 mesh), the P2 one boxed (3 kB)
+#[allow(clippy::large_enum_variant)]
+pub enum Rule<'g> {
+    /// A P1 cell.
+    Linear(LinearRule<'g>),
+    /// A P2 cell.
+    Quadratic(Box<QuadraticRule>),
+}
+
+impl<'g> Rule<'g> {
+    /// The quadrature of the cell `g` of dimension `dim` and polynomial order `order`.
+    pub fn of(dim: usize, order: usize, g: &'g SimplexGeometry) -> Self {
+        match order {
+            2 => Rule::Quadratic(Box::new(QuadraticRule::new(dim, g))),
+            _ => Rule::Linear(LinearRule::new(dim, g)),
+        }
+    }
+
+    /// The rule of one point at the cell's centroid (where a cell's fields are reported), of
+    /// weight the cell's volume.
+    pub fn centroid(dim: usize, order: usize, g: &'g SimplexGeometry) -> Self {
+        let third = 1.0 / (dim + 1) as f64;
+        let l = [third, third, third, if dim == 3 { third } else { 0.0 }];
+        if order == 2 {
+            let mut r = QuadraticRule::at(dim, g, &[(l, 1.0)]);
+            r.weight[0] = g.volume();
+            return Rule::Quadratic(Box::new(r));
+        }
+        let mut rule = LinearRule::new(dim, g);
+        rule.n_points = 1;
+        rule.points[0] = CellPoint {
+            weight: g.volume(),
+            hoop: g.centroid_hoop(),
+        };
+        rule.bary[0] = l;
+        Rule::Linear(rule)
+    }
+}
+
+impl CellRule for Rule<'_> {
+    fn n_local(&self) -> usize {
+        match self {
+            Rule::Linear(r) => r.n_local(),
+            Rule::Quadratic(r) => r.n_local(),
+        }
+    }
+    fn n_points(&self) -> usize {
+        match self {
+            Rule::Linear(r) => r.n_points(),
+            Rule::Quadratic(r) => r.n_points(),
+        }
+    }
+    fn weight(&self, p: usize) -> f64 {
+        match self {
+            Rule::Linear(r) => r.weight(p),
+            Rule::Quadratic(r) => r.weight(p),
+        }
+    }
+    fn value(&self, p: usize, a: usize) -> f64 {
+        match self {
+            Rule::Linear(r) => r.value(p, a),
+            Rule::Quadratic(r) => r.value(p, a),
+        }
+    }
+    fn grad(&self, p: usize, a: usize) -> &[f64; 3] {
+        match self {
+            Rule::Linear(r) => r.grad(p, a),
+            Rule::Quadratic(r) => r.grad(p, a),
+        }
+    }
+    fn hoop(&self, p: usize, a: usize) -> f64 {
+        match self {
+            Rule::Linear(r) => r.hoop(p, a),
+            Rule::Quadratic(r) => r.hoop(p, a),
+        }
+    }
+    fn constant_gradients(&self) -> Option<f64> {
+        match self {
+            Rule::Linear(r) => r.constant_gradients(),
+            Rule::Quadratic(r) => r.constant_gradients(),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -4,9 +4,12 @@
 //! - `q_ψ = ∫_Ω q0 ψ dx - ∫_Γb q2 ψ ds`              (the paper's (3) `div D = q0`, and `D·n = q2`),
 //!
 //! minus the columns of `K` of the prescribed dofs times their values (Dirichlet lifting).
-//! Integrals use rules exact for quadratics (degree 2), enough for O(h²) in L2 with P1.
+//! Integrals use rules exact for quadratics (degree 2) with P1, enough for O(h²) in L2; with
+//! P2, rules of degree 5 on segments, 4 on triangles and 3 on tetrahedra (at least `2k - 1`
+//! for `k = 2`: the loads' quadrature keeps the L2 error's O(h³); Ciarlet, The Finite
+//! Element Method for Elliptic Problems, 1978, section 4.1).
 
-use crate::kernels::{coupling_column, coupling_row, dielectric_column, elasticity_column};
+use crate::kernels::{coupling_column, coupling_row, dielectric_column, elasticity_column, MAX_NODES};
 use crate::InputError;
 use crate::{AssemblyError, Discretization, Dof, ScalarFn, VectorFn};
 
@@ -55,29 +58,92 @@ impl std::fmt::Debug for Load {
     }
 }
 
-/// Barycentric quadrature on a simplex of dimension `dim`, degree 2: `(weights, points)`,
-/// weights summing to 1 (multiply by the measure).
-fn simplex_rule(dim: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
-    match dim {
-        1 => {
+/// Barycentric quadrature on a simplex of dimension `dim` for shape functions of order
+/// `order`: `(weights, points)`, weights summing to 1 (multiply by the measure). Order 1:
+/// degree 2. Order 2: Gauss' three points on a segment (degree 5), Dunavant's six on a
+/// triangle (degree 4), and on a tetrahedron the five-point rule of degree 3 (its centroid
+/// weighted -4/5, the points `(1/2, 1/6, 1/6, 1/6)` 9/20; Stroud, Approximate Calculation of
+/// Multiple Integrals, 1971, T3:3-1).
+pub(crate) fn simplex_rule(dim: usize, order: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
+    match (dim, order) {
+        (1, 1) => {
             let s = 0.5 / 3f64.sqrt();
             (
                 vec![0.5, 0.5],
                 vec![[0.5 - s, 0.5 + s, 0.0, 0.0], [0.5 + s, 0.5 - s, 0.0, 0.0]],
             )
         }
-        2 => {
+        (2, 1) => {
             let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
             (vec![1.0 / 3.0; 3], vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]])
         }
-        _ => {
+        (_, 1) => {
             let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
             (
                 vec![0.25; 4],
                 vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
             )
         }
+        (1, _) => {
+            let s = 0.5 * (3.0f64 / 5.0).sqrt();
+            (
+                vec![5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0],
+                vec![
+                    [0.5 - s, 0.5 + s, 0.0, 0.0],
+                    [0.5, 0.5, 0.0, 0.0],
+                    [0.5 + s, 0.5 - s, 0.0, 0.0],
+                ],
+            )
+        }
+        (2, _) => {
+            let (a1, w1) = (0.445_948_490_915_965, 0.223_381_589_678_011);
+            let (a2, w2) = (0.091_576_213_509_771, 0.109_951_743_655_322);
+            let (b1, b2) = (1.0 - 2.0 * a1, 1.0 - 2.0 * a2);
+            (
+                vec![w1, w1, w1, w2, w2, w2],
+                vec![
+                    [a1, a1, b1, 0.0],
+                    [a1, b1, a1, 0.0],
+                    [b1, a1, a1, 0.0],
+                    [a2, a2, b2, 0.0],
+                    [a2, b2, a2, 0.0],
+                    [b2, a2, a2, 0.0],
+                ],
+            )
+        }
+        _ => {
+            let (a, b) = (0.5, 1.0 / 6.0);
+            (
+                vec![-0.8, 0.45, 0.45, 0.45, 0.45],
+                vec![[0.25; 4], [a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
+            )
+        }
     }
+}
+
+/// The shape functions of order `order` on a simplex of dimension `dim` at the barycentric
+/// coordinates `l`: P1, `λ_a`; P2, the corners' `λ_i (2 λ_i - 1)` then the edges' `4 λ_i λ_j`
+/// (a segment's one edge; a triangle's 0-1, 1-2, 2-0; a tetrahedron's 0-1, 1-2, 2-0, 0-3, 1-3,
+/// 2-3: the order of the cells' and facets' nodes).
+pub(crate) fn shape_values(dim: usize, order: usize, l: &[f64; 4]) -> [f64; MAX_NODES] {
+    let corners = dim + 1;
+    let mut n = [0.0; MAX_NODES];
+    if order == 1 {
+        n[..corners].copy_from_slice(&l[..corners]);
+        return n;
+    }
+    let edges: &[[usize; 2]] = match dim {
+        1 => &[[0, 1]],
+        2 => &[[0, 1], [1, 2], [2, 0]],
+        _ => &[[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]],
+    };
+    for i in 0..corners {
+        n[i] = l[i] * (2.0 * l[i] - 1.0);
+    }
+    for (e, &[i, j]) in edges.iter().enumerate() {
+        n[corners + e] = 4.0 * l[i] * l[j];
+    }
+    n
 }
 
 /// `v`, or the error naming the load `what` where it is not finite.
@@ -150,10 +216,14 @@ impl Discretization<'_> {
         let d = &self.dofs;
         let mut bu = vec![0.0; d.n_u];
         let mut bphi = vec![0.0; d.n_phi];
-        let (w_cell, p_cell) = simplex_rule(dim);
-        let (w_facet, p_facet) = simplex_rule(dim - 1);
+        let order = mesh.kind.order();
+        let (w_cell, p_cell) = simplex_rule(dim, order);
+        let (w_facet, p_facet) = simplex_rule(dim - 1, order);
+        let n_cell: Vec<_> = p_cell.iter().map(|p| shape_values(dim, order, p)).collect();
+        let n_facet: Vec<_> = p_facet.iter().map(|p| shape_values(dim - 1, order, p)).collect();
+        // the points of a cell or a facet from its corners (straight-sided)
         let (at, ring) = (
-            |nodes: &[usize], bary: &[f64; 4]| self.point_at(nodes, bary),
+            |nodes: &[usize], bary: &[f64; 4], corners: usize| self.point_at(&nodes[..corners], bary),
             |x: &[f64; 3]| self.ring(x),
         );
         for load in loads {
@@ -161,14 +231,14 @@ impl Discretization<'_> {
                 Load::BodyForce(f) => {
                     for (c, cell) in mesh.iter_cells().enumerate() {
                         let vol = self.geometry[c].measure;
-                        for (w, p) in w_cell.iter().zip(&p_cell) {
-                            let x = at(cell, p);
+                        for ((w, p), n) in w_cell.iter().zip(&p_cell).zip(&n_cell) {
+                            let x = at(cell, p, dim + 1);
                             let fx = f(&x[..dim]);
                             let vol = vol * ring(&x);
                             for (a, &v) in cell.iter().enumerate() {
                                 for k in 0..dim {
                                     if let Dof::Free(j) = d.u[v * dim + k] {
-                                        bu[j] += check("the body force", fx[k])? * w * vol * p[a];
+                                        bu[j] += check("the body force", fx[k])? * w * vol * n[a];
                                     }
                                 }
                             }
@@ -181,13 +251,13 @@ impl Discretization<'_> {
                             continue;
                         }
                         let vol = self.geometry[c].measure;
-                        for (w, p) in w_cell.iter().zip(&p_cell) {
-                            let x = at(cell, p);
+                        for ((w, p), n) in w_cell.iter().zip(&p_cell).zip(&n_cell) {
+                            let x = at(cell, p, dim + 1);
                             let qx = check("the body charge", q0(&x[..dim]))?;
                             let vol = vol * ring(&x);
                             for (a, &v) in cell.iter().enumerate() {
                                 if let Dof::Free(j) = d.phi[v] {
-                                    bphi[j] -= qx * w * vol * p[a];
+                                    bphi[j] -= qx * w * vol * n[a];
                                 }
                             }
                         }
@@ -195,16 +265,16 @@ impl Discretization<'_> {
                 }
                 Load::Traction { group, value } => {
                     for f in mesh.boundary(group)?.iter() {
-                        let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
+                        let x: Vec<[f64; 3]> = f[..dim].iter().map(|&v| mesh.points[v]).collect();
                         let len = facet_measure(&x);
-                        for (w, p) in w_facet.iter().zip(&p_facet) {
-                            let y = at(f, p);
+                        for ((w, p), n) in w_facet.iter().zip(&p_facet).zip(&n_facet) {
+                            let y = at(f, p, dim);
                             let t = value(&y[..dim]);
                             let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {
                                 for k in 0..dim {
                                     if let Dof::Free(j) = d.u[v * dim + k] {
-                                        bu[j] += check("the traction", t[k])? * w * len * p[a];
+                                        bu[j] += check("the traction", t[k])? * w * len * n[a];
                                     }
                                 }
                             }
@@ -213,16 +283,16 @@ impl Discretization<'_> {
                 }
                 Load::SurfaceCharge { group, value } => {
                     for f in mesh.boundary(group)?.iter() {
-                        let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
+                        let x: Vec<[f64; 3]> = f[..dim].iter().map(|&v| mesh.points[v]).collect();
                         let len = facet_measure(&x);
-                        for (w, p) in w_facet.iter().zip(&p_facet) {
-                            let y = at(f, p);
+                        for ((w, p), n) in w_facet.iter().zip(&p_facet).zip(&n_facet) {
+                            let y = at(f, p, dim);
                             let qx = check("the surface charge", value(&y[..dim]))?;
                             let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {
                                 if let Dof::Free(j) = d.phi[v] {
                                     // q has -∫ q2 ψ, and b_φ = -q
-                                    bphi[j] += qx * w * len * p[a];
+                                    bphi[j] += qx * w * len * n[a];
                                 }
                             }
                         }
@@ -266,7 +336,6 @@ impl Discretization<'_> {
     fn lift(&self, bu: &mut [f64], bphi: &mut [f64], which: Lifted) {
         let mesh = self.mesh;
         let dim = mesh.dim;
-        let nl = dim + 1;
         let d = &self.dofs;
         for (c, cell) in mesh.iter_cells().enumerate() {
             let lifts_u = |k: usize| matches!(which, Lifted::All) || which == Lifted::Component(k);
@@ -278,7 +347,7 @@ impl Discretization<'_> {
             if !fixed_u && !fixed_phi {
                 continue;
             }
-            let (m, geo) = (self.material(c), &self.geometry[c]);
+            let (m, r) = (self.material(c), self.rule(c));
             for (a, &va) in cell.iter().enumerate() {
                 for k in (0..dim).filter(|&k| lifts_u(k)) {
                     let Dof::Fixed(val) = d.u[va * dim + k] else {
@@ -287,8 +356,8 @@ impl Discretization<'_> {
                     if val == 0.0 {
                         continue;
                     }
-                    let col = elasticity_column(m, geo, nl, a, k);
-                    let colg = coupling_column(m, geo, nl, a, k);
+                    let col: [[f64; 3]; MAX_NODES] = elasticity_column(m, &r, a, k);
+                    let colg: [f64; MAX_NODES] = coupling_column(m, &r, a, k);
                     for (b, &vb) in cell.iter().enumerate() {
                         for l in 0..dim {
                             if let Dof::Free(j) = d.u[vb * dim + l] {
@@ -309,8 +378,8 @@ impl Discretization<'_> {
                 if val == 0.0 {
                     continue;
                 }
-                let gt = coupling_row(m, geo, nl, a);
-                let bcol = dielectric_column(m, geo, nl, a);
+                let gt: [[f64; 3]; MAX_NODES] = coupling_row(m, &r, a);
+                let bcol: [f64; MAX_NODES] = dielectric_column(m, &r, a);
                 for (b, &vb) in cell.iter().enumerate() {
                     for l in 0..dim {
                         if let Dof::Free(j) = d.u[vb * dim + l] {

@@ -1,7 +1,8 @@
 //! Recovery of the stress `σ = C ε(u) + eᵀ ∇φ` and the electric displacement
-//! `D = e ε(u) - β ∇φ` (docs/theory.md's law; `E = -∇φ`), constant on each P1 cell.
+//! `D = e ε(u) - β ∇φ` (docs/theory.md's law; `E = -∇φ`), at each cell's centroid (constant on
+//! a P1 cell, linear on a P2 one).
 
-use crate::kernels::{cell_gradient, cell_strain, strain_at};
+use crate::kernels::{gradient_at, strain_at, CellRule, MAX_NODES};
 use crate::Discretization;
 use crate::Material;
 
@@ -35,13 +36,13 @@ impl Discretization<'_> {
             electric_field: Vec::with_capacity(n * dim),
         };
         for (c, cell) in mesh.iter_cells().enumerate() {
-            let g = &self.geometry[c];
+            let r = self.centroid_rule(c);
             let m = self.material(c);
             let ul: Vec<[f64; 3]> = cell.iter().map(|&v| u[v]).collect();
             let pl: Vec<f64> = cell.iter().map(|&v| phi[v]).collect();
-            let eps = cell_strain(dim, g, &ul);
+            let eps = strain_at(dim, &r, 0, &ul);
             let grad = if self.cell_electric[c] {
-                cell_gradient(dim, g, &pl)
+                gradient_at(dim, &r, 0, &pl)
             } else {
                 [0.0; 3]
             };
@@ -99,42 +100,75 @@ impl Discretization<'_> {
             if !cell.iter().any(|&v| owner[v] != usize::MAX) {
                 continue;
             }
-            let (g, m) = (&self.geometry[c], self.material(c));
+            let (r, m) = (self.rule(c), self.material(c));
             let ul: Vec<[f64; 3]> = cell.iter().map(|&v| u[v]).collect();
             let pl: Vec<f64> = cell.iter().map(|&v| phi[v]).collect();
-            let grad = if self.cell_electric[c] {
-                cell_gradient(dim, g, &pl)
-            } else {
-                [0.0; 3]
+            let source = match q0 {
+                Some(q) => self.source_weights(c, q),
+                None => [0.0; MAX_NODES],
             };
-            let source = q0.map_or(0.0, |q| {
-                let mut x = [0.0; 3];
-                for &v in cell {
-                    for k in 0..dim {
-                        x[k] += mesh.points[v][k] / cell.len() as f64;
-                    }
-                }
-                q(&x[..dim]) / cell.len() as f64
-            });
             // D at each point of the cell's quadrature, once for all its nodes
-            let (points, n_points) = g.points();
-            let flux_at: Vec<(f64, [f64; 3])> = points[..n_points]
-                .iter()
-                .map(|p| (p.weight, displacement(m, &strain_at(dim, g, &p.hoop, &ul), &grad)))
+            let flux_at: Vec<(f64, [f64; 3])> = (0..r.n_points())
+                .map(|p| {
+                    let grad = if self.cell_electric[c] {
+                        gradient_at(dim, &r, p, &pl)
+                    } else {
+                        [0.0; 3]
+                    };
+                    (r.weight(p), displacement(m, &strain_at(dim, &r, p, &ul), &grad))
+                })
                 .collect();
             for (a, &v) in cell.iter().enumerate() {
                 if owner[v] == usize::MAX {
                     continue;
                 }
                 // the conductor's charge is the negative of the flux out of the body
-                for (weight, d) in &flux_at {
-                    let flux: f64 = (0..dim).map(|k| d[k] * g.grads[a][k]).sum();
+                for (p, (weight, d)) in flux_at.iter().enumerate() {
+                    let flux: f64 = (0..dim).map(|k| d[k] * r.grad(p, a)[k]).sum();
                     out[owner[v]] -= weight * flux;
                 }
-                out[owner[v]] -= g.volume() * source;
+                out[owner[v]] -= source[a];
             }
         }
         Ok(out)
+    }
+
+    /// `∫_T q0 N_a` for each node `a` of cell `c`: on a P1 cell at its centroid (`|T| q0(x̄)
+    /// / (dim + 1)`), on a P2 cell by the loads' rule.
+    fn source_weights(&self, c: usize, q: &crate::ScalarFn) -> [f64; MAX_NODES] {
+        let (mesh, dim) = (self.mesh, self.mesh.dim);
+        let cell = mesh.cell(c);
+        let mut out = [0.0; MAX_NODES];
+        if mesh.kind.order() == 1 {
+            let mut x = [0.0; 3];
+            for &v in cell {
+                for k in 0..dim {
+                    x[k] += mesh.points[v][k] / cell.len() as f64;
+                }
+            }
+            let each = q(&x[..dim]) / cell.len() as f64;
+            out[..cell.len()].fill(self.geometry[c].volume() * each);
+            return out;
+        }
+        let (weights, points) = crate::loads::simplex_rule(dim, 2);
+        for (w, l) in weights.iter().zip(&points) {
+            let mut x = [0.0; 3];
+            for (i, &v) in cell[..=dim].iter().enumerate() {
+                for k in 0..3 {
+                    x[k] += l[i] * mesh.points[v][k];
+                }
+            }
+            let ring = match self.coordinates {
+                crate::Coordinates::Axisymmetric => std::f64::consts::TAU * x[0],
+                crate::Coordinates::Cartesian => 1.0,
+            };
+            let qx = q(&x[..dim]) * w * self.geometry[c].measure * ring;
+            let n = crate::loads::shape_values(dim, 2, l);
+            for (o, na) in out.iter_mut().zip(n) {
+                *o += qx * na;
+            }
+        }
+        out
     }
 
     /// For each node, the index in `groups` of the first group holding it (`usize::MAX`: none).
@@ -169,30 +203,35 @@ impl Discretization<'_> {
             if !cell.iter().any(|&v| owner[v] != usize::MAX) {
                 continue;
             }
-            let (g, m) = (&self.geometry[c], self.material(c));
-            let (points, n_points) = g.points();
+            let (r, m) = (self.rule(c), self.material(c));
             for (a, &va) in cell.iter().enumerate() {
                 let Some((a_u, a_phi)) = out.get_mut(owner[va]) else {
                     continue;
                 };
-                let grad_a = &g.grads[a];
                 for (b, &vb) in cell.iter().enumerate() {
-                    for p in &points[..n_points] {
-                        let columns = crate::kernels::strain_columns_at(dim, &g.grads[b], p.hoop[b]);
+                    for p in 0..r.n_points() {
+                        let grad_a = r.grad(p, a);
+                        let columns = crate::kernels::strain_columns_at(dim, r.grad(p, b), r.hoop(p, b));
                         for (k, column) in columns.iter().enumerate().take(dim) {
                             if let crate::Dof::Free(j) = self.dofs.u[vb * dim + k] {
                                 let d: f64 = (0..dim)
                                     .map(|l| grad_a[l] * (0..nv).map(|v| m.e[l * nv + v] * column[v]).sum::<f64>())
                                     .sum();
-                                a_u[j] -= p.weight * d;
+                                a_u[j] -= r.weight(p) * d;
                             }
                         }
                     }
                     if let (true, crate::Dof::Free(j)) = (self.cell_electric[c], self.dofs.phi[vb]) {
-                        let d: f64 = (0..dim)
-                            .map(|l| grad_a[l] * (0..dim).map(|q| m.beta[l * dim + q] * g.grads[b][q]).sum::<f64>())
-                            .sum();
-                        a_phi[j] += g.volume() * d;
+                        let beta = |p: usize| -> f64 {
+                            let (ga, gb) = (r.grad(p, a), r.grad(p, b));
+                            (0..dim)
+                                .map(|l| ga[l] * (0..dim).map(|q| m.beta[l * dim + q] * gb[q]).sum::<f64>())
+                                .sum()
+                        };
+                        a_phi[j] += match r.constant_gradients() {
+                            Some(volume) => volume * beta(0),
+                            None => (0..r.n_points()).map(|p| r.weight(p) * beta(p)).sum(),
+                        };
                     }
                 }
             }

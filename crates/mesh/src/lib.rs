@@ -31,6 +31,7 @@ mod generate;
 mod gmsh;
 mod ordering;
 mod parts;
+mod quadratic;
 mod quality;
 mod topology;
 
@@ -52,6 +53,12 @@ pub enum CellKind {
     Quad4,
     /// Four-node tetrahedron (P1), 3D.
     Tet4,
+    /// Six-node triangle (P2), 2D: the corners counter-clockwise, then the midpoints of the
+    /// edges 0-1, 1-2, 2-0 (VTK's and Gmsh's order).
+    Tri6,
+    /// Ten-node tetrahedron (P2), 3D: the corners positively oriented, then the midpoints of
+    /// the edges 0-1, 1-2, 2-0, 0-3, 1-3, 2-3 (VTK's order; Gmsh's swaps the last two).
+    Tet10,
 }
 
 impl CellKind {
@@ -60,20 +67,38 @@ impl CellKind {
         match self {
             CellKind::Tri3 => 3,
             CellKind::Quad4 | CellKind::Tet4 => 4,
+            CellKind::Tri6 => 6,
+            CellKind::Tet10 => 10,
+        }
+    }
+    /// Corner nodes per cell (the first of its nodes): what its shape is made of.
+    pub fn n_corners(self) -> usize {
+        match self {
+            CellKind::Tri3 | CellKind::Tri6 => 3,
+            CellKind::Quad4 | CellKind::Tet4 | CellKind::Tet10 => 4,
         }
     }
     /// Spatial dimension of the cell.
     pub fn dim(self) -> usize {
         match self {
-            CellKind::Tri3 | CellKind::Quad4 => 2,
-            CellKind::Tet4 => 3,
+            CellKind::Tri3 | CellKind::Quad4 | CellKind::Tri6 => 2,
+            CellKind::Tet4 | CellKind::Tet10 => 3,
         }
     }
-    /// Nodes per boundary facet of a mesh of this kind.
+    /// The polynomial order of the cell's shape functions: 1 or 2.
+    pub fn order(self) -> usize {
+        match self {
+            CellKind::Tri6 | CellKind::Tet10 => 2,
+            _ => 1,
+        }
+    }
+    /// Nodes per boundary facet of a mesh of this kind (its corners first, then its edges'
+    /// midpoints in a quadratic mesh).
     pub fn facet_n_nodes(self) -> usize {
         match self {
             CellKind::Tri3 | CellKind::Quad4 => 2,
-            CellKind::Tet4 => 3,
+            CellKind::Tet4 | CellKind::Tri6 => 3,
+            CellKind::Tet10 => 6,
         }
     }
     /// A short name, as in messages.
@@ -82,6 +107,25 @@ impl CellKind {
             CellKind::Tri3 => "triangle (P1)",
             CellKind::Quad4 => "quadrilateral (Q1)",
             CellKind::Tet4 => "tetrahedron (P1)",
+            CellKind::Tri6 => "triangle (P2)",
+            CellKind::Tet10 => "tetrahedron (P2)",
+        }
+    }
+    /// The edges whose midpoints are the cell's nodes after its corners, in their order (its
+    /// corners' local indices); none for a P1 cell.
+    pub fn midside_edges(self) -> &'static [[usize; 2]] {
+        match self {
+            CellKind::Tri6 => &[[0, 1], [1, 2], [2, 0]],
+            CellKind::Tet10 => &[[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]],
+            _ => &[],
+        }
+    }
+    /// The simplex of order 2 with the same corners (a quadrilateral has none: `None`).
+    pub fn quadratic(self) -> Option<CellKind> {
+        match self {
+            CellKind::Tri3 | CellKind::Tri6 => Some(CellKind::Tri6),
+            CellKind::Tet4 | CellKind::Tet10 => Some(CellKind::Tet10),
+            CellKind::Quad4 => None,
         }
     }
 }

@@ -13,10 +13,11 @@ pub struct MeshParts {
     pub points: Vec<[f64; 3]>,
     /// Flat cell connectivity, `nodes_per_cell` per cell.
     pub cells: Vec<usize>,
-    /// Nodes per cell: 3 (triangles) or 4 (quadrilaterals) in 2D, 4 (tetrahedra) in 3D.
+    /// Nodes per cell: 3 or 6 (P1 or P2 triangles) or 4 (quadrilaterals) in 2D, 4 or 10 (P1 or
+    /// P2 tetrahedra) in 3D; a P2 cell's edge nodes in VTK's (and meshio's) order.
     pub nodes_per_cell: usize,
-    /// Named boundary facet lists, flat, `dim` nodes per facet (segments in 2D, triangles in
-    /// 3D).
+    /// Named boundary facet lists, flat: `dim` nodes per facet (segments in 2D, triangles in
+    /// 3D), and in a P2 mesh its edges' midpoints after them (3 and 6 nodes).
     pub boundaries: BTreeMap<String, Vec<usize>>,
     /// Named cell lists (regions, to attach materials to).
     pub regions: BTreeMap<String, Vec<usize>>,
@@ -29,6 +30,8 @@ impl CellKind {
             (2, 3) => Some(CellKind::Tri3),
             (2, 4) => Some(CellKind::Quad4),
             (3, 4) => Some(CellKind::Tet4),
+            (2, 6) => Some(CellKind::Tri6),
+            (3, 10) => Some(CellKind::Tet10),
             _ => None,
         }
     }
@@ -72,7 +75,7 @@ impl Mesh {
         let bad = |message: String| MeshError::Parts { message };
         let kind = CellKind::of(dim, nodes_per_cell).ok_or_else(|| {
             bad(format!(
-                "cells of {nodes_per_cell} nodes in dimension {dim}: the cells are triangles (3) or quadrilaterals (4) in 2D, tetrahedra (4) in 3D"
+                "cells of {nodes_per_cell} nodes in dimension {dim}: the cells are triangles (3 or 6) or quadrilaterals (4) in 2D, tetrahedra (4 or 10) in 3D"
             ))
         })?;
         if cells.len() % nodes_per_cell != 0 {

@@ -85,10 +85,11 @@ impl Mesh {
             interior_group_facets: 0,
         };
         let measure_name = if self.dim == 2 { "area" } else { "volume" };
+        let corners = self.kind.n_corners();
         for (c, cell) in self.iter_cells().enumerate() {
             let (mut lmin, mut lmax) = (f64::INFINITY, 0.0f64);
-            for (a, &i) in cell.iter().enumerate() {
-                for &j in &cell[a + 1..] {
+            for (a, &i) in cell[..corners].iter().enumerate() {
+                for &j in &cell[a + 1..corners] {
                     let l = crate::dist(&self.points[i], &self.points[j]);
                     lmin = lmin.min(l);
                     lmax = lmax.max(l);
@@ -109,14 +110,17 @@ impl Mesh {
             if measure < 0.0 || !corners_ok {
                 return Err(bad("inverted"));
             }
+            if !self.straight(cell, lmax) {
+                return Err(bad("curved (an edge node off its edge's midpoint; only straight-sided second-order cells are supported)"));
+            }
             report.total_measure += measure;
             report.min_measure = report.min_measure.min(measure);
             report.h_max = report.h_max.max(lmax);
             report.h_min = report.h_min.min(lmin);
             let reference = match self.kind {
-                CellKind::Tri3 => 0.25,       // right isoceles triangle: h^2 / 4 with h the hypotenuse
-                CellKind::Quad4 => 0.5,       // square: h^2 / 2 with h the diagonal
-                CellKind::Tet4 => 1.0 / 27.0, // cube-corner-ish scale, see Kuhn tetrahedra
+                CellKind::Tri3 | CellKind::Tri6 => 0.25, // right isoceles triangle: h^2 / 4 with h the hypotenuse
+                CellKind::Quad4 => 0.5,                  // square: h^2 / 2 with h the diagonal
+                CellKind::Tet4 | CellKind::Tet10 => 1.0 / 27.0, // cube-corner-ish scale, see Kuhn tetrahedra
             };
             report.max_aspect = report.max_aspect.max(reference * scale / measure);
         }
@@ -129,7 +133,7 @@ impl Mesh {
     fn cell_measure(&self, cell: &[usize]) -> (f64, bool) {
         let p = |q: usize| self.points[cell[q]];
         match self.kind {
-            CellKind::Tri3 => {
+            CellKind::Tri3 | CellKind::Tri6 => {
                 let (a, b, c) = (p(0), p(1), p(2));
                 (
                     0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])),
@@ -147,8 +151,22 @@ impl Mesh {
                 }
                 (area, convex)
             }
-            CellKind::Tet4 => (signed_volume(&self.points, cell), true),
+            CellKind::Tet4 | CellKind::Tet10 => (signed_volume(&self.points, cell), true),
         }
+    }
+
+    /// Whether each edge node of a quadratic cell lies at its edge's midpoint (to 1e-9 of the
+    /// cell's longest edge `h`); true for a P1 cell.
+    fn straight(&self, cell: &[usize], h: f64) -> bool {
+        let p = |q: usize| self.points[cell[q]];
+        self.kind.midside_edges().iter().enumerate().all(|(m, &[a, b])| {
+            let (xa, xb, xm) = (p(a), p(b), p(self.kind.n_corners() + m));
+            let off = (0..3)
+                .map(|k| (xm[k] - 0.5 * (xa[k] + xb[k])).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            off <= 1e-9 * h
+        })
     }
 }
 

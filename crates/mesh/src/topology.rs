@@ -11,24 +11,41 @@
 use crate::{CellKind, Mesh, MeshError};
 use rayon::prelude::*;
 
-/// A facet as its sorted nodes (unused slots `usize::MAX`), so equal facets compare equal.
+/// A facet (or a cell) as its sorted corners (unused slots `usize::MAX`), so equal facets
+/// compare equal: the corners are the first nodes of a quadratic facet, its midpoints follow.
 type Key = [usize; 4];
 
-fn key(nodes: &[usize]) -> Key {
+/// The key of the entity whose first `corners` nodes are its corners.
+fn key_of(nodes: &[usize], corners: usize) -> Key {
+    let n = corners.min(nodes.len()).min(4);
     let mut k = [usize::MAX; 4];
-    k[..nodes.len()].copy_from_slice(nodes);
-    k[..nodes.len()].sort_unstable();
+    k[..n].copy_from_slice(&nodes[..n]);
+    k[..n].sort_unstable();
     k
 }
 
 impl CellKind {
-    /// The local nodes of each facet of a cell (edges in 2D, faces of a tetrahedron).
+    /// The local nodes of each facet of a cell (edges in 2D, faces of a tetrahedron): its
+    /// corners, then, in a quadratic cell, the midpoints of its edges in the facet's order
+    /// (a face `(a, b, c)`: the midpoints of `a-b`, `b-c`, `c-a`).
     pub fn facets(self) -> &'static [&'static [usize]] {
         match self {
             CellKind::Tri3 => &[&[0, 1], &[1, 2], &[2, 0]],
             CellKind::Quad4 => &[&[0, 1], &[1, 2], &[2, 3], &[3, 0]],
             CellKind::Tet4 => &[&[1, 2, 3], &[0, 2, 3], &[0, 1, 3], &[0, 1, 2]],
+            CellKind::Tri6 => &[&[0, 1, 3], &[1, 2, 4], &[2, 0, 5]],
+            CellKind::Tet10 => &[
+                &[1, 2, 3, 5, 9, 8],
+                &[0, 2, 3, 6, 9, 7],
+                &[0, 1, 3, 4, 8, 7],
+                &[0, 1, 2, 4, 5, 6],
+            ],
         }
+    }
+
+    /// Corner nodes per facet (the first of a facet's nodes).
+    pub fn facet_corners(self) -> usize {
+        self.dim()
     }
 }
 
@@ -36,14 +53,15 @@ impl Mesh {
     /// Every facet of every cell with its cell, sorted by facet.
     fn cell_facets(&self) -> Vec<(Key, usize)> {
         let local = self.kind.facets();
+        let corners = self.kind.facet_corners();
         let mut all = Vec::with_capacity(self.n_cells() * local.len());
         let mut buf = [0usize; 3];
         for (c, cell) in self.iter_cells().enumerate() {
             for f in local {
-                for (q, &l) in f.iter().enumerate() {
+                for (q, &l) in f.iter().take(corners).enumerate() {
                     buf[q] = cell[l];
                 }
-                all.push((key(&buf[..f.len()]), c));
+                all.push((key_of(&buf[..corners], corners), c));
             }
         }
         all.par_sort_unstable();
@@ -137,7 +155,12 @@ impl Mesh {
             }
             i = j;
         }
-        let mut cells: Vec<(Key, usize)> = self.iter_cells().enumerate().map(|(c, n)| (key(n), c)).collect();
+        let corners = self.kind.n_corners();
+        let mut cells: Vec<(Key, usize)> = self
+            .iter_cells()
+            .enumerate()
+            .map(|(c, n)| (key_of(n, corners), c))
+            .collect();
         cells.sort_unstable();
         if let Some(w) = cells.windows(2).find(|w| w[0].0 == w[1].0) {
             return Err(MeshError::DuplicateCell {
@@ -147,7 +170,12 @@ impl Mesh {
         }
         let mut interior = 0;
         for (name, group) in &self.boundaries {
-            let mut seen: Vec<(Key, usize)> = group.iter().enumerate().map(|(f, n)| (key(n), f)).collect();
+            let facet_corners = self.kind.facet_corners();
+            let mut seen: Vec<(Key, usize)> = group
+                .iter()
+                .enumerate()
+                .map(|(f, n)| (key_of(n, facet_corners), f))
+                .collect();
             seen.sort_unstable();
             let bad = |facet: usize, problem: &'static str| MeshError::BadBoundaryFacet {
                 group: name.clone(),
@@ -166,9 +194,28 @@ impl Mesh {
                     1 => {}
                     _ => interior += 1,
                 }
+                if !self.same_edge_nodes(group.facet(*f), facets[at].1) {
+                    return Err(bad(*f, "has edge nodes that are not its cell's (a second-order facet's midpoint nodes must be those of the cell that holds it)"));
+                }
             }
         }
         Ok((self.coincident_nodes(), interior))
+    }
+
+    /// Whether `facet` (a facet of cell `c` by its corners) has the nodes of that facet of the
+    /// cell, its edges' midpoints included (always, in a P1 mesh).
+    fn same_edge_nodes(&self, facet: &[usize], c: usize) -> bool {
+        if self.kind.order() == 1 {
+            return true;
+        }
+        let cell = self.cell(c);
+        let mut given = facet.to_vec();
+        given.sort_unstable();
+        self.kind.facets().iter().any(|f| {
+            let mut nodes: Vec<usize> = f.iter().map(|&l| cell[l]).collect();
+            nodes.sort_unstable();
+            nodes == given
+        })
     }
 
     /// The facets of group `group` that lie inside the mesh (shared by two cells), by their
@@ -194,7 +241,8 @@ impl Mesh {
         (offsets, node_cells): &'a (Vec<usize>, Vec<usize>),
         facet: &'a [usize],
     ) -> impl Iterator<Item = usize> + 'a {
-        let k = key(facet);
+        let corners = self.kind.facet_corners();
+        let k = key_of(facet, corners);
         let near = match facet.first() {
             Some(&v) if v + 1 < offsets.len() => &node_cells[offsets[v]..offsets[v + 1]],
             _ => &[],
@@ -203,10 +251,10 @@ impl Mesh {
             let cell = self.cell(c);
             self.kind.facets().iter().any(|f| {
                 let mut nodes = [0usize; 3];
-                for (q, &l) in f.iter().enumerate() {
+                for (q, &l) in f.iter().take(corners).enumerate() {
                     nodes[q] = cell[l];
                 }
-                f.len() == facet.len() && key(&nodes[..f.len()]) == k
+                f.len() == facet.len() && key_of(&nodes[..corners], corners) == k
             })
         })
     }

@@ -117,6 +117,8 @@ impl RunResult {
             mesh::CellKind::Tri3 => "triangle",
             mesh::CellKind::Quad4 => "quad",
             mesh::CellKind::Tet4 => "tetra",
+            mesh::CellKind::Tri6 => "triangle6",
+            mesh::CellKind::Tet10 => "tetra10",
         }
     }
 }

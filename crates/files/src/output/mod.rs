@@ -205,6 +205,8 @@ fn mesh_arrays(mesh: &mesh::Mesh) -> (Vec<f64>, Vec<u64>, Vec<u64>, CellType) {
         mesh::CellKind::Tri3 => CellType::Triangle,
         mesh::CellKind::Quad4 => CellType::Quad,
         mesh::CellKind::Tet4 => CellType::Tetra,
+        mesh::CellKind::Tri6 => CellType::QuadraticTriangle,
+        mesh::CellKind::Tet10 => CellType::QuadraticTetra,
     };
     (points, connectivity, offsets, cell_type)
 }
@@ -369,21 +371,29 @@ fn revolved_vtu(
         let mid = 0.5 * (angle(k) + angle(k) + 2.0 * std::f64::consts::PI / segments as f64);
         let (c, s) = (mid.cos(), mid.sin());
         for cell in 0..cells {
+            // a six-node triangle as its four triangles of corners and edge nodes, each
+            // counter-clockwise (the quadratic fields drawn linear on each)
             let t = mesh.cell(cell);
-            // VTK's wedge: the base (0, 1, 2) turns about its outward normal, away from the
-            // top (3, 4, 5); a counterclockwise meridian triangle faces the growing angle, so
-            // the base is the later angle's
-            connectivity.extend(t.iter().map(|&v| hi + v as u64));
-            connectivity.extend(t.iter().map(|&v| lo + v as u64));
-            offsets.push(connectivity.len() as u64);
-            stress.extend_from_slice(&fields.stress[cell * nv..(cell + 1) * nv]);
-            strain.extend_from_slice(&fields.strain[cell * nv..(cell + 1) * nv]);
-            for (out, of) in [
-                (&mut d, &fields.electric_displacement),
-                (&mut e, &fields.electric_field),
-            ] {
-                let (vr, vz) = (of[2 * cell], of[2 * cell + 1]);
-                out.extend([vr * c, vz, vr * s]);
+            let parts: &[[usize; 3]] = match mesh.kind {
+                mesh::CellKind::Tri6 => &[[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]],
+                _ => &[[0, 1, 2]],
+            };
+            for part in parts {
+                // VTK's wedge: the base (0, 1, 2) turns about its outward normal, away from
+                // the top (3, 4, 5); a counterclockwise meridian triangle faces the growing
+                // angle, so the base is the later angle's
+                connectivity.extend(part.iter().map(|&q| hi + t[q] as u64));
+                connectivity.extend(part.iter().map(|&q| lo + t[q] as u64));
+                offsets.push(connectivity.len() as u64);
+                stress.extend_from_slice(&fields.stress[cell * nv..(cell + 1) * nv]);
+                strain.extend_from_slice(&fields.strain[cell * nv..(cell + 1) * nv]);
+                for (out, of) in [
+                    (&mut d, &fields.electric_displacement),
+                    (&mut e, &fields.electric_field),
+                ] {
+                    let (vr, vz) = (of[2 * cell], of[2 * cell + 1]);
+                    out.extend([vr * c, vz, vr * s]);
+                }
             }
         }
     }

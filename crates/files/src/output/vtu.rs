@@ -34,6 +34,8 @@ pub(super) enum CellType {
     Quad = 9,
     Tetra = 10,
     Wedge = 13,
+    QuadraticTriangle = 22,
+    QuadraticTetra = 24,
 }
 
 /// An unstructured grid of cells of one type.

@@ -20,25 +20,48 @@ struct View {
     labels: (String, String),
 }
 
+/// The triangles a cell or facet is drawn as: itself, or a six-node triangle's four of its
+/// corners and edge nodes (its quadratic fields drawn linear on each).
+fn triangles(t: &[usize]) -> Vec<[usize; 3]> {
+    match t.len() {
+        6 => vec![
+            [t[0], t[3], t[5]],
+            [t[3], t[1], t[4]],
+            [t[5], t[4], t[2]],
+            [t[3], t[4], t[5]],
+        ],
+        _ => vec![[t[0], t[1], t[2]]],
+    }
+}
+
+/// The segments a boundary facet of a 2D mesh is drawn as: itself, or a three-node segment's
+/// two halves.
+fn segments(f: &[usize]) -> Vec<[usize; 2]> {
+    match f.len() {
+        3 => vec![[f[0], f[2]], [f[2], f[1]]],
+        _ => vec![[f[0], f[1]]],
+    }
+}
+
 impl View {
     fn new(mesh: &mesh::Mesh, u: &[[f64; 3]], units: &problem::Units) -> Option<View> {
         let axis = |name: &str| units.label(name, "length");
         if mesh.dim == 2 {
             return Some(View {
                 title: "",
-                tris: mesh.iter_cells().map(|c| [c[0], c[1], c[2]]).collect(),
+                tris: mesh.iter_cells().flat_map(triangles).collect(),
                 xy: mesh.points.iter().map(|p| [p[0], p[1]]).collect(),
                 uv: u.iter().map(|v| [v[0], v[1]]).collect(),
                 outline: mesh
                     .boundaries
                     .values()
-                    .flat_map(|g| g.iter().map(|f| [f[0], f[1]]).collect::<Vec<_>>())
+                    .flat_map(|g| g.iter().flat_map(segments).collect::<Vec<_>>())
                     .collect(),
                 labels: (axis("x"), axis("y")),
             });
         }
         let face = mesh.boundaries.get("front")?;
-        let tris: Vec<[usize; 3]> = face.iter().map(|f| [f[0], f[1], f[2]]).collect();
+        let tris: Vec<[usize; 3]> = face.iter().flat_map(triangles).collect();
         let mut edges = std::collections::HashMap::new();
         for t in &tris {
             for q in 0..3 {

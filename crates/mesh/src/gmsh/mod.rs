@@ -114,17 +114,18 @@ fn build(file: &File) -> Result<Mesh, String> {
         .flat_map(|(c, e)| c.iter().map(move |&t| (t, e)))
         .map(|(t, e)| node_index(&index_of, t, e))
         .collect::<Result<_, _>>()?;
+    from_gmsh_order(kind, &mut cells);
     let mut reoriented = 0;
     for &(first, last) in &blocks {
         reoriented += orient_block(&coords, &mut cells, kind, first, last);
     }
     let n_cells = cells.len() / kind.n_nodes();
-    if kind == CellKind::Tet4 && reoriented == n_cells {
+    if kind.dim() == 3 && reoriented == n_cells {
         return Err(format!(
             "all {n_cells} tetrahedra are inverted (negative volume): Gmsh writes them positive, so the file is mirrored or its nodes are misnumbered"
         ));
     }
-    let facets = facet_groups(file, dim, &index_of)?;
+    let facets = facet_groups(file, kind, &index_of)?;
     for v in regions.values_mut() {
         v.sort_unstable();
         v.dedup();
@@ -177,20 +178,26 @@ fn node_table(file: &File) -> Result<NodeTable, String> {
 }
 
 /// The facet groups: the elements one dimension below the cells in each physical group (a
-/// segment in 2D, a triangle in 3D), on the boundary or inside.
-fn facet_groups(file: &File, dim: i32, index_of: &HashMap<u64, usize>) -> Result<BTreeMap<String, FacetGroup>, String> {
+/// segment in 2D, a triangle in 3D, of the cells' order), on the boundary or inside.
+fn facet_groups(
+    file: &File,
+    kind: CellKind,
+    index_of: &HashMap<u64, usize>,
+) -> Result<BTreeMap<String, FacetGroup>, String> {
+    let dim = kind.dim() as i32;
     let mut out: BTreeMap<String, FacetGroup> = BTreeMap::new();
     for block in file.elements.iter().filter(|b| b.dim == dim - 1) {
         let names = groups_of(file, dim - 1, block.entity);
         if names.is_empty() || block.tags.is_empty() {
             continue; // elements in no group (Mesh.SaveAll) are not used
         }
-        let facet_type = if dim == 2 { 1 } else { 2 };
+        let facet_type = facet_type(kind);
         if block.element_type != facet_type {
             return Err(format!(
-                "group `{}` holds {} elements: the facets of a {dim}D mesh of first-order cells are {}",
+                "group `{}` holds {} elements: the facets of a {dim}D mesh of {} cells are {}",
                 names[0],
                 type_name(block.element_type),
+                kind.name(),
                 type_name(facet_type)
             ));
         }
@@ -202,7 +209,7 @@ fn facet_groups(file: &File, dim: i32, index_of: &HashMap<u64, usize>) -> Result
         }
         for g in names {
             let group = out.entry(g).or_insert_with(|| FacetGroup {
-                nodes_per_facet: dim as usize,
+                nodes_per_facet: kind.facet_n_nodes(),
                 facets: vec![],
             });
             group.facets.extend_from_slice(&facets);
@@ -217,14 +224,16 @@ fn cell_kind(t: i32, dim: i32, so_far: Option<CellKind>) -> Result<CellKind, Str
         2 => CellKind::Tri3,
         3 => CellKind::Quad4,
         4 => CellKind::Tet4,
+        9 => CellKind::Tri6,
+        11 => CellKind::Tet10,
         _ => {
-            let hint = if matches!(t, 9 | 10 | 11 | 16 | 20..=31) {
-                " (higher-order elements: mesh with Mesh.ElementOrder = 1)"
+            let hint = if matches!(t, 10 | 16 | 20..=31) {
+                " (serendipity, third- and higher-order elements: mesh with Mesh.ElementOrder = 1 or 2, and Mesh.SecondOrderIncomplete = 0 for quadrilaterals)"
             } else {
                 ""
             };
             return Err(format!(
-                "{} cells are not supported: cells must be 3-node triangles, 4-node quadrilaterals or 4-node tetrahedra{hint}",
+                "{} cells are not supported: cells must be 3- or 6-node triangles, 4-node quadrilaterals or 4- or 10-node tetrahedra{hint}",
                 type_name(t)
             ));
         }
@@ -239,6 +248,27 @@ fn cell_kind(t: i32, dim: i32, so_far: Option<CellKind>) -> Result<CellKind, Str
             k.name()
         )),
         _ => Ok(k),
+    }
+}
+
+/// Gmsh's type of the facets of a mesh of `kind`: a 2- or 3-node line in 2D, a 3- or 6-node
+/// triangle in 3D.
+fn facet_type(kind: CellKind) -> i32 {
+    match kind {
+        CellKind::Tri3 | CellKind::Quad4 => 1,
+        CellKind::Tet4 => 2,
+        CellKind::Tri6 => 8,
+        CellKind::Tet10 => 9,
+    }
+}
+
+/// A cell's nodes as Gmsh lists them, in this crate's (VTK's) order: the ten-node
+/// tetrahedron's last two edge nodes (edges 2-3 and 1-3 in Gmsh, 1-3 and 2-3 here) swap.
+fn from_gmsh_order(kind: CellKind, cells: &mut [usize]) {
+    if kind == CellKind::Tet10 {
+        for c in cells.chunks_exact_mut(10) {
+            c.swap(8, 9);
+        }
     }
 }
 
@@ -272,7 +302,7 @@ pub(crate) fn orient_block(
     let k = kind.n_nodes();
     let sign = |c: &[usize]| -> f64 {
         match kind {
-            CellKind::Tet4 => crate::generate::signed_volume(points, c),
+            CellKind::Tet4 | CellKind::Tet10 => crate::generate::signed_volume(points, c),
             _ => {
                 let (a, b, cc) = (points[c[0]], points[c[1]], points[c[2]]);
                 (b[0] - a[0]) * (cc[1] - a[1]) - (cc[0] - a[0]) * (b[1] - a[1])
@@ -286,6 +316,17 @@ pub(crate) fn orient_block(
     for c in block.chunks_exact_mut(k) {
         match kind {
             CellKind::Quad4 => c.swap(1, 3),
+            // the corners 1 and 2 swapped: the edges 0-1 and 2-0 swap, 1-2 stays
+            CellKind::Tri6 => {
+                c.swap(1, 2);
+                c.swap(3, 5);
+            }
+            // and in a tetrahedron the edges 1-3 and 2-3 swap too
+            CellKind::Tet10 => {
+                c.swap(1, 2);
+                c.swap(4, 6);
+                c.swap(8, 9);
+            }
             _ => c.swap(1, 2),
         }
     }

@@ -1,0 +1,274 @@
+//! Quadratic elements (six-node triangles, ten-node tetrahedra) against what nobody here
+//! wrote:
+//!
+//! - the patch test of order 2: a quadratic displacement and potential (their body force and
+//!   charge constant, from the Hessians) are reproduced to round-off on jittered meshes in 2D
+//!   and 3D, where P1 misses them;
+//! - the manufactured solution of `mms.rs`: L2 error O(h³) and energy error O(h²);
+//! - bodies of revolution: Lamé's thick cylinder (Timoshenko & Goodier, §28) at third order
+//!   in the nodal error, and a poled disc between electrodes (a uniform field) to round-off with
+//!   the whole disc's charge;
+//! - the node-owned parallel assembly equals the serial cell loop.
+
+mod common;
+
+use fe_assembly::{Constraint, Coordinates, Crystal, Discretization, Exact, Field, Load, Material, Parallelism};
+use linalg::{CoupledSolver, DirectLdlt, Ordering};
+use std::sync::Arc;
+
+fn solve(disc: &Discretization<'_>, loads: &[Load]) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let blocks = disc.assemble(Parallelism::Rayon);
+    let (bu, bphi) = disc.rhs(loads).unwrap();
+    let mut direct = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq).unwrap();
+    let (mut u, mut p) = (vec![0.0; disc.dofs.n_u], vec![0.0; disc.dofs.n_phi]);
+    direct.solve(&bu, &bphi, &mut u, &mut p).unwrap();
+    (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&p))
+}
+
+/// Moves the interior corner nodes of a P1 mesh by up to `amount / 2` (a pseudo-random
+/// sequence), before it is raised to order 2 (its edge nodes then at the moved edges'
+/// midpoints).
+fn jitter(m: &mut mesh::Mesh, amount: f64) {
+    let (lo, hi) = m.bounding_box();
+    let mut seed = 4242u64;
+    for p in &mut m.points {
+        for k in 0..m.dim {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let r = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            if (0..m.dim).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
+                p[k] += amount * r;
+            }
+        }
+    }
+}
+
+/// `u_k = Σ a_kij x_i x_j + b_k · x`, `φ` likewise: full quadratics with all their terms.
+fn quadratic(dim: usize) -> Exact {
+    let coef = |k: usize, i: usize, j: usize| 1e-3 * (1.0 + 0.3 * k as f64 - 0.2 * i as f64 + 0.7 * j as f64);
+    let jet = move |k: usize, x: &[f64]| {
+        let (mut v, mut g, mut h) = (0.0, [0.0; 3], [[0.0; 3]; 3]);
+        for i in 0..dim {
+            v += 2e-3 * (k + i + 1) as f64 * x[i];
+            g[i] += 2e-3 * (k + i + 1) as f64;
+            for j in 0..dim {
+                let a = coef(k, i, j);
+                v += a * x[i] * x[j];
+                g[i] += a * x[j];
+                g[j] += a * x[i];
+                h[i][j] += a;
+                h[j][i] += a;
+            }
+        }
+        (v, g, h)
+    };
+    Exact {
+        dim,
+        u: Arc::new(move |x| {
+            let mut out = [(0.0, [0.0; 3], [[0.0; 3]; 3]); 3];
+            for (k, o) in out.iter_mut().enumerate().take(dim) {
+                *o = jet(k, x);
+            }
+            out
+        }),
+        phi: Arc::new(move |x| {
+            let (v, g, h) = jet(3, x);
+            (10.0 * v, g.map(|y| 10.0 * y), h.map(|r| r.map(|y| 10.0 * y)))
+        }),
+    }
+}
+
+fn block(dim: usize, n: usize) -> mesh::Mesh {
+    if dim == 2 {
+        mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 2 * n, n)
+    } else {
+        mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 2 * n, n, n)
+    }
+}
+
+fn groups(dim: usize) -> &'static [&'static str] {
+    if dim == 2 {
+        &["left", "right", "bottom", "top"]
+    } else {
+        &["left", "right", "bottom", "top", "front", "back"]
+    }
+}
+
+fn pzt5a(dim: usize) -> Material {
+    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
+    Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap()
+}
+
+/// The relative errors `(L2 of (u, φ), energy)` of `exact` on `mesh`, its boundary prescribed.
+fn errors(mesh: &mesh::Mesh, exact: &Exact) -> (f64, f64) {
+    let dim = mesh.dim;
+    let m = pzt5a(dim);
+    let disc = Discretization::new(
+        mesh,
+        Coordinates::Cartesian,
+        &[("body".into(), m.clone())],
+        &exact.constraints(groups(dim)),
+    )
+    .unwrap();
+    let (u, phi) = solve(&disc, &exact.loads(&m));
+    let e = disc.error_norms(&u, &phi, exact);
+    let l2 = (e.l2_u.powi(2) + e.l2_phi.powi(2)).sqrt() / (e.norms.0.powi(2) + e.norms.1.powi(2)).sqrt();
+    (l2, e.rel_energy())
+}
+
+#[test]
+fn quadratic_fields_are_reproduced_to_round_off() {
+    for (dim, n) in [(2, 3), (3, 2)] {
+        let mut p1 = block(dim, n);
+        jitter(&mut p1, 0.3 / n as f64);
+        let p2 = p1.quadratic().unwrap();
+        p2.check().unwrap();
+        let exact = quadratic(dim);
+        let (l2, energy) = errors(&p2, &exact);
+        assert!(l2 < 1e-11 && energy < 1e-10, "{dim}D P2: L2 {l2:e}, energy {energy:e}");
+        // the test can fail: P1 does not hold a quadratic
+        let (l2, energy) = errors(&p1, &exact);
+        assert!(l2 > 1e-4 && energy > 1e-2, "{dim}D P1: L2 {l2:e}, energy {energy:e}");
+    }
+}
+
+fn rates(rows: &[(usize, f64, f64)]) -> Vec<(f64, f64)> {
+    rows.windows(2)
+        .map(|w| {
+            let r = (w[1].0 as f64 / w[0].0 as f64).ln();
+            ((w[0].1 / w[1].1).ln() / r, (w[0].2 / w[1].2).ln() / r)
+        })
+        .collect()
+}
+
+#[test]
+fn the_manufactured_solution_converges_at_third_order_in_l2_and_second_in_energy() {
+    for (dim, levels) in [(2, &[2, 4, 8, 16][..]), (3, &[1, 2, 4][..])] {
+        let exact = Exact::manufactured(dim);
+        let rows: Vec<(usize, f64, f64)> = levels
+            .iter()
+            .map(|&n| {
+                let (l2, en) = errors(&block(dim, n).quadratic().unwrap(), &exact);
+                (n, l2, en)
+            })
+            .collect();
+        let r = rates(&rows);
+        eprintln!("{dim}D P2 MMS: {rows:?}\nrates (L2, energy): {r:?}");
+        let last = r.last().unwrap();
+        assert!(last.0 > 2.8 && last.0 < 3.4, "{dim}D L2 rate {}", last.0);
+        assert!(last.1 > 1.85 && last.1 < 2.3, "{dim}D energy rate {}", last.1);
+        // at the same mesh, far below P1's
+        let n = *levels.last().unwrap();
+        let (p1, _) = errors(&block(dim, n), &exact);
+        assert!(
+            rows.last().unwrap().1 < 0.2 * p1,
+            "{dim}D n = {n}: P2 {rows:?}, P1 {p1:e}"
+        );
+    }
+}
+
+#[test]
+fn lames_cylinder_converges_at_third_order() {
+    let (a, b, e, nu, p) = (1.0, 2.0, 100.0, 0.3, 1.5);
+    let exact = |r: f64| (1.0 + nu) * p * a * a / (e * (b * b - a * a)) * ((1.0 - 2.0 * nu) * r + b * b / r);
+    let mut errors = vec![];
+    for n in [2, 4, 8] {
+        let mesh = mesh::rectangle_tri([a, 0.0], [b, 0.25], 4 * n, n).quadratic().unwrap();
+        let mat =
+            Material::from_crystal_axisymmetric("steel", &Crystal::isotropic(e, nu, 0.0), [0.0, 1.0, 0.0]).unwrap();
+        let bcs = vec![
+            Constraint::constant("top", Field::Displacement(1), 0.0),
+            Constraint::constant("bottom", Field::Displacement(1), 0.0),
+        ];
+        let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat)], &bcs).unwrap();
+        disc.check_held().unwrap();
+        let load = Load::Traction {
+            group: "left".into(),
+            value: Arc::new(move |_| [p, 0.0, 0.0]),
+        };
+        let (u, _) = solve(&disc, &[load]);
+        let sum: f64 = mesh
+            .points
+            .iter()
+            .zip(&u)
+            .map(|(x, u)| (u[0] - exact(x[0])).powi(2) + u[1].powi(2))
+            .sum();
+        errors.push((sum / mesh.n_nodes() as f64).sqrt() / exact(a));
+    }
+    let rates: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    eprintln!("Lamé P2: errors {errors:?}, rates {rates:?}");
+    // P1 at n = 16 (a finer mesh): 3.4e-5 (axisymmetric.rs)
+    assert!(errors[2] < 3.4e-5, "errors {errors:?}");
+    assert!(rates.iter().all(|&r| r > 2.8), "errors {errors:?}, rates {rates:?}");
+}
+
+#[test]
+fn a_poled_disc_between_electrodes_is_reproduced_with_the_whole_discs_charge() {
+    let (radius, height, volts) = (1.0, 0.5, 0.02);
+    let mut p1 = mesh::rectangle_tri([0.0, 0.0], [radius, height], 6, 3);
+    jitter(&mut p1, 0.05);
+    let mesh = p1.quadratic().unwrap();
+    let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
+    let bcs = vec![
+        Constraint::constant("left", Field::Displacement(0), 0.0),
+        Constraint::constant("bottom", Field::Displacement(1), 0.0),
+        Constraint::constant("bottom", Field::Potential, 0.0),
+        Constraint::constant("top", Field::Potential, volts),
+    ];
+    let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat.clone())], &bcs).unwrap();
+    let (u, phi) = solve(&disc, &[]);
+    let grad = [0.0, volts / height];
+    let c = nalgebra::DMatrix::from_row_slice(4, 4, &mat.c);
+    let rhs = nalgebra::DVector::from_iterator(
+        4,
+        (0..4).map(|v| -(0..2).map(|k| mat.e[k * 4 + v] * grad[k]).sum::<f64>()),
+    );
+    let eps = c.lu().solve(&rhs).unwrap();
+    let scale = eps.amax() * radius;
+    for (x, (u, p)) in mesh.points.iter().zip(u.iter().zip(&phi)) {
+        assert!((u[0] - eps[0] * x[0]).abs() < 1e-11 * scale, "u_r at {x:?}");
+        assert!((u[1] - eps[1] * x[1]).abs() < 1e-11 * scale, "u_z at {x:?}");
+        assert!((p - volts * x[1] / height).abs() < 1e-12 * volts, "φ at {x:?}");
+    }
+    let d_z: f64 = (0..4).map(|v| mat.e[4 + v] * eps[v]).sum::<f64>() - mat.beta[3] * grad[1];
+    let charges = disc.charges(&u, &phi, &["top", "bottom"], &[]).unwrap();
+    let whole = -d_z * std::f64::consts::PI * radius * radius;
+    assert!(
+        (charges[0] - whole).abs() < 1e-11 * whole.abs(),
+        "top {} against {whole}",
+        charges[0]
+    );
+    assert!(
+        (charges[1] + whole).abs() < 1e-11 * whole.abs(),
+        "bottom {}",
+        charges[1]
+    );
+    // the charge's functionals give the same charge from the free unknowns
+    let fields = disc.recover(&u, &phi);
+    assert!(fields.stress.iter().all(|s| s.abs() < 1e-9 * mat.c[0] * eps.amax()));
+}
+
+#[test]
+fn the_parallel_assembly_equals_the_cell_loop() {
+    for dim in [2, 3] {
+        let mut p1 = block(dim, 2);
+        jitter(&mut p1, 0.1);
+        let mesh = p1.quadratic().unwrap();
+        let m = pzt5a(dim);
+        let bcs = vec![
+            Constraint::constant("left", Field::Displacement(0), 0.0),
+            Constraint::constant("bottom", Field::Potential, 0.0),
+        ];
+        let disc = Discretization::new(&mesh, Coordinates::Cartesian, &[("body".into(), m)], &bcs).unwrap();
+        let (a, b) = (disc.assemble(Parallelism::Rayon), disc.assemble(Parallelism::Serial));
+        for (x, y) in [(&a.a, &b.a), (&a.g, &b.g), (&a.b, &b.b)] {
+            let scale = x.val().iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            assert_eq!(x.symbolic().row_idx(), y.symbolic().row_idx());
+            let worst = x
+                .val()
+                .iter()
+                .zip(y.val())
+                .fold(0.0f64, |s, (p, q)| s.max((p - q).abs()));
+            assert!(worst <= 1e-14 * scale, "{dim}D: {worst:e}");
+        }
+    }
+}
