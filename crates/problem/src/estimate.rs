@@ -38,7 +38,9 @@ const OVERHEAD: f64 = 1.3;
 pub(crate) fn generated(scene: &Scene) -> Option<(usize, f64, f64, f64)> {
     let dim = scene.mesh.dim()?;
     let axes = scene.mesh.cells_per_axis();
-    let nodes: f64 = axes.iter().map(|&c| c as f64 + 1.0).product();
+    // a second-order mesh: the nodes of the grid of half the spacing
+    let per_cell = scene.mesh.order.unwrap_or(1) as f64;
+    let nodes: f64 = axes.iter().map(|&c| per_cell * c as f64 + 1.0).product();
     // simplices per square (2) or cube (6, Kuhn's split)
     let cells = axes.iter().map(|&c| c as f64).product::<f64>() * if dim == 2 { 2.0 } else { 6.0 };
     let electric = scene

@@ -755,6 +755,12 @@ pub struct MeshSpec {
     /// (an interior one: an electrode between two layers, a film's bottom electrode).
     #[serde(default, rename = "layer", skip_serializing_if = "Vec::is_empty")]
     pub layers: Vec<LayerSpec>,
+    /// The polynomial order of the elements: 1 (three-node triangles, four-node tetrahedra) or
+    /// 2 (six-node triangles, ten-node tetrahedra: a node at the midpoint of every edge of the
+    /// generated or read mesh, straight-sided). Absent: a generated mesh's order 1, a Gmsh
+    /// file's own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
 }
 
 /// One layer of a layered body (`[[mesh.layer]]`), from the bottom up.
@@ -837,6 +843,7 @@ impl MeshSpec {
             cylinder: false,
             revolve: None,
             layers: vec![],
+            order: None,
         }
     }
 

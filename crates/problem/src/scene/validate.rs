@@ -439,6 +439,12 @@ fn on_group(e: SceneError, group: &str) -> SceneError {
 }
 
 fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
+    if let Some(order) = m.order.filter(|o| !(1..=2).contains(o)) {
+        return Err(SceneError::new(
+            "mesh.order",
+            format!("mesh.order = {order}: the elements are of order 1 (linear) or 2 (quadratic)"),
+        ));
+    }
     for (key, v) in [
         ("mesh.n", m.n),
         ("mesh.nx", m.nx),
