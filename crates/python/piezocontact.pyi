@@ -108,7 +108,9 @@ class Scene:
     ) -> None:
         """Gives the scene a mesh as arrays (`mesh.kind` becomes "given"): `points` (n, 2) or
         (n, 3); `cells` (m, 3) triangles or (m, 4) quadrilaterals in 2D, (m, 4) tetrahedra in
-        3D, 0-based; `boundary` named facet arrays ((k, 2) in 2D, (k, 3) in 3D); `regions`
+        3D, 0-based, or second-order (m, 6) triangles and (m, 10) tetrahedra (VTK's order);
+        `boundary` named facet arrays ((k, 2) in 2D, (k, 3) in 3D; at order 2 (k, 3) and
+        (k, 6), the corners then the edges' midpoints); `regions`
         named cell-index arrays (default: all cells in "body"). Checked as a file's mesh is
         (`MeshError`). The arrays replace only how the mesh was made: the `[mesh]` keys that
         describe the body (`axisymmetric`, `revolve`) stay. A mesh too large for the memory
@@ -193,7 +195,7 @@ class Result:
         """Cell connectivity, (n_cells, nodes per cell), 0-based."""
     @property
     def cell_type(self) -> str:
-        """"triangle", "quad" or "tetra" (meshio's names)."""
+        """"triangle", "quad", "tetra", or at order 2 "triangle6", "tetra10" (meshio's names)."""
     @property
     def dim(self) -> int:
         """2 (plane strain) or 3."""

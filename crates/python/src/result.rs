@@ -146,7 +146,8 @@ impl RunResult {
         )
     }
 
-    /// The cells' kind, as meshio names it: "triangle", "quad" or "tetra".
+    /// The cells' kind, as meshio names it: "triangle", "quad", "tetra", and at order 2
+    /// "triangle6" or "tetra10" (VTK's node order).
     #[getter(cell_type)]
     fn py_cell_type(&self) -> &'static str {
         self.cell_type()

@@ -351,8 +351,10 @@ impl Scene {
 
     /// Gives the scene a mesh as arrays (`mesh.kind` becomes `"given"`): `points` (n, 2) or (n,
     /// 3) floats; `cells` (m, 3) triangles or (m, 4) quadrilaterals in 2D, (m, 4) tetrahedra in
-    /// 3D, 0-based; `boundary` a dict of named facet arrays ((k, 2) segments in 2D, (k, 3)
-    /// triangles in 3D) for the conditions' groups; `regions` a dict of named cell-index
+    /// 3D, 0-based, or second-order cells ((m, 6) triangles, (m, 10) tetrahedra, their edge
+    /// nodes in VTK's order); `boundary` a dict of named facet arrays ((k, 2) segments in 2D,
+    /// (k, 3) triangles in 3D; of a second-order mesh (k, 3) and (k, 6), the corners then the
+    /// edges' midpoints) for the conditions' groups; `regions` a dict of named cell-index
     /// arrays for the materials (default: all cells in `"body"`). Cells numbered clockwise
     /// (2D) or negatively (3D) throughout are turned round. The mesh is checked as a file's
     /// is (`MeshError`). The arrays replace only how the mesh was made: the `[mesh]` keys that
@@ -376,9 +378,14 @@ impl Scene {
         for item in boundary.items()?.iter() {
             let (name, facets): (String, Bound<'_, PyAny>) = item.extract()?;
             let (flat, width) = indices(py, &facets, &format!("boundary[{name:?}]"))?;
-            if !flat.is_empty() && width != dim {
+            // a facet of a second-order mesh: its corners, then its edges' midpoints
+            let expected = match mesh::CellKind::of(dim, nodes_per_cell) {
+                Some(kind) => kind.facet_n_nodes(),
+                None => dim,
+            };
+            if !flat.is_empty() && width != expected {
                 return Err(Kind::Mesh.err(format!(
-                    "mesh arrays: boundary[{name:?}] has facets of {width} nodes: {dim} in {dim}D"
+                    "mesh arrays: boundary[{name:?}] has facets of {width} nodes: {expected} for cells of {nodes_per_cell} nodes in {dim}D"
                 )));
             }
             boundaries.insert(name, flat);

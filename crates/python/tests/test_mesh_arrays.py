@@ -2,6 +2,7 @@
 
 import meshio
 import numpy as np
+import pytest
 
 import piezocontact as pc
 
@@ -101,3 +102,33 @@ def test_a_3d_mesh_as_arrays_gives_the_generated_answer():
     given = pc.run(scene)
     assert np.abs(given.u - generated.u).max() <= 1e-12 * np.abs(generated.u).max()
     assert np.isclose(given.report["contact"]["normal_force"], generated.report["contact"]["normal_force"], rtol=1e-12)
+
+
+def test_quadratic_elements_from_the_scene_and_as_arrays():
+    # mesh.order = 2 raises the generated mesh: six-node triangles, the manufactured error far
+    # below order 1's on the same cells
+    p1 = pc.run(pc.Scene.load("manufactured", {"mesh.n": 8}))
+    p2 = pc.run(pc.Scene.load("manufactured", {"mesh.n": 8, "mesh.order": 2}))
+    assert p2.cell_type == "triangle6" and np.asarray(p2.cells).shape == (np.asarray(p1.cells).shape[0], 6)
+    e1, e2 = (r.report["exact"]["error"] for r in (p1, p2))
+    assert e2 < 0.2 * e1, (e1, e2)
+    # its arrays handed back as a given mesh (edge nodes in VTK's order, facets of 3 nodes)
+    # give the same answer
+    points, cells = np.array(p2.points), np.array(p2.cells)
+    corners = rectangle_groups(points, cells[:, :3])
+    mids = {}
+    for name, edges in corners.items():
+        # each boundary edge's midpoint node: the node of the cell's edge with both corners
+        at = {tuple(sorted((c[a], c[b]))): c[m] for c in cells for a, b, m in ((0, 1, 3), (1, 2, 4), (2, 0, 5))}
+        mids[name] = np.array([[e[0], e[1], at[tuple(sorted(e))]] for e in edges])
+    scene = pc.Scene.load("manufactured", {"mesh.order": 2, "exact.groups": list(mids)})
+    scene.set_mesh(points, cells, mids)
+    given = pc.run(scene)
+    assert given.cell_type == "triangle6"
+    assert np.abs(given.u - p2.u).max() <= 1e-12 * np.abs(p2.u).max()
+    # to meshio: the quadratic cells under their name
+    m = p2.to_meshio()
+    assert m.cells[0].type == "triangle6"
+    # contact at order 2 is refused by its key
+    with pytest.raises(pc.InputError, match="contact on second-order elements"):
+        pc.run(pc.Scene.load("paper", {"mesh.n": 4, "mesh.order": 2}))

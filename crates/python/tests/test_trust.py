@@ -89,12 +89,13 @@ def test_every_form_the_installed_gmsh_writes_reads_as_the_same_mesh(tmp_path):
     except (ImportError, OSError) as e:
         pytest.skip(f"gmsh is not usable here: {e}")
     subprocess.run([sys.executable, str(FORMS / "write_forms.py"), str(tmp_path)], check=True)
-    files = sorted(p for p in tmp_path.glob("2d-*.msh") if "order2" not in p.name)
-    assert len(files) >= 10
+    files = sorted(tmp_path.glob("2d-*.msh"))
+    assert len(files) >= 11
     for f in files:
         check_stack(pc.run(pc.Scene.from_dict(stack(f))))
-    with pytest.raises(pc.MeshError, match="second-order"):
-        pc.run(pc.Scene.from_dict(stack(tmp_path / "2d-ascii-order2.msh")))
+    # the second-order file: six-node triangles, its edge nodes exact too
+    r = pc.run(pc.Scene.from_dict(stack(tmp_path / "2d-ascii-order2.msh")))
+    assert r.cell_type == "triangle6" and np.asarray(r.cells).shape[1] == 6
 
 
 def test_a_body_only_its_bed_holds_runs_and_what_it_leaves_free_is_named():
