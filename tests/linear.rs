@@ -535,3 +535,37 @@ v = 1.0
         "{e}"
     );
 }
+
+/// `piezocontact study --orders 1,2`: both orders over every size, each order's rates its own,
+/// and the pictures drawn with both fronts (the error-against-time plot names each order).
+#[test]
+fn a_study_over_both_orders_gives_both_fronts() {
+    use driver::studies::convergence::{csv, pictures, study, StudySpec};
+    let spec = StudySpec {
+        sizes: vec![8, 16],
+        strategies: vec![problem::Strategy::NewtonCondensed],
+        tols: vec![1e-10],
+        reference_n: None,
+        orders: vec![1, 2],
+    };
+    let s = study("manufactured", &[], &spec, &mut |_| {}).unwrap();
+    assert_eq!(s.orders(), vec![1, 2]);
+    let rates = s.rates();
+    assert_eq!(rates.len(), 2, "{rates:?}");
+    assert!((0.9..1.2).contains(&rates[0].value) && rates[0].order == 1, "{rates:?}");
+    assert!((1.8..2.3).contains(&rates[1].value) && rates[1].order == 2, "{rates:?}");
+    assert!(csv(&s).lines().nth(1).unwrap().starts_with("manufactured,1,8,"));
+    let files = pictures("study", &s).unwrap();
+    let svg = files
+        .iter()
+        .find(|(name, _)| name == "study-error-time.svg")
+        .map(|(_, bytes)| String::from_utf8_lossy(bytes).to_string())
+        .unwrap();
+    assert!(svg.contains("P1: tight runs") && svg.contains("P2: tight runs"));
+    let bad = StudySpec {
+        orders: vec![3],
+        ..spec
+    };
+    let e = study("manufactured", &[], &bad, &mut |_| {}).unwrap_err().to_string();
+    assert!(e.contains("element order 3"), "{e}");
+}

@@ -123,6 +123,10 @@ enum Command {
         /// largest size).
         #[arg(long)]
         reference: Option<usize>,
+        /// Element orders (mesh.order), each over every size: `--orders 1,2` draws both
+        /// fronts of error against run time (default: the scene's).
+        #[arg(long, value_delimiter = ',')]
+        orders: Vec<usize>,
         /// Other overrides.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
@@ -473,11 +477,19 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             strategies,
             tols,
             reference,
+            orders,
             set,
             out,
         } => {
             let scene = scene.unwrap_or_else(|| "paper".into());
-            study(&scene, sizes, strategies, tols, reference, &set, out)
+            let spec = convergence::StudySpec {
+                sizes,
+                strategies,
+                tols,
+                reference_n: reference,
+                orders,
+            };
+            study(&scene, spec, &set, out)
         }
         Command::Verification { full, out } => verification(full, &out),
         Command::Stability {
@@ -675,28 +687,19 @@ fn overrides(set: Vec<String>, unset: Vec<String>) -> Vec<String> {
 /// `piezocontact study`: defaults from the scene, the study, its files.
 fn study(
     scene: &str,
-    mut sizes: Vec<usize>,
-    mut strategies: Vec<Strategy>,
-    tols: Vec<f64>,
-    reference_n: Option<usize>,
+    mut spec: convergence::StudySpec,
     set: &[String],
     out: Option<PathBuf>,
 ) -> Result<(), DriverError> {
     let (base, _) = scene_file::load(scene, set)?;
-    if sizes.is_empty() {
+    if spec.sizes.is_empty() {
         let n = base.mesh.n.unwrap_or(16).max(4);
-        sizes = vec![n / 4, n / 2, n];
+        spec.sizes = vec![n / 4, n / 2, n];
     }
-    if strategies.is_empty() {
-        strategies.push(base.solver.strategy);
+    if spec.strategies.is_empty() {
+        spec.strategies.push(base.solver.strategy);
     }
     let dir = out.unwrap_or_else(|| output::default_dir(&format!("{}-study", base.name)));
-    let spec = convergence::StudySpec {
-        sizes,
-        strategies,
-        tols,
-        reference_n,
-    };
     let study = convergence::study(scene, set, &spec, &mut say)?;
     let mut outs = output::Outputs::new(&dir);
     let md = format!(

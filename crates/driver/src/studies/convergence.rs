@@ -1,5 +1,5 @@
-//! The convergence study (`piezocontact study`): one scene over mesh sizes, strategies and
-//! tolerances, and for every run its error and its wall time.
+//! The convergence study (`piezocontact study`): one scene over element orders, mesh sizes,
+//! strategies and tolerances, and for every run its error and its wall time.
 //!
 //! Every error says what it is measured against:
 //! - a scene with an `[exact]` section is measured against its exact solution (run.json's
@@ -36,11 +36,15 @@ pub struct StudySpec {
     /// The size of the reference run, for a scene without an exact solution (default: four
     /// times the largest size).
     pub reference_n: Option<usize>,
+    /// Element orders (`mesh.order`: 1, 2), each over every size (empty: the scene's own).
+    pub orders: Vec<usize>,
 }
 
 /// One run of the study.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StudyRow {
+    /// The elements' order (`mesh.order`).
+    pub order: usize,
     /// `mesh.n`.
     pub n: usize,
     /// Largest cell diameter.
@@ -74,17 +78,65 @@ pub struct Study {
     pub against: String,
     /// The runs.
     pub rows: Vec<StudyRow>,
-    /// `(n, discretisation error, h)` of the tight runs, coarse to fine.
-    pub tight: Vec<(usize, f64, f64)>,
+    /// The tight runs, per element order coarse to fine.
+    pub tight: Vec<Tight>,
+}
+
+/// A tight run of the study: the discretisation error of its order and size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tight {
+    /// The elements' order.
+    pub order: usize,
+    /// `mesh.n`.
+    pub n: usize,
+    /// The discretisation error.
+    pub error: f64,
+    /// Largest cell diameter.
+    pub h: f64,
+    /// Wall time of the run, s.
+    pub seconds: f64,
+    /// Free unknowns, u + φ.
+    pub dofs: usize,
+}
+
+/// The convergence rate observed between two sizes of one element order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rate {
+    /// The elements' order.
+    pub order: usize,
+    /// The coarser size.
+    pub from: usize,
+    /// The finer size.
+    pub to: usize,
+    /// `log(e0/e1) / log(h0/h1)`.
+    pub value: f64,
 }
 
 impl Study {
-    /// Observed orders `log(e0/e1) / log(h0/h1)` between successive sizes of the tight runs.
-    pub fn rates(&self) -> Vec<(usize, usize, f64)> {
+    /// Observed orders `log(e0/e1) / log(h0/h1)` between successive sizes of the tight runs
+    /// of each element order (the orders in their study's order).
+    pub fn rates(&self) -> Vec<Rate> {
         self.tight
             .windows(2)
-            .map(|w| (w[0].0, w[1].0, (w[0].1 / w[1].1).ln() / (w[0].2 / w[1].2).ln()))
+            .filter(|w| w[0].order == w[1].order)
+            .map(|w| Rate {
+                order: w[0].order,
+                from: w[0].n,
+                to: w[1].n,
+                value: (w[0].error / w[1].error).ln() / (w[0].h / w[1].h).ln(),
+            })
             .collect()
+    }
+
+    /// The element orders of the study, in their order.
+    pub fn orders(&self) -> Vec<usize> {
+        let mut out: Vec<usize> = vec![];
+        for t in &self.tight {
+            if !out.contains(&t.order) {
+                out.push(t.order);
+            }
+        }
+        out
     }
 }
 
@@ -150,8 +202,15 @@ impl Snapshot {
     }
 }
 
-fn settings(sets: &[String], n: usize, strategy: Strategy, tol: f64, has_contact: bool) -> Vec<String> {
+fn settings(
+    sets: &[String],
+    (order, n): (usize, usize),
+    strategy: Strategy,
+    tol: f64,
+    has_contact: bool,
+) -> Vec<String> {
     let mut s = sets.to_vec();
+    s.push(format!("mesh.order={order}"));
     s.push(format!("mesh.n={n}"));
     s.push(format!("solver.strategy=\"{strategy}\""));
     s.push("solver.rule=\"tight\"".into());
@@ -199,14 +258,15 @@ fn check(spec: &StudySpec) -> Result<(), DriverError> {
 }
 
 /// The size of every run of a study, in the order it runs them: the finer reference (without
-/// an exact solution), then per size its tight run and its strategies' runs at each tolerance.
-fn planned_sizes(spec: &StudySpec, sizes: &[usize], has_contact: bool, exact: bool) -> Vec<usize> {
+/// an exact solution), then per order and size its tight run and its strategies' runs at each
+/// tolerance.
+fn planned_sizes(spec: &StudySpec, sizes: &[usize], orders: usize, has_contact: bool, exact: bool) -> Vec<usize> {
     let mut out = vec![];
     if !exact {
         let largest = *sizes.last().unwrap_or(&1);
         out.push(spec.reference_n.unwrap_or(4 * largest));
     }
-    for &n in sizes {
+    for &n in sizes.iter().cycle().take(sizes.len() * orders) {
         out.push(n);
         for strategy in &spec.strategies {
             let tols = if !has_contact && !strategy.runs_pcg() {
@@ -236,18 +296,25 @@ pub fn study(
     sizes.sort_unstable();
     sizes.dedup();
     let (base, _) = files::scene_file::load(scene_name, sets)?;
+    let orders = match spec.orders.is_empty() {
+        true => vec![base.mesh.order.unwrap_or(1)],
+        false => spec.orders.clone(),
+    };
+    if let Some(o) = orders.iter().find(|o| !(1..=2).contains(*o)) {
+        return Err(DriverError::Usage(format!("element order {o}: the orders are 1 and 2")));
+    }
     let has_contact = base.contact_law() != ContactLaw::None;
     // the runs' sizes in the order they run, for the estimate of the time left
-    let mut pending = planned_sizes(spec, &sizes, has_contact, base.exact.is_some());
+    let mut pending = planned_sizes(spec, &sizes, orders.len(), has_contact, base.exact.is_some());
     pending.reverse();
     let mut eta = super::Eta::default();
-    let mut one = |n: usize, strategy: Strategy, tol: f64| -> Result<Solution, DriverError> {
+    let mut one = |(order, n): (usize, usize), strategy: Strategy, tol: f64| -> Result<Solution, DriverError> {
         let t = std::time::Instant::now();
-        let r = solve(scene_name, &settings(sets, n, strategy, tol, has_contact))?;
+        let r = solve(scene_name, &settings(sets, (order, n), strategy, tol, has_contact))?;
         eta.record(n, t.elapsed().as_secs_f64());
         pending.pop();
         progress(&format!(
-            "study {}: n = {n}, {strategy}, tol {tol:.0e}: {:.3} s; {} run{} to go, {}",
+            "study {}: order {order}, n = {n}, {strategy}, tol {tol:.0e}: {:.3} s; {} run{} to go, {}",
             base.name,
             r.report.timings_s.total,
             pending.len(),
@@ -256,6 +323,7 @@ pub fn study(
         ));
         Ok(r)
     };
+    let highest = orders.iter().copied().max().unwrap_or(1);
     let reference = match &base.exact {
         Some(_) => Reference::Exact,
         None => {
@@ -266,12 +334,13 @@ pub fn study(
                     "the reference size {n_ref} must be a multiple of the largest size {largest}, and larger"
                 )));
             }
-            Reference::Finer(n_ref, Snapshot::of(&one(n_ref, Strategy::NewtonCondensed, TIGHT_TOL)?))
+            let run = one((highest, n_ref), Strategy::NewtonCondensed, TIGHT_TOL)?;
+            Reference::Finer(n_ref, Snapshot::of(&run))
         }
     };
     let against = match (&reference, &base.exact) {
         (Reference::Finer(n_ref, _), _) => format!(
-            "a tight run on the finer mesh n = {n_ref}: relative l2 difference of the {} ",
+            "a tight run on the finer mesh n = {n_ref} (order {highest}): relative l2 difference of the {} ",
             if has_contact {
                 "contact multipliers at the coarse contact nodes"
             } else {
@@ -283,36 +352,46 @@ pub fn study(
     };
     let mut rows = vec![];
     let mut tight = vec![];
-    for &n in &sizes {
-        let t_run = one(n, Strategy::NewtonCondensed, TIGHT_TOL)?;
-        let t_snap = Snapshot::of(&t_run);
-        let disc = reference.error_of(&t_snap)?;
-        let h = t_run.report.mesh.h;
-        tight.push((n, disc, h));
-        for &strategy in &spec.strategies {
-            // a direct solve without contact has no tolerance: one run stands for all
-            let tols = if !has_contact && !strategy.runs_pcg() {
-                &spec.tols[..1]
-            } else {
-                &spec.tols[..]
-            };
-            for &tol in tols {
-                let r = one(n, strategy, tol)?;
-                let snap = Snapshot::of(&r);
-                let (iterations, iteration_kind) = r.report.iterations.outer(strategy);
-                rows.push(StudyRow {
-                    n,
-                    h,
-                    dofs: r.report.dofs.total(),
-                    strategy,
-                    tol,
-                    iterations,
-                    iteration_kind,
-                    seconds: r.report.timings_s.total,
-                    error: reference.error_of(&snap)?,
-                    discretisation: disc,
-                    algebraic: snap.difference(&t_snap)?,
-                });
+    for &order in &orders {
+        for &n in &sizes {
+            let t_run = one((order, n), Strategy::NewtonCondensed, TIGHT_TOL)?;
+            let t_snap = Snapshot::of(&t_run);
+            let disc = reference.error_of(&t_snap)?;
+            let h = t_run.report.mesh.h;
+            tight.push(Tight {
+                order,
+                n,
+                error: disc,
+                h,
+                seconds: t_run.report.timings_s.total,
+                dofs: t_run.report.dofs.total(),
+            });
+            for &strategy in &spec.strategies {
+                // a direct solve without contact has no tolerance: one run stands for all
+                let tols = if !has_contact && !strategy.runs_pcg() {
+                    &spec.tols[..1]
+                } else {
+                    &spec.tols[..]
+                };
+                for &tol in tols {
+                    let r = one((order, n), strategy, tol)?;
+                    let snap = Snapshot::of(&r);
+                    let (iterations, iteration_kind) = r.report.iterations.outer(strategy);
+                    rows.push(StudyRow {
+                        order,
+                        n,
+                        h,
+                        dofs: r.report.dofs.total(),
+                        strategy,
+                        tol,
+                        iterations,
+                        iteration_kind,
+                        seconds: r.report.timings_s.total,
+                        error: reference.error_of(&snap)?,
+                        discretisation: disc,
+                        algebraic: snap.difference(&t_snap)?,
+                    });
+                }
             }
         }
     }
@@ -327,13 +406,14 @@ pub fn study(
 /// The study as CSV.
 pub fn csv(s: &Study) -> String {
     let mut out = String::from(
-        "scene,n,h,dofs,strategy,tol,iterations,iteration_kind,seconds,error,discretisation_error,algebraic_error\n",
+        "scene,order,n,h,dofs,strategy,tol,iterations,iteration_kind,seconds,error,discretisation_error,algebraic_error\n",
     );
     for r in &s.rows {
         let _ = writeln!(
             out,
-            "{},{},{:.6e},{},{},{:.1e},{},{},{:.6e},{:.6e},{:.6e},{:.6e}",
+            "{},{},{},{:.6e},{},{},{:.1e},{},{},{:.6e},{:.6e},{:.6e},{:.6e}",
             s.scene,
+            r.order,
             r.n,
             r.h,
             r.dofs,
@@ -355,26 +435,33 @@ pub fn csv(s: &Study) -> String {
 pub fn markdown(s: &Study, img: &str) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "Errors against {}.\n", s.against);
-    let _ = writeln!(out, "| n | h | discretisation error | observed order |");
-    let _ = writeln!(out, "|---|---|---|---|");
+    let _ = writeln!(
+        out,
+        "| order | n | h | unknowns | time (s) | discretisation error | observed order |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|");
     let rates = s.rates();
-    for (i, (n, e, h)) in s.tight.iter().enumerate() {
-        let rate = if i == 0 {
-            "-".to_string()
-        } else {
-            format!("{:.2}", rates[i - 1].2)
-        };
-        let _ = writeln!(out, "| {n} | {h:.4e} | {e:.3e} | {rate} |");
+    for t in &s.tight {
+        let rate = rates
+            .iter()
+            .find(|r| r.order == t.order && r.to == t.n)
+            .map_or("-".to_string(), |r| format!("{:.2}", r.value));
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.4e} | {} | {:.3} | {:.3e} | {rate} |",
+            t.order, t.n, t.h, t.dofs, t.seconds, t.error
+        );
     }
     let _ = writeln!(
         out,
-        "\n| n | dofs | strategy | tol | iterations | time (s) | error | discretisation | algebraic |"
+        "\n| order | n | dofs | strategy | tol | iterations | time (s) | error | discretisation | algebraic |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|");
     for r in &s.rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {:.0e} | {} {} | {:.3} | {:.3e} | {:.3e} | {:.3e} |",
+            "| {} | {} | {} | {} | {:.0e} | {} {} | {:.3} | {:.3e} | {:.3e} | {:.3e} |",
+            r.order,
             r.n,
             r.dofs,
             r.strategy,
@@ -396,22 +483,40 @@ pub fn markdown(s: &Study, img: &str) -> String {
     out
 }
 
-/// The three pictures of a study: error against time (one colour per strategy, a line per
-/// size through its tolerances), discretisation error against h, iterations against h (a line
-/// per strategy, at its tightest tolerance). Names start with `prefix`.
+/// The three pictures of a study: error against time (one colour per strategy and element
+/// order, a line per size through its tolerances; with several orders each order's front of
+/// tight runs too), discretisation error against h (a line per order), iterations against h (a
+/// line per strategy and order, at its tightest tolerance). Names start with `prefix`.
 ///
 /// # Errors
 /// [`files::Error::Picture`] where plotters cannot draw.
 pub fn pictures(prefix: &str, s: &Study) -> Result<plots::Files, DriverError> {
-    let mut strategies: Vec<Strategy> = vec![];
+    let orders = s.orders();
+    let several = orders.len() > 1;
+    let named = |what: &str, order: usize| match several {
+        true => format!("{what}, P{order}"),
+        false => what.to_string(),
+    };
+    let mut kinds: Vec<(Strategy, usize)> = vec![];
     for r in &s.rows {
-        if !strategies.contains(&r.strategy) {
-            strategies.push(r.strategy);
+        if !kinds.contains(&(r.strategy, r.order)) {
+            kinds.push((r.strategy, r.order));
         }
     }
     let (mut time, mut iters) = (vec![], vec![]);
-    for &st in &strategies {
-        let rows: Vec<&StudyRow> = s.rows.iter().filter(|r| r.strategy == st).collect();
+    if several {
+        for &order in &orders {
+            let front = s
+                .tight
+                .iter()
+                .filter(|t| t.order == order)
+                .map(|t| (t.seconds, t.error))
+                .collect();
+            time.push(Series::line(&format!("P{order}: tight runs"), front));
+        }
+    }
+    for &(st, order) in &kinds {
+        let rows: Vec<&StudyRow> = s.rows.iter().filter(|r| r.strategy == st && r.order == order).collect();
         let mut sizes: Vec<usize> = rows.iter().map(|r| r.n).collect();
         sizes.dedup();
         for (i, n) in sizes.iter().enumerate() {
@@ -421,21 +526,29 @@ pub fn pictures(prefix: &str, s: &Study) -> Result<plots::Files, DriverError> {
                 .map(|r| (r.seconds, r.error))
                 .collect();
             p.sort_by(|a, b| a.0.total_cmp(&b.0));
-            // one colour per strategy; a line per size joins its tolerances
-            time.push(Series::line(if i == 0 { st.name() } else { "" }, p));
+            // one colour per strategy and order; a line per size joins its tolerances
+            let label = if i == 0 { named(st.name(), order) } else { String::new() };
+            time.push(Series::line(&label, p));
         }
         let tightest = rows.iter().map(|r| r.tol).fold(f64::INFINITY, f64::min);
         let at_tightest = rows.iter().filter(|r| r.tol == tightest);
         iters.push(Series::line(
-            st.name(),
+            &named(st.name(), order),
             at_tightest.map(|r| (r.h, r.iterations.max(1) as f64)).collect(),
         ));
     }
-    let label = match s.rates().last() {
-        Some(r) => format!("tight runs (last order {:.2})", r.2),
-        None => "tight runs".to_string(),
-    };
-    let err_h = [Series::line(&label, s.tight.iter().map(|&(_, e, h)| (h, e)).collect())];
+    let rates = s.rates();
+    let err_h: Vec<Series> = orders
+        .iter()
+        .map(|&order| {
+            let label = match rates.iter().rev().find(|r| r.order == order) {
+                Some(r) => format!("tight runs (last order {:.2})", r.value),
+                None => "tight runs".to_string(),
+            };
+            let points = s.tight.iter().filter(|t| t.order == order).map(|t| (t.h, t.error));
+            Series::line(&named(&label, order), points.collect())
+        })
+        .collect();
     let mut out = plots::loglog(
         &format!("{prefix}-error-time"),
         &format!("{}: error against run time", s.scene),
@@ -467,10 +580,27 @@ mod tests {
             scene: "x".into(),
             against: "y".into(),
             rows: vec![],
-            tight: vec![(4, 1.0, 0.5), (8, 0.25, 0.25), (16, 0.125, 0.125)],
+            tight: [
+                (1, 4, 1.0, 0.5),
+                (1, 8, 0.25, 0.25),
+                (1, 16, 0.125, 0.125),
+                (2, 4, 0.1, 0.5),
+                (2, 8, 0.0125, 0.25),
+            ]
+            .map(|(order, n, error, h)| Tight {
+                order,
+                n,
+                error,
+                h,
+                seconds: 1.0,
+                dofs: 1,
+            })
+            .to_vec(),
         };
         let r = s.rates();
-        assert!((r[0].2 - 2.0).abs() < 1e-12 && (r[1].2 - 1.0).abs() < 1e-12);
+        assert_eq!(r.len(), 3, "no rate across two orders");
+        assert!((r[0].value - 2.0).abs() < 1e-12 && (r[1].value - 1.0).abs() < 1e-12);
+        assert!((r[2].value - 3.0).abs() < 1e-12 && r[2].order == 2);
     }
 
     #[test]
@@ -480,6 +610,7 @@ mod tests {
             strategies: vec![Strategy::NewtonCondensed],
             tols: vec![-1e-6],
             reference_n: None,
+            orders: vec![],
         };
         let e = study("paper", &[], &spec, &mut |_| {}).unwrap_err().to_string();
         assert!(e.contains("tolerance -0.000001 must be positive"), "{e}");

@@ -20,6 +20,8 @@ pub struct Entry {
     pub sizes: (&'static [usize], &'static [usize]),
     /// Reference size for scenes without an exact solution (quick, full).
     pub reference: (Option<usize>, Option<usize>),
+    /// Element orders (`mesh.order`), each over every size.
+    pub orders: &'static [usize],
     /// Strategies.
     pub strategies: &'static [Strategy],
     /// Tolerances.
@@ -31,7 +33,7 @@ pub struct Entry {
 }
 
 fn last_rate(s: &Study) -> f64 {
-    s.rates().last().map_or(f64::NAN, |r| r.2)
+    s.rates().last().map_or(f64::NAN, |r| r.value)
 }
 
 /// Whether the observed order on the finest pair of sizes lies in `range`.
@@ -45,12 +47,12 @@ fn last_order_within(s: &Study, range: std::ops::Range<f64>) -> Result<(), Strin
 }
 
 fn finest(s: &Study) -> f64 {
-    s.tight.last().map_or(f64::NAN, |t| t.1)
+    s.tight.last().map_or(f64::NAN, |t| t.error)
 }
 
 /// Whether the error falls from each size to the next and ends below `bound`.
 fn falls_to_below(s: &Study, bound: f64) -> Result<(), String> {
-    let falls = s.tight.windows(2).all(|w| w[1].1 < w[0].1);
+    let falls = s.tight.windows(2).all(|w| w[1].error < w[0].error);
     let e = finest(s);
     if falls && e < bound {
         Ok(())
@@ -65,6 +67,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "patch",
         sizes: (&[2, 4, 8], &[2, 4, 8, 16]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, UzawaSchurPcg],
         tols: &[1e-12],
         claim: "an affine (u, φ) is reproduced to round-off: relative energy error below 1e-11 on every mesh and strategy",
@@ -77,6 +80,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "manufactured",
         sizes: (&[4, 8, 16, 32], &[4, 8, 16, 32, 64, 128]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, UzawaSchurPcg],
         tols: &[1e-6, 1e-10],
         claim: "P1 converges at order 1 in the energy norm (observed order between 0.95 and 1.2 on the finest pair)",
@@ -86,20 +90,49 @@ pub const ENTRIES: &[Entry] = &[
         scene: "manufactured-3d",
         sizes: (&[2, 4, 8], &[2, 4, 8, 16]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, UzawaSchurPcg],
         tols: &[1e-6, 1e-10],
         claim: "order 1 in the energy norm in 3D (between 0.9 and 1.2 on the finest pair)",
         check: |s| last_order_within(s, 0.9..1.2),
     },
     Entry {
+        scene: "manufactured",
+        sizes: (&[4, 8, 16], &[4, 8, 16, 32, 64]),
+        reference: (None, None),
+        orders: &[1, 2],
+        strategies: &[NewtonCondensed],
+        tols: &[1e-10],
+        claim: "quadratic elements (mesh.order = 2) converge at order 2 in the energy norm (observed order between 1.85 and 2.3 on the finest pair), and at every size below a fifth of P1's error",
+        check: |s| {
+            last_order_within(s, 1.85..2.3)?;
+            let at = |order: usize, n: usize| s.tight.iter().find(|t| t.order == order && t.n == n).map(|t| t.error);
+            match s.tight.iter().filter(|t| t.order == 1).find(|t| at(2, t.n).is_none_or(|e| e >= 0.2 * t.error)) {
+                Some(t) => Err(format!("n = {}: P1 {:.3e}, P2 {:?}", t.n, t.error, at(2, t.n))),
+                None => Ok(()),
+            }
+        },
+    },
+    Entry {
+        scene: "manufactured-3d",
+        sizes: (&[2, 4], &[2, 4, 8]),
+        reference: (None, None),
+        orders: &[2],
+        strategies: &[NewtonCondensed],
+        tols: &[1e-10],
+        claim: "quadratic elements in 3D: order 2 in the energy norm (between 1.75 and 2.3 on the finest pair: the coarse pair is pre-asymptotic)",
+        check: |s| last_order_within(s, 1.75..2.3),
+    },
+    Entry {
         scene: "hertz",
         sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, ApgCondensed],
         tols: &[1e-6, 1e-10],
         claim: "the contact pressure approaches Hertz's: profile error below 3 % on the finest mesh and below half the coarsest's (the block's finite size leaves about 1 %)",
         check: |s| {
-            let (first, e) = (s.tight.first().map_or(f64::NAN, |t| t.1), finest(s));
+            let (first, e) = (s.tight.first().map_or(f64::NAN, |t| t.error), finest(s));
             if e < 0.03 && e < 0.5 * first {
                 Ok(())
             } else {
@@ -111,6 +144,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "hertz-sphere",
         sizes: (&[96, 128, 160], &[96, 128, 160, 192]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, ApgCondensed],
         tols: &[1e-6, 1e-10],
         claim: "on a body of revolution under a sphere, the contact pressure approaches Hertz's: profile error falling with h, below 1 % on the finest mesh (the body's finite size leaves about 0.4 %)",
@@ -120,6 +154,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "indent-sphere",
         sizes: (&[96, 128, 160], &[96, 128, 160, 224]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, ApgCondensed],
         tols: &[1e-6, 1e-10],
         claim: "a PZT-4 body of revolution under an insulating sphere carries the half-space's force (problem::halfspace's closed form): error falling with h, below 1 % on the finest mesh (the body's finite size leaves about 0.5 %, halving as the body doubles: docs/theory.md)",
@@ -129,6 +164,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "indent-cone",
         sizes: (&[96, 128, 160], &[96, 128, 160, 224]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, ApgCondensed],
         tols: &[1e-6, 1e-10],
         claim: "a PZT-4 body of revolution under an insulating 70° cone carries the half-space's force (problem::halfspace, Sneddon's cone through the correspondence principle): error falling with h, below 1 % on the finest mesh (the tip's pressure singular, the body's size effect as the sphere's)",
@@ -138,12 +174,13 @@ pub const ENTRIES: &[Entry] = &[
         scene: "cattaneo-mindlin",
         sizes: (&[48, 96, 192], &[48, 96, 192, 384]),
         reference: (None, None),
+        orders: &[1],
         strategies: &[NewtonCondensed, ApgCondensed],
         tols: &[1e-6, 1e-10],
         claim: "the tangential traction approaches Cattaneo-Mindlin's: error falling with h, below 12 % at n = 192 (β = 0.048 and P1 near-incompressibility remain, see the scene)",
         check: |s| {
-            let falls = s.tight.windows(2).all(|w| w[1].1 < w[0].1);
-            let at192 = s.tight.iter().find(|t| t.0 == 192).map_or(f64::NAN, |t| t.1);
+            let falls = s.tight.windows(2).all(|w| w[1].error < w[0].error);
+            let at192 = s.tight.iter().find(|t| t.n == 192).map_or(f64::NAN, |t| t.error);
             if falls && at192 < 0.12 {
                 Ok(())
             } else {
@@ -155,6 +192,7 @@ pub const ENTRIES: &[Entry] = &[
         scene: "paper",
         sizes: (&[8, 16, 32, 64], &[16, 32, 64, 128]),
         reference: (Some(256), Some(512)),
+        orders: &[1],
         strategies: &[NewtonCondensed, ApgCondensed, UzawaCondensed, UzawaSchurPcg],
         tols: &[1e-2, 1e-4, 1e-6, 1e-8],
         claim: "the multipliers converge under refinement (observed order above 0.8 against the finer mesh), and every strategy reaches the tight run's answer as its tolerance falls",
@@ -234,6 +272,7 @@ fn run_entry(
         strategies: entry.strategies.to_vec(),
         tols: entry.tols.to_vec(),
         reference_n: if full { entry.reference.1 } else { entry.reference.0 },
+        orders: entry.orders.to_vec(),
     };
     let t = Instant::now();
     let study = convergence::study(entry.scene, &[], &spec, progress)?;
