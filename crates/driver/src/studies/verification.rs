@@ -252,7 +252,8 @@ pub fn smoke(progress: &mut dyn FnMut(&str)) -> Vec<SmokeRow> {
 
 /// One study of the report, done: its section of the page and its summary line.
 struct Done {
-    scene: &'static str,
+    /// The scene, with its element orders where they are not P1's alone.
+    scene: String,
     rate: f64,
     finest: f64,
     seconds: f64,
@@ -278,9 +279,20 @@ fn run_entry(
     let study = convergence::study(entry.scene, &[], &spec, progress)?;
     let seconds = t.elapsed().as_secs_f64();
     let verdict = (entry.check)(&study);
-    let prefix = format!("verification-{}", entry.scene);
+    // a scene studied at other orders than P1's alone is named with them (one file each)
+    let (named, suffix) = match entry.orders {
+        [1] => (format!("`{}`", entry.scene), String::new()),
+        orders => {
+            let list: Vec<String> = orders.iter().map(|o| format!("P{o}")).collect();
+            (
+                format!("`{}` ({})", entry.scene, list.join(", ")),
+                format!("-{}", list.join("-").to_lowercase()),
+            )
+        }
+    };
+    let prefix = format!("verification-{}{suffix}", entry.scene);
     pictures.extend(convergence::pictures(&prefix, &study)?);
-    let mut section = format!("## `{}`\n\n", entry.scene);
+    let mut section = format!("## {named}\n\n");
     let _ = writeln!(
         section,
         "Claim: {}. **{}**{}.\n",
@@ -291,7 +303,7 @@ fn run_entry(
     section.push_str(&convergence::markdown(&study, &format!("img/{prefix}")));
     section.push('\n');
     let done = Done {
-        scene: entry.scene,
+        scene: named,
         rate: last_rate(&study),
         finest: finest(&study),
         seconds,
