@@ -167,23 +167,44 @@ fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(
     Ok(())
 }
 
-/// Lumped boundary mass of each node on `group`: each facet's measure shared equally among its
-/// nodes; on a body of revolution ([`Coordinates::Axisymmetric`]), the ring's, `∫ N_a 2π r ds = 2π L (2 r_a +
-/// r_b) / 6` for the segment of length L from node a to node b.
+/// The boundary mass of each node on `group`, `∫ N_a ds` over its facets: with P1 each
+/// facet's measure shared equally among its nodes; on a body of revolution
+/// ([`Coordinates::Axisymmetric`]), the ring's, `∫ N_a 2π r ds = 2π L (2 r_a + r_b) / 6` for
+/// the segment of length L from node a to node b. A second-order segment (2D, its corners then
+/// its midpoint) gives Simpson's `L / 6, L / 6, 2 L / 3`, and on a body of revolution
+/// `2π L (r_a / 6, r_b / 6, (r_a + r_b) / 3)` (the corners' share of the linear part of `r`
+/// vanishes: `∫ s (1 - s)(1 - 2s) ds = 0`), so a corner on the axis weighs nothing.
 fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup, coordinates: Coordinates) -> Vec<f64> {
     let mut weight = vec![0.0; mesh.n_nodes()];
+    let ring = coordinates == Coordinates::Axisymmetric;
     for f in group.iter() {
         let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
-        let len = facet_measure(&x);
-        if coordinates == Coordinates::Axisymmetric {
-            let (ra, rb) = (x[0][0], x[1][0]);
-            weight[f[0]] += std::f64::consts::TAU * len * (2.0 * ra + rb) / 6.0;
-            weight[f[1]] += std::f64::consts::TAU * len * (ra + 2.0 * rb) / 6.0;
-            continue;
-        }
-        let m = len / f.len() as f64;
-        for &v in f {
-            weight[v] += m;
+        let corners = &x[..mesh.dim.min(x.len())];
+        let len = facet_measure(corners);
+        let tau = std::f64::consts::TAU;
+        match (f.len(), ring) {
+            (3, true) if mesh.dim == 2 => {
+                let (ra, rb) = (x[0][0], x[1][0]);
+                weight[f[0]] += tau * len * ra / 6.0;
+                weight[f[1]] += tau * len * rb / 6.0;
+                weight[f[2]] += tau * len * (ra + rb) / 3.0;
+            }
+            (3, false) if mesh.dim == 2 => {
+                weight[f[0]] += len / 6.0;
+                weight[f[1]] += len / 6.0;
+                weight[f[2]] += 2.0 * len / 3.0;
+            }
+            (_, true) => {
+                let (ra, rb) = (x[0][0], x[1][0]);
+                weight[f[0]] += tau * len * (2.0 * ra + rb) / 6.0;
+                weight[f[1]] += tau * len * (ra + 2.0 * rb) / 6.0;
+            }
+            (n, false) => {
+                let m = len / n as f64;
+                for &v in f {
+                    weight[v] += m;
+                }
+            }
         }
     }
     weight
@@ -309,6 +330,19 @@ impl ContactBoundary {
         let (mut added, mut held_nodes, mut out_of_reach) = (0, 0, 0);
         for node in group.nodes() {
             let x = mesh.points[node];
+            if !(weight[node] > 0.0) {
+                // a second-order corner on the axis of a body of revolution: no force of the
+                // face's acts on it, so its contact law could hold nothing there
+                return Err(SetupError::new(
+                    "mesh.order",
+                    format!(
+                        "node {node} of contact group `{}` (at {:?}) carries no weight of the face (∫ N 2πr ds = 0: a second-order corner on the axis), so contact could not act on it: solve this body of revolution at mesh.order = 1 (a basis with positive weights is not built yet)",
+                        spec.group,
+                        &x[..dim]
+                    ),
+                )
+                .into());
+            }
             let Some(gap) = spec.gap_at(&x, &nv) else {
                 // beyond the indenter's shape (a punch's edge, a sphere's equator)
                 out_of_reach += 1;
