@@ -1,6 +1,6 @@
 //! `piezocontact`: the command line. See `piezocontact --help`.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use driver::studies::{convergence, stability, sweep, table1, verification};
 use driver::{fclib, DriverError};
 use files::{output, scene_file};
@@ -105,35 +105,9 @@ enum Command {
         #[arg(long, default_value = "docs")]
         out: PathBuf,
     },
-    /// Error against h and against run time: a scene over mesh sizes, strategies and
-    /// tolerances; writes study.md, study.csv and log-log plots (SVG, PNG).
-    Study {
-        /// Scene name or file (default: paper).
-        scene: Option<String>,
-        /// Mesh sizes mesh.n (default: the scene's n/4, n/2, n).
-        #[arg(long, value_delimiter = ',')]
-        sizes: Vec<usize>,
-        /// Strategies (default: the scene's).
-        #[arg(long, value_delimiter = ',')]
-        strategies: Vec<Strategy>,
-        /// Tolerances (default: 1e-4, 1e-6, 1e-8).
-        #[arg(long, value_delimiter = ',', default_values_t = [1e-4, 1e-6, 1e-8])]
-        tols: Vec<f64>,
-        /// Size of the reference run for a scene without an exact solution (default: 4 x the
-        /// largest size).
-        #[arg(long)]
-        reference: Option<usize>,
-        /// Element orders (mesh.order), each over every size: `--orders 1,2` draws both
-        /// fronts of error against run time (default: the scene's).
-        #[arg(long, value_delimiter = ',')]
-        orders: Vec<usize>,
-        /// Other overrides.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Output directory (default: out/SCENE-study/).
-        #[arg(long)]
-        out: Option<PathBuf>,
-    },
+    /// Error against h and against run time: a scene over element orders, mesh sizes,
+    /// strategies and tolerances; writes study.md, study.csv and log-log plots (SVG, PNG).
+    Study(StudyArgs),
     /// Solve third-party frictional contact problems (Siconos' text format, e.g. FCLib's test
     /// problems) with the contact crate alone; prints one line per file.
     Fclib {
@@ -178,6 +152,36 @@ enum Command {
         #[arg(long)]
         ranks: Option<usize>,
     },
+}
+
+/// The arguments of `piezocontact study`.
+#[derive(Args)]
+struct StudyArgs {
+    /// Scene name or file (default: paper).
+    scene: Option<String>,
+    /// Mesh sizes mesh.n (default: the scene's n/4, n/2, n).
+    #[arg(long, value_delimiter = ',')]
+    sizes: Vec<usize>,
+    /// Strategies (default: the scene's).
+    #[arg(long, value_delimiter = ',')]
+    strategies: Vec<Strategy>,
+    /// Tolerances (default: 1e-4, 1e-6, 1e-8).
+    #[arg(long, value_delimiter = ',', default_values_t = [1e-4, 1e-6, 1e-8])]
+    tols: Vec<f64>,
+    /// Size of the reference run for a scene without an exact solution (default: 4 x the
+    /// largest size).
+    #[arg(long)]
+    reference: Option<usize>,
+    /// Element orders (mesh.order), each over every size: `--orders 1,2` draws both
+    /// fronts of error against run time (default: the scene's).
+    #[arg(long, value_delimiter = ',')]
+    orders: Vec<usize>,
+    /// Other overrides.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Output directory (default: out/SCENE-study/).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 /// Lines to stderr, and a progress bar for the contact solve when stderr is a terminal; along
@@ -471,26 +475,7 @@ fn dispatch(command: Command) -> Result<(), DriverError> {
             o.add("table1.md", md.into_bytes());
             Ok(o.commit()?)
         }
-        Command::Study {
-            scene,
-            sizes,
-            strategies,
-            tols,
-            reference,
-            orders,
-            set,
-            out,
-        } => {
-            let scene = scene.unwrap_or_else(|| "paper".into());
-            let spec = convergence::StudySpec {
-                sizes,
-                strategies,
-                tols,
-                reference_n: reference,
-                orders,
-            };
-            study(&scene, spec, &set, out)
-        }
+        Command::Study(args) => study(args),
         Command::Verification { full, out } => verification(full, &out),
         Command::Stability {
             quick,
@@ -685,12 +670,26 @@ fn overrides(set: Vec<String>, unset: Vec<String>) -> Vec<String> {
 }
 
 /// `piezocontact study`: defaults from the scene, the study, its files.
-fn study(
-    scene: &str,
-    mut spec: convergence::StudySpec,
-    set: &[String],
-    out: Option<PathBuf>,
-) -> Result<(), DriverError> {
+fn study(args: StudyArgs) -> Result<(), DriverError> {
+    let StudyArgs {
+        scene,
+        sizes,
+        strategies,
+        tols,
+        reference,
+        orders,
+        set,
+        out,
+    } = args;
+    let scene = scene.unwrap_or_else(|| "paper".into());
+    let mut spec = convergence::StudySpec {
+        sizes,
+        strategies,
+        tols,
+        reference_n: reference,
+        orders,
+    };
+    let (scene, set) = (&scene[..], &set[..]);
     let (base, _) = scene_file::load(scene, set)?;
     if spec.sizes.is_empty() {
         let n = base.mesh.n.unwrap_or(16).max(4);

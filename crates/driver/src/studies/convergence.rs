@@ -350,49 +350,12 @@ pub fn study(
         (Reference::Exact, Some(x)) => format!("the exact solution ({}): {}", x.kind, x.kind.measures()),
         (Reference::Exact, None) => String::new(),
     };
-    let mut rows = vec![];
-    let mut tight = vec![];
+    let (mut rows, mut tight) = (vec![], vec![]);
     for &order in &orders {
         for &n in &sizes {
-            let t_run = one((order, n), Strategy::NewtonCondensed, TIGHT_TOL)?;
-            let t_snap = Snapshot::of(&t_run);
-            let disc = reference.error_of(&t_snap)?;
-            let h = t_run.report.mesh.h;
-            tight.push(Tight {
-                order,
-                n,
-                error: disc,
-                h,
-                seconds: t_run.report.timings_s.total,
-                dofs: t_run.report.dofs.total(),
-            });
-            for &strategy in &spec.strategies {
-                // a direct solve without contact has no tolerance: one run stands for all
-                let tols = if !has_contact && !strategy.runs_pcg() {
-                    &spec.tols[..1]
-                } else {
-                    &spec.tols[..]
-                };
-                for &tol in tols {
-                    let r = one((order, n), strategy, tol)?;
-                    let snap = Snapshot::of(&r);
-                    let (iterations, iteration_kind) = r.report.iterations.outer(strategy);
-                    rows.push(StudyRow {
-                        order,
-                        n,
-                        h,
-                        dofs: r.report.dofs.total(),
-                        strategy,
-                        tol,
-                        iterations,
-                        iteration_kind,
-                        seconds: r.report.timings_s.total,
-                        error: reference.error_of(&snap)?,
-                        discretisation: disc,
-                        algebraic: snap.difference(&t_snap)?,
-                    });
-                }
-            }
+            let (t, mut runs) = one_size((order, n), spec, has_contact, &reference, &mut one)?;
+            tight.push(t);
+            rows.append(&mut runs);
         }
     }
     Ok(Study {
@@ -401,6 +364,58 @@ pub fn study(
         rows,
         tight,
     })
+}
+
+/// The runs of one element order and size: its tight run, then each strategy at each
+/// tolerance (one for all where a direct solve without contact has no tolerance), measured
+/// against `reference` and the tight run.
+fn one_size(
+    (order, n): (usize, usize),
+    spec: &StudySpec,
+    has_contact: bool,
+    reference: &Reference,
+    one: &mut dyn FnMut((usize, usize), Strategy, f64) -> Result<Solution, DriverError>,
+) -> Result<(Tight, Vec<StudyRow>), DriverError> {
+    let t_run = one((order, n), Strategy::NewtonCondensed, TIGHT_TOL)?;
+    let t_snap = Snapshot::of(&t_run);
+    let disc = reference.error_of(&t_snap)?;
+    let h = t_run.report.mesh.h;
+    let tight = Tight {
+        order,
+        n,
+        error: disc,
+        h,
+        seconds: t_run.report.timings_s.total,
+        dofs: t_run.report.dofs.total(),
+    };
+    let mut rows = vec![];
+    for &strategy in &spec.strategies {
+        let tols = if !has_contact && !strategy.runs_pcg() {
+            &spec.tols[..1]
+        } else {
+            &spec.tols[..]
+        };
+        for &tol in tols {
+            let r = one((order, n), strategy, tol)?;
+            let snap = Snapshot::of(&r);
+            let (iterations, iteration_kind) = r.report.iterations.outer(strategy);
+            rows.push(StudyRow {
+                order,
+                n,
+                h,
+                dofs: r.report.dofs.total(),
+                strategy,
+                tol,
+                iterations,
+                iteration_kind,
+                seconds: r.report.timings_s.total,
+                error: reference.error_of(&snap)?,
+                discretisation: disc,
+                algebraic: snap.difference(&t_snap)?,
+            });
+        }
+    }
+    Ok((tight, rows))
 }
 
 /// The study as CSV.
