@@ -711,30 +711,50 @@ fn a_floating_conducting_zone_among_several_is_a_floating_terminal_where_it_touc
     assert!(dphi <= 1e-9 * scale, "potentials differ by {dphi:e} of {scale:e}");
 }
 
-/// The manufactured solution in contact at order 2 (`mesh.order = 2`): sticking on a
-/// conducting foundation, and sliding under Coulomb's law.
+/// The manufactured solution in contact at order 2 (`mesh.order = 2`): in 2D sticking on a
+/// conducting foundation and sliding under Coulomb's law; in 3D (the modified basis, an
+/// insulated face) sticking and sliding.
 ///
 /// - Source: for P2 the energy-norm error is O(h²) where the solution is smooth (Ciarlet
-///   1978); the contact face's points are the nodes of its three-node segments, weighted by
-///   `∫ N_a ds` (Simpson's `L/6, 2L/3, L/6`: all positive in 2D).
-/// - Expected (measured): sticking 3.88e-4, 9.70e-5, 2.43e-5 at n = 8, 16, 32 (order 2.00);
-///   sliding 6.65e-4, 1.67e-4, 4.19e-5 (2.00); P1's at n = 32: 4.7e-3.
+///   1978); in 2D the contact face's points are the nodes of its three-node segments, weighted
+///   by `∫ N_a ds` (Simpson's `L/6, 2L/3, L/6`); in 3D the modified basis of Popp et al. (2012),
+///   its gap the basis's too (`boundary::MODIFIED_ALPHA`).
+/// - Expected (measured): 2D sticking 3.88e-4, 9.70e-5, 2.43e-5 at n = 8, 16, 32 (order
+///   2.00), sliding 6.65e-4, 1.67e-4, 4.19e-5 (2.00); 3D sticking 5.26e-3, 1.31e-3, 3.29e-4 at
+///   n = 2, 4, 8 (2.00; P1 at n = 8: 2.1e-2), sliding 5.22e-3, 1.34e-3, 3.42e-4 (1.96, 1.98).
 /// - Tolerance: order in [1.9, 2.1].
 #[test]
 fn the_manufactured_solution_in_contact_converges_at_order_two_with_quadratic_elements() {
-    let laws: [(&str, &[&str]); 2] = [
-        ("sticking, conducting", &[]),
-        ("sliding", &["contact.friction=0.3", "exact.slip=2e-3"]),
+    const BOX: [&str; 7] = [
+        "mesh.kind=\"box\"",
+        "mesh.lo=[0.0, 0.0, 0.0]",
+        "mesh.hi=[1.0, 1.0, 1.0]",
+        "material.0.poling=[0.0, 0.0, 1.0]",
+        "contact.normal=[0.0, 0.0, -1.0]",
+        "contact.gap_center=[0.5, 0.5, 0.0]",
+        "contact.electric=\"insulated\"",
     ];
-    for (law, extra) in laws {
-        let errors: Vec<f64> = [8, 16, 32]
+    let sliding = ["contact.friction=0.3", "exact.slip=2e-3"];
+    let mut sliding_3d = BOX.to_vec();
+    sliding_3d.extend(sliding);
+    sliding_3d.push("~contact.foundation_potential");
+    let mut sticking_3d = BOX.to_vec();
+    sticking_3d.push("~contact.foundation_potential");
+    let cases: [(&str, &[&str], [usize; 3]); 4] = [
+        ("2D sticking, conducting", &[], [8, 16, 32]),
+        ("2D sliding", &sliding, [8, 16, 32]),
+        ("3D sticking (the modified basis)", &sticking_3d, [2, 4, 8]),
+        ("3D sliding (the modified basis)", &sliding_3d, [2, 4, 8]),
+    ];
+    for (law, extra, sizes) in cases {
+        let errors: Vec<f64> = sizes
             .iter()
             .map(|n| {
                 let mut sets = vec![format!("mesh.n={n}"), "mesh.order=2".into()];
                 sets.extend(extra.iter().map(|s| s.to_string()));
                 let r =
                     driver::studies::solve("manufactured-conducting", &sets).unwrap_or_else(|e| panic!("{law}: {e}"));
-                assert_eq!(r.mesh.kind, mesh::CellKind::Tri6);
+                assert_eq!(r.mesh.kind.order(), 2);
                 r.report.exact.unwrap().error()
             })
             .collect();

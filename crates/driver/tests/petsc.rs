@@ -146,11 +146,12 @@ fn farthest(a: &problem::Solution, b: &problem::Solution) -> (f64, String) {
         .fold((0.0, String::new()), |m, w| if w.0 > m.0 { w } else { m })
 }
 
-/// Every shipped scene at its smoke size, and some at order 2 too (without contact, and 2D
-/// contact), solved by the PETSc backend and by the default one, agrees to 1e-7 in everything
-/// it reports ([`farthest`]).
+/// Every shipped scene at its smoke size, and some at order 2 too (without contact, with
+/// contact in 2D and in the modified basis), solved by the PETSc backend and by the default
+/// one, agrees to 1e-7 in everything it reports ([`farthest`]).
 fn every_scene_agrees(petsc: &Petsc) {
-    // at order 2 too: the scenes without contact, and 2D contact (a path, electrical contact)
+    // at order 2 too: the scenes without contact, 2D contact (a path, electrical contact),
+    // and the modified basis (3D, a body of revolution, a 3D path with friction)
     let quadratic = [
         "manufactured",
         "manufactured-3d",
@@ -160,6 +161,9 @@ fn every_scene_agrees(petsc: &Petsc) {
         "paper-cycle",
         "manufactured-conducting",
         "cattaneo-mindlin",
+        "paper-3d",
+        "hertz-sphere",
+        "mindlin-sphere-cycle",
     ];
     let orders = scene_file::SHIPPED.iter().map(|s| (s, "mesh.order=1")).chain(
         scene_file::SHIPPED

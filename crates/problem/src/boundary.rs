@@ -32,9 +32,11 @@ pub struct ContactBoundary {
     /// The free u dofs of the points' nodes, point by point, components in order: the dofs the
     /// condensation puts last.
     pub dofs: Vec<usize>,
-    /// Each component (`dim` per point) of the points' displacement: free (its place in
-    /// `dofs`) or prescribed by a Dirichlet condition.
-    slots: Vec<Slot>,
+    /// Each component (`dim` per point) of the points' displacement: a sum of terms, each a
+    /// coefficient times a nodal component, free (its place in `dofs`) or prescribed by a
+    /// Dirichlet condition; one term of coefficient 1, the point's node's, except at the edge
+    /// nodes of a second-order face in the modified basis ([`MODIFIED_ALPHA`]).
+    slots: Vec<Vec<Term>>,
     /// Nodes of the group whose normal displacement a Dirichlet condition prescribes: the
     /// support holds them, and they are no contact points (a clamped corner).
     pub held_nodes: usize,
@@ -52,6 +54,19 @@ pub struct ContactBoundary {
     /// depth), which a load path's `gap` factor scales.
     uniform: Vec<f64>,
 }
+
+/// A term of a contact point's displacement component: its coefficient and the nodal
+/// component it takes.
+type Term = (f64, Slot);
+
+/// The share of each edge function of a second-order contact face moved to its two corners in
+/// the modified basis (`Ñ_i = N_i + α Σ_edges N_ij`, `Ñ_ij = (1 - 2α) N_ij`; Popp, Wohlmuth,
+/// Gee & Wall, SIAM J. Sci. Comput. 34 (2012) B421, whose `α = 1/5` gives a six-node face's
+/// corners `2A/15` and its edges `A/5`): every point's weight positive where a corner's own
+/// vanishes (a 3D face, a corner on the axis of a body of revolution). The points then carry
+/// the displacements of that basis, `û_c = u_c` at a corner and `û_ij = (u_ij - α (u_i +
+/// u_j)) / (1 - 2α)` at an edge node (equal to `u` for every linear field).
+pub const MODIFIED_ALPHA: f64 = 0.2;
 
 /// One displacement component of a contact point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -210,6 +225,71 @@ fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup, coordinates: Coor
     weight
 }
 
+/// The basis of a contact face's points: their weights, and the corners of each edge node
+/// whose displacement the modified basis mixes in (none with P1, or a 2D second-order face
+/// off the axis, whose weights are all positive as they are).
+struct FaceBasis {
+    weight: Vec<f64>,
+    edge_corners: std::collections::HashMap<usize, [usize; 2]>,
+}
+
+impl FaceBasis {
+    /// The basis of `group`: the face's own (`∫ N_a`, [`lumped_weights`]), or on a
+    /// second-order face in 3D or on a body of revolution the modified one
+    /// ([`MODIFIED_ALPHA`]): `w̃_c = ∫ N_c + α Σ ∫ N_e` over the edges at each corner,
+    /// `w̃_e = (1 - 2α) ∫ N_e`.
+    fn of(mesh: &mesh::Mesh, group: &mesh::FacetGroup, coordinates: Coordinates) -> FaceBasis {
+        let own = lumped_weights(mesh, group, coordinates);
+        let modified = mesh.kind.order() == 2 && (mesh.dim == 3 || coordinates == Coordinates::Axisymmetric);
+        if !modified {
+            return FaceBasis {
+                weight: own,
+                edge_corners: Default::default(),
+            };
+        }
+        let alpha = MODIFIED_ALPHA;
+        let edges: &[[usize; 2]] = if mesh.dim == 3 {
+            &[[0, 1], [1, 2], [2, 0]]
+        } else {
+            &[[0, 1]]
+        };
+        let corners = mesh.dim;
+        let mut weight = vec![0.0; mesh.n_nodes()];
+        let mut edge_corners = std::collections::HashMap::new();
+        for f in group.iter() {
+            // the facet's own ∫ N_a, each node's share of this facet alone
+            let single = mesh::FacetGroup {
+                nodes_per_facet: f.len(),
+                facets: f.to_vec(),
+            };
+            let n = lumped_weights(mesh, &single, coordinates);
+            for (e, &[a, b]) in edges.iter().enumerate() {
+                let m = f[corners + e];
+                let ne = n[m];
+                weight[f[a]] += alpha * ne;
+                weight[f[b]] += alpha * ne;
+                weight[m] += (1.0 - 2.0 * alpha) * ne;
+                edge_corners.insert(m, [f[a], f[b]]);
+            }
+            for &c in &f[..corners] {
+                weight[c] += n[c];
+            }
+        }
+        FaceBasis { weight, edge_corners }
+    }
+
+    /// The nodal components point `node`'s displacement is made of: `(coefficient, node)`.
+    fn terms(&self, node: usize) -> Vec<(f64, usize)> {
+        match self.edge_corners.get(&node) {
+            None => vec![(1.0, node)],
+            Some(&[a, b]) => {
+                let (alpha, scale) = (MODIFIED_ALPHA, 1.0 / (1.0 - 2.0 * MODIFIED_ALPHA));
+                vec![(scale, node), (-alpha * scale, a), (-alpha * scale, b)]
+            }
+        }
+    }
+}
+
 impl ContactBoundary {
     /// The contact points of the group of `spec`: its nodes, weighted by their lumped boundary
     /// mass, with the gap `gap + |x - c|²_t / (2R)` (uniform, plus the parabola of a curved
@@ -269,6 +349,18 @@ impl ContactBoundary {
         }
         // the zone that conducts (at most one: validated), its points' potentials condensed
         if let Some((k, spec)) = specs.iter().enumerate().find(|(_, s)| s.electric_law().is_some()) {
+            let modified = disc.mesh.kind.order() == 2 && (dim == 3 || disc.coordinates == Coordinates::Axisymmetric);
+            if modified {
+                // the points' potentials would be the nodes', their weights the modified basis's
+                return Err(SetupError::new(
+                    "contact.electric",
+                    format!(
+                        "electrical contact on a second-order face in 3D or on a body of revolution (group `{}`) is not built yet: its points carry the modified basis's displacements and weights, and the potential's are not made so; solve it at mesh.order = 1",
+                        spec.group
+                    ),
+                )
+                .into());
+            }
             let members = (0..b.nodes.len())
                 .filter(|&i| b.group_of[i] == k)
                 .map(|i| (i, b.nodes[i]));
@@ -325,20 +417,21 @@ impl ContactBoundary {
         check_normal(mesh, spec, nv)?;
         let tangents = tangent_basis(dim, nv);
         let group = mesh.boundary(&spec.group)?;
-        let weight = lumped_weights(mesh, group, disc.coordinates);
+        let basis = FaceBasis::of(mesh, group, disc.coordinates);
+        let weight = &basis.weight;
         let friction = spec.friction();
         let (mut added, mut held_nodes, mut out_of_reach) = (0, 0, 0);
         for node in group.nodes() {
             let x = mesh.points[node];
             if !(weight[node] > 0.0) {
-                // a second-order corner on the axis of a body of revolution: no force of the
-                // face's acts on it, so its contact law could hold nothing there
+                // no force of the face's acts on the point: its law could hold nothing there
                 return Err(SetupError::new(
-                    "mesh.order",
+                    "contact.group",
                     format!(
-                        "node {node} of contact group `{}` (at {:?}) carries no weight of the face (∫ N 2πr ds = 0: a second-order corner on the axis), so contact could not act on it: solve this body of revolution at mesh.order = 1 (a basis with positive weights is not built yet)",
+                        "node {node} of contact group `{}` (at {:?}) carries no weight of the face ({:e}): contact could not act on it (a face of zero measure there?)",
                         spec.group,
-                        &x[..dim]
+                        &x[..dim],
+                        weight[node]
                     ),
                 )
                 .into());
@@ -348,6 +441,15 @@ impl ContactBoundary {
                 out_of_reach += 1;
                 continue;
             };
+            // in the modified basis the gap is the basis's too: `ĝ = Σ c g(x_m)` over the
+            // point's terms, as its displacement is (the constraint `û_n ≤ ĝ` is then the
+            // nodal interpolant's, exact for a quadratic gap)
+            let terms = basis.terms(node);
+            let gap = terms
+                .iter()
+                .map(|&(c, m)| spec.gap_at(&mesh.points[m], &nv).map(|g| c * g))
+                .sum::<Option<f64>>()
+                .unwrap_or(gap);
             let comps: Vec<Dof> = (0..dim).map(|k| dofs.u[node * dim + k]).collect();
             let held = match held_directions(spec, node, &x, &comps, &nv, &tangents)? {
                 Held::Normal(u_n) => {
@@ -361,15 +463,20 @@ impl ContactBoundary {
                 }
                 Held::Tangents(held) => held,
             };
-            for c in &comps {
-                self.slots.push(match *c {
-                    Dof::Free(j) => Slot::Free(*place.entry(j).or_insert_with(|| {
-                        self.dofs.push(j);
-                        self.dofs.len() - 1
-                    })),
-                    Dof::Fixed(v) => Slot::Fixed(v),
-                    Dof::Absent => Slot::Fixed(0.0),
-                });
+            for k in 0..dim {
+                let mut component = Vec::with_capacity(terms.len());
+                for &(c, m) in &terms {
+                    let slot = match dofs.u[m * dim + k] {
+                        Dof::Free(j) => Slot::Free(*place.entry(j).or_insert_with(|| {
+                            self.dofs.push(j);
+                            self.dofs.len() - 1
+                        })),
+                        Dof::Fixed(v) => Slot::Fixed(v),
+                        Dof::Absent => Slot::Fixed(0.0),
+                    };
+                    component.push((c, slot));
+                }
+                self.slots.push(component);
             }
             self.nodes.push(node);
             let p = &mut self.points;
@@ -432,9 +539,11 @@ impl ContactBoundary {
         if let Some((electric, _)) = b.electric.as_mut() {
             electric.potential *= voltage;
         }
-        for (j, slot) in b.slots.iter_mut().enumerate() {
-            if let Slot::Fixed(v) = slot {
-                *v *= displacement[j % dim];
+        for (j, terms) in b.slots.iter_mut().enumerate() {
+            for (_, slot) in terms {
+                if let Slot::Fixed(v) = slot {
+                    *v *= displacement[j % dim];
+                }
             }
         }
         b
@@ -455,17 +564,24 @@ impl ContactBoundary {
         let mut place = vec![usize::MAX; self.dofs.len()];
         let (mut dofs, mut slots) = (vec![], Vec::with_capacity(keep.len() * dim));
         for &i in keep {
-            for slot in &self.slots[i * dim..(i + 1) * dim] {
-                slots.push(match *slot {
-                    Slot::Free(j) => {
-                        if place[j] == usize::MAX {
-                            place[j] = dofs.len();
-                            dofs.push(self.dofs[j]);
-                        }
-                        Slot::Free(place[j])
-                    }
-                    fixed @ Slot::Fixed(_) => fixed,
-                });
+            for terms in &self.slots[i * dim..(i + 1) * dim] {
+                let mut component = Vec::with_capacity(terms.len());
+                for &(c, slot) in terms {
+                    component.push((
+                        c,
+                        match slot {
+                            Slot::Free(j) => {
+                                if place[j] == usize::MAX {
+                                    place[j] = dofs.len();
+                                    dofs.push(self.dofs[j]);
+                                }
+                                Slot::Free(place[j])
+                            }
+                            fixed @ Slot::Fixed(_) => fixed,
+                        },
+                    ));
+                }
+                slots.push(component);
             }
         }
         Some(ContactBoundary {
@@ -542,14 +658,15 @@ impl ContactBoundary {
         let mut out = vec![0.0; self.dofs.len()];
         for i in 0..p.len() {
             for k in 0..dim {
-                let Slot::Free(j) = self.slots[i * dim + k] else {
-                    continue;
-                };
                 let mut f = lambda.normal[i] * p.normal[i][k];
                 for q in 0..nt {
                     f += lambda.tangential[i * nt + q] * p.tangent[i][q][k];
                 }
-                out[j] -= p.weight[i] * f;
+                for &(c, slot) in &self.slots[i * dim + k] {
+                    if let Slot::Free(j) = slot {
+                        out[j] -= c * p.weight[i] * f;
+                    }
+                }
             }
         }
         out
@@ -575,16 +692,16 @@ impl ContactBoundary {
         let mut out = vec![];
         for i in (0..p.len()).filter(|&i| p.foundation_of(i) != contact::Foundation::Rigid) {
             for a in 0..dim {
-                let Slot::Free(ja) = self.slots[i * dim + a] else {
-                    continue;
-                };
-                for b in 0..dim {
-                    let Slot::Free(jb) = self.slots[i * dim + b] else {
-                        continue;
-                    };
-                    let v = k * p.weight[i] * p.normal[i][a] * p.normal[i][b];
-                    if v != 0.0 {
-                        out.push((self.dofs[ja], self.dofs[jb], v));
+                for &(ca, sa) in &self.slots[i * dim + a] {
+                    let Slot::Free(ja) = sa else { continue };
+                    for b in 0..dim {
+                        for &(cb, sb) in &self.slots[i * dim + b] {
+                            let Slot::Free(jb) = sb else { continue };
+                            let v = k * p.weight[i] * ca * cb * p.normal[i][a] * p.normal[i][b];
+                            if v != 0.0 {
+                                out.push((self.dofs[ja], self.dofs[jb], v));
+                            }
+                        }
                     }
                 }
             }
@@ -622,8 +739,13 @@ impl ContactBoundary {
     fn point_u(&self, i: usize, u_c: &[f64]) -> [f64; 3] {
         let dim = self.points.dim;
         std::array::from_fn(|k| match self.slots.get(i * dim + k) {
-            Some(Slot::Free(j)) if k < dim => u_c[*j],
-            Some(Slot::Fixed(v)) if k < dim => *v,
+            Some(terms) if k < dim => terms
+                .iter()
+                .map(|&(c, slot)| match slot {
+                    Slot::Free(j) => c * u_c[j],
+                    Slot::Fixed(v) => c * v,
+                })
+                .sum(),
             _ => 0.0,
         })
     }
@@ -648,7 +770,13 @@ impl ContactBoundary {
         let (dim, nt) = (p.dim, out.n_tangential());
         for i in 0..p.len() {
             let ui: [f64; 3] = std::array::from_fn(|k| match self.slots.get(i * dim + k) {
-                Some(Slot::Free(j)) if k < dim => u[self.dofs[*j]],
+                Some(terms) if k < dim => terms
+                    .iter()
+                    .map(|&(c, slot)| match slot {
+                        Slot::Free(j) => c * u[self.dofs[j]],
+                        Slot::Fixed(_) => 0.0,
+                    })
+                    .sum(),
                 _ => 0.0,
             });
             out.normal[i] = (0..dim).map(|k| ui[k] * p.normal[i][k]).sum();
@@ -723,7 +851,10 @@ impl ContactBoundary {
         for r in 0..m {
             let (i, a) = self.direction_of(r, nt);
             for e in 0..ne {
-                let v: f64 = free[i].iter().map(|&(x, jx)| a[x] * inv[(k + e) * kk + jx]).sum();
+                let v: f64 = free[i]
+                    .iter()
+                    .map(|&(x, jx, cx)| cx * a[x] * inv[(k + e) * kk + jx])
+                    .sum();
                 d[(m + e) * o + r] = v;
                 d[r * o + m + e] = -v;
             }
@@ -746,15 +877,17 @@ impl ContactBoundary {
         Ok((problem, condensed.loads))
     }
 
-    /// The free dofs of each point: `(component, place in the condensed dofs)`.
-    fn free_slots(&self) -> Vec<Vec<(usize, usize)>> {
+    /// The free dofs of each point: `(component, place in the condensed dofs, coefficient)`.
+    fn free_slots(&self) -> Vec<Vec<(usize, usize, f64)>> {
         let dim = self.points.dim;
         (0..self.points.len())
             .map(|i| {
                 (0..dim)
-                    .filter_map(|x| match self.slots[i * dim + x] {
-                        Slot::Free(j) => Some((x, j)),
-                        Slot::Fixed(_) => None,
+                    .flat_map(|x| {
+                        self.slots[i * dim + x].iter().filter_map(move |&(c, slot)| match slot {
+                            Slot::Free(j) => Some((x, j, c)),
+                            Slot::Fixed(_) => None,
+                        })
                     })
                     .collect()
             })
@@ -788,9 +921,9 @@ impl ContactBoundary {
             for (c, out) in row.iter_mut().enumerate().take(r + 1) {
                 let (j, b) = self.direction_of(c, nt);
                 let mut v = 0.0;
-                for &(x, jx) in &free[i] {
-                    for &(y, jy) in &free[j] {
-                        v += a[x] * inv[jx * stride + jy] * b[y];
+                for &(x, jx, cx) in &free[i] {
+                    for &(y, jy, cy) in &free[j] {
+                        v += cx * a[x] * inv[jx * stride + jy] * b[y] * cy;
                     }
                 }
                 *out = v;
@@ -1044,4 +1177,54 @@ fn held_directions(
         }
     }
     Ok(Held::Tangents(held))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The modified basis of a second-order face: every weight positive, the weights summing
+    /// to the face's measure (a 3D face) or to `∫ 2π r ds` (a body of revolution's), and the
+    /// points' displacements equal to the nodes' for every linear field.
+    #[test]
+    fn the_modified_basis_has_positive_weights_and_holds_linear_fields() {
+        let linear = |x: &[f64; 3]| 0.3 + 1.1 * x[0] - 0.7 * x[1] + 0.4 * x[2];
+        let cases = [
+            (
+                mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2),
+                Coordinates::Cartesian,
+                2.0,
+            ),
+            (
+                mesh::rectangle_tri([0.0, 0.0], [1.5, 1.0], 6, 4),
+                Coordinates::Axisymmetric,
+                std::f64::consts::PI * 1.5 * 1.5,
+            ),
+        ];
+        for (p1, coordinates, measure) in cases {
+            let m = p1.quadratic().unwrap();
+            let group = m.boundary("bottom").unwrap();
+            let basis = FaceBasis::of(&m, group, coordinates);
+            let nodes = group.nodes();
+            assert!(nodes.iter().all(|&v| basis.weight[v] > 0.0), "{coordinates:?}");
+            let total: f64 = nodes.iter().map(|&v| basis.weight[v]).sum();
+            assert!(
+                (total - measure).abs() < 1e-12 * measure,
+                "{coordinates:?}: {total} against {measure}"
+            );
+            for &v in &nodes {
+                let at: f64 = basis.terms(v).iter().map(|&(c, n)| c * linear(&m.points[n])).sum();
+                assert!((at - linear(&m.points[v])).abs() < 1e-13, "node {v}");
+            }
+            // the edge nodes mix in their corners, the corners are their own
+            assert_eq!(
+                basis.edge_corners.len(),
+                nodes.len() - p1.boundary("bottom").unwrap().nodes().len()
+            );
+        }
+        // a 2D face in plane strain keeps its own (Simpson's) weights
+        let m = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2).quadratic().unwrap();
+        let basis = FaceBasis::of(&m, m.boundary("bottom").unwrap(), Coordinates::Cartesian);
+        assert!(basis.edge_corners.is_empty());
+    }
 }

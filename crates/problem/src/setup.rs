@@ -241,8 +241,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
 
 /// `mesh` at the scene's `mesh.order`: raised to order 2 where it asks (a node at every
 /// edge's midpoint), as it is otherwise; a second-order mesh where the scene asks for order 1
-/// is refused (its edge nodes would be dropped silently), and so is contact on a second-order
-/// mesh in 3D (not built: the weights of a six-node face's corners vanish).
+/// is refused (its edge nodes would be dropped silently).
 fn of_order(mesh: mesh::Mesh, scene: &Scene) -> Result<mesh::Mesh, ProblemError> {
     let mesh = match (scene.mesh.order, mesh.kind.order()) {
         (Some(2), 1) => mesh.quadratic()?,
@@ -258,16 +257,6 @@ fn of_order(mesh: mesh::Mesh, scene: &Scene) -> Result<mesh::Mesh, ProblemError>
         }
         _ => mesh,
     };
-    if mesh.kind.order() == 2 && mesh.dim == 3 && !scene.zones().is_empty() {
-        return Err(SetupError::new(
-            "mesh.order",
-            format!(
-                "contact on second-order elements in 3D ({}) is not built yet: a six-node face's corners carry no weight of their own (∫ N = 0 over the face), and the contact points need a positive one (a dual or modified basis, docs/theory.md); solve this scene at order 1, or remove its [contact]",
-                mesh.kind.name()
-            ),
-        )
-        .into());
-    }
     Ok(mesh)
 }
 
