@@ -68,6 +68,19 @@ type Term = (f64, Slot);
 /// u_j)) / (1 - 2α)` at an edge node (equal to `u` for every linear field).
 pub const MODIFIED_ALPHA: f64 = 0.2;
 
+/// The error of a contact node `node` at `x` whose weight `w` is not positive: no force of the
+/// face's acts on it, so its law could hold nothing there.
+fn weightless(spec: &ContactSpec, node: usize, x: &[f64], w: f64) -> ProblemError {
+    SetupError::new(
+        "contact.group",
+        format!(
+            "node {node} of contact group `{}` (at {x:?}) carries no weight of the face ({w:e}): contact could not act on it (a face of zero measure there?)",
+            spec.group
+        ),
+    )
+    .into()
+}
+
 /// One displacement component of a contact point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Slot {
@@ -424,17 +437,7 @@ impl ContactBoundary {
         for node in group.nodes() {
             let x = mesh.points[node];
             if !(weight[node] > 0.0) {
-                // no force of the face's acts on the point: its law could hold nothing there
-                return Err(SetupError::new(
-                    "contact.group",
-                    format!(
-                        "node {node} of contact group `{}` (at {:?}) carries no weight of the face ({:e}): contact could not act on it (a face of zero measure there?)",
-                        spec.group,
-                        &x[..dim],
-                        weight[node]
-                    ),
-                )
-                .into());
+                return Err(weightless(spec, node, &x[..dim], weight[node]));
             }
             let Some(gap) = spec.gap_at(&x, &nv) else {
                 // beyond the indenter's shape (a punch's edge, a sphere's equator)
@@ -463,21 +466,7 @@ impl ContactBoundary {
                 }
                 Held::Tangents(held) => held,
             };
-            for k in 0..dim {
-                let mut component = Vec::with_capacity(terms.len());
-                for &(c, m) in &terms {
-                    let slot = match dofs.u[m * dim + k] {
-                        Dof::Free(j) => Slot::Free(*place.entry(j).or_insert_with(|| {
-                            self.dofs.push(j);
-                            self.dofs.len() - 1
-                        })),
-                        Dof::Fixed(v) => Slot::Fixed(v),
-                        Dof::Absent => Slot::Fixed(0.0),
-                    };
-                    component.push((c, slot));
-                }
-                self.slots.push(component);
-            }
+            self.push_terms(&terms, dofs, place);
             self.nodes.push(node);
             let p = &mut self.points;
             p.position.push(x);
@@ -513,6 +502,32 @@ impl ContactBoundary {
             .into());
         }
         Ok(())
+    }
+
+    /// Pushes a point's displacement components, each the sum of `terms` (`(coefficient,
+    /// node)`) of that component; a free dof is condensed once (`place`: its place in `dofs`).
+    fn push_terms(
+        &mut self,
+        terms: &[(f64, usize)],
+        dofs: &DofMap,
+        place: &mut std::collections::HashMap<usize, usize>,
+    ) {
+        let dim = self.points.dim;
+        for k in 0..dim {
+            let mut component = Vec::with_capacity(terms.len());
+            for &(c, m) in terms {
+                let slot = match dofs.u[m * dim + k] {
+                    Dof::Free(j) => Slot::Free(*place.entry(j).or_insert_with(|| {
+                        self.dofs.push(j);
+                        self.dofs.len() - 1
+                    })),
+                    Dof::Fixed(v) => Slot::Fixed(v),
+                    Dof::Absent => Slot::Fixed(0.0),
+                };
+                component.push((c, slot));
+            }
+            self.slots.push(component);
+        }
     }
 
     /// The boundary at an instant of a load path: the uniform part of every gap (its group's
