@@ -10,32 +10,11 @@
 //! - a cylinder pressed between sliding plates (uniaxial stress): its lateral expansion
 //!   `ν δ r / H` and its force `E (δ / H) π R²` through the cells' volumes of revolution.
 
-use fe_assembly::{Constraint, Coordinates, Crystal, Discretization, Field, Load, Material, Parallelism};
-use linalg::{CoupledSolver, DirectLdlt, Ordering};
+mod common;
+
+use common::{jitter, solve_nodal as solve};
+use fe_assembly::{Constraint, Coordinates, Crystal, Discretization, Field, Load, Material};
 use std::sync::Arc;
-
-fn solve(disc: &Discretization<'_>, loads: &[Load]) -> (Vec<[f64; 3]>, Vec<f64>) {
-    let blocks = disc.assemble(Parallelism::Rayon);
-    let (bu, bphi) = disc.rhs(loads).unwrap();
-    let mut direct = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq).unwrap();
-    let (mut u, mut p) = (vec![0.0; disc.dofs.n_u], vec![0.0; disc.dofs.n_phi]);
-    direct.solve(&bu, &bphi, &mut u, &mut p).unwrap();
-    (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&p))
-}
-
-fn jitter(m: &mut mesh::Mesh, amount: f64) {
-    let (lo, hi) = m.bounding_box();
-    let mut seed = 777u64;
-    for p in &mut m.points {
-        for k in 0..2 {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            let r = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            if (0..2).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
-                p[k] += amount * r;
-            }
-        }
-    }
-}
 
 #[test]
 fn lame_cylinder_converges_at_second_order() {
@@ -79,7 +58,7 @@ fn lame_cylinder_converges_at_second_order() {
 fn a_disc_between_electrodes_is_reproduced_and_its_charge_is_the_whole_discs() {
     let (radius, height, volts) = (1.0, 0.5, 0.02);
     let mut mesh = mesh::rectangle_tri([0.0, 0.0], [radius, height], 8, 4);
-    jitter(&mut mesh, 0.04);
+    jitter(&mut mesh, 0.04, 777);
     let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
     let bcs = vec![
         Constraint::constant("left", Field::Displacement(0), 0.0),

@@ -16,7 +16,7 @@
 
 mod common;
 
-use common::solve_both;
+use common::{rates, solve_both};
 use fe_assembly::{Crystal, Discretization, Exact, Material};
 
 /// `(L2 error of (u, φ), energy error)` on the mesh of size n.
@@ -107,15 +107,6 @@ fn check_against_reference(dim: usize, rows: &[(usize, f64, f64)]) {
         "reference table {} lacks {dim}D rows",
         path.display()
     );
-}
-
-fn rates(rows: &[(usize, f64, f64)]) -> Vec<(f64, f64)> {
-    rows.windows(2)
-        .map(|w| {
-            let r = (w[1].0 as f64 / w[0].0 as f64).ln();
-            ((w[0].1 / w[1].1).ln() / r, (w[0].2 / w[1].2).ln() / r)
-        })
-        .collect()
 }
 
 #[test]

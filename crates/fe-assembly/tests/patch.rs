@@ -17,24 +17,9 @@
 
 mod common;
 
-use common::{max_diff, solve_both, stress_and_d};
+use common::{jitter, max_diff, solve_both, stress_and_d};
 use fe_assembly::{Constraint, Crystal, Discretization, Field, Load, Material};
 use std::sync::Arc;
-
-fn jitter(m: &mut mesh::Mesh, amount: f64) {
-    let (lo, hi) = m.bounding_box();
-    let mut seed = 12345u64;
-    for p in &mut m.points {
-        for k in 0..m.dim {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            let r = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            let on_boundary = (0..m.dim).any(|q| p[q] == lo[q] || p[q] == hi[q]);
-            if !on_boundary {
-                p[k] += amount * r;
-            }
-        }
-    }
-}
 
 fn run_patch(dim: usize) {
     let mut mesh = if dim == 2 {
@@ -42,7 +27,7 @@ fn run_patch(dim: usize) {
     } else {
         mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2)
     };
-    jitter(&mut mesh, if dim == 2 { 0.08 } else { 0.1 });
+    jitter(&mut mesh, if dim == 2 { 0.08 } else { 0.1 }, 12345);
     mesh.check().unwrap();
     let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
     let mat = Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap();

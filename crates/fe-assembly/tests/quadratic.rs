@@ -12,35 +12,10 @@
 
 mod common;
 
+use common::{jitter, pzt5a, rates, solve_nodal as solve};
+
 use fe_assembly::{Constraint, Coordinates, Crystal, Discretization, Exact, Field, Load, Material, Parallelism};
-use linalg::{CoupledSolver, DirectLdlt, Ordering};
 use std::sync::Arc;
-
-fn solve(disc: &Discretization<'_>, loads: &[Load]) -> (Vec<[f64; 3]>, Vec<f64>) {
-    let blocks = disc.assemble(Parallelism::Rayon);
-    let (bu, bphi) = disc.rhs(loads).unwrap();
-    let mut direct = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq).unwrap();
-    let (mut u, mut p) = (vec![0.0; disc.dofs.n_u], vec![0.0; disc.dofs.n_phi]);
-    direct.solve(&bu, &bphi, &mut u, &mut p).unwrap();
-    (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&p))
-}
-
-/// Moves the interior corner nodes of a P1 mesh by up to `amount / 2` (a pseudo-random
-/// sequence), before it is raised to order 2 (its edge nodes then at the moved edges'
-/// midpoints).
-fn jitter(m: &mut mesh::Mesh, amount: f64) {
-    let (lo, hi) = m.bounding_box();
-    let mut seed = 4242u64;
-    for p in &mut m.points {
-        for k in 0..m.dim {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            let r = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            if (0..m.dim).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
-                p[k] += amount * r;
-            }
-        }
-    }
-}
 
 /// `u_k = Σ a_kij x_i x_j + b_k · x`, `φ` likewise: full quadratics with all their terms.
 fn quadratic(dim: usize) -> Exact {
@@ -93,15 +68,10 @@ fn groups(dim: usize) -> &'static [&'static str] {
     }
 }
 
-fn pzt5a(dim: usize) -> Material {
-    let poling = if dim == 2 { [0.0, 1.0, 0.0] } else { [0.0, 0.0, 1.0] };
-    Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap()
-}
-
 /// The relative errors `(L2 of (u, φ), energy)` of `exact` on `mesh`, its boundary prescribed.
 fn errors(mesh: &mesh::Mesh, exact: &Exact) -> (f64, f64) {
     let dim = mesh.dim;
-    let m = pzt5a(dim);
+    let m = pzt5a(dim, false);
     let disc = Discretization::new(
         mesh,
         Coordinates::Cartesian,
@@ -119,7 +89,7 @@ fn errors(mesh: &mesh::Mesh, exact: &Exact) -> (f64, f64) {
 fn quadratic_fields_are_reproduced_to_round_off() {
     for (dim, n) in [(2, 3), (3, 2)] {
         let mut p1 = block(dim, n);
-        jitter(&mut p1, 0.3 / n as f64);
+        jitter(&mut p1, 0.3 / n as f64, 4242);
         let p2 = p1.quadratic().unwrap();
         p2.check().unwrap();
         let exact = quadratic(dim);
@@ -129,15 +99,6 @@ fn quadratic_fields_are_reproduced_to_round_off() {
         let (l2, energy) = errors(&p1, &exact);
         assert!(l2 > 1e-4 && energy > 1e-2, "{dim}D P1: L2 {l2:e}, energy {energy:e}");
     }
-}
-
-fn rates(rows: &[(usize, f64, f64)]) -> Vec<(f64, f64)> {
-    rows.windows(2)
-        .map(|w| {
-            let r = (w[1].0 as f64 / w[0].0 as f64).ln();
-            ((w[0].1 / w[1].1).ln() / r, (w[0].2 / w[1].2).ln() / r)
-        })
-        .collect()
 }
 
 #[test]
@@ -205,7 +166,7 @@ fn lames_cylinder_converges_at_third_order() {
 fn a_poled_disc_between_electrodes_is_reproduced_with_the_whole_discs_charge() {
     let (radius, height, volts) = (1.0, 0.5, 0.02);
     let mut p1 = mesh::rectangle_tri([0.0, 0.0], [radius, height], 6, 3);
-    jitter(&mut p1, 0.05);
+    jitter(&mut p1, 0.05, 4242);
     let mesh = p1.quadratic().unwrap();
     let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
     let bcs = vec![
@@ -251,9 +212,9 @@ fn a_poled_disc_between_electrodes_is_reproduced_with_the_whole_discs_charge() {
 fn the_parallel_assembly_equals_the_cell_loop() {
     for dim in [2, 3] {
         let mut p1 = block(dim, 2);
-        jitter(&mut p1, 0.1);
+        jitter(&mut p1, 0.1, 4242);
         let mesh = p1.quadratic().unwrap();
-        let m = pzt5a(dim);
+        let m = pzt5a(dim, false);
         let bcs = vec![
             Constraint::constant("left", Field::Displacement(0), 0.0),
             Constraint::constant("bottom", Field::Potential, 0.0),

@@ -105,3 +105,40 @@ pub fn pzt5a(dim: usize, axisymmetric: bool) -> fe_assembly::Material {
         Material::from_crystal("pzt5a", &Crystal::pzt5a(), poling, dim).unwrap()
     }
 }
+
+/// Moves the interior nodes of `m` (those on no face of its bounding box) by up to `amount / 2`
+/// in each coordinate, the numbers of a linear congruential generator seeded with `seed`
+/// drawn for every node and coordinate in order.
+pub fn jitter(m: &mut mesh::Mesh, amount: f64, seed: u64) {
+    let (lo, hi) = m.bounding_box();
+    let mut random = random_source(seed);
+    for p in &mut m.points {
+        for k in 0..m.dim {
+            let r = random();
+            if (0..m.dim).all(|q| p[q] != lo[q] && p[q] != hi[q]) {
+                p[k] += amount * r;
+            }
+        }
+    }
+}
+
+/// The nodal `(u, φ)` of the direct solve under `loads` (every node, as
+/// `DofMap::expand_u` gives them).
+pub fn solve_nodal(disc: &Discretization<'_>, loads: &[Load]) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let blocks = disc.assemble(Parallelism::Rayon);
+    let (bu, bphi) = disc.rhs(loads).unwrap();
+    let mut direct = DirectLdlt::new(&blocks.a, &blocks.g, &blocks.b, &Ordering::Amd, faer::Par::Seq).unwrap();
+    let (mut u, mut p) = (vec![0.0; disc.dofs.n_u], vec![0.0; disc.dofs.n_phi]);
+    direct.solve(&bu, &bphi, &mut u, &mut p).unwrap();
+    (disc.dofs.expand_u(&u), disc.dofs.expand_phi(&p))
+}
+
+/// The observed orders `(L2, energy)` between successive rows `(n, L2 error, energy error)`.
+pub fn rates(rows: &[(usize, f64, f64)]) -> Vec<(f64, f64)> {
+    rows.windows(2)
+        .map(|w| {
+            let r = (w[1].0 as f64 / w[0].0 as f64).ln();
+            ((w[0].1 / w[1].1).ln() / r, (w[0].2 / w[1].2).ln() / r)
+        })
+        .collect()
+}
