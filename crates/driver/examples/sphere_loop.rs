@@ -1,7 +1,9 @@
 //! The friction loop of `mindlin-sphere-cycle` against Mindlin and Deresiewicz's closed form,
 //! over mesh sizes and numbers of path steps: the table of docs/theory.md ("Load paths").
 //!
-//!   cargo run --release -p driver --example sphere_loop -- 8,12,16,20,24 24,96,192
+//!   cargo run --release -p driver --example sphere_loop -- 8,12,16,20,24 24,96,192 [ORDER]
+//!
+//! (`ORDER` the elements' order, `mesh.order`: 1 by default, 2 for quadratic ones.)
 
 fn list(arg: Option<String>, default: &str) -> Vec<usize> {
     arg.unwrap_or_else(|| default.into())
@@ -14,12 +16,13 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let sizes = list(args.next(), "8,12,16,20,24");
     let steps = list(args.next(), "24,96");
+    let order: usize = args.next().map_or(1, |o| o.parse().expect("an order, 1 or 2"));
     println!("| n | steps | loop area | Mindlin-Deresiewicz | error | P | Q* | Q at t = 0 | s |");
     println!("|---|---|---|---|---|---|---|---|---|");
     for &n in &sizes {
         for &s in &steps {
             let t = std::time::Instant::now();
-            match driver::studies::loops::sphere_loop(n, Some(s)) {
+            match driver::studies::loops::sphere_loop_of_order(n, Some(s), order) {
                 Ok(f) => println!(
                     "| {n} | {s} | {:.4e} | {:.4e} | {:+.2} % | {:.4e} | {:.4e} | {:.3e} | {:.1} |",
                     f.area,

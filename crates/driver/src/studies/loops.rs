@@ -30,7 +30,15 @@ pub struct LoopFigures {
 /// # Errors
 /// The scene's or the run's error.
 pub fn sphere_loop(n: usize, steps: Option<usize>) -> Result<LoopFigures, DriverError> {
-    let mut sets = vec![format!("mesh.n={n}")];
+    sphere_loop_of_order(n, steps, 1)
+}
+
+/// [`sphere_loop`] with elements of `order` (`mesh.order`: 1 or 2).
+///
+/// # Errors
+/// The scene's or the run's error.
+pub fn sphere_loop_of_order(n: usize, steps: Option<usize>, order: usize) -> Result<LoopFigures, DriverError> {
+    let mut sets = vec![format!("mesh.n={n}"), format!("mesh.order={order}")];
     sets.extend(steps.map(|s| format!("path.steps={s}")));
     let (scene, _) = scene_file::load("mindlin-sphere-cycle", &sets)?;
     let m = &scene.material[0];
