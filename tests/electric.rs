@@ -712,8 +712,8 @@ fn a_floating_conducting_zone_among_several_is_a_floating_terminal_where_it_touc
 }
 
 /// The manufactured solution in contact at order 2 (`mesh.order = 2`): in 2D sticking on a
-/// conducting foundation and sliding under Coulomb's law; in 3D (the modified basis, an
-/// insulated face) sticking and sliding.
+/// conducting foundation and sliding under Coulomb's law; in 3D (the modified basis) sticking
+/// and sliding on an insulated face, and sticking on a conducting foundation.
 ///
 /// - Source: for P2 the energy-norm error is O(h²) where the solution is smooth (Ciarlet
 ///   1978); in 2D the contact face's points are the nodes of its three-node segments, weighted
@@ -721,7 +721,8 @@ fn a_floating_conducting_zone_among_several_is_a_floating_terminal_where_it_touc
 ///   its gap the basis's too (`boundary::MODIFIED_ALPHA`).
 /// - Expected (measured): 2D sticking 3.88e-4, 9.70e-5, 2.43e-5 at n = 8, 16, 32 (order
 ///   2.00), sliding 6.65e-4, 1.67e-4, 4.19e-5 (2.00); 3D sticking 5.26e-3, 1.31e-3, 3.29e-4 at
-///   n = 2, 4, 8 (2.00; P1 at n = 8: 2.1e-2), sliding 5.22e-3, 1.34e-3, 3.42e-4 (1.96, 1.98).
+///   n = 2, 4, 8 (2.00; P1 at n = 8: 2.1e-2), sliding 5.22e-3, 1.34e-3, 3.42e-4 (1.96, 1.98),
+///   conducting 6.29e-3, 1.58e-3, 3.97e-4 (1.99; P1 at n = 8: 2.6e-2).
 /// - Tolerance: order in [1.9, 2.1].
 #[test]
 fn the_manufactured_solution_in_contact_converges_at_order_two_with_quadratic_elements() {
@@ -740,11 +741,15 @@ fn the_manufactured_solution_in_contact_converges_at_order_two_with_quadratic_el
     sliding_3d.push("~contact.foundation_potential");
     let mut sticking_3d = BOX.to_vec();
     sticking_3d.push("~contact.foundation_potential");
-    let cases: [(&str, &[&str], [usize; 3]); 4] = [
+    // conducting in 3D: the points' potentials in the modified basis too (their terms on
+    // the sides' prescribed potentials among them)
+    let conducting_3d = &BOX[..6];
+    let cases: [(&str, &[&str], [usize; 3]); 5] = [
         ("2D sticking, conducting", &[], [8, 16, 32]),
         ("2D sliding", &sliding, [8, 16, 32]),
         ("3D sticking (the modified basis)", &sticking_3d, [2, 4, 8]),
         ("3D sliding (the modified basis)", &sliding_3d, [2, 4, 8]),
+        ("3D sticking, conducting (the modified basis)", conducting_3d, [2, 4, 8]),
     ];
     for (law, extra, sizes) in cases {
         let errors: Vec<f64> = sizes

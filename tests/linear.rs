@@ -462,28 +462,6 @@ fn quadratic_elements_converge_at_order_two_on_the_manufactured_scenes() {
     assert!(e < 1e-11, "patch at order 2: energy error {e}");
 }
 
-/// Electrical contact on a face of the modified basis (3D, a body of revolution) is refused
-/// by its key: its potentials are not made so (the second-order Gmsh file's run and refusals:
-/// `crates/driver/tests/mesh_files.rs`).
-#[test]
-fn electrical_contact_on_a_face_of_the_modified_basis_is_refused_by_key() {
-    for scene in ["indent-sphere", "indent-sphere-3d"] {
-        let sets = [
-            "mesh.n=6".to_string(),
-            "mesh.order=2".to_string(),
-            "contact.electric=\"conducting\"".to_string(),
-        ];
-        let e = match driver::studies::solve(scene, &sets) {
-            Err(e) => e.to_string(),
-            Ok(_) => panic!("{scene}: electrical contact at order 2 ran"),
-        };
-        assert!(
-            e.contains("electrical contact on a second-order face") && e.contains("mesh.order = 1"),
-            "{scene}: {e}"
-        );
-    }
-}
-
 /// `piezocontact study --orders 1,2`: both orders over every size, each order's rates its own,
 /// and the pictures drawn with both fronts (the error-against-time plot names each order).
 #[test]

@@ -43,9 +43,16 @@ pub struct ContactBoundary {
     /// Those of them that the condition holds past the gap, inside the foundation (a clamped
     /// corner of a body pressed in by a negative gap): the condition wins.
     pub held_inside: usize,
-    /// Electrical contact: the law and the points with a free potential, and those potentials'
-    /// dofs (indices into `[u; φ]`), condensed after `dofs`.
+    /// Electrical contact: the law and the points with a free potential, and the potentials'
+    /// dofs their potentials are made of (indices into `[u; φ]`), condensed after `dofs`: each
+    /// point's own first, in the points' order, then those its terms add.
     pub electric: Option<(contact::ElectricContact, Vec<usize>)>,
+    /// Each electric point's potential as terms: a coefficient times a free potential (its
+    /// place in the electric dofs) or a prescribed one; its own dof alone, or in the modified
+    /// basis its edge's corners' too.
+    phi_terms: Vec<Vec<Term>>,
+    /// Each point's displacement's terms `(coefficient, node)` ([`FaceBasis::terms`]).
+    node_terms: Vec<Vec<(f64, usize)>>,
     /// The contact group of each point (an index into `groups`).
     pub group_of: Vec<usize>,
     /// The contact groups, in the scene's order.
@@ -67,6 +74,14 @@ type Term = (f64, Slot);
 /// the displacements of that basis, `û_c = u_c` at a corner and `û_ij = (u_ij - α (u_i +
 /// u_j)) / (1 - 2α)` at an edge node (equal to `u` for every linear field).
 pub const MODIFIED_ALPHA: f64 = 0.2;
+
+/// The free terms of a point's potential: `(coefficient, place in the electric dofs)`.
+fn free_terms(terms: &[Term]) -> impl Iterator<Item = (f64, usize)> + '_ {
+    terms.iter().filter_map(|&(c, slot)| match slot {
+        Slot::Free(j) => Some((c, j)),
+        Slot::Fixed(_) => None,
+    })
+}
 
 /// The error of a contact node `node` at `x` whose weight `w` is not positive: no force of the
 /// face's acts on it, so its law could hold nothing there.
@@ -352,6 +367,8 @@ impl ContactBoundary {
             held_nodes: 0,
             held_inside: 0,
             electric: None,
+            phi_terms: vec![],
+            node_terms: vec![],
             group_of: vec![],
             groups: specs.iter().map(|s| s.group.clone()).collect(),
             uniform: vec![],
@@ -362,22 +379,11 @@ impl ContactBoundary {
         }
         // the zone that conducts (at most one: validated), its points' potentials condensed
         if let Some((k, spec)) = specs.iter().enumerate().find(|(_, s)| s.electric_law().is_some()) {
-            let modified = disc.mesh.kind.order() == 2 && (dim == 3 || disc.coordinates == Coordinates::Axisymmetric);
-            if modified {
-                // the points' potentials would be the nodes', their weights the modified basis's
-                return Err(SetupError::new(
-                    "contact.electric",
-                    format!(
-                        "electrical contact on a second-order face in 3D or on a body of revolution (group `{}`) is not built yet: its points carry the modified basis's displacements and weights, and the potential's are not made so; solve it at mesh.order = 1",
-                        spec.group
-                    ),
-                )
-                .into());
-            }
             let members = (0..b.nodes.len())
                 .filter(|&i| b.group_of[i] == k)
                 .map(|i| (i, b.nodes[i]));
             b.electric = electric_points(spec, &disc.dofs, members)?;
+            b.phi_terms = b.electric_terms(spec, &disc.dofs)?;
         }
         // zones whose friction weakens with the slip: each point its zone's law (a law from a
         // static coefficient of 0 is frictionless: its points keep the coefficient 0)
@@ -467,6 +473,7 @@ impl ContactBoundary {
                 Held::Tangents(held) => held,
             };
             self.push_terms(&terms, dofs, place);
+            self.node_terms.push(terms);
             self.nodes.push(node);
             let p = &mut self.points;
             p.position.push(x);
@@ -544,6 +551,8 @@ impl ContactBoundary {
             held_nodes: self.held_nodes,
             held_inside: self.held_inside,
             electric: self.electric.clone(),
+            phi_terms: self.phi_terms.clone(),
+            node_terms: self.node_terms.clone(),
             group_of: self.group_of.clone(),
             groups: self.groups.clone(),
             uniform: self.uniform.clone(),
@@ -553,6 +562,11 @@ impl ContactBoundary {
         }
         if let Some((electric, _)) = b.electric.as_mut() {
             electric.potential *= voltage;
+        }
+        for (_, slot) in b.phi_terms.iter_mut().flatten() {
+            if let Slot::Fixed(v) = slot {
+                *v *= voltage;
+            }
         }
         for (j, terms) in b.slots.iter_mut().enumerate() {
             for (_, slot) in terms {
@@ -607,6 +621,8 @@ impl ContactBoundary {
             held_nodes: self.held_nodes,
             held_inside: self.held_inside,
             electric: None,
+            phi_terms: vec![],
+            node_terms: keep.iter().map(|&i| self.node_terms[i].clone()).collect(),
             group_of: keep.iter().map(|&i| self.group_of[i]).collect(),
             groups: self.groups.clone(),
             uniform: keep.iter().map(|&i| self.uniform[i]).collect(),
@@ -632,10 +648,131 @@ impl ContactBoundary {
         let (Some((_, dofs)), Some(e)) = (&self.electric, &sol.electric) else {
             return vec![];
         };
-        dofs.iter()
-            .zip(e.points.iter().zip(&e.flux))
-            .map(|(&d, (&i, q))| (d - n_u, self.points.weight[i] * q))
+        let mut out = Vec::with_capacity(dofs.len());
+        for ((terms, &i), q) in self.phi_terms.iter().zip(&e.points).zip(&e.flux) {
+            for &(c, slot) in terms {
+                // a prescribed potential takes its share from its terminal
+                if let Slot::Free(j) = slot {
+                    out.push((dofs[j] - n_u, c * self.points.weight[i] * q));
+                }
+            }
+        }
+        out
+    }
+
+    /// The potentials at the electric points of the free potentials `phi` (of `n_u` free
+    /// displacements before them in `[u; φ]`): each point's terms, the prescribed ones at this
+    /// boundary's values where `prescribed` (a response to a load has none: `false`).
+    fn potentials_of(&self, phi: &[f64], n_u: usize, prescribed: bool) -> Vec<f64> {
+        let Some((_, dofs)) = &self.electric else {
+            return vec![];
+        };
+        self.phi_terms
+            .iter()
+            .map(|terms| {
+                terms
+                    .iter()
+                    .map(|&(c, slot)| match slot {
+                        Slot::Free(j) => c * phi[dofs[j] - n_u],
+                        Slot::Fixed(v) if prescribed => c * v,
+                        Slot::Fixed(_) => 0.0,
+                    })
+                    .sum()
+            })
             .collect()
+    }
+
+    /// The potentials at the electric points of the fields' free potentials `phi` (of `n_u`
+    /// free displacements before them in `[u; φ]`), the prescribed terms at this boundary's
+    /// values.
+    pub fn potentials_at_points(&self, phi: &[f64], n_u: usize) -> Vec<f64> {
+        self.potentials_of(phi, n_u, true)
+    }
+
+    /// As [`ContactBoundary::potentials_at_points`] for a response to a load (a path's part):
+    /// the free terms alone, the prescribed ones added at each instant's values
+    /// ([`ContactBoundary::prescribed_potentials`]).
+    pub fn free_potentials_at_points(&self, phi: &[f64], n_u: usize) -> Vec<f64> {
+        self.potentials_of(phi, n_u, false)
+    }
+
+    /// The prescribed terms of each electric point's potential, at this boundary's values.
+    pub fn prescribed_potentials(&self) -> Vec<f64> {
+        self.phi_terms
+            .iter()
+            .map(|terms| {
+                terms
+                    .iter()
+                    .map(|&(c, slot)| match slot {
+                        Slot::Fixed(v) => c * v,
+                        Slot::Free(_) => 0.0,
+                    })
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// The potentials at the electric points of the values `phi_c` at the condensed
+    /// potentials (in the order of the electric dofs).
+    fn potentials_of_condensed(&self, phi_c: &[f64]) -> Vec<f64> {
+        self.phi_terms
+            .iter()
+            .map(|terms| {
+                terms
+                    .iter()
+                    .map(|&(c, slot)| match slot {
+                        Slot::Free(j) => c * phi_c[j],
+                        Slot::Fixed(v) => c * v,
+                    })
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// Each electric point's potential terms, and the dofs they add after the points' own
+    /// (the edge's corners of a point of the modified basis); a corner on a terminal gives a
+    /// prescribed term, which a load path scales with its voltage. A term on no potential (a
+    /// corner of a body without electric unknowns there) is refused.
+    fn electric_terms(&mut self, spec: &ContactSpec, dofs: &DofMap) -> Result<Vec<Vec<Term>>, ProblemError> {
+        let Some((electric, phi)) = self.electric.as_mut() else {
+            return Ok(vec![]);
+        };
+        let mut place: std::collections::HashMap<usize, usize> = phi.iter().enumerate().map(|(e, &d)| (d, e)).collect();
+        let mut out = Vec::with_capacity(electric.points.len());
+        for (e, &i) in electric.points.iter().enumerate() {
+            let mut terms = vec![];
+            for &(c, m) in &self.node_terms[i] {
+                if m == self.nodes[i] {
+                    terms.push((c, Slot::Free(e)));
+                    continue;
+                }
+                let j = match dofs.phi[m] {
+                    Dof::Free(j) => j,
+                    Dof::Fixed(v) => {
+                        terms.push((c, Slot::Fixed(v)));
+                        continue;
+                    }
+                    Dof::Absent => {
+                        return Err(SetupError::new(
+                            "contact.electric",
+                            format!(
+                                "a point of contact group `{}` in the modified basis (node {}) takes node {m}'s potential, and that node has none (no electric material there): electrical contact needs the face's every node electric",
+                                spec.group, self.nodes[i]
+                            ),
+                        )
+                        .into())
+                    }
+                };
+                let d = dofs.n_u + j;
+                let at = *place.entry(d).or_insert_with(|| {
+                    phi.push(d);
+                    phi.len() - 1
+                });
+                terms.push((c, Slot::Free(at)));
+            }
+            out.push(terms);
+        }
+        Ok(out)
     }
 
     /// Tells `reporter` what Dirichlet conditions hold of the group `group` where it is more
@@ -855,7 +992,9 @@ impl ContactBoundary {
         let (inv, kk, k) = (&condensed.inverse, all.len(), self.dofs.len());
         let p = &self.points;
         let (n, m) = (p.len(), p.len() * (1 + nt));
-        let ne = kk - k;
+        // the electric points (their potentials' terms on the condensed potentials)
+        let terms = &self.phi_terms;
+        let ne = terms.len();
         let o = m + ne;
         let mech = self.mechanical_block(inv, kk, nt);
         let mut d = vec![0.0; o * o];
@@ -865,25 +1004,37 @@ impl ContactBoundary {
         let free = self.free_slots();
         for r in 0..m {
             let (i, a) = self.direction_of(r, nt);
-            for e in 0..ne {
-                let v: f64 = free[i]
-                    .iter()
-                    .map(|&(x, jx, cx)| cx * a[x] * inv[(k + e) * kk + jx])
+            for (e, te) in terms.iter().enumerate() {
+                let v: f64 = free_terms(te)
+                    .map(|(ce, je)| {
+                        ce * free[i]
+                            .iter()
+                            .map(|&(x, jx, cx)| cx * a[x] * inv[(k + je) * kk + jx])
+                            .sum::<f64>()
+                    })
                     .sum();
                 d[(m + e) * o + r] = v;
                 d[r * o + m + e] = -v;
             }
         }
-        for e in 0..ne {
-            for f in 0..ne {
-                d[(m + e) * o + m + f] = -inv[(k + e) * kk + k + f];
+        for (e, te) in terms.iter().enumerate() {
+            for (f, tf) in terms.iter().enumerate() {
+                let v: f64 = free_terms(te)
+                    .map(|(ce, je)| {
+                        free_terms(tf)
+                            .map(|(cf, jf)| ce * inv[(k + je) * kk + k + jf] * cf)
+                            .sum::<f64>()
+                    })
+                    .sum();
+                d[(m + e) * o + m + f] = -v;
             }
         }
         let mut u0 = PointValues::zeros(n, nt);
         self.project(&condensed.loads.solution[..k], &mut u0);
+        let at_points = self.potentials_of_condensed(&condensed.loads.solution[k..]);
         let problem = ElectricContactProblem {
             u0,
-            phi0: condensed.loads.solution[k..].to_vec(),
+            phi0: at_points,
             compliance: d,
             weight: p.weight.clone(),
             nt,
@@ -979,7 +1130,18 @@ impl ContactBoundary {
         b_phi: &[f64],
     ) -> Result<(Vec<f64>, Vec<f64>), ProblemError> {
         let mut d = self.forces(&sol.lambda);
-        d.extend(self.electric_charges(sol, b_u.len()).iter().map(|(_, v)| v));
+        // each condensed potential's share of the flux, in their order
+        let n = self.electric.as_ref().map_or(0, |(_, dofs)| dofs.len());
+        let at = d.len();
+        d.resize(at + n, 0.0);
+        let place: std::collections::HashMap<usize, usize> = self
+            .electric
+            .iter()
+            .flat_map(|(_, dofs)| dofs.iter().enumerate().map(|(e, &j)| (j - b_u.len(), e)))
+            .collect();
+        for (j, q) in self.electric_charges(sol, b_u.len()) {
+            d[at + place[&j]] += q;
+        }
         solver.solve_with_update(loads, b_u, b_phi, &d)
     }
 }

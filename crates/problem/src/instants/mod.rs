@@ -126,7 +126,8 @@ impl Instants {
             note_condensed(&mut self.condense, reporter, problem.order(), condensed.route, t);
             let first = (problem.u0.clone(), problem.phi0.clone());
             let solved = solve_parts(f, parts)?;
-            let at_points = |(u, phi): &Fields| (u.clone(), at_electric_points(boundary, phi, u.len()));
+            // a part is a response to a load: the prescribed terms come with each instant
+            let at_points = |(u, phi): &Fields| (u.clone(), boundary.free_potentials_at_points(phi, u.len()));
             self.kept = Kept::Electric(Electric {
                 problem,
                 loads: Some(condensed),
@@ -195,7 +196,10 @@ impl Instants {
                     (None, false) => e.first.clone(),
                     (Some(factors), false) => {
                         let u = superpose(e.parts.iter().map(|(u, _)| &u[..]), factors);
-                        let phi0 = superpose(e.parts.iter().map(|(_, phi)| &phi[..]), factors);
+                        let mut phi0 = superpose(e.parts.iter().map(|(_, phi)| &phi[..]), factors);
+                        for (p, c) in phi0.iter_mut().zip(framed.boundary.prescribed_potentials()) {
+                            *p += c;
+                        }
                         (
                             in_frame(fields_at_points(framed.boundary, &u, nt), Some(framed.shift)),
                             phi0,
@@ -560,8 +564,7 @@ fn largest(values: &[f64]) -> f64 {
 /// The potentials at the boundary's electric points, from the free potentials `phi` (the free
 /// unknowns laid out `[u; φ]`, `n_u` displacements first).
 fn at_electric_points(boundary: &ContactBoundary, phi: &[f64], n_u: usize) -> Vec<f64> {
-    let dofs = boundary.electric.as_ref().map_or(&[][..], |(_, d)| &d[..]);
-    dofs.iter().map(|&d| phi[d - n_u]).collect()
+    boundary.potentials_at_points(phi, n_u)
 }
 
 /// `K⁻¹ b_q` for each part `q` of a path's right-hand side, in their order, solved together.
