@@ -151,7 +151,8 @@ fn farthest(a: &problem::Solution, b: &problem::Solution) -> (f64, String) {
 /// one, agrees to 1e-7 in everything it reports ([`farthest`]).
 fn every_scene_agrees(petsc: &Petsc) {
     // at order 2 too: the scenes without contact, 2D contact (a path, electrical contact),
-    // and the modified basis (3D, a body of revolution, a 3D path with friction)
+    // and the modified basis (3D, a body of revolution, a 3D path with friction, a conducting
+    // tip)
     let quadratic = [
         "manufactured",
         "manufactured-3d",
@@ -164,6 +165,7 @@ fn every_scene_agrees(petsc: &Petsc) {
         "paper-3d",
         "hertz-sphere",
         "mindlin-sphere-cycle",
+        "pfm",
     ];
     let orders = scene_file::SHIPPED.iter().map(|s| (s, "mesh.order=1")).chain(
         scene_file::SHIPPED
