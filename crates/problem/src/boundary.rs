@@ -638,8 +638,7 @@ impl ContactBoundary {
     /// The dofs the condensation puts last: the points' free displacements, then (electrical
     /// contact) their free potentials.
     pub fn condensed_dofs(&self) -> Vec<usize> {
-        let phi = self.electric.as_ref().map_or(&[][..], |(_, d)| d.as_slice());
-        self.dofs.iter().chain(phi).copied().collect()
+        self.dofs.iter().chain(self.electric_dofs()).copied().collect()
     }
 
     /// The flux of `sol` as the change of the electric right-hand side (the potential's rows
@@ -660,20 +659,17 @@ impl ContactBoundary {
         out
     }
 
-    /// The potentials at the electric points of the free potentials `phi` (of `n_u` free
-    /// displacements before them in `[u; φ]`): each point's terms, the prescribed ones at this
-    /// boundary's values where `prescribed` (a response to a load has none: `false`).
-    fn potentials_of(&self, phi: &[f64], n_u: usize, prescribed: bool) -> Vec<f64> {
-        let Some((_, dofs)) = &self.electric else {
-            return vec![];
-        };
+    /// Each electric point's potential from its terms: `free(j)` the value of the `j`-th
+    /// electric dof, the prescribed terms at this boundary's values where `prescribed` (a
+    /// response to a load has none: `false`).
+    fn combine(&self, free: impl Fn(usize) -> f64, prescribed: bool) -> Vec<f64> {
         self.phi_terms
             .iter()
             .map(|terms| {
                 terms
                     .iter()
                     .map(|&(c, slot)| match slot {
-                        Slot::Free(j) => c * phi[dofs[j] - n_u],
+                        Slot::Free(j) => c * free(j),
                         Slot::Fixed(v) if prescribed => c * v,
                         Slot::Fixed(_) => 0.0,
                     })
@@ -682,51 +678,36 @@ impl ContactBoundary {
             .collect()
     }
 
+    /// The free potentials' dofs (indices into `[u; φ]`) of electrical contact, none without.
+    fn electric_dofs(&self) -> &[usize] {
+        self.electric.as_ref().map_or(&[][..], |(_, d)| d.as_slice())
+    }
+
     /// The potentials at the electric points of the fields' free potentials `phi` (of `n_u`
     /// free displacements before them in `[u; φ]`), the prescribed terms at this boundary's
     /// values.
     pub fn potentials_at_points(&self, phi: &[f64], n_u: usize) -> Vec<f64> {
-        self.potentials_of(phi, n_u, true)
+        let dofs = self.electric_dofs();
+        self.combine(|j| phi[dofs[j] - n_u], true)
     }
 
     /// As [`ContactBoundary::potentials_at_points`] for a response to a load (a path's part):
     /// the free terms alone, the prescribed ones added at each instant's values
     /// ([`ContactBoundary::prescribed_potentials`]).
     pub fn free_potentials_at_points(&self, phi: &[f64], n_u: usize) -> Vec<f64> {
-        self.potentials_of(phi, n_u, false)
+        let dofs = self.electric_dofs();
+        self.combine(|j| phi[dofs[j] - n_u], false)
     }
 
     /// The prescribed terms of each electric point's potential, at this boundary's values.
     pub fn prescribed_potentials(&self) -> Vec<f64> {
-        self.phi_terms
-            .iter()
-            .map(|terms| {
-                terms
-                    .iter()
-                    .map(|&(c, slot)| match slot {
-                        Slot::Fixed(v) => c * v,
-                        Slot::Free(_) => 0.0,
-                    })
-                    .sum()
-            })
-            .collect()
+        self.combine(|_| 0.0, true)
     }
 
     /// The potentials at the electric points of the values `phi_c` at the condensed
     /// potentials (in the order of the electric dofs).
     fn potentials_of_condensed(&self, phi_c: &[f64]) -> Vec<f64> {
-        self.phi_terms
-            .iter()
-            .map(|terms| {
-                terms
-                    .iter()
-                    .map(|&(c, slot)| match slot {
-                        Slot::Free(j) => c * phi_c[j],
-                        Slot::Fixed(v) => c * v,
-                    })
-                    .sum()
-            })
-            .collect()
+        self.combine(|j| phi_c[j], true)
     }
 
     /// Each electric point's potential terms, and the dofs they add after the points' own
