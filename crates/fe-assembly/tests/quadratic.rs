@@ -5,16 +5,15 @@
 //!   charge constant, from the Hessians) are reproduced to round-off on jittered meshes in 2D
 //!   and 3D, where P1 misses them;
 //! - the manufactured solution of `mms.rs`: L2 error O(h³) and energy error O(h²);
-//! - bodies of revolution: Lamé's thick cylinder (Timoshenko & Goodier, §28) at third order
-//!   in the nodal error, and a poled disc between electrodes (a uniform field) to round-off with
-//!   the whole disc's charge;
+//! - (bodies of revolution at order 2: Lamé's cylinder and the poled disc, in
+//!   `axisymmetric.rs` beside their P1 checks);
 //! - the node-owned parallel assembly equals the serial cell loop.
 
 mod common;
 
 use common::{jitter, pzt5a, rates, solve_nodal as solve};
 
-use fe_assembly::{Constraint, Coordinates, Crystal, Discretization, Exact, Field, Load, Material, Parallelism};
+use fe_assembly::{Constraint, Coordinates, Discretization, Exact, Field, Parallelism};
 use std::sync::Arc;
 
 /// `u_k = Σ a_kij x_i x_j + b_k · x`, `φ` likewise: full quadratics with all their terms.
@@ -125,87 +124,6 @@ fn the_manufactured_solution_converges_at_third_order_in_l2_and_second_in_energy
             "{dim}D n = {n}: P2 {rows:?}, P1 {p1:e}"
         );
     }
-}
-
-#[test]
-fn lames_cylinder_converges_at_third_order() {
-    let (a, b, e, nu, p) = (1.0, 2.0, 100.0, 0.3, 1.5);
-    let exact = |r: f64| (1.0 + nu) * p * a * a / (e * (b * b - a * a)) * ((1.0 - 2.0 * nu) * r + b * b / r);
-    let mut errors = vec![];
-    for n in [2, 4, 8] {
-        let mesh = mesh::rectangle_tri([a, 0.0], [b, 0.25], 4 * n, n).quadratic().unwrap();
-        let mat =
-            Material::from_crystal_axisymmetric("steel", &Crystal::isotropic(e, nu, 0.0), [0.0, 1.0, 0.0]).unwrap();
-        let bcs = vec![
-            Constraint::constant("top", Field::Displacement(1), 0.0),
-            Constraint::constant("bottom", Field::Displacement(1), 0.0),
-        ];
-        let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat)], &bcs).unwrap();
-        disc.check_held().unwrap();
-        let load = Load::Traction {
-            group: "left".into(),
-            value: Arc::new(move |_| [p, 0.0, 0.0]),
-        };
-        let (u, _) = solve(&disc, &[load]);
-        let sum: f64 = mesh
-            .points
-            .iter()
-            .zip(&u)
-            .map(|(x, u)| (u[0] - exact(x[0])).powi(2) + u[1].powi(2))
-            .sum();
-        errors.push((sum / mesh.n_nodes() as f64).sqrt() / exact(a));
-    }
-    let rates: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-    eprintln!("Lamé P2: errors {errors:?}, rates {rates:?}");
-    // P1 at n = 16 (a finer mesh): 3.4e-5 (axisymmetric.rs)
-    assert!(errors[2] < 3.4e-5, "errors {errors:?}");
-    assert!(rates.iter().all(|&r| r > 2.8), "errors {errors:?}, rates {rates:?}");
-}
-
-#[test]
-fn a_poled_disc_between_electrodes_is_reproduced_with_the_whole_discs_charge() {
-    let (radius, height, volts) = (1.0, 0.5, 0.02);
-    let mut p1 = mesh::rectangle_tri([0.0, 0.0], [radius, height], 6, 3);
-    jitter(&mut p1, 0.05, 4242);
-    let mesh = p1.quadratic().unwrap();
-    let mat = Material::from_crystal_axisymmetric("pzt5a", &Crystal::pzt5a(), [0.0, 1.0, 0.0]).unwrap();
-    let bcs = vec![
-        Constraint::constant("left", Field::Displacement(0), 0.0),
-        Constraint::constant("bottom", Field::Displacement(1), 0.0),
-        Constraint::constant("bottom", Field::Potential, 0.0),
-        Constraint::constant("top", Field::Potential, volts),
-    ];
-    let disc = Discretization::new(&mesh, Coordinates::Axisymmetric, &[("body".into(), mat.clone())], &bcs).unwrap();
-    let (u, phi) = solve(&disc, &[]);
-    let grad = [0.0, volts / height];
-    let c = nalgebra::DMatrix::from_row_slice(4, 4, &mat.c);
-    let rhs = nalgebra::DVector::from_iterator(
-        4,
-        (0..4).map(|v| -(0..2).map(|k| mat.e[k * 4 + v] * grad[k]).sum::<f64>()),
-    );
-    let eps = c.lu().solve(&rhs).unwrap();
-    let scale = eps.amax() * radius;
-    for (x, (u, p)) in mesh.points.iter().zip(u.iter().zip(&phi)) {
-        assert!((u[0] - eps[0] * x[0]).abs() < 1e-11 * scale, "u_r at {x:?}");
-        assert!((u[1] - eps[1] * x[1]).abs() < 1e-11 * scale, "u_z at {x:?}");
-        assert!((p - volts * x[1] / height).abs() < 1e-12 * volts, "φ at {x:?}");
-    }
-    let d_z: f64 = (0..4).map(|v| mat.e[4 + v] * eps[v]).sum::<f64>() - mat.beta[3] * grad[1];
-    let charges = disc.charges(&u, &phi, &["top", "bottom"], &[]).unwrap();
-    let whole = -d_z * std::f64::consts::PI * radius * radius;
-    assert!(
-        (charges[0] - whole).abs() < 1e-11 * whole.abs(),
-        "top {} against {whole}",
-        charges[0]
-    );
-    assert!(
-        (charges[1] + whole).abs() < 1e-11 * whole.abs(),
-        "bottom {}",
-        charges[1]
-    );
-    // the charge's functionals give the same charge from the free unknowns
-    let fields = disc.recover(&u, &phi);
-    assert!(fields.stress.iter().all(|s| s.abs() < 1e-9 * mat.c[0] * eps.amax()));
 }
 
 #[test]
