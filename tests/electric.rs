@@ -260,6 +260,16 @@ fn keys_that_do_not_fit_electrical_contact_are_refused_by_name() {
     assert!(files::scene_file::load(c, &["contact.law=\"none\"".into()]).is_ok());
 }
 
+/// The manufactured contact scene made a unit cube poled along z, its contact face the bottom.
+const BOX_3D: [&str; 6] = [
+    "mesh.kind=\"box\"",
+    "mesh.lo=[0.0, 0.0, 0.0]",
+    "mesh.hi=[1.0, 1.0, 1.0]",
+    "material.0.poling=[0.0, 0.0, 1.0]",
+    "contact.normal=[0.0, 0.0, -1.0]",
+    "contact.gap_center=[0.5, 0.5, 0.0]",
+];
+
 /// The manufactured solution in sticking contact with the foundation on the whole contact
 /// face (`exact.kind = "manufactured-contact"`, `fe_assembly::Exact::on_foundation`): P1
 /// converges as O(h) in the energy norm and O(h²) in L2, in 2D and 3D, every point in contact
@@ -290,17 +300,7 @@ fn the_manufactured_solution_in_contact_converges_at_order_one() {
                     sets.push(format!("contact.compliance.exponent={m}"));
                 }
                 if dim == 3 {
-                    sets.extend(
-                        [
-                            "mesh.kind=\"box\"",
-                            "mesh.lo=[0.0, 0.0, 0.0]",
-                            "mesh.hi=[1.0, 1.0, 1.0]",
-                            "material.0.poling=[0.0, 0.0, 1.0]",
-                            "contact.normal=[0.0, 0.0, -1.0]",
-                            "contact.gap_center=[0.5, 0.5, 0.0]",
-                        ]
-                        .map(String::from),
-                    );
+                    sets.extend(BOX_3D.map(String::from));
                 }
                 let what = format!("{dim}D n = {n}, {face}, bed {bed:?}");
                 let (scene, _) = files::scene_file::load("manufactured-conducting", &sets).unwrap();
@@ -406,17 +406,7 @@ fn the_manufactured_sliding_solution_converges_at_order_one() {
                 let mut sets = vec![format!("mesh.n={n}")];
                 sets.extend(law_sets.iter().map(|s| s.to_string()));
                 if dim == 3 {
-                    sets.extend(
-                        [
-                            "mesh.kind=\"box\"",
-                            "mesh.lo=[0.0, 0.0, 0.0]",
-                            "mesh.hi=[1.0, 1.0, 1.0]",
-                            "material.0.poling=[0.0, 0.0, 1.0]",
-                            "contact.normal=[0.0, 0.0, -1.0]",
-                            "contact.gap_center=[0.5, 0.5, 0.0]",
-                        ]
-                        .map(String::from),
-                    );
+                    sets.extend(BOX_3D.map(String::from));
                 }
                 let what = format!("{dim}D n = {n}, {law}");
                 let (scene, _) = files::scene_file::load("manufactured-conducting", &sets).unwrap();
@@ -726,24 +716,17 @@ fn a_floating_conducting_zone_among_several_is_a_floating_terminal_where_it_touc
 /// - Tolerance: order in [1.9, 2.1].
 #[test]
 fn the_manufactured_solution_in_contact_converges_at_order_two_with_quadratic_elements() {
-    const BOX: [&str; 7] = [
-        "mesh.kind=\"box\"",
-        "mesh.lo=[0.0, 0.0, 0.0]",
-        "mesh.hi=[1.0, 1.0, 1.0]",
-        "material.0.poling=[0.0, 0.0, 1.0]",
-        "contact.normal=[0.0, 0.0, -1.0]",
-        "contact.gap_center=[0.5, 0.5, 0.0]",
-        "contact.electric=\"insulated\"",
-    ];
+    let mut box_insulated = BOX_3D.to_vec();
+    box_insulated.push("contact.electric=\"insulated\"");
     let sliding = ["contact.friction=0.3", "exact.slip=2e-3"];
-    let mut sliding_3d = BOX.to_vec();
+    let mut sliding_3d = box_insulated.clone();
     sliding_3d.extend(sliding);
     sliding_3d.push("~contact.foundation_potential");
-    let mut sticking_3d = BOX.to_vec();
+    let mut sticking_3d = box_insulated.clone();
     sticking_3d.push("~contact.foundation_potential");
     // conducting in 3D: the points' potentials in the modified basis too (their terms on
     // the sides' prescribed potentials among them)
-    let conducting_3d = &BOX[..6];
+    let conducting_3d = &BOX_3D[..];
     let cases: [(&str, &[&str], [usize; 3]); 5] = [
         ("2D sticking, conducting", &[], [8, 16, 32]),
         ("2D sliding", &sliding, [8, 16, 32]),
