@@ -61,7 +61,8 @@ pub struct Blocks {
 
 impl<'m> Discretization<'m> {
     /// Sets up the discretisation: `materials` pairs a region name with its material; every
-    /// cell must lie in exactly one of these regions. Only P1 simplices are supported.
+    /// cell must lie in exactly one of these regions. P1 and P2 simplices are supported (not
+    /// quadrilaterals).
     /// [`Coordinates::Axisymmetric`] makes the 2D mesh the meridian section of a body of
     /// revolution about the y axis (every node at `x >= 0`), each material made for it
     /// ([`Material::from_crystal_axisymmetric`]); the caller holds the radial displacement of

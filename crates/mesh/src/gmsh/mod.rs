@@ -227,10 +227,10 @@ fn cell_kind(t: i32, dim: i32, so_far: Option<CellKind>) -> Result<CellKind, Str
         9 => CellKind::Tri6,
         11 => CellKind::Tet10,
         _ => {
-            let hint = if matches!(t, 10 | 16 | 20..=31) {
-                " (serendipity, third- and higher-order elements: mesh with Mesh.ElementOrder = 1 or 2, and Mesh.SecondOrderIncomplete = 0 for quadrilaterals)"
-            } else {
-                ""
+            let hint = match t {
+                10 | 16 => " (second-order quadrilaterals: mesh with triangles, Mesh.RecombineAll = 0, or at Mesh.ElementOrder = 1)",
+                20..=31 => " (third- and higher-order elements: mesh with Mesh.ElementOrder = 1 or 2)",
+                _ => "",
             };
             return Err(format!(
                 "{} cells are not supported: cells must be 3- or 6-node triangles, 4-node quadrilaterals or 4- or 10-node tetrahedra{hint}",
