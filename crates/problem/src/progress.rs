@@ -33,6 +33,8 @@ pub enum Event<'a> {
         n_nodes: usize,
         /// Mesh cells.
         n_cells: usize,
+        /// Their kind, in words (`mesh::CellKind::name`).
+        kind: &'static str,
         /// Largest cell diameter.
         h: f64,
         /// Free displacement unknowns.
@@ -201,6 +203,7 @@ impl Event<'_> {
         Event::Assembled {
             n_nodes: mesh.n_nodes(),
             n_cells: mesh.n_cells(),
+            kind: mesh.kind.name(),
             h: mesh.h_max(),
             n_u: dofs.n_u,
             n_phi: dofs.n_phi,
@@ -291,13 +294,14 @@ impl fmt::Display for Event<'_> {
             Event::Assembled {
                 n_nodes,
                 n_cells,
+                kind,
                 h,
                 n_u,
                 n_phi,
                 seconds,
             } => write!(
                 f,
-                "mesh: {n_nodes} nodes, {n_cells} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
+                "mesh: {n_nodes} nodes, {n_cells} {kind} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
             ),
             Event::PathPlan {
                 instants,
