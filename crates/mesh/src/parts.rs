@@ -137,8 +137,24 @@ impl Mesh {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// The arrays of `m`, as another program would hand them over.
+    pub(crate) fn parts_of(m: &Mesh) -> MeshParts {
+        MeshParts {
+            dim: m.dim,
+            points: m.points.clone(),
+            cells: m.cells.clone(),
+            nodes_per_cell: m.kind.n_nodes(),
+            boundaries: m
+                .boundaries
+                .iter()
+                .map(|(k, g)| (k.clone(), g.facets.clone()))
+                .collect(),
+            regions: m.regions.clone(),
+        }
+    }
 
     fn square(cells: Vec<usize>) -> MeshParts {
         MeshParts {
@@ -154,19 +170,7 @@ mod tests {
     #[test]
     fn parts_give_the_generated_mesh() {
         let m = crate::rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2);
-        let parts = MeshParts {
-            dim: 2,
-            points: m.points.clone(),
-            cells: m.cells.clone(),
-            nodes_per_cell: 3,
-            boundaries: m
-                .boundaries
-                .iter()
-                .map(|(k, g)| (k.clone(), g.facets.clone()))
-                .collect(),
-            regions: m.regions.clone(),
-        };
-        assert_eq!(Mesh::from_parts(parts).unwrap(), m);
+        assert_eq!(Mesh::from_parts(parts_of(&m)).unwrap(), m);
     }
 
     #[test]

@@ -97,7 +97,8 @@ impl Mesh {
 
 #[cfg(test)]
 mod tests {
-    use crate::{box_tet, rectangle_tri, CellKind, MeshParts};
+    use crate::parts::tests::parts_of as parts;
+    use crate::{box_tet, rectangle_tri, CellKind};
 
     #[test]
     fn a_quadratic_rectangle_has_a_node_on_every_edge() {
@@ -130,18 +131,6 @@ mod tests {
     #[test]
     fn a_curved_cell_and_a_facet_with_foreign_edge_nodes_are_named() {
         let m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1).quadratic().unwrap();
-        let parts = |m: &crate::Mesh| MeshParts {
-            dim: 2,
-            points: m.points.clone(),
-            cells: m.cells.clone(),
-            nodes_per_cell: 6,
-            boundaries: m
-                .boundaries
-                .iter()
-                .map(|(k, g)| (k.clone(), g.facets.clone()))
-                .collect(),
-            regions: m.regions.clone(),
-        };
         crate::Mesh::from_parts(parts(&m)).unwrap();
         let mut bent = m.clone();
         let mid = bent.cells[3];

@@ -15,12 +15,11 @@ use rayon::prelude::*;
 /// compare equal: the corners are the first nodes of a quadratic facet, its midpoints follow.
 type Key = [usize; 4];
 
-/// The key of the entity whose first `corners` nodes are its corners.
-fn key_of(nodes: &[usize], corners: usize) -> Key {
-    let n = corners.min(nodes.len()).min(4);
+/// The key of the entity whose corners are `corners` (at most 4).
+fn key(corners: &[usize]) -> Key {
     let mut k = [usize::MAX; 4];
-    k[..n].copy_from_slice(&nodes[..n]);
-    k[..n].sort_unstable();
+    k[..corners.len()].copy_from_slice(corners);
+    k[..corners.len()].sort_unstable();
     k
 }
 
@@ -61,7 +60,7 @@ impl Mesh {
                 for (q, &l) in f.iter().take(corners).enumerate() {
                     buf[q] = cell[l];
                 }
-                all.push((key_of(&buf[..corners], corners), c));
+                all.push((key(&buf[..corners]), c));
             }
         }
         all.par_sort_unstable();
@@ -159,7 +158,7 @@ impl Mesh {
         let mut cells: Vec<(Key, usize)> = self
             .iter_cells()
             .enumerate()
-            .map(|(c, n)| (key_of(n, corners), c))
+            .map(|(c, n)| (key(&n[..corners]), c))
             .collect();
         cells.sort_unstable();
         if let Some(w) = cells.windows(2).find(|w| w[0].0 == w[1].0) {
@@ -169,13 +168,9 @@ impl Mesh {
             });
         }
         let mut interior = 0;
+        let corners = self.kind.facet_corners();
         for (name, group) in &self.boundaries {
-            let facet_corners = self.kind.facet_corners();
-            let mut seen: Vec<(Key, usize)> = group
-                .iter()
-                .enumerate()
-                .map(|(f, n)| (key_of(n, facet_corners), f))
-                .collect();
+            let mut seen: Vec<(Key, usize)> = group.iter().enumerate().map(|(f, n)| (key(&n[..corners]), f)).collect();
             seen.sort_unstable();
             let bad = |facet: usize, problem: &'static str| MeshError::BadBoundaryFacet {
                 group: name.clone(),
@@ -242,7 +237,7 @@ impl Mesh {
         facet: &'a [usize],
     ) -> impl Iterator<Item = usize> + 'a {
         let corners = self.kind.facet_corners();
-        let k = key_of(facet, corners);
+        let k = key(&facet[..corners.min(facet.len())]);
         let near = match facet.first() {
             Some(&v) if v + 1 < offsets.len() => &node_cells[offsets[v]..offsets[v + 1]],
             _ => &[],
@@ -254,7 +249,7 @@ impl Mesh {
                 for (q, &l) in f.iter().take(corners).enumerate() {
                     nodes[q] = cell[l];
                 }
-                f.len() == facet.len() && key_of(&nodes[..corners], corners) == k
+                f.len() == facet.len() && key(&nodes[..corners]) == k
             })
         })
     }
