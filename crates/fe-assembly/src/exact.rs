@@ -454,21 +454,8 @@ impl Discretization<'_> {
     pub fn error_norms(&self, u: &[[f64; 3]], phi: &[f64], exact: &Exact) -> ErrorNorms {
         let (mesh, dim) = (self.mesh, self.mesh.dim);
         let order = mesh.kind.order();
-        let (weights, rule): (Vec<f64>, Vec<[f64; 4]>) = match (order, dim) {
-            (2, _) => crate::loads::simplex_rule(dim, 2),
-            (_, 2) => {
-                let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
-                (vec![1.0 / 3.0; 3], vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]])
-            }
-            _ => {
-                let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
-                (
-                    vec![0.25; 4],
-                    vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
-                )
-            }
-        };
-        let shapes: Vec<_> = rule.iter().map(|l| crate::loads::shape_values(dim, order, l)).collect();
+        let (weights, rule) = kernels::simplex_rule(dim, order);
+        let shapes: Vec<_> = rule.iter().map(|l| kernels::shape_values(dim, order, l)).collect();
         let (mut eu, mut ep, mut en) = (0.0, 0.0, 0.0);
         let (mut nu, mut np, mut nn) = (0.0, 0.0, 0.0);
         let energy = |m: &Material, eps: &[f64; 6], grad: &[f64]| {

@@ -226,29 +226,104 @@ impl CellRule for LinearRule<'_> {
     }
 }
 
-/// The triangle's interior six-point rule of degree 4 (Dunavant, Int. J. Numer. Methods Eng.
-/// 21 (1985) 1129, table for p = 4): `(a, a, 1 - 2a)` and its permutations, weights of the
-/// unit measure.
-const TRIANGLE_RULE_4: [([f64; 3], f64); 6] = {
-    const A1: f64 = 0.445_948_490_915_965;
-    const W1: f64 = 0.223_381_589_678_011;
-    const A2: f64 = 0.091_576_213_509_771;
-    const W2: f64 = 0.109_951_743_655_322;
-    [
-        ([A1, A1, 1.0 - 2.0 * A1], W1),
-        ([A1, 1.0 - 2.0 * A1, A1], W1),
-        ([1.0 - 2.0 * A1, A1, A1], W1),
-        ([A2, A2, 1.0 - 2.0 * A2], W2),
-        ([A2, 1.0 - 2.0 * A2, A2], W2),
-        ([1.0 - 2.0 * A2, A2, A2], W2),
-    ]
-};
+/// Barycentric quadrature on a simplex of dimension `dim` for shape functions of order
+/// `order`: `(weights, points)`, weights summing to 1 (multiply by the measure). Order 1:
+/// degree 2 (Gauss' two points on a segment, the interior `(2/3, 1/6, 1/6)` and its
+/// permutations on a triangle, and on a
+/// tetrahedron `(a, b, b, b)` and its permutations with `a = (5 + 3√5) / 20`,
+/// `b = (5 - √5) / 20`, each of weight 1/4: Keast, Comput. Methods Appl. Mech. Eng. 55 (1986)
+/// 339, rule 2). Order 2: Gauss' three points on a segment (degree 5), Dunavant's six on a
+/// triangle (degree 4: `(a, a, 1 - 2a)` and its permutations; Int. J. Numer. Methods Eng. 21
+/// (1985) 1129, table for p = 4), and on a tetrahedron the five-point rule of degree 3 (its
+/// centroid weighted -4/5, the points `(1/2, 1/6, 1/6, 1/6)` 9/20; Stroud, Approximate
+/// Calculation of Multiple Integrals, 1971, T3:3-1).
+pub fn simplex_rule(dim: usize, order: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
+    match (dim, order) {
+        (1, 1) => {
+            let s = 0.5 / 3f64.sqrt();
+            (
+                vec![0.5, 0.5],
+                vec![[0.5 - s, 0.5 + s, 0.0, 0.0], [0.5 + s, 0.5 - s, 0.0, 0.0]],
+            )
+        }
+        (2, 1) => (
+            vec![1.0 / 3.0; 3],
+            TRIANGLE_RULE.iter().map(|l| [l[0], l[1], l[2], 0.0]).collect(),
+        ),
+        (_, 1) => {
+            let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
+            (
+                vec![0.25; 4],
+                vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
+            )
+        }
+        (1, _) => {
+            let s = 0.5 * (3.0f64 / 5.0).sqrt();
+            (
+                vec![5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0],
+                vec![
+                    [0.5 - s, 0.5 + s, 0.0, 0.0],
+                    [0.5, 0.5, 0.0, 0.0],
+                    [0.5 + s, 0.5 - s, 0.0, 0.0],
+                ],
+            )
+        }
+        (2, _) => {
+            let (a1, w1) = (0.445_948_490_915_965, 0.223_381_589_678_011);
+            let (a2, w2) = (0.091_576_213_509_771, 0.109_951_743_655_322);
+            let (b1, b2) = (1.0 - 2.0 * a1, 1.0 - 2.0 * a2);
+            (
+                vec![w1, w1, w1, w2, w2, w2],
+                vec![
+                    [a1, a1, b1, 0.0],
+                    [a1, b1, a1, 0.0],
+                    [b1, a1, a1, 0.0],
+                    [a2, a2, b2, 0.0],
+                    [a2, b2, a2, 0.0],
+                    [b2, a2, a2, 0.0],
+                ],
+            )
+        }
+        _ => {
+            let (a, b) = (0.5, 1.0 / 6.0);
+            (
+                vec![-0.8, 0.45, 0.45, 0.45, 0.45],
+                vec![[0.25; 4], [a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
+            )
+        }
+    }
+}
 
-/// The tetrahedron's four-point rule of degree 2: `(b, b, b, a)` and its permutations with
-/// `a = (5 + 3√5) / 20`, `b = (5 - √5) / 20`, each of weight 1/4 (Keast, Comput. Methods Appl.
-/// Mech. Eng. 55 (1986) 339, rule 2).
-const TET_A: f64 = 0.585_410_196_624_968_5;
-const TET_B: f64 = 0.138_196_601_125_010_5;
+/// The shape functions of order `order` on a simplex of dimension `dim` at the barycentric
+/// coordinates `l`: P1, `λ_a`; P2, the corners' `λ_i (2 λ_i - 1)` then the edges' `4 λ_i λ_j`
+/// (a segment's one edge; a triangle's 0-1, 1-2, 2-0; a tetrahedron's 0-1, 1-2, 2-0, 0-3, 1-3,
+/// 2-3: the order of the cells' and facets' nodes).
+pub fn shape_values(dim: usize, order: usize, l: &[f64; 4]) -> [f64; MAX_NODES] {
+    let corners = dim + 1;
+    let mut n = [0.0; MAX_NODES];
+    if order == 1 {
+        n[..corners].copy_from_slice(&l[..corners]);
+        return n;
+    }
+    for i in 0..corners {
+        n[i] = l[i] * (2.0 * l[i] - 1.0);
+    }
+    for (e, &[i, j]) in simplex_edges(dim).iter().enumerate() {
+        n[corners + e] = 4.0 * l[i] * l[j];
+    }
+    n
+}
+
+/// The edges of a simplex of dimension `dim` by its corners, in the order of a second-order
+/// simplex's edge nodes: a segment's one edge; a triangle's 0-1, 1-2, 2-0; a tetrahedron's
+/// 0-1, 1-2, 2-0, 0-3, 1-3, 2-3 (`mesh::CellKind::midside_edges` of the cells).
+pub fn simplex_edges(dim: usize) -> &'static [[usize; 2]] {
+    match dim {
+        1 => &[[0, 1]],
+        2 => &[[0, 1], [1, 2], [2, 0]],
+        _ => &[[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]],
+    }
+}
 
 /// A P2 cell's quadrature: the six-node triangle or ten-node tetrahedron on its straight-sided
 /// simplex, its shape functions in the barycentric coordinates `λ` (corner `i`:
@@ -268,18 +343,11 @@ pub struct QuadraticRule {
 impl QuadraticRule {
     /// The rule of the P2 cell on the simplex `g` of dimension `dim`.
     pub fn new(dim: usize, g: &SimplexGeometry) -> Self {
-        let mut points: Vec<([f64; 4], f64)> = Vec::with_capacity(MAX_POINTS);
-        if dim == 3 {
-            for i in 0..4 {
-                let mut l = [TET_B; 4];
-                l[i] = TET_A;
-                points.push((l, 0.25));
-            }
-        } else if g.radii.is_some() {
-            points.extend(TRIANGLE_RULE_4.iter().map(|(l, w)| ([l[0], l[1], l[2], 0.0], *w)));
-        } else {
-            points.extend(TRIANGLE_RULE.iter().map(|l| ([l[0], l[1], l[2], 0.0], 1.0 / 3.0)));
-        }
+        // degree 2 (the rule for P1's loads), or degree 4 for the hoop terms of a body of
+        // revolution (the rule for P2's loads on a triangle)
+        let rule_order = if g.radii.is_some() { 2 } else { 1 };
+        let (weights, points) = simplex_rule(dim, rule_order);
+        let points: Vec<([f64; 4], f64)> = points.into_iter().zip(weights).collect();
         Self::at(dim, g, &points)
     }
 
@@ -287,11 +355,7 @@ impl QuadraticRule {
     /// coordinates, and the fraction of the cell's measure each stands for).
     pub fn at(dim: usize, g: &SimplexGeometry, points: &[([f64; 4], f64)]) -> Self {
         let corners = dim + 1;
-        let edges: &[[usize; 2]] = if dim == 2 {
-            &[[0, 1], [1, 2], [2, 0]]
-        } else {
-            &[[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]
-        };
+        let edges = simplex_edges(dim);
         let mut rule = QuadraticRule {
             n_local: corners + edges.len(),
             n_points: points.len().min(MAX_POINTS),
@@ -302,12 +366,11 @@ impl QuadraticRule {
         };
         for (p, (l, w)) in points.iter().enumerate().take(MAX_POINTS) {
             let gl = &g.grads;
+            rule.value[p] = shape_values(dim, 2, l);
             for i in 0..corners {
-                rule.value[p][i] = l[i] * (2.0 * l[i] - 1.0);
                 rule.grad[p][i] = gl[i].map(|x| (4.0 * l[i] - 1.0) * x);
             }
             for (e, &[i, j]) in edges.iter().enumerate() {
-                rule.value[p][corners + e] = 4.0 * l[i] * l[j];
                 rule.grad[p][corners + e] = std::array::from_fn(|k| 4.0 * (l[i] * gl[j][k] + l[j] * gl[i][k]));
             }
             rule.weight[p] = w * g.measure;

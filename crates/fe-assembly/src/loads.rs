@@ -9,7 +9,9 @@
 //! for `k = 2`: the loads' quadrature keeps the L2 error's O(h³); Ciarlet, The Finite
 //! Element Method for Elliptic Problems, 1978, section 4.1).
 
-use crate::kernels::{coupling_column, coupling_row, dielectric_column, elasticity_column, MAX_NODES};
+use crate::kernels::{
+    coupling_column, coupling_row, dielectric_column, elasticity_column, shape_values, simplex_rule, MAX_NODES,
+};
 use crate::InputError;
 use crate::{AssemblyError, Discretization, Dof, ScalarFn, VectorFn};
 
@@ -56,94 +58,6 @@ impl std::fmt::Debug for Load {
             Load::TerminalCharge { group, charge } => write!(f, "TerminalCharge {charge} on `{group}`"),
         }
     }
-}
-
-/// Barycentric quadrature on a simplex of dimension `dim` for shape functions of order
-/// `order`: `(weights, points)`, weights summing to 1 (multiply by the measure). Order 1:
-/// degree 2. Order 2: Gauss' three points on a segment (degree 5), Dunavant's six on a
-/// triangle (degree 4), and on a tetrahedron the five-point rule of degree 3 (its centroid
-/// weighted -4/5, the points `(1/2, 1/6, 1/6, 1/6)` 9/20; Stroud, Approximate Calculation of
-/// Multiple Integrals, 1971, T3:3-1).
-pub(crate) fn simplex_rule(dim: usize, order: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
-    match (dim, order) {
-        (1, 1) => {
-            let s = 0.5 / 3f64.sqrt();
-            (
-                vec![0.5, 0.5],
-                vec![[0.5 - s, 0.5 + s, 0.0, 0.0], [0.5 + s, 0.5 - s, 0.0, 0.0]],
-            )
-        }
-        (2, 1) => {
-            let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
-            (vec![1.0 / 3.0; 3], vec![[a, b, b, 0.0], [b, a, b, 0.0], [b, b, a, 0.0]])
-        }
-        (_, 1) => {
-            let (a, b) = (0.585_410_196_624_968_5, 0.138_196_601_125_010_5);
-            (
-                vec![0.25; 4],
-                vec![[a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
-            )
-        }
-        (1, _) => {
-            let s = 0.5 * (3.0f64 / 5.0).sqrt();
-            (
-                vec![5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0],
-                vec![
-                    [0.5 - s, 0.5 + s, 0.0, 0.0],
-                    [0.5, 0.5, 0.0, 0.0],
-                    [0.5 + s, 0.5 - s, 0.0, 0.0],
-                ],
-            )
-        }
-        (2, _) => {
-            let (a1, w1) = (0.445_948_490_915_965, 0.223_381_589_678_011);
-            let (a2, w2) = (0.091_576_213_509_771, 0.109_951_743_655_322);
-            let (b1, b2) = (1.0 - 2.0 * a1, 1.0 - 2.0 * a2);
-            (
-                vec![w1, w1, w1, w2, w2, w2],
-                vec![
-                    [a1, a1, b1, 0.0],
-                    [a1, b1, a1, 0.0],
-                    [b1, a1, a1, 0.0],
-                    [a2, a2, b2, 0.0],
-                    [a2, b2, a2, 0.0],
-                    [b2, a2, a2, 0.0],
-                ],
-            )
-        }
-        _ => {
-            let (a, b) = (0.5, 1.0 / 6.0);
-            (
-                vec![-0.8, 0.45, 0.45, 0.45, 0.45],
-                vec![[0.25; 4], [a, b, b, b], [b, a, b, b], [b, b, a, b], [b, b, b, a]],
-            )
-        }
-    }
-}
-
-/// The shape functions of order `order` on a simplex of dimension `dim` at the barycentric
-/// coordinates `l`: P1, `λ_a`; P2, the corners' `λ_i (2 λ_i - 1)` then the edges' `4 λ_i λ_j`
-/// (a segment's one edge; a triangle's 0-1, 1-2, 2-0; a tetrahedron's 0-1, 1-2, 2-0, 0-3, 1-3,
-/// 2-3: the order of the cells' and facets' nodes).
-pub(crate) fn shape_values(dim: usize, order: usize, l: &[f64; 4]) -> [f64; MAX_NODES] {
-    let corners = dim + 1;
-    let mut n = [0.0; MAX_NODES];
-    if order == 1 {
-        n[..corners].copy_from_slice(&l[..corners]);
-        return n;
-    }
-    let edges: &[[usize; 2]] = match dim {
-        1 => &[[0, 1]],
-        2 => &[[0, 1], [1, 2], [2, 0]],
-        _ => &[[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]],
-    };
-    for i in 0..corners {
-        n[i] = l[i] * (2.0 * l[i] - 1.0);
-    }
-    for (e, &[i, j]) in edges.iter().enumerate() {
-        n[corners + e] = 4.0 * l[i] * l[j];
-    }
-    n
 }
 
 /// `v`, or the error naming the load `what` where it is not finite.

@@ -150,7 +150,7 @@ impl Discretization<'_> {
             out[..cell.len()].fill(self.geometry[c].volume() * each);
             return out;
         }
-        let (weights, points) = crate::loads::simplex_rule(dim, 2);
+        let (weights, points) = crate::kernels::simplex_rule(dim, 2);
         for (w, l) in weights.iter().zip(&points) {
             let mut x = [0.0; 3];
             for (i, &v) in cell[..=dim].iter().enumerate() {
@@ -163,7 +163,7 @@ impl Discretization<'_> {
                 crate::Coordinates::Cartesian => 1.0,
             };
             let qx = q(&x[..dim]) * w * self.geometry[c].measure * ring;
-            let n = crate::loads::shape_values(dim, 2, l);
+            let n = crate::kernels::shape_values(dim, 2, l);
             for (o, na) in out.iter_mut().zip(n) {
                 *o += qx * na;
             }

@@ -276,11 +276,7 @@ impl FaceBasis {
             };
         }
         let alpha = MODIFIED_ALPHA;
-        let edges: &[[usize; 2]] = if mesh.dim == 3 {
-            &[[0, 1], [1, 2], [2, 0]]
-        } else {
-            &[[0, 1]]
-        };
+        let edges = fe_assembly::kernels::simplex_edges(mesh.dim - 1);
         let corners = mesh.dim;
         let mut weight = vec![0.0; mesh.n_nodes()];
         let mut edge_corners = std::collections::HashMap::new();
