@@ -484,11 +484,11 @@ impl Discretization<'_> {
                 kernels::strain_at(dim, &centroid, 0, &ul),
                 kernels::gradient_at(dim, &centroid, 0, &pl),
             );
-            for ((bary, n), weight) in rule.iter().zip(&shapes).zip(&weights) {
+            for ((bary, n), weight) in rule.iter().zip(&shapes).zip(weights) {
                 let w = g.measure * weight;
                 let (eps_h, gp_h) = match order {
                     2 => {
-                        let r = kernels::QuadraticRule::at(dim, g, &[(*bary, 1.0)]);
+                        let r = kernels::QuadraticRule::at(dim, g, &[*bary], &[1.0]);
                         (
                             kernels::strain_at(dim, &r, 0, &ul),
                             kernels::gradient_at(dim, &r, 0, &pl),

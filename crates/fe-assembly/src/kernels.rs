@@ -237,7 +237,19 @@ impl CellRule for LinearRule<'_> {
 /// (1985) 1129, table for p = 4), and on a tetrahedron the five-point rule of degree 3 (its
 /// centroid weighted -4/5, the points `(1/2, 1/6, 1/6, 1/6)` 9/20; Stroud, Approximate
 /// Calculation of Multiple Integrals, 1971, T3:3-1).
-pub fn simplex_rule(dim: usize, order: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
+///
+/// The rules are made once and kept: a P2 cell's rule is built for each of its nodes' columns
+/// in the assembly.
+pub fn simplex_rule(dim: usize, order: usize) -> (&'static [f64], &'static [[f64; 4]]) {
+    type Rules = Vec<Vec<(Vec<f64>, Vec<[f64; 4]>)>>;
+    static RULES: std::sync::LazyLock<Rules> =
+        std::sync::LazyLock::new(|| (1..=3).map(|d| (1..=2).map(|o| made_rule(d, o)).collect()).collect());
+    let (weights, points) = &RULES[dim.clamp(1, 3) - 1][order.clamp(1, 2) - 1];
+    (weights, points)
+}
+
+/// The rule of [`simplex_rule`], made.
+fn made_rule(dim: usize, order: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
     match (dim, order) {
         (1, 1) => {
             let s = 0.5 / 3f64.sqrt();
@@ -347,13 +359,12 @@ impl QuadraticRule {
         // revolution (the rule for P2's loads on a triangle)
         let rule_order = if g.radii.is_some() { 2 } else { 1 };
         let (weights, points) = simplex_rule(dim, rule_order);
-        let points: Vec<([f64; 4], f64)> = points.into_iter().zip(weights).collect();
-        Self::at(dim, g, &points)
+        Self::at(dim, g, points, weights)
     }
 
-    /// The P2 shape functions of the simplex `g` at the points `(λ, w)` (barycentric
-    /// coordinates, and the fraction of the cell's measure each stands for).
-    pub fn at(dim: usize, g: &SimplexGeometry, points: &[([f64; 4], f64)]) -> Self {
+    /// The P2 shape functions of the simplex `g` at the `points` (barycentric coordinates),
+    /// each standing for its `weights`' fraction of the cell's measure.
+    pub fn at(dim: usize, g: &SimplexGeometry, points: &[[f64; 4]], weights: &[f64]) -> Self {
         let corners = dim + 1;
         let edges = simplex_edges(dim);
         let mut rule = QuadraticRule {
@@ -364,7 +375,7 @@ impl QuadraticRule {
             grad: [[[0.0; 3]; MAX_NODES]; MAX_POINTS],
             hoop: [[0.0; MAX_NODES]; MAX_POINTS],
         };
-        for (p, (l, w)) in points.iter().enumerate().take(MAX_POINTS) {
+        for (p, (l, w)) in points.iter().zip(weights).enumerate().take(MAX_POINTS) {
             let gl = &g.grads;
             rule.value[p] = shape_values(dim, 2, l);
             for i in 0..corners {
@@ -612,7 +623,7 @@ impl<'g> Rule<'g> {
         let third = 1.0 / (dim + 1) as f64;
         let l = [third, third, third, if dim == 3 { third } else { 0.0 }];
         if order == 2 {
-            let mut r = QuadraticRule::at(dim, g, &[(l, 1.0)]);
+            let mut r = QuadraticRule::at(dim, g, &[l], &[1.0]);
             r.weight[0] = g.volume();
             return Rule::Quadratic(Box::new(r));
         }

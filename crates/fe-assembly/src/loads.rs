@@ -145,7 +145,7 @@ impl Discretization<'_> {
                 Load::BodyForce(f) => {
                     for (c, cell) in mesh.iter_cells().enumerate() {
                         let vol = self.geometry[c].measure;
-                        for ((w, p), n) in w_cell.iter().zip(&p_cell).zip(&n_cell) {
+                        for ((w, p), n) in w_cell.iter().zip(p_cell).zip(&n_cell) {
                             let x = at(cell, p, dim + 1);
                             let fx = f(&x[..dim]);
                             let vol = vol * ring(&x);
@@ -165,7 +165,7 @@ impl Discretization<'_> {
                             continue;
                         }
                         let vol = self.geometry[c].measure;
-                        for ((w, p), n) in w_cell.iter().zip(&p_cell).zip(&n_cell) {
+                        for ((w, p), n) in w_cell.iter().zip(p_cell).zip(&n_cell) {
                             let x = at(cell, p, dim + 1);
                             let qx = check("the body charge", q0(&x[..dim]))?;
                             let vol = vol * ring(&x);
@@ -181,7 +181,7 @@ impl Discretization<'_> {
                     for f in mesh.boundary(group)?.iter() {
                         let x: Vec<[f64; 3]> = f[..dim].iter().map(|&v| mesh.points[v]).collect();
                         let len = facet_measure(&x);
-                        for ((w, p), n) in w_facet.iter().zip(&p_facet).zip(&n_facet) {
+                        for ((w, p), n) in w_facet.iter().zip(p_facet).zip(&n_facet) {
                             let y = at(f, p, dim);
                             let t = value(&y[..dim]);
                             let len = len * ring(&y);
@@ -199,7 +199,7 @@ impl Discretization<'_> {
                     for f in mesh.boundary(group)?.iter() {
                         let x: Vec<[f64; 3]> = f[..dim].iter().map(|&v| mesh.points[v]).collect();
                         let len = facet_measure(&x);
-                        for ((w, p), n) in w_facet.iter().zip(&p_facet).zip(&n_facet) {
+                        for ((w, p), n) in w_facet.iter().zip(p_facet).zip(&n_facet) {
                             let y = at(f, p, dim);
                             let qx = check("the surface charge", value(&y[..dim]))?;
                             let len = len * ring(&y);
@@ -225,7 +225,7 @@ impl Discretization<'_> {
     }
 
     /// The point of barycentric coordinates `bary` on the simplex of `nodes`.
-    fn point_at(&self, nodes: &[usize], bary: &[f64; 4]) -> [f64; 3] {
+    pub(crate) fn point_at(&self, nodes: &[usize], bary: &[f64; 4]) -> [f64; 3] {
         let mut x = [0.0; 3];
         for (q, &v) in nodes.iter().enumerate() {
             for k in 0..3 {
@@ -237,7 +237,7 @@ impl Discretization<'_> {
 
     /// The measure's factor at `x`: `2π r` on a body of revolution (its integrals are over the
     /// whole body), 1 otherwise.
-    fn ring(&self, x: &[f64; 3]) -> f64 {
+    pub(crate) fn ring(&self, x: &[f64; 3]) -> f64 {
         if self.coordinates == crate::Coordinates::Axisymmetric {
             std::f64::consts::TAU * x[0]
         } else {

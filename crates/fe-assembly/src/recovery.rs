@@ -151,18 +151,9 @@ impl Discretization<'_> {
             return out;
         }
         let (weights, points) = crate::kernels::simplex_rule(dim, 2);
-        for (w, l) in weights.iter().zip(&points) {
-            let mut x = [0.0; 3];
-            for (i, &v) in cell[..=dim].iter().enumerate() {
-                for k in 0..3 {
-                    x[k] += l[i] * mesh.points[v][k];
-                }
-            }
-            let ring = match self.coordinates {
-                crate::Coordinates::Axisymmetric => std::f64::consts::TAU * x[0],
-                crate::Coordinates::Cartesian => 1.0,
-            };
-            let qx = q(&x[..dim]) * w * self.geometry[c].measure * ring;
+        for (w, l) in weights.iter().zip(points) {
+            let x = self.point_at(&cell[..=dim], l);
+            let qx = q(&x[..dim]) * w * self.geometry[c].measure * self.ring(&x);
             let n = crate::kernels::shape_values(dim, 2, l);
             for (o, na) in out.iter_mut().zip(n) {
                 *o += qx * na;
