@@ -51,8 +51,6 @@ pub struct ContactBoundary {
     /// place in the electric dofs) or a prescribed one; its own dof alone, or in the modified
     /// basis its edge's corners' too.
     phi_terms: Vec<Vec<Term>>,
-    /// Each point's displacement's terms `(coefficient, node)` ([`FaceBasis::terms`]).
-    node_terms: Vec<Vec<(f64, usize)>>,
     /// The contact group of each point (an index into `groups`).
     pub group_of: Vec<usize>,
     /// The contact groups, in the scene's order.
@@ -364,14 +362,15 @@ impl ContactBoundary {
             held_inside: 0,
             electric: None,
             phi_terms: vec![],
-            node_terms: vec![],
             group_of: vec![],
             groups: specs.iter().map(|s| s.group.clone()).collect(),
             uniform: vec![],
         };
         let mut place: std::collections::HashMap<usize, usize> = Default::default();
+        // each point's displacement as terms on nodes, for the potentials of electrical contact
+        let mut node_terms = vec![];
         for (k, spec) in specs.iter().enumerate() {
-            b.add_group(disc, k, spec, &mut place)?;
+            node_terms.extend(b.add_group(disc, k, spec, &mut place)?);
         }
         // the zone that conducts (at most one: validated), its points' potentials condensed
         if let Some((k, spec)) = specs.iter().enumerate().find(|(_, s)| s.electric_law().is_some()) {
@@ -379,7 +378,7 @@ impl ContactBoundary {
                 .filter(|&i| b.group_of[i] == k)
                 .map(|i| (i, b.nodes[i]));
             b.electric = electric_points(spec, &disc.dofs, members)?;
-            b.phi_terms = b.electric_terms(spec, &disc.dofs)?;
+            b.phi_terms = b.electric_terms(spec, &disc.dofs, &node_terms)?;
         }
         // zones whose friction weakens with the slip: each point its zone's law (a law from a
         // static coefficient of 0 is frictionless: its points keep the coefficient 0)
@@ -417,14 +416,15 @@ impl ContactBoundary {
     }
 
     /// Adds the points of group `k` (`spec`); `place` holds each condensed dof's place in
-    /// `dofs`, shared by the points of one node.
+    /// `dofs`, shared by the points of one node. Returns each added point's displacement as
+    /// terms `(coefficient, node)` ([`FaceBasis::terms`]).
     fn add_group(
         &mut self,
         disc: &Discretization<'_>,
         k: usize,
         spec: &ContactSpec,
         place: &mut std::collections::HashMap<usize, usize>,
-    ) -> Result<(), ProblemError> {
+    ) -> Result<Vec<Vec<(f64, usize)>>, ProblemError> {
         let (mesh, dofs) = (disc.mesh, &disc.dofs);
         let dim = mesh.dim;
         let nv = unit_normal(spec, dim)?;
@@ -435,7 +435,7 @@ impl ContactBoundary {
         let basis = FaceBasis::of(mesh, group, disc.coordinates);
         let weight = &basis.weight;
         let friction = spec.friction();
-        let (mut added, mut held_nodes, mut out_of_reach) = (0, 0, 0);
+        let (mut added, mut held_nodes, mut out_of_reach) = (vec![], 0, 0);
         for node in group.nodes() {
             let x = mesh.points[node];
             if !(weight[node] > 0.0) {
@@ -469,7 +469,6 @@ impl ContactBoundary {
                 Held::Tangents(held) => held,
             };
             self.push_terms(&terms, dofs, place);
-            self.node_terms.push(terms);
             self.nodes.push(node);
             let p = &mut self.points;
             p.position.push(x);
@@ -481,10 +480,10 @@ impl ContactBoundary {
             p.held.push(held);
             self.group_of.push(k);
             self.uniform.push(spec.uniform_gap());
-            added += 1;
+            added.push(terms);
         }
         self.held_nodes += held_nodes;
-        if added == 0 && out_of_reach > 0 {
+        if added.is_empty() && out_of_reach > 0 {
             return Err(SetupError::new(
                 "contact.indenter",
                 format!(
@@ -494,7 +493,7 @@ impl ContactBoundary {
             )
             .into());
         }
-        if added == 0 {
+        if added.is_empty() {
             return Err(SetupError::new(
                 "contact.group",
                 format!(
@@ -504,7 +503,7 @@ impl ContactBoundary {
             )
             .into());
         }
-        Ok(())
+        Ok(added)
     }
 
     /// Pushes a point's displacement components, each the sum of `terms` (`(coefficient,
@@ -548,7 +547,6 @@ impl ContactBoundary {
             held_inside: self.held_inside,
             electric: self.electric.clone(),
             phi_terms: self.phi_terms.clone(),
-            node_terms: self.node_terms.clone(),
             group_of: self.group_of.clone(),
             groups: self.groups.clone(),
             uniform: self.uniform.clone(),
@@ -618,7 +616,6 @@ impl ContactBoundary {
             held_inside: self.held_inside,
             electric: None,
             phi_terms: vec![],
-            node_terms: keep.iter().map(|&i| self.node_terms[i].clone()).collect(),
             group_of: keep.iter().map(|&i| self.group_of[i]).collect(),
             groups: self.groups.clone(),
             uniform: keep.iter().map(|&i| self.uniform[i]).collect(),
@@ -709,8 +706,14 @@ impl ContactBoundary {
     /// Each electric point's potential terms, and the dofs they add after the points' own
     /// (the edge's corners of a point of the modified basis); a corner on a terminal gives a
     /// prescribed term, which a load path scales with its voltage. A term on no potential (a
-    /// corner of a body without electric unknowns there) is refused.
-    fn electric_terms(&mut self, spec: &ContactSpec, dofs: &DofMap) -> Result<Vec<Vec<Term>>, ProblemError> {
+    /// corner of a body without electric unknowns there) is refused. `node_terms`: each
+    /// point's displacement as terms on nodes.
+    fn electric_terms(
+        &mut self,
+        spec: &ContactSpec,
+        dofs: &DofMap,
+        node_terms: &[Vec<(f64, usize)>],
+    ) -> Result<Vec<Vec<Term>>, ProblemError> {
         let Some((electric, phi)) = self.electric.as_mut() else {
             return Ok(vec![]);
         };
@@ -718,7 +721,7 @@ impl ContactBoundary {
         let mut out = Vec::with_capacity(electric.points.len());
         for (e, &i) in electric.points.iter().enumerate() {
             let mut terms = vec![];
-            for &(c, m) in &self.node_terms[i] {
+            for &(c, m) in &node_terms[i] {
                 if m == self.nodes[i] {
                     terms.push((c, Slot::Free(e)));
                     continue;
