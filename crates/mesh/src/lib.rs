@@ -120,6 +120,17 @@ impl CellKind {
             _ => &[],
         }
     }
+    /// A triangle (or a triangular face of a tetrahedron of the same order) as first-order
+    /// triangles of its nodes' local indices, each counter-clockwise as it is: itself, or a
+    /// six-node triangle's four of its corners and edge nodes (its quadratic fields drawn
+    /// linear on each); none for the other kinds.
+    pub fn linear_triangles(self) -> &'static [[usize; 3]] {
+        match self {
+            CellKind::Tri3 | CellKind::Tet4 => &[[0, 1, 2]],
+            CellKind::Tri6 | CellKind::Tet10 => &[[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]],
+            CellKind::Quad4 => &[],
+        }
+    }
     /// The simplex of order 2 with the same corners (a quadrilateral has none: `None`).
     pub fn quadratic(self) -> Option<CellKind> {
         match self {

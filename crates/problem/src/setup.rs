@@ -243,21 +243,18 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
 /// edge's midpoint), as it is otherwise; a second-order mesh where the scene asks for order 1
 /// is refused (its edge nodes would be dropped silently).
 fn of_order(mesh: mesh::Mesh, scene: &Scene) -> Result<mesh::Mesh, ProblemError> {
-    let mesh = match (scene.mesh.order, mesh.kind.order()) {
-        (Some(2), 1) => mesh.quadratic()?,
-        (Some(1), 2) => {
-            return Err(SetupError::new(
-                "mesh.order",
-                format!(
-                    "mesh.order = 1, and the mesh holds second-order cells ({}): remove mesh.order, or mesh with Mesh.ElementOrder = 1",
-                    mesh.kind.name()
-                ),
-            )
-            .into())
-        }
-        _ => mesh,
-    };
-    Ok(mesh)
+    match (scene.mesh.order, mesh.kind.order()) {
+        (Some(2), 1) => Ok(mesh.quadratic()?),
+        (Some(1), 2) => Err(SetupError::new(
+            "mesh.order",
+            format!(
+                "mesh.order = 1, and the mesh holds second-order cells ({}): remove mesh.order, or mesh with Mesh.ElementOrder = 1",
+                mesh.kind.name()
+            ),
+        )
+        .into()),
+        _ => Ok(mesh),
+    }
 }
 
 /// The regions by box (`[[mesh.region]]`): the cells whose centroid lies in each box.

@@ -371,14 +371,9 @@ fn revolved_vtu(
         let mid = 0.5 * (angle(k) + angle(k) + 2.0 * std::f64::consts::PI / segments as f64);
         let (c, s) = (mid.cos(), mid.sin());
         for cell in 0..cells {
-            // a six-node triangle as its four triangles of corners and edge nodes, each
-            // counter-clockwise (the quadratic fields drawn linear on each)
+            // a six-node triangle as its four triangles of corners and edge nodes
             let t = mesh.cell(cell);
-            let parts: &[[usize; 3]] = match mesh.kind {
-                mesh::CellKind::Tri6 => &[[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]],
-                _ => &[[0, 1, 2]],
-            };
-            for part in parts {
+            for part in mesh.kind.linear_triangles() {
                 // VTK's wedge: the base (0, 1, 2) turns about its outward normal, away from
                 // the top (3, 4, 5); a counterclockwise meridian triangle faces the growing
                 // angle, so the base is the later angle's

@@ -20,18 +20,10 @@ struct View {
     labels: (String, String),
 }
 
-/// The triangles a cell or facet is drawn as: itself, or a six-node triangle's four of its
-/// corners and edge nodes (its quadratic fields drawn linear on each).
-fn triangles(t: &[usize]) -> Vec<[usize; 3]> {
-    match t.len() {
-        6 => vec![
-            [t[0], t[3], t[5]],
-            [t[3], t[1], t[4]],
-            [t[5], t[4], t[2]],
-            [t[3], t[4], t[5]],
-        ],
-        _ => vec![[t[0], t[1], t[2]]],
-    }
+/// The triangles a triangle of `kind`'s order (a 2D cell, or a 3D cell's face) is drawn as
+/// ([`mesh::CellKind::linear_triangles`]).
+fn triangles(kind: mesh::CellKind, t: &[usize]) -> Vec<[usize; 3]> {
+    kind.linear_triangles().iter().map(|p| p.map(|q| t[q])).collect()
 }
 
 /// The segments a boundary facet of a 2D mesh is drawn as: itself, or a three-node segment's
@@ -49,7 +41,7 @@ impl View {
         if mesh.dim == 2 {
             return Some(View {
                 title: "",
-                tris: mesh.iter_cells().flat_map(triangles).collect(),
+                tris: mesh.iter_cells().flat_map(|c| triangles(mesh.kind, c)).collect(),
                 xy: mesh.points.iter().map(|p| [p[0], p[1]]).collect(),
                 uv: u.iter().map(|v| [v[0], v[1]]).collect(),
                 outline: mesh
@@ -61,7 +53,7 @@ impl View {
             });
         }
         let face = mesh.boundaries.get("front")?;
-        let tris: Vec<[usize; 3]> = face.iter().flat_map(triangles).collect();
+        let tris: Vec<[usize; 3]> = face.iter().flat_map(|f| triangles(mesh.kind, f)).collect();
         let mut edges = std::collections::HashMap::new();
         for t in &tris {
             for q in 0..3 {
