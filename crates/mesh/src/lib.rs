@@ -276,6 +276,23 @@ pub enum MeshError {
         /// What is wrong.
         problem: &'static str,
     },
+    /// A second-order mesh whose cells do not share their edges' midpoint nodes: an edge
+    /// with two midpoint nodes (edge nodes made per cell and not merged), or a node that is
+    /// one cell's edge node and another's corner (a hanging node). Either splits the body
+    /// along the edge, silently.
+    #[error("edge {edge:?} of cell {cell} {problem} (node {node}, cell {other}): a quadratic mesh's cells must share each edge's midpoint node")]
+    NonConformingEdge {
+        /// The edge's corners.
+        edge: [usize; 2],
+        /// The cell whose edge it is.
+        cell: usize,
+        /// Its midpoint node in that cell.
+        node: usize,
+        /// What is wrong.
+        problem: &'static str,
+        /// The other cell that uses the node or the edge.
+        other: usize,
+    },
     /// A file could not be read.
     #[error("cannot read mesh file {path}: {message}")]
     Io {

@@ -129,6 +129,47 @@ mod tests {
     }
 
     #[test]
+    fn edge_nodes_not_shared_by_the_cells_of_an_edge_are_named() {
+        // two cells on a diagonal, each with its own copy of the diagonal's midpoint
+        let m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1).quadratic().unwrap();
+        let mut split = m.clone();
+        let (c0, c1) = (split.cell(0).to_vec(), split.cell(1).to_vec());
+        let shared = c0[3..].iter().copied().find(|v| c1[3..].contains(v)).unwrap();
+        split.points.push(split.points[shared]);
+        let copy = split.n_nodes() - 1;
+        let slot = 6 + c1[3..].iter().position(|&v| v == shared).unwrap() + 3;
+        split.cells[slot] = copy;
+        match crate::Mesh::from_parts(parts(&split)) {
+            Err(crate::MeshError::NonConformingEdge { node, other: 0, .. }) => assert_eq!(node, copy),
+            other => panic!("{other:?}"),
+        }
+        // a hanging node: the midpoint of one cell's edge is a corner of the cell below it
+        let points = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [0.0, 2.0],
+            [1.0, 0.0],
+            [1.0, 1.0],
+            [0.0, 1.0],
+            [1.0, -1.0],
+            [0.5, -0.5],
+            [1.0, -0.5],
+            [0.5, 0.0],
+        ];
+        let hanging = crate::parts::MeshParts {
+            dim: 2,
+            points: points.iter().map(|p| [p[0], p[1], 0.0]).collect(),
+            cells: vec![0, 1, 2, 3, 4, 5, 0, 6, 3, 7, 8, 9],
+            nodes_per_cell: 6,
+            boundaries: Default::default(),
+            regions: Default::default(),
+        };
+        let e = crate::Mesh::from_parts(hanging).unwrap_err();
+        assert!(matches!(e, crate::MeshError::NonConformingEdge { node: 3, .. }), "{e}");
+        assert!(e.to_string().contains("corner of another cell"), "{e}");
+    }
+
+    #[test]
     fn a_curved_cell_and_a_facet_with_foreign_edge_nodes_are_named() {
         let m = rectangle_tri([0.0, 0.0], [1.0, 1.0], 1, 1).quadratic().unwrap();
         crate::Mesh::from_parts(parts(&m)).unwrap();

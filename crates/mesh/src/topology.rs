@@ -167,6 +167,7 @@ impl Mesh {
                 second: w[0].1.max(w[1].1),
             });
         }
+        self.check_edges()?;
         let mut interior = 0;
         let corners = self.kind.facet_corners();
         for (name, group) in &self.boundaries {
@@ -195,6 +196,51 @@ impl Mesh {
             }
         }
         Ok((self.coincident_nodes(), interior))
+    }
+
+    /// In a quadratic mesh: each edge has one midpoint node, whichever cell names it, and no
+    /// midpoint node is a corner (a hanging node); nothing to check in a linear mesh.
+    fn check_edges(&self) -> Result<(), MeshError> {
+        let corners = self.kind.n_corners();
+        let edges = self.kind.midside_edges();
+        if edges.is_empty() {
+            return Ok(());
+        }
+        // (edge, midpoint node, cell), sorted by edge
+        let mut all: Vec<([usize; 2], usize, usize)> = Vec::with_capacity(self.n_cells() * edges.len());
+        let mut corner_of = vec![usize::MAX; self.n_nodes()];
+        for (c, cell) in self.iter_cells().enumerate() {
+            for &v in &cell[..corners] {
+                corner_of[v] = corner_of[v].min(c);
+            }
+            for (m, &[a, b]) in edges.iter().enumerate() {
+                let (a, b) = (cell[a], cell[b]);
+                all.push(([a.min(b), a.max(b)], cell[corners + m], c));
+            }
+        }
+        all.par_sort_unstable();
+        let bad = |(edge, node, cell): ([usize; 2], usize, usize), problem, other| MeshError::NonConformingEdge {
+            edge,
+            cell,
+            node,
+            problem,
+            other,
+        };
+        if let Some(w) = all.windows(2).find(|w| w[0].0 == w[1].0 && w[0].1 != w[1].1) {
+            return Err(bad(w[1], "has a second midpoint node", w[0].2));
+        }
+        if let Some(&e) = all.iter().find(|e| corner_of[e.1] != usize::MAX) {
+            return Err(bad(e, "has as its midpoint a corner of another cell", corner_of[e.1]));
+        }
+        all.par_sort_unstable_by_key(|e| (e.1, e.0));
+        if let Some(w) = all.windows(2).find(|w| w[0].1 == w[1].1 && w[0].0 != w[1].0) {
+            return Err(bad(
+                w[1],
+                "has as its midpoint the midpoint node of another edge",
+                w[0].2,
+            ));
+        }
+        Ok(())
     }
 
     /// Whether `facet` (a facet of cell `c` by its corners) has the nodes of that facet of the

@@ -126,6 +126,14 @@ def test_quadratic_elements_from_the_scene_and_as_arrays():
     given = pc.run(scene)
     assert given.cell_type == "triangle6"
     assert np.abs(given.u - p2.u).max() <= 1e-12 * np.abs(p2.u).max()
+    # edge nodes made per cell (each cell its own copy of a shared edge's midpoint) split the
+    # body along the edge: refused by name, not run
+    split_points = np.vstack([points, points[cells[1, 3:]]])
+    split_cells = cells.copy()
+    split_cells[1, 3:] = len(points) + np.arange(3)
+    scene.set_mesh(split_points, split_cells, mids)
+    with pytest.raises(pc.MeshError, match="second midpoint node"):
+        pc.run(scene)
     # to meshio: the quadratic cells under their name
     m = p2.to_meshio()
     assert m.cells[0].type == "triangle6"
