@@ -179,9 +179,7 @@ impl<'p> Direct<'p> {
 /// with a Schur complement is AMD, 35 times the flops on `paper-3d` at n = 16.
 fn pivot_order(disc: &Discretization<'_>, chosen: &[usize]) -> Vec<usize> {
     let mesh = disc.mesh;
-    let order = disc
-        .dofs
-        .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
+    let order = disc.dofs.expand_node_order(&mesh.nested_dissection());
     let mut last = vec![false; order.len()];
     for &c in chosen {
         last[c] = true;

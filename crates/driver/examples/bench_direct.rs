@@ -51,9 +51,7 @@ fn main() {
     );
     for _ in 0..repeats {
         let t = Instant::now();
-        let order = disc
-            .dofs
-            .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
+        let order = disc.dofs.expand_node_order(&mesh.nested_dissection());
         let ordering = match &last {
             Some(last) => Ordering::GivenThenLast {
                 order,

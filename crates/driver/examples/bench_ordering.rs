@@ -28,9 +28,7 @@ fn main() {
     let b = disc.assemble(Parallelism::Rayon);
     let k = linalg::sparse::lower_quasi_definite(b.a.as_ref(), b.g.as_ref(), b.b.as_ref());
     let t = Instant::now();
-    let nd = disc
-        .dofs
-        .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
+    let nd = disc.dofs.expand_node_order(&mesh.nested_dissection());
     let t_nd = t.elapsed().as_secs_f64();
     println!("n = {n}: nested dissection order computed in {t_nd:.3} s");
     let bottom = mesh.boundary("bottom").expect("paper has a bottom").nodes();

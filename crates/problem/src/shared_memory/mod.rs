@@ -363,10 +363,7 @@ fn factor(
         LinearSolver::SchurPcg(pcg)
     } else {
         let mesh = &posed.setup.mesh;
-        let order = posed
-            .disc
-            .dofs
-            .expand_node_order(&mesh::nested_dissection(&mesh.points, &mesh.node_graph()));
+        let order = posed.disc.dofs.expand_node_order(&mesh.nested_dissection());
         let ordering = match (boundary, plan.linear_strategy.is_condensed()) {
             (Some(cb), true) => Ordering::GivenThenLast {
                 order,
