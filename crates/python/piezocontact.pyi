@@ -219,6 +219,12 @@ class Result:
     def electric_field(self) -> npt.NDArray[np.float64]:
         """Electric field E = -grad phi per cell, (n_cells, dim)."""
     @property
+    def fields_at_nodes(self) -> Optional[dict[str, npt.NDArray[np.float64]]]:
+        """On quadratic (P2) cells: `stress`, `strain` ((n_points, nv)), `electric_displacement`
+        and `electric_field` ((n_points, dim)) at the nodes, each node's value the
+        measure-weighted average of its cells' values there; None on P1 cells (constant in
+        each cell: the per-cell arrays are the whole field)."""
+    @property
     def contact(self) -> Optional[Contact]:
         """The contact boundary's values; None for a scene without contact."""
     @property

@@ -1,10 +1,11 @@
 //! Recovery of the stress `σ = C ε(u) + eᵀ ∇φ` and the electric displacement
 //! `D = e ε(u) - β ∇φ` (docs/theory.md's law; `E = -∇φ`), at each cell's centroid (constant on
-//! a P1 cell, linear on a P2 one).
+//! a P1 cell, linear on a P2 one) and, on P2 cells, at the nodes too.
 
-use crate::kernels::{gradient_at, strain_at, CellRule, MAX_NODES};
+use crate::kernels::{gradient_at, simplex_edges, strain_at, CellRule, QuadraticRule, SimplexGeometry, MAX_NODES};
 use crate::Discretization;
 use crate::Material;
+use rayon::prelude::*;
 
 /// Per-cell fields, Voigt order for the stress (`[xx, yy, xy]` in 2D, 6 entries in 3D).
 #[derive(Clone, Debug, PartialEq)]
@@ -16,6 +17,27 @@ pub struct CellFields {
     /// Strain per cell (Voigt, engineering shear, flat).
     pub strain: Vec<f64>,
     /// Electric field `E = -∇φ` per cell (`dim` entries each, flat).
+    pub electric_field: Vec<f64>,
+    /// On a mesh of P2 cells (whose fields are linear in each cell, so that the centroid's
+    /// value leaves out their variation): the same fields at the nodes, `None` on P1 cells
+    /// (constant in each).
+    pub at_nodes: Option<NodeFields>,
+}
+
+/// The fields at the mesh's nodes, laid out as [`CellFields`]' but one entry per node: at
+/// each node the average, weighted by the cells' measures, of the values there of the cells
+/// around it (each cell's own value at its node, not at its centroid: exact for a field that
+/// the cells hold, continuous across cells or not; a node where materials meet averages both
+/// sides' values, as ParaView's cell-to-point filter would).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NodeFields {
+    /// Stress per node (Voigt, `nv` entries each).
+    pub stress: Vec<f64>,
+    /// Electric displacement per node (`dim` entries each).
+    pub electric_displacement: Vec<f64>,
+    /// Strain per node (Voigt, engineering shear).
+    pub strain: Vec<f64>,
+    /// Electric field per node (`dim` entries each).
     pub electric_field: Vec<f64>,
 }
 
@@ -34,6 +56,7 @@ impl Discretization<'_> {
             electric_displacement: Vec::with_capacity(n * dim),
             strain: Vec::with_capacity(n * nv),
             electric_field: Vec::with_capacity(n * dim),
+            at_nodes: (mesh.kind.order() == 2).then(|| self.recover_at_nodes(u, phi)),
         };
         for (c, cell) in mesh.iter_cells().enumerate() {
             let r = self.centroid_rule(c);
@@ -46,18 +69,96 @@ impl Discretization<'_> {
             } else {
                 [0.0; 3]
             };
-            for i in 0..nv {
-                let s: f64 = (0..nv).map(|j| m.c[i * nv + j] * eps[j]).sum::<f64>()
-                    + (0..dim).map(|k| m.e[k * nv + i] * grad[k]).sum::<f64>();
-                out.stress.push(s);
-                out.strain.push(eps[i]);
-            }
+            out.stress.extend_from_slice(&stress(m, &eps, &grad)[..nv]);
+            out.strain.extend_from_slice(&eps[..nv]);
             let d = displacement(m, &eps, &grad);
             for k in 0..dim {
                 out.electric_displacement.push(d[k]);
                 out.electric_field.push(-grad[k]);
             }
         }
+        out
+    }
+
+    /// [`NodeFields`] of a mesh of P2 cells: each node's cells' values at it (the P2 shape
+    /// functions' gradients at the node; on a body of revolution the hoop strain `u_r / r` of
+    /// the node, on the axis its limit `∂u_r/∂r`), averaged with the cells' measures as
+    /// weights. Nodes in parallel on rayon's pool.
+    fn recover_at_nodes(&self, u: &[[f64; 3]], phi: &[f64]) -> NodeFields {
+        let mesh = self.mesh;
+        let (dim, nv, n) = (mesh.dim, self.nv(), mesh.n_nodes());
+        let corners = dim + 1;
+        // each local node's barycentric coordinates: the corners, then the edges' midpoints
+        let mut bary = [[0.0; 4]; MAX_NODES];
+        for (a, b) in bary.iter_mut().enumerate().take(corners) {
+            b[a] = 1.0;
+        }
+        for (e, &[i, j]) in simplex_edges(dim).iter().enumerate() {
+            bary[corners + e][i] = 0.5;
+            bary[corners + e][j] = 0.5;
+        }
+        let (offsets, node_cells) = mesh.node_cells();
+        let mut out = NodeFields {
+            stress: vec![0.0; n * nv],
+            electric_displacement: vec![0.0; n * dim],
+            strain: vec![0.0; n * nv],
+            electric_field: vec![0.0; n * dim],
+        };
+        out.stress
+            .par_chunks_mut(nv)
+            .zip(out.strain.par_chunks_mut(nv))
+            .zip(out.electric_displacement.par_chunks_mut(dim))
+            .zip(out.electric_field.par_chunks_mut(dim))
+            .enumerate()
+            .for_each(|(v, (((s_out, eps_out), d_out), e_out))| {
+                let mut total = 0.0;
+                for &c in &node_cells[offsets[v]..offsets[v + 1]] {
+                    let cell = mesh.cell(c);
+                    let Some(a) = cell.iter().position(|&w| w == v) else {
+                        continue;
+                    };
+                    let g = &self.geometry[c];
+                    let plain = SimplexGeometry { radii: None, ..*g };
+                    let rule = QuadraticRule::at(dim, &plain, &bary[a..=a], &[1.0]);
+                    let ul: Vec<[f64; 3]> = cell.iter().map(|&w| u[w]).collect();
+                    let mut eps = strain_at(dim, &rule, 0, &ul);
+                    if let Some(r) = g.radii {
+                        let (rn, reach) = (
+                            (0..3).map(|i| bary[a][i] * r[i]).sum::<f64>(),
+                            r.iter().fold(0.0f64, |m, x| m.max(x.abs())),
+                        );
+                        eps[3] = if rn > 1e-12 * reach { u[v][0] / rn } else { eps[0] };
+                    }
+                    let grad = if self.cell_electric[c] {
+                        let pl: Vec<f64> = cell.iter().map(|&w| phi[w]).collect();
+                        gradient_at(dim, &rule, 0, &pl)
+                    } else {
+                        [0.0; 3]
+                    };
+                    let m = self.material(c);
+                    let (sigma, d) = (stress(m, &eps, &grad), displacement(m, &eps, &grad));
+                    let w = g.measure;
+                    total += w;
+                    for i in 0..nv {
+                        s_out[i] += w * sigma[i];
+                        eps_out[i] += w * eps[i];
+                    }
+                    for k in 0..dim {
+                        d_out[k] += w * d[k];
+                        e_out[k] -= w * grad[k];
+                    }
+                }
+                if total > 0.0 {
+                    for x in s_out
+                        .iter_mut()
+                        .chain(eps_out.iter_mut())
+                        .chain(d_out.iter_mut())
+                        .chain(e_out.iter_mut())
+                    {
+                        *x /= total;
+                    }
+                }
+            });
         out
     }
 
@@ -229,6 +330,17 @@ impl Discretization<'_> {
         }
         Ok(out)
     }
+}
+
+/// `σ = C ε + eᵀ ∇φ` at a point (Voigt, `nv` entries).
+fn stress(m: &Material, eps: &[f64; 6], grad: &[f64; 3]) -> [f64; 6] {
+    let (dim, nv) = (m.dim, m.nv());
+    let mut s = [0.0; 6];
+    for (i, si) in s.iter_mut().enumerate().take(nv) {
+        *si = (0..nv).map(|j| m.c[i * nv + j] * eps[j]).sum::<f64>()
+            + (0..dim).map(|k| m.e[k * nv + i] * grad[k]).sum::<f64>();
+    }
+    s
 }
 
 /// `D = e ε - β ∇φ` at a point.

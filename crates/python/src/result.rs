@@ -201,6 +201,28 @@ impl RunResult {
         lend(this.as_any(), table(&r.solution.fields.electric_field, r.dim()))
     }
 
+    /// On quadratic (P2) cells, whose fields vary across each cell: the fields at the nodes,
+    /// a dict of `stress`, `strain` ((n_points, nv)), `electric_displacement` and
+    /// `electric_field` ((n_points, dim)), each node's value the measure-weighted average of
+    /// its cells' values there; None on P1 cells (constant in each: the per-cell arrays are
+    /// the whole field).
+    #[getter]
+    fn fields_at_nodes<'py>(this: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let r = this.get();
+        let Some(at) = &r.solution.fields.at_nodes else {
+            return Ok(None);
+        };
+        let (owner, out) = (this.as_any(), PyDict::new(this.py()));
+        out.set_item("stress", lend(owner, table(&at.stress, r.nv()))?)?;
+        out.set_item("strain", lend(owner, table(&at.strain, r.nv()))?)?;
+        out.set_item(
+            "electric_displacement",
+            lend(owner, table(&at.electric_displacement, r.dim()))?,
+        )?;
+        out.set_item("electric_field", lend(owner, table(&at.electric_field, r.dim()))?)?;
+        Ok(Some(out))
+    }
+
     /// The contact boundary's values, None for a scene without contact.
     #[getter]
     fn contact(this: &Bound<'_, Self>) -> Option<Contact> {
@@ -359,6 +381,12 @@ impl RunResult {
                 status[node] = status_code(c.solution.status[i]);
             }
             point_data.set_item("contact_status", status.into_pyarray(py))?;
+        }
+        if let Some(at) = Self::fields_at_nodes(this)? {
+            // P2 cells: the fields at the nodes beside the cells'
+            for (name, values) in at.iter() {
+                point_data.set_item(name, values)?;
+            }
         }
         let cell_data = PyDict::new(py);
         cell_data.set_item("stress", [Self::stress(this)?])?;

@@ -131,12 +131,17 @@ def test_quadratic_elements_from_the_scene_and_as_arrays():
     split_points = np.vstack([points, points[cells[1, 3:]]])
     split_cells = cells.copy()
     split_cells[1, 3:] = len(points) + np.arange(3)
-    scene.set_mesh(split_points, split_cells, mids)
     with pytest.raises(pc.MeshError, match="second midpoint node"):
-        pc.run(scene)
+        scene.set_mesh(split_points, split_cells, mids)
+    # the fields at the nodes of P2 cells (none on P1 cells, constant in each), in meshio's
+    # point data too
+    assert p1.fields_at_nodes is None
+    at = p2.fields_at_nodes
+    assert at["stress"].shape == (len(points), 3) and at["electric_field"].shape == (len(points), 2)
     # to meshio: the quadratic cells under their name
     m = p2.to_meshio()
     assert m.cells[0].type == "triangle6"
+    assert np.array_equal(m.point_data["stress"], at["stress"])
     # contact at order 2 in 3D runs (the modified basis), electrical contact too
     r = pc.run(pc.Scene.load("paper-3d", {"mesh.n": 2, "mesh.order": 2}))
     assert r.cell_type == "tetra10" and r.report["residuals"]["converged_to_tolerance"]

@@ -238,7 +238,8 @@ impl NamedValues<'_> {
 }
 
 /// The point and cell data of a solution's grid: `u`, `phi` and, with contact, its point data
-/// (status, pressure, traction, gap, flux); with `cells`, the cell data (stress, strain, D, E).
+/// (status, pressure, traction, gap, flux); with `cells`, the cell data (stress, strain, D, E)
+/// and, on P2 cells, the same fields as point data (their values at the nodes).
 struct FieldArrays<'a> {
     point: Vec<NamedValues<'a>>,
     cell: Vec<NamedValues<'a>>,
@@ -276,6 +277,20 @@ impl<'a> FieldArrays<'a> {
             if let Some(flux) = data.flux {
                 point.push(named("contact_flux", 1, Cow::Owned(flux)));
             }
+        }
+        if let Some(at) = cells.and_then(|f| f.at_nodes.as_ref()) {
+            // P2 cells: the fields at the nodes too, which ParaView draws quadratic
+            let nv = at.stress.len() / mesh.n_nodes().max(1);
+            point.extend([
+                named("stress", nv, Cow::Borrowed(&at.stress[..])),
+                named("strain", nv, Cow::Borrowed(&at.strain[..])),
+                named(
+                    "electric_displacement",
+                    mesh.dim,
+                    Cow::Borrowed(&at.electric_displacement[..]),
+                ),
+                named("electric_field", mesh.dim, Cow::Borrowed(&at.electric_field[..])),
+            ]);
         }
         let cell = cells.map_or(vec![], |f| {
             // Voigt components per cell: 3 in plane strain, 4 on a body of revolution ([rr,
@@ -1025,6 +1040,7 @@ mod tests {
             strain: vec![0.5; 4 * cells],
             electric_displacement: [1.0, 0.0].repeat(cells),
             electric_field: [0.0, 1.0].repeat(cells),
+            at_nodes: None,
         };
         let bytes = revolved_vtu(&mesh, (&u, &phi), &fields, 12).unwrap();
         let vtk = Vtk::parse_xml(&bytes[..]).unwrap();
