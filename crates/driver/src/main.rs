@@ -521,11 +521,19 @@ fn run(
             .iter()
             .map(|o| o.name().to_string())
             .collect();
-        if let Some(path) = &solution.report.path {
-            names.push(format!(
-                "path.csv, path.svg/png, path.pvd with step-0000.vtu ... step-{:04}.vtu",
-                path.instants.saturating_sub(1)
-            ));
+        if let (Some(path), Some(spec)) = (&solution.report.path, &scene.path) {
+            // the instants whose step file was written: every output_every-th and the last
+            let n = path.instants;
+            let written: Vec<usize> = (0..n).filter(|&k| spec.has_fields(k, n)).collect();
+            let steps = match written[..] {
+                [only] => format!("step-{only:04}.vtu"),
+                [first, .., last] => format!(
+                    "{} step files, step-{first:04}.vtu ... step-{last:04}.vtu",
+                    written.len()
+                ),
+                [] => "no step file".into(),
+            };
+            names.push(format!("path.csv, path.svg/png, path.pvd with {steps}"));
         }
         say(&format!("wrote {} in {}", names.join(", "), dir.display()));
     }
