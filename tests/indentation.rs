@@ -787,6 +787,34 @@ fn revolved_and_3d(n: usize) -> ([f64; 3], [f64; 3]) {
 }
 
 #[test]
+fn a_quadratic_cylinder_has_its_edge_nodes_on_the_round_face() {
+    // mesh.cylinder at order 2: the edge nodes rounded with the corners, so every node of the
+    // round face (right and back) lies on the cylinder R = 8, the cells there curved; on the
+    // chords the edge nodes would lie inside it
+    let sets: Vec<String> = [
+        "mesh.cylinder=true",
+        "mesh.n=4",
+        "mesh.order=2",
+        "mesh.hi=[8.0,8.0,8.0]",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let (scene, _) = files::scene_file::load("indent-sphere-3d", &sets).unwrap();
+    let s = problem::solve(&scene, None, &mut Silent).unwrap();
+    let mesh = &s.mesh;
+    assert_eq!(mesh.kind.order(), 2);
+    assert!(mesh.curved_cells().iter().filter(|&&c| c).count() > 0);
+    for face in ["right", "back"] {
+        for v in mesh.boundary(face).unwrap().nodes() {
+            let r = mesh.points[v][0].hypot(mesh.points[v][1]);
+            assert!((r - 8.0).abs() < 1e-12, "{face}: node {v} at r = {r}");
+        }
+    }
+    assert!(s.report.residuals.converged_to_tolerance);
+}
+
+#[test]
 fn the_body_of_revolution_is_the_3d_cylinder() {
     // measured (force, tip potential; 3D against axisymmetric at the same meridian grid):
     // n = 8 +1.2 %, +5.2 %; 12 +1.25 %, +5.3 %; 16 +0.95 %, +5.3 %; 24 +0.68 %, +4.5 %;

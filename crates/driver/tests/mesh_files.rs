@@ -175,3 +175,103 @@ fn a_fifo_as_mesh_file_is_refused_not_read() {
         "{stderr}"
     );
 }
+
+/// A cylindrical capacitor: the quarter annulus 1 < r < 2 of Gmsh's curved second-order meshes
+/// (crates/mesh/tests/fixtures/make_curved.py), a dielectric (ε = 3, no coupling) grounded at
+/// r = 1 with an electrode at V = 1 on r = 2: `φ = V ln r / ln 2`, and the electrode's charge
+/// `π ε V / (2 ln 2)` per unit depth (times the 3D mesh's depth 1/2).
+fn capacitor(file: &Path) -> String {
+    format!(
+        r#"
+name = "capacitor"
+description = "a cylindrical capacitor on curved cells"
+[mesh]
+kind = "gmsh"
+file = "{}"
+[[material]]
+region = "body"
+model = "isotropic"
+young = 100.0
+poisson = 0.3
+permittivity = [3.0]
+[[dirichlet]]
+group = "inner"
+u = [0.0, 0.0, 0.0]
+phi = 0.0
+[electrode]
+group = "outer"
+v = 1.0
+"#,
+        file.display()
+    )
+}
+
+#[test]
+fn gmshs_curved_cells_hold_a_cylindrical_capacitor() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mesh/tests/fixtures");
+    let source = files::scene_file::Source {
+        label: "capacitor".into(),
+        dir: PathBuf::new(),
+    };
+    for (file, depth) in [("annulus2d-order2.msh", 1.0), ("annulus3d-order2.msh", 0.5)] {
+        let path = dir.join(file);
+        let mut text = capacitor(&path);
+        if file.starts_with("annulus2d") {
+            text = text.replace("u = [0.0, 0.0, 0.0]", "u = [0.0, 0.0]");
+        }
+        let scene = files::scene_file::parse(&text, "capacitor", &[]).unwrap();
+        let s = files::run::solve(&scene, &source, &mut problem::Silent).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(s.mesh.curved_cells().iter().any(|&c| c), "{file}: no curved cell");
+        let ln2 = std::f64::consts::LN_2;
+        let mut worst = 0.0f64;
+        for (v, x) in s.mesh.points.iter().enumerate() {
+            worst = worst.max((s.phi[v] - x[0].hypot(x[1]).ln() / ln2).abs());
+        }
+        let exact = std::f64::consts::PI * 3.0 / (2.0 * ln2) * depth;
+        let q = s
+            .report
+            .terminals
+            .iter()
+            .find(|t| t.group == "electrode")
+            .unwrap()
+            .charge;
+        let ground = s.report.terminals.iter().find(|t| t.group == "inner").unwrap().charge;
+        eprintln!(
+            "{file}: potential within {worst:.2e}, charge {q} against {exact} ({:.1e})",
+            (q - exact) / exact
+        );
+        assert!(worst < 1e-3, "{file}: φ off by {worst:e}");
+        assert!(((q - exact) / exact).abs() < 1e-4, "{file}: charge {q} against {exact}");
+        assert!((q + ground).abs() < 1e-9 * q.abs(), "{file}: Gauss: {q} + {ground}");
+    }
+    // the 2D mesh as a meridian section (r, z): a hemispherical shell 1 < R < 2, a spherical
+    // capacitor with φ = 2 V (1 - 1/R) and the charge 4π ε V (half of 8π ε V) on R = 2
+    let text = capacitor(&dir.join("annulus2d-order2.msh"))
+        .replace("u = [0.0, 0.0, 0.0]", "u = [0.0, 0.0]")
+        .replace("file = ", "axisymmetric = true\nfile = ");
+    let scene = files::scene_file::parse(&text, "capacitor", &[]).unwrap();
+    let s = files::run::solve(&scene, &source, &mut problem::Silent).unwrap();
+    let worst = s
+        .mesh
+        .points
+        .iter()
+        .zip(&s.phi)
+        .map(|(x, p)| (p - 2.0 * (1.0 - 1.0 / x[0].hypot(x[1]))).abs())
+        .fold(0.0f64, f64::max);
+    let exact = 4.0 * std::f64::consts::PI * 3.0;
+    let q = s
+        .report
+        .terminals
+        .iter()
+        .find(|t| t.group == "electrode")
+        .unwrap()
+        .charge;
+    eprintln!(
+        "shell: potential within {worst:.2e}, charge {q} against {exact} ({:.1e})",
+        (q - exact) / exact
+    );
+    assert!(
+        worst < 1e-3 && ((q - exact) / exact).abs() < 1e-4,
+        "shell: φ {worst:e}, charge {q}"
+    );
+}

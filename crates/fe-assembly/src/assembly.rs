@@ -44,6 +44,9 @@ pub struct Discretization<'m> {
     pub geometry: Vec<SimplexGeometry>,
     /// Whether each cell's material is electric.
     pub cell_electric: Vec<bool>,
+    /// Whether each cell is curved: a P2 cell with an edge node off its edge's midpoint,
+    /// mapped through its nodes ([`crate::mapping`]; its `geometry` is its corners').
+    pub curved: Vec<bool>,
     /// The body itself, or a body of revolution about the y axis meshed in its meridian plane
     /// (every integral carries `2π r`).
     pub coordinates: Coordinates,
@@ -123,6 +126,19 @@ impl<'m> Discretization<'m> {
                 nodes: mesh.cell(c).to_vec(),
             }));
         }
+        let curved = mesh.curved_cells();
+        if let Some((c, at)) = (0..n_cells)
+            .filter(|&c| curved[c])
+            .find_map(|c| folded(mesh, c).map(|at| (c, at)))
+        {
+            return Err(AssemblyError::Mesh(mesh::MeshError::BadCell {
+                cell: c,
+                what: "folded (a curved cell whose map turns inside out: its edge nodes too far off their edges)",
+                measure_name: "Jacobian determinant (times dim!) at one of its nodes or points",
+                measure: at,
+                nodes: mesh.cell(c).to_vec(),
+            }));
+        }
         let cell_electric: Vec<bool> = cell_material.iter().map(|&m| materials[m].1.electric).collect();
         let mut has_phi = vec![false; mesh.n_nodes()];
         for (c, cell) in mesh.iter_cells().enumerate() {
@@ -140,6 +156,7 @@ impl<'m> Discretization<'m> {
             dofs,
             geometry,
             cell_electric,
+            curved,
             coordinates,
         })
     }
@@ -162,14 +179,70 @@ impl<'m> Discretization<'m> {
         &self.materials[self.cell_material[c]]
     }
 
-    /// The quadrature of cell `c` ([`crate::kernels::Rule::of`]).
+    /// The quadrature of cell `c` ([`crate::kernels::Rule::of`]; a curved cell's,
+    /// [`Discretization::quadratic_rule`]).
     pub fn rule(&self, c: usize) -> crate::kernels::Rule<'_> {
+        if self.curved[c] {
+            return crate::kernels::Rule::Quadratic(Box::new(self.quadratic_rule(c)));
+        }
         crate::kernels::Rule::of(self.mesh.dim, self.mesh.kind.order(), &self.geometry[c])
     }
 
+    /// The assembly's quadrature of the P2 cell `c`: [`QuadraticRule::new`] on a straight-sided
+    /// cell; on a curved one its map's ([`QuadraticRule::mapped`]) at the points of
+    /// [`crate::kernels::curved_rule`].
+    pub fn quadratic_rule(&self, c: usize) -> QuadraticRule {
+        let dim = self.mesh.dim;
+        if !self.curved[c] {
+            return QuadraticRule::new(dim, &self.geometry[c]);
+        }
+        let (weights, points) = crate::kernels::curved_rule(dim);
+        self.quadratic_rule_at(c, points, weights, true)
+    }
+
+    /// The P2 shape functions of cell `c` at `points` (barycentric) standing for `weights` of
+    /// its measure: [`QuadraticRule::at`], or a curved cell's [`QuadraticRule::mapped`]; with
+    /// `ring` false, without a body of revolution's `2π r` and hoop values (as a plane cell).
+    pub fn quadratic_rule_at(&self, c: usize, points: &[[f64; 4]], weights: &[f64], ring: bool) -> QuadraticRule {
+        let dim = self.mesh.dim;
+        let axisymmetric = ring && self.coordinates == Coordinates::Axisymmetric;
+        if self.curved[c] {
+            let x: Vec<[f64; 3]> = self.mesh.cell(c).iter().map(|&v| self.mesh.points[v]).collect();
+            return QuadraticRule::mapped(dim, &x, points, weights, axisymmetric);
+        }
+        let g = self.geometry[c];
+        let g = if axisymmetric {
+            g
+        } else {
+            SimplexGeometry { radii: None, ..g }
+        };
+        QuadraticRule::at(dim, &g, points, weights)
+    }
+
+    /// The point of cell `c` at the barycentric coordinates `l` and the measure a unit of
+    /// reference weight stands for there (the cell's measure where it is straight; `|det J| /
+    /// dim!` of a curved cell's map), without a body of revolution's `2π r`.
+    pub(crate) fn cell_point(&self, c: usize, l: &[f64; 4]) -> ([f64; 3], f64) {
+        let (mesh, dim) = (self.mesh, self.mesh.dim);
+        let cell = mesh.cell(c);
+        if !self.curved[c] {
+            return (self.point_at(&cell[..=dim], l), self.geometry[c].measure);
+        }
+        let x: Vec<[f64; 3]> = cell.iter().map(|&v| mesh.points[v]).collect();
+        let (at, jac) = crate::mapping::map_at(dim, &x, l);
+        (at, crate::mapping::measure_at(dim, &jac))
+    }
+
     /// The one-point rule at the centroid of cell `c` ([`crate::kernels::Rule::centroid`]).
+    /// On a curved cell, its map's value there (the weight the map's measure there).
     pub fn centroid_rule(&self, c: usize) -> crate::kernels::Rule<'_> {
-        crate::kernels::Rule::centroid(self.mesh.dim, self.mesh.kind.order(), &self.geometry[c])
+        let dim = self.mesh.dim;
+        if self.curved[c] {
+            let third = 1.0 / (dim + 1) as f64;
+            let l = [third, third, third, if dim == 3 { third } else { 0.0 }];
+            return crate::kernels::Rule::Quadratic(Box::new(self.quadratic_rule_at(c, &[l], &[1.0], true)));
+        }
+        crate::kernels::Rule::centroid(dim, self.mesh.kind.order(), &self.geometry[c])
     }
 
     /// Assembles `A`, `G` and `B`. A floating terminal's rows and columns are its nodes'
@@ -204,7 +277,7 @@ impl<'m> Discretization<'m> {
         match (par, mesh.kind.order()) {
             (Parallelism::Rayon, 2) => {
                 self.assemble_node_owned::<{ crate::kernels::MAX_NODES }, _>(d, &node_cells, (patterns, values), |c| {
-                    QuadraticRule::new(dim, &self.geometry[c])
+                    self.quadratic_rule(c)
                 })
             }
             (Parallelism::Rayon, _) => self.assemble_node_owned::<4, _>(d, &node_cells, (patterns, values), |c| {
@@ -212,7 +285,7 @@ impl<'m> Discretization<'m> {
             }),
             (Parallelism::Serial, 2) => {
                 self.assemble_cell_loop::<{ crate::kernels::MAX_NODES }, _>(d, (patterns, values), |c| {
-                    QuadraticRule::new(dim, &self.geometry[c])
+                    self.quadratic_rule(c)
                 })
             }
             (Parallelism::Serial, _) => {
@@ -615,4 +688,24 @@ fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<Vec<u
         .into());
     }
     Ok(cell_material)
+}
+
+/// Where the map of the curved P2 cell `c` folds: its Jacobian determinant (times `dim!`, the
+/// straight cell's measure scale) at the first of its nodes and rule points where it is not
+/// positive; `None` where it is positive at all of them.
+fn folded(mesh: &Mesh, c: usize) -> Option<f64> {
+    let dim = mesh.dim;
+    let x: Vec<[f64; 3]> = mesh.cell(c).iter().map(|&v| mesh.points[v]).collect();
+    let mut at: Vec<[f64; 4]> = (0..=dim)
+        .map(|i| std::array::from_fn(|k| if k == i { 1.0 } else { 0.0 }))
+        .collect();
+    at.extend(
+        crate::kernels::simplex_edges(dim)
+            .iter()
+            .map(|&[i, j]| std::array::from_fn(|k| if k == i || k == j { 0.5 } else { 0.0 })),
+    );
+    at.extend_from_slice(crate::kernels::simplex_rule(dim, 2).1);
+    at.iter()
+        .map(|l| crate::mapping::jacobian_det(dim, &crate::mapping::map_at(dim, &x, l).1))
+        .find(|det| !(*det > 0.0))
 }

@@ -474,7 +474,6 @@ impl Discretization<'_> {
             s
         };
         for (c, cell) in mesh.iter_cells().enumerate() {
-            let g = &self.geometry[c];
             let m = &self.materials[self.cell_material[c]];
             let ul: Vec<[f64; 3]> = cell.iter().map(|&v| u[v]).collect();
             let pl: Vec<f64> = cell.iter().map(|&v| phi[v]).collect();
@@ -485,10 +484,11 @@ impl Discretization<'_> {
                 kernels::gradient_at(dim, &centroid, 0, &pl),
             );
             for ((bary, n), weight) in rule.iter().zip(&shapes).zip(weights) {
-                let w = g.measure * weight;
+                let (x, measure) = self.cell_point(c, bary);
+                let w = measure * weight;
                 let (eps_h, gp_h) = match order {
                     2 => {
-                        let r = kernels::QuadraticRule::at(dim, g, &[*bary], &[1.0]);
+                        let r = self.quadratic_rule_at(c, &[*bary], &[1.0], true);
                         (
                             kernels::strain_at(dim, &r, 0, &ul),
                             kernels::gradient_at(dim, &r, 0, &pl),
@@ -496,13 +496,7 @@ impl Discretization<'_> {
                     }
                     _ => at_centroid,
                 };
-                let mut x = [0.0; 3];
                 let (mut uh, mut ph) = ([0.0; 3], 0.0);
-                for (a, &v) in cell[..=dim].iter().enumerate() {
-                    for k in 0..3 {
-                        x[k] += bary[a] * mesh.points[v][k];
-                    }
-                }
                 for (a, &v) in cell.iter().enumerate() {
                     for k in 0..3 {
                         uh[k] += n[a] * u[v][k];

@@ -144,8 +144,8 @@ impl SimplexGeometry {
 /// The most nodes of a cell (the ten-node tetrahedron).
 pub const MAX_NODES: usize = 10;
 
-/// The most points of a cell's quadrature (P2 on a body of revolution).
-pub const MAX_POINTS: usize = 6;
+/// The most points of a cell's quadrature (a curved tetrahedron's, [`curved_rule`]).
+pub const MAX_POINTS: usize = 14;
 
 /// What the element kernels read of a cell: the points of its quadrature, and at each the
 /// weight (the measure it stands for, `2π r` included on a body of revolution), every shape
@@ -248,6 +248,43 @@ pub fn simplex_rule(dim: usize, order: usize) -> (&'static [f64], &'static [[f64
     (weights, points)
 }
 
+/// The quadrature of a curved (isoparametric) P2 cell, whose map's Jacobian varies: on a
+/// triangle Dunavant's six points of degree 4 ([`simplex_rule`]`(2, 2)`); on a tetrahedron
+/// fourteen of degree 5 with positive weights (Walkington's, as libMesh and Keast's tables
+/// give it), where the straight cell's four of degree 2 would miss the degree-3 integrand
+/// `adj(J)ᵀ ∇_ξ N` of the patch test and Keast's five of degree 3 has a negative weight.
+/// Weights as fractions of the reference measure (summing to 1).
+pub fn curved_rule(dim: usize) -> (&'static [f64], &'static [[f64; 4]]) {
+    static TET: std::sync::LazyLock<(Vec<f64>, Vec<[f64; 4]>)> = std::sync::LazyLock::new(|| {
+        let (mut w, mut p) = (vec![], vec![]);
+        // four points (a, a, a, 1 - 3a) of each of two kinds, then six (b, b, 1/2 - b, 1/2 - b)
+        for (a, weight) in [
+            (0.092_735_250_310_891_23, 0.012_248_840_519_393_66),
+            (0.310_885_919_263_300_6, 0.018_781_320_953_002_64),
+        ] {
+            for k in 0..4 {
+                let mut l = [a; 4];
+                l[k] = 1.0 - 3.0 * a;
+                p.push(l);
+                w.push(6.0 * weight);
+            }
+        }
+        let (b, weight) = (0.045_503_704_125_649_65, 0.007_091_003_462_846_911);
+        for &[i, j] in simplex_edges(3) {
+            let mut l = [0.5 - b; 4];
+            (l[i], l[j]) = (b, b);
+            p.push(l);
+            w.push(6.0 * weight);
+        }
+        (w, p)
+    });
+    if dim == 3 {
+        (&TET.0, &TET.1)
+    } else {
+        simplex_rule(dim, 2)
+    }
+}
+
 /// The rule of [`simplex_rule`], made.
 fn made_rule(dim: usize, order: usize) -> (Vec<f64>, Vec<[f64; 4]>) {
     match (dim, order) {
@@ -344,12 +381,12 @@ pub fn simplex_edges(dim: usize) -> &'static [[usize; 2]] {
 /// the products of gradients); on a body of revolution six of degree 4.
 #[derive(Clone, Debug)]
 pub struct QuadraticRule {
-    n_local: usize,
-    n_points: usize,
-    weight: [f64; MAX_POINTS],
-    value: [[f64; MAX_NODES]; MAX_POINTS],
-    grad: [[[f64; 3]; MAX_NODES]; MAX_POINTS],
-    hoop: [[f64; MAX_NODES]; MAX_POINTS],
+    pub(crate) n_local: usize,
+    pub(crate) n_points: usize,
+    pub(crate) weight: [f64; MAX_POINTS],
+    pub(crate) value: [[f64; MAX_NODES]; MAX_POINTS],
+    pub(crate) grad: [[[f64; 3]; MAX_NODES]; MAX_POINTS],
+    pub(crate) hoop: [[f64; MAX_NODES]; MAX_POINTS],
 }
 
 impl QuadraticRule {
@@ -686,6 +723,29 @@ impl CellRule for Rule<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_curved_tetrahedrons_rule_integrates_every_quintic() {
+        // ∫ λ0^a λ1^b λ2^c λ3^d over the simplex, as a fraction of its measure:
+        // a! b! c! d! 3! / (a + b + c + d + 3)!
+        let fact = |n: u32| (1..=n).map(f64::from).product::<f64>();
+        let (w, p) = curved_rule(3);
+        assert_eq!(w.len(), 14);
+        assert!(w.iter().all(|&x| x > 0.0));
+        for e in 0..=5u32.pow(4) {
+            let k = [e % 6, e / 6 % 6, e / 36 % 6, e / 216 % 6];
+            if k.iter().sum::<u32>() > 5 {
+                continue;
+            }
+            let exact = k.iter().map(|&x| fact(x)).product::<f64>() * 6.0 / fact(k.iter().sum::<u32>() + 3);
+            let rule: f64 = w
+                .iter()
+                .zip(p)
+                .map(|(w, l)| w * (0..4).map(|i| l[i].powi(k[i] as i32)).product::<f64>())
+                .sum();
+            assert!((rule - exact).abs() < 1e-14, "{k:?}: {rule} against {exact}");
+        }
+    }
 
     #[test]
     fn gradients_sum_to_zero_and_reproduce_linears() {

@@ -84,6 +84,23 @@ pub fn facet_measure(x: &[[f64; 3]]) -> f64 {
     }
 }
 
+/// The point of the facet `f` (its nodes: corners, then in a P2 mesh its edges' midpoints) at
+/// the barycentric coordinates `l`, and the measure a unit of reference weight stands for
+/// there: the facet's measure where it is straight-sided (its corners' map); on a curved P2
+/// facet its map's `√det(JᵀJ) / d!` ([`crate::mapping`]). Without a body of revolution's
+/// `2π r`.
+pub fn facet_point(mesh: &mesh::Mesh, f: &[usize], l: &[f64; 4]) -> ([f64; 3], f64) {
+    let d = mesh.dim - 1;
+    let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
+    if mesh::straight_sided(&x, d + 1, crate::kernels::simplex_edges(d)) {
+        let corners = &x[..=d];
+        (crate::mapping::map_at(d, corners, l).0, facet_measure(corners))
+    } else {
+        let (at, jac) = crate::mapping::map_at(d, &x, l);
+        (at, crate::mapping::measure_at(d, &jac))
+    }
+}
+
 impl Discretization<'_> {
     /// The right-hand sides `(b_u, b_φ)` of `K [u; φ] = [b_u; b_φ]` for the given loads, with
     /// the prescribed values lifted: `b_u = f - A_ud u_d - Gᵀ_uφd φ_d`,
@@ -135,18 +152,13 @@ impl Discretization<'_> {
         let (w_facet, p_facet) = simplex_rule(dim - 1, order);
         let n_cell: Vec<_> = p_cell.iter().map(|p| shape_values(dim, order, p)).collect();
         let n_facet: Vec<_> = p_facet.iter().map(|p| shape_values(dim - 1, order, p)).collect();
-        // the points of a cell or a facet from its corners (straight-sided)
-        let (at, ring) = (
-            |nodes: &[usize], bary: &[f64; 4], corners: usize| self.point_at(&nodes[..corners], bary),
-            |x: &[f64; 3]| self.ring(x),
-        );
+        let ring = |x: &[f64; 3]| self.ring(x);
         for load in loads {
             match load {
                 Load::BodyForce(f) => {
                     for (c, cell) in mesh.iter_cells().enumerate() {
-                        let vol = self.geometry[c].measure;
                         for ((w, p), n) in w_cell.iter().zip(p_cell).zip(&n_cell) {
-                            let x = at(cell, p, dim + 1);
+                            let (x, vol) = self.cell_point(c, p);
                             let fx = f(&x[..dim]);
                             let vol = vol * ring(&x);
                             for (a, &v) in cell.iter().enumerate() {
@@ -164,9 +176,8 @@ impl Discretization<'_> {
                         if !self.cell_electric[c] {
                             continue;
                         }
-                        let vol = self.geometry[c].measure;
                         for ((w, p), n) in w_cell.iter().zip(p_cell).zip(&n_cell) {
-                            let x = at(cell, p, dim + 1);
+                            let (x, vol) = self.cell_point(c, p);
                             let qx = check("the body charge", q0(&x[..dim]))?;
                             let vol = vol * ring(&x);
                             for (a, &v) in cell.iter().enumerate() {
@@ -179,10 +190,8 @@ impl Discretization<'_> {
                 }
                 Load::Traction { group, value } => {
                     for f in mesh.boundary(group)?.iter() {
-                        let x: Vec<[f64; 3]> = f[..dim].iter().map(|&v| mesh.points[v]).collect();
-                        let len = facet_measure(&x);
                         for ((w, p), n) in w_facet.iter().zip(p_facet).zip(&n_facet) {
-                            let y = at(f, p, dim);
+                            let (y, len) = facet_point(mesh, f, p);
                             let t = value(&y[..dim]);
                             let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {
@@ -197,10 +206,8 @@ impl Discretization<'_> {
                 }
                 Load::SurfaceCharge { group, value } => {
                     for f in mesh.boundary(group)?.iter() {
-                        let x: Vec<[f64; 3]> = f[..dim].iter().map(|&v| mesh.points[v]).collect();
-                        let len = facet_measure(&x);
                         for ((w, p), n) in w_facet.iter().zip(p_facet).zip(&n_facet) {
-                            let y = at(f, p, dim);
+                            let (y, len) = facet_point(mesh, f, p);
                             let qx = check("the surface charge", value(&y[..dim]))?;
                             let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {

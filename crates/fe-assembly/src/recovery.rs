@@ -2,7 +2,7 @@
 //! `D = e ε(u) - β ∇φ` (docs/theory.md's law; `E = -∇φ`), at each cell's centroid (constant on
 //! a P1 cell, linear on a P2 one) and, on P2 cells, at the nodes too.
 
-use crate::kernels::{gradient_at, simplex_edges, strain_at, CellRule, QuadraticRule, SimplexGeometry, MAX_NODES};
+use crate::kernels::{gradient_at, simplex_edges, strain_at, CellRule, MAX_NODES};
 use crate::Discretization;
 use crate::Material;
 use rayon::prelude::*;
@@ -118,15 +118,12 @@ impl Discretization<'_> {
                         continue;
                     };
                     let g = &self.geometry[c];
-                    let plain = SimplexGeometry { radii: None, ..*g };
-                    let rule = QuadraticRule::at(dim, &plain, &bary[a..=a], &[1.0]);
+                    let rule = self.quadratic_rule_at(c, &bary[a..=a], &[1.0], false);
                     let ul: Vec<[f64; 3]> = cell.iter().map(|&w| u[w]).collect();
                     let mut eps = strain_at(dim, &rule, 0, &ul);
                     if let Some(r) = g.radii {
-                        let (rn, reach) = (
-                            (0..3).map(|i| bary[a][i] * r[i]).sum::<f64>(),
-                            r.iter().fold(0.0f64, |m, x| m.max(x.abs())),
-                        );
+                        // the node's own radius (on a curved cell too)
+                        let (rn, reach) = (mesh.points[v][0], r.iter().fold(0.0f64, |m, x| m.max(x.abs())));
                         eps[3] = if rn > 1e-12 * reach { u[v][0] / rn } else { eps[0] };
                     }
                     let grad = if self.cell_electric[c] {
@@ -137,7 +134,7 @@ impl Discretization<'_> {
                     };
                     let m = self.material(c);
                     let (sigma, d) = (stress(m, &eps, &grad), displacement(m, &eps, &grad));
-                    let w = g.measure;
+                    let w = rule.weight(0);
                     total += w;
                     for i in 0..nv {
                         s_out[i] += w * sigma[i];
@@ -253,8 +250,8 @@ impl Discretization<'_> {
         }
         let (weights, points) = crate::kernels::simplex_rule(dim, 2);
         for (w, l) in weights.iter().zip(points) {
-            let x = self.point_at(&cell[..=dim], l);
-            let qx = q(&x[..dim]) * w * self.geometry[c].measure * self.ring(&x);
+            let (x, measure) = self.cell_point(c, l);
+            let qx = q(&x[..dim]) * w * measure * self.ring(&x);
             let n = crate::kernels::shape_values(dim, 2, l);
             for (o, na) in out.iter_mut().zip(n) {
                 *o += qx * na;

@@ -39,7 +39,7 @@ pub use generate::{box_tet, rectangle_quad, rectangle_tri, round_quarter_section
 pub use gmsh::{read_msh, read_msh_bytes};
 pub use ordering::nested_dissection;
 pub use parts::MeshParts;
-pub use quality::QualityReport;
+pub use quality::{straight_sided, QualityReport};
 
 use rayon::prelude::*;
 use std::collections::BTreeMap;

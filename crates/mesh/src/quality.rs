@@ -38,7 +38,9 @@ impl Mesh {
     /// Errors, in the order they are looked for: [`MeshError::Empty`],
     /// [`MeshError::NonFiniteCoordinate`], [`MeshError::NodeOutOfRange`] (cells, facets,
     /// region entries), [`MeshError::BadCell`] (degenerate: `|measure| <= 1e-12 h^dim`;
-    /// inverted: negative measure, or for a quadrilateral a non-positive corner Jacobian),
+    /// inverted: negative measure, or for a quadrilateral a non-positive corner Jacobian; a
+    /// curved second-order cell is measured by its corners, its map checked where it is
+    /// assembled),
     /// then the topology: [`MeshError::OverlappingCells`],
     /// [`MeshError::DuplicateCell`], [`MeshError::BadBoundaryFacet`].
     pub fn check(&self) -> Result<QualityReport, MeshError> {
@@ -110,9 +112,6 @@ impl Mesh {
             if measure < 0.0 || !corners_ok {
                 return Err(bad("inverted"));
             }
-            if !self.straight(cell, lmax) {
-                return Err(bad("curved (an edge node off its edge's midpoint; only straight-sided second-order cells are supported)"));
-            }
             report.total_measure += measure;
             report.min_measure = report.min_measure.min(measure);
             report.h_max = report.h_max.max(lmax);
@@ -155,19 +154,33 @@ impl Mesh {
         }
     }
 
-    /// Whether each edge node of a quadratic cell lies at its edge's midpoint (to 1e-9 of the
-    /// cell's longest edge `h`); true for a P1 cell.
-    fn straight(&self, cell: &[usize], h: f64) -> bool {
-        let p = |q: usize| self.points[cell[q]];
-        self.kind.midside_edges().iter().enumerate().all(|(m, &[a, b])| {
-            let (xa, xb, xm) = (p(a), p(b), p(self.kind.n_corners() + m));
-            let off = (0..3)
-                .map(|k| (xm[k] - 0.5 * (xa[k] + xb[k])).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            off <= 1e-9 * h
-        })
+    /// Which cells are curved: a second-order cell with an edge node off its edge's midpoint
+    /// ([`straight_sided`]); none in a linear mesh.
+    pub fn curved_cells(&self) -> Vec<bool> {
+        let (corners, edges) = (self.kind.n_corners(), self.kind.midside_edges());
+        self.iter_cells()
+            .map(|cell| {
+                let x: Vec<[f64; 3]> = cell.iter().map(|&v| self.points[v]).collect();
+                !straight_sided(&x, corners, edges)
+            })
+            .collect()
     }
+}
+
+/// Whether a second-order simplex whose nodes are at `x` (its `corners`, then the midpoints of
+/// `edges`, by the corners' local indices) has each edge node at its edge's midpoint, to 1e-9
+/// of its longest edge: a straight-sided simplex, whose map is its corners' (affine). True for
+/// a first-order simplex (`x` its corners alone).
+pub fn straight_sided(x: &[[f64; 3]], corners: usize, edges: &[[usize; 2]]) -> bool {
+    if x.len() <= corners {
+        return true;
+    }
+    let dist = |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
+    let h = edges.iter().map(|&[a, b]| dist(&x[a], &x[b])).fold(0.0f64, f64::max);
+    edges.iter().enumerate().all(|(m, &[a, b])| {
+        let mid: [f64; 3] = std::array::from_fn(|k| 0.5 * (x[a][k] + x[b][k]));
+        dist(&x[corners + m], &mid) <= 1e-9 * h
+    })
 }
 
 #[cfg(test)]

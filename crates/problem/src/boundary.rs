@@ -214,15 +214,31 @@ fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(
 /// the segment of length L from node a to node b. A second-order segment (2D, its corners then
 /// its midpoint) gives Simpson's `L / 6, L / 6, 2 L / 3`, and on a body of revolution
 /// `2π L (r_a / 6, r_b / 6, (r_a + r_b) / 3)` (the corners' share of the linear part of `r`
-/// vanishes: `∫ s (1 - s)(1 - 2s) ds = 0`), so a corner on the axis weighs nothing.
+/// vanishes: `∫ s (1 - s)(1 - 2s) ds = 0`), so a corner on the axis weighs nothing. A curved
+/// second-order facet (an edge node off its chord): by the loads' rule over its map
+/// ([`fe_assembly::facet_point`]).
 fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup, coordinates: Coordinates) -> Vec<f64> {
     let mut weight = vec![0.0; mesh.n_nodes()];
     let ring = coordinates == Coordinates::Axisymmetric;
+    let d = mesh.dim - 1;
     for f in group.iter() {
         let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
         let corners = &x[..mesh.dim.min(x.len())];
         let len = facet_measure(corners);
         let tau = std::f64::consts::TAU;
+        if !mesh::straight_sided(&x, d + 1, fe_assembly::kernels::simplex_edges(d)) {
+            // a curved second-order facet: ∫ N_a over its map, by the loads' rule
+            let (weights, points) = fe_assembly::kernels::simplex_rule(d, 2);
+            for (w, l) in weights.iter().zip(points) {
+                let (at, measure) = fe_assembly::facet_point(mesh, f, l);
+                let n = fe_assembly::kernels::shape_values(d, 2, l);
+                let ds = w * measure * if ring { tau * at[0] } else { 1.0 };
+                for (a, &v) in f.iter().enumerate() {
+                    weight[v] += ds * n[a];
+                }
+            }
+            continue;
+        }
         match (f.len(), ring) {
             (3, true) if mesh.dim == 2 => {
                 let (ra, rb) = (x[0][0], x[1][0]);

@@ -373,6 +373,12 @@ fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
             n.coincident_nodes
         ));
     }
+    if n.curved_cells > 0 {
+        notes.push(format!(
+            "{} curved cells (edge nodes off their edges' midpoints): mapped through their nodes",
+            n.curved_cells
+        ));
+    }
     if n.unused_nodes > 0 {
         notes.push(format!(
             "{} nodes belong to no cell (the centre of an arc, a point off the body): they carry no unknown",

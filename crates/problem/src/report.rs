@@ -227,6 +227,7 @@ impl MeshReport {
             reoriented_cells: setup.notes.reoriented_cells,
             coincident_nodes: setup.notes.coincident_nodes,
             unused_nodes: setup.notes.unused_nodes,
+            curved_cells: setup.notes.curved_cells,
         }
     }
 }
@@ -291,6 +292,10 @@ pub struct MeshReport {
     /// Nodes that no cell uses (the centre of a Gmsh arc): they carry no unknown.
     #[serde(default)]
     pub unused_nodes: usize,
+    /// Curved second-order cells (edge nodes off their edges' midpoints, as Gmsh puts them on a
+    /// curved boundary), mapped through their nodes (isoparametric).
+    #[serde(default)]
+    pub curved_cells: usize,
 }
 
 /// Free unknowns.

@@ -44,6 +44,9 @@ pub struct MeshNotes {
     pub coincident_nodes: usize,
     /// Nodes that no cell uses (the centre of a Gmsh arc): carried with no unknown.
     pub unused_nodes: usize,
+    /// Curved second-order cells (an edge node off its edge's midpoint), mapped through their
+    /// nodes.
+    pub curved_cells: usize,
 }
 
 /// Without electric unknowns (no coupling and no potential or charge that is not 0), what acts
@@ -193,6 +196,9 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         layer(&mut mesh, m)?;
     }
     if m.cylinder {
+        // at order 2 the edge nodes are rounded with the corners, onto the cylinder's face:
+        // curved cells that follow it, where rounding first would leave them on its chords
+        mesh = of_order(mesh, scene)?;
         mesh::round_quarter_section(&mut mesh);
     }
     mesh = of_order(mesh, scene)?;
@@ -201,6 +207,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         reoriented_cells: mesh.reoriented_cells,
         coincident_nodes: quality.coincident_nodes,
         unused_nodes: quality.unused_nodes,
+        curved_cells: mesh.curved_cells().iter().filter(|&&c| c).count(),
     };
     for l in scene.loads() {
         crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;

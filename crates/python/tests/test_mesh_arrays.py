@@ -20,10 +20,10 @@ def gmsh_arrays(path):
     tags = m.cell_data["gmsh:physical"]
     boundary, regions, cells = {}, {}, []
     for block, tag in zip(m.cells, tags):
-        if block.type == "line":
+        if block.type in ("line", "line3"):
             for t in np.unique(tag):
                 boundary.setdefault(names[(t, 1)], []).append(block.data[tag == t])
-        elif block.type == "triangle":
+        elif block.type in ("triangle", "triangle6"):
             for t in np.unique(tag):
                 first = sum(len(c) for c in cells)
                 regions.setdefault(names[(t, 2)], []).append(first + np.flatnonzero(tag == t))
@@ -153,3 +153,27 @@ def test_quadratic_elements_from_the_scene_and_as_arrays():
     # in 2D it runs
     r = pc.run(pc.Scene.load("paper", {"mesh.n": 8, "mesh.order": 2}))
     assert r.report["residuals"]["converged_to_tolerance"] and len(r.contact.lambda_n) == 2 * 16 - 1  # the clamped ends are no points
+
+
+def test_curved_second_order_cells_as_arrays():
+    # Gmsh's quarter annulus 1 < r < 2 at second order, its edge nodes on the arcs (curved,
+    # isoparametric cells), handed over as meshio's arrays: a cylindrical capacitor whose
+    # electrode's charge is pi eps V / (2 ln 2)
+    points, cells, boundary, regions = gmsh_arrays(REPO / "crates" / "mesh" / "tests" / "fixtures" / "annulus2d-order2.msh")
+    assert cells.shape[1] == 6
+    scene = pc.Scene.from_dict(
+        {
+            "name": "capacitor",
+            "description": "a cylindrical capacitor on curved cells",
+            "mesh": {"kind": "given"},
+            "material": [{"region": "body", "model": "isotropic", "young": 100.0, "poisson": 0.3, "permittivity": [3.0]}],
+            "dirichlet": [{"group": "inner", "u": [0.0, 0.0], "phi": 0.0}],
+            "electrode": {"group": "outer", "v": 1.0},
+        }
+    )
+    scene.set_mesh(points[:, :2], cells, boundary, regions)
+    r = pc.run(scene)
+    assert r.report["mesh"]["curved_cells"] > 0 and r.cell_type == "triangle6"
+    q = next(t["charge"] for t in r.report["terminals"] if t["group"] == "electrode")
+    assert abs(q / (np.pi * 3.0 / (2 * np.log(2.0))) - 1.0) < 1e-4, q
+

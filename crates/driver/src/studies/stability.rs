@@ -749,6 +749,15 @@ pub const CASES: &[Case] = &[
         fine: false,
     },
     Case {
+        name: "P2 curved cylinder",
+        why: "indent-sphere-3d on the quarter cylinder at order 2: curved ten-node tetrahedra on its round face, mapped through their nodes",
+        scene: "indent-sphere-3d",
+        sets: &["mesh.n=12", "mesh.order=2", "mesh.cylinder=true"],
+        paper_sets: None,
+        expect: Expect::Converged,
+        fine: false,
+    },
+    Case {
         name: "P2 conducting tip",
         why: "a conducting sphere on a body of revolution at order 2: the points' potentials in the modified basis",
         scene: "indent-sphere",
