@@ -757,8 +757,9 @@ pub struct MeshSpec {
     pub layers: Vec<LayerSpec>,
     /// The polynomial order of the elements: 1 (three-node triangles, four-node tetrahedra) or
     /// 2 (six-node triangles, ten-node tetrahedra: a node at the midpoint of every edge of the
-    /// generated or read mesh, straight-sided). Absent: a generated mesh's order 1, a Gmsh
-    /// file's own.
+    /// generated or read mesh, straight-sided; on `mesh.cylinder`'s round face, on the
+    /// cylinder). Absent: a generated mesh's order 1, a Gmsh file's own (a second-order file's
+    /// cells on a curved boundary curved, mapped through their nodes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub order: Option<usize>,
 }
