@@ -369,11 +369,8 @@ fn sets(rows: &ContactRows<'_>, law: &Law, lambda: &PointValues, u: &PointValues
             continue;
         }
         active[i] = true;
-        let s = match law {
-            Law::Frictionless => 0.0,
-            Law::Tresca(s) => s[i],
-            Law::Coulomb => p.friction[i] * zn,
-        };
+        // the slip radius as the contact crate writes it (Tresca's bound, Coulomb's F z_n)
+        let s = law.radius(p, i, zn);
         if nt == 0 || !(s > 0.0) {
             continue;
         }
