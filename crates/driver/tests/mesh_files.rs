@@ -206,6 +206,16 @@ v = 1.0
     )
 }
 
+/// The charge on the terminal `group` of a run's report.
+fn charge_on(s: &problem::Solution, group: &str) -> f64 {
+    s.report
+        .terminals
+        .iter()
+        .find(|t| t.group == group)
+        .expect("the terminal")
+        .charge
+}
+
 #[test]
 fn gmshs_curved_cells_hold_a_cylindrical_capacitor() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mesh/tests/fixtures");
@@ -228,14 +238,7 @@ fn gmshs_curved_cells_hold_a_cylindrical_capacitor() {
             worst = worst.max((s.phi[v] - x[0].hypot(x[1]).ln() / ln2).abs());
         }
         let exact = std::f64::consts::PI * 3.0 / (2.0 * ln2) * depth;
-        let q = s
-            .report
-            .terminals
-            .iter()
-            .find(|t| t.group == "electrode")
-            .unwrap()
-            .charge;
-        let ground = s.report.terminals.iter().find(|t| t.group == "inner").unwrap().charge;
+        let (q, ground) = (charge_on(&s, "electrode"), charge_on(&s, "inner"));
         eprintln!(
             "{file}: potential within {worst:.2e}, charge {q} against {exact} ({:.1e})",
             (q - exact) / exact
@@ -259,13 +262,7 @@ fn gmshs_curved_cells_hold_a_cylindrical_capacitor() {
         .map(|(x, p)| (p - 2.0 * (1.0 - 1.0 / x[0].hypot(x[1]))).abs())
         .fold(0.0f64, f64::max);
     let exact = 4.0 * std::f64::consts::PI * 3.0;
-    let q = s
-        .report
-        .terminals
-        .iter()
-        .find(|t| t.group == "electrode")
-        .unwrap()
-        .charge;
+    let q = charge_on(&s, "electrode");
     eprintln!(
         "shell: potential within {worst:.2e}, charge {q} against {exact} ({:.1e})",
         (q - exact) / exact

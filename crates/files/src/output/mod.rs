@@ -278,34 +278,25 @@ impl<'a> FieldArrays<'a> {
                 point.push(named("contact_flux", 1, Cow::Owned(flux)));
             }
         }
+        // the four fields, `count` entries (cells or nodes) of them: Voigt components 3 in
+        // plane strain, 4 on a body of revolution ([rr, zz, rz, θθ]), 6 in 3D
+        let four = |count: usize, [s, e, d, f]: [&'a [f64]; 4]| {
+            let nv = s.len() / count.max(1);
+            vec![
+                named("stress", nv, Cow::Borrowed(s)),
+                named("strain", nv, Cow::Borrowed(e)),
+                named("electric_displacement", mesh.dim, Cow::Borrowed(d)),
+                named("electric_field", mesh.dim, Cow::Borrowed(f)),
+            ]
+        };
         if let Some(at) = cells.and_then(|f| f.at_nodes.as_ref()) {
             // P2 cells: the fields at the nodes too, which ParaView draws quadratic
-            let nv = at.stress.len() / mesh.n_nodes().max(1);
-            point.extend([
-                named("stress", nv, Cow::Borrowed(&at.stress[..])),
-                named("strain", nv, Cow::Borrowed(&at.strain[..])),
-                named(
-                    "electric_displacement",
-                    mesh.dim,
-                    Cow::Borrowed(&at.electric_displacement[..]),
-                ),
-                named("electric_field", mesh.dim, Cow::Borrowed(&at.electric_field[..])),
-            ]);
+            let arrays = [&at.stress, &at.strain, &at.electric_displacement, &at.electric_field];
+            point.extend(four(mesh.n_nodes(), arrays.map(|a| &a[..])));
         }
         let cell = cells.map_or(vec![], |f| {
-            // Voigt components per cell: 3 in plane strain, 4 on a body of revolution ([rr,
-            // zz, rz, θθ]), 6 in 3D
-            let nv = f.stress.len() / mesh.n_cells().max(1);
-            vec![
-                named("stress", nv, Cow::Borrowed(&f.stress[..])),
-                named("strain", nv, Cow::Borrowed(&f.strain[..])),
-                named(
-                    "electric_displacement",
-                    mesh.dim,
-                    Cow::Borrowed(&f.electric_displacement[..]),
-                ),
-                named("electric_field", mesh.dim, Cow::Borrowed(&f.electric_field[..])),
-            ]
+            let arrays = [&f.stress, &f.strain, &f.electric_displacement, &f.electric_field];
+            four(mesh.n_cells(), arrays.map(|a| &a[..]))
         });
         FieldArrays { point, cell }
     }
