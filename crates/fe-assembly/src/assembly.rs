@@ -691,8 +691,8 @@ fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<Vec<u
 }
 
 /// Where the map of the curved P2 cell `c` folds: its Jacobian determinant (times `dim!`, the
-/// straight cell's measure scale) at the first of its nodes and rule points where it is not
-/// positive; `None` where it is positive at all of them.
+/// straight cell's measure scale) at the first of its nodes and rule points (the loads', the
+/// assembly's) where it is not positive; `None` where it is positive at all of them.
 fn folded(mesh: &Mesh, c: usize) -> Option<f64> {
     let dim = mesh.dim;
     let x: Vec<[f64; 3]> = mesh.cell(c).iter().map(|&v| mesh.points[v]).collect();
@@ -704,7 +704,9 @@ fn folded(mesh: &Mesh, c: usize) -> Option<f64> {
             .iter()
             .map(|&[i, j]| std::array::from_fn(|k| if k == i || k == j { 0.5 } else { 0.0 })),
     );
+    // every point a curved cell is integrated at: the loads' and norms' rule, the assembly's
     at.extend_from_slice(crate::kernels::simplex_rule(dim, 2).1);
+    at.extend_from_slice(crate::kernels::curved_rule(dim).1);
     at.iter()
         .map(|l| crate::mapping::jacobian_det(dim, &crate::mapping::map_at(dim, &x, l).1))
         .find(|det| !(*det > 0.0))

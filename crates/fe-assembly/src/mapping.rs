@@ -160,7 +160,8 @@ impl QuadraticRule {
             let dn = shape_derivatives(dim, l);
             rule.value[p] = shape_values(dim, 2, l);
             rule.grad[p] = physical_gradients(dim, n_local, &dn, &jac, det);
-            rule.weight[p] = w * det.abs() / factorial;
+            // positive: a cell whose map folds is refused where it is made (`Discretization::new`)
+            rule.weight[p] = w * det / factorial;
             if axisymmetric {
                 let r = at[0];
                 rule.weight[p] *= std::f64::consts::TAU * r;
