@@ -184,7 +184,14 @@ impl Event<'_> {
         (flux, cells): (bool, bool),
     ) -> Self {
         let (n, c) = (mesh.n_nodes() as f64, mesh.n_cells() as f64);
-        let per_node = 3.0 + 4.0 + 6.0 + if flux { 1.0 } else { 0.0 };
+        // u, φ and the contact's point data; with the cell fields on P2 cells, the same four
+        // fields at the nodes too
+        let at_nodes = cells && mesh.kind.order() == 2;
+        let per_node = 3.0
+            + 4.0
+            + 6.0
+            + if flux { 1.0 } else { 0.0 }
+            + if at_nodes { (2 * nv + 2 * mesh.dim) as f64 } else { 0.0 };
         let per_cell = (mesh.kind.n_nodes() + 1) as f64 * 8.0 + 1.0;
         let fields = if cells {
             (2 * nv + 2 * mesh.dim) as f64 * 8.0
