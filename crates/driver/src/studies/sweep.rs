@@ -118,12 +118,13 @@ pub fn sweep(
             // the shortest digits that read back to the value (`{:?}`: 1e300, not 301 digits)
             s.push(format!("{param}={value:?}"));
         }
+        let shown = shown(value, integer);
         let t = Instant::now();
         let r = match solve(scene, &s) {
             Ok(solved) => solved.report,
             Err(e) => {
                 eta.record(0, t.elapsed().as_secs_f64());
-                progress(&format!("[{}/{steps}] {param} = {value:.6e}: failed: {e}", k + 1));
+                progress(&format!("[{}/{steps}] {param} = {shown}: failed: {e}", k + 1));
                 rows.push(SweepRow::failed(value, t.elapsed().as_secs_f64(), e.to_string()));
                 first_error.get_or_insert(e);
                 continue;
@@ -132,7 +133,7 @@ pub fn sweep(
         let row = SweepRow::of(value, &r, t.elapsed().as_secs_f64());
         eta.record(0, row.seconds);
         progress(&format!(
-            "[{}/{steps}] {param} = {value:.6e}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}; {}",
+            "[{}/{steps}] {param} = {shown}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}; {}",
             k + 1,
             row.counts.0,
             row.counts.1,
@@ -145,7 +146,11 @@ pub fn sweep(
     }
     let failed: Vec<String> = rows
         .iter()
-        .filter_map(|r| r.error.as_ref().map(|e| format!("{param} = {:e}: {e}", r.value)))
+        .filter_map(|r| {
+            r.error
+                .as_ref()
+                .map(|e| format!("{param} = {}: {e}", shown(r.value, integer)))
+        })
         .collect();
     if let (Some(e), true) = (first_error, failed.len() == rows.len()) {
         // nothing found: the first point's error, nothing written
@@ -153,7 +158,7 @@ pub fn sweep(
     }
     if let Some(dir) = out {
         let mut outs = Outputs::new(dir);
-        outs.add("sweep.csv", csv(param, &rows).into_bytes());
+        outs.add("sweep.csv", csv(param, &rows, integer).into_bytes());
         outs.extend(picture(param, &rows)?);
         outs.commit()?;
         progress(&format!("wrote sweep.csv, sweep.svg, sweep.png in {}", dir.display()));
@@ -224,6 +229,15 @@ impl SweepRow {
     }
 }
 
+/// A swept value as the progress lines show it: an integer key's as the integer it is set to,
+/// another's with seven digits.
+fn shown(value: f64, integer: bool) -> String {
+    match integer {
+        true => format!("{}", value as i64),
+        false => format!("{value:.6e}"),
+    }
+}
+
 /// Whether `param` is an integer key of the scene: its value in the scene (with `sets`) is a
 /// TOML integer; where the scene leaves it out, whether both bounds are whole numbers within
 /// the integers a double holds exactly.
@@ -259,8 +273,8 @@ fn terminal_groups(rows: &[SweepRow]) -> Vec<String> {
 /// one's), `indenter_force`, `indenter_contact_radius`, `indenter_potential`) and the
 /// half-space's closed form beside them (`half_space_force`, `_contact_radius`, `_charge`,
 /// `nan` where it does not apply); each terminal's `charge_GROUP` and `potential_GROUP`; a
-/// failed point's `error`.
-pub fn csv(param: &str, rows: &[SweepRow]) -> String {
+/// failed point's `error`. The swept value an integer where the key is one (`integer`).
+pub fn csv(param: &str, rows: &[SweepRow], integer: bool) -> String {
     let indenter = rows.iter().any(|r| r.indenter.is_some());
     let errors = rows.iter().any(|r| r.error.is_some());
     let groups = terminal_groups(rows);
@@ -311,9 +325,12 @@ pub fn csv(param: &str, rows: &[SweepRow]) -> String {
             (false, _) => String::new(),
             (true, e) => format!(",{}", files::output::csv_field(e.as_deref().unwrap_or(""))),
         };
+        let value = match integer {
+            true => format!("{}", r.value as i64),
+            false => format!("{:e}", r.value),
+        };
         csv.push_str(&format!(
-            "{:e},{},{},{},{:e},{:e},{:.3e},{:.3e},{},{},{:.4}{extra}{error}\n",
-            r.value,
+            "{value},{},{},{},{:e},{:e},{:.3e},{:.3e},{},{},{:.4}{extra}{error}\n",
             r.counts.0,
             r.counts.1,
             r.counts.2,
@@ -492,7 +509,7 @@ mod tests {
             steps: 2,
         };
         let rows = sweep("pfm", &["mesh.n=24".into()], &spec, None, &mut |_| {}).unwrap();
-        let text = csv(&spec.param, &rows);
+        let text = csv(&spec.param, &rows, false);
         let lines: Vec<&str> = text.lines().collect();
         let header: Vec<&str> = lines[0].split(',').collect();
         for column in [
