@@ -538,6 +538,17 @@ mod tests {
 
     #[test]
     fn a_sweep_knows_an_integer_key_from_the_scene() {
+        // written as the integers they are set to
+        let spec = SweepSpec {
+            param: "mesh.n".into(),
+            from: 4.0,
+            to: 7.6,
+            steps: 2,
+        };
+        let rows = sweep("paper", &[], &spec, None, &mut |_| {}).unwrap();
+        let text = csv(&spec.param, &rows, true);
+        let first: Vec<&str> = text.lines().skip(1).map(|l| l.split(',').next().unwrap()).collect();
+        assert_eq!(first, ["4", "8"]);
         assert!(integer_key("paper", &[], "mesh.n", [8.0, 9.5]));
         assert!(!integer_key("paper", &[], "load.p", [-4.0, -2.0]));
         assert!(integer_key("cattaneo-mindlin-cycle", &[], "path.steps", [3.0, 7.0]));
