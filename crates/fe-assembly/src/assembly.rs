@@ -696,14 +696,7 @@ fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<Vec<u
 fn folded(mesh: &Mesh, c: usize) -> Option<f64> {
     let dim = mesh.dim;
     let x: Vec<[f64; 3]> = mesh.cell(c).iter().map(|&v| mesh.points[v]).collect();
-    let mut at: Vec<[f64; 4]> = (0..=dim)
-        .map(|i| std::array::from_fn(|k| if k == i { 1.0 } else { 0.0 }))
-        .collect();
-    at.extend(
-        crate::kernels::simplex_edges(dim)
-            .iter()
-            .map(|&[i, j]| std::array::from_fn(|k| if k == i || k == j { 0.5 } else { 0.0 })),
-    );
+    let mut at = crate::kernels::simplex_nodes(dim);
     // every point a curved cell is integrated at: the loads' and norms' rule, the assembly's
     at.extend_from_slice(crate::kernels::simplex_rule(dim, 2).1);
     at.extend_from_slice(crate::kernels::curved_rule(dim).1);

@@ -363,6 +363,16 @@ pub fn shape_values(dim: usize, order: usize, l: &[f64; 4]) -> [f64; MAX_NODES] 
     n
 }
 
+/// The barycentric coordinates of a second-order simplex's nodes: its `dim + 1` corners, then
+/// its edges' midpoints in [`simplex_edges`]' order.
+pub fn simplex_nodes(dim: usize) -> Vec<[f64; 4]> {
+    let corners = (0..=dim).map(|i| std::array::from_fn(|k| if k == i { 1.0 } else { 0.0 }));
+    let edges = simplex_edges(dim)
+        .iter()
+        .map(|&[i, j]| std::array::from_fn(|k| if k == i || k == j { 0.5 } else { 0.0 }));
+    corners.chain(edges).collect()
+}
+
 /// The edges of a simplex of dimension `dim` by its corners, in the order of a second-order
 /// simplex's edge nodes: a segment's one edge; a triangle's 0-1, 1-2, 2-0; a tetrahedron's
 /// 0-1, 1-2, 2-0, 0-3, 1-3, 2-3 (`mesh::CellKind::midside_edges` of the cells).
@@ -732,7 +742,7 @@ mod tests {
         let (w, p) = curved_rule(3);
         assert_eq!(w.len(), 14);
         assert!(w.iter().all(|&x| x > 0.0));
-        for e in 0..=5u32.pow(4) {
+        for e in 0..6u32.pow(4) {
             let k = [e % 6, e / 6 % 6, e / 36 % 6, e / 216 % 6];
             if k.iter().sum::<u32>() > 5 {
                 continue;

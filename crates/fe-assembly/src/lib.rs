@@ -55,7 +55,7 @@ pub use assembly::{Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field, Prescribed};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
 pub use held::{Held, Support, Unheld};
-pub use loads::{facet_measure, facet_point, Load, RhsParts};
+pub use loads::{facet_measure, FacetMap, Load, RhsParts};
 pub use material::{voigt, voigt_len, Coordinates, Crystal, Material, MaterialError};
 pub use recovery::{CellFields, ChargeFunctional};
 

@@ -71,33 +71,54 @@ fn check(what: &'static str, v: f64) -> Result<f64, AssemblyError> {
 
 /// Measure of a facet (segment length or triangle area).
 pub fn facet_measure(x: &[[f64; 3]]) -> f64 {
-    let d = |q: usize, k: usize| x[q][k] - x[0][k];
-    if x.len() == 2 {
-        (d(1, 0).powi(2) + d(1, 1).powi(2) + d(1, 2).powi(2)).sqrt()
-    } else {
-        let c = [
-            d(1, 1) * d(2, 2) - d(1, 2) * d(2, 1),
-            d(1, 2) * d(2, 0) - d(1, 0) * d(2, 2),
-            d(1, 0) * d(2, 1) - d(1, 1) * d(2, 0),
-        ];
-        0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
-    }
+    let d = x.len() - 1;
+    crate::mapping::measure_at(d, &crate::mapping::map_at(d, x, &[0.0; 4]).1)
 }
 
-/// The point of the facet `f` (its nodes: corners, then in a P2 mesh its edges' midpoints) at
-/// the barycentric coordinates `l`, and the measure a unit of reference weight stands for
-/// there: the facet's measure where it is straight-sided (its corners' map); on a curved P2
-/// facet its map's `√det(JᵀJ) / d!` ([`crate::mapping`]). Without a body of revolution's
-/// `2π r`.
-pub fn facet_point(mesh: &mesh::Mesh, f: &[usize], l: &[f64; 4]) -> ([f64; 3], f64) {
-    let d = mesh.dim - 1;
-    let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
-    if mesh::straight_sided(&x, d + 1, crate::kernels::simplex_edges(d)) {
-        let corners = &x[..=d];
-        (crate::mapping::map_at(d, corners, l).0, facet_measure(corners))
-    } else {
-        let (at, jac) = crate::mapping::map_at(d, &x, l);
-        (at, crate::mapping::measure_at(d, &jac))
+/// The map of a boundary facet (its nodes: corners, then in a P2 mesh its edges' midpoints):
+/// its corners' (affine) where it is straight-sided, through all its nodes on a curved P2
+/// facet ([`crate::mapping`]). Made once per facet, for the points of a rule on it.
+pub struct FacetMap {
+    /// The facet's dimension (the mesh's less one).
+    d: usize,
+    /// Its nodes' coordinates (`n` of them).
+    x: [[f64; 3]; 6],
+    n: usize,
+    /// A straight-sided facet's measure; `None` on a curved one.
+    straight: Option<f64>,
+}
+
+impl FacetMap {
+    /// The map of facet `f` of `mesh`.
+    pub fn of(mesh: &mesh::Mesh, f: &[usize]) -> Self {
+        let d = mesh.dim - 1;
+        let mut x = [[0.0; 3]; 6];
+        for (xa, &v) in x.iter_mut().zip(f) {
+            *xa = mesh.points[v];
+        }
+        let n = f.len().min(6);
+        let straight =
+            mesh::straight_sided(&x[..n], d + 1, crate::kernels::simplex_edges(d)).then(|| facet_measure(&x[..=d]));
+        FacetMap { d, x, n, straight }
+    }
+
+    /// Whether the facet is curved (a P2 facet with an edge node off its chord).
+    pub fn is_curved(&self) -> bool {
+        self.straight.is_none()
+    }
+
+    /// The point at the barycentric coordinates `l`, and the measure a unit of reference
+    /// weight stands for there: the facet's measure where it is straight-sided; on a curved P2
+    /// facet its map's `√det(JᵀJ) / d!`. Without a body of revolution's `2π r`.
+    pub fn at(&self, l: &[f64; 4]) -> ([f64; 3], f64) {
+        let d = self.d;
+        match self.straight {
+            Some(measure) => (crate::mapping::map_at(d, &self.x[..=d], l).0, measure),
+            None => {
+                let (at, jac) = crate::mapping::map_at(d, &self.x[..self.n], l);
+                (at, crate::mapping::measure_at(d, &jac))
+            }
+        }
     }
 }
 
@@ -190,8 +211,9 @@ impl Discretization<'_> {
                 }
                 Load::Traction { group, value } => {
                     for f in mesh.boundary(group)?.iter() {
+                        let map = FacetMap::of(mesh, f);
                         for ((w, p), n) in w_facet.iter().zip(p_facet).zip(&n_facet) {
-                            let (y, len) = facet_point(mesh, f, p);
+                            let (y, len) = map.at(p);
                             let t = value(&y[..dim]);
                             let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {
@@ -206,8 +228,9 @@ impl Discretization<'_> {
                 }
                 Load::SurfaceCharge { group, value } => {
                     for f in mesh.boundary(group)?.iter() {
+                        let map = FacetMap::of(mesh, f);
                         for ((w, p), n) in w_facet.iter().zip(p_facet).zip(&n_facet) {
-                            let (y, len) = facet_point(mesh, f, p);
+                            let (y, len) = map.at(p);
                             let qx = check("the surface charge", value(&y[..dim]))?;
                             let len = len * ring(&y);
                             for (a, &v) in f.iter().enumerate() {

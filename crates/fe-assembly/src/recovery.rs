@@ -2,7 +2,7 @@
 //! `D = e ε(u) - β ∇φ` (docs/theory.md's law; `E = -∇φ`), at each cell's centroid (constant on
 //! a P1 cell, linear on a P2 one) and, on P2 cells, at the nodes too.
 
-use crate::kernels::{gradient_at, simplex_edges, strain_at, CellRule, MAX_NODES};
+use crate::kernels::{gradient_at, simplex_nodes, strain_at, CellRule, MAX_NODES};
 use crate::Discretization;
 use crate::Material;
 use rayon::prelude::*;
@@ -87,16 +87,8 @@ impl Discretization<'_> {
     fn recover_at_nodes(&self, u: &[[f64; 3]], phi: &[f64]) -> NodeFields {
         let mesh = self.mesh;
         let (dim, nv, n) = (mesh.dim, self.nv(), mesh.n_nodes());
-        let corners = dim + 1;
         // each local node's barycentric coordinates: the corners, then the edges' midpoints
-        let mut bary = [[0.0; 4]; MAX_NODES];
-        for (a, b) in bary.iter_mut().enumerate().take(corners) {
-            b[a] = 1.0;
-        }
-        for (e, &[i, j]) in simplex_edges(dim).iter().enumerate() {
-            bary[corners + e][i] = 0.5;
-            bary[corners + e][j] = 0.5;
-        }
+        let bary = simplex_nodes(dim);
         let (offsets, node_cells) = mesh.node_cells();
         let mut out = NodeFields {
             stress: vec![0.0; n * nv],

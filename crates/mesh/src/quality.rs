@@ -158,10 +158,13 @@ impl Mesh {
     /// ([`straight_sided`]); none in a linear mesh.
     pub fn curved_cells(&self) -> Vec<bool> {
         let (corners, edges) = (self.kind.n_corners(), self.kind.midside_edges());
+        let mut x = [[0.0; 3]; 10];
         self.iter_cells()
             .map(|cell| {
-                let x: Vec<[f64; 3]> = cell.iter().map(|&v| self.points[v]).collect();
-                !straight_sided(&x, corners, edges)
+                for (xa, &v) in x.iter_mut().zip(cell) {
+                    *xa = self.points[v];
+                }
+                !straight_sided(&x[..cell.len()], corners, edges)
             })
             .collect()
     }

@@ -216,53 +216,51 @@ fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(
 /// `2π L (r_a / 6, r_b / 6, (r_a + r_b) / 3)` (the corners' share of the linear part of `r`
 /// vanishes: `∫ s (1 - s)(1 - 2s) ds = 0`), so a corner on the axis weighs nothing. A curved
 /// second-order facet (an edge node off its chord): by the loads' rule over its map
-/// ([`fe_assembly::facet_point`]).
+/// ([`fe_assembly::FacetMap`]).
 fn lumped_weights(mesh: &mesh::Mesh, group: &mesh::FacetGroup, coordinates: Coordinates) -> Vec<f64> {
     let mut weight = vec![0.0; mesh.n_nodes()];
-    let ring = coordinates == Coordinates::Axisymmetric;
-    let d = mesh.dim - 1;
     for f in group.iter() {
-        let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
-        let corners = &x[..mesh.dim.min(x.len())];
-        let len = facet_measure(corners);
-        let tau = std::f64::consts::TAU;
-        if !mesh::straight_sided(&x, d + 1, fe_assembly::kernels::simplex_edges(d)) {
-            // a curved second-order facet: ∫ N_a over its map, by the loads' rule
-            let (weights, points) = fe_assembly::kernels::simplex_rule(d, 2);
-            for (w, l) in weights.iter().zip(points) {
-                let (at, measure) = fe_assembly::facet_point(mesh, f, l);
-                let n = fe_assembly::kernels::shape_values(d, 2, l);
-                let ds = w * measure * if ring { tau * at[0] } else { 1.0 };
-                for (a, &v) in f.iter().enumerate() {
-                    weight[v] += ds * n[a];
-                }
-            }
-            continue;
+        for (&v, w) in f.iter().zip(facet_weights(mesh, f, coordinates)) {
+            weight[v] += w;
         }
-        match (f.len(), ring) {
-            (3, true) if mesh.dim == 2 => {
-                let (ra, rb) = (x[0][0], x[1][0]);
-                weight[f[0]] += tau * len * ra / 6.0;
-                weight[f[1]] += tau * len * rb / 6.0;
-                weight[f[2]] += tau * len * (ra + rb) / 3.0;
-            }
-            (3, false) if mesh.dim == 2 => {
-                weight[f[0]] += len / 6.0;
-                weight[f[1]] += len / 6.0;
-                weight[f[2]] += 2.0 * len / 3.0;
-            }
-            (_, true) => {
-                let (ra, rb) = (x[0][0], x[1][0]);
-                weight[f[0]] += tau * len * (2.0 * ra + rb) / 6.0;
-                weight[f[1]] += tau * len * (ra + 2.0 * rb) / 6.0;
-            }
-            (n, false) => {
-                let m = len / n as f64;
-                for &v in f {
-                    weight[v] += m;
-                }
+    }
+    weight
+}
+
+/// Facet `f`'s share of [`lumped_weights`]: `∫ N_a ds` over it of each of its nodes, in its
+/// order (at most six).
+fn facet_weights(mesh: &mesh::Mesh, f: &[usize], coordinates: Coordinates) -> [f64; 6] {
+    let ring = coordinates == Coordinates::Axisymmetric;
+    let tau = std::f64::consts::TAU;
+    let mut weight = [0.0; 6];
+    let map = fe_assembly::FacetMap::of(mesh, f);
+    if map.is_curved() {
+        // a curved second-order facet: ∫ N_a over its map, by the loads' rule
+        let d = mesh.dim - 1;
+        let (weights, points) = fe_assembly::kernels::simplex_rule(d, 2);
+        for (w, l) in weights.iter().zip(points) {
+            let (at, measure) = map.at(l);
+            let n = fe_assembly::kernels::shape_values(d, 2, l);
+            let ds = w * measure * if ring { tau * at[0] } else { 1.0 };
+            for (o, na) in weight.iter_mut().zip(n).take(f.len()) {
+                *o += ds * na;
             }
         }
+        return weight;
+    }
+    let x: Vec<[f64; 3]> = f.iter().map(|&v| mesh.points[v]).collect();
+    let len = facet_measure(&x[..mesh.dim.min(x.len())]);
+    match (f.len(), ring) {
+        (3, true) if mesh.dim == 2 => {
+            let (ra, rb) = (x[0][0], x[1][0]);
+            weight[..3].copy_from_slice(&[tau * len * ra / 6.0, tau * len * rb / 6.0, tau * len * (ra + rb) / 3.0]);
+        }
+        (3, false) if mesh.dim == 2 => weight[..3].copy_from_slice(&[len / 6.0, len / 6.0, 2.0 * len / 3.0]),
+        (_, true) => {
+            let (ra, rb) = (x[0][0], x[1][0]);
+            weight[..2].copy_from_slice(&[tau * len * (2.0 * ra + rb) / 6.0, tau * len * (ra + 2.0 * rb) / 6.0]);
+        }
+        (n, false) => weight[..n].fill(len / n as f64),
     }
     weight
 }
@@ -296,21 +294,17 @@ impl FaceBasis {
         let mut edge_corners = std::collections::HashMap::new();
         for f in group.iter() {
             // the facet's own ∫ N_a, each node's share of this facet alone
-            let single = mesh::FacetGroup {
-                nodes_per_facet: f.len(),
-                facets: f.to_vec(),
-            };
-            let n = lumped_weights(mesh, &single, coordinates);
+            let n = facet_weights(mesh, f, coordinates);
             for (e, &[a, b]) in edges.iter().enumerate() {
                 let m = f[corners + e];
-                let ne = n[m];
+                let ne = n[corners + e];
                 weight[f[a]] += alpha * ne;
                 weight[f[b]] += alpha * ne;
                 weight[m] += (1.0 - 2.0 * alpha) * ne;
                 edge_corners.insert(m, [f[a], f[b]]);
             }
-            for &c in &f[..corners] {
-                weight[c] += n[c];
+            for (&c, nc) in f[..corners].iter().zip(n) {
+                weight[c] += nc;
             }
         }
         FaceBasis { weight, edge_corners }

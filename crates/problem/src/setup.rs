@@ -195,13 +195,12 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     if !m.layers.is_empty() {
         layer(&mut mesh, m)?;
     }
+    // raised before the cylinder is rounded: at order 2 the edge nodes are rounded with the
+    // corners, onto the cylinder's face (curved cells that follow it, not its chords)
+    mesh = of_order(mesh, scene)?;
     if m.cylinder {
-        // at order 2 the edge nodes are rounded with the corners, onto the cylinder's face:
-        // curved cells that follow it, where rounding first would leave them on its chords
-        mesh = of_order(mesh, scene)?;
         mesh::round_quarter_section(&mut mesh);
     }
-    mesh = of_order(mesh, scene)?;
     let quality = mesh.check()?;
     let notes = MeshNotes {
         reoriented_cells: mesh.reoriented_cells,
