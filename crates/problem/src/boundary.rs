@@ -209,7 +209,8 @@ fn check_normal(mesh: &mesh::Mesh, spec: &ContactSpec, nv: [f64; 3]) -> Result<(
 }
 
 /// The boundary mass of each node on `group`, `∫ N_a ds` over its facets: with P1 each
-/// facet's measure shared equally among its nodes; on a body of revolution
+/// facet's measure shared equally among its nodes; a straight six-node triangle (3D, P2)
+/// gives its corners 0 and its edges a third each; on a body of revolution
 /// ([`Coordinates::Axisymmetric`]), the ring's, `∫ N_a 2π r ds = 2π L (2 r_a + r_b) / 6` for
 /// the segment of length L from node a to node b. A second-order segment (2D, its corners then
 /// its midpoint) gives Simpson's `L / 6, L / 6, 2 L / 3`, and on a body of revolution
@@ -260,6 +261,8 @@ fn facet_weights(mesh: &mesh::Mesh, f: &[usize], coordinates: Coordinates) -> [f
             let (ra, rb) = (x[0][0], x[1][0]);
             weight[..2].copy_from_slice(&[tau * len * (2.0 * ra + rb) / 6.0, tau * len * (ra + 2.0 * rb) / 6.0]);
         }
+        // a six-node triangle: its corners' ∫ N_c = 0, its edges' ∫ N_ij = A/3
+        (6, false) => weight[3..6].fill(len / 3.0),
         (n, false) => weight[..n].fill(len / n as f64),
     }
     weight
@@ -1387,6 +1390,26 @@ mod tests {
             assert_eq!(
                 basis.edge_corners.len(),
                 nodes.len() - p1.boundary("bottom").unwrap().nodes().len()
+            );
+        }
+        // in 3D the weights are ∫ Ñ: each straight six-node face of area A gives its corners
+        // 2A/15 and its edges A/5 (∫ N_c = 0, ∫ N_ij = A/3; Popp et al. 2012), not an equal share
+        let m = mesh::box_tet([0.0; 3], [2.0, 1.0, 1.0], 4, 2, 2).quadratic().unwrap();
+        let group = m.boundary("bottom").unwrap();
+        let basis = FaceBasis::of(&m, group, Coordinates::Cartesian);
+        let mut expected = vec![0.0; m.n_nodes()];
+        for f in group.iter() {
+            let area = facet_measure(&[m.points[f[0]], m.points[f[1]], m.points[f[2]]]);
+            for (k, &v) in f.iter().enumerate() {
+                expected[v] += area * if k < 3 { 2.0 / 15.0 } else { 0.2 };
+            }
+        }
+        for v in group.nodes() {
+            assert!(
+                (basis.weight[v] - expected[v]).abs() < 1e-14,
+                "node {v}: {} against {}",
+                basis.weight[v],
+                expected[v]
             );
         }
         // a 2D face in plane strain keeps its own (Simpson's) weights
