@@ -1,16 +1,21 @@
-//! Runs under a memory limit (issue 20, class 5): under an address-space limit (`ulimit -v`),
-//! runs of every size either finish or stop with the typed refusal that names the limit,
-//! never killed by a signal at an allocation.
+//! Runs under a memory limit (issue 20, class 5): under an address-space limit (`ulimit -v`)
+//! or a data-size limit (`ulimit -d`), runs of every size either finish or stop with the typed
+//! refusal that names the limit, never killed by a signal at an allocation.
 
 use std::process::Command;
 
 /// Runs `piezocontact ARGS` under `ulimit -v KIB`; `(exit code, stderr)`, the code `None` where
 /// a signal ended it.
 fn under_limit(kib: u64, args: &str) -> (Option<i32>, String) {
+    under("-v", kib, args)
+}
+
+/// Runs `piezocontact ARGS` under `ulimit FLAG KIB`; as [`under_limit`].
+fn under(flag: &str, kib: u64, args: &str) -> (Option<i32>, String) {
     let exe = env!("CARGO_BIN_EXE_piezocontact");
     let o = Command::new("sh")
         .arg("-c")
-        .arg(format!("ulimit -v {kib} && exec '{exe}' {args}"))
+        .arg(format!("ulimit {flag} {kib} && exec '{exe}' {args}"))
         .output()
         .expect("sh runs");
     (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
@@ -44,6 +49,32 @@ fn under_an_address_space_limit_runs_finish_or_are_refused_by_name() {
             Some(0) => {}
             Some(1) => assert!(stderr.contains("the run needs about"), "{scene} {n}: {stderr}"),
             other => panic!("{scene} {n}: ended by {other:?} (a signal?): {stderr}"),
+        }
+    }
+}
+
+/// Under a data-size limit the dense products' scratch counts too (a run of `paper` at n = 256
+/// under `ulimit -d 1500000` aborted at its 960 MiB allocation, exit 134): each run finishes or
+/// is refused by the estimate, whatever the limit.
+#[test]
+fn under_a_data_size_limit_runs_finish_or_are_refused_by_name() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    for kib in [1_500_000, 3_000_000, 6_000_000] {
+        for (scene, n) in [("paper", 96), ("paper", 256), ("paper-3d", 10), ("paper-3d", 18)] {
+            let (code, stderr) = under(
+                "-d",
+                kib,
+                &format!("run {scene} --set mesh.n={n} --out {}", out.display()),
+            );
+            match code {
+                Some(0) => {}
+                Some(1) => assert!(
+                    stderr.contains("the run needs about") && stderr.contains("ulimit -d"),
+                    "{scene} {n} under {kib} KiB: {stderr}"
+                ),
+                other => panic!("{scene} {n} under {kib} KiB: ended by {other:?} (a signal?): {stderr}"),
+            }
         }
     }
 }

@@ -51,11 +51,17 @@ fn l3_bytes() -> u64 {
         .unwrap_or(0)
 }
 
-/// Address space the solver's threads reserve whatever the run needs: faer's dense products
-/// (private-gemm) keep a scratch of twice the L3 cache per thread, reserved and touched only
-/// as used (520 MiB a thread here, with a 260 MiB L3), and glibc's heaps (arenas).
+/// The scratch of faer's dense products (private-gemm): twice the L3 cache per thread,
+/// allocated whole by a thread's first large product and touched only as used (960 MiB a
+/// thread with a 480 MiB L3, measured: the allocation that aborted a run under `ulimit -d`).
+fn dense_scratch() -> u64 {
+    threads() * 2 * l3_bytes()
+}
+
+/// Address space the solver's threads reserve whatever the run needs: the dense products'
+/// scratch ([`dense_scratch`]) and glibc's heaps (arenas).
 fn thread_reserve() -> u64 {
-    threads() * 2 * l3_bytes() + thread_heaps()
+    dense_scratch() + thread_heaps()
 }
 
 /// Under an address-space limit (`ulimit -v`), the program runs again with `MALLOC_ARENA_MAX=2`
@@ -93,14 +99,22 @@ pub fn peak_bytes() -> u64 {
 
 /// The memory this process may still take, `None` where nothing is known (not Linux).
 pub fn available() -> Option<Available> {
+    available_to_one_of(1)
+}
+
+/// The memory this process may still take as one of `processes` alike (the ranks of an MPI
+/// run on one machine): the machine's available memory and the cgroup's shared among them,
+/// the process's own limits (`ulimit -v`, `ulimit -d`) its own; `None` where nothing is known.
+pub fn available_to_one_of(processes: u64) -> Option<Available> {
     let mut candidates: Vec<Available> = vec![];
     let mut add = |bytes: Option<u64>, limit: &'static str| {
         if let Some(bytes) = bytes {
             candidates.push(Available { bytes, limit });
         }
     };
+    let share = |bytes: u64| bytes / processes.max(1);
     add(
-        meminfo_kib("MemAvailable:").map(|kb| kb * 1024),
+        meminfo_kib("MemAvailable:").map(|kb| share(kb * 1024)),
         "the machine's available memory",
     );
     // the address space counts what is mapped (thread stacks and malloc's arenas too), the
@@ -111,11 +125,13 @@ pub fn available() -> Option<Available> {
             .map(|l| l.saturating_sub(status_kib("VmSize:").unwrap_or(0) * 1024 + thread_reserve())),
         "the address-space limit (ulimit -v), less what the solver's threads reserve of it",
     );
+    // (the dense products' scratch, allocated whole by each thread's first large product,
+    // counts in the data limit too: an allocation past it aborts the process)
     add(
-        rlimit("Max data size").map(|l| l.saturating_sub(status_kib("VmData:").unwrap_or(0) * 1024)),
-        "the data-size limit (ulimit -d)",
+        rlimit("Max data size").map(|l| l.saturating_sub(status_kib("VmData:").unwrap_or(0) * 1024 + dense_scratch())),
+        "the data-size limit (ulimit -d), less the dense products' scratch of the solver's threads",
     );
-    add(cgroup_left(), "the memory cgroup's limit");
+    add(cgroup_left().map(share), "the memory cgroup's limit");
     candidates.into_iter().min_by_key(|a| a.bytes)
 }
 

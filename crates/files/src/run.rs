@@ -14,11 +14,12 @@ pub fn peak_memory_bytes() -> u64 {
     crate::memory::peak_bytes()
 }
 
-/// The memory limits of a run in this process: what [`crate::memory::available`] finds,
-/// shared among `ranks` processes of one machine.
+/// The memory limits of a run in this process as one of `ranks` processes of one machine:
+/// what [`crate::memory::available_to_one_of`] finds (the machine's memory shared, a
+/// process's own limits its own).
 pub fn memory_limits(ranks: u64) -> (Option<u64>, Option<&'static str>) {
-    match crate::memory::available() {
-        Some(a) => (Some(a.bytes / ranks.max(1)), Some(a.limit)),
+    match crate::memory::available_to_one_of(ranks) {
+        Some(a) => (Some(a.bytes), Some(a.limit)),
         None => (None, None),
     }
 }
