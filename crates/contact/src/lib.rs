@@ -64,7 +64,7 @@ pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
 pub use newton::{solve_newton, solve_newton_cached, solve_newton_electric, NewtonCache, NewtonParams};
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};
 pub use points::{ContactPoints, Foundation, PointValues, Status};
-pub use projection::{project_cone, project_disc, project_nonnegative};
+pub use projection::{disc_piece, project_cone, project_disc, project_nonnegative, DiscPiece};
 pub use schedule::{Phase, ProblemClass, Schedule};
 pub use solution::{
     classify, complementarity_residual, coulomb_radius, desaxce_residual, multiplier_scale, slip_bound, ContactInfo,

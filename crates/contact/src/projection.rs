@@ -46,6 +46,48 @@ pub fn project_disc(x: &mut [f64], radius: f64) {
     }
 }
 
+/// The piece of the friction disc's projection `P_S(q)` (radius `S`, [`project_disc`]) on
+/// which `q` lies, with what its value and derivative need there: every semismooth Newton
+/// method on the natural map picks a point's tangential branch by it (the condensed Newton's
+/// generalised Jacobian, the PETSc backend's active sets).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DiscPiece {
+    /// `S ≤ 0` (or not a number): `P_S(q) = 0`, derivative 0 (no friction there, or the
+    /// point out of contact).
+    Zero,
+    /// `|q| ≤ S`: `P_S(q) = q`, derivative the identity (stick).
+    Inside,
+    /// `|q| > S`: `P_S(q) = S d` with `d = q / |q|`, derivative `κ (I - d dᵀ)` in `q` (and
+    /// `d` in `S`), `κ = S / |q| < 1` (slip).
+    Boundary {
+        /// `κ = S / |q|`.
+        ratio: f64,
+        /// `d = q / |q|` (its first `q.len()` components).
+        direction: [f64; 2],
+    },
+}
+
+/// Which piece of the friction disc's projection of radius `radius` `q` (one or two
+/// tangential components) lies on ([`DiscPiece`]).
+#[inline]
+pub fn disc_piece(q: &[f64], radius: f64) -> DiscPiece {
+    if !(radius > 0.0) {
+        return DiscPiece::Zero;
+    }
+    let qn = norm(q);
+    if qn <= radius {
+        return DiscPiece::Inside;
+    }
+    let mut direction = [0.0; 2];
+    for (d, &x) in direction.iter_mut().zip(q) {
+        *d = x / qn;
+    }
+    DiscPiece::Boundary {
+        ratio: radius / qn,
+        direction,
+    }
+}
+
 /// Projection onto Coulomb's cone `K = {(x_n, x_t): |x_t| ≤ μ x_n}` (Siconos' and De Saxcé's
 /// convention: `x[0]` the normal component, `x[1..]` the tangential ones): `x` itself inside
 /// `K`, `0` in the polar cone `{μ |x_t| ≤ -x_n}`, else the point of the cone's boundary
@@ -95,5 +137,34 @@ mod tests {
         let mut c = [1.0, 3.0];
         project_cone(&mut c, 0.0);
         assert_eq!(c, [1.0, 0.0]);
+    }
+
+    /// The pieces agree with the projection: its value `q`, `0` or `S d`, on each.
+    #[test]
+    fn the_discs_pieces_agree_with_its_projection() {
+        for (q, radius) in [
+            (vec![3.0, 4.0], 1.0),
+            (vec![0.3, 0.4], 1.0),
+            (vec![-2.0], 0.5),
+            (vec![0.1, 0.2], 0.0),
+            (vec![1e-300, 1e-300], 1e-301),
+        ] {
+            let mut projected = q.clone();
+            project_disc(&mut projected, radius);
+            let value: Vec<f64> = match disc_piece(&q, radius) {
+                DiscPiece::Zero => vec![0.0; q.len()],
+                DiscPiece::Inside => q.clone(),
+                DiscPiece::Boundary { ratio, direction } => {
+                    assert!(ratio < 1.0, "{q:?} {radius}");
+                    direction[..q.len()].iter().map(|d| radius * d).collect()
+                }
+            };
+            for (a, b) in value.iter().zip(&projected) {
+                assert!(
+                    (a - b).abs() <= 1e-15 * b.abs().max(1e-300),
+                    "{q:?} {radius}: {value:?} vs {projected:?}"
+                );
+            }
+        }
     }
 }

@@ -10,6 +10,7 @@
 use crate::electric::ElectricContact;
 use crate::operator::Compliance;
 use crate::points::{ContactPoints, Foundation, PointValues};
+use crate::projection::DiscPiece;
 use crate::Law;
 
 /// One row of the generalised Jacobian, `J_r = E_r + B_r C`: `(index, coefficient)` pairs.
@@ -50,14 +51,6 @@ pub(super) fn pattern(rows: &[RowForm]) -> u64 {
 /// The floor of the electric residual's denominator, relative to the ideal conductor's flux
 /// scale ([`Flat::electric_residual`]).
 const ELECTRIC_FLOOR: f64 = 1e-6;
-
-/// The branch of a point's tangential equations at `z`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Branch {
-    Separated,
-    Stick,
-    Slip,
-}
 
 /// An affine contact problem in the flat layout.
 #[derive(Clone)]
@@ -470,7 +463,6 @@ impl<'a> Flat<'a> {
             held_out[..nt].copy_from_slice(&s.z[t..t + nt]);
             self.points.hold(i, &mut held_out[..nt]);
             let q = &held_out[..nt];
-            let qn = crate::projection::norm(q);
             let radius = self.radius(i, &s.z, &s.x, &s.u);
             // slip weakening: the coefficient at the point's slip, and its slope there
             // (at what it slipped before the problem and its slip in it)
@@ -480,13 +472,7 @@ impl<'a> Flat<'a> {
                 Some(w) => (w.coefficient(total), w.slope(total)),
                 None => (self.points.friction[i], 0.0),
             };
-            let branch = if !(radius > 0.0) {
-                Branch::Separated
-            } else if qn <= radius {
-                Branch::Stick
-            } else {
-                Branch::Slip
-            };
+            let piece = crate::projection::disc_piece(q, radius);
             for k in 0..nt {
                 let row = &mut rows[t + k];
                 if self.points.is_held(i, k) {
@@ -494,15 +480,14 @@ impl<'a> Flat<'a> {
                     row.e.push((t + k, 1.0));
                     continue;
                 }
-                match branch {
+                match piece {
                     // λ_t - z_t: derivative C
-                    Branch::Stick => row.b.push((t + k, 1.0)),
+                    DiscPiece::Inside => row.b.push((t + k, 1.0)),
                     // λ_t - P_0(z_t) = λ_t (a zero radius): the identity
-                    Branch::Separated => row.e.push((t + k, 1.0)),
-                    Branch::Slip => {
+                    DiscPiece::Zero => row.e.push((t + k, 1.0)),
+                    DiscPiece::Boundary { ratio, direction: d } => {
                         // λ_t - S q/|q|: derivative I - (S/|q|)(I - q̂q̂ᵀ) M_t - q̂ dS, with
-                        // dS = F M_n for Coulomb at a contact point
-                        let ratio = radius / qn;
+                        // dS = F M_n for Coulomb at a contact point (q̂ = d, S/|q| = ratio)
                         let rigid = self.points.foundation_of(i) == Foundation::Rigid;
                         // the normal value the radius is taken at, in contact where positive
                         let normal = crate::project_nonnegative(self.radius_normal(i, &s.z, &s.x));
@@ -512,7 +497,7 @@ impl<'a> Flat<'a> {
                         };
                         row.e.push((t + k, 1.0));
                         for l in (0..nt).filter(|&l| !self.points.is_held(i, l)) {
-                            let proj = if k == l { 1.0 } else { 0.0 } - (q[k] / qn) * (q[l] / qn);
+                            let proj = if k == l { 1.0 } else { 0.0 } - d[k] * d[l];
                             if proj != 0.0 {
                                 row.e.push((t + l, -ratio * proj));
                                 row.b.push((t + l, ratio * proj));
@@ -521,16 +506,16 @@ impl<'a> Flat<'a> {
                         if slope > 0.0 {
                             // dS = F M_n = F (I - C)_n on a rigid foundation (S = F [z_n]₊),
                             // F e_n on a compliant one (S = F λ_n)
-                            row.e.push((i, -q[k] / qn * slope));
+                            row.e.push((i, -d[k] * slope));
                             if rigid {
-                                row.b.push((i, q[k] / qn * slope));
+                                row.b.push((i, d[k] * slope));
                             }
                         }
                         // slip weakening: dS ∋ [n]₊ μ'(s) û_t · du_t, with du = -(C δ) / c
                         if weakens != 0.0 && slip > 0.0 && normal > 0.0 {
                             for l in (0..nt).filter(|&l| !self.points.is_held(i, l)) {
                                 let u_hat = s.u[t + l] / slip;
-                                let v = q[k] / qn * normal * weakens * u_hat / self.c[t + l];
+                                let v = d[k] * normal * weakens * u_hat / self.c[t + l];
                                 if v != 0.0 {
                                     row.b.push((t + l, v));
                                 }
