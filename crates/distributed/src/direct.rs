@@ -57,7 +57,8 @@ impl Entries {
 impl<'p> Direct<'p> {
     /// Factors `K` of `disc`, this rank's cells those `layout` gives it, with the entries
     /// `extra` (both triangles, in the free displacements' numbering: a compliant bed's
-    /// springs) added once, and the Schur complement of `chosen` (empty: none). Collective.
+    /// springs) added once, and the Schur complement of `chosen` (empty: none), within the
+    /// `memory` a rank may use (MUMPS' estimate checked after its analysis). Collective.
     ///
     /// # Errors
     /// MUMPS' (a singular `K` among them).
@@ -67,6 +68,7 @@ impl<'p> Direct<'p> {
         layout: &Layout,
         extra: &[(usize, usize, f64)],
         chosen: Vec<usize>,
+        memory: Option<u64>,
     ) -> Result<Self, PetscError> {
         let t = std::time::Instant::now();
         let (n_u, n_phi) = (disc.dofs.n_u, disc.dofs.n_phi);
@@ -94,6 +96,7 @@ impl<'p> Direct<'p> {
             symmetry,
             &chosen,
             Some(&order),
+            memory,
         )?;
         let k = chosen.len();
         let mut inverse = vec![0.0; k * k];

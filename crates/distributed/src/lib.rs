@@ -34,7 +34,7 @@
 
 mod supports;
 
-pub use supports::{active_sets_hold, direct as factors_directly, supports};
+pub use supports::{active_sets_hold, active_sets_hold_on, direct as factors_directly, supports};
 
 #[cfg(feature = "petsc")]
 mod active;
@@ -66,4 +66,4 @@ pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS};
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
-pub use run::{solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared};
+pub use run::{solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared, ACTIVE_SETS_FROM};

@@ -16,7 +16,7 @@ use problem::backend::{
     At, Backend, Contact, ContactBoundary, ContactSolve, Fields, Figures, InstantOf, InstantSolution, Posed, Primed,
     Unsupported,
 };
-use problem::{Event, Factorization, Instants, PetscReport, ProblemError, Reporter, Scene, Solution, Step};
+use problem::{Bytes, Event, Factorization, Instants, PetscReport, ProblemError, Reporter, Scene, Solution, Step};
 
 /// Solves `scene` on the ranks of `petsc`. Every rank calls it (it is collective); rank 0
 /// returns the [`Solution`], as [`problem::solve`] gives it, the others `None`. `mesh` is the
@@ -75,11 +75,21 @@ pub fn solve_with(
     Ok(solution.filter(|_| petsc.rank() == 0))
 }
 
+/// The unknowns of a 3D body from which a run with contact that the active sets hold takes
+/// them rather than MUMPS' condensed route: measured on `paper-3d` on 2 ranks (one session,
+/// run.json's totals; docs/performance.md), the active sets 1.96 / 7.5 / 18.3 s against MUMPS'
+/// 1.80 / 12.3 / 61.7 s at 38,148 / 117,500 / 283,140 unknowns (n = 16, 24, 32): the crossover
+/// near 50,000, the factorisation's cost growing as the square of the unknowns in 3D, the
+/// Krylov solves' as their first power.
+pub const ACTIVE_SETS_FROM: f64 = 5.0e4;
+
 /// How a run with contact solves it on the ranks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ContactRoute {
-    /// MUMPS' condensed route where its factorisation fits the memory of a rank, else the
-    /// Krylov route's active sets where they hold the scene.
+    /// The Krylov route's active sets where they hold the run and either MUMPS' factorisation
+    /// would not fit the memory of a rank or the body is 3D with at least
+    /// [`ACTIVE_SETS_FROM`] unknowns (where they are the faster); MUMPS' condensed route
+    /// otherwise.
     #[default]
     Auto,
     /// MUMPS' condensed route (every law).
@@ -101,15 +111,18 @@ pub struct DistributedMemory<'p> {
     pub contact: ContactRoute,
 }
 
-impl DistributedMemory<'_> {
+impl<'p> DistributedMemory<'p> {
     /// Whether a run of `scene` factors `K` by MUMPS ([`crate::factors_directly`]), unless the
     /// factorisation's estimate per rank exceeds the memory each rank may use and the Krylov
     /// route's active sets hold the scene ([`crate::active_sets_hold`]).
-    fn direct_route(&self, scene: &Scene) -> bool {
-        let held = || crate::active_sets_hold(scene).is_ok();
+    ///
+    /// The size is told from `mesh` (with whether the body has potentials) once it is made or
+    /// read, before from the scene (a generated mesh; a Gmsh file's size is not known then).
+    fn direct_route(&self, scene: &Scene, mesh: Option<(&mesh::Mesh, bool)>) -> bool {
+        let held = || crate::active_sets_hold_on(scene, mesh.map(|(m, _)| m)).is_ok();
         crate::factors_directly(scene)
             && match self.contact {
-                ContactRoute::Auto => !(self.direct_too_large(scene) && held()),
+                ContactRoute::Auto => !(self.direct_too_large(scene, mesh) && held()),
                 ContactRoute::Condensed => true,
                 ContactRoute::ActiveSets => !held(),
             }
@@ -117,18 +130,107 @@ impl DistributedMemory<'_> {
 
     /// Whether MUMPS' factorisation, estimated as the default backend's run shared among the
     /// ranks, exceeds the memory of a rank.
-    fn direct_too_large(&self, scene: &Scene) -> bool {
-        match (self.limits.memory_bytes, direct_estimate(scene, self.petsc.size())) {
+    fn direct_too_large(&self, scene: &Scene, mesh: Option<(&mesh::Mesh, bool)>) -> bool {
+        match (
+            self.limits.memory_bytes,
+            direct_estimate(scene, mesh, self.petsc.size()),
+        ) {
             (Some(limit), Some((bytes, _))) => bytes > limit as f64,
             _ => false,
         }
     }
+
+    /// Whether a run that MUMPS would factor takes the Krylov route's active sets for speed:
+    /// a run on its own (the route not asked for) of a 3D body of at least
+    /// [`ACTIVE_SETS_FROM`] unknowns, whose contact they hold (no tangent of a contact point
+    /// held by a Dirichlet condition among it).
+    fn prefers_active_sets(&self, posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> bool {
+        let unknowns = posed.disc.dofs.n_u + posed.disc.dofs.n_phi;
+        self.contact == ContactRoute::Auto
+            && posed.setup.mesh.dim == 3
+            && unknowns as f64 >= ACTIVE_SETS_FROM
+            && crate::factors_directly(&posed.scene)
+            && crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).is_ok()
+            && boundary.is_some_and(|b| b.first_held_tangent().is_none())
+    }
+
+    /// Whether the Krylov route's active sets hold the run of `posed` and their estimate fits
+    /// a rank's memory in `limits`.
+    fn active_sets_fit(&self, posed: &Posed<'_>, limits: problem::Limits) -> bool {
+        let estimate = per_rank_estimate(&posed.scene, Some(on_mesh(posed)), self.petsc.size());
+        crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).is_ok()
+            && match (limits.memory_bytes, estimate) {
+                (Some(limit), Some((bytes, _))) => bytes <= limit as f64,
+                _ => true,
+            }
+    }
+
+    /// Why a run with contact that MUMPS would factor takes the active sets, in words.
+    fn why_active_sets(&self, posed: &Posed<'_>) -> String {
+        let estimate = direct_estimate(&posed.scene, Some(on_mesh(posed)), self.petsc.size());
+        match (self.contact, self.limits.memory_bytes, estimate) {
+            (ContactRoute::Auto, Some(limit), Some((bytes, what))) => format!(
+                "MUMPS' factorisation would need about {} a rank ({what}), more than the {} a rank may use",
+                Bytes(bytes),
+                Bytes(limit as f64)
+            ),
+            _ => "asked for".to_string(),
+        }
+    }
+
+    /// MUMPS' factorisation of `K` of `posed` on the ranks, with the Schur complement of the
+    /// contact dofs of `boundary` where the plan condenses, within the memory of `limits`; and
+    /// its description. Collective.
+    fn factor(
+        &self,
+        posed: &Posed<'_>,
+        layout: &Layout,
+        boundary: Option<&ContactBoundary>,
+        limits: problem::Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(Direct<'p>, String), DistributedError> {
+        let chosen = match boundary {
+            Some(cb) if posed.plan().linear_strategy.is_condensed() => cb.condensed_dofs(),
+            _ => vec![],
+        };
+        let springs = match (posed.bed, boundary) {
+            (Some(bed), Some(cb)) => cb.normal_springs(bed.stiffness),
+            _ => vec![],
+        };
+        // every rank holds the dense contact problem whole (its contact solve is each rank's
+        // own): MUMPS has what it leaves
+        let dense = match boundary {
+            Some(cb) if !chosen.is_empty() => cb.dense_bytes(posed.plan().n_tangential()),
+            _ => 0.0,
+        };
+        let memory = limits
+            .memory_bytes
+            .map(|m| (m as f64 - dense - problem::BASE_BYTES).max(0.0) as u64);
+        let k = chosen.len();
+        let direct = Direct::new(self.petsc, posed.disc, layout, &springs, chosen, memory)?;
+        reporter.event(&Event::Factored {
+            seconds: direct.seconds,
+        });
+        let options = format!(
+            "MUMPS (L D Lᵀ on {} ranks, its own C interface; the default backend's nested dissection), the Schur complement of {k} contact dofs; {:.3e} flops, {:.3e} bytes of factors",
+            self.petsc.size(),
+            direct.factor_flops(),
+            direct.factor_bytes()
+        );
+        Ok((direct, options))
+    }
 }
 
 /// The default backend's estimate of its run's peak (the factor, the dense compliance) shared
-/// among `ranks`: MUMPS' factorisation on them.
-fn direct_estimate(scene: &Scene, ranks: usize) -> Option<(f64, String)> {
-    let (bytes, what) = Backend::estimate(&problem::SharedMemory, scene)?;
+/// among `ranks`: MUMPS' factorisation on them; on `mesh` where it is known, the larger of the
+/// scene's and the mesh's.
+fn direct_estimate(scene: &Scene, mesh: Option<(&mesh::Mesh, bool)>, ranks: usize) -> Option<(f64, String)> {
+    let shared = problem::SharedMemory;
+    let on_mesh = mesh.and_then(|(mesh, electric)| shared.estimate_on_mesh(scene, mesh, electric));
+    let (bytes, what) = [Backend::estimate(&shared, scene), on_mesh]
+        .into_iter()
+        .flatten()
+        .max_by(|a, b| a.0.total_cmp(&b.0))?;
     Some((
         bytes / ranks.max(1) as f64,
         format!("on each of {ranks} ranks, its share of MUMPS' factorisation: {what}"),
@@ -194,15 +296,23 @@ impl<'p> Backend for DistributedMemory<'p> {
     }
 
     fn estimate(&self, scene: &Scene) -> Option<(f64, String)> {
-        match self.direct_route(scene) {
-            true => direct_estimate(scene, self.petsc.size()),
-            false => per_rank_estimate(scene, self.petsc.size()),
+        match self.direct_route(scene, None) {
+            true => direct_estimate(scene, None, self.petsc.size()),
+            false => per_rank_estimate(scene, None, self.petsc.size()),
+        }
+    }
+
+    fn estimate_on_mesh(&self, scene: &Scene, mesh: &mesh::Mesh, electric: bool) -> Option<(f64, String)> {
+        let mesh = Some((mesh, electric));
+        match self.direct_route(scene, mesh) {
+            true => direct_estimate(scene, mesh, self.petsc.size()),
+            false => per_rank_estimate(scene, mesh, self.petsc.size()),
         }
     }
 
     fn assemble(&mut self, posed: &Posed<'_>) -> Result<Assembled<'p>, DistributedError> {
         let layout = Layout::new(self.petsc, &posed.setup.mesh, &posed.disc.dofs)?;
-        let system = match self.direct_route(&posed.scene) {
+        let system = match self.direct_route(&posed.scene, Some(on_mesh(posed))) {
             true => None,
             false => Some(assemble(
                 self.petsc,
@@ -220,48 +330,59 @@ impl<'p> Backend for DistributedMemory<'p> {
         posed: &Posed<'_>,
         Assembled { layout, system }: Assembled<'p>,
         boundary: Option<&ContactBoundary>,
-        _: problem::Limits,
+        limits: problem::Limits,
         reporter: &mut dyn Reporter,
     ) -> Result<Prepared<'p>, DistributedError> {
-        let (route, options) = match system {
-            None => {
-                let chosen = match boundary {
-                    Some(cb) if posed.plan().linear_strategy.is_condensed() => cb.condensed_dofs(),
-                    _ => vec![],
-                };
-                let springs = match (posed.bed, boundary) {
-                    (Some(bed), Some(cb)) => cb.normal_springs(bed.stiffness),
-                    _ => vec![],
-                };
-                let k = chosen.len();
-                let direct = Direct::new(self.petsc, posed.disc, &layout, &springs, chosen)?;
-                reporter.event(&Event::Factored {
-                    seconds: direct.seconds,
-                });
-                let options = format!(
-                    "MUMPS (L D Lᵀ on {} ranks, its own C interface; the default backend's nested dissection), the Schur complement of {k} contact dofs; {:.3e} flops, {:.3e} bytes of factors",
-                    self.petsc.size(),
-                    direct.factor_flops(),
-                    direct.factor_bytes()
-                );
-                (Route::Direct(Box::new(direct)), options)
+        let mut why_krylov = None;
+        let system = match system {
+            Some(system) => system,
+            None if self.prefers_active_sets(posed, boundary) => {
+                why_krylov = Some(format!(
+                    "a 3D body of {:.3e} unknowns, at least {ACTIVE_SETS_FROM:.1e}, where the active sets' Krylov solves are faster than MUMPS' factorisation (docs/performance.md)",
+                    posed.disc.dofs.n_u + posed.disc.dofs.n_phi
+                ));
+                assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?
             }
-            Some(system) => {
-                let contact = boundary.is_some();
-                let options = configure(self.petsc, &posed.scene, &layout, contact.then_some(posed.plan().tol))?;
-                // (the paper's Uzawa on this route takes the same tolerance: its multipliers are
-                // updated from the solves' displacements)
-                let fields = KrylovFields::new(self.petsc, posed.setup, &layout);
-                let krylov = Krylov::new(self.petsc, posed.disc, &layout, system, fields);
-                (Route::Krylov(Box::new(krylov)), options)
-            }
+            None => match self.factor(posed, &layout, boundary, limits, reporter) {
+                Ok((direct, options)) => {
+                    return Ok(Prepared {
+                        route: Route::Direct(Box::new(direct)),
+                        active: None,
+                        instants: Instants::default(),
+                        layout,
+                        options,
+                    })
+                }
+                // MUMPS' own estimate, after its analysis, exceeds a rank's memory (the
+                // estimate before the mesh is a lower one), or its allocation failed (what the
+                // run took since its start is not in the limits): the Krylov route's active
+                // sets where they hold the run
+                Err(DistributedError::Petsc(
+                    e @ (PetscError::MumpsTooLarge { .. } | PetscError::Mumps { info: -13, .. }),
+                )) if self.contact == ContactRoute::Auto && self.active_sets_fit(posed, limits) => {
+                    why_krylov = Some(e.to_string());
+                    assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?
+                }
+                Err(e) => return Err(e),
+            },
         };
+        let contact = boundary.is_some();
+        let mut options = configure(self.petsc, &posed.scene, &layout, contact.then_some(posed.plan().tol))?;
         // the active sets where the run's contact would have factored by MUMPS; on the Krylov
         // route otherwise (the paper's Uzawa) the instants' full solves
-        let active = (boundary.is_some() && crate::factors_directly(&posed.scene) && !self.direct_route(&posed.scene))
-            .then(ActiveSets::default);
+        let active = (contact && crate::factors_directly(&posed.scene)).then(ActiveSets::default);
+        if active.is_some() {
+            // a route asked for by the library on a mesh whose order only its file told
+            crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).map_err(ProblemError::from)?;
+            let why = why_krylov.unwrap_or_else(|| self.why_active_sets(posed));
+            options = format!("{why}: the Krylov route's active sets; {options}");
+        }
+        // (the paper's Uzawa on this route takes the same tolerance: its multipliers are
+        // updated from the solves' displacements)
+        let fields = KrylovFields::new(self.petsc, posed.setup, &layout);
+        let krylov = Krylov::new(self.petsc, posed.disc, &layout, system, fields);
         Ok(Prepared {
-            route,
+            route: Route::Krylov(Box::new(krylov)),
             active,
             instants: Instants::default(),
             layout,
@@ -410,10 +531,22 @@ const BYTES_PER_UNKNOWN: f64 = 5.0e3;
 /// and dof map are built whole on each rank: 100 MB for 393k cells measured, taken low).
 const BYTES_PER_CELL: f64 = 200.0;
 
-/// The estimate of each rank's peak memory in a run of the PETSc backend on `ranks` ranks, in
-/// bytes, with what it counts; `None` for a Gmsh mesh.
-fn per_rank_estimate(scene: &Scene, ranks: usize) -> Option<(f64, String)> {
-    let (_, _, cells, unknowns) = problem::backend::generated_sizes(scene)?;
+/// The mesh of a posed run, and whether its body has potentials.
+fn on_mesh<'a>(posed: &'a Posed<'_>) -> (&'a mesh::Mesh, bool) {
+    (&posed.setup.mesh, posed.plan().electric)
+}
+
+/// The estimate of each rank's peak memory in a run of the Krylov route on `ranks` ranks, in
+/// bytes, with what it counts: on `mesh` where it is known (with whether the body has
+/// potentials), else on the scene's generated mesh (`None` for a Gmsh file not yet read).
+fn per_rank_estimate(scene: &Scene, mesh: Option<(&mesh::Mesh, bool)>, ranks: usize) -> Option<(f64, String)> {
+    let (cells, unknowns) = match mesh {
+        Some((mesh, electric)) => (
+            mesh.n_cells() as f64,
+            (mesh.n_nodes() * (mesh.dim + usize::from(electric))) as f64,
+        ),
+        None => problem::backend::generated_sizes(scene).map(|(_, _, cells, unknowns)| (cells, unknowns))?,
+    };
     let share = unknowns / ranks.max(1) as f64;
     let bytes = BYTES_PER_UNKNOWN * share + BYTES_PER_CELL * cells;
     Some((

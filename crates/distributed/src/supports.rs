@@ -7,10 +7,11 @@
 //! strategy. It refuses only a scene that asks for the default backend, and PETSc's options
 //! where the run does not take them ([`direct`]).
 //!
-//! Where MUMPS' factorisation would not fit the ranks' memory, a run whose contact the Krylov
-//! route's active sets hold ([`active_sets_hold`]: the paper's base model on one zone) takes
-//! that route instead: Krylov solves on the whole system, no factorisation, no dense
-//! compliance (`paper-3d` at n = 64, 2.2 million unknowns, on this machine).
+//! Where MUMPS' factorisation would not fit the ranks' memory, or the body is 3D and large
+//! enough that Krylov solves are the faster ([`crate::ACTIVE_SETS_FROM`] unknowns), a run whose
+//! contact the Krylov route's active sets hold ([`active_sets_hold`]: the paper's base model on
+//! one zone) takes that route instead: Krylov solves on the whole system, no factorisation, no
+//! dense compliance (`paper-3d` at n = 64, 2.2 million unknowns, on this machine).
 
 use problem::backend::Unsupported;
 use problem::{BackendChoice, ContactSpec, Rule, Scene, Strategy};
@@ -67,6 +68,19 @@ pub fn direct(scene: &Scene) -> bool {
 /// # Errors
 /// [`Unsupported`] naming the key.
 pub fn active_sets_hold(scene: &Scene) -> Result<(), Unsupported> {
+    active_sets_hold_on(scene, None)
+}
+
+/// [`active_sets_hold`] on the run's `mesh` where it is known (a Gmsh file's cells tell its
+/// order only once read): linear cells only, a quadratic face's contact points being those
+/// of a modified basis whose multipliers are not the nodes' reactions.
+///
+/// # Errors
+/// [`Unsupported`] naming the key.
+pub fn active_sets_hold_on(scene: &Scene, mesh: Option<&mesh::Mesh>) -> Result<(), Unsupported> {
+    if scene.mesh.order.unwrap_or(1) > 1 || mesh.is_some_and(|m| m.kind.order() > 1) {
+        return not_held("mesh.order", "quadratic elements (a modified basis' contact points)");
+    }
     let zones = scene.zones();
     if zones.len() > 1 {
         return not_held("contact", "several [[contact]] zones");

@@ -262,8 +262,8 @@ fn agree_on_active_sets(petsc: &Petsc) {
         let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
         let (d, what) = farthest(&direct, &dist);
         eprintln!(
-            "{name} {sets:?}: {} Krylov iterations, farthest {what} at {d:.1e}",
-            report.krylov_iterations
+            "{name} {sets:?}: {} steps, {} Krylov iterations, farthest {what} at {d:.1e}",
+            dist.report.iterations.newton, report.krylov_iterations
         );
         assert!(d < 1e-7, "{name} {sets:?}: {what} differs by {d:.2e}");
         assert!(dist.report.residuals.complementarity <= scene.solver.tol);
@@ -430,6 +430,80 @@ fn a_mesh_too_large_is_refused_by_its_estimate() {
             .map(|_| ())
             .unwrap_err();
         assert!(e.to_string().contains("on each of 2 ranks"), "{e}");
+    });
+}
+
+/// Where MUMPS' factorisation would not fit a rank's memory (its own estimate after its
+/// analysis, above the estimate before the mesh) and the active sets hold the run, the run
+/// takes the Krylov route's active sets and gives the default backend's answer; where they do
+/// not hold it, MUMPS' refusal is the error, typed, before it allocates. A large 3D body takes
+/// the active sets for speed.
+#[test]
+fn where_mumps_would_not_fit_the_active_sets_solve() {
+    on_ranks("where_mumps_would_not_fit_the_active_sets_solve", 2, |petsc| {
+        use problem::backend::Backend;
+        // paper-3d at n = 14 (26,100 unknowns, below `ACTIVE_SETS_FROM`: MUMPS' route by
+        // speed): MUMPS' estimate after its analysis about 1.6 times the share of the default
+        // backend's estimate, within which the run would start on MUMPS; the active sets'
+        // estimate 72 MB a rank
+        let (faer, scene) = both("paper-3d", &["mesh.n=14"], &[]);
+        let (share, _) = problem::SharedMemory.estimate(&scene).expect("a generated mesh");
+        let limits = problem::Limits {
+            memory_bytes: Some((1.05 * share / 2.0) as u64),
+            ..Default::default()
+        };
+        let dist = distributed::solve(&scene, None, petsc, limits, &mut problem::Silent)
+            .unwrap_or_else(|e| panic!("the PETSc run within {:?} a rank: {e}", limits.memory_bytes));
+        if let Some(dist) = dist {
+            let report = dist.report.petsc.as_ref().expect("the PETSc section");
+            assert!(
+                report.options.starts_with("MUMPS' analysis estimates")
+                    && report.options.contains("the Krylov route's active sets"),
+                "{}",
+                report.options
+            );
+            let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+            let (d, what) = farthest(&direct, &dist);
+            assert!(d < 1e-7, "{what} differs by {d:.2e}");
+        }
+        // where MUMPS' factorisation would not fit by the estimate before it: the active sets,
+        // and the run says why
+        let limits = problem::Limits {
+            memory_bytes: Some((0.9 * share / 2.0) as u64),
+            ..Default::default()
+        };
+        let dist = distributed::solve(&scene, None, petsc, limits, &mut problem::Silent)
+            .unwrap_or_else(|e| panic!("the PETSc run within {:?} a rank: {e}", limits.memory_bytes));
+        if let Some(dist) = dist {
+            let options = &dist.report.petsc.as_ref().expect("the PETSc section").options;
+            assert!(
+                options.starts_with("MUMPS' factorisation would need about") && options.contains("active sets"),
+                "{options}"
+            );
+        }
+        // a deformable foundation, which the active sets do not hold: refused before MUMPS
+        // allocates (by its estimate, or by the lower one before the mesh)
+        let (_, scene) = both("paper-3d", &["mesh.n=14", "contact.compliance={stiffness=100.0}"], &[]);
+        let e = distributed::solve(&scene, None, petsc, limits, &mut problem::Silent)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("MUMPS' analysis estimates") || e.starts_with("the run needs about"),
+            "{e}"
+        );
+        // a 3D body above `ACTIVE_SETS_FROM` unknowns (n = 20: 68,800 free), memory to spare: the
+        // active sets by speed, the default backend's answer
+        let (faer, scene) = both("paper-3d", &["mesh.n=20"], &[]);
+        let dist = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .unwrap_or_else(|e| panic!("the PETSc run at n = 20: {e}"));
+        if let Some(dist) = dist {
+            let options = &dist.report.petsc.as_ref().expect("the PETSc section").options;
+            assert!(options.starts_with("a 3D body of 6.880e4 unknowns"), "{options}");
+            let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+            let (d, what) = farthest(&direct, &dist);
+            assert!(d < 1e-7, "{what} differs by {d:.2e}");
+        }
     });
 }
 

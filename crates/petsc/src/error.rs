@@ -9,6 +9,9 @@ use std::ffi::{c_char, c_int, c_void, CStr};
 
 use petsc_sys as sys;
 
+/// Bytes in a MiB.
+const MIB: f64 = (1u64 << 20) as f64;
+
 /// The result of a call into PETSc.
 pub type Result<T> = std::result::Result<T, PetscError>;
 
@@ -63,6 +66,15 @@ pub enum PetscError {
         detail: i32,
         /// What the code means.
         meaning: String,
+    },
+    /// MUMPS' analysis estimates more memory for its factorisation on a rank than the rank
+    /// may use: refused before the factorisation allocates it.
+    #[error("MUMPS' analysis estimates {:.0} MiB on its most loaded rank for the factorisation, more than the {:.0} MiB a rank has for it", *needed as f64 / MIB, *available as f64 / MIB)]
+    MumpsTooLarge {
+        /// MUMPS' estimate (`INFOG(16)`, millions of bytes), bytes.
+        needed: u64,
+        /// What a rank may use, bytes.
+        available: u64,
     },
     /// A Krylov solve stopped without converging; `reason` is PETSc's `KSPConvergedReason`.
     #[error("the Krylov solve did not converge: {reason} after {iterations} iterations (residual norm {residual_norm:.3e}); try other -ksp_type/-pc_type options, or -ksp_max_it")]

@@ -79,10 +79,13 @@ impl<'p> Mumps<'p> {
     /// `order`: the pivot order (every unknown once, the Schur unknowns last; rank 0's is read),
     /// or `None` for MUMPS' own choice. Give one where there is a Schur complement: MUMPS then
     /// orders by AMD alone (measured: METIS and SCOTCH asked for, AMD used), whose fill on a 3D
-    /// mesh costs 20 to 35 times a nested dissection's flops. Collective.
+    /// mesh costs 20 to 35 times a nested dissection's flops. `memory`: the bytes a rank may
+    /// use, checked against MUMPS' own estimate after its analysis, before the factorisation
+    /// allocates (`None`: not checked). Collective.
     ///
     /// # Errors
     /// [`PetscError::Argument`] where the entries disagree or an index is out of range;
+    /// [`PetscError::MumpsTooLarge`] where MUMPS' estimate exceeds `memory`;
     /// [`PetscError::Mumps`] where MUMPS fails (a singular matrix among its reasons).
     pub fn factor(
         petsc: &'p Petsc,
@@ -91,6 +94,7 @@ impl<'p> Mumps<'p> {
         symmetry: Symmetry,
         schur: &[usize],
         order: Option<&[usize]>,
+        memory: Option<u64>,
     ) -> Result<Self> {
         if rows.len() != cols.len() || rows.len() != values.len() {
             return Err(PetscError::Argument(format!(
@@ -137,6 +141,10 @@ impl<'p> Mumps<'p> {
         m.initialised = true;
         m.configure()?;
         m.call(JOB_ANALYSE, "analysis")?;
+        let needed = m.estimated_bytes();
+        if let Some(available) = memory.filter(|&a| needed > a) {
+            return Err(PetscError::MumpsTooLarge { needed, available });
+        }
         let started = std::time::Instant::now();
         m.call(JOB_FACTOR, "factorisation")
             .or_else(|e| m.factor_with_more_space(e))?;
@@ -323,6 +331,12 @@ impl<'p> Mumps<'p> {
         self.id.rhs = std::ptr::null_mut();
         self.id.redrhs = std::ptr::null_mut();
         result
+    }
+
+    /// MUMPS' estimate after its analysis of the memory its factorisation takes in core on the
+    /// most loaded rank (`INFOG(16)`, millions of bytes), in bytes; the same on every rank.
+    pub fn estimated_bytes(&self) -> u64 {
+        u64::try_from(self.id.infog[15]).unwrap_or(0) * 1_000_000
     }
 
     /// Floating-point operations of the factorisation, over all ranks (`RINFOG(3)`).

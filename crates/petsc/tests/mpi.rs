@@ -286,7 +286,7 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
                 let exact = dense_solve(n, dense.clone(), b.clone());
                 let (r, c, v) = mine(&entries, symmetry != Symmetry::General);
                 // without a Schur complement: one solve
-                let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), symmetry, &[], None).unwrap();
+                let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), symmetry, &[], None, None).unwrap();
                 let mut x = if p.rank() == 0 { b.clone() } else { vec![] };
                 plain.solve(&mut x).unwrap();
                 if p.rank() == 0 {
@@ -294,7 +294,7 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
                     assert!(err < 1e-12, "{symmetry:?}: the solve is off by {err:.2e}");
                 }
                 // with one: S, the condensed right-hand side, the expansion
-                let mut m = Mumps::factor(p, n, (&r, &c, v), symmetry, &chosen, None).unwrap();
+                let mut m = Mumps::factor(p, n, (&r, &c, v), symmetry, &chosen, None, None).unwrap();
                 let mut rhs = if p.rank() == 0 { b.clone() } else { vec![] };
                 let reduced = m.condense(&mut rhs).unwrap();
                 let s = m.schur_complement().map(<[f64]>::to_vec);
@@ -345,8 +345,8 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
             // a pivot order given (the others first, reversed; the chosen last)
             let mut order: Vec<usize> = (0..n).rev().filter(|i| i % 2 == 1).collect();
             order.extend(&chosen);
-            let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), Symmetry::Indefinite, &[], None).unwrap();
-            let m = Mumps::factor(p, n, (&r, &c, v), Symmetry::Indefinite, &chosen, Some(&order)).unwrap();
+            let mut plain = Mumps::factor(p, n, (&r, &c, v.clone()), Symmetry::Indefinite, &[], None, None).unwrap();
+            let m = Mumps::factor(p, n, (&r, &c, v), Symmetry::Indefinite, &chosen, Some(&order), None).unwrap();
             let ks = chosen.len();
             for jj in [0, ks / 3, ks - 1] {
                 let mut col = vec![0.0; n];
@@ -367,10 +367,27 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
             // a singular matrix: MUMPS' error, typed
             let (r, c) = (vec![0, 1], vec![0, 1]);
             let v = if p.rank() == 0 { vec![1.0, 0.0] } else { vec![0.0, 0.0] };
-            match Mumps::factor(p, 2, (&r, &c, v), Symmetry::General, &[], None) {
+            match Mumps::factor(p, 2, (&r, &c, v), Symmetry::General, &[], None, None) {
                 Err(PetscError::Mumps { info: -10, .. }) => {}
                 Err(other) => panic!("expected MUMPS' singular matrix, got {other}"),
                 Ok(_) => panic!("a singular matrix was factored"),
+            }
+            // more memory than a rank may use, by MUMPS' own estimate: refused before the
+            // factorisation, the estimate the same on every rank
+            let (n, entries) = quasi_definite(80, -1.0);
+            let (r, c, v) = mine(&entries, true);
+            let fits = Mumps::factor(p, n, (&r, &c, v.clone()), Symmetry::QuasiDefinite, &[], None, None).unwrap();
+            let needed = fits.estimated_bytes();
+            assert!(needed > 0, "MUMPS estimates its memory");
+            let estimates = p.all_gather(needed).unwrap();
+            assert!(estimates.iter().all(|&e| e == needed), "{estimates:?}");
+            let limit = Some(needed - 1);
+            match Mumps::factor(p, n, (&r, &c, v), Symmetry::QuasiDefinite, &[], None, limit) {
+                Err(PetscError::MumpsTooLarge { needed: n, available }) => {
+                    assert_eq!((n, available), (needed, needed - 1));
+                }
+                Err(other) => panic!("expected the estimate's refusal, got {other}"),
+                Ok(_) => panic!("a factorisation past its memory was done"),
             }
             // the same data broadcast from rank 0
             let mut values = vec![p.rank() as f64; 3];

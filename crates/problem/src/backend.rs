@@ -129,6 +129,11 @@ pub trait Backend {
     /// file, whose size the run checks once read).
     fn estimate(&self, scene: &Scene) -> Option<(f64, String)>;
 
+    /// The same estimate once the mesh is made or read (its nodes and cells known), for a
+    /// body with potentials where `electric`: the run checks it before it builds anything on
+    /// the mesh.
+    fn estimate_on_mesh(&self, scene: &Scene, mesh: &mesh::Mesh, electric: bool) -> Option<(f64, String)>;
+
     /// Assembles the system of `posed` (its loads the first instant's).
     ///
     /// # Errors

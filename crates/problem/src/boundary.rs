@@ -641,6 +641,16 @@ impl ContactBoundary {
         self.points.gap[i] - self.uniform[i]
     }
 
+    /// Bytes of a condensed strategy's dense contact problem on this boundary, with
+    /// `n_tangential` tangential components a point: the inverse block on the condensed dofs,
+    /// the compliance on the contact components and Newton's matrices
+    /// ([`crate::estimate::dense_contact`]).
+    pub fn dense_bytes(&self, n_tangential: usize) -> f64 {
+        let k = self.condensed_dofs().len();
+        let m = self.points.len() * (1 + n_tangential) + (k - self.dofs.len());
+        crate::estimate::dense_contact(k, m)
+    }
+
     /// The dofs the condensation puts last: the points' free displacements, then (electrical
     /// contact) their free potentials.
     pub fn condensed_dofs(&self) -> Vec<usize> {

@@ -24,6 +24,22 @@ pub const BASE_BYTES: f64 = 256.0 * 1048576.0;
 /// Bytes in a gibibyte, for messages.
 pub const GIB: f64 = (1u64 << 30) as f64;
 
+/// A count of bytes as a message writes it: in GiB from one GiB up, in MiB below (a small
+/// run's estimate is not "0.0 GiB").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bytes(pub f64);
+
+impl std::fmt::Display for Bytes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        const MIB: f64 = (1u64 << 20) as f64;
+        match self.0 {
+            b if b >= GIB => write!(f, "{:.1} GiB", b / GIB),
+            b if b >= 10.0 * MIB => write!(f, "{:.0} MiB", b / MIB),
+            b => write!(f, "{:.1} MiB", b / MIB),
+        }
+    }
+}
+
 /// Entries of the factor per `n log₂ n` (2D) in the nested-dissection model.
 const ALPHA_2D: f64 = 9.0;
 /// Entries of the factor per `n^{4/3}` (3D).
@@ -63,9 +79,9 @@ pub fn before_mesh(scene: &Scene) -> Option<(f64, String)> {
     Some((
         bytes,
         format!(
-            "about {unknowns:.3e} unknowns, a sparse factor of at least {:.3e} entries ({:.1} GiB)",
+            "about {unknowns:.3e} unknowns, a sparse factor of at least {:.3e} entries ({})",
             entries,
-            8.0 * entries / GIB
+            Bytes(8.0 * entries)
         ),
     ))
 }
@@ -82,9 +98,9 @@ pub fn after_mesh(mesh: &mesh::Mesh, electric: bool) -> Option<(f64, String)> {
     Some((
         8.0 * entries * OVERHEAD,
         format!(
-            "{unknowns:.3e} unknowns on the mesh of {} cells, a sparse factor of at least {entries:.3e} entries ({:.1} GiB)",
+            "{unknowns:.3e} unknowns on the mesh of {} cells, a sparse factor of at least {entries:.3e} entries ({})",
             mesh.n_cells(),
-            8.0 * entries / GIB
+            Bytes(8.0 * entries)
         ),
     ))
 }

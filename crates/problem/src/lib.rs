@@ -83,6 +83,7 @@ mod units;
 pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindlin_deresiewicz_traction};
 pub use backend::Limits;
 pub use capacitance::Capacitance;
+pub use estimate::{Bytes, BASE_BYTES};
 pub use exact::ExactReport;
 pub use factorization::{Factorization, Refinement};
 pub use fe_assembly::CellFields;
@@ -330,7 +331,7 @@ pub enum ProblemError {
         factors: String,
     },
     /// A run that would need more memory than it may use, found before the memory is taken.
-    #[error("the run needs about {:.1} GiB ({what}), more than the {:.1} GiB that {limit} leaves: use a coarser mesh (a smaller mesh.n or a larger mesh.h)", *needed as f64 / estimate::GIB, *available as f64 / estimate::GIB)]
+    #[error("the run needs about {} ({what}), more than the {} that {limit} leaves: use a coarser mesh (a smaller mesh.n or a larger mesh.h)", estimate::Bytes(*needed as f64), estimate::Bytes(*available as f64))]
     TooLarge {
         /// What the estimate counts.
         what: String,

@@ -138,7 +138,7 @@ pub(crate) fn walk<B: Backend>(
     let valid = scene.validate().map_err(ProblemError::from)?;
     backend.supports(&valid).map_err(ProblemError::from)?;
     let t_total = Instant::now();
-    let setup = begin(valid, mesh, backend.estimate(&valid), &limits, reporter)?;
+    let setup = begin(backend, valid, mesh, &limits, reporter)?;
     let t_setup = t_total.elapsed().as_secs_f64();
     stop_if_interrupted(&limits, "set-up")?;
     let mut points = Points::ThatCanTouch;

@@ -5,7 +5,7 @@
 //! the report once; here are the steps it shares between its instants: the set-up, the
 //! checks, the recovery and the report.
 
-use crate::backend::{Figures, Limits, Loads, Posed};
+use crate::backend::{Backend, Figures, Limits, Loads, Posed};
 use crate::boundary::ContactBoundary;
 use crate::exact::contact_errors;
 use crate::plan::Plan;
@@ -21,21 +21,24 @@ use crate::ProblemError;
 use contact::{ContactSolution, PointValues};
 use fe_assembly::{CellFields, Discretization};
 
-/// The start of a run: the memory `estimate` (bytes, and what it counts) checked against
-/// `limits` before the memory is taken, then the [`Setup`], its plan and what the mesh's
-/// checks noted reported.
-pub(crate) fn begin(
+/// The start of a run on `backend`: its memory estimate (bytes, and what it counts) checked
+/// against `limits` before the memory is taken, then the [`Setup`], its plan and what the
+/// mesh's checks noted reported.
+pub(crate) fn begin<B: Backend>(
+    backend: &B,
     scene: Valid<'_>,
     mesh: Option<mesh::Mesh>,
-    estimate: Option<(f64, String)>,
     limits: &Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<Setup, ProblemError> {
-    check_memory(limits, estimate)?;
+    check_memory(limits, backend.estimate(&scene))?;
     let setup = setup(scene, mesh)?;
-    // a mesh read or handed over is known only now: the same model, before anything is built
-    // on it
-    check_memory(limits, crate::estimate::after_mesh(&setup.mesh, setup.plan.electric))?;
+    // a mesh read or handed over is known only now: the backend's estimate on it, before
+    // anything is built on it
+    check_memory(
+        limits,
+        backend.estimate_on_mesh(&scene, &setup.mesh, setup.plan.electric),
+    )?;
     reporter.event(&Event::Planned(&setup.plan));
     reporter.event(&Event::Units(&setup.units));
     if setup.notes != MeshNotes::default() {

@@ -54,6 +54,10 @@ impl Backend for SharedMemory {
         crate::estimate::before_mesh(scene)
     }
 
+    fn estimate_on_mesh(&self, _: &Scene, mesh: &mesh::Mesh, electric: bool) -> Option<(f64, String)> {
+        crate::estimate::after_mesh(mesh, electric)
+    }
+
     /// Assembles `A`, `G`, `B` over the free dofs (on rayon's threads), checked finite.
     fn assemble(&mut self, posed: &Posed<'_>) -> Result<Blocks, ProblemError> {
         let blocks = posed.disc.assemble(Parallelism::Rayon);
@@ -407,11 +411,7 @@ fn factor_budget(
     let nnz = b.a.val().len() + b.g.val().len() + b.b.val().len();
     let held = crate::estimate::assembled(nnz, posed.setup.mesh.n_nodes(), dofs.n_u + dofs.n_phi);
     let dense = match boundary {
-        Some(cb) if plan.linear_strategy.is_condensed() => {
-            let k = cb.condensed_dofs().len();
-            let m = cb.points.len() * (1 + plan.n_tangential()) + (k - cb.dofs.len());
-            crate::estimate::dense_contact(k, m)
-        }
+        Some(cb) if plan.linear_strategy.is_condensed() => cb.dense_bytes(plan.n_tangential()),
         _ => 0.0,
     };
     // the peak of a run is the assembled system and the factor together, times PEAK_RATIO, and
@@ -421,8 +421,8 @@ fn factor_budget(
     if held + dense > available_f {
         return Err(ProblemError::TooLarge {
             what: format!(
-                "the assembled system and the dense contact compliance of a condensed strategy ({:.1} GiB)",
-                dense / crate::estimate::GIB
+                "the assembled system and the dense contact compliance of a condensed strategy ({})",
+                crate::estimate::Bytes(dense)
             ),
             needed: ((held + dense) * crate::estimate::PEAK_RATIO + crate::estimate::BASE_BYTES) as u64,
             available,
@@ -442,8 +442,8 @@ fn too_large(e: linalg::LinalgError, limits: Limits, scene: &Scene) -> ProblemEr
     match (inner, limits.memory_bytes) {
         (linalg::LinalgError::TooLarge { needed, budget }, Some(available)) => ProblemError::TooLarge {
             what: format!(
-                "a sparse factor of {:.1} GiB, counted by its symbolic analysis, beside the assembled system",
-                *needed as f64 / crate::estimate::GIB
+                "a sparse factor of {}, counted by its symbolic analysis, beside the assembled system",
+                crate::estimate::Bytes(*needed as f64)
             ),
             // the rest of the run takes what the factor's budget left out
             needed: (*needed + (available as usize).saturating_sub(*budget)) as u64,
