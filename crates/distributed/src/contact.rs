@@ -115,10 +115,20 @@ fn dot(a: &[f64; 3], b: &[f64; 3], dim: usize) -> f64 {
     (0..dim).map(|k| a[k] * b[k]).sum()
 }
 
-/// The linear solve of one step: matrix, right-hand side, and the initial guess, overwritten
-/// by the solution; returns Krylov iterations and PETSc's reason.
+/// The linear solve of one step: matrix, right-hand side, the initial guess, overwritten by
+/// the solution, and the relative tolerance the step may be solved to where it is looser than
+/// the solver's own (an inexact Newton step; `None`: the solver's); returns Krylov iterations
+/// and PETSc's reason.
 pub type LinearSolve<'s, 'p> =
-    dyn FnMut(&mut Matrix<'p>, &Vector<'p>, &mut Vector<'p>) -> Result<(usize, String), PetscError> + 's;
+    dyn FnMut(&mut Matrix<'p>, &Vector<'p>, &mut Vector<'p>, Option<f64>) -> Result<(usize, String), PetscError> + 's;
+
+/// An inexact step's relative tolerance per unit of the last complementarity residual (the
+/// forcing term of an inexact Newton method, `η_k = FORCING r_(k-1)`: the step's error of the
+/// order of the residual squared keeps the convergence superlinear; Eisenstat and Walker,
+/// SIAM J. Sci. Comput. 17 (1996) 16-32).
+const FORCING: f64 = 1e-2;
+/// The loosest relative tolerance of a step.
+const LOOSEST: f64 = 1e-4;
 
 /// The iterate: multipliers, point displacements, the solution vector, and the counts.
 struct Iterate<'p> {
@@ -131,6 +141,8 @@ struct Iterate<'p> {
     reason: String,
     /// The multiplier scale of the residual, `c |(u_n(0) - g, u_t(0))|_W`.
     reference: f64,
+    /// The complementarity residual of the last iterate (the next step's forcing).
+    last_residual: f64,
 }
 
 /// How one run of active-set steps on a law ended.
@@ -161,7 +173,7 @@ pub fn active_set<'p>(
     // the loads alone: the first iterate, and the residual's multiplier scale
     let mut x = system.rhs.duplicate()?;
     let mut k0 = system.matrix.duplicate()?;
-    let (krylov, reason) = solve(&mut k0, &system.rhs, &mut x)?;
+    let (krylov, reason) = solve(&mut k0, &system.rhs, &mut x, None)?;
     drop(k0);
     let u = displacements(petsc, layout, rows, &x)?;
     let mut gap_u = u.clone();
@@ -169,8 +181,10 @@ pub fn active_set<'p>(
         gap_u.normal[i] -= p.gap[i];
     }
     let reference = rows.c * gap_u.weighted_norm(&p.weight);
+    let lambda = PointValues::zeros(n, nt);
+    let last_residual = complementarity_residual(p, &bound(p, law, &lambda.normal), &lambda, &u, rows.c, reference);
     let mut it = Iterate {
-        lambda: PointValues::zeros(n, nt),
+        lambda,
         u,
         x,
         steps: 0,
@@ -178,6 +192,7 @@ pub fn active_set<'p>(
         krylov,
         reason,
         reference,
+        last_residual,
     };
     let mut rows = rows.clone();
     loop {
@@ -246,6 +261,7 @@ impl<'p> Context<'_, 'p> {
             let (sets, direction) = sets(self.rows, law, &it.lambda, &it.u);
             self.step(it, law, &sets, &direction, solve)?;
             let residual = self.residual(it, law);
+            it.last_residual = residual;
             progress(&Progress {
                 stage: Stage::Newton,
                 iter: it.steps,
@@ -287,7 +303,8 @@ impl<'p> Context<'_, 'p> {
         set_held_values(layout, petsc.rank(), &held, &mut values)?;
         let rows_only: Vec<Index> = held.iter().map(|&(r, _)| r).collect();
         matrix.zero_rows_columns(&rows_only, system.diagonal[0], &values, &mut b)?;
-        let (its, reason) = solve(&mut matrix, &b, &mut it.x)?;
+        let loose = (FORCING * it.last_residual).min(LOOSEST);
+        let (its, reason) = solve(&mut matrix, &b, &mut it.x, Some(loose))?;
         it.krylov += its;
         it.reason = reason;
         it.u = displacements(petsc, layout, self.rows, &it.x)?;

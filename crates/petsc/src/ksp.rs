@@ -79,6 +79,26 @@ impl<'p> Ksp<'p> {
         })
     }
 
+    /// The relative tolerance on the residual norm in force (after the options are read).
+    pub fn relative_tolerance(&self) -> Result<f64> {
+        let (mut rtol, mut atol, mut dtol) = (0.0, 0.0, 0.0);
+        let mut max_iters: sys::PetscInt = 0;
+        // SAFETY: a live solver; PETSc writes the four values.
+        check("KSPGetTolerances", unsafe {
+            sys::KSPGetTolerances(self.raw, &mut rtol, &mut atol, &mut dtol, &mut max_iters)
+        })?;
+        Ok(rtol)
+    }
+
+    /// The relative tolerance on the residual norm alone (the others kept).
+    pub fn set_relative_tolerance(&mut self, rtol: f64) -> Result<()> {
+        // SAFETY: a live solver; PETSC_DEFAULT (-2) keeps the absolute and divergence
+        // tolerances and the iteration limit.
+        check("KSPSetTolerances", unsafe {
+            sys::KSPSetTolerances(self.raw, rtol, -2.0, -2.0, -2)
+        })
+    }
+
     /// The prefix of this solver's options in the database (`"elastic_"` reads
     /// `-elastic_ksp_type`, ...).
     pub fn set_options_prefix(&mut self, prefix: &str) -> Result<()> {
