@@ -66,4 +66,7 @@ pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS};
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
-pub use run::{solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared, ACTIVE_SETS_FROM};
+pub use run::{
+    solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared, ACTIVE_SETS_FROM,
+    ACTIVE_SETS_ZONE,
+};

@@ -83,6 +83,14 @@ pub fn solve_with(
 /// Krylov solves' as their first power.
 pub const ACTIVE_SETS_FROM: f64 = 5.0e4;
 
+/// The share of the unknowns a contact zone (its points that can touch) must hold for a run
+/// to take the active sets for speed: an indenter's small zone costs MUMPS' condensed route
+/// little and the active sets several steps (a paraboloid in a 3D block of 139,392 unknowns,
+/// `indent-sphere-3d` without its symmetry planes at n = 32, 2 ranks: 15.7 s on the active sets
+/// in 6 steps, 9.8 s on the default backend), where a face that touches everywhere (2.2 to
+/// 4.4 % of `paper-3d`'s unknowns) costs MUMPS its Schur complement.
+pub const ACTIVE_SETS_ZONE: f64 = 0.01;
+
 /// How a run with contact solves it on the ranks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ContactRoute {
@@ -142,13 +150,16 @@ impl<'p> DistributedMemory<'p> {
 
     /// Whether a run that MUMPS would factor takes the Krylov route's active sets for speed:
     /// a run on its own (the route not asked for) of a 3D body of at least
-    /// [`ACTIVE_SETS_FROM`] unknowns, whose contact they hold (no tangent of a contact point
-    /// held by a Dirichlet condition among it).
+    /// [`ACTIVE_SETS_FROM`] unknowns whose contact zone (the points that can touch) holds at
+    /// least [`ACTIVE_SETS_ZONE`] of them, and whose contact they hold (no tangent of a contact
+    /// point held by a Dirichlet condition among it).
     fn prefers_active_sets(&self, posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> bool {
-        let unknowns = posed.disc.dofs.n_u + posed.disc.dofs.n_phi;
+        let unknowns = (posed.disc.dofs.n_u + posed.disc.dofs.n_phi) as f64;
+        let zone = boundary.map_or(0, |b| b.condensed_dofs().len()) as f64;
         self.contact == ContactRoute::Auto
             && posed.setup.mesh.dim == 3
-            && unknowns as f64 >= ACTIVE_SETS_FROM
+            && unknowns >= ACTIVE_SETS_FROM
+            && zone >= ACTIVE_SETS_ZONE * unknowns
             && crate::factors_directly(&posed.scene)
             && crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).is_ok()
             && boundary.is_some_and(|b| b.first_held_tangent().is_none())
@@ -338,8 +349,10 @@ impl<'p> Backend for DistributedMemory<'p> {
             Some(system) => system,
             None if self.prefers_active_sets(posed, boundary) => {
                 why_krylov = Some(format!(
-                    "a 3D body of {:.3e} unknowns, at least {ACTIVE_SETS_FROM:.1e}, where the active sets' Krylov solves are faster than MUMPS' factorisation (docs/performance.md)",
-                    posed.disc.dofs.n_u + posed.disc.dofs.n_phi
+                    "a 3D body of {:.3e} unknowns, at least {ACTIVE_SETS_FROM:.1e}, with a contact zone of {} of them, at least {:.0} %, where the active sets' Krylov solves are faster than MUMPS' factorisation (docs/performance.md)",
+                    posed.disc.dofs.n_u + posed.disc.dofs.n_phi,
+                    boundary.map_or(0, |b| b.condensed_dofs().len()),
+                    100.0 * ACTIVE_SETS_ZONE
                 ));
                 assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?
             }

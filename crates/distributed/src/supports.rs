@@ -8,7 +8,8 @@
 //! where the run does not take them ([`direct`]).
 //!
 //! Where MUMPS' factorisation would not fit the ranks' memory, or the body is 3D and large
-//! enough that Krylov solves are the faster ([`crate::ACTIVE_SETS_FROM`] unknowns), a run whose
+//! enough that Krylov solves are the faster ([`crate::ACTIVE_SETS_FROM`] unknowns, a share
+//! [`crate::ACTIVE_SETS_ZONE`] of them in the contact zone), a run whose
 //! contact the Krylov route's active sets hold ([`active_sets_hold`]: the paper's base model on
 //! one zone) takes that route instead: Krylov solves on the whole system, no factorisation, no
 //! dense compliance (`paper-3d` at n = 64, 2.2 million unknowns, on this machine).

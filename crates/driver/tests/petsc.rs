@@ -433,6 +433,35 @@ fn a_mesh_too_large_is_refused_by_its_estimate() {
     });
 }
 
+/// Runs `scene` on the ranks of `petsc` within `memory` bytes a rank, checks that it took the
+/// active sets for the reason that `why` begins, and (where `faer` is given) that it gives the
+/// default backend's answer on that scene.
+fn on_the_active_sets(
+    petsc: &Petsc,
+    scene: &problem::Scene,
+    memory: Option<u64>,
+    why: &str,
+    faer: Option<&problem::Scene>,
+) {
+    let limits = problem::Limits {
+        memory_bytes: memory,
+        ..Default::default()
+    };
+    let dist = distributed::solve(scene, None, petsc, limits, &mut problem::Silent)
+        .unwrap_or_else(|e| panic!("the PETSc run within {memory:?} a rank: {e}"));
+    let Some(dist) = dist else { return };
+    let options = &dist.report.petsc.as_ref().expect("the PETSc section").options;
+    assert!(
+        options.starts_with(why) && options.contains("the Krylov route's active sets"),
+        "{options}"
+    );
+    if let Some(faer) = faer {
+        let direct = problem::solve(faer, None, &mut problem::Silent).expect("the faer run");
+        let (d, what) = farthest(&direct, &dist);
+        assert!(d < 1e-7, "{what} differs by {d:.2e}");
+    }
+}
+
 /// Where MUMPS' factorisation would not fit a rank's memory (its own estimate after its
 /// analysis, above the estimate before the mesh) and the active sets hold the run, the run
 /// takes the Krylov route's active sets and gives the default backend's answer; where they do
@@ -448,42 +477,24 @@ fn where_mumps_would_not_fit_the_active_sets_solve() {
         // estimate 72 MB a rank
         let (faer, scene) = both("paper-3d", &["mesh.n=14"], &[]);
         let (share, _) = problem::SharedMemory.estimate(&scene).expect("a generated mesh");
-        let limits = problem::Limits {
-            memory_bytes: Some((1.05 * share / 2.0) as u64),
-            ..Default::default()
-        };
-        let dist = distributed::solve(&scene, None, petsc, limits, &mut problem::Silent)
-            .unwrap_or_else(|e| panic!("the PETSc run within {:?} a rank: {e}", limits.memory_bytes));
-        if let Some(dist) = dist {
-            let report = dist.report.petsc.as_ref().expect("the PETSc section");
-            assert!(
-                report.options.starts_with("MUMPS' analysis estimates")
-                    && report.options.contains("the Krylov route's active sets"),
-                "{}",
-                report.options
-            );
-            let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
-            let (d, what) = farthest(&direct, &dist);
-            assert!(d < 1e-7, "{what} differs by {d:.2e}");
-        }
+        let within = |fraction: f64| Some((fraction * share / 2.0) as u64);
+        on_the_active_sets(petsc, &scene, within(1.05), "MUMPS' analysis estimates", Some(&faer));
         // where MUMPS' factorisation would not fit by the estimate before it: the active sets,
         // and the run says why
-        let limits = problem::Limits {
-            memory_bytes: Some((0.9 * share / 2.0) as u64),
-            ..Default::default()
-        };
-        let dist = distributed::solve(&scene, None, petsc, limits, &mut problem::Silent)
-            .unwrap_or_else(|e| panic!("the PETSc run within {:?} a rank: {e}", limits.memory_bytes));
-        if let Some(dist) = dist {
-            let options = &dist.report.petsc.as_ref().expect("the PETSc section").options;
-            assert!(
-                options.starts_with("MUMPS' factorisation would need about") && options.contains("active sets"),
-                "{options}"
-            );
-        }
+        on_the_active_sets(
+            petsc,
+            &scene,
+            within(0.9),
+            "MUMPS' factorisation would need about",
+            None,
+        );
         // a deformable foundation, which the active sets do not hold: refused before MUMPS
         // allocates (by its estimate, or by the lower one before the mesh)
         let (_, scene) = both("paper-3d", &["mesh.n=14", "contact.compliance={stiffness=100.0}"], &[]);
+        let limits = problem::Limits {
+            memory_bytes: within(0.9),
+            ..Default::default()
+        };
         let e = distributed::solve(&scene, None, petsc, limits, &mut problem::Silent)
             .map(|_| ())
             .unwrap_err()
@@ -495,15 +506,7 @@ fn where_mumps_would_not_fit_the_active_sets_solve() {
         // a 3D body above `ACTIVE_SETS_FROM` unknowns (n = 20: 68,800 free), memory to spare: the
         // active sets by speed, the default backend's answer
         let (faer, scene) = both("paper-3d", &["mesh.n=20"], &[]);
-        let dist = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
-            .unwrap_or_else(|e| panic!("the PETSc run at n = 20: {e}"));
-        if let Some(dist) = dist {
-            let options = &dist.report.petsc.as_ref().expect("the PETSc section").options;
-            assert!(options.starts_with("a 3D body of 6.880e4 unknowns"), "{options}");
-            let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
-            let (d, what) = farthest(&direct, &dist);
-            assert!(d < 1e-7, "{what} differs by {d:.2e}");
-        }
+        on_the_active_sets(petsc, &scene, None, "a 3D body of 6.880e4 unknowns", Some(&faer));
     });
 }
 
