@@ -29,7 +29,7 @@ pub fn run_distributed(
     let mut silent = problem::Silent;
     let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
     // the ranks of one machine share its memory (on several machines this is conservative)
-    let (memory_bytes, memory_limit) = memory_limits(petsc.size() as u64);
+    let (memory_bytes, memory_limit) = agreed_limits(&petsc, memory_limits(petsc.size() as u64))?;
     let limits = problem::Limits {
         memory_bytes,
         memory_limit,
@@ -75,4 +75,27 @@ pub fn run_distributed(
         None => output::write(&solution, dir)?,
     }
     Ok(Some(solution))
+}
+
+/// The least of the ranks' memory limits, on every rank: each rank reads its own (the machine's
+/// memory at its own moment, its own `ulimit`), and a run that one rank refused by its estimate
+/// while the others went on would leave them waiting in their next collective call. The limit's
+/// name is this rank's where its own is the least, else another rank's.
+fn agreed_limits(
+    petsc: &petsc::Petsc,
+    (bytes, limit): (Option<u64>, Option<&'static str>),
+) -> Result<(Option<u64>, Option<&'static str>), DriverError> {
+    let least = petsc
+        .all_gather(bytes.unwrap_or(u64::MAX))?
+        .into_iter()
+        .min()
+        .unwrap_or(u64::MAX);
+    Ok(match (least, bytes) {
+        (u64::MAX, _) => (None, None),
+        (least, Some(mine)) if mine == least => (Some(least), limit),
+        (least, _) => (
+            Some(least),
+            Some("the memory limit of another rank (the least of the ranks')"),
+        ),
+    })
 }

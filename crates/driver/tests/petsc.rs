@@ -540,3 +540,41 @@ fn an_indenters_narrowed_problem_on_two_ranks_agrees_with_the_default_backend() 
         narrowed_on_every_rank,
     );
 }
+
+/// Ranks with different memory limits (here rank 1 under a data-size limit) agree on the least
+/// before any of them judges the run: every rank refuses it alike, rank 0 saying that another
+/// rank's limit is the least, and none is left waiting in a collective call for one that
+/// stopped (the program under `mpirun -np 2`, each rank's shell setting its own limit).
+#[test]
+fn ranks_with_different_limits_refuse_a_run_alike() {
+    let exe = env!("CARGO_BIN_EXE_piezocontact");
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let script = format!(
+        "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then ulimit -d 1500000; fi; exec '{exe}' run paper-3d --set mesh.n=24 --set 'solver.backend=\"petsc\"' --out '{}'",
+        out.display()
+    );
+    let o = std::process::Command::new("timeout")
+        .args([
+            "300",
+            "mpirun",
+            "-np",
+            "2",
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "sh",
+            "-c",
+            &script,
+        ])
+        .output()
+        .expect("mpirun runs");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    // timeout's 124 would be a rank left waiting
+    assert_ne!(o.status.code(), Some(124), "a rank was left waiting: {stderr}");
+    assert!(!o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("the run needs about") && stderr.contains("the memory limit of another rank"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
