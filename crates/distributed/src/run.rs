@@ -356,6 +356,10 @@ impl<'p> Backend for DistributedMemory<'p> {
                 ));
                 assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?
             }
+            // options for the Krylov solvers in a run that MUMPS factors: not ignored silently
+            None if posed.scene.solver.petsc_options.is_some() => {
+                return Err(ProblemError::from(crate::supports::options_refused()).into())
+            }
             None => match self.factor(posed, &layout, boundary, limits, reporter) {
                 Ok((direct, options)) => {
                     return Ok(Prepared {

@@ -36,16 +36,22 @@ pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
         )
         .advise("set solver.backend = \"petsc\""));
     }
-    if direct(scene) && scene.solver.petsc_options.is_some() {
+    if direct(scene) && active_sets_hold(scene).is_err() && scene.solver.petsc_options.is_some() {
         // options for the Krylov solvers, which this run does not use: not ignored silently
-        return Err(Unsupported::new(
-            BACKEND,
-            "solver.petsc_options",
-            "options for PETSc's Krylov solvers in a run that factors K by MUMPS (a run with contact, a floating terminal or a body of revolution), which takes none",
-        )
-        .advise("remove solver.petsc_options"));
+        return Err(options_refused());
     }
     Ok(())
+}
+
+/// PETSc's options refused in a run that factors `K` by MUMPS (a run that the active sets
+/// might take is judged once its route is chosen, on its mesh).
+pub(crate) fn options_refused() -> Unsupported {
+    Unsupported::new(
+        BACKEND,
+        "solver.petsc_options",
+        "options for PETSc's Krylov solvers in a run that factors K by MUMPS (a run with contact, a floating terminal or a body of revolution, the Krylov route's active sets aside), which takes none",
+    )
+    .advise("remove solver.petsc_options")
 }
 
 /// Whether a run of `scene` factors `K` by MUMPS rather than solving by Krylov: a run with

@@ -435,21 +435,22 @@ fn a_mesh_too_large_is_refused_by_its_estimate() {
 
 /// Runs `scene` on the ranks of `petsc` within `memory` bytes a rank, checks that it took the
 /// active sets for the reason that `why` begins, and (where `faer` is given) that it gives the
-/// default backend's answer on that scene.
+/// default backend's answer on that scene; returns the options in force (rank 0; `None` on
+/// the others).
 fn on_the_active_sets(
     petsc: &Petsc,
     scene: &problem::Scene,
     memory: Option<u64>,
     why: &str,
     faer: Option<&problem::Scene>,
-) {
+) -> Option<String> {
     let limits = problem::Limits {
         memory_bytes: memory,
         ..Default::default()
     };
     let dist = distributed::solve(scene, None, petsc, limits, &mut problem::Silent)
         .unwrap_or_else(|e| panic!("the PETSc run within {memory:?} a rank: {e}"));
-    let Some(dist) = dist else { return };
+    let dist = dist?;
     let options = &dist.report.petsc.as_ref().expect("the PETSc section").options;
     assert!(
         options.starts_with(why) && options.contains("the Krylov route's active sets"),
@@ -460,6 +461,7 @@ fn on_the_active_sets(
         let (d, what) = farthest(&direct, &dist);
         assert!(d < 1e-7, "{what} differs by {d:.2e}");
     }
+    Some(options.clone())
 }
 
 /// Where MUMPS' factorisation would not fit a rank's memory (its own estimate after its
@@ -507,6 +509,17 @@ fn where_mumps_would_not_fit_the_active_sets_solve() {
         // active sets by speed, the default backend's answer
         let (faer, scene) = both("paper-3d", &["mesh.n=20"], &[]);
         on_the_active_sets(petsc, &scene, None, "a 3D body of 6.880e4 unknowns", Some(&faer));
+        // which takes PETSc's options (refused where MUMPS factors)
+        let restart = "solver.petsc_options=\"-ksp_gmres_restart 150\"";
+        let (_, scene) = both("paper-3d", &["mesh.n=20", restart], &[]);
+        if let Some(options) = on_the_active_sets(petsc, &scene, None, "a 3D body of 6.880e4 unknowns", None) {
+            assert!(options.ends_with("-ksp_gmres_restart 150"), "{options}");
+        }
+        let (_, scene) = both("paper-3d", &["mesh.n=8", restart], &[]);
+        let e = distributed::solve(&scene, None, petsc, problem::Limits::default(), &mut problem::Silent)
+            .map(|_| ())
+            .unwrap_err();
+        assert!(e.to_string().contains("solver.petsc_options"), "{e}");
     });
 }
 
