@@ -36,7 +36,10 @@ pub fn supports(scene: &Scene) -> Result<(), Unsupported> {
         )
         .advise("set solver.backend = \"petsc\""));
     }
-    if direct(scene) && active_sets_hold(scene).is_err() && scene.solver.petsc_options.is_some() {
+    // (a 3D run the active sets hold may take them, and their options, by speed: judged once
+    // its route is chosen on the mesh; a plane one factors by MUMPS)
+    let may_take_active_sets = active_sets_hold(scene).is_ok() && scene.mesh.dim() != Some(2);
+    if direct(scene) && !may_take_active_sets && scene.solver.petsc_options.is_some() {
         // options for the Krylov solvers, which this run does not use: not ignored silently
         return Err(options_refused());
     }
