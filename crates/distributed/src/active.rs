@@ -11,7 +11,7 @@ use crate::layout::Layout;
 use crate::system::System;
 use petsc::{Index, Petsc, PetscError, Vector};
 use problem::backend::{At, ContactBoundary, ContactSolve, Fields, InstantOf, InstantSolution, Posed, Primed};
-use problem::{Event, ProblemError, Reporter, Scene};
+use problem::{Event, ProblemError, Reporter};
 
 /// Steps of the active-set iteration at most.
 pub const MAX_ACTIVE_SET_STEPS: usize = 60;
@@ -54,7 +54,6 @@ pub(crate) fn solve<'p>(
 ) -> Result<contact::ContactSolution, DistributedError> {
     let petsc = k.petsc;
     let boundary = active.boundary.as_ref().ok_or_else(unprimed)?;
-    refuse_held_tangent(how.scene, boundary)?;
     let rows = ContactRows::new(petsc, at.points, &boundary.nodes, layout, &k.system);
     let params = ActiveSetParams {
         tol: how.tol,
@@ -126,7 +125,7 @@ fn residual(
 ) -> Result<f64, PetscError> {
     let mut r = system.reactions(x)?;
     // the points' forces, each added once, by the rank that owns its node
-    let forces = b.forces(&sol.lambda);
+    let forces = b.point_forces(&sol.lambda);
     let scale = system.load_norm.max(forces.iter().map(|f| f * f).sum::<f64>().sqrt());
     let dim = layout.dim;
     let (mut idx, mut vals) = (vec![], vec![]);
@@ -142,25 +141,6 @@ fn residual(
     r.assemble()?;
     let scale = if scale > 0.0 { scale } else { 1.0 };
     Ok(r.norm()? / scale)
-}
-
-/// The active sets hold the normal and tangential components of a contact point as unknowns
-/// of the system: a tangent prescribed by a Dirichlet condition is refused, naming its node.
-fn refuse_held_tangent(scene: &Scene, boundary: &ContactBoundary) -> Result<(), ProblemError> {
-    let (Some(node), Some(spec)) = (boundary.first_held_tangent(), scene.active_contact()) else {
-        return Ok(());
-    };
-    // found once the mesh is read (the scene alone does not tell it): the route's refusal
-    Err(problem::backend::Unsupported::new(
-        "petsc",
-        "contact.group",
-        format!(
-            "node {node} of contact group `{}` has a tangential component prescribed by a Dirichlet condition (a roller or symmetry plane through the contact face), and the active sets (the route taken where MUMPS' factorisation would not fit the memory) do not hold a tangent of a contact point",
-            spec.group
-        ),
-    )
-    .advise("more memory per rank, or more ranks, for MUMPS' factorisation")
-    .into())
 }
 
 /// A path on the active sets' route (chosen only for one instant: `active_sets_hold`).

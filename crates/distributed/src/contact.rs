@@ -401,9 +401,11 @@ fn sets(rows: &ContactRows<'_>, law: &Law, lambda: &PointValues, u: &PointValues
             stick[i] = true;
             continue;
         }
-        let zt: Vec<f64> = (0..nt)
+        let mut zt: Vec<f64> = (0..nt)
             .map(|q| lambda.tangential[i * nt + q] + c * u.tangential[i * nt + q])
             .collect();
+        // the projection sees the free directions only (a support holds the others)
+        p.hold(i, &mut zt);
         // the branch of the disc's projection, as the contact crate's Newton picks it
         match contact::disc_piece(&zt, s) {
             DiscPiece::Zero => {}
@@ -455,8 +457,11 @@ fn hold(
         let kn = axis(&p.normal[i], dim);
         held.push(((first + kn) as Index, p.gap[i] * p.normal[i][kn]));
         let kt: Vec<usize> = (0..nt).map(|q| axis(&p.tangent[i][q], dim)).collect();
+        // a tangent a support holds (a roller through the contact face) is its prescribed
+        // unknown already: the contact conditions are the free tangents'
+        let free: Vec<usize> = (0..nt).filter(|&q| !p.is_held(i, q)).collect();
         if sets.stick[i] {
-            held.extend(kt.iter().map(|&k| ((first + k) as Index, 0.0)));
+            held.extend(free.iter().map(|&q| ((first + kt[q]) as Index, 0.0)));
             continue;
         }
         let d = &direction.tangential[i * nt..(i + 1) * nt];
@@ -470,7 +475,7 @@ fn hold(
             Law::Coulomb => Some(matrix.row((first + kn) as Index)?),
             _ => None,
         };
-        for q in 0..nt {
+        for &q in &free {
             let rt = (first + kt[q]) as Index;
             let (cols, mut vals) = matrix.row(rt)?;
             let sign_t = p.tangent[i][q][kt[q]];
@@ -491,7 +496,7 @@ fn hold(
                 _ => {}
             }
             // the spring w β P across the slip direction
-            for q2 in 0..nt {
+            for &q2 in &free {
                 let pq = f64::from(u8::from(q == q2)) - d[q] * d[q2];
                 let col = (first + kt[q2]) as Index;
                 if let Ok(at) = cols.binary_search(&col) {
@@ -578,7 +583,8 @@ fn multipliers(
         let f: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
         let w = p.weight[i];
         flat[i] = -dot(&f, &p.normal[i], dim) / w;
-        for q in 0..nt {
+        // (a held tangent's reaction is its support's, not the contact's)
+        for q in (0..nt).filter(|&q| !p.is_held(i, q)) {
             flat[n + i * nt + q] = -dot(&f, &p.tangent[i][q], dim) / w;
         }
     }

@@ -151,8 +151,7 @@ impl<'p> DistributedMemory<'p> {
     /// Whether a run that MUMPS would factor takes the Krylov route's active sets for speed:
     /// a run on its own (the route not asked for) of a 3D body of at least
     /// [`ACTIVE_SETS_FROM`] unknowns whose contact zone (the points that can touch) holds at
-    /// least [`ACTIVE_SETS_ZONE`] of them, and whose contact they hold (no tangent of a contact
-    /// point held by a Dirichlet condition among it).
+    /// least [`ACTIVE_SETS_ZONE`] of them, and whose contact they hold.
     fn prefers_active_sets(&self, posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> bool {
         let unknowns = (posed.disc.dofs.n_u + posed.disc.dofs.n_phi) as f64;
         let zone = boundary.map_or(0, |b| b.condensed_dofs().len()) as f64;
@@ -162,7 +161,7 @@ impl<'p> DistributedMemory<'p> {
             && zone >= ACTIVE_SETS_ZONE * unknowns
             && crate::factors_directly(&posed.scene)
             && crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).is_ok()
-            && boundary.is_some_and(|b| b.first_held_tangent().is_none())
+            && boundary.is_some()
     }
 
     /// Whether the Krylov route's active sets hold the run of `posed` and their estimate fits

@@ -239,6 +239,23 @@ const ACTIVE_SET_CASES: &[(&str, &[&str])] = &[
     ("paper-frictionless", &["mesh.n=32"]),
     ("paper-3d", &["mesh.n=6"]),
     ("paper-3d", &["mesh.n=6", "contact.friction=0.1"]),
+    // a roller through the contact face: the left side's x held, the contact edge's points'
+    // x tangent with it
+    (
+        "paper-3d",
+        &["mesh.n=6", "contact.friction=0.1", "~dirichlet.0.u", "dirichlet.0.ux=0"],
+    ),
+    (
+        "paper",
+        &[
+            "mesh.n=32",
+            "contact.friction=0.1",
+            "~dirichlet.0.u",
+            "dirichlet.0.ux=0",
+        ],
+    ),
+    // a quarter model: two symmetry planes through an indenter's zone
+    ("indent-sphere-3d", &[]),
     ("actuator", &[]),
     ("paper-elastic", &["mesh.n=32"]),
 ];

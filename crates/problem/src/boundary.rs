@@ -808,23 +808,43 @@ impl ContactBoundary {
     /// The contact forces `-Nᵀ W λ_n - Tᵀ W λ_t` on the contact dofs, in the order of `dofs`
     /// (the components a support holds take theirs from it).
     pub fn forces(&self, lambda: &PointValues) -> Vec<f64> {
+        let mut out = vec![0.0; self.dofs.len()];
+        self.each_force(lambda, |slots, w, f| {
+            for &(c, slot) in slots {
+                if let Slot::Free(j) = slot {
+                    out[j] -= c * w * f;
+                }
+            }
+        });
+        out
+    }
+
+    /// The contact force `-w (λ_n n + λ_t t)` of each point, `dim` components a point, 0 in a
+    /// component a support holds (a linear face's points are its nodes: the force on the
+    /// point's node).
+    pub fn point_forces(&self, lambda: &PointValues) -> Vec<f64> {
+        let mut out = Vec::with_capacity(self.points.len() * self.points.dim);
+        self.each_force(lambda, |slots, w, f| {
+            let free = slots.iter().any(|(_, slot)| matches!(slot, Slot::Free(_)));
+            out.push(if free { -w * f } else { 0.0 });
+        });
+        out
+    }
+
+    /// `each(slots, w, f)` for every point and component in order, with the point's weight
+    /// `w`, `f = λ_n n_k + λ_t t_k` (the force is `-w f`) and the component's slots.
+    fn each_force(&self, lambda: &PointValues, mut each: impl FnMut(&[Term], f64, f64)) {
         let p = &self.points;
         let (dim, nt) = (p.dim, lambda.n_tangential());
-        let mut out = vec![0.0; self.dofs.len()];
         for i in 0..p.len() {
             for k in 0..dim {
                 let mut f = lambda.normal[i] * p.normal[i][k];
                 for q in 0..nt {
                     f += lambda.tangential[i * nt + q] * p.tangent[i][q][k];
                 }
-                for &(c, slot) in &self.slots[i * dim + k] {
-                    if let Slot::Free(j) = slot {
-                        out[j] -= c * p.weight[i] * f;
-                    }
-                }
+                each(&self.slots[i * dim + k], p.weight[i], f);
             }
         }
-        out
     }
 
     /// The points' holds along their normals, for the rigid motions a compliant bed holds
