@@ -67,7 +67,8 @@ pub(crate) fn solve<'p>(
         let mut ksp = fields.krylov(petsc, m)?;
         *t_pc += t.elapsed().as_secs_f64();
         // an inexact step where the iteration allows one looser than the options' tolerance
-        if let Some(rtol) = loose.filter(|&r| r > ksp.relative_tolerance().unwrap_or(f64::INFINITY)) {
+        let tight = ksp.relative_tolerance()?;
+        if let Some(rtol) = loose.filter(|&r| r > tight) {
             ksp.set_relative_tolerance(rtol)?;
         }
         let info = ksp.solve(b, x)?;

@@ -148,20 +148,25 @@ impl<'p> DistributedMemory<'p> {
         }
     }
 
-    /// Whether a run that MUMPS would factor takes the Krylov route's active sets for speed:
-    /// a run on its own (the route not asked for) of a 3D body of at least
+    /// Why a run that MUMPS would factor takes the Krylov route's active sets for speed, in
+    /// words, where it does: a run on its own (the route not asked for) of a 3D body of at least
     /// [`ACTIVE_SETS_FROM`] unknowns whose contact zone (the points that can touch) holds at
     /// least [`ACTIVE_SETS_ZONE`] of them, and whose contact they hold.
-    fn prefers_active_sets(&self, posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> bool {
-        let unknowns = (posed.disc.dofs.n_u + posed.disc.dofs.n_phi) as f64;
-        let zone = boundary.map_or(0, |b| b.condensed_dofs().len()) as f64;
-        self.contact == ContactRoute::Auto
+    fn active_sets_for_speed(&self, posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> Option<String> {
+        let unknowns = posed.disc.dofs.n_u + posed.disc.dofs.n_phi;
+        let zone = boundary?.condensed_dofs().len();
+        let faster = self.contact == ContactRoute::Auto
             && posed.setup.mesh.dim == 3
-            && unknowns >= ACTIVE_SETS_FROM
-            && zone >= ACTIVE_SETS_ZONE * unknowns
+            && unknowns as f64 >= ACTIVE_SETS_FROM
+            && zone as f64 >= ACTIVE_SETS_ZONE * unknowns as f64
             && crate::factors_directly(&posed.scene)
-            && crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).is_ok()
-            && boundary.is_some()
+            && crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).is_ok();
+        faster.then(|| {
+            format!(
+                "a 3D body of {unknowns:.3e} unknowns, at least {ACTIVE_SETS_FROM:.1e}, with a contact zone of {zone} of them, at least {:.0} %, where the active sets' Krylov solves are faster than MUMPS' factorisation (docs/performance.md)",
+                100.0 * ACTIVE_SETS_ZONE
+            )
+        })
     }
 
     /// Whether the Krylov route's active sets hold the run of `posed` and their estimate fits
@@ -343,23 +348,22 @@ impl<'p> Backend for DistributedMemory<'p> {
         limits: problem::Limits,
         reporter: &mut dyn Reporter,
     ) -> Result<Prepared<'p>, DistributedError> {
+        let speed = match system {
+            None => self.active_sets_for_speed(posed, boundary),
+            Some(_) => None,
+        };
         let mut why_krylov = None;
-        let system = match system {
-            Some(system) => system,
-            None if self.prefers_active_sets(posed, boundary) => {
-                why_krylov = Some(format!(
-                    "a 3D body of {:.3e} unknowns, at least {ACTIVE_SETS_FROM:.1e}, with a contact zone of {} of them, at least {:.0} %, where the active sets' Krylov solves are faster than MUMPS' factorisation (docs/performance.md)",
-                    posed.disc.dofs.n_u + posed.disc.dofs.n_phi,
-                    boundary.map_or(0, |b| b.condensed_dofs().len()),
-                    100.0 * ACTIVE_SETS_ZONE
-                ));
+        let system = match (system, speed) {
+            (Some(system), _) => system,
+            (None, Some(why)) => {
+                why_krylov = Some(why);
                 assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?
             }
             // options for the Krylov solvers in a run that MUMPS factors: not ignored silently
-            None if posed.scene.solver.petsc_options.is_some() => {
+            (None, None) if posed.scene.solver.petsc_options.is_some() => {
                 return Err(ProblemError::from(crate::supports::options_refused()).into())
             }
-            None => match self.factor(posed, &layout, boundary, limits, reporter) {
+            (None, None) => match self.factor(posed, &layout, boundary, limits, reporter) {
                 Ok((direct, options)) => {
                     return Ok(Prepared {
                         route: Route::Direct(Box::new(direct)),

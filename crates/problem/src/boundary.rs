@@ -796,15 +796,6 @@ impl ContactBoundary {
         }
     }
 
-    /// The first point with a tangent held by a support, as its mesh node (for a backend that
-    /// cannot hold a tangent of a contact point).
-    pub fn first_held_tangent(&self) -> Option<usize> {
-        let nt = self.points.n_tangential();
-        (0..self.points.len())
-            .find(|&i| self.points.held[i][..nt].iter().any(|&h| h))
-            .map(|i| self.nodes[i])
-    }
-
     /// The contact forces `-Nᵀ W λ_n - Tᵀ W λ_t` on the contact dofs, in the order of `dofs`
     /// (the components a support holds take theirs from it).
     pub fn forces(&self, lambda: &PointValues) -> Vec<f64> {
