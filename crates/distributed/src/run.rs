@@ -87,7 +87,7 @@ pub const ACTIVE_SETS_FROM: f64 = 5.0e4;
 /// to take the active sets for speed: an indenter's small zone costs MUMPS' condensed route
 /// little and the active sets several steps (a paraboloid in a 3D block of 139,392 unknowns,
 /// `indent-sphere-3d` without its symmetry planes at n = 32, 2 ranks: 15.7 s on the active sets
-/// in 6 steps, 9.8 s on the default backend), where a face that touches everywhere (2.2 to
+/// in 6 steps, 13.3 s on MUMPS, 9.8 s on the default backend), where a face that touches everywhere (2.2 to
 /// 4.4 % of `paper-3d`'s unknowns) costs MUMPS its Schur complement.
 pub const ACTIVE_SETS_ZONE: f64 = 0.01;
 
