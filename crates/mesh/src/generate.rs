@@ -178,7 +178,7 @@ pub fn box_tet(lo: [f64; 3], hi: [f64; 3], nx: usize, ny: usize, nz: usize) -> M
 }
 
 /// `lo + (hi - lo) i / n`, exact at both ends.
-fn lerp(lo: f64, hi: f64, i: usize, n: usize) -> f64 {
+pub(crate) fn lerp(lo: f64, hi: f64, i: usize, n: usize) -> f64 {
     if i == n {
         hi
     } else {

@@ -31,6 +31,7 @@ mod generate;
 mod gmsh;
 mod ordering;
 mod parts;
+mod pieces;
 mod quadratic;
 mod quality;
 mod topology;
@@ -39,6 +40,7 @@ pub use generate::{box_tet, rectangle_quad, rectangle_tri, round_quarter_section
 pub use gmsh::{read_msh, read_msh_bytes};
 pub use ordering::nested_dissection;
 pub use parts::MeshParts;
+pub use pieces::{Blocks, MeshPiece};
 pub use quality::{straight_sided, QualityReport};
 
 use rayon::prelude::*;
