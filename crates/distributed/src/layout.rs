@@ -3,7 +3,7 @@
 
 use fe_assembly::{Dof, DofMap};
 use mesh::Mesh;
-use petsc::{partition, Index, Petsc, PetscError};
+use petsc::{partition, Index, Petsc, PetscError, Vector};
 
 /// The distribution of a mesh's cells and unknowns among the ranks. The same on every rank.
 #[derive(Clone, Debug)]
@@ -58,6 +58,58 @@ impl Layout {
             dim,
             cell_rank,
             node_rank,
+            first,
+            has_phi,
+            rank_start,
+        })
+    }
+
+    /// The layout of a run whose every rank holds only its piece of the mesh (`piece`, its
+    /// block of cells and one layer of ghosts, numbered locally; `dofs` the piece's dof map):
+    /// the same numbering as [`Layout::new`] gives a whole mesh (each rank's nodes contiguous,
+    /// node by node), with every entry indexed by the piece's local nodes and cells. A rank
+    /// numbers its own nodes; the first unknown of a node another rank owns comes from that
+    /// rank through a directory, a parallel vector indexed by the whole mesh's node numbers
+    /// (each rank holds `1/p` of it). `piece.mesh` is not read: the run may have taken it for
+    /// its set-up. Collective.
+    pub fn of_piece(petsc: &Petsc, piece: &mesh::MeshPiece, dofs: &DofMap) -> Result<Layout, PetscError> {
+        let (rank, ranks, dim) = (petsc.rank(), petsc.size(), dofs.dim);
+        let n = piece.global_node.len();
+        let has_phi: Vec<bool> = (0..n).map(|v| !matches!(dofs.phi[v], Dof::Absent)).collect();
+        let width = |v: usize| dim + usize::from(has_phi[v]);
+        let mine: usize = (0..n).filter(|&v| piece.node_rank[v] == rank).map(width).sum();
+        let counts = petsc.all_gather(mine as u64)?;
+        let mut rank_start = Vec::with_capacity(ranks + 1);
+        let mut next = 0;
+        for c in &counts {
+            rank_start.push(next);
+            next += *c as usize;
+        }
+        rank_start.push(next);
+        // the directory: at each node's whole-mesh number, its first unknown (exact in f64 to
+        // 2^53), set by its owner
+        let (lo, hi) = petsc.split(piece.n_global_nodes);
+        let mut directory = Vector::mpi(petsc, hi - lo)?;
+        let mut first = vec![usize::MAX; n];
+        let (mut at, mut values) = (vec![], vec![]);
+        let mut f = rank_start[rank];
+        for v in (0..n).filter(|&v| piece.node_rank[v] == rank) {
+            first[v] = f;
+            at.push(Layout::index(piece.global_node[v]));
+            values.push(f as f64);
+            f += width(v);
+        }
+        directory.set_values(&at, &values)?;
+        directory.assemble()?;
+        let others: Vec<usize> = (0..n).filter(|&v| piece.node_rank[v] != rank).collect();
+        let asked: Vec<Index> = others.iter().map(|&v| Layout::index(piece.global_node[v])).collect();
+        for (&v, x) in others.iter().zip(directory.fetch(&asked)?) {
+            first[v] = x as usize;
+        }
+        Ok(Layout {
+            dim,
+            cell_rank: piece.cell_rank.clone(),
+            node_rank: piece.node_rank.clone(),
             first,
             has_phi,
             rank_start,

@@ -51,6 +51,8 @@ mod krylov;
 #[cfg(feature = "petsc")]
 mod layout;
 #[cfg(feature = "petsc")]
+mod pieces;
+#[cfg(feature = "petsc")]
 mod run;
 #[cfg(feature = "petsc")]
 pub mod system;
@@ -65,6 +67,8 @@ pub use error::DistributedError;
 pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS};
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
+#[cfg(feature = "petsc")]
+pub use pieces::{pieces_support, solve_on_pieces, PieceSolution};
 #[cfg(feature = "petsc")]
 pub use run::{
     solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared, ACTIVE_SETS_FROM,

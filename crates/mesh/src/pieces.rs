@@ -60,8 +60,8 @@ impl Blocks {
     pub fn new(dim: usize, n: [usize; 3], ranks: usize) -> Option<Blocks> {
         let n = [n[0].max(1), n[1].max(1), if dim == 2 { 1 } else { n[2].max(1) }];
         let mut best: Option<(usize, [usize; 3])> = None;
-        for p0 in (1..=ranks).filter(|p| ranks % p == 0) {
-            for p1 in (1..=ranks / p0).filter(|p| (ranks / p0) % p == 0) {
+        for p0 in (1..=ranks).filter(|p| ranks.is_multiple_of(*p)) {
+            for p1 in (1..=ranks / p0).filter(|p| (ranks / p0).is_multiple_of(*p)) {
                 let p = [p0, p1, ranks / (p0 * p1)];
                 if (0..3).any(|k| p[k] > n[k]) {
                     continue;
@@ -145,7 +145,11 @@ impl Blocks {
         for k in g[2].start..=g[2].end {
             for j in g[1].start..=g[1].end {
                 for i in g[0].start..=g[0].end {
-                    let p = [lerp(lo[0], hi[0], i, n[0]), lerp(lo[1], hi[1], j, n[1]), lerp(lo[2], hi[2], k, n[2])];
+                    let p = [
+                        lerp(lo[0], hi[0], i, n[0]),
+                        lerp(lo[1], hi[1], j, n[1]),
+                        lerp(lo[2], hi[2], k, n[2]),
+                    ];
                     piece.push(p, whole([i, j, k]), self.rank_of_node([i, j, k]));
                 }
             }
@@ -188,7 +192,11 @@ impl Blocks {
             };
             for (side, name) in [(0usize, names[axis].0), (n[axis], names[axis].1)] {
                 let outward = if side == 0 { -1.0 } else { 1.0 };
-                let reached = if side == 0 { g[axis].start == 0 } else { g[axis].end == n[axis] };
+                let reached = if side == 0 {
+                    g[axis].start == 0
+                } else {
+                    g[axis].end == n[axis]
+                };
                 let mut facets = vec![];
                 for jb in g[b].clone().filter(|_| reached) {
                     for ia in g[a].clone() {
@@ -260,7 +268,9 @@ impl Blocks {
         boundaries.insert("bottom".into(), seg(bottom.collect()));
         let right = on(x.end == n[0], y.clone()).map(|j| (local(n[0], j), local(n[0], j + 1)));
         boundaries.insert("right".into(), seg(right.collect()));
-        let top = on(y.end == n[1], x.clone()).rev().map(|i| (local(i + 1, n[1]), local(i, n[1])));
+        let top = on(y.end == n[1], x.clone())
+            .rev()
+            .map(|i| (local(i + 1, n[1]), local(i, n[1])));
         boundaries.insert("top".into(), seg(top.collect()));
         let left = on(x.start == 0, y).rev().map(|j| (local(0, j + 1), local(0, j)));
         boundaries.insert("left".into(), seg(left.collect()));
@@ -364,7 +374,11 @@ mod tests {
                 let gc = p.global_cell[c];
                 let mapped: Vec<usize> = p.mesh.cell(c).iter().map(|&v| p.global_node[v]).collect();
                 assert_eq!(mapped, whole.cell(gc), "rank {r} cell {c}");
-                assert_eq!(c < p.own_cells, p.cell_rank[c] == r, "rank {r} cell {c}: own cells first");
+                assert_eq!(
+                    c < p.own_cells,
+                    p.cell_rank[c] == r,
+                    "rank {r} cell {c}: own cells first"
+                );
                 if c < p.own_cells {
                     assert_eq!(owner_of_cell[gc], usize::MAX, "cell {gc} owned twice");
                     owner_of_cell[gc] = r;
@@ -394,7 +408,9 @@ mod tests {
             for (name, group) in &whole.boundaries {
                 let mine = &p.mesh.boundaries[name];
                 let set = |f: &[usize], map: &dyn Fn(usize) -> usize| {
-                    f.chunks(group.nodes_per_facet).map(|x| x.iter().map(|&v| map(v)).collect::<Vec<_>>()).collect::<Vec<_>>()
+                    f.chunks(group.nodes_per_facet)
+                        .map(|x| x.iter().map(|&v| map(v)).collect::<Vec<_>>())
+                        .collect::<Vec<_>>()
                 };
                 let local = set(&mine.facets, &|v| p.global_node[v]);
                 let nodes: std::collections::HashSet<usize> = p.global_node.iter().copied().collect();

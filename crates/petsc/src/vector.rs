@@ -187,6 +187,85 @@ impl<'p> Vector<'p> {
     pub fn gather(&self) -> Result<Option<Vec<f64>>> {
         self.petsc.gather_f64(&self.local()?)
     }
+
+    /// The entries at the global `indices` (any rank's), in their order, on this rank: a
+    /// `VecScatter` from this vector into a sequential one. Collective (every rank calls it,
+    /// each with its own indices); what a rank receives is what it asks for, so a rank's
+    /// memory grows with its own indices, never with the global size.
+    pub fn fetch(&self, indices: &[Index]) -> Result<Vec<f64>> {
+        let n = index("a count of entries to fetch", indices.len())?;
+        let mut is: sys::IS = std::ptr::null_mut();
+        let mut seq: sys::Vec = std::ptr::null_mut();
+        let mut scatter: sys::VecScatter = std::ptr::null_mut();
+        // SAFETY: PETSc is initialised; the index set copies `indices`; the sequential vector
+        // lives on this process alone (MPI_COMM_SELF, a predefined communicator); every object
+        // created here is destroyed below on every path after its creation.
+        unsafe {
+            let comm_self: sys::MPI_Comm = (&raw mut sys::ompi_mpi_comm_self).cast();
+            let created = check(
+                "ISCreateGeneral",
+                sys::ISCreateGeneral(
+                    comm_self,
+                    n,
+                    indices.as_ptr(),
+                    sys::PetscCopyMode::PETSC_COPY_VALUES,
+                    &mut is,
+                ),
+            )
+            .and_then(|()| check("VecCreateSeq", sys::VecCreateSeq(comm_self, n, &mut seq)))
+            .and_then(|()| {
+                check(
+                    "VecScatterCreate",
+                    sys::VecScatterCreate(self.raw, is, seq, std::ptr::null_mut(), &mut scatter),
+                )
+            })
+            .and_then(|()| {
+                check(
+                    "VecScatterBegin",
+                    sys::VecScatterBegin(
+                        scatter,
+                        self.raw,
+                        seq,
+                        sys::InsertMode::INSERT_VALUES,
+                        sys::ScatterMode::SCATTER_FORWARD,
+                    ),
+                )
+            })
+            .and_then(|()| {
+                check(
+                    "VecScatterEnd",
+                    sys::VecScatterEnd(
+                        scatter,
+                        self.raw,
+                        seq,
+                        sys::InsertMode::INSERT_VALUES,
+                        sys::ScatterMode::SCATTER_FORWARD,
+                    ),
+                )
+            });
+            let out = created.and_then(|()| {
+                let mut ptr: *const f64 = std::ptr::null();
+                check("VecGetArrayRead", sys::VecGetArrayRead(seq, &mut ptr))?;
+                let out = if indices.is_empty() {
+                    vec![]
+                } else {
+                    std::slice::from_raw_parts(ptr, indices.len()).to_vec()
+                };
+                check("VecRestoreArrayRead", sys::VecRestoreArrayRead(seq, &mut ptr))?;
+                Ok(out)
+            });
+            if !scatter.is_null() {
+                sys::VecScatterDestroy(&mut scatter);
+            }
+            if !seq.is_null() {
+                sys::VecDestroy(&mut seq);
+            }
+            if !is.is_null() {
+                sys::ISDestroy(&mut is);
+            }
+            out
+        }
+    }
 }
 
 impl Drop for Vector<'_> {

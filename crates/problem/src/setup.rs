@@ -77,8 +77,33 @@ fn refuse_electric_keys_without_unknowns(scene: &Scene, plan: &Plan) -> Result<(
 /// # Errors
 /// A [`ProblemError`] naming the scene key, mesh group or material at fault.
 pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, ProblemError> {
+    set_up(scene, Source::Whole(given))
+}
+
+/// The [`Setup`] of one rank's piece of a generated mesh (a [`mesh::MeshPiece`]'s mesh: the
+/// rank's block of cells and one layer of ghosts), for a run in which no rank holds the whole
+/// mesh. The scene's mesh must be one a piece is made of: generated, of order 1, neither
+/// graded nor layered nor rounded (the caller refuses the others by key). What only the whole
+/// mesh can tell is the caller's to check, by reductions over the ranks: that each region
+/// (`mesh.region`) holds a cell and each electrode a facet on some piece.
+///
+/// # Errors
+/// As [`setup`].
+pub fn setup_piece(scene: Valid<'_>, piece: mesh::Mesh) -> Result<Setup, ProblemError> {
+    set_up(scene, Source::Piece(piece))
+}
+
+/// Where the mesh of a set-up comes from.
+enum Source {
+    /// The whole mesh: handed over (a `gmsh` or `given` scene), or generated here.
+    Whole(Option<mesh::Mesh>),
+    /// A rank's piece of the generated mesh.
+    Piece(mesh::Mesh),
+}
+
+fn set_up(scene: Valid<'_>, source: Source) -> Result<Setup, ProblemError> {
     let scene = scene.scene();
-    let (mesh, notes) = mesh(scene, given)?;
+    let (mesh, notes) = mesh(scene, source)?;
     let dim = mesh.dim;
     scene.check_dimension(dim)?;
     let materials = materials(scene, dim)?;
@@ -153,9 +178,13 @@ impl Setup {
 
 /// The mesh of the scene, checked, with its regions by box and an `electrode` group where the
 /// scene has one, and what its checks noted.
-fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNotes), ProblemError> {
+fn mesh(scene: &Scene, source: Source) -> Result<(mesh::Mesh, MeshNotes), ProblemError> {
     let m = &scene.mesh;
     let n = m.cells_per_axis();
+    let given = match source {
+        Source::Whole(given) => given,
+        Source::Piece(piece) => return mesh_piece(scene, piece),
+    };
     let mut mesh = match (m.kind, given) {
         // a mesh handed over to a scene that makes its own would be ignored
         (MeshKind::Rectangle | MeshKind::Box, Some(_)) => {
@@ -211,7 +240,49 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
     for l in scene.loads() {
         crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;
     }
-    box_regions(&mut mesh, &m.regions)?;
+    box_regions(&mut mesh, &m.regions, true)?;
+    electrodes(&mut mesh, scene, true)?;
+    if m.axisymmetric {
+        axis_group(&mut mesh)?;
+    }
+    Ok((mesh, notes))
+}
+
+/// [`mesh`] of a rank's piece: its regions and electrodes, the emptiness of each left to the
+/// caller (a piece may hold none of a region that other pieces hold).
+fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNotes), ProblemError> {
+    let m = &scene.mesh;
+    let refused = [
+        (m.grading.is_some(), "mesh.grading"),
+        (!m.layers.is_empty(), "mesh.layer"),
+        (m.order.is_some_and(|o| o != 1), "mesh.order"),
+        (m.cylinder, "mesh.cylinder"),
+        (!matches!(m.kind, MeshKind::Rectangle | MeshKind::Box), "mesh.kind"),
+    ];
+    if let Some((_, key)) = refused.iter().find(|(r, _)| *r) {
+        return Err(SetupError::new(
+            key,
+            format!("{key}: a mesh made in pieces is a generated rectangle or box of order 1, neither graded, layered nor rounded"),
+        )
+        .into());
+    }
+    let quality = mesh.check()?;
+    let notes = MeshNotes {
+        coincident_nodes: quality.coincident_nodes,
+        unused_nodes: quality.unused_nodes,
+        ..MeshNotes::default()
+    };
+    box_regions(&mut mesh, &m.regions, false)?;
+    electrodes(&mut mesh, scene, false)?;
+    if m.axisymmetric {
+        axis_group(&mut mesh)?;
+    }
+    Ok((mesh, notes))
+}
+
+/// The electrodes' facet groups (`electrode.x_range` of `electrode.group`), each refused
+/// where it covers no facet when `whole` (a piece may cover none of an electrode).
+fn electrodes(mesh: &mut mesh::Mesh, scene: &Scene, whole: bool) -> Result<(), ProblemError> {
     for (k, e) in scene.electrodes().iter().enumerate() {
         let range = e
             .x_range
@@ -220,7 +291,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         let tol = 1e-12 * (1.0 + range[0].abs().max(range[1].abs()));
         let g = mesh.select_facets(&e.group, |x| x[0] >= range[0] - tol && x[0] <= range[1] + tol)?;
         let name = e.group_name(k);
-        if g.n_facets() == 0 {
+        if whole && g.n_facets() == 0 {
             return Err(SetupError::new(
                 "electrode.x_range",
                 format!(
@@ -239,10 +310,7 @@ fn mesh(scene: &Scene, given: Option<mesh::Mesh>) -> Result<(mesh::Mesh, MeshNot
         }
         mesh.boundaries.insert(name, g);
     }
-    if m.axisymmetric {
-        axis_group(&mut mesh)?;
-    }
-    Ok((mesh, notes))
+    Ok(())
 }
 
 /// `mesh` at the scene's `mesh.order`: raised to order 2 where it asks (a node at every
@@ -263,8 +331,9 @@ fn of_order(mesh: mesh::Mesh, scene: &Scene) -> Result<mesh::Mesh, ProblemError>
     }
 }
 
-/// The regions by box (`[[mesh.region]]`): the cells whose centroid lies in each box.
-fn box_regions(mesh: &mut mesh::Mesh, regions: &[crate::scene::RegionSpec]) -> Result<(), ProblemError> {
+/// The regions by box (`[[mesh.region]]`): the cells whose centroid lies in each box, each
+/// refused where it holds none when `whole` (a piece may hold none of a region).
+fn box_regions(mesh: &mut mesh::Mesh, regions: &[crate::scene::RegionSpec], whole: bool) -> Result<(), ProblemError> {
     for r in regions {
         let cells: Vec<usize> = (0..mesh.n_cells())
             .filter(|&c| {
@@ -275,7 +344,7 @@ fn box_regions(mesh: &mut mesh::Mesh, regions: &[crate::scene::RegionSpec]) -> R
                 })
             })
             .collect();
-        if cells.is_empty() {
+        if whole && cells.is_empty() {
             return Err(SetupError::new("mesh.region", format!("mesh.region `{}` holds no cell", r.name)).into());
         }
         mesh.regions.insert(r.name.clone(), cells);

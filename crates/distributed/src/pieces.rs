@@ -1,0 +1,306 @@
+//! A run in which no rank holds the whole mesh (issue 45's route): each rank generates its
+//! piece of the scene's mesh ([`mesh::Blocks`]: its block of cells and one layer of ghosts),
+//! sets it up ([`problem::backend::setup_piece`]), numbers the unknowns with the other ranks
+//! ([`Layout::of_piece`]), assembles its own cells and solves by the Krylov route; each rank
+//! then holds the solution at its piece's nodes (fetched from their owners, never gathered)
+//! and recovers the fields on its piece's cells.
+//!
+//! What it solves today: the linear problem (no contact, no path, no floating terminal) of a
+//! generated rectangle or box of order 1; every other scene is refused by key
+//! ([`pieces_support`]). The contact of the active sets, the outputs written by pieces and
+//! the run's report from reductions are the next steps (docs/performance.md, issue 45).
+//!
+//! Why the pieces are complete: a rank's own node lies only in cells of its piece (its own and
+//! the ghost layer), so its rows of the matrix, of the loads and of their lifting by prescribed
+//! values are summed from the piece alone, and the fields of every own cell are recovered
+//! from the piece's nodal values.
+
+use crate::error::DistributedError;
+use crate::krylov::{configure, KrylovFields};
+use crate::layout::Layout;
+use crate::system::assemble;
+use fe_assembly::CellFields;
+use mesh::{Blocks, MeshPiece};
+use petsc::{Index, Petsc, Vector};
+use problem::backend::{setup_piece, Unsupported};
+use problem::{MeshKind, ProblemError, Scene, SetupError};
+
+/// The backend name a run on pieces refuses under.
+const NAME: &str = "petsc";
+
+/// The bytes a rank takes per unknown it owns on the Krylov route (the matrix, the field
+/// split's sub-matrices, the two multigrid hierarchies and the Krylov basis; measured,
+/// docs/performance.md), and per cell of its piece (the piece's mesh, geometry, dof map and
+/// recovered fields).
+const BYTES_PER_UNKNOWN: f64 = 5.0e3;
+const BYTES_PER_CELL: f64 = 200.0;
+
+/// One rank's share of a run on pieces.
+pub struct PieceSolution {
+    /// The rank's piece: its mesh as set up (the scene's regions and electrodes), its cells'
+    /// and nodes' owners and their numbers in the whole mesh.
+    pub piece: MeshPiece,
+    /// The displacement at each node of the piece (`z = 0` in 2D).
+    pub u: Vec<[f64; 3]>,
+    /// The potential at each node of the piece (0 where a node has none).
+    pub phi: Vec<f64>,
+    /// Stress, strain, electric displacement and field in each cell of the piece (the ghost
+    /// cells' too: they are their owners' values).
+    pub fields: CellFields,
+    /// Unknowns of the whole problem (prescribed ones among them).
+    pub unknowns: usize,
+    /// The blocks of cells per axis the mesh was cut into.
+    pub blocks: [usize; 3],
+    /// Krylov iterations, and why the solve stopped (PETSc's reason).
+    pub iterations: usize,
+    /// PETSc's converged reason.
+    pub reason: String,
+    /// The PETSc options of the solve (the backend's, then the scene's).
+    pub options: String,
+}
+
+/// Whether a run on pieces solves `scene`: a generated rectangle or box of order 1 (not
+/// graded, layered or rounded), without contact, path or floating terminal.
+///
+/// # Errors
+/// [`Unsupported`], naming the key of what a run on pieces does not solve yet.
+pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
+    let m = &scene.mesh;
+    let refused = [
+        (
+            !matches!(m.kind, MeshKind::Rectangle | MeshKind::Box),
+            "mesh.kind",
+            "a mesh that is not generated",
+        ),
+        (m.grading.is_some(), "mesh.grading", "a graded mesh"),
+        (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
+        (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
+        (m.cylinder, "mesh.cylinder", "a rounded mesh"),
+        (!scene.zones().is_empty(), "contact", "contact"),
+        (scene.path.is_some(), "path", "a path"),
+        (
+            scene.floating_key().is_some(),
+            scene.floating_key().unwrap_or(""),
+            "a floating terminal",
+        ),
+    ];
+    match refused.iter().find(|(r, _, _)| *r) {
+        Some((_, key, what)) => {
+            Err(
+                Unsupported::new(NAME, key, format!("{what} on a mesh made in pieces (mesh.pieces)"))
+                    .advise("a run whose every rank holds the whole mesh solves it"),
+            )
+        }
+        None => Ok(()),
+    }
+}
+
+/// Solves `scene` on the ranks of `petsc`, each rank holding only its piece of the mesh, and
+/// returns each rank's share. Collective. `limits.memory_bytes` is what one rank may take:
+/// the estimate of a rank's peak is checked against it before the piece is made, on every
+/// rank.
+///
+/// # Errors
+/// [`Unsupported`] (as a scene error) for what a run on pieces does not solve; more ranks than
+/// the mesh has cells along its axes; the estimate over the limit ([`ProblemError::TooLarge`]
+/// naming the rank); the set-up's errors; PETSc's.
+pub fn solve_on_pieces(
+    petsc: &Petsc,
+    scene: &Scene,
+    limits: problem::Limits,
+) -> Result<PieceSolution, DistributedError> {
+    let valid = scene.validate()?;
+    pieces_support(scene).map_err(ProblemError::from)?;
+    let (rank, ranks) = (petsc.rank(), petsc.size());
+    let m = &scene.mesh;
+    let dim = m.lo.len();
+    let n = m.cells_per_axis();
+    let cells = [n[0], n[1], n.get(2).copied().unwrap_or(1)];
+    let blocks = Blocks::new(dim, cells, ranks).ok_or_else(|| {
+        ProblemError::from(SetupError::new(
+            "mesh.n",
+            format!(
+                "{ranks} ranks cannot each hold a block of the {} cells per axis (mesh.n): fewer ranks, or a finer mesh",
+                cells[..dim].iter().map(usize::to_string).collect::<Vec<_>>().join(" x ")
+            ),
+        ))
+    })?;
+    check_memory(scene, &blocks, rank, limits)?;
+    let mut piece = match dim {
+        2 => blocks.rectangle_piece([m.lo[0], m.lo[1]], [m.hi[0], m.hi[1]], rank),
+        _ => blocks.box_piece([m.lo[0], m.lo[1], m.lo[2]], [m.hi[0], m.hi[1], m.hi[2]], rank),
+    };
+    let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
+    check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
+    conditions_on_the_piece(petsc, &mut setup)?;
+    let disc = setup.discretize()?;
+    let (b_u, b_phi) = disc.rhs(&setup.loads)?;
+    ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
+    ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
+    let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
+    let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
+    let options = configure(petsc, scene, &layout, None)?;
+    let fields = KrylovFields::new(petsc, &setup, &layout);
+    let mut ksp = fields.krylov(petsc, &mut system.matrix)?;
+    let mut x = system.rhs.duplicate()?;
+    let info = ksp.solve(&system.rhs, &mut x)?;
+    if !info.reason.starts_with("CONVERGED") {
+        return Err(ProblemError::NoSolution {
+            sought: "the Krylov solve on the pieces",
+            why: format!("{} after {} iterations", info.reason, info.iterations),
+        }
+        .into());
+    }
+    let (u, phi) = nodal(&x, &layout)?;
+    let fields = disc.recover(&u, &phi);
+    ProblemError::check_finite(&fields.stress, "the stress", &valid)?;
+    drop(disc);
+    piece.mesh = setup.mesh;
+    Ok(PieceSolution {
+        piece,
+        u,
+        phi,
+        fields,
+        unknowns: layout.n_global(),
+        blocks: blocks.p,
+        iterations: info.iterations,
+        reason: info.reason,
+        options,
+    })
+}
+
+/// A mesh with nothing in it, in place of a piece's mesh while its set-up holds it.
+fn empty(dim: usize) -> mesh::Mesh {
+    mesh::Mesh {
+        dim,
+        kind: if dim == 2 {
+            mesh::CellKind::Tri3
+        } else {
+            mesh::CellKind::Tet4
+        },
+        points: vec![],
+        cells: vec![],
+        boundaries: Default::default(),
+        regions: Default::default(),
+        reoriented_cells: 0,
+    }
+}
+
+/// The solution `x` at every node of the piece: each node's unknowns fetched from the rank
+/// that owns them (the displacements, then the potential where the node has one).
+fn nodal(x: &Vector<'_>, layout: &Layout) -> Result<(Vec<[f64; 3]>, Vec<f64>), DistributedError> {
+    let n = layout.first.len();
+    let rows: Vec<Index> = (0..n).flat_map(|v| layout.node_dofs(v)).map(Layout::index).collect();
+    let values = x.fetch(&rows)?;
+    let (mut u, mut phi) = (vec![[0.0; 3]; n], vec![0.0; n]);
+    let mut at = 0;
+    for v in 0..n {
+        u[v][..layout.dim].copy_from_slice(&values[at..at + layout.dim]);
+        at += layout.dim;
+        if layout.has_phi[v] {
+            phi[v] = values[at];
+            at += 1;
+        }
+    }
+    Ok((u, phi))
+}
+
+/// The estimate of a rank's peak on pieces (its share of the unknowns, its piece's cells)
+/// against what one rank may take; refused on every rank alike (the estimate is the largest
+/// block's), naming the rank that reaches it.
+fn check_memory(scene: &Scene, blocks: &Blocks, rank: usize, limits: problem::Limits) -> Result<(), ProblemError> {
+    let Some(available) = limits.memory_bytes else {
+        return Ok(());
+    };
+    let Some((dim, _, cells, unknowns)) = problem::backend::generated_sizes(scene) else {
+        return Ok(());
+    };
+    // the largest block's share, widened by its ghost layer on both sides of every cut axis
+    let widened: f64 = (0..dim)
+        .map(|k| {
+            let own = blocks.cells(k, 0).len();
+            let ghosts = 2 * usize::from(blocks.p[k] > 1);
+            (own + ghosts) as f64 / blocks.n[k] as f64
+        })
+        .product();
+    let (cells, unknowns) = (cells * widened, unknowns * widened);
+    let bytes = BYTES_PER_UNKNOWN * unknowns + BYTES_PER_CELL * cells;
+    if bytes > available as f64 {
+        return Err(ProblemError::TooLarge {
+            what: format!(
+                "rank {rank} of {}: a piece of {cells:.3e} cells and {unknowns:.3e} unknowns",
+                blocks.ranks()
+            ),
+            needed: bytes as u64,
+            available,
+            limit: limits.memory_limit.unwrap_or("the memory available to one rank"),
+        });
+    }
+    Ok(())
+}
+
+/// The Dirichlet conditions of the set-up that reach the piece: a condition on a group of
+/// which the piece holds no facet fixes nothing here and is dropped (the dof map refuses a
+/// condition that reaches no unknown); one that no piece reaches is kept on every rank, so that
+/// each refuses it alike.
+fn conditions_on_the_piece(petsc: &Petsc, setup: &mut problem::backend::Setup) -> Result<(), DistributedError> {
+    let mesh = &setup.mesh;
+    let here: Vec<bool> = setup
+        .constraints
+        .iter()
+        .map(|c| mesh.boundaries.get(&c.group).is_some_and(|g| g.n_facets() > 0))
+        .collect();
+    let counts: Vec<f64> = here.iter().map(|&h| f64::from(u8::from(h))).collect();
+    let anywhere = petsc.sum(&counts)?;
+    let mut k = 0;
+    setup.constraints.retain(|_| {
+        let keep = here[k] || anywhere[k] == 0.0;
+        k += 1;
+        keep
+    });
+    Ok(())
+}
+
+/// Refuses a region (`mesh.region`) that holds no cell, or an electrode that covers no facet,
+/// on every piece: counted on each rank's own cells and summed.
+fn check_regions_and_electrodes(
+    petsc: &Petsc,
+    scene: &Scene,
+    mesh: &mesh::Mesh,
+    own_cells: usize,
+) -> Result<(), DistributedError> {
+    let regions: Vec<&str> = scene.mesh.regions.iter().map(|r| r.name.as_str()).collect();
+    let electrodes: Vec<String> = (0..scene.electrodes().len())
+        .map(|k| scene.electrodes()[k].group_name(k))
+        .collect();
+    let mut counts: Vec<f64> = regions
+        .iter()
+        .map(|r| {
+            mesh.regions
+                .get(*r)
+                .map_or(0, |c| c.iter().filter(|&&c| c < own_cells).count()) as f64
+        })
+        .collect();
+    counts.extend(
+        electrodes
+            .iter()
+            .map(|e| mesh.boundaries.get(e).map_or(0, |g| g.n_facets()) as f64),
+    );
+    let sums = petsc.sum(&counts)?;
+    if let Some(k) = (0..regions.len()).find(|&k| sums[k] == 0.0) {
+        return Err(ProblemError::from(SetupError::new(
+            "mesh.region",
+            format!("mesh.region `{}` holds no cell", regions[k]),
+        ))
+        .into());
+    }
+    if let Some(k) = (0..electrodes.len()).find(|&k| sums[regions.len() + k] == 0.0) {
+        let e = &scene.electrodes()[k];
+        return Err(ProblemError::from(SetupError::new(
+            "electrode.x_range",
+            format!("the electrode `{}` covers no facet of `{}`", electrodes[k], e.group),
+        ))
+        .into());
+    }
+    Ok(())
+}
