@@ -67,8 +67,9 @@ pub use points::{ContactPoints, Foundation, PointValues, Status};
 pub use projection::{disc_piece, project_cone, project_disc, project_nonnegative, DiscPiece};
 pub use schedule::{Phase, ProblemClass, Schedule};
 pub use solution::{
-    classify, complementarity_residual, coulomb_radius, desaxce_residual, multiplier_scale, slip_bound, ContactInfo,
-    ContactSolution, Interrupt, Interruption, Iterate, Law, Measure, Progress, Stage, Stall,
+    classify, complementarity_norms, complementarity_residual, coulomb_radius, desaxce_residual, multiplier_scale,
+    relative_complementarity, slip_bound, ContactInfo, ContactSolution, Interrupt, Interruption, Iterate, Law, Measure,
+    Progress, Stage, Stall,
 };
 pub use uniqueness::slip_bound_expansion;
 pub use uzawa::{solve_uzawa, StopRule, UzawaParams, FIXED_POINT_PATIENCE};

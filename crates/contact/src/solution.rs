@@ -299,6 +299,15 @@ pub fn slip_bound(points: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f6
 }
 
 impl Law {
+    /// The law at the points `keep` of its points (Tresca's bounds there; the others have
+    /// none per point), as [`ContactPoints::select`] keeps them.
+    pub fn select(&self, keep: &[usize]) -> Law {
+        match self {
+            Law::Tresca(s) => Law::Tresca(keep.iter().map(|&i| s[i]).collect()),
+            other => other.clone(),
+        }
+    }
+
     /// The slip radius of point `i` at the normal value `z_n` (a multiplier, or Newton's
     /// augmented `z_n`): Tresca's `S_i`, Coulomb's `F_i [z_n]₊` ([`coulomb_radius`]) or, at a
     /// point of a Tresca zone beside Coulomb's ([`ContactPoints::tresca_of`]), its bound; 0
@@ -337,6 +346,32 @@ pub fn complementarity_residual(
     c: f64,
     reference: f64,
 ) -> f64 {
+    let (num, lam) = complementarity_norms(points, radius, lambda, u, c);
+    relative_complementarity(num, lam, reference)
+}
+
+/// [`complementarity_residual`] from its parts: the natural map's norm `num`, the multipliers'
+/// `lam` (both `‖·‖_W`) and the multiplier scale `reference`. For a caller that holds the
+/// points in parts (the ranks of a parallel run: each part's norms from
+/// [`complementarity_norms`], combined as `sqrt(Σ ‖·‖²)`).
+pub fn relative_complementarity(num: f64, lam: f64, reference: f64) -> f64 {
+    let den = lam.max(reference);
+    if den > 0.0 {
+        num / den
+    } else {
+        num
+    }
+}
+
+/// The two norms of [`complementarity_residual`] over `points`: the natural map's
+/// `‖(λ_n - max(0, λ_n + c (u_n - g)), λ_t - P_S(λ_t + c u_t))‖_W` and `‖λ‖_W`.
+pub fn complementarity_norms(
+    points: &ContactPoints,
+    radius: &[f64],
+    lambda: &PointValues,
+    u: &PointValues,
+    c: f64,
+) -> (f64, f64) {
     let n = points.len();
     let nt = lambda.n_tangential();
     let mut r = PointValues::zeros(n, nt);
@@ -356,13 +391,7 @@ pub fn complementarity_residual(
             }
         }
     }
-    let num = r.weighted_norm(&points.weight);
-    let den = lambda.weighted_norm(&points.weight).max(reference);
-    if den > 0.0 {
-        num / den
-    } else {
-        num
-    }
+    (r.weighted_norm(&points.weight), lambda.weighted_norm(&points.weight))
 }
 
 /// Siconos' error measure in this crate's terms ([`Measure::DeSaxce`]). With `r = λ`, the

@@ -54,7 +54,7 @@ pub(crate) fn solve<'p>(
 ) -> Result<contact::ContactSolution, DistributedError> {
     let petsc = k.petsc;
     let boundary = active.boundary.as_ref().ok_or_else(unprimed)?;
-    let rows = ContactRows::new(petsc, at.points, &boundary.nodes, layout, &k.system);
+    let rows = ContactRows::new(petsc, (at.points, &boundary.nodes, &how.law), true, layout, &k.system)?;
     let params = ActiveSetParams {
         tol: how.tol,
         max_steps: MAX_ACTIVE_SET_STEPS,
@@ -74,24 +74,16 @@ pub(crate) fn solve<'p>(
         let info = ksp.solve(b, x)?;
         Ok((info.iterations, info.reason))
     };
-    let out = active_set(
-        petsc,
-        layout,
-        &k.system,
-        &rows,
-        &how.law,
-        params,
-        &mut solve_one,
-        &mut progress,
-    )
-    .map_err(|e| match e {
-        ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
-        other => DistributedError::Contact(other),
-    })?;
+    let out =
+        active_set(petsc, layout, &k.system, &rows, params, &mut solve_one, &mut progress).map_err(|e| match e {
+            ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+            other => DistributedError::Contact(other),
+        })?;
     (k.iterations, k.reason) = (out.krylov_iterations, out.reason);
     k.report(reporter);
     active.x = Some(out.x);
-    Ok(out.solution)
+    // the run reports the whole boundary's solution on every rank
+    Ok(rows.whole(petsc, &out.solution, &how.law, at.points)?)
 }
 
 /// The contact solve's solution, whole on every rank, with its equilibrium residual

@@ -28,8 +28,8 @@
 use crate::layout::Layout;
 use crate::system::System;
 use contact::{
-    classify, complementarity_residual, ContactInfo, ContactPoints, ContactSolution, DiscPiece, Law, PointValues,
-    Progress, Stage, Status,
+    classify, complementarity_norms, relative_complementarity, ContactInfo, ContactPoints, ContactSolution, DiscPiece,
+    Law, PointValues, Progress, Stage, Status,
 };
 use petsc::{Index, Matrix, Petsc, PetscError, Vector};
 
@@ -42,19 +42,27 @@ pub struct ActiveSetParams {
     pub max_steps: usize,
 }
 
-/// The contact points owned by this rank, with their rows.
+/// The contact points this rank owns (those at its nodes), with their rows: every rank works
+/// on its own points only, and what the iteration decides on (the residual, the multiplier
+/// scale, whether the sets repeat) is reduced over the ranks.
 #[derive(Clone)]
-pub struct ContactRows<'a> {
-    points: &'a ContactPoints,
-    /// The mesh node of each point.
-    nodes: &'a [usize],
-    /// The points whose node this rank owns.
+pub struct ContactRows {
+    /// This rank's points, as the contact crate's points.
+    points: ContactPoints,
+    /// The mesh node of each of them.
+    nodes: Vec<usize>,
+    /// Each one's index among the points it was chosen from.
     mine: Vec<usize>,
+    /// The points chosen from, on every rank together (where each rank was handed the whole
+    /// boundary: its size; where each was handed its own points: their sum).
+    total: usize,
+    /// The law at this rank's points.
+    law: Law,
     /// This rank.
     rank: usize,
     /// `c` of the natural map, pressure per length: [`C_START`] times the stiffness scale (the
-    /// mean diagonal of `A` over the mean weight) to begin with, divided by 10 where the sets
-    /// cycle.
+    /// mean diagonal of `A` over the mean weight of all the ranks' points) to begin with,
+    /// divided by 10 where the sets cycle.
     c: f64,
 }
 
@@ -74,10 +82,11 @@ impl PartialEq for Sets {
     }
 }
 
-/// What the iteration produced: the multipliers and displacements at the points (every rank),
-/// the final solution vector, counts.
+/// What the iteration produced: the multipliers and displacements at this rank's points, the
+/// final solution vector, counts.
 pub struct ContactOutcome<'p> {
-    /// The contact solution (multipliers, displacements, statuses, counts).
+    /// The contact solution at this rank's points (multipliers, displacements, statuses; the
+    /// counts are the run's).
     pub solution: ContactSolution,
     /// The solution of the last step.
     pub x: Vector<'p>,
@@ -87,26 +96,64 @@ pub struct ContactOutcome<'p> {
     pub reason: String,
 }
 
-impl<'a> ContactRows<'a> {
-    /// The points of `points` (at the mesh `nodes`) this rank owns under `layout`.
+impl ContactRows {
+    /// The points of `points` (at the mesh `nodes`, under `law`) this rank owns under
+    /// `layout`: `points` may be the whole boundary, the same on every rank, or this rank's
+    /// piece of it (`whole` says which). Collective.
     pub fn new(
         petsc: &Petsc,
-        points: &'a ContactPoints,
-        nodes: &'a [usize],
+        (points, nodes, law): (&ContactPoints, &[usize], &Law),
+        whole: bool,
         layout: &Layout,
         system: &System<'_>,
-    ) -> Self {
-        let mine = (0..points.len())
+    ) -> Result<Self, PetscError> {
+        let mine: Vec<usize> = (0..points.len())
             .filter(|&i| layout.node_rank[nodes[i]] == petsc.rank())
             .collect();
-        let mean_w = points.weight.iter().sum::<f64>() / points.len().max(1) as f64;
-        ContactRows {
-            points,
-            nodes,
+        let own = points.select(&mine);
+        let sums = petsc.sum(&[own.weight.iter().sum::<f64>(), own.len() as f64, points.len() as f64])?;
+        let mean_w = sums[0] / sums[1].max(1.0);
+        Ok(ContactRows {
+            nodes: mine.iter().map(|&i| nodes[i]).collect(),
+            points: own,
+            law: law.select(&mine),
             mine,
+            total: if whole { points.len() } else { sums[2] as usize },
             rank: petsc.rank(),
             c: C_START * system.diagonal[0] / mean_w,
-        }
+        })
+    }
+
+    /// A solution at this rank's points spread into the whole boundary's, on every rank (the
+    /// points were chosen from the whole boundary): multipliers and displacements summed over
+    /// the ranks (each point is one rank's), the statuses classified again under `law`.
+    /// Collective.
+    pub fn whole(
+        &self,
+        petsc: &Petsc,
+        own: &ContactSolution,
+        law: &Law,
+        all: &ContactPoints,
+    ) -> Result<ContactSolution, PetscError> {
+        let (n, nt) = (self.total, self.points.n_tangential());
+        let spread = |v: &PointValues| -> Result<PointValues, PetscError> {
+            let mut flat = vec![0.0; n * (1 + nt)];
+            for (k, &i) in self.mine.iter().enumerate() {
+                flat[i] = v.normal[k];
+                flat[n + i * nt..n + (i + 1) * nt].copy_from_slice(&v.tangential[k * nt..(k + 1) * nt]);
+            }
+            let sum = petsc.sum(&flat)?;
+            Ok(PointValues::from_parts(sum[..n].to_vec(), sum[n..].to_vec(), nt).expect("lengths agree"))
+        };
+        let (lambda, u) = (spread(&own.lambda)?, spread(&own.u)?);
+        let status = classify(&lambda, &bound(all, law, &lambda.normal));
+        Ok(ContactSolution {
+            lambda,
+            u,
+            status,
+            info: own.info.clone(),
+            electric: None,
+        })
     }
 }
 
@@ -162,13 +209,12 @@ pub fn active_set<'p>(
     petsc: &'p Petsc,
     layout: &Layout,
     system: &System<'p>,
-    rows: &ContactRows<'_>,
-    law: &Law,
+    rows: &ContactRows,
     params: ActiveSetParams,
     solve: &mut LinearSolve<'_, 'p>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactOutcome<'p>, ActiveSetError> {
-    let p = rows.points;
+    let (p, law) = (&rows.points, &rows.law);
     let (n, nt) = (p.len(), p.n_tangential());
     // the loads alone: the first iterate, and the residual's multiplier scale
     let mut x = system.rhs.duplicate()?;
@@ -180,9 +226,9 @@ pub fn active_set<'p>(
     for i in 0..n {
         gap_u.normal[i] -= p.gap[i];
     }
-    let reference = rows.c * gap_u.weighted_norm(&p.weight);
+    let reference = rows.c * over_ranks(petsc, gap_u.weighted_norm(&p.weight))?;
     let lambda = PointValues::zeros(n, nt);
-    let last_residual = complementarity_residual(p, &bound(p, law, &lambda.normal), &lambda, &u, rows.c, reference);
+    let last_residual = residual(petsc, rows, law, (&lambda, &u), reference)?;
     let mut it = Iterate {
         lambda,
         u,
@@ -203,7 +249,7 @@ pub fn active_set<'p>(
             rows: &rows,
         };
         let residual = match ctx.steps(&mut it, law, params, solve, progress)? {
-            Ended::Converged => return Ok(ctx.outcome(it, law)),
+            Ended::Converged => return Ok(ctx.outcome(it, law)?),
             Ended::Cycled(r) => r,
         };
         if it.reductions == MAX_REDUCTIONS || it.steps >= params.max_steps {
@@ -239,7 +285,7 @@ struct Context<'a, 'p> {
     petsc: &'p Petsc,
     layout: &'a Layout,
     system: &'a System<'p>,
-    rows: &'a ContactRows<'a>,
+    rows: &'a ContactRows,
 }
 
 impl<'p> Context<'_, 'p> {
@@ -253,22 +299,26 @@ impl<'p> Context<'_, 'p> {
         solve: &mut LinearSolve<'_, 'p>,
         progress: &mut dyn FnMut(&Progress),
     ) -> Result<Ended, ActiveSetError> {
-        let p = self.rows.points;
+        let p = &self.rows.points;
         let mut seen: Vec<Sets> = vec![];
         let (mut best, mut since_best) = (f64::INFINITY, 0);
         while it.steps < params.max_steps {
             it.steps += 1;
             let (sets, direction) = sets(self.rows, law, &it.lambda, &it.u);
             self.step(it, law, &sets, &direction, solve)?;
-            let residual = self.residual(it, law);
+            let residual = self.residual(it, law)?;
             it.last_residual = residual;
+            let counts = counts(&classify(&it.lambda, &bound(p, law, &it.lambda.normal)));
+            let all = self.petsc.sum(&[counts.0 as f64, counts.1 as f64, counts.2 as f64])?;
             progress(&Progress {
                 stage: Stage::Newton,
                 iter: it.steps,
                 residual,
-                counts: counts(&classify(&it.lambda, &bound(p, law, &it.lambda.normal))),
+                counts: (all[0] as usize, all[1] as usize, all[2] as usize),
             });
-            let repeated = seen.last() == Some(&sets);
+            // the sets of every rank against its own earlier ones: the same on all ranks or not
+            let same = self.everywhere(seen.iter().map(|s| *s == sets))?;
+            let repeated = same.last() == Some(&true);
             if residual <= params.tol && (repeated || residual <= 0.01 * params.tol) {
                 return Ok(Ended::Converged);
             }
@@ -277,13 +327,19 @@ impl<'p> Context<'_, 'p> {
             } else {
                 since_best += 1;
             }
-            let cycled = !repeated && seen.iter().rev().skip(1).any(|s| *s == sets);
+            let cycled = !repeated && same.iter().rev().skip(1).any(|&s| s);
             if cycled || since_best >= PATIENCE {
                 return Ok(Ended::Cycled(residual));
             }
             seen.push(sets);
         }
-        Ok(Ended::Cycled(self.residual(it, law)))
+        Ok(Ended::Cycled(self.residual(it, law)?))
+    }
+
+    /// Whether each of `flags` holds on every rank. Collective.
+    fn everywhere(&self, flags: impl Iterator<Item = bool>) -> Result<Vec<bool>, PetscError> {
+        let misses: Vec<f64> = flags.map(|f| f64::from(u8::from(!f))).collect();
+        Ok(self.petsc.sum(&misses)?.into_iter().map(|m| m == 0.0).collect())
     }
 
     /// One step: hold the active and sticking components, load the slipping ones, solve.
@@ -312,17 +368,16 @@ impl<'p> Context<'_, 'p> {
         Ok(())
     }
 
-    /// The natural-map residual of `law` at the iterate.
-    fn residual(&self, it: &Iterate<'_>, law: &Law) -> f64 {
-        let p = self.rows.points;
-        let radius = bound(p, law, &it.lambda.normal);
-        complementarity_residual(p, &radius, &it.lambda, &it.u, self.rows.c, it.reference)
+    /// The natural-map residual of `law` at the iterate, over the ranks. Collective.
+    fn residual(&self, it: &Iterate<'_>, law: &Law) -> Result<f64, PetscError> {
+        residual(self.petsc, self.rows, law, (&it.lambda, &it.u), it.reference)
     }
 
-    /// The converged iterate as the contact crate's solution.
-    fn outcome(&self, it: Iterate<'p>, law: &Law) -> ContactOutcome<'p> {
-        let residual = self.residual(&it, law);
-        let status = classify(&it.lambda, &bound(self.rows.points, law, &it.lambda.normal));
+    /// The converged iterate as the contact crate's solution at this rank's points.
+    /// Collective.
+    fn outcome(&self, it: Iterate<'p>, law: &Law) -> Result<ContactOutcome<'p>, PetscError> {
+        let residual = self.residual(&it, law)?;
+        let status = classify(&it.lambda, &bound(&self.rows.points, law, &it.lambda.normal));
         let info = ContactInfo {
             newton_iters: it.steps,
             operator_calls: it.steps + 1,
@@ -331,7 +386,7 @@ impl<'p> Context<'_, 'p> {
             augmentation: Some(self.rows.c),
             ..ContactInfo::new(1.0 / self.rows.c)
         };
-        ContactOutcome {
+        Ok(ContactOutcome {
             solution: ContactSolution {
                 lambda: it.lambda,
                 u: it.u,
@@ -342,7 +397,7 @@ impl<'p> Context<'_, 'p> {
             x: it.x,
             krylov_iterations: it.krylov,
             reason: it.reason,
-        }
+        })
     }
 }
 
@@ -376,8 +431,8 @@ fn bound(p: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f64> {
 
 /// The step's sets, and the slip direction `d = z_t / |z_t|` of each slipping point (zero
 /// elsewhere).
-fn sets(rows: &ContactRows<'_>, law: &Law, lambda: &PointValues, u: &PointValues) -> (Sets, PointValues) {
-    let p = rows.points;
+fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) -> (Sets, PointValues) {
+    let p = &rows.points;
     let (n, nt) = (p.len(), p.n_tangential());
     let c = rows.c;
     let mut active = vec![false; n];
@@ -433,7 +488,7 @@ fn sets(rows: &ContactRows<'_>, law: &Law, lambda: &PointValues, u: &PointValues
 /// multiple of the row of `u_n`). Collective (the matrix and `b` are assembled).
 #[allow(clippy::too_many_arguments)]
 fn hold(
-    rows: &ContactRows<'_>,
+    rows: &ContactRows,
     layout: &Layout,
     law: &Law,
     sets: &Sets,
@@ -441,14 +496,14 @@ fn hold(
     matrix: &mut Matrix<'_>,
     b: &mut Vector<'_>,
 ) -> Result<Vec<(Index, f64)>, PetscError> {
-    let p = rows.points;
+    let p = &rows.points;
     let (dim, nt) = (p.dim, p.n_tangential());
     let b_local = b.local()?;
     let start = layout.rank_start[rows.rank];
     let mut held = vec![];
     let (mut idx, mut forces) = (vec![], vec![]);
     let mut new_rows = vec![];
-    for &i in &rows.mine {
+    for i in 0..p.len() {
         if !sets.active[i] {
             continue;
         }
@@ -535,59 +590,85 @@ fn set_held_values(
     })
 }
 
-/// `u_n` and `u_t` at every point (each rank fills its own points; a sum gathers them).
+/// `u_n` and `u_t` at this rank's points.
 fn displacements(
     petsc: &Petsc,
     layout: &Layout,
-    rows: &ContactRows<'_>,
+    rows: &ContactRows,
     x: &Vector<'_>,
 ) -> Result<PointValues, PetscError> {
-    let p = rows.points;
+    let p = &rows.points;
     let (n, dim, nt) = (p.len(), p.dim, p.n_tangential());
     let local = x.local()?;
     let start = layout.owned(petsc.rank()).start;
-    let mut flat = vec![0.0; n * (1 + nt)];
-    for &i in &rows.mine {
+    let mut u = PointValues::zeros(n, nt);
+    for i in 0..n {
         let first = layout.first[rows.nodes[i]] - start;
         let ui: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
-        flat[i] = dot(&ui, &p.normal[i], dim);
+        u.normal[i] = dot(&ui, &p.normal[i], dim);
         for q in 0..nt {
-            flat[n + i * nt + q] = dot(&ui, &p.tangent[i][q], dim);
+            u.tangential[i * nt + q] = dot(&ui, &p.tangent[i][q], dim);
         }
     }
-    let all = petsc.sum(&flat)?;
-    Ok(PointValues::from_parts(all[..n].to_vec(), all[n..].to_vec(), nt).expect("lengths agree"))
+    Ok(u)
 }
 
-/// The multipliers of the step: the reactions `r = K x - b` of the loads without contact, at
-/// the active points (`λ_n = -(r·n)/w`, `λ_t = -(r·t)/w`: held components, Tresca's load and
-/// Coulomb's equation alike), zero where separated.
+/// The multipliers of the step at this rank's points: the reactions `r = K x - b` of the
+/// loads without contact, at the active points (`λ_n = -(r·n)/w`, `λ_t = -(r·t)/w`: held
+/// components, Tresca's load and Coulomb's equation alike), zero where separated. Collective
+/// (the product).
 fn multipliers(
     petsc: &Petsc,
     layout: &Layout,
     system: &System<'_>,
-    rows: &ContactRows<'_>,
+    rows: &ContactRows,
     sets: &Sets,
     x: &Vector<'_>,
 ) -> Result<PointValues, PetscError> {
-    let p = rows.points;
+    let p = &rows.points;
     let (n, dim, nt) = (p.len(), p.dim, p.n_tangential());
     let local = system.reactions(x)?.local()?;
     let start = layout.owned(petsc.rank()).start;
-    let mut flat = vec![0.0; n * (1 + nt)];
-    for &i in &rows.mine {
-        if !sets.active[i] {
-            continue;
-        }
+    let mut lambda = PointValues::zeros(n, nt);
+    for i in (0..n).filter(|&i| sets.active[i]) {
         let first = layout.first[rows.nodes[i]] - start;
         let f: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
         let w = p.weight[i];
-        flat[i] = -dot(&f, &p.normal[i], dim) / w;
+        lambda.normal[i] = -dot(&f, &p.normal[i], dim) / w;
         // (a held tangent's reaction is its support's, not the contact's)
         for q in (0..nt).filter(|&q| !p.is_held(i, q)) {
-            flat[n + i * nt + q] = -dot(&f, &p.tangent[i][q], dim) / w;
+            lambda.tangential[i * nt + q] = -dot(&f, &p.tangent[i][q], dim) / w;
         }
     }
-    let all = petsc.sum(&flat)?;
-    Ok(PointValues::from_parts(all[..n].to_vec(), all[n..].to_vec(), nt).expect("lengths agree"))
+    Ok(lambda)
+}
+
+/// The Euclidean combination `sqrt(Σ x_r²)` of the ranks' `x` (each a norm over its own
+/// points), scaled by the largest so that no square overflows. Collective.
+fn over_ranks(petsc: &Petsc, x: f64) -> Result<f64, PetscError> {
+    let m = petsc.max(&[x])?[0];
+    if !(m > 0.0) || !m.is_finite() {
+        return Ok(m);
+    }
+    Ok(m * petsc.sum(&[(x / m) * (x / m)])?[0].sqrt())
+}
+
+/// The natural-map residual of `law` at `(λ, u)` over every rank's points, as the contact
+/// crate's `complementarity_residual` is over one set ([`relative_complementarity`] of the
+/// norms combined over the ranks). Collective.
+fn residual(
+    petsc: &Petsc,
+    rows: &ContactRows,
+    law: &Law,
+    (lambda, u): (&PointValues, &PointValues),
+    reference: f64,
+) -> Result<f64, PetscError> {
+    let p = &rows.points;
+    let radius = bound(p, law, &lambda.normal);
+    let (num, lam) = complementarity_norms(p, &radius, lambda, u, rows.c);
+    Ok(relative_complementarity(
+        over_ranks(petsc, num)?,
+        over_ranks(petsc, lam)?,
+        reference,
+    ))
 }
