@@ -6,7 +6,7 @@
 
 use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
-use crate::krylov::Krylov;
+use crate::krylov::{Krylov, KrylovFields};
 use crate::layout::Layout;
 use crate::system::System;
 use petsc::{Index, Petsc, PetscError, Vector};
@@ -63,16 +63,7 @@ pub(crate) fn solve<'p>(
     let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
     let (fields, t_pc) = (&k.fields, &mut k.t_pc);
     let mut solve_one = |m: &mut petsc::Matrix<'p>, b: &Vector<'p>, x: &mut Vector<'p>, loose: Option<f64>| {
-        let t = std::time::Instant::now();
-        let mut ksp = fields.krylov(petsc, m)?;
-        *t_pc += t.elapsed().as_secs_f64();
-        // an inexact step where the iteration allows one looser than the options' tolerance
-        let tight = ksp.relative_tolerance()?;
-        if let Some(rtol) = loose.filter(|&r| r > tight) {
-            ksp.set_relative_tolerance(rtol)?;
-        }
-        let info = ksp.solve(b, x)?;
-        Ok((info.iterations, info.reason))
+        step(petsc, fields, t_pc, (m, b, x), loose)
     };
     let out =
         active_set(petsc, layout, &k.system, &rows, params, &mut solve_one, &mut progress).map_err(|e| match e {
@@ -84,6 +75,28 @@ pub(crate) fn solve<'p>(
     active.x = Some(out.x);
     // the run reports the whole boundary's solution on every rank
     Ok(rows.whole(petsc, &out.solution, &how.law, at.points)?)
+}
+
+/// One active-set step's linear solve: the Krylov solver of the step's matrix `m` (its
+/// preconditioner's set-up time added to `t_pc`), to the relative tolerance `loose` where it is
+/// looser than the options' (an inexact step), `x` the start and the solution; Krylov
+/// iterations and PETSc's reason.
+pub(crate) fn step<'p>(
+    petsc: &'p Petsc,
+    fields: &KrylovFields,
+    t_pc: &mut f64,
+    (m, b, x): (&mut petsc::Matrix<'p>, &Vector<'p>, &mut Vector<'p>),
+    loose: Option<f64>,
+) -> Result<(usize, String), PetscError> {
+    let t = std::time::Instant::now();
+    let mut ksp = fields.krylov(petsc, m)?;
+    *t_pc += t.elapsed().as_secs_f64();
+    let tight = ksp.relative_tolerance()?;
+    if let Some(rtol) = loose.filter(|&r| r > tight) {
+        ksp.set_relative_tolerance(rtol)?;
+    }
+    let info = ksp.solve(b, x)?;
+    Ok((info.iterations, info.reason))
 }
 
 /// The contact solve's solution, whole on every rank, with its equilibrium residual
@@ -109,7 +122,7 @@ pub(crate) fn fields(
 
 /// `|K x - b - f_c| / max(|loads|, |f_c|)` over all unknowns, with `f_c` the contact forces of
 /// the multipliers (the prescribed rows hold exactly), as the default backend measures it.
-fn residual(
+pub(crate) fn residual(
     system: &System<'_>,
     x: &Vector<'_>,
     (b, sol): (&ContactBoundary, &contact::ContactSolution),

@@ -5,25 +5,30 @@
 //! then holds the solution at its piece's nodes (fetched from their owners, never gathered)
 //! and recovers the fields on its piece's cells.
 //!
-//! What it solves today: the linear problem (no contact, no path, no floating terminal) of a
-//! generated rectangle or box of order 1; every other scene is refused by key
-//! ([`pieces_support`]). The contact of the active sets, the outputs written by pieces and
-//! the run's report from reductions are the next steps (docs/performance.md, issue 45).
+//! What it solves today: a generated rectangle or box of order 1 without path or floating
+//! terminal, without contact or with the contact the active sets hold (the paper's base model
+//! on one zone: [`crate::active_sets_hold`]), each rank iterating on the contact points at
+//! the nodes it owns; every other scene is refused by key ([`pieces_support`]). The outputs
+//! written by pieces and the run's report from reductions are the next steps
+//! (docs/performance.md, issue 45).
 //!
 //! Why the pieces are complete: a rank's own node lies only in cells of its piece (its own and
 //! the ghost layer), so its rows of the matrix, of the loads and of their lifting by prescribed
 //! values are summed from the piece alone, and the fields of every own cell are recovered
 //! from the piece's nodal values.
 
+use crate::active::{residual, step};
+use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
 use crate::krylov::{configure, KrylovFields};
 use crate::layout::Layout;
-use crate::system::assemble;
+use crate::system::{assemble, System};
+use crate::MAX_ACTIVE_SET_STEPS;
 use fe_assembly::CellFields;
 use mesh::{Blocks, MeshPiece};
 use petsc::{Index, Petsc, Vector};
-use problem::backend::{setup_piece, Unsupported};
-use problem::{MeshKind, ProblemError, Scene, SetupError};
+use problem::backend::{setup_piece, ContactBoundary, ContactSolve, Unsupported};
+use problem::{Event, MeshKind, ProblemError, Reporter, Scene, SetupError};
 
 /// The backend name a run on pieces refuses under.
 const NAME: &str = "petsc";
@@ -47,6 +52,8 @@ pub struct PieceSolution {
     /// Stress, strain, electric displacement and field in each cell of the piece (the ghost
     /// cells' too: they are their owners' values).
     pub fields: CellFields,
+    /// The rank's share of the contact solution, where the scene has contact.
+    pub contact: Option<PieceContact>,
     /// Unknowns of the whole problem (prescribed ones among them).
     pub unknowns: usize,
     /// The blocks of cells per axis the mesh was cut into.
@@ -60,7 +67,8 @@ pub struct PieceSolution {
 }
 
 /// Whether a run on pieces solves `scene`: a generated rectangle or box of order 1 (not
-/// graded, layered or rounded), without contact, path or floating terminal.
+/// graded, layered or rounded), without path or floating terminal, its contact (if any) one
+/// the active sets hold.
 ///
 /// # Errors
 /// [`Unsupported`], naming the key of what a run on pieces does not solve yet.
@@ -76,7 +84,6 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
         (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
         (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
         (m.cylinder, "mesh.cylinder", "a rounded mesh"),
-        (!scene.zones().is_empty(), "contact", "contact"),
         (scene.path.is_some(), "path", "a path"),
         (
             scene.floating_key().is_some(),
@@ -84,52 +91,46 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
             "a floating terminal",
         ),
     ];
-    match refused.iter().find(|(r, _, _)| *r) {
-        Some((_, key, what)) => {
-            Err(
-                Unsupported::new(NAME, key, format!("{what} on a mesh made in pieces (mesh.pieces)"))
-                    .advise("a run whose every rank holds the whole mesh solves it"),
-            )
-        }
-        None => Ok(()),
+    if let Some((_, key, what)) = refused.iter().find(|(r, _, _)| *r) {
+        return Err(Unsupported::new(NAME, key, format!("{what} on a mesh made in pieces"))
+            .advise("a run whose every rank holds the whole mesh solves it"));
     }
+    // contact by the active sets, on each rank's own points
+    if scene.zones().is_empty() {
+        return Ok(());
+    }
+    crate::active_sets_hold_on(scene, None).map_err(|e| {
+        Unsupported::new(
+            NAME,
+            &e.key,
+            format!(
+                "{} on a mesh made in pieces (contact there is the active sets')",
+                e.feature
+            ),
+        )
+        .advise("a run whose every rank holds the whole mesh solves it")
+    })
 }
 
 /// Solves `scene` on the ranks of `petsc`, each rank holding only its piece of the mesh, and
 /// returns each rank's share. Collective. `limits.memory_bytes` is what one rank may take:
 /// the estimate of a rank's peak is checked against it before the piece is made, on every
-/// rank.
+/// rank. `reporter` hears the contact iteration's progress (only rank 0's should print).
 ///
 /// # Errors
 /// [`Unsupported`] (as a scene error) for what a run on pieces does not solve; more ranks than
 /// the mesh has cells along its axes; the estimate over the limit ([`ProblemError::TooLarge`]
-/// naming the rank); the set-up's errors; PETSc's.
+/// naming the rank); the set-up's errors; the active sets' and PETSc's.
 pub fn solve_on_pieces(
     petsc: &Petsc,
     scene: &Scene,
     limits: problem::Limits,
+    reporter: &mut dyn Reporter,
 ) -> Result<PieceSolution, DistributedError> {
     let valid = scene.validate()?;
     pieces_support(scene).map_err(ProblemError::from)?;
-    let (rank, ranks) = (petsc.rank(), petsc.size());
-    let m = &scene.mesh;
-    let dim = m.lo.len();
-    let n = m.cells_per_axis();
-    let cells = [n[0], n[1], n.get(2).copied().unwrap_or(1)];
-    let blocks = Blocks::new(dim, cells, ranks).ok_or_else(|| {
-        ProblemError::from(SetupError::new(
-            "mesh.n",
-            format!(
-                "{ranks} ranks cannot each hold a block of the {} cells per axis (mesh.n): fewer ranks, or a finer mesh",
-                cells[..dim].iter().map(usize::to_string).collect::<Vec<_>>().join(" x ")
-            ),
-        ))
-    })?;
-    check_memory(scene, &blocks, rank, limits)?;
-    let mut piece = match dim {
-        2 => blocks.rectangle_piece([m.lo[0], m.lo[1]], [m.hi[0], m.hi[1]], rank),
-        _ => blocks.box_piece([m.lo[0], m.lo[1], m.lo[2]], [m.hi[0], m.hi[1], m.hi[2]], rank),
-    };
+    let (blocks, mut piece) = make_piece(petsc, scene, limits)?;
+    let dim = piece.mesh.dim;
     let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
     check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
     conditions_on_the_piece(petsc, &mut setup)?;
@@ -139,8 +140,84 @@ pub fn solve_on_pieces(
     ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
     let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
-    let options = configure(petsc, scene, &layout, None)?;
     let fields = KrylovFields::new(petsc, &setup, &layout);
+    let (x, solved, contact) = match scene.zones().is_empty() {
+        true => {
+            let options = configure(petsc, scene, &layout, None)?;
+            let (x, solved) = linear(petsc, &fields, &mut system, options)?;
+            (x, solved, None)
+        }
+        false => {
+            let on = OnPiece {
+                petsc,
+                scene,
+                setup: &setup,
+                disc: &disc,
+                layout: &layout,
+                owned: piece.node_rank.iter().map(|&r| r == petsc.rank()).collect(),
+            };
+            let (x, solved, contact) = on.contact(&system, &fields, limits, reporter)?;
+            (x, solved, Some(contact))
+        }
+    };
+    let (u, phi) = nodal(&x, &layout)?;
+    let recovered = disc.recover(&u, &phi);
+    ProblemError::check_finite(&recovered.stress, "the stress", &valid)?;
+    drop(disc);
+    piece.mesh = setup.mesh;
+    Ok(PieceSolution {
+        piece,
+        u,
+        phi,
+        fields: recovered,
+        contact,
+        unknowns: layout.n_global(),
+        blocks: blocks.p,
+        iterations: solved.iterations,
+        reason: solved.reason,
+        options: solved.options,
+    })
+}
+
+/// How a solve on the pieces went.
+struct Solved {
+    iterations: usize,
+    reason: String,
+    options: String,
+}
+
+/// The blocks of the scene's mesh among the ranks, the estimate of a rank's peak checked, and
+/// this rank's piece. Every rank decides alike.
+fn make_piece(petsc: &Petsc, scene: &Scene, limits: problem::Limits) -> Result<(Blocks, MeshPiece), ProblemError> {
+    let (rank, ranks) = (petsc.rank(), petsc.size());
+    let m = &scene.mesh;
+    let dim = m.lo.len();
+    let n = m.cells_per_axis();
+    let cells = [n[0], n[1], n.get(2).copied().unwrap_or(1)];
+    let blocks = Blocks::new(dim, cells, ranks).ok_or_else(|| {
+        SetupError::new(
+            "mesh.n",
+            format!(
+                "{ranks} ranks cannot each hold a block of the {} cells per axis (mesh.n): fewer ranks, or a finer mesh",
+                cells[..dim].iter().map(usize::to_string).collect::<Vec<_>>().join(" x ")
+            ),
+        )
+    })?;
+    check_memory(scene, &blocks, rank, limits)?;
+    let piece = match dim {
+        2 => blocks.rectangle_piece([m.lo[0], m.lo[1]], [m.hi[0], m.hi[1]], rank),
+        _ => blocks.box_piece([m.lo[0], m.lo[1], m.lo[2]], [m.hi[0], m.hi[1], m.hi[2]], rank),
+    };
+    Ok((blocks, piece))
+}
+
+/// The linear problem: one Krylov solve.
+fn linear<'p>(
+    petsc: &'p Petsc,
+    fields: &KrylovFields,
+    system: &mut System<'p>,
+    options: String,
+) -> Result<(Vector<'p>, Solved), DistributedError> {
     let mut ksp = fields.krylov(petsc, &mut system.matrix)?;
     let mut x = system.rhs.duplicate()?;
     let info = ksp.solve(&system.rhs, &mut x)?;
@@ -151,22 +228,115 @@ pub fn solve_on_pieces(
         }
         .into());
     }
-    let (u, phi) = nodal(&x, &layout)?;
-    let fields = disc.recover(&u, &phi);
-    ProblemError::check_finite(&fields.stress, "the stress", &valid)?;
-    drop(disc);
-    piece.mesh = setup.mesh;
-    Ok(PieceSolution {
-        piece,
-        u,
-        phi,
-        fields,
-        unknowns: layout.n_global(),
-        blocks: blocks.p,
-        iterations: info.iterations,
-        reason: info.reason,
-        options,
-    })
+    Ok((
+        x,
+        Solved {
+            iterations: info.iterations,
+            reason: info.reason,
+            options,
+        },
+    ))
+}
+
+/// What a rank's piece holds of the run, for its contact.
+struct OnPiece<'a, 'p> {
+    petsc: &'p Petsc,
+    scene: &'a Scene,
+    setup: &'a problem::backend::Setup,
+    disc: &'a fe_assembly::Discretization<'a>,
+    layout: &'a Layout,
+    /// Whether this rank owns each node of its piece.
+    owned: Vec<bool>,
+}
+
+impl<'p> OnPiece<'_, 'p> {
+    /// Contact by the active sets on this rank's points (those at the nodes it owns), each step
+    /// one Krylov solve of the whole system; what the iteration decides on is reduced.
+    fn contact(
+        &self,
+        system: &System<'p>,
+        fields: &KrylovFields,
+        limits: problem::Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(Vector<'p>, Solved, PieceContact), DistributedError> {
+        let (petsc, scene) = (self.petsc, self.scene);
+        let specs = scene.zones();
+        let boundary = ContactBoundary::of_groups_on_piece(self.disc, &specs, &self.owned)?;
+        let total = petsc.sum(&[boundary.points.len() as f64])?[0];
+        if total == 0.0 {
+            return Err(ProblemError::from(SetupError::new(
+                "contact.group",
+                format!(
+                    "contact group `{}` has no contact point: Dirichlet conditions prescribe the normal displacement of all its nodes, or an indenter reaches none of them",
+                    specs[0].group
+                ),
+            ))
+            .into());
+        }
+        let how = ContactSolve::new(&self.setup.plan, scene, &boundary, limits.interrupt);
+        let options = configure(petsc, scene, self.layout, Some(how.tol))?;
+        let rows = ContactRows::new(
+            petsc,
+            (&boundary.points, &boundary.nodes, &how.law),
+            false,
+            self.layout,
+            system,
+        )?;
+        let params = ActiveSetParams {
+            tol: how.tol,
+            max_steps: MAX_ACTIVE_SET_STEPS,
+        };
+        let tol = how.tol;
+        let mut progress = |p: &contact::Progress| reporter.event(&Event::Contact { progress: p, tol });
+        let mut t_pc = 0.0;
+        let mut solve_one = |m: &mut petsc::Matrix<'p>, b: &Vector<'p>, x: &mut Vector<'p>, loose: Option<f64>| {
+            step(petsc, fields, &mut t_pc, (m, b, x), loose)
+        };
+        let out = active_set(petsc, self.layout, system, &rows, params, &mut solve_one, &mut progress).map_err(
+            |e| match e {
+                ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+                other => DistributedError::Contact(other),
+            },
+        )?;
+        let equilibrium = residual(system, &out.x, (&boundary, &out.solution), self.layout, petsc)?;
+        let sol = &out.solution;
+        let force: f64 = (0..sol.lambda.normal.len())
+            .map(|i| boundary.points.weight[i] * sol.lambda.normal[i])
+            .sum();
+        let contact = PieceContact {
+            steps: sol.info.newton_iters,
+            residual: sol.info.complementarity,
+            equilibrium,
+            normal_force: petsc.sum(&[force])?[0],
+            points: total as usize,
+            solution: out.solution,
+            boundary,
+        };
+        let solved = Solved {
+            iterations: out.krylov_iterations,
+            reason: out.reason,
+            options,
+        };
+        Ok((out.x, solved, contact))
+    }
+}
+
+/// A rank's share of the contact solution of a run on pieces.
+pub struct PieceContact {
+    /// The rank's contact points (at the nodes of its piece it owns).
+    pub boundary: ContactBoundary,
+    /// Their multipliers, displacements and statuses.
+    pub solution: contact::ContactSolution,
+    /// Active-set steps.
+    pub steps: usize,
+    /// The complementarity residual over every rank's points.
+    pub residual: f64,
+    /// The equilibrium residual `|K x - b - f_c| / max(|loads|, |f_c|)` over all unknowns.
+    pub equilibrium: f64,
+    /// The normal force `Σ w λ_n` over every rank's points.
+    pub normal_force: f64,
+    /// Contact points over every rank.
+    pub points: usize,
 }
 
 /// A mesh with nothing in it, in place of a piece's mesh while its set-up holds it.

@@ -37,6 +37,30 @@ const CASES: &[(&str, &[&str])] = &[
     ),
 ];
 
+/// Scenes with contact that the active sets hold: Signorini, Tresca (uniform and a profile),
+/// Coulomb in 2D and 3D, a roller through the contact face, a purely elastic body.
+const CONTACT_CASES: &[(&str, &[&str])] = &[
+    ("paper", &["mesh.n=32"]),
+    ("paper-slip", &["mesh.n=32"]),
+    ("paper-tresca", &["mesh.n=32"]),
+    (
+        "paper-tresca",
+        &[
+            "mesh.n=32",
+            "~contact.slip_bound",
+            "contact.slip_bound_profile={along=[1.0,0.0],at=[0.0,2.0],value=[0.01,0.1]}",
+        ],
+    ),
+    ("paper-frictionless", &["mesh.n=32"]),
+    ("paper-elastic", &["mesh.n=32"]),
+    ("paper-3d", &["mesh.n=6"]),
+    ("paper-3d", &["mesh.n=6", "contact.friction=0.1"]),
+    (
+        "paper-3d",
+        &["mesh.n=6", "contact.friction=0.1", "~dirichlet.0.u", "dirichlet.0.ux=0"],
+    ),
+];
+
 /// The largest difference over the largest magnitude of `whole`, comparing each of the piece's
 /// items that `take` selects with the whole mesh's item it maps to.
 fn farthest(whole: &[f64], piece: &[f64], map: &[usize], width: usize, take: impl Fn(usize) -> bool) -> f64 {
@@ -54,7 +78,7 @@ fn agree_on_pieces(p: &Petsc) {
     for (name, sets) in CASES {
         let (faer, scene) = both(name, sets);
         let whole = problem::solve(&faer, None, &mut problem::Silent).expect("the whole mesh's run");
-        let s = distributed::solve_on_pieces(p, &scene, problem::Limits::default())
+        let s = distributed::solve_on_pieces(p, &scene, problem::Limits::default(), &mut problem::Silent)
             .unwrap_or_else(|e| panic!("{name} {sets:?} on pieces: {e}"));
         let piece = &s.piece;
         let rank = p.rank();
@@ -100,6 +124,80 @@ fn agree_on_pieces(p: &Petsc) {
     }
 }
 
+/// The contact cases on pieces against the default backend's whole run: nodal solution, and
+/// each rank's multipliers at its own points against the whole run's at the same nodes.
+fn contact_on_pieces(p: &Petsc) {
+    for (name, sets) in CONTACT_CASES {
+        let (faer, scene) = both(name, sets);
+        let whole = problem::solve(&faer, None, &mut problem::Silent).expect("the whole mesh's run");
+        let s = distributed::solve_on_pieces(p, &scene, problem::Limits::default(), &mut problem::Silent)
+            .unwrap_or_else(|e| panic!("{name} {sets:?} on pieces: {e}"));
+        let piece = &s.piece;
+        let flat = |u: &[[f64; 3]]| u.iter().flat_map(|x| x.iter().copied()).collect::<Vec<f64>>();
+        let du = farthest(&flat(&whole.u), &flat(&s.u), &piece.global_node, 3, |_| true);
+        let dphi = farthest(&whole.phi, &s.phi, &piece.global_node, 1, |_| true);
+        let (wc, c) = (
+            whole.contact.as_ref().expect("contact"),
+            s.contact.as_ref().expect("contact"),
+        );
+        let at: std::collections::HashMap<usize, usize> = wc.nodes.iter().enumerate().map(|(i, &v)| (v, i)).collect();
+        let (wl, l) = (&wc.solution.lambda, &c.solution.lambda);
+        let nt = l.n_tangential();
+        let scale = wl.normal.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+        let mut dl = 0.0f64;
+        for (i, &v) in c.boundary.nodes.iter().enumerate() {
+            let j = at[&piece.global_node[v]];
+            dl = dl.max((l.normal[i] - wl.normal[j]).abs());
+            // (frictionless: no tangential multipliers)
+            for q in (0..nt).filter(|_| !l.tangential.is_empty() && !wl.tangential.is_empty()) {
+                dl = dl.max((l.tangential[i * nt + q] - wl.tangential[j * nt + q]).abs());
+            }
+        }
+        let dl = dl / scale;
+        let df = (c.normal_force - whole.report.contact.normal_force).abs() / whole.report.contact.normal_force.abs();
+        assert_eq!(c.points, wc.nodes.len(), "{name}: the points over the ranks");
+        eprintln!(
+            "{name} {sets:?} rank {}/{}: {} steps, residual {:.1e}, equilibrium {:.1e}; u {du:.1e}, phi {dphi:.1e}, multipliers {dl:.1e}, normal force {df:.1e}",
+            p.rank(),
+            p.size(),
+            c.steps,
+            c.residual,
+            c.equilibrium
+        );
+        assert!(c.residual <= scene.solver.tol, "{name}: residual {}", c.residual);
+        for (what, d) in [("u", du), ("phi", dphi), ("multipliers", dl), ("normal force", df)] {
+            assert!(d < 1e-7, "{name} {sets:?} rank {}: {what} differs by {d:.2e}", p.rank());
+        }
+    }
+}
+
+#[test]
+fn contact_on_pieces_agrees_with_the_whole_mesh_on_one_rank() {
+    on_ranks(
+        "contact_on_pieces_agrees_with_the_whole_mesh_on_one_rank",
+        1,
+        contact_on_pieces,
+    );
+}
+
+#[test]
+fn contact_on_pieces_agrees_with_the_whole_mesh_on_two_ranks() {
+    on_ranks(
+        "contact_on_pieces_agrees_with_the_whole_mesh_on_two_ranks",
+        2,
+        contact_on_pieces,
+    );
+}
+
+#[test]
+fn contact_on_pieces_agrees_with_the_whole_mesh_on_four_ranks() {
+    on_ranks(
+        "contact_on_pieces_agrees_with_the_whole_mesh_on_four_ranks",
+        4,
+        contact_on_pieces,
+    );
+}
+
 #[test]
 fn pieces_agree_with_the_whole_mesh_on_one_rank() {
     on_ranks("pieces_agree_with_the_whole_mesh_on_one_rank", 1, agree_on_pieces);
@@ -122,13 +220,15 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
     on_ranks("what_pieces_do_not_solve_is_refused_by_key", 2, |p| {
         let refused = |name: &str, sets: &[&str]| {
             let (_, scene) = both(name, sets);
-            match distributed::solve_on_pieces(p, &scene, problem::Limits::default()) {
+            match distributed::solve_on_pieces(p, &scene, problem::Limits::default(), &mut problem::Silent) {
                 Ok(_) => panic!("{name} {sets:?} solved on pieces"),
                 Err(e) => e.to_string(),
             }
         };
-        let e = refused("paper", &["mesh.n=8"]);
-        assert!(e.contains("contact") && e.contains("pieces"), "{e}");
+        let e = refused("paper-cycle", &["mesh.n=8"]);
+        assert!(e.contains("path") && e.contains("pieces"), "{e}");
+        let e = refused("indent-sphere", &["mesh.n=8"]);
+        assert!(e.contains("mesh.grading") && e.contains("pieces"), "{e}");
         let e = refused("actuator", &["mesh.n=8", "contact.law=\"none\"", "mesh.grading=4.0"]);
         assert!(e.contains("mesh.grading"), "{e}");
         let e = refused("paper", &["mesh.n=1", "contact.law=\"none\"", "mesh.hi=[1.0,1.0]"]);
@@ -139,7 +239,7 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
             memory_limit: Some("a test's limit"),
             ..Default::default()
         };
-        let e = distributed::solve_on_pieces(p, &scene, limits)
+        let e = distributed::solve_on_pieces(p, &scene, limits, &mut problem::Silent)
             .map(|_| ())
             .unwrap_err()
             .to_string();

@@ -351,6 +351,31 @@ impl ContactBoundary {
     /// # Errors
     /// As [`ContactBoundary::new`], for each group.
     pub fn of_groups(disc: &Discretization<'_>, specs: &[&ContactSpec]) -> Result<Self, ProblemError> {
+        Self::of_nodes(disc, specs, None)
+    }
+
+    /// [`ContactBoundary::of_groups`] on a rank's piece of the mesh: the points of the nodes
+    /// the rank owns (`owned`, per node of the piece) only, each counted by one rank. A group
+    /// may hold none of them here (another rank's piece holds its points): whether it holds
+    /// any on some rank is the caller's to sum.
+    ///
+    /// # Errors
+    /// As [`ContactBoundary::of_groups`], but for a group without points.
+    pub fn of_groups_on_piece(
+        disc: &Discretization<'_>,
+        specs: &[&ContactSpec],
+        owned: &[bool],
+    ) -> Result<Self, ProblemError> {
+        Self::of_nodes(disc, specs, Some(owned))
+    }
+
+    /// The boundary of the points of `specs` at the nodes `owned` marks (every node where
+    /// `None`, and then a group without points is refused).
+    fn of_nodes(
+        disc: &Discretization<'_>,
+        specs: &[&ContactSpec],
+        owned: Option<&[bool]>,
+    ) -> Result<Self, ProblemError> {
         let dim = disc.mesh.dim;
         let mut b = ContactBoundary {
             points: ContactPoints {
@@ -383,7 +408,7 @@ impl ContactBoundary {
         // each point's displacement as terms on nodes, for the potentials of electrical contact
         let mut node_terms = vec![];
         for (k, spec) in specs.iter().enumerate() {
-            node_terms.extend(b.add_group(disc, k, spec, &mut place)?);
+            node_terms.extend(b.add_group(disc, (k, spec), owned, &mut place)?);
         }
         // the zone that conducts (at most one: validated), its points' potentials condensed
         if let Some((k, spec)) = specs.iter().enumerate().find(|(_, s)| s.electric_law().is_some()) {
@@ -434,8 +459,8 @@ impl ContactBoundary {
     fn add_group(
         &mut self,
         disc: &Discretization<'_>,
-        k: usize,
-        spec: &ContactSpec,
+        (k, spec): (usize, &ContactSpec),
+        owned: Option<&[bool]>,
         place: &mut std::collections::HashMap<usize, usize>,
     ) -> Result<Vec<Vec<(f64, usize)>>, ProblemError> {
         let (mesh, dofs) = (disc.mesh, &disc.dofs);
@@ -449,7 +474,7 @@ impl ContactBoundary {
         let weight = &basis.weight;
         let friction = spec.friction();
         let (mut added, mut held_nodes, mut out_of_reach) = (vec![], 0, 0);
-        for node in group.nodes() {
+        for node in group.nodes().into_iter().filter(|&v| owned.is_none_or(|o| o[v])) {
             let x = mesh.points[node];
             if !(weight[node] > 0.0) {
                 return Err(weightless(spec, node, &x[..dim], weight[node]));
@@ -496,6 +521,9 @@ impl ContactBoundary {
             added.push(terms);
         }
         self.held_nodes += held_nodes;
+        if owned.is_some() {
+            return Ok(added);
+        }
         if added.is_empty() && out_of_reach > 0 {
             return Err(SetupError::new(
                 "contact.indenter",
