@@ -520,6 +520,7 @@ impl<'p> Backend for DistributedMemory<'p> {
             unknowns_per_rank,
             peak_bytes_per_rank: vec![],
             preconditioner_setup_s: setup,
+            pieces: None,
         };
         let factor_rate = match &s.route {
             Route::Direct(d) => Some(d.factor_rate()),

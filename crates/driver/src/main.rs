@@ -521,6 +521,22 @@ fn run(
             .iter()
             .map(|o| o.name().to_string())
             .collect();
+        if let Some(n) = solution
+            .report
+            .petsc
+            .as_ref()
+            .filter(|p| p.pieces.is_some())
+            .map(|p| p.ranks)
+        {
+            // no rank held the whole mesh: the solution is in pieces
+            let pieces = match n {
+                1 => "solution-0.vtu".to_string(),
+                n => format!("solution-0.vtu ... solution-{}.vtu", n - 1),
+            };
+            for name in names.iter_mut().filter(|x| *x == "solution.vtu") {
+                *name = format!("solution.pvtu with {pieces}");
+            }
+        }
         if let (Some(path), Some(spec)) = (&solution.report.path, &scene.path) {
             // the instants whose step file was written: every output_every-th and the last
             let n = path.instants;

@@ -581,7 +581,7 @@ fn ranks_with_different_limits_refuse_a_run_alike() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     let script = format!(
-        "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then ulimit -d 1500000; fi; exec '{exe}' run paper-3d --set mesh.n=24 --set 'solver.backend=\"petsc\"' --out '{}'",
+        "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then ulimit -d 1500000; fi; exec '{exe}' run paper-3d --set mesh.n=48 --set 'solver.backend=\"petsc\"' --out '{}'",
         out.display()
     );
     let o = std::process::Command::new("timeout")

@@ -178,9 +178,33 @@ impl Discretization<'_> {
         groups: &[&str],
         loads: &[crate::Load],
     ) -> Result<Vec<f64>, crate::AssemblyError> {
+        self.charges_at(u, phi, groups, loads, None)
+    }
+
+    /// [`Discretization::charges`] summed over the nodes `counted` marks only (every node
+    /// where `None`): a rank's share of the charges where the mesh is a rank's piece (its own
+    /// nodes, each of whose cells the piece holds), the ranks' shares summing to the charges.
+    ///
+    /// # Errors
+    /// As [`Discretization::charges`].
+    pub fn charges_at(
+        &self,
+        u: &[[f64; 3]],
+        phi: &[f64],
+        groups: &[&str],
+        loads: &[crate::Load],
+        counted: Option<&[bool]>,
+    ) -> Result<Vec<f64>, crate::AssemblyError> {
         let mesh = self.mesh;
         let dim = mesh.dim;
-        let owner = self.owners(groups)?;
+        let mut owner = self.owners(groups)?;
+        if let Some(counted) = counted {
+            for (o, &c) in owner.iter_mut().zip(counted) {
+                if !c {
+                    *o = usize::MAX;
+                }
+            }
+        }
         let q0 = loads.iter().find_map(|l| match l {
             crate::Load::BodyCharge(q) => Some(q),
             _ => None,

@@ -176,6 +176,26 @@ impl Petsc {
         check_mpi("MPI_Bcast", code)
     }
 
+    /// Rank 0's `bytes` on every rank (the others' replaced; their lengths need not agree).
+    pub fn broadcast_bytes(&self, bytes: &mut Vec<u8>) -> Result<()> {
+        let mut len = [bytes.len() as f64];
+        self.broadcast(&mut len)?;
+        bytes.resize(len[0] as usize, 0);
+        let count = mpi_count(bytes.len())?;
+        // SAFETY: a buffer of `count` bytes on every rank (resized above to rank 0's length);
+        // MPI_BYTE is u8.
+        let code = unsafe {
+            sys::MPI_Bcast(
+                bytes.as_mut_ptr().cast(),
+                count,
+                (&raw mut sys::ompi_mpi_byte).cast(),
+                0,
+                self.comm(),
+            )
+        };
+        check_mpi("MPI_Bcast", code)
+    }
+
     /// Every rank's `value`, in rank order, on every rank.
     pub fn all_gather(&self, value: u64) -> Result<Vec<u64>> {
         let mut out = vec![0u64; self.size];

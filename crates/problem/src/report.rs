@@ -256,6 +256,11 @@ pub struct PetscReport {
     pub peak_bytes_per_rank: Vec<u64>,
     /// Building the preconditioner (multigrid hierarchies, the Schur approximation), s.
     pub preconditioner_setup_s: f64,
+    /// A run in which no rank held the whole mesh: the blocks of cells per axis the generated
+    /// mesh was cut into, one per rank (the solution written as `solution.pvtu` with one
+    /// `solution-<rank>.vtu` per rank); absent where every rank held the whole mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pieces: Option<[usize; 3]>,
 }
 
 /// The scene as run.

@@ -203,7 +203,7 @@ pub const EQUILIBRIUM_TOL: f64 = 1e-8;
 /// relative tolerance where a Schur-complement PCG is asked for a looser one (`solver.pcg_tol`:
 /// the run meets what it was asked, and its residual is that tolerance's, not a sign of an
 /// ill-conditioned system).
-fn equilibrium_tol(plan: &Plan) -> f64 {
+pub fn equilibrium_tol(plan: &Plan) -> f64 {
     if plan.linear_strategy.runs_pcg() {
         EQUILIBRIUM_TOL.max(plan.pcg_tol)
     } else {
@@ -401,7 +401,7 @@ fn conductor_potential(c: &crate::ContactSpec, b: &ContactBoundary, sol: &Contac
 
 /// The terminals: the groups where the potential is prescribed or floats (none without
 /// electric unknowns), each once, in the order of the conditions.
-pub(crate) fn terminal_groups(setup: &Setup) -> Vec<&str> {
+pub fn terminal_groups(setup: &Setup) -> Vec<&str> {
     let mut groups: Vec<&str> = vec![];
     if !setup.plan.electric {
         return groups;

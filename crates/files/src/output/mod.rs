@@ -4,6 +4,7 @@
 //! appears all at once, in place of the previous one, or not at all.
 
 mod frames;
+pub mod pieces;
 mod set;
 mod vtu;
 

@@ -247,6 +247,33 @@ impl SetWriter {
         Ok(())
     }
 
+    /// The directory the set's files are written into before the set is turned to, where
+    /// another process may write files of the set ([`super::pieces::write_into`]; the ranks of
+    /// a parallel run) for [`SetWriter::adopt`] to take in; `None` where the platform stages
+    /// files in memory.
+    pub fn staging(&self) -> Option<&Path> {
+        #[cfg(unix)]
+        return Some(&self.inner.set);
+        #[cfg(not(unix))]
+        None
+    }
+
+    /// Takes into the set the file `name` that another process wrote into
+    /// [`SetWriter::staging`].
+    ///
+    /// # Errors
+    /// As [`SetWriter::write`]; [`Error::Output`] where the file is not there.
+    pub fn adopt(&mut self, name: &str) -> Result<(), Error> {
+        check_name(&self.dir, name)?;
+        #[cfg(unix)]
+        return self.inner.adopt(name);
+        #[cfg(not(unix))]
+        Err(Error::Output {
+            what: format!("cannot adopt {name}: files are staged in memory on this platform"),
+            source: std::io::Error::from(std::io::ErrorKind::Unsupported),
+        })
+    }
+
     /// Turns the directory to the set.
     ///
     /// # Errors
@@ -480,7 +507,7 @@ mod unix {
     pub(super) struct Writer {
         dir: PathBuf,
         hidden: PathBuf,
-        set: PathBuf,
+        pub(super) set: PathBuf,
         legacy: Vec<String>,
         names: Vec<String>,
         /// What the writer made that was not there: the directory itself, its hidden one.
@@ -546,6 +573,21 @@ mod unix {
             // was being removed would leave it behind)
             let _writing = staging();
             std::fs::write(self.set.join(name), bytes).map_err(|e| io("cannot write", &self.dir.join(name), e))?;
+            self.names.push(name.to_string());
+            Ok(())
+        }
+
+        /// Takes in the file `name` another process wrote into the set's directory.
+        pub(super) fn adopt(&mut self, name: &str) -> Result<(), Error> {
+            check_free(&self.dir, name, &self.legacy)?;
+            if self.names.iter().any(|n| n == name) {
+                return Err(conflict(
+                    &self.dir.join(name),
+                    "is twice in the set: two files would write one name",
+                ));
+            }
+            let path = self.set.join(name);
+            std::fs::metadata(&path).map_err(|e| io("cannot find the file written for the set", &path, e))?;
             self.names.push(name.to_string());
             Ok(())
         }

@@ -114,7 +114,7 @@ fn scalars(point: &[Array<'_>]) -> String {
 }
 
 /// VTK's name of the values' type.
-fn type_name(v: Values<'_>) -> &'static str {
+pub(super) fn type_name(v: Values<'_>) -> &'static str {
     match v {
         Values::F64(_) => "Float64",
         Values::U64(_) => "UInt64",

@@ -17,6 +17,9 @@
 //! values are summed from the piece alone, and the fields of every own cell are recovered
 //! from the piece's nodal values.
 
+mod gather;
+mod report;
+
 use crate::active::{residual, step};
 use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
@@ -27,8 +30,9 @@ use crate::MAX_ACTIVE_SET_STEPS;
 use fe_assembly::CellFields;
 use mesh::{Blocks, MeshPiece};
 use petsc::{Index, Petsc, Vector};
-use problem::backend::{setup_piece, ContactBoundary, ContactSolve, Unsupported};
+use problem::backend::{setup_piece, terminal_groups, ContactBoundary, ContactSolve, Unsupported};
 use problem::{Event, MeshKind, ProblemError, Reporter, Scene, SetupError};
+use std::time::Instant;
 
 /// The backend name a run on pieces refuses under.
 const NAME: &str = "petsc";
@@ -52,6 +56,10 @@ pub struct PieceSolution {
     /// Stress, strain, electric displacement and field in each cell of the piece (the ghost
     /// cells' too: they are their owners' values).
     pub fields: CellFields,
+    /// The run's report (`run.json`), the same on every rank, from sums over the ranks; its
+    /// contact section is left to the caller, from the gathered points
+    /// ([`PieceSolution::gathered_contact`]).
+    pub report: problem::RunReport,
     /// The rank's share of the contact solution, where the scene has contact.
     pub contact: Option<PieceContact>,
     /// Unknowns of the whole problem (prescribed ones among them).
@@ -85,6 +93,16 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
         (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
         (m.cylinder, "mesh.cylinder", "a rounded mesh"),
         (scene.path.is_some(), "path", "a path"),
+        (
+            scene.exact.is_some(),
+            "exact",
+            "an error against an exact solution (its norms are not yet summed over the pieces)",
+        ),
+        (
+            scene.zones().iter().any(|z| z.indenter.is_some()),
+            "contact.indenter",
+            "an indenter's figures (not yet gathered from the pieces)",
+        ),
         (
             scene.floating_key().is_some(),
             scene.floating_key().unwrap_or(""),
@@ -129,18 +147,22 @@ pub fn solve_on_pieces(
 ) -> Result<PieceSolution, DistributedError> {
     let valid = scene.validate()?;
     pieces_support(scene).map_err(ProblemError::from)?;
+    let start = Instant::now();
     let (blocks, mut piece) = make_piece(petsc, scene, limits)?;
     let dim = piece.mesh.dim;
     let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
     check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
+    let terminals: Vec<String> = terminal_groups(&setup).into_iter().map(String::from).collect();
     conditions_on_the_piece(petsc, &mut setup)?;
     let disc = setup.discretize()?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
+    let t_setup = start.elapsed().as_secs_f64();
     let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
     let fields = KrylovFields::new(petsc, &setup, &layout);
+    let t_assembly = start.elapsed().as_secs_f64() - t_setup;
     let (x, solved, contact) = match scene.zones().is_empty() {
         true => {
             let options = configure(petsc, scene, &layout, None)?;
@@ -160,9 +182,45 @@ pub fn solve_on_pieces(
             (x, solved, Some(contact))
         }
     };
+    let t_solve = start.elapsed().as_secs_f64() - t_setup - t_assembly;
+    let equilibrium = match contact {
+        Some(_) => 0.0,
+        None => system.reactions(&x)?.norm()? / system.load_norm.max(f64::MIN_POSITIVE),
+    };
     let (u, phi) = nodal(&x, &layout)?;
     let recovered = disc.recover(&u, &phi);
     ProblemError::check_finite(&recovered.stress, "the stress", &valid)?;
+    let owned: Vec<bool> = piece.node_rank.iter().map(|&r| r == petsc.rank()).collect();
+    let shares = report::Shares {
+        petsc,
+        scene,
+        setup: &setup,
+        disc: &disc,
+        owned: &owned,
+        global_node: &piece.global_node,
+        terminals: &terminals,
+        own_cells: piece.own_cells,
+        whole: (piece.n_global_nodes, piece.n_global_cells),
+    };
+    let timings = problem::report::Timings {
+        setup: t_setup,
+        assembly: t_assembly,
+        factorization: solved.setup_seconds,
+        contact: if contact.is_some() { t_solve } else { 0.0 },
+        solve: t_solve,
+        total: start.elapsed().as_secs_f64(),
+        ..Default::default()
+    };
+    let figures = report::Figures {
+        solved: &solved,
+        contact: contact.as_ref(),
+        equilibrium,
+        unknowns: layout.n_global(),
+        timings,
+        blocks: blocks.p,
+        nonzeros: petsc.sum(&[system.matrix.local_info()?.0])?[0],
+    };
+    let report = shares.report(&u, &phi, figures)?;
     drop(disc);
     piece.mesh = setup.mesh;
     Ok(PieceSolution {
@@ -171,6 +229,7 @@ pub fn solve_on_pieces(
         phi,
         fields: recovered,
         contact,
+        report,
         unknowns: layout.n_global(),
         blocks: blocks.p,
         iterations: solved.iterations,
@@ -184,6 +243,8 @@ struct Solved {
     iterations: usize,
     reason: String,
     options: String,
+    /// The preconditioners' set-up, s.
+    setup_seconds: f64,
 }
 
 /// The blocks of the scene's mesh among the ranks, the estimate of a rank's peak checked, and
@@ -218,7 +279,9 @@ fn linear<'p>(
     system: &mut System<'p>,
     options: String,
 ) -> Result<(Vector<'p>, Solved), DistributedError> {
+    let t = Instant::now();
     let mut ksp = fields.krylov(petsc, &mut system.matrix)?;
+    let setup_seconds = t.elapsed().as_secs_f64();
     let mut x = system.rhs.duplicate()?;
     let info = ksp.solve(&system.rhs, &mut x)?;
     if !info.reason.starts_with("CONVERGED") {
@@ -234,6 +297,7 @@ fn linear<'p>(
             iterations: info.iterations,
             reason: info.reason,
             options,
+            setup_seconds,
         },
     ))
 }
@@ -316,6 +380,7 @@ impl<'p> OnPiece<'_, 'p> {
             iterations: out.krylov_iterations,
             reason: out.reason,
             options,
+            setup_seconds: t_pc,
         };
         Ok((out.x, solved, contact))
     }

@@ -2,6 +2,8 @@
 //! `petsc`): the mesh read on every rank, the problem solved by `distributed`, the outputs
 //! written by rank 0.
 
+mod pieces;
+
 use crate::DriverError;
 use files::run::{memory_limits, peak_memory_bytes};
 use files::{output, scene_file::Source};
@@ -35,6 +37,9 @@ pub fn run_distributed(
         memory_limit,
         ..Default::default()
     };
+    if on_pieces(scene) {
+        return pieces::run(scene, source, dir, (&petsc, limits), reporter);
+    }
     // a path's steps written by rank 0 as they come, into a set committed at the end
     let mut writer = match (petsc.rank(), &scene.path) {
         (0, Some(_)) => Some(output::SetWriter::begin(
@@ -51,12 +56,7 @@ pub fn run_distributed(
         }),
         None => Ok(()),
     };
-    let solved = distributed::solve_path(scene, mesh, &petsc, limits, reporter, &mut each).map_err(|e| match e {
-        distributed::DistributedError::Problem(p) => DriverError::from(p),
-        distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
-        distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),
-        other => DriverError::Distributed(other),
-    })?;
+    let solved = distributed::solve_path(scene, mesh, &petsc, limits, reporter, &mut each).map_err(driver_error)?;
     let peaks = petsc.all_gather(peak_memory_bytes())?;
     let Some(mut solution) = solved else {
         return Ok(None);
@@ -75,6 +75,28 @@ pub fn run_distributed(
         None => output::write(&solution, dir)?,
     }
     Ok(Some(solution))
+}
+
+/// Whether a run takes the route on which no rank holds the whole mesh ([`pieces`]): a 3D
+/// generated body that the pieces solve ([`distributed::pieces_support`]), without contact, or
+/// with contact and at least [`distributed::ACTIVE_SETS_FROM`] unknowns (where the whole
+/// mesh's route would take the same active sets for speed; below, MUMPS' condensed route is
+/// as fast, issue 44's measurements).
+fn on_pieces(scene: &Scene) -> bool {
+    let unknowns = problem::backend::generated_sizes(scene).map_or(0.0, |(_, _, _, n)| n);
+    scene.mesh.lo.len() == 3
+        && distributed::pieces_support(scene).is_ok()
+        && (scene.zones().is_empty() || unknowns >= distributed::ACTIVE_SETS_FROM)
+}
+
+/// A distributed error as the driver's.
+fn driver_error(e: distributed::DistributedError) -> DriverError {
+    match e {
+        distributed::DistributedError::Problem(p) => DriverError::from(p),
+        distributed::DistributedError::Petsc(p) => DriverError::Petsc(p),
+        distributed::DistributedError::Contact(c) => DriverError::ActiveSet(c),
+        other => DriverError::Distributed(other),
+    }
 }
 
 /// The least of the ranks' memory limits, on every rank: each rank reads its own (the machine's

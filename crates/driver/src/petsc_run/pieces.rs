@@ -1,0 +1,155 @@
+//! The run in which no rank holds the whole mesh (issue 45): each rank solves on its piece
+//! ([`distributed::solve_on_pieces`]) and writes its piece of the solution into the output
+//! set rank 0 has begun (`solution-<rank>.vtu`, beside `solution.pvtu`); rank 0 writes the
+//! rest from the gathered surfaces (the contact points, the face the pictures draw) and the
+//! report's sums, and turns the directory to the set only once every rank has written: a
+//! rank that fails leaves no set behind, and the previous one stays.
+
+use super::driver_error;
+use crate::DriverError;
+use files::output::pieces::{files_beside_pieces, names_beside_pieces, piece_name, write_into, Piece};
+use files::output::SetWriter;
+use files::run::peak_memory_bytes;
+use files::scene_file::Source;
+use problem::{ContactResult, Reporter, Scene, Solution};
+use std::path::Path;
+
+/// Solves `scene` on pieces and writes its set into `dir`. Collective; rank 0 returns the
+/// solution as its files were made from (its mesh the gathered face of the pictures, its
+/// contact every rank's points), the others `None`.
+///
+/// # Errors
+/// As [`super::run_distributed`].
+pub(super) fn run(
+    scene: &Scene,
+    source: &Source,
+    dir: &Path,
+    (petsc, limits): (&petsc::Petsc, problem::Limits),
+    reporter: &mut dyn Reporter,
+) -> Result<Option<Solution>, DriverError> {
+    let (rank, ranks) = (petsc.rank(), petsc.size());
+    let s = distributed::solve_on_pieces(petsc, scene, limits, reporter).map_err(driver_error)?;
+    let contact = s.gathered_contact(petsc).map_err(driver_error)?;
+    let front = s.gathered_front(petsc).map_err(driver_error)?;
+    let held = s.contact.as_ref().map_or([0.0; 2], |c| {
+        [c.boundary.held_nodes as f64, c.boundary.held_inside as f64]
+    });
+    let held = petsc.sum(&held)?;
+    // this rank's piece of the solution, with its own contact points
+    let own = s.contact.as_ref().map(|c| ContactResult {
+        points: c.boundary.points.clone(),
+        nodes: c.boundary.nodes.clone(),
+        solution: c.solution.clone(),
+        displacement: c.solution.u.clone(),
+        groups: c.boundary.groups.clone(),
+        group_of: c.boundary.group_of.clone(),
+    });
+    let ghost: Vec<bool> = s.piece.cell_rank.iter().map(|&r| r != rank).collect();
+    let (piece, pvtu) = Piece {
+        mesh: &s.piece.mesh,
+        fields: (&s.u, &s.phi),
+        cells: &s.fields,
+        contact: own.as_ref(),
+        ghost: &ghost,
+        node_id: &s.piece.global_node,
+        cell_id: &s.piece.global_cell,
+    }
+    .files(ranks);
+    // rank 0 begins the set, and every rank learns where to write its piece
+    let mut writer = None;
+    let mut staging: Vec<u8> = vec![];
+    let mut began = [1.0];
+    if rank == 0 {
+        let names = names_beside_pieces(&s.report.plan.outputs, ranks);
+        let w = SetWriter::begin(dir, &names);
+        began[0] = f64::from(u8::from(w.as_ref().is_ok_and(|w| w.staging().is_some())));
+        if let Ok(w) = &w {
+            staging = w
+                .staging()
+                .map_or(vec![], |p| p.as_os_str().as_encoded_bytes().to_vec());
+            // (on Unix, a path's encoded bytes are its bytes)
+        }
+        writer = Some(w);
+    }
+    petsc.broadcast(&mut began)?;
+    petsc.broadcast_bytes(&mut staging)?;
+    if began[0] == 0.0 {
+        return match writer {
+            Some(Err(e)) => Err(e.into()),
+            Some(Ok(_)) => Err(DriverError::Usage(
+                "a run on pieces writes its set through a directory every rank can reach; this platform stages sets in memory".into(),
+            )),
+            None => Ok(None),
+        };
+    }
+    let mut writer = writer.and_then(Result::ok);
+    let wrote = match writer.as_mut() {
+        Some(w) => w.write(&piece_name(rank), &piece),
+        None => write_into(&path_of(&staging), &piece_name(rank), &piece),
+    };
+    let failed = petsc.sum(&[f64::from(u8::from(wrote.is_err()))])?[0];
+    let peaks = petsc.all_gather(peak_memory_bytes())?;
+    wrote?;
+    let Some(mut w) = writer else {
+        return Ok(None);
+    };
+    if failed > 0.0 {
+        // the set is abandoned (dropped unfinished): the directory keeps its previous one
+        return Err(DriverError::Usage(format!(
+            "{failed} of the {ranks} ranks could not write their piece of the solution into the output set: nothing written"
+        )));
+    }
+    for r in 1..ranks {
+        w.adopt(&piece_name(r))?;
+    }
+    w.write("solution.pvtu", &pvtu)?;
+    let mut report = s.report.clone();
+    report.scene.source = source.label.clone();
+    report.memory.peak_bytes = peaks.first().copied().unwrap_or(0);
+    if let Some(p) = report.petsc.as_mut() {
+        p.peak_bytes_per_rank = peaks;
+    }
+    if let Some(c) = &contact {
+        report.contact = problem::report::ContactReport {
+            held_nodes: held[0] as usize,
+            held_inside: held[1] as usize,
+            ..problem::report::ContactReport::of_groups(&c.points, &c.solution, &c.groups, &c.group_of)
+        };
+    }
+    // (a run on pieces is a generated box's, which has the face)
+    let (mesh, u, phi) = front.ok_or_else(|| {
+        DriverError::Usage("a run on pieces of a body without the face `front` its pictures draw".into())
+    })?;
+    let solution = Solution {
+        report,
+        mesh,
+        u,
+        phi,
+        fields: problem::CellFields {
+            stress: vec![],
+            electric_displacement: vec![],
+            strain: vec![],
+            electric_field: vec![],
+            at_nodes: None,
+        },
+        contact,
+    };
+    for (name, bytes) in files_beside_pieces(&solution)? {
+        w.write(&name, &bytes)?;
+    }
+    w.finish()?;
+    Ok(Some(solution))
+}
+
+/// The path whose bytes rank 0 sent.
+#[cfg(unix)]
+fn path_of(bytes: &[u8]) -> std::path::PathBuf {
+    use std::os::unix::ffi::OsStrExt;
+    Path::new(std::ffi::OsStr::from_bytes(bytes)).to_path_buf()
+}
+
+/// The path whose bytes rank 0 sent (never reached: sets are staged in memory here).
+#[cfg(not(unix))]
+fn path_of(bytes: &[u8]) -> std::path::PathBuf {
+    std::path::PathBuf::from(String::from_utf8_lossy(bytes).into_owned())
+}
