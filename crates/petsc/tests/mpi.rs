@@ -396,3 +396,49 @@ fn mumps_factors_on_two_ranks_with_the_schur_complement_of_chosen_unknowns() {
         },
     );
 }
+
+/// `Vector::fetch` gives each rank the entries it asks for, wherever they are owned, in the
+/// order asked (repeats and an empty request included); `Petsc::broadcast_bytes` gives rank 0's
+/// bytes to every rank whatever their lengths were.
+#[test]
+fn each_rank_fetches_the_entries_it_asks_for_and_hears_rank_0s_bytes() {
+    on_ranks(
+        "each_rank_fetches_the_entries_it_asks_for_and_hears_rank_0s_bytes",
+        2,
+        |p| {
+            let n = 11;
+            let (lo, hi) = p.split(n);
+            let mut v = Vector::mpi(p, hi - lo).unwrap();
+            v.with_local_mut(|x| {
+                for (k, e) in x.iter_mut().enumerate() {
+                    *e = 10.0 * (lo + k) as f64;
+                }
+            })
+            .unwrap();
+            // every entry of the other ranks', backwards, then one of its own twice
+            let asked: Vec<petsc::Index> = (0..n)
+                .rev()
+                .filter(|i| !(lo..hi).contains(i))
+                .chain([lo, lo])
+                .map(|i| i as petsc::Index)
+                .collect();
+            let got = v.fetch(&asked).unwrap();
+            let expected: Vec<f64> = asked.iter().map(|&i| 10.0 * i as f64).collect();
+            assert_eq!(got, expected);
+            // a rank may ask for nothing while the others ask
+            let none = if p.rank() == 1 {
+                v.fetch(&[]).unwrap()
+            } else {
+                v.fetch(&[0]).unwrap()
+            };
+            assert_eq!(none.len(), usize::from(p.rank() != 1));
+            let mut bytes = if p.rank() == 0 {
+                b"/a/staging/dir".to_vec()
+            } else {
+                vec![7; 40]
+            };
+            p.broadcast_bytes(&mut bytes).unwrap();
+            assert_eq!(bytes, b"/a/staging/dir");
+        },
+    );
+}

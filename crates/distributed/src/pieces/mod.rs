@@ -152,6 +152,8 @@ pub fn solve_on_pieces(
     let dim = piece.mesh.dim;
     let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
     check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
+    reporter.event(&Event::Planned(&setup.plan));
+    reporter.event(&Event::Units(&setup.units));
     let terminals: Vec<String> = terminal_groups(&setup).into_iter().map(String::from).collect();
     conditions_on_the_piece(petsc, &mut setup)?;
     let disc = setup.discretize()?;
@@ -183,6 +185,11 @@ pub fn solve_on_pieces(
         }
     };
     let t_solve = start.elapsed().as_secs_f64() - t_setup - t_assembly;
+    reporter.event(&Event::Krylov {
+        iterations: solved.iterations,
+        reason: &solved.reason,
+        setup_seconds: solved.setup_seconds,
+    });
     let equilibrium = match contact {
         Some(_) => 0.0,
         None => system.reactions(&x)?.norm()? / system.load_norm.max(f64::MIN_POSITIVE),
