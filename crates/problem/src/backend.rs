@@ -19,7 +19,6 @@ use linalg::CondenseRoute;
 
 pub use crate::boundary::{ContactBoundary, MAX_NORMAL_ANGLE_DEG};
 pub use crate::plan::Plan;
-pub use crate::run::terminal_groups;
 pub use crate::setup::{setup, setup_piece, MeshNotes, Setup};
 
 /// A scene a backend does not solve: the backend, the scene key that asks for what it lacks,

@@ -30,7 +30,8 @@ use crate::MAX_ACTIVE_SET_STEPS;
 use fe_assembly::CellFields;
 use mesh::{Blocks, MeshPiece};
 use petsc::{Index, Petsc, Vector};
-use problem::backend::{setup_piece, terminal_groups, ContactBoundary, ContactSolve, Unsupported};
+use problem::backend::{setup_piece, ContactBoundary, ContactSolve, Unsupported};
+use problem::terminal_groups;
 use problem::{Event, MeshKind, ProblemError, Reporter, Scene, SetupError};
 use std::time::Instant;
 
@@ -148,14 +149,7 @@ pub fn solve_on_pieces(
     let valid = scene.validate()?;
     pieces_support(scene).map_err(ProblemError::from)?;
     let start = Instant::now();
-    let (blocks, mut piece) = make_piece(petsc, scene, limits)?;
-    let dim = piece.mesh.dim;
-    let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
-    check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
-    reporter.event(&Event::Planned(&setup.plan));
-    reporter.event(&Event::Units(&setup.units));
-    let terminals: Vec<String> = terminal_groups(&setup).into_iter().map(String::from).collect();
-    conditions_on_the_piece(petsc, &mut setup)?;
+    let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, limits, reporter)?;
     let disc = setup.discretize()?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
@@ -213,7 +207,7 @@ pub fn solve_on_pieces(
         setup: t_setup,
         assembly: t_assembly,
         factorization: solved.setup_seconds,
-        contact: if contact.is_some() { t_solve } else { 0.0 },
+        contact: t_solve * f64::from(u8::from(contact.is_some())),
         solve: t_solve,
         total: start.elapsed().as_secs_f64(),
         ..Default::default()
@@ -243,6 +237,27 @@ pub fn solve_on_pieces(
         reason: solved.reason,
         options: solved.options,
     })
+}
+
+/// This rank's piece set up: the blocks, the piece (its mesh taken by the set-up), the set-up
+/// with the conditions that reach the piece, and the terminals' groups of the whole scene;
+/// the plan and units reported. Collective.
+fn set_up(
+    petsc: &Petsc,
+    valid: problem::Valid<'_>,
+    limits: problem::Limits,
+    reporter: &mut dyn Reporter,
+) -> Result<(Blocks, MeshPiece, problem::backend::Setup, Vec<String>), DistributedError> {
+    let scene = valid.scene();
+    let (blocks, mut piece) = make_piece(petsc, scene, limits)?;
+    let dim = piece.mesh.dim;
+    let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
+    check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
+    reporter.event(&Event::Planned(&setup.plan));
+    reporter.event(&Event::Units(&setup.units));
+    let terminals: Vec<String> = terminal_groups(&setup).into_iter().map(String::from).collect();
+    conditions_on_the_piece(petsc, &mut setup)?;
+    Ok((blocks, piece, setup, terminals))
 }
 
 /// How a solve on the pieces went.

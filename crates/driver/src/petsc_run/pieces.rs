@@ -35,26 +35,7 @@ pub(super) fn run(
         [c.boundary.held_nodes as f64, c.boundary.held_inside as f64]
     });
     let held = petsc.sum(&held)?;
-    // this rank's piece of the solution, with its own contact points
-    let own = s.contact.as_ref().map(|c| ContactResult {
-        points: c.boundary.points.clone(),
-        nodes: c.boundary.nodes.clone(),
-        solution: c.solution.clone(),
-        displacement: c.solution.u.clone(),
-        groups: c.boundary.groups.clone(),
-        group_of: c.boundary.group_of.clone(),
-    });
-    let ghost: Vec<bool> = s.piece.cell_rank.iter().map(|&r| r != rank).collect();
-    let (piece, pvtu) = Piece {
-        mesh: &s.piece.mesh,
-        fields: (&s.u, &s.phi),
-        cells: &s.fields,
-        contact: own.as_ref(),
-        ghost: &ghost,
-        node_id: &s.piece.global_node,
-        cell_id: &s.piece.global_cell,
-    }
-    .files(ranks);
+    let (piece, pvtu) = piece_files(&s, rank, ranks);
     // rank 0 begins the set, and every rank learns where to write its piece
     let mut writer = None;
     let mut staging: Vec<u8> = vec![];
@@ -103,6 +84,48 @@ pub(super) fn run(
         w.adopt(&piece_name(r))?;
     }
     w.write("solution.pvtu", &pvtu)?;
+    let solution = rank_0s_solution(&s, source, (contact, front), (held, peaks))?;
+    for (name, bytes) in files_beside_pieces(&solution)? {
+        w.write(&name, &bytes)?;
+    }
+    w.finish()?;
+    Ok(Some(solution))
+}
+
+/// This rank's piece of the solution (with its own contact points) as a `.vtu`, and the
+/// `.pvtu` naming the `ranks` pieces.
+fn piece_files(s: &distributed::PieceSolution, rank: usize, ranks: usize) -> (Vec<u8>, Vec<u8>) {
+    let own = s.contact.as_ref().map(|c| ContactResult {
+        points: c.boundary.points.clone(),
+        nodes: c.boundary.nodes.clone(),
+        solution: c.solution.clone(),
+        displacement: c.solution.u.clone(),
+        groups: c.boundary.groups.clone(),
+        group_of: c.boundary.group_of.clone(),
+    });
+    let ghost: Vec<bool> = s.piece.cell_rank.iter().map(|&r| r != rank).collect();
+    Piece {
+        mesh: &s.piece.mesh,
+        fields: (&s.u, &s.phi),
+        cells: &s.fields,
+        contact: own.as_ref(),
+        ghost: &ghost,
+        node_id: &s.piece.global_node,
+        cell_id: &s.piece.global_cell,
+    }
+    .files(ranks)
+}
+
+/// The solution rank 0 writes the rest of the set from: the report with its source, the ranks'
+/// peaks and the gathered contact's section (`held`: the nodes a support holds, those held
+/// inside, summed over the ranks), the gathered face `front` as its mesh.
+#[allow(clippy::type_complexity)]
+fn rank_0s_solution(
+    s: &distributed::PieceSolution,
+    source: &Source,
+    (contact, front): (Option<ContactResult>, Option<(mesh::Mesh, Vec<[f64; 3]>, Vec<f64>)>),
+    (held, peaks): (Vec<f64>, Vec<u64>),
+) -> Result<Solution, DriverError> {
     let mut report = s.report.clone();
     report.scene.source = source.label.clone();
     report.memory.peak_bytes = peaks.first().copied().unwrap_or(0);
@@ -120,7 +143,7 @@ pub(super) fn run(
     let (mesh, u, phi) = front.ok_or_else(|| {
         DriverError::Usage("a run on pieces of a body without the face `front` its pictures draw".into())
     })?;
-    let solution = Solution {
+    Ok(Solution {
         report,
         mesh,
         u,
@@ -133,12 +156,7 @@ pub(super) fn run(
             at_nodes: None,
         },
         contact,
-    };
-    for (name, bytes) in files_beside_pieces(&solution)? {
-        w.write(&name, &bytes)?;
-    }
-    w.finish()?;
-    Ok(Some(solution))
+    })
 }
 
 /// The path whose bytes rank 0 sent.
