@@ -80,23 +80,24 @@ pub(crate) fn solve<'p>(
 /// One active-set step's linear solve: the Krylov solver of the step's matrix `m` (its
 /// preconditioner's set-up time added to `t_pc`), to the relative tolerance `loose` where it is
 /// looser than the options' (an inexact step), `x` the start and the solution; Krylov
-/// iterations and PETSc's reason.
+/// iterations, PETSc's reason, and whether the tolerance was loosened.
 pub(crate) fn step<'p>(
     petsc: &'p Petsc,
     fields: &KrylovFields,
     t_pc: &mut f64,
     (m, b, x): (&mut petsc::Matrix<'p>, &Vector<'p>, &mut Vector<'p>),
     loose: Option<f64>,
-) -> Result<(usize, String), PetscError> {
+) -> Result<(usize, String, bool), PetscError> {
     let t = std::time::Instant::now();
     let mut ksp = fields.krylov(petsc, m)?;
     *t_pc += t.elapsed().as_secs_f64();
     let tight = ksp.relative_tolerance()?;
-    if let Some(rtol) = loose.filter(|&r| r > tight) {
+    let loosened = loose.filter(|&r| r > tight);
+    if let Some(rtol) = loosened {
         ksp.set_relative_tolerance(rtol)?;
     }
     let info = ksp.solve(b, x)?;
-    Ok((info.iterations, info.reason))
+    Ok((info.iterations, info.reason, loosened.is_some()))
 }
 
 /// The contact solve's solution, whole on every rank, with its equilibrium residual

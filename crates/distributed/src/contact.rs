@@ -164,10 +164,10 @@ fn dot(a: &[f64; 3], b: &[f64; 3], dim: usize) -> f64 {
 
 /// The linear solve of one step: matrix, right-hand side, the initial guess, overwritten by
 /// the solution, and the relative tolerance the step may be solved to where it is looser than
-/// the solver's own (an inexact Newton step; `None`: the solver's); returns Krylov iterations
-/// and PETSc's reason.
-pub type LinearSolve<'s, 'p> =
-    dyn FnMut(&mut Matrix<'p>, &Vector<'p>, &mut Vector<'p>, Option<f64>) -> Result<(usize, String), PetscError> + 's;
+/// the solver's own (an inexact Newton step; `None`: the solver's); returns Krylov iterations,
+/// PETSc's reason, and whether the step was solved looser than the solver's tolerance.
+pub type LinearSolve<'s, 'p> = dyn FnMut(&mut Matrix<'p>, &Vector<'p>, &mut Vector<'p>, Option<f64>) -> Result<(usize, String, bool), PetscError>
+    + 's;
 
 /// An inexact step's relative tolerance per unit of the last complementarity residual (the
 /// forcing term of an inexact Newton method, `η_k = FORCING r_(k-1)`: the step's error of the
@@ -219,7 +219,7 @@ pub fn active_set<'p>(
     // the loads alone: the first iterate, and the residual's multiplier scale
     let mut x = system.rhs.duplicate()?;
     let mut k0 = system.matrix.duplicate()?;
-    let (krylov, reason) = solve(&mut k0, &system.rhs, &mut x, None)?;
+    let (krylov, reason, _) = solve(&mut k0, &system.rhs, &mut x, None)?;
     drop(k0);
     let u = displacements(petsc, layout, rows, &x)?;
     let mut gap_u = u.clone();
@@ -305,7 +305,11 @@ impl<'p> Context<'_, 'p> {
         while it.steps < params.max_steps {
             it.steps += 1;
             let (sets, direction) = sets(self.rows, law, &it.lambda, &it.u);
-            self.step(it, law, &sets, &direction, solve)?;
+            // a step from an iterate within the tolerance is solved to the solver's own: the
+            // iteration ends only on such a step, whose solution meets the equilibrium too
+            // (the complementarity of an inexact step's iterate says nothing of it)
+            let loose = (it.last_residual > params.tol).then(|| (FORCING * it.last_residual).min(LOOSEST));
+            let loosened = self.step(it, law, (&sets, &direction), solve, loose)?;
             let residual = self.residual(it, law)?;
             it.last_residual = residual;
             let counts = counts(&classify(&it.lambda, &bound(p, law, &it.lambda.normal)));
@@ -319,7 +323,7 @@ impl<'p> Context<'_, 'p> {
             // the sets of every rank against its own earlier ones: the same on all ranks or not
             let same = self.everywhere(seen.iter().map(|s| *s == sets))?;
             let repeated = same.last() == Some(&true);
-            if residual <= params.tol && (repeated || residual <= 0.01 * params.tol) {
+            if !loosened && residual <= params.tol && (repeated || residual <= 0.01 * params.tol) {
                 return Ok(Ended::Converged);
             }
             if residual < best {
@@ -342,15 +346,17 @@ impl<'p> Context<'_, 'p> {
         Ok(self.petsc.sum(&misses)?.into_iter().map(|m| m == 0.0).collect())
     }
 
-    /// One step: hold the active and sticking components, load the slipping ones, solve.
+    /// One step: hold the active and sticking components, load the slipping ones, solve (to
+    /// the relative tolerance `loose` where it is looser than the solver's); whether the solve
+    /// was loosened.
     fn step(
         &self,
         it: &mut Iterate<'p>,
         law: &Law,
-        sets: &Sets,
-        direction: &PointValues,
+        (sets, direction): (&Sets, &PointValues),
         solve: &mut LinearSolve<'_, 'p>,
-    ) -> Result<(), PetscError> {
+        loose: Option<f64>,
+    ) -> Result<bool, PetscError> {
         let (petsc, layout, system) = (self.petsc, self.layout, self.system);
         let mut matrix = system.matrix.duplicate()?;
         let mut b = system.rhs.copy()?;
@@ -359,13 +365,12 @@ impl<'p> Context<'_, 'p> {
         set_held_values(layout, petsc.rank(), &held, &mut values)?;
         let rows_only: Vec<Index> = held.iter().map(|&(r, _)| r).collect();
         matrix.zero_rows_columns(&rows_only, system.diagonal[0], &values, &mut b)?;
-        let loose = (FORCING * it.last_residual).min(LOOSEST);
-        let (its, reason) = solve(&mut matrix, &b, &mut it.x, Some(loose))?;
+        let (its, reason, loosened) = solve(&mut matrix, &b, &mut it.x, loose)?;
         it.krylov += its;
         it.reason = reason;
         it.u = displacements(petsc, layout, self.rows, &it.x)?;
         it.lambda = multipliers(petsc, layout, system, self.rows, sets, &it.x)?;
-        Ok(())
+        Ok(loosened)
     }
 
     /// The natural-map residual of `law` at the iterate, over the ranks. Collective.
@@ -615,7 +620,7 @@ fn displacements(
 
 /// The multipliers of the step at this rank's points: the reactions `r = K x - b` of the
 /// loads without contact, at the active points (`λ_n = -(r·n)/w`, `λ_t = -(r·t)/w`: held
-/// components, Tresca's load and Coulomb's equation alike), zero where separated. Collective
+/// components, Tresca's load and Coulomb's equation alike; `λ_t = 0` without friction), zero where separated. Collective
 /// (the product).
 fn multipliers(
     petsc: &Petsc,
@@ -635,8 +640,10 @@ fn multipliers(
         let f: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
         let w = p.weight[i];
         lambda.normal[i] = -dot(&f, &p.normal[i], dim) / w;
-        // (a held tangent's reaction is its support's, not the contact's)
-        for q in (0..nt).filter(|&q| !p.is_held(i, q)) {
+        // (a held tangent's reaction is its support's, not the contact's; without friction a
+        // tangent is free, and its reaction the solve's round-off, not a multiplier)
+        let frictional = !matches!(rows.law, Law::Frictionless);
+        for q in (0..nt).filter(|&q| frictional && !p.is_held(i, q)) {
             lambda.tangential[i * nt + q] = -dot(&f, &p.tangent[i][q], dim) / w;
         }
     }

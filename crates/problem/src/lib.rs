@@ -93,7 +93,7 @@ pub use path::{run, run_steps, PathSolution, Step, StepFields};
 pub use plan::{Output, Plan};
 pub use progress::{Event, FactorWatch, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
-pub use run::{equilibrium_tol, terminal_groups, ContactResult, Solution, EQUILIBRIUM_TOL};
+pub use run::{equilibrium_tol, indenter_figures, terminal_groups, ContactResult, Indented, Solution, EQUILIBRIUM_TOL};
 pub use scene::{
     BackendChoice, ComplianceSpec, ContactLaw, ContactSolver, ContactSpec, Contacts, DirichletSpec, ElectricCondition,
     ElectrodeSpec, Electrodes, ExactKind, ExactSpec, Factors, Grading, IndenterShape, IndenterSpec, LayerSpec,

@@ -1364,7 +1364,8 @@ impl Walk<'_> {
     /// An indenter's figures in the step's row: its depth, contact radius, a conducting tip's
     /// charge, and the half-space's closed form beside them at the step's factors `f`.
     fn indenter_row(&self, row: &mut StepRow, (boundary, sol): (&ContactBoundary, &ContactSolution), f: &Factors) {
-        if let Some(mut indenter) = indenter_report(self.scene, boundary, sol) {
+        let at = crate::run::indented(self.scene, boundary, sol);
+        if let Some(mut indenter) = at.and_then(|at| indenter_report(self.scene, at)) {
             (row.depth, row.contact_radius) = (Some(indenter.depth), Some(indenter.contact_radius));
             row.tip_charge = indenter.charge;
             closed_form(self.scene, self.setup.plan.electric, &mut indenter, f);

@@ -258,20 +258,13 @@ pub(crate) fn recover(
         ..ContactReport::of_groups(&b.points, sol, &b.groups, &b.group_of)
     });
     let indenter = contact.and_then(|(b, sol)| {
-        let mut r = indenter_report(scene, b, sol)?;
-        if setup.plan.electric {
-            // the contact node nearest the indenter's axis
-            let (k, c) = scene.indenter_contact()?;
-            let ind = c.indenter.as_ref()?;
-            let nearest = (0..b.points.len()).filter(|&i| b.group_of[i] == k).min_by(|&i, &j| {
-                let ri = ind.local(&b.points.position[i], &b.points.normal[i]).1;
-                let rj = ind.local(&b.points.position[j], &b.points.normal[j]).1;
-                ri.total_cmp(&rj)
-            });
-            r.tip_potential = nearest.map(|i| phi[b.nodes[i]]);
-        }
-        closed_form(scene, setup.plan.electric, &mut r, f);
-        Some(r)
+        indenter_figures(
+            scene,
+            setup.plan.electric,
+            indented(scene, b, sol)?,
+            &|i| phi[b.nodes[i]],
+            f,
+        )
     });
     let half_space = scene
         .exact
@@ -343,18 +336,68 @@ pub(crate) fn closed_form(scene: &Scene, electric: bool, r: &mut crate::report::
     };
 }
 
-/// A rigid indenter's figures at the solution `sol` on `points` (the depth read off their
-/// gaps), the body carrying `normal_force`; `None` without `contact.indenter`.
-pub(crate) fn indenter_report(
+/// A contact solution on its points, as an indenter's figures read it.
+#[derive(Clone, Copy)]
+pub struct Indented<'a> {
+    /// The contact points.
+    pub points: &'a contact::ContactPoints,
+    /// The scene's contact zone of each point (an index into its `[[contact]]` zones).
+    pub group_of: &'a [usize],
+    /// The solution on them.
+    pub sol: &'a ContactSolution,
+    /// A conducting tip's potential (`None` on an insulating one).
+    pub potential: Option<f64>,
+}
+
+/// The solution `sol` on `b`'s points as an indenter's figures read it; `None` without
+/// `contact.indenter`.
+pub(crate) fn indented<'a>(scene: &Scene, b: &'a ContactBoundary, sol: &'a ContactSolution) -> Option<Indented<'a>> {
+    Some(Indented {
+        points: &b.points,
+        group_of: &b.group_of,
+        sol,
+        potential: conductor_potential(scene.indenter_contact()?.1, b, sol),
+    })
+}
+
+/// A rigid indenter's figures at the solution `at` ([`indenter_report`]), with, where the body
+/// has potentials, the surface's potential at the indenter's point nearest its axis
+/// (`phi_at(i)`: the potential at point `i`), and the half-space's closed form beside them at
+/// the instant's factors `f` (a static run's are [`crate::Factors::ONE`]); `None` without
+/// `contact.indenter`. For a caller that holds the contact points without the mesh (the
+/// points gathered from the ranks of a run on pieces), as the run reports them.
+pub fn indenter_figures(
     scene: &Scene,
-    b: &ContactBoundary,
-    sol: &ContactSolution,
+    electric: bool,
+    at: Indented<'_>,
+    phi_at: &dyn Fn(usize) -> f64,
+    f: &crate::Factors,
 ) -> Option<crate::report::IndenterReport> {
+    let mut r = indenter_report(scene, at)?;
+    if electric {
+        // the contact point nearest the indenter's axis
+        let (k, c) = scene.indenter_contact()?;
+        let ind = c.indenter.as_ref()?;
+        let p = at.points;
+        let nearest = (0..p.len()).filter(|&i| at.group_of[i] == k).min_by(|&i, &j| {
+            let ri = ind.local(&p.position[i], &p.normal[i]).1;
+            let rj = ind.local(&p.position[j], &p.normal[j]).1;
+            ri.total_cmp(&rj)
+        });
+        r.tip_potential = nearest.map(phi_at);
+    }
+    closed_form(scene, electric, &mut r, f);
+    Some(r)
+}
+
+/// A rigid indenter's figures at the solution `at` (the depth read off its points' gaps);
+/// `None` without `contact.indenter`.
+pub(crate) fn indenter_report(scene: &Scene, at: Indented<'_>) -> Option<crate::report::IndenterReport> {
     let (k, c) = scene.indenter_contact()?;
     let ind = c.indenter.as_ref()?;
-    let points = &b.points;
+    let (points, sol) = (at.points, at.sol);
     // the indenter's own points (the other groups rest on foundations)
-    let mine: Vec<usize> = (0..points.len()).filter(|&i| b.group_of[i] == k).collect();
+    let mine: Vec<usize> = (0..points.len()).filter(|&i| at.group_of[i] == k).collect();
     let (mut radius, mut count, mut force) = (0.0f64, 0, 0.0);
     for &i in &mine {
         if sol.lambda.normal[i] > 0.0 {
@@ -370,7 +413,7 @@ pub(crate) fn indenter_report(
         force,
         contact_radius: radius,
         points_in_contact: count,
-        potential: conductor_potential(c, b, sol),
+        potential: at.potential,
         // the charge across its own zone, where it conducts (another zone may)
         charge: sol
             .electric

@@ -83,7 +83,8 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
 /// The [`Setup`] of one rank's piece of a generated mesh (a [`mesh::MeshPiece`]'s mesh: the
 /// rank's block of cells and one layer of ghosts), for a run in which no rank holds the whole
 /// mesh. The scene's mesh must be one a piece is made of: generated, of order 1, neither
-/// graded nor layered nor rounded (the caller refuses the others by key). What only the whole
+/// layered nor rounded (the caller refuses the others by key); a grading maps each node by its
+/// own grid index, as on the whole mesh. What only the whole
 /// mesh can tell is the caller's to check, by reductions over the ranks: that each region
 /// (`mesh.region`) holds a cell and each electrode a facet on some piece.
 ///
@@ -253,7 +254,6 @@ fn mesh(scene: &Scene, source: Source) -> Result<(mesh::Mesh, MeshNotes), Proble
 fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNotes), ProblemError> {
     let m = &scene.mesh;
     let refused = [
-        (m.grading.is_some(), "mesh.grading"),
         (!m.layers.is_empty(), "mesh.layer"),
         (m.order.is_some_and(|o| o != 1), "mesh.order"),
         (m.cylinder, "mesh.cylinder"),
@@ -262,9 +262,16 @@ fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNo
     if let Some((_, key)) = refused.iter().find(|(r, _)| *r) {
         return Err(SetupError::new(
             key,
-            format!("{key}: a mesh made in pieces is a generated rectangle or box of order 1, neither graded, layered nor rounded"),
+            format!(
+                "{key}: a mesh made in pieces is a generated rectangle or box of order 1, neither layered nor rounded"
+            ),
         )
         .into());
+    }
+    // a node's graded coordinate depends on its own grid index alone: a piece's are the
+    // whole mesh's
+    if let Some(g) = &m.grading {
+        grade(&mut mesh, m, &g.ratios());
     }
     let quality = mesh.check()?;
     let notes = MeshNotes {

@@ -14,9 +14,10 @@ use std::collections::BTreeMap;
 
 /// Values per contact point in the gathered rows, for `nt` tangential components: the node's
 /// number in the whole mesh, position (3), normal (3), tangents (3 nt), weight, gap,
-/// friction, held tangents (nt), `λ_n`, `λ_t` (nt), `u_n`, `u_t` (nt), status.
+/// friction, held tangents (nt), `λ_n`, `λ_t` (nt), `u_n`, `u_t` (nt), status, the node's
+/// potential.
 fn width(nt: usize) -> usize {
-    1 + 3 + 3 + 3 * nt + 3 + nt + 1 + nt + 1 + nt + 1
+    1 + 3 + 3 + 3 * nt + 3 + nt + 1 + nt + 1 + nt + 1 + 1
 }
 
 /// The status as a number, and back.
@@ -36,11 +37,59 @@ fn status_of(x: f64) -> Status {
     }
 }
 
+/// What rank 0 holds of a run on pieces once the ranks' surfaces are gathered.
+pub struct Gathered {
+    /// The run's report, whole: the sums over the ranks, the contact section and an
+    /// indenter's figures from every rank's points.
+    pub report: problem::RunReport,
+    /// Every rank's contact points (their `nodes` the whole mesh's numbers).
+    pub contact: Option<ContactResult>,
+    /// The face `front` (y = lo) of a 3D body as a mesh of its facets alone, with its nodes'
+    /// displacements and potentials.
+    #[allow(clippy::type_complexity)]
+    pub front: Option<(mesh::Mesh, Vec<[f64; 3]>, Vec<f64>)>,
+}
+
 impl PieceSolution {
+    /// The ranks' surfaces gathered on rank 0 and the report completed there (`None` on the
+    /// other ranks). Collective.
+    pub fn gathered(&self, petsc: &Petsc, scene: &problem::Scene) -> Result<Option<Gathered>, DistributedError> {
+        let contact = self.gathered_contact(petsc)?;
+        let front = self.gathered_front(petsc)?;
+        let held = self.contact.as_ref().map_or([0.0; 2], |c| {
+            [c.boundary.held_nodes as f64, c.boundary.held_inside as f64]
+        });
+        let held = petsc.sum(&held)?;
+        if petsc.rank() != 0 {
+            return Ok(None);
+        }
+        let mut report = self.report.clone();
+        if let Some((c, phi)) = &contact {
+            report.contact = problem::report::ContactReport {
+                held_nodes: held[0] as usize,
+                held_inside: held[1] as usize,
+                ..problem::report::ContactReport::of_groups(&c.points, &c.solution, &c.groups, &c.group_of)
+            };
+            let at = problem::Indented {
+                points: &c.points,
+                group_of: &c.group_of,
+                sol: &c.solution,
+                potential: None,
+            };
+            report.indenter =
+                problem::indenter_figures(scene, report.plan.electric, at, &|i| phi[i], &problem::Factors::ONE);
+        }
+        Ok(Some(Gathered {
+            report,
+            contact: contact.map(|(c, _)| c),
+            front,
+        }))
+    }
+
     /// The contact points of every rank on rank 0, in the order of their nodes' numbers in the
-    /// whole mesh (the whole mesh's own order), as the default backend's run reports them; `None`
-    /// on the other ranks and without contact. Collective.
-    pub fn gathered_contact(&self, petsc: &Petsc) -> Result<Option<ContactResult>, DistributedError> {
+    /// whole mesh (the whole mesh's own order), as the default backend's run reports them, with
+    /// the potential at each; `None` on the other ranks and without contact. Collective.
+    pub fn gathered_contact(&self, petsc: &Petsc) -> Result<Option<(ContactResult, Vec<f64>)>, DistributedError> {
         let s = self;
         let Some(c) = &s.contact else {
             return Ok(None);
@@ -63,6 +112,7 @@ impl PieceSolution {
             rows.push(sol.u.normal[i]);
             rows.extend((0..nt).map(|q| sol.u.tangential[i * nt + q]));
             rows.push(status_code(sol.status[i]));
+            rows.push(s.phi[c.boundary.nodes[i]]);
         }
         let Some(all) = petsc.gather_f64(&rows)? else {
             return Ok(None);
@@ -81,7 +131,7 @@ impl PieceSolution {
             ..p.select(&[])
         };
         let (mut lambda, mut u) = (PointValues::zeros(n, nt), PointValues::zeros(n, nt));
-        let (mut nodes, mut status) = (vec![], vec![]);
+        let (mut nodes, mut status, mut phi) = (vec![], vec![], vec![]);
         for (i, r) in sorted.iter().enumerate() {
             let mut at = 1;
             let mut take = |k: usize| {
@@ -113,6 +163,7 @@ impl PieceSolution {
             u.normal[i] = take(1)[0];
             u.tangential[i * nt..(i + 1) * nt].copy_from_slice(take(nt));
             status.push(status_of(take(1)[0]));
+            phi.push(take(1)[0]);
         }
         if !has_t {
             lambda.tangential.clear();
@@ -124,14 +175,15 @@ impl PieceSolution {
             info: sol.info.clone(),
             electric: None,
         };
-        Ok(Some(ContactResult {
+        let result = ContactResult {
             group_of: vec![0; n],
             groups: c.boundary.groups.clone(),
             points,
             nodes,
             solution,
             displacement: u,
-        }))
+        };
+        Ok(Some((result, phi)))
     }
 
     /// The face `front` (y = lo) of a 3D run on rank 0, as a mesh of its facets alone (no cells:

@@ -20,6 +20,8 @@
 mod gather;
 mod report;
 
+pub use gather::Gathered;
+
 use crate::active::{residual, step};
 use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
@@ -58,8 +60,8 @@ pub struct PieceSolution {
     /// cells' too: they are their owners' values).
     pub fields: CellFields,
     /// The run's report (`run.json`), the same on every rank, from sums over the ranks; its
-    /// contact section is left to the caller, from the gathered points
-    /// ([`PieceSolution::gathered_contact`]).
+    /// contact section and an indenter's figures are rank 0's, from the gathered points
+    /// ([`PieceSolution::gathered`]).
     pub report: problem::RunReport,
     /// The rank's share of the contact solution, where the scene has contact.
     pub contact: Option<PieceContact>,
@@ -75,8 +77,8 @@ pub struct PieceSolution {
     pub options: String,
 }
 
-/// Whether a run on pieces solves `scene`: a generated rectangle or box of order 1 (not
-/// graded, layered or rounded), without path or floating terminal, its contact (if any) one
+/// Whether a run on pieces solves `scene`: a generated rectangle or box of order 1 (graded
+/// or not; not layered or rounded), without path or floating terminal, its contact (if any) one
 /// the active sets hold.
 ///
 /// # Errors
@@ -89,7 +91,6 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
             "mesh.kind",
             "a mesh that is not generated",
         ),
-        (m.grading.is_some(), "mesh.grading", "a graded mesh"),
         (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
         (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
         (m.cylinder, "mesh.cylinder", "a rounded mesh"),
@@ -98,11 +99,6 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
             scene.exact.is_some(),
             "exact",
             "an error against an exact solution (its norms are not yet summed over the pieces)",
-        ),
-        (
-            scene.zones().iter().any(|z| z.indenter.is_some()),
-            "contact.indenter",
-            "an indenter's figures (not yet gathered from the pieces)",
         ),
         (
             scene.floating_key().is_some(),

@@ -29,12 +29,7 @@ pub(super) fn run(
 ) -> Result<Option<Solution>, DriverError> {
     let (rank, ranks) = (petsc.rank(), petsc.size());
     let s = distributed::solve_on_pieces(petsc, scene, limits, reporter).map_err(driver_error)?;
-    let contact = s.gathered_contact(petsc).map_err(driver_error)?;
-    let front = s.gathered_front(petsc).map_err(driver_error)?;
-    let held = s.contact.as_ref().map_or([0.0; 2], |c| {
-        [c.boundary.held_nodes as f64, c.boundary.held_inside as f64]
-    });
-    let held = petsc.sum(&held)?;
+    let gathered = s.gathered(petsc, scene).map_err(driver_error)?;
     let (piece, pvtu) = piece_files(&s, rank, ranks);
     // rank 0 begins the set, and every rank learns where to write its piece
     let mut writer = None;
@@ -84,7 +79,10 @@ pub(super) fn run(
         w.adopt(&piece_name(r))?;
     }
     w.write("solution.pvtu", &pvtu)?;
-    let solution = rank_0s_solution(&s, source, (contact, front), (held, peaks))?;
+    let Some(gathered) = gathered else {
+        return Ok(None);
+    };
+    let solution = rank_0s_solution(gathered, source, peaks)?;
     for (name, bytes) in files_beside_pieces(&solution)? {
         w.write(&name, &bytes)?;
     }
@@ -116,31 +114,17 @@ fn piece_files(s: &distributed::PieceSolution, rank: usize, ranks: usize) -> (Ve
     .files(ranks)
 }
 
-/// The solution rank 0 writes the rest of the set from: the report with its source, the ranks'
-/// peaks and the gathered contact's section (`held`: the nodes a support holds, those held
-/// inside, summed over the ranks), the gathered face `front` as its mesh.
-#[allow(clippy::type_complexity)]
-fn rank_0s_solution(
-    s: &distributed::PieceSolution,
-    source: &Source,
-    (contact, front): (Option<ContactResult>, Option<(mesh::Mesh, Vec<[f64; 3]>, Vec<f64>)>),
-    (held, peaks): (Vec<f64>, Vec<u64>),
-) -> Result<Solution, DriverError> {
-    let mut report = s.report.clone();
+/// The solution rank 0 writes the rest of the set from: the gathered report with its source
+/// and the ranks' peaks, the gathered contact, the gathered face `front` as its mesh.
+fn rank_0s_solution(g: distributed::Gathered, source: &Source, peaks: Vec<u64>) -> Result<Solution, DriverError> {
+    let mut report = g.report;
     report.scene.source = source.label.clone();
     report.memory.peak_bytes = peaks.first().copied().unwrap_or(0);
     if let Some(p) = report.petsc.as_mut() {
         p.peak_bytes_per_rank = peaks;
     }
-    if let Some(c) = &contact {
-        report.contact = problem::report::ContactReport {
-            held_nodes: held[0] as usize,
-            held_inside: held[1] as usize,
-            ..problem::report::ContactReport::of_groups(&c.points, &c.solution, &c.groups, &c.group_of)
-        };
-    }
     // (a run on pieces is a generated box's, which has the face)
-    let (mesh, u, phi) = front.ok_or_else(|| {
+    let (mesh, u, phi) = g.front.ok_or_else(|| {
         DriverError::Usage("a run on pieces of a body without the face `front` its pictures draw".into())
     })?;
     Ok(Solution {
@@ -155,7 +139,7 @@ fn rank_0s_solution(
             electric_field: vec![],
             at_nodes: None,
         },
-        contact,
+        contact: g.contact,
     })
 }
 
