@@ -11,16 +11,13 @@ use std::collections::BTreeMap;
 /// hold segments ordered counter-clockwise around the rectangle; the region `body` holds every
 /// cell. `nx` and `ny` are clamped to at least 1.
 pub fn rectangle_tri(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize) -> Mesh {
-    let (nx, ny) = (nx.max(1), ny.max(1));
-    let mut cells = Vec::with_capacity(6 * nx * ny);
-    let id = |i: usize, j: usize| j * (nx + 1) + i;
-    for j in 0..ny {
-        for i in 0..nx {
-            let (n00, n10, n11, n01) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            cells.extend_from_slice(&[n00, n10, n11, n00, n11, n01]);
-        }
-    }
-    rectangle(lo, hi, nx, ny, CellKind::Tri3, cells)
+    // the whole rectangle is the one piece of one rank: one generator for both
+    let blocks = crate::Blocks {
+        dim: 2,
+        n: [nx.max(1), ny.max(1), 1],
+        p: [1, 1, 1],
+    };
+    blocks.rectangle_piece(lo, hi, 0).mesh
 }
 
 /// The rectangle `[lo, hi]` cut into `nx x ny` Q1 quadrilaterals `(n00, n10, n11, n01)`,
@@ -89,92 +86,13 @@ fn rectangle(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize, kind: CellKind, c
 /// (x = lo/hi), `front`/`back` (y = lo/hi), `bottom`/`top` (z = lo/hi), triangles ordered so
 /// that their right-hand normal points out of the box. Region: `body`.
 pub fn box_tet(lo: [f64; 3], hi: [f64; 3], nx: usize, ny: usize, nz: usize) -> Mesh {
-    let n = [nx.max(1), ny.max(1), nz.max(1)];
-    let id = |i: usize, j: usize, k: usize| (k * (n[1] + 1) + j) * (n[0] + 1) + i;
-    let mut points = Vec::with_capacity((n[0] + 1) * (n[1] + 1) * (n[2] + 1));
-    for k in 0..=n[2] {
-        for j in 0..=n[1] {
-            for i in 0..=n[0] {
-                points.push([
-                    lerp(lo[0], hi[0], i, n[0]),
-                    lerp(lo[1], hi[1], j, n[1]),
-                    lerp(lo[2], hi[2], k, n[2]),
-                ]);
-            }
-        }
-    }
-    const ORDERS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
-    let mut cells = Vec::with_capacity(24 * n[0] * n[1] * n[2]);
-    for k in 0..n[2] {
-        for j in 0..n[1] {
-            for i in 0..n[0] {
-                for order in ORDERS {
-                    let mut c = [i, j, k];
-                    let mut tet = [id(i, j, k), 0, 0, id(i + 1, j + 1, k + 1)];
-                    for (slot, &axis) in order[..2].iter().enumerate() {
-                        c[axis] += 1;
-                        tet[slot + 1] = id(c[0], c[1], c[2]);
-                    }
-                    if signed_volume(&points, &tet) < 0.0 {
-                        tet.swap(2, 3);
-                    }
-                    cells.extend_from_slice(&tet);
-                }
-            }
-        }
-    }
-    // Faces: for a face normal to `axis` at layer `at`, with in-plane axes (a, b) in increasing
-    // order, split each square along its lowest-highest diagonal, then orient outwards.
-    let mut boundaries = BTreeMap::new();
-    let names = [("left", "right"), ("front", "back"), ("bottom", "top")];
-    for axis in 0..3 {
-        let (a, b) = match axis {
-            0 => (1, 2),
-            1 => (0, 2),
-            _ => (0, 1),
-        };
-        for (side, name) in [(0usize, names[axis].0), (n[axis], names[axis].1)] {
-            let outward = if side == 0 { -1.0 } else { 1.0 };
-            let mut facets = Vec::with_capacity(6 * n[a] * n[b]);
-            for jb in 0..n[b] {
-                for ia in 0..n[a] {
-                    let node = |da: usize, db: usize| {
-                        let mut c = [0usize; 3];
-                        c[axis] = side;
-                        c[a] = ia + da;
-                        c[b] = jb + db;
-                        id(c[0], c[1], c[2])
-                    };
-                    let (n00, n10, n11, n01) = (node(0, 0), node(1, 0), node(1, 1), node(0, 1));
-                    for mut tri in [[n00, n10, n11], [n00, n11, n01]] {
-                        if triangle_normal(&points, &tri)[axis] * outward < 0.0 {
-                            tri.swap(1, 2);
-                        }
-                        facets.extend_from_slice(&tri);
-                    }
-                }
-            }
-            boundaries.insert(
-                name.to_string(),
-                FacetGroup {
-                    nodes_per_facet: 3,
-                    facets,
-                },
-            );
-        }
-    }
-    let n_cells = cells.len() / 4;
-    let mut regions = BTreeMap::new();
-    regions.insert("body".into(), (0..n_cells).collect());
-    Mesh {
+    // the whole box is the one piece of one rank: one generator for both
+    let blocks = crate::Blocks {
         dim: 3,
-        kind: CellKind::Tet4,
-        points,
-        cells,
-        boundaries,
-        regions,
-        reoriented_cells: 0,
-    }
+        n: [nx.max(1), ny.max(1), nz.max(1)],
+        p: [1, 1, 1],
+    };
+    blocks.box_piece(lo, hi, 0).mesh
 }
 
 /// `lo + (hi - lo) i / n`, exact at both ends.
