@@ -288,6 +288,24 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
         assert!(e.contains("path") && e.contains("pieces"), "{e}");
         let e = refused("manufactured", &["mesh.n=8"]);
         assert!(e.contains("exact") && e.contains("pieces"), "{e}");
+        // a body its conditions do not hold: refused as the whole mesh's check refuses it, by
+        // the conditions summed over the ranks (no rank holds them all)
+        let e = refused(
+            "paper-3d",
+            &[
+                "mesh.n=4",
+                "contact.law=\"none\"",
+                "~dirichlet.1",
+                "~dirichlet.0.u",
+                "dirichlet.0.ux=0.0",
+            ],
+        );
+        assert!(e.contains("3 rigid motions of the body free"), "{e}");
+        let e = refused(
+            "paper-3d",
+            &["mesh.n=4", "contact.law=\"none\"", "~dirichlet.1", "~dirichlet.0.phi"],
+        );
+        assert!(e.contains("the potential is floating"), "{e}");
         let e = refused("paper-3d", &["mesh.n=4", "contact.law=\"none\"", "mesh.order=2"]);
         assert!(e.contains("mesh.order") && e.contains("pieces"), "{e}");
         let e = refused("paper", &["mesh.n=1", "contact.law=\"none\"", "mesh.hi=[1.0,1.0]"]);

@@ -337,41 +337,75 @@ impl Solids {
     /// the null space of the Gram matrix of the conditions they put on its motions.
     fn free_motions(&self, mesh: &Mesh, dofs: &DofMap, i: usize, supports: &[Support]) -> Vec<String> {
         let dim = dofs.dim;
-        let n_modes = if dim == 2 { 3 } else { 6 };
-        let mut gram = DMatrix::<f64>::zeros(n_modes, n_modes);
-        let scaled = |v: usize| -> [f64; 3] {
-            std::array::from_fn(|k| {
-                if k < dim {
-                    (mesh.points[v][k] - self.centroid[i][k]) / self.size[i]
-                } else {
-                    0.0
-                }
-            })
-        };
-        for &(_, v) in &self.members[self.start[i]..self.start[i + 1]] {
-            for k in (0..dim).filter(|&k| matches!(dofs.u[v * dim + k], Dof::Fixed(_))) {
-                let row = nalgebra::DVector::from_vec(rigid_row(dim, k, scaled(v)));
-                gram += &row * row.transpose();
-            }
-        }
+        let frame = (self.centroid[i], self.size[i]);
+        let members = self.members[self.start[i]..self.start[i + 1]].iter().map(|&(_, v)| v);
+        let mut gram = gram_of(mesh, dofs, members, frame);
         // a support's condition: the motion's component along its direction, r(x) · n = 0
         for s in self.supports_of(i, supports) {
-            let mut row = nalgebra::DVector::<f64>::zeros(n_modes);
+            let mut row = nalgebra::DVector::<f64>::zeros(gram.nrows());
             for k in 0..dim {
-                row += nalgebra::DVector::from_vec(rigid_row(dim, k, scaled(s.node))) * s.direction[k];
+                row +=
+                    nalgebra::DVector::from_vec(rigid_row(dim, k, scaled(mesh, s.node, frame, dim))) * s.direction[k];
             }
             gram += &row * row.transpose();
         }
-        let eig = SymmetricEigen::new(gram);
-        let largest = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
-        (0..n_modes)
-            .filter(|&j| !(eig.eigenvalues[j] > FREE * largest))
-            .map(|j| {
-                let v: Vec<f64> = eig.eigenvectors.column(j).iter().cloned().collect();
-                describe(dim, &v, self.centroid[i], self.size[i])
-            })
-            .collect()
+        free_of(dim, gram, frame)
     }
+}
+
+/// Node `v`'s coordinates about the centre `c` of a part of size `size`, over that size.
+fn scaled(mesh: &Mesh, v: usize, (c, size): ([f64; 3], f64), dim: usize) -> [f64; 3] {
+    std::array::from_fn(|k| {
+        if k < dim {
+            (mesh.points[v][k] - c[k]) / size
+        } else {
+            0.0
+        }
+    })
+}
+
+/// The Gram matrix of the rigid-motion conditions that the prescribed displacement components
+/// of `nodes` make (one row per component, `r_k(x) = 0`), about the centre `c` of a part of size
+/// `size`, flat (column by column; 3 x 3 in 2D, 6 x 6 in 3D). A sum over the nodes: the Gram
+/// matrix of a part held in pieces (the ranks of a parallel run, each with its own nodes) is
+/// its pieces' sum, judged by [`free_in`].
+pub fn rigid_gram(mesh: &Mesh, dofs: &DofMap, nodes: impl Iterator<Item = usize>, frame: ([f64; 3], f64)) -> Vec<f64> {
+    gram_of(mesh, dofs, nodes, frame).as_slice().to_vec()
+}
+
+/// The rigid motions that a part's Gram matrix of conditions ([`rigid_gram`], flat, in the
+/// frame `(c, size)`) leaves free, in words: those along its eigenvalues below 1e-12 times the
+/// largest, as the check of a whole mesh ([`check`]) judges them.
+pub fn free_in(dim: usize, gram: &[f64], frame: ([f64; 3], f64)) -> Vec<String> {
+    let n = if dim == 2 { 3 } else { 6 };
+    free_of(dim, DMatrix::from_column_slice(n, n, gram), frame)
+}
+
+fn gram_of(mesh: &Mesh, dofs: &DofMap, nodes: impl Iterator<Item = usize>, frame: ([f64; 3], f64)) -> DMatrix<f64> {
+    let dim = dofs.dim;
+    let n_modes = if dim == 2 { 3 } else { 6 };
+    let mut gram = DMatrix::<f64>::zeros(n_modes, n_modes);
+    for v in nodes {
+        for k in (0..dim).filter(|&k| matches!(dofs.u[v * dim + k], Dof::Fixed(_))) {
+            let row = nalgebra::DVector::from_vec(rigid_row(dim, k, scaled(mesh, v, frame, dim)));
+            gram += &row * row.transpose();
+        }
+    }
+    gram
+}
+
+/// The motions along the eigenvalues of `gram` below [`FREE`] times the largest, in words.
+fn free_of(dim: usize, gram: DMatrix<f64>, (c, size): ([f64; 3], f64)) -> Vec<String> {
+    let n_modes = gram.nrows();
+    let eig = SymmetricEigen::new(gram);
+    let largest = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+    (0..n_modes)
+        .filter(|&j| !(eig.eigenvalues[j] > FREE * largest))
+        .map(|j| {
+            let v: Vec<f64> = eig.eigenvectors.column(j).iter().cloned().collect();
+            describe(dim, &v, c, size)
+        })
+        .collect()
 }
 
 /// The first electric part (joined by electric cells through any node) that no prescribed φ

@@ -54,7 +54,7 @@ mod recovery;
 pub use assembly::{Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field, Prescribed};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
-pub use held::{Held, Support, Unheld};
+pub use held::{free_in, rigid_gram, Held, Support, Unheld};
 pub use loads::{facet_measure, FacetMap, Load, RhsParts};
 pub use material::{voigt, voigt_len, Coordinates, Crystal, Material, MaterialError};
 pub use recovery::{CellFields, ChargeFunctional};

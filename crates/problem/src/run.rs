@@ -360,7 +360,7 @@ pub(crate) fn indented<'a>(scene: &Scene, b: &'a ContactBoundary, sol: &'a Conta
     })
 }
 
-/// A rigid indenter's figures at the solution `at` ([`indenter_report`]), with, where the body
+/// A rigid indenter's figures at the solution `at` (shape, depth, force, contact radius), with, where the body
 /// has potentials, the surface's potential at the indenter's point nearest its axis
 /// (`phi_at(i)`: the potential at point `i`), and the half-space's closed form beside them at
 /// the instant's factors `f` (a static run's are [`crate::Factors::ONE`]); `None` without

@@ -94,6 +94,7 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
         (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
         (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
         (m.cylinder, "mesh.cylinder", "a rounded mesh"),
+        (m.axisymmetric, "mesh.axisymmetric", "a body of revolution"),
         (scene.path.is_some(), "path", "a path"),
         (
             scene.exact.is_some(),
@@ -147,6 +148,7 @@ pub fn solve_on_pieces(
     let start = Instant::now();
     let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, limits, reporter)?;
     let disc = setup.discretize()?;
+    held_on_pieces(petsc, scene, &disc, &piece)?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
@@ -233,6 +235,60 @@ pub fn solve_on_pieces(
         reason: solved.reason,
         options: solved.options,
     })
+}
+
+/// Refuses, on every rank alike, a body that the Dirichlet conditions do not hold, as the whole
+/// mesh's check does (`fe_assembly::held`): a generated box is one connected part, so its rigid
+/// motions are held when the Gram matrix of the conditions, summed over the ranks' own nodes
+/// (`fe_assembly::rigid_gram`), has full rank; its potential, where every cell is electric,
+/// when some rank prescribes φ at a node it owns. A body of electric and non-electric cells,
+/// whose electric parts a piece cannot join, is refused by key. Collective.
+fn held_on_pieces(
+    petsc: &Petsc,
+    scene: &Scene,
+    disc: &fe_assembly::Discretization<'_>,
+    piece: &MeshPiece,
+) -> Result<(), DistributedError> {
+    let (dim, m, rank) = (disc.dofs.dim, &scene.mesh, petsc.rank());
+    let centre: [f64; 3] = std::array::from_fn(|k| if k < dim { 0.5 * (m.lo[k] + m.hi[k]) } else { 0.0 });
+    let size = (0..dim).map(|k| m.hi[k] - m.lo[k]).fold(0.0, f64::max);
+    let owned: Vec<usize> = (0..piece.node_rank.len())
+        .filter(|&v| piece.node_rank[v] == rank)
+        .collect();
+    let gram = fe_assembly::rigid_gram(disc.mesh, &disc.dofs, owned.iter().copied(), (centre, size));
+    let gram = petsc.sum(&gram)?;
+    let free = fe_assembly::free_in(dim, &gram, (centre, size));
+    let cells = piece.n_global_cells;
+    if !free.is_empty() {
+        let unheld = fe_assembly::Unheld::Motion {
+            count: free.len(),
+            motions: free.join("; "),
+            cell: 0,
+            cells,
+            with_supports: false,
+        };
+        return Err(fe_assembly::AssemblyError::from(unheld).into());
+    }
+    let electric = (0..piece.own_cells).filter(|&c| disc.cell_electric[c]).count() as f64;
+    let fixed = owned
+        .iter()
+        .filter(|&&v| matches!(disc.dofs.phi[v], fe_assembly::Dof::Fixed(_)))
+        .count() as f64;
+    let sums = petsc.sum(&[electric, fixed])?;
+    if sums[0] > 0.0 && sums[0] < cells as f64 {
+        let u = Unsupported::new(
+            NAME,
+            "material",
+            "a body of electric and non-electric cells on a mesh made in pieces",
+        )
+        .advise("a run whose every rank holds the whole mesh solves it");
+        return Err(ProblemError::from(u).into());
+    }
+    if sums[0] > 0.0 && sums[1] == 0.0 {
+        let unheld = fe_assembly::Unheld::Potential { cell: 0, cells };
+        return Err(fe_assembly::AssemblyError::from(unheld).into());
+    }
+    Ok(())
 }
 
 /// This rank's piece set up: the blocks, the piece (its mesh taken by the set-up), the set-up
@@ -551,7 +607,13 @@ fn check_regions_and_electrodes(
         let e = &scene.electrodes()[k];
         return Err(ProblemError::from(SetupError::new(
             "electrode.x_range",
-            format!("the electrode `{}` covers no facet of `{}`", electrodes[k], e.group),
+            match &e.x_range {
+                Some(r) => format!(
+                    "the electrode `{}` covers no facet of `{}` in x in [{}, {}]",
+                    electrodes[k], e.group, r[0], r[1]
+                ),
+                None => format!("the electrode `{}` covers no facet of `{}`", electrodes[k], e.group),
+            },
         ))
         .into());
     }
