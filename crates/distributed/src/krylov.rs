@@ -235,18 +235,31 @@ impl linalg::CoupledSolver for Krylov<'_> {
     }
 }
 
+/// On a run on pieces, with potentials and hypre, the elastic block's preconditioner: one
+/// BoomerAMG cycle in place of GAMG's. Measured on `paper-3d` n = 48 with contact (one session,
+/// docs/performance.md): per rank 5565 / 2980 / 1627 MB on 1 / 2 / 4 ranks (0.535 and 0.292 of
+/// one rank) against GAMG's 4583 / 3094 / 1677 MB (0.675 and 0.366), 158.5 / 95.7 / 119.0 s
+/// against 191.7 / 92.9 / 125.4 s, and 53-55 Krylov iterations on every rank count where GAMG's
+/// grew from 105 to 129: the memory a rank needs falls as `1/p`, and the iterations do not grow
+/// with the ranks. (GAMG's parallel Galerkin products are what did not fall.)
+pub const PIECES_ELASTIC_BLOCK: &str = "-fieldsplit_u_pc_type hypre";
+
 /// Puts the backend's options, then the scene's, into PETSc's database; returns them as one
-/// string.
+/// string. `pieces`: a run on pieces ([`PIECES_ELASTIC_BLOCK`]).
 pub(crate) fn configure(
     petsc: &Petsc,
     scene: &Scene,
     layout: &Layout,
     contact_tol: Option<f64>,
+    pieces: bool,
 ) -> Result<String, PetscError> {
     let mut all = if layout.has_phi.iter().any(|&p| p) {
         let mut o = COUPLED_OPTIONS.to_owned();
         if !petsc.has_package("hypre")? {
             o = o.replace("-fieldsplit_phi_pc_type hypre", "-fieldsplit_phi_pc_type gamg");
+        } else if pieces {
+            o.push(' ');
+            o.push_str(PIECES_ELASTIC_BLOCK);
         }
         o
     } else {

@@ -64,7 +64,7 @@ pub use direct::Direct;
 #[cfg(feature = "petsc")]
 pub use error::DistributedError;
 #[cfg(feature = "petsc")]
-pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS};
+pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS, PIECES_ELASTIC_BLOCK};
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]

@@ -387,7 +387,13 @@ impl<'p> Backend for DistributedMemory<'p> {
             },
         };
         let contact = boundary.is_some();
-        let mut options = configure(self.petsc, &posed.scene, &layout, contact.then_some(posed.plan().tol))?;
+        let mut options = configure(
+            self.petsc,
+            &posed.scene,
+            &layout,
+            contact.then_some(posed.plan().tol),
+            false,
+        )?;
         // the active sets where the run's contact would have factored by MUMPS; on the Krylov
         // route otherwise (the paper's Uzawa) the instants' full solves
         let active = (contact && crate::factors_directly(&posed.scene)).then(ActiveSets::default);

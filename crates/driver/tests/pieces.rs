@@ -107,6 +107,10 @@ fn agree_on_pieces(p: &Petsc) {
             whole.fields.electric_displacement.len() / whole.mesh.n_cells(),
             |_| true,
         );
+        // a coupled body on pieces: BoomerAMG on the elastic block where PETSc has hypre
+        if s.options.contains("-fieldsplit_phi_pc_type hypre") {
+            assert!(s.options.contains(distributed::PIECES_ELASTIC_BLOCK), "{}", s.options);
+        }
         let mine = (0..piece.node_rank.len()).filter(|&v| owned(v)).count();
         let all = p.sum(&[mine as f64]).expect("a sum")[0];
         assert_eq!(all as usize, whole.mesh.n_nodes(), "{name}: each node owned once");

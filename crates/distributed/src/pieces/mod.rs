@@ -159,7 +159,7 @@ pub fn solve_on_pieces(
     let t_assembly = start.elapsed().as_secs_f64() - t_setup;
     let (x, solved, contact) = match scene.zones().is_empty() {
         true => {
-            let options = configure(petsc, scene, &layout, None)?;
+            let options = configure(petsc, scene, &layout, None, true)?;
             let (x, solved) = linear(petsc, &fields, &mut system, options)?;
             (x, solved, None)
         }
@@ -412,7 +412,7 @@ impl<'p> OnPiece<'_, 'p> {
             .into());
         }
         let how = ContactSolve::new(&self.setup.plan, scene, &boundary, limits.interrupt);
-        let options = configure(petsc, scene, self.layout, Some(how.tol))?;
+        let options = configure(petsc, scene, self.layout, Some(how.tol), true)?;
         let rows = ContactRows::new(
             petsc,
             (&boundary.points, &boundary.nodes, &how.law),
