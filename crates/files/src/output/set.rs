@@ -177,13 +177,14 @@ fn check_dir(dir: &Path) -> Result<(), Error> {
         Ok(m) if !m.is_dir() => Err(conflict(dir, "is not a directory")),
         Ok(_) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            if std::fs::symlink_metadata(dir).is_ok() {
-                Err(conflict(
+            // a link whose target is absent; not a directory another run made meanwhile (it
+            // was absent a moment ago: commits into one new directory race to make it)
+            match std::fs::symlink_metadata(dir) {
+                Ok(l) if l.file_type().is_symlink() && std::fs::metadata(dir).is_err() => Err(conflict(
                     dir,
                     "is a link to nothing: make its target, or give another --out",
-                ))
-            } else {
-                Ok(())
+                )),
+                _ => Ok(()),
             }
         }
         Err(e) => Err(io("cannot read", dir, e)),
