@@ -809,6 +809,20 @@ mod tests {
         assert_eq!(read(&target, "run.json"), "new");
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn a_link_to_nothing_is_refused_and_a_link_to_a_directory_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        let link = dir.path().join("out");
+        std::os::unix::fs::symlink(dir.path().join("absent"), &link).unwrap();
+        let e = commit(&link, &[("run.json", "x")]).unwrap_err();
+        assert!(e.to_string().contains("a link to nothing"), "{e}");
+        assert!(!dir.path().join("absent").exists());
+        std::fs::create_dir(dir.path().join("absent")).unwrap();
+        commit(&link, &[("run.json", "x")]).unwrap();
+        assert_eq!(read(&dir.path().join("absent"), "run.json"), "x");
+    }
+
     #[test]
     fn runs_into_one_directory_do_not_mix() {
         let dir = tempfile::tempdir().unwrap();
