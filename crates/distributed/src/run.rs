@@ -553,10 +553,10 @@ fn per_rank(petsc: &Petsc, layout: &Layout) -> Result<Vec<usize>, PetscError> {
 /// Bytes per unknown on its rank in a run of the PETSc backend: the matrix, its copy for a
 /// contact step, the field split's blocks and both multigrid hierarchies (measured on
 /// `paper-3d` with Coulomb friction: 5.4 KB at n = 64 on 2 ranks; docs/performance.md).
-const BYTES_PER_UNKNOWN: f64 = 5.0e3;
+pub(crate) const BYTES_PER_UNKNOWN: f64 = 5.0e3;
 /// Bytes per cell that every rank holds in a run of the PETSc backend (the mesh, its geometry
 /// and dof map are built whole on each rank: 100 MB for 393k cells measured, taken low).
-const BYTES_PER_CELL: f64 = 200.0;
+pub(crate) const BYTES_PER_CELL: f64 = 200.0;
 
 /// The mesh of a posed run, and whether its body has potentials.
 fn on_mesh<'a>(posed: &'a Posed<'_>) -> (&'a mesh::Mesh, bool) {

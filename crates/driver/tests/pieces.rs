@@ -108,8 +108,10 @@ fn agree_on_pieces(p: &Petsc) {
             |_| true,
         );
         // a coupled body on pieces: BoomerAMG on the elastic block where PETSc has hypre
-        if s.options.contains("-fieldsplit_phi_pc_type hypre") {
-            assert!(s.options.contains(distributed::PIECES_ELASTIC_BLOCK), "{}", s.options);
+        let petsc_report = s.report.petsc.as_ref().expect("the PETSc section");
+        let options = &petsc_report.options;
+        if options.contains("-fieldsplit_phi_pc_type hypre") {
+            assert!(options.contains(distributed::PIECES_ELASTIC_BLOCK), "{options}");
         }
         let mine = (0..piece.node_rank.len()).filter(|&v| owned(v)).count();
         let all = p.sum(&[mine as f64]).expect("a sum")[0];
@@ -117,10 +119,16 @@ fn agree_on_pieces(p: &Petsc) {
         eprintln!(
             "{name} {sets:?} rank {rank}/{}: blocks {:?}, {} of {} cells held, {} iterations; u {du:.1e}, phi {dphi:.1e}, stress {ds:.1e}, D {dd:.1e}",
             p.size(),
-            s.blocks,
+            petsc_report.pieces,
             piece.mesh.n_cells(),
             whole.mesh.n_cells(),
-            s.iterations
+            petsc_report.krylov_iterations
+        );
+        // the per-rank unknowns are the layout's, and sum to the whole problem's
+        assert_eq!(petsc_report.unknowns_per_rank.len(), p.size());
+        assert_eq!(
+            petsc_report.unknowns_per_rank.iter().sum::<usize>(),
+            petsc_report.unknowns
         );
         // the report's sums over the ranks: the terminals' charges, the free unknowns
         assert_eq!(s.report.dofs, whole.report.dofs, "{name}");

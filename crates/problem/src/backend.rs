@@ -19,7 +19,9 @@ use linalg::CondenseRoute;
 
 pub use crate::boundary::{ContactBoundary, MAX_NORMAL_ANGLE_DEG};
 pub use crate::plan::Plan;
-pub use crate::setup::{setup, setup_piece, MeshNotes, Setup};
+pub use crate::setup::{
+    electrode_without_facets, piece_refusal, region_without_cells, setup, setup_piece, MeshNotes, Setup,
+};
 
 /// A scene a backend does not solve: the backend, the scene key that asks for what it lacks,
 /// and what that is. Raised by [`Backend::supports`] before anything is built; the scene is

@@ -108,7 +108,7 @@ pub(crate) fn contact_boundary(
 impl ContactResult {
     /// The contact part of a solution whose fields were not computed: the displacement of
     /// the points the contact solve's own (all tangential components 0 where it has none).
-    pub(crate) fn condensed(b: ContactBoundary, solution: ContactSolution) -> ContactResult {
+    pub fn condensed(b: ContactBoundary, solution: ContactSolution) -> ContactResult {
         let n_t = b.points.n_tangential();
         let mut displacement = PointValues::zeros(b.points.len(), n_t);
         displacement.normal.clone_from(&solution.u.normal);

@@ -82,9 +82,8 @@ pub fn setup(scene: Valid<'_>, given: Option<mesh::Mesh>) -> Result<Setup, Probl
 
 /// The [`Setup`] of one rank's piece of a generated mesh (a [`mesh::MeshPiece`]'s mesh: the
 /// rank's block of cells and one layer of ghosts), for a run in which no rank holds the whole
-/// mesh. The scene's mesh must be one a piece is made of: generated, of order 1, neither
-/// layered nor rounded (the caller refuses the others by key); a grading maps each node by its
-/// own grid index, as on the whole mesh. What only the whole
+/// mesh. The scene's mesh must be one a piece is made of ([`piece_refusal`]); a grading maps
+/// each node by its own grid index, as on the whole mesh. What only the whole
 /// mesh can tell is the caller's to check, by reductions over the ranks: that each region
 /// (`mesh.region`) holds a cell and each electrode a facet on some piece.
 ///
@@ -253,20 +252,8 @@ fn mesh(scene: &Scene, source: Source) -> Result<(mesh::Mesh, MeshNotes), Proble
 /// caller (a piece may hold none of a region that other pieces hold).
 fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNotes), ProblemError> {
     let m = &scene.mesh;
-    let refused = [
-        (!m.layers.is_empty(), "mesh.layer"),
-        (m.order.is_some_and(|o| o != 1), "mesh.order"),
-        (m.cylinder, "mesh.cylinder"),
-        (!matches!(m.kind, MeshKind::Rectangle | MeshKind::Box), "mesh.kind"),
-    ];
-    if let Some((_, key)) = refused.iter().find(|(r, _)| *r) {
-        return Err(SetupError::new(
-            key,
-            format!(
-                "{key}: a mesh made in pieces is a generated rectangle or box of order 1, neither layered nor rounded"
-            ),
-        )
-        .into());
+    if let Some((key, what)) = piece_refusal(m) {
+        return Err(SetupError::new(key, format!("{key}: {what} on a mesh made in pieces")).into());
     }
     // a node's graded coordinate depends on its own grid index alone: a piece's are the
     // whole mesh's
@@ -281,10 +268,54 @@ fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNo
     };
     box_regions(&mut mesh, &m.regions, false)?;
     electrodes(&mut mesh, scene, false)?;
-    if m.axisymmetric {
-        axis_group(&mut mesh)?;
-    }
     Ok((mesh, notes))
+}
+
+/// What a mesh made in pieces cannot be, as the key that asks for it and the thing in words,
+/// or `None`: a piece is a generated rectangle or box of order 1 (graded or not), neither
+/// layered nor rounded nor a body of revolution. [`setup_piece`] refuses these, and so does a
+/// backend before it makes a piece.
+pub fn piece_refusal(m: &crate::scene::MeshSpec) -> Option<(&'static str, &'static str)> {
+    [
+        (
+            !matches!(m.kind, MeshKind::Rectangle | MeshKind::Box),
+            "mesh.kind",
+            "a mesh that is not generated",
+        ),
+        (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
+        (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
+        (m.cylinder, "mesh.cylinder", "a rounded mesh"),
+        (m.axisymmetric, "mesh.axisymmetric", "a body of revolution"),
+    ]
+    .into_iter()
+    .find(|(refused, _, _)| *refused)
+    .map(|(_, key, what)| (key, what))
+}
+
+/// The refusal of a region by box (`mesh.region` named `name`) that holds no cell: of the
+/// whole mesh, or of every piece.
+pub fn region_without_cells(name: &str) -> SetupError {
+    SetupError::new("mesh.region", format!("mesh.region `{name}` holds no cell"))
+}
+
+/// The refusal of the scene's electrode `k` that covers no facet: of the whole mesh, or of
+/// every piece.
+pub fn electrode_without_facets(scene: &Scene, k: usize) -> SetupError {
+    let e = &scene.electrodes()[k];
+    let range = e
+        .x_range
+        .clone()
+        .unwrap_or_else(|| vec![f64::NEG_INFINITY, f64::INFINITY]);
+    SetupError::new(
+        "electrode.x_range",
+        format!(
+            "the electrode `{}` covers no facet of `{}` in x in [{}, {}]",
+            e.group_name(k),
+            e.group,
+            range[0],
+            range[1]
+        ),
+    )
 }
 
 /// The electrodes' facet groups (`electrode.x_range` of `electrode.group`), each refused
@@ -299,14 +330,7 @@ fn electrodes(mesh: &mut mesh::Mesh, scene: &Scene, whole: bool) -> Result<(), P
         let g = mesh.select_facets(&e.group, |x| x[0] >= range[0] - tol && x[0] <= range[1] + tol)?;
         let name = e.group_name(k);
         if whole && g.n_facets() == 0 {
-            return Err(SetupError::new(
-                "electrode.x_range",
-                format!(
-                    "the electrode `{name}` covers no facet of `{}` in x in [{}, {}]",
-                    e.group, range[0], range[1]
-                ),
-            )
-            .into());
+            return Err(electrode_without_facets(scene, k).into());
         }
         if mesh.boundaries.contains_key(&name) {
             return Err(SetupError::new(
@@ -352,7 +376,7 @@ fn box_regions(mesh: &mut mesh::Mesh, regions: &[crate::scene::RegionSpec], whol
             })
             .collect();
         if whole && cells.is_empty() {
-            return Err(SetupError::new("mesh.region", format!("mesh.region `{}` holds no cell", r.name)).into());
+            return Err(region_without_cells(&r.name).into());
         }
         mesh.regions.insert(r.name.clone(), cells);
     }

@@ -7,7 +7,7 @@
 
 use super::PieceSolution;
 use crate::error::DistributedError;
-use contact::{ContactPoints, ContactSolution, PointValues, Status};
+use contact::{ContactSolution, PointValues, Status};
 use petsc::Petsc;
 use problem::ContactResult;
 use std::collections::BTreeMap;
@@ -120,16 +120,8 @@ impl PieceSolution {
         let mut sorted: Vec<&[f64]> = all.chunks(width(nt)).collect();
         sorted.sort_by(|a, b| a[0].total_cmp(&b[0]));
         let n = sorted.len();
-        let mut points = ContactPoints {
-            position: vec![],
-            normal: vec![],
-            tangent: vec![],
-            weight: vec![],
-            gap: vec![],
-            friction: vec![],
-            held: vec![],
-            ..p.select(&[])
-        };
+        // the boundary's per-zone data with no point yet; the points pushed below
+        let mut points = p.select(&[]);
         let (mut lambda, mut u) = (PointValues::zeros(n, nt), PointValues::zeros(n, nt));
         let (mut nodes, mut status, mut phi) = (vec![], vec![], vec![]);
         for (i, r) in sorted.iter().enumerate() {

@@ -8,9 +8,10 @@
 //! What it solves today: a generated rectangle or box of order 1 without path or floating
 //! terminal, without contact or with the contact the active sets hold (the paper's base model
 //! on one zone: [`crate::active_sets_hold`]), each rank iterating on the contact points at
-//! the nodes it owns; every other scene is refused by key ([`pieces_support`]). The outputs
-//! written by pieces and the run's report from reductions are the next steps
-//! (docs/performance.md, issue 45).
+//! the nodes it owns; every other scene is refused by key ([`pieces_support`]). The run's
+//! report is made of sums over the ranks ([`PieceSolution::report`]), completed on rank 0 from
+//! the gathered surfaces ([`PieceSolution::gathered`]); the driver writes each rank's piece of
+//! the solution.
 //!
 //! Why the pieces are complete: a rank's own node lies only in cells of its piece (its own and
 //! the ghost layer), so its rows of the matrix, of the loads and of their lifting by prescribed
@@ -34,18 +35,11 @@ use mesh::{Blocks, MeshPiece};
 use petsc::{Index, Petsc, Vector};
 use problem::backend::{setup_piece, ContactBoundary, ContactSolve, Unsupported};
 use problem::terminal_groups;
-use problem::{Event, MeshKind, ProblemError, Reporter, Scene, SetupError};
+use problem::{Event, ProblemError, Reporter, Scene, SetupError};
 use std::time::Instant;
 
 /// The backend name a run on pieces refuses under.
 const NAME: &str = "petsc";
-
-/// The bytes a rank takes per unknown it owns on the Krylov route (the matrix, the field
-/// split's sub-matrices, the two multigrid hierarchies and the Krylov basis; measured,
-/// docs/performance.md), and per cell of its piece (the piece's mesh, geometry, dof map and
-/// recovered fields).
-const BYTES_PER_UNKNOWN: f64 = 5.0e3;
-const BYTES_PER_CELL: f64 = 200.0;
 
 /// One rank's share of a run on pieces.
 pub struct PieceSolution {
@@ -65,16 +59,6 @@ pub struct PieceSolution {
     pub report: problem::RunReport,
     /// The rank's share of the contact solution, where the scene has contact.
     pub contact: Option<PieceContact>,
-    /// Unknowns of the whole problem (prescribed ones among them).
-    pub unknowns: usize,
-    /// The blocks of cells per axis the mesh was cut into.
-    pub blocks: [usize; 3],
-    /// Krylov iterations, and why the solve stopped (PETSc's reason).
-    pub iterations: usize,
-    /// PETSc's converged reason.
-    pub reason: String,
-    /// The PETSc options of the solve (the backend's, then the scene's).
-    pub options: String,
 }
 
 /// Whether a run on pieces solves `scene`: a generated rectangle or box of order 1 (graded
@@ -84,17 +68,7 @@ pub struct PieceSolution {
 /// # Errors
 /// [`Unsupported`], naming the key of what a run on pieces does not solve yet.
 pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
-    let m = &scene.mesh;
     let refused = [
-        (
-            !matches!(m.kind, MeshKind::Rectangle | MeshKind::Box),
-            "mesh.kind",
-            "a mesh that is not generated",
-        ),
-        (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
-        (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
-        (m.cylinder, "mesh.cylinder", "a rounded mesh"),
-        (m.axisymmetric, "mesh.axisymmetric", "a body of revolution"),
         (scene.path.is_some(), "path", "a path"),
         (
             scene.exact.is_some(),
@@ -107,7 +81,12 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
             "a floating terminal",
         ),
     ];
-    if let Some((_, key, what)) = refused.iter().find(|(r, _, _)| *r) {
+    let mesh = problem::backend::piece_refusal(&scene.mesh);
+    let scene_keys = refused
+        .into_iter()
+        .find(|(r, _, _)| *r)
+        .map(|(_, key, what)| (key, what));
+    if let Some((key, what)) = mesh.or(scene_keys) {
         return Err(Unsupported::new(NAME, key, format!("{what} on a mesh made in pieces"))
             .advise("a run whose every rank holds the whole mesh solves it"));
     }
@@ -214,7 +193,7 @@ pub fn solve_on_pieces(
         solved: &solved,
         contact: contact.as_ref(),
         equilibrium,
-        unknowns: layout.n_global(),
+        unknowns: (0..petsc.size()).map(|r| layout.owned(r).len()).collect(),
         timings,
         blocks: blocks.p,
         nonzeros: petsc.sum(&[system.matrix.local_info()?.0])?[0],
@@ -229,11 +208,6 @@ pub fn solve_on_pieces(
         fields: recovered,
         contact,
         report,
-        unknowns: layout.n_global(),
-        blocks: blocks.p,
-        iterations: solved.iterations,
-        reason: solved.reason,
-        options: solved.options,
     })
 }
 
@@ -533,7 +507,7 @@ fn check_memory(scene: &Scene, blocks: &Blocks, rank: usize, limits: problem::Li
         })
         .product();
     let (cells, unknowns) = (cells * widened, unknowns * widened);
-    let bytes = BYTES_PER_UNKNOWN * unknowns + BYTES_PER_CELL * cells;
+    let bytes = crate::run::BYTES_PER_UNKNOWN * unknowns + crate::run::BYTES_PER_CELL * cells;
     if bytes > available as f64 {
         return Err(ProblemError::TooLarge {
             what: format!(
@@ -597,25 +571,10 @@ fn check_regions_and_electrodes(
     );
     let sums = petsc.sum(&counts)?;
     if let Some(k) = (0..regions.len()).find(|&k| sums[k] == 0.0) {
-        return Err(ProblemError::from(SetupError::new(
-            "mesh.region",
-            format!("mesh.region `{}` holds no cell", regions[k]),
-        ))
-        .into());
+        return Err(ProblemError::from(problem::backend::region_without_cells(regions[k])).into());
     }
     if let Some(k) = (0..electrodes.len()).find(|&k| sums[regions.len() + k] == 0.0) {
-        let e = &scene.electrodes()[k];
-        return Err(ProblemError::from(SetupError::new(
-            "electrode.x_range",
-            match &e.x_range {
-                Some(r) => format!(
-                    "the electrode `{}` covers no facet of `{}` in x in [{}, {}]",
-                    electrodes[k], e.group, r[0], r[1]
-                ),
-                None => format!("the electrode `{}` covers no facet of `{}`", electrodes[k], e.group),
-            },
-        ))
-        .into());
+        return Err(ProblemError::from(problem::backend::electrode_without_facets(scene, k)).into());
     }
     Ok(())
 }

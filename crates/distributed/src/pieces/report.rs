@@ -38,7 +38,8 @@ pub(super) struct Figures<'a> {
     pub(super) contact: Option<&'a PieceContact>,
     /// `|K x - b| / |b|` of a run without contact.
     pub(super) equilibrium: f64,
-    pub(super) unknowns: usize,
+    /// The unknowns each rank owns (the layout's ranges, known on every rank).
+    pub(super) unknowns: Vec<usize>,
     pub(super) timings: Timings,
     /// The blocks of cells per axis, one per rank.
     pub(super) blocks: [usize; 3],
@@ -61,19 +62,11 @@ impl Shares<'_> {
                 .count() as f64;
             free_phi += f64::from(u8::from(matches!(dofs.phi[v], Dof::Free(_))));
         }
-        let own_unknowns = self
-            .owned
-            .iter()
-            .enumerate()
-            .filter(|(_, &o)| o)
-            .map(|(v, _)| dim + usize::from(!matches!(dofs.phi[v], Dof::Absent)))
-            .sum::<usize>();
         let sums = petsc.sum(&[free_u, free_phi])?;
         let h = petsc.max(&[setup.mesh.h_max()])?[0];
         let info = f.contact.map(|c| &c.solution.info);
         let equilibrium = f.contact.map_or(f.equilibrium, |c| c.equilibrium);
         let cells_per_rank = petsc.all_gather(self.own_cells as u64)?;
-        let unknowns_per_rank = petsc.all_gather(own_unknowns as u64)?;
         Ok(RunReport {
             scene: SceneReport::of(scene),
             plan: plan.clone(),
@@ -111,13 +104,13 @@ impl Shares<'_> {
             },
             petsc: Some(PetscReport {
                 ranks: petsc.size(),
-                unknowns: f.unknowns,
+                unknowns: f.unknowns.iter().sum(),
                 nonzeros: f.nonzeros,
                 krylov_iterations: f.solved.iterations,
                 reason: f.solved.reason.clone(),
                 options: f.solved.options.clone(),
                 cells_per_rank: cells_per_rank.into_iter().map(|c| c as usize).collect(),
-                unknowns_per_rank: unknowns_per_rank.into_iter().map(|c| c as usize).collect(),
+                unknowns_per_rank: f.unknowns,
                 peak_bytes_per_rank: vec![],
                 preconditioner_setup_s: f.solved.setup_seconds,
                 pieces: Some(f.blocks),

@@ -93,14 +93,10 @@ pub(super) fn run(
 /// This rank's piece of the solution (with its own contact points) as a `.vtu`, and the
 /// `.pvtu` naming the `ranks` pieces.
 fn piece_files(s: &distributed::PieceSolution, rank: usize, ranks: usize) -> (Vec<u8>, Vec<u8>) {
-    let own = s.contact.as_ref().map(|c| ContactResult {
-        points: c.boundary.points.clone(),
-        nodes: c.boundary.nodes.clone(),
-        solution: c.solution.clone(),
-        displacement: c.solution.u.clone(),
-        groups: c.boundary.groups.clone(),
-        group_of: c.boundary.group_of.clone(),
-    });
+    let own = s
+        .contact
+        .as_ref()
+        .map(|c| ContactResult::condensed(c.boundary.clone(), c.solution.clone()));
     let ghost: Vec<bool> = s.piece.cell_rank.iter().map(|&r| r != rank).collect();
     Piece {
         mesh: &s.piece.mesh,
