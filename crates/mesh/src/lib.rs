@@ -37,7 +37,7 @@ mod quality;
 mod topology;
 
 pub use generate::{box_tet, rectangle_quad, rectangle_tri, round_quarter_section};
-pub use gmsh::{read_msh, read_msh_bytes};
+pub use gmsh::{parts_of, read_msh, read_msh_bytes, read_msh_part, MshPart};
 pub use ordering::nested_dissection;
 pub use parts::MeshParts;
 pub use pieces::{Blocks, MeshPiece};

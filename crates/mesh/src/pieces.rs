@@ -472,3 +472,21 @@ mod tests {
         }
     }
 }
+
+impl MeshPiece {
+    /// The one piece of a run on one rank: the whole of `mesh`, every cell and node its own
+    /// and numbered as in `mesh`.
+    pub fn whole(mesh: Mesh) -> MeshPiece {
+        let (nodes, cells) = (mesh.n_nodes(), mesh.n_cells());
+        MeshPiece {
+            mesh,
+            own_cells: cells,
+            cell_rank: vec![0; cells],
+            global_cell: (0..cells).collect(),
+            global_node: (0..nodes).collect(),
+            node_rank: vec![0; nodes],
+            n_global_nodes: nodes,
+            n_global_cells: cells,
+        }
+    }
+}

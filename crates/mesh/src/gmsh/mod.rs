@@ -22,7 +22,10 @@
 //! orientations is left as it is, and [`Mesh::check`] then reports the inverted cells.
 
 mod cursor;
+mod part;
 mod sections;
+
+pub use part::{parts_of, read_msh_part, MshPart};
 
 use crate::{CellKind, FacetGroup, Mesh, MeshError};
 use sections::{type_name, File};
@@ -53,7 +56,8 @@ pub fn read_msh_bytes(bytes: &[u8], name: &str) -> Result<Mesh, MeshError> {
         message,
     };
     let file = sections::read(bytes).map_err(err)?;
-    let mut mesh = build(&file).map_err(err)?;
+    whole_partitions(&file).map_err(err)?;
+    let mut mesh = build(&file, false).map_err(err)?;
     flatten_2d(&mut mesh).map_err(err)?;
     mesh.check().map_err(|e| err(format!("{e}")))?;
     Ok(mesh)
@@ -74,10 +78,8 @@ fn groups_of(file: &File, d: i32, tag: i32) -> Vec<String> {
     out
 }
 
-/// The mesh of the file's sections: cells of the highest dimension present (one kind, each
-/// block turned round where all its cells are negatively oriented) with their regions, facets
-/// one dimension lower in their groups.
-fn build(file: &File) -> Result<Mesh, String> {
+/// The dimension of the file's cells: the highest of its elements', 2 or 3.
+fn cell_dim(file: &File) -> Result<i32, String> {
     let dim = file
         .elements
         .iter()
@@ -90,13 +92,62 @@ fn build(file: &File) -> Result<Mesh, String> {
             "the highest element dimension is {dim}; a 2D or 3D mesh is needed"
         ));
     }
+    Ok(dim)
+}
+
+/// The blocks of cells of dimension `dim`: the file's own, then (with `ghosts`) those on
+/// ghost entities, which hold other partitions' cells in a part of a split mesh.
+fn cell_blocks(file: &File, dim: i32, ghosts: bool) -> Vec<&sections::ElementBlock> {
+    let cells = file.elements.iter().filter(|b| b.dim == dim && !b.tags.is_empty());
+    let on_ghost = |b: &&sections::ElementBlock| file.ghost_entities.contains_key(&b.entity);
+    let own = cells.clone().filter(|b| !on_ghost(b));
+    let ghost = cells.filter(on_ghost).filter(|_| ghosts);
+    own.chain(ghost).collect()
+}
+
+/// The partitions whose cells a partitioned file holds, and the partitions in all (`0` for a
+/// file that is not partitioned).
+fn partitions_held(file: &File) -> Result<(Vec<i32>, u64), String> {
+    let dim = cell_dim(file)?;
+    let mut held: Vec<i32> = cell_blocks(file, dim, false)
+        .iter()
+        .filter_map(|b| file.entity_partitions.get(&(dim, b.entity)))
+        .flatten()
+        .copied()
+        .collect();
+    held.sort_unstable();
+    held.dedup();
+    Ok((held, file.partitions))
+}
+
+/// Refuses a part of a mesh Gmsh split into files (`Mesh.PartitionSplitMeshFiles = 1`) read
+/// as a whole mesh: it holds one partition's cells and a layer of its neighbours', a piece of
+/// the body that would be solved as if it were the body.
+fn whole_partitions(file: &File) -> Result<(), String> {
+    let (held, partitions) = partitions_held(file)?;
+    if partitions > 1 && (held.len() as u64) < partitions {
+        let which = held.iter().map(i32::to_string).collect::<Vec<_>>().join(", ");
+        return Err(format!(
+            "the file is part {which} of a mesh that Gmsh split into {partitions} files (Mesh.PartitionSplitMeshFiles = 1): alone it is a piece of the body. Name the mesh saved whole, or name the parts' common stem (`mesh.msh` for `mesh_1.msh` .. `mesh_{partitions}.msh`) and run on {partitions} ranks of the PETSc backend, each of which reads its part"
+        ));
+    }
+    Ok(())
+}
+
+/// The mesh of the file's sections: cells of the highest dimension present (one kind, each
+/// block turned round where all its cells are negatively oriented) with their regions, facets
+/// one dimension lower in their groups. With `ghosts`, the cells on ghost entities follow
+/// the file's own (a part of a split mesh); without, they are left out.
+fn build(file: &File, ghosts: bool) -> Result<Mesh, String> {
+    let dim = cell_dim(file)?;
     let (coords, index_of) = node_table(file)?;
     // the cells first (a second-order mesh is named by its cells, not its facets)
     let mut kind: Option<CellKind> = None;
     let mut cell_tags: Vec<u64> = vec![];
     let mut blocks = vec![];
     let mut regions: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-    for block in file.elements.iter().filter(|b| b.dim == dim && !b.tags.is_empty()) {
+    let cell_blocks = cell_blocks(file, dim, ghosts);
+    for &block in &cell_blocks {
         let k = cell_kind(block.element_type, dim, kind)?;
         kind = Some(k);
         let first = cell_tags.len() / k.n_nodes();
@@ -110,7 +161,7 @@ fn build(file: &File) -> Result<Mesh, String> {
     let kind = kind.ok_or_else(|| format!("no {dim}D cells"))?;
     let mut cells: Vec<usize> = cell_tags
         .chunks_exact(kind.n_nodes())
-        .zip(cell_element_tags(file, dim))
+        .zip(cell_blocks.iter().flat_map(|b| b.tags.iter().copied()))
         .flat_map(|(c, e)| c.iter().map(move |&t| (t, e)))
         .map(|(t, e)| node_index(&index_of, t, e))
         .collect::<Result<_, _>>()?;
@@ -140,14 +191,6 @@ fn build(file: &File) -> Result<Mesh, String> {
         regions,
         reoriented_cells: reoriented,
     })
-}
-
-/// The element tags of the cells, in the order of their blocks.
-fn cell_element_tags(file: &File, dim: i32) -> impl Iterator<Item = u64> + '_ {
-    file.elements
-        .iter()
-        .filter(move |b| b.dim == dim)
-        .flat_map(|b| b.tags.iter().copied())
 }
 
 /// The index of node tag `tag`, named by element `elem` where the file lacks it.

@@ -1,7 +1,7 @@
 //! The sections of an MSH 4.1 file, read as the format defines them (Gmsh reference manual,
 //! "MSH file format", version 4.1): `$MeshFormat`, `$PhysicalNames`, `$Entities`,
-//! `$PartitionedEntities`, `$Nodes` and `$Elements` are read; every other section (`$Periodic`,
-//! `$GhostElements`, `$Parametrizations`, `$NodeData`, `$ElementData`, `$ElementNodeData`,
+//! `$PartitionedEntities`, `$Nodes`, `$Elements` and `$GhostElements` are read; every other
+//! section (`$Periodic`, `$Parametrizations`, `$NodeData`, `$ElementData`, `$ElementNodeData`,
 //! `$InterpolationScheme`, comments, a program's own) is passed over to its end marker, as
 //! Gmsh does with the sections it does not know.
 
@@ -36,6 +36,15 @@ pub(super) struct File {
     pub(super) physical: HashMap<(i32, i32), Vec<i32>>,
     pub(super) nodes: Vec<NodeBlock>,
     pub(super) elements: Vec<ElementBlock>,
+    /// The partitions of a partitioned file (`$PartitionedEntities`), 0 where it is not.
+    pub(super) partitions: u64,
+    /// `(dimension, entity tag) -> partitions` of a partitioned file's partition entities.
+    pub(super) entity_partitions: HashMap<(i32, i32), Vec<i32>>,
+    /// The ghost entities (the entities that hold another partition's cells) and the
+    /// partition that holds them.
+    pub(super) ghost_entities: HashMap<i32, i32>,
+    /// `$GhostElements`: each ghost element's tag and the partition that owns it.
+    pub(super) ghost_owner: HashMap<u64, i32>,
     seen: Vec<&'static str>,
 }
 
@@ -127,6 +136,7 @@ pub(super) fn read(bytes: &[u8]) -> Result<File> {
             "PartitionedEntities" => "`$PartitionedEntities`",
             "Nodes" => "`$Nodes`",
             "Elements" => "`$Elements`",
+            "GhostElements" => "`$GhostElements`",
             "MeshFormat" => return Err("a second `$MeshFormat`: two files joined into one?".into()),
             _ => {
                 // a section this reader does not use, passed over as Gmsh does
@@ -151,6 +161,7 @@ pub(super) fn read(bytes: &[u8]) -> Result<File> {
             "Entities" => entities(&mut c, &mut file)?,
             "PartitionedEntities" => partitioned_entities(&mut c, &mut file)?,
             "Nodes" => nodes(&mut c, &mut file)?,
+            "GhostElements" => ghost_elements(&mut c, &mut file)?,
             _ => elements(&mut c, &mut file)?,
         }
         c.expect_end(name)?;
@@ -307,11 +318,12 @@ fn entities(c: &mut Cursor<'_>, file: &mut File) -> Result<()> {
 /// `$PartitionedEntities`: the partition entities' physical tags (a partitioned file's node and
 /// element blocks are on them).
 fn partitioned_entities(c: &mut Cursor<'_>, file: &mut File) -> Result<()> {
-    c.size("the count of partitions")?;
+    file.partitions = c.size("the count of partitions")?;
     let ghosts = c.size("the count of ghost entities")?;
     for _ in 0..ghosts {
-        c.int("a ghost entity tag")?;
-        c.int("a ghost entity's partition")?;
+        let tag = c.int("a ghost entity tag")?;
+        let partition = c.int("a ghost entity's partition")?;
+        file.ghost_entities.insert(tag, partition);
     }
     let counts = entity_counts(c)?;
     for (d, &count) in counts.iter().enumerate() {
@@ -320,9 +332,11 @@ fn partitioned_entities(c: &mut Cursor<'_>, file: &mut File) -> Result<()> {
             c.int("a parent's dimension")?;
             c.int("a parent's tag")?;
             let parts = c.size("a count of partitions")?;
+            let mut partitions = Vec::with_capacity(c.capacity(parts, c.least_bytes()));
             for _ in 0..parts {
-                c.int("a partition tag")?;
+                partitions.push(c.int("a partition tag")?);
             }
+            file.entity_partitions.insert((d as i32, tag), partitions);
             c.skip_floats(if d == 0 { 3 } else { 6 }, "an entity's coordinates")?;
             let phys = physical_tags(c)?;
             if d > 0 {
@@ -374,6 +388,25 @@ fn nodes(c: &mut Cursor<'_>, file: &mut File) -> Result<()> {
         return Err(format!(
             "the $Nodes header declares {total} nodes but its blocks hold {held}"
         ));
+    }
+    Ok(())
+}
+
+/// `$GhostElements`: each ghost element's tag, the partition that owns it, and the partitions
+/// that hold it as a ghost (not kept).
+fn ghost_elements(c: &mut Cursor<'_>, file: &mut File) -> Result<()> {
+    let n = c.size("the count of ghost elements")?;
+    file.ghost_owner.reserve(c.capacity(n, 3 * c.least_bytes()));
+    for _ in 0..n {
+        let tag = c.size("a ghost element's tag")?;
+        let owner = c.int("a ghost element's partition")?;
+        let holders = c.size("a ghost element's count of ghost partitions")?;
+        for _ in 0..holders {
+            c.int("a ghost partition")?;
+        }
+        if file.ghost_owner.insert(tag, owner).is_some() {
+            return Err(format!("`$GhostElements` lists element {tag} twice"));
+        }
     }
     Ok(())
 }
