@@ -352,6 +352,24 @@ impl Cells {
     }
 }
 
+impl MeshPiece {
+    /// The one piece of a run on one rank: the whole of `mesh`, every cell and node its own
+    /// and numbered as in `mesh`.
+    pub fn whole(mesh: Mesh) -> MeshPiece {
+        let (nodes, cells) = (mesh.n_nodes(), mesh.n_cells());
+        MeshPiece {
+            mesh,
+            own_cells: cells,
+            cell_rank: vec![0; cells],
+            global_cell: (0..cells).collect(),
+            global_node: (0..nodes).collect(),
+            node_rank: vec![0; nodes],
+            n_global_nodes: nodes,
+            n_global_cells: cells,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -469,24 +487,6 @@ mod tests {
             if let Some(blocks) = Blocks::new(2, [nx, ny, 0], ranks) {
                 agrees(&whole, &blocks, |r| blocks.rectangle_piece(lo, hi, r));
             }
-        }
-    }
-}
-
-impl MeshPiece {
-    /// The one piece of a run on one rank: the whole of `mesh`, every cell and node its own
-    /// and numbered as in `mesh`.
-    pub fn whole(mesh: Mesh) -> MeshPiece {
-        let (nodes, cells) = (mesh.n_nodes(), mesh.n_cells());
-        MeshPiece {
-            mesh,
-            own_cells: cells,
-            cell_rank: vec![0; cells],
-            global_cell: (0..cells).collect(),
-            global_node: (0..nodes).collect(),
-            node_rank: vec![0; nodes],
-            n_global_nodes: nodes,
-            n_global_cells: cells,
         }
     }
 }
