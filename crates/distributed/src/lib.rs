@@ -68,7 +68,7 @@ pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS, PIECES_ELASTIC_BLOCK};
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
-pub use pieces::{pieces_support, solve_on_pieces, Gathered, PieceContact, PieceSolution};
+pub use pieces::{pieces_support, solve_on_pieces, Gathered, PieceContact, PieceMesh, PieceSolution};
 #[cfg(feature = "petsc")]
 pub use run::{
     solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared, ACTIVE_SETS_FROM,

@@ -78,8 +78,14 @@ fn agree_on_pieces(p: &Petsc) {
     for (name, sets) in CASES {
         let (faer, scene) = both(name, sets);
         let whole = problem::solve(&faer, None, &mut problem::Silent).expect("the whole mesh's run");
-        let s = distributed::solve_on_pieces(p, &scene, problem::Limits::default(), &mut problem::Silent)
-            .unwrap_or_else(|e| panic!("{name} {sets:?} on pieces: {e}"));
+        let s = distributed::solve_on_pieces(
+            p,
+            &scene,
+            distributed::PieceMesh::Generated,
+            problem::Limits::default(),
+            &mut problem::Silent,
+        )
+        .unwrap_or_else(|e| panic!("{name} {sets:?} on pieces: {e}"));
         let piece = &s.piece;
         let rank = p.rank();
         assert_eq!(piece.n_global_nodes, whole.mesh.n_nodes());
@@ -165,8 +171,14 @@ fn contact_on_pieces(p: &Petsc) {
     for (name, sets) in CONTACT_CASES {
         let (faer, scene) = both(name, sets);
         let whole = problem::solve(&faer, None, &mut problem::Silent).expect("the whole mesh's run");
-        let s = distributed::solve_on_pieces(p, &scene, problem::Limits::default(), &mut problem::Silent)
-            .unwrap_or_else(|e| panic!("{name} {sets:?} on pieces: {e}"));
+        let s = distributed::solve_on_pieces(
+            p,
+            &scene,
+            distributed::PieceMesh::Generated,
+            problem::Limits::default(),
+            &mut problem::Silent,
+        )
+        .unwrap_or_else(|e| panic!("{name} {sets:?} on pieces: {e}"));
         let piece = &s.piece;
         let flat = |u: &[[f64; 3]]| u.iter().flat_map(|x| x.iter().copied()).collect::<Vec<f64>>();
         let du = farthest(&flat(&whole.u), &flat(&s.u), &piece.global_node, 3, |_| true);
@@ -291,7 +303,13 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
     on_ranks("what_pieces_do_not_solve_is_refused_by_key", 2, |p| {
         let refused = |name: &str, sets: &[&str]| {
             let (_, scene) = both(name, sets);
-            match distributed::solve_on_pieces(p, &scene, problem::Limits::default(), &mut problem::Silent) {
+            match distributed::solve_on_pieces(
+                p,
+                &scene,
+                distributed::PieceMesh::Generated,
+                problem::Limits::default(),
+                &mut problem::Silent,
+            ) {
                 Ok(_) => panic!("{name} {sets:?} solved on pieces"),
                 Err(e) => e.to_string(),
             }
@@ -328,10 +346,16 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
             memory_limit: Some("a test's limit"),
             ..Default::default()
         };
-        let e = distributed::solve_on_pieces(p, &scene, limits, &mut problem::Silent)
-            .map(|_| ())
-            .unwrap_err()
-            .to_string();
+        let e = distributed::solve_on_pieces(
+            p,
+            &scene,
+            distributed::PieceMesh::Generated,
+            limits,
+            &mut problem::Silent,
+        )
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
         assert!(
             e.contains(&format!("rank {} of 2", p.rank())) && e.contains("a test's limit"),
             "{e}"
@@ -592,4 +616,143 @@ fn a_rank_that_cannot_write_its_piece_leaves_the_previous_set() {
         "the previous set stays"
     );
     assert!(tmp.path().join("out/solution-1.vtu").exists());
+}
+
+/// The fixtures of the mesh crate: the layered box (regions `substrate` and `pzt`, the
+/// interior group `interface`) whole, and split by Gmsh into three parts with ghost cells.
+fn forms() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../mesh/tests/fixtures/forms")
+}
+
+/// The layered box on a Gmsh mesh: both layers PZT-5A (a substrate of half its stiffness),
+/// clamped at x = 0 and x = 2, pressed on top, on a Coulomb foundation at z = 0.
+const LAYERED: &str = r#"
+name = "layered-gmsh"
+description = "the layered Gmsh box of the mesh crate's fixtures, on a Coulomb foundation"
+[units]
+length = "m"
+stress = "GPa"
+[mesh]
+kind = "gmsh"
+file = "3d-ascii-split.msh"
+[[material]]
+region = "pzt"
+model = "crystal-6mm"
+c = [121.0, 75.4, 75.2, 111.0, 21.1, 22.6]
+e = [-5.4, 15.8, 12.3]
+permittivity = [8.11, 7.35]
+poling = [0.0, 0.0, 1.0]
+[[material]]
+region = "substrate"
+model = "crystal-6mm"
+c = [60.5, 37.7, 37.6, 55.5, 10.55, 11.3]
+e = [-5.4, 15.8, 12.3]
+permittivity = [8.11, 7.35]
+poling = [0.0, 0.0, 1.0]
+[[dirichlet]]
+group = "left"
+u = [0.0, 0.0, 0.0]
+phi = 0.0
+[[dirichlet]]
+group = "right"
+u = [0.0, 0.0, 0.0]
+phi = 0.0
+[load]
+group = "top"
+p = -2.0
+direction = [0.0, 0.0, 1.0]
+[contact]
+group = "bottom"
+law = "coulomb"
+friction = 0.3
+gap = 0.0
+normal = [0.0, 0.0, -1.0]
+"#;
+
+/// A node's place, rounded: the same node in the whole file and in a part.
+fn place(x: &[f64; 3]) -> [i64; 3] {
+    x.map(|c| (c * 1e10).round() as i64)
+}
+
+/// A Gmsh mesh split into three parts, each rank reading its own: with and without contact,
+/// the nodal solution (ghosts' fetched) and the multipliers at the rank's points equal the
+/// default backend's on the whole file, node by node; the report's sums the whole run's.
+#[test]
+fn gmsh_parts_agree_with_the_whole_mesh_on_three_ranks() {
+    on_ranks("gmsh_parts_agree_with_the_whole_mesh_on_three_ranks", 3, |p| {
+        let parts = mesh::parts_of(&forms().join("3d-ascii-split.msh"));
+        for sets in [vec!["contact.law=\"none\""], vec![]] {
+            let sets: Vec<String> = sets.into_iter().map(String::from).collect();
+            let faer = scene_file::parse(LAYERED, "layered-gmsh", &sets).expect("the scene");
+            let mut with = sets.clone();
+            with.push("solver.backend=\"petsc\"".into());
+            let scene = scene_file::parse(LAYERED, "layered-gmsh", &with).expect("the scene");
+            let whole_mesh = mesh::read_msh(forms().join("3d-ascii.msh")).expect("the whole file");
+            let whole = problem::solve(&faer, Some(whole_mesh), &mut problem::Silent).expect("the whole run");
+            let from = distributed::PieceMesh::Parts(parts.clone());
+            let s = distributed::solve_on_pieces(p, &scene, from, problem::Limits::default(), &mut problem::Silent)
+                .unwrap_or_else(|e| panic!("{sets:?} on parts: {e}"));
+            let at: std::collections::HashMap<[i64; 3], usize> = whole
+                .mesh
+                .points
+                .iter()
+                .enumerate()
+                .map(|(v, x)| (place(x), v))
+                .collect();
+            let map: Vec<usize> = s.piece.mesh.points.iter().map(|x| at[&place(x)]).collect();
+            let flat = |u: &[[f64; 3]]| u.iter().flat_map(|x| x.iter().copied()).collect::<Vec<f64>>();
+            let du = farthest(&flat(&whole.u), &flat(&s.u), &map, 3, |_| true);
+            let dphi = farthest(&whole.phi, &s.phi, &map, 1, |_| true);
+            assert!(
+                s.piece.mesh.n_cells() < whole.mesh.n_cells(),
+                "a rank holds the whole mesh"
+            );
+            assert_eq!(s.report.mesh.n_cells, whole.mesh.n_cells());
+            assert_eq!(s.report.mesh.n_nodes, whole.mesh.n_nodes());
+            assert_eq!(s.report.dofs, whole.report.dofs, "{sets:?}: the free unknowns");
+            let mut dl = 0.0f64;
+            if let (Some(wc), Some(c)) = (&whole.contact, &s.contact) {
+                let index: std::collections::HashMap<usize, usize> =
+                    wc.nodes.iter().enumerate().map(|(i, &v)| (v, i)).collect();
+                let scale = wc
+                    .solution
+                    .lambda
+                    .normal
+                    .iter()
+                    .fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+                for (i, &v) in c.boundary.nodes.iter().enumerate() {
+                    dl =
+                        dl.max((c.solution.lambda.normal[i] - wc.solution.lambda.normal[index[&map[v]]]).abs() / scale);
+                }
+                assert_eq!(c.points, wc.nodes.len(), "the points over the ranks");
+            }
+            eprintln!(
+                "gmsh parts {sets:?} rank {}/3: {} of {} cells held; u {du:.1e}, phi {dphi:.1e}, multipliers {dl:.1e}",
+                p.rank(),
+                s.piece.mesh.n_cells(),
+                whole.mesh.n_cells()
+            );
+            for (what, d) in [("u", du), ("phi", dphi), ("multipliers", dl)] {
+                assert!(d < 1e-7, "{sets:?} rank {}: {what} differs by {d:.2e}", p.rank());
+            }
+        }
+        // parts for another count of ranks are refused on every rank, naming the count
+        let two = vec![parts[0].clone(), parts[1].clone()];
+        let scene =
+            scene_file::parse(LAYERED, "layered-gmsh", &["solver.backend=\"petsc\"".into()]).expect("the scene");
+        let e = distributed::solve_on_pieces(
+            p,
+            &scene,
+            distributed::PieceMesh::Parts(two),
+            problem::Limits::default(),
+            &mut problem::Silent,
+        )
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+        assert!(
+            e.contains("the mesh is in 2 parts") && e.contains("run on 2 ranks"),
+            "{e}"
+        );
+    });
 }

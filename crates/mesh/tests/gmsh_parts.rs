@@ -183,3 +183,48 @@ fn a_table_of_another_mesh_is_refused() {
     let e = part.complete(&rows, 1000, 100).expect_err("not this mesh's table");
     assert!(e.to_string().contains("not of one mesh"), "{e}");
 }
+
+#[test]
+fn a_ghost_cell_that_no_part_owns_is_refused() {
+    // the table without the records of part 3: part 1's ghosts of part 3 have no owner's mark
+    let paths = parts_of(&forms().join("3d-ascii-split.msh"));
+    let parts: Vec<MshPart> = paths.iter().map(|p| read_msh_part(p).expect("a part")).collect();
+    let mut table: HashMap<usize, f64> = HashMap::new();
+    for part in &parts[..2] {
+        for (slot, value) in part.records().expect("records") {
+            *table.entry(slot).or_default() += value;
+        }
+    }
+    let errors: Vec<String> = parts
+        .into_iter()
+        .filter(|p| p.cell_rank.contains(&2) && p.rank != 2)
+        .map(|part| {
+            let rows: Vec<f64> = part
+                .slots()
+                .iter()
+                .map(|s| table.get(s).copied().unwrap_or(0.0))
+                .collect();
+            part.complete(&rows, 10_000, 10_000)
+                .expect_err("a ghost without its owner")
+                .to_string()
+        })
+        .collect();
+    assert!(!errors.is_empty());
+    for e in errors {
+        assert!(
+            e.contains("is a ghost of part 3 here, but no part holds it as its own"),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn a_split_mesh_named_whole_says_where_its_parts_are() {
+    let e = read_msh(forms().join("3d-ascii-split.msh")).expect_err("no such file");
+    let text = e.to_string();
+    assert!(
+        text.contains("3d-ascii-split_1.msh") && text.contains("3d-ascii-split_3.msh"),
+        "{text}"
+    );
+    assert!(text.contains("run on 3 ranks of the PETSc backend"), "{text}");
+}

@@ -272,15 +272,15 @@ fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNo
 }
 
 /// What a mesh made in pieces cannot be, as the key that asks for it and the thing in words,
-/// or `None`: a piece is a generated rectangle or box of order 1 (graded or not), neither
-/// layered nor rounded nor a body of revolution. [`setup_piece`] refuses these, and so does a
+/// or `None`: a piece is of a generated rectangle or box (graded or not) or of a Gmsh mesh,
+/// of order 1, neither layered nor rounded nor a body of revolution. [`setup_piece`] refuses these, and so does a
 /// backend before it makes a piece.
 pub fn piece_refusal(m: &crate::scene::MeshSpec) -> Option<(&'static str, &'static str)> {
     [
         (
-            !matches!(m.kind, MeshKind::Rectangle | MeshKind::Box),
+            !matches!(m.kind, MeshKind::Rectangle | MeshKind::Box | MeshKind::Gmsh),
             "mesh.kind",
-            "a mesh that is not generated",
+            "a mesh handed over by the caller",
         ),
         (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
         (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),

@@ -5,7 +5,12 @@
 //! then holds the solution at its piece's nodes (fetched from their owners, never gathered)
 //! and recovers the fields on its piece's cells.
 //!
-//! What it solves today: a generated rectangle or box of order 1 without path or floating
+//! Where the pieces come from ([`PieceMesh`]): a generated rectangle or box, each rank making
+//! its block; or a Gmsh mesh split into one file per rank, each rank reading its part and the
+//! parts completing each other (`parts`).
+//!
+//! What it solves today: a generated rectangle or box, or a Gmsh mesh of one body, of order 1
+//! without path or floating
 //! terminal, without contact or with the contact the active sets hold (the paper's base model
 //! on one zone: [`crate::active_sets_hold`]), each rank iterating on the contact points at
 //! the nodes it owns; every other scene is refused by key ([`pieces_support`]). The run's
@@ -19,6 +24,7 @@
 //! from the piece's nodal values.
 
 mod gather;
+mod parts;
 mod report;
 
 pub use gather::Gathered;
@@ -35,11 +41,25 @@ use mesh::{Blocks, MeshPiece};
 use petsc::{Index, Petsc, Vector};
 use problem::backend::{setup_piece, ContactBoundary, ContactSolve, Unsupported};
 use problem::terminal_groups;
+use problem::ContactResult;
 use problem::{Event, ProblemError, Reporter, Scene, SetupError};
 use std::time::Instant;
 
 /// The backend name a run on pieces refuses under.
 const NAME: &str = "petsc";
+
+/// Where the pieces of a run come from.
+#[derive(Clone, Debug)]
+pub enum PieceMesh {
+    /// The scene's generated rectangle or box: each rank makes its block of cells and one
+    /// layer of ghosts ([`mesh::Blocks`]).
+    Generated,
+    /// A mesh that the one rank of a one-rank run holds whole (read from the scene's file).
+    Whole(mesh::Mesh),
+    /// The files of a mesh that Gmsh split, one per partition and rank, in rank order
+    /// ([`mesh::parts_of`]): each rank reads its own ([`mesh::read_msh_part`]).
+    Parts(Vec<std::path::PathBuf>),
+}
 
 /// One rank's share of a run on pieces.
 pub struct PieceSolution {
@@ -61,7 +81,8 @@ pub struct PieceSolution {
     pub contact: Option<PieceContact>,
 }
 
-/// Whether a run on pieces solves `scene`: a generated rectangle or box of order 1 (graded
+/// Whether a run on pieces solves `scene`: a generated rectangle or box, or a Gmsh mesh, of
+/// order 1 (graded
 /// or not; not layered or rounded), without path or floating terminal, its contact (if any) one
 /// the active sets hold.
 ///
@@ -119,15 +140,17 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
 pub fn solve_on_pieces(
     petsc: &Petsc,
     scene: &Scene,
+    source: PieceMesh,
     limits: problem::Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<PieceSolution, DistributedError> {
     let valid = scene.validate()?;
     pieces_support(scene).map_err(ProblemError::from)?;
     let start = Instant::now();
-    let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, limits, reporter)?;
+    let generated = matches!(source, PieceMesh::Generated);
+    let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, source, limits, reporter)?;
     let disc = setup.discretize()?;
-    held_on_pieces(petsc, scene, &disc, &piece)?;
+    held_on_pieces(petsc, scene, &disc, &piece, generated)?;
     let (b_u, b_phi) = disc.rhs(&setup.loads)?;
     ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
@@ -150,6 +173,7 @@ pub fn solve_on_pieces(
                 disc: &disc,
                 layout: &layout,
                 owned: piece.node_rank.iter().map(|&r| r == petsc.rank()).collect(),
+                piece: &piece,
             };
             let (x, solved, contact) = on.contact(&system, &fields, limits, reporter)?;
             (x, solved, Some(contact))
@@ -178,7 +202,7 @@ pub fn solve_on_pieces(
         global_node: &piece.global_node,
         terminals: &terminals,
         own_cells: piece.own_cells,
-        whole: (piece.n_global_nodes, piece.n_global_cells),
+        cells: piece.n_global_cells,
     };
     let timings = problem::report::Timings {
         setup: t_setup,
@@ -195,7 +219,7 @@ pub fn solve_on_pieces(
         equilibrium,
         unknowns: (0..petsc.size()).map(|r| layout.owned(r).len()).collect(),
         timings,
-        blocks: blocks.p,
+        blocks,
         nonzeros: petsc.sum(&[system.matrix.local_info()?.0])?[0],
     };
     let report = shares.report(&u, &phi, figures)?;
@@ -212,20 +236,42 @@ pub fn solve_on_pieces(
 }
 
 /// Refuses, on every rank alike, a body that the Dirichlet conditions do not hold, as the whole
-/// mesh's check does (`fe_assembly::held`): a generated box is one connected part, so its rigid
-/// motions are held when the Gram matrix of the conditions, summed over the ranks' own nodes
+/// mesh's check does (`fe_assembly::held`): a body in one connected part (a generated box, or
+/// a mesh read whose bodies are counted across the pieces, [`parts::bodies`]) has its rigid
+/// motions held when the Gram matrix of the conditions, summed over the ranks' own nodes
 /// (`fe_assembly::rigid_gram`), has full rank; its potential, where every cell is electric,
-/// when some rank prescribes φ at a node it owns. A body of electric and non-electric cells,
-/// whose electric parts a piece cannot join, is refused by key. Collective.
+/// when some rank prescribes φ at a node it owns. A mesh of several bodies, and a body of
+/// electric and non-electric cells, whose parts a piece cannot tell apart, are refused by key.
+/// Collective.
 fn held_on_pieces(
     petsc: &Petsc,
     scene: &Scene,
     disc: &fe_assembly::Discretization<'_>,
     piece: &MeshPiece,
+    generated: bool,
 ) -> Result<(), DistributedError> {
     let (dim, m, rank) = (disc.dofs.dim, &scene.mesh, petsc.rank());
-    let centre: [f64; 3] = std::array::from_fn(|k| if k < dim { 0.5 * (m.lo[k] + m.hi[k]) } else { 0.0 });
-    let size = (0..dim).map(|k| m.hi[k] - m.lo[k]).fold(0.0, f64::max);
+    let (centre, size) = match generated {
+        true => (
+            std::array::from_fn(|k| if k < dim { 0.5 * (m.lo[k] + m.hi[k]) } else { 0.0 }),
+            (0..dim).map(|k| m.hi[k] - m.lo[k]).fold(0.0, f64::max),
+        ),
+        false => parts::frame(petsc, disc.mesh, piece)?,
+    };
+    let bodies = if generated {
+        1
+    } else {
+        parts::bodies(petsc, disc.mesh, piece)?
+    };
+    if bodies > 1 {
+        let u = Unsupported::new(
+            NAME,
+            "mesh.file",
+            format!("a mesh of {bodies} separate bodies on a mesh made in pieces"),
+        )
+        .advise("a run whose every rank holds the whole mesh solves it");
+        return Err(ProblemError::from(u).into());
+    }
     let owned: Vec<usize> = (0..piece.node_rank.len())
         .filter(|&v| piece.node_rank[v] == rank)
         .collect();
@@ -265,17 +311,26 @@ fn held_on_pieces(
     Ok(())
 }
 
-/// This rank's piece set up: the blocks, the piece (its mesh taken by the set-up), the set-up
+/// This rank's piece set up: the blocks per axis (a mesh read: its parts, `[p, 1, 1]`), the
+/// piece (its mesh taken by the set-up), the set-up
 /// with the conditions that reach the piece, and the terminals' groups of the whole scene;
 /// the plan and units reported. Collective.
 fn set_up(
     petsc: &Petsc,
     valid: problem::Valid<'_>,
+    source: PieceMesh,
     limits: problem::Limits,
     reporter: &mut dyn Reporter,
-) -> Result<(Blocks, MeshPiece, problem::backend::Setup, Vec<String>), DistributedError> {
+) -> Result<([usize; 3], MeshPiece, problem::backend::Setup, Vec<String>), DistributedError> {
     let scene = valid.scene();
-    let (blocks, mut piece) = make_piece(petsc, scene, limits)?;
+    let (blocks, mut piece) = match source {
+        PieceMesh::Generated => make_piece(petsc, scene, limits).map(|(b, p)| (b.p, p))?,
+        PieceMesh::Whole(mesh) => {
+            parts::check_memory(petsc, &mesh, limits)?;
+            ([1, 1, 1], MeshPiece::whole(mesh))
+        }
+        PieceMesh::Parts(files) => ([petsc.size(), 1, 1], parts::read(petsc, &files, limits)?),
+    };
     let dim = piece.mesh.dim;
     let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
     check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
@@ -359,6 +414,8 @@ struct OnPiece<'a, 'p> {
     layout: &'a Layout,
     /// Whether this rank owns each node of its piece.
     owned: Vec<bool>,
+    /// The piece (its numbers in the whole mesh, its own cells; its mesh is the set-up's).
+    piece: &'a MeshPiece,
 }
 
 impl<'p> OnPiece<'_, 'p> {
@@ -415,7 +472,9 @@ impl<'p> OnPiece<'_, 'p> {
         let force: f64 = (0..sol.lambda.normal.len())
             .map(|i| boundary.points.weight[i] * sol.lambda.normal[i])
             .sum();
+        let on_piece = self.on_piece(&boundary, sol)?;
         let contact = PieceContact {
+            on_piece,
             steps: sol.info.newton_iters,
             residual: sol.info.complementarity,
             equilibrium,
@@ -434,8 +493,85 @@ impl<'p> OnPiece<'_, 'p> {
     }
 }
 
+impl OnPiece<'_, '_> {
+    /// The contact at every node of the piece's own cells, for its piece of the outputs: the
+    /// points there (as their owners make them: every facet around such a node is in the
+    /// piece), their multipliers, displacements and statuses fetched from the ranks that own
+    /// them through a directory over the whole mesh's node numbers. Without it a piece's own
+    /// cells would show no contact at the nodes it shares with a lower rank. Collective.
+    fn on_piece(
+        &self,
+        own: &ContactBoundary,
+        sol: &contact::ContactSolution,
+    ) -> Result<ContactResult, DistributedError> {
+        let (petsc, mesh) = (self.petsc, self.disc.mesh);
+        let mut in_own_cells = vec![false; mesh.n_nodes()];
+        for c in 0..self.piece.own_cells {
+            for &v in mesh.cell(c) {
+                in_own_cells[v] = true;
+            }
+        }
+        let all = ContactBoundary::of_groups_on_piece(self.disc, &self.scene.zones(), &in_own_cells)?;
+        let nt = own.points.n_tangential();
+        // per node: status (1 stick, 2 slip, 3 separated), λ_n, u_n, λ_t, u_t
+        let width = 3 + 2 * nt;
+        let (lo, hi) = petsc.split(width * self.piece.n_global_nodes);
+        let mut directory = Vector::mpi(petsc, hi - lo)?;
+        let (mut at, mut values) = (vec![], vec![]);
+        for (i, &v) in own.nodes.iter().enumerate() {
+            let first = width * self.piece.global_node[v];
+            let status = match sol.status[i] {
+                contact::Status::Stick => 1.0,
+                contact::Status::Slip => 2.0,
+                contact::Status::Separated => 3.0,
+            };
+            let row = [status, sol.lambda.normal[i], sol.u.normal[i]]
+                .into_iter()
+                .chain(sol.lambda.tangential[i * nt..(i + 1) * nt].iter().copied())
+                .chain(sol.u.tangential[i * nt..(i + 1) * nt].iter().copied());
+            for (j, x) in row.enumerate() {
+                at.push(Layout::index(first + j));
+                values.push(x);
+            }
+        }
+        directory.set_values(&at, &values)?;
+        directory.assemble()?;
+        let asked: Vec<_> = all
+            .nodes
+            .iter()
+            .flat_map(|&v| (0..width).map(move |j| (v, j)))
+            .map(|(v, j)| Layout::index(width * self.piece.global_node[v] + j))
+            .collect();
+        let rows = directory.fetch(&asked)?;
+        let n = all.points.len();
+        let (mut lambda, mut u) = (contact::PointValues::zeros(n, nt), contact::PointValues::zeros(n, nt));
+        let mut status = Vec::with_capacity(n);
+        for (i, row) in rows.chunks_exact(width).enumerate() {
+            status.push(match row[0] {
+                1.0 => contact::Status::Stick,
+                2.0 => contact::Status::Slip,
+                _ => contact::Status::Separated,
+            });
+            (lambda.normal[i], u.normal[i]) = (row[1], row[2]);
+            lambda.tangential[i * nt..(i + 1) * nt].copy_from_slice(&row[3..3 + nt]);
+            u.tangential[i * nt..(i + 1) * nt].copy_from_slice(&row[3 + nt..]);
+        }
+        let solution = contact::ContactSolution {
+            lambda,
+            u,
+            status,
+            info: sol.info.clone(),
+            electric: None,
+        };
+        Ok(ContactResult::condensed(all, solution))
+    }
+}
+
 /// A rank's share of the contact solution of a run on pieces.
 pub struct PieceContact {
+    /// The contact at every node of the rank's own cells (those another rank owns fetched
+    /// from it): what its piece of the outputs shows.
+    pub on_piece: ContactResult,
     /// The rank's contact points (at the nodes of its piece it owns).
     pub boundary: ContactBoundary,
     /// Their multipliers, displacements and statuses.

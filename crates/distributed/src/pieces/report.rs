@@ -28,8 +28,8 @@ pub(super) struct Shares<'a> {
     pub(super) terminals: &'a [String],
     /// This rank's own cells.
     pub(super) own_cells: usize,
-    /// The whole mesh's nodes and cells.
-    pub(super) whole: (usize, usize),
+    /// The whole mesh's cells.
+    pub(super) cells: usize,
 }
 
 /// The figures of the solve, for the report.
@@ -55,14 +55,15 @@ impl Shares<'_> {
         let plan = &setup.plan;
         let dofs = &self.disc.dofs;
         let dim = setup.mesh.dim;
-        let (mut free_u, mut free_phi) = (0.0, 0.0);
+        let (mut free_u, mut free_phi, mut nodes) = (0.0, 0.0, 0.0);
         for v in (0..self.owned.len()).filter(|&v| self.owned[v]) {
+            nodes += 1.0;
             free_u += (0..dim)
                 .filter(|&k| matches!(dofs.u[v * dim + k], Dof::Free(_)))
                 .count() as f64;
             free_phi += f64::from(u8::from(matches!(dofs.phi[v], Dof::Free(_))));
         }
-        let sums = petsc.sum(&[free_u, free_phi])?;
+        let sums = petsc.sum(&[free_u, free_phi, nodes])?;
         let h = petsc.max(&[setup.mesh.h_max()])?[0];
         let info = f.contact.map(|c| &c.solution.info);
         let equilibrium = f.contact.map_or(f.equilibrium, |c| c.equilibrium);
@@ -71,8 +72,8 @@ impl Shares<'_> {
             scene: SceneReport::of(scene),
             plan: plan.clone(),
             mesh: MeshReport {
-                n_nodes: self.whole.0,
-                n_cells: self.whole.1,
+                n_nodes: sums[2] as usize,
+                n_cells: self.cells,
                 h,
                 cells_per_axis: scene.mesh.cells_per_axis(),
                 reoriented_cells: 0,

@@ -24,10 +24,6 @@ pub fn run_distributed(
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DriverError> {
     let petsc = petsc::Petsc::init()?;
-    let mesh = match (scene.mesh.kind, &scene.mesh.file) {
-        (MeshKind::Gmsh, Some(file)) => Some(mesh::read_msh(source.dir.join(file)).map_err(files::Error::from)?),
-        _ => None,
-    };
     let mut silent = problem::Silent;
     let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
     // the ranks of one machine share its memory (on several machines this is conservative)
@@ -37,9 +33,10 @@ pub fn run_distributed(
         memory_limit,
         ..Default::default()
     };
-    if on_pieces(scene) {
-        return pieces::run(scene, source, dir, (&petsc, limits), reporter);
-    }
+    let mesh = match route(scene, source, petsc.size())? {
+        Route::Pieces(from) => return pieces::run(scene, source, dir, (&petsc, limits), from, reporter),
+        Route::Whole(mesh) => mesh,
+    };
     // a path's steps written by rank 0 as they come, into a set committed at the end
     let mut writer = match (petsc.rank(), &scene.path) {
         (0, Some(_)) => Some(output::SetWriter::begin(
@@ -77,16 +74,46 @@ pub fn run_distributed(
     Ok(Some(solution))
 }
 
-/// Whether a run takes the route on which no rank holds the whole mesh ([`pieces`]): a 3D
-/// generated body that the pieces solve ([`distributed::pieces_support`]), without contact, or
-/// with contact and at least [`distributed::ACTIVE_SETS_FROM`] unknowns (where the whole
-/// mesh's route would take the same active sets for speed; below, MUMPS' condensed route is
-/// as fast, issue 44's measurements).
-fn on_pieces(scene: &Scene) -> bool {
-    let unknowns = problem::backend::generated_sizes(scene).map_or(0.0, |(_, _, _, n)| n);
-    scene.mesh.lo.len() == 3
-        && distributed::pieces_support(scene).is_ok()
-        && (scene.zones().is_empty() || unknowns >= distributed::ACTIVE_SETS_FROM)
+/// The route of a run: on pieces (no rank holds the whole mesh, [`pieces`]), or with the whole
+/// mesh on every rank (the mesh read, where the scene names a file).
+enum Route {
+    Pieces(distributed::PieceMesh),
+    Whole(Option<mesh::Mesh>),
+}
+
+/// The route of `scene` on `ranks` ranks. A Gmsh mesh split into as many parts as there are
+/// ranks (`mesh_1.msh` .. `mesh_p.msh` beside the `mesh.msh` the scene names) runs on pieces,
+/// each rank reading its part (the whole file is not read, and need not exist). Otherwise a
+/// 3D body that the pieces solve ([`distributed::pieces_support`]) runs on them without
+/// contact, or with contact and at least [`distributed::ACTIVE_SETS_FROM`] unknowns (where the
+/// whole mesh's route would take the same active sets for speed; below, MUMPS' condensed route
+/// is as fast, issue 44's measurements): a generated box on any count of ranks, a Gmsh mesh
+/// read whole on one rank. The rest takes the whole mesh's route.
+fn route(scene: &Scene, source: &Source, ranks: usize) -> Result<Route, DriverError> {
+    let solved = distributed::pieces_support(scene).is_ok();
+    let file = match (scene.mesh.kind, &scene.mesh.file) {
+        (MeshKind::Gmsh, Some(file)) => Some(source.dir.join(file)),
+        _ => None,
+    };
+    let parts = file.as_deref().map(mesh::parts_of).unwrap_or_default();
+    if solved && ranks > 1 && parts.len() == ranks {
+        return Ok(Route::Pieces(distributed::PieceMesh::Parts(parts)));
+    }
+    let mesh = match &file {
+        Some(path) => Some(mesh::read_msh(path).map_err(files::Error::from)?),
+        None => None,
+    };
+    let unknowns = match &mesh {
+        Some(m) => (m.n_nodes() * (m.dim + 1)) as f64,
+        None => problem::backend::generated_sizes(scene).map_or(0.0, |(_, _, _, n)| n),
+    };
+    let dim = mesh.as_ref().map_or(scene.mesh.lo.len(), |m| m.dim);
+    let large = scene.zones().is_empty() || unknowns >= distributed::ACTIVE_SETS_FROM;
+    Ok(match (mesh, solved && dim == 3 && large) {
+        (None, true) => Route::Pieces(distributed::PieceMesh::Generated),
+        (Some(m), true) if ranks == 1 => Route::Pieces(distributed::PieceMesh::Whole(m)),
+        (mesh, _) => Route::Whole(mesh),
+    })
 }
 
 /// A distributed error as the driver's.

@@ -11,7 +11,7 @@ use files::output::pieces::{files_beside_pieces, names_beside_pieces, piece_name
 use files::output::SetWriter;
 use files::run::peak_memory_bytes;
 use files::scene_file::Source;
-use problem::{ContactResult, Reporter, Scene, Solution};
+use problem::{Output, Reporter, Scene, Solution};
 use std::path::Path;
 
 /// Solves `scene` on pieces and writes its set into `dir`. Collective; rank 0 returns the
@@ -25,10 +25,11 @@ pub(super) fn run(
     source: &Source,
     dir: &Path,
     (petsc, limits): (&petsc::Petsc, problem::Limits),
+    from: distributed::PieceMesh,
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DriverError> {
     let (rank, ranks) = (petsc.rank(), petsc.size());
-    let s = distributed::solve_on_pieces(petsc, scene, limits, reporter).map_err(driver_error)?;
+    let s = distributed::solve_on_pieces(petsc, scene, from, limits, reporter).map_err(driver_error)?;
     let gathered = s.gathered(petsc, scene).map_err(driver_error)?;
     let (piece, pvtu) = piece_files(&s, rank, ranks);
     // rank 0 begins the set, and every rank learns where to write its piece
@@ -93,16 +94,13 @@ pub(super) fn run(
 /// This rank's piece of the solution (with its own contact points) as a `.vtu`, and the
 /// `.pvtu` naming the `ranks` pieces.
 fn piece_files(s: &distributed::PieceSolution, rank: usize, ranks: usize) -> (Vec<u8>, Vec<u8>) {
-    let own = s
-        .contact
-        .as_ref()
-        .map(|c| ContactResult::condensed(c.boundary.clone(), c.solution.clone()));
+    let own = s.contact.as_ref().map(|c| &c.on_piece);
     let ghost: Vec<bool> = s.piece.cell_rank.iter().map(|&r| r != rank).collect();
     Piece {
         mesh: &s.piece.mesh,
         fields: (&s.u, &s.phi),
         cells: &s.fields,
-        contact: own.as_ref(),
+        contact: own,
         ghost: &ghost,
         node_id: &s.piece.global_node,
         cell_id: &s.piece.global_cell,
@@ -119,10 +117,22 @@ fn rank_0s_solution(g: distributed::Gathered, source: &Source, peaks: Vec<u64>) 
     if let Some(p) = report.petsc.as_mut() {
         p.peak_bytes_per_rank = peaks;
     }
-    // (a run on pieces is a generated box's, which has the face)
-    let (mesh, u, phi) = g.front.ok_or_else(|| {
-        DriverError::Usage("a run on pieces of a body without the face `front` its pictures draw".into())
-    })?;
+    // the pictures of a box draw its face `front`; a mesh read has none planned, and its
+    // solution's mesh is then left empty
+    let pictures = report
+        .plan
+        .outputs
+        .iter()
+        .any(|o| matches!(o, Output::Deformed | Output::Potential));
+    let (mesh, u, phi) = match g.front {
+        Some(front) => front,
+        None if !pictures => (nothing(report.plan.dim), vec![], vec![]),
+        None => {
+            return Err(DriverError::Usage(
+                "a run on pieces of a body without the face `front` its pictures draw".into(),
+            ))
+        }
+    };
     Ok(Solution {
         report,
         mesh,
@@ -137,6 +147,23 @@ fn rank_0s_solution(g: distributed::Gathered, source: &Source, peaks: Vec<u64>) 
         },
         contact: g.contact,
     })
+}
+
+/// A mesh of nothing, of dimension `dim`.
+fn nothing(dim: usize) -> mesh::Mesh {
+    mesh::Mesh {
+        dim,
+        kind: if dim == 2 {
+            mesh::CellKind::Tri3
+        } else {
+            mesh::CellKind::Tet4
+        },
+        points: vec![],
+        cells: vec![],
+        boundaries: Default::default(),
+        regions: Default::default(),
+        reoriented_cells: 0,
+    }
 }
 
 /// The path whose bytes rank 0 sent.

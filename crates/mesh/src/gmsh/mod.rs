@@ -41,7 +41,20 @@ pub fn read_msh(path: impl AsRef<Path>) -> Result<Mesh, MeshError> {
         path: path.display().to_string(),
         message,
     };
-    let meta = std::fs::metadata(path).map_err(|e| io(e.to_string()))?;
+    let meta = std::fs::metadata(path).map_err(|e| {
+        let parts = part::parts_of(path);
+        match (e.kind(), parts.first(), parts.last()) {
+            (std::io::ErrorKind::NotFound, Some(first), Some(last)) => io(format!(
+                "does not exist, but {} .. {} are its parts (a mesh Gmsh split into {} files): run on {} ranks of the PETSc backend (solver.backend = \"petsc\", mpirun -np {}), each of which reads its part, or save the mesh whole",
+                first.display(),
+                last.display(),
+                parts.len(),
+                parts.len(),
+                parts.len()
+            )),
+            _ => io(e.to_string()),
+        }
+    })?;
     if !meta.is_file() {
         return Err(io("is not a regular file (a directory, a FIFO or a device)".into()));
     }

@@ -10,7 +10,8 @@
 //! whole mesh's element tags, [`MshPart::SLOTS`] numbers per cell, that a parallel run spreads over
 //! its ranks: each part writes its own cells' regions and its facets into it
 //! ([`MshPart::records`]), and reads back the rows of its piece's cells ([`MshPart::slots`],
-//! [`MshPart::complete`]). A row holds the cell's regions as bits, then for each of its faces
+//! [`MshPart::complete`]). A row holds the cell's regions as bits (doubled, plus one: the mark
+//! of a cell that its owner wrote), then for each of its faces
 //! the facet groups on it as bits, times 6, plus the order of the facet's corners (one of the
 //! 6 permutations of the face's), so that a facet keeps the orientation its file gives it.
 
@@ -214,7 +215,7 @@ impl MshPart {
         let m = &self.mesh;
         let region_bits = self.region_bits();
         let mut out: Vec<(usize, f64)> = (0..self.own_cells)
-            .map(|c| (self.slot(c, 0), region_bits[c] as f64))
+            .map(|c| (self.slot(c, 0), (1 + 2 * region_bits[c]) as f64))
             .collect();
         // the cells on each face (two on an interior facet)
         let mut faces: HashMap<Vec<usize>, Vec<(usize, usize)>> = HashMap::new();
@@ -328,7 +329,15 @@ impl MshPart {
         let mut seen: std::collections::HashSet<(Vec<usize>, usize)> = std::collections::HashSet::new();
         for c in 0..n_cells {
             let row = &rows[SLOTS * c..SLOTS * (c + 1)];
-            let bits = as_bits(row[0])
+            let owned = as_bits(row[0]).filter(|b| b % 2 == 1).ok_or_else(|| MeshError::Gmsh {
+                path: format!("part {}", self.rank + 1),
+                message: format!(
+                    "cell {} is a ghost of part {} here, but no part holds it as its own: the parts are not of one mesh",
+                    self.cell_tag[c],
+                    self.cell_rank[c] + 1
+                ),
+            })?;
+            let bits = Some(owned / 2)
                 .filter(|b| b >> self.regions.len() == 0)
                 .ok_or_else(|| bad("regions no part names"))?;
             for (_, name) in self.regions.iter().enumerate().filter(|(b, _)| bits >> b & 1 == 1) {

@@ -1,0 +1,257 @@
+//! A Gmsh mesh read in parts: each rank reads the one file of its partition
+//! ([`mesh::read_msh_part`]), the parts complete each other through a table over the element
+//! tags spread across the ranks (a parallel vector: each rank holds `1/p` of it), and the
+//! connected bodies of the whole mesh are found by labels passed between the pieces. No rank
+//! reads or holds the whole mesh.
+
+use crate::error::DistributedError;
+use crate::layout::Layout;
+use mesh::{MeshPiece, MshPart};
+use petsc::{Petsc, Vector};
+use problem::{ProblemError, SetupError};
+use std::path::PathBuf;
+
+/// This rank's piece of the mesh split into `parts` (one file per rank, in rank order), the
+/// estimate of each rank's peak checked against `limits` before the set-up (the part read is a
+/// few percent of it). Collective: a rank that cannot read its part makes every rank fail.
+///
+/// # Errors
+/// A count of parts other than the ranks', a part of another partition or of another mesh,
+/// the reader's errors, the estimate over the limit ([`ProblemError::TooLarge`], naming the
+/// rank).
+pub(super) fn read(petsc: &Petsc, parts: &[PathBuf], limits: problem::Limits) -> Result<MeshPiece, DistributedError> {
+    let (rank, ranks) = (petsc.rank(), petsc.size());
+    if parts.len() != ranks {
+        return Err(mesh_file(format!(
+            "the mesh is in {} parts ({} .. {}), one per rank: run on {} ranks (mpirun -np {})",
+            parts.len(),
+            name(parts.first()),
+            name(parts.last()),
+            parts.len(),
+            parts.len()
+        )));
+    }
+    let read = mesh::read_msh_part(&parts[rank]).map_err(ProblemError::from).and_then(|part| {
+        if part.rank == rank && part.parts == ranks {
+            return Ok(part);
+        }
+        Err(SetupError::new(
+            "mesh.file",
+            format!(
+                "{} is part {} of {}, where rank {rank} of {ranks} reads part {} of {ranks}: the parts are not of one split",
+                name(parts.get(rank)),
+                part.rank + 1,
+                part.parts,
+                rank + 1
+            ),
+        )
+        .into())
+    });
+    let part = agreed(petsc, read)?;
+    same_groups(petsc, &part)?;
+    check_memory(petsc, &part.mesh, limits)?;
+    complete(petsc, part)
+}
+
+/// `result` where every rank has one; where some rank has an error, an error on every rank
+/// (the rank's own, or one naming the ranks that failed). Collective.
+fn agreed<T>(petsc: &Petsc, result: Result<T, ProblemError>) -> Result<T, DistributedError> {
+    let failed = petsc.sum(&[f64::from(u8::from(result.is_err()))])?[0];
+    match result {
+        Err(e) => Err(e.into()),
+        Ok(_) if failed > 0.0 => Err(mesh_file(format!(
+            "{failed} of the {} ranks could not read their part of the mesh (each says why)",
+            petsc.size()
+        ))),
+        Ok(t) => Ok(t),
+    }
+}
+
+/// Refuses parts that name different regions or facet groups (not parts of one mesh), by a
+/// hash of the names compared across the ranks. Collective.
+fn same_groups(petsc: &Petsc, part: &MshPart) -> Result<(), DistributedError> {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (&part.regions, &part.groups).hash(&mut h);
+    let x = (h.finish() >> 12) as f64; // exact in f64
+    let range = petsc.max(&[x, -x])?;
+    if range[0] != -range[1] {
+        return Err(mesh_file(
+            "the parts name different regions or facet groups: they are not parts of one mesh".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The estimate of a rank's peak from its piece's cells and nodes (`m`), refused on every
+/// rank alike where the largest is over what one rank may take, naming that rank. Collective.
+pub(super) fn check_memory(petsc: &Petsc, m: &mesh::Mesh, limits: problem::Limits) -> Result<(), DistributedError> {
+    let unknowns = (m.dim + 1) as f64 * m.n_nodes() as f64;
+    let bytes = crate::run::BYTES_PER_UNKNOWN * unknowns + crate::run::BYTES_PER_CELL * m.n_cells() as f64;
+    let all = petsc.all_gather(bytes as u64)?;
+    let (worst, &needed) = all.iter().enumerate().max_by_key(|(_, b)| **b).unwrap_or((0, &0));
+    match limits.memory_bytes {
+        Some(available) if needed > available => Err(ProblemError::TooLarge {
+            what: format!("rank {worst} of {}: a piece of the mesh and its unknowns", petsc.size()),
+            needed,
+            available,
+            limit: limits.memory_limit.unwrap_or("the memory available to one rank"),
+        }
+        .into()),
+        _ => Ok(()),
+    }
+}
+
+/// The piece of `part`, completed through the table every part writes into. Collective.
+fn complete(petsc: &Petsc, part: MshPart) -> Result<MeshPiece, DistributedError> {
+    let records = part.records().map_err(ProblemError::from)?;
+    let records = agreed(petsc, Ok(records))?;
+    let top_cell = part.cell_tag.iter().max().copied().unwrap_or(0) as f64;
+    let top_node = part.node_tag.iter().max().copied().unwrap_or(0) as f64;
+    let tops = petsc.max(&[top_cell, top_node])?;
+    let cells = petsc.sum(&[part.own_cells as f64])?[0] as usize;
+    let (lo, hi) = petsc.split(MshPart::SLOTS * tops[0] as usize);
+    let mut table = Vector::mpi(petsc, hi - lo)?;
+    let (at, values): (Vec<_>, Vec<_>) = records.into_iter().map(|(s, v)| (Layout::index(s), v)).unzip();
+    table.add_values(&at, &values)?;
+    table.assemble()?;
+    let slots: Vec<_> = part.slots().into_iter().map(Layout::index).collect();
+    let rows = table.fetch(&slots)?;
+    drop(table);
+    let piece = part
+        .complete(&rows, tops[1] as usize, cells)
+        .map_err(ProblemError::from);
+    let piece = agreed(petsc, piece)?;
+    same_nodes(petsc, &piece)?;
+    Ok(piece)
+}
+
+/// Refuses parts whose shared nodes are not where their owners put them (parts of different
+/// meshes, or of one mesh saved twice): each node's owner writes its coordinates into a
+/// directory over the node numbers, and the other ranks compare theirs. Collective.
+fn same_nodes(petsc: &Petsc, piece: &MeshPiece) -> Result<(), DistributedError> {
+    let (rank, m) = (petsc.rank(), &piece.mesh);
+    let (lo, hi) = petsc.split(3 * piece.n_global_nodes);
+    let mut directory = Vector::mpi(petsc, hi - lo)?;
+    let (mut at, mut values, mut asked, mut mine) = (vec![], vec![], vec![], vec![]);
+    for (v, x) in m.points.iter().enumerate() {
+        let slots = (0..3).map(|k| Layout::index(3 * piece.global_node[v] + k));
+        if piece.node_rank[v] == rank {
+            at.extend(slots);
+            values.extend_from_slice(x);
+        } else {
+            asked.extend(slots);
+            mine.extend_from_slice(x);
+        }
+    }
+    directory.set_values(&at, &values)?;
+    directory.assemble()?;
+    let theirs = directory.fetch(&asked)?;
+    let moved = mine.iter().zip(&theirs).filter(|(a, b)| a != b).count() / 3;
+    let moved_anywhere = petsc.sum(&[moved as f64])?[0];
+    if moved_anywhere > 0.0 {
+        return Err(mesh_file(format!(
+            "{moved_anywhere} nodes that parts share lie elsewhere in the part of the rank that owns them: the parts are not of one mesh (split them again from one Gmsh model)"
+        )));
+    }
+    Ok(())
+}
+
+/// The connected bodies of the whole mesh, counted across the pieces (`m`: the piece's mesh,
+/// which the set-up took from it). A directory over the
+/// whole mesh's node numbers holds a label per node, at first its number. Each round, every
+/// rank gives each node of a connected part of its piece the least label that the directory
+/// holds for the part's nodes, and writes it back where it is less than the directory's (where
+/// several ranks write one node, one of their values stays: each less than the round's
+/// start, so the labels only fall and the rounds end). When no rank writes, every connected
+/// part of every piece holds one label; every cell lies whole in its owner's piece, so two
+/// nodes share a label exactly when a path of cells joins them, and the bodies are the nodes
+/// whose label is their own number. Collective.
+pub(super) fn bodies(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result<usize, DistributedError> {
+    let rank = petsc.rank();
+    let n = m.n_nodes();
+    // the connected parts of the piece: a union-find over its cells
+    let mut root: Vec<usize> = (0..n).collect();
+    fn find(root: &mut [usize], mut v: usize) -> usize {
+        while root[v] != v {
+            root[v] = root[root[v]];
+            v = root[v];
+        }
+        v
+    }
+    let mut used = vec![false; n];
+    for cell in m.iter_cells() {
+        let a = find(&mut root, cell[0]);
+        for &v in cell {
+            used[v] = true;
+            let b = find(&mut root, v);
+            root[b] = a;
+        }
+    }
+    let part: Vec<usize> = (0..n).map(|v| find(&mut root, v)).collect();
+    let nodes: Vec<usize> = (0..n).filter(|&v| used[v]).collect();
+    let at: Vec<_> = nodes.iter().map(|&v| Layout::index(piece.global_node[v])).collect();
+    let (lo, hi) = petsc.split(piece.n_global_nodes);
+    let mut directory = Vector::mpi(petsc, hi - lo)?;
+    let (own_at, own): (Vec<_>, Vec<f64>) = nodes
+        .iter()
+        .zip(&at)
+        .filter(|(&v, _)| piece.node_rank[v] == rank)
+        .map(|(&v, &i)| (i, piece.global_node[v] as f64))
+        .unzip();
+    directory.set_values(&own_at, &own)?;
+    directory.assemble()?;
+    let mut known = directory.fetch(&at)?;
+    loop {
+        let mut least = vec![f64::INFINITY; n];
+        for (k, &v) in nodes.iter().enumerate() {
+            least[part[v]] = least[part[v]].min(known[k]);
+        }
+        let (lower_at, lower): (Vec<_>, Vec<f64>) = nodes
+            .iter()
+            .enumerate()
+            .filter(|&(k, &v)| least[part[v]] < known[k])
+            .map(|(k, &v)| (at[k], least[part[v]]))
+            .unzip();
+        if petsc.sum(&[lower.len() as f64])?[0] == 0.0 {
+            break;
+        }
+        directory.set_values(&lower_at, &lower)?;
+        directory.assemble()?;
+        known = directory.fetch(&at)?;
+    }
+    let roots = nodes
+        .iter()
+        .zip(&known)
+        .filter(|&(&v, &l)| piece.node_rank[v] == rank && l == piece.global_node[v] as f64)
+        .count();
+    Ok(petsc.sum(&[roots as f64])?[0] as usize)
+}
+
+/// The centre and size of the whole mesh's bounding box, from the owned nodes of every piece
+/// (`m`: the piece's mesh).
+/// Collective.
+pub(super) fn frame(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result<([f64; 3], f64), DistributedError> {
+    let rank = petsc.rank();
+    let mut ends = [f64::NEG_INFINITY; 6];
+    for (_, x) in m.points.iter().enumerate().filter(|(v, _)| piece.node_rank[*v] == rank) {
+        for k in 0..3 {
+            ends[k] = ends[k].max(x[k]);
+            ends[3 + k] = ends[3 + k].max(-x[k]);
+        }
+    }
+    let ends = petsc.max(&ends)?;
+    let centre = std::array::from_fn(|k| 0.5 * (ends[k] - ends[3 + k]));
+    let size = (0..m.dim).map(|k| ends[k] + ends[3 + k]).fold(0.0, f64::max);
+    Ok((centre, size))
+}
+
+/// A refusal of the scene's mesh file.
+fn mesh_file(message: String) -> DistributedError {
+    ProblemError::from(SetupError::new("mesh.file", message)).into()
+}
+
+/// A part's file name, for messages.
+fn name(path: Option<&PathBuf>) -> String {
+    path.map_or(String::new(), |p| p.display().to_string())
+}
