@@ -59,6 +59,18 @@ const CONTACT_CASES: &[(&str, &[&str])] = &[
     ),
     // a graded quarter model under a sphere: two symmetry planes through the contact face
     ("indent-sphere-3d", &["mesh.n=8"]),
+    // a tall box cut along z, upside down: rank 0 holds no contact point
+    (
+        "paper-3d",
+        &[
+            "mesh.n=4",
+            "mesh.hi=[1.0,1.0,2.0]",
+            "contact.group=\"top\"",
+            "contact.normal=[0.0,0.0,1.0]",
+            "load.group=\"bottom\"",
+            "load.direction=[0.0,0.0,-1.0]",
+        ],
+    ),
 ];
 
 /// The largest difference over the largest magnitude of `whole`, comparing each of the piece's
@@ -203,6 +215,16 @@ fn contact_on_pieces(p: &Petsc) {
         let dl = dl / scale;
         let df = (c.normal_force - whole.report.contact.normal_force).abs() / whole.report.contact.normal_force.abs();
         assert_eq!(c.points, wc.nodes.len(), "{name}: the points over the ranks");
+        // rank 0's report of every rank's points (a rank may hold none)
+        let gathered = s.gathered(p, &scene).expect("the gathered surfaces");
+        if let Some(g) = gathered {
+            let force = g.report.contact.normal_force;
+            let expected = whole.report.contact.normal_force;
+            assert!(
+                (force - expected).abs() <= 1e-6 * expected.abs(),
+                "{name}: {force} against {expected}"
+            );
+        }
         eprintln!(
             "{name} {sets:?} rank {}/{}: {} steps, residual {:.1e}, equilibrium {:.1e}; u {du:.1e}, phi {dphi:.1e}, multipliers {dl:.1e}, normal force {df:.1e}",
             p.rank(),

@@ -96,7 +96,9 @@ impl PieceSolution {
         };
         let (p, sol) = (&c.boundary.points, &c.solution);
         let nt = p.n_tangential();
-        let has_t = !sol.lambda.tangential.is_empty();
+        // whether the law has tangential multipliers: from every rank (one without points has
+        // none to show)
+        let has_t = petsc.max(&[f64::from(u8::from(!sol.lambda.tangential.is_empty()))])?[0] > 0.0;
         let mut rows = Vec::with_capacity(p.len() * width(nt));
         for i in 0..p.len() {
             rows.push(s.piece.global_node[c.boundary.nodes[i]] as f64);

@@ -323,13 +323,19 @@ fn set_up(
     reporter: &mut dyn Reporter,
 ) -> Result<([usize; 3], MeshPiece, problem::backend::Setup, Vec<String>), DistributedError> {
     let scene = valid.scene();
+    // a mesh read is numbered as its generator made it, which puts neighbours far apart in
+    // memory: its pieces are numbered along a space-filling curve (the generated grid's order
+    // is already near)
     let (blocks, mut piece) = match source {
         PieceMesh::Generated => make_piece(petsc, scene, limits).map(|(b, p)| (b.p, p))?,
         PieceMesh::Whole(mesh) => {
             parts::check_memory(petsc, &mesh, limits)?;
-            ([1, 1, 1], MeshPiece::whole(mesh))
+            ([1, 1, 1], MeshPiece::whole(mesh).in_space_order())
         }
-        PieceMesh::Parts(files) => ([petsc.size(), 1, 1], parts::read(petsc, &files, limits)?),
+        PieceMesh::Parts(files) => (
+            [petsc.size(), 1, 1],
+            parts::read(petsc, &files, limits)?.in_space_order(),
+        ),
     };
     let dim = piece.mesh.dim;
     let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
@@ -525,9 +531,15 @@ impl OnPiece<'_, '_> {
                 contact::Status::Slip => 2.0,
                 contact::Status::Separated => 3.0,
             };
+            // (frictionless: no tangential multipliers)
+            let lt = sol
+                .lambda
+                .tangential
+                .get(i * nt..(i + 1) * nt)
+                .unwrap_or(&[0.0; 2][..nt]);
             let row = [status, sol.lambda.normal[i], sol.u.normal[i]]
                 .into_iter()
-                .chain(sol.lambda.tangential[i * nt..(i + 1) * nt].iter().copied())
+                .chain(lt.iter().copied())
                 .chain(sol.u.tangential[i * nt..(i + 1) * nt].iter().copied());
             for (j, x) in row.enumerate() {
                 at.push(Layout::index(first + j));
