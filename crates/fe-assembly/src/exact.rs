@@ -432,6 +432,33 @@ pub struct ErrorNorms {
 }
 
 impl ErrorNorms {
+    /// The norms of squared integrals summed over parts of a mesh (the [`ErrorNorms::squares`]
+    /// of each part, added): the squares of the errors' three norms, then of the exact
+    /// solution's.
+    pub fn from_squares(sq: &[f64]) -> ErrorNorms {
+        let r = |k: usize| sq.get(k).copied().unwrap_or(0.0).sqrt();
+        ErrorNorms {
+            l2_u: r(0),
+            l2_phi: r(1),
+            energy: r(2),
+            norms: (r(3), r(4), r(5)),
+        }
+    }
+
+    /// The squares of the six norms, to be summed over the parts of a mesh
+    /// ([`ErrorNorms::from_squares`]).
+    pub fn squares(&self) -> [f64; 6] {
+        [
+            self.l2_u,
+            self.l2_phi,
+            self.energy,
+            self.norms.0,
+            self.norms.1,
+            self.norms.2,
+        ]
+        .map(|x| x * x)
+    }
+
     /// `‖u_h - u‖ / ‖u‖` in L2.
     pub fn rel_l2_u(&self) -> f64 {
         self.l2_u / self.norms.0
@@ -452,6 +479,19 @@ impl Discretization<'_> {
     /// square of a P1 function; for the smooth part, accurate to `O(h³)` relative, enough for
     /// rates) and of degree 4 on triangles, 3 on tetrahedra with P2.
     pub fn error_norms(&self, u: &[[f64; 3]], phi: &[f64], exact: &Exact) -> ErrorNorms {
+        self.error_norms_on(u, phi, exact, 0..self.mesh.n_cells())
+    }
+
+    /// [`Discretization::error_norms`] over the cells `cells` alone (a rank's own cells of a
+    /// mesh in pieces: their [`ErrorNorms::squares`] summed over the ranks are the whole
+    /// mesh's).
+    pub fn error_norms_on(
+        &self,
+        u: &[[f64; 3]],
+        phi: &[f64],
+        exact: &Exact,
+        cells: impl Iterator<Item = usize>,
+    ) -> ErrorNorms {
         let (mesh, dim) = (self.mesh, self.mesh.dim);
         let order = mesh.kind.order();
         let (weights, rule) = kernels::simplex_rule(dim, order);
@@ -473,7 +513,8 @@ impl Discretization<'_> {
             }
             s
         };
-        for (c, cell) in mesh.iter_cells().enumerate() {
+        for c in cells {
+            let cell = mesh.cell(c);
             let m = &self.materials[self.cell_material[c]];
             let ul: Vec<[f64; 3]> = cell.iter().map(|&v| u[v]).collect();
             let pl: Vec<f64> = cell.iter().map(|&v| phi[v]).collect();

@@ -104,7 +104,12 @@ impl FieldSolution {
 
     /// The errors of the nodal solution `(u, φ)` against it.
     pub fn errors(&self, disc: &Discretization<'_>, u: &[[f64; 3]], phi: &[f64], electric: bool) -> ExactReport {
-        let e = disc.error_norms(u, phi, &self.exact);
+        self.report(&disc.error_norms(u, phi, &self.exact), electric)
+    }
+
+    /// The report of the error norms `e` (of the whole mesh: a run on pieces sums their
+    /// squares over the ranks, `fe_assembly::ErrorNorms::from_squares`).
+    pub fn report(&self, e: &fe_assembly::ErrorNorms, electric: bool) -> ExactReport {
         ExactReport::Field(FieldErrors {
             kind: self.kind,
             error: e.rel_energy(),

@@ -10,7 +10,7 @@
 //! parts completing each other (`parts`).
 //!
 //! What it solves today: a generated rectangle or box, or a Gmsh mesh of one body, of order 1
-//! without path or floating
+//! (an error against a field solution summed over the ranks' own cells), without path or floating
 //! terminal, without contact or with the contact the active sets hold (the paper's base model
 //! on one zone: [`crate::active_sets_hold`]), each rank iterating on the contact points at
 //! the nodes it owns; every other scene is refused by key ([`pieces_support`]). The run's
@@ -92,9 +92,9 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
     let refused = [
         (scene.path.is_some(), "path", "a path"),
         (
-            scene.exact.is_some(),
-            "exact",
-            "an error against an exact solution (its norms are not yet summed over the pieces)",
+            scene.exact.as_ref().is_some_and(|x| !x.kind.is_field()),
+            "exact.kind",
+            "an error against a contact's closed form (Hertz, Cattaneo-Mindlin, the half-space)",
         ),
         (
             scene.floating_key().is_some(),
@@ -223,6 +223,13 @@ pub fn solve_on_pieces(
         nonzeros: petsc.sum(&[system.matrix.local_info()?.0])?[0],
     };
     let report = shares.report(&u, &phi, figures)?;
+    if let Some(e) = &report.exact {
+        reporter.event(&Event::Exact {
+            kind: e.kind(),
+            what: e.error_name(),
+            error: e.error(),
+        });
+    }
     drop(disc);
     piece.mesh = setup.mesh;
     Ok(PieceSolution {

@@ -68,6 +68,15 @@ impl Shares<'_> {
         let info = f.contact.map(|c| &c.solution.info);
         let equilibrium = f.contact.map_or(f.equilibrium, |c| c.equilibrium);
         let cells_per_rank = petsc.all_gather(self.own_cells as u64)?;
+        // the errors against a field solution: each rank's own cells' squares, summed
+        let exact = match &setup.exact {
+            Some(ex) => {
+                let own = self.disc.error_norms_on(u, phi, &ex.exact, 0..self.own_cells);
+                let sums = petsc.sum(&own.squares())?;
+                Some(ex.report(&fe_assembly::ErrorNorms::from_squares(&sums), plan.electric))
+            }
+            None => None,
+        };
         Ok(RunReport {
             scene: SceneReport::of(scene),
             plan: plan.clone(),
@@ -86,7 +95,7 @@ impl Shares<'_> {
                 phi: sums[1] as usize,
             },
             contact: Default::default(),
-            exact: None,
+            exact,
             iterations: Iterations::of(info, 0),
             residuals: Residuals {
                 equilibrium,

@@ -191,6 +191,11 @@ fn face(kind: CellKind, c: &[usize], k: usize) -> Option<Vec<usize>> {
     }
 }
 
+/// `x` as the integer it holds (exact in `f64`), where it is one.
+fn as_bits(x: f64) -> Option<u64> {
+    (x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53)).then_some(x as u64)
+}
+
 /// The corners of a face, sorted: the key that finds it whatever its order.
 fn key(corners: &[usize]) -> Vec<usize> {
     let mut k = corners.to_vec();
@@ -290,29 +295,12 @@ impl MshPart {
     /// [`MeshError::Gmsh`] where `rows` hold what no part writes (the table was not this
     /// mesh's).
     pub fn complete(self, rows: &[f64], nodes: usize, cells: usize) -> Result<MeshPiece, MeshError> {
-        let bad = |what: &str| MeshError::Gmsh {
-            path: format!("part {}", self.rank + 1),
-            message: format!("the parts' table holds {what}: the parts are not of one mesh"),
-        };
         let n_cells = self.mesh.n_cells();
         if rows.len() != SLOTS * n_cells {
-            return Err(bad("rows of another length"));
+            return Err(self.bad("rows of another length"));
         }
-        let as_bits =
-            |x: f64| -> Option<u64> { (x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53)).then_some(x as u64) };
-        // the nodes the cells hold, numbered anew
-        let mut new = vec![usize::MAX; self.mesh.n_nodes()];
-        let mut points = vec![];
-        let mut global_node = vec![];
-        for &v in &self.mesh.cells {
-            if new[v] == usize::MAX {
-                new[v] = points.len();
-                points.push(self.mesh.points[v]);
-                global_node.push(self.node_tag[v] as usize - 1);
-            }
-        }
+        let (cell_nodes, points, global_node) = self.renumbered();
         let kind = self.mesh.kind;
-        let cell_nodes: Vec<usize> = self.mesh.cells.iter().map(|&v| new[v]).collect();
         let mut regions: BTreeMap<String, Vec<usize>> = self.regions.iter().map(|r| (r.clone(), vec![])).collect();
         let mut boundaries: BTreeMap<String, FacetGroup> = self
             .groups
@@ -329,39 +317,14 @@ impl MshPart {
         let mut seen: std::collections::HashSet<(Vec<usize>, usize)> = std::collections::HashSet::new();
         for c in 0..n_cells {
             let row = &rows[SLOTS * c..SLOTS * (c + 1)];
-            let owned = as_bits(row[0]).filter(|b| b % 2 == 1).ok_or_else(|| MeshError::Gmsh {
-                path: format!("part {}", self.rank + 1),
-                message: format!(
-                    "cell {} is a ghost of part {} here, but no part holds it as its own: the parts are not of one mesh",
-                    self.cell_tag[c],
-                    self.cell_rank[c] + 1
-                ),
-            })?;
-            let bits = Some(owned / 2)
-                .filter(|b| b >> self.regions.len() == 0)
-                .ok_or_else(|| bad("regions no part names"))?;
+            let bits = self.regions_of(c, row[0])?;
             for (_, name) in self.regions.iter().enumerate().filter(|(b, _)| bits >> b & 1 == 1) {
                 regions.entry(name.clone()).or_default().push(c);
             }
-            let corners = &cell_nodes[per * c..per * (c + 1)];
-            for k in 0..SLOTS - 1 {
-                let (Some(f), Some(value)) = (face(kind, corners, k), as_bits(row[1 + k])) else {
-                    if row[1 + k] != 0.0 {
-                        return Err(bad("a face no cell has"));
-                    }
-                    continue;
-                };
-                let (bits, order) = (value / 6, (value % 6) as usize);
-                if bits >> self.groups.len() != 0 || (f.len() == 2 && order > 1) {
-                    return Err(bad("facet groups no part names"));
-                }
-                let facet: Vec<usize> = (0..f.len()).map(|i| f[ORDERS[order][i]]).collect();
-                for (b, name) in self.groups.iter().enumerate().filter(|(b, _)| bits >> b & 1 == 1) {
-                    // an interior facet is on the faces of both its cells: kept once
-                    if !seen.insert((key(&facet), b)) {
-                        continue;
-                    }
-                    if let Some(g) = boundaries.get_mut(name) {
+            for (b, facet) in self.facets_of(&cell_nodes[per * c..per * (c + 1)], &row[1..])? {
+                // an interior facet is on the faces of both its cells: kept once
+                if seen.insert((key(&facet), b)) {
+                    if let Some(g) = boundaries.get_mut(&self.groups[b]) {
                         g.facets.extend_from_slice(&facet);
                     }
                 }
@@ -395,5 +358,68 @@ impl MshPart {
             n_global_nodes: nodes,
             n_global_cells: cells,
         })
+    }
+
+    /// A refusal of the parts' table.
+    fn bad(&self, what: &str) -> MeshError {
+        MeshError::Gmsh {
+            path: format!("part {}", self.rank + 1),
+            message: format!("the parts' table holds {what}: the parts are not of one mesh"),
+        }
+    }
+
+    /// The nodes the cells hold, numbered anew in the order the cells meet them: the cells'
+    /// nodes, the points, each point's number in the whole mesh.
+    fn renumbered(&self) -> (Vec<usize>, Vec<[f64; 3]>, Vec<usize>) {
+        let mut new = vec![usize::MAX; self.mesh.n_nodes()];
+        let (mut points, mut global_node) = (vec![], vec![]);
+        for &v in &self.mesh.cells {
+            if new[v] == usize::MAX {
+                new[v] = points.len();
+                points.push(self.mesh.points[v]);
+                global_node.push(self.node_tag[v] as usize - 1);
+            }
+        }
+        (self.mesh.cells.iter().map(|&v| new[v]).collect(), points, global_node)
+    }
+
+    /// Cell `c`'s regions as bits, from its row's first number (odd: written by its owner).
+    fn regions_of(&self, c: usize, x: f64) -> Result<u64, MeshError> {
+        let owned = as_bits(x).filter(|b| b % 2 == 1).ok_or_else(|| MeshError::Gmsh {
+            path: format!("part {}", self.rank + 1),
+            message: format!(
+                "cell {} is a ghost of part {} here, but no part holds it as its own: the parts are not of one mesh",
+                self.cell_tag[c],
+                self.cell_rank[c] + 1
+            ),
+        })?;
+        Some(owned / 2)
+            .filter(|b| b >> self.regions.len() == 0)
+            .ok_or_else(|| self.bad("regions no part names"))
+    }
+
+    /// The facets on the faces of a cell (its corners `corners`, its row's face numbers
+    /// `faces`): each facet group's index and the facet's nodes in its file's order.
+    fn facets_of(&self, corners: &[usize], faces: &[f64]) -> Result<Vec<(usize, Vec<usize>)>, MeshError> {
+        let mut out = vec![];
+        for (k, &x) in faces.iter().enumerate() {
+            let (Some(f), Some(value)) = (face(self.mesh.kind, corners, k), as_bits(x)) else {
+                if x != 0.0 {
+                    return Err(self.bad("a face no cell has"));
+                }
+                continue;
+            };
+            let (bits, order) = (value / 6, (value % 6) as usize);
+            if bits >> self.groups.len() != 0 || (f.len() == 2 && order > 1) {
+                return Err(self.bad("facet groups no part names"));
+            }
+            let facet: Vec<usize> = (0..f.len()).map(|i| f[ORDERS[order][i]]).collect();
+            out.extend(
+                (0..self.groups.len())
+                    .filter(|b| bits >> b & 1 == 1)
+                    .map(|b| (b, facet.clone())),
+            );
+        }
+        Ok(out)
     }
 }
