@@ -28,6 +28,8 @@ const CASES: &[(&str, &[&str])] = &[
     ("paper", &["mesh.n=32", "contact.law=\"none\""]),
     // errors against a field solution, summed over the ranks' own cells
     ("manufactured-3d", &["mesh.n=4"]),
+    // a layered body: four layers, internal electrodes on their interfaces
+    ("stack", &["contact.law=\"none\""]),
     ("patch", &[]),
     ("paper-3d", &["mesh.n=6", "contact.law=\"none\""]),
     ("actuator", &["mesh.n=16", "contact.law=\"none\""]),
@@ -62,6 +64,8 @@ const CONTACT_CASES: &[(&str, &[&str])] = &[
     ),
     // a graded quarter model under a sphere: two symmetry planes through the contact face
     ("indent-sphere-3d", &["mesh.n=8"]),
+    // a layered stack, internal electrodes on its interfaces, on a Coulomb foundation
+    ("stack", &[]),
     // a tall box cut along z, upside down: rank 0 holds no contact point
     (
         "paper-3d",

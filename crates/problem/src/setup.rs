@@ -260,6 +260,11 @@ fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNo
     if let Some(g) = &m.grading {
         grade(&mut mesh, m, &g.ratios());
     }
+    // so do a layered mesh's (its rows of nodes moved by their grid row), its cells' layers
+    // (by their centroids) and its interfaces (the facets of the layer below in each plane)
+    if !m.layers.is_empty() {
+        layer(&mut mesh, m)?;
+    }
     let quality = mesh.check()?;
     let notes = MeshNotes {
         coincident_nodes: quality.coincident_nodes,
@@ -272,8 +277,8 @@ fn mesh_piece(scene: &Scene, mut mesh: mesh::Mesh) -> Result<(mesh::Mesh, MeshNo
 }
 
 /// What a mesh made in pieces cannot be, as the key that asks for it and the thing in words,
-/// or `None`: a piece is of a generated rectangle or box (graded or not) or of a Gmsh mesh,
-/// of order 1, neither layered nor rounded nor a body of revolution. [`setup_piece`] refuses these, and so does a
+/// or `None`: a piece is of a generated rectangle or box (graded or layered or not) or of a
+/// Gmsh mesh, of order 1, neither rounded nor a body of revolution. [`setup_piece`] refuses these, and so does a
 /// backend before it makes a piece.
 pub fn piece_refusal(m: &crate::scene::MeshSpec) -> Option<(&'static str, &'static str)> {
     [
@@ -282,7 +287,6 @@ pub fn piece_refusal(m: &crate::scene::MeshSpec) -> Option<(&'static str, &'stat
             "mesh.kind",
             "a mesh handed over by the caller",
         ),
-        (!m.layers.is_empty(), "mesh.layer", "a layered mesh"),
         (m.order.is_some_and(|o| o != 1), "mesh.order", "second-order cells"),
         (m.cylinder, "mesh.cylinder", "a rounded mesh"),
         (m.axisymmetric, "mesh.axisymmetric", "a body of revolution"),

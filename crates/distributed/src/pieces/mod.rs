@@ -81,10 +81,9 @@ pub struct PieceSolution {
     pub contact: Option<PieceContact>,
 }
 
-/// Whether a run on pieces solves `scene`: a generated rectangle or box, or a Gmsh mesh, of
-/// order 1 (graded
-/// or not; not layered or rounded), without path or floating terminal, its contact (if any) one
-/// the active sets hold.
+/// Whether a run on pieces solves `scene`: a generated rectangle or box (graded, layered or
+/// not; not rounded), or a Gmsh mesh, of order 1, without path or floating terminal, its
+/// contact (if any) one the active sets hold.
 ///
 /// # Errors
 /// [`Unsupported`], naming the key of what a run on pieces does not solve yet.
