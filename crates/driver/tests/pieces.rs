@@ -30,6 +30,8 @@ const CASES: &[(&str, &[&str])] = &[
     ("manufactured-3d", &["mesh.n=4"]),
     // a layered body: four layers, internal electrodes on their interfaces
     ("stack", &["contact.law=\"none\""]),
+    // a PZT layer on an elastic substrate: electric and non-electric cells
+    ("layered", &["mesh.n=16", "contact.law=\"none\""]),
     ("patch", &[]),
     ("paper-3d", &["mesh.n=6", "contact.law=\"none\""]),
     ("actuator", &["mesh.n=16", "contact.law=\"none\""]),
@@ -66,6 +68,8 @@ const CONTACT_CASES: &[(&str, &[&str])] = &[
     ("indent-sphere-3d", &["mesh.n=8"]),
     // a layered stack, internal electrodes on its interfaces, on a Coulomb foundation
     ("stack", &[]),
+    // a PZT layer on an elastic substrate, the substrate on the foundation
+    ("layered", &["mesh.n=16"]),
     // a tall box cut along z, upside down: rank 0 holds no contact point
     (
         "paper-3d",
@@ -373,6 +377,18 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
         let e = refused(
             "paper-3d",
             &["mesh.n=4", "contact.law=\"none\"", "~dirichlet.1", "~dirichlet.0.phi"],
+        );
+        assert!(e.contains("the potential is floating"), "{e}");
+        // a PZT layer on a non-electric substrate, its potential held nowhere: the electric
+        // parts counted across the ranks (no piece sees the whole layer)
+        let e = refused(
+            "layered",
+            &[
+                "mesh.n=8",
+                "contact.law=\"none\"",
+                "~dirichlet.0.phi",
+                "~dirichlet.1.phi",
+            ],
         );
         assert!(e.contains("the potential is floating"), "{e}");
         let e = refused("paper-3d", &["mesh.n=4", "contact.law=\"none\"", "mesh.order=2"]);

@@ -657,7 +657,11 @@ impl Pattern {
 }
 
 /// The material of each cell: the index in `materials` of the one region holding it.
-fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<Vec<usize>, AssemblyError> {
+///
+/// # Errors
+/// A material of another dimension than the mesh's, a region the mesh lacks, a cell in two
+/// materials' regions or in none ([`InputError`]).
+pub fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<Vec<usize>, AssemblyError> {
     let mut cell_material = vec![usize::MAX; mesh.n_cells()];
     for (mi, (region, m)) in materials.iter().enumerate() {
         if m.dim != mesh.dim {

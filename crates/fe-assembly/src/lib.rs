@@ -51,7 +51,7 @@ pub mod mapping;
 mod material;
 mod recovery;
 
-pub use assembly::{Blocks, Discretization, Parallelism};
+pub use assembly::{cell_materials, Blocks, Discretization, Parallelism};
 pub use dofs::{Constraint, Dof, DofMap, Field, Prescribed};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
 pub use held::{free_in, rigid_gram, Held, Support, Unheld};

@@ -156,7 +156,7 @@ pub fn solve_on_pieces(
     let t_setup = start.elapsed().as_secs_f64();
     let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
-    let fields = KrylovFields::new(petsc, &setup, &layout);
+    let fields = KrylovFields::new(petsc, &setup, &layout)?;
     let t_assembly = start.elapsed().as_secs_f64() - t_setup;
     let (x, solved, contact) = match scene.zones().is_empty() {
         true => {
@@ -246,9 +246,9 @@ pub fn solve_on_pieces(
 /// a mesh read whose bodies are counted across the pieces, [`parts::bodies`]) has its rigid
 /// motions held when the Gram matrix of the conditions, summed over the ranks' own nodes
 /// (`fe_assembly::rigid_gram`), has full rank; its potential, where every cell is electric,
-/// when some rank prescribes φ at a node it owns. A mesh of several bodies, and a body of
-/// electric and non-electric cells, whose parts a piece cannot tell apart, are refused by key.
-/// Collective.
+/// when some rank prescribes φ at a node it owns; in a body of electric and non-electric
+/// cells, each electric part's where some node of it has φ prescribed ([`parts::floating_parts`]).
+/// A mesh of several bodies is refused by key. Collective.
 fn held_on_pieces(
     petsc: &Petsc,
     scene: &Scene,
@@ -296,21 +296,17 @@ fn held_on_pieces(
         return Err(fe_assembly::AssemblyError::from(unheld).into());
     }
     let electric = (0..piece.own_cells).filter(|&c| disc.cell_electric[c]).count() as f64;
-    let fixed = owned
-        .iter()
-        .filter(|&&v| matches!(disc.dofs.phi[v], fe_assembly::Dof::Fixed(_)))
-        .count() as f64;
-    let sums = petsc.sum(&[electric, fixed])?;
-    if sums[0] > 0.0 && sums[0] < cells as f64 {
-        let u = Unsupported::new(
-            NAME,
-            "material",
-            "a body of electric and non-electric cells on a mesh made in pieces",
-        )
-        .advise("a run whose every rank holds the whole mesh solves it");
-        return Err(ProblemError::from(u).into());
-    }
-    if sums[0] > 0.0 && sums[1] == 0.0 {
+    let fixed = |v: usize| matches!(disc.dofs.phi[v], fe_assembly::Dof::Fixed(_));
+    let prescribed = owned.iter().filter(|&&v| fixed(v)).count() as f64;
+    let sums = petsc.sum(&[electric, prescribed])?;
+    // a body of electric cells alone: its potential is held where some rank prescribes it;
+    // electric and non-electric cells: each electric part (joined by electric cells) must be
+    let floating = match sums[0] {
+        e if e == 0.0 => 0,
+        e if e == cells as f64 => usize::from(sums[1] == 0.0),
+        _ => parts::floating_parts(petsc, disc.mesh, piece, &disc.cell_electric, &fixed)?,
+    };
+    if floating > 0 {
         let unheld = fe_assembly::Unheld::Potential { cell: 0, cells };
         return Err(fe_assembly::AssemblyError::from(unheld).into());
     }
@@ -677,15 +673,33 @@ fn check_memory(scene: &Scene, blocks: &Blocks, rank: usize, limits: problem::Li
 }
 
 /// The Dirichlet conditions of the set-up that reach the piece: a condition on a group of
-/// which the piece holds no facet fixes nothing here and is dropped (the dof map refuses a
+/// which the piece holds no facet (for a potential: no node of an electric cell) fixes
+/// nothing here and is dropped (the dof map refuses a
 /// condition that reaches no unknown); one that no piece reaches is kept on every rank, so that
 /// each refuses it alike.
 fn conditions_on_the_piece(petsc: &Petsc, setup: &mut problem::backend::Setup) -> Result<(), DistributedError> {
     let mesh = &setup.mesh;
+    // the nodes that carry a potential on this piece: those of its electric cells (where the
+    // materials do not cover the cells, every node: the discretisation refuses them)
+    let mut carries_phi = vec![true; mesh.n_nodes()];
+    if let Ok(of) = fe_assembly::cell_materials(mesh, &setup.materials) {
+        carries_phi.fill(false);
+        let electric = |&(c, _): &(usize, &[usize])| setup.materials[of[c]].1.electric;
+        for (_, cell) in mesh.iter_cells().enumerate().filter(electric) {
+            for &v in cell {
+                carries_phi[v] = true;
+            }
+        }
+    }
     let here: Vec<bool> = setup
         .constraints
         .iter()
-        .map(|c| mesh.boundaries.get(&c.group).is_some_and(|g| g.n_facets() > 0))
+        .map(|c| {
+            let on_phi = matches!(c.field, fe_assembly::Field::Potential | fe_assembly::Field::Floating);
+            mesh.boundaries
+                .get(&c.group)
+                .is_some_and(|g| g.facets.iter().any(|&v| !on_phi || carries_phi[v]))
+        })
         .collect();
     let counts: Vec<f64> = here.iter().map(|&h| f64::from(u8::from(h))).collect();
     let anywhere = petsc.sum(&counts)?;

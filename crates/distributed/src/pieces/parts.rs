@@ -157,20 +157,25 @@ fn same_nodes(petsc: &Petsc, piece: &MeshPiece) -> Result<(), DistributedError> 
     Ok(())
 }
 
-/// The connected bodies of the whole mesh, counted across the pieces (`m`: the piece's mesh,
-/// which the set-up took from it). A directory over the
-/// whole mesh's node numbers holds a label per node, at first its number. Each round, every
-/// rank gives each node of a connected part of its piece the least label that the directory
-/// holds for the part's nodes, and writes it back where it is less than the directory's (where
-/// several ranks write one node, one of their values stays: each less than the round's
-/// start, so the labels only fall and the rounds end). When no rank writes, every connected
-/// part of every piece holds one label; every cell lies whole in its owner's piece, so two
-/// nodes share a label exactly when a path of cells joins them, and the bodies are the nodes
-/// whose label is their own number. Collective.
-pub(super) fn bodies(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result<usize, DistributedError> {
-    let rank = petsc.rank();
+/// The connected parts of the whole mesh's cells that `keep` marks (joined through any node),
+/// labelled across the pieces (`m`: the piece's mesh, which the set-up took from it): each
+/// node of a kept cell of the piece with its part's label, the least of the part's node
+/// numbers in the whole mesh. A directory over those numbers holds a label per node, at first
+/// its number. Each round, every rank gives each node of a connected part of its piece the
+/// least label that the directory holds for the part's nodes, and writes it back where it is
+/// less than the directory's (where several ranks write one node, one of their values stays:
+/// each less than the round's start, so the labels only fall and the rounds end). When no rank
+/// writes, every connected part of every piece holds one label; every cell lies whole in its
+/// owner's piece, so two nodes share a label exactly when a path of kept cells joins them.
+/// Collective.
+fn labels(
+    petsc: &Petsc,
+    m: &mesh::Mesh,
+    piece: &MeshPiece,
+    keep: &dyn Fn(usize) -> bool,
+) -> Result<Vec<(usize, f64)>, DistributedError> {
     let n = m.n_nodes();
-    // the connected parts of the piece: a union-find over its cells
+    // the connected parts of the piece: a union-find over its kept cells
     let mut root: Vec<usize> = (0..n).collect();
     fn find(root: &mut [usize], mut v: usize) -> usize {
         while root[v] != v {
@@ -180,7 +185,7 @@ pub(super) fn bodies(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result
         v
     }
     let mut used = vec![false; n];
-    for cell in m.iter_cells() {
+    for (_, cell) in m.iter_cells().enumerate().filter(|(c, _)| keep(*c)) {
         let a = find(&mut root, cell[0]);
         for &v in cell {
             used[v] = true;
@@ -196,7 +201,7 @@ pub(super) fn bodies(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result
     let (own_at, own): (Vec<_>, Vec<f64>) = nodes
         .iter()
         .zip(&at)
-        .filter(|(&v, _)| piece.node_rank[v] == rank)
+        .filter(|(&v, _)| piece.node_rank[v] == petsc.rank())
         .map(|(&v, &i)| (i, piece.global_node[v] as f64))
         .unzip();
     directory.set_values(&own_at, &own)?;
@@ -220,12 +225,54 @@ pub(super) fn bodies(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result
         directory.assemble()?;
         known = directory.fetch(&at)?;
     }
-    let roots = nodes
-        .iter()
-        .zip(&known)
-        .filter(|&(&v, &l)| piece.node_rank[v] == rank && l == piece.global_node[v] as f64)
+    Ok(nodes.into_iter().zip(known).collect())
+}
+
+/// The connected bodies of the whole mesh, counted across the pieces ([`labels`] of every
+/// cell): the nodes, each counted by its owner, whose label is their own number. Collective.
+pub(super) fn bodies(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result<usize, DistributedError> {
+    let rank = petsc.rank();
+    let roots = labels(petsc, m, piece, &|_| true)?
+        .into_iter()
+        .filter(|&(v, l)| piece.node_rank[v] == rank && l == piece.global_node[v] as f64)
         .count();
     Ok(petsc.sum(&[roots as f64])?[0] as usize)
+}
+
+/// The electric parts of the whole mesh (joined by the `electric` cells through any node,
+/// [`labels`]) whose potential no prescribed φ holds (`fixed` at a node): their count, as the
+/// whole mesh's check judges them (`fe_assembly::held`). Each rank lists the parts its owned
+/// nodes start (the node whose number is the label) and the parts its owned nodes prescribe,
+/// and the lists are gathered: their sizes are the count of parts, not of nodes. Collective.
+pub(super) fn floating_parts(
+    petsc: &Petsc,
+    m: &mesh::Mesh,
+    piece: &MeshPiece,
+    electric: &[bool],
+    fixed: &dyn Fn(usize) -> bool,
+) -> Result<usize, DistributedError> {
+    let rank = petsc.rank();
+    let labels = labels(petsc, m, piece, &|c| electric[c])?;
+    let as_i32 = |l: f64| -> Result<i32, DistributedError> {
+        i32::try_from(l as u64).map_err(|_| {
+            mesh_file("an electric part's label past 2^31 nodes: too large a mesh to check on pieces".into())
+        })
+    };
+    let (mut parts, mut held) = (vec![], vec![]);
+    for &(v, l) in labels.iter().filter(|(v, _)| piece.node_rank[*v] == rank) {
+        if l == piece.global_node[v] as f64 {
+            parts.push(as_i32(l)?);
+        }
+        if fixed(v) {
+            held.push(as_i32(l)?);
+        }
+    }
+    held.sort_unstable();
+    held.dedup();
+    let parts = petsc.all_gather_i32(&parts)?;
+    let mut held = petsc.all_gather_i32(&held)?;
+    held.sort_unstable();
+    Ok(parts.iter().filter(|p| held.binary_search(p).is_err()).count())
 }
 
 /// The centre and size of the whole mesh's bounding box, from the owned nodes of every piece
