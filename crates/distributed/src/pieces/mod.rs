@@ -301,10 +301,12 @@ fn held_on_pieces(
     let sums = petsc.sum(&[electric, prescribed])?;
     // a body of electric cells alone: its potential is held where some rank prescribes it;
     // electric and non-electric cells: each electric part (joined by electric cells) must be
-    let floating = match sums[0] {
-        e if e == 0.0 => 0,
-        e if e == cells as f64 => usize::from(sums[1] == 0.0),
-        _ => parts::floating_parts(petsc, disc.mesh, piece, &disc.cell_electric, &fixed)?,
+    let floating = if sums[0] == 0.0 {
+        0
+    } else if sums[0] == cells as f64 {
+        usize::from(sums[1] == 0.0)
+    } else {
+        parts::floating_parts(petsc, disc.mesh, piece, &disc.cell_electric, &fixed)?
     };
     if floating > 0 {
         let unheld = fe_assembly::Unheld::Potential { cell: 0, cells };
