@@ -54,6 +54,8 @@ pub struct MshPart {
     pub regions: Vec<String>,
     /// The whole mesh's facet groups (the physical groups one dimension lower), by name.
     pub groups: Vec<String>,
+    /// The part's file, for messages.
+    pub name: String,
 }
 
 /// The parts of a mesh that Gmsh split for `path`: `stem_1.ext`, `stem_2.ext`, ... as long
@@ -93,7 +95,9 @@ pub fn read_msh_part(path: impl AsRef<Path>) -> Result<MshPart, MeshError> {
     };
     let file = sections::read(&bytes).map_err(err)?;
     drop(bytes);
-    part_of(&file).map_err(err)
+    let mut part = part_of(&file).map_err(err)?;
+    part.name = name;
+    Ok(part)
 }
 
 /// The part of `file`.
@@ -157,6 +161,7 @@ fn part_of(file: &File) -> Result<MshPart, String> {
         node_tag,
         regions,
         groups,
+        name: String::new(),
     })
 }
 
@@ -236,7 +241,7 @@ impl MshPart {
             for f in group.facets.chunks_exact(group.nodes_per_facet) {
                 let Some(cells) = faces.get(&key(f)) else {
                     return Err(MeshError::Gmsh {
-                        path: format!("part {}", self.rank + 1),
+                        path: self.name.clone(),
                         message: format!("a facet of group `{name}` lies on none of the part's cells"),
                     });
                 };
@@ -363,7 +368,7 @@ impl MshPart {
     /// A refusal of the parts' table.
     fn bad(&self, what: &str) -> MeshError {
         MeshError::Gmsh {
-            path: format!("part {}", self.rank + 1),
+            path: self.name.clone(),
             message: format!("the parts' table holds {what}: the parts are not of one mesh"),
         }
     }
@@ -386,7 +391,7 @@ impl MshPart {
     /// Cell `c`'s regions as bits, from its row's first number (odd: written by its owner).
     fn regions_of(&self, c: usize, x: f64) -> Result<u64, MeshError> {
         let owned = as_bits(x).filter(|b| b % 2 == 1).ok_or_else(|| MeshError::Gmsh {
-            path: format!("part {}", self.rank + 1),
+            path: self.name.clone(),
             message: format!(
                 "cell {} is a ghost of part {} here, but no part holds it as its own: the parts are not of one mesh",
                 self.cell_tag[c],
