@@ -222,13 +222,7 @@ pub fn solve_on_pieces(
         nonzeros: petsc.sum(&[system.matrix.local_info()?.0])?[0],
     };
     let report = shares.report(&u, &phi, figures)?;
-    if let Some(e) = &report.exact {
-        reporter.event(&Event::Exact {
-            kind: e.kind(),
-            what: e.error_name(),
-            error: e.error(),
-        });
-    }
+    exact_heard(&report, reporter);
     drop(disc);
     piece.mesh = setup.mesh;
     Ok(PieceSolution {
@@ -239,6 +233,17 @@ pub fn solve_on_pieces(
         contact,
         report,
     })
+}
+
+/// Tells `reporter` the error against an exact solution, where the report has one.
+fn exact_heard(report: &problem::RunReport, reporter: &mut dyn Reporter) {
+    if let Some(e) = &report.exact {
+        reporter.event(&Event::Exact {
+            kind: e.kind(),
+            what: e.error_name(),
+            error: e.error(),
+        });
+    }
 }
 
 /// Refuses, on every rank alike, a body that the Dirichlet conditions do not hold, as the whole
