@@ -320,6 +320,20 @@ pub enum MeshError {
 }
 
 impl Mesh {
+    /// A mesh of nothing (no node, no cell) of dimension `dim`: a placeholder where a mesh
+    /// was taken, or a solution with nothing to draw.
+    pub fn empty(dim: usize) -> Mesh {
+        Mesh {
+            dim,
+            kind: if dim == 2 { CellKind::Tri3 } else { CellKind::Tet4 },
+            points: vec![],
+            cells: vec![],
+            boundaries: BTreeMap::new(),
+            regions: BTreeMap::new(),
+            reoriented_cells: 0,
+        }
+    }
+
     /// Number of nodes.
     pub fn n_nodes(&self) -> usize {
         self.points.len()

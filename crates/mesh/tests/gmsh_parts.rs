@@ -36,6 +36,14 @@ fn sorted(m: &Mesh, nodes: &[usize]) -> Vec<Point> {
     s
 }
 
+/// A part's rows of the table (0 where no part wrote).
+fn rows_of(part: &MshPart, table: &HashMap<usize, f64>) -> Vec<f64> {
+    part.slots()
+        .iter()
+        .map(|s| table.get(s).copied().unwrap_or(0.0))
+        .collect()
+}
+
 /// The pieces of `stem`'s parts, completed through their summed table.
 fn pieces(stem: &str) -> Vec<MeshPiece> {
     let paths = parts_of(&forms().join(format!("{stem}.msh")));
@@ -52,11 +60,7 @@ fn pieces(stem: &str) -> Vec<MeshPiece> {
     parts
         .into_iter()
         .map(|part| {
-            let rows: Vec<f64> = part
-                .slots()
-                .iter()
-                .map(|s| table.get(s).copied().unwrap_or(0.0))
-                .collect();
+            let rows = rows_of(&part, &table);
             part.complete(&rows, nodes, cells).expect("a piece")
         })
         .collect()
@@ -199,11 +203,7 @@ fn a_ghost_cell_that_no_part_owns_is_refused() {
         .into_iter()
         .filter(|p| p.cell_rank.contains(&2) && p.rank != 2)
         .map(|part| {
-            let rows: Vec<f64> = part
-                .slots()
-                .iter()
-                .map(|s| table.get(s).copied().unwrap_or(0.0))
-                .collect();
+            let rows = rows_of(&part, &table);
             part.complete(&rows, 10_000, 10_000)
                 .expect_err("a ghost without its owner")
                 .to_string()

@@ -347,7 +347,7 @@ fn set_up(
         ),
     };
     let dim = piece.mesh.dim;
-    let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, empty(dim)))?;
+    let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, mesh::Mesh::empty(dim)))?;
     check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
     reporter.event(&Event::Planned(&setup.plan));
     reporter.event(&Event::Units(&setup.units));
@@ -607,23 +607,6 @@ pub struct PieceContact {
     pub normal_force: f64,
     /// Contact points over every rank.
     pub points: usize,
-}
-
-/// A mesh with nothing in it, in place of a piece's mesh while its set-up holds it.
-fn empty(dim: usize) -> mesh::Mesh {
-    mesh::Mesh {
-        dim,
-        kind: if dim == 2 {
-            mesh::CellKind::Tri3
-        } else {
-            mesh::CellKind::Tet4
-        },
-        points: vec![],
-        cells: vec![],
-        boundaries: Default::default(),
-        regions: Default::default(),
-        reoriented_cells: 0,
-    }
 }
 
 /// The solution `x` at every node of the piece: each node's unknowns fetched from the rank

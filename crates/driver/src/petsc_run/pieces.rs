@@ -126,7 +126,7 @@ fn rank_0s_solution(g: distributed::Gathered, source: &Source, peaks: Vec<u64>) 
         .any(|o| matches!(o, Output::Deformed | Output::Potential));
     let (mesh, u, phi) = match g.front {
         Some(front) => front,
-        None if !pictures => (nothing(report.plan.dim), vec![], vec![]),
+        None if !pictures => (mesh::Mesh::empty(report.plan.dim), vec![], vec![]),
         None => {
             return Err(DriverError::Usage(
                 "a run on pieces of a body without the face `front` its pictures draw".into(),
@@ -147,23 +147,6 @@ fn rank_0s_solution(g: distributed::Gathered, source: &Source, peaks: Vec<u64>) 
         },
         contact: g.contact,
     })
-}
-
-/// A mesh of nothing, of dimension `dim`.
-fn nothing(dim: usize) -> mesh::Mesh {
-    mesh::Mesh {
-        dim,
-        kind: if dim == 2 {
-            mesh::CellKind::Tri3
-        } else {
-            mesh::CellKind::Tet4
-        },
-        points: vec![],
-        cells: vec![],
-        boundaries: Default::default(),
-        regions: Default::default(),
-        reoriented_cells: 0,
-    }
 }
 
 /// The path whose bytes rank 0 sent.
