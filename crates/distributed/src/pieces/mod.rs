@@ -349,6 +349,12 @@ fn set_up(
     let dim = piece.mesh.dim;
     let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, mesh::Mesh::empty(dim)))?;
     check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
+    // the pictures rank 0 draws from gathered surfaces: a 3D box's face `front`; a 2D body's
+    // pictures draw the whole mesh, which no rank holds here
+    if dim == 2 {
+        let drawn = |o: &problem::Output| !matches!(o, problem::Output::Deformed | problem::Output::Potential);
+        setup.plan.outputs.retain(drawn);
+    }
     reporter.event(&Event::Planned(&setup.plan));
     reporter.event(&Event::Units(&setup.units));
     let terminals: Vec<String> = terminal_groups(&setup).into_iter().map(String::from).collect();
