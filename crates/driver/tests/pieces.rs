@@ -813,5 +813,37 @@ fn gmsh_parts_agree_with_the_whole_mesh_on_three_ranks() {
             e.contains("the mesh is in 2 parts") && e.contains("run on 2 ranks"),
             "{e}"
         );
+        // an element tag far past the count of elements (rank 0's part renumbered by hand):
+        // refused on every rank before the tables over the tags are made
+        let dir = tempfile::tempdir().expect("a directory");
+        let text = std::fs::read_to_string(&parts[p.rank()]).expect("the part");
+        // (rank 0's first own tetrahedron renumbered: a line of 5 numbers, not a ghost's)
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        if p.rank() == 0 {
+            let at = |marker: &str| lines.iter().position(|l| l == marker).expect("a section");
+            let ghosts: Vec<&str> = lines[at("$GhostElements") + 2..at("$EndGhostElements")]
+                .iter()
+                .filter_map(|l| l.split(' ').next())
+                .collect();
+            let own = (at("$Elements")..at("$EndElements"))
+                .find(|&i| {
+                    let t: Vec<&str> = lines[i].split_whitespace().collect();
+                    t.len() == 5 && !ghosts.contains(&t[0])
+                })
+                .expect("an own tetrahedron");
+            let rest: Vec<String> = lines[own].split_whitespace().skip(1).map(String::from).collect();
+            lines[own] = format!("1500000000 {}", rest.join(" "));
+        }
+        let text = lines.join("\n");
+        let mine = dir.path().join(format!("part_{}.msh", p.rank() + 1));
+        std::fs::write(&mine, text).expect("the part written");
+        let mut files = parts.clone();
+        files[p.rank()] = mine;
+        let from = distributed::PieceMesh::Parts(files);
+        let e = distributed::solve_on_pieces(p, &scene, from, problem::Limits::default(), &mut problem::Silent)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("tags reach 1500000000") && e.contains("renumber"), "{e}");
     });
 }

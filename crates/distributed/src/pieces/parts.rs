@@ -110,6 +110,7 @@ fn complete(petsc: &Petsc, part: MshPart) -> Result<MeshPiece, DistributedError>
     let top_node = part.node_tag.iter().max().copied().unwrap_or(0) as f64;
     let tops = petsc.max(&[top_cell, top_node])?;
     let cells = petsc.sum(&[part.own_cells as f64])?[0] as usize;
+    sparse_tags(petsc, &part, &tops)?;
     let (lo, hi) = petsc.split(MshPart::SLOTS * tops[0] as usize);
     let mut table = Vector::mpi(petsc, hi - lo)?;
     let (at, values): (Vec<_>, Vec<_>) = records.into_iter().map(|(s, v)| (Layout::index(s), v)).unzip();
@@ -153,6 +154,28 @@ fn same_nodes(petsc: &Petsc, piece: &MeshPiece) -> Result<(), DistributedError> 
         return Err(mesh_file(format!(
             "{moved_anywhere} nodes that parts share lie elsewhere in the part of the rank that owns them: the parts are not of one mesh (split them again from one Gmsh model)"
         )));
+    }
+    Ok(())
+}
+
+/// Refuses tags that would size the tables past what they index: the tables over the node and
+/// element tags are as long as the highest tag (times their numbers per entry), so tags far
+/// beyond the count of nodes or elements (a file renumbered by hand, or hostile) would take
+/// memory for nothing, and past PETSc's 32-bit indices they would wrap. Collective.
+fn sparse_tags(petsc: &Petsc, part: &MshPart, tops: &[f64]) -> Result<(), DistributedError> {
+    // (over the parts: shared nodes and ghost cells counted more than once, an upper bound)
+    let counts = petsc.sum(&[part.cell_tag.len() as f64, part.node_tag.len() as f64])?;
+    let widest = 8.0; // the contact fields' directory: 3 + 2 (dim - 1) numbers per node
+    let index_limit = f64::from(i32::MAX);
+    for (what, top, count, per) in [
+        ("element", tops[0], counts[0], MshPart::SLOTS as f64),
+        ("node", tops[1], counts[1], widest),
+    ] {
+        if top * per > index_limit || top > 16.0 * count + 1e6 {
+            return Err(mesh_file(format!(
+                "the parts' {what} tags reach {top:.0} for about {count:.0} {what}s: the tables over the tags would be too large; renumber the mesh (Gmsh: gmsh.model.mesh.renumberNodes() and renumberElements(), or Mesh.Renumber = 1) and split it again"
+            )));
+        }
     }
     Ok(())
 }
