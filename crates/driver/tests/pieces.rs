@@ -813,6 +813,23 @@ fn gmsh_parts_agree_with_the_whole_mesh_on_three_ranks() {
             e.contains("the mesh is in 2 parts") && e.contains("run on 2 ranks"),
             "{e}"
         );
+        // a region without material: the ranks that hold it refuse it, and the others with
+        // them (none waits in a collective the others never reach)
+        let start = LAYERED
+            .find("[[material]]\nregion = \"substrate\"")
+            .expect("the substrate");
+        let end = LAYERED.find("[[dirichlet]]").expect("the conditions");
+        let one = format!("{}{}", &LAYERED[..start], &LAYERED[end..]);
+        let scene = scene_file::parse(&one, "layered-gmsh", &["solver.backend=\"petsc\"".into()]).expect("the scene");
+        let from = distributed::PieceMesh::Parts(parts.clone());
+        let e = distributed::solve_on_pieces(p, &scene, from, problem::Limits::default(), &mut problem::Silent)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            e.contains("has no material") || e.contains("ranks could not set up"),
+            "{e}"
+        );
         // an element tag far past the count of elements (rank 0's part renumbered by hand):
         // refused on every rank before the tables over the tags are made
         let dir = tempfile::tempdir().expect("a directory");

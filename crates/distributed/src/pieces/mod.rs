@@ -148,11 +148,17 @@ pub fn solve_on_pieces(
     let start = Instant::now();
     let generated = matches!(source, PieceMesh::Generated);
     let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, source, limits, reporter)?;
-    let disc = setup.discretize()?;
+    let disc = agree(petsc, setup.discretize().map_err(DistributedError::from), "discretise")?;
     held_on_pieces(petsc, scene, &disc, &piece, generated)?;
-    let (b_u, b_phi) = disc.rhs(&setup.loads)?;
-    ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
-    ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
+    let loads = disc
+        .rhs(&setup.loads)
+        .map_err(ProblemError::from)
+        .and_then(|(b_u, b_phi)| {
+            ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
+            ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
+            Ok((b_u, b_phi))
+        });
+    let (b_u, b_phi) = agree(petsc, loads.map_err(DistributedError::from), "assemble their loads")?;
     let t_setup = start.elapsed().as_secs_f64();
     let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
@@ -190,7 +196,8 @@ pub fn solve_on_pieces(
     };
     let (u, phi) = nodal(&x, &layout)?;
     let recovered = disc.recover(&u, &phi);
-    ProblemError::check_finite(&recovered.stress, "the stress", &valid)?;
+    let finite = ProblemError::check_finite(&recovered.stress, "the stress", &valid);
+    agree(petsc, finite.map_err(DistributedError::from), "recover their fields")?;
     let owned: Vec<bool> = piece.node_rank.iter().map(|&r| r == petsc.rank()).collect();
     let shares = report::Shares {
         petsc,
@@ -233,6 +240,25 @@ pub fn solve_on_pieces(
         contact,
         report,
     })
+}
+
+/// `result` where every rank has one; where some rank has an error, an error on every rank
+/// (the rank's own; on the others one that says how many ranks could not `doing`), so that
+/// no rank goes on to a collective call the failed ones never make (a broken cell of one
+/// Gmsh part, a cell of one piece without material). Collective.
+fn agree<T>(petsc: &Petsc, result: Result<T, DistributedError>, doing: &str) -> Result<T, DistributedError> {
+    let failed = petsc.sum(&[f64::from(u8::from(result.is_err()))])?[0];
+    match result {
+        Ok(_) if failed > 0.0 => Err(ProblemError::NoSolution {
+            sought: "a run on pieces",
+            why: format!(
+                "{failed} of the {} ranks could not {doing} (each says why)",
+                petsc.size()
+            ),
+        }
+        .into()),
+        other => other,
+    }
 }
 
 /// Tells `reporter` the error against an exact solution, where the report has one.
@@ -347,7 +373,12 @@ fn set_up(
         ),
     };
     let dim = piece.mesh.dim;
-    let mut setup = setup_piece(valid, std::mem::replace(&mut piece.mesh, mesh::Mesh::empty(dim)))?;
+    let taken = std::mem::replace(&mut piece.mesh, mesh::Mesh::empty(dim));
+    let mut setup = agree(
+        petsc,
+        setup_piece(valid, taken).map_err(DistributedError::from),
+        "set up their piece",
+    )?;
     check_regions_and_electrodes(petsc, scene, &setup.mesh, piece.own_cells)?;
     // the pictures rank 0 draws from gathered surfaces: a 3D box's face `front`; a 2D body's
     // pictures draw the whole mesh, which no rank holds here
