@@ -150,15 +150,7 @@ pub fn solve_on_pieces(
     let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, source, limits, reporter)?;
     let disc = agree(petsc, setup.discretize().map_err(DistributedError::from), "discretise")?;
     held_on_pieces(petsc, scene, &disc, &piece, generated)?;
-    let loads = disc
-        .rhs(&setup.loads)
-        .map_err(ProblemError::from)
-        .and_then(|(b_u, b_phi)| {
-            ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
-            ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
-            Ok((b_u, b_phi))
-        });
-    let (b_u, b_phi) = agree(petsc, loads.map_err(DistributedError::from), "assemble their loads")?;
+    let (b_u, b_phi) = agree(petsc, loads(&disc, &setup, valid), "assemble their loads")?;
     let t_setup = start.elapsed().as_secs_f64();
     let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
@@ -240,6 +232,18 @@ pub fn solve_on_pieces(
         contact,
         report,
     })
+}
+
+/// The piece's load vectors, checked finite.
+fn loads(
+    disc: &fe_assembly::Discretization<'_>,
+    setup: &problem::backend::Setup,
+    valid: problem::Valid<'_>,
+) -> Result<(Vec<f64>, Vec<f64>), DistributedError> {
+    let (b_u, b_phi) = disc.rhs(&setup.loads)?;
+    ProblemError::check_finite(&b_u, "the mechanical load vector", &valid)?;
+    ProblemError::check_finite(&b_phi, "the electric load vector", &valid)?;
+    Ok((b_u, b_phi))
 }
 
 /// `result` where every rank has one; where some rank has an error, an error on every rank
