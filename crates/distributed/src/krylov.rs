@@ -250,7 +250,7 @@ impl linalg::CoupledSolver for Krylov<'_> {
 pub const PIECES_ELASTIC_BLOCK: &str = "-fieldsplit_u_pc_type hypre -fieldsplit_u_pc_hypre_boomeramg_coarsen_type HMIS -fieldsplit_u_pc_hypre_boomeramg_interp_type ext+i -fieldsplit_u_pc_hypre_boomeramg_P_max 4 -fieldsplit_u_pc_hypre_boomeramg_strong_threshold 0.5";
 
 /// Puts the backend's options, then the scene's, into PETSc's database; returns them as one
-/// string. `pieces`: a run on pieces ([`PIECES_ELASTIC_BLOCK`]). Collective.
+/// string. `pieces`: a run on pieces ([`PIECES_ELASTIC_BLOCK`]).
 pub(crate) fn configure(
     petsc: &Petsc,
     scene: &Scene,
@@ -258,9 +258,7 @@ pub(crate) fn configure(
     contact_tol: Option<f64>,
     pieces: bool,
 ) -> Result<String, PetscError> {
-    // (agreed over the ranks: a piece may hold no electric cell where another does)
-    let here = f64::from(u8::from(layout.has_phi.iter().any(|&p| p)));
-    let mut all = if petsc.max(&[here])?[0] > 0.0 {
+    let mut all = if layout.coupled {
         let mut o = COUPLED_OPTIONS.to_owned();
         if !petsc.has_package("hypre")? {
             o = o.replace("-fieldsplit_phi_pc_type hypre", "-fieldsplit_phi_pc_type gamg");
@@ -303,10 +301,8 @@ pub(crate) struct KrylovFields {
 }
 
 impl KrylovFields {
-    /// The fields of this rank's rows. Whether the system is coupled (has potentials) is
-    /// agreed over the ranks: on pieces a rank may hold no electric cell where another does,
-    /// and every rank must build the same preconditioner. Collective.
-    pub(crate) fn new(petsc: &Petsc, setup: &Setup, layout: &Layout) -> Result<Self, PetscError> {
+    /// The fields of this rank's rows; coupled where the layout is (agreed over the ranks).
+    pub(crate) fn new(petsc: &Petsc, setup: &Setup, layout: &Layout) -> Self {
         let dim = layout.dim;
         let (mut u_rows, mut phi_rows, mut coords) = (vec![], vec![], vec![]);
         for v in layout.owned_nodes(petsc.rank()) {
@@ -317,14 +313,13 @@ impl KrylovFields {
                 phi_rows.push((f + dim) as Index);
             }
         }
-        let here = f64::from(u8::from(layout.has_phi.iter().any(|&p| p)));
-        Ok(KrylovFields {
+        KrylovFields {
             dim,
             u_rows,
             phi_rows,
             coords,
-            coupled: petsc.max(&[here])?[0] > 0.0,
-        })
+            coupled: layout.coupled,
+        }
     }
 
     /// The Krylov solver for `matrix`, configured from the options database, with the fields

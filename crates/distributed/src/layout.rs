@@ -19,6 +19,10 @@ pub struct Layout {
     pub first: Vec<usize>,
     /// Whether each node carries a potential.
     pub has_phi: Vec<bool>,
+    /// Whether the system has potentials at all: some node of some rank carries one (the same
+    /// on every rank, which must build the same solver; on pieces a rank may hold no electric
+    /// cell where another does).
+    pub coupled: bool,
     /// Each rank's first unknown, and one past the last rank's (`ranks + 1` entries).
     pub rank_start: Vec<usize>,
 }
@@ -59,6 +63,7 @@ impl Layout {
             cell_rank,
             node_rank,
             first,
+            coupled: has_phi.iter().any(|&p| p),
             has_phi,
             rank_start,
         })
@@ -106,11 +111,14 @@ impl Layout {
         for (&v, x) in others.iter().zip(directory.fetch(&asked)?) {
             first[v] = x as usize;
         }
+        let here = f64::from(u8::from(has_phi.iter().any(|&p| p)));
+        let coupled = petsc.max(&[here])?[0] > 0.0;
         Ok(Layout {
             dim,
             cell_rank: piece.cell_rank.clone(),
             node_rank: piece.node_rank.clone(),
             first,
+            coupled,
             has_phi,
             rank_start,
         })

@@ -405,7 +405,7 @@ impl<'p> Backend for DistributedMemory<'p> {
         }
         // (the paper's Uzawa on this route takes the same tolerance: its multipliers are
         // updated from the solves' displacements)
-        let fields = KrylovFields::new(self.petsc, posed.setup, &layout)?;
+        let fields = KrylovFields::new(self.petsc, posed.setup, &layout);
         let krylov = Krylov::new(self.petsc, posed.disc, &layout, system, fields);
         Ok(Prepared {
             route: Route::Krylov(Box::new(krylov)),

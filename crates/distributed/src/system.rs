@@ -206,9 +206,7 @@ fn preallocated<'p>(petsc: &'p Petsc, disc: &Discretization<'_>, layout: &Layout
             o_nnz[r - owned.start] = o;
         }
     }
-    // without potentials every node has `dim` unknowns: blocks for the multigrid (agreed over
-    // the ranks: a piece may hold no electric cell where another does)
-    let here = f64::from(u8::from(layout.has_phi.iter().any(|&p| p)));
-    let bs = if petsc.sum(&[here])?[0] > 0.0 { 1 } else { layout.dim };
+    // without potentials every node has `dim` unknowns: blocks for the multigrid
+    let bs = if layout.coupled { 1 } else { layout.dim };
     Matrix::aij_blocked(petsc, owned.len(), layout.n_global(), bs, &d_nnz, &o_nnz)
 }

@@ -13,10 +13,10 @@ use rayon::prelude::*;
 
 /// A facet (or a cell) as its sorted corners (unused slots `usize::MAX`), so equal facets
 /// compare equal: the corners are the first nodes of a quadratic facet, its midpoints follow.
-type Key = [usize; 4];
+pub(crate) type Key = [usize; 4];
 
 /// The key of the entity whose corners are `corners` (at most 4).
-fn key(corners: &[usize]) -> Key {
+pub(crate) fn key(corners: &[usize]) -> Key {
     let mut k = [usize::MAX; 4];
     k[..corners.len()].copy_from_slice(corners);
     k[..corners.len()].sort_unstable();

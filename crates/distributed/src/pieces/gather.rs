@@ -21,7 +21,8 @@ fn width(nt: usize) -> usize {
 }
 
 /// The status as a number, and back.
-fn status_code(s: Status) -> f64 {
+/// A status as a number (0 stick, 1 slip, 2 separated), to travel in a vector of `f64`.
+pub(super) fn status_code(s: Status) -> f64 {
     match s {
         Status::Stick => 0.0,
         Status::Slip => 1.0,
@@ -29,7 +30,8 @@ fn status_code(s: Status) -> f64 {
     }
 }
 
-fn status_of(x: f64) -> Status {
+/// The status of [`status_code`]'s number.
+pub(super) fn status_of(x: f64) -> Status {
     match x as u8 {
         0 => Status::Stick,
         1 => Status::Slip,

@@ -149,12 +149,12 @@ pub fn solve_on_pieces(
     let generated = matches!(source, PieceMesh::Generated);
     let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, source, limits, reporter)?;
     let disc = agree(petsc, setup.discretize().map_err(DistributedError::from), "discretise")?;
-    held_on_pieces(petsc, scene, &disc, &piece, generated)?;
+    held_on_pieces(petsc, &disc, &piece, generated)?;
     let (b_u, b_phi) = agree(petsc, loads(&disc, &setup, valid), "assemble their loads")?;
     let t_setup = start.elapsed().as_secs_f64();
     let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
-    let fields = KrylovFields::new(petsc, &setup, &layout)?;
+    let fields = KrylovFields::new(petsc, &setup, &layout);
     let t_assembly = start.elapsed().as_secs_f64() - t_setup;
     let (x, solved, contact) = match scene.zones().is_empty() {
         true => {
@@ -280,25 +280,21 @@ fn exact_heard(report: &problem::RunReport, reporter: &mut dyn Reporter) {
 /// mesh's check does (`fe_assembly::held`): a body in one connected part (a generated box, or
 /// a mesh read whose bodies are counted across the pieces, [`parts::bodies`]) has its rigid
 /// motions held when the Gram matrix of the conditions, summed over the ranks' own nodes
-/// (`fe_assembly::rigid_gram`), has full rank; its potential, where every cell is electric,
+/// (`fe_assembly::rigid_gram`, about the body's bounding box, [`parts::frame`]), has full
+/// rank; its potential, where every cell is electric,
 /// when some rank prescribes φ at a node it owns; in a body of electric and non-electric
 /// cells, each electric part's where some node of it has φ prescribed ([`parts::floating_parts`]).
 /// A mesh of several bodies is refused by key. Collective.
 fn held_on_pieces(
     petsc: &Petsc,
-    scene: &Scene,
     disc: &fe_assembly::Discretization<'_>,
     piece: &MeshPiece,
     generated: bool,
 ) -> Result<(), DistributedError> {
-    let (dim, m, rank) = (disc.dofs.dim, &scene.mesh, petsc.rank());
-    let (centre, size) = match generated {
-        true => (
-            std::array::from_fn(|k| if k < dim { 0.5 * (m.lo[k] + m.hi[k]) } else { 0.0 }),
-            (0..dim).map(|k| m.hi[k] - m.lo[k]).fold(0.0, f64::max),
-        ),
-        false => parts::frame(petsc, disc.mesh, piece)?,
-    };
+    let (dim, rank) = (disc.dofs.dim, petsc.rank());
+    // the frame of the motions: the whole body's bounding box, by reductions
+    let (centre, size) = parts::frame(petsc, disc.mesh, piece)?;
+    // (a generated box is one body)
     let bodies = if generated {
         1
     } else {
@@ -569,18 +565,14 @@ impl OnPiece<'_, '_> {
         }
         let all = ContactBoundary::of_groups_on_piece(self.disc, &self.scene.zones(), &in_own_cells)?;
         let nt = own.points.n_tangential();
-        // per node: status (1 stick, 2 slip, 3 separated), λ_n, u_n, λ_t, u_t
+        // per node: 1 + its status's code (0: no point written), λ_n, u_n, λ_t, u_t
         let width = 3 + 2 * nt;
         let (lo, hi) = petsc.split(width * self.piece.n_global_nodes);
         let mut directory = Vector::mpi(petsc, hi - lo)?;
         let (mut at, mut values) = (vec![], vec![]);
         for (i, &v) in own.nodes.iter().enumerate() {
             let first = width * self.piece.global_node[v];
-            let status = match sol.status[i] {
-                contact::Status::Stick => 1.0,
-                contact::Status::Slip => 2.0,
-                contact::Status::Separated => 3.0,
-            };
+            let status = 1.0 + gather::status_code(sol.status[i]);
             // (frictionless: no tangential multipliers)
             let lt = sol
                 .lambda
@@ -610,9 +602,8 @@ impl OnPiece<'_, '_> {
         let mut status = Vec::with_capacity(n);
         for (i, row) in rows.chunks_exact(width).enumerate() {
             status.push(match row[0] {
-                1.0 => contact::Status::Stick,
-                2.0 => contact::Status::Slip,
-                _ => contact::Status::Separated,
+                0.0 => contact::Status::Separated,
+                x => gather::status_of(x - 1.0),
             });
             (lambda.normal[i], u.normal[i]) = (row[1], row[2]);
             lambda.tangential[i * nt..(i + 1) * nt].copy_from_slice(&row[3..3 + nt]);

@@ -17,6 +17,7 @@
 
 use super::sections::{self, File};
 use super::{build, cell_blocks, cell_dim, flatten_2d, groups_of, partitions_held};
+use crate::topology::{key, Key};
 use crate::{CellKind, FacetGroup, Mesh, MeshError, MeshPiece};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -184,28 +185,16 @@ fn names_of(file: &File, d: i32) -> Result<Vec<String>, String> {
     Ok(names)
 }
 
-/// The corners of face `k` of a cell of `kind` (its corners `c`): a tetrahedron's face
-/// opposite corner `k`, a triangle's edge opposite corner `k`, a quadrilateral's edge from
-/// corner `k` to the next; `None` past the cell's faces.
+/// The corners of face `k` of a cell of `kind` (its nodes `c`), in the order of
+/// [`CellKind::facets`]; `None` past the cell's faces.
 fn face(kind: CellKind, c: &[usize], k: usize) -> Option<Vec<usize>> {
-    match kind {
-        CellKind::Tet4 if k < 4 => Some((0..4).filter(|&j| j != k).map(|j| c[j]).collect()),
-        CellKind::Tri3 if k < 3 => Some((0..3).filter(|&j| j != k).map(|j| c[j]).collect()),
-        CellKind::Quad4 if k < 4 => Some(vec![c[k], c[(k + 1) % 4]]),
-        _ => None,
-    }
+    let f = kind.facets().get(k)?;
+    Some(f[..kind.facet_corners()].iter().map(|&i| c[i]).collect())
 }
 
 /// `x` as the integer it holds (exact in `f64`), where it is one.
 fn as_bits(x: f64) -> Option<u64> {
     (x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53)).then_some(x as u64)
-}
-
-/// The corners of a face, sorted: the key that finds it whatever its order.
-fn key(corners: &[usize]) -> Vec<usize> {
-    let mut k = corners.to_vec();
-    k.sort_unstable();
-    k
 }
 
 impl MshPart {
@@ -228,7 +217,7 @@ impl MshPart {
             .map(|c| (self.slot(c, 0), (1 + 2 * region_bits[c]) as f64))
             .collect();
         // the cells on each face (two on an interior facet)
-        let mut faces: HashMap<Vec<usize>, Vec<(usize, usize)>> = HashMap::new();
+        let mut faces: HashMap<Key, Vec<(usize, usize)>> = HashMap::new();
         for c in 0..m.n_cells() {
             for k in 0.. {
                 let Some(f) = face(m.kind, m.cell(c), k) else { break };
@@ -319,7 +308,7 @@ impl MshPart {
             })
             .collect();
         let per = kind.n_nodes();
-        let mut seen: std::collections::HashSet<(Vec<usize>, usize)> = std::collections::HashSet::new();
+        let mut seen: std::collections::HashSet<(Key, usize)> = std::collections::HashSet::new();
         for c in 0..n_cells {
             let row = &rows[SLOTS * c..SLOTS * (c + 1)];
             let bits = self.regions_of(c, row[0])?;
