@@ -251,16 +251,28 @@ fn loads(
 /// no rank goes on to a collective call the failed ones never make (a broken cell of one
 /// Gmsh part, a cell of one piece without material). Collective.
 fn agree<T>(petsc: &Petsc, result: Result<T, DistributedError>, doing: &str) -> Result<T, DistributedError> {
+    agree_as(petsc, result, doing, |why| {
+        ProblemError::NoSolution {
+            sought: "a run on pieces",
+            why,
+        }
+        .into()
+    })
+}
+
+/// [`agree`], the other ranks' error made by `others` from what it says.
+fn agree_as<T>(
+    petsc: &Petsc,
+    result: Result<T, DistributedError>,
+    doing: &str,
+    others: impl FnOnce(String) -> DistributedError,
+) -> Result<T, DistributedError> {
     let failed = petsc.sum(&[f64::from(u8::from(result.is_err()))])?[0];
     match result {
-        Ok(_) if failed > 0.0 => Err(ProblemError::NoSolution {
-            sought: "a run on pieces",
-            why: format!(
-                "{failed} of the {} ranks could not {doing} (each says why)",
-                petsc.size()
-            ),
-        }
-        .into()),
+        Ok(_) if failed > 0.0 => Err(others(format!(
+            "{failed} of the {} ranks could not {doing} (each says why)",
+            petsc.size()
+        ))),
         other => other,
     }
 }

@@ -54,17 +54,14 @@ pub(super) fn read(petsc: &Petsc, parts: &[PathBuf], limits: problem::Limits) ->
 }
 
 /// `result` where every rank has one; where some rank has an error, an error on every rank
-/// (the rank's own, or one naming the ranks that failed). Collective.
+/// (the rank's own, or one of the mesh's file saying how many ranks failed). Collective.
 fn agreed<T>(petsc: &Petsc, result: Result<T, ProblemError>) -> Result<T, DistributedError> {
-    let failed = petsc.sum(&[f64::from(u8::from(result.is_err()))])?[0];
-    match result {
-        Err(e) => Err(e.into()),
-        Ok(_) if failed > 0.0 => Err(mesh_file(format!(
-            "{failed} of the {} ranks could not read their part of the mesh (each says why)",
-            petsc.size()
-        ))),
-        Ok(t) => Ok(t),
-    }
+    super::agree_as(
+        petsc,
+        result.map_err(DistributedError::from),
+        "read their part of the mesh",
+        mesh_file,
+    )
 }
 
 /// Refuses parts that name different regions or facet groups (not parts of one mesh), by a
@@ -104,8 +101,7 @@ pub(super) fn check_memory(petsc: &Petsc, m: &mesh::Mesh, limits: problem::Limit
 
 /// The piece of `part`, completed through the table every part writes into. Collective.
 fn complete(petsc: &Petsc, part: MshPart) -> Result<MeshPiece, DistributedError> {
-    let records = part.records().map_err(ProblemError::from)?;
-    let records = agreed(petsc, Ok(records))?;
+    let records = agreed(petsc, part.records().map_err(ProblemError::from))?;
     let top_cell = part.cell_tag.iter().max().copied().unwrap_or(0) as f64;
     let top_node = part.node_tag.iter().max().copied().unwrap_or(0) as f64;
     let tops = petsc.max(&[top_cell, top_node])?;
