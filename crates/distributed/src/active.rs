@@ -65,11 +65,19 @@ pub(crate) fn solve<'p>(
     let mut solve_one = |m: &mut petsc::Matrix<'p>, b: &Vector<'p>, x: &mut Vector<'p>, loose: Option<f64>| {
         step(petsc, fields, t_pc, (m, b, x), loose)
     };
-    let out =
-        active_set(petsc, layout, &k.system, &rows, params, &mut solve_one, &mut progress).map_err(|e| match e {
-            ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
-            other => DistributedError::Contact(other),
-        })?;
+    let out = active_set(
+        petsc,
+        layout,
+        &k.system,
+        (&rows, None),
+        params,
+        &mut solve_one,
+        &mut progress,
+    )
+    .map_err(|e| match e {
+        ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+        other => DistributedError::Contact(other),
+    })?;
     (k.iterations, k.reason) = (out.krylov_iterations, out.reason);
     k.report(reporter);
     active.x = Some(out.x);
@@ -91,6 +99,10 @@ pub(crate) fn step<'p>(
     let t = std::time::Instant::now();
     let mut ksp = fields.krylov(petsc, m)?;
     *t_pc += t.elapsed().as_secs_f64();
+    // the start is the iterate before, whose residual may be many times the right-hand
+    // side's norm (a path's instant unloaded to nothing from a loaded one): PETSc's test of
+    // divergence against that norm would stop the solve before its first iteration
+    ksp.set_divergence_tolerance(f64::MAX)?;
     let tight = ksp.relative_tolerance()?;
     let loosened = loose.filter(|&r| r > tight);
     if let Some(rtol) = loosened {

@@ -22,6 +22,11 @@
 //! converges in a few steps; for Coulomb the bound follows `z_n` (as in Hüeber, Stadler and
 //! Wohlmuth), the slip direction is the last iterate's.
 //!
+//! On a load path friction remembers: `u_t` above is the increment since the instant before
+//! (`ContactRows::with_history`), a sticking point is held where it was, and the solution's
+//! `u_t` is the total again (backward Euler of the quasi-static law, as the default backend's
+//! path solves it).
+//!
 //! The normal must be a coordinate axis (the held components are then unknowns of the
 //! system; the scene's validation says so).
 
@@ -64,6 +69,14 @@ pub struct ContactRows {
     /// mean diagonal of `A` over the mean weight of all the ranks' points) to begin with,
     /// divided by 10 where the sets cycle.
     c: f64,
+    /// Friction's memory on a load path: the tangential displacement of each of this rank's
+    /// points at the instant before (zero for a static run). The sets judge, hold and slip
+    /// the increment `u_t - shift` (backward Euler of the quasi-static law, as the default
+    /// backend's path does).
+    shift: PointValues,
+    /// The multipliers the iteration starts from at this rank's points (a path's instant
+    /// before; `None`: zero, the loads alone judge the first sets).
+    start: Option<PointValues>,
 }
 
 /// One step's sets: per point, whether it is in contact, and whether held tangentially; and
@@ -114,6 +127,8 @@ impl ContactRows {
         let sums = petsc.sum(&[own.weight.iter().sum::<f64>(), own.len() as f64, points.len() as f64])?;
         let mean_w = sums[0] / sums[1].max(1.0);
         Ok(ContactRows {
+            shift: PointValues::zeros(own.len(), own.n_tangential()),
+            start: None,
             nodes: mine.iter().map(|&i| nodes[i]).collect(),
             points: own,
             law: law.select(&mine),
@@ -122,6 +137,27 @@ impl ContactRows {
             rank: petsc.rank(),
             c: C_START * system.diagonal[0] / mean_w,
         })
+    }
+
+    /// The rows of an instant of a load path: `shift` the tangential displacement of this
+    /// rank's points (in their order) at the instant before, friction's frame; `start` the
+    /// multipliers to begin with (the iteration's first sets, and its residual's scale).
+    ///
+    /// # Panics
+    /// Where `shift` or `start` is not at this rank's points (a caller's bug).
+    #[must_use]
+    pub fn with_history(mut self, shift: PointValues, start: Option<PointValues>) -> Self {
+        let (n, nt) = (self.points.len(), self.points.n_tangential());
+        assert!(
+            shift.normal.len() == n && shift.tangential.len() == n * nt,
+            "the history is at this rank's points"
+        );
+        assert!(start
+            .as_ref()
+            .is_none_or(|s| s.normal.len() == n && s.tangential.len() == n * nt));
+        self.shift = shift;
+        self.start = start;
+        self
     }
 
     /// A solution at this rank's points spread into the whole boundary's, on every rank (the
@@ -201,33 +237,47 @@ enum Ended {
     Cycled(f64),
 }
 
-/// Solves the contact problem by active sets. `solve` solves one linear system. Where the
-/// sets cycle or the residual stops falling, `c` is divided by 10 and the steps go on from
+/// Solves the contact problem by active sets. `solve` solves one linear system. The first
+/// iterate is `warm` where given (a path's instant before: its solution vector, with the
+/// multipliers of [`ContactRows::with_history`]), else the solution of the loads alone. Where
+/// the sets cycle or the residual stops falling, `c` is divided by 10 and the steps go on from
 /// the iterate (at most [`MAX_REDUCTIONS`] times). Collective.
 #[allow(clippy::too_many_arguments)]
 pub fn active_set<'p>(
     petsc: &'p Petsc,
     layout: &Layout,
     system: &System<'p>,
-    rows: &ContactRows,
+    (rows, warm): (&ContactRows, Option<Vector<'p>>),
     params: ActiveSetParams,
     solve: &mut LinearSolve<'_, 'p>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<ContactOutcome<'p>, ActiveSetError> {
     let (p, law) = (&rows.points, &rows.law);
     let (n, nt) = (p.len(), p.n_tangential());
-    // the loads alone: the first iterate, and the residual's multiplier scale
-    let mut x = system.rhs.duplicate()?;
-    let mut k0 = system.matrix.duplicate()?;
-    let (krylov, reason, _) = solve(&mut k0, &system.rhs, &mut x, None)?;
-    drop(k0);
+    let (x, krylov, reason, reference) = match warm {
+        // a path's instant from the one before: its solution, its sets, and its multipliers'
+        // norm the residual's scale (an instant unloaded to nothing has round-off multipliers,
+        // which cannot scale their own residual)
+        Some(x) => {
+            let before = rows.start.as_ref().map_or(0.0, |l| l.weighted_norm(&p.weight));
+            (x, 0, String::new(), over_ranks(petsc, before)?)
+        }
+        None => {
+            // the loads alone: the first iterate, and the residual's multiplier scale
+            let mut x = system.rhs.duplicate()?;
+            let mut k0 = system.matrix.duplicate()?;
+            let (krylov, reason, _) = solve(&mut k0, &system.rhs, &mut x, None)?;
+            drop(k0);
+            let mut gap_u = displacements(petsc, layout, rows, &x)?;
+            for i in 0..n {
+                gap_u.normal[i] -= p.gap[i];
+            }
+            let reference = rows.c * over_ranks(petsc, gap_u.weighted_norm(&p.weight))?;
+            (x, krylov, reason, reference)
+        }
+    };
     let u = displacements(petsc, layout, rows, &x)?;
-    let mut gap_u = u.clone();
-    for i in 0..n {
-        gap_u.normal[i] -= p.gap[i];
-    }
-    let reference = rows.c * over_ranks(petsc, gap_u.weighted_norm(&p.weight))?;
-    let lambda = PointValues::zeros(n, nt);
+    let lambda = rows.start.clone().unwrap_or_else(|| PointValues::zeros(n, nt));
     let last_residual = residual(petsc, rows, law, (&lambda, &u), reference)?;
     let mut it = Iterate {
         lambda,
@@ -383,6 +433,11 @@ impl<'p> Context<'_, 'p> {
     fn outcome(&self, it: Iterate<'p>, law: &Law) -> Result<ContactOutcome<'p>, PetscError> {
         let residual = self.residual(&it, law)?;
         let status = classify(&it.lambda, &bound(&self.rows.points, law, &it.lambda.normal));
+        // the iterate's tangential displacements are the increments since the instant before
+        let mut u = it.u;
+        for (v, s) in u.tangential.iter_mut().zip(&self.rows.shift.tangential) {
+            *v += s;
+        }
         let info = ContactInfo {
             newton_iters: it.steps,
             operator_calls: it.steps + 1,
@@ -394,7 +449,7 @@ impl<'p> Context<'_, 'p> {
         Ok(ContactOutcome {
             solution: ContactSolution {
                 lambda: it.lambda,
-                u: it.u,
+                u,
                 status,
                 info,
                 electric: None,
@@ -456,8 +511,11 @@ fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) ->
             continue;
         }
         // Coulomb's bound at a point without a normal multiplier yet (the first step) would
-        // judge its slip by the loads alone: the point is held, and its reaction judges it
-        if matches!(law, Law::Coulomb) && lambda.normal[i] == 0.0 && s > 0.0 {
+        // judge its slip by the loads alone: the point is held, and its reaction judges it.
+        // Not on a path's later instant, which starts from the instant before: a point without
+        // one there came into contact during the instant, and held where it was then it jumps
+        // back; the sets alternated so where points slipped back
+        if matches!(law, Law::Coulomb) && rows.start.is_none() && lambda.normal[i] == 0.0 && s > 0.0 {
             stick[i] = true;
             continue;
         }
@@ -480,11 +538,13 @@ fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) ->
 }
 
 /// Applies the step's conditions to this rank's points: returns the held components as
-/// `(row, value)` (`u_n = g` where active, `u_t = 0` where sticking), and writes the slipping
-/// points' tangential rows as Newton's linearisation of `λ_t = S z_t / |z_t|` at the iterate,
+/// `(row, value)` (`u_n = g` where active, `u_t = s` where sticking, `s` the shift: the
+/// tangential displacement at a path's instant before, zero in a static run), and writes the
+/// slipping points' tangential rows as Newton's linearisation of `λ_t = S z_t / |z_t|` at the
+/// iterate (`z_t = λ_t + c (u_t - s)`),
 ///
 /// ```text
-/// λ_t = S d + β P u_t,   P = I - d dᵀ,   β = c κ / (1 - κ),   κ = S / |z_t|
+/// λ_t = S d + β P (u_t - s),   P = I - d dᵀ,   β = c κ / (1 - κ),   κ = S / |z_t|
 /// ```
 ///
 /// (a spring across the slip direction, zero in 2D): Tresca's `S d` as a load (`-w λ_t t`);
@@ -520,8 +580,13 @@ fn hold(
         // a tangent a support holds (a roller through the contact face) is its prescribed
         // unknown already: the contact conditions are the free tangents'
         let free: Vec<usize> = (0..nt).filter(|&q| !p.is_held(i, q)).collect();
+        // (on a path, a sticking point is held where it was at the instant before)
+        let shift = rows.shift.tangential_of(i);
         if sets.stick[i] {
-            held.extend(free.iter().map(|&q| ((first + kt[q]) as Index, 0.0)));
+            held.extend(
+                free.iter()
+                    .map(|&q| ((first + kt[q]) as Index, shift[q] * p.tangent[i][q][kt[q]])),
+            );
             continue;
         }
         let d = &direction.tangential[i * nt..(i + 1) * nt];
@@ -539,10 +604,18 @@ fn hold(
             let rt = (first + kt[q]) as Index;
             let (cols, mut vals) = matrix.row(rt)?;
             let sign_t = p.tangent[i][q][kt[q]];
+            // the spring acts on the increment: `w β P (u_t - shift)`, its shift a load
+            let spring: f64 = free
+                .iter()
+                .map(|&q2| (f64::from(u8::from(q == q2)) - d[q] * d[q2]) * shift[q2])
+                .sum::<f64>()
+                * w
+                * beta
+                * sign_t;
             match (law, &normal_row) {
                 (Law::Tresca(s), _) => {
                     idx.push(rt);
-                    forces.push(-w * s[i] * d[q] * sign_t);
+                    forces.push(-w * s[i] * d[q] * sign_t + spring);
                 }
                 (_, Some((cols_n, vn))) => {
                     debug_assert_eq!(&cols, cols_n, "a node's rows share their columns");
@@ -551,7 +624,7 @@ fn hold(
                         *v -= alpha * n;
                     }
                     idx.push(rt);
-                    forces.push(-alpha * b_local[first + kn - start]);
+                    forces.push(-alpha * b_local[first + kn - start] + spring);
                 }
                 _ => {}
             }
@@ -595,7 +668,8 @@ fn set_held_values(
     })
 }
 
-/// `u_n` and `u_t` at this rank's points.
+/// `u_n` and `u_t - shift` at this rank's points (the tangential increment since a path's
+/// instant before; a static run's shift is zero).
 fn displacements(
     petsc: &Petsc,
     layout: &Layout,
@@ -612,7 +686,7 @@ fn displacements(
         let ui: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
         u.normal[i] = dot(&ui, &p.normal[i], dim);
         for q in 0..nt {
-            u.tangential[i * nt + q] = dot(&ui, &p.tangent[i][q], dim);
+            u.tangential[i * nt + q] = dot(&ui, &p.tangent[i][q], dim) - rows.shift.tangential[i * nt + q];
         }
     }
     Ok(u)

@@ -68,7 +68,10 @@ pub use krylov::{COUPLED_OPTIONS, ELASTIC_OPTIONS, PIECES_ELASTIC_BLOCK};
 #[cfg(feature = "petsc")]
 pub use layout::Layout;
 #[cfg(feature = "petsc")]
-pub use pieces::{pieces_support, solve_on_pieces, Gathered, PieceContact, PieceMesh, PieceSolution};
+pub use pieces::{
+    pieces_support, solve_on_pieces, solve_path_on_pieces, EachStep, Gathered, PieceContact, PieceFrame, PieceMesh,
+    PieceSolution, PieceStep,
+};
 #[cfg(feature = "petsc")]
 pub use run::{
     solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared, ACTIVE_SETS_FROM,

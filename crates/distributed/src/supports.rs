@@ -88,6 +88,18 @@ pub fn active_sets_hold(scene: &Scene) -> Result<(), Unsupported> {
 /// # Errors
 /// [`Unsupported`] naming the key.
 pub fn active_sets_hold_on(scene: &Scene, mesh: Option<&mesh::Mesh>) -> Result<(), Unsupported> {
+    if scene.path.is_some() {
+        return not_held("path", "a load path");
+    }
+    active_sets_hold_at_instants(scene, mesh)
+}
+
+/// [`active_sets_hold_on`] at each instant of a load path, friction's history carried from
+/// one to the next (as a run on pieces walks a path; the whole mesh's route does not).
+///
+/// # Errors
+/// [`Unsupported`] naming the key.
+pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Mesh>) -> Result<(), Unsupported> {
     if scene.mesh.order.unwrap_or(1) > 1 || mesh.is_some_and(|m| m.kind.order() > 1) {
         return not_held("mesh.order", "quadratic elements (a modified basis' contact points)");
     }
@@ -100,9 +112,6 @@ pub fn active_sets_hold_on(scene: &Scene, mesh: Option<&mesh::Mesh>) -> Result<(
     }
     if let Some(key) = scene.floating_key() {
         return not_held(key, "a floating terminal");
-    }
-    if scene.path.is_some() {
-        return not_held("path", "a load path");
     }
     if scene.solver.strategy != Strategy::NewtonCondensed {
         return not_held("solver.strategy", "a strategy other than Newton's");

@@ -31,6 +31,22 @@ pub struct System<'p> {
 }
 
 impl<'p> System<'p> {
+    /// The right-hand side of other loads on the same matrix: `b_u`, `b_phi` over the free
+    /// unknowns (prescribed values already lifted), the prescribed rows the diagonal times
+    /// `disc`'s values (a load path's instant: its parts summed, its prescribed values
+    /// scaled). Collective.
+    pub fn set_loads(
+        &mut self,
+        petsc: &'p Petsc,
+        disc: &Discretization<'_>,
+        layout: &Layout,
+        (b_u, b_phi): (&[f64], &[f64]),
+    ) -> Result<(), PetscError> {
+        let rows = Rows::of(petsc, disc, layout, (b_u, b_phi), self.diagonal)?;
+        (self.rhs, self.load_norm) = (rows.rhs, rows.load_norm);
+        Ok(())
+    }
+
     /// `K x - b`: the forces that balance the loads at `x` (at a contact point, the contact
     /// force on the body; elsewhere the equilibrium residual). Collective.
     pub fn reactions(&self, x: &Vector<'p>) -> Result<Vector<'p>, PetscError> {
@@ -51,7 +67,6 @@ pub fn assemble<'p>(
     b_phi: &[f64],
 ) -> Result<System<'p>, PetscError> {
     let rank = petsc.rank();
-    let owned = layout.owned(rank);
     let mut matrix = preallocated(petsc, disc, layout)?;
     let mut diagonal = [0.0, 0.0]; // sums of A's and B's diagonal entries over this rank's cells
     let mut counts = [0.0, 0.0];
@@ -75,49 +90,80 @@ pub fn assemble<'p>(
         if sums[2] > 0.0 { sums[0] / sums[2] } else { 1.0 },
         if sums[3] > 0.0 { sums[1] / sums[3] } else { 1.0 },
     ];
-    let d = &disc.dofs;
-    let (mut fixed_u, mut fixed_phi): (Vec<Index>, Vec<Index>) = (vec![], vec![]);
-    let mut values = vec![0.0; owned.len()];
-    let mut load_sq = 0.0;
-    for v in layout.owned_nodes(rank) {
-        let f = layout.first[v];
-        for k in 0..layout.dim {
-            values[f + k - owned.start] = match d.u[v * layout.dim + k] {
-                Dof::Free(j) => {
-                    load_sq += b_u[j] * b_u[j];
-                    b_u[j]
-                }
-                Dof::Fixed(x) => {
-                    fixed_u.push(Layout::index(f + k));
-                    scale[0] * x
-                }
-                Dof::Absent => 0.0,
-            };
-        }
-        if layout.has_phi[v] {
-            let row = f + layout.dim;
-            values[row - owned.start] = match d.phi[v] {
-                Dof::Free(j) => {
-                    load_sq += b_phi[j] * b_phi[j];
-                    -b_phi[j]
-                }
-                Dof::Fixed(x) => {
-                    fixed_phi.push(Layout::index(row));
-                    scale[1] * x
-                }
-                Dof::Absent => 0.0,
-            };
-        }
-    }
-    eliminate(petsc, &mut matrix, layout, [&fixed_u, &fixed_phi], scale)?;
-    let rhs = Vector::from_local(petsc, &values)?;
-    let load_norm = petsc.sum(&[load_sq])?[0].sqrt();
+    let rows = Rows::of(petsc, disc, layout, (b_u, b_phi), scale)?;
+    eliminate(petsc, &mut matrix, layout, [&rows.fixed_u, &rows.fixed_phi], scale)?;
+    let (rhs, load_norm) = (rows.rhs, rows.load_norm);
     Ok(System {
         matrix,
         rhs,
         load_norm,
         diagonal: scale,
     })
+}
+
+/// This rank's rows of the right-hand side, and its prescribed rows.
+struct Rows<'p> {
+    rhs: Vector<'p>,
+    load_norm: f64,
+    fixed_u: Vec<Index>,
+    fixed_phi: Vec<Index>,
+}
+
+impl<'p> Rows<'p> {
+    /// The loads `b_u`, `b_phi` at this rank's free rows (the potential's negated), the
+    /// prescribed rows `scale` (the field's diagonal) times their values. Collective.
+    fn of(
+        petsc: &'p Petsc,
+        disc: &Discretization<'_>,
+        layout: &Layout,
+        (b_u, b_phi): (&[f64], &[f64]),
+        scale: [f64; 2],
+    ) -> Result<Self, PetscError> {
+        let rank = petsc.rank();
+        let owned = layout.owned(rank);
+        let d = &disc.dofs;
+        let (mut fixed_u, mut fixed_phi): (Vec<Index>, Vec<Index>) = (vec![], vec![]);
+        let mut values = vec![0.0; owned.len()];
+        let mut load_sq = 0.0;
+        for v in layout.owned_nodes(rank) {
+            let f = layout.first[v];
+            for k in 0..layout.dim {
+                values[f + k - owned.start] = match d.u[v * layout.dim + k] {
+                    Dof::Free(j) => {
+                        load_sq += b_u[j] * b_u[j];
+                        b_u[j]
+                    }
+                    Dof::Fixed(x) => {
+                        fixed_u.push(Layout::index(f + k));
+                        scale[0] * x
+                    }
+                    Dof::Absent => 0.0,
+                };
+            }
+            if layout.has_phi[v] {
+                let row = f + layout.dim;
+                values[row - owned.start] = match d.phi[v] {
+                    Dof::Free(j) => {
+                        load_sq += b_phi[j] * b_phi[j];
+                        -b_phi[j]
+                    }
+                    Dof::Fixed(x) => {
+                        fixed_phi.push(Layout::index(row));
+                        scale[1] * x
+                    }
+                    Dof::Absent => 0.0,
+                };
+            }
+        }
+        let rhs = Vector::from_local(petsc, &values)?;
+        let load_norm = petsc.sum(&[load_sq])?[0].sqrt();
+        Ok(Rows {
+            rhs,
+            load_norm,
+            fixed_u,
+            fixed_phi,
+        })
+    }
 }
 
 /// Zeroes the prescribed rows and columns (`fixed`: the displacements', the potentials'),

@@ -521,13 +521,13 @@ fn run(
             .iter()
             .map(|o| o.name().to_string())
             .collect();
-        if let Some(n) = solution
+        let on_pieces = solution
             .report
             .petsc
             .as_ref()
             .filter(|p| p.pieces.is_some())
-            .map(|p| p.ranks)
-        {
+            .map(|p| p.ranks);
+        if let Some(n) = on_pieces {
             // no rank held the whole mesh: the solution is in pieces
             let pieces = match n {
                 1 => "solution-0.vtu".to_string(),
@@ -541,10 +541,12 @@ fn run(
             // the instants whose step file was written: every output_every-th and the last
             let n = path.instants;
             let written: Vec<usize> = (0..n).filter(|&k| spec.has_fields(k, n)).collect();
+            // (on pieces each instant is a `.pvtu` with one piece per rank)
+            let ext = if on_pieces.is_some() { "pvtu" } else { "vtu" };
             let steps = match written[..] {
-                [only] => format!("step-{only:04}.vtu"),
+                [only] => format!("step-{only:04}.{ext}"),
                 [first, .., last] => format!(
-                    "{} step files, step-{first:04}.vtu ... step-{last:04}.vtu",
+                    "{} step files, step-{first:04}.{ext} ... step-{last:04}.{ext}",
                     written.len()
                 ),
                 [] => "no step file".into(),

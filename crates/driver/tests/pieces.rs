@@ -328,6 +328,140 @@ fn contact_on_pieces_agrees_with_the_whole_mesh_on_four_ranks() {
     );
 }
 
+/// Load paths that the active sets walk on pieces: Coulomb's friction loaded, unloaded (its
+/// points slipping back) and loaded again in 3D, in 2D (the shipped cycle, shortened), Tresca's
+/// and an indenter pressed in (the gap's factor).
+const PATH_CASES: &[(&str, &[&str])] = &[
+    (
+        "paper-3d",
+        &[
+            "mesh.n=6",
+            "contact.friction=0.05",
+            "path.t=[0.0,1.0,2.0,3.0]",
+            "path.load=[0.0,1.0,0.3,1.0]",
+            "path.steps=6",
+        ],
+    ),
+    ("paper-cycle", &["mesh.n=32", "path.steps=9"]),
+    (
+        "paper-tresca",
+        &[
+            "mesh.n=32",
+            "path.t=[0.0,1.0,2.0]",
+            "path.load=[0.0,1.0,0.2]",
+            "path.steps=4",
+        ],
+    ),
+    (
+        "indent-sphere-3d",
+        &["mesh.n=8", "path.t=[0.0,1.0]", "path.gap=[0.0,1.0]", "path.steps=3"],
+    ),
+];
+
+/// The path cases on pieces against the default backend's path on the whole mesh: every
+/// instant's row (forces, counts, slips, an indenter's depth and radius, the terminals'
+/// charges), the written instants handed on with their fields, and the last instant's nodal
+/// solution.
+fn paths_on_pieces(p: &Petsc) {
+    for (name, sets) in PATH_CASES {
+        let (faer, scene) = both(name, sets);
+        let whole = problem::solve(&faer, None, &mut problem::Silent).expect("the whole mesh's run");
+        let mut frames = vec![];
+        let mut each = |step: distributed::PieceStep<'_>| {
+            if let Some(f) = &step.frame {
+                assert_eq!(f.u.len(), f.mesh.n_nodes());
+                frames.push(step.row.step);
+            }
+            Ok(())
+        };
+        let s = distributed::solve_path_on_pieces(
+            p,
+            &scene,
+            distributed::PieceMesh::Generated,
+            problem::Limits::default(),
+            &mut problem::Silent,
+            &mut each,
+        )
+        .unwrap_or_else(|e| panic!("{name} {sets:?} on pieces: {e}"));
+        let (a, b) = (
+            &s.report.path.as_ref().expect("the path's rows").rows,
+            &whole.report.path.as_ref().expect("the path's rows").rows,
+        );
+        assert_eq!(a.len(), b.len(), "{name}: instants");
+        let spec = scene.path.as_ref().expect("a path");
+        let written: Vec<usize> = (0..b.len()).filter(|&k| spec.has_fields(k, b.len())).collect();
+        assert_eq!(frames, written, "{name}: the instants handed on with their fields");
+        let close = |x: f64, y: f64, scale: f64| (x - y).abs() <= 1e-7 * scale.abs().max(1e-300);
+        let force = b.iter().fold(0.0f64, |m, r| m.max(r.normal_force.abs()));
+        for (x, y) in a.iter().zip(b) {
+            let k = y.step;
+            // (an instant unloaded to nothing: its statuses are round-off's, on both)
+            if y.normal_force.abs() > 1e-9 * force {
+                assert_eq!(
+                    (x.n_stick, x.n_slip, x.n_separated),
+                    (y.n_stick, y.n_slip, y.n_separated),
+                    "{name} step {k}"
+                );
+            }
+            assert!(
+                close(x.normal_force, y.normal_force, force),
+                "{name} step {k}: {x:?} {y:?}"
+            );
+            for (tx, ty) in x.tangential_resultant.iter().zip(&y.tangential_resultant) {
+                assert!(close(*tx, *ty, force), "{name} step {k}: tangential {tx} against {ty}");
+            }
+            // (slips against the body's displacements: where all stick they are round-off)
+            let moved = whole.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+            let slip = b.iter().fold(moved, |m, r| m.max(r.max_slip));
+            assert!(close(x.max_slip, y.max_slip, slip), "{name} step {k}: slip {x:?} {y:?}");
+            assert!(
+                close(x.max_slip_increment, y.max_slip_increment, slip),
+                "{name} step {k}"
+            );
+            assert_eq!(x.depth.is_some(), y.depth.is_some(), "{name} step {k}");
+            if let (Some(dx), Some(dy)) = (x.depth, y.depth) {
+                assert!(close(dx, dy, dy), "{name} step {k}: depth {dx} against {dy}");
+                assert_eq!(x.contact_radius, y.contact_radius, "{name} step {k}");
+            }
+            assert_eq!(x.charges.len(), y.charges.len(), "{name}");
+            // (charges of round-off, an insulating indenter's grounded base at 1e-14 where the
+            // paper's terminals carry 3e-4: against a floor of 1e-12 in the scenes' units)
+            let q = b.iter().flat_map(|r| &r.charges).fold(1e-6f64, |m, c| m.max(c.abs()));
+            for (cx, cy) in x.charges.iter().zip(&y.charges) {
+                assert!((cx - cy).abs() <= 1e-6 * q, "{name} step {k}: charge {cx} against {cy}");
+            }
+            assert!(x.complementarity <= scene.solver.tol, "{name} step {k}");
+        }
+        let flat = |u: &[[f64; 3]]| u.iter().flat_map(|x| x.iter().copied()).collect::<Vec<f64>>();
+        let du = farthest(&flat(&whole.u), &flat(&s.u), &s.piece.global_node, 3, |_| true);
+        eprintln!(
+            "{name} {sets:?} rank {}/{}: {} instants, last u {du:.1e}",
+            p.rank(),
+            p.size(),
+            a.len()
+        );
+        assert!(du < 1e-7, "{name} {sets:?}: the last instant's u differs by {du:.2e}");
+    }
+}
+
+#[test]
+fn paths_on_pieces_agree_with_the_whole_mesh_on_one_rank() {
+    on_ranks(
+        "paths_on_pieces_agree_with_the_whole_mesh_on_one_rank",
+        1,
+        paths_on_pieces,
+    );
+}
+
+#[test]
+fn paths_on_pieces_agree_with_the_whole_mesh_on_two_ranks() {
+    on_ranks(
+        "paths_on_pieces_agree_with_the_whole_mesh_on_two_ranks",
+        2,
+        paths_on_pieces,
+    );
+}
+
 #[test]
 fn pieces_agree_with_the_whole_mesh_on_one_rank() {
     on_ranks("pieces_agree_with_the_whole_mesh_on_one_rank", 1, agree_on_pieces);
@@ -361,8 +495,8 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
                 Err(e) => e.to_string(),
             }
         };
-        let e = refused("paper-cycle", &["mesh.n=8"]);
-        assert!(e.contains("path") && e.contains("pieces"), "{e}");
+        let e = refused("paper-slip-weakening", &["mesh.n=8"]);
+        assert!(e.contains("contact.friction_law") && e.contains("pieces"), "{e}");
         let e = refused("hertz", &["mesh.n=8"]);
         assert!(e.contains("exact.kind") && e.contains("pieces"), "{e}");
         // a body its conditions do not hold: refused as the whole mesh's check refuses it, by
@@ -727,6 +861,140 @@ friction = 0.3
 gap = 0.0
 normal = [0.0, 0.0, -1.0]
 "#;
+
+/// A load path on a Gmsh mesh in three parts, from the command line: loaded, unloaded and
+/// loaded again on the Coulomb foundation, each rank reading its part. Every instant the path
+/// writes is a `step-NNNN.pvtu` with one piece per rank (each rank's own), `path.pvd` their
+/// collection; `path.csv` equals the default backend's on the whole file, row by row, and the
+/// last instant's pieces its `solution.vtu`.
+#[test]
+fn a_path_on_gmsh_parts_writes_its_series_from_the_ranks() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::copy(forms().join("3d-ascii.msh"), tmp.path().join("body.msh")).unwrap();
+    let scene = LAYERED.replace("3d-ascii-split.msh", "body.msh")
+        + "[path]\nt = [0.0, 1.0, 2.0, 3.0]\nload = [0.0, 1.0, 0.3, 1.0]\nsteps = 6\noutput_every = 2\n";
+    std::fs::write(tmp.path().join("whole.toml"), &scene).unwrap();
+    let whole = tmp.path().join("whole");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_piezocontact"))
+        .arg("run")
+        .arg(tmp.path().join("whole.toml"))
+        .arg("--out")
+        .arg(&whole)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for k in 1..=3 {
+        let part = format!("3d-ascii-split_{k}.msh");
+        std::fs::copy(forms().join(part), tmp.path().join(format!("body_{k}.msh"))).unwrap();
+    }
+    let parted = scene.replacen("[[material]]", "[solver]\nbackend = \"petsc\"\n\n[[material]]", 1);
+    std::fs::write(tmp.path().join("parts.toml"), parted).unwrap();
+    let dir = tmp.path().join("parts");
+    let toml = tmp.path().join("parts.toml");
+    let o = mpirun(3, "", &["run", toml.to_str().unwrap(), "--out", dir.to_str().unwrap()]);
+    let said = String::from_utf8_lossy(&o.stderr).to_string() + &String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{said}");
+    assert!(said.contains("step-0000.pvtu ... step-0006.pvtu"), "{said}");
+    // the series: instants 0, 2, 4 and the last, each in three pieces, collected in order
+    let pvd = std::fs::read_to_string(dir.join("path.pvd")).unwrap();
+    let listed: Vec<&str> = pvd
+        .split("file=\"")
+        .skip(1)
+        .map(|s| &s[..s.find('"').unwrap()])
+        .collect();
+    assert_eq!(
+        listed,
+        ["step-0000.pvtu", "step-0002.pvtu", "step-0004.pvtu", "step-0006.pvtu"]
+    );
+    for step in listed {
+        let pvtu = std::fs::read_to_string(dir.join(step)).unwrap();
+        assert!(
+            pvtu.contains("vtkGhostType") && pvtu.contains("contact_pressure"),
+            "{step}: {pvtu}"
+        );
+        for r in 0..3 {
+            let piece = step.replace(".pvtu", &format!("-{r}.vtu"));
+            assert!(pvtu.contains(&piece), "{step} names {piece}");
+            let bytes = std::fs::read(dir.join(&piece)).unwrap();
+            assert!(
+                String::from_utf8_lossy(&bytes[..400]).contains("vtkZLibDataCompressor"),
+                "{piece}"
+            );
+        }
+    }
+    assert!(
+        !dir.join("step-0001.pvtu").exists(),
+        "output_every = 2 writes every other instant"
+    );
+    let rows = |d: &std::path::Path| -> Vec<Vec<f64>> {
+        std::fs::read_to_string(d.join("path.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect())
+            .collect()
+    };
+    let header = std::fs::read_to_string(dir.join("path.csv")).unwrap();
+    let columns: Vec<&str> = header.lines().next().unwrap().split(',').collect();
+    let (a, b) = (rows(&dir), rows(&whole));
+    assert_eq!(a.len(), 7);
+    assert_eq!(a.len(), b.len());
+    for name in [
+        "normal_force",
+        "tangential_force_x",
+        "n_stick",
+        "n_slip",
+        "max_slip",
+        "charge_left",
+    ] {
+        let k = columns
+            .iter()
+            .position(|c| c.starts_with(name))
+            .unwrap_or_else(|| panic!("{name}"));
+        let scale = b.iter().fold(1e-12f64, |m, r| m.max(r[k].abs()));
+        for (x, y) in a.iter().zip(&b) {
+            assert!(
+                (x[k] - y[k]).abs() <= 1e-6 * scale,
+                "{}: {} against {}",
+                columns[k],
+                x[k],
+                y[k]
+            );
+        }
+    }
+    // the last instant's contact points, matched by place (the parts number the nodes as
+    // Gmsh tagged them, the whole file's run as it read them)
+    let points = |d: &std::path::Path| -> Vec<Vec<f64>> {
+        let mut rows: Vec<Vec<f64>> = std::fs::read_to_string(d.join("contact.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').filter_map(|x| x.parse().ok()).collect())
+            .collect();
+        rows.sort_by(|a, b| a[..3].partial_cmp(&b[..3]).unwrap());
+        rows
+    };
+    let (c, wc) = (points(&dir), points(&whole));
+    assert_eq!(c.len(), wc.len(), "contact points");
+    // (displacements, columns 4 to 6, against the largest of them: u_n is round-off where
+    // the points touch)
+    let column_scale = |k: usize| {
+        let of = if (4..=6).contains(&k) { 4..7 } else { k..k + 1 };
+        wc.iter()
+            .flat_map(|r| &r[of.clone()])
+            .fold(1e-300f64, |m, x| m.max(x.abs()))
+    };
+    for k in 0..wc[0].len() {
+        let scale = column_scale(k);
+        let d = c.iter().zip(&wc).fold(0.0f64, |m, (x, y)| m.max((x[k] - y[k]).abs())) / scale;
+        assert!(
+            d < 1e-6,
+            "contact.csv column {k} differs by {d:.1e}: {:?} against {:?}",
+            c[0],
+            wc[0]
+        );
+    }
+}
 
 /// A node's place, rounded: the same node in the whole file and in a part.
 fn place(x: &[f64; 3]) -> [i64; 3] {

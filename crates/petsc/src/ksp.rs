@@ -99,6 +99,15 @@ impl<'p> Ksp<'p> {
         })
     }
 
+    /// The divergence tolerance alone (the others kept): the solve stops as diverged where
+    /// the residual norm exceeds `dtol` times the right-hand side's (PETSc's default `1e5`).
+    pub fn set_divergence_tolerance(&mut self, dtol: f64) -> Result<()> {
+        // SAFETY: a live solver; PETSC_DEFAULT (-2) keeps the others.
+        check("KSPSetTolerances", unsafe {
+            sys::KSPSetTolerances(self.raw, -2.0, -2.0, dtol, -2)
+        })
+    }
+
     /// The prefix of this solver's options in the database (`"elastic_"` reads
     /// `-elastic_ksp_type`, ...).
     pub fn set_options_prefix(&mut self, prefix: &str) -> Result<()> {

@@ -1449,8 +1449,12 @@ impl Walk<'_> {
 /// One part of the right-hand side: its mechanical and electric entries.
 type Part = (Vec<f64>, Vec<f64>);
 
-/// The step's loads: the parts of the right-hand side scaled by its factors, checked finite.
-fn step_loads(parts: &RhsParts, f: &Factors, scene: &Scene) -> Result<Loads, ProblemError> {
+/// The step's loads: the parts of the right-hand side scaled by its factors, checked finite
+/// (for a backend that walks a path on its own: a run on pieces).
+///
+/// # Errors
+/// [`ProblemError::NotFinite`] where a scaled load is not finite.
+pub fn step_loads(parts: &RhsParts, f: &Factors, scene: &Scene) -> Result<Loads, ProblemError> {
     let combine = |pick: fn(&Part) -> &Vec<f64>| {
         let mut out: Vec<f64> = pick(&parts.loads).iter().map(|v| f.load * v).collect();
         for (d, fk) in parts.displacements.iter().zip(f.displacement) {
@@ -1497,8 +1501,10 @@ fn check_history(shift: &PointValues, own: f64, plan: &crate::plan::Plan) -> Res
 }
 
 /// The row of a step: its forces (the multipliers weighted), slips and counts; its charges
-/// and equilibrium residual are the caller's to fill.
-fn step_row(
+/// and equilibrium residual are the caller's to fill. `boundary` and `sol` may be a rank's own
+/// points (a run on pieces sums and takes the maxima of the ranks' rows).
+#[must_use]
+pub fn step_row(
     step: usize,
     t: f64,
     f: &Factors,
@@ -1512,8 +1518,12 @@ fn step_row(
     let nt = sol.lambda.n_tangential();
     let mut max_slip = 0.0f64;
     let mut max_inc = 0.0f64;
-    // the slips of the points in contact (a separated point moves freely)
-    for i in (0..points.len()).filter(|&i| sol.status[i] != contact::Status::Separated) {
+    // the slips of the points in contact (a separated point moves freely); without friction
+    // the solution has no tangential components, and no slip is reported at any instant (the
+    // points' tangential displacements, where an instant's fields give them, would make the
+    // column depend on which instants were written)
+    let frictional = nt > 0;
+    for i in (0..points.len()).filter(|&i| frictional && sol.status[i] != contact::Status::Separated) {
         let u = now.tangential_of(i);
         max_slip = max_slip.max(u.iter().map(|v| v * v).sum::<f64>().sqrt());
         if nt > 0 {

@@ -25,9 +25,11 @@
 
 mod gather;
 mod parts;
+mod path;
 mod report;
 
 pub use gather::Gathered;
+pub use path::{EachStep, PieceFrame, PieceStep};
 
 use crate::active::{residual, step};
 use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
@@ -82,14 +84,13 @@ pub struct PieceSolution {
 }
 
 /// Whether a run on pieces solves `scene`: a generated rectangle or box (graded, layered or
-/// not; not rounded), or a Gmsh mesh, of order 1, without path or floating terminal, its
-/// contact (if any) one the active sets hold.
+/// not; not rounded), or a Gmsh mesh, of order 1, without floating terminal, its contact (if
+/// any) one the active sets hold, at one instant or along a load path.
 ///
 /// # Errors
 /// [`Unsupported`], naming the key of what a run on pieces does not solve yet.
 pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
     let refused = [
-        (scene.path.is_some(), "path", "a path"),
         (
             scene.exact.as_ref().is_some_and(|x| !x.kind.is_field()),
             "exact.kind",
@@ -114,7 +115,7 @@ pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
     if scene.zones().is_empty() {
         return Ok(());
     }
-    crate::active_sets_hold_on(scene, None).map_err(|e| {
+    crate::supports::active_sets_hold_at_instants(scene, None).map_err(|e| {
         Unsupported::new(
             NAME,
             &e.key,
@@ -143,12 +144,30 @@ pub fn solve_on_pieces(
     limits: problem::Limits,
     reporter: &mut dyn Reporter,
 ) -> Result<PieceSolution, DistributedError> {
+    solve_path_on_pieces(petsc, scene, source, limits, reporter, &mut |_| Ok(()))
+}
+
+/// [`solve_on_pieces`], each instant of the scene's path (none for a static scene) handed to
+/// `each` on every rank as it is solved: its row, and at the instants the path writes, the
+/// rank's piece of its fields (for a caller that writes a path's files as it goes). The
+/// solution returned is the last instant's, its report with the path's section.
+///
+/// # Errors
+/// As [`solve_on_pieces`]; the error `each` returns on any rank (every rank then stops).
+pub fn solve_path_on_pieces(
+    petsc: &Petsc,
+    scene: &Scene,
+    source: PieceMesh,
+    limits: problem::Limits,
+    reporter: &mut dyn Reporter,
+    each: &mut EachStep<'_>,
+) -> Result<PieceSolution, DistributedError> {
     let valid = scene.validate()?;
     pieces_support(scene).map_err(ProblemError::from)?;
     let start = Instant::now();
     let generated = matches!(source, PieceMesh::Generated);
     let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, source, limits, reporter)?;
-    let disc = agree(petsc, setup.discretize().map_err(DistributedError::from), "discretise")?;
+    let mut disc = agree(petsc, setup.discretize().map_err(DistributedError::from), "discretise")?;
     held_on_pieces(petsc, &disc, &piece, generated)?;
     let (b_u, b_phi) = agree(petsc, loads(&disc, &setup, valid), "assemble their loads")?;
     let t_setup = start.elapsed().as_secs_f64();
@@ -156,26 +175,17 @@ pub fn solve_on_pieces(
     let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
     let fields = KrylovFields::new(petsc, &setup, &layout);
     let t_assembly = start.elapsed().as_secs_f64() - t_setup;
-    let (x, solved, contact) = match scene.zones().is_empty() {
-        true => {
-            let options = configure(petsc, scene, &layout, None, true)?;
-            let (x, solved) = linear(petsc, &fields, &mut system, options)?;
-            (x, solved, None)
-        }
-        false => {
-            let on = OnPiece {
-                petsc,
-                scene,
-                setup: &setup,
-                disc: &disc,
-                layout: &layout,
-                owned: piece.node_rank.iter().map(|&r| r == petsc.rank()).collect(),
-                piece: &piece,
-            };
-            let (x, solved, contact) = on.contact(&system, &fields, limits, reporter)?;
-            (x, solved, Some(contact))
-        }
+    let owned: Vec<bool> = piece.node_rank.iter().map(|&r| r == petsc.rank()).collect();
+    let run = Run {
+        petsc,
+        scene,
+        setup: &setup,
+        layout: &layout,
+        owned: &owned,
+        piece: &piece,
+        terminals: &terminals,
     };
+    let (x, solved, contact, path) = instants(&run, &mut disc, (&mut system, &fields), (limits, reporter), each)?;
     let t_solve = start.elapsed().as_secs_f64() - t_setup - t_assembly;
     reporter.event(&Event::Krylov {
         iterations: solved.iterations,
@@ -190,7 +200,6 @@ pub fn solve_on_pieces(
     let recovered = disc.recover(&u, &phi);
     let finite = ProblemError::check_finite(&recovered.stress, "the stress", &valid);
     agree(petsc, finite.map_err(DistributedError::from), "recover their fields")?;
-    let owned: Vec<bool> = piece.node_rank.iter().map(|&r| r == petsc.rank()).collect();
     let shares = report::Shares {
         petsc,
         scene,
@@ -220,7 +229,8 @@ pub fn solve_on_pieces(
         blocks,
         nonzeros: petsc.sum(&[system.matrix.local_info()?.0])?[0],
     };
-    let report = shares.report(&u, &phi, figures)?;
+    let mut report = shares.report(&u, &phi, figures)?;
+    report.path = path;
     exact_heard(&report, reporter);
     drop(disc);
     piece.mesh = setup.mesh;
@@ -232,6 +242,42 @@ pub fn solve_on_pieces(
         contact,
         report,
     })
+}
+
+/// The run's instants: a linear solve, a static contact solve, or a path's instants
+/// ([`path::walk`]); the last instant's solution vector, the Krylov solves' figures, its
+/// contact and the path's section of the report.
+#[allow(clippy::type_complexity)]
+fn instants<'p>(
+    run: &Run<'_, 'p>,
+    disc: &mut fe_assembly::Discretization<'_>,
+    (system, fields): (&mut System<'p>, &KrylovFields),
+    (limits, reporter): (problem::Limits, &mut dyn Reporter),
+    each: &mut EachStep<'_>,
+) -> Result<
+    (
+        Vector<'p>,
+        Solved,
+        Option<PieceContact>,
+        Option<problem::report::PathReport>,
+    ),
+    DistributedError,
+> {
+    let (petsc, scene) = (run.petsc, run.scene);
+    if scene.zones().is_empty() {
+        let options = configure(petsc, scene, run.layout, None, true)?;
+        let (x, solved) = linear(petsc, fields, system, options)?;
+        return Ok((x, solved, None, None));
+    }
+    if scene.path.is_some() {
+        let w = path::walk(run, disc, (system, fields), (limits, reporter), each)?;
+        return Ok((w.x, w.solved, Some(w.contact), Some(w.path)));
+    }
+    let on = run.on(disc);
+    let boundary = on.boundary()?;
+    let history = History::none(&boundary);
+    let (x, solved, contact) = on.contact((system, fields), boundary, history, limits, reporter)?;
+    Ok((x, solved, Some(contact), None))
 }
 
 /// The piece's load vectors, checked finite.
@@ -469,33 +515,52 @@ fn linear<'p>(
     ))
 }
 
-/// What a rank's piece holds of the run, for its contact.
-struct OnPiece<'a, 'p> {
+/// What a rank's piece holds of the run, for its contact, but its discretisation (which a
+/// path's instants rescale).
+#[derive(Clone, Copy)]
+struct Run<'a, 'p> {
     petsc: &'p Petsc,
     scene: &'a Scene,
     setup: &'a problem::backend::Setup,
-    disc: &'a fe_assembly::Discretization<'a>,
     layout: &'a Layout,
     /// Whether this rank owns each node of its piece.
-    owned: Vec<bool>,
+    owned: &'a [bool],
     /// The piece (its numbers in the whole mesh, its own cells; its mesh is the set-up's).
     piece: &'a MeshPiece,
+    /// The terminals' groups of the whole scene.
+    terminals: &'a [String],
+}
+
+impl<'a, 'p> Run<'a, 'p> {
+    /// The run on the discretisation `disc`.
+    fn on<'b>(&self, disc: &'b fe_assembly::Discretization<'b>) -> OnPiece<'b, 'p>
+    where
+        'a: 'b,
+    {
+        OnPiece { run: *self, disc }
+    }
+}
+
+/// What a rank's piece holds of the run, for its contact.
+struct OnPiece<'a, 'p> {
+    run: Run<'a, 'p>,
+    disc: &'a fe_assembly::Discretization<'a>,
+}
+
+impl<'a, 'p> std::ops::Deref for OnPiece<'a, 'p> {
+    type Target = Run<'a, 'p>;
+    fn deref(&self) -> &Run<'a, 'p> {
+        &self.run
+    }
 }
 
 impl<'p> OnPiece<'_, 'p> {
-    /// Contact by the active sets on this rank's points (those at the nodes it owns), each step
-    /// one Krylov solve of the whole system; what the iteration decides on is reduced.
-    fn contact(
-        &self,
-        system: &System<'p>,
-        fields: &KrylovFields,
-        limits: problem::Limits,
-        reporter: &mut dyn Reporter,
-    ) -> Result<(Vector<'p>, Solved, PieceContact), DistributedError> {
-        let (petsc, scene) = (self.petsc, self.scene);
-        let specs = scene.zones();
-        let boundary = ContactBoundary::of_groups_on_piece(self.disc, &specs, &self.owned)?;
-        let total = petsc.sum(&[boundary.points.len() as f64])?[0];
+    /// This rank's contact points (those at the nodes it owns) at the scene's values; refused
+    /// on every rank alike where no rank has any. Collective.
+    fn boundary(&self) -> Result<ContactBoundary, DistributedError> {
+        let specs = self.scene.zones();
+        let boundary = ContactBoundary::of_groups_on_piece(self.disc, &specs, self.owned)?;
+        let total = self.petsc.sum(&[boundary.points.len() as f64])?[0];
         if total == 0.0 {
             return Err(ProblemError::from(SetupError::new(
                 "contact.group",
@@ -506,6 +571,23 @@ impl<'p> OnPiece<'_, 'p> {
             ))
             .into());
         }
+        Ok(boundary)
+    }
+
+    /// Contact by the active sets on this rank's points `boundary` (an instant's: a path's
+    /// gaps scaled), each step one Krylov solve of the whole system; what the iteration decides
+    /// on is reduced. `history`: friction's frame (the tangential displacements at the
+    /// instant before) and the multipliers to start from, at this rank's points.
+    fn contact(
+        &self,
+        (system, fields): (&System<'p>, &KrylovFields),
+        boundary: ContactBoundary,
+        history: History<'p>,
+        limits: problem::Limits,
+        reporter: &mut dyn Reporter,
+    ) -> Result<(Vector<'p>, Solved, PieceContact), DistributedError> {
+        let (petsc, scene) = (self.petsc, self.scene);
+        let total = petsc.sum(&[boundary.points.len() as f64])?[0];
         let how = ContactSolve::new(&self.setup.plan, scene, &boundary, limits.interrupt);
         let options = configure(petsc, scene, self.layout, Some(how.tol), true)?;
         let rows = ContactRows::new(
@@ -514,7 +596,8 @@ impl<'p> OnPiece<'_, 'p> {
             false,
             self.layout,
             system,
-        )?;
+        )?
+        .with_history(history.shift, history.lambda);
         let params = ActiveSetParams {
             tol: how.tol,
             max_steps: MAX_ACTIVE_SET_STEPS,
@@ -525,12 +608,19 @@ impl<'p> OnPiece<'_, 'p> {
         let mut solve_one = |m: &mut petsc::Matrix<'p>, b: &Vector<'p>, x: &mut Vector<'p>, loose: Option<f64>| {
             step(petsc, fields, &mut t_pc, (m, b, x), loose)
         };
-        let out = active_set(petsc, self.layout, system, &rows, params, &mut solve_one, &mut progress).map_err(
-            |e| match e {
-                ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
-                other => DistributedError::Contact(other),
-            },
-        )?;
+        let out = active_set(
+            petsc,
+            self.layout,
+            system,
+            (&rows, history.x),
+            params,
+            &mut solve_one,
+            &mut progress,
+        )
+        .map_err(|e| match e {
+            ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+            other => DistributedError::Contact(other),
+        })?;
         let equilibrium = residual(system, &out.x, (&boundary, &out.solution), self.layout, petsc)?;
         let sol = &out.solution;
         let force: f64 = (0..sol.lambda.normal.len())
@@ -629,6 +719,26 @@ impl OnPiece<'_, '_> {
             electric: None,
         };
         Ok(ContactResult::condensed(all, solution))
+    }
+}
+
+/// What a contact solve starts from: friction's frame (the tangential displacements at a
+/// path's instant before, at this rank's points), and that instant's multipliers and solution
+/// vector (none for a static run, or a path's first instant).
+struct History<'p> {
+    shift: contact::PointValues,
+    lambda: Option<contact::PointValues>,
+    x: Option<Vector<'p>>,
+}
+
+impl History<'_> {
+    /// No history: a static run's, a path's first instant's.
+    fn none(boundary: &ContactBoundary) -> Self {
+        History {
+            shift: contact::PointValues::zeros(boundary.points.len(), boundary.points.n_tangential()),
+            lambda: None,
+            x: None,
+        }
     }
 }
 

@@ -134,7 +134,7 @@ impl Shares<'_> {
 
     /// The terminals' charges, each rank's share over the nodes it owns summed, and each
     /// one's potential at its node of the lowest number in the whole mesh. Collective.
-    fn terminals(&self, u: &[[f64; 3]], phi: &[f64]) -> Result<Vec<TerminalReport>, DistributedError> {
+    pub(super) fn terminals(&self, u: &[[f64; 3]], phi: &[f64]) -> Result<Vec<TerminalReport>, DistributedError> {
         if self.terminals.is_empty() {
             return Ok(vec![]);
         }

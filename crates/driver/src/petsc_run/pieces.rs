@@ -7,7 +7,10 @@
 
 use super::driver_error;
 use crate::DriverError;
-use files::output::pieces::{files_beside_pieces, names_beside_pieces, piece_name, write_into, Piece};
+use files::output::pieces::{
+    files_beside_pieces, names_of_pieces, piece_file, piece_name, step_stem, write_into, Frames, Piece,
+};
+use files::output::pvd;
 use files::output::SetWriter;
 use files::run::peak_memory_bytes;
 use files::scene_file::Source;
@@ -29,40 +32,29 @@ pub(super) fn run(
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DriverError> {
     let (rank, ranks) = (petsc.rank(), petsc.size());
-    let s = distributed::solve_on_pieces(petsc, scene, from, limits, reporter).map_err(driver_error)?;
+    // rank 0 begins the set before the solve (a path's instants are written as they come),
+    // and every rank learns where to write its pieces
+    let (mut writer, staging) = match begin(petsc, dir, &names_of_pieces(scene, ranks))? {
+        Begun::Set(w, staging) => (w, staging),
+        Begun::Not(e) => return e.map_or(Ok(None), Err),
+    };
+    let mut series = Series::default();
+    let mut each = |step: distributed::PieceStep<'_>| {
+        let written = series.frame(&step, (rank, ranks), (writer.as_mut(), &staging));
+        written.map_err(|e| {
+            distributed::DistributedError::from(problem::ProblemError::NoSolution {
+                sought: "a path's step file",
+                why: e.to_string(),
+            })
+        })
+    };
+    let solved = distributed::solve_path_on_pieces(petsc, scene, from, limits, reporter, &mut each);
+    let s = solved.map_err(driver_error)?;
     let gathered = s.gathered(petsc, scene).map_err(driver_error)?;
     let (piece, pvtu) = piece_files(&s, rank, ranks);
-    // rank 0 begins the set, and every rank learns where to write its piece
-    let mut writer = None;
-    let mut staging: Vec<u8> = vec![];
-    let mut began = [1.0];
-    if rank == 0 {
-        let names = names_beside_pieces(&s.report.plan.outputs, ranks);
-        let w = SetWriter::begin(dir, &names);
-        began[0] = f64::from(u8::from(w.as_ref().is_ok_and(|w| w.staging().is_some())));
-        if let Ok(w) = &w {
-            staging = w
-                .staging()
-                .map_or(vec![], |p| p.as_os_str().as_encoded_bytes().to_vec());
-            // (on Unix, a path's encoded bytes are its bytes)
-        }
-        writer = Some(w);
-    }
-    petsc.broadcast(&mut began)?;
-    petsc.broadcast_bytes(&mut staging)?;
-    if began[0] == 0.0 {
-        return match writer {
-            Some(Err(e)) => Err(e.into()),
-            Some(Ok(_)) => Err(DriverError::Usage(
-                "a run on pieces writes its set through a directory every rank can reach; this platform stages sets in memory".into(),
-            )),
-            None => Ok(None),
-        };
-    }
-    let mut writer = writer.and_then(Result::ok);
     let wrote = match writer.as_mut() {
         Some(w) => w.write(&piece_name(rank), &piece),
-        None => write_into(&path_of(&staging), &piece_name(rank), &piece),
+        None => write_into(&staging, &piece_name(rank), &piece),
     };
     let failed = petsc.sum(&[f64::from(u8::from(wrote.is_err()))])?[0];
     let peaks = petsc.all_gather(peak_memory_bytes())?;
@@ -78,6 +70,9 @@ pub(super) fn run(
     }
     for r in 1..ranks {
         w.adopt(&piece_name(r))?;
+        for stem in &series.stems {
+            w.adopt(&piece_file(stem, r))?;
+        }
     }
     w.write("solution.pvtu", &pvtu)?;
     let Some(gathered) = gathered else {
@@ -87,8 +82,98 @@ pub(super) fn run(
     for (name, bytes) in files_beside_pieces(&solution)? {
         w.write(&name, &bytes)?;
     }
+    if !series.stems.is_empty() {
+        w.write("path.pvd", &pvd(&series.collection))?;
+    }
     w.finish()?;
     Ok(Some(solution))
+}
+
+/// How the set's beginning went, on every rank.
+enum Begun {
+    /// Begun: rank 0's writer (`None` on the others) and the staging directory every rank
+    /// writes its pieces into.
+    Set(Option<SetWriter>, std::path::PathBuf),
+    /// Not begun: rank 0's error (`None` on the others, which stop without one).
+    Not(Option<DriverError>),
+}
+
+/// Rank 0 begins the set in `dir` (`names` checked), and sends every rank its staging
+/// directory. Collective.
+fn begin(petsc: &petsc::Petsc, dir: &Path, names: &[String]) -> Result<Begun, DriverError> {
+    let mut writer = None;
+    let mut staging: Vec<u8> = vec![];
+    let mut began = [1.0];
+    if petsc.rank() == 0 {
+        let w = SetWriter::begin(dir, names);
+        began[0] = f64::from(u8::from(w.as_ref().is_ok_and(|w| w.staging().is_some())));
+        if let Ok(w) = &w {
+            // (on Unix, a path's encoded bytes are its bytes)
+            staging = w
+                .staging()
+                .map_or(vec![], |p| p.as_os_str().as_encoded_bytes().to_vec());
+        }
+        writer = Some(w);
+    }
+    petsc.broadcast(&mut began)?;
+    petsc.broadcast_bytes(&mut staging)?;
+    if began[0] == 0.0 {
+        return Ok(Begun::Not(match writer {
+            Some(Err(e)) => Some(e.into()),
+            Some(Ok(_)) => Some(DriverError::Usage(
+                "a run on pieces writes its set through a directory every rank can reach; this platform stages sets in memory".into(),
+            )),
+            None => None,
+        }));
+    }
+    Ok(Begun::Set(writer.and_then(Result::ok), path_of(&staging)))
+}
+
+/// A path's time series on pieces: each written instant's stem, and `path.pvd`'s entries.
+#[derive(Default)]
+struct Series {
+    frames: Frames,
+    stems: Vec<String>,
+    collection: Vec<(f64, String)>,
+}
+
+impl Series {
+    /// Writes this rank's piece of an instant the path writes (`step-NNNN-<rank>.vtu`, into
+    /// the set on rank 0, into its staging directory on the others) and, on rank 0, its
+    /// `step-NNNN.pvtu`.
+    fn frame(
+        &mut self,
+        step: &distributed::PieceStep<'_>,
+        (rank, ranks): (usize, usize),
+        (writer, staging): (Option<&mut SetWriter>, &Path),
+    ) -> Result<(), files::Error> {
+        let Some(f) = &step.frame else {
+            return Ok(());
+        };
+        let ghost: Vec<bool> = f.piece.cell_rank.iter().map(|&r| r != rank).collect();
+        let stem = step_stem(step.row.step);
+        let piece = Piece {
+            mesh: f.mesh,
+            fields: (f.u, f.phi),
+            cells: f.cells,
+            contact: Some(f.contact),
+            ghost: &ghost,
+            node_id: &f.piece.global_node,
+            cell_id: &f.piece.global_cell,
+        };
+        let (vtu, pvtu) = piece.frame(&mut self.frames, &stem, ranks);
+        let name = piece_file(&stem, rank);
+        match writer {
+            Some(w) => {
+                w.write(&name, &vtu)?;
+                w.write(&format!("{stem}.pvtu"), &pvtu)?;
+            }
+            None => write_into(staging, &name, &vtu)?,
+        }
+        self.collection.push((step.row.t, format!("{stem}.pvtu")));
+        self.stems.push(stem);
+        Ok(())
+    }
 }
 
 /// This rank's piece of the solution (with its own contact points) as a `.vtu`, and the
@@ -99,7 +184,7 @@ fn piece_files(s: &distributed::PieceSolution, rank: usize, ranks: usize) -> (Ve
     Piece {
         mesh: &s.piece.mesh,
         fields: (&s.u, &s.phi),
-        cells: &s.fields,
+        cells: Some(&s.fields),
         contact: own,
         ghost: &ghost,
         node_id: &s.piece.global_node,

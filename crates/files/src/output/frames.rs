@@ -141,8 +141,9 @@ fn step_name(k: usize) -> String {
     format!("step-{k:04}.vtu")
 }
 
-/// `path.pvd`: ParaView's collection of the steps' files, each at its instant.
-fn pvd(series: &[(f64, String)]) -> Vec<u8> {
+/// `path.pvd`: ParaView's collection of the steps' files (`.vtu`, or a run on pieces'
+/// `.pvtu`), each at its instant.
+pub fn pvd(series: &[(f64, String)]) -> Vec<u8> {
     let mut s = String::from(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
     );

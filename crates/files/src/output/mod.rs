@@ -8,7 +8,7 @@ pub mod pieces;
 mod set;
 mod vtu;
 
-pub use frames::PathFiles;
+pub use frames::{pvd, PathFiles};
 pub use set::{abandon_and_exit, Outputs, SetWriter};
 
 use crate::plots::{self, Mark, Panel, Series};
@@ -642,7 +642,7 @@ fn multipliers_picture(
 
 /// A path's own files without its series: `path.csv` and the pictures of its global curves
 /// (none for a run of one instant).
-fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
+pub(super) fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     let Some(path) = &solution.report.path else {
         return Ok(vec![]);
     };

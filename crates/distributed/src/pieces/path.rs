@@ -1,0 +1,237 @@
+//! A load path on pieces: each instant of the scene's `[path]` solved in turn on the same
+//! matrix (it does not change along the path), its right-hand side the parts of the loads and
+//! of the prescribed values' lifting summed at the instant's factors
+//! ([`problem::step_loads`], the default backend's own sum), its prescribed values scaled in
+//! the dof map, its gaps scaled ([`ContactBoundary::at_factors`]), and friction solved on the
+//! slip since the instant before (the active sets' history, `ContactRows::with_history`: the
+//! tangential displacements of the instant before at each rank's own points, and its
+//! multipliers to start from). Each instant's row (`path.csv`) is made of sums and maxima over
+//! the ranks' own points ([`problem::step_row`] on each rank's points, then reduced): nothing
+//! is gathered. The instants the path writes hand each rank's piece of their fields to the
+//! caller, which writes them as they come.
+
+use super::{agree, nodal, report, History, OnPiece, PieceContact, Run, Solved};
+use crate::error::DistributedError;
+use crate::krylov::KrylovFields;
+use crate::system::System;
+use contact::PointValues;
+use fe_assembly::{CellFields, Discretization};
+use mesh::MeshPiece;
+use petsc::Vector;
+use problem::report::{PathReport, StepRow};
+use problem::{ContactResult, Event, Factors, ProblemError, Reporter};
+use std::time::Instant;
+
+/// One instant of a path on pieces, as every rank hands it to the caller.
+pub struct PieceStep<'a> {
+    /// The instant's row, the same on every rank (from sums over the ranks).
+    pub row: &'a StepRow,
+    /// This rank's piece of the instant's fields, at the instants the path writes.
+    pub frame: Option<PieceFrame<'a>>,
+}
+
+/// A rank's piece of an instant's fields.
+pub struct PieceFrame<'a> {
+    /// The piece's mesh (own and ghost cells).
+    pub mesh: &'a mesh::Mesh,
+    /// The piece's cells' and nodes' owners and numbers in the whole mesh (its own mesh is
+    /// `mesh`).
+    pub piece: &'a MeshPiece,
+    /// The displacement at each node of the piece.
+    pub u: &'a [[f64; 3]],
+    /// The potential at each node of the piece.
+    pub phi: &'a [f64],
+    /// The cells' fields, where the path asks for them (`path.cell_fields`).
+    pub cells: Option<&'a CellFields>,
+    /// The contact at every node of the piece's own cells.
+    pub contact: &'a ContactResult,
+}
+
+/// What a path on pieces hands each instant to.
+pub type EachStep<'a> = dyn FnMut(PieceStep<'_>) -> Result<(), DistributedError> + 'a;
+
+/// What the walk leaves: the last instant's solution vector, the Krylov solves' figures over
+/// the path, the last instant's contact, and the path's section of the report.
+pub(super) struct Walked<'p> {
+    pub(super) x: Vector<'p>,
+    pub(super) solved: Solved,
+    pub(super) contact: PieceContact,
+    pub(super) path: PathReport,
+}
+
+/// The path's instants, each solved, reduced into its row and handed to `each` (collective:
+/// every rank walks every instant, and a rank whose `each` fails stops them all). `disc`'s
+/// prescribed values and `system`'s right-hand side are left at the last instant's.
+pub(super) fn walk<'p>(
+    on: &Run<'_, 'p>,
+    disc: &mut Discretization<'_>,
+    (system, fields): (&mut System<'p>, &KrylovFields),
+    (limits, reporter): (problem::Limits, &mut dyn Reporter),
+    each: &mut EachStep<'_>,
+) -> Result<Walked<'p>, DistributedError> {
+    let (petsc, scene) = (on.petsc, on.scene);
+    let spec = scene.path.as_ref().ok_or_else(|| ProblemError::NoSolution {
+        sought: "a path on pieces",
+        why: "the scene has no [path]".into(),
+    })?;
+    let started = Instant::now();
+    let instants = spec.instants();
+    let parts = agree(
+        petsc,
+        disc.rhs_parts(&on.setup.loads).map_err(DistributedError::from),
+        "assemble the parts of their loads",
+    )?;
+    let prescribed = disc.dofs.prescribed();
+    let base = on.on(disc).boundary()?;
+    let (n, nt) = (base.points.len(), base.points.n_tangential());
+    let mut history = History::none(&base);
+    let mut rows = Vec::with_capacity(instants.len());
+    let mut solved = Solved {
+        iterations: 0,
+        reason: String::new(),
+        options: String::new(),
+        setup_seconds: 0.0,
+    };
+    let mut last = None;
+    for (k, &t) in instants.iter().enumerate() {
+        let f = spec.factors(t);
+        disc.dofs.rescale(&prescribed, f.displacement, f.voltage);
+        let loads = agree(
+            petsc,
+            problem::step_loads(&parts, &f, scene).map_err(DistributedError::from),
+            "scale their loads",
+        )?;
+        system.set_loads(petsc, disc, on.layout, (&loads.b_u, &loads.b_phi))?;
+        let at = on.on(disc);
+        let boundary = base.at_factors(f.gap, f.displacement, f.voltage);
+        let before = history.shift.clone();
+        let (x, s, contact) = at.contact((system, fields), boundary, history, limits, reporter)?;
+        (solved.iterations, solved.setup_seconds) =
+            (solved.iterations + s.iterations, solved.setup_seconds + s.setup_seconds);
+        (solved.reason, solved.options) = (s.reason, s.options);
+        let (u, phi) = nodal(&x, on.layout)?;
+        let row = at.row((k, t, &f), &contact, &before, (&u, &phi))?;
+        reporter.event(&Event::PathStepDone {
+            row: &row,
+            of: instants.len() - 1,
+        });
+        let frame_cells = (spec.cell_fields && spec.has_fields(k, instants.len())).then(|| disc.recover(&u, &phi));
+        let frame = spec.has_fields(k, instants.len()).then(|| PieceFrame {
+            mesh: disc.mesh,
+            piece: on.piece,
+            u: &u,
+            phi: &phi,
+            cells: frame_cells.as_ref(),
+            contact: &contact.on_piece,
+        });
+        agree(
+            petsc,
+            each(PieceStep { row: &row, frame }),
+            "hand on an instant of the path",
+        )?;
+        // friction's frame for the next instant: where the points are now
+        let mut shift = PointValues::zeros(n, nt);
+        shift.tangential.clone_from(&contact.solution.u.tangential);
+        rows.push(row);
+        // the next instant starts from this one's solution, its points pressed as now and
+        // held where they are (friction's elastic predictor: tangential multipliers zero, so
+        // that a point whose traction lies on the cone's edge is not linearised there, where
+        // the slip's spring across the direction is infinitely stiff)
+        let mut pressed = PointValues::zeros(n, nt);
+        pressed.normal.clone_from(&contact.solution.lambda.normal);
+        history = History {
+            shift,
+            lambda: Some(pressed),
+            x: Some(x.copy()?),
+        };
+        last = Some((x, contact));
+    }
+    let (x, contact) = last.ok_or_else(|| ProblemError::NoSolution {
+        sought: "a path on pieces",
+        why: "the path has no instant".into(),
+    })?;
+    Ok(Walked {
+        x,
+        solved,
+        contact,
+        path: PathReport {
+            instants: instants.len(),
+            factorisations: 0,
+            condensations: 0,
+            steps_s: started.elapsed().as_secs_f64(),
+            rows,
+        },
+    })
+}
+
+impl OnPiece<'_, '_> {
+    /// The instant's row, the same on every rank: each rank's row of its own points
+    /// ([`problem::step_row`]) summed (forces, counts) and maximised (slips, an indenter's
+    /// contact radius), the terminals' charges and potentials summed over the owned nodes, the
+    /// equilibrium residual of the instant. Collective.
+    fn row(
+        &self,
+        (k, t, f): (usize, f64, &Factors),
+        contact: &PieceContact,
+        before: &PointValues,
+        (u, phi): (&[[f64; 3]], &[f64]),
+    ) -> Result<StepRow, DistributedError> {
+        let petsc = self.petsc;
+        let (boundary, sol) = (&contact.boundary, &contact.solution);
+        let mut row = problem::step_row(k, t, f, boundary, sol, &sol.u, before);
+        let dim = row.tangential_resultant.len();
+        // the indenter's depth (the same at each of its points) and contact radius
+        let at = problem::Indented {
+            points: &boundary.points,
+            group_of: &boundary.group_of,
+            sol,
+            potential: None,
+        };
+        let indenter = problem::indenter_figures(self.scene, false, at, &|_| 0.0, f);
+        let has_indenter = indenter.as_ref().map_or(0.0, |_| 1.0);
+        let mut sums = vec![
+            row.normal_force,
+            row.n_stick as f64,
+            row.n_slip as f64,
+            row.n_separated as f64,
+            has_indenter,
+        ];
+        sums.extend(&row.tangential_resultant);
+        let sums = petsc.sum(&sums)?;
+        let depth = indenter.as_ref().map_or(f64::NEG_INFINITY, |i| i.depth);
+        let radius = indenter.as_ref().map_or(f64::NEG_INFINITY, |i| i.contact_radius);
+        let maxima = petsc.max(&[row.max_slip, row.max_slip_increment, depth, radius])?;
+        row.normal_force = sums[0];
+        (row.n_stick, row.n_slip, row.n_separated) = (sums[1] as usize, sums[2] as usize, sums[3] as usize);
+        row.tangential_resultant = sums[5..5 + dim].to_vec();
+        row.tangential_force = row.tangential_resultant.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // (without friction the plan has no tangential unknowns, and the default backend's
+        // rows no slips: the same here, where the points carry their tangents regardless)
+        if self.setup.plan.n_tangential() > 0 {
+            (row.max_slip, row.max_slip_increment) = (maxima[0], maxima[1]);
+        } else {
+            (row.max_slip, row.max_slip_increment) = (0.0, 0.0);
+        }
+        if sums[4] > 0.0 {
+            (row.depth, row.contact_radius) = (Some(maxima[2]), Some(maxima[3]));
+        }
+        let shares = report::Shares {
+            petsc,
+            scene: self.scene,
+            setup: self.setup,
+            disc: self.disc,
+            owned: self.owned,
+            global_node: &self.piece.global_node,
+            terminals: self.terminals,
+            own_cells: self.piece.own_cells,
+            cells: self.piece.n_global_cells,
+        };
+        (row.charges, row.potentials) = shares
+            .terminals(u, phi)?
+            .into_iter()
+            .map(|t| (t.charge, t.potential))
+            .unzip();
+        row.equilibrium = Some(contact.equilibrium);
+        Ok(row)
+    }
+}
