@@ -84,7 +84,7 @@ pub use analytical::{hertz, hertz_sphere, mindlin_deresiewicz_dissipation, mindl
 pub use backend::Limits;
 pub use capacitance::Capacitance;
 pub use estimate::{Bytes, BASE_BYTES};
-pub use exact::ExactReport;
+pub use exact::{contact_errors, ExactReport};
 pub use factorization::{Factorization, Refinement};
 pub use fe_assembly::CellFields;
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};

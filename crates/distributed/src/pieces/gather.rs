@@ -72,6 +72,11 @@ impl PieceSolution {
                 held_inside: held[1] as usize,
                 ..problem::report::ContactReport::of_groups(&c.points, &c.solution, &c.groups, &c.group_of)
             };
+            // a contact's closed form (Hertz, Cattaneo-Mindlin) is judged on every point
+            if report.exact.is_none() {
+                let (p, q) = (report.contact.normal_force, report.contact.tangential_force);
+                report.exact = problem::contact_errors(scene, &c.points, &c.solution, p, q);
+            }
             let at = problem::Indented {
                 points: &c.points,
                 group_of: &c.group_of,

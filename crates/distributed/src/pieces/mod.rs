@@ -85,23 +85,18 @@ pub struct PieceSolution {
 
 /// Whether a run on pieces solves `scene`: a generated rectangle or box (graded, layered or
 /// not; not rounded), or a Gmsh mesh, of order 1, without floating terminal, its contact (if
-/// any) one the active sets hold, at one instant or along a load path.
+/// any) one the active sets hold, at one instant or along a load path (an error against a
+/// contact's closed form, Hertz's or Cattaneo-Mindlin's, from the points rank 0 gathers; the
+/// half-space's needs a body of revolution, which pieces do not take).
 ///
 /// # Errors
 /// [`Unsupported`], naming the key of what a run on pieces does not solve yet.
 pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
-    let refused = [
-        (
-            scene.exact.as_ref().is_some_and(|x| !x.kind.is_field()),
-            "exact.kind",
-            "an error against a contact's closed form (Hertz, Cattaneo-Mindlin, the half-space)",
-        ),
-        (
-            scene.floating_key().is_some(),
-            scene.floating_key().unwrap_or(""),
-            "a floating terminal",
-        ),
-    ];
+    let refused = [(
+        scene.floating_key().is_some(),
+        scene.floating_key().unwrap_or(""),
+        "a floating terminal",
+    )];
     let mesh = problem::backend::piece_refusal(&scene.mesh);
     let scene_keys = refused
         .into_iter()

@@ -79,6 +79,15 @@ pub(super) fn run(
         return Ok(None);
     };
     let solution = rank_0s_solution(gathered, source, peaks)?;
+    // a contact's closed form is judged on the gathered points (a field solution's error was
+    // heard with the solve)
+    if let Some(e) = solution.report.exact.as_ref().filter(|e| !e.kind().is_field()) {
+        reporter.event(&problem::Event::Exact {
+            kind: e.kind(),
+            what: e.error_name(),
+            error: e.error(),
+        });
+    }
     for (name, bytes) in files_beside_pieces(&solution)? {
         w.write(&name, &bytes)?;
     }
