@@ -74,6 +74,6 @@ pub use pieces::{
 };
 #[cfg(feature = "petsc")]
 pub use run::{
-    solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared, ACTIVE_SETS_FROM,
-    ACTIVE_SETS_ZONE,
+    direct_exceeds, solve, solve_path, solve_with, Assembled, ContactRoute, DistributedMemory, Prepared,
+    ACTIVE_SETS_FROM, ACTIVE_SETS_ZONE,
 };

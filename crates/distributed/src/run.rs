@@ -236,6 +236,17 @@ impl<'p> DistributedMemory<'p> {
     }
 }
 
+/// Whether MUMPS' factorisation of `scene` (its mesh `mesh` where it is read), shared among
+/// `ranks`, would exceed `memory_bytes` a rank by the estimate ([`direct_estimate`]): where a
+/// load path must then walk on pieces, which need no factorisation.
+pub fn direct_exceeds(scene: &Scene, mesh: Option<&mesh::Mesh>, ranks: usize, memory_bytes: Option<u64>) -> bool {
+    // (a mesh read: with potentials, the larger estimate)
+    match (memory_bytes, direct_estimate(scene, mesh.map(|m| (m, true)), ranks)) {
+        (Some(limit), Some((bytes, _))) => bytes > limit as f64,
+        _ => false,
+    }
+}
+
 /// The default backend's estimate of its run's peak (the factor, the dense compliance) shared
 /// among `ranks`: MUMPS' factorisation on them; on `mesh` where it is known, the larger of the
 /// scene's and the mesh's.

@@ -83,7 +83,6 @@ pub(super) fn walk<'p>(
     )?;
     let prescribed = disc.dofs.prescribed();
     let base = on.on(disc).boundary()?;
-    let (n, nt) = (base.points.len(), base.points.n_tangential());
     let mut history = History::none(&base);
     let mut rows = Vec::with_capacity(instants.len());
     let mut solved = Solved {
@@ -129,21 +128,8 @@ pub(super) fn walk<'p>(
             each(PieceStep { row: &row, frame }),
             "hand on an instant of the path",
         )?;
-        // friction's frame for the next instant: where the points are now
-        let mut shift = PointValues::zeros(n, nt);
-        shift.tangential.clone_from(&contact.solution.u.tangential);
         rows.push(row);
-        // the next instant starts from this one's solution, its points pressed as now and
-        // held where they are (friction's elastic predictor: tangential multipliers zero, so
-        // that a point whose traction lies on the cone's edge is not linearised there, where
-        // the slip's spring across the direction is infinitely stiff)
-        let mut pressed = PointValues::zeros(n, nt);
-        pressed.normal.clone_from(&contact.solution.lambda.normal);
-        history = History {
-            shift,
-            lambda: Some(pressed),
-            x: Some(x.copy()?),
-        };
+        history = History::after(&contact.solution, &x)?;
         last = Some((x, contact));
     }
     let (x, contact) = last.ok_or_else(|| ProblemError::NoSolution {
@@ -162,6 +148,26 @@ pub(super) fn walk<'p>(
             rows,
         },
     })
+}
+
+impl<'p> History<'p> {
+    /// What the instant after `sol` (its solution vector `x`) starts from: friction's frame
+    /// where the points are now; their normal multipliers, the tangential ones zero: every point
+    /// that presses is held where it is, and its reaction judges it (friction's elastic
+    /// predictor; from the tangential multipliers too, a slipping point's `z_t` lies on the
+    /// disc's edge, where the slip's spring across the direction is infinitely stiff).
+    fn after(sol: &contact::ContactSolution, x: &Vector<'p>) -> Result<Self, DistributedError> {
+        let (n, nt) = (sol.lambda.normal.len(), sol.u.n_tangential());
+        let mut shift = PointValues::zeros(n, nt);
+        shift.tangential.clone_from(&sol.u.tangential);
+        let mut pressed = PointValues::zeros(n, nt);
+        pressed.normal.clone_from(&sol.lambda.normal);
+        Ok(History {
+            shift,
+            lambda: Some(pressed),
+            x: Some(x.copy()?),
+        })
+    }
 }
 
 impl OnPiece<'_, '_> {

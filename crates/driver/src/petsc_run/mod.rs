@@ -33,7 +33,7 @@ pub fn run_distributed(
         memory_limit,
         ..Default::default()
     };
-    let mesh = match route(scene, source, petsc.size())? {
+    let mesh = match route(scene, source, petsc.size(), memory_bytes)? {
         Route::Pieces(from) => return pieces::run(scene, source, dir, (&petsc, limits), from, reporter),
         Route::Whole(mesh) => mesh,
     };
@@ -53,7 +53,23 @@ pub fn run_distributed(
         }),
         None => Ok(()),
     };
-    let solved = distributed::solve_path(scene, mesh, &petsc, limits, reporter, &mut each).map_err(driver_error)?;
+    let generated = mesh.is_none();
+    let solved = distributed::solve_path(scene, mesh, &petsc, limits, reporter, &mut each);
+    let solved = match solved {
+        // MUMPS' own estimate after its analysis (the one before the mesh is a lower one) or its
+        // allocation: a generated body's load path walks on pieces instead, which factor
+        // nothing (the whole mesh's static runs take the active sets there, in the same run);
+        // the set begun is abandoned before any instant was written
+        Err(distributed::DistributedError::Petsc(
+            petsc::PetscError::MumpsTooLarge { .. } | petsc::PetscError::Mumps { info: -13, .. },
+        )) if generated && scene.path.is_some() && distributed::pieces_support(scene).is_ok() => {
+            drop(each);
+            drop(writer);
+            let from = distributed::PieceMesh::Generated;
+            return pieces::run(scene, source, dir, (&petsc, limits), from, reporter);
+        }
+        other => other.map_err(driver_error)?,
+    };
     let peaks = petsc.all_gather(peak_memory_bytes())?;
     let Some(mut solution) = solved else {
         return Ok(None);
@@ -81,15 +97,18 @@ enum Route {
     Whole(Option<mesh::Mesh>),
 }
 
-/// The route of `scene` on `ranks` ranks. A Gmsh mesh split into as many parts as there are
-/// ranks (`mesh_1.msh` .. `mesh_p.msh` beside the `mesh.msh` the scene names) runs on pieces,
-/// each rank reading its part (the whole file is not read, and need not exist). Otherwise a
-/// 3D body that the pieces solve ([`distributed::pieces_support`]) runs on them without
-/// contact, or with contact and at least [`distributed::ACTIVE_SETS_FROM`] unknowns (where the
-/// whole mesh's route would take the same active sets for speed; below, MUMPS' condensed route
-/// is as fast, issue 44's measurements): a generated box on any count of ranks, a Gmsh mesh
-/// read whole on one rank. The rest takes the whole mesh's route.
-fn route(scene: &Scene, source: &Source, ranks: usize) -> Result<Route, DriverError> {
+/// The route of `scene` on `ranks` ranks (each may take `memory_bytes`). A Gmsh mesh split
+/// into as many parts as there are ranks (`mesh_1.msh` .. `mesh_p.msh` beside the `mesh.msh`
+/// the scene names) runs on pieces, each rank reading its part (the whole file is not read, and
+/// need not exist). Otherwise a 3D body that the pieces solve ([`distributed::pieces_support`])
+/// runs on them without contact, or with contact and at least [`distributed::ACTIVE_SETS_FROM`]
+/// unknowns (where the whole mesh's route would take the same active sets for speed; below,
+/// MUMPS' condensed route is as fast, issue 44's measurements), or, along a load path, where
+/// MUMPS' factorisation would not fit (the whole mesh's route walks a path on one factorisation,
+/// the faster while it fits: `paper-3d` n = 20, 7 instants, 14 s by the default backend against
+/// 61 s on pieces on 2 ranks): a generated box on any count of ranks, a Gmsh mesh read whole on
+/// one rank. The rest takes the whole mesh's route.
+fn route(scene: &Scene, source: &Source, ranks: usize, memory_bytes: Option<u64>) -> Result<Route, DriverError> {
     let solved = distributed::pieces_support(scene).is_ok();
     let file = match (scene.mesh.kind, &scene.mesh.file) {
         (MeshKind::Gmsh, Some(file)) => Some(source.dir.join(file)),
@@ -108,7 +127,10 @@ fn route(scene: &Scene, source: &Source, ranks: usize) -> Result<Route, DriverEr
         None => problem::backend::generated_sizes(scene).map_or(0.0, |(_, _, _, n)| n),
     };
     let dim = mesh.as_ref().map_or(scene.mesh.lo.len(), |m| m.dim);
-    let large = scene.zones().is_empty() || unknowns >= distributed::ACTIVE_SETS_FROM;
+    let large = match scene.path {
+        Some(_) => distributed::direct_exceeds(scene, mesh.as_ref(), ranks, memory_bytes),
+        None => scene.zones().is_empty() || unknowns >= distributed::ACTIVE_SETS_FROM,
+    };
     Ok(match (mesh, solved && dim == 3 && large) {
         (None, true) => Route::Pieces(distributed::PieceMesh::Generated),
         (Some(m), true) if ranks == 1 => Route::Pieces(distributed::PieceMesh::Whole(m)),
