@@ -236,9 +236,9 @@ impl<'p> DistributedMemory<'p> {
     }
 }
 
-/// Whether MUMPS' factorisation of `scene` (its mesh `mesh` where it is read), shared among
-/// `ranks`, would exceed `memory_bytes` a rank by the estimate ([`direct_estimate`]): where a
-/// load path must then walk on pieces, which need no factorisation.
+/// Whether MUMPS' factorisation of `scene` (its mesh `mesh` where it is read) would exceed
+/// `memory_bytes` a rank by the estimate (the default backend's, shared among the `ranks`):
+/// where a load path must then walk on pieces, which need no factorisation.
 pub fn direct_exceeds(scene: &Scene, mesh: Option<&mesh::Mesh>, ranks: usize, memory_bytes: Option<u64>) -> bool {
     // (a mesh read: with potentials, the larger estimate)
     match (memory_bytes, direct_estimate(scene, mesh.map(|m| (m, true)), ranks)) {

@@ -63,7 +63,6 @@ pub fn run_distributed(
         Err(distributed::DistributedError::Petsc(
             petsc::PetscError::MumpsTooLarge { .. } | petsc::PetscError::Mumps { info: -13, .. },
         )) if generated && scene.path.is_some() && distributed::pieces_support(scene).is_ok() => {
-            drop(each);
             drop(writer);
             let from = distributed::PieceMesh::Generated;
             return pieces::run(scene, source, dir, (&petsc, limits), from, reporter);
