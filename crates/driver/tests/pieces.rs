@@ -1010,6 +1010,96 @@ fn a_path_on_gmsh_parts_writes_its_series_from_the_ranks() {
     }
 }
 
+/// Two PZT boxes on a Gmsh mesh (`tests/fixtures/bodies`, written by `write_bodies.py`), held
+/// at `left` (and `right`), pressed on `top`, without contact.
+const BODIES: &str = r#"
+name = "bodies"
+description = "two boxes of the pieces' fixtures"
+[units]
+length = "m"
+stress = "GPa"
+[mesh]
+kind = "gmsh"
+file = "two.msh"
+[[material]]
+region = "body"
+model = "crystal-6mm"
+c = [121.0, 75.4, 75.2, 111.0, 21.1, 22.6]
+e = [-5.4, 15.8, 12.3]
+permittivity = [8.11, 7.35]
+poling = [0.0, 0.0, 1.0]
+[[dirichlet]]
+group = "left"
+u = [0.0, 0.0, 0.0]
+phi = 0.0
+[[dirichlet]]
+group = "right"
+u = [0.0, 0.0, 0.0]
+phi = 0.0
+[load]
+group = "top"
+p = -2.0
+direction = [0.0, 0.0, 1.0]
+"#;
+
+/// A mesh of several bodies in parts: each solid part (cells joined through a facet) held by
+/// its own conditions, as the whole mesh's check holds it. Two separate boxes, each clamped at
+/// its outer end, are solved on pieces as on the whole file (they were refused by key); a box
+/// hanging from another by one edge (a hinge, about which it turns: 6 motions of its part
+/// free) is refused on pieces as on the whole file, where the bodies counted through nodes
+/// took the two boxes for one body held at `left`.
+#[test]
+fn several_bodies_in_parts_are_each_held_as_the_whole_mesh_holds_them() {
+    on_ranks(
+        "several_bodies_in_parts_are_each_held_as_the_whole_mesh_holds_them",
+        2,
+        |p| {
+            let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/bodies");
+            let files = |k: &str| mesh::parts_of(&dir.join(format!("{k}.msh")));
+            let faer = scene_file::parse(BODIES, "bodies", &[]).expect("the scene");
+            let scene = scene_file::parse(BODIES, "bodies", &["solver.backend=\"petsc\"".into()]).expect("the scene");
+            let whole_mesh = mesh::read_msh(dir.join("two.msh")).expect("the whole file");
+            let whole = problem::solve(&faer, Some(whole_mesh), &mut problem::Silent).expect("the whole run");
+            let from = distributed::PieceMesh::Parts(files("two"));
+            let s = distributed::solve_on_pieces(p, &scene, from, problem::Limits::default(), &mut problem::Silent)
+                .unwrap_or_else(|e| panic!("two bodies on parts: {e}"));
+            let at: std::collections::HashMap<[i64; 3], usize> = whole
+                .mesh
+                .points
+                .iter()
+                .enumerate()
+                .map(|(v, x)| (place(x), v))
+                .collect();
+            let map: Vec<usize> = s.piece.mesh.points.iter().map(|x| at[&place(x)]).collect();
+            let flat = |u: &[[f64; 3]]| u.iter().flat_map(|x| x.iter().copied()).collect::<Vec<f64>>();
+            let du = farthest(&flat(&whole.u), &flat(&s.u), &map, 3, |_| true);
+            let dphi = farthest(&whole.phi, &s.phi, &map, 1, |_| true);
+            assert!(du < 1e-7 && dphi < 1e-7, "two bodies: u {du:.1e}, phi {dphi:.1e}");
+            // the hinge: held at `left` alone, its second box free
+            let sets = vec!["~dirichlet.1".to_string(), "mesh.file=\"hinge.msh\"".to_string()];
+            let faer = scene_file::parse(BODIES, "bodies", &sets).expect("the scene");
+            let whole_mesh = mesh::read_msh(dir.join("hinge.msh")).expect("the whole file");
+            let e = problem::solve(&faer, Some(whole_mesh), &mut problem::Silent)
+                .map(|_| ())
+                .unwrap_err()
+                .to_string();
+            let mut with = sets;
+            with.push("solver.backend=\"petsc\"".into());
+            let scene = scene_file::parse(BODIES, "bodies", &with).expect("the scene");
+            let from = distributed::PieceMesh::Parts(files("hinge"));
+            let f = distributed::solve_on_pieces(p, &scene, from, problem::Limits::default(), &mut problem::Silent)
+                .map(|_| ())
+                .unwrap_err()
+                .to_string();
+            for said in [&e, &f] {
+                assert!(said.contains("leave 6 rigid motions of the body free"), "{said}");
+            }
+            let part = |x: &str| x[x.find(" cells)").map_or(0, |i| x[..i].rfind('(').unwrap_or(0))..].to_string();
+            assert_eq!(part(&e)[..12], part(&f)[..12], "the same part: {e} / {f}");
+        },
+    );
+}
+
 /// A node's place, rounded: the same node in the whole file and in a part.
 fn place(x: &[f64; 3]) -> [i64; 3] {
     x.map(|c| (c * 1e10).round() as i64)

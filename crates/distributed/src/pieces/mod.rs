@@ -330,67 +330,72 @@ fn exact_heard(report: &problem::RunReport, reporter: &mut dyn Reporter) {
 }
 
 /// Refuses, on every rank alike, a body that the Dirichlet conditions do not hold, as the whole
-/// mesh's check does (`fe_assembly::held`): a body in one connected part (a generated box, or
-/// a mesh read whose bodies are counted across the pieces, [`parts::bodies`]) has its rigid
-/// motions held when the Gram matrix of the conditions, summed over the ranks' own nodes
-/// (`fe_assembly::rigid_gram`, about the body's bounding box, [`parts::frame`]), has full
-/// rank; its potential, where every cell is electric,
-/// when some rank prescribes φ at a node it owns; in a body of electric and non-electric
-/// cells, each electric part's where some node of it has φ prescribed ([`parts::floating_parts`]).
-/// A mesh of several bodies is refused by key. Collective.
+/// mesh's check does (`fe_assembly::held`): each solid part of the mesh (a generated box is one;
+/// a mesh read's are labelled across the pieces, [`parts::solid_labels`]: cells joined through
+/// a facet, a hinge does not hold two parts together) has its rigid motions held when the Gram
+/// matrix of the conditions at its nodes, summed over the ranks' own nodes
+/// (`fe_assembly::rigid_gram`, about its bounding box, [`parts::frames`]), has full rank; the
+/// first part that has a free motion is named by its least cell, as the whole mesh's check
+/// names it. The potential of a body of one part whose every cell is electric is held when
+/// some rank prescribes φ at a node it owns; otherwise each electric part's (joined by electric
+/// cells through any node) where some node of it has φ prescribed ([`parts::floating_parts`]).
+/// Collective.
 fn held_on_pieces(
     petsc: &Petsc,
     disc: &fe_assembly::Discretization<'_>,
     piece: &MeshPiece,
     generated: bool,
 ) -> Result<(), DistributedError> {
-    let (dim, rank) = (disc.dofs.dim, petsc.rank());
-    // the frame of the motions: the whole body's bounding box, by reductions
-    let (centre, size) = parts::frame(petsc, disc.mesh, piece)?;
-    // (a generated box is one body)
-    let bodies = if generated {
-        1
-    } else {
-        parts::bodies(petsc, disc.mesh, piece)?
-    };
-    if bodies > 1 {
-        let u = Unsupported::new(
-            NAME,
-            "mesh.file",
-            format!("a mesh of {bodies} separate bodies on a mesh made in pieces"),
-        )
-        .advise("a run whose every rank holds the whole mesh solves it");
-        return Err(ProblemError::from(u).into());
-    }
+    let (dim, rank, mesh) = (disc.dofs.dim, petsc.rank(), disc.mesh);
     let owned: Vec<usize> = (0..piece.node_rank.len())
         .filter(|&v| piece.node_rank[v] == rank)
         .collect();
-    let gram = fe_assembly::rigid_gram(disc.mesh, &disc.dofs, owned.iter().copied(), (centre, size));
-    let gram = petsc.sum(&gram)?;
-    let free = fe_assembly::free_in(dim, &gram, (centre, size));
-    let cells = piece.n_global_cells;
-    if !free.is_empty() {
-        let unheld = fe_assembly::Unheld::Motion {
-            count: free.len(),
-            motions: free.join("; "),
-            cell: 0,
-            cells,
-            with_supports: false,
+    let (bodies, frames) = if generated {
+        // one body: every owned node, the box's frame
+        let one = parts::Bodies {
+            labels: vec![0],
+            nodes: vec![owned.clone()],
+            cells: vec![piece.n_global_cells as f64],
         };
-        return Err(fe_assembly::AssemblyError::from(unheld).into());
+        (one, vec![parts::frame(petsc, mesh, piece)?])
+    } else {
+        let labels = parts::solid_labels(petsc, mesh, piece)?;
+        let bodies = parts::bodies(petsc, mesh, piece, &labels)?;
+        let frames = parts::frames(petsc, mesh, &bodies)?;
+        (bodies, frames)
+    };
+    let mut grams = vec![];
+    for (nodes, &frame) in bodies.nodes.iter().zip(&frames) {
+        grams.extend(fe_assembly::rigid_gram(mesh, &disc.dofs, nodes.iter().copied(), frame));
     }
+    let grams = petsc.sum(&grams)?;
+    let width = grams.len() / bodies.labels.len().max(1);
+    for (b, &frame) in frames.iter().enumerate() {
+        let free = fe_assembly::free_in(dim, &grams[b * width..(b + 1) * width], frame);
+        if !free.is_empty() {
+            let unheld = fe_assembly::Unheld::Motion {
+                count: free.len(),
+                motions: free.join("; "),
+                cell: bodies.labels[b] as usize,
+                cells: bodies.cells[b] as usize,
+                with_supports: false,
+            };
+            return Err(fe_assembly::AssemblyError::from(unheld).into());
+        }
+    }
+    let cells = piece.n_global_cells;
     let electric = (0..piece.own_cells).filter(|&c| disc.cell_electric[c]).count() as f64;
     let fixed = |v: usize| matches!(disc.dofs.phi[v], fe_assembly::Dof::Fixed(_));
     let prescribed = owned.iter().filter(|&&v| fixed(v)).count() as f64;
     let sums = petsc.sum(&[electric, prescribed])?;
-    // a body of electric cells alone: its potential is held where some rank prescribes it;
-    // electric and non-electric cells: each electric part (joined by electric cells) must be
+    // one body of electric cells alone: its potential is held where some rank prescribes it;
+    // otherwise each electric part (joined by electric cells) must be
     let floating = if sums[0] == 0.0 {
         0
-    } else if sums[0] == cells as f64 {
+    } else if sums[0] == cells as f64 && bodies.labels.len() == 1 {
         usize::from(sums[1] == 0.0)
     } else {
-        parts::floating_parts(petsc, disc.mesh, piece, &disc.cell_electric, &fixed)?
+        parts::floating_parts(petsc, mesh, piece, &disc.cell_electric, &fixed)?
     };
     if floating > 0 {
         let unheld = fe_assembly::Unheld::Potential { cell: 0, cells };

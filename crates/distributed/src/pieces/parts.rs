@@ -214,48 +214,182 @@ fn labels(
     }
     let part: Vec<usize> = (0..n).map(|v| find(&mut root, v)).collect();
     let nodes: Vec<usize> = (0..n).filter(|&v| used[v]).collect();
-    let at: Vec<_> = nodes.iter().map(|&v| Layout::index(piece.global_node[v])).collect();
-    let (lo, hi) = petsc.split(piece.n_global_nodes);
+    let items = Items {
+        global: &piece.global_node,
+        owner: &piece.node_rank,
+        count: piece.n_global_nodes,
+    };
+    let known = propagate(petsc, &nodes, &part, items)?;
+    Ok(nodes.into_iter().zip(known).collect())
+}
+
+/// Items (nodes or cells) of a piece: each one's number in the whole mesh and its owner, and
+/// how many the whole mesh has.
+#[derive(Clone, Copy)]
+struct Items<'a> {
+    global: &'a [usize],
+    owner: &'a [usize],
+    count: usize,
+}
+
+/// The least whole-mesh number over the connected parts spanning the pieces, at each of the
+/// piece's items `listed` (`part`: each item's connected part in the piece): a directory over
+/// the whole mesh's numbers starts with each item's own, and each round every rank gives the
+/// items of each of its parts the least label the directory holds for them, writing back those
+/// that fell (labels only fall, so the rounds end). Collective.
+fn propagate(petsc: &Petsc, listed: &[usize], part: &[usize], items: Items<'_>) -> Result<Vec<f64>, DistributedError> {
+    let at: Vec<_> = listed.iter().map(|&v| Layout::index(items.global[v])).collect();
+    let (lo, hi) = petsc.split(items.count);
     let mut directory = Vector::mpi(petsc, hi - lo)?;
-    let (own_at, own): (Vec<_>, Vec<f64>) = nodes
+    let (own_at, own): (Vec<_>, Vec<f64>) = listed
         .iter()
         .zip(&at)
-        .filter(|(&v, _)| piece.node_rank[v] == petsc.rank())
-        .map(|(&v, &i)| (i, piece.global_node[v] as f64))
+        .filter(|(&v, _)| items.owner[v] == petsc.rank())
+        .map(|(&v, &i)| (i, items.global[v] as f64))
         .unzip();
     directory.set_values(&own_at, &own)?;
     directory.assemble()?;
     let mut known = directory.fetch(&at)?;
     loop {
-        let mut least = vec![f64::INFINITY; n];
-        for (k, &v) in nodes.iter().enumerate() {
+        let mut least = vec![f64::INFINITY; part.len()];
+        for (k, &v) in listed.iter().enumerate() {
             least[part[v]] = least[part[v]].min(known[k]);
         }
-        let (lower_at, lower): (Vec<_>, Vec<f64>) = nodes
+        let (lower_at, lower): (Vec<_>, Vec<f64>) = listed
             .iter()
             .enumerate()
             .filter(|&(k, &v)| least[part[v]] < known[k])
             .map(|(k, &v)| (at[k], least[part[v]]))
             .unzip();
         if petsc.sum(&[lower.len() as f64])?[0] == 0.0 {
-            break;
+            return Ok(known);
         }
         directory.set_values(&lower_at, &lower)?;
         directory.assemble()?;
         known = directory.fetch(&at)?;
     }
-    Ok(nodes.into_iter().zip(known).collect())
 }
 
-/// The connected bodies of the whole mesh, counted across the pieces ([`labels`] of every
-/// cell): the nodes, each counted by its owner, whose label is their own number. Collective.
-pub(super) fn bodies(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result<usize, DistributedError> {
+/// Each cell's solid part across the pieces, as the whole mesh's check sees the parts
+/// (`Mesh::solid_parts`: cells joined through a shared facet, not through a lone node or edge,
+/// a hinge about which two parts turn freely): the least whole-mesh number of the part's cells
+/// ([`propagate`]). A piece holds every facet neighbour of its own cells (they share its nodes),
+/// so every join is seen by the owner of one of its cells. Collective.
+pub(super) fn solid_labels(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result<Vec<f64>, DistributedError> {
+    let (n, k) = (m.n_cells(), m.kind.n_nodes());
+    let mut root: Vec<usize> = (0..n).collect();
+    fn find(root: &mut [usize], mut c: usize) -> usize {
+        while root[c] != c {
+            root[c] = root[root[c]];
+            c = root[c];
+        }
+        c
+    }
+    let (offsets, node_cells) = m.node_cells();
+    for (c, cell) in m.iter_cells().enumerate() {
+        for f in m.kind.facets() {
+            let first = cell[f[0]];
+            for &c2 in &node_cells[offsets[first]..offsets[first + 1]] {
+                let other = &m.cells[c2 * k..(c2 + 1) * k];
+                if c2 > c && f.iter().all(|&l| other.contains(&cell[l])) {
+                    let (a, b) = (find(&mut root, c), find(&mut root, c2));
+                    root[b] = a;
+                }
+            }
+        }
+    }
+    let part: Vec<usize> = (0..n).map(|c| find(&mut root, c)).collect();
+    let cells: Vec<usize> = (0..n).collect();
+    // (a Gmsh part's cells are numbered by their element tags, which may pass the count of
+    // cells: the directory spans the largest)
+    let largest = piece.global_cell.iter().max().map_or(0.0, |&g| g as f64 + 1.0);
+    let items = Items {
+        global: &piece.global_cell,
+        owner: &piece.cell_rank,
+        count: (petsc.max(&[largest])?[0] as usize).max(piece.n_global_cells),
+    };
+    propagate(petsc, &cells, &part, items)
+}
+
+/// The solid parts of the whole mesh ([`solid_labels`]) as a rank sees them: every part's
+/// label (the least whole-mesh number of its cells), in order, the same on every rank; this
+/// rank's owned nodes of each (a hinge node in both of its parts); and each part's cells over
+/// the ranks.
+pub(super) struct Bodies {
+    pub(super) labels: Vec<i32>,
+    pub(super) nodes: Vec<Vec<usize>>,
+    pub(super) cells: Vec<f64>,
+}
+
+/// [`Bodies`] of the piece's cells labelled `labels`. Collective.
+pub(super) fn bodies(
+    petsc: &Petsc,
+    m: &mesh::Mesh,
+    piece: &MeshPiece,
+    labels: &[f64],
+) -> Result<Bodies, DistributedError> {
     let rank = petsc.rank();
-    let roots = labels(petsc, m, piece, &|_| true)?
-        .into_iter()
-        .filter(|&(v, l)| piece.node_rank[v] == rank && l == piece.global_node[v] as f64)
-        .count();
-    Ok(petsc.sum(&[roots as f64])?[0] as usize)
+    let as_i32 = |l: f64| -> Result<i32, DistributedError> {
+        i32::try_from(l as u64)
+            .map_err(|_| mesh_file("a body's label past 2^31 cells: too large a mesh to check on pieces".into()))
+    };
+    let mut roots = vec![];
+    for c in (0..piece.own_cells).filter(|&c| labels[c] == piece.global_cell[c] as f64) {
+        roots.push(as_i32(labels[c])?);
+    }
+    let mut all = petsc.all_gather_i32(&roots)?;
+    all.sort_unstable();
+    let index = |l: f64| all.binary_search(&(l as i32)).ok();
+    let mut cells = vec![0.0; all.len()];
+    for c in 0..piece.own_cells {
+        if let Some(b) = index(labels[c]) {
+            cells[b] += 1.0;
+        }
+    }
+    let cells = petsc.sum(&cells)?;
+    // an owned node's cells are all in the piece: its bodies are theirs
+    let (offsets, node_cells) = m.node_cells();
+    let mut nodes = vec![vec![]; all.len()];
+    for v in (0..m.n_nodes()).filter(|&v| piece.node_rank[v] == rank) {
+        let mut of: Vec<usize> = node_cells[offsets[v]..offsets[v + 1]]
+            .iter()
+            .filter_map(|&c| index(labels[c]))
+            .collect();
+        of.sort_unstable();
+        of.dedup();
+        for b in of {
+            nodes[b].push(v);
+        }
+    }
+    Ok(Bodies {
+        labels: all,
+        nodes,
+        cells,
+    })
+}
+
+/// Each body's frame: the centre and size of its bounding box, from its owned nodes on every
+/// rank. Collective.
+pub(super) fn frames(petsc: &Petsc, m: &mesh::Mesh, bodies: &Bodies) -> Result<Vec<([f64; 3], f64)>, DistributedError> {
+    let mut ends = vec![f64::NEG_INFINITY; 6 * bodies.labels.len()];
+    for (b, nodes) in bodies.nodes.iter().enumerate() {
+        for &v in nodes {
+            let x = m.points[v];
+            for k in 0..3 {
+                ends[6 * b + k] = ends[6 * b + k].max(x[k]);
+                ends[6 * b + 3 + k] = ends[6 * b + 3 + k].max(-x[k]);
+            }
+        }
+    }
+    let ends = petsc.max(&ends)?;
+    Ok(ends
+        .chunks(6)
+        .map(|e| {
+            let centre = std::array::from_fn(|k| 0.5 * (e[k] - e[3 + k]));
+            let size = (0..m.dim).map(|k| e[k] + e[3 + k]).fold(0.0, f64::max);
+            (centre, size)
+        })
+        .collect())
 }
 
 /// The electric parts of the whole mesh (joined by the `electric` cells through any node,
