@@ -4,7 +4,7 @@
 //! model on one zone ([`crate::active_sets_hold`] chooses it); its steps here are the
 //! backend's `begin`, `prime`, `solve_posed` and `instant_fields` on that route.
 
-use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
+use crate::contact::{active_set, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
 use crate::krylov::{Krylov, KrylovFields};
 use crate::layout::Layout;
@@ -73,11 +73,7 @@ pub(crate) fn solve<'p>(
         params,
         &mut solve_one,
         &mut progress,
-    )
-    .map_err(|e| match e {
-        ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
-        other => DistributedError::Contact(other),
-    })?;
+    )?;
     (k.iterations, k.reason) = (out.krylov_iterations, out.reason);
     k.report(reporter);
     active.x = Some(out.x);

@@ -19,6 +19,16 @@ pub enum DistributedError {
     Contact(crate::contact::ActiveSetError),
 }
 
+impl From<crate::contact::ActiveSetError> for DistributedError {
+    /// PETSc's own failure as PETSc's, the iteration's as the contact's.
+    fn from(e: crate::contact::ActiveSetError) -> Self {
+        match e {
+            crate::contact::ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
+            other => DistributedError::Contact(other),
+        }
+    }
+}
+
 impl From<fe_assembly::AssemblyError> for DistributedError {
     fn from(e: fe_assembly::AssemblyError) -> Self {
         DistributedError::Problem(e.into())

@@ -32,7 +32,7 @@ pub use gather::Gathered;
 pub use path::{EachStep, PieceFrame, PieceStep};
 
 use crate::active::{residual, step};
-use crate::contact::{active_set, ActiveSetError, ActiveSetParams, ContactRows};
+use crate::contact::{active_set, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
 use crate::krylov::{configure, KrylovFields};
 use crate::layout::Layout;
@@ -616,11 +616,7 @@ impl<'p> OnPiece<'_, 'p> {
             params,
             &mut solve_one,
             &mut progress,
-        )
-        .map_err(|e| match e {
-            ActiveSetError::Petsc(p) => DistributedError::Petsc(p),
-            other => DistributedError::Contact(other),
-        })?;
+        )?;
         let equilibrium = residual(system, &out.x, (&boundary, &out.solution), self.layout, petsc)?;
         let sol = &out.solution;
         let force: f64 = (0..sol.lambda.normal.len())

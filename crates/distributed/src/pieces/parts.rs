@@ -276,29 +276,9 @@ fn propagate(petsc: &Petsc, listed: &[usize], part: &[usize], items: Items<'_>) 
 /// ([`propagate`]). A piece holds every facet neighbour of its own cells (they share its nodes),
 /// so every join is seen by the owner of one of its cells. Collective.
 pub(super) fn solid_labels(petsc: &Petsc, m: &mesh::Mesh, piece: &MeshPiece) -> Result<Vec<f64>, DistributedError> {
-    let (n, k) = (m.n_cells(), m.kind.n_nodes());
-    let mut root: Vec<usize> = (0..n).collect();
-    fn find(root: &mut [usize], mut c: usize) -> usize {
-        while root[c] != c {
-            root[c] = root[root[c]];
-            c = root[c];
-        }
-        c
-    }
-    let (offsets, node_cells) = m.node_cells();
-    for (c, cell) in m.iter_cells().enumerate() {
-        for f in m.kind.facets() {
-            let first = cell[f[0]];
-            for &c2 in &node_cells[offsets[first]..offsets[first + 1]] {
-                let other = &m.cells[c2 * k..(c2 + 1) * k];
-                if c2 > c && f.iter().all(|&l| other.contains(&cell[l])) {
-                    let (a, b) = (find(&mut root, c), find(&mut root, c2));
-                    root[b] = a;
-                }
-            }
-        }
-    }
-    let part: Vec<usize> = (0..n).map(|c| find(&mut root, c)).collect();
+    // the piece's own solid parts, by the whole mesh's rule
+    let (part, _) = m.solid_parts();
+    let n = m.n_cells();
     let cells: Vec<usize> = (0..n).collect();
     // (a Gmsh part's cells are numbered by their element tags, which may pass the count of
     // cells: the directory spans the largest)
