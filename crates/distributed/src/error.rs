@@ -19,6 +19,18 @@ pub enum DistributedError {
     Contact(crate::contact::ActiveSetError),
 }
 
+impl DistributedError {
+    /// The error as at a path's step `step` (instant `t`): the problem's own wrapped as the
+    /// default backend's path wraps them, the others as they are.
+    #[must_use]
+    pub fn at_step(self, step: usize, t: f64) -> Self {
+        match self {
+            DistributedError::Problem(p) => DistributedError::Problem(p.at_step(step, t)),
+            other => other,
+        }
+    }
+}
+
 impl From<crate::contact::ActiveSetError> for DistributedError {
     /// PETSc's own failure as PETSc's, the iteration's as the contact's.
     fn from(e: crate::contact::ActiveSetError) -> Self {

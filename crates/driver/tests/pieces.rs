@@ -456,6 +456,38 @@ fn paths_on_pieces(p: &Petsc) {
         );
         assert!(du < 1e-7, "{name} {sets:?}: the last instant's u differs by {du:.2e}");
     }
+    // an excursion of the load: the instant after it is round-off beside friction's history,
+    // refused as the default backend's path refuses it (it was judged against the excursion's
+    // multipliers, and met the tolerance at once)
+    let excursion = [
+        "mesh.n=4",
+        "contact.friction=0.05",
+        "path.t=[0.0,1.0,2.0]",
+        "path.load=[1.0,1e30,1.0]",
+        "path.steps=2",
+    ];
+    let (faer, scene) = both("paper-3d", &excursion);
+    let e = problem::solve(&faer, None, &mut problem::Silent)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    let f = distributed::solve_path_on_pieces(
+        p,
+        &scene,
+        distributed::PieceMesh::Generated,
+        problem::Limits::default(),
+        &mut problem::Silent,
+        &mut |_| Ok(()),
+    )
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    for said in [&e, &f] {
+        assert!(
+            said.contains("path step 2") && said.contains("friction's history"),
+            "{said}"
+        );
+    }
 }
 
 #[test]

@@ -89,7 +89,7 @@ pub use factorization::{Factorization, Refinement};
 pub use fe_assembly::CellFields;
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
 pub use instants::Instants;
-pub use path::{run, run_steps, step_loads, step_row, PathSolution, Step, StepFields};
+pub use path::{check_history_scales, run, run_steps, step_loads, step_row, PathSolution, Step, StepFields};
 pub use plan::{Output, Plan};
 pub use progress::{Event, FactorWatch, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};

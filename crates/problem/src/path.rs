@@ -1484,6 +1484,19 @@ pub fn step_loads(parts: &RhsParts, f: &Factors, scene: &Scene) -> Result<Loads,
 /// rule the path stops there with [`ProblemError::IllConditioned`].
 fn check_history(shift: &PointValues, own: f64, plan: &crate::plan::Plan) -> Result<(), ProblemError> {
     let history = shift.tangential.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    check_history_scales(history, own, plan)
+}
+
+/// Whether an instant can be resolved beside friction's history, on its two scales:
+/// `history` the largest tangential displacement the history carries, `own` the displacement
+/// the instant's own data make (a path's own check; a backend that holds the points in pieces
+/// reduces each scale over them). An instant whose own data make nothing has nothing to
+/// resolve.
+///
+/// # Errors
+/// [`ProblemError::IllConditioned`] under the tight rule where double precision resolves the
+/// instant to more than the tolerance of itself.
+pub fn check_history_scales(history: f64, own: f64, plan: &crate::plan::Plan) -> Result<(), ProblemError> {
     if plan.rule != crate::Rule::Tight || history == 0.0 || own == 0.0 {
         return Ok(());
     }

@@ -84,6 +84,7 @@ pub(super) fn walk<'p>(
     let prescribed = disc.dofs.prescribed();
     let base = on.on(disc).boundary()?;
     let mut history = History::none(&base);
+    let mut scale = OwnScale::default();
     let mut rows = Vec::with_capacity(instants.len());
     let mut solved = Solved {
         iterations: 0,
@@ -103,8 +104,14 @@ pub(super) fn walk<'p>(
         system.set_loads(petsc, disc, on.layout, (&loads.b_u, &loads.b_phi))?;
         let at = on.on(disc);
         let boundary = base.at_factors(f.gap, f.displacement, f.voltage);
+        let plan = &on.setup.plan;
+        scale
+            .check(petsc, &boundary, &history, system.load_norm, plan)
+            .map_err(|e| e.at_step(k, t))?;
         let before = history.shift.clone();
-        let (x, s, contact) = at.contact((system, fields), boundary, history, limits, reporter)?;
+        let (x, s, contact) = at
+            .contact((system, fields), boundary, history, limits, reporter)
+            .map_err(|e| e.at_step(k, t))?;
         (solved.iterations, solved.setup_seconds) =
             (solved.iterations + s.iterations, solved.setup_seconds + s.setup_seconds);
         (solved.reason, solved.options) = (s.reason, s.options);
@@ -129,6 +136,7 @@ pub(super) fn walk<'p>(
             "hand on an instant of the path",
         )?;
         rows.push(row);
+        scale.seen(petsc, &contact.solution, system.load_norm)?;
         history = History::after(&contact.solution, &x)?;
         last = Some((x, contact));
     }
@@ -148,6 +156,63 @@ pub(super) fn walk<'p>(
             rows,
         },
     })
+}
+
+/// The displacement an instant's own data make, told from the instants solved: the points'
+/// largest displacement at the instant of the largest loads so far, in proportion to the
+/// instant's loads (`K` is the same along the path), for the check that friction's history
+/// does not drown an instant in round-off ([`problem::check_history_scales`], the default
+/// backend's, which tells the scale from the parts' responses instead).
+#[derive(Default)]
+struct OwnScale {
+    /// The largest load norm so far, and the points' largest displacement then.
+    peak: Option<(f64, f64)>,
+}
+
+impl OwnScale {
+    /// Refuses (every rank alike) an instant that the history drowns: with friction, its own
+    /// displacement (its loads' share of the peak's, or how far its gaps press in) at most
+    /// `tol / ε` times smaller than the history's. Collective.
+    fn check(
+        &self,
+        petsc: &petsc::Petsc,
+        boundary: &problem::backend::ContactBoundary,
+        history: &History<'_>,
+        load_norm: f64,
+        plan: &problem::Plan,
+    ) -> Result<(), DistributedError> {
+        if plan.n_tangential() == 0 {
+            return Ok(());
+        }
+        let carried = history.shift.tangential.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let pressed = boundary.points.gap.iter().fold(0.0f64, |m, g| m.max(-g));
+        let most = petsc.max(&[carried, pressed])?;
+        let loaded = self
+            .peak
+            .map_or(0.0, |(load, u)| if load > 0.0 { u * load_norm / load } else { 0.0 });
+        problem::check_history_scales(most[0], loaded.max(most[1]), plan).map_err(DistributedError::from)
+    }
+
+    /// Takes in the solved instant of `load_norm`: the peak where its loads are the largest.
+    /// Collective.
+    fn seen(
+        &mut self,
+        petsc: &petsc::Petsc,
+        sol: &contact::ContactSolution,
+        load_norm: f64,
+    ) -> Result<(), DistributedError> {
+        let own = sol
+            .u
+            .normal
+            .iter()
+            .chain(&sol.u.tangential)
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let u = petsc.max(&[own])?[0];
+        if self.peak.is_none_or(|(load, _)| load_norm > load) {
+            self.peak = Some((load_norm, u));
+        }
+        Ok(())
+    }
 }
 
 impl<'p> History<'p> {
