@@ -195,17 +195,7 @@ pub fn solve_path_on_pieces(
     let recovered = disc.recover(&u, &phi);
     let finite = ProblemError::check_finite(&recovered.stress, "the stress", &valid);
     agree(petsc, finite.map_err(DistributedError::from), "recover their fields")?;
-    let shares = report::Shares {
-        petsc,
-        scene,
-        setup: &setup,
-        disc: &disc,
-        owned: &owned,
-        global_node: &piece.global_node,
-        terminals: &terminals,
-        own_cells: piece.own_cells,
-        cells: piece.n_global_cells,
-    };
+    let shares = run.shares(&disc);
     let timings = problem::report::Timings {
         setup: t_setup,
         assembly: t_assembly,
@@ -532,6 +522,24 @@ struct Run<'a, 'p> {
 }
 
 impl<'a, 'p> Run<'a, 'p> {
+    /// What the run's piece holds for the report, on the discretisation `disc`.
+    fn shares<'b>(&'b self, disc: &'b fe_assembly::Discretization<'b>) -> report::Shares<'b>
+    where
+        'a: 'b,
+    {
+        report::Shares {
+            petsc: self.petsc,
+            scene: self.scene,
+            setup: self.setup,
+            disc,
+            owned: self.owned,
+            global_node: &self.piece.global_node,
+            terminals: self.terminals,
+            own_cells: self.piece.own_cells,
+            cells: self.piece.n_global_cells,
+        }
+    }
+
     /// The run on the discretisation `disc`.
     fn on<'b>(&self, disc: &'b fe_assembly::Discretization<'b>) -> OnPiece<'b, 'p>
     where

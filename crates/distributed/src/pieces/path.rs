@@ -10,7 +10,7 @@
 //! is gathered. The instants the path writes hand each rank's piece of their fields to the
 //! caller, which writes them as they come.
 
-use super::{agree, nodal, report, History, OnPiece, PieceContact, Run, Solved};
+use super::{agree, nodal, History, OnPiece, PieceContact, Run, Solved};
 use crate::error::DistributedError;
 use crate::krylov::KrylovFields;
 use crate::system::System;
@@ -104,9 +104,8 @@ pub(super) fn walk<'p>(
         system.set_loads(petsc, disc, on.layout, (&loads.b_u, &loads.b_phi))?;
         let at = on.on(disc);
         let boundary = base.at_factors(f.gap, f.displacement, f.voltage);
-        let plan = &on.setup.plan;
         scale
-            .check(petsc, &boundary, &history, system.load_norm, plan)
+            .check(petsc, &boundary, &history, system.load_norm, &on.setup.plan)
             .map_err(|e| e.at_step(k, t))?;
         let before = history.shift.clone();
         let (x, s, contact) = at
@@ -121,8 +120,9 @@ pub(super) fn walk<'p>(
             row: &row,
             of: instants.len() - 1,
         });
-        let frame_cells = (spec.cell_fields && spec.has_fields(k, instants.len())).then(|| disc.recover(&u, &phi));
-        let frame = spec.has_fields(k, instants.len()).then(|| PieceFrame {
+        let written = spec.has_fields(k, instants.len());
+        let frame_cells = (spec.cell_fields && written).then(|| disc.recover(&u, &phi));
+        let frame = written.then(|| PieceFrame {
             mesh: disc.mesh,
             piece: on.piece,
             u: &u,
@@ -137,13 +137,16 @@ pub(super) fn walk<'p>(
         )?;
         rows.push(row);
         scale.seen(petsc, &contact.solution, system.load_norm)?;
-        history = History::after(&contact.solution, &x)?;
-        last = Some((x, contact));
+        history = History::after(&contact.solution, x);
+        last = Some(contact);
     }
-    let (x, contact) = last.ok_or_else(|| ProblemError::NoSolution {
-        sought: "a path on pieces",
-        why: "the path has no instant".into(),
-    })?;
+    let (Some(contact), Some(x)) = (last, history.x) else {
+        return Err(ProblemError::NoSolution {
+            sought: "a path on pieces",
+            why: "the path has no instant".into(),
+        }
+        .into());
+    };
     Ok(Walked {
         x,
         solved,
@@ -216,22 +219,22 @@ impl OwnScale {
 }
 
 impl<'p> History<'p> {
-    /// What the instant after `sol` (its solution vector `x`) starts from: friction's frame
+    /// What the instant after `sol` (its solution vector `x`, kept as the path's last) starts from: friction's frame
     /// where the points are now; their normal multipliers, the tangential ones zero: every point
     /// that presses is held where it is, and its reaction judges it (friction's elastic
     /// predictor; from the tangential multipliers too, a slipping point's `z_t` lies on the
     /// disc's edge, where the slip's spring across the direction is infinitely stiff).
-    fn after(sol: &contact::ContactSolution, x: &Vector<'p>) -> Result<Self, DistributedError> {
+    fn after(sol: &contact::ContactSolution, x: Vector<'p>) -> Self {
         let (n, nt) = (sol.lambda.normal.len(), sol.u.n_tangential());
         let mut shift = PointValues::zeros(n, nt);
         shift.tangential.clone_from(&sol.u.tangential);
         let mut pressed = PointValues::zeros(n, nt);
         pressed.normal.clone_from(&sol.lambda.normal);
-        Ok(History {
+        History {
             shift,
             lambda: Some(pressed),
-            x: Some(x.copy()?),
-        })
+            x: Some(x),
+        }
     }
 }
 
@@ -286,18 +289,9 @@ impl OnPiece<'_, '_> {
         if sums[4] > 0.0 {
             (row.depth, row.contact_radius) = (Some(maxima[2]), Some(maxima[3]));
         }
-        let shares = report::Shares {
-            petsc,
-            scene: self.scene,
-            setup: self.setup,
-            disc: self.disc,
-            owned: self.owned,
-            global_node: &self.piece.global_node,
-            terminals: self.terminals,
-            own_cells: self.piece.own_cells,
-            cells: self.piece.n_global_cells,
-        };
-        (row.charges, row.potentials) = shares
+        (row.charges, row.potentials) = self
+            .run
+            .shares(self.disc)
             .terminals(u, phi)?
             .into_iter()
             .map(|t| (t.charge, t.potential))

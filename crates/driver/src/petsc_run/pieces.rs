@@ -159,14 +159,13 @@ impl Series {
         let Some(f) = &step.frame else {
             return Ok(());
         };
-        let ghost: Vec<bool> = f.piece.cell_rank.iter().map(|&r| r != rank).collect();
         let stem = step_stem(step.row.step);
         let piece = Piece {
             mesh: f.mesh,
             fields: (f.u, f.phi),
             cells: f.cells,
             contact: Some(f.contact),
-            ghost: &ghost,
+            owner: (&f.piece.cell_rank, rank),
             node_id: &f.piece.global_node,
             cell_id: &f.piece.global_cell,
         };
@@ -189,13 +188,12 @@ impl Series {
 /// `.pvtu` naming the `ranks` pieces.
 fn piece_files(s: &distributed::PieceSolution, rank: usize, ranks: usize) -> (Vec<u8>, Vec<u8>) {
     let own = s.contact.as_ref().map(|c| &c.on_piece);
-    let ghost: Vec<bool> = s.piece.cell_rank.iter().map(|&r| r != rank).collect();
     Piece {
         mesh: &s.piece.mesh,
         fields: (&s.u, &s.phi),
         cells: Some(&s.fields),
         contact: own,
-        ghost: &ghost,
+        owner: (&s.piece.cell_rank, rank),
         node_id: &s.piece.global_node,
         cell_id: &s.piece.global_cell,
     }

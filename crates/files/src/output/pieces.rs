@@ -56,7 +56,7 @@ pub fn names_of_pieces(scene: &problem::Scene, ranks: usize) -> Vec<String> {
 }
 
 /// One rank's piece: its mesh (own and ghost cells), nodal fields, cell fields, its contact
-/// points (with nodes of its mesh), each cell's ghost flag and the whole mesh's numbers of its
+/// points (with nodes of its mesh), each cell's owner and the whole mesh's numbers of its
 /// nodes and cells.
 pub struct Piece<'a> {
     /// The piece's mesh.
@@ -68,8 +68,8 @@ pub struct Piece<'a> {
     /// The rank's contact points, where the run has contact (an empty set on a rank without
     /// any: every piece carries the same arrays).
     pub contact: Option<&'a ContactResult>,
-    /// Whether each cell is another rank's.
-    pub ghost: &'a [bool],
+    /// The rank that owns each cell, and this rank: a cell another rank owns is a ghost.
+    pub owner: (&'a [usize], usize),
     /// Each node's number in the whole mesh.
     pub node_id: &'a [usize],
     /// Each cell's number in the whole mesh.
@@ -98,7 +98,11 @@ impl Piece<'_> {
     /// The piece's `.vtu` (compressed on `mesh` where given) and the `.pvtu` of `stem`.
     fn encoded(&self, stem: &str, ranks: usize, mesh: Option<&vtu::CompressedMesh>) -> (Vec<u8>, Vec<u8>) {
         let data = FieldArrays::new(self.mesh, self.fields, self.cells, self.contact);
-        let ghost: Vec<u8> = self.ghost.iter().map(|&g| if g { DUPLICATE_CELL } else { 0 }).collect();
+        let (cell_rank, rank) = self.owner;
+        let ghost: Vec<u8> = cell_rank
+            .iter()
+            .map(|&r| if r != rank { DUPLICATE_CELL } else { 0 })
+            .collect();
         let node_id: Vec<u64> = self.node_id.iter().map(|&v| v as u64).collect();
         let cell_id: Vec<u64> = self.cell_id.iter().map(|&c| c as u64).collect();
         let mut point: Vec<Array<'_>> = data.point.iter().map(NamedValues::array).collect();
