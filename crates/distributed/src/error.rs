@@ -17,16 +17,32 @@ pub enum DistributedError {
     /// The active sets (the Krylov route's contact) did not converge.
     #[error("contact: {0}")]
     Contact(crate::contact::ActiveSetError),
+    /// PETSc's or the active sets' error at a path's step (the problem's own are wrapped as
+    /// the default backend wraps them, [`ProblemError::AtStep`]).
+    #[error("path step {step} (t = {t}): {source}")]
+    AtStep {
+        /// The step (0 is the path's first instant).
+        step: usize,
+        /// Its instant.
+        t: f64,
+        /// What stopped it.
+        source: Box<DistributedError>,
+    },
 }
 
 impl DistributedError {
     /// The error as at a path's step `step` (instant `t`): the problem's own wrapped as the
-    /// default backend's path wraps them, the others as they are.
+    /// default backend's path wraps them, the others in [`DistributedError::AtStep`].
     #[must_use]
     pub fn at_step(self, step: usize, t: f64) -> Self {
         match self {
             DistributedError::Problem(p) => DistributedError::Problem(p.at_step(step, t)),
-            other => other,
+            e @ DistributedError::AtStep { .. } => e,
+            other => DistributedError::AtStep {
+                step,
+                t,
+                source: Box::new(other),
+            },
         }
     }
 }

@@ -291,7 +291,7 @@ pub(crate) fn configure(
 
 /// What the Krylov solver needs to know of the unknowns: this rank's rows of the
 /// displacements (with their nodes' coordinates, for the rigid-body modes) and of the
-/// potentials.
+/// potentials (the floating terminals' among them).
 pub(crate) struct KrylovFields {
     dim: usize,
     u_rows: Vec<Index>,
@@ -309,9 +309,13 @@ impl KrylovFields {
             let f = layout.first[v];
             u_rows.extend((0..dim).map(|k| (f + k) as Index));
             coords.extend_from_slice(&setup.mesh.points[v][..dim]);
-            if layout.has_phi[v] {
+            if layout.has_phi[v] && layout.tie[v].is_none() {
                 phi_rows.push((f + dim) as Index);
             }
+        }
+        // the floating terminals' potentials
+        if petsc.rank() == layout.terminals_rank() {
+            phi_rows.extend((0..layout.terminals).map(|t| Layout::index(layout.terminal_row(t))));
         }
         KrylovFields {
             dim,

@@ -25,6 +25,13 @@ pub struct Layout {
     pub coupled: bool,
     /// Each rank's first unknown, and one past the last rank's (`ranks + 1` entries).
     pub rank_start: Vec<usize>,
+    /// The floating terminal (an index into the run's terminals, the same on every rank) whose
+    /// one potential each node's is tied to: such a node has no potential unknown of its own
+    /// (its cells' potential rows and columns are the terminal's, [`Layout::phi_row`]).
+    pub tie: Vec<Option<usize>>,
+    /// Floating terminals: each one's potential the last rank's, after its nodes' unknowns
+    /// ([`Layout::terminal_row`]).
+    pub terminals: usize,
 }
 
 impl Layout {
@@ -66,6 +73,8 @@ impl Layout {
             coupled: has_phi.iter().any(|&p| p),
             has_phi,
             rank_start,
+            tie: vec![None; n],
+            terminals: 0,
         })
     }
 
@@ -76,13 +85,23 @@ impl Layout {
     /// numbers its own nodes; the first unknown of a node another rank owns comes from that
     /// rank through a directory, a parallel vector indexed by the whole mesh's node numbers
     /// (each rank holds `1/p` of it). `piece.mesh` is not read: the run may have taken it for
-    /// its set-up. Collective.
-    pub fn of_piece(petsc: &Petsc, piece: &mesh::MeshPiece, dofs: &DofMap) -> Result<Layout, PetscError> {
+    /// its set-up. `(tie, terminals)`: the floating terminal each node's potential is tied to
+    /// (`dofs` untied: a potential at every node that carries one), and how many terminals the
+    /// whole run has; their potentials are the last rank's last unknowns. Collective.
+    pub fn of_piece(
+        petsc: &Petsc,
+        piece: &mesh::MeshPiece,
+        dofs: &DofMap,
+        (tie, terminals): (Vec<Option<usize>>, usize),
+    ) -> Result<Layout, PetscError> {
         let (rank, ranks, dim) = (petsc.rank(), petsc.size(), dofs.dim);
         let n = piece.global_node.len();
         let has_phi: Vec<bool> = (0..n).map(|v| !matches!(dofs.phi[v], Dof::Absent)).collect();
-        let width = |v: usize| dim + usize::from(has_phi[v]);
-        let mine: usize = (0..n).filter(|&v| piece.node_rank[v] == rank).map(width).sum();
+        let width = |v: usize| dim + usize::from(has_phi[v] && tie[v].is_none());
+        let mut mine: usize = (0..n).filter(|&v| piece.node_rank[v] == rank).map(width).sum();
+        if rank + 1 == ranks {
+            mine += terminals;
+        }
         let counts = petsc.all_gather(mine as u64)?;
         let mut rank_start = Vec::with_capacity(ranks + 1);
         let mut next = 0;
@@ -121,6 +140,8 @@ impl Layout {
             coupled,
             has_phi,
             rank_start,
+            tie,
+            terminals,
         })
     }
 
@@ -134,9 +155,29 @@ impl Layout {
         self.rank_start[rank]..self.rank_start[rank + 1]
     }
 
-    /// The unknowns of node `v`: `dim` displacements, then its potential if it has one.
+    /// The unknowns of node `v`: `dim` displacements, then its potential if it has one of its
+    /// own (not tied to a floating terminal's).
     pub fn node_dofs(&self, v: usize) -> std::ops::Range<usize> {
-        self.first[v]..self.first[v] + self.dim + usize::from(self.has_phi[v])
+        self.first[v]..self.first[v] + self.dim + usize::from(self.has_phi[v] && self.tie[v].is_none())
+    }
+
+    /// The row of node `v`'s potential: its own, or its floating terminal's; `None` where it
+    /// carries none.
+    pub fn phi_row(&self, v: usize) -> Option<usize> {
+        match self.tie[v] {
+            Some(t) => Some(self.terminal_row(t)),
+            None => self.has_phi[v].then_some(self.first[v] + self.dim),
+        }
+    }
+
+    /// The row of floating terminal `t`'s potential (the last rank's).
+    pub fn terminal_row(&self, t: usize) -> usize {
+        self.n_global() - self.terminals + t
+    }
+
+    /// The rank that owns the floating terminals' rows.
+    pub fn terminals_rank(&self) -> usize {
+        self.rank_start.len() - 2
     }
 
     /// The nodes `rank` owns, in the order of their unknowns.

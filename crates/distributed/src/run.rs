@@ -344,8 +344,7 @@ impl<'p> Backend for DistributedMemory<'p> {
                 self.petsc,
                 posed.disc,
                 &layout,
-                &posed.loads.b_u,
-                &posed.loads.b_phi,
+                (&posed.loads.b_u, &posed.loads.b_phi, &[]),
             )?),
         };
         Ok(Assembled { layout, system })
@@ -368,7 +367,12 @@ impl<'p> Backend for DistributedMemory<'p> {
             (Some(system), _) => system,
             (None, Some(why)) => {
                 why_krylov = Some(why);
-                assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?
+                assemble(
+                    self.petsc,
+                    posed.disc,
+                    &layout,
+                    (&posed.loads.b_u, &posed.loads.b_phi, &[]),
+                )?
             }
             // options for the Krylov solvers in a run that MUMPS factors: not ignored silently
             (None, None) if posed.scene.solver.petsc_options.is_some() => {
@@ -392,7 +396,12 @@ impl<'p> Backend for DistributedMemory<'p> {
                     e @ (PetscError::MumpsTooLarge { .. } | PetscError::Mumps { info: -13, .. }),
                 )) if self.contact == ContactRoute::Auto && self.active_sets_fit(posed, limits) => {
                     why_krylov = Some(e.to_string());
-                    assemble(self.petsc, posed.disc, &layout, &posed.loads.b_u, &posed.loads.b_phi)?
+                    assemble(
+                        self.petsc,
+                        posed.disc,
+                        &layout,
+                        (&posed.loads.b_u, &posed.loads.b_phi, &[]),
+                    )?
                 }
                 Err(e) => return Err(e),
             },

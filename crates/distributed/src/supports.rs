@@ -91,11 +91,16 @@ pub fn active_sets_hold_on(scene: &Scene, mesh: Option<&mesh::Mesh>) -> Result<(
     if scene.path.is_some() {
         return not_held("path", "a load path");
     }
+    // (the whole mesh's rows are node by node; pieces tie a terminal's nodes to one row)
+    if let Some(key) = scene.floating_key() {
+        return not_held(key, "a floating terminal");
+    }
     active_sets_hold_at_instants(scene, mesh)
 }
 
 /// [`active_sets_hold_on`] at each instant of a load path, friction's history carried from
-/// one to the next (as a run on pieces walks a path; the whole mesh's route does not).
+/// one to the next, floating terminals among the potentials (as a run on pieces walks a path
+/// and ties a terminal's nodes; the whole mesh's route does neither).
 ///
 /// # Errors
 /// [`Unsupported`] naming the key.
@@ -109,9 +114,6 @@ pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Me
     }
     if scene.mesh.axisymmetric {
         return not_held("mesh.axisymmetric", "a body of revolution");
-    }
-    if let Some(key) = scene.floating_key() {
-        return not_held(key, "a floating terminal");
     }
     if scene.solver.strategy != Strategy::NewtonCondensed {
         return not_held("solver.strategy", "a strategy other than Newton's");

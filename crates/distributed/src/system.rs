@@ -34,15 +34,15 @@ impl<'p> System<'p> {
     /// The right-hand side of other loads on the same matrix: `b_u`, `b_phi` over the free
     /// unknowns (prescribed values already lifted), the prescribed rows the diagonal times
     /// `disc`'s values (a load path's instant: its parts summed, its prescribed values
-    /// scaled). Collective.
+    /// scaled); `charges` those on the floating terminals ([`assemble`]). Collective.
     pub fn set_loads(
         &mut self,
         petsc: &'p Petsc,
         disc: &Discretization<'_>,
         layout: &Layout,
-        (b_u, b_phi): (&[f64], &[f64]),
+        (b_u, b_phi, charges): (&[f64], &[f64], &[f64]),
     ) -> Result<(), PetscError> {
-        let rows = Rows::of(petsc, disc, layout, (b_u, b_phi), self.diagonal)?;
+        let rows = Rows::of(petsc, disc, layout, (b_u, b_phi, charges), self.diagonal)?;
         (self.rhs, self.load_norm) = (rows.rhs, rows.load_norm);
         Ok(())
     }
@@ -58,13 +58,14 @@ impl<'p> System<'p> {
 }
 
 /// Assembles this rank's cells and rows. `b_u`, `b_phi` are the loads over the free unknowns
-/// (as `Discretization::rhs` gives them, the same on every rank). Collective.
+/// (as `Discretization::rhs` gives them, on a piece: its nodes' own), `charges` the charge put
+/// on each floating terminal of the layout (given once for the whole run, not in `b_phi`).
+/// Collective.
 pub fn assemble<'p>(
     petsc: &'p Petsc,
     disc: &Discretization<'_>,
     layout: &Layout,
-    b_u: &[f64],
-    b_phi: &[f64],
+    (b_u, b_phi, charges): (&[f64], &[f64], &[f64]),
 ) -> Result<System<'p>, PetscError> {
     let rank = petsc.rank();
     let mut matrix = preallocated(petsc, disc, layout)?;
@@ -90,7 +91,7 @@ pub fn assemble<'p>(
         if sums[2] > 0.0 { sums[0] / sums[2] } else { 1.0 },
         if sums[3] > 0.0 { sums[1] / sums[3] } else { 1.0 },
     ];
-    let rows = Rows::of(petsc, disc, layout, (b_u, b_phi), scale)?;
+    let rows = Rows::of(petsc, disc, layout, (b_u, b_phi, charges), scale)?;
     eliminate(petsc, &mut matrix, layout, [&rows.fixed_u, &rows.fixed_phi], scale)?;
     let (rhs, load_norm) = (rows.rhs, rows.load_norm);
     Ok(System {
@@ -111,12 +112,14 @@ struct Rows<'p> {
 
 impl<'p> Rows<'p> {
     /// The loads `b_u`, `b_phi` at this rank's free rows (the potential's negated), the
-    /// prescribed rows `scale` (the field's diagonal) times their values. Collective.
+    /// prescribed rows `scale` (the field's diagonal) times their values; a floating terminal's
+    /// row the sum of its nodes' `b_φ` over the ranks, less the charge put on it (docs/theory.md,
+    /// "Floating terminals on pieces"). Collective.
     fn of(
         petsc: &'p Petsc,
         disc: &Discretization<'_>,
         layout: &Layout,
-        (b_u, b_phi): (&[f64], &[f64]),
+        (b_u, b_phi, charges): (&[f64], &[f64], &[f64]),
         scale: [f64; 2],
     ) -> Result<Self, PetscError> {
         let rank = petsc.rank();
@@ -125,6 +128,8 @@ impl<'p> Rows<'p> {
         let (mut fixed_u, mut fixed_phi): (Vec<Index>, Vec<Index>) = (vec![], vec![]);
         let mut values = vec![0.0; owned.len()];
         let mut load_sq = 0.0;
+        // each terminal's b_φ: its nodes' (free, untied) summed, the charge subtracted once
+        let mut terminal = vec![0.0; layout.terminals];
         for v in layout.owned_nodes(rank) {
             let f = layout.first[v];
             for k in 0..layout.dim {
@@ -140,6 +145,10 @@ impl<'p> Rows<'p> {
                     Dof::Absent => 0.0,
                 };
             }
+            if let (Some(t), Dof::Free(j)) = (layout.tie[v], d.phi[v]) {
+                terminal[t] += b_phi[j];
+                continue;
+            }
             if layout.has_phi[v] {
                 let row = f + layout.dim;
                 values[row - owned.start] = match d.phi[v] {
@@ -153,6 +162,17 @@ impl<'p> Rows<'p> {
                     }
                     Dof::Absent => 0.0,
                 };
+            }
+        }
+        if layout.terminals > 0 {
+            let sums = petsc.sum(&terminal)?;
+            if rank == layout.terminals_rank() {
+                for (t, (b, q)) in sums.iter().zip(charges).enumerate() {
+                    // (the flux out of the body is -Q: Discretization::rhs's rule)
+                    let b = b - q;
+                    load_sq += b * b;
+                    values[layout.terminal_row(t) - owned.start] = -b;
+                }
             }
         }
         let rhs = Vector::from_local(petsc, &values)?;
@@ -197,7 +217,10 @@ pub fn element(disc: &Discretization<'_>, layout: &Layout, c: usize) -> (Vec<Ind
         rows.extend((0..dim).map(|k| Layout::index(layout.first[v] + k)));
     }
     if electric {
-        rows.extend(cell.iter().map(|&v| Layout::index(layout.first[v] + dim)));
+        // every node of an electric cell carries a potential (the dof map's rule): its own or
+        // its floating terminal's
+        let row = |v: usize| layout.phi_row(v).expect("an electric cell's node carries a potential");
+        rows.extend(cell.iter().map(|&v| Layout::index(row(v))));
     }
     let (m, r) = (disc.material(c), disc.rule(c));
     let mut ke = vec![0.0; ne * ne];
@@ -230,13 +253,19 @@ pub fn element(disc: &Discretization<'_>, layout: &Layout, c: usize) -> (Vec<Ind
 }
 
 /// The matrix with each owned row's entries counted: a row of node `v` holds the unknowns of
-/// every node that shares a cell with `v`, split into those of this rank and the others'.
+/// every node that shares a cell with `v`, split into those of this rank and the others'; a
+/// floating terminal's row those of every node next to its group (each rank counts the
+/// neighbours of the group's nodes it owns, and the counts are summed: a bound, where two
+/// ranks count one neighbour). Collective.
 fn preallocated<'p>(petsc: &'p Petsc, disc: &Discretization<'_>, layout: &Layout) -> Result<Matrix<'p>, PetscError> {
     let rank = petsc.rank();
     let owned = layout.owned(rank);
     let (off, adj) = disc.mesh.node_graph();
     let mut d_nnz = vec![0 as Index; owned.len()];
     let mut o_nnz = vec![0 as Index; owned.len()];
+    let terminals_rank = layout.terminals_rank();
+    // each terminal's row: its neighbours' unknowns on the terminals' rank, and on the others
+    let mut terminal = vec![0.0; 2 * layout.terminals];
     for v in layout.owned_nodes(rank) {
         let (mut d, mut o) = (0, 0);
         for &w in &adj[off[v]..off[v + 1]] {
@@ -246,10 +275,34 @@ fn preallocated<'p>(petsc: &'p Petsc, disc: &Discretization<'_>, layout: &Layout
             } else {
                 o += n;
             }
+            // a tied neighbour's potential: its terminal's column
+            if layout.tie[w].is_some() {
+                if rank == terminals_rank {
+                    d += 1;
+                } else {
+                    o += 1;
+                }
+            }
+            if let Some(t) = layout.tie[v] {
+                terminal[2 * t + usize::from(layout.node_rank[w] != terminals_rank)] += n as f64;
+            }
         }
         for r in layout.node_dofs(v) {
             d_nnz[r - owned.start] = d;
             o_nnz[r - owned.start] = o;
+        }
+    }
+    if layout.terminals > 0 {
+        let terminal = petsc.sum(&terminal)?;
+        if rank == terminals_rank {
+            let (mine, others) = (owned.len(), layout.n_global() - owned.len());
+            for t in 0..layout.terminals {
+                // (and every terminal's column: two terminals may share a cell)
+                let d = (terminal[2 * t] as usize + layout.terminals).min(mine);
+                let o = (terminal[2 * t + 1] as usize).min(others);
+                let r = layout.terminal_row(t) - owned.start;
+                (d_nnz[r], o_nnz[r]) = (d as Index, o as Index);
+            }
         }
     }
     // without potentials every node has `dim` unknowns: blocks for the multigrid

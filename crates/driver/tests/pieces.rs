@@ -40,6 +40,22 @@ const CASES: &[(&str, &[&str])] = &[
         "paper-3d",
         &["mesh.n=4", "mesh.hi=[1.0,1.0,1.0]", "contact.law=\"none\""],
     ),
+    // floating terminals: a pressed plate's open top (its voltage found), and a box's face
+    // carrying a charge, its group over several ranks (one row, the last rank's)
+    // (a charge on it: an open circuit's D is round-off, on both sides)
+    (
+        "sensor",
+        &["mesh.axisymmetric=false", "~mesh.revolve", "dirichlet.2.charge=1e-4"],
+    ),
+    (
+        "paper-3d",
+        &[
+            "mesh.n=6",
+            "contact.law=\"none\"",
+            "~dirichlet.1.phi",
+            "dirichlet.1.charge=2e-3",
+        ],
+    ),
 ];
 
 /// Scenes with contact that the active sets hold: Signorini, Tresca (uniform and a profile),
@@ -66,6 +82,17 @@ const CONTACT_CASES: &[(&str, &[&str])] = &[
     ),
     // a graded quarter model under a sphere: two symmetry planes through the contact face
     ("indent-sphere-3d", &["mesh.n=8"]),
+    // a floating terminal (a face carrying a charge, its potential found) beside the contact
+    ("paper", &["mesh.n=32", "~dirichlet.1.phi", "dirichlet.1.charge=-1e-3"]),
+    (
+        "paper-3d",
+        &[
+            "mesh.n=6",
+            "contact.friction=0.1",
+            "~dirichlet.1.phi",
+            "dirichlet.1.charge=2e-3",
+        ],
+    ),
     // a contact's closed form judged on the gathered points: Hertz's cylinder, and
     // Cattaneo-Mindlin's partial slip
     ("hertz", &["mesh.n=48"]),
@@ -180,11 +207,13 @@ fn agree_on_pieces(p: &Petsc) {
             (a, b) => assert_eq!(a.is_some(), b.is_some(), "{name}: an exact section on one side only"),
         }
         assert_eq!(s.report.terminals.len(), whole.report.terminals.len(), "{name}");
+        // (an open circuit's charges are round-off on both sides: against a floor of 1e-6 in
+        // the scenes' units, where the paper's terminals carry 3e-4)
         let scale = whole
             .report
             .terminals
             .iter()
-            .fold(f64::MIN_POSITIVE, |m, t| m.max(t.charge.abs()));
+            .fold(1e-6f64, |m, t| m.max(t.charge.abs()));
         for (a, b) in s.report.terminals.iter().zip(&whole.report.terminals) {
             assert_eq!(a.group, b.group);
             assert!(
@@ -194,10 +223,19 @@ fn agree_on_pieces(p: &Petsc) {
                 a.charge,
                 b.charge
             );
+            assert_eq!(a.floating, b.floating, "{name} {}", a.group);
+            // (a prescribed potential is exact; a floating terminal's is the Krylov solve's)
+            let tol = if b.floating {
+                1e-7 * b.potential.abs()
+            } else {
+                1e-12 * (1.0 + b.potential.abs())
+            };
             assert!(
-                (a.potential - b.potential).abs() <= 1e-12 * (1.0 + b.potential.abs()),
-                "{name} {}",
-                a.group
+                (a.potential - b.potential).abs() <= tol,
+                "{name} {}: potential {} against {}",
+                a.group,
+                a.potential,
+                b.potential
             );
         }
         for (what, d) in [("u", du), ("phi", dphi), ("stress", ds), ("D", dd)] {
@@ -357,6 +395,24 @@ const PATH_CASES: &[(&str, &[&str])] = &[
         ],
     ),
     ("paper-cycle", &["mesh.n=32", "path.steps=9"]),
+    // every point sticks from the first instant (their displacement is no scale of the
+    // body's), then slips at the unloaded turn: the instants after it are resolved
+    (
+        "paper-cycle",
+        &["mesh.n=32", "path.load=[0.2,1.0,0.0,1.0]", "path.steps=9"],
+    ),
+    // a floating terminal's charge along the path (scaled with the potentials' factor); at
+    // t = 0 the charge alone pulls the body onto the foundation, every touching point slipping
+    // (friction's predictor: from the loads alone the active sets cycle)
+    (
+        "paper-cycle",
+        &[
+            "mesh.n=32",
+            "path.steps=9",
+            "~dirichlet.1.phi",
+            "dirichlet.1.charge=1e-3",
+        ],
+    ),
     (
         "paper-tresca",
         &[
@@ -443,6 +499,17 @@ fn paths_on_pieces(p: &Petsc) {
             let q = b.iter().flat_map(|r| &r.charges).fold(1e-6f64, |m, c| m.max(c.abs()));
             for (cx, cy) in x.charges.iter().zip(&y.charges) {
                 assert!((cx - cy).abs() <= 1e-6 * q, "{name} step {k}: charge {cx} against {cy}");
+            }
+            // the terminals' potentials (a floating one's found at each instant)
+            let v = b
+                .iter()
+                .flat_map(|r| &r.potentials)
+                .fold(1e-12f64, |m, v| m.max(v.abs()));
+            for (vx, vy) in x.potentials.iter().zip(&y.potentials) {
+                assert!(
+                    (vx - vy).abs() <= 1e-7 * v,
+                    "{name} step {k}: potential {vx} against {vy}"
+                );
             }
             assert!(x.complementarity <= scene.solver.tol, "{name} step {k}");
         }
@@ -561,6 +628,18 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
         let e = refused(
             "paper-3d",
             &["mesh.n=4", "contact.law=\"none\"", "~dirichlet.1", "~dirichlet.0.phi"],
+        );
+        assert!(e.contains("the potential is floating"), "{e}");
+        // a floating terminal alone does not hold the potential's level (its own is unknown)
+        let e = refused(
+            "paper-3d",
+            &[
+                "mesh.n=4",
+                "contact.law=\"none\"",
+                "~dirichlet.0.phi",
+                "~dirichlet.1.phi",
+                "dirichlet.1.charge=1e-3",
+            ],
         );
         assert!(e.contains("the potential is floating"), "{e}");
         // a PZT layer on a non-electric substrate, its potential held nowhere: the electric

@@ -10,10 +10,11 @@
 //! parts completing each other (`parts`).
 //!
 //! What it solves today: a generated rectangle or box, or a Gmsh mesh of one body, of order 1
-//! (an error against a field solution summed over the ranks' own cells), without path or floating
-//! terminal, without contact or with the contact the active sets hold (the paper's base model
-//! on one zone: [`crate::active_sets_hold`]), each rank iterating on the contact points at
-//! the nodes it owns; every other scene is refused by key ([`pieces_support`]). The run's
+//! (an error against a field solution summed over the ranks' own cells), with floating
+//! terminals (`floating`), at one instant or along a load path, without contact or with the
+//! contact the active sets hold (the paper's base model on one zone:
+//! [`crate::active_sets_hold`]), each rank iterating on the contact points at the nodes it
+//! owns; every other scene is refused by key ([`pieces_support`]). The run's
 //! report is made of sums over the ranks ([`PieceSolution::report`]), completed on rank 0 from
 //! the gathered surfaces ([`PieceSolution::gathered`]); the driver writes each rank's piece of
 //! the solution.
@@ -23,6 +24,7 @@
 //! values are summed from the piece alone, and the fields of every own cell are recovered
 //! from the piece's nodal values.
 
+mod floating;
 mod gather;
 mod parts;
 mod path;
@@ -39,6 +41,7 @@ use crate::layout::Layout;
 use crate::system::{assemble, System};
 use crate::MAX_ACTIVE_SET_STEPS;
 use fe_assembly::CellFields;
+use floating::Floating;
 use mesh::{Blocks, MeshPiece};
 use petsc::{Index, Petsc, Vector};
 use problem::backend::{setup_piece, ContactBoundary, ContactSolve, Unsupported};
@@ -84,25 +87,15 @@ pub struct PieceSolution {
 }
 
 /// Whether a run on pieces solves `scene`: a generated rectangle or box (graded, layered or
-/// not; not rounded), or a Gmsh mesh, of order 1, without floating terminal, its contact (if
-/// any) one the active sets hold, at one instant or along a load path (an error against a
+/// not; not rounded), or a Gmsh mesh, of order 1, with or without floating terminals, its
+/// contact (if any) one the active sets hold, at one instant or along a load path (an error against a
 /// contact's closed form, Hertz's or Cattaneo-Mindlin's, from the points rank 0 gathers; the
 /// half-space's needs a body of revolution, which pieces do not take).
 ///
 /// # Errors
 /// [`Unsupported`], naming the key of what a run on pieces does not solve yet.
 pub fn pieces_support(scene: &Scene) -> Result<(), Unsupported> {
-    let refused = [(
-        scene.floating_key().is_some(),
-        scene.floating_key().unwrap_or(""),
-        "a floating terminal",
-    )];
-    let mesh = problem::backend::piece_refusal(&scene.mesh);
-    let scene_keys = refused
-        .into_iter()
-        .find(|(r, _, _)| *r)
-        .map(|(_, key, what)| (key, what));
-    if let Some((key, what)) = mesh.or(scene_keys) {
+    if let Some((key, what)) = problem::backend::piece_refusal(&scene.mesh) {
         return Err(Unsupported::new(NAME, key, format!("{what} on a mesh made in pieces"))
             .advise("a run whose every rank holds the whole mesh solves it"));
     }
@@ -161,13 +154,14 @@ pub fn solve_path_on_pieces(
     pieces_support(scene).map_err(ProblemError::from)?;
     let start = Instant::now();
     let generated = matches!(source, PieceMesh::Generated);
-    let (blocks, mut piece, setup, terminals) = set_up(petsc, valid, source, limits, reporter)?;
+    let (blocks, mut piece, setup, (terminals, floating)) = set_up(petsc, valid, source, limits, reporter)?;
     let mut disc = agree(petsc, setup.discretize().map_err(DistributedError::from), "discretise")?;
     held_on_pieces(petsc, &disc, &piece, generated)?;
+    let tie = floating.untie(&mut disc);
     let (b_u, b_phi) = agree(petsc, loads(&disc, &setup, valid), "assemble their loads")?;
     let t_setup = start.elapsed().as_secs_f64();
-    let layout = Layout::of_piece(petsc, &piece, &disc.dofs)?;
-    let mut system = assemble(petsc, &disc, &layout, &b_u, &b_phi)?;
+    let layout = Layout::of_piece(petsc, &piece, &disc.dofs, tie)?;
+    let mut system = assemble(petsc, &disc, &layout, (&b_u, &b_phi, &floating.charges(1.0)))?;
     let fields = KrylovFields::new(petsc, &setup, &layout);
     let t_assembly = start.elapsed().as_secs_f64() - t_setup;
     let owned: Vec<bool> = piece.node_rank.iter().map(|&r| r == petsc.rank()).collect();
@@ -179,6 +173,7 @@ pub fn solve_path_on_pieces(
         owned: &owned,
         piece: &piece,
         terminals: &terminals,
+        floating: &floating,
     };
     let (x, solved, contact, path) = instants(&run, &mut disc, (&mut system, &fields), (limits, reporter), each)?;
     let t_solve = start.elapsed().as_secs_f64() - t_setup - t_assembly;
@@ -396,15 +391,17 @@ fn held_on_pieces(
 
 /// This rank's piece set up: the blocks per axis (a mesh read: its parts, `[p, 1, 1]`), the
 /// piece (its mesh taken by the set-up), the set-up
-/// with the conditions that reach the piece, and the terminals' groups of the whole scene;
-/// the plan and units reported. Collective.
+/// with the conditions that reach the piece, and the terminals' groups of the whole scene with
+/// its floating terminals (their charges taken out of the set-up's loads); the plan and units
+/// reported. Collective.
+#[allow(clippy::type_complexity)]
 fn set_up(
     petsc: &Petsc,
     valid: problem::Valid<'_>,
     source: PieceMesh,
     limits: problem::Limits,
     reporter: &mut dyn Reporter,
-) -> Result<([usize; 3], MeshPiece, problem::backend::Setup, Vec<String>), DistributedError> {
+) -> Result<([usize; 3], MeshPiece, problem::backend::Setup, (Vec<String>, Floating)), DistributedError> {
     let scene = valid.scene();
     // a mesh read is numbered as its generator made it, which puts neighbours far apart in
     // memory: its pieces are numbered along a space-filling curve (the generated grid's order
@@ -437,8 +434,9 @@ fn set_up(
     reporter.event(&Event::Planned(&setup.plan));
     reporter.event(&Event::Units(&setup.units));
     let terminals: Vec<String> = terminal_groups(&setup).into_iter().map(String::from).collect();
+    let floating = Floating::take(&mut setup);
     conditions_on_the_piece(petsc, &mut setup)?;
-    Ok((blocks, piece, setup, terminals))
+    Ok((blocks, piece, setup, (terminals, floating)))
 }
 
 /// How a solve on the pieces went.
@@ -519,6 +517,8 @@ struct Run<'a, 'p> {
     piece: &'a MeshPiece,
     /// The terminals' groups of the whole scene.
     terminals: &'a [String],
+    /// The floating terminals of the whole scene, with their charges.
+    floating: &'a Floating,
 }
 
 impl<'a, 'p> Run<'a, 'p> {
@@ -535,6 +535,8 @@ impl<'a, 'p> Run<'a, 'p> {
             owned: self.owned,
             global_node: &self.piece.global_node,
             terminals: self.terminals,
+            floating: self.floating,
+            tie: &self.layout.tie,
             own_cells: self.piece.own_cells,
             cells: self.piece.n_global_cells,
         }
@@ -768,10 +770,14 @@ pub struct PieceContact {
 }
 
 /// The solution `x` at every node of the piece: each node's unknowns fetched from the rank
-/// that owns them (the displacements, then the potential where the node has one).
+/// that owns them (the displacements, then the potential where the node has one: its own or
+/// its floating terminal's).
 fn nodal(x: &Vector<'_>, layout: &Layout) -> Result<(Vec<[f64; 3]>, Vec<f64>), DistributedError> {
     let n = layout.first.len();
-    let rows: Vec<Index> = (0..n).flat_map(|v| layout.node_dofs(v)).map(Layout::index).collect();
+    let rows: Vec<Index> = (0..n)
+        .flat_map(|v| (layout.first[v]..layout.first[v] + layout.dim).chain(layout.phi_row(v)))
+        .map(Layout::index)
+        .collect();
     let values = x.fetch(&rows)?;
     let (mut u, mut phi) = (vec![[0.0; 3]; n], vec![0.0; n]);
     let mut at = 0;

@@ -96,12 +96,7 @@ pub(super) fn walk<'p>(
     for (k, &t) in instants.iter().enumerate() {
         let f = spec.factors(t);
         disc.dofs.rescale(&prescribed, f.displacement, f.voltage);
-        let loads = agree(
-            petsc,
-            problem::step_loads(&parts, &f, scene).map_err(DistributedError::from),
-            "scale their loads",
-        )?;
-        system.set_loads(petsc, disc, on.layout, (&loads.b_u, &loads.b_phi))?;
+        pose(on, disc, system, &parts, &f)?;
         let at = on.on(disc);
         let boundary = base.at_factors(f.gap, f.displacement, f.voltage);
         scale
@@ -136,7 +131,7 @@ pub(super) fn walk<'p>(
             "hand on an instant of the path",
         )?;
         rows.push(row);
-        scale.seen(petsc, &contact.solution, system.load_norm)?;
+        scale.seen(petsc, &u, system.load_norm)?;
         history = History::after(&contact.solution, x);
         last = Some(contact);
     }
@@ -161,11 +156,34 @@ pub(super) fn walk<'p>(
     })
 }
 
-/// The displacement an instant's own data make, told from the instants solved: the points'
+/// Sets `system`'s right-hand side to the instant of factors `f`: the parts of the loads
+/// summed at `f` (`disc`'s prescribed values already scaled), the floating terminals' charges
+/// scaled with the prescribed potentials, as the default backend's parts scale them.
+/// Collective.
+fn pose<'p>(
+    on: &Run<'_, 'p>,
+    disc: &Discretization<'_>,
+    system: &mut System<'p>,
+    parts: &fe_assembly::RhsParts,
+    f: &problem::Factors,
+) -> Result<(), DistributedError> {
+    let loads = agree(
+        on.petsc,
+        problem::step_loads(parts, f, on.scene).map_err(DistributedError::from),
+        "scale their loads",
+    )?;
+    let charges = on.floating.charges(f.voltage);
+    system.set_loads(on.petsc, disc, on.layout, (&loads.b_u, &loads.b_phi, &charges))?;
+    Ok(())
+}
+
+/// The displacement an instant's own data make, told from the instants solved: the body's
 /// largest displacement at the instant of the largest loads so far, in proportion to the
 /// instant's loads (`K` is the same along the path), for the check that friction's history
 /// does not drown an instant in round-off ([`problem::check_history_scales`], the default
-/// backend's, which tells the scale from the parts' responses instead).
+/// backend's, which tells the scale from the parts' responses at the points instead). The
+/// body's, not the points': where every point sticks from the first instant on, the points do
+/// not move however the body deforms, and a scale of zero refused every instant after a slip.
 #[derive(Default)]
 struct OwnScale {
     /// The largest load norm so far, and the points' largest displacement then.
@@ -196,20 +214,10 @@ impl OwnScale {
         problem::check_history_scales(most[0], loaded.max(most[1]), plan).map_err(DistributedError::from)
     }
 
-    /// Takes in the solved instant of `load_norm`: the peak where its loads are the largest.
-    /// Collective.
-    fn seen(
-        &mut self,
-        petsc: &petsc::Petsc,
-        sol: &contact::ContactSolution,
-        load_norm: f64,
-    ) -> Result<(), DistributedError> {
-        let own = sol
-            .u
-            .normal
-            .iter()
-            .chain(&sol.u.tangential)
-            .fold(0.0f64, |m, v| m.max(v.abs()));
+    /// Takes in the solved instant of `load_norm` (its displacements `u` at the piece's
+    /// nodes): the peak where its loads are the largest. Collective.
+    fn seen(&mut self, petsc: &petsc::Petsc, u: &[[f64; 3]], load_norm: f64) -> Result<(), DistributedError> {
+        let own = u.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
         let u = petsc.max(&[own])?[0];
         if self.peak.is_none_or(|(load, _)| load_norm > load) {
             self.peak = Some((load_norm, u));

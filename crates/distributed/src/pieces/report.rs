@@ -26,6 +26,10 @@ pub(super) struct Shares<'a> {
     /// The terminals' groups (those of the whole scene, before the piece dropped the
     /// conditions it does not reach).
     pub(super) terminals: &'a [String],
+    /// The floating terminals among them.
+    pub(super) floating: &'a super::Floating,
+    /// The floating terminal each node's potential is tied to (the layout's).
+    pub(super) tie: &'a [Option<usize>],
     /// This rank's own cells.
     pub(super) own_cells: usize,
     /// The whole mesh's cells.
@@ -61,9 +65,11 @@ impl Shares<'_> {
             free_u += (0..dim)
                 .filter(|&k| matches!(dofs.u[v * dim + k], Dof::Free(_)))
                 .count() as f64;
-            free_phi += f64::from(u8::from(matches!(dofs.phi[v], Dof::Free(_))));
+            // (a floating terminal's potential counted once, below)
+            free_phi += f64::from(u8::from(matches!(dofs.phi[v], Dof::Free(_)) && self.tie[v].is_none()));
         }
         let sums = petsc.sum(&[free_u, free_phi, nodes])?;
+        let free_phi = sums[1] as usize + self.floating.len();
         let h = petsc.max(&[setup.mesh.h_max()])?[0];
         let info = f.contact.map(|c| &c.solution.info);
         let equilibrium = f.contact.map_or(f.equilibrium, |c| c.equilibrium);
@@ -92,7 +98,7 @@ impl Shares<'_> {
             },
             dofs: DofsReport {
                 u: sums[0] as usize,
-                phi: sums[1] as usize,
+                phi: free_phi,
             },
             contact: Default::default(),
             exact,
@@ -165,7 +171,7 @@ impl Shares<'_> {
                 group: group.to_string(),
                 potential: petsc.sum(&[mine])?[0],
                 charge,
-                floating: false,
+                floating: self.floating.holds(group),
             });
         }
         Ok(out)
