@@ -375,6 +375,58 @@ fn what_a_path_writes_changes_none_of_its_contact() {
     }
 }
 
+/// A written instant's fields, made of the path's parts summed at its factors and the solve of
+/// its contact forces alone (`Instants::frames_superposed`), are the fields of a path that
+/// ends at that instant, whose last instant is solved whole: `paper-cycle` written at every
+/// instant against the same path cut at its peak (t = 1) and at its unloaded turn (t = 2),
+/// with the same instants before. And the written rows' equilibrium is measured, within
+/// 1e-11.
+#[test]
+fn a_written_instant_s_fields_are_those_of_a_path_that_ends_there() {
+    let path = |t: &str, load: &str, steps: usize, every: usize| {
+        let sets = [
+            "mesh.n=32".to_string(),
+            format!("path.t={t}"),
+            format!("path.load={load}"),
+            format!("path.steps={steps}"),
+            format!("path.output_every={every}"),
+        ];
+        let (scene, _) = scene_file::load("paper-cycle", &sets).unwrap();
+        let mut written = vec![];
+        let p = problem::solve_path(&scene, None, Limits::default(), &mut Silent, true, &mut |step| {
+            if let Some(f) = &step.fields {
+                written.push((step.row.t, f.u.to_vec(), f.phi.to_vec()));
+            }
+            Ok(())
+        })
+        .unwrap();
+        (p, written)
+    };
+    let (whole, written) = path("[0.0,1.0,2.0,3.0]", "[0.0,1.0,0.0,1.0]", 9, 1);
+    let rows = &whole.last.report.path.as_ref().unwrap().rows;
+    assert_eq!(written.len(), rows.len());
+    for r in rows {
+        assert!(
+            r.equilibrium.is_some_and(|e| e <= 1e-11),
+            "step {}: {:?}",
+            r.step,
+            r.equilibrium
+        );
+    }
+    for (t, load, steps) in [(1.0, "[0.0,1.0]", 3), (2.0, "[0.0,1.0,0.0]", 6)] {
+        let ts = if steps == 3 { "[0.0,1.0]" } else { "[0.0,1.0,2.0]" };
+        let (cut, _) = path(ts, load, steps, 0);
+        let (_, u, phi) = written.iter().find(|(s, _, _)| (s - t).abs() < 1e-12).unwrap();
+        let gap = |a: &[f64], b: &[f64]| {
+            let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+        };
+        let flat = |u: &[[f64; 3]]| u.iter().flatten().copied().collect::<Vec<f64>>();
+        let (du, dphi) = (gap(&flat(u), &flat(&cut.last.u)), gap(phi, &cut.last.phi));
+        assert!(du < 1e-9 && dphi < 1e-9, "t = {t}: u {du:e}, phi {dphi:e}");
+    }
+}
+
 /// `cattaneo-mindlin-cycle` with slip-weakening friction (the coefficient at each point's slip
 /// accumulated in contact along the path).
 fn weakening_cycle(n: usize, static_coefficient: f64, dynamic: f64) -> Vec<StepRowLite> {

@@ -33,6 +33,9 @@ pub struct Condensed {
     pub loads: CondensedLoads,
 }
 
+/// A solution split into its displacements and its potentials `(u, φ)`.
+pub type Split = (Vec<f64>, Vec<f64>);
+
 /// The loads' part of a condensation: the solution at `c` under the loads alone, and what the
 /// final solve with a change of the right-hand side at `c` needs.
 #[derive(Debug)]
@@ -100,6 +103,52 @@ impl DirectLdlt {
         self.factor.solve_in_place(&mut rhs);
         let phi = rhs.split_off(n_u);
         Ok((rhs, phi))
+    }
+
+    /// `K⁻¹ Σ_i d_i e_{c_i}` for each `d` of `updates` (values at the dofs `c`, in `dofs`'
+    /// order), solved together, where the factor's order ends with `dofs` (as a condensation's
+    /// trailing-block route orders them): the forward half of such a right-hand side is the
+    /// trailing block's alone (`L_cc⁻¹ d`, dense), so each solve costs a backward sweep, and
+    /// the sweeps of all are one. `None` where the factor's order does not end with `dofs`
+    /// (the caller then solves in full).
+    ///
+    /// # Errors
+    /// [`LinalgError::Shape`] where an update does not have one value per dof.
+    pub fn solve_trailing_many(&self, dofs: &[usize], updates: &[&[f64]]) -> Result<Option<Vec<Split>>, LinalgError> {
+        let (k, m) = (dofs.len(), updates.len());
+        if let Some(d) = updates.iter().find(|d| d.len() != k) {
+            return Err(ShapeError::CondensedValues {
+                values: d.len(),
+                dofs: k,
+            }
+            .into());
+        }
+        let fwd = self.factor.permutation();
+        let n = fwd.len();
+        if k == 0 || k > n || fwd[n - k..] != *dofs || m == 0 {
+            return Ok(None);
+        }
+        // the forward halves, index by index: zero but on the trailing indices
+        let mut y = vec![0.0; n * m];
+        for (j, d) in updates.iter().enumerate() {
+            let Some(tail) = self.factor.trailing_forward(d) else {
+                return Ok(None);
+            };
+            for (i, v) in tail.into_iter().enumerate() {
+                y[(n - k + i) * m + j] = v;
+            }
+        }
+        let Some(xs) = self.factor.backward_many(y, m) else {
+            return Ok(None);
+        };
+        Ok(Some(
+            xs.into_iter()
+                .map(|mut x| {
+                    let phi = x.split_off(self.n_u);
+                    (x, phi)
+                })
+                .collect(),
+        ))
     }
 
     /// The trailing-block route, where the factor's order ends with `dofs`; `None` otherwise.

@@ -176,7 +176,7 @@ impl CoupledSolver for SchurPcg {
 /// One `L D Lᵀ` of `K` (lower triangle built from the blocks).
 pub struct DirectLdlt {
     pub(crate) factor: SparseFactor,
-    n_u: usize,
+    pub(crate) n_u: usize,
     buf: Vec<f64>,
 }
 

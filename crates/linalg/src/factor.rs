@@ -619,18 +619,27 @@ impl SparseFactor {
     /// (`L` is block lower triangular, so such a change reaches no earlier index). `false`
     /// where the trailing indices are not all in the last supernode.
     pub(crate) fn forward_update_trailing(&self, y: &mut [f64], d: &[f64]) -> bool {
-        let k = d.len();
-        let Some(l) = self.trailing_block(k) else {
+        let Some(z) = self.trailing_forward(d) else {
             return false;
         };
-        let mut z = d.to_vec();
-        let zm = MatMut::from_column_major_slice_mut(&mut z, k, 1);
-        faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place(l, zm, Par::Seq);
         let n = self.n();
-        for (yi, zi) in y[n - k..].iter_mut().zip(&z) {
+        for (yi, zi) in y[n - d.len()..].iter_mut().zip(&z) {
             *yi += zi;
         }
         true
+    }
+
+    /// `L_cc⁻¹ d`: the forward half, on the last `d.len()` indices of the factor's order, of a
+    /// right-hand side that is `d` there and zero elsewhere (`L` is block lower triangular, so
+    /// it is zero on every earlier index). `None` where those indices are not all in the last
+    /// supernode.
+    pub(crate) fn trailing_forward(&self, d: &[f64]) -> Option<Vec<f64>> {
+        let k = d.len();
+        let l = self.trailing_block(k)?;
+        let mut z = d.to_vec();
+        let zm = MatMut::from_column_major_slice_mut(&mut z, k, 1);
+        faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place(l, zm, Par::Seq);
+        Some(z)
     }
 
     /// The last `k` entries of the solution `Pᵀ L⁻ᵀ D⁻¹ y` (in the factor's order), from the
@@ -688,6 +697,29 @@ impl SparseFactor {
             x[old] = y[new];
         }
         Some(x)
+    }
+
+    /// The backward halves of several solves at once: `x_j = Pᵀ L⁻ᵀ D⁻¹ y_j` for the `k`
+    /// forward results in `y` (in the factor's order, index by index: `y[i k + j]`, consumed),
+    /// returned column by column in the original order. One sweep reads the factor once for
+    /// every column (on the tree where it solves, else column by column). `None` unless the
+    /// factor is a supernodal `L D Lᵀ`.
+    pub(crate) fn backward_many(&self, mut y: Vec<f64>, k: usize) -> Option<Vec<Vec<f64>>> {
+        let (sym, fwd) = self.supernodal_ldlt()?;
+        let n = self.n();
+        if let Some(tree) = self.tree_sweeps() {
+            tree.backward(sym, &self.values, &mut y, k);
+            let mut out = vec![vec![0.0; n]; k];
+            for (new, &old) in fwd.iter().enumerate() {
+                for (j, x) in out.iter_mut().enumerate() {
+                    x[old] = y[new * k + j];
+                }
+            }
+            return Some(out);
+        }
+        (0..k)
+            .map(|j| self.backward((0..n).map(|i| y[i * k + j]).collect()))
+            .collect()
     }
 
     /// The tree, where its sweeps solve: a factor made on it, solved on a pool of several

@@ -6,7 +6,7 @@
 
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Par;
-use linalg::{DirectLdlt, FactorKind, Ordering, SparseFactor};
+use linalg::{CoupledSolver, DirectLdlt, FactorKind, Ordering, SparseFactor};
 
 /// `K` of an `m x m` grid: `A = L ⊗ I₂ + I`, `B = L + I` (`L` the graph Laplacian with random
 /// positive edge weights), `G` coupling each potential to its node's and its neighbours'
@@ -193,6 +193,46 @@ fn the_condensation_reads_the_same_trailing_block_off_the_parallel_factor() {
     let (up, pp) = on_threads(2, || par.solve_with_update(cp.loads, &b_u, &b_phi, &d)).unwrap();
     assert!(relative_gap(&up, &us) < 1e-12);
     assert!(relative_gap(&pp, &ps) < 1e-12);
+}
+
+/// Solves whose right-hand sides are zero but at the trailing dofs, solved together by their
+/// backward sweeps alone, are each the full solve of that right-hand side (on one core and on
+/// the tree's two); dofs the factor does not end with are declined.
+#[test]
+fn trailing_right_hand_sides_solved_together_are_full_solves() {
+    let m = 50;
+    let (a, g, b) = grid(m, 3);
+    let (n_u, n_phi) = (a.nrows(), b.nrows());
+    let last: Vec<usize> = (0..2 * m).collect();
+    let ordering = Ordering::GivenThenLast {
+        order: dissection(m),
+        last: last.clone(),
+    };
+    let updates: Vec<Vec<f64>> = (0..5)
+        .map(|s| (0..last.len()).map(|i| ((i * (3 + s)) % 7) as f64 - 3.0).collect())
+        .collect();
+    let views: Vec<&[f64]> = updates.iter().map(|d| &d[..]).collect();
+    for threads in [1, 2] {
+        let mut f = on_threads(threads, || DirectLdlt::new(&a, &g, &b, &ordering, Par::rayon(threads))).unwrap();
+        let got = on_threads(threads, || f.solve_trailing_many(&last, &views))
+            .unwrap()
+            .expect("the factor ends with the dofs");
+        assert_eq!(got.len(), updates.len());
+        for (d, (u, phi)) in updates.iter().zip(&got) {
+            let mut b_u = vec![0.0; n_u];
+            for (&i, v) in last.iter().zip(d) {
+                b_u[i] = *v;
+            }
+            let (mut x, mut y) = (vec![0.0; n_u], vec![0.0; n_phi]);
+            on_threads(threads, || f.solve(&b_u, &vec![0.0; n_phi], &mut x, &mut y)).unwrap();
+            assert!(relative_gap(u, &x) < 1e-12, "{threads} threads");
+            assert!(relative_gap(phi, &y) < 1e-12, "{threads} threads");
+        }
+        let mut other = last.clone();
+        other.reverse();
+        assert!(f.solve_trailing_many(&other, &views).unwrap().is_none());
+        assert!(f.solve_trailing_many(&last, &[&[1.0][..]]).is_err());
+    }
 }
 
 /// Several right-hand sides solved together are each one's own solve (on one core and on the

@@ -364,6 +364,10 @@ pub struct Loads {
     pub b_u: Vec<f64>,
     /// On the free potentials.
     pub b_phi: Vec<f64>,
+    /// The factors of a path's parts that these loads sum, in the backend's order of the
+    /// parts (the loads, each displacement component's lifting, the potentials'); `None`
+    /// where the loads are no such sum (a static scene's).
+    pub factors: Option<Vec<f64>>,
 }
 
 /// The fields of an instant ([`Backend::instant_fields`]).

@@ -88,7 +88,11 @@ pub(crate) fn capacitance<B: Backend>(
             scene: valid,
             setup: &setup,
             disc: &disc,
-            loads: Loads { b_u, b_phi },
+            loads: Loads {
+                b_u,
+                b_phi,
+                factors: None,
+            },
             bed: None,
         };
         // one preparation for every column: the matrix does not change with the potentials

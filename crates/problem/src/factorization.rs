@@ -101,6 +101,19 @@ pub trait Factorization {
             .collect()
     }
 
+    /// `K⁻¹ Σ_i d_i e_{c_i}` for each `d` of `updates` (values at the condensation's dofs
+    /// `dofs`), solved together, where the factorisation can solve such right-hand sides for
+    /// less than full solves (a factor whose order ends with `dofs`: a backward sweep each,
+    /// [`linalg::DirectLdlt::solve_trailing_many`]); `None` otherwise (the caller solves in
+    /// full).
+    ///
+    /// # Errors
+    /// The solver's.
+    fn solve_trailing_many(&mut self, dofs: &[usize], updates: &[&[f64]]) -> Result<Option<Vec<Fields>>, ProblemError> {
+        let _ = (dofs, updates);
+        Ok(None)
+    }
+
     /// `‖K x - b‖ / max(‖b‖, scale)` ([`linalg::equilibrium_residual`]).
     ///
     /// # Errors

@@ -871,10 +871,9 @@ impl Walk<'_> {
             return Ok((self.first.clone(), None));
         };
         disc.dofs.rescale(&self.prescribed, f.displacement, f.voltage);
-        let mut factors = vec![f.load];
-        factors.extend_from_slice(&f.displacement[..self.setup.mesh.dim]);
-        factors.push(f.voltage);
-        Ok((step_loads(parts, f, self.scene)?, Some(factors)))
+        let loads = step_loads(parts, f, self.scene)?;
+        let factors = loads.factors.clone();
+        Ok((loads, factors))
     }
 
     /// A path's parts of the right-hand side in the backend's order: the loads, each
@@ -1471,7 +1470,15 @@ pub fn step_loads(parts: &RhsParts, f: &Factors, scene: &Scene) -> Result<Loads,
     let b_phi = combine(|p| &p.1);
     ProblemError::check_finite(&b_u, "the mechanical load vector", scene)?;
     ProblemError::check_finite(&b_phi, "the electric load vector", scene)?;
-    Ok(Loads { b_u, b_phi })
+    // (the parts' order: Walk::ordered_parts')
+    let mut factors = vec![f.load];
+    factors.extend(f.displacement.iter().take(parts.displacements.len()));
+    factors.push(f.voltage);
+    Ok(Loads {
+        b_u,
+        b_phi,
+        factors: Some(factors),
+    })
 }
 
 /// Whether an instant can be resolved at its own scale `own` (the displacement its

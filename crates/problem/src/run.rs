@@ -85,7 +85,11 @@ pub(crate) fn pose<'a>(
         scene,
         setup,
         disc,
-        loads: Loads { b_u, b_phi },
+        loads: Loads {
+            b_u,
+            b_phi,
+            factors: None,
+        },
         bed: None,
     })
 }

@@ -166,6 +166,15 @@ pub(super) const REFINE_TOL: f64 = 1e-14;
 /// step's own cost (measured on `paper-cycle`, n = 128: 1 to 3 refinement steps tripled it).
 pub(super) const PATH_REFINE_TOL: f64 = 1e-12;
 
+/// The equilibrium residual above which a written instant's fields summed from the path's
+/// parts are refined ([`super::Instants::frames_superposed`]): the sum carries the parts'
+/// round-off where the loads and the contact forces cancel (3.5e-12 to 3.7e-12 on every
+/// written instant of `paper-cycle` at n = 256, against about 1e-12 for a solve of the
+/// whole right-hand side), so that 1e-12 refined every one of them, at the price of the full
+/// solve the sum saves. Still 1000 times below what a run must reach
+/// ([`crate::EQUILIBRIUM_TOL`]).
+pub(super) const SUPERPOSED_REFINE_TOL: f64 = 1e-11;
+
 impl Refining<'_> {
     /// The fields are those of the last solve: refined, and the contact law judged on them
     /// (not on the condensed problem's own displacement); where the compliance lost digits to
@@ -211,13 +220,14 @@ impl Refining<'_> {
     }
 }
 
+/// A right-hand side `(b_u, b_φ)` with the size of the parts it is made of (`linalg::Rhs`'s
+/// `scale`), owned.
+pub(crate) type ScaledRhs = (Vec<f64>, Vec<f64>, f64);
+
 /// The right-hand sides with the contact forces of `contact` (and the electric flux, with
 /// electrical contact), and the size of their parts (the loads, the contact forces: they may
 /// cancel in the sum).
-pub(crate) fn rhs_with_contact(
-    posed: &Posed<'_>,
-    contact: Option<(&ContactBoundary, &ContactSolution)>,
-) -> (Vec<f64>, Vec<f64>, f64) {
+pub(crate) fn rhs_with_contact(posed: &Posed<'_>, contact: Option<(&ContactBoundary, &ContactSolution)>) -> ScaledRhs {
     let loads = &posed.loads;
     let (mut b_full, mut b_phi) = (loads.b_u.clone(), loads.b_phi.clone());
     let mut scale = linalg::norm(&loads.b_u).hypot(linalg::norm(&loads.b_phi));
@@ -238,7 +248,7 @@ pub(crate) fn rhs_with_contact(
 }
 
 /// The right-hand side `(b_u, b_φ)` of size `scale`, as linalg takes it.
-pub(super) fn rhs<'a>((b_u, b_phi, scale): &'a (Vec<f64>, Vec<f64>, f64)) -> linalg::Rhs<'a> {
+pub(super) fn rhs<'a>((b_u, b_phi, scale): &'a ScaledRhs) -> linalg::Rhs<'a> {
     linalg::Rhs {
         u: b_u,
         phi: b_phi,

@@ -16,9 +16,10 @@ use crate::progress::{Event, Reporter};
 use crate::scene::ZoneElectric;
 use crate::ProblemError;
 pub(crate) use condensed::rhs_with_contact;
+use condensed::ScaledRhs;
 use condensed::{
     condense_reported, fields_at_points, in_frame, law_residual, note_condensed, rhs, Operator, Refining,
-    PATH_REFINE_TOL, REFINE_TOL,
+    PATH_REFINE_TOL, REFINE_TOL, SUPERPOSED_REFINE_TOL,
 };
 use contact::{
     ContactOperator, ContactPoints, ContactSolution, DenseContactProblem, ElectricContactProblem, NewtonParams,
@@ -63,6 +64,11 @@ struct Condensed {
     /// `x_q`'s displacement part, per part of a path's right-hand side, in their order
     /// (empty for one instant).
     parts: Vec<Vec<f64>>,
+    /// `x_q` whole, per part (empty for one instant): a written instant's fields are their
+    /// sum at its factors and the solve of its contact forces alone ([`Instants::frames_superposed`]).
+    solved: Vec<Fields>,
+    /// The dofs of the condensation, in its order.
+    dofs: Vec<usize>,
 }
 
 /// The condensed problem with electrical contact, its loads part and `u⁰`, `φ⁰`, and a path's
@@ -145,11 +151,25 @@ impl Instants {
             reporter,
         )?;
         let solved = solve_parts(f, parts)?;
+        // the parts' solutions refined (a written instant's sum of them is refined against its
+        // own right-hand side after: unrefined parts left every one a refinement step to take)
+        let mut refined = solved.clone();
+        let measures: Vec<_> = parts
+            .iter()
+            .map(|(b_u, b_phi)| linalg::Rhs {
+                u: b_u,
+                phi: b_phi,
+                scale: 0.0,
+            })
+            .collect();
+        f.refine_many(&measures, &mut refined, REFINE_TOL)?;
         self.kept = Kept::Condensed(Condensed {
             first: dense.u0.clone(),
             dense,
+            dofs: condensed.dofs().to_vec(),
             loads: Some(condensed),
             parts: solved.iter().map(|(u, _)| u.clone()).collect(),
+            solved: refined,
         });
         Ok(solved)
     }
@@ -329,16 +349,51 @@ impl Instants {
         f: &mut dyn Factorization,
         frames: Vec<(Posed<'_>, InstantOf<'_>)>,
     ) -> Result<Vec<InstantSolution>, ProblemError> {
-        let b: Vec<_> = frames
-            .iter()
-            .map(|(posed, of)| rhs_with_contact(posed, Some((of.framed.boundary, &of.sol))))
-            .collect();
+        let b = frames_rhs(&frames);
         let columns: Vec<(&[f64], &[f64])> = b.iter().map(|(b_u, b_phi, _)| (&b_u[..], &b_phi[..])).collect();
-        let mut solved = f.solve_many(&columns)?;
+        let solved = f.solve_many(&columns)?;
+        Self::refined_frames(f, frames, (&b, PATH_REFINE_TOL), solved)
+    }
+
+    /// [`Instants::frames`], each written instant's solve made of the path's parts' solutions
+    /// summed at its factors, `Σ_q f_q x_q`, and the solve of its contact forces alone at the
+    /// condensation's dofs, `K⁻¹ Rᵀ W λ`, which a factor ordered with those dofs last solves
+    /// by its backward sweep (the forward half is the trailing block's,
+    /// [`Factorization::solve_trailing_many`]); then refined as [`Instants::frames`] refines
+    /// them, against the whole right-hand side. Where an instant's loads are not the parts'
+    /// sum (a bed's springs, electrical contact) or the factor cannot, as [`Instants::frames`].
+    ///
+    /// # Errors
+    /// The factorisation's; a field that is not finite.
+    pub fn frames_superposed(
+        &self,
+        f: &mut dyn Factorization,
+        frames: Vec<(Posed<'_>, InstantOf<'_>)>,
+    ) -> Result<Vec<InstantSolution>, ProblemError> {
+        let Kept::Condensed(c) = &self.kept else {
+            return Self::frames(f, frames);
+        };
+        match c.superposed(f, &frames)? {
+            Some(solved) => {
+                let b = frames_rhs(&frames);
+                Self::refined_frames(f, frames, (&b, SUPERPOSED_REFINE_TOL), solved)
+            }
+            None => Self::frames(f, frames),
+        }
+    }
+
+    /// The written instants' fields `solved` (of the right-hand sides `b`) refined together
+    /// where their residual is above `tol`, checked and measured.
+    fn refined_frames(
+        f: &mut dyn Factorization,
+        frames: Vec<(Posed<'_>, InstantOf<'_>)>,
+        (b, tol): (&[ScaledRhs], f64),
+        mut solved: Vec<Fields>,
+    ) -> Result<Vec<InstantSolution>, ProblemError> {
         let measures: Vec<_> = b.iter().map(rhs).collect();
-        let refined = f.refine_many(&measures, &mut solved, PATH_REFINE_TOL)?;
+        let refined = f.refine_many(&measures, &mut solved, tol)?;
         let mut out = Vec::with_capacity(frames.len());
-        for ((((_, of), (u, phi)), b), refined) in frames.into_iter().zip(solved).zip(&b).zip(refined) {
+        for ((((_, of), (u, phi)), b), refined) in frames.into_iter().zip(solved).zip(b).zip(refined) {
             let mut sol = of.sol;
             if let Some(values) = &mut sol.electric {
                 // the potentials reported are the refined fields'
@@ -460,7 +515,7 @@ impl Instants {
 fn measured(
     f: &mut dyn Factorization,
     (u, phi): (&[f64], &[f64]),
-    b: &(Vec<f64>, Vec<f64>, f64),
+    b: &ScaledRhs,
     refined: Option<f64>,
 ) -> Result<f64, ProblemError> {
     match refined {
@@ -475,7 +530,7 @@ fn finished(
     f: &mut dyn Factorization,
     x: Fields,
     sol: ContactSolution,
-    b: &(Vec<f64>, Vec<f64>, f64),
+    b: &ScaledRhs,
     refined: Option<f64>,
 ) -> Result<InstantSolution, ProblemError> {
     let equilibrium = measured(f, (&x.0, &x.1), b, refined)?;
@@ -517,6 +572,55 @@ fn electric_solve(
 }
 
 impl Condensed {
+    /// The written instants' solves as [`Instants::frames_superposed`] makes them: the parts'
+    /// solutions at each instant's factors plus the solve of its contact forces alone (all
+    /// together); `None` where an instant's loads are not the parts' sum at known factors, it
+    /// has a bed or electrical contact, a contact force falls outside the condensation's dofs,
+    /// or the factorisation cannot solve them so.
+    fn superposed(
+        &self,
+        f: &mut dyn Factorization,
+        frames: &[(Posed<'_>, InstantOf<'_>)],
+    ) -> Result<Option<Vec<Fields>>, ProblemError> {
+        if self.solved.is_empty() || self.dofs.is_empty() {
+            return Ok(None);
+        }
+        let at: std::collections::HashMap<usize, usize> = self.dofs.iter().enumerate().map(|(i, &d)| (d, i)).collect();
+        let mut updates = Vec::with_capacity(frames.len());
+        let mut factors = Vec::with_capacity(frames.len());
+        for (posed, of) in frames {
+            let boundary = of.framed.boundary;
+            let Some(fs) = posed.loads.factors.as_ref().filter(|fs| fs.len() == self.solved.len()) else {
+                return Ok(None);
+            };
+            if posed.bed.is_some() || boundary.electric.is_some() {
+                return Ok(None);
+            }
+            let mut d = vec![0.0; self.dofs.len()];
+            for (j, force) in boundary.dofs.iter().zip(boundary.forces(&of.sol.lambda)) {
+                let Some(&i) = at.get(j) else {
+                    return Ok(None);
+                };
+                d[i] += force;
+            }
+            updates.push(d);
+            factors.push(fs);
+        }
+        let views: Vec<&[f64]> = updates.iter().map(|d| &d[..]).collect();
+        let Some(mut solved) = f.solve_trailing_many(&self.dofs, &views)? else {
+            return Ok(None);
+        };
+        for ((u, phi), fs) in solved.iter_mut().zip(factors) {
+            for ((pu, pphi), &w) in self.solved.iter().zip(fs) {
+                if w != 0.0 {
+                    u.iter_mut().zip(pu).for_each(|(x, p)| *x += w * p);
+                    phi.iter_mut().zip(pphi).for_each(|(x, p)| *x += w * p);
+                }
+            }
+        }
+        Ok(Some(solved))
+    }
+
     /// Adds the displacement of the forces of the multipliers `lambda` to the primed
     /// instant's `u⁰` (the springs that hold a body only its bed holds, which act as
     /// multipliers).
@@ -539,6 +643,14 @@ impl Condensed {
         }
         Ok(())
     }
+}
+
+/// Each written instant's right-hand side with its contact forces ([`rhs_with_contact`]).
+fn frames_rhs(frames: &[(Posed<'_>, InstantOf<'_>)]) -> Vec<ScaledRhs> {
+    frames
+        .iter()
+        .map(|(posed, of)| rhs_with_contact(posed, Some((of.framed.boundary, &of.sol))))
+        .collect()
 }
 
 /// `Σ_q f_q x_q`: the parts `x_q` of a path's right-hand side's solution (all of one length)

@@ -144,8 +144,8 @@ impl Backend for SharedMemory {
         frames: Vec<(Posed<'_>, InstantOf<'_>)>,
         _: &mut dyn Reporter,
     ) -> Result<Vec<Option<InstantSolution>>, ProblemError> {
-        let Factored { linear, .. } = system;
-        let solved = Instants::frames(linear, frames)?;
+        let Factored { linear, instants } = system;
+        let solved = instants.frames_superposed(linear, frames)?;
         Ok(solved.into_iter().map(Some).collect())
     }
 
@@ -306,6 +306,13 @@ impl Factorization for Linear {
         match &mut self.solver {
             LinearSolver::Direct(direct) => Ok(direct.solve_many(rhs)?),
             LinearSolver::SchurPcg(_) => rhs.iter().map(|(b_u, b_phi)| Ok(self.solve(b_u, b_phi)?.0)).collect(),
+        }
+    }
+
+    fn solve_trailing_many(&mut self, dofs: &[usize], updates: &[&[f64]]) -> Result<Option<Vec<Fields>>, ProblemError> {
+        match &self.solver {
+            LinearSolver::Direct(direct) => Ok(direct.solve_trailing_many(dofs, updates)?),
+            LinearSolver::SchurPcg(_) => Ok(None),
         }
     }
 
