@@ -56,6 +56,19 @@ const CASES: &[(&str, &[&str])] = &[
             "dirichlet.1.charge=2e-3",
         ],
     ),
+    // two floating terminals, one a partial electrode, which share cells (their rows couple)
+    (
+        "paper-3d",
+        &[
+            "mesh.n=8",
+            "contact.law=\"none\"",
+            "~dirichlet.0.phi",
+            "dirichlet.0.charge=1e-3",
+            "electrode.group=\"top\"",
+            "electrode.charge=-2e-3",
+            "electrode.x_range=[0.25,1.75]",
+        ],
+    ),
 ];
 
 /// Scenes with contact that the active sets hold: Signorini, Tresca (uniform and a profile),
@@ -1223,7 +1236,10 @@ fn place(x: &[f64; 3]) -> [i64; 3] {
 fn gmsh_parts_agree_with_the_whole_mesh_on_three_ranks() {
     on_ranks("gmsh_parts_agree_with_the_whole_mesh_on_three_ranks", 3, |p| {
         let parts = mesh::parts_of(&forms().join("3d-ascii-split.msh"));
-        for sets in [vec!["contact.law=\"none\""], vec![]] {
+        // (the third: the right face a floating terminal carrying a charge, its group over the
+        // parts)
+        let floating = vec!["~dirichlet.1.phi", "dirichlet.1.charge=1e-3"];
+        for sets in [vec!["contact.law=\"none\""], vec![], floating] {
             let sets: Vec<String> = sets.into_iter().map(String::from).collect();
             let faer = scene_file::parse(LAYERED, "layered-gmsh", &sets).expect("the scene");
             let mut with = sets.clone();
@@ -1252,6 +1268,25 @@ fn gmsh_parts_agree_with_the_whole_mesh_on_three_ranks() {
             assert_eq!(s.report.mesh.n_cells, whole.mesh.n_cells());
             assert_eq!(s.report.mesh.n_nodes, whole.mesh.n_nodes());
             assert_eq!(s.report.dofs, whole.report.dofs, "{sets:?}: the free unknowns");
+            assert_eq!(s.report.terminals.len(), whole.report.terminals.len(), "{sets:?}");
+            for (a, b) in s.report.terminals.iter().zip(&whole.report.terminals) {
+                assert_eq!((&a.group, a.floating), (&b.group, b.floating), "{sets:?}");
+                let close = |x: f64, y: f64| (x - y).abs() <= 1e-7 * y.abs().max(1e-6);
+                assert!(
+                    close(a.charge, b.charge),
+                    "{sets:?} {}: charge {} against {}",
+                    a.group,
+                    a.charge,
+                    b.charge
+                );
+                assert!(
+                    close(a.potential, b.potential),
+                    "{sets:?} {}: potential {} against {}",
+                    a.group,
+                    a.potential,
+                    b.potential
+                );
+            }
             let mut dl = 0.0f64;
             if let (Some(wc), Some(c)) = (&whole.contact, &s.contact) {
                 let index: std::collections::HashMap<usize, usize> =
