@@ -762,17 +762,20 @@ fn path_picture(
         2..=4 => format!("tangential force along {}", &FACTORS[driver][1..]),
         _ => "tangential force (magnitude)".to_string(),
     };
+    // (a frictionless path has no tangential force: no line of zeros for it, no loop)
+    let friction = rows.iter().any(|r| r.tangential_force != 0.0);
+    let mut forces = vec![Series::line("normal force", over(&|r| (r.t, r.normal_force)))];
+    if friction {
+        forces.push(Series::line("tangential force", over(&|r| (r.t, r.tangential_force))));
+    }
     let mut panels = vec![Panel {
         title: "Contact forces along the path".into(),
         labels: ("t".into(), units.label("force", "force")),
-        series: vec![
-            Series::line("normal force", over(&|r| (r.t, r.normal_force))),
-            Series::line("tangential force", over(&|r| (r.t, r.tangential_force))),
-        ],
+        series: forces,
     }];
-    // friction's loop where there is friction (a frictionless path has no tangential force),
-    // against the quantity the driving factor scales where the scene prescribes one
-    if rows.iter().any(|r| r.tangential_force != 0.0) {
+    // friction's loop where there is friction, against the quantity the driving factor scales
+    // where the scene prescribes one
+    if friction {
         let (scale, x_label, what) = match driven(scene, driver) {
             Some((value, quantity, name)) => (value, units.label(&name, quantity), name),
             None => {
