@@ -97,8 +97,10 @@ impl Layout {
         let (rank, ranks, dim) = (petsc.rank(), petsc.size(), dofs.dim);
         let n = piece.global_node.len();
         let has_phi: Vec<bool> = (0..n).map(|v| !matches!(dofs.phi[v], Dof::Absent)).collect();
-        let width = |v: usize| dim + usize::from(has_phi[v] && tie[v].is_none());
-        let mut mine: usize = (0..n).filter(|&v| piece.node_rank[v] == rank).map(width).sum();
+        let width: Vec<usize> = (0..n)
+            .map(|v| dim + usize::from(has_phi[v] && tie[v].is_none()))
+            .collect();
+        let mut mine: usize = (0..n).filter(|&v| piece.node_rank[v] == rank).map(|v| width[v]).sum();
         if rank + 1 == ranks {
             mine += terminals;
         }
@@ -110,25 +112,39 @@ impl Layout {
             next += *c as usize;
         }
         rank_start.push(next);
-        // the directory: at each node's whole-mesh number, its first unknown (exact in f64 to
-        // 2^53), set by its owner
+        // the directory: at each node's whole-mesh number `g`, its first unknown (at 2 g, exact
+        // in f64 to 2^53) and what its potential is (at 2 g + 1: 0 none, 1 its own, 2 + t
+        // floating terminal t's), set by its owner. A node of the piece's ghost cells alone
+        // takes both from its owner, who sees every cell around it: its piece may see none
+        // of the electric cells, or of the terminal's facets, that the node has.
         let (lo, hi) = petsc.split(piece.n_global_nodes);
-        let mut directory = Vector::mpi(petsc, hi - lo)?;
-        let mut first = vec![usize::MAX; n];
+        let mut directory = Vector::mpi(petsc, 2 * (hi - lo))?;
+        let (mut first, mut has_phi, mut tie) = (vec![usize::MAX; n], has_phi, tie);
         let (mut at, mut values) = (vec![], vec![]);
         let mut f = rank_start[rank];
         for v in (0..n).filter(|&v| piece.node_rank[v] == rank) {
             first[v] = f;
-            at.push(Layout::index(piece.global_node[v]));
-            values.push(f as f64);
-            f += width(v);
+            let code = match (has_phi[v], tie[v]) {
+                (false, _) => 0,
+                (true, None) => 1,
+                (true, Some(t)) => 2 + t,
+            };
+            at.extend([2 * piece.global_node[v], 2 * piece.global_node[v] + 1].map(Layout::index));
+            values.extend([f as f64, code as f64]);
+            f += width[v];
         }
         directory.set_values(&at, &values)?;
         directory.assemble()?;
         let others: Vec<usize> = (0..n).filter(|&v| piece.node_rank[v] != rank).collect();
-        let asked: Vec<Index> = others.iter().map(|&v| Layout::index(piece.global_node[v])).collect();
-        for (&v, x) in others.iter().zip(directory.fetch(&asked)?) {
-            first[v] = x as usize;
+        let asked: Vec<Index> = others
+            .iter()
+            .flat_map(|&v| [2 * piece.global_node[v], 2 * piece.global_node[v] + 1])
+            .map(Layout::index)
+            .collect();
+        for (&v, x) in others.iter().zip(directory.fetch(&asked)?.chunks_exact(2)) {
+            first[v] = x[0] as usize;
+            let code = x[1] as usize;
+            (has_phi[v], tie[v]) = (code > 0, code.checked_sub(2));
         }
         let here = f64::from(u8::from(has_phi.iter().any(|&p| p)));
         let coupled = petsc.max(&[here])?[0] > 0.0;
