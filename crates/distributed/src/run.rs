@@ -259,8 +259,20 @@ fn direct_estimate(scene: &Scene, mesh: Option<(&mesh::Mesh, bool)>, ranks: usiz
         .max_by(|a, b| a.0.total_cmp(&b.0))?;
     Some((
         bytes / ranks.max(1) as f64,
-        format!("on each of {ranks} ranks, its share of MUMPS' factorisation: {what}"),
+        format!(
+            "on each of {ranks} ranks, its share of MUMPS' factorisation: {what}{}",
+            in_parts(scene, mesh.is_some(), ranks)
+        ),
     ))
+}
+
+/// Where a run of `scene` reads its mesh whole on several ranks and a run on pieces would take
+/// it, the way past one rank's memory that is not a coarser mesh: the mesh in parts.
+fn in_parts(scene: &Scene, read: bool, ranks: usize) -> &'static str {
+    match read && ranks > 1 && crate::pieces_support(scene).is_ok() {
+        true => "; saved in one part per rank, the Gmsh mesh runs on pieces instead, no rank holding it whole nor a factorisation (README: \"a Gmsh mesh in parts\")",
+        false => "",
+    }
 }
 
 /// The cells laid out over the ranks, and (the Krylov route) the system assembled on them.
@@ -599,7 +611,8 @@ fn per_rank_estimate(scene: &Scene, mesh: Option<(&mesh::Mesh, bool)>, ranks: us
     Some((
         bytes,
         format!(
-            "on each of {ranks} ranks: {share:.3e} of the {unknowns:.3e} unknowns, and the whole mesh of {cells:.3e} cells"
+            "on each of {ranks} ranks: {share:.3e} of the {unknowns:.3e} unknowns, and the whole mesh of {cells:.3e} cells{}",
+            in_parts(scene, mesh.is_some(), ranks)
         ),
     ))
 }

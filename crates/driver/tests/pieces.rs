@@ -978,6 +978,38 @@ fn forms() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../mesh/tests/fixtures/forms")
 }
 
+/// A Gmsh mesh read whole on several ranks, too large for a rank's memory, is refused before
+/// anything is built, and the refusal says the way past it that is not a coarser mesh: the
+/// mesh saved in parts, which runs on pieces.
+#[test]
+fn a_whole_gmsh_mesh_too_large_for_its_ranks_is_told_of_its_parts() {
+    on_ranks(
+        "a_whole_gmsh_mesh_too_large_for_its_ranks_is_told_of_its_parts",
+        2,
+        |p| {
+            let sets = [
+                "solver.backend=\"petsc\"".to_string(),
+                "contact.law=\"none\"".to_string(),
+            ];
+            let scene = scene_file::parse(LAYERED, "layered-gmsh", &sets).expect("the scene");
+            let mesh = mesh::read_msh(forms().join("3d-ascii.msh")).expect("the whole file");
+            let limits = problem::Limits {
+                memory_bytes: Some(1 << 20),
+                memory_limit: Some("a test's limit"),
+                ..Default::default()
+            };
+            let e = distributed::solve(&scene, Some(mesh), p, limits, &mut problem::Silent)
+                .map(|_| ())
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("the run needs about") && e.contains("one part per rank"),
+                "{e}"
+            );
+        },
+    );
+}
+
 /// The layered box on a Gmsh mesh: both layers PZT-5A (a substrate of half its stiffness),
 /// clamped at x = 0 and x = 2, pressed on top, on a Coulomb foundation at z = 0.
 const LAYERED: &str = r#"
