@@ -167,17 +167,23 @@ fn the_tree_on_two_cores_factors_as_faer_does_on_one() {
     }
 }
 
-#[test]
-fn the_condensation_reads_the_same_trailing_block_off_the_parallel_factor() {
-    let m = 70;
-    let (a, g, b) = grid(m, 3);
-    let (n_u, n_phi) = (a.nrows(), b.nrows());
-    // the displacements of the grid's first row, as contact dofs would be
+/// The displacements of an `m x m` grid's first row, as contact dofs would be, and the
+/// grid's nested dissection with them last.
+fn first_row_last(m: usize) -> (Vec<usize>, Ordering) {
     let last: Vec<usize> = (0..2 * m).collect();
     let ordering = Ordering::GivenThenLast {
         order: dissection(m),
         last: last.clone(),
     };
+    (last, ordering)
+}
+
+#[test]
+fn the_condensation_reads_the_same_trailing_block_off_the_parallel_factor() {
+    let m = 70;
+    let (a, g, b) = grid(m, 3);
+    let (n_u, n_phi) = (a.nrows(), b.nrows());
+    let (last, ordering) = first_row_last(m);
     let b_u: Vec<f64> = (0..n_u).map(|i| ((i * 13) % 7) as f64 - 3.0).collect();
     let b_phi: Vec<f64> = (0..n_phi).map(|i| ((i * 5) % 3) as f64).collect();
     let mut seq = DirectLdlt::new(&a, &g, &b, &ordering, Par::Seq).unwrap();
@@ -203,11 +209,7 @@ fn trailing_right_hand_sides_solved_together_are_full_solves() {
     let m = 50;
     let (a, g, b) = grid(m, 3);
     let (n_u, n_phi) = (a.nrows(), b.nrows());
-    let last: Vec<usize> = (0..2 * m).collect();
-    let ordering = Ordering::GivenThenLast {
-        order: dissection(m),
-        last: last.clone(),
-    };
+    let (last, ordering) = first_row_last(m);
     let updates: Vec<Vec<f64>> = (0..5)
         .map(|s| (0..last.len()).map(|i| ((i * (3 + s)) % 7) as f64 - 3.0).collect())
         .collect();
