@@ -195,6 +195,16 @@ impl<'a> Flat<'a> {
         *self.asymmetry.get_or_init(|| self.d.asymmetry())
     }
 
+    /// The asymmetry where it was computed (or given), without computing it.
+    pub(super) fn known_asymmetry(&self) -> Option<f64> {
+        self.asymmetry.get().copied()
+    }
+
+    /// Gives the compliance's asymmetry, known from an earlier solve of the same `D`.
+    pub(super) fn know_asymmetry(&mut self, asymmetry: f64) {
+        let _ = self.asymmetry.set(asymmetry);
+    }
+
     /// The natural map's constant of a row whose own compliance is `own`: its inverse, within
     /// `[1/μ_max, 10⁸/μ_max]`.
     fn local_constant(&self, own: f64) -> f64 {

@@ -644,11 +644,14 @@ pub fn solve_newton<P: AffineProblem>(
 /// What the Newton solves of one compliance `D` share, whatever their loads `u₀` and their
 /// law's data (a load path's steps, a fixed point's steps on the friction coefficients, the
 /// corrections of a solve by the refined fields): the directions' factorisation of `D` (its
-/// inverse, `m³` flops: at 1022 rows 0.05 s, more than the steps of a warm-started solve), and
-/// the estimate of `μ_max`. Hand the same cache only to solves of one `D` (and weights).
+/// inverse, `m³` flops: at 1022 rows 0.05 s, more than the steps of a warm-started solve), the
+/// estimate of `μ_max`, and `D`'s asymmetry (an `m²` pass: at 1026 rows about 2 ms of a
+/// path's 7 ms instant). Hand the same cache only to solves of one `D` (and weights).
 #[derive(Default)]
 pub struct NewtonCache {
     directions: Option<Directions>,
+    /// `D`'s largest relative asymmetry, where a solve of the mechanical rows read it.
+    asymmetry: Option<f64>,
     /// The insulated problem's answer of a coupled problem (`Some(None)` where its solve
     /// failed).
     insulated: Option<Option<PointValues>>,
@@ -699,14 +702,19 @@ pub fn solve_newton_cached<P: AffineProblem>(
     let u0 = problem.loads().clone();
     let mut flat = Flat::new(problem.compliance(), &u0, points, law, nt, mu_max);
     flat.weakening = params.weakening;
+    if let Some(a) = cache.asymmetry {
+        flat.know_asymmetry(a);
+    }
     info.augmentation = Some(1.0 / mu_max);
     let asked = Asked { points, law, params };
+    let in_sweeps = Directions::step_in_sweeps(&flat);
+    cache.asymmetry = flat.known_asymmetry();
     let x0 = match sweeps_first(
         problem,
         asked,
         (mu_max, reference),
         &start,
-        Directions::step_in_sweeps(&flat),
+        in_sweeps,
         &mut info,
         progress,
     )? {
@@ -718,6 +726,7 @@ pub fn solve_newton_cached<P: AffineProblem>(
         judge.seed = Some(judge.flat.state(vec![0.0; x0.len()]).norm);
     }
     let (best, best_residual, stall) = judge.run_stages(x0, params, &mut info, progress, &mut cache.directions)?;
+    cache.asymmetry = judge.flat.known_asymmetry();
     let Some(reason) = stall else {
         let (lambda, u) = (judge.flat.values(&best.x), judge.flat.values(&best.u));
         info.complementarity = judge.complementarity(&best);

@@ -194,8 +194,19 @@ impl Instants {
                 let nt = c.dense.nt;
                 match factors {
                     Some(factors) => {
-                        let x0 = superpose(c.parts.iter().map(|u| &u[..]), factors);
-                        c.dense.u0 = in_frame(fields_at_points(framed.boundary, &x0, nt), Some(framed.shift));
+                        // each part read at the points, then summed (the points' values are
+                        // linear in the field: no sum over the whole field)
+                        let at_points: Vec<PointValues> = c
+                            .parts
+                            .iter()
+                            .map(|u| fields_at_points(framed.boundary, u, nt))
+                            .collect();
+                        let normal = superpose(at_points.iter().map(|p| &p.normal[..]), factors);
+                        let tangential = superpose(at_points.iter().map(|p| &p.tangential[..]), factors);
+                        let n = framed.boundary.points.len();
+                        let x0 = PointValues::from_parts(normal, tangential, nt)
+                            .unwrap_or_else(|_| PointValues::zeros(n, nt));
+                        c.dense.u0 = in_frame(x0, Some(framed.shift));
                         c.loads = None;
                     }
                     None => c.dense.u0.clone_from(&c.first),
