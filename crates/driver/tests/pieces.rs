@@ -666,6 +666,21 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
             &["mesh.n=4", "contact.law=\"none\"", "~dirichlet.1", "~dirichlet.0.phi"],
         );
         assert!(e.contains("the potential is floating"), "{e}");
+        // loads finite one by one whose squares overflow: named as the default backend names
+        // them (it was the Krylov solve's NaN, with advice on PETSc's options)
+        for (set, named) in [
+            ("load.p=1e308", "load.p = 1e308"),
+            ("dirichlet.1.charge=1e308", "dirichlet.charge = 1e308"),
+        ] {
+            let e = refused(
+                "paper-3d",
+                &["mesh.n=4", "contact.law=\"none\"", "~dirichlet.1.phi", set],
+            );
+            assert!(
+                e.contains("the norm of the loads is not finite") && e.contains(named),
+                "{e}"
+            );
+        }
         // a floating terminal alone does not hold the potential's level (its own is unknown)
         let e = refused(
             "paper-3d",

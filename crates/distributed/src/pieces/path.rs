@@ -174,6 +174,8 @@ fn pose<'p>(
     )?;
     let charges = on.floating.charges(f.voltage);
     system.set_loads(on.petsc, disc, on.layout, (&loads.b_u, &loads.b_phi, &charges))?;
+    // (as the run's first loads: finite one by one, their squares may overflow)
+    ProblemError::check_finite(&[system.load_norm], "the norm of the loads", on.scene)?;
     Ok(())
 }
 

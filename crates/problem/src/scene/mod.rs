@@ -595,6 +595,7 @@ impl Scene {
             add("dirichlet.uy", d.uy.as_slice());
             add("dirichlet.uz", d.uz.as_slice());
             add("dirichlet.phi", d.phi.as_slice());
+            add("dirichlet.charge", d.charge.as_slice());
         }
         for l in self.loads() {
             add("load.p", &[l.p]);
@@ -620,6 +621,12 @@ impl Scene {
             add("contact.slip_length", c.slip_length.as_slice());
             add("contact.foundation_potential", c.foundation_potential.as_slice());
             add("contact.conductance", c.conductance.as_slice());
+            add("contact.charge", c.charge.as_slice());
+            if let Some(i) = &c.indenter {
+                add("contact.indenter.radius", i.radius.as_slice());
+                add("contact.indenter.depth", &[i.depth]);
+                add("contact.indenter.force", i.force.as_slice());
+            }
         }
         out
     }
