@@ -309,7 +309,7 @@ impl KrylovFields {
             let f = layout.first[v];
             u_rows.extend((0..dim).map(|k| (f + k) as Index));
             coords.extend_from_slice(&setup.mesh.points[v][..dim]);
-            if layout.has_phi[v] && layout.tie[v].is_none() {
+            if layout.own_phi(v) {
                 phi_rows.push((f + dim) as Index);
             }
         }

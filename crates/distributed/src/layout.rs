@@ -174,7 +174,13 @@ impl Layout {
     /// The unknowns of node `v`: `dim` displacements, then its potential if it has one of its
     /// own (not tied to a floating terminal's).
     pub fn node_dofs(&self, v: usize) -> std::ops::Range<usize> {
-        self.first[v]..self.first[v] + self.dim + usize::from(self.has_phi[v] && self.tie[v].is_none())
+        self.first[v]..self.first[v] + self.dim + usize::from(self.own_phi(v))
+    }
+
+    /// Whether node `v` has a potential unknown of its own (it carries a potential, not tied
+    /// to a floating terminal's).
+    pub fn own_phi(&self, v: usize) -> bool {
+        self.has_phi[v] && self.tie[v].is_none()
     }
 
     /// The row of node `v`'s potential: its own, or its floating terminal's; `None` where it

@@ -188,7 +188,7 @@ fn pose<'p>(
 /// not move however the body deforms, and a scale of zero refused every instant after a slip.
 #[derive(Default)]
 struct OwnScale {
-    /// The largest load norm so far, and the points' largest displacement then.
+    /// The largest load norm so far, and the body's largest displacement then.
     peak: Option<(f64, f64)>,
 }
 

@@ -168,10 +168,10 @@ pub(super) const PATH_REFINE_TOL: f64 = 1e-12;
 
 /// The equilibrium residual above which a written instant's fields summed from the path's
 /// parts are refined ([`super::Instants::frames_superposed`]): the sum carries the parts'
-/// round-off where the loads and the contact forces cancel (3.5e-12 to 3.7e-12 on every
-/// written instant of `paper-cycle` at n = 256, against about 1e-12 for a solve of the
-/// whole right-hand side), so that 1e-12 refined every one of them, at the price of the full
-/// solve the sum saves. Still 1000 times below what a run must reach
+/// round-off where the loads and the contact forces cancel (up to 4.5e-12 on the written
+/// instants of `paper-cycle` at n = 256, against about 1e-12 for a solve of the whole
+/// right-hand side), so that 1e-12 refined every one of them, at the price of the full solve
+/// the sum saves. Still 1000 times below what a run must reach
 /// ([`crate::EQUILIBRIUM_TOL`]).
 pub(super) const SUPERPOSED_REFINE_TOL: f64 = 1e-11;
 

@@ -61,12 +61,11 @@ struct Condensed {
     loads: Option<CondensedLoads>,
     /// `u⁰` of the condensation.
     first: PointValues,
-    /// `x_q`'s displacement part, per part of a path's right-hand side, in their order
-    /// (empty for one instant).
-    parts: Vec<Vec<f64>>,
-    /// `x_q` whole, per part (empty for one instant): a written instant's fields are their
-    /// sum at its factors and the solve of its contact forces alone ([`Instants::frames_superposed`]).
-    solved: Vec<Fields>,
+    /// `x_q`, per part of a path's right-hand side, in their order (empty for one instant):
+    /// an instant's `u⁰` is their displacements at the points summed at its factors, a written
+    /// instant's fields their sum and the solve of its contact forces alone
+    /// ([`Instants::frames_superposed`]).
+    parts: Vec<Fields>,
     /// The dofs of the condensation, in its order.
     dofs: Vec<usize>,
 }
@@ -151,25 +150,12 @@ impl Instants {
             reporter,
         )?;
         let solved = solve_parts(f, parts)?;
-        // the parts' solutions refined (a written instant's sum of them is refined against its
-        // own right-hand side after: unrefined parts left every one a refinement step to take)
-        let mut refined = solved.clone();
-        let measures: Vec<_> = parts
-            .iter()
-            .map(|(b_u, b_phi)| linalg::Rhs {
-                u: b_u,
-                phi: b_phi,
-                scale: 0.0,
-            })
-            .collect();
-        f.refine_many(&measures, &mut refined, REFINE_TOL)?;
         self.kept = Kept::Condensed(Condensed {
             first: dense.u0.clone(),
             dense,
             dofs: condensed.dofs().to_vec(),
             loads: Some(condensed),
-            parts: solved.iter().map(|(u, _)| u.clone()).collect(),
-            solved: refined,
+            parts: solved.clone(),
         });
         Ok(solved)
     }
@@ -199,7 +185,7 @@ impl Instants {
                         let at_points: Vec<PointValues> = c
                             .parts
                             .iter()
-                            .map(|u| fields_at_points(framed.boundary, u, nt))
+                            .map(|(u, _)| fields_at_points(framed.boundary, u, nt))
                             .collect();
                         let normal = superpose(at_points.iter().map(|p| &p.normal[..]), factors);
                         let tangential = superpose(at_points.iter().map(|p| &p.tangential[..]), factors);
@@ -427,7 +413,9 @@ impl Instants {
     /// [`crate::backend::Backend::own_scale`].
     pub fn own_scale(&self, factors: &[f64]) -> f64 {
         match &self.kept {
-            Kept::Condensed(c) if !c.parts.is_empty() => largest(&superpose(c.parts.iter().map(|u| &u[..]), factors)),
+            Kept::Condensed(c) if !c.parts.is_empty() => {
+                largest(&superpose(c.parts.iter().map(|(u, _)| &u[..]), factors))
+            }
             Kept::Electric(e) if !e.parts.is_empty() => {
                 largest(&superpose(e.parts.iter().map(|(u, _)| &u[..]), factors))
             }
@@ -593,7 +581,7 @@ impl Condensed {
         f: &mut dyn Factorization,
         frames: &[(Posed<'_>, InstantOf<'_>)],
     ) -> Result<Option<Vec<Fields>>, ProblemError> {
-        if self.solved.is_empty() || self.dofs.is_empty() {
+        if self.parts.is_empty() || self.dofs.is_empty() {
             return Ok(None);
         }
         let at: std::collections::HashMap<usize, usize> = self.dofs.iter().enumerate().map(|(i, &d)| (d, i)).collect();
@@ -601,7 +589,7 @@ impl Condensed {
         let mut factors = Vec::with_capacity(frames.len());
         for (posed, of) in frames {
             let boundary = of.framed.boundary;
-            let Some(fs) = posed.loads.factors.as_ref().filter(|fs| fs.len() == self.solved.len()) else {
+            let Some(fs) = posed.loads.factors.as_ref().filter(|fs| fs.len() == self.parts.len()) else {
                 return Ok(None);
             };
             if posed.bed.is_some() || boundary.electric.is_some() {
@@ -622,7 +610,7 @@ impl Condensed {
             return Ok(None);
         };
         for ((u, phi), fs) in solved.iter_mut().zip(factors) {
-            for ((pu, pphi), &w) in self.solved.iter().zip(fs) {
+            for ((pu, pphi), &w) in self.parts.iter().zip(fs) {
                 if w != 0.0 {
                     u.iter_mut().zip(pu).for_each(|(x, p)| *x += w * p);
                     phi.iter_mut().zip(pphi).for_each(|(x, p)| *x += w * p);
