@@ -8,9 +8,9 @@
 
 use crate::factor::{FactorKind, Ordering, SparseFactor};
 use crate::pcg::{pcg, LinearOperator, PcgParams};
-use crate::sparse::{lower_quasi_definite, mul_add, mul_add_seq, mul_t_add, mul_t_add_seq};
+use crate::sparse::{lower_quasi_definite, mul_add, mul_add_interleaved, mul_t_add, mul_t_add_interleaved};
 use crate::{LinalgError, ShapeError};
-use faer::sparse::{SparseColMat, SparseColMatRef};
+use faer::sparse::SparseColMat;
 use faer::{MatMut, Par};
 use rayon::prelude::*;
 
@@ -314,32 +314,60 @@ pub struct Rhs<'a> {
     pub scale: f64,
 }
 
-/// `y += alpha M x` or `y += alpha Mᵀ x` ([`mul_add`], [`mul_t_add`], or their one-thread
-/// forms).
-type Product = fn(SparseColMatRef<'_, usize, f64>, &[f64], &mut [f64], f64);
-
-/// The products on rayon's pool ([`mul_add`], [`mul_t_add`]).
-const ON_THE_POOL: (Product, Product) = (mul_add, mul_t_add);
-
-/// The products on the calling thread alone, for several residuals formed at once, one per
-/// task ([`mul_add_seq`], [`mul_t_add_seq`]).
-const ON_THIS_THREAD: (Product, Product) = (mul_add_seq, mul_t_add_seq);
-
-/// `b - K x` by blocks, `(b_u - A u - Gᵀ φ, b_φ - G u + B φ)`, with the products `mul`,
-/// `mul_t` ([`ON_THE_POOL`] or [`ON_THIS_THREAD`]).
-fn minus_k_x(
-    k: CoupledBlocks<'_>,
-    (u, phi): (&[f64], &[f64]),
-    (b_u, b_phi): (&[f64], &[f64]),
-    (mul, mul_t): (Product, Product),
-) -> (Vec<f64>, Vec<f64>) {
+/// `b - K x` by blocks, `(b_u - A u - Gᵀ φ, b_φ - G u + B φ)`, the products on rayon's pool.
+fn minus_k_x(k: CoupledBlocks<'_>, (u, phi): (&[f64], &[f64]), (b_u, b_phi): (&[f64], &[f64])) -> (Vec<f64>, Vec<f64>) {
     let mut ru = b_u.to_vec();
-    mul(k.a.as_ref(), u, &mut ru, -1.0);
-    mul_t(k.g.as_ref(), phi, &mut ru, -1.0);
+    mul_add(k.a.as_ref(), u, &mut ru, -1.0);
+    mul_t_add(k.g.as_ref(), phi, &mut ru, -1.0);
     let mut rp = b_phi.to_vec();
-    mul(k.g.as_ref(), u, &mut rp, -1.0);
-    mul(k.b.as_ref(), phi, &mut rp, 1.0);
+    mul_add(k.g.as_ref(), u, &mut rp, -1.0);
+    mul_add(k.b.as_ref(), phi, &mut rp, 1.0);
     (ru, rp)
+}
+
+/// [`minus_k_x`] of several vectors, each `(b_u - A u - Gᵀ φ, b_φ - G u + B φ)` summed in
+/// the order of one column after another on one thread: the vectors split into as many groups as the pool has
+/// threads, each group's products made at once on one thread from its vectors stored
+/// interleaved, so that a thread reads `K` once for its group (the written instants of a path
+/// measured each a product with a 2D `K` of 10^7 entries, 10 ms, bound by reading them).
+fn minus_k_x_many(k: CoupledBlocks<'_>, xs: &[UPhiRef<'_>], bs: &[UPhiRef<'_>]) -> Vec<UPhi> {
+    let group = xs.len().div_ceil(rayon::current_num_threads().max(1)).max(1);
+    let groups: Vec<Vec<UPhi>> = xs
+        .par_chunks(group)
+        .zip(bs.par_chunks(group))
+        .map(|(xs, bs)| minus_k_x_interleaved(k, xs, bs))
+        .collect();
+    groups.into_iter().flatten().collect()
+}
+
+/// Vectors of one length stored interleaved: entry `i` of vector `f` at `i n + f`.
+fn interleave(vectors: &[&[f64]]) -> Vec<f64> {
+    let n = vectors.len();
+    let mut out = vec![0.0; vectors.first().map_or(0, |v| v.len()) * n];
+    for (f, v) in vectors.iter().enumerate() {
+        for (i, &x) in v.iter().enumerate() {
+            out[i * n + f] = x;
+        }
+    }
+    out
+}
+
+/// [`minus_k_x_many`]'s products of one group on the calling thread.
+fn minus_k_x_interleaved(k: CoupledBlocks<'_>, xs: &[UPhiRef<'_>], bs: &[UPhiRef<'_>]) -> Vec<UPhi> {
+    let n = xs.len();
+    if n == 0 {
+        return vec![];
+    }
+    let xu = interleave(&xs.iter().map(|x| x.0).collect::<Vec<_>>());
+    let xp = interleave(&xs.iter().map(|x| x.1).collect::<Vec<_>>());
+    let mut ru = interleave(&bs.iter().map(|b| b.0).collect::<Vec<_>>());
+    let mut rp = interleave(&bs.iter().map(|b| b.1).collect::<Vec<_>>());
+    mul_add_interleaved(k.a.as_ref(), &xu, &mut ru, n, -1.0);
+    mul_t_add_interleaved(k.g.as_ref(), &xp, &mut ru, n, -1.0);
+    mul_add_interleaved(k.g.as_ref(), &xu, &mut rp, n, -1.0);
+    mul_add_interleaved(k.b.as_ref(), &xp, &mut rp, n, 1.0);
+    let column = |r: &[f64], f: usize| -> Vec<f64> { r.iter().skip(f).step_by(n).copied().collect() };
+    (0..n).map(|f| (column(&ru, f), column(&rp, f))).collect()
 }
 
 /// What iterative refinement did.
@@ -399,12 +427,17 @@ pub fn refine_many(
         }
         .into());
     }
-    // the products with `K` one per task, each on one thread
-    let measure = |(u, phi): &UPhi, b: &Rhs<'_>| {
-        let (ru, rp) = minus_k_x(k, (u, phi), (b.u, b.phi), ON_THIS_THREAD);
-        Residual::of(ru, rp, *b)
+    // the products with `K` made together, each thread reading `K` once
+    let measure = |xs: &[UPhiRef<'_>], rhs: &[&Rhs<'_>]| -> Vec<Residual> {
+        let bs: Vec<UPhiRef<'_>> = rhs.iter().map(|b| (b.u, b.phi)).collect();
+        let r = minus_k_x_many(k, xs, &bs);
+        r.into_iter()
+            .zip(rhs)
+            .map(|((ru, rp), b)| Residual::of(ru, rp, **b))
+            .collect()
     };
-    let mut r: Vec<Residual> = xs.par_iter().zip(rhs).map(|(x, b)| measure(x, b)).collect();
+    let all: Vec<UPhiRef<'_>> = xs.iter().map(|(u, phi)| (&u[..], &phi[..])).collect();
+    let mut r: Vec<Residual> = measure(&all, &rhs.iter().collect::<Vec<_>>());
     let mut out: Vec<Refined> = r
         .iter()
         .map(|r| Refined {
@@ -420,17 +453,23 @@ pub fn refine_many(
         }
         let columns: Vec<UPhiRef<'_>> = active.iter().map(|&j| (&r[j].u[..], &r[j].phi[..])).collect();
         let corrections = solver.solve_many(&columns)?;
-        let corrected: Vec<_> = active
-            .par_iter()
+        let candidates: Vec<UPhi> = active
+            .iter()
             .zip(corrections)
             .map(|(&j, (du, dp))| {
                 let (u, phi) = &xs[j];
                 let nu: Vec<f64> = u.iter().zip(&du).map(|(a, b)| a + b).collect();
                 let np: Vec<f64> = phi.iter().zip(&dp).map(|(a, b)| a + b).collect();
-                let x = (nu, np);
-                let next = measure(&x, &rhs[j]);
-                (j, x, next)
+                (nu, np)
             })
+            .collect();
+        let refs: Vec<UPhiRef<'_>> = candidates.iter().map(|(u, phi)| (&u[..], &phi[..])).collect();
+        let measured = measure(&refs, &active.iter().map(|&j| &rhs[j]).collect::<Vec<_>>());
+        let corrected: Vec<_> = active
+            .iter()
+            .zip(candidates)
+            .zip(measured)
+            .map(|((&j, x), next)| (j, x, next))
             .collect();
         let mut next_active = Vec::with_capacity(active.len());
         for (j, x, next) in corrected {
@@ -538,7 +577,7 @@ impl Refinable for Blockwise<'_, '_> {
     type Error = LinalgError;
 
     fn residual(&mut self, u: &[f64], phi: &[f64]) -> Result<Residual, LinalgError> {
-        let (ru, rp) = minus_k_x(self.k, (u, phi), (self.rhs.u, self.rhs.phi), ON_THE_POOL);
+        let (ru, rp) = minus_k_x(self.k, (u, phi), (self.rhs.u, self.rhs.phi));
         Ok(Residual::of(ru, rp, self.rhs))
     }
 
@@ -554,7 +593,7 @@ impl Refinable for Blockwise<'_, '_> {
 /// contact forces: `‖b‖` then says nothing of the error's size). The norms are scaled, so the
 /// residual is the same for data of any magnitude.
 pub fn equilibrium_residual(k: CoupledBlocks<'_>, u: &[f64], phi: &[f64], rhs: Rhs<'_>) -> f64 {
-    let (ru, rp) = minus_k_x(k, (u, phi), (rhs.u, rhs.phi), ON_THE_POOL);
+    let (ru, rp) = minus_k_x(k, (u, phi), (rhs.u, rhs.phi));
     relative_residual(&ru, &rp, rhs)
 }
 

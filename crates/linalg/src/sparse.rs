@@ -44,9 +44,9 @@ pub fn mul_add(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alp
     });
 }
 
-/// `y += alpha M x` on the calling thread alone (for products made several at once, one per
-/// task: no task's partial sums to allocate and add).
-pub(crate) fn mul_add_seq(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alpha: f64) {
+/// `y += alpha M x` on the calling thread alone (the reference of the interleaved products).
+#[cfg(test)]
+fn mul_add_seq(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], alpha: f64) {
     mul_add_columns(m, 0..m.ncols().min(x.len()), x, y, alpha);
 }
 
@@ -57,6 +57,58 @@ pub(crate) fn mul_t_add_seq(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &m
         .iter_mut()
         .enumerate()
         .for_each(|(j, yj)| *yj += alpha * column_dot(m, x, j));
+}
+
+/// `Y += alpha M X` on the calling thread for `k` vectors stored interleaved (entry `j` of
+/// vector `f` at `X[j k + f]`): `M` read once for all of them, where [`mul_add_seq`] per
+/// vector reads it `k` times (a product of a 2D `K` is bound by reading its entries). Each
+/// vector's entries are summed in [`mul_add_seq`]'s order, so each is that product's.
+pub(crate) fn mul_add_interleaved(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], k: usize, alpha: f64) {
+    let (cp, ri, vals) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
+    let ncols = m.ncols().min(x.len() / k.max(1));
+    let mut s = vec![0.0; k];
+    for j in 0..ncols {
+        let xj = &x[j * k..(j + 1) * k];
+        if xj.iter().all(|&v| v == 0.0) {
+            continue;
+        }
+        for (sf, &xf) in s.iter_mut().zip(xj) {
+            *sf = alpha * xf;
+        }
+        for p in cp[j]..cp[j + 1] {
+            let v = vals[p];
+            let yi = &mut y[ri[p] * k..(ri[p] + 1) * k];
+            for (yf, sf) in yi.iter_mut().zip(&s) {
+                *yf += v * sf;
+            }
+        }
+    }
+}
+
+/// `Y += alpha Mᵀ X` on the calling thread for `k` vectors stored interleaved
+/// ([`mul_add_interleaved`]'s transpose; each vector's entries those of [`mul_t_add_seq`]).
+pub(crate) fn mul_t_add_interleaved(
+    m: SparseColMatRef<'_, usize, f64>,
+    x: &[f64],
+    y: &mut [f64],
+    k: usize,
+    alpha: f64,
+) {
+    let (cp, ri, vals) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
+    let n = m.ncols().min(y.len() / k.max(1));
+    let mut s = vec![0.0; k];
+    for j in 0..n {
+        s.fill(0.0);
+        for p in cp[j]..cp[j + 1] {
+            let v = vals[p];
+            for (sf, xf) in s.iter_mut().zip(&x[ri[p] * k..(ri[p] + 1) * k]) {
+                *sf += v * xf;
+            }
+        }
+        for (yf, sf) in y[j * k..(j + 1) * k].iter_mut().zip(&s) {
+            *yf += alpha * sf;
+        }
+    }
 }
 
 /// Column `j` of `M` dotted with `x`: entry `j` of `Mᵀ x`.
@@ -312,6 +364,42 @@ mod tests {
                 (got - want).abs() <= 1e-13 * (1.0 + want.abs()),
                 "(K x)[{i}]: {got} against {want}"
             );
+        }
+    }
+
+    /// Products of several vectors stored interleaved are, vector by vector and bit for bit,
+    /// the products of one vector (`M X` and `Mᵀ X`, with zero columns of some vectors and of
+    /// all, and empty columns of `M`).
+    #[test]
+    fn interleaved_products_are_each_vector_s_own() {
+        let (rows, cols, k) = (40, 30, 3);
+        let mut rnd = uniform(5);
+        let mut t = vec![];
+        for j in (0..cols).filter(|j| j % 7 != 3) {
+            for _ in 0..4 {
+                t.push(Triplet::new((rnd() * rows as f64) as usize, j, rnd() - 0.5));
+            }
+        }
+        let m = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, &t).unwrap();
+        let mut vector = |n: usize, f: usize| -> Vec<f64> {
+            (0..n)
+                .map(|i| if i % 5 == f || i % 11 == 0 { 0.0 } else { rnd() - 0.5 })
+                .collect()
+        };
+        let xs: Vec<Vec<f64>> = (0..k).map(|f| vector(cols, f)).collect();
+        let xts: Vec<Vec<f64>> = (0..k).map(|f| vector(rows, f)).collect();
+        let interleave = |v: &[Vec<f64>], n: usize| -> Vec<f64> { (0..n * k).map(|i| v[i % k][i / k]).collect() };
+        let (mut y, mut yt) = (vec![1.0; rows * k], vec![1.0; cols * k]);
+        mul_add_interleaved(m.as_ref(), &interleave(&xs, cols), &mut y, k, -2.0);
+        mul_t_add_interleaved(m.as_ref(), &interleave(&xts, rows), &mut yt, k, 0.5);
+        for f in 0..k {
+            let (mut one, mut one_t) = (vec![1.0; rows], vec![1.0; cols]);
+            mul_add_seq(m.as_ref(), &xs[f], &mut one, -2.0);
+            mul_t_add_seq(m.as_ref(), &xts[f], &mut one_t, 0.5);
+            let got: Vec<f64> = (0..rows).map(|i| y[i * k + f]).collect();
+            let got_t: Vec<f64> = (0..cols).map(|j| yt[j * k + f]).collect();
+            assert_eq!(got, one, "M x of vector {f}");
+            assert_eq!(got_t, one_t, "Mᵀ x of vector {f}");
         }
     }
 
