@@ -3,17 +3,24 @@
 //! the last instant's files and the path's own.
 
 use super::vtu::{self, CompressedMesh};
-use super::{files, mesh_arrays, FieldArrays, NamedValues, Outputs, SetWriter};
+use super::{files_but, mesh_arrays, run_json_of, FieldArrays, NamedValues, Outputs, SetWriter};
 use crate::Error;
+use problem::Output;
 use problem::Solution;
 use std::collections::VecDeque;
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-/// Steps encoded at once, at most (each holds its fields' copy and its bytes: about 4 MB for a
-/// 2D mesh of 130,000 nodes).
-const ENCODING: usize = 4;
+/// Steps encoded and written at once, at most: as many as a path's written instants solved
+/// together (up to 16), so that the path goes on with its next instants while they are
+/// written (with four, it waited 0.65 s of its 4.2 s on them at `paper-cycle` n = 256).
+const ENCODING: usize = 16;
+
+/// The bytes of the fields' copies held by the steps being encoded, at most (each holds its
+/// point and cell data's copy until its file is written: 10 MB a step for a 2D mesh of
+/// 130,000 nodes; a 3D mesh's cell data is larger).
+const ENCODING_BYTES: usize = 256 << 20;
 
 /// The files of a load path, written step by step ([`PathFiles::step`]: each written instant's
 /// `step-NNNN.vtu`, a ParaView time series) and finished with the last instant's solution
@@ -25,14 +32,17 @@ const ENCODING: usize = 4;
 /// A step's file holds the point data (`u`, `phi`, and the contact's status, pressure,
 /// traction, gap and flux), and the cell data (stress, strain, D, E) where the scene asks for
 /// it (`path.cell_fields`); its arrays are zlib-compressed, the mesh's compressed once for all
-/// steps. Each step is encoded on its own thread while the path goes on, at most
-/// four at a time (the written instants of a path come several together: their fields
-/// are solved together), and written in order.
+/// steps. Each step is encoded and written into the set's staging directory on its own
+/// thread while the path goes on, at most four at a time (the written instants of a path come
+/// several together: their fields are solved together), and taken into the set in order (the
+/// path's thread wrote them, 10 ms a step at `paper-cycle` n = 256, while the next instants
+/// waited).
 pub struct PathFiles {
     series: Vec<(f64, String)>,
     cell_fields: bool,
     mesh: Option<Arc<CompressedMesh>>,
-    pending: VecDeque<JoinHandle<(String, Vec<u8>)>>,
+    /// The steps being encoded, each with the bytes of its fields' copy.
+    pending: VecDeque<(JoinHandle<Result<Encoded, Error>>, usize)>,
     /// Seconds the path waited on its steps' files while it ran.
     seconds: f64,
 }
@@ -59,9 +69,10 @@ impl PathFiles {
         names
     }
 
-    /// Starts one instant's `step-NNNN.vtu` (written by a later step or by
-    /// [`PathFiles::finish`]), after writing the oldest being encoded into the set where
-    /// four are.
+    /// Starts one instant's `step-NNNN.vtu` (encoded and written on a thread of its own, taken
+    /// into the set by a later step or by [`PathFiles::finish`]), after taking in the oldest
+    /// being encoded while 16 are, or while their fields' copies and this step's would pass
+    /// 256 MB.
     ///
     /// # Errors
     /// [`Error::Output`] where a step before cannot be written.
@@ -70,7 +81,12 @@ impl PathFiles {
             return Ok(());
         };
         let started = Instant::now();
-        while self.pending.len() >= ENCODING {
+        let cells = f.fields.filter(|_| self.cell_fields);
+        let data = FieldArrays::new(step.mesh, (f.u, f.phi), cells, Some(step.contact)).into_owned();
+        let held = data.bytes();
+        while self.pending.len() >= ENCODING
+            || (!self.pending.is_empty() && self.pending_bytes() + held > ENCODING_BYTES)
+        {
             self.flush_one(writer)?;
         }
         let mesh = self
@@ -80,17 +96,28 @@ impl PathFiles {
                 Arc::new(CompressedMesh::new(&points, (&connectivity, &offsets), cell_type))
             })
             .clone();
-        let cells = f.fields.filter(|_| self.cell_fields);
-        let data = FieldArrays::new(step.mesh, (f.u, f.phi), cells, Some(step.contact)).into_owned();
         let name = step_name(step.row.step);
         self.series.push((step.row.t, name.clone()));
-        self.pending.push_back(std::thread::spawn(move || {
+        let staged = writer.staged();
+        let encoding = std::thread::spawn(move || {
             let point: Vec<_> = data.point.iter().map(NamedValues::array).collect();
             let cell: Vec<_> = data.cell.iter().map(NamedValues::array).collect();
-            (name, vtu::write_compressed(&mesh, &point, &cell))
-        }));
+            let file = vtu::write_compressed(&mesh, &point, &cell);
+            match staged {
+                Some(staged) => staged
+                    .write(&name, |w| file.write_to(w))
+                    .map(|()| Encoded::Written(name)),
+                None => Ok(Encoded::Bytes(name, file.to_bytes())),
+            }
+        });
+        self.pending.push_back((encoding, held));
         self.seconds += started.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// The bytes of the fields' copies the steps being encoded hold.
+    fn pending_bytes(&self) -> usize {
+        self.pending.iter().map(|(_, b)| b).sum()
     }
 
     /// Writes every step being encoded into the set, in order.
@@ -103,37 +130,51 @@ impl PathFiles {
 
     /// Writes the oldest step being encoded, if any, into the set.
     fn flush_one(&mut self, writer: &mut SetWriter) -> Result<(), Error> {
-        let Some(pending) = self.pending.pop_front() else {
+        let Some((pending, _)) = self.pending.pop_front() else {
             return Ok(());
         };
-        let (name, bytes) = pending.join().map_err(|_| Error::Picture {
+        let encoded = pending.join().map_err(|_| Error::Picture {
             name: "a step's file".into(),
             message: "its encoding thread panicked".into(),
         })?;
-        writer.write(&name, &bytes)
+        match encoded? {
+            Encoded::Written(name) => writer.adopt(&name),
+            Encoded::Bytes(name, bytes) => writer.write(&name, &bytes),
+        }
     }
 
-    /// The files of the last instant and the path's own, after the last step's file is
-    /// written; the time spent on the steps' files is booked in `last`'s report as
-    /// `timings_s.output`, and what of it the path waited while it ran is taken out of the
-    /// contact and solve stages, whose clocks ran then (the last step's, written after the
-    /// path, is not).
+    /// The files of the last instant and the path's own, made while the last steps' files
+    /// are written, and `run.json` once they are: the time spent on the steps' files is
+    /// booked in `last`'s report as `timings_s.output`, and what of it the path waited while
+    /// it ran is taken out of the contact and solve stages, whose clocks ran then (the last
+    /// steps', written after the path, are not).
     ///
     /// # Errors
-    /// As [`files`], and [`Error::Output`] where the last step's file cannot be written.
+    /// As [`super::files`], and [`Error::Output`] where a step's file cannot be written.
     pub fn finish(mut self, last: &mut Solution, writer: &mut SetWriter) -> Result<Outputs, Error> {
         let started = Instant::now();
+        // the last instant's files made while the last steps are written, run.json after them
+        let mut out = files_but(last, Some(Output::RunJson))?;
         self.flush(writer)?;
         let t = &mut last.report.timings_s;
         t.output += self.seconds + started.elapsed().as_secs_f64();
         t.contact = (t.contact - self.seconds).max(0.0);
         t.solve = (t.solve - self.seconds).max(0.0);
-        let mut out = files(last)?;
+        if last.report.plan.outputs.contains(&Output::RunJson) {
+            out.add("run.json", run_json_of(last)?);
+        }
         if !self.series.is_empty() {
             out.add("path.pvd", pvd(&self.series));
         }
         Ok(out)
     }
+}
+
+/// A step's file as its thread leaves it: written into the set's staging directory, or its
+/// bytes, for the set's writer to write, where the platform stages files in memory.
+enum Encoded {
+    Written(String),
+    Bytes(String, Vec<u8>),
 }
 
 /// The name of a path's instant `k` in its series.

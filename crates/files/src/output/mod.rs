@@ -9,7 +9,7 @@ mod set;
 mod vtu;
 
 pub use frames::{pvd, PathFiles};
-pub use set::{abandon_and_exit, Outputs, SetWriter};
+pub use set::{abandon_and_exit, Outputs, SetWriter, Staged};
 
 use crate::plots::{self, Mark, Panel, Series};
 use crate::Error;
@@ -82,11 +82,18 @@ fn terminal_groups(report: &RunReport) -> Vec<&str> {
 /// # Errors
 /// [`Error::Picture`] where a file cannot be made (the first in the plan's order).
 pub fn files(solution: &Solution) -> Result<Outputs, Error> {
+    files_but(solution, None)
+}
+
+/// [`files`] without the plan's output `left_out` (a path's `run.json`, made once its steps'
+/// files are written and timed).
+fn files_but(solution: &Solution, left_out: Option<Output>) -> Result<Outputs, Error> {
     let made: Vec<Result<plots::Files, Error>> = solution
         .report
         .plan
         .outputs
         .par_iter()
+        .filter(|&&output| Some(output) != left_out)
         .map(|&output| output_files(solution, output))
         .collect();
     let mut out = Outputs::new(Path::new(""));
@@ -303,6 +310,11 @@ impl<'a> FieldArrays<'a> {
     }
 
     /// The arrays, every one owned.
+    /// The bytes of the arrays' values.
+    fn bytes(&self) -> usize {
+        self.point.iter().chain(&self.cell).map(|a| 8 * a.values.len()).sum()
+    }
+
     fn into_owned(self) -> FieldArrays<'static> {
         FieldArrays {
             point: self.point.into_iter().map(NamedValues::into_owned).collect(),

@@ -124,7 +124,7 @@ impl Piece<'_> {
         });
         let pvtu = pvtu(&point, &cell, stem, ranks);
         if let Some(mesh) = mesh {
-            return (vtu::write_compressed(mesh, &point, &cell), pvtu);
+            return (vtu::write_compressed(mesh, &point, &cell).to_bytes(), pvtu);
         }
         let (points, connectivity, offsets, cell_type) = mesh_arrays(self.mesh);
         let piece = vtu::write(&Grid {

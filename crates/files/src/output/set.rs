@@ -259,6 +259,19 @@ impl SetWriter {
         None
     }
 
+    /// A handle through which other threads write files of the set ([`Staged::write`]) for
+    /// [`SetWriter::adopt`] to take in (a load path's steps, each written by the thread that
+    /// encoded it while the path goes on); `None` where the platform stages files in memory.
+    pub fn staged(&self) -> Option<Staged> {
+        #[cfg(unix)]
+        return Some(Staged {
+            set: self.inner.set.clone(),
+            dir: self.dir.clone(),
+        });
+        #[cfg(not(unix))]
+        None
+    }
+
     /// Takes into the set the file `name` that another process wrote into
     /// [`SetWriter::staging`].
     ///
@@ -284,6 +297,46 @@ impl SetWriter {
         return self.inner.finish();
         #[cfg(not(unix))]
         self.out.commit()
+    }
+}
+
+/// A set's staging directory, written into from any thread ([`SetWriter::staged`]).
+#[derive(Clone, Debug)]
+pub struct Staged {
+    set: PathBuf,
+    dir: PathBuf,
+}
+
+impl Staged {
+    /// Writes one file of the set into its staging directory, its bytes given by `write`,
+    /// under the registry's lock as [`SetWriter::write`] writes (a signal's removal of the set waits for it; a set already
+    /// removed is not written into). The file is the set's once [`SetWriter::adopt`] takes it.
+    ///
+    /// # Errors
+    /// As [`SetWriter::write`]; [`Error::Output`] where the set was abandoned.
+    pub fn write(
+        &self,
+        name: &str,
+        write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+    ) -> Result<(), Error> {
+        check_name(&self.dir, name)?;
+        let sets = staging();
+        if !sets.contains(&self.set) {
+            return Err(Error::Output {
+                what: format!(
+                    "cannot write {}: the set being written was abandoned",
+                    self.dir.join(name).display()
+                ),
+                source: std::io::Error::from(std::io::ErrorKind::NotFound),
+            });
+        }
+        let written = std::fs::File::create(self.set.join(name)).and_then(|file| {
+            // pieces as large as the buffer go to the file without a copy
+            let mut w = std::io::BufWriter::with_capacity(1 << 15, file);
+            write(&mut w)?;
+            w.into_inner().map(drop).map_err(std::io::IntoInnerError::into_error)
+        });
+        written.map_err(|e| io("cannot write", &self.dir.join(name), e))
     }
 }
 
