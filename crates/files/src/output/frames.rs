@@ -1,6 +1,6 @@
 //! A load path's files: its time series (each written instant a `step-NNNN.vtu`, compressed,
-//! encoded on a thread of its own while the path goes on; `path.pvd` their collection), then
-//! the last instant's files and the path's own.
+//! encoded and written by threads kept for the path while it goes on; `path.pvd` their
+//! collection), then the last instant's files and the path's own.
 
 use super::vtu::{self, CompressedMesh};
 use super::{files_but, mesh_arrays, run_json_of, FieldArrays, NamedValues, Outputs, SetWriter};
@@ -8,13 +8,15 @@ use crate::Error;
 use problem::Output;
 use problem::Solution;
 use std::collections::VecDeque;
-use std::sync::Arc;
+use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-/// Steps encoded and written at once, at most: as many as a path's written instants solved
-/// together (up to 16), so that the path goes on with its next instants while they are
-/// written (with four, it waited 0.65 s of its 4.2 s on them at `paper-cycle` n = 256).
+/// Steps waiting to be encoded and written or being so, at most: as many as a path's written
+/// instants solved together (up to 16), so that the path goes on with its next instants while
+/// they are written (with four, it waited 0.65 s of its 4.2 s on them at `paper-cycle`
+/// n = 256).
 const ENCODING: usize = 16;
 
 /// The bytes of the fields' copies held by the steps being encoded, at most (each holds its
@@ -32,17 +34,19 @@ const ENCODING_BYTES: usize = 256 << 20;
 /// A step's file holds the point data (`u`, `phi`, and the contact's status, pressure,
 /// traction, gap and flux), and the cell data (stress, strain, D, E) where the scene asks for
 /// it (`path.cell_fields`); its arrays are zlib-compressed, the mesh's compressed once for all
-/// steps. Each step is encoded and written into the set's staging directory on its own
-/// thread while the path goes on, at most four at a time (the written instants of a path come
-/// several together: their fields are solved together), and taken into the set in order (the
-/// path's thread wrote them, 10 ms a step at `paper-cycle` n = 256, while the next instants
-/// waited).
+/// steps. Each step is encoded and written into the set's staging directory by one of a few
+/// threads kept for the path while the path goes on, at most 16 waiting (the written
+/// instants of a path come several together: their fields are solved together), and taken
+/// into the set in order (the path's thread wrote them, 10 ms a step at `paper-cycle`
+/// n = 256, while the next instants waited).
 pub struct PathFiles {
     series: Vec<(f64, String)>,
     cell_fields: bool,
     mesh: Option<Arc<CompressedMesh>>,
+    /// The threads that encode and write the steps, started at the first.
+    encoders: Option<Encoders>,
     /// The steps being encoded, each with the bytes of its fields' copy.
-    pending: VecDeque<(JoinHandle<Result<Encoded, Error>>, usize)>,
+    pending: VecDeque<(Receiver<Result<Encoded, Error>>, usize)>,
     /// Seconds the path waited on its steps' files while it ran.
     seconds: f64,
 }
@@ -54,6 +58,7 @@ impl PathFiles {
             series: vec![],
             cell_fields: scene.path.as_ref().is_some_and(|p| p.cell_fields),
             mesh: None,
+            encoders: None,
             pending: VecDeque::new(),
             seconds: 0.0,
         }
@@ -69,8 +74,8 @@ impl PathFiles {
         names
     }
 
-    /// Starts one instant's `step-NNNN.vtu` (encoded and written on a thread of its own, taken
-    /// into the set by a later step or by [`PathFiles::finish`]), after taking in the oldest
+    /// Starts one instant's `step-NNNN.vtu` (encoded and written by one of the path's threads,
+    /// taken into the set by a later step or by [`PathFiles::finish`]), after taking in the oldest
     /// being encoded while 16 are, or while their fields' copies and this step's would pass
     /// 256 MB.
     ///
@@ -99,7 +104,7 @@ impl PathFiles {
         let name = step_name(step.row.step);
         self.series.push((step.row.t, name.clone()));
         let staged = writer.staged();
-        let encoding = std::thread::spawn(move || {
+        let encoding = self.encoders.get_or_insert_with(Encoders::new).run(move || {
             let point: Vec<_> = data.point.iter().map(NamedValues::array).collect();
             let cell: Vec<_> = data.cell.iter().map(NamedValues::array).collect();
             let file = vtu::write_compressed(&mesh, &point, &cell);
@@ -133,9 +138,9 @@ impl PathFiles {
         let Some((pending, _)) = self.pending.pop_front() else {
             return Ok(());
         };
-        let encoded = pending.join().map_err(|_| Error::Picture {
+        let encoded = pending.recv().map_err(|_| Error::Picture {
             name: "a step's file".into(),
-            message: "its encoding thread panicked".into(),
+            message: "its encoding panicked".into(),
         })?;
         match encoded? {
             Encoded::Written(name) => writer.adopt(&name),
@@ -170,6 +175,64 @@ impl PathFiles {
     }
 }
 
+/// Threads kept for a path's steps, each taking the next job sent (a thread per step cost
+/// the mapping of its stack and, at its end, the other core's TLB flushes: 4.5 % of the
+/// samples of `paper-cycle` at n = 256 with 51 steps written).
+struct Encoders {
+    jobs: Option<Sender<Job>>,
+    threads: Vec<JoinHandle<()>>,
+}
+
+/// A job of [`Encoders`].
+type Job = Box<dyn FnOnce() + Send>;
+
+impl Encoders {
+    /// As many threads as the machine's cores, from 1 to 4 (each compresses its arrays'
+    /// blocks on rayon's pool).
+    fn new() -> Self {
+        let n = std::thread::available_parallelism().map_or(1, |n| n.get().clamp(1, 4));
+        let (jobs, queue) = channel::<Job>();
+        let queue = Arc::new(Mutex::new(queue));
+        let threads = (0..n)
+            .map(|_| {
+                let queue = Arc::clone(&queue);
+                std::thread::spawn(move || loop {
+                    let job = queue.lock().unwrap_or_else(PoisonError::into_inner).recv();
+                    let Ok(job) = job else { break };
+                    // a job that panics drops its sender: its receiver says so
+                    let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+                })
+            })
+            .collect();
+        Encoders {
+            jobs: Some(jobs),
+            threads,
+        }
+    }
+
+    /// Runs `f` on the next free thread; its result comes on the receiver (an error there:
+    /// `f` panicked).
+    fn run<T: Send + 'static>(&self, f: impl FnOnce() -> T + Send + 'static) -> Receiver<T> {
+        let (done, result) = channel();
+        if let Some(jobs) = &self.jobs {
+            let _ = jobs.send(Box::new(move || {
+                let _ = done.send(f());
+            }));
+        }
+        result
+    }
+}
+
+impl Drop for Encoders {
+    /// The queue closed, the threads end after the jobs sent.
+    fn drop(&mut self) {
+        self.jobs.take();
+        for thread in self.threads.drain(..) {
+            let _ = thread.join();
+        }
+    }
+}
+
 /// A step's file as its thread leaves it: written into the set's staging directory, or its
 /// bytes, for the set's writer to write, where the platform stages files in memory.
 enum Encoded {
@@ -195,4 +258,42 @@ pub fn pvd(series: &[(f64, String)]) -> Vec<u8> {
     }
     s.push_str("  </Collection>\n</VTKFile>\n");
     s.into_bytes()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Encoders;
+
+    /// Each job's result comes on its own receiver, whichever thread ran it; a job that panics
+    /// says so on its receiver and the threads go on with the next jobs; dropping the
+    /// encoders waits for the jobs sent.
+    #[test]
+    fn jobs_come_back_on_their_receivers_and_a_panic_is_told() {
+        let encoders = Encoders::new();
+        let results: Vec<_> = (0..20u64)
+            .map(|k| {
+                encoders.run(move || {
+                    assert!(k != 7, "job 7 fails");
+                    (0..=k).sum::<u64>()
+                })
+            })
+            .collect();
+        for (k, r) in results.into_iter().enumerate() {
+            let k = k as u64;
+            match r.recv() {
+                Ok(sum) => assert_eq!(sum, k * (k + 1) / 2),
+                Err(_) => assert_eq!(k, 7),
+            }
+        }
+        let done = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        for _ in 0..8 {
+            let done = std::sync::Arc::clone(&done);
+            drop(encoders.run(move || {
+                std::thread::sleep(std::time::Duration::from_millis(5));
+                done.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            }));
+        }
+        drop(encoders);
+        assert_eq!(done.load(std::sync::atomic::Ordering::SeqCst), 8);
+    }
 }
