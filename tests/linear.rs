@@ -481,6 +481,13 @@ fn a_study_over_both_orders_gives_both_fronts() {
     assert!((0.9..1.2).contains(&rates[0].value) && rates[0].order == 1, "{rates:?}");
     assert!((1.8..2.3).contains(&rates[1].value) && rates[1].order == 2, "{rates:?}");
     assert!(csv(&s).lines().nth(1).unwrap().starts_with("manufactured,1,8,"));
+    // the header's units: h a length in the scene's unit, the time in seconds
+    let header = csv(&s).lines().next().unwrap().to_string();
+    let h = format!("h [{}]", s.units.of_quantity("length"));
+    assert!(
+        header.contains(&format!(",{h},")) && header.contains(",seconds [s],"),
+        "{header}"
+    );
     let files = pictures("study", &s).unwrap();
     let svg = files
         .iter()

@@ -592,16 +592,19 @@ fn capacitance(scene: Option<String>, set: &[String], out: Option<PathBuf>) -> R
     let c = files::run::capacitance(&scene, &source, None)?;
     let field = files::output::csv_field;
     let names: Vec<_> = c.terminals.iter().map(|t| field(t)).collect();
-    let mut csv = format!("terminal,{}\n", names.join(","));
+    // each column's unit in brackets, as every CSV output carries it
+    let columns: Vec<_> = c
+        .terminals
+        .iter()
+        .map(|t| field(&format!("{t} [{}]", c.unit)).into_owned())
+        .collect();
+    let mut csv = format!("terminal,{}\n", columns.join(","));
     for (t, row) in names.iter().zip(&c.matrix) {
         let cells: Vec<String> = row.iter().map(|x| format!("{x:e}")).collect();
         csv.push_str(&format!("{t},{}\n", cells.join(",")));
     }
     let width = c.terminals.iter().map(|t| t.len()).max().unwrap_or(0).max(8);
-    println!(
-        "capacitance of `{}` (Q_i = sum_j C_ij V_j, the scene's units):",
-        scene.name
-    );
+    println!("capacitance of `{}` (Q_i = sum_j C_ij V_j, in {}):", scene.name, c.unit);
     println!(
         "{:width$} {}",
         "",

@@ -36,6 +36,9 @@ pub struct Capacitance {
     /// charge may leave through a face with a surface charge or through the contact face of
     /// a conductive foundation, which the matrix leaves out).
     pub column_sum: f64,
+    /// The unit of each `C_ij`: the scene's charge per its potential (`pC/kV`, a femtofarad,
+    /// with lengths in µm and stresses in GPa; per unit thickness in plane strain).
+    pub unit: String,
 }
 
 /// The capacitance matrix of `scene` on `backend` (validated here; `mesh` the mesh of a
@@ -135,11 +138,18 @@ pub(crate) fn capacitance<B: Backend>(
         .map(|j| (0..n).map(|i| matrix[i][j]).sum::<f64>().abs())
         .fold(0.0, f64::max)
         / big;
+    let units = crate::Units::of(&scene, setup.mesh.dim);
+    let (charge, potential) = (units.of_quantity("charge"), units.of_quantity("potential"));
+    let unit = match charge.contains('/') {
+        true => format!("({charge})/{potential}"),
+        false => format!("{charge}/{potential}"),
+    };
     Ok(Some(Capacitance {
         terminals: names,
         matrix,
         asymmetry,
         column_sum,
+        unit,
     }))
 }
 

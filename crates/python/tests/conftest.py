@@ -23,3 +23,12 @@ def binary() -> pathlib.Path:
         subprocess.run(["cargo", "build", "--release", "-p", "driver"], cwd=REPO, check=True)
     assert path.exists(), f"no program at {path}"
     return path
+
+
+def csv_rows(path: pathlib.Path) -> list:
+    """A CSV output's rows, each a dict by column name: the header's units in brackets taken
+    off (`normal_force [mN]` is `normal_force`), as run.json's `units.columns` names them."""
+    import csv
+
+    with open(path, encoding="utf-8") as f:
+        return [{k.split(" [")[0]: v for k, v in row.items()} for row in csv.DictReader(f)]

@@ -37,6 +37,8 @@ def test_the_capacitance_matrix_from_python():
     assert abs(m - m.T).max() < 1e-10 * abs(m).max()
     assert abs(m.sum(axis=0)).max() < 1e-10 * abs(m).max()
     assert c["asymmetry"] < 1e-10 and c["column_sum"] < 1e-10
+    # in the scene's units: lengths in m, stresses in GPa, plane strain (per unit thickness)
+    assert c["unit"] == "(C/m)/GV"
 
 
 def test_an_open_electrode_from_python():

@@ -1,10 +1,11 @@
 """Load paths from Python: the series as arrays, the same numbers as the command-line
 program's path.csv, the contact values of every instant on request."""
 
-import csv
+import json
 import subprocess
 
 import numpy as np
+from conftest import csv_rows
 
 import piezocontact as pc
 
@@ -15,8 +16,14 @@ def test_the_series_are_the_programs_path_csv(binary, tmp_path):
     for k, v in overrides.items():
         args += ["--set", f"{k}={v}"]
     subprocess.run(args, check=True, capture_output=True)
-    with open(tmp_path / "path.csv") as f:
-        rows = list(csv.DictReader(f))
+    rows = csv_rows(tmp_path / "path.csv")
+    # each column's unit in its header is run.json's
+    header = (tmp_path / "path.csv").read_text(encoding="utf-8").splitlines()[0].split(",")
+    units = json.loads((tmp_path / "run.json").read_text(encoding="utf-8"))["units"]["columns"]["path.csv"]
+    for cell in header:
+        name = cell.split(" [")[0]
+        assert cell == (f"{name} [{units[name]}]" if units[name] else name), cell
+    assert "normal_force [" in ",".join(header)
     r = pc.run(pc.Scene.load("actuator-cycle", overrides))
     p = r.path
     assert p is not None

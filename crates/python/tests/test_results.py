@@ -1,7 +1,6 @@
 """Results: the same numbers as the command-line program, arrays of the documented shapes and
 dtypes, read-only views that outlive the result, the report, the outputs."""
 
-import csv
 import gc
 import json
 import subprocess
@@ -9,6 +8,7 @@ import subprocess
 import meshio
 import numpy as np
 import pytest
+from conftest import csv_rows
 
 import piezocontact as pc
 
@@ -48,8 +48,7 @@ def test_the_results_are_the_programs_outputs(binary, tmp_path, name, overrides)
     for field in ["stress", "strain", "electric_displacement", "electric_field"]:
         close(getattr(r, field), vtu.cell_data[field][0])
     # contact.csv is written with 13 significant digits
-    with open(out / "contact.csv") as f:
-        rows = list(csv.DictReader(f))
+    rows = csv_rows(out / "contact.csv")
     c = r.contact
     assert len(rows) == len(c)
     col = lambda k: np.array([float(row[k]) for row in rows])  # noqa: E731

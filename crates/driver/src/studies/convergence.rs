@@ -80,6 +80,8 @@ pub struct Study {
     pub rows: Vec<StudyRow>,
     /// The tight runs, per element order coarse to fine.
     pub tight: Vec<Tight>,
+    /// The units of the runs' numbers (study.csv's `h` is a length).
+    pub units: problem::Units,
 }
 
 /// A tight run of the study: the discretisation error of its order and size.
@@ -308,9 +310,11 @@ pub fn study(
     let mut pending = planned_sizes(spec, &sizes, orders.len(), has_contact, base.exact.is_some());
     pending.reverse();
     let mut eta = super::Eta::default();
+    let mut units = None;
     let mut one = |(order, n): (usize, usize), strategy: Strategy, tol: f64| -> Result<Solution, DriverError> {
         let t = std::time::Instant::now();
         let r = solve(scene_name, &settings(sets, (order, n), strategy, tol, has_contact))?;
+        units.get_or_insert_with(|| r.report.units.clone());
         eta.record(n, t.elapsed().as_secs_f64());
         pending.pop();
         progress(&format!(
@@ -363,6 +367,7 @@ pub fn study(
         against,
         rows,
         tight,
+        units: units.unwrap_or_default(),
     })
 }
 
@@ -420,8 +425,10 @@ fn one_size(
 
 /// The study as CSV.
 pub fn csv(s: &Study) -> String {
-    let mut out = String::from(
-        "scene,order,n,h,dofs,strategy,tol,iterations,iteration_kind,seconds,error,discretisation_error,algebraic_error\n",
+    // each column's unit in brackets where it has one (the errors are relative)
+    let mut out = format!(
+        "scene,order,n,{},dofs,strategy,tol,iterations,iteration_kind,seconds [s],error,discretisation_error,algebraic_error\n",
+        files::output::csv_field(&s.units.label("h", "length"))
     );
     for r in &s.rows {
         let _ = writeln!(
@@ -594,6 +601,7 @@ mod tests {
         let s = Study {
             scene: "x".into(),
             against: "y".into(),
+            units: problem::Units::default(),
             rows: vec![],
             tight: [
                 (1, 4, 1.0, 0.5),

@@ -278,22 +278,42 @@ pub fn csv(param: &str, rows: &[SweepRow], integer: bool) -> String {
     let indenter = rows.iter().any(|r| r.indenter.is_some());
     let errors = rows.iter().any(|r| r.error.is_some());
     let groups = terminal_groups(rows);
-    let mut header = format!(
-        "{param},n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds"
-    );
+    let mut columns: Vec<String> = std::iter::once(param.to_string())
+        .chain(
+            "n_stick,n_slip,n_separated,normal_force,tangential_force,complementarity,equilibrium,uzawa_iters,fixed_point_iters,seconds"
+                .split(',')
+                .map(String::from),
+        )
+        .collect();
     if indenter {
-        header.push_str(",indenter_depth,indenter_charge,indenter_force,indenter_contact_radius,indenter_potential,half_space_force,half_space_contact_radius,half_space_charge");
+        columns.extend("indenter_depth,indenter_charge,indenter_force,indenter_contact_radius,indenter_potential,half_space_force,half_space_contact_radius,half_space_charge".split(',').map(String::from));
     }
     for (prefix, g) in ["charge", "potential"]
         .iter()
         .flat_map(|p| groups.iter().map(move |g| (p, g)))
     {
-        header.push_str(&format!(",{}", files::output::csv_field(&format!("{prefix}_{g}"))));
+        columns.push(format!("{prefix}_{g}"));
     }
     if errors {
-        header.push_str(",error");
+        columns.push("error".into());
     }
-    let mut csv = header + "\n";
+    // each column's unit in brackets, the swept key's its quantity's
+    let units = rows.iter().find_map(|r| r.units.clone()).unwrap_or_default();
+    let header: Vec<String> = columns
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let unit = match k {
+                0 => units.of_quantity(param_quantity(param)).to_string(),
+                _ => files::output::column_unit("sweep.csv", c, &units),
+            };
+            match unit.is_empty() {
+                true => files::output::csv_field(c).into_owned(),
+                false => files::output::csv_field(&format!("{c} [{unit}]")).into_owned(),
+            }
+        })
+        .collect();
+    let mut csv = header.join(",") + "\n";
     let or_nan = |v: Option<f64>| v.unwrap_or(f64::NAN);
     for r in rows {
         let mut extra = String::new();
@@ -511,7 +531,17 @@ mod tests {
         let rows = sweep("pfm", &["mesh.n=24".into()], &spec, None, &mut |_| {}).unwrap();
         let text = csv(&spec.param, &rows, false);
         let lines: Vec<&str> = text.lines().collect();
-        let header: Vec<&str> = lines[0].split(',').collect();
+        // each column's unit in its header, the scene's (lengths in µm, potentials in kV)
+        for named in [
+            "contact.foundation_potential [kV]",
+            "indenter_depth [µm]",
+            "indenter_force [mN]",
+            "normal_force [mN]",
+            "seconds [s]",
+        ] {
+            assert!(lines[0].split(',').any(|c| c == named), "{named}: {}", lines[0]);
+        }
+        let header: Vec<&str> = lines[0].split(',').map(files::output::column_name).collect();
         for column in [
             "indenter_depth",
             "indenter_force",

@@ -109,6 +109,9 @@ fn files_but(solution: &Solution, left_out: Option<Output>) -> Result<Outputs, E
 /// has none: a count, a status, a path's time or factor, a relative residual).
 pub fn column_unit(file: &str, column: &str, units: &problem::Units) -> String {
     let path = file == "path.csv";
+    if column == "seconds" {
+        return "s".into();
+    }
     let quantity = match column {
         // a path's factors and its time are pure numbers
         "t" | "load" | "voltage" | "ux" | "uy" | "uz" | "gap" if path => "",
@@ -124,7 +127,10 @@ pub fn column_unit(file: &str, column: &str, units: &problem::Units) -> String {
         | "max_slip"
         | "max_slip_increment"
         | "half_space_depth"
-        | "half_space_contact_radius" => "length",
+        | "half_space_contact_radius"
+        | "indenter_depth"
+        | "indenter_contact_radius" => "length",
+        "indenter_potential" => "potential",
         "lambda_n" | "lambda_t" | "lambda_t2" => "traction",
         "flux" => "flux",
         c if c.starts_with("potential") => "potential",
@@ -156,7 +162,7 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
         }
         Output::ContactCsv => {
             let c = solution.contact.as_ref().ok_or_else(|| missing("contact.csv"))?;
-            one("contact.csv", contact_csv(c))
+            one("contact.csv", contact_csv(c, &solution.report.units))
         }
         Output::Multipliers => {
             let c = solution.contact.as_ref().ok_or_else(|| missing("multipliers"))?;
@@ -477,23 +483,40 @@ fn contact_columns(c: &ContactResult) -> Vec<String> {
     out.into_iter().map(String::from).collect()
 }
 
-/// A CSV header line of `columns`, each quoted where it needs it.
-fn header(columns: &[String]) -> String {
-    let mut s = columns.iter().map(|c| csv_field(c)).collect::<Vec<_>>().join(",");
+/// The CSV header line of `file`'s `columns`: each column's name and, where it has one, its
+/// unit in brackets ([`column_unit`]: `normal_force [mN]`, `t`), quoted where it needs it.
+fn header(file: &str, columns: &[String], units: &problem::Units) -> String {
+    let named = |c: &String| -> String {
+        match column_unit(file, c, units) {
+            unit if unit.is_empty() => csv_field(c).into_owned(),
+            unit => csv_field(&format!("{c} [{unit}]")).into_owned(),
+        }
+    };
+    let mut s = columns.iter().map(named).collect::<Vec<_>>().join(",");
     s.push('\n');
     s
 }
 
-/// One row per contact point: `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
+/// A CSV header's column `cell` without its unit (`normal_force [mN]` is `normal_force`): the
+/// name run.json's `units.columns` gives its unit under.
+pub fn column_name(cell: &str) -> &str {
+    match cell.strip_suffix(']').and_then(|c| c.rsplit_once(" [")) {
+        Some((name, _)) => name,
+        None => cell,
+    }
+}
+
+/// One row per contact point, under a [`header`] with the columns' units:
+/// `x,y[,z],gap,u_n,u_t[,u_t2],lambda_n,lambda_t[,lambda_t2],status`
 /// and, with electrical contact, `flux,potential` (`nan` where an electrode holds the point),
 /// with several contact groups `group`;
 /// the displacements are those of the final solution (a frictionless body slides: its `u_t`
 /// is written too), the tangential multipliers 0 where the law carries none.
-fn contact_csv(c: &ContactResult) -> Vec<u8> {
+fn contact_csv(c: &ContactResult, units: &problem::Units) -> Vec<u8> {
     let (points, sol, u) = (&c.points, &c.solution, &c.displacement);
     let dim = points.dim;
     let nt = sol.lambda.n_tangential();
-    let mut s = header(&contact_columns(c));
+    let mut s = header("contact.csv", &contact_columns(c), units);
     // electrical contact: the flux D.n and the potential of each point (nan on an electrode)
     let electric = sol.electric.as_ref().map(|e| {
         let mut at = vec![(f64::NAN, f64::NAN); points.len()];
@@ -659,7 +682,8 @@ pub(super) fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
         return Ok(vec![]);
     };
     let terminals = terminal_groups(&solution.report);
-    let mut out = vec![("path.csv".to_string(), path_csv(&path.rows, &terminals))];
+    let units = &solution.report.units;
+    let mut out = vec![("path.csv".to_string(), path_csv(&path.rows, &terminals, units))];
     let scene = &solution.report.scene.settings;
     out.extend(path_picture(&path.rows, &terminals, (scene, &solution.report.units))?);
     Ok(out)
@@ -688,7 +712,7 @@ fn path_columns(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<St
     out
 }
 
-/// `path.csv`: one row per instant (an indenter's depth, contact radius and a conducting tip's
+/// `path.csv`, under a [`header`] with the columns' units: one row per instant (an indenter's depth, contact radius and a conducting tip's
 /// charge, with the half-space's closed form beside them where it applies:
 /// `half_space_depth`, `_force`, `_contact_radius`, `_charge`), with the tangential force's
 /// magnitude (`tangential_force`)
@@ -697,8 +721,8 @@ fn path_columns(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<St
 /// `tangential_force_x_G`, ...), the charge
 /// on each terminal (`charge_GROUP`, the charge on the conductor) and its potential
 /// (`potential_GROUP`).
-fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<u8> {
-    let mut s = header(&path_columns(rows, terminals));
+fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str], units: &problem::Units) -> Vec<u8> {
+    let mut s = header("path.csv", &path_columns(rows, terminals), units);
     let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
     let n_groups = rows.first().map_or(0, |r| r.groups.len());
     for r in rows {
@@ -980,6 +1004,47 @@ mod tests {
         fields.push(field);
         assert_eq!(fields, names);
         assert_eq!(csv_field("plain"), "plain");
+    }
+
+    /// A CSV header names each column with its unit in brackets where it has one, the unit
+    /// run.json's `units.columns` gives it (a file's own reading: path.csv's `gap` is a factor,
+    /// contact.csv's a length), and [`column_name`] gives back the name run.json keys it by,
+    /// also for a group's name that holds brackets or commas.
+    #[test]
+    fn csv_headers_carry_the_columns_units() {
+        let mut quantities = std::collections::BTreeMap::new();
+        for (q, u) in [("length", "µm"), ("force", "mN"), ("traction", "GPa"), ("charge", "pC")] {
+            quantities.insert(q.to_string(), u.to_string());
+        }
+        let units = problem::Units {
+            quantities,
+            ..problem::Units::default()
+        };
+        let columns: Vec<String> = [
+            "t",
+            "gap",
+            "normal_force",
+            "n_stick",
+            "charge_a [b], c",
+            "lambda_n",
+            "seconds",
+        ]
+        .map(String::from)
+        .to_vec();
+        let path = header("path.csv", &columns, &units);
+        assert_eq!(
+            path,
+            "t,gap,normal_force [mN],n_stick,\"charge_a [b], c [pC]\",lambda_n [GPa],seconds [s]\n"
+        );
+        assert!(header("contact.csv", &columns, &units).starts_with("t,gap [µm],"));
+        for (cell, name) in [
+            ("normal_force [mN]", "normal_force"),
+            ("n_stick", "n_stick"),
+            ("charge_a [b], c [pC]", "charge_a [b], c"),
+            ("odd [", "odd ["),
+        ] {
+            assert_eq!(column_name(cell), name);
+        }
     }
 
     /// The contact values in every ParaView file (the solution's and a path's steps): the
