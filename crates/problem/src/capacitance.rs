@@ -138,19 +138,23 @@ pub(crate) fn capacitance<B: Backend>(
         .map(|j| (0..n).map(|i| matrix[i][j]).sum::<f64>().abs())
         .fold(0.0, f64::max)
         / big;
-    let units = crate::Units::of(&scene, setup.mesh.dim);
-    let (charge, potential) = (units.of_quantity("charge"), units.of_quantity("potential"));
-    let unit = match charge.contains('/') {
-        true => format!("({charge})/{potential}"),
-        false => format!("{charge}/{potential}"),
-    };
     Ok(Some(Capacitance {
         terminals: names,
         matrix,
         asymmetry,
         column_sum,
-        unit,
+        unit: unit(&scene, setup.mesh.dim),
     }))
+}
+
+/// The unit of a capacitance in `scene`'s system: its charge per its potential.
+fn unit(scene: &Scene, dim: usize) -> String {
+    let units = crate::Units::of(scene, dim);
+    let (charge, potential) = (units.of_quantity("charge"), units.of_quantity("potential"));
+    match charge.contains('/') {
+        true => format!("({charge})/{potential}"),
+        false => format!("{charge}/{potential}"),
+    }
 }
 
 /// The dof map of column `j`: terminal `j` (the nodes whose `member` it is) at unit

@@ -417,7 +417,7 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
     let x = units.label(param, param_quantity(param));
     let states = Panel {
         title: format!("Contact states along {param}"),
-        labels: (String::new(), "points".into()),
+        labels: (x.clone(), "points".into()),
         series: vec![
             Series::line("separated", along(&|r| r.counts.2 as f64)),
             Series::line("slip", along(&|r| r.counts.1 as f64)),

@@ -318,19 +318,12 @@ fn colour_bar<DB: DrawingBackend>(
     let mut chart = ChartBuilder::on(area)
         .margin_top(49)
         .margin_bottom(50)
-        .margin_right(12)
-        .y_label_area_size(100)
+        .margin_left(12)
+        .margin_right(16)
+        // the labels right of the bar, left-aligned: a label a little wider than plotters
+        // measures it runs into the free margin (right-aligned on its left, its end was cut)
+        .right_y_label_area_size(84)
         .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_labels(7)
-        .y_label_formatter(&|v| format!("{v:.2e}"))
-        .y_desc(unit)
-        .label_style((FONT, 12))
-        .draw()
         .map_err(e)?;
     let steps = 120;
     chart
@@ -341,6 +334,16 @@ fn colour_bar<DB: DrawingBackend>(
             );
             Rectangle::new([(0.0, a), (1.0, b)], color(0.5 * (a + b)).filled())
         }))
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(7)
+        .y_label_formatter(&|v| format!("{v:.2e}"))
+        .y_desc(unit)
+        .label_style((FONT, 12))
+        .draw()
         .map_err(e)?;
     Ok(())
 }

@@ -102,7 +102,7 @@ const PALETTE: [RGBColor; 6] = [
 pub enum Mark {
     /// A line through the points, in the series' colour.
     Line,
-    /// A thin grey line (a bound, a reference).
+    /// A thin black dashed line over the others (a bound, a closed form).
     Reference,
     /// Dots at the points, in the colour of the series before it.
     Dots,
@@ -130,7 +130,8 @@ impl Series {
         }
     }
 
-    /// A thin grey line through `points`: a reference (a bound, a closed form).
+    /// A thin dashed line through `points`, drawn over the lines: a reference (a bound, a
+    /// closed form).
     pub fn reference(name: &str, points: Vec<(f64, f64)>) -> Self {
         Series {
             name: name.into(),
@@ -150,6 +151,9 @@ pub struct Panel {
     /// What it draws.
     pub series: Vec<Series>,
 }
+
+/// A line of at most this many points is drawn with a dot at each.
+const FEW_POINTS: usize = 40;
 
 /// Beyond this magnitude values are clamped, so that no span overflows.
 const LIMIT: f64 = 1e300;
@@ -229,6 +233,8 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, (FONT, 22))
         .margin(12)
+        // the last x tick's label centred on the right edge: room for its half
+        .margin_right(30)
         .x_label_area_size(38)
         .y_label_area_size(76)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
@@ -243,21 +249,38 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
         .label_style((FONT, 13))
         .draw()
         .map_err(e)?;
+    // each series' colour (a series of dots takes the one before it); the references (closed
+    // forms, bounds) drawn last, dashed, over the lines they are compared with
+    let mut colours = Vec::with_capacity(panel.series.len());
     let mut k = 0;
     for (i, s) in panel.series.iter().enumerate() {
         if i > 0 && !s.name.is_empty() && s.mark != Mark::Dots {
             k += 1;
         }
+        colours.push(PALETTE[k % PALETTE.len()]);
+    }
+    let order = (0..panel.series.len())
+        .filter(|&i| panel.series[i].mark != Mark::Reference)
+        .chain((0..panel.series.len()).filter(|&i| panel.series[i].mark == Mark::Reference));
+    for i in order {
+        let (s, color) = (&panel.series[i], colours[i]);
         let points: Vec<(f64, f64)> = s
             .points
             .iter()
             .filter(|(a, b)| a.is_finite() && b.is_finite())
             .map(|&(a, b)| (a.clamp(-LIMIT, LIMIT), b.clamp(-LIMIT, LIMIT)))
             .collect();
-        let color = PALETTE[k % PALETTE.len()];
+        // a line of few points shows them: the values computed, not what lies between
+        let dotted = s.mark == Mark::Line && points.len() <= FEW_POINTS;
         let drawn = match s.mark {
+            Mark::Line if dotted => {
+                chart
+                    .draw_series(points.iter().map(|&q| Circle::new(q, 3, color.filled())))
+                    .map_err(e)?;
+                chart.draw_series(LineSeries::new(points, color.stroke_width(2)))
+            }
             Mark::Line => chart.draw_series(LineSeries::new(points, color.stroke_width(2))),
-            Mark::Reference => chart.draw_series(LineSeries::new(points, BLACK.mix(0.5))),
+            Mark::Reference => chart.draw_series(DashedLineSeries::new(points, 7, 5, BLACK.stroke_width(1))),
             Mark::Dots => chart.draw_series(points.into_iter().map(|q| Circle::new(q, 3, color.filled()))),
         }
         .map_err(e)?;
@@ -268,7 +291,9 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
                 .legend(move |(x, y)| -> DynElement<'static, DB, (i32, i32)> {
                     match mark {
                         Mark::Dots => Circle::new((x + 10, y), 3, color.filled()).into_dyn(),
-                        Mark::Reference => PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.5)).into_dyn(),
+                        Mark::Reference => {
+                            PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)).into_dyn()
+                        }
                         Mark::Line => PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)).into_dyn(),
                     }
                 });
