@@ -410,6 +410,8 @@ fn units_are_stated_and_carried_to_every_output() {
     );
     let potential = std::fs::read_to_string(out.join("potential.svg")).unwrap();
     assert!(potential.contains("[µm]") && potential.contains("[kV]"));
+    // and the tip's zone drawn close below the whole body
+    assert!(potential.contains("near the tip (r/a ≤ 3)"), "the zone's view");
     // the same scene without its [units]: SI assumed, labelled so, and a note; same numbers
     let (bare, _) = files::scene_file::load("pfm", &["mesh.n=16".into(), "~units".into()]).unwrap();
     let again = files::run::solve(&bare, &source, &mut Silent).unwrap();

@@ -174,7 +174,9 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
         }
         Output::Potential => {
             let fields = (&solution.u[..], &solution.phi[..]);
-            let pic = plots::mesh_view::potential_picture(&solution.mesh, fields, &solution.report.units)?;
+            let zone = solution.contact.as_ref().and_then(|c| tip_window(solution, c));
+            let pic =
+                plots::mesh_view::potential_picture(&solution.mesh, fields, &solution.report.units, zone.as_ref())?;
             pic.ok_or_else(|| missing("potential"))?
         }
     })
@@ -568,6 +570,40 @@ fn indenter_zone(solution: &Solution, c: &ContactResult) -> Option<(Vec<f64>, f6
         })
         .collect();
     Some((rho, a))
+}
+
+/// A 2D body's part near an indenter that touches: the contact face's points within three
+/// contact radii of its axis give the x range (both sides of a plane tip's axis, from the
+/// axis of a body of revolution) and the face's y, the body on the side its outward normal
+/// does not point to, the x range over 1.7 deep (the width over the height of the picture's
+/// close view, whose axes keep the body's proportions).
+fn tip_window(solution: &Solution, c: &ContactResult) -> Option<plots::mesh_view::Window> {
+    if solution.mesh.dim != 2 {
+        return None;
+    }
+    let (rho, a) = indenter_zone(solution, c)?;
+    let near: Vec<usize> = (0..rho.len()).filter(|&i| rho[i] <= 3.0 * a).collect();
+    let p = &c.points;
+    let xs = near.iter().map(|&i| p.position[i][0]);
+    let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(x), h.max(x)));
+    if !(x1 > x0) {
+        return None;
+    }
+    let m = near.len() as f64;
+    let surface = near.iter().map(|&i| p.position[i][1]).sum::<f64>() / m;
+    let outward = near.iter().map(|&i| p.normal[i][1]).sum::<f64>() / m;
+    let depth = (x1 - x0) / 1.7;
+    let y = match outward < 0.0 {
+        true => surface..surface + depth,
+        false => surface - depth..surface,
+    };
+    // the face's own nodes on the window's edge are within it
+    let pad = 1e-9 * (x1 - x0);
+    Some(plots::mesh_view::Window {
+        x: x0 - pad..x1 + pad,
+        y: y.start - pad..y.end + pad,
+        what: "near the tip (r/a ≤ 3)".into(),
+    })
 }
 
 /// The multipliers along the contact boundary (in 3D, along the contact face's middle line

@@ -96,8 +96,28 @@ pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], units: &problem::Unit
         .transpose()
 }
 
+/// A part of a 2D body drawn close, below the whole (an indenter's contact zone, where the
+/// whole body's picture shows it as a speck at its edge).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Window {
+    /// Its x range.
+    pub x: std::ops::Range<f64>,
+    /// Its y range.
+    pub y: std::ops::Range<f64>,
+    /// What it shows, in the caption (`near the tip, r/a ≤ 3`).
+    pub what: String,
+}
+
+impl Window {
+    fn holds(&self, p: [f64; 2]) -> bool {
+        self.x.contains(&p[0]) && self.y.contains(&p[1])
+    }
+}
+
 /// Filled contours of the nodal field `phi` with 12 isolines and a colour bar in the
-/// potential's unit, as SVG and PNG named `potential`; `None` where the mesh has no view.
+/// potential's unit, as SVG and PNG named `potential`; with a `zone`, the cells within it
+/// drawn close below the whole body, with contours and a colour bar of their own; `None`
+/// where the mesh has no view.
 ///
 /// # Errors
 /// [`Error::Picture`] where plotters cannot draw.
@@ -105,11 +125,32 @@ pub fn potential_picture(
     mesh: &mesh::Mesh,
     (u, phi): (&[[f64; 3]], &[f64]),
     units: &problem::Units,
+    zone: Option<&Window>,
 ) -> Result<Option<Files>, Error> {
     let unit = units.of_quantity("potential");
-    View::new(mesh, u, units)
-        .map(|view| both!("potential", |a| potential(a, &view, phi, unit)))
-        .transpose()
+    let Some(view) = View::new(mesh, u, units) else {
+        return Ok(None);
+    };
+    let Some(zone) = zone.filter(|w| view.tris.iter().any(|t| t.iter().all(|&v| w.holds(view.xy[v])))) else {
+        return both!("potential", |a| potential(a, &view, phi, unit, None)).map(Some);
+    };
+    let size = (super::SIZE.0, 2 * super::SIZE.1 - 100);
+    let draw = (&view, phi, unit, zone);
+    super::render_sized("potential", size, &|a| whole_and_zone(a, draw), &|a| {
+        whole_and_zone(a, draw)
+    })
+    .map(Some)
+}
+
+/// The whole body's potential above, the zone's below.
+fn whole_and_zone<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (view, phi, unit, zone): (&View, &[f64], &str, &Window),
+) -> Result<(), String> {
+    let (_, h) = area.dim_in_pixel();
+    let (whole, close) = area.split_vertically(h / 2);
+    potential(&whole, view, phi, unit, None)?;
+    potential(&close, view, phi, unit, Some(zone))
 }
 
 /// The axes of a picture of a [`View`]: caption, ranges, axis names, no grid; the ranges grown
@@ -220,13 +261,23 @@ fn potential<DB: DrawingBackend>(
     view: &View,
     phi: &[f64],
     unit: &str,
+    window: Option<&Window>,
 ) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
-    let (lo, hi) = view.bounds();
-    let (pmin, pmax) = view
+    // the triangles drawn: all, or those wholly within the window
+    let tris: Vec<&[usize; 3]> = view
         .tris
         .iter()
+        .filter(|t| window.is_none_or(|w| t.iter().all(|&v| w.holds(view.xy[v]))))
+        .collect();
+    let (lo, hi) = match window {
+        Some(w) => ([w.x.start, w.y.start], [w.x.end, w.y.end]),
+        None => view.bounds(),
+    };
+    let (pmin, pmax) = tris
+        .iter()
+        .copied()
         .flatten()
         .map(|&v| phi[v])
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
@@ -240,8 +291,9 @@ fn potential<DB: DrawingBackend>(
     } else {
         format!(" [{unit}]")
     };
+    let close = window.map_or(String::new(), |w| format!(" {}", w.what));
     let caption = format!(
-        "Electric potential{in_unit}{}: {pmin:.3e} to {pmax:.3e}, 12 contours",
+        "Electric potential{in_unit}{}{close}: {pmin:.3e} to {pmax:.3e}, 12 contours",
         view.title
     );
     let (w, _) = area.dim_in_pixel();
@@ -257,7 +309,7 @@ fn potential<DB: DrawingBackend>(
     colour_bar(&bar, (pmin, pmax), &color, unit)?;
     let xy = |v: usize| (view.xy[v][0], view.xy[v][1]);
     chart
-        .draw_series(view.tris.iter().map(|t| {
+        .draw_series(tris.iter().map(|t| {
             let mean = t.iter().map(|&v| phi[v]).sum::<f64>() / 3.0;
             Polygon::new(t.iter().map(|&v| xy(v)).collect::<Vec<_>>(), color(mean).filled())
         }))
@@ -265,7 +317,7 @@ fn potential<DB: DrawingBackend>(
     // isolines by marching triangles
     let levels = 12;
     let mut segments = vec![];
-    for t in &view.tris {
+    for t in &tris {
         for l in 1..levels {
             let level = pmin + span * l as f64 / levels as f64;
             let mut cut = vec![];

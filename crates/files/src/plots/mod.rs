@@ -15,7 +15,7 @@ use plotters::prelude::*;
 use std::sync::Once;
 
 pub(crate) const FONT: &str = "sans-serif";
-const SIZE: (u32, u32) = (960, 600);
+pub(crate) const SIZE: (u32, u32) = (960, 600);
 
 /// A picture's files: `(name.svg, bytes)` and `(name.png, bytes)`.
 pub type Files = Vec<(String, Vec<u8>)>;
