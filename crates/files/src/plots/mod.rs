@@ -272,6 +272,8 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
             .collect();
         // a line of few points shows them: the values computed, not what lies between
         let dotted = s.mark == Mark::Line && points.len() <= FEW_POINTS;
+        // a series with nothing to draw (no point slips) has no entry in the legend
+        let shown = !points.is_empty();
         let drawn = match s.mark {
             Mark::Line if dotted => {
                 chart
@@ -284,7 +286,7 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
             Mark::Dots => chart.draw_series(points.into_iter().map(|q| Circle::new(q, 3, color.filled()))),
         }
         .map_err(e)?;
-        if !s.name.is_empty() {
+        if !s.name.is_empty() && shown {
             let mark = s.mark;
             drawn
                 .label(s.name.as_str())
