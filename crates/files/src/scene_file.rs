@@ -268,6 +268,15 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
             table.insert(last.to_string(), toml::Value::String(typed_here.display().to_string()));
         }
         Some(v) => {
+            // an array of tables ([[material]]) does not take one table in its place
+            if let (Some(toml::Value::Array(a)), toml::Value::Table(_)) = (table.get(last.as_str()), &v) {
+                if a.iter().all(toml::Value::is_table) {
+                    return Err(format!(
+                        "`{key}` is an array of tables ([[{last}]], {} of them): one is replaced by its index (`{key}.0={{...}}`), its keys set one by one (`{key}.0.KEY=...`, or `{key}.KEY=...` where it holds one), or the whole array given (`{key}=[{{...}}]`)",
+                        a.len()
+                    ));
+                }
+            }
             // mesh.h and mesh.n are two ways to give one size: the one set replaces the other
             if let Some(other) = alternative(&path) {
                 table.remove(other);
@@ -437,6 +446,26 @@ mod tests {
         // a choice that does not exist names itself and its key
         let e = load("paper", &["solver.strategy=fast".into()]).unwrap_err().to_string();
         assert!(e.contains("fast") && e.contains("solver.strategy"), "{e}");
+    }
+
+    /// A table given where the scene has an array of tables is refused with the three ways
+    /// that work; each of them is taken.
+    #[test]
+    fn a_table_in_place_of_an_array_of_tables_says_how_to_set_it() {
+        let e = load("paper", &["material={crystal=\"PZT-5A\", units=\"GPa\"}".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("array of tables ([[material]]") && e.contains("`material.0={...}`"),
+            "{e}"
+        );
+        for set in [
+            "material.0={region=\"body\", crystal=\"PZT-5A\", units=\"GPa\", poling=[0.0, 1.0, 0.0]}",
+            "material=[{region=\"body\", crystal=\"PZT-5A\", units=\"GPa\", poling=[0.0, 1.0, 0.0]}]",
+        ] {
+            let (s, _) = load("paper", &[set.into()]).unwrap_or_else(|e| panic!("{set}: {e}"));
+            assert_eq!(s.material.len(), 1, "{set}");
+        }
     }
 
     #[test]
