@@ -340,6 +340,19 @@ fn a_film_on_its_bottom_electrode_at_an_interface_is_its_closed_form() {
     let t = &solution.report.terminals;
     let q = |g: &str| t.iter().find(|x| x.group == g).unwrap().charge;
     assert!((q("top") + q("bottom_electrode")).abs() < 1e-10 * q("top").abs());
+    // the substrate carries no potential: its cells drawn grey in the picture, the film's not
+    let electric = problem::cell_electric(&solution.report.scene.settings, mesh).unwrap();
+    for (region, carries) in [("film", true), ("substrate", false)] {
+        assert!(mesh.regions[region].iter().all(|&c| electric[c] == carries), "{region}");
+    }
+    let fields = (&solution.u[..], &solution.phi[..]);
+    let drawn = |electric: Option<&[bool]>| {
+        let files =
+            files::plots::mesh_view::potential_picture(mesh, fields, &solution.report.units, (None, electric)).unwrap();
+        String::from_utf8(files.unwrap()[0].1.clone()).unwrap()
+    };
+    assert!(drawn(Some(&electric)).contains("(grey: no potential)"));
+    assert!(!drawn(None).contains("grey"));
 }
 
 /// Layers whose data cannot make a body are refused by key: thicknesses that do not fill the

@@ -102,6 +102,7 @@ pub use scene::{
 };
 pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel, DEFAULT_FRAMES};
 pub use scene::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, CRYSTALS};
+pub use setup::cell_electric;
 pub use shared_memory::SharedMemory;
 pub use units::{LengthUnit, StressUnit, Units, UnitsSpec};
 

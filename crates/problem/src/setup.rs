@@ -543,6 +543,15 @@ fn material(spec: &MaterialSpec, dim: usize, axisymmetric: bool) -> Result<Mater
 }
 
 /// The materials of the scene by region, in the global frame.
+/// Whether each cell of `mesh` carries the potential (its material has a permittivity) under
+/// `scene`'s materials; `None` where they do not resolve on the mesh (a picture then draws
+/// every cell's potential).
+pub fn cell_electric(scene: &Scene, mesh: &mesh::Mesh) -> Option<Vec<bool>> {
+    let materials = materials(scene, mesh.dim).ok()?;
+    let of = fe_assembly::cell_materials(mesh, &materials).ok()?;
+    Some(of.iter().map(|&m| materials[m].1.electric).collect())
+}
+
 fn materials(scene: &Scene, dim: usize) -> Result<Vec<(String, Material)>, ProblemError> {
     scene
         .material

@@ -175,8 +175,13 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
         Output::Potential => {
             let fields = (&solution.u[..], &solution.phi[..]);
             let zone = solution.contact.as_ref().and_then(|c| tip_window(solution, c));
-            let pic =
-                plots::mesh_view::potential_picture(&solution.mesh, fields, &solution.report.units, zone.as_ref())?;
+            let electric = problem::cell_electric(&solution.report.scene.settings, &solution.mesh);
+            let pic = plots::mesh_view::potential_picture(
+                &solution.mesh,
+                fields,
+                &solution.report.units,
+                (zone.as_ref(), electric.as_deref()),
+            )?;
             pic.ok_or_else(|| missing("potential"))?
         }
     })

@@ -14,6 +14,8 @@ use plotters::prelude::*;
 struct View {
     title: &'static str,
     tris: Vec<[usize; 3]>,
+    /// The cell each triangle is drawn for (a 2D mesh's; `usize::MAX` for a 3D face's).
+    cell: Vec<usize>,
     xy: Vec<[f64; 2]>,
     uv: Vec<[f64; 2]>,
     outline: Vec<[usize; 2]>,
@@ -39,9 +41,15 @@ impl View {
     fn new(mesh: &mesh::Mesh, u: &[[f64; 3]], units: &problem::Units) -> Option<View> {
         let axis = |name: &str| units.label(name, "length");
         if mesh.dim == 2 {
+            let (cell, tris) = mesh
+                .iter_cells()
+                .enumerate()
+                .flat_map(|(k, c)| triangles(mesh.kind, c).into_iter().map(move |t| (k, t)))
+                .unzip();
             return Some(View {
                 title: "",
-                tris: mesh.iter_cells().flat_map(|c| triangles(mesh.kind, c)).collect(),
+                tris,
+                cell,
                 xy: mesh.points.iter().map(|p| [p[0], p[1]]).collect(),
                 uv: u.iter().map(|v| [v[0], v[1]]).collect(),
                 outline: mesh
@@ -63,12 +71,23 @@ impl View {
         }
         Some(View {
             title: " (face y = lo, seen in x-z)",
+            cell: vec![usize::MAX; tris.len()],
             tris,
             xy: mesh.points.iter().map(|p| [p[0], p[2]]).collect(),
             uv: u.iter().map(|v| [v[0], v[2]]).collect(),
             outline: edges.into_iter().filter(|(_, k)| *k == 1).map(|(e, _)| e).collect(),
             labels: (axis("x"), axis("z")),
         })
+    }
+
+    /// Marks the triangles of the cells that carry no potential (`usize::MAX` their cell).
+    fn without_potential(&mut self, electric: Option<&[bool]>) {
+        let Some(electric) = electric else { return };
+        for c in &mut self.cell {
+            if electric.get(*c) == Some(&false) {
+                *c = NO_POTENTIAL;
+            }
+        }
     }
 
     fn bounds(&self) -> ([f64; 2], [f64; 2]) {
@@ -96,6 +115,9 @@ pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], units: &problem::Unit
         .transpose()
 }
 
+/// [`View::cell`] of a triangle whose cell carries no potential.
+const NO_POTENTIAL: usize = usize::MAX - 1;
+
 /// A part of a 2D body drawn close, below the whole (an indenter's contact zone, where the
 /// whole body's picture shows it as a speck at its edge).
 #[derive(Clone, Debug, PartialEq)]
@@ -116,8 +138,10 @@ impl Window {
 
 /// Filled contours of the nodal field `phi` with 12 isolines and a colour bar in the
 /// potential's unit, as SVG and PNG named `potential`; with a `zone`, the cells within it
-/// drawn close below the whole body, with contours and a colour bar of their own; `None`
-/// where the mesh has no view.
+/// drawn close below the whole body, with contours and a colour bar of their own; the cells
+/// that `electric` (by cell) says carry no potential drawn grey, out of the range and the
+/// contours (a substrate under a film was white, as a potential of 0 is); `None` where the
+/// mesh has no view.
 ///
 /// # Errors
 /// [`Error::Picture`] where plotters cannot draw.
@@ -125,12 +149,13 @@ pub fn potential_picture(
     mesh: &mesh::Mesh,
     (u, phi): (&[[f64; 3]], &[f64]),
     units: &problem::Units,
-    zone: Option<&Window>,
+    (zone, electric): (Option<&Window>, Option<&[bool]>),
 ) -> Result<Option<Files>, Error> {
     let unit = units.of_quantity("potential");
-    let Some(view) = View::new(mesh, u, units) else {
+    let Some(mut view) = View::new(mesh, u, units) else {
         return Ok(None);
     };
+    view.without_potential(electric);
     let Some(zone) = zone.filter(|w| view.tris.iter().any(|t| t.iter().all(|&v| w.holds(view.xy[v])))) else {
         return both!("potential", |a| potential(a, &view, phi, unit, None)).map(Some);
     };
@@ -265,11 +290,17 @@ fn potential<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
-    // the triangles drawn: all, or those wholly within the window
-    let tris: Vec<&[usize; 3]> = view
-        .tris
-        .iter()
-        .filter(|t| window.is_none_or(|w| t.iter().all(|&v| w.holds(view.xy[v]))))
+    // the triangles drawn: all, or those wholly within the window; grey those of cells
+    // without the potential
+    let within = |t: &&[usize; 3]| window.is_none_or(|w| t.iter().all(|&v| w.holds(view.xy[v])));
+    let shown = || view.tris.iter().enumerate().filter(|(_, t)| within(t));
+    let grey: Vec<&[usize; 3]> = shown()
+        .filter(|&(k, _)| view.cell[k] == NO_POTENTIAL)
+        .map(|(_, t)| t)
+        .collect();
+    let tris: Vec<&[usize; 3]> = shown()
+        .filter(|&(k, _)| view.cell[k] != NO_POTENTIAL)
+        .map(|(_, t)| t)
         .collect();
     let (lo, hi) = match window {
         Some(w) => ([w.x.start, w.y.start], [w.x.end, w.y.end]),
@@ -291,7 +322,10 @@ fn potential<DB: DrawingBackend>(
     } else {
         format!(" [{unit}]")
     };
-    let close = window.map_or(String::new(), |w| format!(" {}", w.what));
+    let mut close = window.map_or(String::new(), |w| format!(" {}", w.what));
+    if !grey.is_empty() {
+        close.push_str(" (grey: no potential)");
+    }
     let caption = format!(
         "Electric potential{in_unit}{}{close}: {pmin:.3e} to {pmax:.3e}, 12 contours",
         view.title
@@ -308,6 +342,14 @@ fn potential<DB: DrawingBackend>(
     let color = |v: f64| diverging(v / reach);
     colour_bar(&bar, (pmin, pmax), &color, unit)?;
     let xy = |v: usize| (view.xy[v][0], view.xy[v][1]);
+    chart
+        .draw_series(grey.iter().map(|t| {
+            Polygon::new(
+                t.iter().map(|&v| xy(v)).collect::<Vec<_>>(),
+                RGBColor(215, 215, 215).filled(),
+            )
+        }))
+        .map_err(e)?;
     chart
         .draw_series(tris.iter().map(|t| {
             let mean = t.iter().map(|&v| phi[v]).sum::<f64>() / 3.0;
