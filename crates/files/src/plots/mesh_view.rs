@@ -356,10 +356,19 @@ fn potential<DB: DrawingBackend>(
             Polygon::new(t.iter().map(|&v| xy(v)).collect::<Vec<_>>(), color(mean).filled())
         }))
         .map_err(e)?;
-    // isolines by marching triangles
+    let segments = isolines(view, &tris, phi, (pmin, span));
+    chart
+        .draw_series(segments.into_iter().map(|s| PathElement::new(s, BLACK.mix(0.7))))
+        .map_err(e)?;
+    Ok(())
+}
+
+/// The 11 isolines of `phi` between `pmin` and `pmin + span` over the triangles `tris`, by
+/// marching triangles: a segment per triangle and level that crosses it.
+fn isolines(view: &View, tris: &[&[usize; 3]], phi: &[f64], (pmin, span): (f64, f64)) -> Vec<Vec<(f64, f64)>> {
     let levels = 12;
     let mut segments = vec![];
-    for t in &tris {
+    for t in tris {
         for l in 1..levels {
             let level = pmin + span * l as f64 / levels as f64;
             let mut cut = vec![];
@@ -379,10 +388,7 @@ fn potential<DB: DrawingBackend>(
             }
         }
     }
-    chart
-        .draw_series(segments.into_iter().map(|s| PathElement::new(s, BLACK.mix(0.7))))
-        .map_err(e)?;
-    Ok(())
+    segments
 }
 
 /// The diverging map at `t` in [-1, 1]: blue at -1, white at 0, red at 1.
