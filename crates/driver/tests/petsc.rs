@@ -481,6 +481,54 @@ fn on_the_active_sets(
     Some(options.clone())
 }
 
+/// A generated body's load path that MUMPS' own estimate, after its analysis, does not fit on
+/// a rank, where the estimate before the mesh (a lower one) did: the driver walks the path on
+/// pieces instead, in the same run, no rank factoring anything, and gives the default
+/// backend's path. The memory is given as the driver takes it from the process's limits (the
+/// fallback had no test for want of a machine where the two estimates disagree).
+#[test]
+fn a_path_mumps_cannot_factor_walks_on_pieces() {
+    on_ranks("a_path_mumps_cannot_factor_walks_on_pieces", 2, |petsc| {
+        use problem::backend::Backend;
+        let sets = ["mesh.n=14", "path={t=[0.0,1.0],load=[0.0,1.0],steps=2}"];
+        let (faer, _) = both("paper-3d", &sets, &[]);
+        let mut with: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        with.push("solver.backend=\"petsc\"".into());
+        let (scene, source) = scene_file::load("paper-3d", &with).expect("the scene reads");
+        // within the estimate before the mesh, below MUMPS' own (about 1.6 times the share)
+        let (share, _) = problem::SharedMemory.estimate(&scene).expect("a generated mesh");
+        let memory = (Some((1.05 * share / 2.0) as u64), Some("the test's limit"));
+        assert!(
+            !distributed::direct_exceeds(&scene, None, 2, memory.0),
+            "the estimate before the mesh takes the whole mesh's route"
+        );
+        // one directory for the ranks, named by rank 0
+        let nonce = petsc.all_gather(u64::from(std::process::id())).expect("gathered")[0];
+        let dir = std::env::temp_dir().join(format!("piezocontact-fallback-{nonce}"));
+        let solved = driver::petsc_run::run_on(petsc, &scene, &source, &dir, memory, &mut problem::Silent)
+            .unwrap_or_else(|e| panic!("the run within {memory:?} a rank: {e}"));
+        let Some(solution) = solved else { return };
+        let pieces = solution.report.petsc.as_ref().and_then(|p| p.pieces);
+        let rows = |s: &problem::Solution| -> Vec<f64> {
+            s.report
+                .path
+                .as_ref()
+                .expect("a path")
+                .rows
+                .iter()
+                .map(|r| r.normal_force)
+                .collect()
+        };
+        let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
+        let written = dir.join("path.csv").exists() && dir.join("run.json").exists();
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(pieces.is_some(), "the path on pieces: {:?}", solution.report.petsc);
+        assert!(written, "the path's files");
+        let d = rel_diff(&rows(&direct), &rows(&solution));
+        assert!(d < 1e-6, "the normal forces along the path differ by {d:.2e}");
+    });
+}
+
 /// Where MUMPS' factorisation would not fit a rank's memory (its own estimate after its
 /// analysis, above the estimate before the mesh) and the active sets hold the run, the run
 /// takes the Krylov route's active sets and gives the default backend's answer; where they do

@@ -24,17 +24,35 @@ pub fn run_distributed(
     reporter: &mut dyn Reporter,
 ) -> Result<Option<Solution>, DriverError> {
     let petsc = petsc::Petsc::init()?;
+    // the ranks of one machine share its memory (on several machines this is conservative)
+    let memory = memory_limits(petsc.size() as u64);
+    run_on(&petsc, scene, source, dir, memory, reporter)
+}
+
+/// [`run_distributed`] on PETSc initialised by the caller, each rank's memory given: the bytes
+/// it may use and the limit they come from (the least of the ranks' is taken), as
+/// [`files::run::memory_limits`] finds them.
+///
+/// # Errors
+/// As [`run_distributed`].
+pub fn run_on(
+    petsc: &petsc::Petsc,
+    scene: &Scene,
+    source: &Source,
+    dir: &Path,
+    memory: (Option<u64>, Option<&'static str>),
+    reporter: &mut dyn Reporter,
+) -> Result<Option<Solution>, DriverError> {
     let mut silent = problem::Silent;
     let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
-    // the ranks of one machine share its memory (on several machines this is conservative)
-    let (memory_bytes, memory_limit) = agreed_limits(&petsc, memory_limits(petsc.size() as u64))?;
+    let (memory_bytes, memory_limit) = agreed_limits(petsc, memory)?;
     let limits = problem::Limits {
         memory_bytes,
         memory_limit,
         ..Default::default()
     };
     let mesh = match route(scene, source, petsc.size(), memory_bytes)? {
-        Route::Pieces(from) => return pieces::run(scene, source, dir, (&petsc, limits), from, reporter),
+        Route::Pieces(from) => return pieces::run(scene, source, dir, (petsc, limits), from, reporter),
         Route::Whole(mesh) => mesh,
     };
     // a path's steps written by rank 0 as they come, into a set committed at the end
@@ -54,7 +72,7 @@ pub fn run_distributed(
         None => Ok(()),
     };
     let generated = mesh.is_none();
-    let solved = distributed::solve_path(scene, mesh, &petsc, limits, reporter, &mut each);
+    let solved = distributed::solve_path(scene, mesh, petsc, limits, reporter, &mut each);
     let solved = match solved {
         // MUMPS' own estimate after its analysis (the one before the mesh is a lower one) or its
         // allocation: a generated body's load path walks on pieces instead, which factor
@@ -65,7 +83,7 @@ pub fn run_distributed(
         )) if generated && scene.path.is_some() && distributed::pieces_support(scene).is_ok() => {
             drop(writer);
             let from = distributed::PieceMesh::Generated;
-            return pieces::run(scene, source, dir, (&petsc, limits), from, reporter);
+            return pieces::run(scene, source, dir, (petsc, limits), from, reporter);
         }
         other => other.map_err(driver_error)?,
     };
