@@ -33,7 +33,8 @@ const ENCODING_BYTES: usize = 256 << 20;
 ///
 /// A step's file holds the point data (`u`, `phi`, and the contact's status, pressure,
 /// traction, gap and flux), and the cell data (stress, strain, D, E) where the scene asks for
-/// it (`path.cell_fields`); its arrays are zlib-compressed, the mesh's compressed once for all
+/// it (`path.cell_fields`); its arrays in zlib blocks, deflated where they are mostly zeros
+/// and stored where not (a field's mantissas do not compress), the mesh's made once for all
 /// steps. Each step is encoded and written into the set's staging directory by one of a few
 /// threads kept for the path while the path goes on, at most 16 waiting (the written
 /// instants of a path come several together: their fields are solved together), and taken
