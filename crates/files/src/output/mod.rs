@@ -753,8 +753,9 @@ fn path_columns(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<St
     out
 }
 
-/// `path.csv`, under a [`header`] with the columns' units: one row per instant (an indenter's depth, contact radius and a conducting tip's
-/// charge, with the half-space's closed form beside them where it applies:
+/// `path.csv`, under a [`header`] with the columns' units: one row per instant (an
+/// indenter's depth, contact radius and a conducting tip's charge, with the half-space's
+/// closed form beside them where it applies:
 /// `half_space_depth`, `_force`, `_contact_radius`, `_charge`), with the tangential force's
 /// magnitude (`tangential_force`)
 /// and its components in the global frame (`tangential_force_x`, `_y`, `_z` in 3D), with

@@ -309,8 +309,9 @@ pub struct Staged {
 
 impl Staged {
     /// Writes one file of the set into its staging directory, its bytes given by `write`,
-    /// under the registry's lock as [`SetWriter::write`] writes (a signal's removal of the set waits for it; a set already
-    /// removed is not written into). The file is the set's once [`SetWriter::adopt`] takes it.
+    /// under the registry's lock as [`SetWriter::write`] writes (a signal's removal of the set
+    /// waits for it; a set already removed is not written into). The file is the set's once
+    /// [`SetWriter::adopt`] takes it (which checks its name against the user's files).
     ///
     /// # Errors
     /// As [`SetWriter::write`]; [`Error::Output`] where the set was abandoned.
