@@ -596,7 +596,7 @@ fn capacitance(scene: Option<String>, set: &[String], out: Option<PathBuf>) -> R
     let columns: Vec<_> = c
         .terminals
         .iter()
-        .map(|t| field(&format!("{t} [{}]", c.unit)).into_owned())
+        .map(|t| files::output::header_cell(t, &c.unit))
         .collect();
     let mut csv = format!("terminal,{}\n", columns.join(","));
     for (t, row) in names.iter().zip(&c.matrix) {

@@ -542,7 +542,6 @@ fn material(spec: &MaterialSpec, dim: usize, axisymmetric: bool) -> Result<Mater
     Ok(material.with_coupling_scale(scale))
 }
 
-/// The materials of the scene by region, in the global frame.
 /// Whether each cell of `mesh` carries the potential (its material has a permittivity) under
 /// `scene`'s materials; `None` where they do not resolve on the mesh (a picture then draws
 /// every cell's potential).
@@ -552,6 +551,7 @@ pub fn cell_electric(scene: &Scene, mesh: &mesh::Mesh) -> Option<Vec<bool>> {
     Some(of.iter().map(|&m| materials[m].1.electric).collect())
 }
 
+/// The materials of the scene by region, in the global frame.
 fn materials(scene: &Scene, dim: usize) -> Result<Vec<(String, Material)>, ProblemError> {
     scene
         .material

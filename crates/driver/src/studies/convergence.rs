@@ -428,7 +428,7 @@ pub fn csv(s: &Study) -> String {
     // each column's unit in brackets where it has one (the errors are relative)
     let mut out = format!(
         "scene,order,n,{},dofs,strategy,tol,iterations,iteration_kind,seconds [s],error,discretisation_error,algebraic_error\n",
-        files::output::csv_field(&s.units.label("h", "length"))
+        files::output::header_cell("h", s.units.of_quantity("length"))
     );
     for r in &s.rows {
         let _ = writeln!(

@@ -307,10 +307,7 @@ pub fn csv(param: &str, rows: &[SweepRow], integer: bool) -> String {
                 0 => units.of_quantity(param_quantity(param)).to_string(),
                 _ => files::output::column_unit("sweep.csv", c, &units),
             };
-            match unit.is_empty() {
-                true => files::output::csv_field(c).into_owned(),
-                false => files::output::csv_field(&format!("{c} [{unit}]")).into_owned(),
-            }
+            files::output::header_cell(c, &unit)
         })
         .collect();
     let mut csv = header.join(",") + "\n";

@@ -322,12 +322,12 @@ impl<'a> FieldArrays<'a> {
         FieldArrays { point, cell }
     }
 
-    /// The arrays, every one owned.
     /// The bytes of the arrays' values.
     fn bytes(&self) -> usize {
         self.point.iter().chain(&self.cell).map(|a| 8 * a.values.len()).sum()
     }
 
+    /// The arrays, every one owned.
     fn into_owned(self) -> FieldArrays<'static> {
         FieldArrays {
             point: self.point.into_iter().map(NamedValues::into_owned).collect(),
@@ -493,15 +493,19 @@ fn contact_columns(c: &ContactResult) -> Vec<String> {
 /// The CSV header line of `file`'s `columns`: each column's name and, where it has one, its
 /// unit in brackets ([`column_unit`]: `normal_force [mN]`, `t`), quoted where it needs it.
 fn header(file: &str, columns: &[String], units: &problem::Units) -> String {
-    let named = |c: &String| -> String {
-        match column_unit(file, c, units) {
-            unit if unit.is_empty() => csv_field(c).into_owned(),
-            unit => csv_field(&format!("{c} [{unit}]")).into_owned(),
-        }
-    };
+    let named = |c: &String| header_cell(c, &column_unit(file, c, units));
     let mut s = columns.iter().map(named).collect::<Vec<_>>().join(",");
     s.push('\n');
     s
+}
+
+/// A CSV header's cell of column `name` in `unit`: `name [unit]`, or `name` alone without a
+/// unit, quoted where it needs it ([`column_name`] reads the name back).
+pub fn header_cell(name: &str, unit: &str) -> String {
+    match unit {
+        "" => csv_field(name).into_owned(),
+        unit => csv_field(&format!("{name} [{unit}]")).into_owned(),
+    }
 }
 
 /// A CSV header's column `cell` without its unit (`normal_force [mN]` is `normal_force`): the
