@@ -14,7 +14,8 @@ use plotters::prelude::*;
 struct View {
     title: &'static str,
     tris: Vec<[usize; 3]>,
-    /// The cell each triangle is drawn for (a 2D mesh's; `usize::MAX` for a 3D face's).
+    /// The cell each triangle is drawn for (a 2D mesh's; `usize::MAX`, no cell, for a 3D
+    /// face's).
     cell: Vec<usize>,
     xy: Vec<[f64; 2]>,
     uv: Vec<[f64; 2]>,
@@ -80,16 +81,6 @@ impl View {
         })
     }
 
-    /// Marks the triangles of the cells that carry no potential (`usize::MAX` their cell).
-    fn without_potential(&mut self, electric: Option<&[bool]>) {
-        let Some(electric) = electric else { return };
-        for c in &mut self.cell {
-            if electric.get(*c) == Some(&false) {
-                *c = NO_POTENTIAL;
-            }
-        }
-    }
-
     fn bounds(&self) -> ([f64; 2], [f64; 2]) {
         let used: std::collections::BTreeSet<usize> = self.tris.iter().flatten().copied().collect();
         let mut lo = [f64::INFINITY; 2];
@@ -115,8 +106,14 @@ pub fn deformed_picture(mesh: &mesh::Mesh, u: &[[f64; 3]], units: &problem::Unit
         .transpose()
 }
 
-/// [`View::cell`] of a triangle whose cell carries no potential.
-const NO_POTENTIAL: usize = usize::MAX - 1;
+/// What a potential picture draws: a view, its nodal potential and unit, and which of the
+/// view's triangles are grey (their cell carries no potential).
+struct Drawn<'a> {
+    view: &'a View,
+    phi: &'a [f64],
+    unit: &'a str,
+    grey: Vec<bool>,
+}
 
 /// A part of a 2D body drawn close, below the whole (an indenter's contact zone, where the
 /// whole body's picture shows it as a speck at its edge).
@@ -151,18 +148,24 @@ pub fn potential_picture(
     units: &problem::Units,
     (zone, electric): (Option<&Window>, Option<&[bool]>),
 ) -> Result<Option<Files>, Error> {
-    let unit = units.of_quantity("potential");
-    let Some(mut view) = View::new(mesh, u, units) else {
+    let Some(view) = View::new(mesh, u, units) else {
         return Ok(None);
     };
-    view.without_potential(electric);
+    let grey = (view.cell.iter())
+        .map(|&c| electric.is_some_and(|e| e.get(c) == Some(&false)))
+        .collect();
+    let drawn = Drawn {
+        view: &view,
+        phi,
+        unit: units.of_quantity("potential"),
+        grey,
+    };
     let Some(zone) = zone.filter(|w| view.tris.iter().any(|t| t.iter().all(|&v| w.holds(view.xy[v])))) else {
-        return both!("potential", |a| potential(a, &view, phi, unit, None)).map(Some);
+        return both!("potential", |a| potential(a, &drawn, None)).map(Some);
     };
     let size = (super::SIZE.0, 2 * super::SIZE.1 - 100);
-    let draw = (&view, phi, unit, zone);
-    super::render_sized("potential", size, &|a| whole_and_zone(a, draw), &|a| {
-        whole_and_zone(a, draw)
+    super::render_sized("potential", size, &|a| whole_and_zone(a, &drawn, zone), &|a| {
+        whole_and_zone(a, &drawn, zone)
     })
     .map(Some)
 }
@@ -170,12 +173,13 @@ pub fn potential_picture(
 /// The whole body's potential above, the zone's below.
 fn whole_and_zone<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    (view, phi, unit, zone): (&View, &[f64], &str, &Window),
+    drawn: &Drawn<'_>,
+    zone: &Window,
 ) -> Result<(), String> {
     let (_, h) = area.dim_in_pixel();
     let (whole, close) = area.split_vertically(h / 2);
-    potential(&whole, view, phi, unit, None)?;
-    potential(&close, view, phi, unit, Some(zone))
+    potential(&whole, drawn, None)?;
+    potential(&close, drawn, Some(zone))
 }
 
 /// The axes of a picture of a [`View`]: caption, ranges, axis names, no grid; the ranges grown
@@ -283,25 +287,18 @@ fn deformed<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, view: &View) -> R
 
 fn potential<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    view: &View,
-    phi: &[f64],
-    unit: &str,
+    drawn: &Drawn<'_>,
     window: Option<&Window>,
 ) -> Result<(), String> {
+    let Drawn { view, phi, unit, .. } = *drawn;
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
     // the triangles drawn: all, or those wholly within the window; grey those of cells
     // without the potential
     let within = |t: &&[usize; 3]| window.is_none_or(|w| t.iter().all(|&v| w.holds(view.xy[v])));
     let shown = || view.tris.iter().enumerate().filter(|(_, t)| within(t));
-    let grey: Vec<&[usize; 3]> = shown()
-        .filter(|&(k, _)| view.cell[k] == NO_POTENTIAL)
-        .map(|(_, t)| t)
-        .collect();
-    let tris: Vec<&[usize; 3]> = shown()
-        .filter(|&(k, _)| view.cell[k] != NO_POTENTIAL)
-        .map(|(_, t)| t)
-        .collect();
+    let grey: Vec<&[usize; 3]> = shown().filter(|&(k, _)| drawn.grey[k]).map(|(_, t)| t).collect();
+    let tris: Vec<&[usize; 3]> = shown().filter(|&(k, _)| !drawn.grey[k]).map(|(_, t)| t).collect();
     let (lo, hi) = match window {
         Some(w) => ([w.x.start, w.y.start], [w.x.end, w.y.end]),
         None => view.bounds(),
