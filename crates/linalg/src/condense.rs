@@ -9,7 +9,7 @@
 //! triangular update of that forward sweep and one backward sweep: the whole contact run then
 //! costs the sparse work of one solve. Otherwise, by block solves with the factor.
 
-use crate::coupled::DirectLdlt;
+use crate::coupled::{DirectLdlt, UPhi};
 use crate::LinalgError;
 use crate::ShapeError;
 
@@ -32,9 +32,6 @@ pub struct Condensed {
     /// The loads' part, kept for [`DirectLdlt::solve_with_update`].
     pub loads: CondensedLoads,
 }
-
-/// A solution split into its displacements and its potentials `(u, φ)`.
-pub type Split = (Vec<f64>, Vec<f64>);
 
 /// The loads' part of a condensation: the solution at `c` under the loads alone, and what the
 /// final solve with a change of the right-hand side at `c` needs.
@@ -114,7 +111,7 @@ impl DirectLdlt {
     ///
     /// # Errors
     /// [`LinalgError::Shape`] where an update does not have one value per dof.
-    pub fn solve_trailing_many(&self, dofs: &[usize], updates: &[&[f64]]) -> Result<Option<Vec<Split>>, LinalgError> {
+    pub fn solve_trailing_many(&self, dofs: &[usize], updates: &[&[f64]]) -> Result<Option<Vec<UPhi>>, LinalgError> {
         let (k, m) = (dofs.len(), updates.len());
         if let Some(d) = updates.iter().find(|d| d.len() != k) {
             return Err(ShapeError::CondensedValues {

@@ -326,9 +326,9 @@ fn minus_k_x(k: CoupledBlocks<'_>, (u, phi): (&[f64], &[f64]), (b_u, b_phi): (&[
 }
 
 /// [`minus_k_x`] of several vectors, each `(b_u - A u - Gᵀ φ, b_φ - G u + B φ)` summed in
-/// the order of one column after another on one thread: the vectors split into as many groups as the pool has
-/// threads, each group's products made at once on one thread from its vectors stored
-/// interleaved, so that a thread reads `K` once for its group (the written instants of a path
+/// the order of one column after another on one thread: the vectors split into as many
+/// groups as the pool has threads, each group's products made at once on one thread from its
+/// vectors stored interleaved, so that a thread reads `K` once for its group (the written instants of a path
 /// measured each a product with a 2D `K` of 10^7 entries, 10 ms, bound by reading them).
 fn minus_k_x_many(k: CoupledBlocks<'_>, xs: &[UPhiRef<'_>], bs: &[UPhiRef<'_>]) -> Vec<UPhi> {
     let group = xs.len().div_ceil(rayon::current_num_threads().max(1)).max(1);
