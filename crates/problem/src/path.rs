@@ -578,12 +578,11 @@ impl Springs {
     }
 }
 
-/// An instant's data for its contact solves: the discrete problem with its loads, a path's
-/// factors of the parts, and its load factor (force control's force scales with it).
+/// An instant's data for its contact solves: the discrete problem with its loads (and a
+/// path's factors of the parts), and its load factor (force control's force scales with it).
 #[derive(Clone, Copy)]
 struct InstantData<'a> {
     posed: &'a Posed<'a>,
-    factors: Option<&'a [f64]>,
     load: f64,
 }
 
@@ -864,16 +863,15 @@ impl Walk<'_> {
         }
     }
 
-    /// An instant's loads at the factors `f`, and a path's factors of the parts in their order,
-    /// its prescribed values scaled in `disc`'s dof map (a static scene's: its own loads).
-    fn data_at(&self, f: &Factors, disc: &mut Discretization<'_>) -> Result<(Loads, Option<Vec<f64>>), ProblemError> {
+    /// An instant's loads at the factors `f` (with a path's factors of the parts in their
+    /// order), its prescribed values scaled in `disc`'s dof map (a static scene's: its own
+    /// loads).
+    fn data_at(&self, f: &Factors, disc: &mut Discretization<'_>) -> Result<Loads, ProblemError> {
         let Some(parts) = self.parts else {
-            return Ok((self.first.clone(), None));
+            return Ok(self.first.clone());
         };
         disc.dofs.rescale(&self.prescribed, f.displacement, f.voltage);
-        let loads = step_loads(parts, f, self.scene)?;
-        let factors = loads.factors.clone();
-        Ok((loads, factors))
+        step_loads(parts, f, self.scene)
     }
 
     /// A path's parts of the right-hand side in the backend's order: the loads, each
@@ -922,7 +920,9 @@ impl Walk<'_> {
     ) -> Result<Stepped, B::Error> {
         let started = Instant::now();
         let f = self.factors(t);
-        let (loads, factors) = self.data_at(&f, disc)?;
+        let loads = self.data_at(&f, disc)?;
+        // (kept apart from the loads, which a deferred written instant takes with it)
+        let factors = loads.factors.clone();
         let mut boundary = on.base.map(|b| match self.parts {
             Some(_) => b.at_factors(f.gap, f.displacement, f.voltage),
             None => b.clone(),
@@ -937,7 +937,6 @@ impl Walk<'_> {
             (Some(b), Some(how)) => {
                 let data = InstantData {
                     posed: &posed,
-                    factors: factors.as_deref(),
                     load: f.load,
                 };
                 let (sol, springs) = self.contact_at(on, how, b, data, reporter)?;
@@ -1027,7 +1026,7 @@ impl Walk<'_> {
                     boundary,
                     shift: &state.shift,
                 },
-                factors: data.factors,
+                factors: data.posed.loads.factors.as_deref(),
                 springs: &springs.lambda,
             };
             backend.prime(system, primed)?;
