@@ -1341,21 +1341,10 @@ fn gmsh_parts_agree_with_the_whole_mesh_on_three_ranks() {
             assert_eq!(s.report.terminals.len(), whole.report.terminals.len(), "{sets:?}");
             for (a, b) in s.report.terminals.iter().zip(&whole.report.terminals) {
                 assert_eq!((&a.group, a.floating), (&b.group, b.floating), "{sets:?}");
-                let close = |x: f64, y: f64| (x - y).abs() <= 1e-7 * y.abs().max(1e-6);
-                assert!(
-                    close(a.charge, b.charge),
-                    "{sets:?} {}: charge {} against {}",
-                    a.group,
-                    a.charge,
-                    b.charge
-                );
-                assert!(
-                    close(a.potential, b.potential),
-                    "{sets:?} {}: potential {} against {}",
-                    a.group,
-                    a.potential,
-                    b.potential
-                );
+                for (what, x, y) in [("charge", a.charge, b.charge), ("potential", a.potential, b.potential)] {
+                    let close = (x - y).abs() <= 1e-7 * y.abs().max(1e-6);
+                    assert!(close, "{sets:?} {}: {what} {x} against {y}", a.group);
+                }
             }
             let mut dl = 0.0f64;
             if let (Some(wc), Some(c)) = (&whole.contact, &s.contact) {
