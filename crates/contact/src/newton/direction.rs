@@ -5,10 +5,13 @@
 //! combinations of the compliance's rows), so that no `m x m` dense matrix is formed.
 
 use super::equations::{Flat, RowForm, State};
+use super::refactor::PivotedLu;
 use crate::operator::{dot8, Compliance};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::solvers::Solve;
+use faer::perm::PermRef;
+use faer::sparse::linalg::lu::simplicial::factorize_simplicial_numeric_lu_scratch;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, MatRef, Par};
@@ -162,10 +165,20 @@ pub(super) struct SparsePattern {
     ptr: Vec<usize>,
     /// Column indices of `J`'s rows, sorted.
     idx: Vec<usize>,
-    symbolic: SymbolicLu<usize>,
-    /// The numeric factor's storage and the workspace, kept from one step to the next (a
-    /// fresh factor's pages cost as much as its arithmetic).
-    numeric: Mutex<(NumericLu<usize, f64>, MemBuffer)>,
+    /// The factors, kept from one step to the next (a fresh factor's pages cost as much as
+    /// its arithmetic).
+    factors: Mutex<Factors>,
+}
+
+/// How a sparse pattern's Jacobians are factored: as faer's analysis chose, simplicial (by the
+/// refactoring LU, on the first pivots and pattern) or supernodal (where the factors are dense
+/// enough for dense kernels: the Kapla tower's 1,710 rows).
+enum Factors {
+    /// [`PivotedLu`]: the fill-reducing column order (COLAMD's, as `fwd` and `inv`), and the
+    /// factors once made (`None` before the first step, and after a singular one).
+    Pivoted((Vec<usize>, Vec<usize>), Option<Box<PivotedLu>>),
+    /// faer's supernodal LU: its analysis, the numeric factor's storage and the workspace.
+    Supernodal(Box<(SymbolicLu<usize>, NumericLu<usize, f64>, MemBuffer)>),
 }
 
 impl SparsePattern {
@@ -193,15 +206,24 @@ impl SparsePattern {
         }
         let pattern = SymbolicSparseColMatRef::new_checked(m, m, &ptr, None, &idx);
         let symbolic = factorize_symbolic_lu(pattern, Default::default()).ok()?;
-        let scratch = symbolic
-            .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.solve_transpose_in_place_scratch::<f64>(1, Par::Seq));
-        let numeric = Mutex::new((NumericLu::new(), MemBuffer::try_new(scratch).ok()?));
+        let scratch = symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default());
+        // (faer's analysis does not say which form it chose; the simplicial form's workspace
+        // tells it)
+        let factors = if scratch == factorize_simplicial_numeric_lu_scratch::<usize, f64>(m, m) {
+            let (fwd, inv) = symbolic.col_perm().arrays();
+            Factors::Pivoted((fwd.to_vec(), inv.to_vec()), None)
+        } else {
+            let scratch = scratch.or(symbolic.solve_transpose_in_place_scratch::<f64>(1, Par::Seq));
+            Factors::Supernodal(Box::new((
+                symbolic,
+                NumericLu::new(),
+                MemBuffer::try_new(scratch).ok()?,
+            )))
+        };
         Some(SparsePattern {
             ptr,
             idx,
-            symbolic,
-            numeric,
+            factors: Mutex::new(factors),
         })
     }
 }
@@ -388,23 +410,30 @@ fn sparse_lu(flat: &Flat<'_>, s: &State, rows: &[RowForm], pattern: &SparsePatte
         }
     }
     let structure = SymbolicSparseColMatRef::new_checked(m, m, &pattern.ptr, None, &pattern.idx);
-    // sequential: these matrices are small (a thread pool's start costs more than it saves)
-    let (symbolic, par) = (&pattern.symbolic, Par::Seq);
-    let mut kept = pattern.numeric.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    let (numeric, buffer) = &mut *kept;
-    let stack = MemStack::new(buffer);
-    let lu = symbolic
-        .factorize_numeric_lu(
-            numeric,
-            SparseColMatRef::new(structure, &values),
-            par,
-            stack,
-            Default::default(),
-        )
-        .ok()?;
-    let mut rhs = Mat::<f64>::from_fn(m, 1, |r, _| -s.f[r]);
-    lu.solve_transpose_in_place_with_conj(Conj::No, rhs.as_mut(), par, stack);
-    let delta: Vec<f64> = (0..m).map(|r| rhs[(r, 0)]).collect();
+    let jt = SparseColMatRef::new(structure, &values);
+    let mut kept = pattern.factors.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let mut delta: Vec<f64> = s.f.iter().map(|f| -f).collect();
+    match &mut *kept {
+        Factors::Pivoted((fwd, inv), lu) => {
+            // on the last step's pivots where they hold (new ones from the first column where
+            // they do not), else afresh
+            if !lu.as_mut().is_some_and(|lu| lu.refactor(jt)) {
+                *lu = PivotedLu::factor(jt, PermRef::new_checked(fwd, inv, m)).map(Box::new);
+            }
+            lu.as_ref()?.solve_transpose_in_place(&mut delta);
+        }
+        Factors::Supernodal(kept) => {
+            // sequential: these matrices are small (a thread pool's start costs more than it
+            // saves)
+            let (symbolic, numeric, buffer) = &mut **kept;
+            let stack = MemStack::new(buffer);
+            let lu = symbolic
+                .factorize_numeric_lu(numeric, jt, Par::Seq, stack, Default::default())
+                .ok()?;
+            let mut rhs = MatMut::from_column_major_slice_mut(&mut delta, m, 1);
+            lu.solve_transpose_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, stack);
+        }
+    }
     delta.iter().all(|v| v.is_finite()).then_some(delta)
 }
 

@@ -40,6 +40,7 @@
 mod direction;
 mod equations;
 mod member;
+mod refactor;
 
 use crate::coarse;
 use crate::electric::{ElectricContactProblem, ElectricValues};
