@@ -1,10 +1,10 @@
 //! The Krylov route's contact, where MUMPS' factorisation would not fit the ranks' memory: the
 //! primal-dual active set iteration on the whole system ([`crate::contact::active_set`]), each
 //! step one Krylov solve, no factorisation and no dense compliance. It holds the paper's base
-//! model on one zone ([`crate::active_sets_hold`] chooses it); its steps here are the
+//! model, on one zone or several ([`crate::active_sets_hold`] chooses it); its steps here are the
 //! backend's `begin`, `prime`, `solve_posed` and `instant_fields` on that route.
 
-use crate::contact::{active_set, ActiveSetParams, ContactRows};
+use crate::contact::{active_set, shared_components, shared_refusal, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
 use crate::krylov::{Krylov, KrylovFields};
 use crate::layout::Layout;
@@ -54,6 +54,10 @@ pub(crate) fn solve<'p>(
 ) -> Result<contact::ContactSolution, DistributedError> {
     let petsc = k.petsc;
     let boundary = active.boundary.as_ref().ok_or_else(unprimed)?;
+    // (every rank holds the whole boundary: the same verdict on each)
+    if let Some(i) = shared_components(at.points, &boundary.nodes, &how.law) {
+        return Err(ProblemError::from(shared_refusal(at.points.position[i])).into());
+    }
     let rows = ContactRows::new(petsc, (at.points, &boundary.nodes, &how.law), true, layout, &k.system)?;
     let params = ActiveSetParams {
         tol: how.tol,

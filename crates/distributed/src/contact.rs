@@ -193,6 +193,48 @@ impl ContactRows {
     }
 }
 
+/// The first of `points` (at the mesh `nodes`, under `law`) whose node is another point's and
+/// whose conditions act on a component of the node's displacement that the other's act on
+/// too: a normal along the other's normal, or a tangent that friction loads along the other's
+/// normal or loaded tangent. The active sets hold or load each component of a node once (a
+/// held component is an eliminated row), where the condensed route couples the two points'
+/// multipliers; frictionless zones meeting at a corner act on different components and are
+/// held. `None` where no two points share a component.
+pub fn shared_components(points: &ContactPoints, nodes: &[usize], law: &Law) -> Option<usize> {
+    let (dim, nt) = (points.dim, points.n_tangential());
+    let rubs = |i: usize| match law {
+        Law::Frictionless => false,
+        Law::Tresca(s) => s[i] > 0.0,
+        Law::Coulomb => points.tresca_of(i).map_or(points.friction[i] > 0.0, |s| s > 0.0),
+    };
+    let mut taken: std::collections::HashMap<(usize, usize), usize> = Default::default();
+    for i in 0..points.len() {
+        let normal = std::iter::once(axis(&points.normal[i], dim));
+        let tangents = (0..nt)
+            .filter(|&q| rubs(i) && !points.is_held(i, q))
+            .map(|q| axis(&points.tangent[i][q], dim));
+        for component in normal.chain(tangents) {
+            if taken.insert((nodes[i], component), i).is_some_and(|j| j != i) {
+                return Some(i);
+            }
+        }
+    }
+    None
+}
+
+/// The refusal of the point at `at`, which [`shared_components`] found.
+pub(crate) fn shared_refusal(at: [f64; 3]) -> problem::backend::Unsupported {
+    problem::backend::Unsupported::new(
+        "petsc",
+        "contact",
+        format!(
+            "a node of two contact zones whose conditions act on one component of its displacement (the node at ({:.6e}, {:.6e}, {:.6e}): friction along the other zone's normal, or one normal), which the active sets do not hold",
+            at[0], at[1], at[2]
+        ),
+    )
+    .advise("frictionless zones may meet at a node; else keep the zones apart, or give the ranks the memory for MUMPS' route")
+}
+
 /// `a · b` over the first `dim` components.
 fn dot(a: &[f64; 3], b: &[f64; 3], dim: usize) -> f64 {
     (0..dim).map(|k| a[k] * b[k]).sum()
@@ -575,7 +617,12 @@ fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) ->
         // Not on a path's later instant, which starts from the instant before: a point without
         // one there came into contact during the instant, and held where it was then it jumps
         // back; the sets alternated so where points slipped back
-        if matches!(law, Law::Coulomb) && rows.start.is_none() && lambda.normal[i] == 0.0 && s > 0.0 {
+        if matches!(law, Law::Coulomb)
+            && p.tresca_of(i).is_none()
+            && rows.start.is_none()
+            && lambda.normal[i] == 0.0
+            && s > 0.0
+        {
             stick[i] = true;
             continue;
         }
@@ -656,8 +703,15 @@ fn hold(
         let kappa = sets.kappa[i];
         let beta = rows.c * kappa / (1.0 - kappa);
         let w = p.weight[i];
-        let normal_row = match law {
-            Law::Coulomb => Some(matrix.row((first + kn) as Index)?),
+        // a given slip force (Tresca's law, or a Tresca zone's point beside Coulomb zones), or
+        // Coulomb's law coupling the tangential reactions to the normal one
+        let tresca = match law {
+            Law::Tresca(s) => Some(s[i]),
+            Law::Coulomb => p.tresca_of(i),
+            Law::Frictionless => None,
+        };
+        let normal_row = match (law, tresca) {
+            (Law::Coulomb, None) => Some(matrix.row((first + kn) as Index)?),
             _ => None,
         };
         for &q in &free {
@@ -672,12 +726,12 @@ fn hold(
                 * w
                 * beta
                 * sign_t;
-            match (law, &normal_row) {
-                (Law::Tresca(s), _) => {
+            match (tresca, &normal_row) {
+                (Some(s), _) => {
                     idx.push(rt);
-                    forces.push(-w * s[i] * d[q] * sign_t + spring);
+                    forces.push(-w * s * d[q] * sign_t + spring);
                 }
-                (_, Some((cols_n, vn))) => {
+                (None, Some((cols_n, vn))) => {
                     debug_assert_eq!(&cols, cols_n, "a node's rows share their columns");
                     let alpha = p.friction[i] * d[q] * p.normal[i][kn] * sign_t;
                     for (v, n) in vals.iter_mut().zip(vn) {

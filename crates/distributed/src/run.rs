@@ -102,7 +102,7 @@ pub enum ContactRoute {
     Auto,
     /// MUMPS' condensed route (every law).
     Condensed,
-    /// The Krylov route's active sets (the paper's base model on one zone; other scenes
+    /// The Krylov route's active sets (the paper's base model, one zone or several; other scenes
     /// refused by key).
     ActiveSets,
 }

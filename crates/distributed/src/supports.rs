@@ -10,8 +10,8 @@
 //! Where MUMPS' factorisation would not fit the ranks' memory, or the body is 3D and large
 //! enough that Krylov solves are the faster ([`crate::ACTIVE_SETS_FROM`] unknowns, a share
 //! [`crate::ACTIVE_SETS_ZONE`] of them in the contact zone), a run whose
-//! contact the Krylov route's active sets hold ([`active_sets_hold`]: the paper's base model on
-//! one zone) takes that route instead: Krylov solves on the whole system, no factorisation, no
+//! contact the Krylov route's active sets hold ([`active_sets_hold`]: the paper's base model, on
+//! one zone or several) takes that route instead: Krylov solves on the whole system, no factorisation, no
 //! dense compliance (`paper-3d` at n = 64, 2.2 million unknowns, on this machine).
 
 use problem::backend::Unsupported;
@@ -70,10 +70,12 @@ pub fn direct(scene: &Scene) -> bool {
 }
 
 /// Whether the Krylov route's active sets hold `scene`'s contact (`Err`: the first thing they
-/// lack, by key): Signorini's conditions with Coulomb or Tresca friction on one insulating,
-/// rigid, flat or indenting zone whose normal is a coordinate axis, at one instant, with a
-/// given depth and prescribed potentials, on plane and 3D bodies, with Newton's strategy and
-/// the tight rule. The route a run takes where MUMPS would not fit.
+/// lack, by key): Signorini's conditions with Coulomb or Tresca friction on insulating, rigid,
+/// flat or indenting zones (one or several) whose normals are coordinate axes, at one instant,
+/// with a given depth and prescribed potentials, on plane and 3D bodies, with Newton's
+/// strategy and the tight rule. The route a run takes where MUMPS would not fit. (A node of
+/// two zones whose conditions act on one component is told on the mesh:
+/// [`crate::contact::shared_components`].)
 ///
 /// # Errors
 /// [`Unsupported`] naming the key.
@@ -109,9 +111,6 @@ pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Me
         return not_held("mesh.order", "quadratic elements (a modified basis' contact points)");
     }
     let zones = scene.zones();
-    if zones.len() > 1 {
-        return not_held("contact", "several [[contact]] zones");
-    }
     if scene.mesh.axisymmetric {
         return not_held("mesh.axisymmetric", "a body of revolution");
     }

@@ -8,18 +8,62 @@ use files::scene_file;
 use petsc::testing::on_ranks;
 use petsc::Petsc;
 
-/// A shipped scene with the overrides `sets`, for the default backend and for PETSc.
+/// A shipped scene, or one of the scenes of several contact zones made here from them
+/// ([`zoned`]), with the overrides `sets`, for the default backend and for PETSc.
 fn both(name: &str, sets: &[&str]) -> (problem::Scene, problem::Scene) {
-    let text = scene_file::SHIPPED
+    let text = zoned(name).unwrap_or_else(|| shipped(name).to_string());
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let faer = scene_file::parse(&text, name, &sets).expect("the scene reads");
+    let mut with = sets;
+    with.push("solver.backend=\"petsc\"".into());
+    (faer, scene_file::parse(&text, name, &with).expect("the scene reads"))
+}
+
+/// The shipped scene `name`'s text.
+fn shipped(name: &str) -> &'static str {
+    scene_file::SHIPPED
         .iter()
         .find(|(n, _)| *n == name)
         .expect("a shipped scene")
-        .1;
-    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let faer = scene_file::parse(text, name, &sets).expect("the scene reads");
-    let mut with = sets;
-    with.push("solver.backend=\"petsc\"".into());
-    (faer, scene_file::parse(text, name, &with).expect("the scene reads"))
+        .1
+}
+
+/// Scenes of several contact zones: `squeeze` and `squeeze-3d`, the paper's block pressed
+/// by a plate on its top (a Tresca zone, the plate 0.05 into the block) above its Coulomb
+/// foundation (the zones share no node: the clamped ends hold the corners); `corner-3d`, a
+/// cube pushed into a corner by three frictionless walls that meet at its edges and corner.
+fn zoned(name: &str) -> Option<String> {
+    let plate = |base: &str, normal: &str| {
+        shipped(base).replace("[contact]\n", "[[contact]]\n")
+            + &format!(
+                "\n[[contact]]\ngroup = \"top\"\nlaw = \"tresca\"\nslip_bound = 0.05\ngap = -0.05\nnormal = {normal}\n"
+            )
+    };
+    match name {
+        "squeeze" => Some(plate("paper", "[0.0, 1.0]")),
+        "squeeze-3d" => Some(plate("paper-3d", "[0.0, 0.0, 1.0]")),
+        "corner-3d" => {
+            let mut text = String::from(
+                "name = \"corner-3d\"\ndescription = \"a cube pushed into a corner by three walls\"\n[units]\nlength = \"m\"\nstress = \"GPa\"\n\
+                 [mesh]\nkind = \"box\"\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, 1.0]\nn = 4\n\
+                 [[material]]\nregion = \"body\"\nmodel = \"crystal-6mm\"\n\
+                 c = [121.0, 75.4, 75.2, 111.0, 21.1, 22.6]\ne = [-5.4, 15.8, 12.3]\n\
+                 permittivity = [8.11, 7.35]\npoling = [0.0, 0.0, 1.0]\n\
+                 [[dirichlet]]\ngroup = \"left\"\nux = 0.0\n[[dirichlet]]\ngroup = \"front\"\nuy = 0.0\n\
+                 [[dirichlet]]\ngroup = \"bottom\"\nuz = 0.0\nphi = 0.0\n",
+            );
+            for (group, normal) in [
+                ("right", "[1.0, 0.0, 0.0]"),
+                ("back", "[0.0, 1.0, 0.0]"),
+                ("top", "[0.0, 0.0, 1.0]"),
+            ] {
+                text +=
+                    &format!("[[contact]]\ngroup = \"{group}\"\nlaw = \"signorini\"\nnormal = {normal}\ngap = -1e-3\n");
+            }
+            Some(text)
+        }
+        _ => None,
+    }
 }
 
 /// Scenes without contact: coupled 2D and 3D, a partial electrode at a non-zero potential, a
@@ -127,6 +171,12 @@ const CONTACT_CASES: &[(&str, &[&str])] = &[
     ("stack", &[]),
     // a PZT layer on an elastic substrate, the substrate on the foundation
     ("layered", &["mesh.n=16"]),
+    // several zones: two frictionless walls meeting at a corner node, with a floating
+    // electrode; three meeting at edges in 3D; a Tresca plate above a Coulomb foundation
+    ("corner", &["mesh.n=16"]),
+    ("corner-3d", &[]),
+    ("squeeze", &["mesh.n=32"]),
+    ("squeeze-3d", &["mesh.n=6"]),
     // a tall box cut along z, upside down: rank 0 holds no contact point
     (
         "paper-3d",
@@ -302,13 +352,16 @@ fn contact_on_pieces(p: &Petsc) {
             whole.contact.as_ref().expect("contact"),
             s.contact.as_ref().expect("contact"),
         );
-        let at: std::collections::HashMap<usize, usize> = wc.nodes.iter().enumerate().map(|(i, &v)| (v, i)).collect();
+        // (a node of two zones is a point of each)
+        let at: std::collections::HashMap<(usize, usize), usize> = (0..wc.nodes.len())
+            .map(|i| ((wc.group_of[i], wc.nodes[i]), i))
+            .collect();
         let (wl, l) = (&wc.solution.lambda, &c.solution.lambda);
         let nt = l.n_tangential();
         let scale = wl.normal.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
         let mut dl = 0.0f64;
         for (i, &v) in c.boundary.nodes.iter().enumerate() {
-            let j = at[&piece.global_node[v]];
+            let j = at[&(c.boundary.group_of[i], piece.global_node[v])];
             dl = dl.max((l.normal[i] - wl.normal[j]).abs());
             // (frictionless: no tangential multipliers)
             for q in (0..nt).filter(|_| !l.tangential.is_empty() && !wl.tangential.is_empty()) {
@@ -349,6 +402,22 @@ fn contact_on_pieces(p: &Petsc) {
                 (a.normal_force - b.normal_force).abs() <= 1e-8 * b.normal_force.abs(),
                 "{name}"
             );
+            // several zones: each one's counts and forces
+            assert_eq!(a.groups.len(), b.groups.len(), "{name}");
+            for (x, y) in a.groups.iter().zip(&b.groups) {
+                assert_eq!(
+                    (&x.group, x.n_points, x.n_stick, x.n_slip, x.n_separated),
+                    (&y.group, y.n_points, y.n_stick, y.n_slip, y.n_separated),
+                    "{name}"
+                );
+                assert!(
+                    (x.normal_force - y.normal_force).abs() <= 1e-8 * y.normal_force.abs().max(b.normal_force.abs()),
+                    "{name} {}: {} against {}",
+                    x.group,
+                    x.normal_force,
+                    y.normal_force
+                );
+            }
             assert_eq!(g.report.indenter.is_some(), whole.report.indenter.is_some(), "{name}");
             assert_eq!(g.report.exact.is_some(), whole.report.exact.is_some(), "{name}");
             if let (Some(x), Some(y)) = (&g.report.exact, &whole.report.exact) {
@@ -431,6 +500,17 @@ const PATH_CASES: &[(&str, &[&str])] = &[
         ],
     ),
     ("paper-cycle", &["mesh.n=32", "path.steps=9"]),
+    // two zones along a path: the plate's Tresca zone and the Coulomb foundation, loaded and
+    // unloaded
+    (
+        "squeeze-3d",
+        &[
+            "mesh.n=4",
+            "path.t=[0.0,1.0,2.0]",
+            "path.load=[0.2,1.0,0.4]",
+            "path.steps=4",
+        ],
+    ),
     // every point sticks from the first instant (their displacement is no scale of the
     // body's), then slips at the unloaded turn: the instants after it are resolved
     (
@@ -515,6 +595,24 @@ fn paths_on_pieces(p: &Petsc) {
             );
             for (tx, ty) in x.tangential_resultant.iter().zip(&y.tangential_resultant) {
                 assert!(close(*tx, *ty, force), "{name} step {k}: tangential {tx} against {ty}");
+            }
+            // several zones: each one's counts and forces at the instant
+            assert_eq!(x.groups.len(), y.groups.len(), "{name} step {k}");
+            for (gx, gy) in x.groups.iter().zip(&y.groups) {
+                assert_eq!(
+                    (gx.n_points, gx.n_stick, gx.n_slip, gx.n_separated),
+                    (gy.n_points, gy.n_stick, gy.n_slip, gy.n_separated),
+                    "{name} step {k} {}",
+                    gy.group
+                );
+                assert!(
+                    close(gx.normal_force, gy.normal_force, force),
+                    "{name} step {k} {}",
+                    gy.group
+                );
+                for (tx, ty) in gx.tangential_resultant.iter().zip(&gy.tangential_resultant) {
+                    assert!(close(*tx, *ty, force), "{name} step {k} {}", gy.group);
+                }
             }
             // (slips against the body's displacements: where all stick they are round-off)
             let moved = whole.u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -705,6 +803,22 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
             ],
         );
         assert!(e.contains("the potential is floating"), "{e}");
+        // two frictional walls meeting at the corner: the corner node's friction along the
+        // other wall's normal
+        let e = refused(
+            "corner",
+            &[
+                "mesh.n=8",
+                "contact.0.law=\"coulomb\"",
+                "contact.0.friction=0.3",
+                "contact.1.law=\"coulomb\"",
+                "contact.1.friction=0.3",
+            ],
+        );
+        assert!(
+            e.contains("contact") && e.contains("two contact zones") && e.contains("(1.000000e0, 1.000000e0"),
+            "{e}"
+        );
         let e = refused("paper-3d", &["mesh.n=4", "contact.law=\"none\"", "mesh.order=2"]);
         assert!(e.contains("mesh.order") && e.contains("pieces"), "{e}");
         let e = refused("paper", &["mesh.n=1", "contact.law=\"none\"", "mesh.hi=[1.0,1.0]"]);

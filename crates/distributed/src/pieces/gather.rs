@@ -12,12 +12,12 @@ use petsc::Petsc;
 use problem::ContactResult;
 use std::collections::BTreeMap;
 
-/// Values per contact point in the gathered rows, for `nt` tangential components: the node's
-/// number in the whole mesh, position (3), normal (3), tangents (3 nt), weight, gap,
-/// friction, held tangents (nt), `λ_n`, `λ_t` (nt), `u_n`, `u_t` (nt), status, the node's
-/// potential.
+/// Values per contact point in the gathered rows, for `nt` tangential components: its zone,
+/// the node's number in the whole mesh, position (3), normal (3), tangents (3 nt), weight,
+/// gap, friction, its Tresca bound beside Coulomb zones (NaN: none), held tangents (nt),
+/// `λ_n`, `λ_t` (nt), `u_n`, `u_t` (nt), status, the node's potential.
 fn width(nt: usize) -> usize {
-    1 + 3 + 3 + 3 * nt + 3 + nt + 1 + nt + 1 + nt + 1 + 1
+    2 + 3 + 3 + 3 * nt + 4 + nt + 1 + nt + 1 + nt + 1 + 1
 }
 
 /// The status as a number, and back.
@@ -108,13 +108,14 @@ impl PieceSolution {
         let has_t = petsc.max(&[f64::from(u8::from(!sol.lambda.tangential.is_empty()))])?[0] > 0.0;
         let mut rows = Vec::with_capacity(p.len() * width(nt));
         for i in 0..p.len() {
+            rows.push(c.boundary.group_of[i] as f64);
             rows.push(s.piece.global_node[c.boundary.nodes[i]] as f64);
             rows.extend_from_slice(&p.position[i]);
             rows.extend_from_slice(&p.normal[i]);
             for q in 0..nt {
                 rows.extend_from_slice(&p.tangent[i][q]);
             }
-            rows.extend([p.weight[i], p.gap[i], p.friction[i]]);
+            rows.extend([p.weight[i], p.gap[i], p.friction[i], p.tresca_of(i).unwrap_or(f64::NAN)]);
             rows.extend((0..nt).map(|q| f64::from(u8::from(p.is_held(i, q)))));
             rows.push(sol.lambda.normal[i]);
             rows.extend((0..nt).map(|q| if has_t { sol.lambda.tangential[i * nt + q] } else { 0.0 }));
@@ -126,21 +127,24 @@ impl PieceSolution {
         let Some(all) = petsc.gather_f64(&rows)? else {
             return Ok(None);
         };
+        // zone by zone, each in the order of its nodes: the whole mesh's run's order
         let mut sorted: Vec<&[f64]> = all.chunks(width(nt)).collect();
-        sorted.sort_by(|a, b| a[0].total_cmp(&b[0]));
+        sorted.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
         let n = sorted.len();
         // the boundary's per-zone data with no point yet; the points pushed below
         let mut points = p.select(&[]);
         let (mut lambda, mut u) = (PointValues::zeros(n, nt), PointValues::zeros(n, nt));
         let (mut nodes, mut status, mut phi) = (vec![], vec![], vec![]);
+        let (mut group_of, mut tresca) = (vec![], vec![]);
         for (i, r) in sorted.iter().enumerate() {
-            let mut at = 1;
+            let mut at = 2;
             let mut take = |k: usize| {
                 let out = &r[at..at + k];
                 at += k;
                 out
             };
-            nodes.push(r[0] as usize);
+            group_of.push(r[0] as usize);
+            nodes.push(r[1] as usize);
             let three = |x: &[f64]| [x[0], x[1], x[2]];
             points.position.push(three(take(3)));
             points.normal.push(three(take(3)));
@@ -149,10 +153,11 @@ impl PieceSolution {
                 *t = three(take(3));
             }
             points.tangent.push(tangent);
-            let wgf = take(3);
+            let wgf = take(4);
             points.weight.push(wgf[0]);
             points.gap.push(wgf[1]);
             points.friction.push(wgf[2]);
+            tresca.push(Some(wgf[3]).filter(|b| !b.is_nan()));
             let held = take(nt);
             let mut h = [false; 2];
             for q in 0..nt {
@@ -169,6 +174,9 @@ impl PieceSolution {
         if !has_t {
             lambda.tangential.clear();
         }
+        if tresca.iter().any(Option::is_some) {
+            points.tresca = tresca;
+        }
         let solution = ContactSolution {
             lambda,
             u: u.clone(),
@@ -177,7 +185,7 @@ impl PieceSolution {
             electric: None,
         };
         let result = ContactResult {
-            group_of: vec![0; n],
+            group_of,
             groups: c.boundary.groups.clone(),
             points,
             nodes,

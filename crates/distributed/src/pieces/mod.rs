@@ -12,7 +12,7 @@
 //! What it solves today: a generated rectangle or box, or a Gmsh mesh of one body, of order 1
 //! (an error against a field solution summed over the ranks' own cells), with floating
 //! terminals (`floating`), at one instant or along a load path, without contact or with the
-//! contact the active sets hold (the paper's base model on one zone:
+//! contact the active sets hold (the paper's base model, on one zone or several:
 //! [`crate::active_sets_hold`]), each rank iterating on the contact points at the nodes it
 //! owns; every other scene is refused by key ([`pieces_support`]). The run's
 //! report is made of sums over the ranks ([`PieceSolution::report`]), completed on rank 0 from
@@ -34,7 +34,7 @@ pub use gather::Gathered;
 pub use path::{EachStep, PieceFrame, PieceStep};
 
 use crate::active::{residual, step};
-use crate::contact::{active_set, ActiveSetParams, ContactRows};
+use crate::contact::{active_set, shared_components, shared_refusal, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
 use crate::krylov::{configure, KrylovFields};
 use crate::layout::Layout;
@@ -574,16 +574,33 @@ impl<'p> OnPiece<'_, 'p> {
     fn boundary(&self) -> Result<ContactBoundary, DistributedError> {
         let specs = self.scene.zones();
         let boundary = ContactBoundary::of_groups_on_piece(self.disc, &specs, self.owned)?;
-        let total = self.petsc.sum(&[boundary.points.len() as f64])?[0];
-        if total == 0.0 {
+        // each zone's points over the ranks
+        let mut counts = vec![0.0; specs.len()];
+        for &k in &boundary.group_of {
+            counts[k] += 1.0;
+        }
+        let counts = self.petsc.sum(&counts)?;
+        if let Some(k) = (0..specs.len()).find(|&k| counts[k] == 0.0) {
             return Err(ProblemError::from(SetupError::new(
                 "contact.group",
                 format!(
                     "contact group `{}` has no contact point: Dirichlet conditions prescribe the normal displacement of all its nodes, or an indenter reaches none of them",
-                    specs[0].group
+                    specs[k].group
                 ),
             ))
             .into());
+        }
+        // a node's points on one component: told on every rank, at the lowest such rank's point
+        let law = self.setup.plan.law(&boundary.points, &boundary.group_of);
+        let shared = shared_components(&boundary.points, &boundary.nodes, &law);
+        let rank = self.petsc.rank();
+        let first = self.petsc.max(&[shared.map_or(0.0, |_| (rank + 1) as f64)])?[0];
+        if first > 0.0 {
+            let mine = shared.filter(|_| first as usize == rank + 1);
+            let at = self
+                .petsc
+                .sum(&mine.map_or([0.0; 3], |i| boundary.points.position[i]))?;
+            return Err(ProblemError::from(shared_refusal([at[0], at[1], at[2]])).into());
         }
         Ok(boundary)
     }

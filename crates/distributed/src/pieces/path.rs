@@ -281,7 +281,21 @@ impl OnPiece<'_, '_> {
             has_indenter,
         ];
         sums.extend(&row.tangential_resultant);
+        // several zones: each one's counts and forces, summed too
+        let per_group = 5 + dim;
+        for g in &row.groups {
+            sums.extend([g.n_points, g.n_stick, g.n_slip, g.n_separated].map(|c| c as f64));
+            sums.push(g.normal_force);
+            sums.extend(&g.tangential_resultant);
+        }
         let sums = petsc.sum(&sums)?;
+        for (g, s) in row.groups.iter_mut().zip(sums[5 + dim..].chunks(per_group)) {
+            (g.n_points, g.n_stick, g.n_slip, g.n_separated) =
+                (s[0] as usize, s[1] as usize, s[2] as usize, s[3] as usize);
+            g.normal_force = s[4];
+            g.tangential_resultant = s[5..].to_vec();
+            g.tangential_force = g.tangential_resultant.iter().map(|x| x * x).sum::<f64>().sqrt();
+        }
         let depth = indenter.as_ref().map_or(f64::NEG_INFINITY, |i| i.depth);
         let radius = indenter.as_ref().map_or(f64::NEG_INFINITY, |i| i.contact_radius);
         let maxima = petsc.max(&[row.max_slip, row.max_slip_increment, depth, radius])?;
