@@ -86,6 +86,9 @@ struct Sets {
     active: Vec<bool>,
     stick: Vec<bool>,
     kappa: Vec<f64>,
+    /// At a point pressed into a compliant foundation, its pressure's linearisation at the
+    /// iterate, `λ_n ≈ a + s u_n`: `(s, a)` (`s = k m p^(m-1)`, `a = k p^m - s u_n`).
+    spring: Vec<Option<(f64, f64)>>,
 }
 
 impl PartialEq for Sets {
@@ -374,7 +377,20 @@ fn sets_from<'p>(
             for i in 0..n {
                 gap_u.normal[i] -= p.gap[i];
             }
-            let reference = rows.c * over_ranks(petsc, gap_u.weighted_norm(&p.weight))?;
+            let rigid = rows.c * over_ranks(petsc, gap_u.weighted_norm(&p.weight))?;
+            // on a compliant foundation the bed's pressures at the free penetrations, where
+            // smaller (the contact crate's multiplier scale: a soft bed's pressures are many
+            // decades below the rigid scale, whose round-off would pass for its answer)
+            let compliant = petsc.max(&[f64::from(u8::from(!p.all_rigid()))])?[0] > 0.0;
+            let reference = if compliant {
+                let mut bed = PointValues::zeros(n, 0);
+                for (i, b) in bed.normal.iter_mut().enumerate() {
+                    *b = p.foundation_of(i).pressure(gap_u.normal[i]).map_or(0.0, |(q, _)| q);
+                }
+                rigid.min(over_ranks(petsc, bed.weighted_norm(&p.weight))?)
+            } else {
+                rigid
+            };
             (x, krylov, reason, reference)
         }
     };
@@ -456,7 +472,7 @@ impl<'p> Context<'_, 'p> {
         let (mut best, mut since_best) = (f64::INFINITY, 0);
         while it.steps < params.max_steps {
             it.steps += 1;
-            let (sets, direction) = sets(self.rows, law, &it.lambda, &it.u);
+            let (sets, direction) = sets(self.rows, law, (&it.lambda, &it.u), it.reference);
             // a step from an iterate within the tolerance is solved to the solver's own: the
             // iteration ends only on such a step, whose solution meets the equilibrium too
             // (the complementarity of an inexact step's iterate says nothing of it)
@@ -592,8 +608,14 @@ fn bound(p: &ContactPoints, law: &Law, lambda_n: &[f64]) -> Vec<f64> {
 }
 
 /// The step's sets, and the slip direction `d = z_t / |z_t|` of each slipping point (zero
-/// elsewhere).
-fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) -> (Sets, PointValues) {
+/// elsewhere); a point on a compliant foundation presses where it penetrates, its pressure
+/// above [`BED_FLOOR`] of `reference` (the multiplier scale).
+fn sets(
+    rows: &ContactRows,
+    law: &Law,
+    (lambda, u): (&PointValues, &PointValues),
+    reference: f64,
+) -> (Sets, PointValues) {
     let p = &rows.points;
     let (n, nt) = (p.len(), p.n_tangential());
     let c = rows.c;
@@ -601,14 +623,30 @@ fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) ->
     let mut stick = vec![false; n];
     let mut direction = PointValues::zeros(n, nt);
     let mut kappa = vec![0.0; n];
+    let mut spring = vec![None; n];
     for i in 0..n {
-        let zn = lambda.normal[i] + c * (u.normal[i] - p.gap[i]);
-        if !(zn > 0.0) {
+        let penetration = u.normal[i] - p.gap[i];
+        let zn = lambda.normal[i] + c * penetration;
+        let foundation = p.foundation_of(i);
+        let pressed = match foundation.pressure(penetration) {
+            // a compliant foundation presses where the point penetrates it: Newton's
+            // linearisation of `λ_n = k [p]₊^m` there
+            Some((pressure, slope)) if penetration > 0.0 && pressure > BED_FLOOR * reference => {
+                spring[i] = Some((slope, pressure - slope * u.normal[i]));
+                true
+            }
+            Some(_) => false,
+            None => zn > 0.0,
+        };
+        // a given slip bound (Tresca's) holds whether or not the point presses: its
+        // tangential law is judged at a separated point too, as the contact crate poses it
+        if !pressed && !given_bound(p, law, i) {
             continue;
         }
-        active[i] = true;
-        // the slip radius as the contact crate writes it (Tresca's bound, Coulomb's F z_n)
-        let s = law.radius(p, i, zn);
+        active[i] = pressed;
+        // the slip radius as the contact crate writes it (Tresca's bound, Coulomb's F z_n; on
+        // a compliant foundation F λ_n)
+        let s = law.radius(p, i, foundation.radius_normal(zn, lambda.normal[i]));
         if nt == 0 {
             continue;
         }
@@ -621,7 +659,7 @@ fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) ->
             && p.tresca_of(i).is_none()
             && rows.start.is_none()
             && lambda.normal[i] == 0.0
-            && s > 0.0
+            && p.friction[i] > 0.0
         {
             stick[i] = true;
             continue;
@@ -641,8 +679,32 @@ fn sets(rows: &ContactRows, law: &Law, lambda: &PointValues, u: &PointValues) ->
             }
         }
     }
-    (Sets { active, stick, kappa }, direction)
+    (
+        Sets {
+            active,
+            stick,
+            kappa,
+            spring,
+        },
+        direction,
+    )
 }
+
+/// Whether point `i`'s slip bound is given (Tresca's law, or a Tresca zone beside Coulomb
+/// ones) rather than its normal force's.
+fn given_bound(p: &ContactPoints, law: &Law, i: usize) -> bool {
+    match law {
+        Law::Tresca(_) => true,
+        Law::Coulomb => p.tresca_of(i).is_some(),
+        Law::Frictionless => false,
+    }
+}
+
+/// A compliant foundation's pressure below this share of the multiplier scale is the
+/// round-off of a bed that nothing presses (an instant of a path unloaded to nothing: its
+/// Krylov solves leave penetrations of 1e-47, whose points would report contact), and the
+/// point is separated.
+const BED_FLOOR: f64 = 1e-14;
 
 /// Applies the step's conditions to this rank's points: returns the held components as
 /// `(row, value)` (`u_n = g` where active, `u_t = s` where sticking, `s` the shift: the
@@ -676,13 +738,28 @@ fn hold(
     let (mut idx, mut forces) = (vec![], vec![]);
     let mut new_rows = vec![];
     for i in 0..p.len() {
-        if !sets.active[i] {
+        // (a separated point with a given slip bound keeps its tangential law)
+        if !sets.active[i] && !given_bound(p, law, i) {
             continue;
         }
         let first = layout.first[rows.nodes[i]];
-        // the normal is an axis: its component holds u_n = g
+        // the normal is an axis: its component holds u_n = g on a rigid foundation; on a
+        // compliant one the bed's linearised pressure acts on it, `-w (a + s u_n) n`
         let kn = axis(&p.normal[i], dim);
-        held.push(((first + kn) as Index, p.gap[i] * p.normal[i][kn]));
+        match sets.spring[i] {
+            _ if !sets.active[i] => {}
+            None => held.push(((first + kn) as Index, p.gap[i] * p.normal[i][kn])),
+            Some((slope, at_zero)) => {
+                let rn = (first + kn) as Index;
+                let (cols, mut vals) = matrix.row(rn)?;
+                if let Ok(at) = cols.binary_search(&rn) {
+                    vals[at] += p.weight[i] * slope;
+                }
+                new_rows.push((rn, cols, vals));
+                idx.push(rn);
+                forces.push(-p.weight[i] * at_zero * p.normal[i][kn]);
+            }
+        }
         let kt: Vec<usize> = (0..nt).map(|q| axis(&p.tangent[i][q], dim)).collect();
         // a tangent a support holds (a roller through the contact face) is its prescribed
         // unknown already: the contact conditions are the free tangents'
@@ -808,7 +885,8 @@ fn displacements(
 
 /// The multipliers of the step at this rank's points: the reactions `r = K x - b` of the
 /// loads without contact, at the active points (`λ_n = -(r·n)/w`, `λ_t = -(r·t)/w`: held
-/// components, Tresca's load and Coulomb's equation alike; `λ_t = 0` without friction), zero where separated. Collective
+/// components, Tresca's load and Coulomb's equation alike; `λ_t = 0` without friction), zero
+/// where separated but for a given slip bound's `λ_t` (Tresca's law holds there). Collective
 /// (the product).
 fn multipliers(
     petsc: &Petsc,
@@ -823,11 +901,14 @@ fn multipliers(
     let local = system.reactions(x)?.local()?;
     let start = layout.owned(petsc.rank()).start;
     let mut lambda = PointValues::zeros(n, nt);
-    for i in (0..n).filter(|&i| sets.active[i]) {
+    for i in (0..n).filter(|&i| sets.active[i] || given_bound(p, &rows.law, i)) {
         let first = layout.first[rows.nodes[i]] - start;
         let f: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
         let w = p.weight[i];
-        lambda.normal[i] = -dot(&f, &p.normal[i], dim) / w;
+        // (a separated point's normal row is free: no normal multiplier)
+        if sets.active[i] {
+            lambda.normal[i] = -dot(&f, &p.normal[i], dim) / w;
+        }
         // (a held tangent's reaction is its support's, not the contact's; without friction a
         // tangent is free, and its reaction the solve's round-off, not a multiplier)
         let frictional = !matches!(rows.law, Law::Frictionless);

@@ -258,6 +258,10 @@ const ACTIVE_SET_CASES: &[(&str, &[&str])] = &[
     ("indent-sphere-3d", &[]),
     ("actuator", &[]),
     ("paper-elastic", &["mesh.n=32"]),
+    // a compliant foundation, and two zones meeting at a corner (its floating electrode
+    // removed: the whole mesh's rows are node by node)
+    ("paper-compliance", &["mesh.n=32"]),
+    ("corner", &["mesh.n=16", "~electrode"]),
 ];
 
 /// The Krylov route's active sets (taken where MUMPS' factorisation would not fit the memory
@@ -299,11 +303,11 @@ fn agree_on_active_sets(petsc: &Petsc) {
     }
     backend.contact = distributed::ContactRoute::ActiveSets;
     // a law they do not hold: refused by its key
-    let (_, scene) = both("paper-compliance", &["mesh.n=32"], &[]);
+    let (_, scene) = both("paper-slip-weakening", &["mesh.n=32"], &[]);
     let e = distributed::solve_with(&mut backend, &scene, None, &mut problem::Silent, &mut |_| Ok(()))
         .map(|_| ())
         .unwrap_err();
-    assert!(e.to_string().contains("contact.compliance"), "{e}");
+    assert!(e.to_string().contains("contact.friction_law"), "{e}");
 }
 
 #[test]
@@ -555,9 +559,17 @@ fn where_mumps_would_not_fit_the_active_sets_solve() {
             "MUMPS' factorisation would need about",
             None,
         );
-        // a deformable foundation, which the active sets do not hold: refused before MUMPS
+        // slip-weakening friction, which the active sets do not hold: refused before MUMPS
         // allocates (by its estimate, or by the lower one before the mesh)
-        let (_, scene) = both("paper-3d", &["mesh.n=14", "contact.compliance={stiffness=100.0}"], &[]);
+        let weakening = [
+            "mesh.n=14",
+            "~contact.friction",
+            "contact.friction_law=\"slip-weakening\"",
+            "contact.friction_static=0.6",
+            "contact.friction_dynamic=0.3",
+            "contact.slip_length=1e-3",
+        ];
+        let (_, scene) = both("paper-3d", &weakening, &[]);
         let limits = problem::Limits {
             memory_bytes: within(0.9),
             ..Default::default()
