@@ -68,11 +68,48 @@ pub fn solve_force_controlled<E>(
     driven: Option<&[bool]>,
     force: f64,
     start: Option<PointValues>,
+    solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, E>,
+) -> Result<ContactSolution, ForceError<E>> {
+    solve_force_controlled_spread(points, driven, force, start, solve, |_, x| Ok(x))
+}
+
+/// How [`solve_force_controlled_spread`] combines a value of its points with the other
+/// processes' where the points are spread over several (each process its own points and its
+/// own contact solve of them, the search the same on every one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spread {
+    /// The sum over the processes (the force carried).
+    Sum,
+    /// The smallest (the nearest gap, the face's lower bounds).
+    Min,
+    /// The largest (the face's upper bounds).
+    Max,
+}
+
+/// [`solve_force_controlled`] on points spread over several processes: `points` and the
+/// solutions are this process's, and `combine(how, x)` gives the combination of this
+/// process's `x` with the others' (collective: every process calls it in the same order), so
+/// that the force, the first touch and the face's size, and so the search's every step, are
+/// those of all the points together.
+///
+/// # Errors
+/// As [`solve_force_controlled`]; `combine`'s error as a solve's.
+pub fn solve_force_controlled_spread<E>(
+    points: &mut ContactPoints,
+    driven: Option<&[bool]>,
+    force: f64,
+    start: Option<PointValues>,
     mut solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, E>,
+    mut combine: impl FnMut(Spread, f64) -> Result<f64, E>,
 ) -> Result<ContactSolution, ForceError<E>> {
     let base = points.gap.clone();
     let drives = |i: usize| driven.is_none_or(|d| d.get(i).copied().unwrap_or(false));
-    let size = face_size(points);
+    let size = face_size(points, &mut combine).map_err(ForceError::Solve)?;
+    let touch = (0..base.len())
+        .filter(|&i| drives(i))
+        .map(|i| base[i])
+        .fold(f64::INFINITY, f64::min);
+    let touch = combine(Spread::Min, touch).map_err(ForceError::Solve)?;
     let mut last = start;
     // the largest force carried so far (`f - force` loses `f` when the force asked is huge)
     let mut most = 0.0f64;
@@ -80,7 +117,7 @@ pub fn solve_force_controlled<E>(
         lower(points, &base, s, &drives);
         let sol = solve(points, last.take())?;
         last = Some(sol.lambda.clone());
-        let f = sol
+        let own = sol
             .lambda
             .normal
             .iter()
@@ -89,6 +126,7 @@ pub fn solve_force_controlled<E>(
             .filter(|&(i, _)| drives(i))
             .map(|(_, (l, w))| l * w)
             .sum::<f64>();
+        let f = combine(Spread::Sum, own)?;
         most = most.max(f);
         Ok(Evaluation {
             residual: f - force,
@@ -97,10 +135,6 @@ pub fn solve_force_controlled<E>(
             value: sol,
         })
     };
-    let touch = (0..base.len())
-        .filter(|&i| drives(i))
-        .map(|i| base[i])
-        .fold(f64::INFINITY, f64::min);
     if force == 0.0 {
         // every depth short of first touch carries no force: the indenter just touching
         return eval(touch, points).map(|e| e.value).map_err(ForceError::Solve);
@@ -144,16 +178,17 @@ fn lower(points: &mut ContactPoints, base: &[f64], s: f64, drives: &dyn Fn(usize
 }
 
 /// The largest extent of the contact points along any axis (the scale of the search's steps).
-fn face_size(points: &ContactPoints) -> f64 {
-    (0..3)
-        .map(|k| {
-            let (lo, hi) = points
-                .position
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                    (lo.min(x[k]), hi.max(x[k]))
-                });
-            hi - lo
-        })
-        .fold(f64::MIN_POSITIVE, f64::max)
+fn face_size<E>(points: &ContactPoints, combine: &mut impl FnMut(Spread, f64) -> Result<f64, E>) -> Result<f64, E> {
+    let mut size = f64::MIN_POSITIVE;
+    for k in 0..3 {
+        let (lo, hi) = points
+            .position
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x[k]), hi.max(x[k]))
+            });
+        let (lo, hi) = (combine(Spread::Min, lo)?, combine(Spread::Max, hi)?);
+        size = size.max(hi - lo);
+    }
+    Ok(size)
 }

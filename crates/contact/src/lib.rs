@@ -59,7 +59,7 @@ mod weakening;
 
 pub use electric::{ElectricContact, ElectricContactProblem, ElectricLaw, ElectricValues};
 pub use floating::{solve_floating, FloatingError, CHARGE_TOL};
-pub use force_control::{solve_force_controlled, ForceError, FORCE_TOL};
+pub use force_control::{solve_force_controlled, solve_force_controlled_spread, ForceError, Spread, FORCE_TOL};
 pub use gauss_seidel::{solve_gauss_seidel, GaussSeidelParams};
 pub use newton::{solve_newton, solve_newton_cached, solve_newton_electric, NewtonCache, NewtonParams};
 pub use operator::{AffineProblem, Compliance, ContactOperator, DenseContactProblem, SparseContactProblem};

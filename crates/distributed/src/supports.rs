@@ -73,7 +73,7 @@ pub fn direct(scene: &Scene) -> bool {
 /// lack, by key): Signorini's conditions or normal compliance (a rigid or a deformable
 /// foundation) with Coulomb or Tresca friction on insulating, flat or indenting zones (one or
 /// several) whose normals are coordinate axes, at one instant,
-/// with a given depth and prescribed potentials, on plane and 3D bodies, with Newton's
+/// at a given depth or force and prescribed potentials, on plane and 3D bodies, with Newton's
 /// strategy and the tight rule. The route a run takes where MUMPS would not fit. (A node of
 /// two zones whose conditions act on one component is told on the mesh:
 /// [`crate::contact::shared_components`].)
@@ -126,9 +126,6 @@ pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Me
 
 /// What one contact zone asks for that the active sets do not hold.
 fn zone_held(c: &ContactSpec) -> Result<(), Unsupported> {
-    if c.indenter.as_ref().is_some_and(|i| i.force.is_some()) {
-        return not_held("contact.indenter.force", "force control");
-    }
     if c.slip_weakening().is_some() {
         return not_held("contact.friction_law", "slip-weakening friction");
     }

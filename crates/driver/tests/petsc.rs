@@ -262,6 +262,11 @@ const ACTIVE_SET_CASES: &[(&str, &[&str])] = &[
     // removed: the whole mesh's rows are node by node)
     ("paper-compliance", &["mesh.n=32"]),
     ("corner", &["mesh.n=16", "~electrode"]),
+    // force control (the search around the active sets' solves)
+    (
+        "indent-sphere-3d",
+        &["mesh.n=8", "contact.indenter.depth=0.0", "contact.indenter.force=0.1"],
+    ),
 ];
 
 /// The Krylov route's active sets (taken where MUMPS' factorisation would not fit the memory

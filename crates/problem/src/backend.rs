@@ -18,6 +18,7 @@ use fe_assembly::Discretization;
 use linalg::CondenseRoute;
 
 pub use crate::boundary::{ContactBoundary, MAX_NORMAL_ANGLE_DEG};
+pub use crate::outer::ForceControl;
 pub use crate::plan::Plan;
 pub use crate::setup::{
     electrode_without_facets, piece_refusal, region_without_cells, setup, setup_piece, MeshNotes, Setup,

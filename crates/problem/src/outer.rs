@@ -11,7 +11,7 @@ use contact::{ContactPoints, ContactSolution, PointValues};
 /// A force-controlled indenter (`contact.indenter.force`): the force it presses with, and its
 /// own points among the boundary's (`None` where the boundary is its zone alone; the other
 /// zones rest on foundations, their gaps as they are).
-pub(crate) struct ForceControl {
+pub struct ForceControl {
     /// The force, in the scene's units (a path scales it by its load factor).
     pub force: f64,
     /// Whether each point of the boundary is the indenter's.
@@ -20,7 +20,7 @@ pub(crate) struct ForceControl {
 
 impl ForceControl {
     /// The scene's force-controlled indenter on `boundary`, if it has one.
-    pub(crate) fn of(scene: &Scene, boundary: &ContactBoundary) -> Option<ForceControl> {
+    pub fn of(scene: &Scene, boundary: &ContactBoundary) -> Option<ForceControl> {
         let (k, c) = scene.indenter_contact()?;
         let Obstacle::Indenter {
             control: Control::Force(force),

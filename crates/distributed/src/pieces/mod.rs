@@ -40,6 +40,7 @@ use crate::krylov::{configure, KrylovFields};
 use crate::layout::Layout;
 use crate::system::{assemble, System};
 use crate::MAX_ACTIVE_SET_STEPS;
+use contact::{PointValues, Spread};
 use fe_assembly::CellFields;
 use floating::Floating;
 use mesh::{Blocks, MeshPiece};
@@ -260,7 +261,7 @@ fn instants<'p>(
     let on = run.on(disc);
     let boundary = on.boundary()?;
     let history = History::none(&boundary);
-    let (x, solved, contact) = on.contact((system, fields), boundary, history, limits, reporter)?;
+    let (x, solved, contact) = on.contact((system, fields), boundary, (history, 1.0), limits, reporter)?;
     Ok((x, solved, Some(contact), None))
 }
 
@@ -612,23 +613,15 @@ impl<'p> OnPiece<'_, 'p> {
     fn contact(
         &self,
         (system, fields): (&System<'p>, &KrylovFields),
-        boundary: ContactBoundary,
-        history: History<'p>,
+        mut boundary: ContactBoundary,
+        (history, load): (History<'p>, f64),
         limits: problem::Limits,
         reporter: &mut dyn Reporter,
     ) -> Result<(Vector<'p>, Solved, PieceContact), DistributedError> {
-        let (petsc, scene) = (self.petsc, self.scene);
+        let (petsc, scene, layout) = (self.petsc, self.scene, self.layout);
         let total = petsc.sum(&[boundary.points.len() as f64])?[0];
         let how = ContactSolve::new(&self.setup.plan, scene, &boundary, limits.interrupt);
-        let options = configure(petsc, scene, self.layout, Some(how.tol), true)?;
-        let rows = ContactRows::new(
-            petsc,
-            (&boundary.points, &boundary.nodes, &how.law),
-            false,
-            self.layout,
-            system,
-        )?
-        .with_history(history.shift, history.lambda);
+        let options = configure(petsc, scene, layout, Some(how.tol), true)?;
         let params = ActiveSetParams {
             tol: how.tol,
             max_steps: MAX_ACTIVE_SET_STEPS,
@@ -639,15 +632,69 @@ impl<'p> OnPiece<'_, 'p> {
         let mut solve_one = |m: &mut petsc::Matrix<'p>, b: &Vector<'p>, x: &mut Vector<'p>, loose: Option<f64>| {
             step(petsc, fields, &mut t_pc, (m, b, x), loose)
         };
-        let out = active_set(
-            petsc,
-            self.layout,
-            system,
-            (&rows, history.x),
-            params,
-            &mut solve_one,
-            &mut progress,
-        )?;
+        let (nodes, shift) = (boundary.nodes.clone(), history.shift);
+        let mut krylov = 0;
+        // the active sets on `points` from the multipliers `start` (and the solution `warm`)
+        let mut solve_at = |points: &contact::ContactPoints,
+                            start: Option<PointValues>,
+                            warm: Option<Vector<'p>>|
+         -> Result<crate::contact::ContactOutcome<'p>, DistributedError> {
+            let rows = ContactRows::new(petsc, (points, &nodes, &how.law), false, layout, system)?
+                .with_history(shift.clone(), start);
+            let out = active_set(
+                petsc,
+                layout,
+                system,
+                (&rows, warm),
+                params,
+                &mut solve_one,
+                &mut progress,
+            )?;
+            krylov += out.krylov_iterations;
+            Ok(out)
+        };
+        let out = match problem::backend::ForceControl::of(scene, &boundary) {
+            None => solve_at(&boundary.points, history.lambda, history.x)?,
+            // force control: the depth that carries the force (a path's scaled by its load
+            // factor), the search's every step the same on every rank (the force, the first
+            // touch and the face's size summed or bounded over the ranks)
+            Some(control) => {
+                let mut last = None;
+                let found = contact::solve_force_controlled_spread(
+                    &mut boundary.points,
+                    control.driven.as_deref(),
+                    control.force * load,
+                    history.lambda,
+                    |points, start| {
+                        let out = solve_at(points, start, None)?;
+                        let sol = out.solution.clone();
+                        last = Some(out);
+                        Ok::<_, DistributedError>(sol)
+                    },
+                    |how, x| {
+                        Ok::<_, DistributedError>(match how {
+                            Spread::Sum => petsc.sum(&[x])?[0],
+                            Spread::Min => -petsc.max(&[-x])?[0],
+                            Spread::Max => petsc.max(&[x])?[0],
+                        })
+                    },
+                )
+                .map_err(|e: contact::ForceError<DistributedError>| {
+                    e.into_solve().unwrap_or_else(|why| {
+                        ProblemError::NoSolution {
+                            sought: "contact.indenter.force",
+                            why,
+                        }
+                        .into()
+                    })
+                })?;
+                // the depth found: the search's last solve, or one more from its multipliers
+                match last.filter(|o: &crate::contact::ContactOutcome<'p>| o.solution.lambda == found.lambda) {
+                    Some(out) => out,
+                    None => solve_at(&boundary.points, Some(found.lambda), None)?,
+                }
+            }
+        };
         let equilibrium = residual(system, &out.x, (&boundary, &out.solution), self.layout, petsc)?;
         let sol = &out.solution;
         let force: f64 = (0..sol.lambda.normal.len())
@@ -665,7 +712,7 @@ impl<'p> OnPiece<'_, 'p> {
             boundary,
         };
         let solved = Solved {
-            iterations: out.krylov_iterations,
+            iterations: krylov,
             reason: out.reason,
             options,
             setup_seconds: t_pc,

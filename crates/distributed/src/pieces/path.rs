@@ -104,7 +104,7 @@ pub(super) fn walk<'p>(
             .map_err(|e| e.at_step(k, t))?;
         let before = history.shift.clone();
         let (x, s, contact) = at
-            .contact((system, fields), boundary, history, limits, reporter)
+            .contact((system, fields), boundary, (history, f.load), limits, reporter)
             .map_err(|e| e.at_step(k, t))?;
         (solved.iterations, solved.setup_seconds) =
             (solved.iterations + s.iterations, solved.setup_seconds + s.setup_seconds);
