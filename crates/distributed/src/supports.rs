@@ -98,6 +98,10 @@ pub fn active_sets_hold_on(scene: &Scene, mesh: Option<&mesh::Mesh>) -> Result<(
     if let Some(key) = scene.floating_key() {
         return not_held(key, "a floating terminal");
     }
+    // (pieces run the fixed point on the coefficients around their active sets)
+    if scene.zones().iter().any(|c| c.slip_weakening().is_some()) {
+        return not_held("contact.friction_law", "slip-weakening friction");
+    }
     active_sets_hold_at_instants(scene, mesh)
 }
 
@@ -112,6 +116,10 @@ pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Me
         return not_held("mesh.order", "quadratic elements (a modified basis' contact points)");
     }
     let zones = scene.zones();
+    // (a path's instants would need each point's slip before them: not carried on pieces)
+    if scene.path.is_some() && zones.iter().any(|c| c.slip_weakening().is_some()) {
+        return not_held("contact.friction_law", "slip-weakening friction along a load path");
+    }
     if scene.mesh.axisymmetric {
         return not_held("mesh.axisymmetric", "a body of revolution");
     }
@@ -126,9 +134,6 @@ pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Me
 
 /// What one contact zone asks for that the active sets do not hold.
 fn zone_held(c: &ContactSpec) -> Result<(), Unsupported> {
-    if c.slip_weakening().is_some() {
-        return not_held("contact.friction_law", "slip-weakening friction");
-    }
     if let Some(condition) = c.electric.filter(|_| c.electric_law().is_some()) {
         return not_held("contact.electric", &format!("contact.electric = \"{condition}\""));
     }

@@ -205,6 +205,19 @@ const CONTACT_CASES: &[(&str, &[&str])] = &[
             "contact.1.gap=0.0",
         ],
     ),
+    // slip-weakening friction: the fixed point on the coefficients around the active sets
+    ("paper-slip-weakening", &["mesh.n=32"]),
+    (
+        "paper-3d",
+        &[
+            "mesh.n=6",
+            "~contact.friction",
+            "contact.friction_law=\"slip-weakening\"",
+            "contact.friction_static=0.3",
+            "contact.friction_dynamic=0.1",
+            "contact.slip_length=1e-3",
+        ],
+    ),
     // Tresca's law at points that separate (a curved gap): the given bound holds there too
     (
         "paper-tresca",
@@ -809,7 +822,10 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
                 Err(e) => e.to_string(),
             }
         };
-        let e = refused("paper-slip-weakening", &["mesh.n=8"]);
+        let e = refused(
+            "paper-slip-weakening",
+            &["mesh.n=8", "path.t=[0.0,1.0]", "path.load=[0.5,1.0]", "path.steps=2"],
+        );
         assert!(e.contains("contact.friction_law") && e.contains("pieces"), "{e}");
         let e = refused("indent-sphere", &["mesh.n=8"]);
         assert!(e.contains("mesh.axisymmetric") && e.contains("pieces"), "{e}");

@@ -653,6 +653,18 @@ impl<'p> OnPiece<'_, 'p> {
             krylov += out.krylov_iterations;
             Ok(out)
         };
+        // slip-weakening friction: the fixed point on the coefficients around the active sets
+        // (on every rank alike: a rank may hold no point of the zone)
+        let weakens = petsc.max(&[f64::from(u8::from(boundary.points.weakens()))])?[0] > 0.0;
+        let mut solve_at = |points: &contact::ContactPoints,
+                            start: Option<PointValues>,
+                            warm: Option<Vector<'p>>|
+         -> Result<crate::contact::ContactOutcome<'p>, DistributedError> {
+            match weakens {
+                true => weakened(petsc, points, (start, warm), tol, &mut solve_at),
+                false => solve_at(points, start, warm),
+            }
+        };
         let out = match problem::backend::ForceControl::of(scene, &boundary) {
             None => solve_at(&boundary.points, history.lambda, history.x)?,
             // force control: the depth that carries the force (a path's scaled by its load
@@ -695,6 +707,10 @@ impl<'p> OnPiece<'_, 'p> {
                 }
             }
         };
+        // the coefficients at the answer's slips, which its statuses and report read
+        if weakens {
+            boundary.points = boundary.points.at_slips(&out.solution.u);
+        }
         let equilibrium = residual(system, &out.x, (&boundary, &out.solution), self.layout, petsc)?;
         let sol = &out.solution;
         let force: f64 = (0..sol.lambda.normal.len())
@@ -719,6 +735,55 @@ impl<'p> OnPiece<'_, 'p> {
         };
         Ok((out.x, solved, contact))
     }
+}
+
+/// Steps of the fixed point on the slip-weakening coefficients at most.
+const MAX_WEAKENING_STEPS: usize = 200;
+
+/// Slip-weakening friction on the points `points`: the fixed point on the coefficients, each
+/// step Coulomb's law with the coefficients frozen (`solve`, from the last step's multipliers
+/// and solution), from the stick start (the static coefficient at every point: `points` as
+/// the boundary makes them), until no coefficient moves by more than `tol` of the largest
+/// static one between two steps (over the ranks); the last step's outcome, whose coefficients
+/// are then those of its slips to that tolerance (the contact crate's fixed point, without its
+/// Anderson mixing and Newton's polish on the law itself, which need the whole compliance).
+/// Collective.
+fn weakened<'p>(
+    petsc: &Petsc,
+    points: &contact::ContactPoints,
+    (mut start, mut warm): (Option<PointValues>, Option<Vector<'p>>),
+    tol: f64,
+    solve: &mut impl FnMut(
+        &contact::ContactPoints,
+        Option<PointValues>,
+        Option<Vector<'p>>,
+    ) -> Result<crate::contact::ContactOutcome<'p>, DistributedError>,
+) -> Result<crate::contact::ContactOutcome<'p>, DistributedError> {
+    let mut at = points.clone();
+    let static_most = petsc.max(&[points.friction.iter().fold(0.0f64, |m, f| m.max(*f))])?[0];
+    let mut change = f64::INFINITY;
+    for _ in 0..MAX_WEAKENING_STEPS {
+        let out = solve(&at, start.take(), warm.take())?;
+        let next = at.coefficients_at(&out.solution.u);
+        let own = next
+            .iter()
+            .zip(&at.friction)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        change = petsc.max(&[own])?[0];
+        if change <= tol * static_most {
+            return Ok(out);
+        }
+        at.friction = next;
+        start = Some(out.solution.lambda);
+        warm = Some(out.x);
+    }
+    Err(ProblemError::NoSolution {
+        sought: "contact.friction_law",
+        why: format!(
+            "the fixed point on the slip-weakening coefficients did not settle in {MAX_WEAKENING_STEPS} steps (the last moved a coefficient by {change:.3e}); the default backend's Newton on the law itself may"
+        ),
+    }
+    .into())
 }
 
 impl OnPiece<'_, '_> {
