@@ -734,9 +734,7 @@ fn hold(
     let (dim, nt) = (p.dim, p.n_tangential());
     let b_local = b.local()?;
     let start = layout.rank_start[rows.rank];
-    let mut held = vec![];
-    let (mut idx, mut forces) = (vec![], vec![]);
-    let mut new_rows = vec![];
+    let mut edits = Edits::default();
     for i in 0..p.len() {
         // (a separated point with a given slip bound keeps its tangential law)
         if !sets.active[i] && !given_bound(p, law, i) {
@@ -746,18 +744,17 @@ fn hold(
         // the normal is an axis: its component holds u_n = g on a rigid foundation; on a
         // compliant one the bed's linearised pressure acts on it, `-w (a + s u_n) n`
         let kn = axis(&p.normal[i], dim);
+        let rn = (first + kn) as Index;
         match sets.spring[i] {
             _ if !sets.active[i] => {}
-            None => held.push(((first + kn) as Index, p.gap[i] * p.normal[i][kn])),
+            None => edits.held.push((rn, p.gap[i] * p.normal[i][kn])),
             Some((slope, at_zero)) => {
-                let rn = (first + kn) as Index;
                 let (cols, mut vals) = matrix.row(rn)?;
                 if let Ok(at) = cols.binary_search(&rn) {
                     vals[at] += p.weight[i] * slope;
                 }
-                new_rows.push((rn, cols, vals));
-                idx.push(rn);
-                forces.push(-p.weight[i] * at_zero * p.normal[i][kn]);
+                edits.rows.push((rn, cols, vals));
+                edits.load(rn, -p.weight[i] * at_zero * p.normal[i][kn]);
             }
         }
         let kt: Vec<usize> = (0..nt).map(|q| axis(&p.tangent[i][q], dim)).collect();
@@ -767,7 +764,7 @@ fn hold(
         // (on a path, a sticking point is held where it was at the instant before)
         let shift = rows.shift.tangential_of(i);
         if sets.stick[i] {
-            held.extend(
+            edits.held.extend(
                 free.iter()
                     .map(|&q| ((first + kt[q]) as Index, shift[q] * p.tangent[i][q][kt[q]])),
             );
@@ -777,66 +774,114 @@ fn hold(
         if d.iter().all(|&x| x == 0.0) {
             continue; // frictionless: the tangential rows stay free
         }
-        let kappa = sets.kappa[i];
-        let beta = rows.c * kappa / (1.0 - kappa);
-        let w = p.weight[i];
-        // a given slip force (Tresca's law, or a Tresca zone's point beside Coulomb zones), or
-        // Coulomb's law coupling the tangential reactions to the normal one
+        let at = Sliding {
+            i,
+            first,
+            kn,
+            kt: &kt,
+            free: &free,
+            d,
+            beta: rows.c * sets.kappa[i] / (1.0 - sets.kappa[i]),
+            b_n: b_local[first + kn - start],
+        };
+        edits.slide(rows, law, &at, matrix)?;
+    }
+    for (rt, cols, vals) in &edits.rows {
+        matrix.set_values(&[*rt], cols, vals)?;
+    }
+    matrix.assemble()?;
+    b.add_values(&edits.loads.0, &edits.loads.1)?;
+    b.assemble()?;
+    Ok(edits.held)
+}
+
+/// A step's changes to the system at this rank's points: the held components `(row,
+/// value)`, the loads added, and the rows rewritten (row, columns, values).
+#[derive(Default)]
+struct Edits {
+    held: Vec<(Index, f64)>,
+    loads: (Vec<Index>, Vec<f64>),
+    rows: Vec<(Index, Vec<Index>, Vec<f64>)>,
+}
+
+/// A sliding point's data for [`Edits::slide`]: its index, its node's first unknown, the
+/// axes of its normal and tangents, its free tangents, the slip direction `d`, the spring's
+/// `β`, and the load at its normal row (Coulomb's equation reads it).
+struct Sliding<'a> {
+    i: usize,
+    first: usize,
+    kn: usize,
+    kt: &'a [usize],
+    free: &'a [usize],
+    d: &'a [f64],
+    beta: f64,
+    b_n: f64,
+}
+
+impl Edits {
+    fn load(&mut self, row: Index, value: f64) {
+        self.loads.0.push(row);
+        self.loads.1.push(value);
+    }
+
+    /// A sliding point's tangential rows (see [`hold`]): a given slip force (Tresca's law, or
+    /// a Tresca zone's point beside Coulomb zones) as a load, or Coulomb's law coupling the
+    /// tangential reactions to the normal one; the spring `w β P` across the direction.
+    fn slide(
+        &mut self,
+        rows: &ContactRows,
+        law: &Law,
+        at: &Sliding<'_>,
+        matrix: &Matrix<'_>,
+    ) -> Result<(), PetscError> {
+        let (p, i, d) = (&rows.points, at.i, at.d);
+        let (w, shift) = (p.weight[i], rows.shift.tangential_of(i));
         let tresca = match law {
             Law::Tresca(s) => Some(s[i]),
             Law::Coulomb => p.tresca_of(i),
             Law::Frictionless => None,
         };
         let normal_row = match (law, tresca) {
-            (Law::Coulomb, None) => Some(matrix.row((first + kn) as Index)?),
+            (Law::Coulomb, None) => Some(matrix.row((at.first + at.kn) as Index)?),
             _ => None,
         };
-        for &q in &free {
-            let rt = (first + kt[q]) as Index;
+        for &q in at.free {
+            let rt = (at.first + at.kt[q]) as Index;
             let (cols, mut vals) = matrix.row(rt)?;
-            let sign_t = p.tangent[i][q][kt[q]];
+            let sign_t = p.tangent[i][q][at.kt[q]];
             // the spring acts on the increment: `w β P (u_t - shift)`, its shift a load
-            let spring: f64 = free
+            let spring: f64 = at
+                .free
                 .iter()
                 .map(|&q2| (f64::from(u8::from(q == q2)) - d[q] * d[q2]) * shift[q2])
                 .sum::<f64>()
                 * w
-                * beta
+                * at.beta
                 * sign_t;
             match (tresca, &normal_row) {
-                (Some(s), _) => {
-                    idx.push(rt);
-                    forces.push(-w * s * d[q] * sign_t + spring);
-                }
+                (Some(s), _) => self.load(rt, -w * s * d[q] * sign_t + spring),
                 (None, Some((cols_n, vn))) => {
                     debug_assert_eq!(&cols, cols_n, "a node's rows share their columns");
-                    let alpha = p.friction[i] * d[q] * p.normal[i][kn] * sign_t;
+                    let alpha = p.friction[i] * d[q] * p.normal[i][at.kn] * sign_t;
                     for (v, n) in vals.iter_mut().zip(vn) {
                         *v -= alpha * n;
                     }
-                    idx.push(rt);
-                    forces.push(-alpha * b_local[first + kn - start] + spring);
+                    self.load(rt, -alpha * at.b_n + spring);
                 }
                 _ => {}
             }
             // the spring w β P across the slip direction
-            for &q2 in &free {
+            for &q2 in at.free {
                 let pq = f64::from(u8::from(q == q2)) - d[q] * d[q2];
-                let col = (first + kt[q2]) as Index;
-                if let Ok(at) = cols.binary_search(&col) {
-                    vals[at] += w * beta * sign_t * pq * p.tangent[i][q2][kt[q2]];
+                let col = (at.first + at.kt[q2]) as Index;
+                if let Ok(k) = cols.binary_search(&col) {
+                    vals[k] += w * at.beta * sign_t * pq * p.tangent[i][q2][at.kt[q2]];
                 }
             }
-            new_rows.push((rt, cols, vals));
+            self.rows.push((rt, cols, vals));
         }
+        Ok(())
     }
-    for (rt, cols, vals) in &new_rows {
-        matrix.set_values(&[*rt], cols, vals)?;
-    }
-    matrix.assemble()?;
-    b.add_values(&idx, &forces)?;
-    b.assemble()?;
-    Ok(held)
 }
 
 /// The component along which a unit axis vector points.

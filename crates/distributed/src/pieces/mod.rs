@@ -667,45 +667,12 @@ impl<'p> OnPiece<'_, 'p> {
         };
         let out = match problem::backend::ForceControl::of(scene, &boundary) {
             None => solve_at(&boundary.points, history.lambda, history.x)?,
-            // force control: the depth that carries the force (a path's scaled by its load
-            // factor), the search's every step the same on every rank (the force, the first
-            // touch and the face's size summed or bounded over the ranks)
-            Some(control) => {
-                let mut last = None;
-                let found = contact::solve_force_controlled_spread(
-                    &mut boundary.points,
-                    control.driven.as_deref(),
-                    control.force * load,
-                    history.lambda,
-                    |points, start| {
-                        let out = solve_at(points, start, None)?;
-                        let sol = out.solution.clone();
-                        last = Some(out);
-                        Ok::<_, DistributedError>(sol)
-                    },
-                    |how, x| {
-                        Ok::<_, DistributedError>(match how {
-                            Spread::Sum => petsc.sum(&[x])?[0],
-                            Spread::Min => -petsc.max(&[-x])?[0],
-                            Spread::Max => petsc.max(&[x])?[0],
-                        })
-                    },
-                )
-                .map_err(|e: contact::ForceError<DistributedError>| {
-                    e.into_solve().unwrap_or_else(|why| {
-                        ProblemError::NoSolution {
-                            sought: "contact.indenter.force",
-                            why,
-                        }
-                        .into()
-                    })
-                })?;
-                // the depth found: the search's last solve, or one more from its multipliers
-                match last.filter(|o: &crate::contact::ContactOutcome<'p>| o.solution.lambda == found.lambda) {
-                    Some(out) => out,
-                    None => solve_at(&boundary.points, Some(found.lambda), None)?,
-                }
-            }
+            Some(control) => forced(
+                petsc,
+                &mut boundary.points,
+                (&control, load, history.lambda),
+                &mut solve_at,
+            )?,
         };
         // the coefficients at the answer's slips, which its statuses and report read
         if weakens {
@@ -734,6 +701,57 @@ impl<'p> OnPiece<'_, 'p> {
             setup_seconds: t_pc,
         };
         Ok((out.x, solved, contact))
+    }
+}
+
+/// Force control on this rank's `points`: the depth that carries `control`'s force times
+/// `load` (a path's load factor), each evaluation `solve` at that depth from the last
+/// multipliers (the first from `start`), the search's every step the same on every rank (the
+/// force, the first touch and the face's size summed or bounded over the ranks); the depth
+/// found's outcome, the search's last solve where it is the one found, else one more from its
+/// multipliers. Leaves the points at that depth. Collective.
+fn forced<'p>(
+    petsc: &Petsc,
+    points: &mut contact::ContactPoints,
+    (control, load, start): (&problem::backend::ForceControl, f64, Option<PointValues>),
+    solve: &mut impl FnMut(
+        &contact::ContactPoints,
+        Option<PointValues>,
+        Option<Vector<'p>>,
+    ) -> Result<crate::contact::ContactOutcome<'p>, DistributedError>,
+) -> Result<crate::contact::ContactOutcome<'p>, DistributedError> {
+    let mut last = None;
+    let found = contact::solve_force_controlled_spread(
+        points,
+        control.driven.as_deref(),
+        control.force * load,
+        start,
+        |points, start| {
+            let out = solve(points, start, None)?;
+            let sol = out.solution.clone();
+            last = Some(out);
+            Ok::<_, DistributedError>(sol)
+        },
+        |how, x| {
+            Ok::<_, DistributedError>(match how {
+                Spread::Sum => petsc.sum(&[x])?[0],
+                Spread::Min => -petsc.max(&[-x])?[0],
+                Spread::Max => petsc.max(&[x])?[0],
+            })
+        },
+    )
+    .map_err(|e: contact::ForceError<DistributedError>| {
+        e.into_solve().unwrap_or_else(|why| {
+            ProblemError::NoSolution {
+                sought: "contact.indenter.force",
+                why,
+            }
+            .into()
+        })
+    })?;
+    match last.filter(|o: &crate::contact::ContactOutcome<'p>| o.solution.lambda == found.lambda) {
+        Some(out) => Ok(out),
+        None => solve(points, Some(found.lambda), None),
     }
 }
 
