@@ -29,6 +29,7 @@ mod gather;
 mod parts;
 mod path;
 mod report;
+mod weakening;
 
 pub use gather::Gathered;
 pub use path::{EachStep, PieceFrame, PieceStep};
@@ -661,7 +662,7 @@ impl<'p> OnPiece<'_, 'p> {
                             warm: Option<Vector<'p>>|
          -> Result<crate::contact::ContactOutcome<'p>, DistributedError> {
             match weakens {
-                true => weakened(petsc, points, (start, warm), tol, &mut solve_at),
+                true => weakening::weakened(petsc, points, (start, warm), tol, &mut solve_at),
                 false => solve_at(points, start, warm),
             }
         };
@@ -753,55 +754,6 @@ fn forced<'p>(
         Some(out) => Ok(out),
         None => solve(points, Some(found.lambda), None),
     }
-}
-
-/// Steps of the fixed point on the slip-weakening coefficients at most.
-const MAX_WEAKENING_STEPS: usize = 200;
-
-/// Slip-weakening friction on the points `points`: the fixed point on the coefficients, each
-/// step Coulomb's law with the coefficients frozen (`solve`, from the last step's multipliers
-/// and solution), from the stick start (the static coefficient at every point: `points` as
-/// the boundary makes them), until no coefficient moves by more than `tol` of the largest
-/// static one between two steps (over the ranks); the last step's outcome, whose coefficients
-/// are then those of its slips to that tolerance (the contact crate's fixed point, without its
-/// Anderson mixing and Newton's polish on the law itself, which need the whole compliance).
-/// Collective.
-fn weakened<'p>(
-    petsc: &Petsc,
-    points: &contact::ContactPoints,
-    (mut start, mut warm): (Option<PointValues>, Option<Vector<'p>>),
-    tol: f64,
-    solve: &mut impl FnMut(
-        &contact::ContactPoints,
-        Option<PointValues>,
-        Option<Vector<'p>>,
-    ) -> Result<crate::contact::ContactOutcome<'p>, DistributedError>,
-) -> Result<crate::contact::ContactOutcome<'p>, DistributedError> {
-    let mut at = points.clone();
-    let static_most = petsc.max(&[points.friction.iter().fold(0.0f64, |m, f| m.max(*f))])?[0];
-    let mut change = f64::INFINITY;
-    for _ in 0..MAX_WEAKENING_STEPS {
-        let out = solve(&at, start.take(), warm.take())?;
-        let next = at.coefficients_at(&out.solution.u);
-        let own = next
-            .iter()
-            .zip(&at.friction)
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        change = petsc.max(&[own])?[0];
-        if change <= tol * static_most {
-            return Ok(out);
-        }
-        at.friction = next;
-        start = Some(out.solution.lambda);
-        warm = Some(out.x);
-    }
-    Err(ProblemError::NoSolution {
-        sought: "contact.friction_law",
-        why: format!(
-            "the fixed point on the slip-weakening coefficients did not settle in {MAX_WEAKENING_STEPS} steps (the last moved a coefficient by {change:.3e}); the default backend's Newton on the law itself may"
-        ),
-    }
-    .into())
 }
 
 impl OnPiece<'_, '_> {
