@@ -116,10 +116,6 @@ pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Me
         return not_held("mesh.order", "quadratic elements (a modified basis' contact points)");
     }
     let zones = scene.zones();
-    // (a path's instants would need each point's slip before them: not carried on pieces)
-    if scene.path.is_some() && zones.iter().any(|c| c.slip_weakening().is_some()) {
-        return not_held("contact.friction_law", "slip-weakening friction along a load path");
-    }
     if scene.mesh.axisymmetric {
         return not_held("mesh.axisymmetric", "a body of revolution");
     }

@@ -584,6 +584,16 @@ const PATH_CASES: &[(&str, &[&str])] = &[
             "path.steps=2",
         ],
     ),
+    // slip weakening along a path: each point's slip carried from instant to instant
+    (
+        "paper-slip-weakening",
+        &[
+            "mesh.n=32",
+            "path.t=[0.0,1.0,2.0]",
+            "path.load=[0.5,1.0,0.7]",
+            "path.steps=4",
+        ],
+    ),
     // a compliant foundation along the cycle
     (
         "paper-cycle",
@@ -822,11 +832,8 @@ fn what_pieces_do_not_solve_is_refused_by_key() {
                 Err(e) => e.to_string(),
             }
         };
-        let e = refused(
-            "paper-slip-weakening",
-            &["mesh.n=8", "path.t=[0.0,1.0]", "path.load=[0.5,1.0]", "path.steps=2"],
-        );
-        assert!(e.contains("contact.friction_law") && e.contains("pieces"), "{e}");
+        let e = refused("paper-conductive", &["mesh.n=8"]);
+        assert!(e.contains("contact.electric") && e.contains("pieces"), "{e}");
         let e = refused("indent-sphere", &["mesh.n=8"]);
         assert!(e.contains("mesh.axisymmetric") && e.contains("pieces"), "{e}");
         // a body its conditions do not hold: refused as the whole mesh's check refuses it, by

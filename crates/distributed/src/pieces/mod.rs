@@ -634,6 +634,7 @@ impl<'p> OnPiece<'_, 'p> {
             step(petsc, fields, &mut t_pc, (m, b, x), loose)
         };
         let (nodes, shift) = (boundary.nodes.clone(), history.shift);
+        let frame = shift.clone();
         let mut krylov = 0;
         // the active sets on `points` from the multipliers `start` (and the solution `warm`)
         let mut solve_at = |points: &contact::ContactPoints,
@@ -662,7 +663,7 @@ impl<'p> OnPiece<'_, 'p> {
                             warm: Option<Vector<'p>>|
          -> Result<crate::contact::ContactOutcome<'p>, DistributedError> {
             match weakens {
-                true => weakening::weakened(petsc, points, (start, warm), tol, &mut solve_at),
+                true => weakening::weakened(petsc, (points, &frame), (start, warm), tol, &mut solve_at),
                 false => solve_at(points, start, warm),
             }
         };
@@ -677,7 +678,9 @@ impl<'p> OnPiece<'_, 'p> {
         };
         // the coefficients at the answer's slips, which its statuses and report read
         if weakens {
-            boundary.points = boundary.points.at_slips(&out.solution.u);
+            boundary.points = boundary
+                .points
+                .at_slips(&weakening::increments(&out.solution.u, &frame));
         }
         let equilibrium = residual(system, &out.x, (&boundary, &out.solution), self.layout, petsc)?;
         let sol = &out.solution;

@@ -84,6 +84,9 @@ pub(super) fn walk<'p>(
     let prescribed = disc.dofs.prescribed();
     let base = on.on(disc).boundary()?;
     let mut history = History::none(&base);
+    // the slip each of this rank's points accumulated in contact (slip-weakening friction's
+    // argument at the next instants), as the default backend's path adds it
+    let mut slipped = vec![0.0; base.points.len()];
     let mut scale = OwnScale::default();
     let mut rows = Vec::with_capacity(instants.len());
     let mut solved = Solved {
@@ -98,7 +101,10 @@ pub(super) fn walk<'p>(
         disc.dofs.rescale(&prescribed, f.displacement, f.voltage);
         pose(on, disc, system, &parts, &f)?;
         let at = on.on(disc);
-        let boundary = base.at_factors(f.gap, f.displacement, f.voltage);
+        let mut boundary = base.at_factors(f.gap, f.displacement, f.voltage);
+        if boundary.points.weakens() {
+            boundary.points.slipped.clone_from(&slipped);
+        }
         scale
             .check(petsc, &boundary, &history, system.load_norm, &on.setup.plan)
             .map_err(|e| e.at_step(k, t))?;
@@ -132,7 +138,14 @@ pub(super) fn walk<'p>(
         )?;
         rows.push(row);
         scale.seen(petsc, &u, system.load_norm)?;
-        history = History::after(&contact.solution, x);
+        let sol = &contact.solution;
+        for (i, s) in slipped.iter_mut().enumerate() {
+            if sol.status[i] != contact::Status::Separated {
+                let (now, then) = (sol.u.tangential_of(i), before.tangential_of(i));
+                *s += now.iter().zip(then).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+            }
+        }
+        history = History::after(sol, x);
         last = Some(contact);
     }
     let (Some(contact), Some(x)) = (last, history.x) else {

@@ -18,11 +18,13 @@ const MAX_STEPS: usize = 200;
 /// Steps of history in the mixing (the contact crate's depth).
 const DEPTH: usize = 3;
 
-/// Slip-weakening friction on the points `points`: from the stick start (the static
-/// coefficient at every point: `points` as the boundary makes them), each step `solve`
+/// Slip-weakening friction on the points `points`: from the coefficients at the slip before
+/// this problem (the static ones in a static run; a path's earlier slip in
+/// [`ContactPoints::slipped`]), each step `solve`
 /// (Coulomb's law with the coefficients frozen, from the last step's multipliers and
 /// solution), the next coefficients those at its slips, mixed and kept within each law's
-/// range, until no coefficient moves by more than `tol` of the largest static one between a
+/// range (each at the slip before plus this problem's, `u` less `shift`), until no
+/// coefficient moves by more than `tol` of the largest static one between a
 /// step's and its slips' (over the ranks). Returns the last step's outcome, whose coefficients
 /// are then those of its slips to that tolerance, with the fixed point's steps and every
 /// step's active-set steps counted. Collective.
@@ -32,7 +34,7 @@ const DEPTH: usize = 3;
 /// does not settle in [`MAX_STEPS`] steps.
 pub(super) fn weakened<'p>(
     petsc: &Petsc,
-    points: &ContactPoints,
+    (points, shift): (&ContactPoints, &PointValues),
     (mut start, mut warm): (Option<PointValues>, Option<Vector<'p>>),
     tol: f64,
     solve: &mut impl FnMut(
@@ -41,14 +43,22 @@ pub(super) fn weakened<'p>(
         Option<Vector<'p>>,
     ) -> Result<ContactOutcome<'p>, DistributedError>,
 ) -> Result<ContactOutcome<'p>, DistributedError> {
+    // the coefficients at the slip before this problem (a path's earlier instants; the static
+    // ones in a static run), and the largest static coefficient, the change's scale
     let mut at = points.clone();
-    let scale = petsc.max(&[points.friction.iter().fold(0.0f64, |m, f| m.max(*f))])?[0];
+    at.friction = points.coefficients_at(&PointValues::zeros(points.len(), points.n_tangential()));
+    let most = points
+        .weakening
+        .iter()
+        .flatten()
+        .fold(f64::MIN_POSITIVE, |m, w| m.max(w.static_coefficient));
+    let scale = petsc.max(&[most])?[0];
     let mut mixing = Mixing::default();
     let (mut change, mut steps) = (f64::INFINITY, 0);
     for k in 1..=MAX_STEPS {
         let mut out = solve(&at, start.take(), warm.take())?;
         steps += out.solution.info.newton_iters;
-        let next = at.coefficients_at(&out.solution.u);
+        let next = at.coefficients_at(&increments(&out.solution.u, shift));
         let own = next
             .iter()
             .zip(&at.friction)
@@ -76,6 +86,17 @@ pub(super) fn weakened<'p>(
         ),
     }
     .into())
+}
+
+/// The tangential displacements `u` less friction's frame `shift` (a path's instant before;
+/// zero in a static run): the slip of this problem, the coefficient's argument beside the
+/// slip before it.
+pub(super) fn increments(u: &PointValues, shift: &PointValues) -> PointValues {
+    let mut slip = u.clone();
+    for (v, s) in slip.tangential.iter_mut().zip(&shift.tangential) {
+        *v -= s;
+    }
+    slip
 }
 
 /// Anderson's mixing of a fixed point `x = G(x)` whose vectors are spread over the ranks: from
