@@ -18,6 +18,7 @@ use contact::PointValues;
 use fe_assembly::{CellFields, Discretization};
 use mesh::MeshPiece;
 use petsc::Vector;
+use problem::backend::ContactBoundary;
 use problem::report::{PathReport, StepRow};
 use problem::{ContactResult, Event, Factors, ProblemError, Reporter};
 use std::time::Instant;
@@ -101,10 +102,7 @@ pub(super) fn walk<'p>(
         disc.dofs.rescale(&prescribed, f.displacement, f.voltage);
         pose(on, disc, system, &parts, &f)?;
         let at = on.on(disc);
-        let mut boundary = base.at_factors(f.gap, f.displacement, f.voltage);
-        if boundary.points.weakens() {
-            boundary.points.slipped.clone_from(&slipped);
-        }
+        let boundary = at_instant(&base, &f, &slipped);
         scale
             .check(petsc, &boundary, &history, system.load_norm, &on.setup.plan)
             .map_err(|e| e.at_step(k, t))?;
@@ -138,14 +136,8 @@ pub(super) fn walk<'p>(
         )?;
         rows.push(row);
         scale.seen(petsc, &u, system.load_norm)?;
-        let sol = &contact.solution;
-        for (i, s) in slipped.iter_mut().enumerate() {
-            if sol.status[i] != contact::Status::Separated {
-                let (now, then) = (sol.u.tangential_of(i), before.tangential_of(i));
-                *s += now.iter().zip(then).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
-            }
-        }
-        history = History::after(sol, x);
+        add_slips(&mut slipped, &contact.solution, &before);
+        history = History::after(&contact.solution, x);
         last = Some(contact);
     }
     let (Some(contact), Some(x)) = (last, history.x) else {
@@ -212,7 +204,7 @@ impl OwnScale {
     fn check(
         &self,
         petsc: &petsc::Petsc,
-        boundary: &problem::backend::ContactBoundary,
+        boundary: &ContactBoundary,
         history: &History<'_>,
         load_norm: f64,
         plan: &problem::Plan,
@@ -238,6 +230,29 @@ impl OwnScale {
             self.peak = Some((load_norm, u));
         }
         Ok(())
+    }
+}
+
+/// This rank's points at an instant of factors `f`: the gaps scaled, and where friction
+/// weakens, the slip each accumulated before it.
+fn at_instant(base: &ContactBoundary, f: &Factors, slipped: &[f64]) -> ContactBoundary {
+    let mut boundary = base.at_factors(f.gap, f.displacement, f.voltage);
+    if boundary.points.weakens() {
+        boundary.points.slipped = slipped.to_vec();
+    }
+    boundary
+}
+
+/// Adds to each of this rank's points that touch at the instant of `sol` the length of its
+/// tangential increment from `before` (friction's frame at the instant before): the slip
+/// accumulated in contact, slip-weakening friction's argument, as the default backend's path
+/// adds it.
+fn add_slips(slipped: &mut [f64], sol: &contact::ContactSolution, before: &PointValues) {
+    for (i, s) in slipped.iter_mut().enumerate() {
+        if sol.status[i] != contact::Status::Separated {
+            let (now, then) = (sol.u.tangential_of(i), before.tangential_of(i));
+            *s += now.iter().zip(then).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+        }
     }
 }
 
