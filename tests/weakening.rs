@@ -74,6 +74,17 @@ fn keys_that_do_not_fit_slip_weakening_are_refused_by_name() {
     // the PETSc backend solves it too
     let (petsc, _) = scene_file::load("paper-slip-weakening", &["solver.backend=petsc".into()]).unwrap();
     distributed::supports(&petsc).expect("the PETSc backend solves slip weakening");
+    // its fixed point solves the contact many times over: MUMPS' route, which factors once,
+    // where it fits; the active sets (a pass each) only where it does not
+    assert!(distributed::repeats_contact_solves(&petsc));
+    let (plain, _) = scene_file::load("paper-slip", &["solver.backend=petsc".into()]).unwrap();
+    assert!(!distributed::repeats_contact_solves(&plain));
+    let (forced, _) = scene_file::load(
+        "indent-sphere-3d",
+        &["contact.indenter.depth=0.0".into(), "contact.indenter.force=0.1".into()],
+    )
+    .unwrap();
+    assert!(distributed::repeats_contact_solves(&forced));
     assert_eq!(
         refused(&["contact.law=signorini", "~contact.friction_static"]),
         "contact.friction_law"

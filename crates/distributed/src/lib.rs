@@ -34,7 +34,9 @@
 
 mod supports;
 
-pub use supports::{active_sets_hold, active_sets_hold_on, direct as factors_directly, supports};
+pub use supports::{
+    active_sets_hold, active_sets_hold_on, direct as factors_directly, repeats_contact_solves, supports,
+};
 
 #[cfg(feature = "petsc")]
 mod active;

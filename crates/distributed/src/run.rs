@@ -151,7 +151,8 @@ impl<'p> DistributedMemory<'p> {
     /// Why a run that MUMPS would factor takes the Krylov route's active sets for speed, in
     /// words, where it does: a run on its own (the route not asked for) of a 3D body of at least
     /// [`ACTIVE_SETS_FROM`] unknowns whose contact zone (the points that can touch) holds at
-    /// least [`ACTIVE_SETS_ZONE`] of them, and whose contact they hold.
+    /// least [`ACTIVE_SETS_ZONE`] of them, and whose contact they hold in one pass (not force
+    /// control's or slip weakening's many: [`crate::repeats_contact_solves`]).
     fn active_sets_for_speed(&self, posed: &Posed<'_>, boundary: Option<&ContactBoundary>) -> Option<String> {
         let unknowns = posed.disc.dofs.n_u + posed.disc.dofs.n_phi;
         let zone = boundary?.condensed_dofs().len();
@@ -160,6 +161,7 @@ impl<'p> DistributedMemory<'p> {
             && unknowns as f64 >= ACTIVE_SETS_FROM
             && zone as f64 >= ACTIVE_SETS_ZONE * unknowns as f64
             && crate::factors_directly(&posed.scene)
+            && !crate::repeats_contact_solves(&posed.scene)
             && crate::active_sets_hold_on(&posed.scene, Some(&posed.setup.mesh)).is_ok();
         faster.then(|| {
             format!(

@@ -128,6 +128,17 @@ pub(crate) fn active_sets_hold_at_instants(scene: &Scene, mesh: Option<&mesh::Me
     zones.into_iter().try_for_each(zone_held)
 }
 
+/// Whether the active sets would solve `scene`'s contact many times over (force control's
+/// search on the depth, slip weakening's fixed point on the coefficients): where MUMPS fits,
+/// its condensed route, which factors once and solves each of those problems on the contact
+/// dofs alone, is the faster, and the active sets are taken only where it does not fit.
+pub fn repeats_contact_solves(scene: &Scene) -> bool {
+    scene
+        .zones()
+        .iter()
+        .any(|c| c.indenter.as_ref().is_some_and(|i| i.force.is_some()) || c.slip_weakening().is_some())
+}
+
 /// What one contact zone asks for that the active sets do not hold.
 fn zone_held(c: &ContactSpec) -> Result<(), Unsupported> {
     if let Some(condition) = c.electric.filter(|_| c.electric_law().is_some()) {

@@ -75,12 +75,16 @@ pub fn run_on(
     let solved = distributed::solve_path(scene, mesh, petsc, limits, reporter, &mut each);
     let solved = match solved {
         // MUMPS' own estimate after its analysis (the one before the mesh is a lower one) or its
-        // allocation: a generated body's load path walks on pieces instead, which factor
-        // nothing (the whole mesh's static runs take the active sets there, in the same run);
-        // the set begun is abandoned before any instant was written
+        // allocation: a generated body's load path (or its force control's search, its slip
+        // weakening's fixed point) runs on pieces instead, which factor nothing (the whole
+        // mesh's other static runs take the active sets there, in the same run); the set begun
+        // is abandoned before any instant was written
         Err(distributed::DistributedError::Petsc(
             petsc::PetscError::MumpsTooLarge { .. } | petsc::PetscError::Mumps { info: -13, .. },
-        )) if generated && scene.path.is_some() && distributed::pieces_support(scene).is_ok() => {
+        )) if generated
+            && (scene.path.is_some() || distributed::repeats_contact_solves(scene))
+            && distributed::pieces_support(scene).is_ok() =>
+        {
             drop(writer);
             let from = distributed::PieceMesh::Generated;
             return pieces::run(scene, source, dir, (petsc, limits), from, reporter);
@@ -120,8 +124,9 @@ enum Route {
 /// need not exist). Otherwise a 3D body that the pieces solve ([`distributed::pieces_support`])
 /// runs on them without contact, or with contact and at least [`distributed::ACTIVE_SETS_FROM`]
 /// unknowns (where the whole mesh's route would take the same active sets for speed; below,
-/// MUMPS' condensed route is as fast, issue 44's measurements), or, along a load path, where
-/// MUMPS' factorisation would not fit (the whole mesh's route walks a path on one factorisation,
+/// MUMPS' condensed route is as fast, issue 44's measurements), or, along a load path or with
+/// force control or slip weakening (contact solved many times over), where MUMPS'
+/// factorisation would not fit (the whole mesh's route walks a path on one factorisation,
 /// the faster while it fits: `paper-3d` n = 20, 7 instants, 14 s by the default backend against
 /// 61 s on pieces on 2 ranks): a generated box on any count of ranks, a Gmsh mesh read whole on
 /// one rank. The rest takes the whole mesh's route.
@@ -144,9 +149,11 @@ fn route(scene: &Scene, source: &Source, ranks: usize, memory_bytes: Option<u64>
         None => problem::backend::generated_sizes(scene).map_or(0.0, |(_, _, _, n)| n),
     };
     let dim = mesh.as_ref().map_or(scene.mesh.lo.len(), |m| m.dim);
-    let large = match scene.path {
-        Some(_) => distributed::direct_exceeds(scene, mesh.as_ref(), ranks, memory_bytes),
-        None => scene.zones().is_empty() || unknowns >= distributed::ACTIVE_SETS_FROM,
+    // (a path, force control's search and slip weakening's fixed point solve the contact many
+    // times: MUMPS' route, which factors once, is the faster where it fits)
+    let large = match scene.path.is_some() || distributed::repeats_contact_solves(scene) {
+        true => distributed::direct_exceeds(scene, mesh.as_ref(), ranks, memory_bytes),
+        false => scene.zones().is_empty() || unknowns >= distributed::ACTIVE_SETS_FROM,
     };
     Ok(match (mesh, solved && dim == 3 && large) {
         (None, true) => Route::Pieces(distributed::PieceMesh::Generated),
