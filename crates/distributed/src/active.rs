@@ -4,10 +4,11 @@
 //! model, on one zone or several ([`crate::active_sets_hold`] chooses it); its steps here are the
 //! backend's `begin`, `prime`, `solve_posed` and `instant_fields` on that route.
 
-use crate::contact::{active_set, shared_components, shared_refusal, ActiveSetParams, ContactRows};
+use crate::contact::{active_set, shared_components, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
 use crate::krylov::{Krylov, KrylovFields};
 use crate::layout::Layout;
+use crate::supports::shared_refusal;
 use crate::system::System;
 use petsc::{Index, Petsc, PetscError, Vector};
 use problem::backend::{At, ContactBoundary, ContactSolve, Fields, InstantOf, InstantSolution, Posed, Primed};

@@ -205,11 +205,8 @@ impl ContactRows {
 /// held. `None` where no two points share a component.
 pub fn shared_components(points: &ContactPoints, nodes: &[usize], law: &Law) -> Option<usize> {
     let (dim, nt) = (points.dim, points.n_tangential());
-    let rubs = |i: usize| match law {
-        Law::Frictionless => false,
-        Law::Tresca(s) => s[i] > 0.0,
-        Law::Coulomb => points.tresca_of(i).map_or(points.friction[i] > 0.0, |s| s > 0.0),
-    };
+    // friction acts where the law's radius at a unit normal value is positive
+    let rubs = |i: usize| law.radius(points, i, 1.0) > 0.0;
     let mut taken: std::collections::HashMap<(usize, usize), usize> = Default::default();
     for i in 0..points.len() {
         let normal = std::iter::once(axis(&points.normal[i], dim));
@@ -223,19 +220,6 @@ pub fn shared_components(points: &ContactPoints, nodes: &[usize], law: &Law) -> 
         }
     }
     None
-}
-
-/// The refusal of the point at `at`, which [`shared_components`] found.
-pub(crate) fn shared_refusal(at: [f64; 3]) -> problem::backend::Unsupported {
-    problem::backend::Unsupported::new(
-        "petsc",
-        "contact",
-        format!(
-            "a node of two contact zones whose conditions act on one component of its displacement (the node at ({:.6e}, {:.6e}, {:.6e}): friction along the other zone's normal, or one normal), which the active sets do not hold",
-            at[0], at[1], at[2]
-        ),
-    )
-    .advise("frictionless zones may meet at a node; else keep the zones apart, or give the ranks the memory for MUMPS' route")
 }
 
 /// `a · b` over the first `dim` components.
@@ -640,7 +624,7 @@ fn sets(
         };
         // a given slip bound (Tresca's) holds whether or not the point presses: its
         // tangential law is judged at a separated point too, as the contact crate poses it
-        if !pressed && !given_bound(p, law, i) {
+        if !pressed && given_bound(p, law, i).is_none() {
             continue;
         }
         active[i] = pressed;
@@ -656,7 +640,7 @@ fn sets(
         // one there came into contact during the instant, and held where it was then it jumps
         // back; the sets alternated so where points slipped back
         if matches!(law, Law::Coulomb)
-            && p.tresca_of(i).is_none()
+            && given_bound(p, law, i).is_none()
             && rows.start.is_none()
             && lambda.normal[i] == 0.0
             && p.friction[i] > 0.0
@@ -690,13 +674,13 @@ fn sets(
     )
 }
 
-/// Whether point `i`'s slip bound is given (Tresca's law, or a Tresca zone beside Coulomb
+/// Point `i`'s slip bound where it is given (Tresca's law, or a Tresca zone beside Coulomb
 /// ones) rather than its normal force's.
-fn given_bound(p: &ContactPoints, law: &Law, i: usize) -> bool {
+fn given_bound(p: &ContactPoints, law: &Law, i: usize) -> Option<f64> {
     match law {
-        Law::Tresca(_) => true,
-        Law::Coulomb => p.tresca_of(i).is_some(),
-        Law::Frictionless => false,
+        Law::Tresca(s) => Some(s[i]),
+        Law::Coulomb => p.tresca_of(i),
+        Law::Frictionless => None,
     }
 }
 
@@ -737,7 +721,7 @@ fn hold(
     let mut edits = Edits::default();
     for i in 0..p.len() {
         // (a separated point with a given slip bound keeps its tangential law)
-        if !sets.active[i] && !given_bound(p, law, i) {
+        if !sets.active[i] && given_bound(p, law, i).is_none() {
             continue;
         }
         let first = layout.first[rows.nodes[i]];
@@ -836,11 +820,7 @@ impl Edits {
     ) -> Result<(), PetscError> {
         let (p, i, d) = (&rows.points, at.i, at.d);
         let (w, shift) = (p.weight[i], rows.shift.tangential_of(i));
-        let tresca = match law {
-            Law::Tresca(s) => Some(s[i]),
-            Law::Coulomb => p.tresca_of(i),
-            Law::Frictionless => None,
-        };
+        let tresca = given_bound(p, law, i);
         let normal_row = match (law, tresca) {
             (Law::Coulomb, None) => Some(matrix.row((at.first + at.kn) as Index)?),
             _ => None,
@@ -946,7 +926,7 @@ fn multipliers(
     let local = system.reactions(x)?.local()?;
     let start = layout.owned(petsc.rank()).start;
     let mut lambda = PointValues::zeros(n, nt);
-    for i in (0..n).filter(|&i| sets.active[i] || given_bound(p, &rows.law, i)) {
+    for i in (0..n).filter(|&i| sets.active[i] || given_bound(p, &rows.law, i).is_some()) {
         let first = layout.first[rows.nodes[i]] - start;
         let f: [f64; 3] = std::array::from_fn(|k| if k < dim { local[first + k] } else { 0.0 });
         let w = p.weight[i];

@@ -155,9 +155,23 @@ fn zone_held(c: &ContactSpec) -> Result<(), Unsupported> {
 
 /// `feature`, asked for by `key`, which the active sets do not hold.
 fn not_held(key: &str, feature: &str) -> Result<(), Unsupported> {
-    Err(Unsupported::new(
-        BACKEND,
-        key,
-        format!("{feature}, which the active sets do not hold"),
-    ))
+    Err(unheld(key, feature))
+}
+
+/// The refusal of the point at `at`, which [`crate::contact::shared_components`] found.
+#[cfg(feature = "petsc")]
+pub(crate) fn shared_refusal(at: [f64; 3]) -> Unsupported {
+    unheld(
+        "contact",
+        &format!(
+            "a node of two contact zones whose conditions act on one component of its displacement (the node at ({:.6e}, {:.6e}, {:.6e}): friction along the other zone's normal, or one normal)",
+            at[0], at[1], at[2]
+        ),
+    )
+    .advise("frictionless zones may meet at a node; else keep the zones apart, or give the ranks the memory for MUMPS' route")
+}
+
+/// The refusal of `feature`, asked for by `key`, which the active sets do not hold.
+pub(crate) fn unheld(key: &str, feature: &str) -> Unsupported {
+    Unsupported::new(BACKEND, key, format!("{feature}, which the active sets do not hold"))
 }

@@ -32,6 +32,18 @@ impl ForceControl {
         let driven = (boundary.groups.len() > 1).then(|| boundary.group_of.iter().map(|&g| g == k).collect());
         Some(ForceControl { force, driven })
     }
+
+    /// The search's failure as the caller's error: a contact solve's own, or no solution keyed
+    /// `contact.indenter.force` where no depth carries the force.
+    pub fn failed<E: From<ProblemError>>(e: contact::ForceError<E>) -> E {
+        e.into_solve().unwrap_or_else(|why| {
+            ProblemError::NoSolution {
+                sought: "contact.indenter.force",
+                why,
+            }
+            .into()
+        })
+    }
 }
 
 /// Force control (`contact.indenter.force`): [`contact::solve_force_controlled`] around the
@@ -44,15 +56,8 @@ pub(crate) fn force_controlled<E: From<ProblemError>>(
     start: Option<PointValues>,
     solve: impl FnMut(&ContactPoints, Option<PointValues>) -> Result<ContactSolution, E>,
 ) -> Result<ContactSolution, E> {
-    contact::solve_force_controlled(points, control.driven.as_deref(), force, start, solve).map_err(|e| {
-        e.into_solve().unwrap_or_else(|why| {
-            ProblemError::NoSolution {
-                sought: "contact.indenter.force",
-                why,
-            }
-            .into()
-        })
-    })
+    contact::solve_force_controlled(points, control.driven.as_deref(), force, start, solve)
+        .map_err(ForceControl::failed)
 }
 
 /// A floating conducting tip (`contact.charge`): [`contact::solve_floating`] around the

@@ -35,10 +35,11 @@ pub use gather::Gathered;
 pub use path::{EachStep, PieceFrame, PieceStep};
 
 use crate::active::{residual, step};
-use crate::contact::{active_set, shared_components, shared_refusal, ActiveSetParams, ContactRows};
+use crate::contact::{active_set, shared_components, ActiveSetParams, ContactRows};
 use crate::error::DistributedError;
 use crate::krylov::{configure, KrylovFields};
 use crate::layout::Layout;
+use crate::supports::shared_refusal;
 use crate::system::{assemble, System};
 use crate::MAX_ACTIVE_SET_STEPS;
 use contact::{PointValues, Spread};
@@ -744,15 +745,7 @@ fn forced<'p>(
             })
         },
     )
-    .map_err(|e: contact::ForceError<DistributedError>| {
-        e.into_solve().unwrap_or_else(|why| {
-            ProblemError::NoSolution {
-                sought: "contact.indenter.force",
-                why,
-            }
-            .into()
-        })
-    })?;
+    .map_err(problem::backend::ForceControl::failed::<DistributedError>)?;
     match last.filter(|o: &crate::contact::ContactOutcome<'p>| o.solution.lambda == found.lambda) {
         Some(out) => Ok(out),
         None => solve(points, Some(found.lambda), None),
