@@ -74,7 +74,8 @@ pub use solution::{
 pub use uniqueness::slip_bound_expansion;
 pub use uzawa::{solve_uzawa, StopRule, UzawaParams, FIXED_POINT_PATIENCE};
 pub use weakening::{
-    solve_slip_weakening, solve_slip_weakening_cached, Inner, SlipWeakening, Weakening, WeakeningParams,
+    solve_slip_weakening, solve_slip_weakening_cached, Anderson, Inner, SlipWeakening, Weakening, WeakeningParams,
+    ANDERSON_DEPTH,
 };
 
 /// A failure of the primal solve behind a [`ContactOperator`], with its cause (for example the

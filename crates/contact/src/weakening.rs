@@ -23,7 +23,7 @@ const NOISE: f64 = 1e4;
 const POLISH: f64 = 1e-2;
 
 /// Steps of history in Anderson's mixing (Walker and Ni, SIAM J. Numer. Anal. 49 (2011) 1715).
-const ANDERSON_DEPTH: usize = 3;
+pub const ANDERSON_DEPTH: usize = 3;
 
 /// `max_i |a_i - b_i|`.
 fn max_difference(a: &[f64], b: &[f64]) -> f64 {
@@ -32,20 +32,45 @@ fn max_difference(a: &[f64], b: &[f64]) -> f64 {
 
 /// Anderson's acceleration of a fixed point `x = G(x)` (type II, Walker and Ni 2011): from the
 /// last `depth` pairs `(x_j, G(x_j))`, `x_{k+1} = G(x_k) - ΔG γ` with `γ` the least-squares
-/// coefficients of the residuals' differences `ΔF` against `f_k = G(x_k) - x_k`.
-struct Anderson {
+/// coefficients of the residuals' differences `ΔF` against `f_k = G(x_k) - x_k`. Its vectors
+/// may be spread over several processes ([`Anderson::step_spread`]).
+pub struct Anderson {
     depth: usize,
     /// The last pairs `(x_j, G(x_j))`, oldest first.
     history: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 impl Anderson {
-    fn new(depth: usize) -> Self {
-        Anderson { depth, history: vec![] }
+    /// No history yet; `depth` pairs at most (at most [`ANDERSON_DEPTH`]: its small system
+    /// is solved in place).
+    pub fn new(depth: usize) -> Self {
+        Anderson {
+            depth: depth.min(ANDERSON_DEPTH),
+            history: vec![],
+        }
     }
 
     /// The next iterate from `x` and `g = G(x)`.
-    fn step(&mut self, x: &[f64], g: &[f64]) -> Vec<f64> {
+    pub fn step(&mut self, x: &[f64], g: &[f64]) -> Vec<f64> {
+        match self.step_spread(x, g, |_| Ok::<_, std::convert::Infallible>(())) {
+            Ok(next) => next,
+            Err(never) => match never {},
+        }
+    }
+
+    /// [`Anderson::step`] on vectors spread over several processes, each calling it with its
+    /// own part of `x` and `g`: `sum` replaces the inner products it is given (this process's
+    /// share of each) by their sums over the processes (collective), so that every process
+    /// takes the same `γ`.
+    ///
+    /// # Errors
+    /// `sum`'s.
+    pub fn step_spread<E>(
+        &mut self,
+        x: &[f64],
+        g: &[f64],
+        mut sum: impl FnMut(&mut [f64]) -> Result<(), E>,
+    ) -> Result<Vec<f64>, E> {
         self.history.push((x.to_vec(), g.to_vec()));
         if self.history.len() > self.depth + 1 {
             self.history.remove(0);
@@ -58,19 +83,26 @@ impl Anderson {
         let fk = f(last);
         let m = last;
         if m == 0 {
-            return g.to_vec();
+            return Ok(g.to_vec());
         }
         // columns j = 0..m: ΔF_j = f_{j+1} - f_j, ΔG_j = g_{j+1} - g_j
         let df: Vec<Vec<f64>> = (0..m)
             .map(|j| f(j + 1).iter().zip(&f(j)).map(|(a, b)| a - b).collect())
             .collect();
+        // the normal equations' entries, then the right-hand side, summed at once
+        let mut products = vec![0.0; m * m + m];
+        for i in 0..m {
+            for j in 0..m {
+                products[i * m + j] = dot(&df[i], &df[j]);
+            }
+            products[m * m + i] = dot(&df[i], &fk);
+        }
+        sum(&mut products)?;
         let mut a = [[0.0; ANDERSON_DEPTH]; ANDERSON_DEPTH];
         let mut b = [0.0; ANDERSON_DEPTH];
         for i in 0..m {
-            for j in 0..m {
-                a[i][j] = dot(&df[i], &df[j]);
-            }
-            b[i] = dot(&df[i], &fk);
+            a[i][..m].copy_from_slice(&products[i * m..(i + 1) * m]);
+            b[i] = products[m * m + i];
         }
         // a touch of Tikhonov: nearly parallel differences make the normal equations singular
         let trace: f64 = (0..m).map(|i| a[i][i]).sum();
@@ -78,7 +110,7 @@ impl Anderson {
             row[i] += 1e-12 * trace.max(f64::MIN_POSITIVE);
         }
         let Some(gamma) = solve_spd(a, b, m) else {
-            return g.to_vec();
+            return Ok(g.to_vec());
         };
         let mut next = g.to_vec();
         for (j, &gj) in gamma.iter().enumerate().take(m) {
@@ -87,7 +119,7 @@ impl Anderson {
                 *v -= gj * (a - b);
             }
         }
-        next
+        Ok(next)
     }
 }
 
