@@ -166,11 +166,78 @@ pub fn parse(text: &str, label: &str, overrides: &[String]) -> Result<Scene, Err
 /// # Errors
 /// [`Error::Scene`], labelled `label`, naming the key at fault.
 pub fn from_tree(tree: toml::Table, label: &str) -> Result<Scene, Error> {
-    let scene: Scene = toml::Value::Table(tree)
+    let scene: Scene = toml::Value::Table(tree.clone())
         .try_into()
-        .map_err(|e: toml::de::Error| Error::scene(label, e))?;
+        .map_err(|e: toml::de::Error| Error::scene(label, placed(&tree, e)))?;
     scene.validate().map_err(|e| Error::scene(label, e))?;
     Ok(scene)
+}
+
+/// The error `e` of reading the typed scene from `tree`, its key named with the place of its
+/// table in an array of tables, as `--set` names it (`contact.1.electric`, "the second
+/// `[[contact]]`"): toml names the key `contact.electric` whichever of the tables holds it.
+/// The place is found from the span of the same error in the tree written out as text (each
+/// table of an array there under a `[[contact]]` header of its own); `e` as it is where the
+/// key is not in such an array of several tables.
+fn placed(tree: &toml::Table, e: toml::de::Error) -> toml::de::Error {
+    let shown = e.to_string();
+    let Some((before, after)) = shown.split_once("in `") else {
+        return e;
+    };
+    let Some((path, rest)) = after.split_once('`') else {
+        return e;
+    };
+    let (head, tail) = path.split_once('.').map_or((path, None), |(h, t)| (h, Some(t)));
+    let Some(tables) = tree.get(head).and_then(toml::Value::as_array) else {
+        return e;
+    };
+    if tables.len() < 2 || !tables.iter().all(toml::Value::is_table) {
+        return e;
+    }
+    let Ok(text) = toml::to_string(tree) else {
+        return e;
+    };
+    let Some(at) = toml::from_str::<Scene>(&text).err().and_then(|e| e.span()) else {
+        return e;
+    };
+    let header = format!("[[{head}]]");
+    let Some(index) = text[..at.end]
+        .lines()
+        .filter(|line| line.trim() == header)
+        .count()
+        .checked_sub(1)
+        .filter(|&i| i < tables.len())
+    else {
+        return e;
+    };
+    let key = match tail {
+        Some(tail) => format!("{head}.{index}.{tail}"),
+        None => format!("{head}.{index}"),
+    };
+    <toml::de::Error as serde::de::Error>::custom(format!(
+        "{before}in `{key}` (the {} `{header}`){rest}",
+        ordinal(index + 1)
+    ))
+}
+
+/// "first", "second", ... for small `n`, "21st" and so on beyond.
+fn ordinal(n: usize) -> String {
+    const WORDS: [&str; 10] = [
+        "first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth",
+    ];
+    match n {
+        1..=10 => WORDS[n - 1].to_string(),
+        _ => {
+            let suffix = match (n % 10, n % 100) {
+                (_, 11..=13) => "th",
+                (1, _) => "st",
+                (2, _) => "nd",
+                (3, _) => "rd",
+                _ => "th",
+            };
+            format!("{n}{suffix}")
+        }
+    }
 }
 
 /// Applies one override, `a.b.c=value` or `~a.b.c`, to the tree.
@@ -446,6 +513,45 @@ mod tests {
         // a choice that does not exist names itself and its key
         let e = load("paper", &["solver.strategy=fast".into()]).unwrap_err().to_string();
         assert!(e.contains("fast") && e.contains("solver.strategy"), "{e}");
+    }
+
+    /// A key of the second or third of several `[[contact]]` (or `[[dirichlet]]`) tables is
+    /// named with its place, as `--set` names it: toml's own path, `contact.electric`, does not
+    /// say which; the values the typed scene refuses are named so by its validation.
+    #[test]
+    fn a_key_in_an_array_of_tables_is_named_with_its_place() {
+        let refused = |sets: &[&str]| {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            load("corner", &sets).unwrap_err().to_string()
+        };
+        for (sets, expected) in [
+            (&["contact.1.gap=\"a\""][..], "in `contact.1.gap` (the second `[[contact]]`)"),
+            (&["contact.0.gap=\"a\""][..], "in `contact.0.gap` (the first `[[contact]]`)"),
+            (&["~contact.1.group"][..], "in `contact.1` (the second `[[contact]]`)"),
+            (&["contact.2.gap=0.0"][..], "in `contact.2` (the third `[[contact]]`)"),
+            (
+                &["contact.1.indenter={shape=\"sphere\",radius=\"a\"}"][..],
+                "in `contact.1.indenter.radius` (the second `[[contact]]`)",
+            ),
+            (&["dirichlet.1.uy=\"x\""][..], "in `dirichlet.1.uy` (the second `[[dirichlet]]`)"),
+            (
+                &["contact.1.normal=[0.0, 0.0]"][..],
+                "[[contact]] 1 on `top`: contact.1.normal is the zero vector",
+            ),
+            (&["dirichlet.1.phi=nan"][..], "dirichlet on `bottom`: dirichlet.phi = NaN"),
+        ] {
+            let e = refused(sets);
+            assert!(e.contains(expected), "{sets:?}: {e}");
+        }
+        // one table: toml's path is unambiguous, and kept
+        let e = load("paper", &["material.0.young=\"x\"".into()]).unwrap_err().to_string();
+        assert!(e.contains("in `material.young`"), "{e}");
+        let e = load("paper", &["load.p=nan".into()]).unwrap_err().to_string();
+        assert!(e.contains("load on `top`: load.p = NaN"), "{e}");
+        assert_eq!(
+            (ordinal(1), ordinal(10), ordinal(11), ordinal(22), ordinal(103)),
+            ("first".into(), "tenth".into(), "11th".into(), "22nd".into(), "103rd".into())
+        );
     }
 
     /// A table given where the scene has an array of tables is refused with the three ways

@@ -154,16 +154,13 @@ impl Scene {
         }
         self.check_units()?;
         for d in &self.dirichlet {
-            let values =
-                d.u.iter()
-                    .flatten()
-                    .chain(&d.ux)
-                    .chain(&d.uy)
-                    .chain(&d.uz)
-                    .chain(&d.phi)
-                    .chain(&d.charge);
-            values.clone().try_for_each(|&v| finite("dirichlet", v))?;
-            if values.count() == 0 {
+            let scalars = [("ux", d.ux), ("uy", d.uy), ("uz", d.uz), ("phi", d.phi), ("charge", d.charge)];
+            all_finite("dirichlet.u", d.u.as_deref().unwrap_or_default()).map_err(|e| on_group(e, &d.group))?;
+            for (name, v) in scalars {
+                v.map_or(Ok(()), |v| finite(&format!("dirichlet.{name}"), v))
+                    .map_err(|e| on_group(e, &d.group))?;
+            }
+            if d.u.is_none() && scalars.iter().all(|(_, v)| v.is_none()) {
                 return Err(SceneError::new(
                     "dirichlet",
                     format!(
@@ -182,13 +179,14 @@ impl Scene {
             )?;
         }
         for l in self.loads() {
-            finite("load.p", l.p)?;
-            all_finite("load.direction", &l.direction)?;
+            let on_load = |e: SceneError| SceneError::new(&e.key, format!("load on `{}`: {}", l.group, e.message));
+            finite("load.p", l.p).map_err(on_load)?;
+            all_finite("load.direction", &l.direction).map_err(on_load)?;
             if !(mesh::scaled_norm(&l.direction) > 0.0) {
-                return Err(SceneError::new(
+                return Err(on_load(SceneError::new(
                     "load.direction",
                     "load.direction is the zero vector: give the traction's direction (its magnitude is load.p)",
-                ));
+                )));
             }
         }
         validate_electrodes(self)?;
@@ -826,6 +824,12 @@ fn validate_contact(c: &ContactSpec) -> Result<(), SceneError> {
     }
     all_finite("contact.gap_center", c.gap_center.as_deref().unwrap_or_default())?;
     all_finite("contact.normal", &c.normal)?;
+    if !(mesh::scaled_norm(&c.normal) > 0.0) {
+        return Err(SceneError::new(
+            "contact.normal",
+            "contact.normal is the zero vector: give the foundation's outward normal (its length does not matter)",
+        ));
+    }
     if let Some(k) = &c.compliance {
         if !(k.stiffness > 0.0 && k.stiffness.is_finite()) {
             return Err(SceneError::new(
