@@ -26,7 +26,7 @@ pub fn memory_limits(ranks: u64) -> (Option<u64>, Option<&'static str>) {
 
 /// The mesh of `scene`: its Gmsh file read (relative to the scene's `source`), or the one
 /// `given` (a `given` scene's), or none (a generated mesh, made by the problem).
-fn mesh_of(scene: &Scene, source: &Source, given: Option<mesh::Mesh>) -> Result<Option<mesh::Mesh>, Error> {
+pub fn mesh_of(scene: &Scene, source: &Source, given: Option<mesh::Mesh>) -> Result<Option<mesh::Mesh>, Error> {
     Ok(match (scene.mesh.kind, &scene.mesh.file, given) {
         (MeshKind::Gmsh, Some(file), None) => Some(mesh::read_msh(source.dir.join(file))?),
         (_, _, given) => given,

@@ -525,32 +525,52 @@ mod tests {
             load("corner", &sets).unwrap_err().to_string()
         };
         for (sets, expected) in [
-            (&["contact.1.gap=\"a\""][..], "in `contact.1.gap` (the second `[[contact]]`)"),
-            (&["contact.0.gap=\"a\""][..], "in `contact.0.gap` (the first `[[contact]]`)"),
+            (
+                &["contact.1.gap=\"a\""][..],
+                "in `contact.1.gap` (the second `[[contact]]`)",
+            ),
+            (
+                &["contact.0.gap=\"a\""][..],
+                "in `contact.0.gap` (the first `[[contact]]`)",
+            ),
             (&["~contact.1.group"][..], "in `contact.1` (the second `[[contact]]`)"),
             (&["contact.2.gap=0.0"][..], "in `contact.2` (the third `[[contact]]`)"),
             (
                 &["contact.1.indenter={shape=\"sphere\",radius=\"a\"}"][..],
                 "in `contact.1.indenter.radius` (the second `[[contact]]`)",
             ),
-            (&["dirichlet.1.uy=\"x\""][..], "in `dirichlet.1.uy` (the second `[[dirichlet]]`)"),
+            (
+                &["dirichlet.1.uy=\"x\""][..],
+                "in `dirichlet.1.uy` (the second `[[dirichlet]]`)",
+            ),
             (
                 &["contact.1.normal=[0.0, 0.0]"][..],
                 "[[contact]] 1 on `top`: contact.1.normal is the zero vector",
             ),
-            (&["dirichlet.1.phi=nan"][..], "dirichlet on `bottom`: dirichlet.phi = NaN"),
+            (
+                &["dirichlet.1.phi=nan"][..],
+                "dirichlet on `bottom`: dirichlet.phi = NaN",
+            ),
         ] {
             let e = refused(sets);
             assert!(e.contains(expected), "{sets:?}: {e}");
         }
         // one table: toml's path is unambiguous, and kept
-        let e = load("paper", &["material.0.young=\"x\"".into()]).unwrap_err().to_string();
+        let e = load("paper", &["material.0.young=\"x\"".into()])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("in `material.young`"), "{e}");
         let e = load("paper", &["load.p=nan".into()]).unwrap_err().to_string();
         assert!(e.contains("load on `top`: load.p = NaN"), "{e}");
         assert_eq!(
             (ordinal(1), ordinal(10), ordinal(11), ordinal(22), ordinal(103)),
-            ("first".into(), "tenth".into(), "11th".into(), "22nd".into(), "103rd".into())
+            (
+                "first".into(),
+                "tenth".into(),
+                "11th".into(),
+                "22nd".into(),
+                "103rd".into()
+            )
         );
     }
 

@@ -40,13 +40,23 @@ pub fn sphere_loop(n: usize, steps: Option<usize>) -> Result<LoopFigures, Driver
 pub fn sphere_loop_of_order(n: usize, steps: Option<usize>, order: usize) -> Result<LoopFigures, DriverError> {
     let mut sets = vec![format!("mesh.n={n}"), format!("mesh.order={order}")];
     sets.extend(steps.map(|s| format!("path.steps={s}")));
-    let (scene, _) = scene_file::load("mindlin-sphere-cycle", &sets)?;
+    sphere_loop_with(&sets)
+}
+
+/// The loop of `mindlin-sphere-cycle` with the overrides `sets` (`--set`'s `KEY=VALUE`: a mesh
+/// of one's own, `mesh.kind="gmsh"` and its `mesh.file`, refined towards the contact).
+///
+/// # Errors
+/// The scene's or the run's error.
+pub fn sphere_loop_with(sets: &[String]) -> Result<LoopFigures, DriverError> {
+    let (scene, source) = scene_file::load("mindlin-sphere-cycle", sets)?;
+    let mesh = files::run::mesh_of(&scene, &source, None)?;
     let m = &scene.material[0];
     let missing = || DriverError::Usage("mindlin-sphere-cycle lost its isotropic material or its drive".into());
     let (young, poisson) = (m.young.ok_or_else(missing)?, m.poisson.ok_or_else(missing)?);
     let c = scene.first_contact().cloned().ok_or_else(missing)?;
     let drive = scene.dirichlet.first().and_then(|d| d.u.as_ref()).ok_or_else(missing)?[0];
-    let p = problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(()))
+    let p = problem::solve_path(&scene, mesh, Limits::default(), &mut Silent, false, &mut |_| Ok(()))
         .map_err(files::Error::from)?;
     let rows = p.last.report.path.ok_or_else(missing)?.rows;
     let cycle: Vec<_> = rows.iter().filter(|r| r.t >= 1.0 - 1e-9).collect();
