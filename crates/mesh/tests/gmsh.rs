@@ -327,3 +327,19 @@ fn physical_groups_of_one_name_are_one_group() {
     assert_eq!(keys.len(), n, "each facet once");
     assert!((length(&m, "bottom") - 2.0).abs() < 1e-12);
 }
+
+/// A file whose cells of highest dimension are triangles that do not lie in one plane (a 3D
+/// body saved without its volume cells: Gmsh writes only the elements of physical groups) is
+/// refused as a surface, naming the missing volume group, not as a 2D mesh off its plane.
+#[test]
+fn a_surface_without_its_volume_is_named_so() {
+    let text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n\
+        $Entities\n0 0 1 0\n1 0 0 0 1 1 1 0 0\n$EndEntities\n\
+        $Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n$EndNodes\n\
+        $Elements\n1 4 1 4\n2 1 2 4\n1 1 3 2\n2 1 2 4\n3 2 3 4\n4 3 1 4\n$EndElements\n";
+    let e = read_msh_bytes(text.as_bytes(), "surface.msh").unwrap_err().to_string();
+    assert!(
+        e.contains("a surface, not a body") && e.contains("Physical Volume"),
+        "{e}"
+    );
+}

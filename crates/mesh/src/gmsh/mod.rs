@@ -336,7 +336,12 @@ fn flatten_2d(mesh: &mut Mesh) -> Result<(), String> {
     let z0 = mesh.points.first().map_or(0.0, |p| p[2]);
     if let Some((i, p)) = mesh.points.iter().enumerate().find(|(_, p)| p[2] != z0) {
         return Err(format!(
-            "a 2D mesh must lie in a plane z = const; node {i} has z = {} (node 0: {z0})",
+            "the file's cells of highest dimension are 2D ({}), and they do not lie in one plane \
+             z = const (node {i} has z = {}, node 0 z = {z0}): a surface, not a body. A 3D body \
+             needs its volume cells: Gmsh writes only the elements of physical groups, so give the \
+             volume one (Physical Volume, gmsh.model.addPhysicalGroup(3, ...)) or set \
+             Mesh.SaveAll = 1; a 2D body lies in a plane z = const",
+            mesh.kind.name(),
             p[2]
         ));
     }
