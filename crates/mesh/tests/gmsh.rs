@@ -343,3 +343,15 @@ fn a_surface_without_its_volume_is_named_so() {
         "{e}"
     );
 }
+
+/// A flat 2D mesh drawn in another plane than z = const is told so, with the plane's normal.
+#[test]
+fn a_flat_mesh_off_the_xy_plane_is_named_so() {
+    let text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n\
+        $Entities\n0 0 1 0\n1 0 0 0 1 0 1 0 0\n$EndEntities\n\
+        $Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n1 0 1\n0 0 1\n$EndNodes\n\
+        $Elements\n1 2 1 2\n2 1 2 2\n1 1 2 3\n2 1 3 4\n$EndElements\n";
+    let e = read_msh_bytes(text.as_bytes(), "xz.msh").unwrap_err().to_string();
+    let plane = e.contains("[0.000, -1.000, 0.000]") || e.contains("[0.000, 1.000, 0.000]");
+    assert!(e.contains("draw the 2D body in the x-y plane") && plane, "{e}");
+}

@@ -328,27 +328,70 @@ fn from_gmsh_order(kind: CellKind, cells: &mut [usize]) {
     }
 }
 
-/// A 2D mesh must lie in a plane `z = const`; it is put at `z = 0`.
+/// A 2D mesh must lie in a plane `z = const`; it is put at `z = 0`. One off that plane is told
+/// apart: flat in another plane (drawn in the x-z plane, say), or not flat at all (the surface
+/// of a 3D body saved without its volume cells).
 fn flatten_2d(mesh: &mut Mesh) -> Result<(), String> {
     if mesh.dim != 2 {
         return Ok(());
     }
     let z0 = mesh.points.first().map_or(0.0, |p| p[2]);
     if let Some((i, p)) = mesh.points.iter().enumerate().find(|(_, p)| p[2] != z0) {
-        return Err(format!(
-            "the file's cells of highest dimension are 2D ({}), and they do not lie in one plane \
-             z = const (node {i} has z = {}, node 0 z = {z0}): a surface, not a body. A 3D body \
-             needs its volume cells: Gmsh writes only the elements of physical groups, so give the \
-             volume one (Physical Volume, gmsh.model.addPhysicalGroup(3, ...)) or set \
-             Mesh.SaveAll = 1; a 2D body lies in a plane z = const",
-            mesh.kind.name(),
-            p[2]
-        ));
+        let at = format!("node {i} has z = {}, node 0 z = {z0}", p[2]);
+        return Err(match plane_normal(&mesh.points) {
+            Some(n) => format!(
+                "a 2D mesh lies in a plane z = const, and this one lies in the plane of normal \
+                 [{:.3}, {:.3}, {:.3}] ({at}): draw the 2D body in the x-y plane",
+                n[0], n[1], n[2]
+            ),
+            None => format!(
+                "the file's cells of highest dimension are 2D ({}), and they do not lie in one \
+                 plane ({at}): a surface, not a body. A 3D body needs its volume cells: Gmsh \
+                 writes only the elements of physical groups, so give the volume one (Physical \
+                 Volume, gmsh.model.addPhysicalGroup(3, ...)) or set Mesh.SaveAll = 1",
+                mesh.kind.name()
+            ),
+        });
     }
     for p in &mut mesh.points {
         p[2] = 0.0;
     }
     Ok(())
+}
+
+/// The unit normal of the plane all `points` lie in (within 1e-9 of their extent), `None`
+/// where they do not lie in one.
+fn plane_normal(points: &[[f64; 3]]) -> Option<[f64; 3]> {
+    let sub = |a: &[f64; 3], b: &[f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let o = points.first()?;
+    let extent = points
+        .iter()
+        .map(|p| dot(&sub(p, o), &sub(p, o)).sqrt())
+        .fold(0.0, f64::max);
+    // the largest normal of a triangle (o, a, b) over the points: the best conditioned plane
+    let far = points
+        .iter()
+        .max_by(|a, b| dot(&sub(a, o), &sub(a, o)).total_cmp(&dot(&sub(b, o), &sub(b, o))))?;
+    let u = sub(far, o);
+    let cross = |v: &[f64; 3]| {
+        [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ]
+    };
+    let normal = points
+        .iter()
+        .map(|p| cross(&sub(p, o)))
+        .max_by(|a, b| dot(a, a).total_cmp(&dot(b, b)))?;
+    let size = dot(&normal, &normal).sqrt();
+    if !(size > 0.0) || !(extent > 0.0) {
+        return None;
+    }
+    let n = normal.map(|c| c / size);
+    let flat = points.iter().all(|p| dot(&sub(p, o), &n).abs() <= 1e-9 * extent);
+    flat.then_some(n)
 }
 
 /// Turns round every cell of `first..last` when all of them are negatively oriented; returns
