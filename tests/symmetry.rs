@@ -68,6 +68,7 @@ fn mirrored(m: &Mesh, plane: f64) -> Mesh {
         boundaries,
         regions: [("body".to_string(), (0..n_cells).collect())].into(),
         reoriented_cells: 0,
+        other_groups: Default::default(),
     };
     mesh.check().expect("the mirrored mesh is a mesh");
     mesh

@@ -74,6 +74,7 @@ fn rectangle(lo: [f64; 2], hi: [f64; 2], nx: usize, ny: usize, kind: CellKind, c
         boundaries,
         regions,
         reoriented_cells: 0,
+        other_groups: Default::default(),
     }
 }
 

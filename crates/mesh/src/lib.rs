@@ -193,6 +193,10 @@ pub struct Mesh {
     pub regions: BTreeMap<String, Vec<usize>>,
     /// Cells the reader turned round (a 2D block written clockwise); 0 for a generated mesh.
     pub reoriented_cells: usize,
+    /// A file's named groups that are neither regions nor boundary groups (points, or curves
+    /// of a 3D mesh), with their dimension: unused, kept to name them where one is asked for
+    /// as a boundary group or a region.
+    pub other_groups: BTreeMap<String, usize>,
 }
 
 /// What can go wrong with a mesh: reading it, checking it, or asking it for a group.
@@ -200,20 +204,25 @@ pub struct Mesh {
 #[non_exhaustive]
 pub enum MeshError {
     /// A boundary group was asked for that the mesh does not have.
-    #[error("boundary group `{name}` is missing (the mesh has: {available})")]
+    #[error("boundary group `{name}` is missing (the mesh has: {available}){elsewhere}")]
     MissingBoundary {
         /// The group asked for.
         name: String,
         /// The groups the mesh has, comma-separated.
         available: String,
+        /// What a group of that name is where the mesh has one of another kind (`: it is a
+        /// region, a group of cells`), or empty.
+        elsewhere: String,
     },
     /// A region was asked for that the mesh does not have.
-    #[error("region `{name}` is missing (the mesh has: {available})")]
+    #[error("region `{name}` is missing (the mesh has: {available}){elsewhere}")]
     MissingRegion {
         /// The region asked for.
         name: String,
         /// The regions the mesh has, comma-separated.
         available: String,
+        /// What a group of that name is where the mesh has one of another kind, or empty.
+        elsewhere: String,
     },
     /// A cell whose signed measure is zero (up to round-off) or has the wrong sign.
     #[error("cell {cell} is {what} (signed {measure_name} {measure:.3e}, nodes {nodes:?})")]
@@ -331,6 +340,7 @@ impl Mesh {
             boundaries: BTreeMap::new(),
             regions: BTreeMap::new(),
             reoriented_cells: 0,
+            other_groups: Default::default(),
         }
     }
 
@@ -360,7 +370,36 @@ impl Mesh {
         self.boundaries.get(name).ok_or_else(|| MeshError::MissingBoundary {
             name: name.to_string(),
             available: join_keys(self.boundaries.keys()),
+            elsewhere: self.group_elsewhere(name),
         })
+    }
+
+    /// What the mesh's group `name` is where it is not the kind asked for: `": `name` is a
+    /// region ..."`, or empty where the mesh has no group of that name.
+    fn group_elsewhere(&self, name: &str) -> String {
+        let facets = if self.dim == 3 { "surfaces" } else { "curves" };
+        if self.regions.contains_key(name) && self.boundaries.contains_key(name) {
+            String::new()
+        } else if self.regions.contains_key(name) {
+            format!(
+                "; `{name}` is a region (a group of the body's {}D cells): a boundary group is one of {facets}",
+                self.dim
+            )
+        } else if self.boundaries.contains_key(name) {
+            format!(
+                "; `{name}` is a boundary group (of {facets}): a region is a group of the body's {}D cells",
+                self.dim
+            )
+        } else if let Some(d) = self.other_groups.get(name) {
+            let what = ["points", "curves", "surfaces"].get(*d).copied().unwrap_or("entities");
+            format!(
+                "; the file's `{name}` is a group of {what} (dimension {d}), which a {}D mesh does not use: \
+                 a boundary group is one of {facets}, a region one of {}D cells",
+                self.dim, self.dim
+            )
+        } else {
+            String::new()
+        }
     }
     /// The region `name`, or a [`MeshError::MissingRegion`] that lists what exists.
     pub fn region(&self, name: &str) -> Result<&[usize], MeshError> {
@@ -370,6 +409,7 @@ impl Mesh {
             .ok_or_else(|| MeshError::MissingRegion {
                 name: name.to_string(),
                 available: join_keys(self.regions.keys()),
+                elsewhere: self.group_elsewhere(name),
             })
     }
     /// The facets of group `name` all of whose nodes satisfy `keep(x)` (for example the part

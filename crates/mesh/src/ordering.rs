@@ -92,6 +92,7 @@ impl Mesh {
             boundaries: Default::default(),
             regions: Default::default(),
             reoriented_cells: 0,
+            other_groups: Default::default(),
         };
         let corner_order = nested_dissection(&linear.points, &linear.node_graph());
         let mut position = vec![0; corner_nodes.len()];

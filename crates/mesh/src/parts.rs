@@ -130,6 +130,7 @@ impl Mesh {
             boundaries: groups,
             regions,
             reoriented_cells,
+            other_groups: Default::default(),
         };
         mesh.check()?;
         Ok(mesh)

@@ -324,6 +324,7 @@ impl Nodes {
                 boundaries,
                 regions,
                 reoriented_cells: 0,
+                other_groups: Default::default(),
             },
             own_cells,
             cell_rank: cells.rank,

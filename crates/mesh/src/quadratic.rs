@@ -91,6 +91,7 @@ impl Mesh {
             boundaries,
             regions: self.regions.clone(),
             reoriented_cells: self.reoriented_cells,
+            other_groups: self.other_groups.clone(),
         })
     }
 }

@@ -355,3 +355,24 @@ fn a_flat_mesh_off_the_xy_plane_is_named_so() {
     let plane = e.contains("[0.000, -1.000, 0.000]") || e.contains("[0.000, 1.000, 0.000]");
     assert!(e.contains("draw the 2D body in the x-y plane") && plane, "{e}");
 }
+
+/// A group asked for as a boundary group that the mesh has as something else (a region, or
+/// a file's group of points or of curves in 3D, which the mesh does not use) is named so.
+#[test]
+fn a_group_of_another_kind_is_named_where_it_is_asked_for() {
+    let text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n\
+        $PhysicalNames\n3\n0 1 \"corner\"\n1 2 \"bottom\"\n2 3 \"body\"\n$EndPhysicalNames\n\
+        $Entities\n1 1 1 0\n1 0 0 0 1 1\n1 0 0 0 1 0 0 1 2 0\n1 0 0 0 1 1 0 1 3 0\n$EndEntities\n\
+        $Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n$EndNodes\n\
+        $Elements\n3 4 1 4\n0 1 15 1\n1 1\n1 1 1 1\n2 1 2\n2 1 2 2\n3 1 2 3\n4 1 3 4\n$EndElements\n";
+    let m = read_msh_bytes(text.as_bytes(), "square.msh").unwrap();
+    assert!(m.boundary("bottom").is_ok());
+    let e = m.boundary("corner").unwrap_err().to_string();
+    assert!(e.contains("`corner` is a group of points (dimension 0)"), "{e}");
+    let e = m.boundary("body").unwrap_err().to_string();
+    assert!(e.contains("`body` is a region"), "{e}");
+    let e = m.region("bottom").unwrap_err().to_string();
+    assert!(e.contains("`bottom` is a boundary group"), "{e}");
+    let e = m.boundary("nothing").unwrap_err().to_string();
+    assert!(e.ends_with("(the mesh has: bottom)"), "{e}");
+}

@@ -259,6 +259,7 @@ impl PieceSolution {
             .into(),
             regions: Default::default(),
             reoriented_cells: 0,
+            other_groups: Default::default(),
         };
         Ok(Some((mesh, u, phi)))
     }

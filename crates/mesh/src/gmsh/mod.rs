@@ -200,10 +200,21 @@ fn build(file: &File, ghosts: bool) -> Result<Mesh, String> {
         kind,
         points: coords,
         cells,
+        other_groups: other_groups(file, dim),
         boundaries: facets,
         regions,
         reoriented_cells: reoriented,
     })
+}
+
+/// The file's named groups below the facets' dimension (points, curves of a 3D mesh), with
+/// their dimension ([`Mesh::other_groups`]).
+fn other_groups(file: &File, dim: i32) -> BTreeMap<String, usize> {
+    file.names
+        .iter()
+        .filter(|((d, _), _)| *d < dim - 1)
+        .map(|((d, _), name)| (name.clone(), *d as usize))
+        .collect()
 }
 
 /// The index of node tag `tag`, named by element `elem` where the file lacks it.

@@ -341,6 +341,7 @@ impl MshPart {
             boundaries,
             regions,
             reoriented_cells: self.mesh.reoriented_cells,
+            other_groups: self.mesh.other_groups.clone(),
         };
         Ok(MeshPiece {
             mesh,

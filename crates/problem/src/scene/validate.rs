@@ -154,7 +154,13 @@ impl Scene {
         }
         self.check_units()?;
         for d in &self.dirichlet {
-            let scalars = [("ux", d.ux), ("uy", d.uy), ("uz", d.uz), ("phi", d.phi), ("charge", d.charge)];
+            let scalars = [
+                ("ux", d.ux),
+                ("uy", d.uy),
+                ("uz", d.uz),
+                ("phi", d.phi),
+                ("charge", d.charge),
+            ];
             all_finite("dirichlet.u", d.u.as_deref().unwrap_or_default()).map_err(|e| on_group(e, &d.group))?;
             for (name, v) in scalars {
                 v.map_or(Ok(()), |v| finite(&format!("dirichlet.{name}"), v))
