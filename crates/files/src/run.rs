@@ -150,6 +150,7 @@ pub fn run(scene: &Scene, source: &Source, dir: &Path, reporter: &mut dyn Report
     if scene.path.is_some() {
         return run_path(scene, source, dir, reporter);
     }
+    output::check_target(dir)?;
     let solution = solve(scene, source, reporter)?;
     output::write(&solution, dir)?;
     Ok(solution)

@@ -46,6 +46,7 @@ pub fn run_on(
     let mut silent = problem::Silent;
     let reporter: &mut dyn Reporter = if petsc.rank() == 0 { reporter } else { &mut silent };
     let (memory_bytes, memory_limit) = agreed_limits(petsc, memory)?;
+    writable_output(petsc, dir)?;
     let limits = problem::Limits {
         memory_bytes,
         memory_limit,
@@ -176,6 +177,26 @@ fn driver_error(e: distributed::DistributedError) -> DriverError {
 /// memory at its own moment, its own `ulimit`), and a run that one rank refused by its estimate
 /// while the others went on would leave them waiting in their next collective call. The limit's
 /// name is this rank's where its own is the least, else another rank's.
+/// Whether rank 0, which writes the outputs, can write them into `dir`, asked before the run
+/// ([`output::check_target`]) and agreed: every rank stops where it cannot (rank 0 with the
+/// reason), none goes on alone into the run's collective steps.
+fn writable_output(petsc: &petsc::Petsc, dir: &Path) -> Result<(), DriverError> {
+    let mine = if petsc.rank() == 0 {
+        output::check_target(dir).err()
+    } else {
+        None
+    };
+    let refused = petsc.all_gather(u64::from(mine.is_some()))?;
+    match (mine, refused.first()) {
+        (Some(e), _) => Err(e.into()),
+        (None, Some(1)) => Err(DriverError::Usage(format!(
+            "rank 0 cannot write the outputs into {} (its message says why)",
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 fn agreed_limits(
     petsc: &petsc::Petsc,
     (bytes, limit): (Option<u64>, Option<&'static str>),

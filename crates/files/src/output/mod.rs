@@ -9,7 +9,7 @@ mod set;
 mod vtu;
 
 pub use frames::{pvd, PathFiles};
-pub use set::{abandon_and_exit, Outputs, SetWriter, Staged};
+pub use set::{abandon_and_exit, check_target, Outputs, SetWriter, Staged};
 
 use crate::plots::{self, Mark, Panel, Series};
 use crate::Error;

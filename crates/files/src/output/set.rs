@@ -171,6 +171,28 @@ impl Outputs {
     }
 }
 
+/// Whether a run's outputs can go to `dir`, asked before the run (which may take hours) rather
+/// than at its end: `dir` is a directory or nothing yet ([`check_dir`]), and the nearest of it
+/// and its ancestors that exists is a directory in which a directory can be made (one is made
+/// and removed: a read-only or special file system refuses it). Nothing is left behind.
+///
+/// # Errors
+/// [`Error::OutputConflict`] where `dir` or an ancestor is a file; [`Error::Output`] where no
+/// directory can be made there.
+pub fn check_target(dir: &Path) -> Result<(), Error> {
+    let absolute = std::path::absolute(dir).map_err(|e| io("cannot resolve", dir, e))?;
+    let Some(existing) = absolute.ancestors().find(|a| std::fs::symlink_metadata(a).is_ok()) else {
+        return Ok(());
+    };
+    if existing != absolute && !existing.is_dir() {
+        return Err(conflict(existing, "is not a directory (it is on the way to --out)"));
+    }
+    check_dir(dir)?;
+    let probe = existing.join(format!(".piezocontact-probe-{}", std::process::id()));
+    std::fs::create_dir(&probe).map_err(|e| io("cannot create", &absolute.join(".piezocontact"), e))?;
+    std::fs::remove_dir(&probe).map_err(|e| io("cannot remove", &probe, e))
+}
+
 /// An output directory: a directory, or nothing yet (a link to nothing is refused).
 fn check_dir(dir: &Path) -> Result<(), Error> {
     match std::fs::metadata(dir) {
@@ -734,6 +756,30 @@ mod tests {
             o.add(name, text.as_bytes().to_vec());
         }
         o.commit()
+    }
+
+    /// The target is checked before a run: a file where the directory goes, or on the way to
+    /// it, is refused by name; a fresh nested directory passes, and nothing is left behind.
+    #[test]
+    fn the_target_is_checked_before_the_run_and_nothing_is_left() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("a-file");
+        std::fs::write(&file, "mine").unwrap();
+        let e = check_target(&file).unwrap_err().to_string();
+        assert!(e.contains("a-file is not a directory"), "{e}");
+        let e = check_target(&file.join("sub")).unwrap_err().to_string();
+        assert!(
+            e.contains("a-file is not a directory (it is on the way to --out)"),
+            "{e}"
+        );
+        check_target(&dir.path().join("new").join("deeper")).unwrap();
+        check_target(dir.path()).unwrap();
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["a-file"]);
     }
 
     /// The visible names of `dir` (the hidden directory aside).
