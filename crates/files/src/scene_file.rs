@@ -261,6 +261,9 @@ fn override_key(o: &str) -> &str {
     }
 }
 
+/// The sections a scene holds as one table or as an array of tables.
+const ONE_OR_MANY: [&str; 3] = ["contact", "electrode", "load"];
+
 /// Sets the dotted `key` of the tree to `value`, or removes it where `value` is `None`;
 /// the tables on the way are made where missing, and a table array of one table (a scene's
 /// one `[[material]]`) is entered as that table. A relative `mesh.file` is made absolute
@@ -284,6 +287,22 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
         let entry = table
             .entry(part.to_string())
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        // a section a scene holds as one table or as an array of tables (`[contact]` or
+        // `[[contact]]`), named by an index: the one table is the array's first (`contact.0.gap`
+        // on a scene of one `[contact]`), and one past it a new one (`contact.1.group` adds a
+        // second zone), as in an array
+        let index = parts.peek().copied().unwrap_or(last).parse::<usize>().is_ok();
+        if let toml::Value::Table(t) = entry {
+            if index && walked == *part && ONE_OR_MANY.contains(&part.as_str()) {
+                let one = std::mem::take(t);
+                let tables = if one.is_empty() {
+                    vec![]
+                } else {
+                    vec![toml::Value::Table(one)]
+                };
+                *entry = toml::Value::Array(tables);
+            }
+        }
         table = match entry {
             toml::Value::Table(t) => t,
             toml::Value::Array(a) => {
@@ -319,10 +338,20 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
                     Some(toml::Value::Table(t)) => t,
                     Some(_) => return Err(format!("`{walked}` is not a table")),
                     None => {
-                        return Err(format!(
-                            "`{walked}` is beyond the {n} tables of `{part}` (indices 0 to {})",
-                            n.saturating_sub(1)
-                        ))
+                        return Err(match n {
+                            0 => {
+                                format!(
+                                    "`{walked}` is beyond the tables of `{part}` (it has none: add one as `{part}.0`)"
+                                )
+                            }
+                            1 => format!(
+                                "`{walked}` is beyond the one table of `{part}` (index 0; `{part}.1` adds a second)"
+                            ),
+                            n => format!(
+                            "`{walked}` is beyond the {n} tables of `{part}` (indices 0 to {}; `{part}.{n}` adds one)",
+                            n - 1
+                        ),
+                        })
                     }
                 }
             }
@@ -572,6 +601,33 @@ mod tests {
                 "103rd".into()
             )
         );
+    }
+
+    /// A section a scene holds as one table (`[contact]`) is named by index as an array's
+    /// tables are: index 0 is the table, 1 adds a second, beyond is refused; a section the scene
+    /// lacks takes its first table at index 0.
+    #[test]
+    fn one_table_is_named_by_index_as_an_array_is() {
+        let (s, _) = load("paper", &["contact.0.friction=0.3".into()]).unwrap();
+        assert_eq!(s.contacts().len(), 1);
+        assert_eq!(s.first_contact().unwrap().friction(), 0.3);
+        let second = [
+            "contact.1.group=\"top\"",
+            "contact.1.law=\"signorini\"",
+            "contact.1.normal=[0.0, 1.0]",
+        ];
+        let (s, _) = load("paper", &second.map(String::from)).unwrap();
+        assert_eq!(s.contacts().len(), 2);
+        assert_eq!(s.contacts()[1].group, "top");
+        let e = load("paper", &["contact.2.gap=0.0".into()]).unwrap_err().to_string();
+        assert!(e.contains("`contact.2` is beyond the one table of `contact`"), "{e}");
+        let sets = ["electrode.0.group=\"top\"".into(), "electrode.0.v=0.0".into()];
+        let (s, _) = load("sensor", &sets).unwrap();
+        assert_eq!(s.electrodes().len(), 1);
+        let e = load("sensor", &["electrode.1.group=\"top\"".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("it has none: add one as `electrode.0`"), "{e}");
     }
 
     /// A table given where the scene has an array of tables is refused with the three ways
