@@ -98,7 +98,9 @@ class Scene:
         removes a key. A key named twice in one call (a dict and a keyword, a table and one of
         its keys) is an InputError."""
     def get(self, key: str, default: Any = None) -> Any:
-        """The value of a dotted key (`scene.get("mesh.n")`), or `default`."""
+        """The value of a dotted key (`scene.get("mesh.n")`, `scene.get("contact.1.gap")`: read
+        as `set` writes it), or `default` where the scene does not set it; an InputError for a
+        key that does not say which of several tables it means (`contact.gap` with two zones)."""
     def set_mesh(
         self,
         points: npt.ArrayLike,

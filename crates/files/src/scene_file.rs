@@ -261,6 +261,50 @@ fn override_key(o: &str) -> &str {
     }
 }
 
+/// The value of the dotted `key` in the tree, read as [`set`] writes it: an array of tables
+/// entered by a 0-based index (`contact.1.gap`, `contact[1].gap`) or as its one table
+/// (`material.young`), a section written as one table by index 0 too (`contact.0.gap` on a
+/// scene of one `[contact]`). `Ok(None)` where the tree holds no such key.
+///
+/// # Errors
+/// A key that is no dotted key; a key that enters an array of several tables without an
+/// index (which of them is meant is not said).
+pub fn get<'t>(tree: &'t toml::Table, key: &str) -> Result<Option<&'t toml::Value>, String> {
+    let path = key_path(key)?;
+    let Some((first, rest)) = path.split_first() else {
+        return Err("an empty key".into());
+    };
+    let Some(mut at) = tree.get(first) else {
+        return Ok(None);
+    };
+    let mut walked = first.clone();
+    for part in rest {
+        let index = part.parse::<usize>().ok();
+        let next = match (at, index) {
+            (toml::Value::Array(a), Some(i)) => a.get(i),
+            (toml::Value::Array(a), None) => match &a[..] {
+                [toml::Value::Table(t)] => t.get(part),
+                tables if tables.iter().all(toml::Value::is_table) => {
+                    return Err(format!(
+                        "`{walked}` holds {} tables: name one by its 0-based index, as `{walked}.0.{part}`",
+                        tables.len()
+                    ))
+                }
+                _ => None,
+            },
+            (toml::Value::Table(t), _) if t.contains_key(part) => t.get(part),
+            (toml::Value::Table(_), Some(0)) => Some(at),
+            _ => None,
+        };
+        let Some(next) = next else {
+            return Ok(None);
+        };
+        at = next;
+        walked = format!("{walked}.{part}");
+    }
+    Ok(Some(at))
+}
+
 /// The sections a scene holds as one table or as an array of tables.
 const ONE_OR_MANY: [&str; 3] = ["contact", "electrode", "load"];
 
@@ -412,11 +456,20 @@ fn set_table(a: &mut Vec<toml::Value>, i: usize, value: Option<toml::Value>, key
 }
 
 /// Whether two dotted keys of one change would overwrite each other: the same key
-/// (`dirichlet[1].phi` is `dirichlet.1.phi`), one a table that holds the other (`mesh` and
+/// (`dirichlet[1].phi` is `dirichlet.1.phi`; `material.young` is `material.0.young`, the one
+/// table of an array being entered either way), one a table that holds the other (`mesh` and
 /// `mesh.n`), or two ways to give one quantity (`mesh.n` and `mesh.h`). A key that is no
 /// dotted key overlaps nothing (its own error comes when it is set).
 pub fn keys_overlap(a: &str, b: &str) -> bool {
-    let (Ok(a), Ok(b)) = (key_path(a), key_path(b)) else {
+    // an index 0 names what the key without it names where the array holds one table
+    let first_table = |p: Vec<String>| -> Vec<String> {
+        p.into_iter()
+            .enumerate()
+            .filter(|(k, part)| *k == 0 || part != "0")
+            .map(|(_, part)| part)
+            .collect()
+    };
+    let (Ok(a), Ok(b)) = (key_path(a).map(first_table), key_path(b).map(first_table)) else {
         return false;
     };
     let within = |outer: &[String], inner: &[String]| inner.starts_with(outer);
@@ -503,6 +556,9 @@ mod tests {
             ("mesh.n", "mesh.h"),
             ("dirichlet[1].phi", "dirichlet.1.phi"),
             ("contact", "contact.1.gap"),
+            ("material.young", "material.0.young"),
+            ("contact.0.friction", "contact.friction"),
+            ("contact[0].gap", "contact.gap"),
         ] {
             assert!(keys_overlap(a, b) && keys_overlap(b, a), "{a} {b}");
         }
@@ -510,6 +566,7 @@ mod tests {
             ("mesh.n", "mesh.nx"),
             ("mesh.n", "load.p"),
             ("dirichlet.0.phi", "dirichlet.1.phi"),
+            ("contact.1.gap", "contact.gap"),
             ("mesh.", "mesh.n"),
         ] {
             assert!(!keys_overlap(a, b), "{a} {b}");
@@ -628,6 +685,31 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("it has none: add one as `electrode.0`"), "{e}");
+    }
+
+    /// A key is read as it is set: by index in an array of tables, the one table of an array
+    /// or of a section written as one table with or without index 0; an array of several
+    /// tables entered without an index is an error, not an absent key.
+    #[test]
+    fn keys_are_read_as_they_are_set() {
+        let text =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/corner.toml")).unwrap();
+        let corner: toml::Table = text.parse().unwrap();
+        let value = |key: &str| get(&corner, key).unwrap().cloned();
+        assert_eq!(value("contact.1.group"), Some(toml::Value::String("top".into())));
+        assert_eq!(value("contact[0].group"), Some(toml::Value::String("right".into())));
+        assert_eq!(value("material.model"), value("material.0.model"));
+        assert!(value("material.model").is_some());
+        assert_eq!(value("contact.2.group"), None);
+        assert_eq!(value("mesh.nothing"), None);
+        let e = get(&corner, "contact.group").unwrap_err();
+        assert!(e.contains("`contact` holds 2 tables"), "{e}");
+        let text =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper.toml")).unwrap();
+        let paper: toml::Table = text.parse().unwrap();
+        let friction = get(&paper, "contact.friction").unwrap().cloned();
+        assert_eq!(get(&paper, "contact.0.friction").unwrap().cloned(), friction);
+        assert!(friction.is_some());
     }
 
     /// A table given where the scene has an array of tables is refused with the three ways

@@ -325,8 +325,9 @@ impl Scene {
         Ok(())
     }
 
-    /// The value of a dotted key (`scene.get("mesh.n")`), or `default` where the scene does not
-    /// set it.
+    /// The value of a dotted key (`scene.get("mesh.n")`, `scene.get("contact.1.gap")`: read as
+    /// `set` writes it), or `default` where the scene does not set it; an `InputError` for a key
+    /// that does not say which of several tables it means (`contact.gap` with two zones).
     #[pyo3(signature = (key, default = None))]
     fn get<'py>(
         &self,
@@ -334,19 +335,11 @@ impl Scene {
         key: &str,
         default: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let mut at = toml::Value::Table(self.tree.clone());
-        for part in key.split('.') {
-            let next = match &at {
-                toml::Value::Table(t) => t.get(part).cloned(),
-                toml::Value::Array(a) if a.len() == 1 => a[0].as_table().and_then(|t| t.get(part).cloned()),
-                _ => None,
-            };
-            match next {
-                Some(v) => at = v,
-                None => return Ok(default),
-            }
+        let found = scene_file::get(&self.tree, key).map_err(|m| Kind::Input.err(format!("get(\"{key}\"): {m}")))?;
+        match found {
+            Some(v) => from_toml(py, v).map(Some),
+            None => Ok(default),
         }
-        from_toml(py, &at).map(Some)
     }
 
     /// Gives the scene a mesh as arrays (`mesh.kind` becomes `"given"`): `points` (n, 2) or (n,

@@ -39,6 +39,9 @@ def test_a_mesh_given_as_arrays_keeps_the_body_of_revolution():
         lambda s: s.set(contact={"friction": 0.3}, contact__friction=0.2),
         lambda s: s.set({"mesh.n": 8}, mesh__h=0.125),
         lambda s: s.set({"dirichlet[0].phi": 0.0, "dirichlet.0.phi": 0.1}),
+        # the one table of an array (or of a section written as one table) by index or without
+        lambda s: s.set({"material.0.poling": [0.0, 1.0, 0.0]}, material__poling=[1.0, 0.0, 0.0]),
+        lambda s: s.set({"contact.0.friction": 0.3}, contact__friction=0.2),
     ],
 )
 def test_one_key_twice_in_one_call_is_refused(call):
@@ -53,3 +56,18 @@ def test_distinct_keys_in_one_call_are_all_set():
     s = pc.Scene.load("paper", {"mesh.n": 4})
     s.set({"mesh.n": 8}, contact__friction=0.3, solver={"tol": 1e-9})
     assert (s.get("mesh.n"), s.get("contact.friction"), s.get("solver.tol")) == (8, 0.3, 1e-9)
+
+
+def test_a_key_is_read_as_it_is_set():
+    # by index in an array of tables (it read None: the value there looked unset)
+    corner = pc.Scene.load("corner")
+    assert corner.get("contact.1.group") == "top" and corner.get("contact[0].group") == "right"
+    assert corner.get("material.0.model") == corner.get("material.model") == "crystal-6mm"
+    assert corner.get("contact.2.group") is None and corner.get("contact.2.group", 7) == 7
+    with pytest.raises(pc.InputError, match="holds 2 tables"):
+        corner.get("contact.group")
+    # a section written as one table, by index 0 too, before and after a change by index
+    paper = pc.Scene.load("paper")
+    assert paper.get("contact.0.friction") == paper.get("contact.friction") == 0.6
+    paper.set({"contact.0.friction": 0.3})
+    assert paper.get("contact.0.friction") == paper.get("contact.friction") == 0.3
