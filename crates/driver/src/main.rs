@@ -26,7 +26,7 @@ enum Command {
     Run {
         /// Scene name or file.
         scene: Option<String>,
-        /// Override a scene key, e.g. --set mesh.n=128 (repeatable; `--set ~KEY` removes a key).
+        /// Override a scene key, e.g. --set mesh.n=128 (repeatable, applied in order: a key set twice keeps the last; `--set ~KEY` removes a key).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// Remove a scene key, e.g. --unset contact.friction (repeatable).

@@ -336,16 +336,8 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
         // on a scene of one `[contact]`), and one past it a new one (`contact.1.group` adds a
         // second zone), as in an array
         let index = parts.peek().copied().unwrap_or(last).parse::<usize>().is_ok();
-        if let toml::Value::Table(t) = entry {
-            if index && walked == *part && ONE_OR_MANY.contains(&part.as_str()) {
-                let one = std::mem::take(t);
-                let tables = if one.is_empty() {
-                    vec![]
-                } else {
-                    vec![toml::Value::Table(one)]
-                };
-                *entry = toml::Value::Array(tables);
-            }
+        if index && walked == *part && ONE_OR_MANY.contains(&part.as_str()) {
+            one_table_as_array(entry);
         }
         table = match entry {
             toml::Value::Table(t) => t,
@@ -381,27 +373,19 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
                 match a.get_mut(at) {
                     Some(toml::Value::Table(t)) => t,
                     Some(_) => return Err(format!("`{walked}` is not a table")),
-                    None => {
-                        return Err(match n {
-                            0 => {
-                                format!(
-                                    "`{walked}` is beyond the tables of `{part}` (it has none: add one as `{part}.0`)"
-                                )
-                            }
-                            1 => format!(
-                                "`{walked}` is beyond the one table of `{part}` (index 0; `{part}.1` adds a second)"
-                            ),
-                            n => format!(
-                            "`{walked}` is beyond the {n} tables of `{part}` (indices 0 to {}; `{part}.{n}` adds one)",
-                            n - 1
-                        ),
-                        })
-                    }
+                    None => return Err(beyond(&walked, part, n)),
                 }
             }
             _ => return Err(format!("`{walked}` is not a table")),
         };
     }
+    put(table, key, &path, value)
+}
+
+/// Sets `path`'s last key (the dotted `key`) in `table`, its parent, to `value`, or removes it
+/// ([`set`]).
+fn put(table: &mut toml::Table, key: &str, path: &[String], value: Option<toml::Value>) -> Result<(), String> {
+    let last = path.last().ok_or("an empty key")?;
     match value {
         Some(toml::Value::String(file)) if key.trim() == "mesh.file" && Path::new(&file).is_relative() => {
             let typed_here = std::env::current_dir().map_or_else(|_| PathBuf::from(&file), |d| d.join(&file));
@@ -418,7 +402,7 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
                 }
             }
             // mesh.h and mesh.n are two ways to give one size: the one set replaces the other
-            if let Some(other) = alternative(&path) {
+            if let Some(other) = alternative(path) {
                 table.remove(other);
             }
             table.insert(last.to_string(), v);
@@ -430,6 +414,32 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
         }
     }
     Ok(())
+}
+
+/// A section written as one table made an array of that one table (of none where the table
+/// is empty: a section the scene lacks, made on the way).
+fn one_table_as_array(entry: &mut toml::Value) {
+    if let toml::Value::Table(t) = entry {
+        let one = std::mem::take(t);
+        let tables = if one.is_empty() {
+            vec![]
+        } else {
+            vec![toml::Value::Table(one)]
+        };
+        *entry = toml::Value::Array(tables);
+    }
+}
+
+/// The message for `walked`, an index past one beyond the `n` tables of `part`.
+fn beyond(walked: &str, part: &str, n: usize) -> String {
+    match n {
+        0 => format!("`{walked}` is beyond the tables of `{part}` (it has none: add one as `{part}.0`)"),
+        1 => format!("`{walked}` is beyond the one table of `{part}` (index 0; `{part}.1` adds a second)"),
+        n => format!(
+            "`{walked}` is beyond the {n} tables of `{part}` (indices 0 to {}; `{part}.{n}` adds one)",
+            n - 1
+        ),
+    }
 }
 
 /// Removes (`value` `None`) or replaces the table at `i` of an array of tables; one past the
