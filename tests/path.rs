@@ -132,28 +132,26 @@ fn the_first_instant_is_the_static_solve() {
     assert!(d <= 1e-9 * ls.norm(), "{d}");
 }
 
-/// The answer at the end of the cycle converges in the number of steps: with instants on the
-/// turns (6, 12, 48 steps) backward Euler is exact on each monotone leg (the slip zones only
-/// grow: the same answer to round-off); with steps that straddle a turn (7, 13, 25) it
-/// converges as the straddling step shrinks.
+/// The answer at the end of the cycle does not depend on the number of steps: every step
+/// count puts instants on the turns (the steps are shared over the legs, each at least one),
+/// and backward Euler is exact on each monotone leg (the slip zones only grow), so 6, 7, 12,
+/// 13, 48 and 49 steps give one answer to round-off. (Evenly spaced over the whole cycle, 7,
+/// 13 and 49 steps straddled the turns: the answer then only converged to this one as the
+/// straddling step shrank.)
 #[test]
-fn the_end_of_the_cycle_converges_in_the_steps() {
+fn the_end_of_the_cycle_does_not_depend_on_the_steps() {
     let end = |steps: usize| {
         let sets = ["mesh.n=24".to_string(), format!("path.steps={steps}")];
         let (scene, _) = scene_file::load("cattaneo-mindlin-cycle", &sets).unwrap();
         let path = problem::solve_path(&scene, None, Limits::default(), &mut Silent, false, &mut |_| Ok(())).unwrap();
         path.last.contact.unwrap().solution.lambda
     };
-    let (l6, l12, l48) = (end(6), end(12), end(48));
+    let l48 = end(48);
     let scale = l48.norm();
-    assert!(l6.minus(&l48).norm() <= 1e-10 * scale && l12.minus(&l48).norm() <= 1e-10 * scale);
-    let (d1, d2, d3) = (
-        l6.minus(&end(7)).norm() / scale,
-        l12.minus(&end(13)).norm() / scale,
-        l48.minus(&end(49)).norm() / scale,
-    );
-    eprintln!("relative distance to the answer on the turns: 7 steps {d1:.3e}, 13 {d2:.3e}, 49 {d3:.3e}");
-    assert!(d3 < d2 && d2 < d1 && d1 > 1e-6, "{d1} {d2} {d3}");
+    for steps in [6, 7, 12, 13, 49] {
+        let d = end(steps).minus(&l48).norm() / scale;
+        assert!(d <= 1e-10, "{steps} steps: {d:e} from 48 steps'");
+    }
 }
 
 /// What a path cannot carry is refused by key, before anything is computed.

@@ -348,15 +348,16 @@ pub struct Scene {
 
 /// A quasi-static load path (`[path]`): instants `t` and, per quantity, its factor at each
 /// instant (piecewise linear between them; a quantity without a table keeps factor 1). The
-/// run solves at `t[0]` from rest and then at `steps` instants evenly spaced up to the last
-/// `t`, each step with the friction law on the slip since the step before (backward Euler of
-/// the quasi-static law).
+/// run solves at `t[0]` from rest and then at `steps` instants up to the last `t`, every
+/// instant of `t` among them ([`PathSpec::instants`]), each step with the friction law on the
+/// slip since the step before (backward Euler of the quasi-static law).
 #[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PathSpec {
     /// The instants, strictly increasing (at least two).
     pub t: Vec<f64>,
-    /// Steps after `t[0]` (default: one per later instant of `t`).
+    /// Steps after `t[0]` (default: one per later instant of `t`), shared out over the legs
+    /// between the instants of `t` by their durations, at least one each.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub steps: Option<usize>,
     /// The factor on the load (`load.p`, every `[[load]]`, and an indenter's force under force
@@ -423,29 +424,48 @@ impl Factors {
 }
 
 impl PathSpec {
-    /// The number of steps after `t[0]`.
-    pub fn n_steps(&self) -> usize {
-        self.steps.unwrap_or(self.t.len().saturating_sub(1))
-    }
-
-    /// The instants solved: `t[0]`, then `n_steps` evenly spaced up to the last `t`.
+    /// The instants solved: `t[0]`, then `steps` more up to the last `t`, shared out over the
+    /// legs between the instants of `t` in proportion to their durations, at least one each
+    /// and evenly spaced within a leg, so that every instant of `t` is solved (a load's turning
+    /// points are where friction's history turns: steps evenly spaced over the whole path
+    /// stepped over them, and a cycle's peak load was never reached). Without `steps`, the
+    /// instants of `t`. Validation asks for at least one step per leg.
     pub fn instants(&self) -> Vec<f64> {
-        let (t0, t1) = (self.t[0], self.t[self.t.len() - 1]);
-        let n = self.n_steps();
-        if self.steps.is_none() {
+        let Some(steps) = self.steps else {
             return self.t.clone();
-        }
-        (0..=n)
-            .map(|k| {
+        };
+        let mut out = vec![self.t[0]];
+        for (w, n) in self.t.windows(2).zip(self.leg_steps(steps)) {
+            let (a, b) = (w[0], w[1]);
+            out.extend((1..=n).map(|k| {
                 // the weighted mean: finite for any finite ends (their difference may overflow)
                 let s = k as f64 / n as f64;
                 if k == n {
-                    t1
+                    b
                 } else {
-                    (1.0 - s) * t0 + s * t1
+                    (1.0 - s) * a + s * b
                 }
-            })
-            .collect()
+            }));
+        }
+        out
+    }
+
+    /// `steps` shared out over the legs of `t`: one each, and the rest by the largest
+    /// remainders of the legs' shares of the whole duration.
+    fn leg_steps(&self, steps: usize) -> Vec<usize> {
+        // halves, so that no difference of finite instants overflows; the shares are the same
+        let durations: Vec<f64> = self.t.windows(2).map(|w| w[1] / 2.0 - w[0] / 2.0).collect();
+        let whole: f64 = durations.iter().sum();
+        let rest = steps.saturating_sub(durations.len());
+        let quotas: Vec<f64> = durations.iter().map(|d| rest as f64 * (d / whole)).collect();
+        let mut counts: Vec<usize> = quotas.iter().map(|q| 1 + (q.floor() as usize).min(rest)).collect();
+        let given: usize = counts.iter().sum::<usize>() - counts.len();
+        let mut by_remainder: Vec<usize> = (0..quotas.len()).collect();
+        by_remainder.sort_by(|&i, &j| (quotas[j] - quotas[j].floor()).total_cmp(&(quotas[i] - quotas[i].floor())));
+        for &i in by_remainder.iter().take(rest.saturating_sub(given)) {
+            counts[i] += 1;
+        }
+        counts
     }
 
     /// Every how many of `n` instants the fields are written: `output_every`, by default 1 up
@@ -2014,5 +2034,34 @@ mod tests {
             let load = path.factors(*x).load;
             assert!((load - y).abs() <= 1e-15, "{load} against {y}");
         }
+    }
+
+    /// A path's steps include every instant of `t` (a cycle's turning points: steps evenly
+    /// spaced over the whole path stepped over them), shared over the legs by their durations.
+    #[test]
+    fn a_paths_steps_include_every_given_instant() {
+        let path = |t: &[f64], steps| PathSpec {
+            t: t.to_vec(),
+            steps: Some(steps),
+            ..Default::default()
+        };
+        let cycle = [0.0, 1.0, 2.0, 3.0];
+        assert_eq!(path(&cycle, 4).instants(), [0.0, 0.5, 1.0, 2.0, 3.0]);
+        assert_eq!(path(&cycle, 3).instants(), cycle);
+        let thirty = path(&cycle, 30).instants();
+        assert_eq!(thirty.len(), 31);
+        for (k, x) in thirty.iter().enumerate() {
+            assert!((x - k as f64 / 10.0).abs() <= 1e-15 * 3.0, "{k}: {x}");
+        }
+        for given in cycle {
+            assert!(thirty.contains(&given) && path(&cycle, 7).instants().contains(&given));
+        }
+        // uneven legs: steps by duration, 10 and 20 of 30
+        let uneven = path(&[0.0, 1.0, 3.0], 30).instants();
+        assert_eq!(uneven.len(), 31);
+        assert_eq!(uneven[10], 1.0);
+        assert_eq!(path(&[0.0, 1.0, 3.0], 30).leg_steps(30), [10, 20]);
+        // a short leg keeps its step however long the others
+        assert_eq!(path(&[0.0, 1e-9, 1.0], 5).leg_steps(5), [1, 4]);
     }
 }

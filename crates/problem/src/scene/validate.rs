@@ -376,6 +376,15 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
                 format!("path.steps = {n}: give between 1 and {MAX_PATH_STEPS} steps"),
             ));
         }
+        let legs = p.t.len() - 1;
+        if n < legs {
+            return Err(SceneError::new(
+                "path.steps",
+                format!(
+                    "path.steps = {n} is fewer than the {legs} legs between the instants of path.t: every instant of path.t is solved (a turning point of the load is where friction's history turns), so give at least {legs}"
+                ),
+            ));
+        }
     }
     let applies = |given: bool, key: &str, what: &str| {
         refuse_if(
