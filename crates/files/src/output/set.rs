@@ -172,7 +172,7 @@ impl Outputs {
 }
 
 /// Whether a run's outputs can go to `dir`, asked before the run (which may take hours) rather
-/// than at its end: `dir` is a directory or nothing yet ([`check_dir`]), and the nearest of it
+/// than at its end: `dir` is a directory or nothing yet (not a link to nothing), and the nearest of it
 /// and its ancestors that exists is a directory in which a directory can be made (one is made
 /// and removed: a read-only or special file system refuses it). Nothing is left behind.
 ///
