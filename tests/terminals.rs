@@ -762,3 +762,40 @@ fn every_terminal_floated_with_its_charge_keeps_its_potential() {
     eprintln!("the round trip ran on {checked} terminals");
     assert!(checked >= 3, "the round trip ran on {checked} terminals");
 }
+
+/// An electrode given by `x_range` is the facets of its group wholly inside the range: where
+/// the mesh has no node at an end, it is shorter than asked, and the run says so (a note, and
+/// run.json's `covered_x`) instead of solving another electrode silently.
+#[test]
+fn an_electrode_narrower_than_its_range_is_noted() {
+    let solve = |n: usize| {
+        let (scene, _) = files::scene_file::load("actuator", &[format!("mesh.n={n}")]).unwrap();
+        problem::solve(&scene, None, &mut problem::Silent).unwrap()
+    };
+    let covered = |s: &problem::Solution| {
+        let t = s.report.terminals.iter().find(|t| t.group == "electrode").unwrap();
+        t.covered_x.unwrap()
+    };
+    // n = 8: nodes every 1/8 in x, on 0.25 and 1.75; n = 10: every 0.1, none there
+    let on = solve(8);
+    assert_eq!(covered(&on), [0.25, 1.75]);
+    let off = solve(10);
+    let [a, b] = covered(&off);
+    assert!((a - 0.3).abs() < 1e-12 && (b - 1.7).abs() < 1e-12, "{a} {b}");
+    let (scene, _) = files::scene_file::load("actuator", &["mesh.n=10".into()]).unwrap();
+    let valid = scene.validate().unwrap();
+    let setup = problem::backend::setup(valid, None).unwrap();
+    let narrowed = &setup.notes.narrowed_electrodes;
+    assert_eq!(narrowed.len(), 1);
+    assert_eq!(narrowed[0].asked, [0.25, 1.75]);
+    let setup = problem::backend::setup(
+        files::scene_file::load("actuator", &["mesh.n=8".into()])
+            .unwrap()
+            .0
+            .validate()
+            .unwrap(),
+        None,
+    )
+    .unwrap();
+    assert!(setup.notes.narrowed_electrodes.is_empty());
+}

@@ -21,7 +21,8 @@ pub use crate::boundary::{ContactBoundary, MAX_NORMAL_ANGLE_DEG};
 pub use crate::outer::ForceControl;
 pub use crate::plan::Plan;
 pub use crate::setup::{
-    electrode_without_facets, piece_refusal, region_without_cells, setup, setup_piece, MeshNotes, Setup,
+    electrode_without_facets, piece_refusal, region_without_cells, setup, setup_piece, x_extent, MeshNotes,
+    NarrowedElectrode, Setup,
 };
 
 /// A scene a backend does not solve: the backend, the scene key that asks for what it lacks,

@@ -392,6 +392,12 @@ fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
             n.unused_nodes
         ));
     }
+    for e in &n.narrowed_electrodes {
+        notes.push(format!(
+            "the electrode `{}` covers x in [{}, {}] of the x_range [{}, {}] asked: its facets are those wholly inside the range, and the mesh has no node at its ends (run.json: terminals' covered_x)",
+            e.name, e.covered[0], e.covered[1], e.asked[0], e.asked[1]
+        ));
+    }
     notes
 }
 

@@ -108,6 +108,10 @@ pub struct TerminalReport {
     /// A floating terminal (`dirichlet.charge`): its potential found, its charge given.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub floating: bool,
+    /// An electrode given by `x_range`: the x extent its facets cover (those of its group wholly
+    /// inside the range: less than the range where the mesh has no node at its ends).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub covered_x: Option<[f64; 2]>,
 }
 
 /// A load path's figures (`run.json`'s `path`): its steps, one row each, and what was reused.

@@ -42,7 +42,7 @@ pub(crate) fn begin<B: Backend>(
     reporter.event(&Event::Planned(&setup.plan));
     reporter.event(&Event::Units(&setup.units));
     if setup.notes != MeshNotes::default() {
-        reporter.event(&Event::MeshNotes(setup.notes));
+        reporter.event(&Event::MeshNotes(setup.notes.clone()));
     }
     Ok(setup)
 }
@@ -480,16 +480,15 @@ pub(crate) fn terminals(
     let charges = disc.charges(u, phi, &groups, &setup.loads)?;
     let mut out = vec![];
     for (group, charge) in groups.iter().zip(charges) {
-        let first = setup
-            .mesh
-            .boundary(group)
-            .map_err(fe_assembly::AssemblyError::from)?
-            .nodes();
+        let facets = setup.mesh.boundary(group).map_err(fe_assembly::AssemblyError::from)?;
+        let first = facets.nodes();
+        let ranged = setup.ranged_electrodes.iter().any(|e| e == group);
         out.push(crate::report::TerminalReport {
             group: group.to_string(),
             potential: first.first().map_or(0.0, |&v| phi[v]),
             charge,
             floating: disc.dofs.floating.iter().any(|(g, _)| g == group),
+            covered_x: ranged.then(|| crate::setup::x_extent(&setup.mesh, facets)),
         });
     }
     Ok(out)

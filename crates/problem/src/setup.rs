@@ -33,10 +33,13 @@ pub struct Setup {
     pub notes: MeshNotes,
     /// The unit of every reported quantity, from the scene's system.
     pub units: crate::Units,
+    /// The group names of the electrodes given by `electrode.x_range` (their covered extent is
+    /// reported: [`crate::report::TerminalReport::covered_x`]).
+    pub ranged_electrodes: Vec<String>,
 }
 
 /// What the mesh's checks noted without refusing it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshNotes {
     /// Cells the Gmsh reader turned round (a surface written clockwise).
     pub reoriented_cells: usize,
@@ -47,6 +50,21 @@ pub struct MeshNotes {
     /// Curved second-order cells (an edge node off its edge's midpoint), mapped through their
     /// nodes.
     pub curved_cells: usize,
+    /// Electrodes given by `x_range` whose facets cover less of it than asked (of the whole
+    /// mesh; a piece's cover only its part).
+    pub narrowed_electrodes: Vec<NarrowedElectrode>,
+}
+
+/// An electrode given by `electrode.x_range` whose facets (those of its group wholly inside the
+/// range) cover less of it than asked: the mesh has no node at an end of the range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NarrowedElectrode {
+    /// The electrode's group name (`electrode.name`).
+    pub name: String,
+    /// `x_range` as asked.
+    pub asked: [f64; 2],
+    /// The x extent its facets cover.
+    pub covered: [f64; 2],
 }
 
 /// Without electric unknowns (no coupling and no potential or charge that is not 0), what acts
@@ -152,6 +170,10 @@ fn set_up(scene: Valid<'_>, source: Source) -> Result<Setup, ProblemError> {
         false => Coordinates::Cartesian,
     };
     let units = crate::Units::of(scene, mesh.dim);
+    let ranged_electrodes = (scene.electrodes().iter().enumerate())
+        .filter(|(_, e)| e.x_range.is_some())
+        .map(|(k, e)| e.group_name(k))
+        .collect();
     Ok(Setup {
         mesh,
         coordinates,
@@ -162,6 +184,7 @@ fn set_up(scene: Valid<'_>, source: Source) -> Result<Setup, ProblemError> {
         exact,
         notes,
         units,
+        ranged_electrodes,
     })
 }
 
@@ -231,17 +254,18 @@ fn mesh(scene: &Scene, source: Source) -> Result<(mesh::Mesh, MeshNotes), Proble
         mesh::round_quarter_section(&mut mesh);
     }
     let quality = mesh.check()?;
+    for l in scene.loads() {
+        crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;
+    }
+    box_regions(&mut mesh, &m.regions, true)?;
+    let narrowed_electrodes = electrodes(&mut mesh, scene, true)?;
     let notes = MeshNotes {
         reoriented_cells: mesh.reoriented_cells,
         coincident_nodes: quality.coincident_nodes,
         unused_nodes: quality.unused_nodes,
         curved_cells: mesh.curved_cells().iter().filter(|&&c| c).count(),
+        narrowed_electrodes,
     };
-    for l in scene.loads() {
-        crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;
-    }
-    box_regions(&mut mesh, &m.regions, true)?;
-    electrodes(&mut mesh, scene, true)?;
     if m.axisymmetric {
         axis_group(&mut mesh)?;
     }
@@ -323,8 +347,10 @@ pub fn electrode_without_facets(scene: &Scene, k: usize) -> SetupError {
 }
 
 /// The electrodes' facet groups (`electrode.x_range` of `electrode.group`), each refused
-/// where it covers no facet when `whole` (a piece may cover none of an electrode).
-fn electrodes(mesh: &mut mesh::Mesh, scene: &Scene, whole: bool) -> Result<(), ProblemError> {
+/// where it covers no facet when `whole` (a piece may cover none of an electrode); the
+/// electrodes whose facets cover less of their range than asked, when `whole`.
+fn electrodes(mesh: &mut mesh::Mesh, scene: &Scene, whole: bool) -> Result<Vec<NarrowedElectrode>, ProblemError> {
+    let mut narrowed = vec![];
     for (k, e) in scene.electrodes().iter().enumerate() {
         let range = e
             .x_range
@@ -343,9 +369,29 @@ fn electrodes(mesh: &mut mesh::Mesh, scene: &Scene, whole: bool) -> Result<(), P
             )
             .into());
         }
+        if let (true, Some(&[a, b])) = (whole, e.x_range.as_deref()) {
+            let covered = x_extent(mesh, &g);
+            // an end within the tolerance of the selection is the range's own
+            if covered[0] > a + tol || covered[1] < b - tol {
+                narrowed.push(NarrowedElectrode {
+                    name: name.clone(),
+                    asked: [a, b],
+                    covered,
+                });
+            }
+        }
         mesh.boundaries.insert(name, g);
     }
-    Ok(())
+    Ok(narrowed)
+}
+
+/// The least and largest x of the nodes of `group`.
+pub fn x_extent(mesh: &mesh::Mesh, group: &mesh::FacetGroup) -> [f64; 2] {
+    group
+        .nodes()
+        .iter()
+        .map(|&v| mesh.points[v][0])
+        .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], x| [lo.min(x), hi.max(x)])
 }
 
 /// `mesh` at the scene's `mesh.order`: raised to order 2 where it asks (a node at every

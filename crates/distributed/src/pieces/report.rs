@@ -167,11 +167,26 @@ impl Shares<'_> {
             let mine = first
                 .filter(|&v| self.global_node[v] as f64 == least)
                 .map_or(0.0, |v| phi[v]);
+            // an electrode of `x_range`: the extent its facets cover, over the pieces
+            let covered_x = if self.setup.ranged_electrodes.iter().any(|e| e == group) {
+                let [lo, hi] = self
+                    .setup
+                    .mesh
+                    .boundary(group)
+                    .map_or([f64::INFINITY, f64::NEG_INFINITY], |g| {
+                        problem::backend::x_extent(&self.setup.mesh, g)
+                    });
+                let extent = petsc.max(&[-lo, hi])?;
+                Some([-extent[0], extent[1]])
+            } else {
+                None
+            };
             out.push(TerminalReport {
                 group: group.to_string(),
                 potential: petsc.sum(&[mine])?[0],
                 charge,
                 floating: self.floating.holds(group),
+                covered_x,
             });
         }
         Ok(out)
