@@ -799,3 +799,30 @@ fn an_electrode_narrower_than_its_range_is_noted() {
     .unwrap();
     assert!(setup.notes.narrowed_electrodes.is_empty());
 }
+
+/// A region by box is the cells whose centroids lie in the box: where the mesh has no cell
+/// faces on the box's sides its boundary is a staircase (a layer thicker or thinner than asked,
+/// or jagged), and the set-up says so with the extent its cells span.
+#[test]
+fn a_region_off_the_mesh_lines_is_noted() {
+    let notes = |n: usize| {
+        let (scene, _) = files::scene_file::load("layered", &[format!("mesh.n={n}")]).unwrap();
+        problem::backend::setup(scene.validate().unwrap(), None)
+            .unwrap()
+            .notes
+            .staircase_regions
+    };
+    // n = 10: y = 0.8 is a line of the mesh; n = 8: rows at 0.75 and 0.875
+    assert!(notes(10).is_empty());
+    let off = notes(8);
+    let pzt = off.iter().find(|r| r.name == "pzt").unwrap();
+    assert_eq!(pzt.asked[1], [0.8, 1.0]);
+    assert_eq!(pzt.covered[1], [0.75, 1.0]);
+    // the shipped default puts the interface on a line
+    let (scene, _) = files::scene_file::load("layered", &[]).unwrap();
+    assert!(problem::backend::setup(scene.validate().unwrap(), None)
+        .unwrap()
+        .notes
+        .staircase_regions
+        .is_empty());
+}

@@ -392,6 +392,20 @@ fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
             n.unused_nodes
         ));
     }
+    for r in &n.staircase_regions {
+        let span = |axes: &[[f64; 2]]| {
+            axes.iter()
+                .map(|[lo, hi]| format!("[{lo}, {hi}]"))
+                .collect::<Vec<_>>()
+                .join(" x ")
+        };
+        notes.push(format!(
+            "mesh.region `{}`: its cells (those whose centroids lie in the box) span {} of the box {}: the mesh has no cell faces on the box's sides, so the region's boundary is a staircase about them (a mesh with nodes on them, or [[mesh.layer]] for layers, follows the box)",
+            r.name,
+            span(&r.covered),
+            span(&r.asked)
+        ));
+    }
     for e in &n.narrowed_electrodes {
         notes.push(format!(
             "the electrode `{}` covers x in [{}, {}] of the x_range [{}, {}] asked: its facets are those wholly inside the range, and the mesh has no node at its ends (run.json: terminals' covered_x)",

@@ -33,8 +33,8 @@ pub struct Setup {
     pub notes: MeshNotes,
     /// The unit of every reported quantity, from the scene's system.
     pub units: crate::Units,
-    /// The group names of the electrodes given by `electrode.x_range` (their covered extent is
-    /// reported: [`crate::report::TerminalReport::covered_x`]).
+    /// The group names of the electrodes given by `electrode.x_range` (run.json's terminals
+    /// report the extent they cover, `covered_x`).
     pub ranged_electrodes: Vec<String>,
 }
 
@@ -53,6 +53,21 @@ pub struct MeshNotes {
     /// Electrodes given by `x_range` whose facets cover less of it than asked (of the whole
     /// mesh; a piece's cover only its part).
     pub narrowed_electrodes: Vec<NarrowedElectrode>,
+    /// Regions by box whose cells do not fill the box to its sides (of the whole mesh).
+    pub staircase_regions: Vec<StaircaseRegion>,
+}
+
+/// A region by box (`[[mesh.region]]`) whose cells (those whose centroids lie in the box) do not
+/// end on the box's sides within the mesh: the mesh has no cell faces there, and the region's
+/// boundary is a staircase about them (a layer's thickness off by up to a cell).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StaircaseRegion {
+    /// The region's name.
+    pub name: String,
+    /// The box as asked, clamped to the mesh's extent: `[lo, hi]` along each axis.
+    pub asked: Vec<[f64; 2]>,
+    /// The extent of its cells along each axis.
+    pub covered: Vec<[f64; 2]>,
 }
 
 /// An electrode given by `electrode.x_range` whose facets (those of its group wholly inside the
@@ -257,7 +272,7 @@ fn mesh(scene: &Scene, source: Source) -> Result<(mesh::Mesh, MeshNotes), Proble
     for l in scene.loads() {
         crate::boundary::check_boundary(&mesh, &l.group, "load.group", "traction")?;
     }
-    box_regions(&mut mesh, &m.regions, true)?;
+    let staircase_regions = box_regions(&mut mesh, &m.regions, true)?;
     let narrowed_electrodes = electrodes(&mut mesh, scene, true)?;
     let notes = MeshNotes {
         reoriented_cells: mesh.reoriented_cells,
@@ -265,6 +280,7 @@ fn mesh(scene: &Scene, source: Source) -> Result<(mesh::Mesh, MeshNotes), Proble
         unused_nodes: quality.unused_nodes,
         curved_cells: mesh.curved_cells().iter().filter(|&&c| c).count(),
         narrowed_electrodes,
+        staircase_regions,
     };
     if m.axisymmetric {
         axis_group(&mut mesh)?;
@@ -413,8 +429,15 @@ fn of_order(mesh: mesh::Mesh, scene: &Scene) -> Result<mesh::Mesh, ProblemError>
 }
 
 /// The regions by box (`[[mesh.region]]`): the cells whose centroid lies in each box, each
-/// refused where it holds none when `whole` (a piece may hold none of a region).
-fn box_regions(mesh: &mut mesh::Mesh, regions: &[crate::scene::RegionSpec], whole: bool) -> Result<(), ProblemError> {
+/// refused where it holds none when `whole` (a piece may hold none of a region); the regions
+/// whose cells do not end on their box's sides within the mesh, when `whole`.
+fn box_regions(
+    mesh: &mut mesh::Mesh,
+    regions: &[crate::scene::RegionSpec],
+    whole: bool,
+) -> Result<Vec<StaircaseRegion>, ProblemError> {
+    let (mesh_lo, mesh_hi) = mesh.bounding_box();
+    let mut staircase = vec![];
     for r in regions {
         let cells: Vec<usize> = (0..mesh.n_cells())
             .filter(|&c| {
@@ -428,9 +451,40 @@ fn box_regions(mesh: &mut mesh::Mesh, regions: &[crate::scene::RegionSpec], whol
         if whole && cells.is_empty() {
             return Err(region_without_cells(&r.name).into());
         }
+        if whole {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for &v in cells.iter().flat_map(|&c| mesh.cell(c)) {
+                for k in 0..mesh.dim {
+                    lo[k] = lo[k].min(mesh.points[v][k]);
+                    hi[k] = hi[k].max(mesh.points[v][k]);
+                }
+            }
+            let axes = 0..mesh.dim.min(r.lo.len());
+            let asked: Vec<[f64; 2]> = axes
+                .clone()
+                .map(|k| {
+                    [
+                        r.lo[k].clamp(mesh_lo[k], mesh_hi[k]),
+                        r.hi[k].clamp(mesh_lo[k], mesh_hi[k]),
+                    ]
+                })
+                .collect();
+            let covered: Vec<[f64; 2]> = axes.clone().map(|k| [lo[k], hi[k]]).collect();
+            let off = axes.into_iter().any(|k| {
+                let tol = 1e-9 * (mesh_hi[k] - mesh_lo[k]);
+                (covered[k][0] - asked[k][0]).abs() > tol || (covered[k][1] - asked[k][1]).abs() > tol
+            });
+            if off {
+                staircase.push(StaircaseRegion {
+                    name: r.name.clone(),
+                    asked,
+                    covered,
+                });
+            }
+        }
         mesh.regions.insert(r.name.clone(), cells);
     }
-    Ok(())
+    Ok(staircase)
 }
 
 /// The group `axis` of a body of revolution's meridian section: its boundary segments on
