@@ -798,6 +798,14 @@ fn an_electrode_narrower_than_its_range_is_noted() {
     )
     .unwrap();
     assert!(setup.notes.narrowed_electrodes.is_empty());
+    // the capacitance matrix, whose electrode's length it scales with, says so too
+    let (scene, _) = files::scene_file::load("actuator", &["mesh.n=10".into()]).unwrap();
+    let c = problem::capacitance(&scene, None).unwrap();
+    assert!(
+        c.notes.iter().any(|n| n.contains("covers x in [0.3, 1.7]")),
+        "{:?}",
+        c.notes
+    );
 }
 
 /// A region by box is the cells whose centroids lie in the box: where the mesh has no cell

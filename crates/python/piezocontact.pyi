@@ -257,8 +257,9 @@ def capacitance(scene: Scene) -> dict[str, Any]:
     at a prescribed potential; the displacements it prescribes held at 0, no load, the contact
     face free): `terminals` (names; groups joined by a node as one, `a+b`), `matrix`
     (`C[i, j]`: the charge on terminal i per unit potential of terminal j, an ndarray),
-    `asymmetry` and `column_sum` (reciprocity and Gauss's law, relative: round-off), and
-    `unit` (the scene's charge per its potential, e.g. `pC/kV`).
+    `asymmetry` and `column_sum` (reciprocity and Gauss's law, relative: round-off), `unit`
+    (the scene's charge per its potential, e.g. `pC/kV`) and `notes` (what the set-up noted,
+    as strings: an electrode the mesh covers less of than its `x_range`, ...).
     Raises InputError, MeshError, SolverError."""
 
 def run(

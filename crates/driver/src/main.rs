@@ -620,6 +620,9 @@ fn capacitance(scene: Option<String>, set: &[String], out: Option<PathBuf>) -> R
         "reciprocity max|C - Cᵀ|/max|C| = {:.1e}; Gauss max|column sum|/max|C| = {:.1e}",
         c.asymmetry, c.column_sum
     ));
+    for note in &c.notes {
+        say(&format!("note: {note}"));
+    }
     let dir = out.unwrap_or_else(|| output::default_dir(&format!("{}-capacitance", scene.name)));
     let mut o = output::Outputs::documents(&dir);
     o.add("capacitance.csv", csv.into_bytes());

@@ -39,6 +39,10 @@ pub struct Capacitance {
     /// The unit of each `C_ij`: the scene's charge per its potential (`pC/kV`, a femtofarad,
     /// with lengths in µm and stresses in GPa; per unit thickness in plane strain).
     pub unit: String,
+    /// What the set-up noted without refusing the scene, as a run says it (an electrode the
+    /// mesh covers less of than its `x_range`, a region by box off the mesh's lines, ...).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// The capacitance matrix of `scene` on `backend` (validated here; `mesh` the mesh of a
@@ -144,6 +148,7 @@ pub(crate) fn capacitance<B: Backend>(
         asymmetry,
         column_sum,
         unit: unit(&scene, setup.mesh.dim),
+        notes: crate::progress::mesh_notes(&setup.notes),
     }))
 }
 

@@ -366,7 +366,7 @@ impl fmt::Display for Event<'_> {
 }
 
 /// The notes on a mesh that is read but unusual.
-fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
+pub(crate) fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
     let mut notes = vec![];
     if n.reoriented_cells > 0 {
         notes.push(format!(

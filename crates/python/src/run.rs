@@ -212,9 +212,10 @@ pub fn run(
 /// prescribed potential; the displacements it prescribes held at 0, no load, the contact face
 /// free): a dict with `terminals` (names; groups joined by a node as one, `a+b`), `matrix`
 /// (`C[i, j]`: the charge on terminal i per unit potential of terminal j), `asymmetry` and
-/// `column_sum` (reciprocity and Gauss's law, relative: round-off), and `unit` (the
-/// scene's charge per its potential, e.g. `pC/kV`). Errors: `InputError`, `MeshError`,
-/// `SolverError`.
+/// `column_sum` (reciprocity and Gauss's law, relative: round-off), `unit` (the scene's
+/// charge per its potential, e.g. `pC/kV`) and `notes` (what the set-up noted: an electrode
+/// the mesh covers less of than its `x_range`, ...; a list of strings, empty where nothing).
+/// Errors: `InputError`, `MeshError`, `SolverError`.
 #[pyfunction]
 pub fn capacitance<'py>(py: Python<'py>, scene: &Scene) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let given = scene.mesh.as_deref().cloned();
@@ -227,5 +228,6 @@ pub fn capacitance<'py>(py: Python<'py>, scene: &Scene) -> PyResult<Bound<'py, p
     out.set_item("asymmetry", c.asymmetry)?;
     out.set_item("column_sum", c.column_sum)?;
     out.set_item("unit", c.unit)?;
+    out.set_item("notes", c.notes)?;
     Ok(out)
 }

@@ -39,6 +39,10 @@ def test_the_capacitance_matrix_from_python():
     assert c["asymmetry"] < 1e-10 and c["column_sum"] < 1e-10
     # in the scene's units: lengths in m, stresses in GPa, plane strain (per unit thickness)
     assert c["unit"] == "(C/m)/GV"
+    # the electrode's ends are nodes at n = 16, not at n = 10 (x every 0.1): then it is shorter
+    assert c["notes"] == []
+    short = pc.capacitance(pc.Scene.load("actuator", {"mesh.n": 10}))
+    assert any("covers x in [0.3, 1.7]" in n for n in short["notes"])
 
 
 def test_an_open_electrode_from_python():
