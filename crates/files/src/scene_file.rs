@@ -702,9 +702,7 @@ mod tests {
     /// tables entered without an index is an error, not an absent key.
     #[test]
     fn keys_are_read_as_they_are_set() {
-        let text =
-            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/corner.toml")).unwrap();
-        let corner: toml::Table = text.parse().unwrap();
+        let corner: toml::Table = text("corner").unwrap().0.parse().unwrap();
         let value = |key: &str| get(&corner, key).unwrap().cloned();
         assert_eq!(value("contact.1.group"), Some(toml::Value::String("top".into())));
         assert_eq!(value("contact[0].group"), Some(toml::Value::String("right".into())));
@@ -714,9 +712,7 @@ mod tests {
         assert_eq!(value("mesh.nothing"), None);
         let e = get(&corner, "contact.group").unwrap_err();
         assert!(e.contains("`contact` holds 2 tables"), "{e}");
-        let text =
-            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper.toml")).unwrap();
-        let paper: toml::Table = text.parse().unwrap();
+        let paper: toml::Table = text("paper").unwrap().0.parse().unwrap();
         let friction = get(&paper, "contact.friction").unwrap().cloned();
         assert_eq!(get(&paper, "contact.0.friction").unwrap().cloned(), friction);
         assert!(friction.is_some());

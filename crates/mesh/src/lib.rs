@@ -210,8 +210,8 @@ pub enum MeshError {
         name: String,
         /// The groups the mesh has, comma-separated.
         available: String,
-        /// What a group of that name is where the mesh has one of another kind (`: it is a
-        /// region, a group of cells`), or empty.
+        /// What a group of that name is where the mesh has one of another kind (`; `name` is a
+        /// region ...`), or empty.
         elsewhere: String,
     },
     /// A region was asked for that the mesh does not have.
@@ -374,13 +374,11 @@ impl Mesh {
         })
     }
 
-    /// What the mesh's group `name` is where it is not the kind asked for: `": `name` is a
+    /// What the mesh's group `name`, missing as the kind asked for, is instead: `"; `name` is a
     /// region ..."`, or empty where the mesh has no group of that name.
     fn group_elsewhere(&self, name: &str) -> String {
         let facets = if self.dim == 3 { "surfaces" } else { "curves" };
-        if self.regions.contains_key(name) && self.boundaries.contains_key(name) {
-            String::new()
-        } else if self.regions.contains_key(name) {
+        if self.regions.contains_key(name) {
             format!(
                 "; `{name}` is a region (a group of the body's {}D cells): a boundary group is one of {facets}",
                 self.dim

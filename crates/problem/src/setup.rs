@@ -452,39 +452,51 @@ fn box_regions(
             return Err(region_without_cells(&r.name).into());
         }
         if whole {
-            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for &v in cells.iter().flat_map(|&c| mesh.cell(c)) {
-                for k in 0..mesh.dim {
-                    lo[k] = lo[k].min(mesh.points[v][k]);
-                    hi[k] = hi[k].max(mesh.points[v][k]);
-                }
-            }
-            let axes = 0..mesh.dim.min(r.lo.len());
-            let asked: Vec<[f64; 2]> = axes
-                .clone()
-                .map(|k| {
-                    [
-                        r.lo[k].clamp(mesh_lo[k], mesh_hi[k]),
-                        r.hi[k].clamp(mesh_lo[k], mesh_hi[k]),
-                    ]
-                })
-                .collect();
-            let covered: Vec<[f64; 2]> = axes.clone().map(|k| [lo[k], hi[k]]).collect();
-            let off = axes.into_iter().any(|k| {
-                let tol = 1e-9 * (mesh_hi[k] - mesh_lo[k]);
-                (covered[k][0] - asked[k][0]).abs() > tol || (covered[k][1] - asked[k][1]).abs() > tol
-            });
-            if off {
-                staircase.push(StaircaseRegion {
-                    name: r.name.clone(),
-                    asked,
-                    covered,
-                });
-            }
+            staircase.extend(off_the_box(mesh, r, &cells, (mesh_lo, mesh_hi)));
         }
         mesh.regions.insert(r.name.clone(), cells);
     }
     Ok(staircase)
+}
+
+/// Region `r`'s `cells` as a [`StaircaseRegion`] where their extent is not its box (clamped to
+/// the mesh's extent `whole`, within 1e-9 of the mesh's size along each axis); `None` where it is.
+fn off_the_box(
+    mesh: &mesh::Mesh,
+    r: &crate::scene::RegionSpec,
+    cells: &[usize],
+    (mesh_lo, mesh_hi): ([f64; 3], [f64; 3]),
+) -> Option<StaircaseRegion> {
+    let axes = 0..mesh.dim.min(r.lo.len());
+    let asked: Vec<[f64; 2]> = axes
+        .clone()
+        .map(|k| {
+            [
+                r.lo[k].clamp(mesh_lo[k], mesh_hi[k]),
+                r.hi[k].clamp(mesh_lo[k], mesh_hi[k]),
+            ]
+        })
+        .collect();
+    let nodes = || cells.iter().flat_map(|&c| mesh.cell(c));
+    let covered: Vec<[f64; 2]> = axes
+        .clone()
+        .map(|k| {
+            let xs = nodes().map(|&v| mesh.points[v][k]);
+            [
+                xs.clone().fold(f64::INFINITY, f64::min),
+                xs.fold(f64::NEG_INFINITY, f64::max),
+            ]
+        })
+        .collect();
+    let off = axes.into_iter().any(|k| {
+        let tol = 1e-9 * (mesh_hi[k] - mesh_lo[k]);
+        (covered[k][0] - asked[k][0]).abs() > tol || (covered[k][1] - asked[k][1]).abs() > tol
+    });
+    off.then(|| StaircaseRegion {
+        name: r.name.clone(),
+        asked,
+        covered,
+    })
 }
 
 /// The group `axis` of a body of revolution's meridian section: its boundary segments on

@@ -173,10 +173,6 @@ fn driver_error(e: distributed::DistributedError) -> DriverError {
     }
 }
 
-/// The least of the ranks' memory limits, on every rank: each rank reads its own (the machine's
-/// memory at its own moment, its own `ulimit`), and a run that one rank refused by its estimate
-/// while the others went on would leave them waiting in their next collective call. The limit's
-/// name is this rank's where its own is the least, else another rank's.
 /// Whether rank 0, which writes the outputs, can write them into `dir`, asked before the run
 /// ([`output::check_target`]) and agreed: every rank stops where it cannot (rank 0 with the
 /// reason), none goes on alone into the run's collective steps.
@@ -197,6 +193,10 @@ fn writable_output(petsc: &petsc::Petsc, dir: &Path) -> Result<(), DriverError> 
     }
 }
 
+/// The least of the ranks' memory limits, on every rank: each rank reads its own (the machine's
+/// memory at its own moment, its own `ulimit`), and a run that one rank refused by its estimate
+/// while the others went on would leave them waiting in their next collective call. The limit's
+/// name is this rank's where its own is the least, else another rank's.
 fn agreed_limits(
     petsc: &petsc::Petsc,
     (bytes, limit): (Option<u64>, Option<&'static str>),

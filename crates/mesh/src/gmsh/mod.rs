@@ -376,15 +376,13 @@ fn plane_normal(points: &[[f64; 3]]) -> Option<[f64; 3]> {
     let sub = |a: &[f64; 3], b: &[f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let o = points.first()?;
-    let extent = points
-        .iter()
-        .map(|p| dot(&sub(p, o), &sub(p, o)).sqrt())
-        .fold(0.0, f64::max);
     // the largest normal of a triangle (o, a, b) over the points: the best conditioned plane
     let far = points
         .iter()
         .max_by(|a, b| dot(&sub(a, o), &sub(a, o)).total_cmp(&dot(&sub(b, o), &sub(b, o))))?;
     let u = sub(far, o);
+    // the points' extent from `o`: the distance to the farthest
+    let extent = dot(&u, &u).sqrt();
     let cross = |v: &[f64; 3]| {
         [
             u[1] * v[2] - u[2] * v[1],
