@@ -215,6 +215,16 @@ class Result:
     def strain(self) -> npt.NDArray[np.float64]:
         """Strain per cell, Voigt order with engineering shears, shaped as `stress`."""
     @property
+    def stress_tensor(self) -> npt.NDArray[np.float64]:
+        """Stress per cell as full symmetric tensors, (n_cells, 3, 3), in every dimension: in
+        plane strain with the stresses across the plane (sigma_zz; sigma_yz, sigma_xz where the
+        material couples them), on a body of revolution in the axes (r, z, theta), in 3D
+        (x, y, z)."""
+    @property
+    def strain_tensor(self) -> npt.NDArray[np.float64]:
+        """Strain per cell as full symmetric tensors (tensor shears), shaped as
+        `stress_tensor`."""
+    @property
     def electric_displacement(self) -> npt.NDArray[np.float64]:
         """Electric displacement per cell, (n_cells, dim)."""
     @property
@@ -250,7 +260,10 @@ class Result:
         """Writes run.json, solution.vtu, contact.csv and the plan's pictures into
         `directory`, as one set (`OutputError`; nothing half-written)."""
     def to_meshio(self) -> Any:
-        """The solution as a `meshio.Mesh` (needs meshio)."""
+        """The solution as a `meshio.Mesh` (needs meshio): `u`, `phi`, `contact_status` as point
+        data; `stress` and `strain` as cell data of six components in VTK's tensor order
+        (xx, yy, zz, xy, yz, xz: what ParaView reads as XX .. XZ; tensor shears), `D` and `E`
+        of three, as solution.vtu holds them."""
 
 def capacitance(scene: Scene) -> dict[str, Any]:
     """The capacitance matrix between the terminals of `scene` (its electrode and the groups

@@ -37,6 +37,18 @@ pub enum Field {
     Floating,
 }
 
+impl std::fmt::Display for Field {
+    /// The unknown as the scene file's keys name it: `ux`, `uy`, `uz`, `phi`, or the floating
+    /// potential of a terminal.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Field::Displacement(k) => write!(f, "u{}", ["x", "y", "z"].get(*k).copied().unwrap_or("?")),
+            Field::Potential => f.write_str("phi"),
+            Field::Floating => f.write_str("a floating terminal's potential"),
+        }
+    }
+}
+
 /// A Dirichlet condition `field = value(x)` on the nodes of a boundary group.
 #[derive(Clone)]
 pub struct Constraint {

@@ -56,8 +56,8 @@ pub use dofs::{Constraint, Dof, DofMap, Field, Prescribed};
 pub use exact::{ErrorNorms, Exact, Face, FaceConstants, FaceElectric, FrictionFn, Sliding};
 pub use held::{free_in, rigid_gram, Held, Support, Unheld};
 pub use loads::{facet_measure, FacetMap, Load, RhsParts};
-pub use material::{voigt, voigt_len, Coordinates, Crystal, Material, MaterialError};
-pub use recovery::{CellFields, ChargeFunctional};
+pub use material::{voigt, voigt_len, Coordinates, Crystal, Material, MaterialError, OutOfPlane};
+pub use recovery::{CellFields, ChargeFunctional, NodeFields, Tensors, VTK_TENSOR_ORDER};
 
 use std::sync::Arc;
 
@@ -125,7 +125,7 @@ pub enum InputError {
         node: usize,
     },
     /// Two conditions that prescribe different values to one unknown.
-    #[error("node {node} at {at:?} gets {field:?} = {first_value} from `{first}` and {second_value} from `{second}`")]
+    #[error("node {node} at {at:?} gets {field} = {first_value} from `{first}` and {field} = {second_value} from `{second}`: two conditions prescribe different values to one unknown where their groups meet")]
     Conflicting {
         /// The node.
         node: usize,
@@ -161,7 +161,7 @@ pub enum InputError {
         other: String,
     },
     /// A condition that reaches no unknown.
-    #[error("condition {field:?} on `{group}` reaches no degree of freedom{}", if matches!(*.field, Field::Potential | Field::Floating) { " (no node of it carries a potential)" } else { "" })]
+    #[error("condition on {field} of `{group}` reaches no degree of freedom{}", if matches!(*.field, Field::Potential | Field::Floating) { " (no node of it carries a potential)" } else { "" })]
     ReachesNothing {
         /// The field.
         field: Field,

@@ -94,6 +94,47 @@ pub struct Material {
     pub beta: Vec<f64>,
     /// Whether the material carries electric unknowns (a non-zero permittivity).
     pub electric: bool,
+    /// In plane strain, what the reduction to `[xx, yy, xy]` leaves out but the state still
+    /// carries: the stresses across the plane and the field along its normal (`None` on a body
+    /// of revolution and in 3D, whose Voigt rows hold every component, and for a material
+    /// built without its 3D tensors, whose out-of-plane values are then unknown).
+    pub out_of_plane: Option<OutOfPlane>,
+}
+
+/// The out-of-plane rows of a plane-strain material's 3D tensors: with `ε_zz = γ_yz = γ_xz =
+/// 0` and `E_z = 0`, the stresses `[σ_zz, σ_yz, σ_xz] = c ε + e ∇φ` and the electric
+/// displacement `D_z = e_z·ε - β_z·∇φ`, from the in-plane strain `ε = [ε_xx, ε_yy, γ_xy]` and
+/// gradient `∇φ = [∂_x φ, ∂_y φ]` (docs/theory.md, "Recovered fields").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutOfPlane {
+    /// `C`'s rows `zz, yz, xz` on the columns `xx, yy, xy`.
+    pub c: [[f64; 3]; 3],
+    /// `eᵀ`'s rows `zz, yz, xz` on the in-plane fields `x, y`: `e_{k, zz}` etc.
+    pub e: [[f64; 2]; 3],
+    /// `e`'s row `z` on the columns `xx, yy, xy`.
+    pub e_z: [f64; 3],
+    /// The permittivity's row `z` on the in-plane fields `x, y`.
+    pub beta_z: [f64; 2],
+}
+
+impl OutOfPlane {
+    /// `[σ_zz, σ_yz, σ_xz, D_z]` at the in-plane strain `eps` and gradient `grad`.
+    pub fn at(&self, eps: &[f64], grad: &[f64]) -> [f64; 4] {
+        let mut out = [0.0; 4];
+        for (r, o) in out.iter_mut().take(3).enumerate() {
+            *o = (0..3).map(|j| self.c[r][j] * eps[j]).sum::<f64>()
+                + (0..2).map(|k| self.e[r][k] * grad[k]).sum::<f64>();
+        }
+        out[3] =
+            (0..3).map(|j| self.e_z[j] * eps[j]).sum::<f64>() - (0..2).map(|k| self.beta_z[k] * grad[k]).sum::<f64>();
+        out
+    }
+
+    /// The piezoelectric parts times `factor` (none at 0).
+    fn scale_coupling(&mut self, factor: f64) {
+        self.e.iter_mut().flatten().for_each(|x| *x *= factor);
+        self.e_z.iter_mut().for_each(|x| *x *= factor);
+    }
 }
 
 /// A material that cannot be used.
@@ -263,7 +304,18 @@ impl Material {
             2 => (vec![0, 1, 5], vec![0, 1]),
             _ => ((0..6).collect(), (0..3).collect()),
         };
-        reduced(name, &(c3, e3, b3), &rows, &fields, dim)
+        let mut m = reduced(name, &(c3, e3, b3), &rows, &fields, dim)?;
+        if dim == 2 {
+            // the rows zz (2), yz (3), xz (4) and the field z (2) on the plane's columns
+            let across = [2, 3, 4];
+            m.out_of_plane = Some(OutOfPlane {
+                c: across.map(|i| [c3[i][0], c3[i][1], c3[i][5]]),
+                e: across.map(|i| [e3[0][i], e3[1][i]]),
+                e_z: [e3[2][0], e3[2][1], e3[2][5]],
+                beta_z: [b3[2][0], b3[2][1]],
+            });
+        }
+        Ok(m)
     }
 
     /// The crystal rotated so that its 3-axis points along `poling`, for a body of revolution
@@ -337,6 +389,9 @@ impl Material {
         for x in &mut self.e {
             *x *= factor;
         }
+        if let Some(o) = &mut self.out_of_plane {
+            o.scale_coupling(factor);
+        }
         self
     }
 
@@ -346,6 +401,10 @@ impl Material {
         self.electric = false;
         self.beta.iter_mut().for_each(|x| *x = 0.0);
         self.e.iter_mut().for_each(|x| *x = 0.0);
+        if let Some(o) = &mut self.out_of_plane {
+            o.scale_coupling(0.0);
+            o.beta_z = [0.0; 2];
+        }
         self
     }
 
@@ -494,6 +553,7 @@ fn reduced(
         e,
         beta,
         electric,
+        out_of_plane: None,
     };
     m.validate(name)?;
     Ok(m)
@@ -559,6 +619,48 @@ mod tests {
         assert_eq!(m.e, vec![0.0, 0.0, 12.3, -5.4, 15.8, 0.0]);
         assert_eq!(m.beta, vec![8.11, 0.0, 0.0, 7.35]);
         assert!(m.electric);
+    }
+
+    /// The plane-strain material's out-of-plane rows give the 3D material's stresses and
+    /// `D_z` at the 3D state the plane carries (`ε_zz = γ_yz = γ_xz = 0`, `∂_z φ = 0`): poled
+    /// obliquely, so that every row couples (`σ_yz`, `σ_xz` and `D_z` non-zero), and for an
+    /// isotropic solid Hooke's `σ_zz = ν (σ_xx + σ_yy)`.
+    #[test]
+    fn plane_strain_carries_the_3d_stresses_across_its_plane() {
+        let (eps, grad) = ([1e-3, -2e-3, 3e-3], [0.5, -0.25]);
+        for poling in [[1.0, 2.0, 2.0], [0.0, 1.0, 0.0]] {
+            let plane = Material::from_crystal("p", &Crystal::pzt5a(), poling, 2).unwrap();
+            let solid = Material::from_crystal("s", &Crystal::pzt5a(), poling, 3).unwrap();
+            let eps3 = [eps[0], eps[1], 0.0, 0.0, 0.0, eps[2]];
+            let grad3 = [grad[0], grad[1], 0.0];
+            let sigma = |i: usize| {
+                (0..6).map(|j| solid.c[i * 6 + j] * eps3[j]).sum::<f64>()
+                    + (0..3).map(|k| solid.e[k * 6 + i] * grad3[k]).sum::<f64>()
+            };
+            let d_z = (0..6).map(|j| solid.e[2 * 6 + j] * eps3[j]).sum::<f64>()
+                - (0..3).map(|k| solid.beta[2 * 3 + k] * grad3[k]).sum::<f64>();
+            let got = plane.out_of_plane.unwrap().at(&eps, &grad);
+            let want = [sigma(2), sigma(3), sigma(4), d_z];
+            for (g, w) in got.iter().zip(want) {
+                assert!((g - w).abs() <= 1e-12 * (1.0 + w.abs()), "{got:?} against {want:?}");
+            }
+            if poling[2] != 0.0 {
+                assert!(
+                    got.iter().all(|x| x.abs() > 1e-6),
+                    "an oblique poling couples every row: {got:?}"
+                );
+            }
+        }
+        let nu = 0.3;
+        let m = Material::from_crystal("iso", &Crystal::isotropic(200.0, nu, 0.0), [0.0, 0.0, 1.0], 2).unwrap();
+        let [zz, yz, xz, d_z] = m.out_of_plane.unwrap().at(&eps, &[0.0, 0.0]);
+        let s = |i: usize| (0..3).map(|j| m.c[i * 3 + j] * eps[j]).sum::<f64>();
+        assert!((zz - nu * (s(0) + s(1))).abs() < 1e-12 && yz == 0.0 && xz == 0.0 && d_z == 0.0);
+        // without its electric part, the coupling and permittivity go from the rows too
+        let cold = Material::from_crystal("p", &Crystal::pzt5a(), [1.0, 2.0, 2.0], 2)
+            .unwrap()
+            .without_electric();
+        assert_eq!(cold.out_of_plane.unwrap().at(&[0.0; 3], &grad), [0.0; 4]);
     }
 
     /// Poled along z in 3D: the crystal frame is the global frame.

@@ -18,6 +18,11 @@ pub struct CellFields {
     pub strain: Vec<f64>,
     /// Electric field `E = -∇φ` per cell (`dim` entries each, flat).
     pub electric_field: Vec<f64>,
+    /// In plane strain, `[σ_zz, σ_yz, σ_xz, D_z]` per cell (4 entries each, flat: what the
+    /// in-plane Voigt rows leave out, [`crate::OutOfPlane`]); empty on a body of revolution
+    /// and in 3D (their Voigt rows hold every component), and where a material has no 3D
+    /// tensors to give them.
+    pub out_of_plane: Vec<f64>,
     /// On a mesh of P2 cells (whose fields are linear in each cell, so that the centroid's
     /// value leaves out their variation): the same fields at the nodes, `None` on P1 cells
     /// (constant in each).
@@ -39,6 +44,107 @@ pub struct NodeFields {
     pub strain: Vec<f64>,
     /// Electric field per node (`dim` entries each).
     pub electric_field: Vec<f64>,
+    /// `[σ_zz, σ_yz, σ_xz, D_z]` per node in plane strain, as [`CellFields::out_of_plane`].
+    pub out_of_plane: Vec<f64>,
+}
+
+/// The components of a symmetric tensor in the order VTK's files hold them (ParaView labels
+/// them `XX, YY, ZZ, XY, YZ, XZ`), the order of [`Tensors`]; Voigt's (the fields' own) is
+/// `xx, yy, zz, yz, xz, xy`.
+pub const VTK_TENSOR_ORDER: [&str; 6] = ["xx", "yy", "zz", "xy", "yz", "xz"];
+
+/// Recovered fields as 3D tensors and vectors, whatever the body's dimension: what a viewer
+/// (ParaView, meshio's formats) reads without knowing the body's Voigt layout. Per entry
+/// (cell or node), the stress and the strain as the six components of a symmetric tensor in
+/// [`VTK_TENSOR_ORDER`] (the strain's shears the tensor's `ε_xy = γ_xy / 2`, not Voigt's
+/// engineering `γ_xy`), `D` and `E` with three components. In plane strain the stress
+/// holds `σ_zz` (and `σ_yz`, `σ_xz` where the material couples them), the strain's
+/// out-of-plane components are 0, `D_z` is that of the state, `E_z = 0`; on a body of
+/// revolution meshed in its meridian plane (`x = r`, `y = z`) the third axis is the hoop
+/// direction: `zz` holds `θθ`, the shears with it vanish, as do `D_θ` and `E_θ`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tensors {
+    /// Stress, 6 entries per cell or node.
+    pub stress: Vec<f64>,
+    /// Strain, 6 entries per cell or node (tensor shears).
+    pub strain: Vec<f64>,
+    /// Electric displacement, 3 entries per cell or node.
+    pub electric_displacement: Vec<f64>,
+    /// Electric field, 3 entries per cell or node.
+    pub electric_field: Vec<f64>,
+}
+
+/// [`Tensors`] of fields laid out as [`CellFields`] (`count` entries, `dim`-dimensional, `nv`
+/// Voigt components, `out_of_plane` 4 per entry or empty).
+fn tensors([stress, strain, d, e]: [&[f64]; 4], out_of_plane: &[f64], count: usize, dim: usize) -> Tensors {
+    let nv = stress.len().checked_div(count).unwrap_or(0);
+    let mut out = Tensors {
+        stress: Vec::with_capacity(6 * count),
+        strain: Vec::with_capacity(6 * count),
+        electric_displacement: Vec::with_capacity(3 * count),
+        electric_field: Vec::with_capacity(3 * count),
+    };
+    for i in 0..count {
+        let (s, eps) = (&stress[i * nv..(i + 1) * nv], &strain[i * nv..(i + 1) * nv]);
+        // [σ_zz, σ_yz, σ_xz, D_z] in plane strain; unknown where the material lacks them
+        let z = out_of_plane.get(4 * i..4 * i + 4);
+        let across = |k: usize| z.map_or(f64::NAN, |z| z[k]);
+        let (t_s, t_e) = match nv {
+            // Voigt [xx, yy, zz, yz, xz, xy]
+            6 => (
+                [s[0], s[1], s[2], s[5], s[3], s[4]],
+                [eps[0], eps[1], eps[2], eps[5] / 2.0, eps[3] / 2.0, eps[4] / 2.0],
+            ),
+            // a body of revolution's [rr, zz, rz, θθ]
+            4 => (
+                [s[0], s[1], s[3], s[2], 0.0, 0.0],
+                [eps[0], eps[1], eps[3], eps[2] / 2.0, 0.0, 0.0],
+            ),
+            // plane strain's [xx, yy, xy]
+            _ => (
+                [s[0], s[1], across(0), s[2], across(1), across(2)],
+                [eps[0], eps[1], 0.0, eps[2] / 2.0, 0.0, 0.0],
+            ),
+        };
+        out.stress.extend(t_s);
+        out.strain.extend(t_e);
+        let (di, ei) = (&d[i * dim..(i + 1) * dim], &e[i * dim..(i + 1) * dim]);
+        if dim == 3 {
+            out.electric_displacement.extend_from_slice(di);
+            out.electric_field.extend_from_slice(ei);
+        } else {
+            let d_z = if nv == 3 { across(3) } else { 0.0 };
+            out.electric_displacement.extend([di[0], di[1], d_z]);
+            out.electric_field.extend([ei[0], ei[1], 0.0]);
+        }
+    }
+    out
+}
+
+impl CellFields {
+    /// The fields of `count` cells of a `dim`-dimensional body as [`Tensors`].
+    pub fn tensors(&self, count: usize, dim: usize) -> Tensors {
+        let arrays = [
+            &self.stress,
+            &self.strain,
+            &self.electric_displacement,
+            &self.electric_field,
+        ];
+        tensors(arrays.map(|a| &a[..]), &self.out_of_plane, count, dim)
+    }
+}
+
+impl NodeFields {
+    /// The fields of `count` nodes of a `dim`-dimensional body as [`Tensors`].
+    pub fn tensors(&self, count: usize, dim: usize) -> Tensors {
+        let arrays = [
+            &self.stress,
+            &self.strain,
+            &self.electric_displacement,
+            &self.electric_field,
+        ];
+        tensors(arrays.map(|a| &a[..]), &self.out_of_plane, count, dim)
+    }
 }
 
 /// A charge's coefficients on the free unknowns: `(a_u, a_φ)`.
@@ -56,6 +162,7 @@ impl Discretization<'_> {
             electric_displacement: Vec::with_capacity(n * dim),
             strain: Vec::with_capacity(n * nv),
             electric_field: Vec::with_capacity(n * dim),
+            out_of_plane: Vec::with_capacity(if self.out_of_plane() { 4 * n } else { 0 }),
             at_nodes: (mesh.kind.order() == 2).then(|| self.recover_at_nodes(u, phi)),
         };
         for (c, cell) in mesh.iter_cells().enumerate() {
@@ -76,8 +183,19 @@ impl Discretization<'_> {
                 out.electric_displacement.push(d[k]);
                 out.electric_field.push(-grad[k]);
             }
+            if out.out_of_plane.capacity() > 0 {
+                out.out_of_plane.extend(out_of_plane(m, &eps, &grad));
+            }
         }
         out
+    }
+
+    /// Whether the fields carry [`CellFields::out_of_plane`]: plane strain, every material
+    /// with its [`crate::OutOfPlane`] rows.
+    fn out_of_plane(&self) -> bool {
+        self.coordinates == crate::Coordinates::Cartesian
+            && self.mesh.dim == 2
+            && (0..self.mesh.n_cells()).all(|c| self.material(c).out_of_plane.is_some())
     }
 
     /// [`NodeFields`] of a mesh of P2 cells: each node's cells' values at it (the P2 shape
@@ -90,19 +208,28 @@ impl Discretization<'_> {
         // each local node's barycentric coordinates: the corners, then the edges' midpoints
         let bary = simplex_nodes(dim);
         let (offsets, node_cells) = mesh.node_cells();
+        let across = if self.out_of_plane() { 4 } else { 0 };
         let mut out = NodeFields {
             stress: vec![0.0; n * nv],
             electric_displacement: vec![0.0; n * dim],
             strain: vec![0.0; n * nv],
             electric_field: vec![0.0; n * dim],
+            out_of_plane: vec![0.0; n * across],
+        };
+        // a node's share of `out_of_plane`: its 4 entries, or an empty slice
+        let mut across_chunks: Vec<&mut [f64]> = if across == 0 {
+            (0..n).map(|_| <&mut [f64]>::default()).collect()
+        } else {
+            out.out_of_plane.chunks_mut(4).collect()
         };
         out.stress
             .par_chunks_mut(nv)
             .zip(out.strain.par_chunks_mut(nv))
             .zip(out.electric_displacement.par_chunks_mut(dim))
             .zip(out.electric_field.par_chunks_mut(dim))
+            .zip(across_chunks.par_iter_mut())
             .enumerate()
-            .for_each(|(v, (((s_out, eps_out), d_out), e_out))| {
+            .for_each(|(v, ((((s_out, eps_out), d_out), e_out), z_out))| {
                 let mut total = 0.0;
                 for &c in &node_cells[offsets[v]..offsets[v + 1]] {
                     let cell = mesh.cell(c);
@@ -128,6 +255,10 @@ impl Discretization<'_> {
                     let (sigma, d) = (stress(m, &eps, &grad), displacement(m, &eps, &grad));
                     let w = rule.weight(0);
                     total += w;
+                    if !z_out.is_empty() {
+                        let z = out_of_plane(m, &eps, &grad);
+                        z_out.iter_mut().zip(z).for_each(|(o, x)| *o += w * x);
+                    }
                     for i in 0..nv {
                         s_out[i] += w * sigma[i];
                         eps_out[i] += w * eps[i];
@@ -143,6 +274,7 @@ impl Discretization<'_> {
                         .chain(eps_out.iter_mut())
                         .chain(d_out.iter_mut())
                         .chain(e_out.iter_mut())
+                        .chain(z_out.iter_mut())
                     {
                         *x /= total;
                     }
@@ -356,6 +488,13 @@ fn stress(m: &Material, eps: &[f64; 6], grad: &[f64; 3]) -> [f64; 6] {
     s
 }
 
+/// `[σ_zz, σ_yz, σ_xz, D_z]` at a point of a plane-strain body (its material has the rows).
+fn out_of_plane(m: &Material, eps: &[f64; 6], grad: &[f64; 3]) -> [f64; 4] {
+    m.out_of_plane
+        .as_ref()
+        .map_or([f64::NAN; 4], |o| o.at(&eps[..3], &grad[..2]))
+}
+
 /// `D = e ε - β ∇φ` at a point.
 fn displacement(m: &Material, eps: &[f64; 6], grad: &[f64; 3]) -> [f64; 3] {
     let (dim, nv) = (m.dim, m.nv());
@@ -365,4 +504,46 @@ fn displacement(m: &Material, eps: &[f64; 6], grad: &[f64; 3]) -> [f64; 3] {
             - (0..dim).map(|l| m.beta[k * dim + l] * grad[l]).sum::<f64>();
     }
     d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each Voigt layout lands in VTK's tensor order, shears of the strain halved: 3D's
+    /// `[xx, yy, zz, yz, xz, xy]`, plane strain's `[xx, yy, xy]` with its out-of-plane rows,
+    /// a body of revolution's `[rr, zz, rz, θθ]` with the hoop direction as z.
+    #[test]
+    fn every_layout_becomes_a_tensor_in_vtks_order() {
+        let fields = |nv: usize, dim: usize, out_of_plane: Vec<f64>| CellFields {
+            stress: (1..=nv).map(|i| i as f64).collect(),
+            strain: (1..=nv).map(|i| 10.0 * i as f64).collect(),
+            electric_displacement: (1..=dim).map(|i| i as f64).collect(),
+            electric_field: (1..=dim).map(|i| -(i as f64)).collect(),
+            out_of_plane,
+            at_nodes: None,
+        };
+        let t = fields(6, 3, vec![]).tensors(1, 3);
+        assert_eq!(t.stress, [1.0, 2.0, 3.0, 6.0, 4.0, 5.0]);
+        assert_eq!(t.strain, [10.0, 20.0, 30.0, 30.0, 20.0, 25.0]);
+        assert_eq!(
+            (t.electric_displacement, t.electric_field),
+            (vec![1.0, 2.0, 3.0], vec![-1.0, -2.0, -3.0])
+        );
+        let t = fields(3, 2, vec![7.0, 8.0, 9.0, 4.0]).tensors(1, 2);
+        assert_eq!(t.stress, [1.0, 2.0, 7.0, 3.0, 8.0, 9.0]);
+        assert_eq!(t.strain, [10.0, 20.0, 0.0, 15.0, 0.0, 0.0]);
+        assert_eq!(
+            (t.electric_displacement, t.electric_field),
+            (vec![1.0, 2.0, 4.0], vec![-1.0, -2.0, 0.0])
+        );
+        // without the rows (a material given without its 3D tensors) the unknowns are NaN
+        let t = fields(3, 2, vec![]).tensors(1, 2);
+        assert!(t.stress[2].is_nan() && t.stress[3] == 3.0 && t.electric_displacement[2].is_nan());
+        let t = fields(4, 2, vec![]).tensors(1, 2);
+        assert_eq!(t.stress, [1.0, 2.0, 4.0, 3.0, 0.0, 0.0]);
+        assert_eq!(t.strain, [10.0, 20.0, 40.0, 15.0, 0.0, 0.0]);
+        assert_eq!(t.electric_displacement, [1.0, 2.0, 0.0]);
+        assert_eq!(fields(6, 3, vec![]).tensors(0, 3), Tensors::default());
+    }
 }

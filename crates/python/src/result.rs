@@ -4,8 +4,8 @@
 use crate::arrays::{lend, owned};
 use crate::errors::{to_py, Kind};
 use crate::values::from_json;
-use numpy::ndarray::{s, ArrayView1, ArrayView2};
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::ndarray::{s, Array2, Array3, ArrayView1, ArrayView2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -94,6 +94,17 @@ fn columns(rows: &[[f64; 3]], dim: usize) -> ArrayView2<'_, f64> {
     full.slice_move(s![.., ..dim])
 }
 
+/// Symmetric tensors of six components in VTK's order (`xx, yy, zz, xy, yz, xz`) as full
+/// `(n, 3, 3)` matrices.
+fn full_tensors(six: &[f64]) -> Array3<f64> {
+    let n = six.len() / 6;
+    Array3::from_shape_fn((n, 3, 3), |(i, a, b)| {
+        // the position in VTK's order of the pair (a, b)
+        const AT: [[usize; 3]; 3] = [[0, 3, 5], [3, 1, 4], [5, 4, 2]];
+        six[6 * i + AT[a][b]]
+    })
+}
+
 /// The `(n / width, width)` view of a flat list.
 fn table(flat: &[f64], width: usize) -> ArrayView2<'_, f64> {
     let rows = flat.len().checked_div(width).unwrap_or(0);
@@ -109,6 +120,11 @@ impl RunResult {
     /// rz, θθ]`), 6 in 3D.
     fn nv(&self) -> usize {
         self.solution.fields.stress.len() / self.solution.mesh.n_cells().max(1)
+    }
+
+    /// The per-cell fields as 3D tensors and vectors.
+    fn cell_tensors(&self) -> problem::Tensors {
+        self.solution.fields.tensors(self.solution.mesh.n_cells(), self.dim())
     }
 
     /// The meshio cell type of the mesh's cells.
@@ -199,6 +215,25 @@ impl RunResult {
     fn electric_field<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let r = this.get();
         lend(this.as_any(), table(&r.solution.fields.electric_field, r.dim()))
+    }
+
+    /// Stress per cell as full symmetric 3x3 tensors, (n_cells, 3, 3), in every dimension: in
+    /// plane strain with the stresses across the plane (σ_zz, and σ_yz, σ_xz where the
+    /// material couples them), on a body of revolution in the axes (r, z, θ) (its hoop
+    /// stress at [2, 2]), in 3D (x, y, z). The same values as `stress`, laid out so that
+    /// no Voigt order needs knowing (the invariants, `numpy.linalg.eigvalsh`, von Mises).
+    #[getter]
+    fn stress_tensor<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        let t = self.cell_tensors();
+        owned(py, full_tensors(&t.stress))
+    }
+
+    /// Strain per cell as full symmetric 3x3 tensors (tensor shears, ε_xy = γ_xy / 2), shaped
+    /// and laid out as `stress_tensor` (in plane strain its out-of-plane components are 0).
+    #[getter]
+    fn strain_tensor<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        let t = self.cell_tensors();
+        owned(py, full_tensors(&t.strain))
     }
 
     /// On quadratic (P2) cells, whose fields vary across each cell: the fields at the nodes,
@@ -359,7 +394,10 @@ impl RunResult {
     }
 
     /// The solution as a `meshio.Mesh` (needs meshio): 3-component points and `u` as ParaView
-    /// takes them, `phi` and `contact_status` as point data, the per-cell fields as cell data;
+    /// takes them, `phi` and `contact_status` as point data, the per-cell fields as cell data
+    /// as solution.vtu holds them (`stress`, `strain` six components in VTK's tensor order,
+    /// `xx, yy, zz, xy, yz, xz`, tensor shears; `electric_displacement`, `electric_field`
+    /// three);
     /// from there, `meshio.write`, PyVista (`pyvista.from_meshio`) and the rest.
     fn to_meshio<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
         let py = this.py();
@@ -382,17 +420,30 @@ impl RunResult {
             }
             point_data.set_item("contact_status", status.into_pyarray(py))?;
         }
-        if let Some(at) = Self::fields_at_nodes(this)? {
+        // the fields as the files hold them: tensors of six components in VTK's order (which
+        // ParaView reads as XX, YY, ZZ, XY, YZ, XZ), vectors of three
+        let viewed = |t: problem::Tensors| -> [(&str, Bound<'py, PyArray2<f64>>); 4] {
+            let rows = |flat: Vec<f64>, w: usize| {
+                let n = flat.len() / w;
+                owned(py, Array2::from_shape_vec((n, w), flat).expect("whole rows"))
+            };
+            [
+                ("stress", rows(t.stress, 6)),
+                ("strain", rows(t.strain, 6)),
+                ("electric_displacement", rows(t.electric_displacement, 3)),
+                ("electric_field", rows(t.electric_field, 3)),
+            ]
+        };
+        if let Some(at) = &r.solution.fields.at_nodes {
             // P2 cells: the fields at the nodes beside the cells'
-            for (name, values) in at.iter() {
+            for (name, values) in viewed(at.tensors(r.solution.mesh.n_nodes(), r.dim())) {
                 point_data.set_item(name, values)?;
             }
         }
         let cell_data = PyDict::new(py);
-        cell_data.set_item("stress", [Self::stress(this)?])?;
-        cell_data.set_item("strain", [Self::strain(this)?])?;
-        cell_data.set_item("electric_displacement", [Self::electric_displacement(this)?])?;
-        cell_data.set_item("electric_field", [Self::electric_field(this)?])?;
+        for (name, values) in viewed(r.cell_tensors()) {
+            cell_data.set_item(name, [values])?;
+        }
         let kwargs = PyDict::new(py);
         kwargs.set_item("point_data", point_data)?;
         kwargs.set_item("cell_data", cell_data)?;

@@ -45,8 +45,18 @@ def test_the_results_are_the_programs_outputs(binary, tmp_path, name, overrides)
     assert np.array_equal(r.cells, vtu.cells[0].data)
     close(r.u, vtu.point_data["u"][:, :dim])
     close(r.phi, vtu.point_data["phi"].ravel())
-    for field in ["stress", "strain", "electric_displacement", "electric_field"]:
-        close(getattr(r, field), vtu.cell_data[field][0])
+    # the file's tensors in VTK's order (xx, yy, zz, xy, yz, xz), tensor shears; vectors of 3
+    pairs = ([0, 1, 2, 0, 1, 0], [0, 1, 2, 1, 2, 2])
+    close(r.stress_tensor[:, pairs[0], pairs[1]], vtu.cell_data["stress"][0])
+    close(r.strain_tensor[:, pairs[0], pairs[1]], vtu.cell_data["strain"][0])
+    for field in ["electric_displacement", "electric_field"]:
+        close(getattr(r, field), vtu.cell_data[field][0][:, :dim])
+    # and the tensors hold the Voigt arrays: [xx, yy, xy] in plane strain, [xx, yy, zz, yz,
+    # xz, xy] in 3D, the strain's engineering shears twice the tensor's
+    voigt = ([0, 1, 0], [0, 1, 1]) if dim == 2 else ([0, 1, 2, 1, 0, 0], [0, 1, 2, 2, 2, 1])
+    close(r.stress, r.stress_tensor[:, voigt[0], voigt[1]])
+    shear = np.array([1.0 if a == b else 2.0 for a, b in zip(*voigt)])
+    close(r.strain, r.strain_tensor[:, voigt[0], voigt[1]] * shear)
     # contact.csv is written with 13 significant digits
     rows = csv_rows(out / "contact.csv")
     c = r.contact
@@ -165,11 +175,31 @@ def test_to_meshio_writes_and_reads_back(tmp_path):
     assert m.points.shape == (len(r.points), 3)
     assert set(m.point_data) == {"u", "phi", "contact_status"}
     assert set(m.cell_data) == {"stress", "strain", "electric_displacement", "electric_field"}
+    assert m.cell_data["stress"][0].shape == (len(r.cells), 6)
+    assert m.cell_data["electric_field"][0].shape == (len(r.cells), 3)
     meshio.write(tmp_path / "s.vtu", m)
     back = meshio.read(tmp_path / "s.vtu")
     close(back.point_data["u"][:, :2], r.u)
     on_contact = back.point_data["contact_status"][r.contact.node]
     assert np.array_equal(on_contact, r.contact.status)
+
+
+def test_plane_strain_stress_holds_the_stress_across_the_plane(tmp_path):
+    """In plane strain the stress across the plane is not zero: Hooke's law with ε_zz = 0 gives
+    σ_zz = ν (σ_xx + σ_yy) in an isotropic body; solution.vtu and `stress_tensor` carry it,
+    and the tensor's invariants are the 3D state's."""
+    r = pc.run(pc.Scene.load("hertz", {"mesh.n": 8}))
+    t = r.stress_tensor
+    nu = 0.3
+    close(t[:, 2, 2], nu * (t[:, 0, 0] + t[:, 1, 1]), 1e-12)
+    assert np.abs(t[:, 2, 2]).max() > 0.1 * np.abs(t).max()
+    assert np.all(t[:, 0, 2] == 0.0) and np.all(t[:, 1, 2] == 0.0)
+    assert np.array_equal(t, np.transpose(t, (0, 2, 1)))
+    e = r.strain_tensor
+    assert np.all(e[:, 2, :] == 0.0)
+    r.write(tmp_path)
+    vtu = meshio.read(tmp_path / "solution.vtu")
+    close(vtu.cell_data["stress"][0][:, 2], t[:, 2, 2])
 
 
 def test_progress_reaches_a_callable():

@@ -235,6 +235,7 @@ fn rank_0s_solution(g: distributed::Gathered, source: &Source, peaks: Vec<u64>) 
             electric_displacement: vec![],
             strain: vec![],
             electric_field: vec![],
+            out_of_plane: vec![],
             at_nodes: None,
         },
         contact: g.contact,

@@ -299,26 +299,22 @@ impl<'a> FieldArrays<'a> {
                 point.push(named("contact_flux", 1, Cow::Owned(flux)));
             }
         }
-        // the four fields, `count` entries (cells or nodes) of them: Voigt components 3 in
-        // plane strain, 4 on a body of revolution ([rr, zz, rz, θθ]), 6 in 3D
-        let four = |count: usize, [s, e, d, f]: [&'a [f64]; 4]| {
-            let nv = s.len() / count.max(1);
+        // the four fields as 3D tensors and vectors, which ParaView reads as such (the six
+        // components of a symmetric tensor in VTK's order, tensor shears; plane strain's
+        // σ_zz and D_z; a body of revolution's hoop components along z)
+        let four = |t: problem::Tensors| {
             vec![
-                named("stress", nv, Cow::Borrowed(s)),
-                named("strain", nv, Cow::Borrowed(e)),
-                named("electric_displacement", mesh.dim, Cow::Borrowed(d)),
-                named("electric_field", mesh.dim, Cow::Borrowed(f)),
+                named("stress", 6, Cow::Owned(t.stress)),
+                named("strain", 6, Cow::Owned(t.strain)),
+                named("electric_displacement", 3, Cow::Owned(t.electric_displacement)),
+                named("electric_field", 3, Cow::Owned(t.electric_field)),
             ]
         };
         if let Some(at) = cells.and_then(|f| f.at_nodes.as_ref()) {
             // P2 cells: the fields at the nodes too, which ParaView draws quadratic
-            let arrays = [&at.stress, &at.strain, &at.electric_displacement, &at.electric_field];
-            point.extend(four(mesh.n_nodes(), arrays.map(|a| &a[..])));
+            point.extend(four(at.tensors(mesh.n_nodes(), mesh.dim)));
         }
-        let cell = cells.map_or(vec![], |f| {
-            let arrays = [&f.stress, &f.strain, &f.electric_displacement, &f.electric_field];
-            four(mesh.n_cells(), arrays.map(|a| &a[..]))
-        });
+        let cell = cells.map_or(vec![], |f| four(f.tensors(mesh.n_cells(), mesh.dim)));
         FieldArrays { point, cell }
     }
 
@@ -375,8 +371,9 @@ fn contact_point_data(c: &ContactResult, n_nodes: usize) -> ContactPointData {
 /// A body of revolution's solution swept round its axis (y) in `segments` steps: each meridian
 /// triangle `(r, z)` a ring of wedges, the point `(r, z)` at the angle θ at `(r cos θ, z, r sin θ)`
 /// (points on the axis repeated at every angle). Point data `u` (Cartesian: `u_r` turned by θ),
-/// `phi`; cell data `stress` and `strain` in the body's own components `[rr, zz, rz, θθ]`,
-/// `electric_displacement` and `electric_field` Cartesian (turned by the wedge's mid-angle).
+/// `phi`; cell data `stress` and `strain` as Cartesian tensors in VTK's order,
+/// `electric_displacement` and `electric_field` as Cartesian vectors, each turned by the
+/// wedge's mid-angle from the meridian's (where the hoop direction is z).
 fn revolved_vtu(
     mesh: &mesh::Mesh,
     (u, phi): (&[[f64; 3]], &[f64]),
@@ -396,7 +393,8 @@ fn revolved_vtu(
         }
     }
     let (mut connectivity, mut offsets) = (vec![], vec![]);
-    let nv = fields.stress.len() / cells.max(1);
+    // the meridian's tensors (x = r, y = z, the hoop direction along z), turned with each wedge
+    let meridian = fields.tensors(cells, 2);
     let (mut stress, mut strain, mut d, mut e) = (vec![], vec![], vec![], vec![]);
     for k in 0..segments {
         let (lo, hi) = ((k * n) as u64, (((k + 1) % segments) * n) as u64);
@@ -412,13 +410,14 @@ fn revolved_vtu(
                 connectivity.extend(part.iter().map(|&q| hi + t[q] as u64));
                 connectivity.extend(part.iter().map(|&q| lo + t[q] as u64));
                 offsets.push(connectivity.len() as u64);
-                stress.extend_from_slice(&fields.stress[cell * nv..(cell + 1) * nv]);
-                strain.extend_from_slice(&fields.strain[cell * nv..(cell + 1) * nv]);
+                for (out, of) in [(&mut stress, &meridian.stress), (&mut strain, &meridian.strain)] {
+                    out.extend(turned_about_y(&of[6 * cell..6 * cell + 6], c, s));
+                }
                 for (out, of) in [
-                    (&mut d, &fields.electric_displacement),
-                    (&mut e, &fields.electric_field),
+                    (&mut d, &meridian.electric_displacement),
+                    (&mut e, &meridian.electric_field),
                 ] {
-                    let (vr, vz) = (of[2 * cell], of[2 * cell + 1]);
+                    let (vr, vz) = (of[3 * cell], of[3 * cell + 1]);
                     out.extend([vr * c, vz, vr * s]);
                 }
             }
@@ -436,12 +435,27 @@ fn revolved_vtu(
         cell_type: CellType::Wedge,
         point: vec![array("u", 3, &uu), array("phi", 1, &pp)],
         cell: vec![
-            array("stress", nv, &stress),
-            array("strain", nv, &strain),
+            array("stress", 6, &stress),
+            array("strain", 6, &strain),
             array("electric_displacement", 3, &d),
             array("electric_field", 3, &e),
         ],
     }))
+}
+
+/// A symmetric tensor in VTK's order (`xx, yy, zz, xy, yz, xz`) turned about the y axis by
+/// the angle of cosine `c` and sine `s` that takes x to `(c, 0, s)`: `Q T Qᵀ`, the columns of
+/// `Q` the turned axes `(c, 0, s)`, `(0, 1, 0)`, `(-s, 0, c)`.
+fn turned_about_y(t: &[f64], c: f64, s: f64) -> [f64; 6] {
+    let m = [[t[0], t[3], t[5]], [t[3], t[1], t[4]], [t[5], t[4], t[2]]];
+    let q = [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]];
+    let at = |i: usize, j: usize| {
+        (0..3)
+            .flat_map(|k| (0..3).map(move |l| (k, l)))
+            .map(|(k, l)| q[i][k] * m[k][l] * q[j][l])
+            .sum::<f64>()
+    };
+    [at(0, 0), at(1, 1), at(2, 2), at(0, 1), at(1, 2), at(0, 2)]
 }
 
 /// A CSV field as RFC 4180 writes it: quoted (its quotes doubled) where it holds a comma, a
@@ -1093,6 +1107,76 @@ mod tests {
         }
     }
 
+    /// The cell arrays a viewer reads: a symmetric tensor of six components in VTK's order
+    /// (ParaView's XX, YY, ZZ, XY, YZ, XZ) with tensor shears, a vector of three. A 3D affine
+    /// patch of the PZT block poled along y, sheared by `∂u_x/∂y` alone, is a pure xy shear:
+    /// `ε_xy = γ/2` and `σ_xy = c44 γ` (docs/scenes.md's c44 = 21.1 GPa; the poling axis
+    /// lies in the plane), in slot 3 of every cell and nowhere else. In plane strain the
+    /// stress across the plane, which the Voigt rows `[xx, yy, xy]` leave out, is in slot 2.
+    #[test]
+    fn tensors_are_written_in_vtks_order_with_tensor_shears() {
+        let cell_array = |overrides: &[&str]| {
+            let set: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+            let (scene, _) = crate::scene_file::load("patch", &set).unwrap();
+            let s = problem::solve(&scene, None, &mut problem::Silent).unwrap();
+            let bytes = vtu(&s.mesh, (&s.u, &s.phi), &s.fields, None).unwrap();
+            let vtk = Vtk::parse_xml(&bytes[..]).unwrap();
+            let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+                panic!("not a grid")
+            };
+            let vtkio::model::Piece::Inline(piece) = &pieces[0] else {
+                panic!("not inline")
+            };
+            let cell = piece.data.cell.clone();
+            move |name: &str| -> (usize, Vec<f64>) {
+                cell.iter()
+                    .find_map(|a| match a {
+                        vtkio::model::Attribute::DataArray(d) if d.name == name => {
+                            Some((d.elem.num_comp() as usize, d.data.clone().cast_into().unwrap()))
+                        }
+                        _ => None,
+                    })
+                    .unwrap_or_else(|| panic!("no cell array {name}"))
+            }
+        };
+        let gamma = 1e-3;
+        let array = cell_array(&[
+            "mesh.kind=\"box\"",
+            "mesh.lo=[0, 0, 0]",
+            "mesh.hi=[2, 1, 1]",
+            "mesh.n=2",
+            "exact.u0=[0, 0, 0]",
+            "exact.grad_u=[0, 1e-3, 0, 0, 0, 0, 0, 0, 0]",
+            "exact.grad_phi=[0, 0, 0]",
+        ]);
+        let ((ns, stress), (ne, strain), (nd, d)) = (array("stress"), array("strain"), array("electric_field"));
+        assert_eq!((ns, ne, nd), (6, 6, 3));
+        for (t, e) in stress.chunks(6).zip(strain.chunks(6)) {
+            for k in 0..6 {
+                let (want_s, want_e) = if k == 3 {
+                    (21.1 * gamma, gamma / 2.0)
+                } else {
+                    (0.0, 0.0)
+                };
+                assert!(
+                    (t[k] - want_s).abs() < 1e-12 && (e[k] - want_e).abs() < 1e-15,
+                    "{t:?} {e:?}"
+                );
+            }
+        }
+        assert!(d.iter().all(|x| x.abs() < 1e-14));
+        // plane strain: ε_xx and ε_yy of the PZT block poled along y carry σ_zz = c12 ε_xx +
+        // c13 ε_yy (z is a crystal 1-axis beside x, y the 3-axis) and E = -∇φ's σ_zz = e31 ∂_y φ
+        let array = cell_array(&["exact.grad_u=[1e-3, 0, 0, -2e-3]", "exact.grad_phi=[0, 0.05]"]);
+        let ((ns, stress), (nd, field)) = (array("stress"), array("electric_field"));
+        assert_eq!((ns, nd), (6, 3));
+        let zz = 75.4 * 1e-3 + 75.2 * -2e-3 + -5.4 * 0.05;
+        for (t, e) in stress.chunks(6).zip(field.chunks(3)) {
+            assert!((t[2] - zz).abs() < 1e-12 && t[4] == 0.0 && t[5] == 0.0, "{t:?}");
+            assert!((e[1] + 0.05).abs() < 1e-12 && e[2] == 0.0, "{e:?}");
+        }
+    }
+
     /// The contact values in every ParaView file (the solution's and a path's steps): the
     /// pressure and the tangential traction of each contact node read back as the solution's
     /// multipliers (the traction along the paper's tangent x), their weighted sum the normal
@@ -1145,6 +1229,39 @@ mod tests {
         );
     }
 
+    /// A meridian's tensor turned with its wedge: at the angle θ its radial, axial and hoop
+    /// components are those along `(cos θ, 0, sin θ)`, `y` and `(-sin θ, 0, cos θ)`, and its
+    /// trace and norm are unchanged.
+    #[test]
+    fn a_meridian_tensor_turns_with_its_wedge() {
+        // [rr, zz (y), θθ, rz, zθ, rθ]: a body of revolution has no shear with the hoop
+        let t = [3.0, -1.0, 2.0, 0.5, 0.0, 0.0];
+        assert_eq!(turned_about_y(&t, 1.0, 0.0), t);
+        for theta in [0.3f64, 1.2, 2.5, 4.0] {
+            let (c, s) = (theta.cos(), theta.sin());
+            let g = turned_about_y(&t, c, s);
+            let m = [[g[0], g[3], g[5]], [g[3], g[1], g[4]], [g[5], g[4], g[2]]];
+            let along = |a: [f64; 3], b: [f64; 3]| -> f64 {
+                (0..3)
+                    .flat_map(|i| (0..3).map(move |j| (i, j)))
+                    .map(|(i, j)| a[i] * m[i][j] * b[j])
+                    .sum()
+            };
+            let (r, y, h) = ([c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]);
+            for (got, want) in [
+                (along(r, r), t[0]),
+                (along(y, y), t[1]),
+                (along(h, h), t[2]),
+                (along(r, y), t[3]),
+                (along(y, h), 0.0),
+                (along(r, h), 0.0),
+                (g[0] + g[1] + g[2], t[0] + t[1] + t[2]),
+            ] {
+                assert!((got - want).abs() < 1e-14, "θ = {theta}: {got} against {want}");
+            }
+        }
+    }
+
     #[test]
     fn a_body_of_revolution_is_swept_into_wedges_that_face_out() {
         let mesh = mesh::rectangle_tri([0.0, 0.0], [1.0, 2.0], 2, 4);
@@ -1158,6 +1275,7 @@ mod tests {
             strain: vec![0.5; 4 * cells],
             electric_displacement: [1.0, 0.0].repeat(cells),
             electric_field: [0.0, 1.0].repeat(cells),
+            out_of_plane: vec![],
             at_nodes: None,
         };
         let bytes = revolved_vtu(&mesh, (&u, &phi), &fields, 12).unwrap();
