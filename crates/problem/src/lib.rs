@@ -86,7 +86,7 @@ pub use capacitance::Capacitance;
 pub use estimate::{Bytes, BASE_BYTES};
 pub use exact::{contact_errors, ExactReport};
 pub use factorization::{Factorization, Refinement};
-pub use fe_assembly::CellFields;
+pub use fe_assembly::{CellFields, Tensors};
 pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
 pub use instants::Instants;
 pub use path::{check_history_scales, run, run_steps, step_loads, step_row, PathSolution, Step, StepFields};

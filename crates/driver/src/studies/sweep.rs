@@ -97,6 +97,9 @@ pub fn sweep(
         }
     }
     let integer = integer_key(scene, sets, param, [*from, *to]);
+    if integer {
+        whole_points(param, *from, *to, *steps)?;
+    }
     let mut rows = vec![];
     let mut eta = super::Eta::default();
     let mut first_error: Option<files::Error> = None;
@@ -175,6 +178,26 @@ pub fn sweep(
         });
     }
     Ok(rows)
+}
+
+/// An integer key's sweep (`mesh.n`, `path.steps`): its points are rounded to whole numbers,
+/// so its bounds must be whole and its steps no more than the whole numbers between them
+/// (else two points would run the same value, or a bound would not be the one asked for).
+fn whole_points(param: &str, from: f64, to: f64, steps: usize) -> Result<(), DriverError> {
+    for (name, v) in [("--from", from), ("--to", to)] {
+        if v.fract() != 0.0 {
+            return Err(DriverError::Usage(format!(
+                "sweep {name} {v}: {param} takes whole numbers"
+            )));
+        }
+    }
+    let distinct = (to - from).abs() + 1.0;
+    if steps as f64 > distinct {
+        return Err(DriverError::Usage(format!(
+            "sweep --steps {steps}: {param} takes whole numbers, and there are {distinct} from {from} to {to} (give --steps {distinct} at most)"
+        )));
+    }
+    Ok(())
 }
 
 impl SweepRow {
@@ -256,7 +279,21 @@ fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> b
         });
     match found {
         Some(v) => v.is_integer(),
-        None => bounds.iter().all(|b| b.fract() == 0.0 && b.abs() < 2f64.powi(53)),
+        // a key the scene leaves unset: its type is the one the scene's reader takes (an
+        // integer key refuses `4.0`, a real one takes it), never a guess from the bounds,
+        // which are whole for many a real key's sweep (`coupling_scale` from 0 to 1)
+        None => {
+            let takes = |value: String| {
+                let mut s = sets.to_vec();
+                s.push(format!("{param}={value}"));
+                files::scene_file::load(scene, &s).is_ok()
+            };
+            let [from, _] = bounds;
+            from.fract() == 0.0
+                && from.abs() < 2f64.powi(53)
+                && !takes(format!("{from:?}"))
+                && takes(format!("{}", from as i64))
+        }
     }
 }
 
@@ -566,22 +603,60 @@ mod tests {
     #[test]
     fn a_sweep_knows_an_integer_key_from_the_scene() {
         // written as the integers they are set to
-        let spec = SweepSpec {
-            param: "mesh.n".into(),
-            from: 4.0,
-            to: 7.6,
-            steps: 2,
+        let spec = |param: &str, from: f64, to: f64, steps: usize| SweepSpec {
+            param: param.into(),
+            from,
+            to,
+            steps,
         };
-        let rows = sweep("paper", &[], &spec, None, &mut |_| {}).unwrap();
-        let text = csv(&spec.param, &rows, true);
+        let s = spec("mesh.n", 4.0, 8.0, 2);
+        let rows = sweep("paper", &[], &s, None, &mut |_| {}).unwrap();
+        let text = csv(&s.param, &rows, true);
         let first: Vec<&str> = text.lines().skip(1).map(|l| l.split(',').next().unwrap()).collect();
         assert_eq!(first, ["4", "8"]);
+        // a bound that is not whole, or more points than whole numbers, would run another
+        // value than asked or one value twice: refused, naming the key
+        for (bad, says) in [
+            (
+                spec("mesh.n", 4.0, 7.6, 2),
+                "sweep --to 7.6: mesh.n takes whole numbers",
+            ),
+            (
+                spec("mesh.n", 4.0, 8.0, 6),
+                "there are 5 from 4 to 8 (give --steps 5 at most)",
+            ),
+            (spec("mesh.nx", 8.0, 16.5, 2), "mesh.nx takes whole numbers"),
+        ] {
+            let e = sweep("paper", &[], &bad, None, &mut |_| {}).unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        }
         assert!(integer_key("paper", &[], "mesh.n", [8.0, 9.5]));
         assert!(!integer_key("paper", &[], "load.p", [-4.0, -2.0]));
         assert!(integer_key("cattaneo-mindlin-cycle", &[], "path.steps", [3.0, 7.0]));
         assert!(!integer_key("corner", &[], "contact.1.gap", [-1.0, 0.0]));
-        // a key the scene leaves out: whole bounds read as integers
+        // a key the scene leaves out: the type its reader takes, whatever the bounds
         assert!(integer_key("paper", &[], "mesh.nx", [8.0, 16.0]));
-        assert!(!integer_key("paper", &[], "mesh.nx", [8.0, 16.5]));
+        assert!(!integer_key("paper", &[], "material.0.coupling_scale", [0.0, 1.0]));
+        assert!(!integer_key("paper", &[], "contact.slip_bound", [0.0, 2.0]));
+    }
+
+    /// A real key the scene leaves unset, swept between whole bounds, runs its points as given
+    /// (they were once rounded to the bounds: coupling_scale 0, 0, 1, 1, 1 for 0 to 1 in 5).
+    #[test]
+    fn an_unset_real_key_is_swept_at_its_points() {
+        let s = SweepSpec {
+            param: "material.0.coupling_scale".into(),
+            from: 0.0,
+            to: 1.0,
+            steps: 5,
+        };
+        let rows = sweep("paper", &["mesh.n=4".into()], &s, None, &mut |_| {}).unwrap();
+        let values: Vec<f64> = rows.iter().map(|r| r.value).collect();
+        assert_eq!(values, [0.0, 0.25, 0.5, 0.75, 1.0]);
+        let forces: Vec<f64> = rows.iter().map(|r| r.normal_force).collect();
+        assert!(
+            forces.windows(2).all(|w| w[0] != w[1]),
+            "each point its own run: {forces:?}"
+        );
     }
 }
