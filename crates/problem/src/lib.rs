@@ -100,7 +100,7 @@ pub use scene::{
     LoadSpec, Loads, MaterialModel, MaterialSpec, MeshKind, MeshSpec, PathSpec, RegionSpec, Rule, Scene, SceneError,
     SlipBoundProfile, SolverSpec, Strategy, Valid,
 };
-pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel, DEFAULT_FRAMES};
+pub use scene::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel, DEFAULT_FRAMES, TOL_RANGE};
 pub use scene::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, CRYSTALS};
 pub use setup::cell_electric;
 pub use shared_memory::SharedMemory;

@@ -256,6 +256,18 @@ fn check(spec: &StudySpec) -> Result<(), DriverError> {
     if let Some(t) = spec.tols.iter().find(|t| !(**t > 0.0 && t.is_finite())) {
         return Err(DriverError::Usage(format!("tolerance {t} must be positive")));
     }
+    // the runs' solver.tol: refused here, before any run, rather than after the first ones
+    let (lo, hi) = problem::TOL_RANGE;
+    if let Some(t) = spec.tols.iter().find(|t| !(lo..=hi).contains(*t)) {
+        return Err(DriverError::Usage(format!(
+            "tolerance {t:e} is outside [{lo:e}, {hi:e}], the range of solver.tol"
+        )));
+    }
+    if spec.sizes.contains(&0) {
+        return Err(DriverError::Usage(
+            "mesh size 0: the sizes are values of mesh.n, at least 1".into(),
+        ));
+    }
     Ok(())
 }
 
@@ -298,10 +310,13 @@ pub fn study(
     sizes.sort_unstable();
     sizes.dedup();
     let (base, _) = files::scene_file::load(scene_name, sets)?;
-    let orders = match spec.orders.is_empty() {
+    let mut orders = match spec.orders.is_empty() {
         true => vec![base.mesh.order.unwrap_or(1)],
         false => spec.orders.clone(),
     };
+    // each order once, as each size (`--orders 1,1` would run every point twice)
+    orders.sort_unstable();
+    orders.dedup();
     if let Some(o) = orders.iter().find(|o| !(1..=2).contains(*o)) {
         return Err(DriverError::Usage(format!("element order {o}: the orders are 1 and 2")));
     }
@@ -644,5 +659,29 @@ mod tests {
         };
         let e = study("paper", &[], &spec, &mut |_| {}).unwrap_err().to_string();
         assert!(e.contains("multiple of the largest size"), "{e}");
+        // refused before any run: a tolerance solver.tol would refuse, a size of no cells
+        let mut runs = 0;
+        for (bad, says) in [
+            (
+                StudySpec {
+                    tols: vec![1e-6, 1e-30],
+                    reference_n: None,
+                    ..spec.clone()
+                },
+                "tolerance 1e-30 is outside [1e-15, 1e-1]",
+            ),
+            (
+                StudySpec {
+                    sizes: vec![0, 4],
+                    reference_n: None,
+                    ..spec.clone()
+                },
+                "mesh size 0",
+            ),
+        ] {
+            let e = study("paper", &[], &bad, &mut |_| runs += 1).unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        }
+        assert_eq!(runs, 0);
     }
 }

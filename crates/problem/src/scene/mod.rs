@@ -13,7 +13,7 @@ use std::fmt;
 
 use crystals::named as named_crystal;
 pub use crystals::{CrystalUnits, Datasheet, NamedCrystal, StressCharge, LIBRARY as CRYSTALS};
-pub use validate::{SceneError, Valid};
+pub use validate::{SceneError, Valid, TOL_RANGE};
 pub use zone::{Control, Friction, Obstacle, ZoneBound, ZoneElectric, ZoneModel};
 
 /// An enum of named choices: serde reads and writes the names, `name()` gives them, `ALL` lists

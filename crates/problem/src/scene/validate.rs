@@ -489,11 +489,12 @@ fn validate_mesh(m: &MeshSpec) -> Result<(), SceneError> {
             "mesh.revolve",
             "mesh.revolve sweeps a body of revolution round its axis, and mesh.axisymmetric is not set",
         )?;
-        refuse_if(
-            !(3..=360).contains(&k),
-            "mesh.revolve",
-            &format!("mesh.revolve = {k}: the segments of the revolved view must number 3 to 360"),
-        )?;
+        if !(3..=360).contains(&k) {
+            return Err(SceneError::new(
+                "mesh.revolve",
+                format!("mesh.revolve = {k}: the segments of the revolved view must number 3 to 360"),
+            ));
+        }
     }
     if m.cylinder {
         refuse_if(
@@ -808,11 +809,12 @@ fn validate_slip_bound_profile(p: &SlipBoundProfile, uniform: bool) -> Result<()
             ),
         ));
     }
-    refuse_if(
-        p.at.windows(2).any(|w| w[0] >= w[1]),
-        &format!("{key}.at"),
-        "contact.slip_bound_profile.at must increase strictly",
-    )?;
+    if p.at.windows(2).any(|w| w[0] >= w[1]) {
+        return Err(SceneError::new(
+            &format!("{key}.at"),
+            "contact.slip_bound_profile.at must increase strictly".to_string(),
+        ));
+    }
     if let Some(v) = p.value.iter().find(|&&v| v < 0.0) {
         return Err(SceneError::new(
             &format!("{key}.value"),
@@ -1443,11 +1445,12 @@ fn validate_field_solution(x: &ExactSpec, s: &Scene) -> Result<(), SceneError> {
             "exact.slip",
             "the slip of the face of exact.kind = \"manufactured-contact\", and exact.kind is another",
         )?;
-        refuse_if(
-            !(a > 0.0 && a.is_finite()),
-            "exact.slip",
-            &format!("exact.slip = {a}: the face's slip amplitude must be positive and finite"),
-        )?;
+        if !(a > 0.0 && a.is_finite()) {
+            return Err(SceneError::new(
+                "exact.slip",
+                format!("exact.slip = {a}: the face's slip amplitude must be positive and finite"),
+            ));
+        }
     }
     if kind != ExactKind::Affine {
         let why = "data of an affine solution, and exact.kind is a manufactured one";
