@@ -114,6 +114,40 @@ fn three_terminals_are_reciprocal_and_joined_groups_are_one_conductor() {
     assert!(joined.matrix[1][1] > c.matrix[2][2], "{joined:?} {c:?}");
 }
 
+/// A floating terminal is a conductor like the others in the capacitance matrix, whether a
+/// floating `dirichlet.charge` or a floating `[[electrode]]` (whose row and column were once
+/// zeros: its potential was never set to a column's unit), and the matrix is the one of the
+/// same electrode at a voltage.
+#[test]
+fn a_floating_electrode_is_a_terminal_of_the_capacitance() {
+    let sets = |second: &str| -> Vec<String> {
+        vec![
+            "mesh.n=8".into(),
+            "electrode.0.x_range=[0.25, 0.75]".into(),
+            format!("electrode.1={{group=\"top\", name=\"second\", {second}, x_range=[1.25, 1.75]}}"),
+        ]
+    };
+    let matrix = |second: &str| {
+        let (scene, _) = files::scene_file::load("actuator", &sets(second)).unwrap();
+        problem::capacitance(&scene, None).unwrap()
+    };
+    let (floating, driven) = (matrix("charge=0.0"), matrix("v=1.0"));
+    assert_eq!(floating.terminals, ["left", "right", "electrode", "second"]);
+    assert_eq!(floating.terminals, driven.terminals);
+    for (row_f, row_d) in floating.matrix.iter().zip(&driven.matrix) {
+        for (f, d) in row_f.iter().zip(row_d) {
+            assert!(
+                (f - d).abs() <= 1e-12 * driven.matrix[3][3],
+                "{floating:?} against {driven:?}"
+            );
+        }
+    }
+    assert!(
+        floating.matrix[3][3] > 0.0 && floating.column_sum < 1e-10,
+        "{floating:?}"
+    );
+}
+
 #[test]
 fn a_scene_without_terminals_or_permittivity_is_refused_by_name() {
     let mut scene = plate(false, false);
@@ -125,6 +159,11 @@ fn a_scene_without_terminals_or_permittivity_is_refused_by_name() {
     let (elastic, _) = files::scene_file::load("hertz-sphere", &[]).unwrap();
     let e = problem::capacitance(&elastic, None).unwrap_err();
     assert!(e.to_string().contains("no electric unknowns"), "{e}");
+    // one conductor: its capacitance to nothing is 0, and what a solve gives is round-off
+    // (indent-sphere grounds its top alone: 2.8e-10 pC/kV was printed, Gauss's check 1.0)
+    let (one, _) = files::scene_file::load("indent-sphere", &["mesh.n=4".into()]).unwrap();
+    let e = problem::capacitance(&one, None).unwrap_err();
+    assert!(e.to_string().contains("one terminal (`top`)"), "{e}");
 }
 
 /// The plate pressed by `p` on its top, its top electrode floating with `charge` on it.

@@ -63,6 +63,15 @@ pub(crate) fn capacitance<B: Backend>(
         d.phi = Some(0.0);
         d.charge = None;
     }
+    for e in scene
+        .electrode
+        .iter_mut()
+        .flat_map(|e| e.all_mut())
+        .filter(|e| e.charge.is_some())
+    {
+        e.v = Some(0.0);
+        e.charge = None;
+    }
     let valid = scene.validate().map_err(ProblemError::from)?;
     let setup = setup(valid, mesh)?;
     if !setup.plan.electric {
@@ -78,6 +87,14 @@ pub(crate) fn capacitance<B: Backend>(
     disc.check_held()
         .map_err(|e| ProblemError::from(AssemblyError::from(e)))?;
     let (conductor, names) = conductors(&setup.mesh, &groups)?;
+    if let [one] = &names[..] {
+        // every flux that leaves one conductor enters it again: its capacitance is 0, and a
+        // number computed for it is round-off
+        let why = format!(
+            "the scene has one terminal (`{one}`), and a capacitance is between two conductors at least: ground another group (dirichlet.phi) or add an [electrode]"
+        );
+        return Err(ProblemError::from(SetupError::new("dirichlet", &why)).into());
+    }
     let mut member = vec![None; setup.mesh.n_nodes()];
     for (g, group) in groups.iter().enumerate() {
         for v in setup.mesh.boundary(group).map_err(ProblemError::from)?.nodes() {

@@ -1176,6 +1176,14 @@ impl Electrodes {
             Electrodes::Many(v) => v,
         }
     }
+
+    /// Every electrode, to change.
+    pub fn all_mut(&mut self) -> &mut [ElectrodeSpec] {
+        match self {
+            Electrodes::One(e) => std::slice::from_mut(e),
+            Electrodes::Many(v) => v,
+        }
+    }
 }
 
 impl From<ElectrodeSpec> for Electrodes {
