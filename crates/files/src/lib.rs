@@ -100,7 +100,8 @@ pub enum SceneFileError {
     #[error(transparent)]
     Read(std::io::Error),
     /// The text is not TOML, or not a scene (an unknown key, a value of the wrong kind).
-    #[error(transparent)]
+    /// (toml's text ends in blank lines, which a message that goes on after it does not want.)
+    #[error("{}", .0.to_string().trim_end())]
     Toml(#[from] toml::de::Error),
     /// An override (`--set`, or a Python keyword) that does not apply.
     #[error("--set {set}: {message}")]
