@@ -39,6 +39,63 @@ fn rel_diff(a: &[f64], b: &[f64], scale_b: f64) -> f64 {
         / s
 }
 
+/// run.json's `contact.frame` (and each group's) gives the directions of contact.csv's
+/// components: the tangential force rebuilt from the points' `λ_t` along the frame's tangents
+/// is the reported resultant, the normal force along the normal balances the load's share,
+/// and the frame is the scene's (`n = -z` gives `t1 = x`, `t2 = y`); zones of different normals
+/// have no shared frame, each its own.
+#[test]
+fn the_contact_frame_gives_the_directions_of_the_components() {
+    for (scene, sets) in [
+        ("paper-slip", vec!["mesh.n=8"]),
+        ("paper-3d", vec!["mesh.n=3"]),
+        ("corner", vec!["mesh.n=8"]),
+    ] {
+        let r = run(scene, &sets);
+        let (c, report) = (r.contact.as_ref().unwrap(), &r.report.contact);
+        let frames: Vec<(&problem::report::ContactFrame, Vec<usize>)> = match &report.frame {
+            Some(f) => vec![(f, (0..c.points.len()).collect())],
+            None => (report.groups.iter().enumerate())
+                .map(|(k, g)| {
+                    (
+                        g.frame.as_ref().unwrap(),
+                        (0..c.points.len()).filter(|&i| c.group_of[i] == k).collect(),
+                    )
+                })
+                .collect(),
+        };
+        assert_eq!(frames.len(), if scene == "corner" { 2 } else { 1 }, "{scene}");
+        let dim = c.points.dim;
+        let nt = c.solution.lambda.n_tangential();
+        let mut resultant = vec![0.0; dim];
+        for (frame, points) in &frames {
+            assert_eq!((frame.normal.len(), frame.tangents.len()), (dim, dim - 1));
+            for &i in points {
+                for q in 0..nt {
+                    let w = c.points.weight[i] * c.solution.lambda.tangential[i * nt + q];
+                    for k in 0..dim {
+                        resultant[k] += w * frame.tangents[q][k];
+                    }
+                }
+            }
+        }
+        let scale = report.normal_force.abs();
+        for k in 0..dim {
+            assert!(
+                (resultant[k] - report.tangential_resultant[k]).abs() <= 1e-12 * scale,
+                "{scene}: {resultant:?} {report:?}"
+            );
+        }
+        if scene == "paper-3d" {
+            let f = &frames[0].0;
+            assert_eq!(
+                (f.normal.as_slice(), &f.tangents[..]),
+                (&[0.0, 0.0, -1.0][..], &[vec![1.0, 0.0, 0.0], vec![0.0, 1.0, 0.0]][..])
+            );
+        }
+    }
+}
+
 #[test]
 fn paper_slip_has_the_slip_zone_of_scenes_md() {
     let r = run("paper-slip", &[]);

@@ -371,9 +371,46 @@ pub struct ContactReport {
     /// electrode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub electric_points: Option<usize>,
+    /// The frame of the contact values, where every point shares one (one zone, or zones of
+    /// one normal): contact.csv's `u_n`, `lambda_n` along its `normal`, `u_t`, `lambda_t`
+    /// (`u_t2`, `lambda_t2` in 3D) along its `tangents`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<ContactFrame>,
     /// Several contact groups (`[[contact]]`): each one's own counts and forces.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub groups: Vec<ContactGroupReport>,
+}
+
+/// The directions of a zone's contact values, unit vectors in the global frame (one
+/// component per dimension): `normal` the body face's outward normal (`contact.normal`,
+/// along which `u_n` moves toward the foundation and `λ_n` presses), `tangents` the `dim - 1`
+/// directions of the tangential components, `t1` the first axis made orthogonal to the
+/// normal, in 3D `t2 = t1 × n` (docs/theory.md, "Signs that every output shares").
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct ContactFrame {
+    /// The outward normal.
+    pub normal: Vec<f64>,
+    /// The tangents, `dim - 1` of them.
+    pub tangents: Vec<Vec<f64>>,
+}
+
+impl ContactFrame {
+    /// The frame the points `of` share; `None` where they share none (or there is no point).
+    fn of(points: &contact::ContactPoints, mut of: impl Iterator<Item = usize>) -> Option<Self> {
+        let first = of.next()?;
+        let same = |a: &[f64; 3], b: &[f64; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12);
+        let (n, t) = (&points.normal[first], &points.tangent[first]);
+        let shared = of.all(|i| {
+            same(&points.normal[i], n) && (0..points.n_tangential()).all(|q| same(&points.tangent[i][q], &t[q]))
+        });
+        let dim = points.dim;
+        // `+ 0.0`: round-off's -0 reads as 0
+        let vector = |v: &[f64; 3]| v[..dim].iter().map(|x| x + 0.0).collect();
+        shared.then(|| ContactFrame {
+            normal: vector(n),
+            tangents: t[..dim - 1].iter().map(vector).collect(),
+        })
+    }
 }
 
 /// One contact group's share of a contact solution (several `[[contact]]` groups).
@@ -396,6 +433,9 @@ pub struct ContactGroupReport {
     /// `Σ w λ_t t` over its points, in the global frame (one component per dimension).
     #[serde(default)]
     pub tangential_resultant: Vec<f64>,
+    /// The frame of its contact values.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<ContactFrame>,
 }
 
 /// The counts (stick, slip, separated), the normal force and the tangential force vector of
@@ -449,6 +489,7 @@ impl ContactReport {
                         normal_force,
                         tangential_force: linalg::norm(&t),
                         tangential_resultant: t[..points.dim].to_vec(),
+                        frame: ContactFrame::of(points, mine()),
                     }
                 })
                 .collect();
@@ -476,6 +517,7 @@ impl ContactReport {
             charge: sol.electric.as_ref().map(|e| e.charge(&points.weight)),
             potential: None,
             electric_points: sol.electric.as_ref().map(|e| e.points.len()),
+            frame: ContactFrame::of(points, 0..points.len()),
             groups: vec![],
         }
     }
