@@ -549,6 +549,18 @@ fn keys_that_cannot_apply_are_refused_by_name() {
         ],
         "contact.indenter.profile",
     );
+    // a profile that dips below its tip touches a ring first: the half-space's closed form
+    // (a disc of contact) does not apply, and the run that asks for it is told why
+    refused(
+        &[
+            "~contact.indenter.radius",
+            "contact.indenter.shape=\"profile\"",
+            "contact.indenter.profile=[[0.0, 0.0], [0.5, -0.01], [2.0, 0.5]]",
+            "exact.kind=\"half-space\"",
+            "mesh.n=8",
+        ],
+        "falls from h = 0 at ρ = 0 to h = -0.01 at ρ = 0.5",
+    );
     // a punch smaller than the first cell reaches no node but the axis: still posed; one
     // whose radius is negative is refused above; a profile beyond every node is refused
     refused(

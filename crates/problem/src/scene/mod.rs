@@ -1385,7 +1385,7 @@ impl Scene {
     /// [`Profile`] and its electric [`Tip`]; `Err` (why, in words) where no closed form applies: a
     /// plane body, friction, a compliant bed, a conductive (finite-conductance) tip, several
     /// materials, a crystal not poled along the axis, an indenter off the axis or without an
-    /// axisymmetric profile. `electric`: whether the run has electric unknowns.
+    /// axisymmetric profile or with one that falls from its tip outward. `electric`: whether the run has electric unknowns.
     ///
     /// [`HalfSpace`]: crate::halfspace::HalfSpace
     /// [`Profile`]: crate::halfspace::Profile
@@ -1438,7 +1438,18 @@ impl Scene {
             IndenterShape::Punch => Profile::Punch {
                 radius: need(ind.radius)?,
             },
-            IndenterShape::Profile => Profile::Tabulated(ind.profile.clone().ok_or("the profile is missing")?),
+            IndenterShape::Profile => {
+                let table = ind.profile.clone().ok_or("the profile is missing")?;
+                // Sneddon's solution presses a disc: the profile rises from its tip outward
+                // (a profile that dips touches a ring first, and its contact is no disc)
+                if let Some(w) = table.windows(2).find(|w| w[1][1] < w[0][1]) {
+                    return Err(format!(
+                        "contact.indenter.profile falls from h = {} at ρ = {} to h = {} at ρ = {}, and the half-space's closed form needs a profile that rises from its tip (its contact a disc)",
+                        w[0][1], w[0][0], w[1][1], w[1][0]
+                    ));
+                }
+                Profile::Tabulated(table)
+            }
             IndenterShape::Plane | IndenterShape::Cylinder => {
                 return Err(format!("a {} is no axisymmetric indenter", ind.shape));
             }
