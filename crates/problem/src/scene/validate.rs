@@ -152,6 +152,17 @@ impl Scene {
             validate_material(m)
                 .map_err(|e| SceneError::new(&e.key, format!("material `{}`: {}", m.region, e.message)))?;
         }
+        for (k, m) in self.material.iter().enumerate() {
+            if let Some(j) = self.material[..k].iter().position(|o| o.region == m.region) {
+                return Err(SceneError::new(
+                    &format!("material.{k}.region"),
+                    format!(
+                        "material.{k}.region = `{}`, and material.{j} is that region's already: one material per region",
+                        m.region
+                    ),
+                ));
+            }
+        }
         self.check_units()?;
         for d in &self.dirichlet {
             let scalars = [
