@@ -96,6 +96,24 @@ fn the_contact_frame_gives_the_directions_of_the_components() {
     }
 }
 
+/// A closed form of a contact zone where nothing touches: its errors would be NaN (the run
+/// once failed on "a reported number is not finite ... the problem may be singular"); it is
+/// refused on `exact.kind`, and the same run without [exact] solves.
+#[test]
+fn a_contact_closed_form_where_nothing_touches_is_refused_by_its_key() {
+    for scene in ["hertz", "cattaneo-mindlin"] {
+        let sets = vec!["mesh.n=8".to_string(), "contact.gap=0.5".to_string()];
+        let e = driver::studies::solve(scene, &sets).err().unwrap().to_string();
+        assert!(
+            e.contains("exact.kind") && e.contains("nothing touches"),
+            "{scene}: {e}"
+        );
+        let without: Vec<String> = sets.into_iter().chain(["~exact".to_string()]).collect();
+        let r = driver::studies::solve(scene, &without).unwrap();
+        assert_eq!(r.report.contact.normal_force, 0.0);
+    }
+}
+
 #[test]
 fn paper_slip_has_the_slip_zone_of_scenes_md() {
     let r = run("paper-slip", &[]);

@@ -45,19 +45,10 @@ pub struct Capacitance {
     pub notes: Vec<String>,
 }
 
-/// The capacitance matrix of `scene` on `backend` (validated here; `mesh` the mesh of a
-/// `gmsh` or `given` scene, read by the caller); `None` on a process that does not hold the
-/// gathered solutions.
-///
-/// # Errors
-/// The scene's and set-up's errors, as a run's; a scene without electric unknowns or without
-/// a terminal (key `dirichlet`); a body its mechanical conditions do not hold; the backend's.
-pub(crate) fn capacitance<B: Backend>(
-    backend: &mut B,
-    scene: &Scene,
-    mesh: Option<mesh::Mesh>,
-) -> Result<Option<Capacitance>, B::Error> {
-    // a floating terminal is a terminal like the others here (its potential a column's)
+/// `scene` with each floating terminal (a `dirichlet.charge`, an `[[electrode]]`'s `charge`)
+/// at a potential: in the capacitance matrix a floating terminal is a terminal like the
+/// others, its potential a column's.
+fn with_every_terminal_driven(scene: &Scene) -> Scene {
     let mut scene = scene.clone();
     for d in scene.dirichlet.iter_mut().filter(|d| d.charge.is_some()) {
         d.phi = Some(0.0);
@@ -72,6 +63,43 @@ pub(crate) fn capacitance<B: Backend>(
         e.v = Some(0.0);
         e.charge = None;
     }
+    scene
+}
+
+/// The conductors of the terminal `groups` ([`conductors`]); refused where there are none, or
+/// one: every flux that leaves one conductor enters it again, its capacitance is 0, and a
+/// number computed for it is round-off.
+fn terminal_conductors(
+    setup: &crate::setup::Setup,
+    groups: &[&str],
+) -> Result<(Vec<usize>, Vec<String>), ProblemError> {
+    if groups.is_empty() {
+        let why = "the scene has no terminal (no [electrode], no dirichlet.phi)";
+        return Err(SetupError::new("dirichlet", why).into());
+    }
+    let (conductor, names) = conductors(&setup.mesh, groups)?;
+    if let [one] = &names[..] {
+        let why = format!(
+            "the scene has one terminal (`{one}`), and a capacitance is between two conductors at least: ground another group (dirichlet.phi) or add an [electrode]"
+        );
+        return Err(SetupError::new("dirichlet", why).into());
+    }
+    Ok((conductor, names))
+}
+
+/// The capacitance matrix of `scene` on `backend` (validated here; `mesh` the mesh of a
+/// `gmsh` or `given` scene, read by the caller); `None` on a process that does not hold the
+/// gathered solutions.
+///
+/// # Errors
+/// The scene's and set-up's errors, as a run's; a scene without electric unknowns or without
+/// a terminal (key `dirichlet`); a body its mechanical conditions do not hold; the backend's.
+pub(crate) fn capacitance<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    mesh: Option<mesh::Mesh>,
+) -> Result<Option<Capacitance>, B::Error> {
+    let scene = with_every_terminal_driven(scene);
     let valid = scene.validate().map_err(ProblemError::from)?;
     let setup = setup(valid, mesh)?;
     if !setup.plan.electric {
@@ -79,22 +107,10 @@ pub(crate) fn capacitance<B: Backend>(
         return Err(ProblemError::from(SetupError::new("material", why)).into());
     }
     let groups = terminal_groups(&setup);
-    if groups.is_empty() {
-        let why = "the scene has no terminal (no [electrode], no dirichlet.phi)";
-        return Err(ProblemError::from(SetupError::new("dirichlet", why)).into());
-    }
+    let (conductor, names) = terminal_conductors(&setup, &groups)?;
     let mut disc = setup.discretize().map_err(ProblemError::from)?;
     disc.check_held()
         .map_err(|e| ProblemError::from(AssemblyError::from(e)))?;
-    let (conductor, names) = conductors(&setup.mesh, &groups)?;
-    if let [one] = &names[..] {
-        // every flux that leaves one conductor enters it again: its capacitance is 0, and a
-        // number computed for it is round-off
-        let why = format!(
-            "the scene has one terminal (`{one}`), and a capacitance is between two conductors at least: ground another group (dirichlet.phi) or add an [electrode]"
-        );
-        return Err(ProblemError::from(SetupError::new("dirichlet", &why)).into());
-    }
     let mut member = vec![None; setup.mesh.n_nodes()];
     for (g, group) in groups.iter().enumerate() {
         for v in setup.mesh.boundary(group).map_err(ProblemError::from)?.nodes() {

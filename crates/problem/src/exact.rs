@@ -280,14 +280,40 @@ fn extent(xs: &[f64], flag: impl Fn(usize) -> bool) -> (f64, f64) {
 /// The `exact` section of a Hertz or Cattaneo-Mindlin scene (validated: one isotropic
 /// material, a curved gap): the reactions `p` (normal) and `q` (tangential), Hertz's `a` and
 /// `p0`, the measured contact and stick zones, and the profile errors. `None` for other scenes.
+///
+/// # Errors
+/// On `exact.kind` where nothing touches (`p` not positive): a closed form of a contact zone
+/// measures none, and its relative errors would be NaN.
 pub fn contact_errors(
     scene: &Scene,
     points: &ContactPoints,
     sol: &ContactSolution,
     p: f64,
     q: f64,
+) -> Result<Option<ExactReport>, crate::SetupError> {
+    let Some(x) = scene.exact.as_ref().filter(|x| !x.kind.is_field()) else {
+        return Ok(None);
+    };
+    if !(p > 0.0) {
+        return Err(crate::SetupError::new(
+            "exact.kind",
+            format!(
+                "exact.kind `{}`: nothing touches (the contact force is {p:e}), and its closed form measures a contact zone: push the body past its gap, or remove [exact] (`--set ~exact`)",
+                x.kind
+            ),
+        ));
+    }
+    Ok(contact_errors_of(scene, x, points, sol, (p, q)))
+}
+
+/// [`contact_errors`] where something touches.
+fn contact_errors_of(
+    scene: &Scene,
+    x: &crate::ExactSpec,
+    points: &ContactPoints,
+    sol: &ContactSolution,
+    (p, q): (f64, f64),
 ) -> Option<ExactReport> {
-    let x = scene.exact.as_ref().filter(|x| !x.kind.is_field())?;
     let c = scene.first_contact()?;
     let m = scene.material.first()?;
     let (young, poisson) = (m.young?, m.poisson?);

@@ -290,7 +290,7 @@ pub(crate) fn recover(
             })?;
             Some(crate::exact::ExactReport::HalfSpace(Box::new(h)))
         }
-        (None, Some((b, sol))) => contact_errors(scene, &b.points, sol, counts.normal_force, counts.tangential_force),
+        (None, Some((b, sol))) => contact_errors(scene, &b.points, sol, counts.normal_force, counts.tangential_force)?,
         (None, None) => None,
     };
     if let Some(e) = &exact {

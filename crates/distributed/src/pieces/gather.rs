@@ -75,7 +75,8 @@ impl PieceSolution {
             // a contact's closed form (Hertz, Cattaneo-Mindlin) is judged on every point
             if report.exact.is_none() {
                 let (p, q) = (report.contact.normal_force, report.contact.tangential_force);
-                report.exact = problem::contact_errors(scene, &c.points, &c.solution, p, q);
+                report.exact = problem::contact_errors(scene, &c.points, &c.solution, p, q)
+                    .map_err(problem::ProblemError::from)?;
             }
             let at = problem::Indented {
                 points: &c.points,

@@ -1380,6 +1380,45 @@ pub struct IndenterSpec {
     pub force: Option<f64>,
 }
 
+impl IndenterSpec {
+    /// The half-space's [`Profile`](crate::halfspace::Profile) of this indenter; `Err` (why,
+    /// in words) for a shape that is not one of revolution, a missing radius or angle, or a
+    /// tabulated profile that falls from its tip outward.
+    fn half_space_profile(&self) -> Result<crate::halfspace::Profile, String> {
+        use crate::halfspace::Profile;
+        let need = |v: Option<f64>| v.ok_or_else(|| "the indenter's radius or angle is missing".to_string());
+        Ok(match self.shape {
+            IndenterShape::Paraboloid => Profile::Paraboloid {
+                radius: need(self.radius)?,
+            },
+            IndenterShape::Sphere => Profile::Sphere {
+                radius: need(self.radius)?,
+            },
+            IndenterShape::Cone => Profile::Cone {
+                half_angle: need(self.half_angle)?,
+            },
+            IndenterShape::Punch => Profile::Punch {
+                radius: need(self.radius)?,
+            },
+            IndenterShape::Profile => {
+                let table = self.profile.clone().ok_or("the profile is missing")?;
+                // Sneddon's solution presses a disc: the profile rises from its tip outward
+                // (a profile that dips touches a ring first, and its contact is no disc)
+                if let Some(w) = table.windows(2).find(|w| w[1][1] < w[0][1]) {
+                    return Err(format!(
+                        "contact.indenter.profile falls from h = {} at ρ = {} to h = {} at ρ = {}, and the half-space's closed form needs a profile that rises from its tip (its contact a disc)",
+                        w[0][1], w[0][0], w[1][1], w[1][0]
+                    ));
+                }
+                Profile::Tabulated(table)
+            }
+            IndenterShape::Plane | IndenterShape::Cylinder => {
+                return Err(format!("a {} is no axisymmetric indenter", self.shape));
+            }
+        })
+    }
+}
+
 impl Scene {
     /// The half-space problem of the scene's indenter: the body's [`HalfSpace`], the indenter's
     /// [`Profile`] and its electric [`Tip`]; `Err` (why, in words) where no closed form applies: a
@@ -1401,7 +1440,7 @@ impl Scene {
         ),
         String,
     > {
-        use crate::halfspace::{HalfSpace, Profile, Tip};
+        use crate::halfspace::{HalfSpace, Tip};
         let zones = self.zones();
         let [c] = zones[..] else {
             return Err(match zones.len() {
@@ -1424,36 +1463,7 @@ impl Scene {
         if !ind.tip.as_deref().and_then(|t| t.first()).is_none_or(|x| *x == 0.0) {
             return Err("the indenter's tip must lie on the axis (contact.indenter.tip = [0, z])".into());
         }
-        let need = |v: Option<f64>| v.ok_or_else(|| "the indenter's radius or angle is missing".to_string());
-        let profile = match ind.shape {
-            IndenterShape::Paraboloid => Profile::Paraboloid {
-                radius: need(ind.radius)?,
-            },
-            IndenterShape::Sphere => Profile::Sphere {
-                radius: need(ind.radius)?,
-            },
-            IndenterShape::Cone => Profile::Cone {
-                half_angle: need(ind.half_angle)?,
-            },
-            IndenterShape::Punch => Profile::Punch {
-                radius: need(ind.radius)?,
-            },
-            IndenterShape::Profile => {
-                let table = ind.profile.clone().ok_or("the profile is missing")?;
-                // Sneddon's solution presses a disc: the profile rises from its tip outward
-                // (a profile that dips touches a ring first, and its contact is no disc)
-                if let Some(w) = table.windows(2).find(|w| w[1][1] < w[0][1]) {
-                    return Err(format!(
-                        "contact.indenter.profile falls from h = {} at ρ = {} to h = {} at ρ = {}, and the half-space's closed form needs a profile that rises from its tip (its contact a disc)",
-                        w[0][1], w[0][0], w[1][1], w[1][0]
-                    ));
-                }
-                Profile::Tabulated(table)
-            }
-            IndenterShape::Plane | IndenterShape::Cylinder => {
-                return Err(format!("a {} is no axisymmetric indenter", ind.shape));
-            }
-        };
+        let profile = ind.half_space_profile()?;
         let mut crystal = m.crystal();
         let scale = m.coupling_scale.unwrap_or(1.0);
         crystal
