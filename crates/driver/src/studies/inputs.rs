@@ -223,6 +223,12 @@ pub const INPUTS: &[Input] = &[
         Refused("an integer beyond 64 bits"),
     ),
     input("numbers", "paper", &["mesh.h=1/8"], Solves),
+    input(
+        "numbers",
+        "paper",
+        &["mesh.h=10"],
+        Refused("longer than the body's shortest side"),
+    ),
     input("numbers", "layered", &["mesh.n=10", "material.1.young=0.02"], Solves),
     input(
         "accepted means honoured",

@@ -678,6 +678,15 @@ fn validate_generated(m: &MeshSpec, d: usize) -> Result<(), SceneError> {
                 format!("mesh.h = {h} must be a positive length"),
             ));
         }
+        // a cell size past the body's shortest side would make one cell of another size (a
+        // length in the wrong unit, as often as not)
+        let shortest = m.lo.iter().zip(&m.hi).map(|(a, b)| b - a).fold(f64::INFINITY, f64::min);
+        if h > shortest {
+            return Err(SceneError::new(
+                "mesh.h",
+                format!("mesh.h = {h} is longer than the body's shortest side, {shortest} (the scene's lengths are in its [units]): at most that, for one cell across it"),
+            ));
+        }
     }
     for r in &m.regions {
         let key = format!("a corner of mesh.region `{}`", r.name);
