@@ -248,8 +248,11 @@ fn paper_rule_is_labelled_and_reproduces_the_table_counts() {
 fn every_shipped_scene_runs_at_its_smoke_size() {
     for (name, text) in files::scene_file::SHIPPED {
         let scene = files::scene_file::parse(text, name, &[]).unwrap();
-        let n = scene.mesh.smoke_n.expect("every shipped scene has a smoke size");
-        let r = run(name, &[&format!("mesh.n={n}")]);
+        assert!(
+            scene.mesh.smoke_n.is_some(),
+            "{name}: every shipped scene has a smoke size"
+        );
+        let r = driver::studies::solve(name, &scene.mesh.smoke()).unwrap();
         let eq = r.report.residuals.equilibrium;
         assert!(eq < 1e-10, "{name}: equilibrium {eq}");
         if r.contact.is_some() {

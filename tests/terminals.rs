@@ -634,7 +634,7 @@ fn charges_read_back_and_sum_to_zero() {
     let mut checked = 0;
     for (name, text) in files::scene_file::SHIPPED {
         let scene = files::scene_file::parse(text, name, &[]).unwrap();
-        let sized = vec![format!("mesh.n={}", scene.mesh.smoke_n.unwrap())];
+        let sized = scene.mesh.smoke();
         let (s, scene) = solve(name, &sized);
         let r = &s.report;
         if r.terminals.is_empty() {
@@ -735,8 +735,7 @@ fn every_terminal_floated_with_its_charge_keeps_its_potential() {
     let mut checked = 0;
     for (name, text) in files::scene_file::SHIPPED {
         let base = files::scene_file::parse(text, name, &[]).unwrap();
-        let n = base.mesh.smoke_n.unwrap();
-        let (scene, _) = files::scene_file::load(name, &[format!("mesh.n={n}")]).unwrap();
+        let (scene, _) = files::scene_file::load(name, &base.mesh.smoke()).unwrap();
         let Ok(solved) = problem::solve(&scene, None, &mut Silent) else {
             continue;
         };

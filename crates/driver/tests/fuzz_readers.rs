@@ -203,10 +203,7 @@ proptest! {
         let text = String::from_utf8_lossy(&bytes);
         let Ok(scene) = files::scene_file::parse(&text, name, &[]) else { return Ok(()) };
         // the mesh forced down to 3 cells along each axis it has
-        let mut small = vec!["mesh.n=3".to_string(), "mesh.nx=3".into(), "mesh.ny=3".into()];
-        if scene.mesh.kind == MeshKind::Box {
-            small.push("mesh.nz=3".into());
-        }
+        let small = scene.mesh.sized(3);
         if let Ok(scene) = files::scene_file::parse(&text, name, &small) {
             // a tolerance below round-off only makes the solvers run to their iteration limits
             if scene.solver.tol >= 1e-13 && scene.mesh.kind != MeshKind::Gmsh {

@@ -180,11 +180,16 @@ fn every_scene_agrees(petsc: &Petsc) {
         .map(|s| (s, "mesh.cylinder=true"));
     for ((name, text), order) in orders.chain(curved) {
         let scene = scene_file::parse(text, name, &[]).expect("the scene reads");
-        let n = format!("mesh.n={}", scene.mesh.smoke_n.expect("a smoke size"));
+        assert!(scene.mesh.smoke_n.is_some(), "{name}: a smoke size");
+        let smoke = scene.mesh.smoke();
+        let mut sized: Vec<&str> = smoke.iter().map(String::as_str).collect();
         let sets: &[&str] = match order {
-            "mesh.order=2" => &[&n, order],
+            "mesh.order=2" => {
+                sized.push(order);
+                &sized
+            }
             "mesh.cylinder=true" => &["mesh.n=4", "mesh.order=2", order],
-            _ => &[&n],
+            _ => &sized,
         };
         let (faer, scene) = both(name, sets, &[]);
         let t = std::time::Instant::now();

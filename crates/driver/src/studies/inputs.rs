@@ -174,6 +174,18 @@ pub const INPUTS: &[Input] = &[
         Refused("solver.pcg_tol does not apply"),
     ),
     input(
+        "keys that do not apply",
+        "paper",
+        &["mesh.n=8", "mesh.nx=8", "mesh.ny=4"],
+        Refused("mesh.n does not apply"),
+    ),
+    input(
+        "keys that do not apply",
+        "pfm-film",
+        &["mesh.n=8"],
+        Refused("mesh.n does not apply"),
+    ),
+    input(
         "inputs silently dropped",
         "paper",
         &["mesh.n=8", "~material.poling"],

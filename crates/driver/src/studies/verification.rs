@@ -218,10 +218,7 @@ pub fn smoke(progress: &mut dyn FnMut(&str)) -> Vec<SmokeRow> {
         .iter()
         .map(|(name, _)| {
             let t = Instant::now();
-            let result = scene_file::load(name, &[]).and_then(|(sc, _)| {
-                let n = sc.mesh.smoke_n.unwrap_or(4);
-                super::solve(name, &[format!("mesh.n={n}")])
-            });
+            let result = scene_file::load(name, &[]).and_then(|(sc, _)| super::solve(name, &sc.mesh.smoke()));
             let secs = t.elapsed().as_secs_f64();
             let row = match result {
                 Ok(r) => {

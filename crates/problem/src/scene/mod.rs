@@ -923,6 +923,37 @@ impl MeshSpec {
         }
     }
 
+    /// The overrides (`--set`) that size a generated mesh by `n`: `mesh.n = n` for the axes
+    /// without a count of their own (where there are any), and `n` for each count the scene
+    /// gives (`mesh.nx`, `ny`, `nz`, each layer's `n`), which `mesh.n` does not reach. Empty
+    /// for a Gmsh or given mesh.
+    pub fn sized(&self, n: usize) -> Vec<String> {
+        if matches!(self.kind, MeshKind::Gmsh | MeshKind::Given) {
+            return vec![];
+        }
+        let counts = [("nx", self.nx), ("ny", self.ny), ("nz", self.nz)];
+        let d = self.lo.len().min(3);
+        let mut out: Vec<String> = (counts.iter().take(d))
+            .filter(|(_, c)| c.is_some())
+            .map(|(k, _)| format!("mesh.{k}={n}"))
+            .collect();
+        let layered = !self.layers.is_empty() && self.layers.iter().all(|l| l.n.is_some());
+        for k in (0..self.layers.len()).filter(|&k| self.layers[k].n.is_some()) {
+            out.push(format!("mesh.layer.{k}.n={n}"));
+        }
+        let fixed = (0..d).all(|k| counts[k].1.is_some() || (k + 1 == d && layered));
+        if !fixed {
+            out.push(format!("mesh.n={n}"));
+        }
+        out
+    }
+
+    /// [`MeshSpec::sized`] at the scene's smoke size (`smoke_n`, 4 where it gives none): the
+    /// size of the verification's and the tests' runs of every shipped scene.
+    pub fn smoke(&self) -> Vec<String> {
+        self.sized(self.smoke_n.unwrap_or(4))
+    }
+
     /// Cells per axis of a generated mesh from `n` (along the shortest edge), `h`, `nx`, `ny`,
     /// `nz` (8 along the shortest edge when none is given); along the stacking axis of a layered
     /// body, the layers' cells together.
