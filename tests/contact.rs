@@ -114,6 +114,38 @@ fn a_contact_closed_form_where_nothing_touches_is_refused_by_its_key() {
     }
 }
 
+/// The command line says the run's results, each number with its unit: the contact's counts
+/// and forces, an indenter's figures, each terminal's charge at its potential.
+#[test]
+fn the_results_are_said_with_their_units() {
+    let r = run("actuator", &["mesh.n=8"]);
+    let lines = problem::report::result_lines(&r.report);
+    let c = &r.report.contact;
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    assert!(
+        lines[0].contains(&format!("normal force {:.4e} GN/m", c.normal_force)),
+        "{lines:?}"
+    );
+    assert!(
+        lines[0].contains("tangential force")
+            && lines[0].contains(&format!("{} of {} points stick", c.n_stick, c.n_points))
+    );
+    let electrode = r.report.terminals.iter().find(|t| t.group == "electrode").unwrap();
+    assert!(
+        lines[1].contains(&format!("`electrode` {:.4e} C/m at 5.0000e-2 GV", electrode.charge)),
+        "{lines:?}"
+    );
+    // an indenter in µm and mN, frictionless: no tangential force said
+    let r = run("indent-sphere", &["mesh.n=8"]);
+    let lines = problem::report::result_lines(&r.report);
+    let i = r.report.indenter.as_ref().unwrap();
+    assert!(!lines[0].contains("tangential"), "{lines:?}");
+    assert!(
+        lines[1].starts_with(&format!("indenter: depth {:.4e} µm, force {:.4e} mN", i.depth, i.force)),
+        "{lines:?}"
+    );
+}
+
 #[test]
 fn paper_slip_has_the_slip_zone_of_scenes_md() {
     let r = run("paper-slip", &[]);

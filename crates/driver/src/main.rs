@@ -508,6 +508,9 @@ fn run(
         BackendChoice::Petsc => run_petsc(&scene, &source, &dir, &mut terminal)?,
     };
     if let Some(solution) = solution {
+        for line in problem::report::result_lines(&solution.report) {
+            say(&line);
+        }
         if let Some(p) = &solution.report.petsc {
             say(&format!(
                 "PETSc: {} ranks, {} unknowns, {} Krylov iterations ({})",

@@ -451,7 +451,11 @@ fn set_table(a: &mut Vec<toml::Value>, i: usize, value: Option<toml::Value>, key
             a.remove(i);
             Ok(())
         }
-        None => Err(format!("the scene has no `{key}` to remove (it has {n} tables, indices 0 to {})", n.saturating_sub(1))),
+        None => Err(match n {
+            0 => format!("the scene has no `{key}` to remove (it has no such table)"),
+            1 => format!("the scene has no `{key}` to remove (it has one table, index 0)"),
+            _ => format!("the scene has no `{key}` to remove (it has {n} tables, indices 0 to {})", n - 1),
+        }),
         Some(t @ toml::Value::Table(_)) if i <= n => {
             if i == n {
                 a.push(t);

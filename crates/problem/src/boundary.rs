@@ -807,12 +807,13 @@ impl ContactBoundary {
     }
 
     /// Tells `reporter` what Dirichlet conditions hold of the group `group` where it is more
-    /// than nodes clamped within the gap (the corners of a clamped body): held tangents, or
+    /// than nodes clamped within the gap (the corners of a clamped body): held tangents (where
+    /// the contact is `frictional`: a frictionless zone's tangents carry no force anyway), or
     /// nodes held inside the foundation.
-    pub fn report_held(&self, group: &str, reporter: &mut dyn crate::Reporter) {
+    pub fn report_held(&self, group: &str, frictional: bool, reporter: &mut dyn crate::Reporter) {
         let nt = self.points.n_tangential();
         let tangents = (0..self.points.len())
-            .filter(|&i| self.points.held[i][..nt].iter().any(|&h| h))
+            .filter(|&i| frictional && self.points.held[i][..nt].iter().any(|&h| h))
             .count();
         if tangents + self.held_inside > 0 {
             reporter.event(&crate::Event::ContactHeld {

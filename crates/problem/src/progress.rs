@@ -37,6 +37,8 @@ pub enum Event<'a> {
         kind: &'static str,
         /// Largest cell diameter.
         h: f64,
+        /// The unit of `h` (the scene's length unit).
+        length: &'a str,
         /// Free displacement unknowns.
         n_u: usize,
         /// Free potential unknowns.
@@ -172,7 +174,7 @@ fn in_bytes(bytes: f64) -> String {
     format!("{value:.3} {unit}")
 }
 
-impl Event<'_> {
+impl<'a> Event<'a> {
     /// A path's plan ([`Event::PathPlan`]) on `mesh`: each written instant's file holds the
     /// mesh (its points, each cell's nodes, offset and type), the nodal `u`, `φ` and the
     /// contact's status, pressure, traction (3 components), gap and, with electrical contact,
@@ -205,13 +207,15 @@ impl Event<'_> {
         }
     }
 
-    /// The event that ends assembly: the mesh's and the dofs' sizes, and the time taken.
-    pub fn assembled(mesh: &mesh::Mesh, dofs: &fe_assembly::DofMap, seconds: f64) -> Self {
+    /// The event that ends assembly: the mesh's and the dofs' sizes (`length` the unit of its
+    /// lengths), and the time taken.
+    pub fn assembled(mesh: &mesh::Mesh, dofs: &fe_assembly::DofMap, length: &'a str, seconds: f64) -> Self {
         Event::Assembled {
             n_nodes: mesh.n_nodes(),
             n_cells: mesh.n_cells(),
             kind: mesh.kind.name(),
             h: mesh.h_max(),
+            length,
             n_u: dofs.n_u,
             n_phi: dofs.n_phi,
             seconds,
@@ -303,12 +307,13 @@ impl fmt::Display for Event<'_> {
                 n_cells,
                 kind,
                 h,
+                length,
                 n_u,
                 n_phi,
                 seconds,
             } => write!(
                 f,
-                "mesh: {n_nodes} nodes, {n_cells} {kind} cells, h = {h:.4e}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
+                "mesh: {n_nodes} nodes, {n_cells} {kind} cells, h = {h:.4e} {length}; dofs: {n_u} u + {n_phi} phi; assembly {seconds:.3} s"
             ),
             Event::PathPlan {
                 instants,
@@ -418,15 +423,19 @@ pub(crate) fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
 /// The notes on contact points where Dirichlet conditions hold some directions.
 fn held_notes(tangents: usize, nodes: usize, inside: usize) -> Vec<String> {
     let mut notes = vec![];
-    if tangents > 0 {
-        notes.push(format!(
+    match tangents {
+        0 => {}
+        1 => notes.push("1 contact point has a tangent held by a Dirichlet condition (no friction force there: the support takes it)".into()),
+        _ => notes.push(format!(
             "{tangents} contact points have a tangent held by a Dirichlet condition (no friction force there: the support takes it)"
-        ));
+        )),
     }
-    if nodes > 0 {
-        notes.push(format!(
+    match nodes {
+        0 => {}
+        1 => notes.push("1 node has its normal displacement prescribed and is left to its support".into()),
+        _ => notes.push(format!(
             "{nodes} nodes have their normal displacement prescribed and are left to their supports"
-        ));
+        )),
     }
     if inside > 0 {
         notes.push(format!(

@@ -413,6 +413,70 @@ impl ContactFrame {
     }
 }
 
+/// The run's results in words, each number with its unit (run.json's `units`): the contact's
+/// counts and forces, an indenter's depth, force and contact radius, each terminal's charge
+/// at its potential. A load path's rows are its own lines; this is its last instant's.
+pub fn result_lines(r: &RunReport) -> Vec<String> {
+    let unit = |q: &str| r.units.quantities.get(q).cloned().unwrap_or_default();
+    let with = |x: f64, q: &str| {
+        let u = unit(q);
+        if u.is_empty() {
+            format!("{x:.4e}")
+        } else {
+            format!("{x:.4e} {u}")
+        }
+    };
+    let mut out = vec![];
+    let c = &r.contact;
+    if c.n_points > 0 {
+        let mut line = format!(
+            "contact: {} of {} points stick, {} slip, {} separated; normal force {}",
+            c.n_stick,
+            c.n_points,
+            c.n_slip,
+            c.n_separated,
+            with(c.normal_force, "force"),
+        );
+        if r.plan.friction {
+            line.push_str(&format!(", tangential force {}", with(c.tangential_force, "force")));
+        }
+        if let Some(q) = c.charge {
+            line.push_str(&format!(", charge across the zone {}", with(q, "charge")));
+        }
+        out.push(line);
+    }
+    if let Some(i) = &r.indenter {
+        let mut line = format!(
+            "indenter: depth {}, force {}, contact radius {}",
+            with(i.depth, "length"),
+            with(i.force, "force"),
+            with(i.contact_radius, "length"),
+        );
+        if let Some(q) = i.charge {
+            line.push_str(&format!(", charge {}", with(q, "charge")));
+        }
+        if let Some(v) = i.tip_potential {
+            line.push_str(&format!(", surface potential at the tip {}", with(v, "potential")));
+        }
+        out.push(line);
+    }
+    if !r.terminals.is_empty() {
+        let each: Vec<String> = (r.terminals.iter())
+            .map(|t| {
+                let floating = if t.floating { " (floating)" } else { "" };
+                format!(
+                    "`{}` {} at {}{floating}",
+                    t.group,
+                    with(t.charge, "charge"),
+                    with(t.potential, "potential")
+                )
+            })
+            .collect();
+        out.push(format!("charges: {}", each.join(", ")));
+    }
+    out
+}
+
 /// One contact group's share of a contact solution (several `[[contact]]` groups).
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct ContactGroupReport {

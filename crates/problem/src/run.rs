@@ -105,7 +105,7 @@ pub(crate) fn contact_boundary(
         return Ok(None);
     }
     let boundary = ContactBoundary::of_groups(posed.disc, &specs)?;
-    boundary.report_held(&boundary.groups.join(", "), reporter);
+    boundary.report_held(&boundary.groups.join(", "), posed.plan().friction, reporter);
     Ok(Some(boundary))
 }
 
