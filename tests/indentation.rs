@@ -587,6 +587,26 @@ fn keys_that_cannot_apply_are_refused_by_name() {
     assert!(e.to_string().contains("symmetric about its axis"), "{e}");
 }
 
+/// On a body of revolution the tangential tractions of its meridian are radial, and radial
+/// tractions cancel over the revolution: the tangential resultant has no radial part (it
+/// was reported as the meridian's sum, 0.089 GN beside a normal force of 0.61 for the Hertz
+/// sphere under Coulomb friction), though friction acts at every sticking point.
+#[test]
+fn a_body_of_revolution_has_no_radial_resultant() {
+    let sets: Vec<String> = ["mesh.n=8", "contact.law=\"coulomb\"", "contact.friction=0.3", "~exact"]
+        .map(String::from)
+        .to_vec();
+    let (scene, _) = files::scene_file::load("hertz-sphere", &sets).unwrap();
+    let s = problem::solve(&scene, None, &mut Silent).unwrap();
+    let (c, report) = (s.contact.as_ref().unwrap(), &s.report.contact);
+    let rubbing: f64 = (0..c.points.len())
+        .map(|i| c.points.weight[i] * c.solution.lambda.tangential_norm(i))
+        .sum();
+    assert!(rubbing > 1e-3 * report.normal_force, "friction acts: {rubbing}");
+    assert_eq!(report.tangential_resultant, [0.0, 0.0]);
+    assert_eq!(report.tangential_force, 0.0);
+}
+
 #[test]
 fn shapes_have_their_heights() {
     let mut i = indenter(IndenterShape::Sphere, 0.0);

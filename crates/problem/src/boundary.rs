@@ -55,6 +55,9 @@ pub struct ContactBoundary {
     pub group_of: Vec<usize>,
     /// The contact groups, in the scene's order.
     pub groups: Vec<String>,
+    /// Whether the body is one of revolution (its meridian meshed, x the radius): a vector's
+    /// radial part has no resultant over the revolution.
+    pub revolution: bool,
     /// The uniform part of each point's gap (its group's `contact.gap` less an indenter's
     /// depth), which a load path's `gap` factor scales.
     uniform: Vec<f64>,
@@ -402,6 +405,7 @@ impl ContactBoundary {
             phi_terms: vec![],
             group_of: vec![],
             groups: specs.iter().map(|s| s.group.clone()).collect(),
+            revolution: disc.coordinates == fe_assembly::Coordinates::Axisymmetric,
             uniform: vec![],
         };
         let mut place: std::collections::HashMap<usize, usize> = Default::default();
@@ -590,6 +594,7 @@ impl ContactBoundary {
             phi_terms: self.phi_terms.clone(),
             group_of: self.group_of.clone(),
             groups: self.groups.clone(),
+            revolution: self.revolution,
             uniform: self.uniform.clone(),
         };
         for (g, g0) in b.points.gap.iter_mut().zip(&self.uniform) {
@@ -659,6 +664,7 @@ impl ContactBoundary {
             phi_terms: vec![],
             group_of: keep.iter().map(|&i| self.group_of[i]).collect(),
             groups: self.groups.clone(),
+            revolution: self.revolution,
             uniform: keep.iter().map(|&i| self.uniform[i]).collect(),
         })
     }

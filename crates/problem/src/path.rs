@@ -1538,7 +1538,8 @@ pub fn step_row(
     before: &PointValues,
 ) -> StepRow {
     let points = &boundary.points;
-    let counts = crate::report::ContactReport::of_groups(points, sol, &boundary.groups, &boundary.group_of);
+    let counts =
+        crate::report::ContactReport::of_groups(points, sol, &boundary.groups, &boundary.group_of, boundary.revolution);
     let nt = sol.lambda.n_tangential();
     let mut max_slip = 0.0f64;
     let mut max_inc = 0.0f64;

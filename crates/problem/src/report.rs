@@ -502,6 +502,16 @@ pub struct ContactGroupReport {
     pub frame: Option<ContactFrame>,
 }
 
+impl ContactGroupReport {
+    /// As [`ContactReport`]'s: no radial part on a body of revolution.
+    fn revolved(&mut self) {
+        if let Some(r) = self.tangential_resultant.first_mut() {
+            *r = 0.0;
+        }
+        self.tangential_force = linalg::norm(&self.tangential_resultant);
+    }
+}
+
 /// The counts (stick, slip, separated), the normal force and the tangential force vector of
 /// the points `of` a contact solution.
 fn tally(
@@ -529,14 +539,21 @@ fn tally(
 
 impl ContactReport {
     /// The summary of a contact solution on its points; with several groups (`groups[k]` the
-    /// name of group k, `group_of[i]` point i's), each group's share too.
+    /// name of group k, `group_of[i]` point i's), each group's share too. On a body of
+    /// `revolution` (its meridian meshed, x the radius) the tangential resultants have no
+    /// radial part: radial tractions cancel over the revolution (a ring pulled outward
+    /// everywhere carries no net force), and the axial part is the whole body's.
     pub fn of_groups(
         points: &contact::ContactPoints,
         sol: &contact::ContactSolution,
         groups: &[String],
         group_of: &[usize],
+        revolution: bool,
     ) -> Self {
         let mut out = Self::of(points, sol);
+        if revolution {
+            out.revolved();
+        }
         if groups.len() > 1 {
             out.groups = groups
                 .iter()
@@ -557,8 +574,20 @@ impl ContactReport {
                     }
                 })
                 .collect();
+            if revolution {
+                out.groups.iter_mut().for_each(ContactGroupReport::revolved);
+            }
         }
         out
+    }
+
+    /// The resultants of a body of revolution: their radial part (x) cancels over the
+    /// revolution.
+    fn revolved(&mut self) {
+        if let Some(r) = self.tangential_resultant.first_mut() {
+            *r = 0.0;
+        }
+        self.tangential_force = linalg::norm(&self.tangential_resultant);
     }
 
     /// The summary of a contact solution on its points.

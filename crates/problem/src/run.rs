@@ -259,7 +259,7 @@ pub(crate) fn recover(
             .into_iter()
             .find(|c| c.electric_law().is_some())
             .and_then(|c| conductor_potential(c, b, sol)),
-        ..ContactReport::of_groups(&b.points, sol, &b.groups, &b.group_of)
+        ..ContactReport::of_groups(&b.points, sol, &b.groups, &b.group_of, b.revolution)
     });
     let indenter = contact.and_then(|(b, sol)| {
         indenter_figures(

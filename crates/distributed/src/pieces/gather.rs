@@ -70,7 +70,13 @@ impl PieceSolution {
             report.contact = problem::report::ContactReport {
                 held_nodes: held[0] as usize,
                 held_inside: held[1] as usize,
-                ..problem::report::ContactReport::of_groups(&c.points, &c.solution, &c.groups, &c.group_of)
+                ..problem::report::ContactReport::of_groups(
+                    &c.points,
+                    &c.solution,
+                    &c.groups,
+                    &c.group_of,
+                    scene.mesh.axisymmetric,
+                )
             };
             // a contact's closed form (Hertz, Cattaneo-Mindlin) is judged on every point
             if report.exact.is_none() {
