@@ -86,6 +86,18 @@ fn the_contact_frame_gives_the_directions_of_the_components() {
                 "{scene}: {resultant:?} {report:?}"
             );
         }
+        // the normal resultant: each zone's normal force pushing the body out along -n
+        let forces: Vec<f64> = match report.groups.len() {
+            0 => vec![report.normal_force],
+            _ => report.groups.iter().map(|g| g.normal_force).collect(),
+        };
+        for k in 0..dim {
+            let pushed: f64 = frames.iter().zip(&forces).map(|((f, _), p)| -p * f.normal[k]).sum();
+            assert!(
+                (pushed - report.normal_resultant[k]).abs() <= 1e-12 * scale,
+                "{scene}: {report:?}"
+            );
+        }
         if scene == "paper-3d" {
             let f = &frames[0].0;
             assert_eq!(

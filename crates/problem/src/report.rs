@@ -334,8 +334,13 @@ pub struct ContactReport {
     pub n_slip: usize,
     /// Points with no contact force.
     pub n_separated: usize,
-    /// `Σ w λ_n`.
+    /// `Σ w λ_n`: the pressures integrated (over zones of different normals a sum of their
+    /// magnitudes; [`ContactReport::normal_resultant`] is the vector).
     pub normal_force: f64,
+    /// The normal force as a vector, `-Σ w λ_n n` in the global frame (one component per
+    /// dimension; the force the foundation exerts on the body, pushing it out along `-n`).
+    #[serde(default)]
+    pub normal_resultant: Vec<f64>,
     /// `|Σ w λ_t t|`: the magnitude of [`ContactReport::tangential_resultant`].
     pub tangential_force: f64,
     /// The tangential force as a vector, `Σ w λ_t t` in the global frame (`x, y[, z]`: one
@@ -584,8 +589,10 @@ impl ContactReport {
     /// The resultants of a body of revolution: their radial part (x) cancels over the
     /// revolution.
     fn revolved(&mut self) {
-        if let Some(r) = self.tangential_resultant.first_mut() {
-            *r = 0.0;
+        for r in [&mut self.tangential_resultant, &mut self.normal_resultant] {
+            if let Some(x) = r.first_mut() {
+                *x = 0.0;
+            }
         }
         self.tangential_force = linalg::norm(&self.tangential_resultant);
     }
@@ -593,12 +600,20 @@ impl ContactReport {
     /// The summary of a contact solution on its points.
     pub fn of(points: &contact::ContactPoints, sol: &contact::ContactSolution) -> Self {
         let ([n_stick, n_slip, n_separated], normal_force, t) = tally(points, sol, 0..points.len());
+        let mut pushed = [0.0; 3];
+        for i in 0..points.len() {
+            for (k, p) in pushed.iter_mut().enumerate() {
+                *p -= points.weight[i] * sol.lambda.normal[i] * points.normal[i][k];
+            }
+        }
         ContactReport {
             n_points: points.len(),
             n_stick,
             n_slip,
             n_separated,
             normal_force,
+            // `+ 0.0`: round-off's -0 reads as 0
+            normal_resultant: pushed[..points.dim].iter().map(|x| x + 0.0).collect(),
             tangential_force: linalg::norm(&t),
             tangential_resultant: t[..points.dim].to_vec(),
             max_lambda_n: Some(sol.lambda.normal.iter().cloned().fold(0.0f64, f64::max)),
