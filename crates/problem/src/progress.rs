@@ -207,9 +207,10 @@ impl<'a> Event<'a> {
         }
     }
 
-    /// The event that ends assembly: the mesh's and the dofs' sizes (`length` the unit of its
-    /// lengths), and the time taken.
-    pub fn assembled(mesh: &mesh::Mesh, dofs: &fe_assembly::DofMap, length: &'a str, seconds: f64) -> Self {
+    /// The event that ends assembly: the mesh's (in its scene's length unit) and the dofs'
+    /// sizes, and the time taken.
+    pub fn assembled(setup: &'a crate::setup::Setup, dofs: &fe_assembly::DofMap, seconds: f64) -> Self {
+        let (mesh, length) = (&setup.mesh, &setup.units.length);
         Event::Assembled {
             n_nodes: mesh.n_nodes(),
             n_cells: mesh.n_cells(),
