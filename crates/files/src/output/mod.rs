@@ -166,7 +166,11 @@ fn output_files(solution: &Solution, output: Output) -> Result<plots::Files, Err
         }
         Output::Multipliers => {
             let c = solution.contact.as_ref().ok_or_else(|| missing("multipliers"))?;
-            multipliers_picture(c, &solution.report.units, indenter_zone(solution, c))?
+            multipliers_picture(
+                c,
+                (&solution.report.units, &solution.report.plan),
+                indenter_zone(solution, c),
+            )?
         }
         Output::Deformed => {
             let pic = plots::mesh_view::deformed_picture(&solution.mesh, &solution.u, &solution.report.units)?;
@@ -630,13 +634,13 @@ fn tip_window(solution: &Solution, c: &ContactResult) -> Option<plots::mesh_view
 }
 
 /// The multipliers along the contact boundary (in 3D, along the contact face's middle line
-/// y = y_mid), like the paper's figures: `λ_n`, `λ_t` (first component), the Coulomb bound
-/// `F λ_n`, and the sliding points. Under an indenter that touches (`zone`: each point's
+/// y = y_mid), like the paper's figures: `λ_n`, `λ_t` (in 3D its magnitude), the slip bound
+/// (Coulomb's `F λ_n`, Tresca's `S`; in 2D on both sides), and the sliding points. Under an indenter that touches (`zone`: each point's
 /// distance from its axis, NaN off its zone, and the contact radius `a`), the zone seen close:
 /// against `r/a` from 0 to 3, every point of the zone within (in 3D each as a dot).
 fn multipliers_picture(
     c: &ContactResult,
-    units: &problem::Units,
+    (units, plan): (&problem::Units, &problem::Plan),
     zone: Option<(Vec<f64>, f64)>,
 ) -> Result<plots::Files, Error> {
     let (p, s) = (&c.points, &c.solution);
@@ -673,26 +677,46 @@ fn multipliers_picture(
     };
     let mut series = vec![curve("lambda_n (pressure)", along(&|i| s.lambda.normal[i]))];
     if nt > 0 {
-        let name = if nt > 1 {
-            "lambda_t (first component)"
-        } else {
-            "lambda_t"
+        // the slip bound each point's |λ_t| meets where it slides: Coulomb's F λ_n, Tresca's S
+        let law = plan.law(p, &c.group_of);
+        let bound = contact::slip_bound(p, &law, &s.lambda.normal);
+        let bound_name = match law {
+            contact::Law::Tresca(_) => "S (Tresca bound)",
+            _ => "F lambda_n (Coulomb bound)",
         };
-        series.push(curve(name, along(&|i| s.lambda.tangential[i * nt])));
+        // in 2D λ_t along the tangent, between -bound and +bound; in 3D its magnitude (its
+        // components lie along the frame of run.json's contact.frame, in contact.csv)
+        let (name, t): (&str, Box<dyn Fn(usize) -> f64>) = if nt > 1 {
+            ("|lambda_t|", Box::new(|i| s.lambda.tangential_norm(i)))
+        } else {
+            ("lambda_t", Box::new(|i| s.lambda.tangential[i]))
+        };
+        series.push(curve(name, along(&|i| t(i))));
         series.push(Series {
             name: "slipping point".into(),
             points: idx
                 .iter()
                 .filter(|&&i| s.status[i] == contact::Status::Slip)
-                .map(|&i| (x[i], s.lambda.tangential[i * nt]))
+                .map(|&i| (x[i], t(i)))
                 .collect(),
             mark: Mark::Dots,
         });
         series.push(Series {
-            name: "F lambda_n (Coulomb bound)".into(),
-            points: along(&|i| p.friction[i] * s.lambda.normal[i]),
+            name: if nt > 1 {
+                bound_name.into()
+            } else {
+                format!("±{bound_name}")
+            },
+            points: along(&|i| bound[i]),
             mark: Mark::Reference,
         });
+        if nt == 1 {
+            series.push(Series {
+                name: String::new(),
+                points: along(&|i| -bound[i]),
+                mark: Mark::Reference,
+            });
+        }
     }
     let (title, x_label) = match &zone {
         Some((_, a)) => (
@@ -1227,6 +1251,29 @@ mod tests {
                     .iter()
                     .all(|&v| pressure[v] == 0.0 && traction[3 * v..3 * v + 3] == [0.0; 3])
         );
+    }
+
+    /// The multipliers' picture draws each law's own slip bound (a Tresca run once drew its
+    /// "Coulomb bound" F λ_n, 0 there) on both sides of the signed λ_t in 2D, and in 3D the
+    /// magnitude |λ_t| that meets it (not one component of the vector).
+    #[test]
+    fn the_multipliers_picture_draws_the_laws_bound_against_the_right_quantity() {
+        for (scene, n, says) in [
+            ("paper-tresca", "mesh.n=8", ["±S (Tresca bound)", "lambda_t"]),
+            ("paper-slip", "mesh.n=8", ["±F lambda_n (Coulomb bound)", "lambda_t"]),
+            ("paper-3d", "mesh.n=3", ["F lambda_n (Coulomb bound)", "|lambda_t|"]),
+        ] {
+            let (sc, _) = crate::scene_file::load(scene, &[n.to_string()]).unwrap();
+            let s = problem::solve(&sc, None, &mut problem::Silent).unwrap();
+            let c = s.contact.as_ref().unwrap();
+            let files = multipliers_picture(c, (&s.report.units, &s.report.plan), None).unwrap();
+            let svg = files.iter().find(|(name, _)| name.ends_with(".svg")).unwrap();
+            let text = String::from_utf8_lossy(&svg.1);
+            for word in says {
+                assert!(text.contains(word), "{scene}: no `{word}` in its picture");
+            }
+            assert!(!text.contains("first component"), "{scene}");
+        }
     }
 
     /// A meridian's tensor turned with its wedge: at the angle θ its radial, axial and hoop
