@@ -250,7 +250,7 @@ fn walk_set_up<B: Backend>(
     let boundary = walk.boundary(&mut posed, &instants, points, reporter)?;
     let assembled = backend.assemble(&posed)?;
     let t_assembly = t.elapsed().as_secs_f64();
-    reporter.event(&Event::assembled(&setup, &disc.dofs, t_assembly));
+    reporter.event(&Event::assembled(setup, &disc.dofs, t_assembly));
     walk.plan_path(instants.len(), &disc, boundary.as_ref(), reporter);
     stop_if_interrupted(&limits, "assembly")?;
     let mut system = backend.prepare(&posed, assembled, boundary.as_ref(), limits, reporter)?;
