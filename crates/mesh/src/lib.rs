@@ -34,6 +34,7 @@ mod parts;
 mod pieces;
 mod quadratic;
 mod quality;
+mod seams;
 mod topology;
 
 pub use generate::{box_tet, rectangle_quad, rectangle_tri, round_quarter_section};

@@ -26,6 +26,10 @@ pub struct QualityReport {
     /// Facets of boundary groups that lie inside the mesh (a material interface, an internal
     /// electrode), over all groups.
     pub interior_group_facets: usize,
+    /// Boundary facets that lie on other boundary facets, and their total length (2D) or area
+    /// (3D): a seam where parts of the mesh are not joined, so that the body is cut along it
+    /// ([`Mesh::seam_facets`]).
+    pub seam: (usize, f64),
 }
 
 /// A cell whose measure is below this fraction of `h^dim` (its longest edge to the power of
@@ -85,6 +89,7 @@ impl Mesh {
             coincident_nodes: 0,
             unused_nodes: 0,
             interior_group_facets: 0,
+            seam: (0, 0.0),
         };
         let measure_name = if self.dim == 2 { "area" } else { "volume" };
         let corners = self.kind.n_corners();
@@ -125,6 +130,7 @@ impl Mesh {
         }
         report.unused_nodes = self.unused_nodes().len();
         (report.coincident_nodes, report.interior_group_facets) = self.check_topology()?;
+        report.seam = self.seam_facets();
         Ok(report)
     }
 

@@ -50,7 +50,7 @@ impl CellKind {
 
 impl Mesh {
     /// Every facet of every cell with its cell, sorted by facet.
-    fn cell_facets(&self) -> Vec<(Key, usize)> {
+    pub(crate) fn cell_facets(&self) -> Vec<(Key, usize)> {
         let local = self.kind.facets();
         let corners = self.kind.facet_corners();
         let mut all = Vec::with_capacity(self.n_cells() * local.len());

@@ -386,6 +386,14 @@ pub(crate) fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
             n.coincident_nodes
         ));
     }
+    if n.seam.facets > 0 {
+        notes.push(format!(
+            "{} boundary facets lie on other boundary facets, the sides of a seam of {} {:.4e} where the mesh's parts are not joined: the body is cut along it (a crack); join them (Gmsh: fragment the parts, BooleanFragments or Coherence) unless the cut is meant",
+            n.seam.facets,
+            if n.seam.dim == 3 { "area" } else { "length" },
+            n.seam.size()
+        ));
+    }
     if n.curved_cells > 0 {
         notes.push(format!(
             "{} curved cells (edge nodes off their edges' midpoints): mapped through their nodes",

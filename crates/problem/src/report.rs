@@ -230,6 +230,8 @@ impl MeshReport {
             cells_per_axis: scene.mesh.cells_per_axis(),
             reoriented_cells: setup.notes.reoriented_cells,
             coincident_nodes: setup.notes.coincident_nodes,
+            seam_facets: setup.notes.seam.facets,
+            seam_size: setup.notes.seam.size(),
             unused_nodes: setup.notes.unused_nodes,
             curved_cells: setup.notes.curved_cells,
         }
@@ -298,6 +300,13 @@ pub struct MeshReport {
     /// Nodes at the coordinates of another node (a crack, or parts not merged).
     #[serde(default)]
     pub coincident_nodes: usize,
+    /// Boundary facets that lie on other boundary facets: the sides of a seam where the mesh's
+    /// parts are not joined, so that the body is cut there.
+    #[serde(default)]
+    pub seam_facets: usize,
+    /// The seam's length (2D) or area (3D), in the scene's length unit (0 without one).
+    #[serde(default)]
+    pub seam_size: f64,
     /// Nodes that no cell uses (the centre of a Gmsh arc): they carry no unknown.
     #[serde(default)]
     pub unused_nodes: usize,

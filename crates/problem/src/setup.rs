@@ -38,6 +38,24 @@ pub struct Setup {
     pub ranged_electrodes: Vec<String>,
 }
 
+/// Boundary facets that lie on other boundary facets ([`mesh::Mesh::seam_facets`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Seam {
+    /// Their number.
+    pub facets: usize,
+    /// Their total length (2D) or area (3D).
+    pub measure: f64,
+    /// The mesh's dimension.
+    pub dim: usize,
+}
+
+impl Seam {
+    /// The seam's length (2D) or area (3D): each of its sides is found, so half the facets'.
+    pub fn size(&self) -> f64 {
+        self.measure / 2.0
+    }
+}
+
 /// What the mesh's checks noted without refusing it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshNotes {
@@ -45,6 +63,9 @@ pub struct MeshNotes {
     pub reoriented_cells: usize,
     /// Nodes at the coordinates of another node (a crack, or parts not merged).
     pub coincident_nodes: usize,
+    /// Boundary facets on other boundary facets: a seam where the mesh's parts are not joined
+    /// (of the whole mesh; none on a piece).
+    pub seam: Seam,
     /// Nodes that no cell uses (the centre of a Gmsh arc): carried with no unknown.
     pub unused_nodes: usize,
     /// Curved second-order cells (an edge node off its edge's midpoint), mapped through their
@@ -277,6 +298,11 @@ fn mesh(scene: &Scene, source: Source) -> Result<(mesh::Mesh, MeshNotes), Proble
     let notes = MeshNotes {
         reoriented_cells: mesh.reoriented_cells,
         coincident_nodes: quality.coincident_nodes,
+        seam: Seam {
+            facets: quality.seam.0,
+            measure: quality.seam.1,
+            dim: mesh.dim,
+        },
         unused_nodes: quality.unused_nodes,
         curved_cells: mesh.curved_cells().iter().filter(|&&c| c).count(),
         narrowed_electrodes,

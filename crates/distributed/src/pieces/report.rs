@@ -93,6 +93,9 @@ impl Shares<'_> {
                 cells_per_axis: scene.mesh.cells_per_axis(),
                 reoriented_cells: 0,
                 coincident_nodes: 0,
+                // a seam across pieces is no piece's: not looked for
+                seam_facets: 0,
+                seam_size: 0.0,
                 unused_nodes: 0,
                 curved_cells: 0,
             },
