@@ -677,46 +677,7 @@ fn multipliers_picture(
     };
     let mut series = vec![curve("lambda_n (pressure)", along(&|i| s.lambda.normal[i]))];
     if nt > 0 {
-        // the slip bound each point's |λ_t| meets where it slides: Coulomb's F λ_n, Tresca's S
-        let law = plan.law(p, &c.group_of);
-        let bound = contact::slip_bound(p, &law, &s.lambda.normal);
-        let bound_name = match law {
-            contact::Law::Tresca(_) => "S (Tresca bound)",
-            _ => "F lambda_n (Coulomb bound)",
-        };
-        // in 2D λ_t along the tangent, between -bound and +bound; in 3D its magnitude (its
-        // components lie along the frame of run.json's contact.frame, in contact.csv)
-        let (name, t): (&str, Box<dyn Fn(usize) -> f64>) = if nt > 1 {
-            ("|lambda_t|", Box::new(|i| s.lambda.tangential_norm(i)))
-        } else {
-            ("lambda_t", Box::new(|i| s.lambda.tangential[i]))
-        };
-        series.push(curve(name, along(&|i| t(i))));
-        series.push(Series {
-            name: "slipping point".into(),
-            points: idx
-                .iter()
-                .filter(|&&i| s.status[i] == contact::Status::Slip)
-                .map(|&i| (x[i], t(i)))
-                .collect(),
-            mark: Mark::Dots,
-        });
-        series.push(Series {
-            name: if nt > 1 {
-                bound_name.into()
-            } else {
-                format!("±{bound_name}")
-            },
-            points: along(&|i| bound[i]),
-            mark: Mark::Reference,
-        });
-        if nt == 1 {
-            series.push(Series {
-                name: String::new(),
-                points: along(&|i| -bound[i]),
-                mark: Mark::Reference,
-            });
-        }
+        series.extend(friction_series(c, plan, (&idx, &x), &curve));
     }
     let (title, x_label) = match &zone {
         Some((_, a)) => (
@@ -756,6 +717,62 @@ fn multipliers_picture(
         });
     }
     plots::panels("multipliers", &panels)
+}
+
+/// The multipliers' picture's friction series: `λ_t` (in 2D along the tangent, in 3D its
+/// magnitude), the sliding points, and the slip bound it meets where it slides (Coulomb's
+/// `F λ_n`, Tresca's `S`; in 2D on both sides) of the points `idx` at `x`.
+fn friction_series(
+    c: &ContactResult,
+    plan: &problem::Plan,
+    (idx, x): (&[usize], &[f64]),
+    curve: &dyn Fn(&str, Vec<(f64, f64)>) -> Series,
+) -> Vec<Series> {
+    let (p, s) = (&c.points, &c.solution);
+    let nt = s.lambda.n_tangential();
+    let along = |f: &dyn Fn(usize) -> f64| idx.iter().map(|&i| (x[i], f(i))).collect::<Vec<_>>();
+    let mut series = vec![];
+    // the slip bound each point's |λ_t| meets where it slides: Coulomb's F λ_n, Tresca's S
+    let law = plan.law(p, &c.group_of);
+    let bound = contact::slip_bound(p, &law, &s.lambda.normal);
+    let bound_name = match law {
+        contact::Law::Tresca(_) => "S (Tresca bound)",
+        _ => "F lambda_n (Coulomb bound)",
+    };
+    // in 2D λ_t along the tangent, between -bound and +bound; in 3D its magnitude (its
+    // components lie along the frame of run.json's contact.frame, in contact.csv)
+    let (name, t): (&str, Box<dyn Fn(usize) -> f64>) = if nt > 1 {
+        ("|lambda_t|", Box::new(|i| s.lambda.tangential_norm(i)))
+    } else {
+        ("lambda_t", Box::new(|i| s.lambda.tangential[i]))
+    };
+    series.push(curve(name, along(&|i| t(i))));
+    series.push(Series {
+        name: "slipping point".into(),
+        points: idx
+            .iter()
+            .filter(|&&i| s.status[i] == contact::Status::Slip)
+            .map(|&i| (x[i], t(i)))
+            .collect(),
+        mark: Mark::Dots,
+    });
+    series.push(Series {
+        name: if nt > 1 {
+            bound_name.into()
+        } else {
+            format!("±{bound_name}")
+        },
+        points: along(&|i| bound[i]),
+        mark: Mark::Reference,
+    });
+    if nt == 1 {
+        series.push(Series {
+            name: String::new(),
+            points: along(&|i| -bound[i]),
+            mark: Mark::Reference,
+        });
+    }
+    series
 }
 
 /// A path's own files without its series: `path.csv` and the pictures of its global curves
