@@ -719,6 +719,9 @@ fn multipliers_picture(
     plots::panels("multipliers", &panels)
 }
 
+/// A series of `(x, y)` points under a name, drawn as the picture draws its curves.
+type Curve<'a> = dyn Fn(&str, Vec<(f64, f64)>) -> Series + 'a;
+
 /// The multipliers' picture's friction series: `λ_t` (in 2D along the tangent, in 3D its
 /// magnitude), the sliding points, and the slip bound it meets where it slides (Coulomb's
 /// `F λ_n`, Tresca's `S`; in 2D on both sides) of the points `idx` at `x`.
@@ -726,7 +729,7 @@ fn friction_series(
     c: &ContactResult,
     plan: &problem::Plan,
     (idx, x): (&[usize], &[f64]),
-    curve: &dyn Fn(&str, Vec<(f64, f64)>) -> Series,
+    curve: &Curve<'_>,
 ) -> Vec<Series> {
     let (p, s) = (&c.points, &c.solution);
     let nt = s.lambda.n_tangential();
