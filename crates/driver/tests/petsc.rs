@@ -199,7 +199,10 @@ fn every_scene_agrees(petsc: &Petsc) {
         let seconds = t.elapsed().as_secs_f64();
         let direct = problem::solve(&faer, None, &mut problem::Silent).expect("the faer run");
         let (d, what) = farthest(&direct, &dist);
-        eprintln!("{name} ({}, {order}): {seconds:.2} s, farthest {what} at {d:.1e}", smoke.join(" "));
+        eprintln!(
+            "{name} ({}, {order}): {seconds:.2} s, farthest {what} at {d:.1e}",
+            smoke.join(" ")
+        );
         assert!(d < 1e-7, "{name}: {what} differs by {d:.2e}");
         if dist.contact.is_some() {
             assert!(dist.report.residuals.complementarity <= scene.solver.tol, "{name}");
