@@ -19,6 +19,9 @@ pub struct SweepRow {
     pub normal_force: f64,
     /// |Σ w λ_t|.
     pub tangential_force: f64,
+    /// `Σ w λ_t t` in the global frame, one component per dimension (run.json's
+    /// `contact.tangential_resultant`; empty where the point failed).
+    pub tangential_resultant: Vec<f64>,
     /// Complementarity residual.
     pub complementarity: f64,
     /// Equilibrium residual.
@@ -209,6 +212,7 @@ impl SweepRow {
             counts: (c.n_stick, c.n_slip, c.n_separated),
             normal_force: c.normal_force,
             tangential_force: c.tangential_force,
+            tangential_resultant: c.tangential_resultant.clone(),
             complementarity: r.residuals.complementarity,
             equilibrium: r.residuals.equilibrium,
             uzawa: r.iterations.uzawa,
@@ -239,6 +243,7 @@ impl SweepRow {
             counts: (0, 0, 0),
             normal_force: f64::NAN,
             tangential_force: f64::NAN,
+            tangential_resultant: vec![],
             complementarity: f64::NAN,
             equilibrium: f64::NAN,
             uzawa: 0,
@@ -305,7 +310,8 @@ fn terminal_groups(rows: &[SweepRow]) -> Vec<String> {
         .map_or(vec![], |r| r.terminals.iter().map(|t| t.0.clone()).collect())
 }
 
-/// The rows as CSV: the counts, forces, residuals, iterations and seconds; where the scene has
+/// The rows as CSV: the counts, forces, residuals, iterations and seconds, the tangential
+/// force's components (`tangential_force_x`, `_y`, `_z` in 3D); where the scene has
 /// an indenter its figures (`indenter_depth`, `indenter_charge` (`nan` for an insulating
 /// one's), `indenter_force`, `indenter_contact_radius`, `indenter_potential`) and the
 /// half-space's closed form beside them (`half_space_force`, `_contact_radius`, `_charge`,
@@ -322,6 +328,14 @@ pub fn csv(param: &str, rows: &[SweepRow], integer: bool) -> String {
                 .map(String::from),
         )
         .collect();
+    // the tangential force's components beside its magnitude (as path.csv's)
+    let dim = rows.iter().map(|r| r.tangential_resultant.len()).max().unwrap_or(0);
+    columns.extend(
+        ["x", "y", "z"]
+            .iter()
+            .take(dim)
+            .map(|a| format!("tangential_force_{a}")),
+    );
     if indenter {
         columns.extend("indenter_depth,indenter_charge,indenter_force,indenter_contact_radius,indenter_potential,half_space_force,half_space_contact_radius,half_space_charge".split(',').map(String::from));
     }
@@ -351,6 +365,9 @@ pub fn csv(param: &str, rows: &[SweepRow], integer: bool) -> String {
     let or_nan = |v: Option<f64>| v.unwrap_or(f64::NAN);
     for r in rows {
         let mut extra = String::new();
+        for k in 0..dim {
+            extra.push_str(&format!(",{:e}", or_nan(r.tangential_resultant.get(k).copied())));
+        }
         if indenter {
             let i = r.indenter.as_ref();
             let h = i.and_then(|i| i.half_space);
@@ -658,5 +675,19 @@ mod tests {
             forces.windows(2).all(|w| w[0] != w[1]),
             "each point its own run: {forces:?}"
         );
+        // the tangential force's components beside its magnitude, as run.json's resultant
+        let text = csv(&s.param, &rows, false);
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let at = |name: &str| header.iter().position(|h| h.starts_with(name)).unwrap();
+        let (x, y, norm) = (
+            at("tangential_force_x"),
+            at("tangential_force_y"),
+            at("tangential_force ["),
+        );
+        for (line, r) in text.lines().skip(1).zip(&rows) {
+            let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap_or(f64::NAN)).collect();
+            assert_eq!([v[x], v[y]], [r.tangential_resultant[0], r.tangential_resultant[1]]);
+            assert!((v[x].hypot(v[y]) - v[norm]).abs() <= 1e-12 * v[norm].abs().max(1e-300));
+        }
     }
 }
