@@ -129,8 +129,10 @@ impl Mesh {
             report.max_aspect = report.max_aspect.max(reference * scale / measure);
         }
         report.unused_nodes = self.unused_nodes().len();
-        (report.coincident_nodes, report.interior_group_facets) = self.check_topology()?;
-        report.seam = self.seam_facets();
+        // the cells' facets sorted once, for the topology's checks and the seams
+        let facets = self.cell_facets();
+        (report.coincident_nodes, report.interior_group_facets) = self.check_topology(&facets)?;
+        report.seam = self.seams_of(&facets);
         Ok(report)
     }
 

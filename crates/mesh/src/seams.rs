@@ -3,50 +3,47 @@
 //! their common curve becomes two, with nodes that match or not). The body is then two bodies
 //! there, held together nowhere along the seam: a crack, meant or not.
 
+use crate::generate::triangle_normal;
+use crate::topology::Key;
 use crate::Mesh;
 use std::collections::HashMap;
-
-/// A boundary facet's corners, for the geometric tests.
-type Corners = [[f64; 3]; 3];
 
 impl Mesh {
     /// The boundary facets (those of one cell) whose centroid lies on another boundary facet:
     /// their number and their total length (2D) or area (3D). Matching seams (duplicated
     /// nodes) and non-matching ones (nodes of one side on the other side's edges) alike.
     pub fn seam_facets(&self) -> (usize, f64) {
-        let facets = self.cell_facets();
+        self.seams_of(&self.cell_facets())
+    }
+
+    /// [`Mesh::seam_facets`] from the cells' facets, sorted ([`Mesh::cell_facets`]).
+    pub(crate) fn seams_of(&self, facets: &[(Key, usize)]) -> (usize, f64) {
         let corners = self.kind.facet_corners();
-        let mut boundary: Vec<Corners> = vec![];
-        let mut i = 0;
-        while i < facets.len() {
-            let j = i + facets[i..].iter().take_while(|f| f.0 == facets[i].0).count();
-            if j - i == 1 {
-                let mut c = [[0.0; 3]; 3];
-                for (q, &v) in facets[i].0[..corners].iter().enumerate() {
-                    c[q] = self.points[v];
-                }
-                boundary.push(c);
-            }
-            i = j;
-        }
-        if boundary.is_empty() {
-            return (0, 0.0);
-        }
-        let size = |f: &Corners| (1..corners).map(|q| crate::dist(&f[0], &f[q])).fold(0.0, f64::max);
+        let boundary: Vec<&[usize]> = facets
+            .chunk_by(|a, b| a.0 == b.0)
+            .filter(|run| run.len() == 1)
+            .map(|run| &run[0].0[..corners])
+            .collect();
+        let at_corner = |f: &[usize], q: usize| &self.points[f[q]];
+        let size = |f: &[usize]| {
+            (1..corners)
+                .map(|q| crate::dist(at_corner(f, 0), at_corner(f, q)))
+                .fold(0.0, f64::max)
+        };
         // a grid of cells about the longest facet's size: a facet is listed in every grid cell
         // its bounding box meets, a centroid looked up in its own
-        let cell = boundary.iter().map(size).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+        let cell = boundary
+            .iter()
+            .map(|f| size(f))
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
         let at = |x: &[f64; 3]| x.map(|c| (c / cell).floor() as i64);
         let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
         for (k, f) in boundary.iter().enumerate() {
-            let (lo, hi) = (0..3).fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(mut lo, mut hi), d| {
-                for p in &f[..corners] {
-                    lo[d] = lo[d].min(p[d]);
-                    hi[d] = hi[d].max(p[d]);
-                }
-                (lo, hi)
-            });
-            let (a, b) = (at(&lo), at(&hi));
+            let bound = |pick: fn(f64, f64) -> f64| -> [f64; 3] {
+                std::array::from_fn(|d| f.iter().map(|&v| self.points[v][d]).reduce(pick).unwrap_or(0.0))
+            };
+            let (a, b) = (at(&bound(f64::min)), at(&bound(f64::max)));
             for x in a[0]..=b[0] {
                 for y in a[1]..=b[1] {
                     for z in a[2]..=b[2] {
@@ -58,66 +55,56 @@ impl Mesh {
         let (mut count, mut measure) = (0, 0.0);
         for (k, f) in boundary.iter().enumerate() {
             let centroid: [f64; 3] =
-                std::array::from_fn(|d| f[..corners].iter().map(|p| p[d]).sum::<f64>() / corners as f64);
+                std::array::from_fn(|d| f.iter().map(|&v| self.points[v][d]).sum::<f64>() / corners as f64);
             let on_another = grid.get(&at(&centroid)).is_some_and(|near| {
-                near.iter()
-                    .any(|&g| g != k && holds(&boundary[g], corners, &centroid, 1e-9 * size(&boundary[g])))
+                (near.iter()).any(|&g| g != k && self.holds(boundary[g], &centroid, 1e-9 * size(boundary[g])))
             });
             if on_another {
                 count += 1;
-                measure += facet_measure(f, corners);
+                measure += match corners {
+                    2 => crate::dist(at_corner(f, 0), at_corner(f, 1)),
+                    _ => 0.5 * norm(&triangle_normal(&self.points, f)),
+                };
             }
         }
         (count, measure)
     }
+
+    /// Whether the facet of corners `f` (a segment of 2, a triangle of 3) holds the point `x`,
+    /// to the distance `tol`.
+    fn holds(&self, f: &[usize], x: &[f64; 3], tol: f64) -> bool {
+        let o = &self.points[f[0]];
+        let (e1, r) = (sub(&self.points[f[1]], o), sub(x, o));
+        if f.len() == 2 {
+            let t = dot(&r, &e1) / dot(&e1, &e1);
+            let off: [f64; 3] = std::array::from_fn(|d| r[d] - t * e1[d]);
+            return (0.0..=1.0).contains(&t) && norm(&off) <= tol;
+        }
+        let e2 = sub(&self.points[f[2]], o);
+        let n = triangle_normal(&self.points, f);
+        if dot(&r, &n).abs() / norm(&n) > tol {
+            return false;
+        }
+        // barycentric coordinates in the facet's plane
+        let (a, b, c) = (dot(&e1, &e1), dot(&e1, &e2), dot(&e2, &e2));
+        let (p, q) = (dot(&r, &e1), dot(&r, &e2));
+        let det = a * c - b * b;
+        let (s, t) = ((c * p - b * q) / det, (a * q - b * p) / det);
+        let slack = 1e-9;
+        s >= -slack && t >= -slack && s + t <= 1.0 + slack
+    }
 }
 
-/// Whether the facet `f` (a segment of 2 corners, a triangle of 3) holds the point `x`, to
-/// the distance `tol`.
-fn holds(f: &Corners, corners: usize, x: &[f64; 3], tol: f64) -> bool {
-    let sub = |a: &[f64; 3], b: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|d| a[d] - b[d]) };
-    let dot = |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|d| a[d] * b[d]).sum::<f64>();
-    let (e1, r) = (sub(&f[1], &f[0]), sub(x, &f[0]));
-    if corners == 2 {
-        let len2 = dot(&e1, &e1);
-        let t = dot(&r, &e1) / len2;
-        let off: [f64; 3] = std::array::from_fn(|d| r[d] - t * e1[d]);
-        return (0.0..=1.0).contains(&t) && dot(&off, &off).sqrt() <= tol;
-    }
-    let e2 = sub(&f[2], &f[0]);
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let area2 = dot(&n, &n).sqrt();
-    if dot(&r, &n).abs() / area2 > tol {
-        return false;
-    }
-    // barycentric coordinates in the facet's plane
-    let (a, b, c) = (dot(&e1, &e1), dot(&e1, &e2), dot(&e2, &e2));
-    let (p, q) = (dot(&r, &e1), dot(&r, &e2));
-    let det = a * c - b * b;
-    let (s, t) = ((c * p - b * q) / det, (a * q - b * p) / det);
-    let slack = 1e-9;
-    s >= -slack && t >= -slack && s + t <= 1.0 + slack
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|d| a[d] - b[d])
 }
 
-/// The length (2 corners) or area (3) of a facet.
-fn facet_measure(f: &Corners, corners: usize) -> f64 {
-    if corners == 2 {
-        return crate::dist(&f[0], &f[1]);
-    }
-    let (u, v): ([f64; 3], [f64; 3]) = (
-        std::array::from_fn(|d| f[1][d] - f[0][d]),
-        std::array::from_fn(|d| f[2][d] - f[0][d]),
-    );
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    (0..3).map(|d| a[d] * b[d]).sum()
+}
+
+fn norm(a: &[f64; 3]) -> f64 {
+    dot(a, a).sqrt()
 }
 
 #[cfg(test)]
