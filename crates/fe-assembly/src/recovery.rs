@@ -74,9 +74,11 @@ pub struct Tensors {
     pub electric_field: Vec<f64>,
 }
 
-/// [`Tensors`] of fields laid out as [`CellFields`] (`count` entries, `dim`-dimensional, `nv`
-/// Voigt components, `out_of_plane` 4 per entry or empty).
-fn tensors([stress, strain, d, e]: [&[f64]; 4], out_of_plane: &[f64], count: usize, dim: usize) -> Tensors {
+/// [`Tensors`] of fields laid out as [`CellFields`] (`dim`-dimensional: `D` has `dim`
+/// components per entry, which counts the entries; `nv` Voigt components, `out_of_plane` 4 per
+/// entry or empty).
+fn tensors([stress, strain, d, e]: [&[f64]; 4], out_of_plane: &[f64], dim: usize) -> Tensors {
+    let count = d.len() / dim;
     let nv = stress.len().checked_div(count).unwrap_or(0);
     let mut out = Tensors {
         stress: Vec::with_capacity(6 * count),
@@ -122,28 +124,28 @@ fn tensors([stress, strain, d, e]: [&[f64]; 4], out_of_plane: &[f64], count: usi
 }
 
 impl CellFields {
-    /// The fields of `count` cells of a `dim`-dimensional body as [`Tensors`].
-    pub fn tensors(&self, count: usize, dim: usize) -> Tensors {
+    /// The fields of the cells of a `dim`-dimensional body as [`Tensors`].
+    pub fn tensors(&self, dim: usize) -> Tensors {
         let arrays = [
             &self.stress,
             &self.strain,
             &self.electric_displacement,
             &self.electric_field,
         ];
-        tensors(arrays.map(|a| &a[..]), &self.out_of_plane, count, dim)
+        tensors(arrays.map(|a| &a[..]), &self.out_of_plane, dim)
     }
 }
 
 impl NodeFields {
-    /// The fields of `count` nodes of a `dim`-dimensional body as [`Tensors`].
-    pub fn tensors(&self, count: usize, dim: usize) -> Tensors {
+    /// The fields of the nodes of a `dim`-dimensional body as [`Tensors`].
+    pub fn tensors(&self, dim: usize) -> Tensors {
         let arrays = [
             &self.stress,
             &self.strain,
             &self.electric_displacement,
             &self.electric_field,
         ];
-        tensors(arrays.map(|a| &a[..]), &self.out_of_plane, count, dim)
+        tensors(arrays.map(|a| &a[..]), &self.out_of_plane, dim)
     }
 }
 
@@ -523,14 +525,14 @@ mod tests {
             out_of_plane,
             at_nodes: None,
         };
-        let t = fields(6, 3, vec![]).tensors(1, 3);
+        let t = fields(6, 3, vec![]).tensors(3);
         assert_eq!(t.stress, [1.0, 2.0, 3.0, 6.0, 4.0, 5.0]);
         assert_eq!(t.strain, [10.0, 20.0, 30.0, 30.0, 20.0, 25.0]);
         assert_eq!(
             (t.electric_displacement, t.electric_field),
             (vec![1.0, 2.0, 3.0], vec![-1.0, -2.0, -3.0])
         );
-        let t = fields(3, 2, vec![7.0, 8.0, 9.0, 4.0]).tensors(1, 2);
+        let t = fields(3, 2, vec![7.0, 8.0, 9.0, 4.0]).tensors(2);
         assert_eq!(t.stress, [1.0, 2.0, 7.0, 3.0, 8.0, 9.0]);
         assert_eq!(t.strain, [10.0, 20.0, 0.0, 15.0, 0.0, 0.0]);
         assert_eq!(
@@ -538,12 +540,21 @@ mod tests {
             (vec![1.0, 2.0, 4.0], vec![-1.0, -2.0, 0.0])
         );
         // without the rows (a material given without its 3D tensors) the unknowns are NaN
-        let t = fields(3, 2, vec![]).tensors(1, 2);
+        let t = fields(3, 2, vec![]).tensors(2);
         assert!(t.stress[2].is_nan() && t.stress[3] == 3.0 && t.electric_displacement[2].is_nan());
-        let t = fields(4, 2, vec![]).tensors(1, 2);
+        let t = fields(4, 2, vec![]).tensors(2);
         assert_eq!(t.stress, [1.0, 2.0, 4.0, 3.0, 0.0, 0.0]);
         assert_eq!(t.strain, [10.0, 20.0, 40.0, 15.0, 0.0, 0.0]);
         assert_eq!(t.electric_displacement, [1.0, 2.0, 0.0]);
-        assert_eq!(fields(6, 3, vec![]).tensors(0, 3), Tensors::default());
+        // no entries (a run on pieces keeps none on rank 0): no tensors
+        let none = CellFields {
+            stress: vec![],
+            strain: vec![],
+            electric_displacement: vec![],
+            electric_field: vec![],
+            out_of_plane: vec![],
+            at_nodes: None,
+        };
+        assert_eq!(none.tensors(3), Tensors::default());
     }
 }

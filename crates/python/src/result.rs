@@ -124,7 +124,7 @@ impl RunResult {
 
     /// The per-cell fields as 3D tensors and vectors.
     fn cell_tensors(&self) -> problem::Tensors {
-        self.solution.fields.tensors(self.solution.mesh.n_cells(), self.dim())
+        self.solution.fields.tensors(self.dim())
     }
 
     /// The meshio cell type of the mesh's cells.
@@ -436,7 +436,7 @@ impl RunResult {
         };
         if let Some(at) = &r.solution.fields.at_nodes {
             // P2 cells: the fields at the nodes beside the cells'
-            for (name, values) in viewed(at.tensors(r.solution.mesh.n_nodes(), r.dim())) {
+            for (name, values) in viewed(at.tensors(r.dim())) {
                 point_data.set_item(name, values)?;
             }
         }

@@ -316,9 +316,9 @@ impl<'a> FieldArrays<'a> {
         };
         if let Some(at) = cells.and_then(|f| f.at_nodes.as_ref()) {
             // P2 cells: the fields at the nodes too, which ParaView draws quadratic
-            point.extend(four(at.tensors(mesh.n_nodes(), mesh.dim)));
+            point.extend(four(at.tensors(mesh.dim)));
         }
-        let cell = cells.map_or(vec![], |f| four(f.tensors(mesh.n_cells(), mesh.dim)));
+        let cell = cells.map_or(vec![], |f| four(f.tensors(mesh.dim)));
         FieldArrays { point, cell }
     }
 
@@ -398,7 +398,7 @@ fn revolved_vtu(
     }
     let (mut connectivity, mut offsets) = (vec![], vec![]);
     // the meridian's tensors (x = r, y = z, the hoop direction along z), turned with each wedge
-    let meridian = fields.tensors(cells, 2);
+    let meridian = fields.tensors(2);
     let (mut stress, mut strain, mut d, mut e) = (vec![], vec![], vec![], vec![]);
     for k in 0..segments {
         let (lo, hi) = ((k * n) as u64, (((k + 1) % segments) * n) as u64);
@@ -635,8 +635,9 @@ fn tip_window(solution: &Solution, c: &ContactResult) -> Option<plots::mesh_view
 
 /// The multipliers along the contact boundary (in 3D, along the contact face's middle line
 /// y = y_mid), like the paper's figures: `λ_n`, `λ_t` (in 3D its magnitude), the slip bound
-/// (Coulomb's `F λ_n`, Tresca's `S`; in 2D on both sides), and the sliding points. Under an indenter that touches (`zone`: each point's
-/// distance from its axis, NaN off its zone, and the contact radius `a`), the zone seen close:
+/// (Coulomb's `F λ_n`, Tresca's `S`; in 2D on both sides), and the sliding points. Under an
+/// indenter that touches (`zone`: each point's distance from its axis, NaN off its zone, and
+/// the contact radius `a`), the zone seen close:
 /// against `r/a` from 0 to 3, every point of the zone within (in 3D each as a dot).
 fn multipliers_picture(
     c: &ContactResult,
