@@ -516,39 +516,53 @@ pub struct ContactGroupReport {
     pub frame: Option<ContactFrame>,
 }
 
-impl ContactGroupReport {
-    /// As [`ContactReport`]'s: no radial part on a body of revolution.
-    fn revolved(&mut self) {
-        if let Some(r) = self.tangential_resultant.first_mut() {
-            *r = 0.0;
-        }
-        self.tangential_force = linalg::norm(&self.tangential_resultant);
-    }
+/// What the points `of` a contact solution add up to.
+struct Tally {
+    /// Stick, slip, separated.
+    counts: [usize; 3],
+    /// `Σ w λ_n`.
+    normal: f64,
+    /// `-Σ w λ_n n`.
+    pushed: [f64; 3],
+    /// `Σ w λ_t t`.
+    tangential: [f64; 3],
 }
 
-/// The counts (stick, slip, separated), the normal force and the tangential force vector of
-/// the points `of` a contact solution.
+/// The points `of` a contact solution added up; on a body of `revolution` the resultants
+/// without their radial part (x), which cancels over the revolution.
 fn tally(
     points: &contact::ContactPoints,
     sol: &contact::ContactSolution,
     of: impl Iterator<Item = usize>,
-) -> ([usize; 3], f64, [f64; 3]) {
+    revolution: bool,
+) -> Tally {
     let nt = sol.lambda.n_tangential();
-    let (mut counts, mut normal, mut t) = ([0; 3], 0.0, [0.0; 3]);
+    let mut out = Tally {
+        counts: [0; 3],
+        normal: 0.0,
+        pushed: [0.0; 3],
+        tangential: [0.0; 3],
+    };
     for i in of {
-        counts[match sol.status[i] {
+        out.counts[match sol.status[i] {
             contact::Status::Stick => 0,
             contact::Status::Slip => 1,
             contact::Status::Separated => 2,
         }] += 1;
-        normal += points.weight[i] * sol.lambda.normal[i];
-        for q in 0..nt {
-            for k in 0..3 {
-                t[k] += points.weight[i] * sol.lambda.tangential[i * nt + q] * points.tangent[i][q][k];
+        let w = points.weight[i];
+        out.normal += w * sol.lambda.normal[i];
+        for k in 0..3 {
+            out.pushed[k] -= w * sol.lambda.normal[i] * points.normal[i][k];
+            for q in 0..nt {
+                out.tangential[k] += w * sol.lambda.tangential[i * nt + q] * points.tangent[i][q][k];
             }
         }
     }
-    (counts, normal, t)
+    if revolution {
+        out.pushed[0] = 0.0;
+        out.tangential[0] = 0.0;
+    }
+    out
 }
 
 impl ContactReport {
@@ -564,67 +578,47 @@ impl ContactReport {
         group_of: &[usize],
         revolution: bool,
     ) -> Self {
-        let mut out = Self::of(points, sol);
-        if revolution {
-            out.revolved();
-        }
+        let mut out = Self::of(points, sol, revolution);
         if groups.len() > 1 {
             out.groups = groups
                 .iter()
                 .enumerate()
                 .map(|(k, group)| {
                     let mine = || (0..points.len()).filter(move |&i| group_of[i] == k);
-                    let ([n_stick, n_slip, n_separated], normal_force, t) = tally(points, sol, mine());
+                    let t = tally(points, sol, mine(), revolution);
+                    let [n_stick, n_slip, n_separated] = t.counts;
                     ContactGroupReport {
                         group: group.clone(),
                         n_points: mine().count(),
                         n_stick,
                         n_slip,
                         n_separated,
-                        normal_force,
-                        tangential_force: linalg::norm(&t),
-                        tangential_resultant: t[..points.dim].to_vec(),
+                        normal_force: t.normal,
+                        tangential_force: linalg::norm(&t.tangential),
+                        tangential_resultant: t.tangential[..points.dim].to_vec(),
                         frame: ContactFrame::of(points, mine()),
                     }
                 })
                 .collect();
-            if revolution {
-                out.groups.iter_mut().for_each(ContactGroupReport::revolved);
-            }
         }
         out
     }
 
-    /// The resultants of a body of revolution: their radial part (x) cancels over the
-    /// revolution.
-    fn revolved(&mut self) {
-        for r in [&mut self.tangential_resultant, &mut self.normal_resultant] {
-            if let Some(x) = r.first_mut() {
-                *x = 0.0;
-            }
-        }
-        self.tangential_force = linalg::norm(&self.tangential_resultant);
-    }
-
-    /// The summary of a contact solution on its points.
-    pub fn of(points: &contact::ContactPoints, sol: &contact::ContactSolution) -> Self {
-        let ([n_stick, n_slip, n_separated], normal_force, t) = tally(points, sol, 0..points.len());
-        let mut pushed = [0.0; 3];
-        for i in 0..points.len() {
-            for (k, p) in pushed.iter_mut().enumerate() {
-                *p -= points.weight[i] * sol.lambda.normal[i] * points.normal[i][k];
-            }
-        }
+    /// The summary of a contact solution on its points (on a body of `revolution`, its
+    /// resultants without their radial part).
+    pub fn of(points: &contact::ContactPoints, sol: &contact::ContactSolution, revolution: bool) -> Self {
+        let t = tally(points, sol, 0..points.len(), revolution);
+        let [n_stick, n_slip, n_separated] = t.counts;
         ContactReport {
             n_points: points.len(),
             n_stick,
             n_slip,
             n_separated,
-            normal_force,
+            normal_force: t.normal,
             // `+ 0.0`: round-off's -0 reads as 0
-            normal_resultant: pushed[..points.dim].iter().map(|x| x + 0.0).collect(),
-            tangential_force: linalg::norm(&t),
-            tangential_resultant: t[..points.dim].to_vec(),
+            normal_resultant: t.pushed[..points.dim].iter().map(|x| x + 0.0).collect(),
+            tangential_force: linalg::norm(&t.tangential),
+            tangential_resultant: t.tangential[..points.dim].to_vec(),
             max_lambda_n: Some(sol.lambda.normal.iter().cloned().fold(0.0f64, f64::max)),
             held_tangent_points: (0..points.len())
                 .filter(|&i| points.held[i][..points.n_tangential()].iter().any(|&h| h))
