@@ -931,21 +931,37 @@ impl MeshSpec {
         if matches!(self.kind, MeshKind::Gmsh | MeshKind::Given) {
             return vec![];
         }
-        let counts = [("nx", self.nx), ("ny", self.ny), ("nz", self.nz)];
-        let d = self.lo.len().min(3);
-        let mut out: Vec<String> = (counts.iter().take(d))
+        let mut out: Vec<String> = [("nx", self.nx), ("ny", self.ny), ("nz", self.nz)]
+            .iter()
+            .take(self.lo.len())
             .filter(|(_, c)| c.is_some())
             .map(|(k, _)| format!("mesh.{k}={n}"))
             .collect();
-        let layered = !self.layers.is_empty() && self.layers.iter().all(|l| l.n.is_some());
         for k in (0..self.layers.len()).filter(|&k| self.layers[k].n.is_some()) {
             out.push(format!("mesh.layer.{k}.n={n}"));
         }
-        let fixed = (0..d).all(|k| counts[k].1.is_some() || (k + 1 == d && layered));
-        if !fixed {
+        if self.counted_axes().contains(&None) {
             out.push(format!("mesh.n={n}"));
         }
         out
+    }
+
+    /// For each axis of a generated mesh, what fixes its count of cells where something does
+    /// (`mesh.nx`, `ny`, `nz`, along a stack every layer's `n`): `None` for the axes `mesh.n`
+    /// or `mesh.h` size.
+    pub fn counted_axes(&self) -> Vec<Option<&'static str>> {
+        let d = self.lo.len().min(3);
+        let layered = !self.layers.is_empty() && self.layers.iter().all(|l| l.n.is_some());
+        [("mesh.nx", self.nx), ("mesh.ny", self.ny), ("mesh.nz", self.nz)]
+            .into_iter()
+            .take(d)
+            .enumerate()
+            .map(|(k, (name, count))| match (count, k + 1 == d && layered) {
+                (Some(_), _) => Some(name),
+                (None, true) => Some("the layers' mesh.layer.n"),
+                (None, false) => None,
+            })
+            .collect()
     }
 
     /// [`MeshSpec::sized`] at the scene's smoke size (`smoke_n`, 4 where it gives none): the
@@ -1455,7 +1471,8 @@ impl Scene {
     /// [`Profile`] and its electric [`Tip`]; `Err` (why, in words) where no closed form applies: a
     /// plane body, friction, a compliant bed, a conductive (finite-conductance) tip, several
     /// materials, a crystal not poled along the axis, an indenter off the axis or without an
-    /// axisymmetric profile or with one that falls from its tip outward. `electric`: whether the run has electric unknowns.
+    /// axisymmetric profile or with one that falls from its tip outward. `electric`: whether
+    /// the run has electric unknowns.
     ///
     /// [`HalfSpace`]: crate::halfspace::HalfSpace
     /// [`Profile`]: crate::halfspace::Profile

@@ -638,26 +638,16 @@ fn validate_read(m: &MeshSpec) -> Result<(), SceneError> {
 /// `mesh.n` or `mesh.h` sets the cells of the axes that no count of their own fixes: where
 /// every axis has one (`mesh.nx`, `ny`, `nz`, along a stack the layers' `n`), the size would be
 /// ignored (`--set mesh.n=8` on such a scene once ran its full size with nothing said).
-fn size_applies(m: &MeshSpec, d: usize) -> Result<(), SceneError> {
+fn size_applies(m: &MeshSpec) -> Result<(), SceneError> {
     let Some(key) = [("mesh.n", m.n.is_some()), ("mesh.h", m.h.is_some())]
         .into_iter()
         .find_map(|(k, given)| given.then_some(k))
     else {
         return Ok(());
     };
-    let layered = !m.layers.is_empty() && m.layers.iter().all(|l| l.n.is_some());
-    let mut fixing: Vec<&str> = vec![];
-    for (k, (name, count)) in [("mesh.nx", m.nx), ("mesh.ny", m.ny), ("mesh.nz", m.nz)]
-        .into_iter()
-        .take(d)
-        .enumerate()
-    {
-        match (count, k + 1 == d && layered) {
-            (Some(_), _) => fixing.push(name),
-            (None, true) => fixing.push("the layers' mesh.layer.n"),
-            (None, false) => return Ok(()),
-        }
-    }
+    let Some(fixing) = m.counted_axes().into_iter().collect::<Option<Vec<&str>>>() else {
+        return Ok(());
+    };
     Err(SceneError::not_applicable(
         key,
         &format!(
@@ -703,7 +693,7 @@ fn validate_generated(m: &MeshSpec, d: usize) -> Result<(), SceneError> {
             "mesh.h and mesh.n both give the mesh's size (mesh.h would win): give one (a --set of either replaces the other)",
         ));
     }
-    size_applies(m, d)?;
+    size_applies(m)?;
     if let Some(h) = m.h {
         if !(h > 0.0 && h.is_finite()) {
             return Err(SceneError::new(
