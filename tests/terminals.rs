@@ -872,3 +872,14 @@ fn a_region_off_the_mesh_lines_is_noted() {
         .staircase_regions
         .is_empty());
 }
+
+/// A mesh with nothing to note says nothing: a run prints no empty `note:` line (a seam of no
+/// facets still carries its dimension, which once made the notes differ from the default).
+#[test]
+fn a_mesh_with_nothing_to_note_says_nothing() {
+    for (name, n) in [("paper", 8), ("paper-3d", 4), ("sensor", 4), ("layered", 10)] {
+        let (scene, _) = files::scene_file::load(name, &[format!("mesh.n={n}")]).unwrap();
+        let setup = problem::backend::setup(scene.validate().unwrap(), None).unwrap();
+        assert!(setup.notes.is_empty(), "{name}: {:?}", setup.notes);
+    }
+}

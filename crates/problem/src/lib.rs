@@ -91,7 +91,7 @@ pub use halfspace::{HalfSpace, HalfSpaceError, Indentation, Profile, Tip};
 pub use instants::Instants;
 pub use path::{check_history_scales, run, run_steps, step_loads, step_row, PathSolution, Step, StepFields};
 pub use plan::{Output, Plan};
-pub use progress::{Event, FactorWatch, Lines, Reporter, Silent};
+pub use progress::{instant, Event, FactorWatch, Lines, Reporter, Silent};
 pub use report::{PetscReport, RunReport};
 pub use run::{equilibrium_tol, indenter_figures, terminal_groups, ContactResult, Indented, Solution, EQUILIBRIUM_TOL};
 pub use scene::{

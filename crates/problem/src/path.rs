@@ -1161,7 +1161,7 @@ impl Walk<'_> {
             None => ContactResult::condensed(boundary, sol),
         };
         if self.spec.is_some() {
-            reporter.event(&Event::PathStepDone { row: &row, of: self.of });
+            reporter.event(&Event::step_done(&row, self.of, &self.setup.units));
         }
         let recovered = fielded.as_ref().map(|(r, _, _)| r);
         let result = self.hand_on((frames, frame), (&row, state.rows.len()), result, recovered, each)?;

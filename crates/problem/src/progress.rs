@@ -134,6 +134,8 @@ pub enum Event<'a> {
         row: &'a crate::report::StepRow,
         /// The last step.
         of: usize,
+        /// The unit of its forces (run.json's `units.quantities.force`).
+        force: &'a str,
     },
     /// A step of a load path begins.
     PathStep {
@@ -220,6 +222,15 @@ impl<'a> Event<'a> {
             n_u: dofs.n_u,
             n_phi: dofs.n_phi,
             seconds,
+        }
+    }
+
+    /// A path's step `row` of the steps to `of` solved, its forces in `units`.
+    pub fn step_done(row: &'a crate::report::StepRow, of: usize, units: &'a crate::Units) -> Self {
+        Event::PathStepDone {
+            row,
+            of,
+            force: units.of_quantity("force"),
         }
     }
 
@@ -332,12 +343,19 @@ impl fmt::Display for Event<'_> {
                 f,
                 "note: the fixed point on the friction coefficients was not contractive on its way (largest ratio {contraction:.3}): the problem may have several solutions; this one is the branch from the stick start"
             ),
-            Event::PathStepDone { row, of } => write!(
+            Event::PathStepDone { row, of, force } => write!(
                 f,
-                "path step {}/{of}, t = {}: normal force {:.4e}, tangential {:.4e}; stick {}, slip {}, separated {}; {} iterations",
-                row.step, row.t, row.normal_force, row.tangential_force, row.n_stick, row.n_slip, row.n_separated, row.iterations
+                "path step {}/{of}, t = {}: normal force {:.4e} {force}, tangential {:.4e} {force}; stick {}, slip {}, separated {}; {} iterations",
+                row.step,
+                instant(row.t),
+                row.normal_force,
+                row.tangential_force,
+                row.n_stick,
+                row.n_slip,
+                row.n_separated,
+                row.iterations
             ),
-            Event::PathStep { step, of, t } => write!(f, "path step {step}/{of}: t = {t}"),
+            Event::PathStep { step, of, t } => write!(f, "path step {step}/{of}: t = {}", instant(*t)),
             Event::BedStep { step, change, settled } => write!(
                 f,
                 "the bed's springs, step {step}: their forces changed by {change:.3e} of the loads (settled below {settled:.0e})"
@@ -372,6 +390,20 @@ impl fmt::Display for Event<'_> {
 }
 
 /// The notes on a mesh that is read but unusual.
+impl crate::setup::MeshNotes {
+    /// Whether there is nothing to say: the notes a run prints are none (a seam of no facets
+    /// still knows its dimension, so a field-by-field comparison with the default would not do).
+    pub fn is_empty(&self) -> bool {
+        mesh_notes(self).is_empty()
+    }
+}
+
+/// An instant of a path as a line prints it: to 10 significant digits, so that the tail of a
+/// sum of binary fractions (2.9000000000000004 for 29 steps of 0.1) does not show.
+pub fn instant(t: f64) -> f64 {
+    format!("{t:.9e}").parse().unwrap_or(t)
+}
+
 pub(crate) fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
     let mut notes = vec![];
     if n.reoriented_cells > 0 {

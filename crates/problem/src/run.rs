@@ -15,7 +15,7 @@ use crate::report::{
     SolverReport, Timings,
 };
 use crate::scene::{ContactLaw, Rule, Scene, Valid};
-use crate::setup::{setup, MeshNotes, Setup};
+use crate::setup::{setup, Setup};
 pub use crate::solution::{ContactResult, Solution};
 use crate::ProblemError;
 use contact::{ContactSolution, PointValues};
@@ -41,7 +41,7 @@ pub(crate) fn begin<B: Backend>(
     )?;
     reporter.event(&Event::Planned(&setup.plan));
     reporter.event(&Event::Units(&setup.units));
-    if setup.notes != MeshNotes::default() {
+    if !setup.notes.is_empty() {
         reporter.event(&Event::MeshNotes(setup.notes.clone()));
     }
     Ok(setup)

@@ -115,10 +115,7 @@ pub(super) fn walk<'p>(
         (solved.reason, solved.options) = (s.reason, s.options);
         let (u, phi) = nodal(&x, on.layout)?;
         let row = at.row((k, t, &f), &contact, &before, (&u, &phi))?;
-        reporter.event(&Event::PathStepDone {
-            row: &row,
-            of: instants.len() - 1,
-        });
+        reporter.event(&Event::step_done(&row, instants.len() - 1, &on.setup.units));
         let written = spec.has_fields(k, instants.len());
         let frame_cells = (spec.cell_fields && written).then(|| disc.recover(&u, &phi));
         let frame = written.then(|| PieceFrame {
