@@ -1070,15 +1070,7 @@ fn narrowed_and_whole(sets: &[&str]) -> (problem::Solution, problem::Solution, V
     let (scene, _) = files::scene_file::load("indent-sphere-3d", &sets).unwrap();
     let mut lines = vec![];
     let narrowed = problem::solve(&scene, None, &mut problem::Lines(|l: &str| lines.push(l.to_string()))).unwrap();
-    sets.extend(
-        [
-            "path.t=[0.0,1.0]",
-            "path.steps=1",
-            "path.gap=[0.0,1.0]",
-            "path.displacement=[0.0,1.0]",
-        ]
-        .map(String::from),
-    );
+    sets.extend(["path.t=[0.0,1.0]", "path.steps=1", "path.gap=[0.0,1.0]"].map(String::from));
     let (scene, _) = files::scene_file::load("indent-sphere-3d", &sets).unwrap();
     let whole = problem::solve(&scene, None, &mut Silent).unwrap();
     (narrowed, whole, lines)

@@ -165,6 +165,14 @@ fn what_a_path_cannot_carry_is_refused_by_key() {
         (vec!["path.load=[1.0, 1.0, 1.0, 1.0]"], "path.load"),
         (vec!["solver.strategy=\"uzawa-direct\""], "path"),
         (vec!["contact.law=\"none\""], "path"),
+        // a factor on values that are all 0 changes no instant
+        (vec!["path.gap=[0.0, 1.0, 0.0, 1.0]"], "path.gap"),
+        (vec!["path.voltage=[0.0, 1.0, 0.0, 1.0]"], "path.voltage"),
+        (
+            vec!["path.uy=[1.0, 1.0, 1.0, 1.0]", "path.displacement=[0.0, 1.0, 0.0, 1.0]"],
+            "path.displacement",
+        ),
+        (vec!["dirichlet.0.u=[0.0, -0.03]"], "path.ux"),
     ] {
         let sets: Vec<String> = sets.into_iter().map(String::from).collect();
         let e = match scene_file::load("cattaneo-mindlin-cycle", &sets) {
@@ -182,6 +190,14 @@ fn what_a_path_cannot_carry_is_refused_by_key() {
             }
         };
         assert_eq!(e.key, key, "{sets:?}: {e}");
+    }
+    // a load factor on a load of p = 0, its message saying why
+    match scene_file::load("paper-cycle", &["load.p=0.0".into()]) {
+        Err(files::Error::Scene {
+            source: files::SceneFileError::Invalid(e),
+            ..
+        }) => assert!(e.key == "path.load" && e.to_string().contains("scales nothing"), "{e}"),
+        other => panic!("{:?}", other.map(|_| ())),
     }
     // the PETSc backend solves paths too
     let (petsc, _) = scene_file::load("cattaneo-mindlin-cycle", &["solver.backend=\"petsc\"".into()]).unwrap();
@@ -275,7 +291,7 @@ fn a_monotone_path_is_the_static_solve_and_a_reversal_is_not() {
         assert!(d <= 1e-9 * full.norm(), "step {k}: {d:e}");
     }
     let cycle = path_lambdas("actuator-cycle", &["mesh.n=16"]);
-    let at_rest = static_lambda("actuator-cycle", &["mesh.n=16", "electrode.v=0.0"]);
+    let at_rest = static_lambda("actuator-cycle", &["mesh.n=16", "electrode.v=0.0", "~path"]);
     let tangential = |l: &contact::PointValues| l.tangential.clone();
     let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
     let diff = |a: &[f64], b: &[f64]| norm(&a.iter().zip(b).map(|(x, y)| x - y).collect::<Vec<_>>());

@@ -359,6 +359,39 @@ const MAX_PATH_STEPS: usize = 1_000_000;
 /// finite, `steps` in range; refused where the run cannot carry friction's history (a solver
 /// without the condensed compliance, an exact solution; a floating conducting tip is refused
 /// with its charge).
+/// Which of a path's factors would scale anything: each multiplies values of the scene, and a
+/// factor on values that are all 0 changes no instant.
+struct Scaled {
+    load: bool,
+    voltage: bool,
+    displacement: [bool; 3],
+    gap: bool,
+}
+
+impl Scaled {
+    fn of(scene: &Scene) -> Scaled {
+        let some = |v: Option<f64>| v.is_some_and(|v| v != 0.0);
+        let force = scene
+            .indenter_contact()
+            .and_then(|(_, c)| c.indenter.as_ref())
+            .is_some_and(|i| some(i.force));
+        let component = |k: usize| {
+            scene.dirichlet.iter().any(|d| {
+                let whole = d.u.as_ref().and_then(|u| u.get(k)).copied();
+                some(whole.or([d.ux, d.uy, d.uz][k]))
+            })
+        };
+        Scaled {
+            load: force || scene.loads().iter().any(|l| l.p != 0.0),
+            voltage: scene.dirichlet.iter().any(|d| some(d.phi) || some(d.charge))
+                || scene.electrodes().iter().any(|e| some(e.v) || some(e.charge))
+                || scene.zones().iter().any(|c| some(c.foundation_potential)),
+            displacement: [component(0), component(1), component(2)],
+            gap: scene.zones().iter().any(|c| c.uniform_gap() != 0.0),
+        }
+    }
+}
+
 fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
     all_finite("path.t", &p.t)?;
     if p.t.len() < 2 || p.t.windows(2).any(|w| !(w[0] < w[1])) {
@@ -409,17 +442,42 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         "path",
         "a path carries friction's history from step to step, and the scene has no contact (contact.law = \"none\"): without it each instant is the static answer scaled",
     )?;
-    // the indenter's zone, whichever it is among several
-    let force_control = scene
-        .indenter_contact()
-        .and_then(|(_, c)| c.indenter.as_ref())
-        .is_some_and(|i| i.force.is_some());
+    // a factor multiplies the scene's own values: where they are all 0 (or none) it changes
+    // no instant, and the path the user asked for is not the one solved
+    let scales = Scaled::of(scene);
     applies(
-        scene.loads().is_empty() && !force_control,
+        !scales.load,
         "path.load",
-        "the scene has no [load] (nor an indenter under force control, contact.indenter.force)",
+        "the factor scales nothing: the scene has no [load] with p other than 0 (nor an indenter under force control with a force, contact.indenter.force)",
     )?;
-    applies(scene.active_contact().is_none(), "path.gap", "the scene has no contact")?;
+    applies(
+        !scales.voltage,
+        "path.voltage",
+        "the factor scales nothing: every prescribed potential (dirichlet.phi, electrode.v, contact.foundation_potential) and every floating terminal's charge (dirichlet.charge, electrode.charge) is 0 or not given",
+    )?;
+    // (a z factor on a generated 2D mesh: check_dimension says why more plainly)
+    let beyond = |k: usize| scene.mesh.dim().is_some_and(|d| k >= d);
+    for (k, key) in ["path.ux", "path.uy", "path.uz"].into_iter().enumerate() {
+        applies(
+            !scales.displacement[k] && !beyond(k),
+            key,
+            &format!(
+                "the factor scales nothing: no dirichlet entry prescribes a {} component other than 0",
+                ["x", "y", "z"][k]
+            ),
+        )?;
+    }
+    let own = [&p.ux, &p.uy, &p.uz];
+    applies(
+        !(0..3).any(|k| own[k].is_none() && scales.displacement[k]),
+        "path.displacement",
+        "the factor scales nothing: no dirichlet entry prescribes a displacement component other than 0 that path.ux, path.uy or path.uz does not scale already",
+    )?;
+    applies(
+        !scales.gap,
+        "path.gap",
+        "the factor scales nothing: every contact zone's uniform gap (contact.gap less an indenter's depth) is 0",
+    )?;
     refuse_if(
         scene.exact.is_some(),
         "path",
