@@ -210,10 +210,10 @@ impl Terminal {
             Event::PathStep { step, of, t } => {
                 let bar = self.path.get_or_insert_with(|| path_bar(*of as u64 + 1));
                 bar.set_position(*step as u64);
-                bar.set_message(format!("t = {t}"));
+                bar.set_message(format!("t = {}", problem::instant(*t)));
                 true
             }
-            Event::PathStepDone { row, of } => {
+            Event::PathStepDone { row, of, .. } => {
                 if let Some(bar) = &self.path {
                     bar.set_position(row.step as u64 + 1);
                     if row.step == *of {
@@ -725,6 +725,7 @@ fn study(args: StudyArgs) -> Result<(), DriverError> {
         orders,
     };
     let (scene, set) = (&scene[..], &set[..]);
+    convergence::refuse_overrides(set, &spec)?;
     let (base, _) = scene_file::load(scene, set)?;
     if spec.sizes.is_empty() {
         let n = base.mesh.n.unwrap_or(16).max(4);

@@ -345,6 +345,9 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
                 // a whole table of the array, by its index (`~dirichlet.1` removes the second)
                 if parts.peek().is_none() {
                     if let Ok(i) = last.parse::<usize>() {
+                        if !a.is_empty() && !a.iter().any(toml::Value::is_table) {
+                            return set_component(a, i, value, &walked);
+                        }
                         return set_table(a, i, value, &format!("{walked}.{i}"));
                     }
                 }
@@ -439,6 +442,43 @@ fn beyond(walked: &str, part: &str, n: usize) -> String {
             "`{walked}` is beyond the {n} tables of `{part}` (indices 0 to {}; `{part}.{n}` adds one)",
             n - 1
         ),
+    }
+}
+
+/// Replaces component `i` of `list`, the list of values (numbers: a vector, a tensor's
+/// constants) at `key` (`--set load.direction.1=0.5`, a sweep of `material.0.c.3`): in range,
+/// by a value of the kind the list holds; a component is not removed nor added (the list's
+/// length is its meaning).
+fn set_component(list: &mut [toml::Value], i: usize, value: Option<toml::Value>, key: &str) -> Result<(), String> {
+    let n = list.len();
+    let whole = || list.iter().map(toml::Value::to_string).collect::<Vec<_>>().join(", ");
+    let number = |v: &toml::Value| v.is_integer() || v.is_float();
+    match value {
+        None => Err(format!(
+            "`{key}.{i}` is a component of the list `{key}` = [{}]: a component is not removed; give the whole list (`{key}=[...]`)",
+            whole()
+        )),
+        Some(_) if i >= n => Err(format!(
+            "`{key}.{i}` is beyond the {n} components of `{key}` = [{}] (indices 0 to {}); give the whole list to change its length (`{key}=[...]`)",
+            whole(),
+            n - 1
+        )),
+        // a number for a number (the reader takes an integer where a real is asked)
+        Some(v) if number(&v) && number(&list[i]) => {
+            list[i] = match (&list[i], v) {
+                (toml::Value::Float(_), toml::Value::Integer(k)) => toml::Value::Float(k as f64),
+                (_, v) => v,
+            };
+            Ok(())
+        }
+        Some(v) if v.same_type(&list[i]) => {
+            list[i] = v;
+            Ok(())
+        }
+        Some(v) => Err(format!(
+            "`{key}.{i}` is a component of the list `{key}` = [{}]: give one value of its kind (not {v})",
+            whole()
+        )),
     }
 }
 
@@ -739,6 +779,27 @@ mod tests {
         ] {
             let (s, _) = load("paper", &[set.into()]).unwrap_or_else(|e| panic!("{set}: {e}"));
             assert_eq!(s.material.len(), 1, "{set}");
+        }
+    }
+
+    /// A component of a list of numbers is set by its index (a vector's, a tensor's constant:
+    /// what a sweep varies); removing one, one past the end or one of another kind is refused
+    /// with the list shown (it was told to be "a table of the array").
+    #[test]
+    fn a_component_of_a_list_is_set_by_its_index() {
+        let (s, _) = load("paper", &["load.direction.1=0.5".into(), "material.0.c.3=100".into()]).unwrap();
+        assert_eq!(s.loads()[0].direction, [0.0, 0.5]);
+        assert_eq!(s.material[0].c[3], 100.0);
+        for (set, says) in [
+            ("~load.direction.1", "a component is not removed"),
+            (
+                "load.direction.2=1.0",
+                "beyond the 2 components of `load.direction` = [0.0, 1.0] (indices 0 to 1)",
+            ),
+            ("load.direction.0=\"x\"", "give one value of its kind"),
+        ] {
+            let e = load("paper", &[set.into()]).unwrap_err().to_string();
+            assert!(e.contains(says) && !e.contains("table"), "{set}: {e}");
         }
     }
 

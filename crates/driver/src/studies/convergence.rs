@@ -271,6 +271,38 @@ fn check(spec: &StudySpec) -> Result<(), DriverError> {
     Ok(())
 }
 
+/// Refuses the overrides of what a study's runs set themselves ([`settings`]): the rule and
+/// the tolerances always, the mesh's size always (the study sizes by `mesh.n`, and `mesh.h`
+/// would be replaced by it), and the strategy or the order where the study's lists are given
+/// (`strategies`, `orders`, `sizes` as asked, before the scene's defaults fill them).
+///
+/// # Errors
+/// A usage error naming the key and the option that decides it.
+pub fn refuse_overrides(sets: &[String], given: &StudySpec) -> Result<(), DriverError> {
+    let mut decided = vec![
+        ("solver.rule", "solver.rule = \"tight\": every point to its tolerance"),
+        ("solver.tol", "--tols"),
+        ("solver.pcg_tol", "from --tols"),
+    ];
+    // mesh.h alone: an override of mesh.n is where the default sizes come from, and the two
+    // keys overlap as two ways to give one size
+    if let Some(set) = sets.iter().find(|s| super::set_key(s) == "mesh.h") {
+        return Err(DriverError::Usage(format!(
+            "--set {set}: the study sizes its meshes by mesh.n (--sizes, or the scene's n/4, n/2, n), which replaces mesh.h on each of its runs; drop the --set"
+        )));
+    }
+    if !given.sizes.is_empty() {
+        decided.push(("mesh.n", "--sizes"));
+    }
+    if !given.strategies.is_empty() {
+        decided.push(("solver.strategy", "--strategies"));
+    }
+    if !given.orders.is_empty() {
+        decided.push(("mesh.order", "--orders"));
+    }
+    super::refuse_decided(sets, &decided)
+}
+
 /// The size of every run of a study, in the order it runs them: the finer reference (without
 /// an exact solution), then per order and size its tight run and its strategies' runs at each
 /// tolerance.
@@ -683,5 +715,45 @@ mod tests {
             assert!(e.contains(says), "{e}");
         }
         assert_eq!(runs, 0);
+    }
+
+    /// What every run of a study sets itself is refused as an override (it was replaced
+    /// silently: `--set solver.rule="loose"` ran tight), and what the study's lists decide
+    /// only where they are given; an override the defaults are drawn from passes.
+    #[test]
+    fn an_override_of_what_the_study_sets_is_refused() {
+        let asked = StudySpec {
+            sizes: vec![],
+            strategies: vec![],
+            tols: vec![1e-6],
+            reference_n: None,
+            orders: vec![],
+        };
+        let listed = StudySpec {
+            sizes: vec![8],
+            strategies: vec![Strategy::NewtonCondensed],
+            orders: vec![1],
+            ..asked.clone()
+        };
+        for (set, spec) in [
+            ("solver.rule=\"loose\"", &asked),
+            ("solver.tol=1e-6", &asked),
+            ("~solver.pcg_tol", &asked),
+            ("mesh.h=0.1", &asked),
+            ("mesh.n=8", &listed),
+            ("solver={strategy=\"uzawa-condensed\"}", &listed),
+            ("mesh.order=2", &listed),
+        ] {
+            let e = refuse_overrides(&[set.into()], spec).unwrap_err().to_string();
+            assert!(e.contains("the study s") && e.contains(set), "{set}: {e}");
+        }
+        for set in [
+            "mesh.n=8",
+            "solver.strategy=\"uzawa-condensed\"",
+            "mesh.order=2",
+            "load.p=-1.0",
+        ] {
+            refuse_overrides(&[set.into()], &asked).unwrap_or_else(|e| panic!("{set}: {e}"));
+        }
     }
 }

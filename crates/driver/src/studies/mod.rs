@@ -25,6 +25,33 @@ pub fn solve(scene: &str, sets: &[String]) -> Result<Solution, files::Error> {
     files::run::solve(&scene, &source, &mut Silent)
 }
 
+/// Refuses a user's override (`--set KEY=VALUE`, `--set ~KEY`) of a value the study sets on
+/// each of its runs itself: `decided` pairs such keys with the option that decides them. The
+/// study's own override comes last and would replace the user's silently.
+///
+/// # Errors
+/// A usage error naming both.
+pub fn refuse_decided(sets: &[String], decided: &[(&str, &str)]) -> Result<(), crate::DriverError> {
+    for set in sets {
+        if let Some((k, by)) = decided.iter().find(|(k, _)| scene_file::keys_overlap(set_key(set), k)) {
+            return Err(crate::DriverError::Usage(format!(
+                "--set {set}: the study sets {k} on each of its runs ({by}), which would replace this silently; drop the --set"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The key an override (`KEY=VALUE`, `~KEY`) names.
+pub fn set_key(set: &str) -> &str {
+    set.split('=')
+        .next()
+        .unwrap_or(set)
+        .trim()
+        .trim_start_matches('~')
+        .trim()
+}
+
 /// The time left in a series of runs, estimated from the runs done: a pending run of size `n`
 /// (cells per edge) takes the mean time of the done runs of its size, else the time of the
 /// nearest done size scaled by `(n / m)^p`, `p` the growth measured between the two largest

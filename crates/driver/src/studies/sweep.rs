@@ -99,7 +99,8 @@ pub fn sweep(
             return Err(DriverError::Usage(format!("sweep {name} {v} is not a finite number")));
         }
     }
-    let integer = integer_key(scene, sets, param, [*from, *to]);
+    super::refuse_decided(sets, &[(param, "--param, its values from --from to --to")])?;
+    let integer = integer_key(scene, sets, param, [*from, *to])?;
     if integer {
         whole_points(param, *from, *to, *steps)?;
     }
@@ -269,7 +270,11 @@ fn shown(value: f64, integer: bool) -> String {
 /// Whether `param` is an integer key of the scene: its value in the scene (with `sets`) is a
 /// TOML integer; where the scene leaves it out, whether both bounds are whole numbers within
 /// the integers a double holds exactly.
-fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> bool {
+///
+/// # Errors
+/// A usage error where the scene's value is no number (a list, a table, a string): a sweep
+/// varies one number, and every point would fail alike.
+fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> Result<bool, DriverError> {
     let found = files::scene_file::load(scene, sets)
         .ok()
         .and_then(|(s, _)| toml::Value::try_from(&s).ok())
@@ -283,7 +288,21 @@ fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> b
                 })
         });
     match found {
-        Some(v) => v.is_integer(),
+        Some(v) if v.is_integer() || v.is_float() => Ok(v.is_integer()),
+        Some(toml::Value::Array(items)) => Err(DriverError::Usage(format!(
+            "sweep --param {param}: the scene's {param} is a list of {} values ({}), and a sweep varies one number: sweep one component, as --param {param}.0",
+            items.len(),
+            toml::Value::Array(items.clone())
+        ))),
+        Some(v) => Err(DriverError::Usage(format!(
+            "sweep --param {param}: the scene's {param} is {} ({v}), and a sweep varies one number",
+            match v {
+                toml::Value::Table(_) => "a table",
+                toml::Value::String(_) => "a string",
+                toml::Value::Boolean(_) => "a boolean",
+                _ => "no number",
+            }
+        ))),
         // a key the scene leaves unset: its type is the one the scene's reader takes (an
         // integer key refuses `4.0`, a real one takes it), never a guess from the bounds,
         // which are whole for many a real key's sweep (`coupling_scale` from 0 to 1)
@@ -294,10 +313,10 @@ fn integer_key(scene: &str, sets: &[String], param: &str, bounds: [f64; 2]) -> b
                 files::scene_file::load(scene, &s).is_ok()
             };
             let [from, _] = bounds;
-            from.fract() == 0.0
+            Ok(from.fract() == 0.0
                 && from.abs() < 2f64.powi(53)
                 && !takes(format!("{from:?}"))
-                && takes(format!("{}", from as i64))
+                && takes(format!("{}", from as i64)))
         }
     }
 }
@@ -647,14 +666,64 @@ mod tests {
             let e = sweep("paper", &[], &bad, None, &mut |_| {}).unwrap_err().to_string();
             assert!(e.contains(says), "{e}");
         }
-        assert!(integer_key("paper", &[], "mesh.n", [8.0, 9.5]));
-        assert!(!integer_key("paper", &[], "load.p", [-4.0, -2.0]));
-        assert!(integer_key("cattaneo-mindlin-cycle", &[], "path.steps", [3.0, 7.0]));
-        assert!(!integer_key("corner", &[], "contact.1.gap", [-1.0, 0.0]));
+        let integer = |scene: &str, key: &str, bounds: [f64; 2]| integer_key(scene, &[], key, bounds).unwrap();
+        assert!(integer("paper", "mesh.n", [8.0, 9.5]));
+        assert!(!integer("paper", "load.p", [-4.0, -2.0]));
+        assert!(integer("cattaneo-mindlin-cycle", "path.steps", [3.0, 7.0]));
+        assert!(!integer("corner", "contact.1.gap", [-1.0, 0.0]));
         // a key the scene leaves out: the type its reader takes, whatever the bounds
-        assert!(integer_key("paper", &[], "mesh.nx", [8.0, 16.0]));
-        assert!(!integer_key("paper", &[], "material.0.coupling_scale", [0.0, 1.0]));
-        assert!(!integer_key("paper", &[], "contact.slip_bound", [0.0, 2.0]));
+        assert!(integer("paper", "mesh.nx", [8.0, 16.0]));
+        assert!(!integer("paper", "material.0.coupling_scale", [0.0, 1.0]));
+        assert!(!integer("paper", "contact.slip_bound", [0.0, 2.0]));
+        // a component of a list is a number
+        assert!(!integer("paper", "material.0.c.3", [100.0, 120.0]));
+    }
+
+    /// A key whose value is no number (a vector, a choice) is refused before any point runs,
+    /// with the way to sweep a component (every point failed alike on the reader's type
+    /// error, after running the others).
+    #[test]
+    fn a_sweep_of_what_is_no_number_is_refused_before_it_runs() {
+        for (param, says) in [
+            ("load.direction", "is a list of 2 values ([0.0, 1.0]), and a sweep varies one number: sweep one component, as --param load.direction.0"),
+            ("contact.law", "is a string (\"coulomb\")"),
+            ("mesh", "is a table"),
+        ] {
+            let s = SweepSpec {
+                param: param.into(),
+                from: 0.0,
+                to: 1.0,
+                steps: 2,
+            };
+            let e = sweep("paper", &[], &s, None, &mut |l| panic!("{param} ran: {l}")).unwrap_err();
+            assert!(e.to_string().contains(says), "{param}: {e}");
+        }
+        // the swept key given by --set too: the sweep's values replaced it silently
+        let s = SweepSpec {
+            param: "load.p".into(),
+            from: -1.0,
+            to: -2.0,
+            steps: 2,
+        };
+        let e = sweep(
+            "paper",
+            &["load={group=\"top\", p=-3.0, direction=[0.0, 1.0]}".into()],
+            &s,
+            None,
+            &mut |l| panic!("ran: {l}"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("the study sets load.p on each of its runs (--param"), "{e}");
+        // and a component sweeps
+        let s = SweepSpec {
+            param: "load.direction.0".into(),
+            from: 0.0,
+            to: 0.2,
+            steps: 2,
+        };
+        let rows = sweep("paper", &["mesh.n=4".into()], &s, None, &mut |_| {}).unwrap();
+        assert!(rows.iter().all(|r| r.error.is_none()));
     }
 
     /// A real key the scene leaves unset, swept between whole bounds, runs its points as given
