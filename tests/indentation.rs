@@ -55,6 +55,46 @@ fn the_hertz_sphere_scene_is_within_one_percent_of_johnson() {
     assert!((ind.depth - 0.01).abs() < 1e-15 && ind.force == f("load_p"));
 }
 
+/// The contact radius is bracketed to the mesh's resolution: the last point that carries
+/// pressure and the next one out, which carries none; Hertz's radius (Johnson eq. (4.22)) lies
+/// in the bracket on hertz-sphere, and a sphere so small that only the axis point touches
+/// reads radius 0 with the first cell's size as its bound (it read 0 alone, as if nothing
+/// touched while a force was carried).
+#[test]
+fn the_contact_radius_is_bracketed_by_the_next_point_out() {
+    let (scene, _) = files::scene_file::load("hertz-sphere", &[]).unwrap();
+    let solution = problem::solve(&scene, None, &mut Silent).unwrap();
+    let json = serde_json::to_value(&solution.report).unwrap();
+    let a = json["exact"]["a"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{}", json["exact"]));
+    let ind = solution.report.indenter.as_ref().unwrap();
+    let next = ind.contact_radius_next.unwrap();
+    assert!(
+        ind.contact_radius <= a && a <= next,
+        "{} {a} {next}",
+        ind.contact_radius
+    );
+    let line = problem::report::result_lines(&solution.report).join("\n");
+    assert!(line.contains("the next point out, at"), "{line}");
+    let (scene, _) = files::scene_file::load(
+        "indent-sphere",
+        &[
+            "mesh.n=16".into(),
+            "contact.indenter.radius=1e-6".into(),
+            "~exact".into(),
+        ],
+    )
+    .unwrap();
+    let tiny = problem::solve(&scene, None, &mut Silent)
+        .unwrap()
+        .report
+        .indenter
+        .unwrap();
+    assert!(tiny.force > 0.0 && tiny.points_in_contact == 1 && tiny.contact_radius == 0.0);
+    assert!(tiny.contact_radius_next.unwrap() > 0.0);
+}
+
 #[test]
 fn force_control_finds_the_depth_that_carries_the_force() {
     // the depth-controlled run's force, given back: its depth found again, from a start

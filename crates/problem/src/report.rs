@@ -66,6 +66,12 @@ pub struct IndenterReport {
     /// The largest distance from its axis of a contact point that carries pressure (0 where
     /// none does): the contact zone's radius, to the mesh's resolution.
     pub contact_radius: f64,
+    /// The distance from the axis of the nearest point beyond `contact_radius` that carries
+    /// no pressure: the zone's edge lies between the two, the mesh's resolution there (a zone
+    /// within the first cell reads `contact_radius` 0 and this the first cell's size); absent
+    /// where no point beyond carries none (the zone reaches the face's edge).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_radius_next: Option<f64>,
     /// Contact points carrying pressure.
     pub points_in_contact: usize,
     /// A conducting indenter (`contact.electric = "conducting"` or `"conductive"`): its
@@ -466,6 +472,12 @@ pub fn result_lines(r: &RunReport) -> Vec<String> {
             with(i.force, "force"),
             with(i.contact_radius, "length"),
         );
+        if let Some(next) = i.contact_radius_next.filter(|_| i.points_in_contact > 0) {
+            line.push_str(&format!(
+                " (the next point out, at {}, carries none)",
+                with(next, "length")
+            ));
+        }
         if let Some(q) = i.charge {
             line.push_str(&format!(", charge {}", with(q, "charge")));
         }

@@ -402,20 +402,28 @@ pub(crate) fn indenter_report(scene: &Scene, at: Indented<'_>) -> Option<crate::
     let (points, sol) = (at.points, at.sol);
     // the indenter's own points (the other groups rest on foundations)
     let mine: Vec<usize> = (0..points.len()).filter(|&i| at.group_of[i] == k).collect();
+    let r = |i: usize| ind.local(&points.position[i], &points.normal[i]).1;
     let (mut radius, mut count, mut force) = (0.0f64, 0, 0.0);
     for &i in &mine {
         if sol.lambda.normal[i] > 0.0 {
-            radius = radius.max(ind.local(&points.position[i], &points.normal[i]).1);
+            radius = radius.max(r(i));
             count += 1;
         }
         force += points.weight[i] * sol.lambda.normal[i];
     }
+    // the zone's edge lies between its last point and the next one that carries nothing
+    let next = (mine.iter())
+        .filter(|&&i| !(sol.lambda.normal[i] > 0.0))
+        .map(|&i| r(i))
+        .filter(|&ri| ri > radius)
+        .min_by(f64::total_cmp);
     let first = *mine.first()?;
     Some(crate::report::IndenterReport {
         shape: ind.shape.to_string(),
         depth: c.depth_at_point(&points.position[first], &points.normal[first], points.gap[first]),
         force,
         contact_radius: radius,
+        contact_radius_next: next,
         points_in_contact: count,
         potential: at.potential,
         // the charge across its own zone, where it conducts (another zone may)
