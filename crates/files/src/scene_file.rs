@@ -504,7 +504,7 @@ fn set_table(a: &mut Vec<toml::Value>, i: usize, value: Option<toml::Value>, key
             }
             Ok(())
         }
-        Some(toml::Value::Table(_)) => Err(format!("`{key}` is beyond the {n} tables (indices 0 to {})", n.saturating_sub(1))),
+        Some(toml::Value::Table(_)) => Err(beyond(key, key.rsplit_once('.').map_or(key, |(part, _)| part), n)),
         Some(v) => Err(format!("`{key}` is a table of the array: give one, as `{key}={{ ... }}`, or set its keys as `{key}.KEY=VALUE` (not {v})")),
     }
 }
@@ -732,6 +732,11 @@ mod tests {
         assert_eq!(s.contacts()[1].group, "top");
         let e = load("paper", &["contact.2.gap=0.0".into()]).unwrap_err().to_string();
         assert!(e.contains("`contact.2` is beyond the one table of `contact`"), "{e}");
+        // a whole table past the end says how many there are (it said "indices 0 to 0" of none)
+        let e = load("paper", &["electrode.1={group=\"top\", v=0.01}".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("it has none: add one as `electrode.0`"), "{e}");
         let sets = ["electrode.0.group=\"top\"".into(), "electrode.0.v=0.0".into()];
         let (s, _) = load("sensor", &sets).unwrap();
         assert_eq!(s.electrodes().len(), 1);
