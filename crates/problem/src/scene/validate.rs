@@ -205,6 +205,7 @@ impl Scene {
                     "load.direction is the zero vector: give the traction's direction (its magnitude is load.p)",
                 )));
             }
+            refuse_load_on_held(self, l).map_err(on_load)?;
         }
         validate_electrodes(self)?;
         // every entry of `[[contact]]` is read as the first one is: its own keys, each
@@ -491,6 +492,28 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
         )?;
     }
     Ok(())
+}
+
+/// A traction pushes along its direction's components; where the Dirichlet conditions of its
+/// own group hold one of them, that part of it acts on nothing (the displacement is given)
+/// and the run would drop it silently: refused, naming the component.
+fn refuse_load_on_held(scene: &Scene, l: &crate::LoadSpec) -> Result<(), SceneError> {
+    let held = |k: usize| {
+        (scene.dirichlet.iter().filter(|d| d.group == l.group))
+            .any(|d| d.u.as_ref().is_some_and(|u| k < u.len()) || [d.ux, d.uy, d.uz][k].is_some())
+    };
+    let pushed = (0..l.direction.len().min(3)).filter(|&k| l.direction[k] != 0.0 && l.p != 0.0);
+    match pushed.filter(|&k| held(k)).map(|k| ["x", "y", "z"][k]).collect::<Vec<_>>()[..] {
+        [] => Ok(()),
+        ref axes => Err(SceneError::new(
+            "load.group",
+            format!(
+                "the traction pushes along {}, which dirichlet on `{}` prescribes: that part of it would act on nothing (a given displacement takes any force) and be dropped; load a group whose displacement is free, or prescribe the displacement alone",
+                axes.join(" and "),
+                l.group
+            ),
+        )),
+    }
 }
 
 /// Runs `check` on every contact entry (each check passes over a section switched off,
