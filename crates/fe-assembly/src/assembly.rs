@@ -684,9 +684,19 @@ pub fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<V
             cell_material[c] = mi;
         }
     }
-    if let Some(c) = cell_material.iter().position(|&m| m == usize::MAX) {
+    let bare: Vec<usize> = (0..mesh.n_cells())
+        .filter(|&c| cell_material[c] == usize::MAX)
+        .collect();
+    if let Some(&c) = bare.first() {
+        // the mesh's regions that hold them
+        let theirs = (mesh.regions.iter())
+            .filter(|(_, cells)| cells.iter().any(|&k| cell_material.get(k) == Some(&usize::MAX)))
+            .map(|(name, _)| name.clone())
+            .collect();
         return Err(InputError::NoMaterial {
             cell: c,
+            cells: bare.len(),
+            theirs,
             regions: materials.iter().map(|(r, _)| r.clone()).collect(),
         }
         .into());
@@ -707,4 +717,31 @@ fn folded(mesh: &Mesh, c: usize) -> Option<f64> {
     at.iter()
         .map(|l| crate::mapping::jacobian_det(dim, &crate::mapping::map_at(dim, &x, l).1))
         .find(|det| !(*det > 0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cell no material's region holds is named with the mesh's regions it lies in (a Gmsh
+    /// group whose name went missing is its tag: the message said only "regions given: body").
+    #[test]
+    fn cells_without_a_material_name_the_regions_they_lie_in() {
+        let mut mesh = mesh::rectangle_tri([0.0, 0.0], [2.0, 1.0], 4, 2);
+        let n = mesh.n_cells();
+        mesh.regions.insert("body".into(), (0..n / 2).collect());
+        mesh.regions.insert("6".into(), (n / 2..n).collect());
+        let m = Material::from_crystal("iso", &crate::Crystal::isotropic(100.0, 0.3, 1.0), [0.0, 0.0, 1.0], 2).unwrap();
+        let e = cell_materials(&mesh, &[("body".into(), m.clone())])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("{} cells lie in no region a material names", n - n / 2))
+                && e.contains("the mesh's region `6`"),
+            "{e}"
+        );
+        mesh.regions.remove("6");
+        let e = cell_materials(&mesh, &[("body".into(), m)]).unwrap_err().to_string();
+        assert!(e.contains("they lie in no region of the mesh"), "{e}");
+    }
 }

@@ -97,10 +97,28 @@ pub enum InputError {
         second: String,
     },
     /// A cell in no region of the materials.
-    #[error("cell {cell} has no material (regions given: {})", .regions.join(", "))]
+    #[error(
+        "cell {cell} has no material (regions given: {}): {cells} cells lie in no region a material names; {}",
+        .regions.join(", "),
+        match &.theirs[..] {
+            [] => "they lie in no region of the mesh (the materials' regions must cover it)".to_string(),
+            theirs => format!(
+                "they lie in the mesh's {} {} (give {} a material, [[material]] region = \"{}\")",
+                if theirs.len() == 1 { "region" } else { "regions" },
+                theirs.iter().map(|r| format!("`{r}`")).collect::<Vec<_>>().join(", "),
+                if theirs.len() == 1 { "it" } else { "each" },
+                theirs[0]
+            ),
+        }
+    )]
     NoMaterial {
-        /// The cell.
+        /// The first cell without one.
         cell: usize,
+        /// How many cells have none.
+        cells: usize,
+        /// The mesh's regions those cells lie in (a Gmsh physical group left unnamed is its
+        /// tag), none of them a material's.
+        theirs: Vec<String>,
         /// The regions of the materials.
         regions: Vec<String>,
     },
