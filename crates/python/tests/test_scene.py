@@ -49,6 +49,11 @@ def test_changes_by_key_mapping_and_section():
     s.set({"mesh.n": np.int64(10), "solver.tol": np.array(1e-9), "load.p": np.float32(-2.0)})
     assert (s.get("mesh.n"), s.get("solver.tol"), s.get("load.p")) == (10, 1e-9, -2.0)
     assert type(s.get("mesh.n")) is int
+    # a component of a list by its index, as --set takes it; past the end refused
+    s.set({"load.direction.1": 0.5, "material.c.3": 100})
+    assert s.get("load.direction") == [0.0, 0.5] and s.get("material.c")[3] == 100.0
+    with pytest.raises(pc.InputError, match="beyond the 2 components of `load.direction`"):
+        s.set("load.direction.2", 1.0)
 
 
 def test_a_copy_is_independent():
