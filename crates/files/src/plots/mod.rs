@@ -293,21 +293,81 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
                 .legend(move |(x, y)| -> DynElement<'static, DB, (i32, i32)> {
                     match mark {
                         Mark::Dots => Circle::new((x + 10, y), 3, color.filled()).into_dyn(),
-                        Mark::Reference => {
-                            PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)).into_dyn()
-                        }
+                        // dashed, as the reference is drawn
+                        Mark::Reference => plotters::element::DashedPathElement::new(
+                            vec![(x, y), (x + 20, y)],
+                            7,
+                            5,
+                            BLACK.stroke_width(1),
+                        )
+                        .into_dyn(),
                         Mark::Line => PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)).into_dyn(),
                     }
                 });
         }
     }
+    let place = legend_place(panel, (x, y), chart.plotting_area().dim_in_pixel());
     chart
         .configure_series_labels()
         .label_font((FONT, 13))
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
+        .position(place)
         .draw()
         .map_err(e)
+}
+
+/// Where a panel's legend covers the least of its curves: of the plot's corners and the
+/// middles of its sides, the place whose box (sized by the named series and their longest
+/// name, in pixels of a plot `size`) holds the fewest samples of the lines and points, the
+/// upper right first among equals. (A legend at one fixed place covered a curve's end.)
+fn legend_place(panel: &Panel, (x, y): ((f64, f64), (f64, f64)), size: (u32, u32)) -> SeriesLabelPosition {
+    let (w, h) = (f64::from(size.0), f64::from(size.1));
+    let named: Vec<&Series> = panel.series.iter().filter(|s| !s.name.is_empty()).collect();
+    let longest = named.iter().map(|s| s.name.chars().count()).max().unwrap_or(0) as f64;
+    // the box, with plotters' margin about it: 13 px text, an entry per line, the mark before it
+    let (bw, bh) = (longest * 7.5 + 60.0, named.len() as f64 * 20.0 + 30.0);
+    let to_px = |(a, b): (f64, f64)| ((a - x.0) / (x.1 - x.0) * w, (1.0 - (b - y.0) / (y.1 - y.0)) * h);
+    let mut samples = vec![];
+    for s in &panel.series {
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|q| q.0.is_finite() && q.1.is_finite())
+            .map(|&q| to_px(q))
+            .collect();
+        samples.extend(pts.iter().copied());
+        if s.mark != Mark::Dots {
+            for seg in pts.windows(2) {
+                samples.extend((1..8).map(|k| {
+                    let t = f64::from(k) / 8.0;
+                    (
+                        seg[0].0 + t * (seg[1].0 - seg[0].0),
+                        seg[0].1 + t * (seg[1].1 - seg[0].1),
+                    )
+                }));
+            }
+        }
+    }
+    let (left, middle, right) = (0.0, (w - bw) / 2.0, w - bw);
+    let (top, centre, bottom) = (0.0, (h - bh) / 2.0, h - bh);
+    let places = [
+        (SeriesLabelPosition::UpperRight, right, top),
+        (SeriesLabelPosition::UpperLeft, left, top),
+        (SeriesLabelPosition::LowerRight, right, bottom),
+        (SeriesLabelPosition::LowerLeft, left, bottom),
+        (SeriesLabelPosition::MiddleRight, right, centre),
+        (SeriesLabelPosition::MiddleLeft, left, centre),
+        (SeriesLabelPosition::UpperMiddle, middle, top),
+        (SeriesLabelPosition::LowerMiddle, middle, bottom),
+    ];
+    let covered = |&(_, x0, y0): &(SeriesLabelPosition, f64, f64)| {
+        (samples.iter())
+            .filter(|&&(a, b)| a >= x0 && a <= x0 + bw && b >= y0 && b <= y0 + bh)
+            .count()
+    };
+    // the first of the least covered (min_by_key keeps the first among equals)
+    (places.iter().min_by_key(|p| covered(p))).map_or(SeriesLabelPosition::UpperRight, |p| p.0.clone())
 }
 
 fn draw_panels<DB: DrawingBackend>(
@@ -487,6 +547,23 @@ pub fn loglog(name: &str, title: &str, labels: (&str, &str), series: &[Series]) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The legend goes where it covers the least: a curve rising to the upper right leaves the
+    /// upper left free; one that fills the top sends it down.
+    #[test]
+    fn the_legend_goes_where_it_covers_least() {
+        let panel = |points: Vec<(f64, f64)>| Panel {
+            title: "t".into(),
+            labels: ("x".into(), "y".into()),
+            series: vec![Series::line("a long series name", points)],
+        };
+        let rising = panel((0..=20).map(|k| (f64::from(k), f64::from(k * k))).collect());
+        let place = legend_place(&rising, ((0.0, 20.0), (0.0, 400.0)), (800, 500));
+        assert!(matches!(place, SeriesLabelPosition::UpperLeft), "{place:?}");
+        let top = panel(vec![(0.0, 1.0), (20.0, 1.0)]);
+        let place = legend_place(&top, ((0.0, 20.0), (0.0, 1.0)), (800, 500));
+        assert!(matches!(place, SeriesLabelPosition::LowerRight), "{place:?}");
+    }
 
     /// Extreme values (infinite, NaN, 1e308) neither hang nor fail a picture.
     #[test]
