@@ -598,3 +598,36 @@ fn a_path_s_steps_are_compressed_series_with_cell_fields_on_request() {
         }
     }
 }
+
+/// path.csv holds the columns a scene can fill, as Python's path dict does: no z factor in 2D
+/// and no indenter's columns without one (they were written empty on every row); a 3D
+/// indenter's path keeps both, and run.json's units name exactly the header's columns.
+#[test]
+fn path_csv_holds_the_columns_its_scene_fills() {
+    let tmp = tempfile::tempdir().unwrap();
+    let header = |name: &str, sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let (scene, source) = scene_file::load(name, &sets).unwrap();
+        let dir = tmp.path().join(name);
+        files::run::run(&scene, &source, &dir, &mut Silent).unwrap();
+        let csv = std::fs::read_to_string(dir.join("path.csv")).unwrap();
+        let head: Vec<String> = (csv.lines().find(|l| !l.starts_with('#')).unwrap().split(','))
+            .map(|c| files::output::column_name(c).to_string())
+            .collect();
+        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("run.json")).unwrap()).unwrap();
+        let units = json["units"]["columns"]["path.csv"].as_object().unwrap().len();
+        (head, units)
+    };
+    let (flat, units) = header("paper-cycle", &["mesh.n=8", "path.steps=3"]);
+    assert_eq!(units, flat.len());
+    for absent in ["uz", "depth", "contact_radius", "tip_charge", "half_space_force"] {
+        assert!(!flat.iter().any(|c| c == absent), "{absent} in {flat:?}");
+    }
+    let (tip, _) = header(
+        "indent-sphere-3d",
+        &["mesh.n=4", "path.t=[0.0,1.0]", "path.gap=[0.0,1.0]", "path.steps=1"],
+    );
+    for present in ["uz", "depth", "contact_radius"] {
+        assert!(tip.iter().any(|c| c == present), "{present} not in {tip:?}");
+    }
+}

@@ -291,7 +291,10 @@ impl RunResult {
         out.set_item("step", column(&|r| r.step as f64))?;
         out.set_item("t", column(&|r| r.t))?;
         for (k, name) in ["load", "voltage", "ux", "uy", "uz", "gap"].iter().enumerate() {
-            out.set_item(*name, column(&|r| r.factors[k]))?;
+            // a 2D scene has no z factor (path.csv leaves the column out too)
+            if *name != "uz" || self.solution.mesh.dim == 3 {
+                out.set_item(*name, column(&|r| r.factors[k]))?;
+            }
         }
         out.set_item("normal_force", column(&|r| r.normal_force))?;
         out.set_item("tangential_force", column(&|r| r.tangential_force))?;

@@ -793,8 +793,36 @@ pub(super) fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
     Ok(out)
 }
 
-/// `path.csv`'s columns (see [`path_csv`]).
+/// `path.csv`'s columns (see [`path_csv`]), those a scene cannot fill left out.
 fn path_columns(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<String> {
+    path_table(rows, terminals).0
+}
+
+/// `path.csv`'s columns and cells, the columns a scene cannot fill left out, as Python's path
+/// dict leaves them: an indenter's where no row has one, the z factor of a 2D scene.
+fn path_table(rows: &[problem::report::StepRow], terminals: &[&str]) -> (Vec<String>, Vec<Vec<String>>) {
+    let (columns, table) = (every_path_column(rows, terminals), path_cells(rows));
+    let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
+    let filled = |k: usize| table.iter().any(|row| !row[k].is_empty());
+    let keep: Vec<bool> = (columns.iter().enumerate())
+        .map(|(k, c)| match c.as_str() {
+            "uz" => dim == 3,
+            "depth" | "contact_radius" | "tip_charge" => filled(k),
+            c if c.starts_with("half_space_") => filled(k),
+            _ => true,
+        })
+        .collect();
+    let kept = |cells: &[String]| -> Vec<String> {
+        (cells.iter().zip(&keep))
+            .filter(|(_, &k)| k)
+            .map(|(c, _)| c.clone())
+            .collect()
+    };
+    (kept(&columns), table.iter().map(|row| kept(row)).collect())
+}
+
+/// Every column `path.csv` can have.
+fn every_path_column(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<String> {
     let mut out: Vec<String> = "step,t,load,voltage,ux,uy,uz,gap,normal_force,tangential_force,max_slip,max_slip_increment,n_stick,n_slip,n_separated,iterations,complementarity,equilibrium,depth,contact_radius,tip_charge,half_space_depth,half_space_force,half_space_contact_radius,half_space_charge"
         .split(',')
         .map(String::from)
@@ -827,9 +855,21 @@ fn path_columns(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<St
 /// on each terminal (`charge_GROUP`, the charge on the conductor) and its potential
 /// (`potential_GROUP`).
 fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str], units: &problem::Units) -> Vec<u8> {
-    let mut s = header("path.csv", &path_columns(rows, terminals), units);
+    let (columns, table) = path_table(rows, terminals);
+    let mut s = header("path.csv", &columns, units);
+    for row in &table {
+        s.push_str(&row.join(","));
+        s.push('\n');
+    }
+    s.into_bytes()
+}
+
+/// The cells of `path.csv`'s rows, every column of [`every_path_column`] (empty where a row has
+/// no value).
+fn path_cells(rows: &[problem::report::StepRow]) -> Vec<Vec<String>> {
     let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
     let n_groups = rows.first().map_or(0, |r| r.groups.len());
+    let mut table = Vec::with_capacity(rows.len());
     for r in rows {
         let mut row = vec![r.step.to_string(), num(r.t)];
         row.extend(r.factors.iter().map(|f| num(*f)));
@@ -867,10 +907,9 @@ fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str], units: &probl
         }
         row.extend(r.charges.iter().map(|q| num(*q)));
         row.extend(r.potentials.iter().map(|v| num(*v)));
-        s.push_str(&row.join(","));
-        s.push('\n');
+        table.push(row);
     }
-    s.into_bytes()
+    table
 }
 
 /// The path's global curves: the contact forces against time; the forces against the factor
