@@ -300,7 +300,7 @@ pub fn refuse_overrides(sets: &[String], given: &StudySpec) -> Result<(), Driver
     if !given.orders.is_empty() {
         decided.push(("mesh.order", "--orders"));
     }
-    super::refuse_decided(sets, &decided)
+    super::refuse_decided("the study", sets, &decided)
 }
 
 /// The size of every run of a study, in the order it runs them: the finer reference (without

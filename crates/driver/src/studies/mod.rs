@@ -25,17 +25,18 @@ pub fn solve(scene: &str, sets: &[String]) -> Result<Solution, files::Error> {
     files::run::solve(&scene, &source, &mut Silent)
 }
 
-/// Refuses a user's override (`--set KEY=VALUE`, `--set ~KEY`) of a value the study sets on
-/// each of its runs itself: `decided` pairs such keys with the option that decides them. The
-/// study's own override comes last and would replace the user's silently.
+/// Refuses a user's override (`--set KEY=VALUE`, `--set ~KEY`) of a value that `study` (a
+/// sweep, a study) sets on each of its runs itself: `decided` pairs such keys with the option
+/// that decides them. The study's own override comes last and would replace the user's
+/// silently.
 ///
 /// # Errors
 /// A usage error naming both.
-pub fn refuse_decided(sets: &[String], decided: &[(&str, &str)]) -> Result<(), crate::DriverError> {
+pub fn refuse_decided(study: &str, sets: &[String], decided: &[(&str, &str)]) -> Result<(), crate::DriverError> {
     for set in sets {
         if let Some((k, by)) = decided.iter().find(|(k, _)| scene_file::keys_overlap(set_key(set), k)) {
             return Err(crate::DriverError::Usage(format!(
-                "--set {set}: the study sets {k} on each of its runs ({by}), which would replace this silently; drop the --set"
+                "--set {set}: {study} sets {k} on each of its runs ({by}), which would replace this silently; drop the --set"
             )));
         }
     }

@@ -99,7 +99,7 @@ pub fn sweep(
             return Err(DriverError::Usage(format!("sweep {name} {v} is not a finite number")));
         }
     }
-    super::refuse_decided(sets, &[(param, "--param, its values from --from to --to")])?;
+    super::refuse_decided("the sweep", sets, &[(param, "--param, its values from --from to --to")])?;
     let integer = integer_key(scene, sets, param, [*from, *to])?;
     if integer {
         whole_points(param, *from, *to, *steps)?;
@@ -714,7 +714,7 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert!(e.contains("the study sets load.p on each of its runs (--param"), "{e}");
+        assert!(e.contains("the sweep sets load.p on each of its runs (--param"), "{e}");
         // and a component sweeps
         let s = SweepSpec {
             param: "load.direction.0".into(),

@@ -356,10 +356,6 @@ fn check_contact_dimension(c: &ContactSpec, dim: usize) -> Result<(), SceneError
 /// Most steps a path may take.
 const MAX_PATH_STEPS: usize = 1_000_000;
 
-/// A path: at least two strictly increasing finite instants, each table as long as `t` and
-/// finite, `steps` in range; refused where the run cannot carry friction's history (a solver
-/// without the condensed compliance, an exact solution; a floating conducting tip is refused
-/// with its charge).
 /// Which of a path's factors would scale anything: each multiplies values of the scene, and a
 /// factor on values that are all 0 changes no instant.
 struct Scaled {
@@ -393,6 +389,10 @@ impl Scaled {
     }
 }
 
+/// A path: at least two strictly increasing finite instants, each table as long as `t` and
+/// finite, `steps` in range; refused where the run cannot carry friction's history (a solver
+/// without the condensed compliance, an exact solution; a floating conducting tip is refused
+/// with its charge); a factor table on values that are all 0 ([`Scaled`]) refused by its key.
 fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
     all_finite("path.t", &p.t)?;
     if p.t.len() < 2 || p.t.windows(2).any(|w| !(w[0] < w[1])) {
