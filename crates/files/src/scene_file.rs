@@ -328,9 +328,20 @@ pub fn set(tree: &mut toml::Table, key: &str, value: Option<toml::Value>) -> Res
             walked.push('.');
         }
         walked.push_str(part);
-        let entry = table
-            .entry(part.to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        // a component of a list the scene leaves out: no list to set it in (a table by its
+        // index is another matter: it adds one to an array of tables, `dirichlet.0={...}`)
+        let by_index = parts.peek().is_none() && last.parse::<usize>().is_ok();
+        let absent = !table.contains_key(part.as_str()) && !ONE_OR_MANY.contains(&part.as_str());
+        if by_index && absent && !matches!(value, Some(toml::Value::Table(_))) {
+            return Err(format!(
+                "the scene has no `{walked}`, so `{walked}.{last}` names a component of nothing: give the whole list (`{walked}=[...]`)"
+            ));
+        }
+        let entry = table.entry(part.to_string()).or_insert_with(|| match by_index {
+            // the array of tables a table by its index starts (`mesh.region.0={...}`)
+            true => toml::Value::Array(vec![]),
+            false => toml::Value::Table(toml::Table::new()),
+        });
         // a section a scene holds as one table or as an array of tables (`[contact]` or
         // `[[contact]]`), named by an index: the one table is the array's first (`contact.0.gap`
         // on a scene of one `[contact]`), and one past it a new one (`contact.1.group` adds a
@@ -795,6 +806,10 @@ mod tests {
         let (s, _) = load("paper", &["load.direction.1=0.5".into(), "material.0.c.3=100".into()]).unwrap();
         assert_eq!(s.loads()[0].direction, [0.0, 0.5]);
         assert_eq!(s.material[0].c[3], 100.0);
+        // a table by its index still adds one to an array the scene leaves out
+        let region = "mesh.region.0={name=\"a\", lo=[0.0, 0.0], hi=[1.0, 1.0]}";
+        let (s, _) = load("paper", &[region.into()]).unwrap();
+        assert_eq!(s.mesh.regions.len(), 1);
         for (set, says) in [
             ("~load.direction.1", "a component is not removed"),
             (
@@ -802,6 +817,11 @@ mod tests {
                 "beyond the 2 components of `load.direction` = [0.0, 1.0] (indices 0 to 1)",
             ),
             ("load.direction.0=\"x\"", "give one value of its kind"),
+            (
+                "contact.gap_center.0=1.0",
+                "the scene has no `contact.gap_center`, so `contact.gap_center.0` names a component of nothing",
+            ),
+            ("mesh.region.0=1.0", "names a component of nothing"),
         ] {
             let e = load("paper", &[set.into()]).unwrap_err().to_string();
             assert!(e.contains(says) && !e.contains("table"), "{set}: {e}");
