@@ -271,7 +271,7 @@ fn check(spec: &StudySpec) -> Result<(), DriverError> {
     Ok(())
 }
 
-/// Refuses the overrides of what a study's runs set themselves ([`settings`]): the rule and
+/// Refuses the overrides of what a study's runs set themselves (its `settings`): the rule and
 /// the tolerances always, the mesh's size always (the study sizes by `mesh.n`, and `mesh.h`
 /// would be replaced by it), and the strategy or the order where the study's lists are given
 /// (`strategies`, `orders`, `sizes` as asked, before the scene's defaults fill them).
