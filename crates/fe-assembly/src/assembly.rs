@@ -688,9 +688,10 @@ pub fn cell_materials(mesh: &Mesh, materials: &[(String, Material)]) -> Result<V
         .filter(|&c| cell_material[c] == usize::MAX)
         .collect();
     if let Some(&c) = bare.first() {
-        // the mesh's regions that hold them
+        // the mesh's regions made of them alone (one that holds others too, as a generated
+        // mesh's `body`, could not take a material of its own)
         let theirs = (mesh.regions.iter())
-            .filter(|(_, cells)| cells.iter().any(|&k| cell_material.get(k) == Some(&usize::MAX)))
+            .filter(|(_, cells)| !cells.is_empty() && cells.iter().all(|&k| cell_material.get(k) == Some(&usize::MAX)))
             .map(|(name, _)| name.clone())
             .collect();
         return Err(InputError::NoMaterial {
@@ -741,7 +742,16 @@ mod tests {
             "{e}"
         );
         mesh.regions.remove("6");
+        let e = cell_materials(&mesh, &[("body".into(), m.clone())])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("they lie in no region of their own"), "{e}");
+        // a region that holds covered cells too (a generated mesh's `all`) is not offered
+        mesh.regions.insert("all".into(), (0..n).collect());
         let e = cell_materials(&mesh, &[("body".into(), m)]).unwrap_err().to_string();
-        assert!(e.contains("they lie in no region of the mesh"), "{e}");
+        assert!(
+            e.contains("they lie in no region of their own") && !e.contains("`all`"),
+            "{e}"
+        );
     }
 }

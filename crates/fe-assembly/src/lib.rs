@@ -101,7 +101,7 @@ pub enum InputError {
         "cell {cell} has no material (regions given: {}): {cells} cells lie in no region a material names; {}",
         .regions.join(", "),
         match &.theirs[..] {
-            [] => "they lie in no region of the mesh (the materials' regions must cover it)".to_string(),
+            [] => "they lie in no region of their own (the materials' regions must cover the mesh: check their boxes or physical groups)".to_string(),
             theirs => format!(
                 "they lie in the mesh's {} {} (give {} a material, [[material]] region = \"{}\")",
                 if theirs.len() == 1 { "region" } else { "regions" },
@@ -116,8 +116,8 @@ pub enum InputError {
         cell: usize,
         /// How many cells have none.
         cells: usize,
-        /// The mesh's regions those cells lie in (a Gmsh physical group left unnamed is its
-        /// tag), none of them a material's.
+        /// The mesh's regions made of such cells alone (a Gmsh physical group left unnamed is
+        /// its tag), none of them a material's.
         theirs: Vec<String>,
         /// The regions of the materials.
         regions: Vec<String>,
