@@ -139,13 +139,20 @@ pub fn sweep(
         };
         let row = SweepRow::of(value, &r, t.elapsed().as_secs_f64());
         eta.record(0, row.seconds);
+        // each number with its unit (none for a count, a factor, a relative residual)
+        let unit = |q: &str| match r.units.of_quantity(q) {
+            "" => String::new(),
+            u => format!(" {u}"),
+        };
         progress(&format!(
-            "[{}/{steps}] {param} = {shown}: stick {}, slip {}, separated {}, normal force {:.4e}, residual {:.2e}; {}",
+            "[{}/{steps}] {param} = {shown}{}: stick {}, slip {}, separated {}, normal force {:.4e}{}, residual {:.2e}; {}",
             k + 1,
+            unit(param_quantity(param)),
             row.counts.0,
             row.counts.1,
             row.counts.2,
             row.normal_force,
+            unit("force"),
             row.complementarity,
             eta.words(&vec![0; steps - k - 1])
         ));
@@ -436,15 +443,27 @@ pub fn csv(param: &str, rows: &[SweepRow], integer: bool) -> String {
     csv
 }
 
-/// The quantity a swept key is (for its unit): a potential, a pressure, a force, a length, or
-/// none known ("").
+/// The quantity a swept key is (for its unit): a potential, a pressure, a force, a length or
+/// displacement, a material constant, a charge, a traction, or none known (""); a component of
+/// a list (`material.0.c.3`) is of the list's quantity.
 pub fn param_quantity(param: &str) -> &'static str {
-    let last = param.rsplit('.').next().unwrap_or(param);
+    let mut parts = param.rsplit('.');
+    let mut last = parts.next().unwrap_or(param);
+    if last.parse::<usize>().is_ok() {
+        last = parts.next().unwrap_or(last);
+    }
     match last {
-        l if l.ends_with("potential") || l == "phi" || l == "voltage" => "potential",
+        l if l.ends_with("potential") || matches!(l, "phi" | "voltage" | "v") => "potential",
         "p" | "pressure" => "pressure",
         l if l.ends_with("force") => "force",
         l if l.ends_with("depth") || l.ends_with("gap") || l.ends_with("radius") => "length",
+        "h" | "lo" | "hi" | "thickness" | "gap_center" | "tip" | "slip_length" => "length",
+        "u" | "ux" | "uy" | "uz" => "displacement",
+        "c" | "young" => "stiffness",
+        "e" => "piezoelectric",
+        "permittivity" => "permittivity",
+        "charge" => "charge",
+        "slip_bound" => "traction",
         _ => "",
     }
 }
@@ -544,7 +563,7 @@ pub fn picture(param: &str, rows: &[SweepRow]) -> Result<plots::Files, DriverErr
 
 #[cfg(test)]
 mod tests {
-    use super::{csv, integer_key, picture, sweep, SweepSpec};
+    use super::{csv, integer_key, param_quantity, picture, sweep, SweepSpec};
     use crate::DriverError;
 
     /// A sweep whose first points fail (nothing touches, and [exact] is refused there) keeps
@@ -677,6 +696,28 @@ mod tests {
         assert!(!integer("paper", "contact.slip_bound", [0.0, 2.0]));
         // a component of a list is a number
         assert!(!integer("paper", "material.0.c.3", [100.0, 120.0]));
+    }
+
+    /// A swept key's quantity, for its unit in sweep.csv, the picture and the progress lines: a
+    /// component of a list is of the list's quantity, a factor or a count has none.
+    #[test]
+    fn a_swept_key_knows_its_quantity() {
+        for (param, q) in [
+            ("load.p", "pressure"),
+            ("electrode.v", "potential"),
+            ("contact.foundation_potential", "potential"),
+            ("material.0.c.3", "stiffness"),
+            ("material.0.e.1", "piezoelectric"),
+            ("dirichlet.0.u.1", "displacement"),
+            ("contact.gap_center.0", "length"),
+            ("mesh.h", "length"),
+            ("dirichlet.2.charge", "charge"),
+            ("contact.friction", ""),
+            ("material.0.coupling_scale", ""),
+            ("mesh.n", ""),
+        ] {
+            assert_eq!(param_quantity(param), q, "{param}");
+        }
     }
 
     /// A key whose value is no number (a vector, a choice) is refused before any point runs,
