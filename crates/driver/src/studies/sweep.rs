@@ -139,23 +139,8 @@ pub fn sweep(
         };
         let row = SweepRow::of(value, &r, t.elapsed().as_secs_f64());
         eta.record(0, row.seconds);
-        // each number with its unit (none for a count, a factor, a relative residual)
-        let unit = |q: &str| match r.units.of_quantity(q) {
-            "" => String::new(),
-            u => format!(" {u}"),
-        };
-        progress(&format!(
-            "[{}/{steps}] {param} = {shown}{}: stick {}, slip {}, separated {}, normal force {:.4e}{}, residual {:.2e}; {}",
-            k + 1,
-            unit(param_quantity(param)),
-            row.counts.0,
-            row.counts.1,
-            row.counts.2,
-            row.normal_force,
-            unit("force"),
-            row.complementarity,
-            eta.words(&vec![0; steps - k - 1])
-        ));
+        let left = eta.words(&vec![0; steps - k - 1]);
+        progress(&point_line((k + 1, *steps), (param, &shown), &row, &r.units, &left));
         rows.push(row);
     }
     let failed: Vec<String> = rows
@@ -189,6 +174,31 @@ pub fn sweep(
         });
     }
     Ok(rows)
+}
+
+/// The progress line of the point `k` of `steps` solved (`param` at its value `shown`), each
+/// number with its unit (none for a count, a factor, a relative residual), and the time `left`.
+fn point_line(
+    (k, steps): (usize, usize),
+    (param, shown): (&str, &str),
+    row: &SweepRow,
+    units: &problem::Units,
+    left: &str,
+) -> String {
+    let unit = |q: &str| match units.of_quantity(q) {
+        "" => String::new(),
+        u => format!(" {u}"),
+    };
+    format!(
+        "[{k}/{steps}] {param} = {shown}{}: stick {}, slip {}, separated {}, normal force {:.4e}{}, residual {:.2e}; {left}",
+        unit(param_quantity(param)),
+        row.counts.0,
+        row.counts.1,
+        row.counts.2,
+        row.normal_force,
+        unit("force"),
+        row.complementarity,
+    )
 }
 
 /// An integer key's sweep (`mesh.n`, `path.steps`): its points are rounded to whole numbers,
