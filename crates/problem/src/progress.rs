@@ -389,7 +389,6 @@ impl fmt::Display for Event<'_> {
     }
 }
 
-/// The notes on a mesh that is read but unusual.
 impl crate::setup::MeshNotes {
     /// Whether there is nothing to say: the notes a run prints are none (a seam of no facets
     /// still knows its dimension, so a field-by-field comparison with the default would not do).
@@ -404,6 +403,7 @@ pub fn instant(t: f64) -> f64 {
     format!("{t:.9e}").parse().unwrap_or(t)
 }
 
+/// The notes on a mesh that is read but unusual.
 pub(crate) fn mesh_notes(n: &crate::setup::MeshNotes) -> Vec<String> {
     let mut notes = vec![];
     if n.reoriented_cells > 0 {

@@ -703,14 +703,9 @@ fn materials(scene: &Scene, dim: usize) -> Result<Vec<(String, Material)>, Probl
 fn constraints(scene: &Scene, plan: &Plan) -> Vec<Constraint> {
     let mut out = vec![];
     for d in &scene.dirichlet {
-        for (k, &v) in d.u.iter().flatten().enumerate() {
+        // the components given (all of `u`, or a roller's alone)
+        for (k, v) in (0..3).filter_map(|k| Some((k, d.component(k)?))) {
             out.push(Constraint::constant(&d.group, Field::Displacement(k), v));
-        }
-        // single components (rollers)
-        for (k, v) in [d.ux, d.uy, d.uz].into_iter().enumerate() {
-            if let Some(v) = v {
-                out.push(Constraint::constant(&d.group, Field::Displacement(k), v));
-            }
         }
         if let (Some(phi), true) = (d.phi, plan.electric) {
             out.push(Constraint::constant(&d.group, Field::Potential, phi));

@@ -1162,6 +1162,15 @@ pub struct DirichletSpec {
     pub charge: Option<f64>,
 }
 
+impl DirichletSpec {
+    /// The displacement component `k` (0 x, 1 y, 2 z) it prescribes, if it does: of `u`
+    /// given whole, or `ux`, `uy`, `uz` alone (a roller).
+    pub fn component(&self, k: usize) -> Option<f64> {
+        let whole = self.u.as_ref().and_then(|u| u.get(k)).copied();
+        whole.or([self.ux, self.uy, self.uz].get(k).copied().flatten())
+    }
+}
+
 /// The scene's tractions: one table `[load]`, or an array `[[load]]`.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 #[serde(untagged)]

@@ -372,12 +372,7 @@ impl Scaled {
             .indenter_contact()
             .and_then(|(_, c)| c.indenter.as_ref())
             .is_some_and(|i| some(i.force));
-        let component = |k: usize| {
-            scene.dirichlet.iter().any(|d| {
-                let whole = d.u.as_ref().and_then(|u| u.get(k)).copied();
-                some(whole.or([d.ux, d.uy, d.uz][k]))
-            })
-        };
+        let component = |k: usize| scene.dirichlet.iter().any(|d| some(d.component(k)));
         Scaled {
             load: force || scene.loads().iter().any(|l| l.p != 0.0),
             voltage: scene.dirichlet.iter().any(|d| some(d.phi) || some(d.charge))
@@ -498,10 +493,7 @@ fn validate_path(p: &PathSpec, scene: &Scene) -> Result<(), SceneError> {
 /// own group hold one of them, that part of it acts on nothing (the displacement is given)
 /// and the run would drop it silently: refused, naming the component.
 fn refuse_load_on_held(scene: &Scene, l: &crate::LoadSpec) -> Result<(), SceneError> {
-    let held = |k: usize| {
-        (scene.dirichlet.iter().filter(|d| d.group == l.group))
-            .any(|d| d.u.as_ref().is_some_and(|u| k < u.len()) || [d.ux, d.uy, d.uz][k].is_some())
-    };
+    let held = |k: usize| (scene.dirichlet.iter()).any(|d| d.group == l.group && d.component(k).is_some());
     let pushed = (0..l.direction.len().min(3)).filter(|&k| l.direction[k] != 0.0 && l.p != 0.0);
     match pushed.filter(|&k| held(k)).map(|k| ["x", "y", "z"][k]).collect::<Vec<_>>()[..] {
         [] => Ok(()),
