@@ -795,30 +795,37 @@ pub(super) fn path_files(solution: &Solution) -> Result<plots::Files, Error> {
 
 /// `path.csv`'s columns (see [`path_csv`]), those a scene cannot fill left out.
 fn path_columns(rows: &[problem::report::StepRow], terminals: &[&str]) -> Vec<String> {
-    path_table(rows, terminals).0
+    let columns = every_path_column(rows, terminals);
+    let keep = filled_columns(&columns, rows);
+    kept(&columns, &keep)
 }
 
-/// `path.csv`'s columns and cells, the columns a scene cannot fill left out, as Python's path
-/// dict leaves them: an indenter's where no row has one, the z factor of a 2D scene.
-fn path_table(rows: &[problem::report::StepRow], terminals: &[&str]) -> (Vec<String>, Vec<Vec<String>>) {
-    let (columns, table) = (every_path_column(rows, terminals), path_cells(rows));
+/// Which of `columns` (every column, [`every_path_column`]) the `rows` fill, as Python's path
+/// dict has them: an indenter's where a row has one, the z factor in 3D alone.
+fn filled_columns(columns: &[String], rows: &[problem::report::StepRow]) -> Vec<bool> {
     let dim = rows.first().map_or(0, |r| r.tangential_resultant.len());
-    let filled = |k: usize| table.iter().any(|row| !row[k].is_empty());
-    let keep: Vec<bool> = (columns.iter().enumerate())
-        .map(|(k, c)| match c.as_str() {
+    let any = |f: &dyn Fn(&problem::report::StepRow) -> bool| rows.iter().any(f);
+    let half_space =
+        |f: &dyn Fn(&problem::report::HalfSpaceRow) -> bool| any(&|r| r.half_space.as_ref().is_some_and(f));
+    (columns.iter())
+        .map(|c| match c.as_str() {
             "uz" => dim == 3,
-            "depth" | "contact_radius" | "tip_charge" => filled(k),
-            c if c.starts_with("half_space_") => filled(k),
+            "depth" => any(&|r| r.depth.is_some()),
+            "contact_radius" => any(&|r| r.contact_radius.is_some()),
+            "tip_charge" => any(&|r| r.tip_charge.is_some()),
+            "half_space_charge" => half_space(&|h| h.charge.is_some()),
+            c if c.starts_with("half_space_") => half_space(&|_| true),
             _ => true,
         })
-        .collect();
-    let kept = |cells: &[String]| -> Vec<String> {
-        (cells.iter().zip(&keep))
-            .filter(|(_, &k)| k)
-            .map(|(c, _)| c.clone())
-            .collect()
-    };
-    (kept(&columns), table.iter().map(|row| kept(row)).collect())
+        .collect()
+}
+
+/// The entries of `cells` that `keep` keeps.
+fn kept(cells: &[String], keep: &[bool]) -> Vec<String> {
+    (cells.iter().zip(keep))
+        .filter(|(_, &k)| k)
+        .map(|(c, _)| c.clone())
+        .collect()
 }
 
 /// Every column `path.csv` can have.
@@ -855,10 +862,11 @@ fn every_path_column(rows: &[problem::report::StepRow], terminals: &[&str]) -> V
 /// on each terminal (`charge_GROUP`, the charge on the conductor) and its potential
 /// (`potential_GROUP`).
 fn path_csv(rows: &[problem::report::StepRow], terminals: &[&str], units: &problem::Units) -> Vec<u8> {
-    let (columns, table) = path_table(rows, terminals);
-    let mut s = header("path.csv", &columns, units);
-    for row in &table {
-        s.push_str(&row.join(","));
+    let columns = every_path_column(rows, terminals);
+    let keep = filled_columns(&columns, rows);
+    let mut s = header("path.csv", &kept(&columns, &keep), units);
+    for row in path_cells(rows) {
+        s.push_str(&kept(&row, &keep).join(","));
         s.push('\n');
     }
     s.into_bytes()
