@@ -254,7 +254,7 @@ fn apply(tree: &mut toml::Table, o: &str) -> Result<(), String> {
 
 /// The key of an override: `KEY` of `KEY=VALUE` or of `~KEY` (the whole text where it has
 /// neither form).
-fn override_key(o: &str) -> &str {
+pub fn override_key(o: &str) -> &str {
     match o.strip_prefix('~') {
         Some(key) => key,
         None => o.split_once('=').map_or(o, |(key, _)| key),

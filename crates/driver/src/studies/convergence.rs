@@ -286,7 +286,10 @@ pub fn refuse_overrides(sets: &[String], given: &StudySpec) -> Result<(), Driver
     ];
     // mesh.h alone: an override of mesh.n is where the default sizes come from, and the two
     // keys overlap as two ways to give one size
-    if let Some(set) = sets.iter().find(|s| super::set_key(s) == "mesh.h") {
+    if let Some(set) = sets
+        .iter()
+        .find(|s| files::scene_file::override_key(s).trim() == "mesh.h")
+    {
         return Err(DriverError::Usage(format!(
             "--set {set}: the study sizes its meshes by mesh.n (--sizes, or the scene's n/4, n/2, n), which replaces mesh.h on each of its runs; drop the --set"
         )));

@@ -34,23 +34,16 @@ pub fn solve(scene: &str, sets: &[String]) -> Result<Solution, files::Error> {
 /// A usage error naming both.
 pub fn refuse_decided(study: &str, sets: &[String], decided: &[(&str, &str)]) -> Result<(), crate::DriverError> {
     for set in sets {
-        if let Some((k, by)) = decided.iter().find(|(k, _)| scene_file::keys_overlap(set_key(set), k)) {
+        if let Some((k, by)) = decided
+            .iter()
+            .find(|(k, _)| scene_file::keys_overlap(scene_file::override_key(set), k))
+        {
             return Err(crate::DriverError::Usage(format!(
                 "--set {set}: {study} sets {k} on each of its runs ({by}), which would replace this silently; drop the --set"
             )));
         }
     }
     Ok(())
-}
-
-/// The key an override (`KEY=VALUE`, `~KEY`) names.
-pub fn set_key(set: &str) -> &str {
-    set.split('=')
-        .next()
-        .unwrap_or(set)
-        .trim()
-        .trim_start_matches('~')
-        .trim()
 }
 
 /// The time left in a series of runs, estimated from the runs done: a pending run of size `n`
